@@ -1,0 +1,90 @@
+"""Ride metrics of spec section 8: RMS and peak-to-peak of the four carbody responses.
+
+RMS is taken about zero, not about the mean, as in the paper's Table 1: every channel is a
+perturbation from static equilibrium, so the mean belongs to the response.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import xarray as xr
+
+#: response name -> (channel, factor to the reported unit)
+RESPONSES = {
+    "acceleration_m_s2": ("carbody_acceleration", 1.0),
+    "displacement_m": ("carbody_bounce", 1.0),
+    "pitch_deg": ("carbody_pitch", 180.0 / math.pi),
+    "roll_deg": ("carbody_roll", 180.0 / math.pi),
+}
+STATISTICS = ("rms", "ptp")
+
+
+def parse_window(text: str) -> tuple[float, float]:
+    """"START:END" in seconds; either side may be empty (start of run, end of run)."""
+    parts = text.split(":")
+    if len(parts) != 2:
+        raise ValueError(f"window = {text!r}: expected START:END in seconds, e.g. 2:10")
+    try:
+        start = float(parts[0]) if parts[0].strip() else 0.0
+        end = float(parts[1]) if parts[1].strip() else math.inf
+    except ValueError:
+        raise ValueError(f"window = {text!r}: START and END must be numbers of seconds") from None
+    return start, end
+
+
+def select_window(ds: xr.Dataset, window) -> xr.Dataset:
+    """The part of a run inside ``window`` = (start, end) seconds, checked against the run."""
+    if window is None:
+        return ds
+    start, end = window
+    t0, t1 = float(ds.time[0]), float(ds.time[-1])
+    if math.isinf(end):
+        end = t1
+    if not (math.isfinite(start) and start >= t0 and end <= t1 + 1e-9 and start < end):
+        raise ValueError(f"window = {start:g}:{end:g} s: must satisfy {t0:g} <= START < END <= {t1:g} "
+                         "(inside the run)")
+    part = ds.sel(time=slice(start - 1e-12, end + 1e-12))
+    if part.sizes["time"] < 2:
+        raise ValueError(f"window = {start:g}:{end:g} s holds fewer than two output samples")
+    return part
+
+
+def ride_metrics(ds: xr.Dataset, window=None) -> xr.DataArray:
+    """RMS and peak-to-peak per response, dims (response, statistic) plus ``sample`` in a batch.
+
+    Responses: carbody CG vertical acceleration (m/s^2), bounce displacement (m), pitch (deg)
+    and roll (deg). ``window`` = (start, end) in seconds restricts the time range.
+    """
+    part = select_window(ds, window)
+    values = []
+    for name, (channel, factor) in RESPONSES.items():
+        x = part[channel] * factor
+        rms = np.sqrt((x**2).mean("time"))
+        ptp = x.max("time") - x.min("time")
+        values.append(xr.concat([rms, ptp], dim="statistic"))
+    out = xr.concat(values, dim="response")
+    out = out.assign_coords(response=list(RESPONSES), statistic=list(STATISTICS))
+    out = out.transpose(*([d for d in ("sample",) if d in out.dims] + ["response", "statistic"]))
+    out.name = "ride_metrics"
+    if not np.all(np.isfinite(out.values)):
+        raise RuntimeError("a ride metric is not finite: the run did not produce finite responses")
+    return out
+
+
+def reduction(metrics: xr.DataArray, baseline: xr.DataArray) -> xr.DataArray:
+    """Reduction in % against a baseline run: (baseline - metrics) / baseline * 100."""
+    if np.any(baseline.values == 0):
+        raise ValueError("a baseline metric is zero: the reduction in % is undefined")
+    out = (baseline - metrics) / baseline * 100.0
+    out.name = "reduction_percent"
+    return out
+
+
+def to_dict(metrics: xr.DataArray) -> dict:
+    """{response: {rms, ptp}} for one run (the JSON schema of docs/cli.md)."""
+    if "sample" in metrics.dims:
+        raise ValueError("to_dict takes the metrics of one run; select a sample first")
+    return {r: {s: float(metrics.sel(response=r, statistic=s)) for s in STATISTICS}
+            for r in metrics.response.values}

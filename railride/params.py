@@ -1,0 +1,186 @@
+"""Vehicle parameter sets: frozen, validated at construction, named presets, TOML round trip.
+
+Symbols follow ``shared/spec/model.md`` section 2 (the paper's appendix). Every field carries its
+SI unit and the rule it must satisfy in its metadata; `VehicleParams.describe()` lists them.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from ._io import atomic_write_text
+
+
+def _p(unit: str, doc: str, rule: str = "positive") -> Any:
+    return field(metadata={"unit": unit, "doc": doc, "rule": rule})
+
+
+_RULES = {
+    "positive": (lambda v: v > 0.0, "a finite number > 0"),
+    "nonnegative": (lambda v: v >= 0.0, "a finite number >= 0"),
+}
+
+
+@dataclass(frozen=True)
+class VehicleParams:
+    """Parameters of the 9-DOF vertical vehicle model (SI units, spec section 2).
+
+    Suspension values are per element: one spring and one damper at each corner or axle box,
+    as in the element table of spec section 3.
+    """
+
+    m_c: float = _p("kg", "carbody mass")
+    m_b: float = _p("kg", "bogie mass (each bogie)")
+    I_cx: float = _p("kg m^2", "carbody roll moment of inertia")
+    I_cy: float = _p("kg m^2", "carbody pitch moment of inertia")
+    I_cz: float = _p("kg m^2", "carbody yaw moment of inertia (not used by the vertical model)")
+    I_bx: float = _p("kg m^2", "bogie roll moment of inertia")
+    I_by: float = _p("kg m^2", "bogie pitch moment of inertia")
+    I_bz: float = _p("kg m^2", "bogie yaw moment of inertia (not used by the vertical model)")
+    k_px: float = _p("N/m", "primary longitudinal stiffness, per axle box")
+    k_py: float = _p("N/m", "primary lateral stiffness, per axle box")
+    k_pz: float = _p("N/m", "primary vertical stiffness, per axle box")
+    c_px: float = _p("N s/m", "primary longitudinal damping, per axle box", "nonnegative")
+    c_py: float = _p("N s/m", "primary lateral damping, per axle box", "nonnegative")
+    c_pz: float = _p("N s/m", "primary vertical damping, per axle box", "nonnegative")
+    k_sx: float = _p("N/m", "secondary longitudinal stiffness, per bogie")
+    k_sy: float = _p("N/m", "secondary lateral stiffness, per bogie")
+    k_sz: float = _p("N/m", "secondary vertical stiffness, per corner")
+    c_sx: float = _p("N s/m", "secondary longitudinal damping, per bogie", "nonnegative")
+    c_sy: float = _p("N s/m", "secondary lateral damping, per bogie", "nonnegative")
+    c_sz: float = _p("N s/m", "secondary vertical (passive) damping, per corner", "nonnegative")
+    l: float = _p("m", "half bogie-centre spacing")
+    d_s: float = _p("m", "half lateral spacing of the secondary suspension")
+    d_p: float = _p("m", "half lateral spacing of the primary suspension")
+    a: float = _p("m", "half wheel-rail contact spacing")
+    b: float = _p("m", "half wheelbase")
+    h_cs: float = _p("m", "carbody CG height above the secondary suspension")
+    h_ts: float = _p("m", "bogie CG depth below the secondary suspension")
+    h_tp: float = _p("m", "bogie CG height above the primary suspension")
+    h_wp: float = _p("m", "wheelset CG depth below the primary suspension")
+
+    def __post_init__(self) -> None:
+        for f in dataclasses.fields(self):
+            value = getattr(self, f.name)
+            check, allowed = _RULES[f.metadata["rule"]]
+            if isinstance(value, bool) or not isinstance(value, (int, float)):
+                raise ValueError(
+                    f"vehicle parameter {f.name!r} = {value!r} ({f.metadata['doc']}, "
+                    f"{f.metadata['unit']}): must be {allowed}"
+                )
+            if not (math.isfinite(value) and check(float(value))):
+                raise ValueError(
+                    f"vehicle parameter {f.name!r} = {value!r} ({f.metadata['doc']}, "
+                    f"{f.metadata['unit']}): must be {allowed}"
+                )
+            object.__setattr__(self, f.name, float(value))
+
+    # -- presets --------------------------------------------------------------------------
+    @classmethod
+    def preset(cls, name: str = "paper") -> "VehicleParams":
+        """A named parameter set; see `PRESETS` for the names."""
+        try:
+            return PRESETS[name]
+        except KeyError:
+            raise ValueError(
+                f"unknown vehicle preset {name!r}; allowed: {', '.join(sorted(PRESETS))}"
+            ) from None
+
+    def replace(self, **changes: float) -> "VehicleParams":
+        """A copy with some fields changed (validated like any new set)."""
+        unknown = set(changes) - {f.name for f in dataclasses.fields(self)}
+        if unknown:
+            raise ValueError(
+                f"unknown vehicle parameter(s) {', '.join(sorted(unknown))}; "
+                f"allowed: {', '.join(f.name for f in dataclasses.fields(self))}"
+            )
+        return dataclasses.replace(self, **changes)
+
+    def to_dict(self) -> dict[str, float]:
+        return dataclasses.asdict(self)
+
+    @classmethod
+    def describe(cls) -> list[tuple[str, str, str, str]]:
+        """(name, unit, meaning, rule) for every field."""
+        return [
+            (f.name, f.metadata["unit"], f.metadata["doc"], _RULES[f.metadata["rule"]][1])
+            for f in dataclasses.fields(cls)
+        ]
+
+    # -- TOML -----------------------------------------------------------------------------
+    def to_toml(self) -> str:
+        """TOML text of all fields under ``[vehicle]``; `from_toml` reads it back exactly.
+
+        Floats are written with ``repr``, the shortest text that parses back to the same
+        double, so the round trip is lossless.
+        """
+        lines = ["# railride vehicle parameters (SI units)", "[vehicle]"]
+        for name, unit, doc, _ in self.describe():
+            lines.append(f"{name} = {getattr(self, name)!r}  # {unit}: {doc}")
+        return "\n".join(lines) + "\n"
+
+    def save(self, path: str | Path) -> None:
+        atomic_write_text(Path(path), self.to_toml())
+
+    @classmethod
+    def from_toml(cls, text: str, source: str = "<string>") -> "VehicleParams":
+        """Parse TOML with a ``[vehicle]`` table.
+
+        The table either lists every field, or names a base with ``preset = "paper"`` and
+        lists only the fields that differ from it.
+        """
+        try:
+            data = tomllib.loads(text)
+        except tomllib.TOMLDecodeError as exc:
+            raise ValueError(f"{source}: not valid TOML: {exc}") from None
+        table = data.get("vehicle")
+        if not isinstance(table, dict):
+            raise ValueError(f"{source}: needs a [vehicle] table of parameters")
+        table = dict(table)
+        names = [f.name for f in dataclasses.fields(cls)]
+        base_name = table.pop("preset", None)
+        unknown = sorted(set(table) - set(names))
+        if unknown:
+            raise ValueError(
+                f"{source}: unknown vehicle parameter(s) {', '.join(unknown)}; "
+                f"allowed: {', '.join(names)}"
+            )
+        if base_name is not None:
+            return cls.preset(str(base_name)).replace(**table)
+        missing = [n for n in names if n not in table]
+        if missing:
+            raise ValueError(
+                f"{source}: missing vehicle parameter(s) {', '.join(missing)} "
+                "(list them all, or start from a base with preset = \"paper\")"
+            )
+        return cls(**table)
+
+    @classmethod
+    def load(cls, path: str | Path) -> "VehicleParams":
+        path = Path(path)
+        try:
+            text = path.read_text(encoding="utf-8")
+        except OSError as exc:
+            raise ValueError(f"cannot read vehicle parameters from {path}: {exc.strerror}") from None
+        return cls.from_toml(text, source=str(path))
+
+
+#: The paper's appendix (Harun et al.), as restated in spec section 2.
+PAPER = VehicleParams(
+    m_c=3.96e4, m_b=3.25e3,
+    I_cx=8.85e4, I_cy=2.46e6, I_cz=2.5e6,
+    I_bx=3.06e3, I_by=3.02e3, I_bz=4.27e3,
+    k_px=4e6, k_py=3.25e6, k_pz=7e6,
+    c_px=0.0, c_py=0.0, c_pz=1.5e4,
+    k_sx=1.5e5, k_sy=1.5e5, k_sz=2.9e5,
+    c_sx=0.0, c_sy=5e4, c_sz=8e4,
+    l=9.0, d_s=1.0, d_p=1.0, a=1.0, b=1.25,
+    h_cs=1.207, h_ts=0.217, h_tp=0.452, h_wp=0.18,
+)
+
+PRESETS: dict[str, VehicleParams] = {"paper": PAPER}

@@ -1,0 +1,308 @@
+"""The one entry point: `simulate` runs one scenario or a batch and returns a `RideResult`."""
+
+from __future__ import annotations
+
+import json
+import math
+import platform
+from collections.abc import Sequence
+from datetime import datetime, timezone
+
+import numpy as np
+import xarray as xr
+
+from . import kernels
+from .params import VehicleParams
+from .track import Scenario, scenario as named_scenario
+from .vehicle import CORNER_NAMES, DOF_NAMES, DOF_UNITS, N_DOF, RAILS, WHEELSETS, Vehicle
+
+DEFAULT_DT = 1e-4
+DEFAULT_OUTPUT_RATE = 1000.0
+#: sample-steps per kernel call when a progress callback is given
+_CHUNK_WORK = 2_000_000
+
+
+def _rk4_gain(z: np.ndarray) -> np.ndarray:
+    return np.abs(1 + z + z**2 / 2 + z**3 / 6 + z**4 / 24)
+
+
+def max_stable_dt(vehicle: Vehicle) -> float:
+    """Largest RK4 step for which every mode of the passive vehicle is stable."""
+    lam = np.linalg.eigvals(vehicle.state_matrix)
+    lo, hi = 0.0, 10.0
+    for _ in range(60):  # bisection on |R(lambda dt)| <= 1
+        mid = 0.5 * (lo + hi)
+        if np.all(_rk4_gain(lam * mid) <= 1.0 + 1e-12):
+            lo = mid
+        else:
+            hi = mid
+    return lo
+
+
+def _check_dt(vehicle: Vehicle, dt: float) -> None:
+    dt_max = max_stable_dt(vehicle)
+    if dt > dt_max:
+        fastest = max(vehicle.modes(), key=lambda m: m.frequency_hz)
+        raise ValueError(
+            f"dt = {dt:g} s is too large: fourth-order Runge-Kutta is unstable for this vehicle "
+            f"(fastest mode {fastest.label}, {fastest.frequency_hz:.1f} Hz); use dt <= {dt_max:.3g} s "
+            f"(the default {DEFAULT_DT:g} s is accurate)"
+        )
+
+
+def _system_arrays(vehicle: Vehicle) -> dict[str, np.ndarray]:
+    """The stepper's matrices: the equations of motion with M^-1 folded in.
+
+    ``a`` = [Aq Av Bf] acts on (q, q', f), ``t`` = Ts on (q, q', f) gives the secondary
+    deflection rates, ``b`` = [Bw Bwd] acts on (w, w').
+    """
+    minv = 1.0 / np.diag(vehicle.M)[:, None]
+    zeros = np.zeros((4, N_DOF))
+    return {
+        "a": np.hstack([-minv * vehicle.K, -minv * vehicle.C0, minv * vehicle.T]),
+        "t": np.hstack([zeros, vehicle.T.T, np.zeros((4, 4))]),
+        "b": np.hstack([-minv * vehicle.K_w, -minv * vehicle.C_w]),
+        "c_sec": np.full(4, vehicle.params.c_sz),
+    }
+
+
+def _csr_batch(mats: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Compressed-row form of each matrix, padded to a common number of nonzeros."""
+    nnz = max(1, max(int(np.count_nonzero(m)) for m in mats))
+    rows = mats[0].shape[0]
+    ptr = np.zeros((len(mats), rows + 1), dtype=np.int64)
+    col = np.zeros((len(mats), nnz), dtype=np.int64)
+    val = np.zeros((len(mats), nnz))
+    for s, m in enumerate(mats):
+        r, c = np.nonzero(m)  # row-major order
+        ptr[s, 1:] = np.cumsum(np.bincount(r, minlength=rows))
+        col[s, : r.size] = c
+        val[s, : r.size] = m[r, c]
+    return ptr, col, val
+
+
+def _as_list(x, n_default=1):
+    if x is None or isinstance(x, (Scenario, VehicleParams, str)):
+        return [x]
+    return list(x)
+
+
+def _resolve_scenario(s) -> Scenario:
+    if s is None:
+        return named_scenario("paper-sine")
+    if isinstance(s, str):
+        return named_scenario(s)
+    if isinstance(s, Scenario):
+        return s
+    raise ValueError(f"scenario = {s!r}: must be a Scenario or a scenario name")
+
+
+def _resolve_params(p) -> VehicleParams:
+    if p is None:
+        return VehicleParams.preset("paper")
+    if isinstance(p, str):
+        return VehicleParams.preset(p)
+    if isinstance(p, VehicleParams):
+        return p
+    raise ValueError(f"params = {p!r}: must be VehicleParams or a preset name")
+
+
+def _positive(name: str, value) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value <= 0:
+        raise ValueError(f"{name} = {value!r}: must be a finite number > 0")
+    return float(value)
+
+
+def simulate(scenario=None, params=None, *, dt: float = DEFAULT_DT,
+             output_rate: float = DEFAULT_OUTPUT_RATE, progress=None) -> "RideResult":
+    """Simulate the passive vehicle on one or many scenarios.
+
+    ``scenario`` is a `Scenario`, a scenario name (see `railride.track.scenario`) or a list of
+    them; ``params`` is a `VehicleParams`, a preset name or a list. Lists run as one batch
+    along a ``sample`` dimension (a single item is broadcast against a list). Every sample of a
+    batch must share the duration. ``dt`` [s] is the fixed RK4 step and ``output_rate`` [Hz] the
+    rate of the stored time histories; 1/(output_rate dt) must be a whole number.
+    ``progress(done_fraction)`` is called between chunks of a long run.
+    """
+    dt = _positive("dt", dt)
+    output_rate = _positive("output_rate", output_rate)
+    batch = not (isinstance(scenario, (Scenario, str)) or scenario is None) or not (
+        isinstance(params, (VehicleParams, str)) or params is None)
+    scenarios = [_resolve_scenario(s) for s in _as_list(scenario)]
+    param_sets = [_resolve_params(p) for p in _as_list(params)]
+    n = max(len(scenarios), len(param_sets))
+    if len(scenarios) not in (1, n) or len(param_sets) not in (1, n):
+        raise ValueError(f"a batch needs equally many scenarios and parameter sets, or one of either; "
+                         f"got {len(scenarios)} scenarios and {len(param_sets)} parameter sets")
+    if n == 0:
+        raise ValueError("an empty batch: give at least one scenario")
+    scenarios = scenarios * (n // len(scenarios))
+    param_sets = param_sets * (n // len(param_sets))
+    duration = scenarios[0].duration
+    if any(abs(s.duration - duration) > 1e-12 * duration for s in scenarios):
+        raise ValueError("every sample of a batch must have the same duration; got "
+                         + ", ".join(sorted({f'{s.duration:g} s' for s in scenarios})))
+    stride_f = 1.0 / (output_rate * dt)
+    stride = int(round(stride_f))
+    if stride < 1 or abs(stride - stride_f) > 1e-6 * stride_f:
+        raise ValueError(f"output_rate = {output_rate:g} Hz with dt = {dt:g} s: the output interval "
+                         f"1/output_rate must be a whole number of steps (at most one sample per step)")
+    n_out_f = duration * output_rate
+    n_out = int(round(n_out_f))
+    if abs(n_out - n_out_f) > 1e-6 * max(1.0, n_out_f) or n_out < 1:
+        raise ValueError(f"duration = {duration:g} s must be a whole number of output intervals "
+                         f"(1/{output_rate:g} Hz)")
+    n_steps = n_out * stride
+
+    vehicles = {}
+    for p in param_sets:
+        if id(p) not in vehicles:
+            vehicles[id(p)] = Vehicle(p)
+            _check_dt(vehicles[id(p)], dt)
+    systems = [_system_arrays(vehicles[id(p)]) for p in param_sets]
+    csr = {k: _csr_batch([s[k] for s in systems]) for k in ("a", "t", "b")}
+    c_sec = np.stack([s["c_sec"] for s in systems])
+
+    tables, offsets, counts, spacings = [], [], [], []
+    off = 0
+    for sc, p in zip(scenarios, param_sets):
+        tab, ds = sc.track.table(sc.speed * (duration + 2 * dt))
+        tables.append(tab)
+        offsets.append(off)
+        counts.append(tab.shape[0])
+        spacings.append(ds)
+        off += tab.shape[0]
+    table = np.ascontiguousarray(np.concatenate(tables))
+    lag = np.stack([vehicles[id(p)].wheelset_lag_distance for p in param_sets])
+    speed = np.array([sc.speed for sc in scenarios])
+
+    rows = n_out + 1
+    x = np.zeros((n, 2 * N_DOF))
+    out = {
+        "q": np.empty((n, rows, N_DOF)), "v": np.empty((n, rows, N_DOF)),
+        "a": np.empty((n, rows, N_DOF)), "f": np.empty((n, rows, 4)),
+        "w": np.empty((n, rows, 8)), "wd": np.empty((n, rows, 8)),
+    }
+    status = np.zeros(n, dtype=np.int64)
+    fail_step = np.full(n, -1, dtype=np.int64)
+
+    chunk = n_steps if progress is None else max(stride, (_CHUNK_WORK // n) // stride * stride)
+    done = 0
+    while True:
+        todo = min(chunk, n_steps - done)
+        final = done + todo == n_steps
+        kernels.run_batch(x, done, todo, final, stride, dt,
+                          *csr["a"], *csr["t"], *csr["b"], c_sec,
+                          speed, lag, table, np.array(offsets, dtype=np.int64),
+                          np.array(counts, dtype=np.int64), np.array(spacings),
+                          out["q"], out["v"], out["a"], out["f"], out["w"], out["wd"],
+                          status, fail_step)
+        done += todo
+        if progress is not None:
+            progress(done / n_steps)
+        if final:
+            break
+    if np.any(status != kernels.STATUS_OK):
+        bad = np.flatnonzero(status != kernels.STATUS_OK)
+        which = ", ".join(f"sample {i} at t = {fail_step[i] * dt:.4g} s" for i in bad[:5])
+        raise RuntimeError(f"the simulation diverged ({which}): a response left +-{kernels.DIVERGED:g} "
+                           f"or stopped being finite; check the parameters or reduce dt")
+
+    ds = _dataset(out, vehicles, param_sets, scenarios, dt, output_rate, rows, batch)
+    return RideResult(ds)
+
+
+def _dataset(out, vehicles, param_sets, scenarios, dt, output_rate, rows, batch) -> xr.Dataset:
+    from . import __version__
+    import numba
+    import scipy
+
+    time = np.arange(rows) / output_rate
+    dims = ("sample", "time")
+    T = np.stack([vehicles[id(p)].T for p in param_sets])  # (n, 9, 4)
+    data = {}
+    for i, name in enumerate(DOF_NAMES):
+        data[name] = (dims, out["q"][:, :, i], {"units": DOF_UNITS[i], "long_name": name.replace("_", " ")})
+        data[f"{name}_velocity"] = (dims, out["v"][:, :, i], {"units": f"{DOF_UNITS[i]}/s"})
+    data["carbody_acceleration"] = (dims, out["a"][:, :, 0],
+                                    {"units": "m/s^2", "long_name": "carbody CG vertical acceleration"})
+    data["carbody_corner_displacement"] = (
+        dims + ("corner",), np.einsum("stj,sjc->stc", out["q"][:, :, :3], T[:, :3]),
+        {"units": "m", "long_name": "carbody vertical displacement above each secondary corner"})
+    data["secondary_deflection"] = (
+        dims + ("corner",), np.einsum("stj,sjc->stc", out["q"], T),
+        {"units": "m", "long_name": "secondary vertical deflection, carbody minus bogie (extension +)"})
+    data["secondary_deflection_velocity"] = (
+        dims + ("corner",), np.einsum("stj,sjc->stc", out["v"], T), {"units": "m/s"})
+    ksz = np.array([p.k_sz for p in param_sets])[:, None, None]
+    data["secondary_spring_force"] = (
+        dims + ("corner",), -ksz * data["secondary_deflection"][1],
+        {"units": "N", "long_name": "secondary vertical spring force on the carbody (up +)"})
+    data["secondary_damper_force"] = (
+        dims + ("corner",), out["f"],
+        {"units": "N", "long_name": "secondary vertical damper force on the carbody (up +)"})
+    shape = out["w"].shape[:2] + (4, 2)
+    data["rail_displacement"] = (dims + ("wheelset", "rail"), out["w"].reshape(shape),
+                                 {"units": "m", "long_name": "rail height under each wheel"})
+    data["rail_velocity"] = (dims + ("wheelset", "rail"), out["wd"].reshape(shape),
+                             {"units": "m/s", "long_name": "rail vertical velocity under each wheel"})
+    coords = {
+        "time": ("time", time, {"units": "s"}),
+        "corner": ("corner", list(CORNER_NAMES)),
+        "wheelset": ("wheelset", list(WHEELSETS)),
+        "rail": ("rail", list(RAILS)),
+        "sample": ("sample", np.arange(len(param_sets))),
+    }
+    ds = xr.Dataset(data, coords=coords)
+    ds["scenario"] = ("sample", [json.dumps(s.describe()) for s in scenarios])
+    ds["vehicle_params"] = ("sample", [json.dumps(p.to_dict()) for p in param_sets])
+    ds.attrs.update({
+        "title": "railride passive ride simulation",
+        "railride_version": __version__,
+        "numpy_version": np.__version__,
+        "numba_version": numba.__version__,
+        "scipy_version": scipy.__version__,
+        "xarray_version": xr.__version__,
+        "python_version": platform.python_version(),
+        "created_utc": datetime.now(timezone.utc).isoformat(timespec="seconds"),
+        "integrator": "classical RK4, fixed step",
+        "dt_s": dt,
+        "output_rate_hz": output_rate,
+        "suspension": "passive viscous secondary dampers",
+        "sign_convention": "z up; pitch + lowers the front; roll + raises the left side",
+    })
+    if not batch:
+        ds = ds.isel(sample=0)
+    return ds
+
+
+class RideResult:
+    """Time histories (``.dataset``, an xarray Dataset) and the ride metrics of a run."""
+
+    def __init__(self, dataset: xr.Dataset):
+        self.dataset = dataset
+
+    def __getitem__(self, name):
+        return self.dataset[name]
+
+    def __repr__(self):
+        return f"RideResult(\n{self.dataset!r}\n)"
+
+    @property
+    def is_batch(self) -> bool:
+        return "sample" in self.dataset.dims
+
+    def metrics(self, window=None) -> xr.DataArray:
+        """RMS and peak-to-peak of the four body responses; see `railride.metrics.ride_metrics`."""
+        from .metrics import ride_metrics
+        return ride_metrics(self.dataset, window)
+
+    def to_pandas(self):
+        """The time histories as a DataFrame, one column per scalar channel."""
+        from .report import to_frame
+        return to_frame(self.dataset)
+
+    def plot(self, path=None):
+        """Plot the four body responses; save to ``path`` if given, return the figure."""
+        from .report import plot_body_responses
+        return plot_body_responses(self.dataset, path)

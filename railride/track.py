@@ -1,0 +1,306 @@
+"""Rail profiles, scenarios and the wheelset delays (spec section 4).
+
+A profile gives the left and right rail heights z_L(s), z_R(s) [m] and their slopes along the
+track. Before s = 0 every profile is 0: the vehicle starts at rest on level track. Wheelset j is at
+s_j(t) = V t - (x1 - x_j), so it sees the leading wheelset's input delayed by (x1 - x_j)/V, and its
+rail velocity is w' = V dz/ds.
+
+For the compiled stepper a profile is sampled once into a uniform table of heights and slopes;
+between nodes the stepper interpolates with cubic Hermite polynomials, which reproduces the
+heights to O(ds^4) and the slopes to O(ds^3). Node 0 (s = 0) always holds the level track before
+the profile begins, so a profile that does not start at zero height (the paper sine with a rail
+phase, for instance) rises to its value over the first interval ds as a smooth cubic ramp instead
+of an infinitely steep step.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+from abc import ABC, abstractmethod
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+#: nodes per shortest feature (wavelength, bump length) in the stepper's table
+NODES_PER_FEATURE = 200
+MAX_TABLE_NODES = 5_000_000
+
+
+def _check(name: str, value, rule: str, allowed: str) -> float:
+    ok = isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+    if ok:
+        value = float(value)
+        ok = {"positive": value > 0, "nonnegative": value >= 0, "finite": True}[rule]
+    if not ok:
+        raise ValueError(f"{name} = {value!r}: must be {allowed}")
+    return value
+
+
+class RailProfile(ABC):
+    """Left and right rail heights along the track."""
+
+    @abstractmethod
+    def _evaluate(self, s: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """z_L, z_R, dz_L/ds, dz_R/ds at s >= 0."""
+
+    @abstractmethod
+    def table_spacing(self) -> float:
+        """The node spacing ds [m] that resolves this profile in the stepper's table."""
+
+    @abstractmethod
+    def describe(self) -> dict:
+        """Settings that define the profile, for the record kept with results."""
+
+    def end(self) -> float:
+        """Last s [m] at which the profile is defined (inf if everywhere)."""
+        return math.inf
+
+    def evaluate(self, s) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """z_L, z_R [m] and their slopes dz_L/ds, dz_R/ds [-] at positions s [m]; 0 for s < 0."""
+        s = np.asarray(s, dtype=float)
+        out = [np.zeros_like(s) for _ in range(4)]
+        on = s >= 0
+        if np.any(on):
+            for o, v in zip(out, self._evaluate(s[on])):
+                o[on] = v
+        return tuple(out)
+
+    def table(self, s_end: float, ds: float | None = None) -> tuple[np.ndarray, float]:
+        """Uniform table (n, 4) of z_L, z_R, dz_L/ds, dz_R/ds from s = 0 to at least s_end."""
+        ds = self.table_spacing() if ds is None else ds
+        n = int(math.ceil(s_end / ds)) + 3
+        if n > MAX_TABLE_NODES:
+            raise ValueError(
+                f"the track table would need {n} nodes (ds = {ds:.3g} m up to s = {s_end:.1f} m); "
+                f"at most {MAX_TABLE_NODES} are allowed: shorten the run or coarsen the profile"
+            )
+        s = np.arange(n) * ds
+        tab = np.empty((n, 4))
+        tab[1:] = np.column_stack(self._evaluate(np.minimum(s[1:], self.end())))
+        tab[1:][s[1:] > self.end(), 2:] = 0.0  # margin nodes past a measured end: held flat
+        tab[0] = 0.0  # level track up to s = 0
+        return tab, ds
+
+
+@dataclass(frozen=True)
+class SineTrack(RailProfile):
+    """The paper's sine: z_L = A sin(2 pi s / lambda), z_R = A sin(2 pi s / lambda - psi)."""
+
+    amplitude: float = 0.05  # m
+    wavelength: float = 60.0  # m
+    rail_phase_deg: float = 90.0  # deg, psi: right rail lags the left
+
+    def __post_init__(self):
+        object.__setattr__(self, "amplitude", _check("amplitude", self.amplitude, "nonnegative", "a finite number >= 0 (m)"))
+        object.__setattr__(self, "wavelength", _check("wavelength", self.wavelength, "positive", "a finite number > 0 (m)"))
+        object.__setattr__(self, "rail_phase_deg", _check("rail_phase", self.rail_phase_deg, "finite", "a finite angle in degrees"))
+
+    def _evaluate(self, s):
+        k = 2 * np.pi / self.wavelength
+        psi = np.deg2rad(self.rail_phase_deg)
+        A = self.amplitude
+        return (A * np.sin(k * s), A * np.sin(k * s - psi),
+                A * k * np.cos(k * s), A * k * np.cos(k * s - psi))
+
+    def table_spacing(self):
+        return self.wavelength / NODES_PER_FEATURE
+
+    def describe(self):
+        return {"profile": "sine", "amplitude_m": self.amplitude, "wavelength_m": self.wavelength,
+                "rail_phase_deg": self.rail_phase_deg}
+
+
+@dataclass(frozen=True)
+class CosineBump(RailProfile):
+    """One cosine bump (height > 0) or dip (height < 0): z = h/2 (1 - cos(2 pi (s - s0) / L))
+    for s0 <= s <= s0 + L, on both rails or on one."""
+
+    height: float = 0.02  # m
+    length: float = 10.0  # m
+    start: float = 10.0  # m, s0
+    rails: str = "both"  # "both", "left" or "right"
+
+    def __post_init__(self):
+        object.__setattr__(self, "height", _check("height", self.height, "finite", "a finite number (m; < 0 for a dip)"))
+        object.__setattr__(self, "length", _check("length", self.length, "positive", "a finite number > 0 (m)"))
+        object.__setattr__(self, "start", _check("start", self.start, "nonnegative", "a finite number >= 0 (m)"))
+        if self.rails not in ("both", "left", "right"):
+            raise ValueError(f"rails = {self.rails!r}: allowed 'both', 'left', 'right'")
+
+    def _evaluate(self, s):
+        x = (s - self.start) / self.length
+        inside = (x >= 0) & (x <= 1)
+        z = np.where(inside, 0.5 * self.height * (1 - np.cos(2 * np.pi * x)), 0.0)
+        dz = np.where(inside, 0.5 * self.height * 2 * np.pi / self.length * np.sin(2 * np.pi * x), 0.0)
+        zero = np.zeros_like(s)
+        left = self.rails in ("both", "left")
+        right = self.rails in ("both", "right")
+        return (z if left else zero, z if right else zero,
+                dz if left else zero, dz if right else zero)
+
+    def table_spacing(self):
+        return self.length / NODES_PER_FEATURE
+
+    def describe(self):
+        return {"profile": "cosine-bump", "height_m": self.height, "length_m": self.length,
+                "start_m": self.start, "rails": self.rails}
+
+
+@dataclass(frozen=True, eq=False)
+class MeasuredTrack(RailProfile):
+    """A sampled profile (s, z_L, z_R), interpolated by shape-preserving cubics (PCHIP).
+
+    PCHIP gives continuous heights and slopes without overshoot at steps in the data, so the
+    rail velocity V dz/ds stays bounded by the data's own slopes.
+    """
+
+    s: np.ndarray
+    z_L: np.ndarray
+    z_R: np.ndarray
+    source: str = "<array>"
+    _interp: tuple = field(default=(), repr=False)
+
+    def __post_init__(self):
+        from scipy.interpolate import PchipInterpolator
+
+        s = np.asarray(self.s, dtype=float)
+        zl = np.asarray(self.z_L, dtype=float)
+        zr = np.asarray(self.z_R, dtype=float)
+        src = self.source
+        if s.ndim != 1 or s.shape != zl.shape or s.shape != zr.shape:
+            raise ValueError(f"{src}: s, z_L and z_R must be 1-D columns of equal length")
+        if s.size < 2:
+            raise ValueError(f"{src}: a measured profile needs at least 2 rows, got {s.size}")
+        for name, col in (("s", s), ("z_L", zl), ("z_R", zr)):
+            bad = np.flatnonzero(~np.isfinite(col))
+            if bad.size:
+                raise ValueError(f"{src}: column {name} has a non-finite value {col[bad[0]]!r} at row {bad[0] + 1}")
+        steps = np.diff(s)
+        if np.any(steps <= 0):
+            i = int(np.flatnonzero(steps <= 0)[0])
+            raise ValueError(f"{src}: s must increase strictly; row {i + 2} has s = {s[i + 1]!r} after {s[i]!r}")
+        if s[0] > 0:
+            raise ValueError(f"{src}: the profile must start at s <= 0 m (the vehicle starts at s = 0); it starts at {s[0]!r} m")
+        object.__setattr__(self, "s", s)
+        object.__setattr__(self, "z_L", zl)
+        object.__setattr__(self, "z_R", zr)
+        pl, pr = PchipInterpolator(s, zl), PchipInterpolator(s, zr)
+        object.__setattr__(self, "_interp", (pl, pr, pl.derivative(), pr.derivative()))
+
+    @classmethod
+    def from_csv(cls, path: str | Path) -> "MeasuredTrack":
+        """Read a CSV with a header naming the columns s, z_L, z_R (metres; a unit suffix such
+        as "s [m]" is allowed, other columns are ignored)."""
+        path = Path(path)
+        try:
+            with path.open(newline="", encoding="utf-8") as fh:
+                rows = list(csv.reader(fh))
+        except OSError as exc:
+            raise ValueError(f"cannot read track file {path}: {exc.strerror or exc}") from None
+        except UnicodeDecodeError:
+            raise ValueError(f"track file {path}: not a UTF-8 text CSV") from None
+        rows = [r for r in rows if r and any(c.strip() for c in r) and not r[0].lstrip().startswith("#")]
+        if not rows:
+            raise ValueError(f"track file {path}: empty; expected a header 's,z_L,z_R' and data rows")
+        header = [c.split("[")[0].strip().lower() for c in rows[0]]
+        idx = {}
+        for want in ("s", "z_l", "z_r"):
+            if want not in header:
+                raise ValueError(
+                    f"track file {path}: no column {want.replace('_l', '_L').replace('_r', '_R')!r} in the header "
+                    f"{rows[0]!r}; expected columns s [m], z_L [m], z_R [m]"
+                )
+            idx[want] = header.index(want)
+        data = {k: [] for k in idx}
+        for lineno, row in enumerate(rows[1:], start=2):
+            for k, j in idx.items():
+                try:
+                    data[k].append(float(row[j]))
+                except (IndexError, ValueError):
+                    cell = row[j] if j < len(row) else "<missing>"
+                    raise ValueError(
+                        f"track file {path}, data row {lineno}: column {rows[0][j].strip()!r} = {cell!r} is not a number"
+                    ) from None
+        return cls(np.array(data["s"]), np.array(data["z_l"]), np.array(data["z_r"]), source=str(path))
+
+    def _evaluate(self, s):
+        if np.any(s > self.s[-1] + 1e-9):
+            raise ValueError(f"{self.source}: the profile ends at s = {self.s[-1]:g} m but the run reaches s = {float(np.max(s)):.1f} m")
+        return tuple(f(s) for f in self._interp)
+
+    def end(self):
+        return float(self.s[-1])
+
+    def table_spacing(self):
+        return float(np.min(np.diff(self.s))) / 2
+
+    def describe(self):
+        return {"profile": "measured", "source": self.source, "rows": int(self.s.size),
+                "s_end_m": float(self.s[-1])}
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """A run: a rail profile passed at constant speed for a duration."""
+
+    track: RailProfile = field(default_factory=SineTrack)
+    speed: float = 55.56  # m/s, V (the paper's value)
+    duration: float = 10.0  # s
+    name: str = "paper-sine"
+
+    def __post_init__(self):
+        object.__setattr__(self, "speed", _check("speed", self.speed, "positive", "a finite number > 0 (m/s)"))
+        object.__setattr__(self, "duration", _check("duration", self.duration, "positive", "a finite number > 0 (s)"))
+        if not isinstance(self.track, RailProfile):
+            raise ValueError(f"track = {self.track!r}: must be a RailProfile")
+        needed = self.speed * self.duration
+        if needed > self.track.end() + 1e-9:
+            raise ValueError(
+                f"the run covers s = 0 to {needed:.1f} m (speed {self.speed:g} m/s x {self.duration:g} s) "
+                f"but the profile ends at s = {self.track.end():g} m: shorten the duration or lower the speed"
+            )
+
+    def describe(self) -> dict:
+        return {"name": self.name, "speed_m_s": self.speed, "duration_s": self.duration,
+                **self.track.describe()}
+
+
+SCENARIOS = ("paper-sine", "bump", "file:PATH")
+
+
+def scenario(name: str = "paper-sine", *, amplitude: float | None = None,
+             wavelength: float | None = None, rail_phase: float | None = None,
+             speed: float | None = None, duration: float | None = None) -> Scenario:
+    """A named scenario with optional overrides.
+
+    ``paper-sine``: amplitude [m], wavelength [m], rail_phase [deg] of the sine (defaults 0.05 m,
+    60 m, 90 deg). ``bump``: amplitude is the bump height [m] (negative for a dip, default 0.02 m)
+    and wavelength its length [m] (default 10 m), starting at s = 10 m on both rails.
+    ``file:PATH``: a measured CSV profile (s, z_L, z_R). Speed defaults to 55.56 m/s and duration
+    to 10 s for every scenario.
+    """
+    common = {"speed": 55.56 if speed is None else speed,
+              "duration": 10.0 if duration is None else duration}
+    if name == "paper-sine":
+        track = SineTrack(amplitude=0.05 if amplitude is None else amplitude,
+                          wavelength=60.0 if wavelength is None else wavelength,
+                          rail_phase_deg=90.0 if rail_phase is None else rail_phase)
+    elif name == "bump":
+        if rail_phase is not None:
+            raise ValueError("rail_phase applies to paper-sine only, not to the bump scenario")
+        track = CosineBump(height=0.02 if amplitude is None else amplitude,
+                           length=10.0 if wavelength is None else wavelength)
+    elif name.startswith("file:"):
+        given = [k for k, v in (("amplitude", amplitude), ("wavelength", wavelength),
+                                ("rail_phase", rail_phase)) if v is not None]
+        if given:
+            raise ValueError(f"{', '.join(given)} cannot be set for a measured profile ({name})")
+        path = name[len("file:"):]
+        if not path:
+            raise ValueError("scenario 'file:' needs a path, as in file:track.csv")
+        track = MeasuredTrack.from_csv(path)
+    else:
+        raise ValueError(f"unknown scenario {name!r}; allowed: {', '.join(SCENARIOS)}")
+    return Scenario(track=track, name=name, **common)
