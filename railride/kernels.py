@@ -5,8 +5,8 @@ The stepper integrates, for each sample of a batch,
     q'' = Aq q + Av q' + Bw w + Bwd w' + Bf f,    f_i = -c_i (Ts q')_i
 
 with classical fourth-order Runge-Kutta at a fixed step. The matrices are the vehicle's
-(M^-1 folded in, see `simulate._system_arrays`), passed in compressed-row form because they are
-mostly zeros (about a third of the entries are not); w, w' are the rail heights and velocities at the
+(M^-1 folded in, see `simulate._system_arrays`), stored transposed so that a product runs
+down the columns with the nine row sums held in registers; w, w' are the rail heights and velocities at the
 four wheelsets, interpolated from a uniform track table with cubic Hermite polynomials. Sizes
 are module constants so that LLVM sees fixed trip counts. Nothing is allocated inside the time
 loop; samples run in parallel over ``prange``.
@@ -21,6 +21,7 @@ N_DOF = 9
 N_CORNER = 4
 N_WHEELSET = 4
 N_RAIL = 8
+NY = 2 * N_DOF + N_CORNER  # length of the stage vector (q, q', f)
 #: a displacement or rotation beyond this (m or rad) is taken as divergence
 DIVERGED = 1.0e3
 
@@ -70,45 +71,86 @@ def _rails(t, speed, lag, table, off, n_nodes, ds, w, wd):
 
 
 @njit(cache=True, inline="always", fastmath=_FAST)
-def _csr_matvec(ptr, col, val, x, out, n_rows):
-    """out[:n_rows] = A x for A in compressed-row form."""
-    for i in range(n_rows):
-        acc = 0.0
-        for k in range(ptr[i], ptr[i + 1]):
-            acc += val[k] * x[col[k]]
-        out[i] = acc
+def _mv9(AT, x, n_cols, r, out):
+    """out = r + A x for the 9 rows of q'', with A stored transposed (n_cols, 9).
+
+    The nine sums live in named locals on purpose: numba cannot tell LLVM that ``out`` does
+    not alias the inputs, so an array accumulator is reloaded and stored at every column and
+    the product becomes load-bound (about 3x slower, see docs/performance.md).
+    """
+    a0 = r[0]
+    a1 = r[1]
+    a2 = r[2]
+    a3 = r[3]
+    a4 = r[4]
+    a5 = r[5]
+    a6 = r[6]
+    a7 = r[7]
+    a8 = r[8]
+    for j in range(n_cols):
+        xj = x[j]
+        a0 += AT[j, 0] * xj
+        a1 += AT[j, 1] * xj
+        a2 += AT[j, 2] * xj
+        a3 += AT[j, 3] * xj
+        a4 += AT[j, 4] * xj
+        a5 += AT[j, 5] * xj
+        a6 += AT[j, 6] * xj
+        a7 += AT[j, 7] * xj
+        a8 += AT[j, 8] * xj
+    out[0] = a0
+    out[1] = a1
+    out[2] = a2
+    out[3] = a3
+    out[4] = a4
+    out[5] = a5
+    out[6] = a6
+    out[7] = a7
+    out[8] = a8
 
 
 @njit(cache=True, inline="always", fastmath=_FAST)
-def _acceleration(y, r, a_ptr, a_col, a_val, t_ptr, t_col, t_val, c_sec, out):
+def _secondary_rates(TT, y, out):
+    """out = deflection rates of the four secondary corners, Ts q' (TT = Ts^T, (9, 4))."""
+    b0 = 0.0
+    b1 = 0.0
+    b2 = 0.0
+    b3 = 0.0
+    for j in range(N_DOF):
+        vj = y[N_DOF + j]
+        b0 += TT[j, 0] * vj
+        b1 += TT[j, 1] * vj
+        b2 += TT[j, 2] * vj
+        b3 += TT[j, 3] * vj
+    out[0] = b0
+    out[1] = b1
+    out[2] = b2
+    out[3] = b3
+
+
+@njit(cache=True, inline="always", fastmath=_FAST)
+def _acceleration(y, r, AT, TT, c_sec, rates, out):
     """out = q'' for y = (q, q', f) with rail forcing r.
 
     First the secondary damper forces f = -c (Ts q') go into y[18:22], then
     q'' = r + [Aq Av Bf] y.
     """
+    _secondary_rates(TT, y, rates)
     for c in range(N_CORNER):
-        rate = 0.0
-        for k in range(t_ptr[c], t_ptr[c + 1]):
-            rate += t_val[k] * y[t_col[k]]
-        y[2 * N_DOF + c] = -c_sec[c] * rate
-    for i in range(N_DOF):
-        acc = r[i]
-        for k in range(a_ptr[i], a_ptr[i + 1]):
-            acc += a_val[k] * y[a_col[k]]
-        out[i] = acc
+        y[2 * N_DOF + c] = -c_sec[c] * rates[c]
+    _mv9(AT, y, NY, r, out)
 
 
 @njit(cache=True, parallel=True, fastmath=_FAST)
-def run_batch(x, step0, n_steps, final, stride, dt,
-              a_ptr, a_col, a_val, t_ptr, t_col, t_val, b_ptr, b_col, b_val, c_sec,
+def run_batch(x, step0, n_steps, final, stride, dt, A, TS, B, c_sec,
               speed, lag, table, table_off, table_n, table_ds,
               out_q, out_v, out_a, out_f, out_w, out_wd,
               status, fail_step):
     """Advance every sample's state x[s] = (q, q') by n_steps RK4 steps of dt.
 
-    Per sample s the matrices are in compressed-row form (ptr[s], col[s], val[s]):
-    ``a`` maps y = (q, q', f) to q'' (Aq, Av, Bf side by side), ``t`` maps y to the secondary
-    deflection rates (Ts acting on q'), ``b`` maps u = (w, w') to q'' (Bw, Bwd).
+    Per sample s the matrices are stored transposed: A[s] (NY, 9) maps y = (q, q', f) to q''
+    (Aq, Av, Bf side by side), TS[s] (9, 4) maps q' to the secondary deflection rates, B[s]
+    (16, 9) maps u = (w, w') to q'' (Bw, Bwd). c_sec[s] holds the four damping coefficients.
 
     Steps are numbered globally from step0 (t = step * dt). At every step whose number is a
     multiple of ``stride`` the state, acceleration, damper forces and rail inputs at that time
@@ -117,7 +159,6 @@ def run_batch(x, step0, n_steps, final, stride, dt,
     status STATUS_DIVERGED and the step number in fail_step, and stops.
     """
     n_samples = x.shape[0]
-    NY = 2 * N_DOF + N_CORNER
     for smp in prange(n_samples):
         if status[smp] != STATUS_OK:
             continue
@@ -125,36 +166,46 @@ def run_batch(x, step0, n_steps, final, stride, dt,
         v = x[smp, N_DOF:].copy()
         y = np.empty(NY)  # stage state (q, q', f)
         f = np.empty(N_CORNER)  # forces at the step's start, for the record
+        rates = np.empty(N_CORNER)
+        zero = np.zeros(N_DOF)
         k1v = np.empty(N_DOF)
         k2v = np.empty(N_DOF)
         k3v = np.empty(N_DOF)
         k4v = np.empty(N_DOF)
         k2q = np.empty(N_DOF)
         k3q = np.empty(N_DOF)
-        r0 = np.empty(N_DOF)
+        r0 = np.empty(N_DOF)  # rail forcing at t, t + dt/2, t + dt
         rm = np.empty(N_DOF)
         r1 = np.empty(N_DOF)
-        u = np.empty(2 * N_RAIL)
+        u = np.empty(2 * N_RAIL)  # (w, w') at t, for the record
         w = u[:N_RAIL]
         wd = u[N_RAIL:]
-        ap, ac, avl = a_ptr[smp], a_col[smp], a_val[smp]
-        tp, tc, tv = t_ptr[smp], t_col[smp], t_val[smp]
-        bp, bc, bv = b_ptr[smp], b_col[smp], b_val[smp]
-        cs = c_sec[smp]
+        um = np.empty(2 * N_RAIL)  # at t + dt/2
+        wm = um[:N_RAIL]
+        wdm = um[N_RAIL:]
+        u1 = np.empty(2 * N_RAIL)  # at t + dt
+        w1 = u1[:N_RAIL]
+        wd1 = u1[N_RAIL:]
+        at, tt, bt, cs = A[smp], TS[smp], B[smp], c_sec[smp]
         V, lg, off, nn, ds = speed[smp], lag[smp], table_off[smp], table_n[smp], table_ds[smp]
         h = 0.5 * dt
         _rails(step0 * dt, V, lg, table, off, nn, ds, w, wd)
-        _csr_matvec(bp, bc, bv, u, r0, N_DOF)
+        _mv9(bt, u, 2 * N_RAIL, zero, r0)
         last = n_steps + 1 if final else n_steps
         for n in range(last):
             step = step0 + n
             t = step * dt
+            if n < n_steps:
+                # the rail inputs do not depend on the state: evaluated first, the CPU can
+                # overlap them with the stage computations that do
+                _rails(t + h, V, lg, table, off, nn, ds, wm, wdm)
+                _mv9(bt, um, 2 * N_RAIL, zero, rm)
+                _rails(t + dt, V, lg, table, off, nn, ds, w1, wd1)
+                _mv9(bt, u1, 2 * N_RAIL, zero, r1)
             for i in range(N_DOF):
                 y[i] = q[i]
                 y[N_DOF + i] = v[i]
-            _acceleration(y, r0, ap, ac, avl, tp, tc, tv, cs, k1v)
-            for c in range(N_CORNER):
-                f[c] = y[2 * N_DOF + c]
+            _acceleration(y, r0, at, tt, cs, rates, k1v)
             if step % stride == 0:
                 row = step // stride
                 bad = False
@@ -165,7 +216,7 @@ def run_batch(x, step0, n_steps, final, stride, dt,
                     if not (abs(q[i]) < DIVERGED and abs(v[i]) < 1e3 * DIVERGED):
                         bad = True
                 for c in range(N_CORNER):
-                    out_f[smp, row, c] = f[c]
+                    out_f[smp, row, c] = y[2 * N_DOF + c]
                 for k in range(N_RAIL):
                     out_w[smp, row, k] = w[k]
                     out_wd[smp, row, k] = wd[k]
@@ -176,28 +227,26 @@ def run_batch(x, step0, n_steps, final, stride, dt,
             if n == n_steps:
                 break
             # stages 2 and 3 share the rail input at t + dt/2
-            _rails(t + h, V, lg, table, off, nn, ds, w, wd)
-            _csr_matvec(bp, bc, bv, u, rm, N_DOF)
             for i in range(N_DOF):
                 y[i] = q[i] + h * v[i]
                 k2q[i] = v[i] + h * k1v[i]
                 y[N_DOF + i] = k2q[i]
-            _acceleration(y, rm, ap, ac, avl, tp, tc, tv, cs, k2v)
+            _acceleration(y, rm, at, tt, cs, rates, k2v)
             for i in range(N_DOF):
                 y[i] = q[i] + h * k2q[i]
                 k3q[i] = v[i] + h * k2v[i]
                 y[N_DOF + i] = k3q[i]
-            _acceleration(y, rm, ap, ac, avl, tp, tc, tv, cs, k3v)
-            _rails(t + dt, V, lg, table, off, nn, ds, w, wd)
-            _csr_matvec(bp, bc, bv, u, r1, N_DOF)
+            _acceleration(y, rm, at, tt, cs, rates, k3v)
             for i in range(N_DOF):
                 y[i] = q[i] + dt * k3q[i]
                 y[N_DOF + i] = v[i] + dt * k3v[i]
-            _acceleration(y, r1, ap, ac, avl, tp, tc, tv, cs, k4v)
+            _acceleration(y, r1, at, tt, cs, rates, k4v)
             for i in range(N_DOF):
                 q[i] += dt / 6.0 * (v[i] + 2.0 * k2q[i] + 2.0 * k3q[i] + y[N_DOF + i])
                 v[i] += dt / 6.0 * (k1v[i] + 2.0 * k2v[i] + 2.0 * k3v[i] + k4v[i])
                 r0[i] = r1[i]
+            for k in range(2 * N_RAIL):
+                u[k] = u1[k]
         for i in range(N_DOF):
             x[smp, i] = q[i]
             x[smp, N_DOF + i] = v[i]

@@ -51,34 +51,16 @@ def _check_dt(vehicle: Vehicle, dt: float) -> None:
 
 
 def _system_arrays(vehicle: Vehicle) -> dict[str, np.ndarray]:
-    """The stepper's matrices: the equations of motion with M^-1 folded in.
+    """The stepper's matrices: the equations of motion with M^-1 folded in, transposed
+    (see `railride.kernels.run_batch`).
 
-    ``a`` = [Aq Av Bf] acts on (q, q', f), ``t`` = Ts on (q, q', f) gives the secondary
-    deflection rates, ``b`` = [Bw Bwd] acts on (w, w').
+    ``A`` = [Aq Av Bf]^T acts on (q, q', f), ``TS`` = T maps q' to the secondary deflection
+    rates, ``B`` = [Bw Bwd]^T acts on (w, w').
     """
     minv = 1.0 / np.diag(vehicle.M)[:, None]
-    zeros = np.zeros((4, N_DOF))
-    return {
-        "a": np.hstack([-minv * vehicle.K, -minv * vehicle.C0, minv * vehicle.T]),
-        "t": np.hstack([zeros, vehicle.T.T, np.zeros((4, 4))]),
-        "b": np.hstack([-minv * vehicle.K_w, -minv * vehicle.C_w]),
-        "c_sec": np.full(4, vehicle.params.c_sz),
-    }
-
-
-def _csr_batch(mats: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Compressed-row form of each matrix, padded to a common number of nonzeros."""
-    nnz = max(1, max(int(np.count_nonzero(m)) for m in mats))
-    rows = mats[0].shape[0]
-    ptr = np.zeros((len(mats), rows + 1), dtype=np.int64)
-    col = np.zeros((len(mats), nnz), dtype=np.int64)
-    val = np.zeros((len(mats), nnz))
-    for s, m in enumerate(mats):
-        r, c = np.nonzero(m)  # row-major order
-        ptr[s, 1:] = np.cumsum(np.bincount(r, minlength=rows))
-        col[s, : r.size] = c
-        val[s, : r.size] = m[r, c]
-    return ptr, col, val
+    A = np.hstack([-minv * vehicle.K, -minv * vehicle.C0, minv * vehicle.T]).T
+    B = np.hstack([-minv * vehicle.K_w, -minv * vehicle.C_w]).T
+    return {"A": A, "TS": vehicle.T.copy(), "B": B, "c_sec": np.full(4, vehicle.params.c_sz)}
 
 
 def _as_list(x, n_default=1):
@@ -160,8 +142,7 @@ def simulate(scenario=None, params=None, *, dt: float = DEFAULT_DT,
             vehicles[id(p)] = Vehicle(p)
             _check_dt(vehicles[id(p)], dt)
     systems = [_system_arrays(vehicles[id(p)]) for p in param_sets]
-    csr = {k: _csr_batch([s[k] for s in systems]) for k in ("a", "t", "b")}
-    c_sec = np.stack([s["c_sec"] for s in systems])
+    arrays = {k: np.ascontiguousarray(np.stack([s[k] for s in systems])) for k in systems[0]}
 
     tables, offsets, counts, spacings = [], [], [], []
     off = 0
@@ -192,7 +173,7 @@ def simulate(scenario=None, params=None, *, dt: float = DEFAULT_DT,
         todo = min(chunk, n_steps - done)
         final = done + todo == n_steps
         kernels.run_batch(x, done, todo, final, stride, dt,
-                          *csr["a"], *csr["t"], *csr["b"], c_sec,
+                          arrays["A"], arrays["TS"], arrays["B"], arrays["c_sec"],
                           speed, lag, table, np.array(offsets, dtype=np.int64),
                           np.array(counts, dtype=np.int64), np.array(spacings),
                           out["q"], out["v"], out["a"], out["f"], out["w"], out["wd"],
