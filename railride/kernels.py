@@ -29,6 +29,10 @@ DIVERGED = 1.0e3
 #: divergence check still sees them
 _FAST = {"reassoc", "contract", "nsz", "arcp"}
 
+#: how the secondary damper forces enter the equations (see `_acceleration`)
+LAW_VISCOUS_IN_C = 0
+LAW_FORCE_INPUT = 1
+
 STATUS_OK = 0
 STATUS_DIVERGED = 1
 
@@ -129,20 +133,30 @@ def _secondary_rates(TT, y, out):
 
 
 @njit(cache=True, inline="always", fastmath=_FAST)
-def _acceleration(y, r, AT, TT, c_sec, rates, out):
-    """out = q'' for y = (q, q', f) with rail forcing r.
-
-    First the secondary damper forces f = -c (Ts q') go into y[18:22], then
-    q'' = r + [Aq Av Bf] y.
-    """
+def _damper_forces(y, TT, c_sec, rates):
+    """Secondary damper forces f = -c (Ts q') into y[18:22]."""
     _secondary_rates(TT, y, rates)
     for c in range(N_CORNER):
         y[2 * N_DOF + c] = -c_sec[c] * rates[c]
-    _mv9(AT, y, NY, r, out)
+
+
+@njit(cache=True, inline="always", fastmath=_FAST)
+def _acceleration(law, y, r, AT, TT, c_sec, rates, out):
+    """out = q'' for y = (q, q', f) with rail forcing r.
+
+    LAW_VISCOUS_IN_C: the viscous dampers are part of Av, so q'' = r + [Aq Av] (q, q') and f is
+    only computed when recorded. LAW_FORCE_INPUT: f = -c (Ts q') goes into y[18:22] first and
+    q'' = r + [Aq Av Bf] y (Av without the dampers).
+    """
+    if law == LAW_VISCOUS_IN_C:
+        _mv9(AT, y, 2 * N_DOF, r, out)
+    else:
+        _damper_forces(y, TT, c_sec, rates)
+        _mv9(AT, y, NY, r, out)
 
 
 @njit(cache=True, parallel=True, fastmath=_FAST)
-def run_batch(x, step0, n_steps, final, stride, dt, A, TS, B, c_sec,
+def run_batch(law, x, step0, n_steps, final, stride, dt, A, TS, B, c_sec,
               speed, lag, table, table_off, table_n, table_ds,
               out_q, out_v, out_a, out_f, out_w, out_wd,
               status, fail_step):
@@ -151,6 +165,7 @@ def run_batch(x, step0, n_steps, final, stride, dt, A, TS, B, c_sec,
     Per sample s the matrices are stored transposed: A[s] (NY, 9) maps y = (q, q', f) to q''
     (Aq, Av, Bf side by side), TS[s] (9, 4) maps q' to the secondary deflection rates, B[s]
     (16, 9) maps u = (w, w') to q'' (Bw, Bwd). c_sec[s] holds the four damping coefficients.
+    ``law`` says how the damper forces enter (LAW_VISCOUS_IN_C or LAW_FORCE_INPUT).
 
     Steps are numbered globally from step0 (t = step * dt). At every step whose number is a
     multiple of ``stride`` the state, acceleration, damper forces and rail inputs at that time
@@ -205,7 +220,7 @@ def run_batch(x, step0, n_steps, final, stride, dt, A, TS, B, c_sec,
             for i in range(N_DOF):
                 y[i] = q[i]
                 y[N_DOF + i] = v[i]
-            _acceleration(y, r0, at, tt, cs, rates, k1v)
+            _acceleration(law, y, r0, at, tt, cs, rates, k1v)
             if step % stride == 0:
                 row = step // stride
                 bad = False
@@ -215,6 +230,8 @@ def run_batch(x, step0, n_steps, final, stride, dt, A, TS, B, c_sec,
                     out_a[smp, row, i] = k1v[i]
                     if not (abs(q[i]) < DIVERGED and abs(v[i]) < 1e3 * DIVERGED):
                         bad = True
+                if law == LAW_VISCOUS_IN_C:
+                    _damper_forces(y, tt, cs, rates)
                 for c in range(N_CORNER):
                     out_f[smp, row, c] = y[2 * N_DOF + c]
                 for k in range(N_RAIL):
@@ -231,16 +248,16 @@ def run_batch(x, step0, n_steps, final, stride, dt, A, TS, B, c_sec,
                 y[i] = q[i] + h * v[i]
                 k2q[i] = v[i] + h * k1v[i]
                 y[N_DOF + i] = k2q[i]
-            _acceleration(y, rm, at, tt, cs, rates, k2v)
+            _acceleration(law, y, rm, at, tt, cs, rates, k2v)
             for i in range(N_DOF):
                 y[i] = q[i] + h * k2q[i]
                 k3q[i] = v[i] + h * k2v[i]
                 y[N_DOF + i] = k3q[i]
-            _acceleration(y, rm, at, tt, cs, rates, k3v)
+            _acceleration(law, y, rm, at, tt, cs, rates, k3v)
             for i in range(N_DOF):
                 y[i] = q[i] + dt * k3q[i]
                 y[N_DOF + i] = v[i] + dt * k3v[i]
-            _acceleration(y, r1, at, tt, cs, rates, k4v)
+            _acceleration(law, y, r1, at, tt, cs, rates, k4v)
             for i in range(N_DOF):
                 q[i] += dt / 6.0 * (v[i] + 2.0 * k2q[i] + 2.0 * k3q[i] + y[N_DOF + i])
                 v[i] += dt / 6.0 * (k1v[i] + 2.0 * k2v[i] + 2.0 * k3v[i] + k4v[i])

@@ -55,10 +55,11 @@ def _system_arrays(vehicle: Vehicle) -> dict[str, np.ndarray]:
     (see `railride.kernels.run_batch`).
 
     ``A`` = [Aq Av Bf]^T acts on (q, q', f), ``TS`` = T maps q' to the secondary deflection
-    rates, ``B`` = [Bw Bwd]^T acts on (w, w').
+    rates, ``B`` = [Bw Bwd]^T acts on (w, w'). The passive viscous dampers are linear, so they
+    stay in Av (law LAW_VISCOUS_IN_C): the stepper then skips the force computation per stage.
     """
     minv = 1.0 / np.diag(vehicle.M)[:, None]
-    A = np.hstack([-minv * vehicle.K, -minv * vehicle.C0, minv * vehicle.T]).T
+    A = np.hstack([-minv * vehicle.K, -minv * vehicle.C, minv * vehicle.T]).T
     B = np.hstack([-minv * vehicle.K_w, -minv * vehicle.C_w]).T
     return {"A": A, "TS": vehicle.T.copy(), "B": B, "c_sec": np.full(4, vehicle.params.c_sz)}
 
@@ -172,7 +173,7 @@ def simulate(scenario=None, params=None, *, dt: float = DEFAULT_DT,
     while True:
         todo = min(chunk, n_steps - done)
         final = done + todo == n_steps
-        kernels.run_batch(x, done, todo, final, stride, dt,
+        kernels.run_batch(kernels.LAW_VISCOUS_IN_C, x, done, todo, final, stride, dt,
                           arrays["A"], arrays["TS"], arrays["B"], arrays["c_sec"],
                           speed, lag, table, np.array(offsets, dtype=np.int64),
                           np.array(counts, dtype=np.int64), np.array(spacings),
@@ -194,51 +195,56 @@ def simulate(scenario=None, params=None, *, dt: float = DEFAULT_DT,
 
 
 def _dataset(out, vehicles, param_sets, scenarios, dt, output_rate, rows, batch) -> xr.Dataset:
+    """Named channels in SI units; a ``sample`` dimension only for a batch."""
     from . import __version__
     import numba
     import scipy
 
     time = np.arange(rows) / output_rate
-    dims = ("sample", "time")
     T = np.stack([vehicles[id(p)].T for p in param_sets])  # (n, 9, 4)
-    data = {}
-    for i, name in enumerate(DOF_NAMES):
-        data[name] = (dims, out["q"][:, :, i], {"units": DOF_UNITS[i], "long_name": name.replace("_", " ")})
-        data[f"{name}_velocity"] = (dims, out["v"][:, :, i], {"units": f"{DOF_UNITS[i]}/s"})
-    data["carbody_acceleration"] = (dims, out["a"][:, :, 0],
-                                    {"units": "m/s^2", "long_name": "carbody CG vertical acceleration"})
-    data["carbody_corner_displacement"] = (
-        dims + ("corner",), np.einsum("stj,sjc->stc", out["q"][:, :, :3], T[:, :3]),
-        {"units": "m", "long_name": "carbody vertical displacement above each secondary corner"})
-    data["secondary_deflection"] = (
-        dims + ("corner",), np.einsum("stj,sjc->stc", out["q"], T),
-        {"units": "m", "long_name": "secondary vertical deflection, carbody minus bogie (extension +)"})
-    data["secondary_deflection_velocity"] = (
-        dims + ("corner",), np.einsum("stj,sjc->stc", out["v"], T), {"units": "m/s"})
     ksz = np.array([p.k_sz for p in param_sets])[:, None, None]
-    data["secondary_spring_force"] = (
-        dims + ("corner",), -ksz * data["secondary_deflection"][1],
-        {"units": "N", "long_name": "secondary vertical spring force on the carbody (up +)"})
-    data["secondary_damper_force"] = (
-        dims + ("corner",), out["f"],
-        {"units": "N", "long_name": "secondary vertical damper force on the carbody (up +)"})
+    deflection = np.einsum("stj,sjc->stc", out["q"], T)
     shape = out["w"].shape[:2] + (4, 2)
-    data["rail_displacement"] = (dims + ("wheelset", "rail"), out["w"].reshape(shape),
-                                 {"units": "m", "long_name": "rail height under each wheel"})
-    data["rail_velocity"] = (dims + ("wheelset", "rail"), out["wd"].reshape(shape),
-                             {"units": "m/s", "long_name": "rail vertical velocity under each wheel"})
+    channels = {}  # name -> (extra dims, values with leading (sample, time), attrs)
+    for i, name in enumerate(DOF_NAMES):
+        channels[name] = ((), out["q"][:, :, i], {"units": DOF_UNITS[i]})
+        channels[f"{name}_velocity"] = ((), out["v"][:, :, i], {"units": f"{DOF_UNITS[i]}/s"})
+    channels["carbody_acceleration"] = ((), out["a"][:, :, 0], {
+        "units": "m/s^2", "long_name": "carbody CG vertical acceleration"})
+    channels["carbody_corner_displacement"] = (("corner",), np.einsum("stj,sjc->stc", out["q"][:, :, :3], T[:, :3]), {
+        "units": "m", "long_name": "carbody vertical displacement above each secondary corner"})
+    channels["secondary_deflection"] = (("corner",), deflection, {
+        "units": "m", "long_name": "secondary vertical deflection, carbody minus bogie (extension +)"})
+    channels["secondary_deflection_velocity"] = (("corner",), np.einsum("stj,sjc->stc", out["v"], T), {
+        "units": "m/s"})
+    channels["secondary_spring_force"] = (("corner",), -ksz * deflection, {
+        "units": "N", "long_name": "secondary vertical spring force on the carbody (up +)"})
+    channels["secondary_damper_force"] = (("corner",), out["f"], {
+        "units": "N", "long_name": "secondary vertical damper force on the carbody (up +)"})
+    channels["rail_displacement"] = (("wheelset", "rail"), out["w"].reshape(shape), {
+        "units": "m", "long_name": "rail height under each wheel"})
+    channels["rail_velocity"] = (("wheelset", "rail"), out["wd"].reshape(shape), {
+        "units": "m/s", "long_name": "rail vertical velocity under each wheel"})
+    scen = np.array([json.dumps(s.describe()) for s in scenarios])
+    pars = np.array([json.dumps(p.to_dict()) for p in param_sets])
+    if batch:
+        data = {k: (("sample", "time") + d, v, a) for k, (d, v, a) in channels.items()}
+        data["scenario"] = ("sample", scen)
+        data["vehicle_params"] = ("sample", pars)
+    else:
+        data = {k: (("time",) + d, v[0], a) for k, (d, v, a) in channels.items()}
+        data["scenario"] = ((), scen[0])
+        data["vehicle_params"] = ((), pars[0])
     coords = {
         "time": ("time", time, {"units": "s"}),
         "corner": ("corner", list(CORNER_NAMES)),
         "wheelset": ("wheelset", list(WHEELSETS)),
         "rail": ("rail", list(RAILS)),
-        "sample": ("sample", np.arange(len(param_sets))),
     }
-    ds = xr.Dataset(data, coords=coords)
-    ds["scenario"] = ("sample", [json.dumps(s.describe()) for s in scenarios])
-    ds["vehicle_params"] = ("sample", [json.dumps(p.to_dict()) for p in param_sets])
-    ds.attrs.update({
-        "title": "railride passive ride simulation",
+    if batch:
+        coords["sample"] = ("sample", np.arange(len(param_sets)))
+    attrs = {
+        "title": "railride ride simulation",
         "railride_version": __version__,
         "numpy_version": np.__version__,
         "numba_version": numba.__version__,
@@ -250,11 +256,10 @@ def _dataset(out, vehicles, param_sets, scenarios, dt, output_rate, rows, batch)
         "dt_s": dt,
         "output_rate_hz": output_rate,
         "suspension": "passive viscous secondary dampers",
-        "sign_convention": "z up; pitch + lowers the front; roll + raises the left side",
-    })
-    if not batch:
-        ds = ds.isel(sample=0)
-    return ds
+        "sign_convention": "z up; pitch + lowers the front; roll + raises the left side; "
+                           "forces on the carbody, up +",
+    }
+    return xr.Dataset(data, coords=coords, attrs=attrs)
 
 
 class RideResult:
