@@ -13,7 +13,7 @@ import xarray as xr
 
 from . import kernels
 from .params import VehicleParams
-from .track import Scenario, scenario as named_scenario
+from .track import Scenario, scenario as named_scenario, wheelset_input_table
 from .vehicle import CORNER_NAMES, DOF_NAMES, DOF_UNITS, N_DOF, RAILS, WHEELSETS, Vehicle
 
 DEFAULT_DT = 1e-4
@@ -55,13 +55,24 @@ def _system_arrays(vehicle: Vehicle) -> dict[str, np.ndarray]:
     (see `railride.kernels.run_batch`).
 
     ``A`` = [Aq Av Bf]^T acts on (q, q', f), ``TS`` = T maps q' to the secondary deflection
-    rates, ``B`` = [Bw Bwd]^T acts on (w, w'). The passive viscous dampers are linear, so they
-    stay in Av (law LAW_VISCOUS_IN_C): the stepper then skips the force computation per stage.
+    rates. The passive viscous dampers are linear, so they stay in Av (law LAW_VISCOUS_IN_C):
+    the stepper then skips the force computation per stage. ``Bw``, ``Bwd`` map the rail
+    inputs to q'' and are applied to the input table once, before the run.
     """
     minv = 1.0 / np.diag(vehicle.M)[:, None]
-    A = np.hstack([-minv * vehicle.K, -minv * vehicle.C, minv * vehicle.T]).T
-    B = np.hstack([-minv * vehicle.K_w, -minv * vehicle.C_w]).T
-    return {"A": A, "TS": vehicle.T.copy(), "B": B, "c_sec": np.full(4, vehicle.params.c_sz)}
+    return {
+        "A": np.hstack([-minv * vehicle.K, -minv * vehicle.C, minv * vehicle.T]).T,
+        "TS": vehicle.T.copy(),
+        "c_sec": np.full(4, vehicle.params.c_sz),
+        "Bw": -minv * vehicle.K_w,
+        "Bwd": -minv * vehicle.C_w,
+    }
+
+
+def _forcing_table(utab: np.ndarray, Bw: np.ndarray, Bwd: np.ndarray) -> np.ndarray:
+    """Node values (Bw w, Bw w', Bwd w, Bwd w') of the rail forcing, see kernels._forcing."""
+    w, wd = utab[:, :8], utab[:, 8:]
+    return np.hstack([w @ Bw.T, wd @ Bw.T, w @ Bwd.T, wd @ Bwd.T])
 
 
 def _as_list(x, n_default=1):
@@ -142,21 +153,32 @@ def simulate(scenario=None, params=None, *, dt: float = DEFAULT_DT,
         if id(p) not in vehicles:
             vehicles[id(p)] = Vehicle(p)
             _check_dt(vehicles[id(p)], dt)
-    systems = [_system_arrays(vehicles[id(p)]) for p in param_sets]
-    arrays = {k: np.ascontiguousarray(np.stack([s[k] for s in systems])) for k in systems[0]}
+    systems = {key: _system_arrays(v) for key, v in vehicles.items()}
+    arrays = {k: np.ascontiguousarray(np.stack([systems[id(p)][k] for p in param_sets]))
+              for k in ("A", "TS", "c_sec")}
 
-    tables, offsets, counts, spacings = [], [], [], []
-    off = 0
-    for sc, p in zip(scenarios, param_sets):
-        tab, ds = sc.track.table(sc.speed * (duration + 2 * dt))
-        tables.append(tab)
-        offsets.append(off)
-        counts.append(tab.shape[0])
-        spacings.append(ds)
-        off += tab.shape[0]
-    table = np.ascontiguousarray(np.concatenate(tables))
-    lag = np.stack([vehicles[id(p)].wheelset_lag_distance for p in param_sets])
-    speed = np.array([sc.speed for sc in scenarios])
+    # rail inputs depend on the scenario and the wheelset spacing, the forcing also on the
+    # vehicle: tables are shared between the samples that agree on those
+    utabs, ftabs, u_index, f_index = [], [], {}, {}
+    u_off, f_off, n_nodes, interval = (np.zeros(n, dtype=np.int64), np.zeros(n, dtype=np.int64),
+                                       np.zeros(n, dtype=np.int64), np.zeros(n))
+    for i, (sc, p) in enumerate(zip(scenarios, param_sets)):
+        lag = vehicles[id(p)].wheelset_lag_distance
+        ukey = (id(sc), tuple(lag))
+        if ukey not in u_index:
+            tab, itv = wheelset_input_table(sc, lag, dt, duration)
+            u_index[ukey] = (sum(len(t) for t in utabs), tab, itv)
+            utabs.append(tab)
+        u_off[i], tab, interval[i] = u_index[ukey]
+        n_nodes[i] = len(tab)
+        fkey = (id(sc), id(p))
+        if fkey not in f_index:
+            sysm = systems[id(p)]
+            f_index[fkey] = sum(len(t) for t in ftabs)
+            ftabs.append(_forcing_table(tab, sysm["Bw"], sysm["Bwd"]))
+        f_off[i] = f_index[fkey]
+    utab = np.ascontiguousarray(np.concatenate(utabs))
+    ftab = np.ascontiguousarray(np.concatenate(ftabs))
 
     rows = n_out + 1
     x = np.zeros((n, 2 * N_DOF))
@@ -174,9 +196,8 @@ def simulate(scenario=None, params=None, *, dt: float = DEFAULT_DT,
         todo = min(chunk, n_steps - done)
         final = done + todo == n_steps
         kernels.run_batch(kernels.LAW_VISCOUS_IN_C, x, done, todo, final, stride, dt,
-                          arrays["A"], arrays["TS"], arrays["B"], arrays["c_sec"],
-                          speed, lag, table, np.array(offsets, dtype=np.int64),
-                          np.array(counts, dtype=np.int64), np.array(spacings),
+                          arrays["A"], arrays["TS"], arrays["c_sec"],
+                          utab, u_off, ftab, f_off, n_nodes, interval,
                           out["q"], out["v"], out["a"], out["f"], out["w"], out["wd"],
                           status, fail_step)
         done += todo

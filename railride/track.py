@@ -5,12 +5,15 @@ track. Before s = 0 every profile is 0: the vehicle starts at rest on level trac
 s_j(t) = V t - (x1 - x_j), so it sees the leading wheelset's input delayed by (x1 - x_j)/V, and its
 rail velocity is w' = V dz/ds.
 
-For the compiled stepper a profile is sampled once into a uniform table of heights and slopes;
-between nodes the stepper interpolates with cubic Hermite polynomials, which reproduces the
-heights to O(ds^4) and the slopes to O(ds^3). Node 0 (s = 0) always holds the level track before
-the profile begins, so a profile that does not start at zero height (the paper sine with a rail
-phase, for instance) rises to its value over the first interval ds as a smooth cubic ramp instead
-of an infinitely steep step.
+For the compiled stepper the inputs are sampled once per run on a time grid t_k = k Delta,
+Delta = m dt (m the largest power of two with Delta <= `RailProfile.table_spacing` / V), for
+each wheelset: heights w_k and rail velocities w'_k. Between nodes the stepper interpolates
+with cubic Hermite polynomials, which reproduce heights to O(Delta^4) and velocities to
+O(Delta^3). Because the nodes fall on step boundaries, every Runge-Kutta step sees a single
+smooth cubic and keeps its fourth order; halving dt doubles m and leaves the input unchanged.
+A profile that does not start at zero height (the paper sine with a rail phase, for instance)
+is 0 up to s = 0 and rises to its value within the first interval after a wheelset passes
+s = 0, as a smooth cubic ramp instead of an infinitely steep step.
 """
 
 from __future__ import annotations
@@ -25,7 +28,7 @@ import numpy as np
 
 #: nodes per shortest feature (wavelength, bump length) in the stepper's table
 NODES_PER_FEATURE = 200
-MAX_TABLE_NODES = 5_000_000
+MAX_TABLE_NODES = 2_000_000
 
 
 def _check(name: str, value, rule: str, allowed: str) -> float:
@@ -61,28 +64,11 @@ class RailProfile(ABC):
         """z_L, z_R [m] and their slopes dz_L/ds, dz_R/ds [-] at positions s [m]; 0 for s < 0."""
         s = np.asarray(s, dtype=float)
         out = [np.zeros_like(s) for _ in range(4)]
-        on = s >= 0
+        on = s > 0  # s = 0 itself still belongs to the level track
         if np.any(on):
             for o, v in zip(out, self._evaluate(s[on])):
                 o[on] = v
         return tuple(out)
-
-    def table(self, s_end: float, ds: float | None = None) -> tuple[np.ndarray, float]:
-        """Uniform table (n, 4) of z_L, z_R, dz_L/ds, dz_R/ds from s = 0 to at least s_end."""
-        ds = self.table_spacing() if ds is None else ds
-        n = int(math.ceil(s_end / ds)) + 3
-        if n > MAX_TABLE_NODES:
-            raise ValueError(
-                f"the track table would need {n} nodes (ds = {ds:.3g} m up to s = {s_end:.1f} m); "
-                f"at most {MAX_TABLE_NODES} are allowed: shorten the run or coarsen the profile"
-            )
-        s = np.arange(n) * ds
-        tab = np.empty((n, 4))
-        tab[1:] = np.column_stack(self._evaluate(np.minimum(s[1:], self.end())))
-        tab[1:][s[1:] > self.end(), 2:] = 0.0  # margin nodes past a measured end: held flat
-        tab[0] = 0.0  # level track up to s = 0
-        return tab, ds
-
 
 @dataclass(frozen=True)
 class SineTrack(RailProfile):
@@ -304,3 +290,35 @@ def scenario(name: str = "paper-sine", *, amplitude: float | None = None,
     else:
         raise ValueError(f"unknown scenario {name!r}; allowed: {', '.join(SCENARIOS)}")
     return Scenario(track=track, name=name, **common)
+
+
+def wheelset_input_table(scenario: Scenario, lag_distance: np.ndarray, dt: float,
+                         duration: float | None = None) -> tuple[np.ndarray, float]:
+    """Rail inputs at the wheelsets on the stepper's time grid.
+
+    Returns ``(table, interval)``: table (n, 16) holds at t_k = k * interval the heights
+    w = (z_1L, z_1R, ..., z_4R) [m] in columns 0-7 and their rates w' = V dz/ds [m/s] in
+    columns 8-15; interval is a whole number of steps dt. ``lag_distance`` is x1 - x_j [m]
+    per wheelset.
+    """
+    duration = scenario.duration if duration is None else duration
+    V = scenario.speed
+    # m is a power of two, so halving dt doubles m and leaves the grid (and the input) alone
+    ratio = scenario.track.table_spacing() / (V * dt)
+    m = 1 << max(0, int(math.floor(math.log2(ratio)))) if ratio >= 1 else 1
+    interval = m * dt
+    n = int(math.ceil((duration + dt) / interval)) + 2
+    if n > MAX_TABLE_NODES:
+        raise ValueError(
+            f"the rail input table would need {n} nodes ({duration:g} s at one node per "
+            f"{interval:.3g} s); at most {MAX_TABLE_NODES} are allowed: shorten the run"
+        )
+    s = V * (np.arange(n) * interval)[:, None] - np.asarray(lag_distance)[None, :]  # (n, 4)
+    zl, zr, dzl, dzr = scenario.track.evaluate(np.minimum(s, scenario.track.end()))
+    past_end = s > scenario.track.end()  # margin nodes past a measured end: held flat
+    dzl[past_end] = 0.0
+    dzr[past_end] = 0.0
+    table = np.empty((n, 16))
+    table[:, 0:8:2], table[:, 1:8:2] = zl, zr
+    table[:, 8:16:2], table[:, 9:16:2] = V * dzl, V * dzr
+    return table, interval
