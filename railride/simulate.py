@@ -108,7 +108,8 @@ def _positive(name: str, value) -> float:
 
 
 def simulate(scenario=None, params=None, *, dt: float = DEFAULT_DT,
-             output_rate: float = DEFAULT_OUTPUT_RATE, progress=None) -> "RideResult":
+             output_rate: float = DEFAULT_OUTPUT_RATE, initial_state=None,
+             progress=None) -> "RideResult":
     """Simulate the passive vehicle on one or many scenarios.
 
     ``scenario`` is a `Scenario`, a scenario name (see `railride.track.scenario`) or a list of
@@ -116,6 +117,8 @@ def simulate(scenario=None, params=None, *, dt: float = DEFAULT_DT,
     along a ``sample`` dimension (a single item is broadcast against a list). Every sample of a
     batch must share the duration. ``dt`` [s] is the fixed RK4 step and ``output_rate`` [Hz] the
     rate of the stored time histories; 1/(output_rate dt) must be a whole number.
+    ``initial_state`` is (q, q') at t = 0 as 18 numbers in DOF order (m, rad, m/s, rad/s), or
+    one row per sample; by default the vehicle starts at rest in equilibrium.
     ``progress(done_fraction)`` is called between chunks of a long run.
     """
     dt = _positive("dt", dt)
@@ -136,6 +139,11 @@ def simulate(scenario=None, params=None, *, dt: float = DEFAULT_DT,
     if any(abs(s.duration - duration) > 1e-12 * duration for s in scenarios):
         raise ValueError("every sample of a batch must have the same duration; got "
                          + ", ".join(sorted({f'{s.duration:g} s' for s in scenarios})))
+    vehicles = {}
+    for p in param_sets:
+        if id(p) not in vehicles:
+            vehicles[id(p)] = Vehicle(p)
+            _check_dt(vehicles[id(p)], dt)
     stride_f = 1.0 / (output_rate * dt)
     stride = int(round(stride_f))
     if stride < 1 or abs(stride - stride_f) > 1e-6 * stride_f:
@@ -148,11 +156,6 @@ def simulate(scenario=None, params=None, *, dt: float = DEFAULT_DT,
                          f"(1/{output_rate:g} Hz)")
     n_steps = n_out * stride
 
-    vehicles = {}
-    for p in param_sets:
-        if id(p) not in vehicles:
-            vehicles[id(p)] = Vehicle(p)
-            _check_dt(vehicles[id(p)], dt)
     systems = {key: _system_arrays(v) for key, v in vehicles.items()}
     arrays = {k: np.ascontiguousarray(np.stack([systems[id(p)][k] for p in param_sets]))
               for k in ("A", "TS", "c_sec")}
@@ -182,6 +185,12 @@ def simulate(scenario=None, params=None, *, dt: float = DEFAULT_DT,
 
     rows = n_out + 1
     x = np.zeros((n, 2 * N_DOF))
+    if initial_state is not None:
+        x0 = np.asarray(initial_state, dtype=float)
+        if x0.shape not in ((2 * N_DOF,), (n, 2 * N_DOF)) or not np.all(np.isfinite(x0)):
+            raise ValueError(f"initial_state must hold {2 * N_DOF} finite numbers (q then q') "
+                             f"or one such row per sample; got shape {x0.shape}")
+        x[:] = x0
     out = {
         "q": np.empty((n, rows, N_DOF)), "v": np.empty((n, rows, N_DOF)),
         "a": np.empty((n, rows, N_DOF)), "f": np.empty((n, rows, 4)),
