@@ -61,8 +61,9 @@ def ride_metrics(ds: xr.Dataset, window=None) -> xr.DataArray:
     values = []
     for name, (channel, factor) in RESPONSES.items():
         x = part[channel] * factor
-        rms = np.sqrt((x**2).mean("time"))
-        ptp = x.max("time") - x.min("time")
+        # skipna=False: a NaN must surface as an error, not vanish from the mean
+        rms = np.sqrt((x**2).mean("time", skipna=False))
+        ptp = x.max("time", skipna=False) - x.min("time", skipna=False)
         values.append(xr.concat([rms, ptp], dim="statistic"))
     out = xr.concat(values, dim="response")
     out = out.assign_coords(response=list(RESPONSES), statistic=list(STATISTICS))

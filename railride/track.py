@@ -162,11 +162,11 @@ class MeasuredTrack(RailProfile):
         for name, col in (("s", s), ("z_L", zl), ("z_R", zr)):
             bad = np.flatnonzero(~np.isfinite(col))
             if bad.size:
-                raise ValueError(f"{src}: column {name} has a non-finite value {col[bad[0]]!r} at row {bad[0] + 1}")
+                raise ValueError(f"{src}: column {name} has a non-finite value {col[bad[0]]!r} at data row {bad[0] + 1}")
         steps = np.diff(s)
         if np.any(steps <= 0):
             i = int(np.flatnonzero(steps <= 0)[0])
-            raise ValueError(f"{src}: s must increase strictly; row {i + 2} has s = {s[i + 1]!r} after {s[i]!r}")
+            raise ValueError(f"{src}: s must increase strictly; data row {i + 2} has s = {s[i + 1]!r} after {s[i]!r}")
         if s[0] > 0:
             raise ValueError(f"{src}: the profile must start at s <= 0 m (the vehicle starts at s = 0); it starts at {s[0]!r} m")
         object.__setattr__(self, "s", s)
@@ -187,27 +187,30 @@ class MeasuredTrack(RailProfile):
             raise ValueError(f"cannot read track file {path}: {exc.strerror or exc}") from None
         except UnicodeDecodeError:
             raise ValueError(f"track file {path}: not a UTF-8 text CSV") from None
-        rows = [r for r in rows if r and any(c.strip() for c in r) and not r[0].lstrip().startswith("#")]
+        # keep file line numbers for the messages; skip blank and comment lines
+        rows = [(n, r) for n, r in enumerate(rows, start=1)
+                if r and any(c.strip() for c in r) and not r[0].lstrip().startswith("#")]
         if not rows:
             raise ValueError(f"track file {path}: empty; expected a header 's,z_L,z_R' and data rows")
-        header = [c.split("[")[0].strip().lower() for c in rows[0]]
+        head = rows[0][1]
+        header = [c.split("[")[0].strip().lower() for c in head]
         idx = {}
         for want in ("s", "z_l", "z_r"):
             if want not in header:
                 raise ValueError(
                     f"track file {path}: no column {want.replace('_l', '_L').replace('_r', '_R')!r} in the header "
-                    f"{rows[0]!r}; expected columns s [m], z_L [m], z_R [m]"
+                    f"{head!r}; expected columns s [m], z_L [m], z_R [m]"
                 )
             idx[want] = header.index(want)
         data = {k: [] for k in idx}
-        for lineno, row in enumerate(rows[1:], start=2):
+        for lineno, row in rows[1:]:
             for k, j in idx.items():
                 try:
                     data[k].append(float(row[j]))
                 except (IndexError, ValueError):
                     cell = row[j] if j < len(row) else "<missing>"
                     raise ValueError(
-                        f"track file {path}, data row {lineno}: column {rows[0][j].strip()!r} = {cell!r} is not a number"
+                        f"track file {path}, line {lineno}: column {head[j].strip()!r} = {cell!r} is not a number"
                     ) from None
         return cls(np.array(data["s"]), np.array(data["z_l"]), np.array(data["z_r"]), source=str(path))
 
