@@ -1,2 +1,24 @@
-"""railride: vertical ride of a railway vehicle with a semi-active secondary suspension."""
+"""railride: vertical ride of a railway vehicle with a semi-active secondary suspension.
+
+The public API, in the order a run needs it::
+
+    import railride as rr
+    params = rr.VehicleParams.preset("paper")          # parameters (spec section 2)
+    vehicle = rr.Vehicle(params)                      # M, C, K, modes, frequency response
+    sc = rr.scenario("paper-sine", speed=55.56)        # track and run (spec section 4)
+    result = rr.simulate(sc, params)                  # time histories (xarray) + metrics
+    result.metrics()                                  # RMS and peak-to-peak (spec section 8)
+"""
+
 __version__ = "0.1.0"
+
+from .metrics import reduction, ride_metrics
+from .params import VehicleParams
+from .simulate import RideResult, simulate
+from .track import CosineBump, MeasuredTrack, Scenario, SineTrack, scenario
+from .vehicle import Vehicle
+
+__all__ = [
+    "CosineBump", "MeasuredTrack", "RideResult", "Scenario", "SineTrack", "Vehicle",
+    "VehicleParams", "reduction", "ride_metrics", "scenario", "simulate",
+]

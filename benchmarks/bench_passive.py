@@ -1,0 +1,137 @@
+"""Passive ride benchmarks (issue 2): single run, batch throughput, CLI cold start.
+
+Run:  python benchmarks/bench_passive.py [--repeat N] [--json FILE]
+Prints a Markdown table for docs/performance.md. Timings are wall-clock minima over repeats;
+nothing here is asserted by the tests.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import shutil
+import subprocess
+import sys
+import time
+from datetime import date
+from pathlib import Path
+
+import numpy as np
+
+
+def _min_time(fn, repeat):
+    best = float("inf")
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        fn()
+        best = min(best, time.perf_counter() - t0)
+    return best
+
+
+def bench_single(repeat):
+    from railride.simulate import simulate
+    from railride.track import scenario
+
+    sc = scenario("paper-sine")  # 10 s at dt = 1e-4 s: 100 000 RK4 steps
+    simulate(sc)  # compile or load the cache
+    return _min_time(lambda: simulate(sc), repeat)
+
+
+def bench_kernel_only(repeat):
+    """The compiled stepper alone, without building tables or the Dataset."""
+    from railride import kernels
+    from railride.simulate import _forcing_table, _system_arrays
+    from railride.track import scenario, wheelset_input_table
+    from railride.vehicle import Vehicle
+
+    sc, veh, dt = scenario("paper-sine"), Vehicle(), 1e-4
+    sysm = _system_arrays(veh)
+    utab, itv = wheelset_input_table(sc, veh.wheelset_lag_distance, dt)
+    ftab = _forcing_table(utab, sysm["Bw"], sysm["Bwd"])
+    rows, n_steps, stride = 10001, 100_000, 10
+
+    def run():
+        x = np.zeros((1, 18))
+        outs = [np.empty((1, rows, k)) for k in (9, 9, 9, 4, 8, 8)]
+        kernels.run_batch(kernels.LAW_VISCOUS_IN_C, x, 0, n_steps, True, stride, dt,
+                          sysm["A"][None], sysm["TS"][None], sysm["c_sec"][None],
+                          utab, np.zeros(1, np.int64), ftab, np.zeros(1, np.int64),
+                          np.array([len(utab)]), np.array([itv]), *outs,
+                          np.zeros(1, np.int64), np.zeros(1, np.int64))
+
+    run()
+    return _min_time(run, repeat)
+
+
+def bench_batch(n_samples, repeat):
+    from railride.params import VehicleParams
+    from railride.simulate import simulate
+    from railride.track import scenario
+
+    base = VehicleParams.preset("paper")
+    params = [base.replace(c_sz=c) for c in np.linspace(2e4, 1.2e5, n_samples)]
+    sc = scenario("paper-sine", duration=2.0)  # 20 000 steps per sample
+    simulate(sc, params[:2])
+    t = _min_time(lambda: simulate(sc, params), repeat)
+    return n_samples * 20_000 / t, t
+
+
+def bench_cli(repeat):
+    """Cold start of `railride simulate`: first call with an empty numba cache, then warm."""
+    import railride
+
+    exe = shutil.which("railride")
+    cmd = [exe, "simulate", "--format", "json"] if exe else [sys.executable, "-m", "railride.cli",
+                                                          "simulate", "--format", "json"]
+    pkg = Path(railride.__file__).parent
+    for f in list((pkg / "__pycache__").glob("*.nbi")) + list((pkg / "__pycache__").glob("*.nbc")):
+        f.unlink()
+    t0 = time.perf_counter()
+    subprocess.run(cmd, check=True, capture_output=True)
+    cold = time.perf_counter() - t0
+    warm = _min_time(lambda: subprocess.run(cmd, check=True, capture_output=True), repeat)
+    t0 = time.perf_counter()
+    subprocess.run([sys.executable, "-c", "import railride.simulate, railride.cli"], check=True)
+    imports = time.perf_counter() - t0
+    return cold, warm, imports
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__)
+    ap.add_argument("--repeat", type=int, default=5)
+    ap.add_argument("--json", type=Path)
+    args = ap.parse_args()
+    import numba
+
+    res = {"date": date.today().isoformat(), "machine": f"{platform.machine()}, {os.cpu_count()} cores, "
+           f"{platform.processor() or 'unknown cpu'}", "python": platform.python_version(),
+           "numba": numba.__version__, "numpy": np.__version__,
+           "threads": numba.config.NUMBA_NUM_THREADS}
+    res["single_run_s"] = bench_single(args.repeat)
+    res["kernel_only_s"] = bench_kernel_only(args.repeat)
+    for n in (64, 512):
+        res[f"batch_{n}_sample_steps_per_s"], res[f"batch_{n}_s"] = bench_batch(n, max(2, args.repeat // 2))
+    res["cli_cold_s"], res["cli_warm_s"], res["import_s"] = bench_cli(max(2, args.repeat // 2))
+
+    print(f"{res['date']}, {res['machine']}, Python {res['python']}, numba {res['numba']}, "
+          f"{res['threads']} threads\n")
+    print("| benchmark | result | target |")
+    print("|---|---|---|")
+    print(f"| one 10 s passive run, dt = 1e-4 s, `simulate()` after compilation | "
+          f"{res['single_run_s'] * 1e3:.1f} ms | <= 20 ms |")
+    print(f"| the same, compiled stepper alone | {res['kernel_only_s'] * 1e3:.1f} ms | |")
+    for n in (64, 512):
+        print(f"| batch of {n} samples x 20 000 steps | {res[f'batch_{n}_sample_steps_per_s'] / 1e6:.2f} M "
+              f"sample-steps/s ({res[f'batch_{n}_s']:.2f} s) | >= 2 M/s |")
+    print(f"| `railride simulate`, first call (empty numba cache, compile included) | "
+          f"{res['cli_cold_s']:.1f} s | |")
+    print(f"| `railride simulate`, second call (numba cache) | {res['cli_warm_s']:.2f} s | |")
+    print(f"| of which Python imports | {res['import_s']:.2f} s | |")
+    if args.json:
+        args.json.write_text(json.dumps(res, indent=2) + "\n")
+
+
+if __name__ == "__main__":
+    main()
