@@ -47,7 +47,7 @@ def bench_kernel_only(repeat):
     from railride.vehicle import Vehicle
 
     sc, veh, dt = scenario("paper-sine"), Vehicle(), 1e-4
-    sysm = _system_arrays(veh)
+    sysm = {k: np.ascontiguousarray(v) for k, v in _system_arrays(veh).items()}
     utab, itv = wheelset_input_table(sc, veh.wheelset_lag_distance, dt)
     ftab = _forcing_table(utab, sysm["Bw"], sysm["Bwd"])
     rows, n_steps, stride = 10001, 100_000, 10

@@ -34,17 +34,23 @@ def parse_window(text: str) -> tuple[float, float]:
     return start, end
 
 
+def check_window(window, t_end: float, t_start: float = 0.0) -> tuple[float, float]:
+    """Check ``window`` = (start, end) s against a run from t_start to t_end; an infinite end
+    means the end of the run. Returns the window with the end resolved."""
+    start, end = window
+    if math.isinf(end) and end > 0:
+        end = t_end
+    if not (math.isfinite(start) and math.isfinite(end) and t_start <= start < end <= t_end + 1e-9):
+        raise ValueError(f"window = {start:g}:{end:g} s: must satisfy {t_start:g} <= START < END <= {t_end:g} "
+                         "(inside the run)")
+    return float(start), float(end)
+
+
 def select_window(ds: xr.Dataset, window) -> xr.Dataset:
     """The part of a run inside ``window`` = (start, end) seconds, checked against the run."""
     if window is None:
         return ds
-    start, end = window
-    t0, t1 = float(ds.time[0]), float(ds.time[-1])
-    if math.isinf(end):
-        end = t1
-    if not (math.isfinite(start) and start >= t0 and end <= t1 + 1e-9 and start < end):
-        raise ValueError(f"window = {start:g}:{end:g} s: must satisfy {t0:g} <= START < END <= {t1:g} "
-                         "(inside the run)")
+    start, end = check_window(window, float(ds.time[-1]), float(ds.time[0]))
     part = ds.sel(time=slice(start - 1e-12, end + 1e-12))
     if part.sizes["time"] < 2:
         raise ValueError(f"window = {start:g}:{end:g} s holds fewer than two output samples")

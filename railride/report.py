@@ -181,11 +181,14 @@ def plot_body_responses(ds: xr.Dataset, path=None):
     axes = fig.subplots(len(_PANELS), 1, sharex=True)
     time = ds["time"].values
     samples = list(ds["sample"].values) if "sample" in ds.dims else [None]
+    names = [r.get("name") for r in _records(ds, "scenario")]
+    legend = {s: f"sample {s}" + (f": {names[i]}" if len(names) == len(samples) and names[i] else "")
+              for i, s in enumerate(samples)}
     for ax, (channel, factor, label) in zip(axes, _PANELS):
         da = ds[channel]
         for s in samples:
             y = (da.sel(sample=s) if s is not None and "sample" in da.dims else da).values * factor
-            ax.plot(time, y, linewidth=0.9, label=None if s is None else f"sample {s}")
+            ax.plot(time, y, linewidth=0.9, label=None if s is None else legend[s])
         ax.set_ylabel(label)
         ax.grid(True, linewidth=0.4, alpha=0.6)
     axes[-1].set_xlabel("time (s)")
@@ -199,92 +202,26 @@ def plot_body_responses(ds: xr.Dataset, path=None):
 
 
 # -- NetCDF -----------------------------------------------------------------------------------
-_INT32 = np.iinfo(np.int32)
-
-
-def _attr_for_netcdf(value):
-    """An attribute value the netCDF3 (scipy) writer accepts, carrying the same information."""
-    if isinstance(value, (bool, np.bool_)):
-        return int(value)
-    if isinstance(value, (int, np.integer)):
-        return int(value) if _INT32.min <= value <= _INT32.max else str(int(value))
-    if isinstance(value, (float, np.floating, str)):
-        return value
-    if isinstance(value, bytes):
-        return value.decode("utf-8", errors="replace")
-    if isinstance(value, np.ndarray) and value.dtype.kind in "iuf" and value.ndim <= 1:
-        if value.dtype.kind in "iu" and value.size and not (
-                _INT32.min <= value.min() and value.max() <= _INT32.max):
-            return value.astype(np.float64)
-        return value.astype(np.int32) if value.dtype.kind in "iu" else value.astype(np.float64)
-    if isinstance(value, (list, tuple)) and value and all(
-            isinstance(v, (int, float)) and not isinstance(v, bool) for v in value):
-        return _attr_for_netcdf(np.asarray(value))
-    # None, dicts, lists of strings, anything else: keep it as JSON text
-    return json.dumps(value, default=str)
-
-
-def _var_for_netcdf(var: xr.Variable) -> xr.Variable:
-    """A variable the netCDF3 (scipy) writer accepts, holding the same data."""
-    attrs = {k: _attr_for_netcdf(v) for k, v in var.attrs.items()}
-    data = var.values
-    kind = data.dtype.kind
-    if kind in "iu" and data.dtype.itemsize >= 4 and data.dtype != np.int32:
-        if data.size == 0 or (_INT32.min <= data.min() and data.max() <= _INT32.max):
-            data = data.astype(np.int32)
-        elif np.all(np.abs(data.astype(np.float64)) <= 2.0**53):
-            attrs["railride_original_dtype"] = str(var.dtype)
-            data = data.astype(np.float64)
-        else:
-            attrs["railride_original_dtype"] = str(var.dtype)
-            data = data.astype(str)
-    elif kind == "f" and data.dtype.itemsize < 4:
-        data = data.astype(np.float32)
-    elif kind == "c":
-        attrs["railride_complex"] = "last dimension 'complex' holds the real and imaginary parts"
-        return xr.Variable(var.dims + ("complex",), np.stack([data.real, data.imag], axis=-1), attrs)
-    elif kind == "O":
-        flat = [v if isinstance(v, str) else v.decode("utf-8") if isinstance(v, bytes)
-                else json.dumps(v, default=str) for v in data.ravel()]
-        data = np.array(flat, dtype=object).reshape(data.shape)
-    return xr.Variable(var.dims, data, attrs)
-
-
 def netcdf_ready(ds: xr.Dataset) -> xr.Dataset:
-    """A copy of ``ds`` that the netCDF3 writer of scipy can store without losing data.
+    """A copy of ``ds`` that scipy's netCDF3 writer accepts without losing data.
 
-    netCDF3 has no 64-bit integers, complex numbers, half floats, or structured attributes, so:
-    64-bit integers become int32 when they fit (float64 or text otherwise, with the original
-    dtype in the attribute ``railride_original_dtype``); complex variables gain a trailing
-    ``complex`` dimension (real, imag); float16 becomes float32; attributes that are booleans
-    become 0/1, and None, dicts and lists of text become JSON text. Strings (also non-ASCII)
-    are stored as UTF-8 and read back unchanged.
+    netCDF3 has no 64-bit integers: integer variables (the ``sample`` and ``wheelset``
+    coordinates) are stored as int32, which holds them exactly. Text (the JSON records
+    ``scenario`` and ``vehicle_params``) is stored as UTF-8 and reads back unchanged.
     """
-    variables = {name: _var_for_netcdf(var) for name, var in ds.variables.items()}
-    coords = {name: variables.pop(name) for name in list(ds.coords)}
-    if any(v.dtype.kind == "c" for v in ds.variables.values()):
-        coords["complex"] = xr.Variable("complex", np.array(["real", "imag"], dtype=object))
-    out = xr.Dataset(variables, coords=coords,
-                     attrs={k: _attr_for_netcdf(v) for k, v in ds.attrs.items()})
+    out = ds.copy()
+    for name, var in ds.variables.items():
+        if var.dtype.kind in "iu" and var.dtype != np.int32:
+            if var.size and (var.values.min() < np.iinfo(np.int32).min
+                             or var.values.max() > np.iinfo(np.int32).max):
+                raise ValueError(f"{name}: integers beyond int32 cannot be stored in netCDF3")
+            out[name] = var.astype(np.int32)
     return out
 
 
-def _as_text(values) -> list[str]:
-    return [v.decode("utf-8") if isinstance(v, bytes) else str(v) for v in np.ravel(values)]
-
-
 def write_netcdf(ds: xr.Dataset, path: Path) -> None:
-    """Write ``ds`` to ``path`` as netCDF3 (scipy engine) and check that it reads back: the text
-    variables and the attribute names must survive unchanged."""
-    ready = netcdf_ready(ds)
-    ready.to_netcdf(path, engine="scipy")
-    with xr.open_dataset(path, engine="scipy") as back:
-        lost = [n for n in ready.variables if n not in back.variables]
-        lost += [f"attribute {a!r}" for a in ready.attrs if a not in back.attrs]
-        lost += [n for n, v in ready.variables.items() if v.dtype.kind in "OUS"
-                 and n in back.variables and _as_text(back[n].values) != _as_text(v.values)]
-    if lost:
-        raise RuntimeError(f"{path.name}: the NetCDF file does not read back intact ({', '.join(lost)})")
+    """Write ``ds`` to ``path`` as netCDF3 (scipy engine, no extra dependency)."""
+    netcdf_ready(ds).to_netcdf(path, engine="scipy")
 
 
 # -- the output folder ------------------------------------------------------------------------
@@ -301,21 +238,12 @@ def check_out_dir(out_dir) -> Path:
     return out_dir
 
 
-def _default_file_mode() -> int:
-    mask = os.umask(0)
-    os.umask(mask)
-    return 0o666 & ~mask
-
-
 def _write_staged(ds: xr.Dataset, stage: Path, metrics_doc: dict) -> None:
     write_netcdf(ds, stage / "ride.nc")
     to_frame(ds).to_csv(stage / "ride.csv")
     text = json.dumps(metrics_doc, indent=2, allow_nan=False) + "\n"
     (stage / "metrics.json").write_text(text, encoding="utf-8")
     plot_body_responses(ds, stage / "body_responses.png")
-    mode = _default_file_mode()
-    for name in OUTPUT_FILES:
-        os.chmod(stage / name, mode)  # temporary files are private; results are not
 
 
 def _move_into(stage: Path, out_dir: Path) -> None:
