@@ -39,8 +39,13 @@ STATUS_DIVERGED = 1
 
 
 @njit(cache=True, inline="always", fastmath=_FAST)
-def _node(t, n_nodes, interval):
-    """Interval index k and local coordinate tau in [0, 1] of time t on the input grid."""
+def _hermite(t, n_nodes, interval):
+    """Node index k of time t on the input grid and the cubic Hermite weights there.
+
+    Returns (k, h00, h10, h01, h11, d00, d10, d11): a quantity with node values y, slopes y'
+    is y(t) = h00 y_k + h10 y'_k + h01 y_k+1 + h11 y'_k+1 and its rate is
+    y'(t) = d00 (y_k - y_k+1) + d10 y'_k + d11 y'_k+1 (the interval is folded in).
+    """
     u = t / interval
     k = int(u)
     if k > n_nodes - 2:
@@ -48,7 +53,15 @@ def _node(t, n_nodes, interval):
     tau = u - k
     if tau > 1.0:
         tau = 1.0
-    return k, tau
+    om = 1.0 - tau
+    return (k,
+            (1.0 + 2.0 * tau) * om * om,
+            tau * om * om * interval,
+            tau * tau * (3.0 - 2.0 * tau),
+            tau * tau * (tau - 1.0) * interval,
+            6.0 * tau * (tau - 1.0) / interval,
+            om * (1.0 - 3.0 * tau),
+            tau * (3.0 * tau - 2.0))
 
 
 @njit(cache=True, inline="always", fastmath=_FAST)
@@ -60,15 +73,7 @@ def _forcing(t, ftab, off, n_nodes, interval, out):
     gives exactly Bw w(t) + Bwd w'(t) of the interpolated rail inputs, in 9 x 8 operations
     instead of interpolating 16 inputs and multiplying by a 9 x 16 matrix.
     """
-    k, tau = _node(t, n_nodes, interval)
-    om = 1.0 - tau
-    h00 = (1.0 + 2.0 * tau) * om * om
-    h10 = tau * om * om * interval
-    h01 = tau * tau * (3.0 - 2.0 * tau)
-    h11 = tau * tau * (tau - 1.0) * interval
-    d00 = 6.0 * tau * (tau - 1.0) / interval
-    d10 = om * (1.0 - 3.0 * tau)
-    d11 = tau * (3.0 * tau - 2.0)
+    k, h00, h10, h01, h11, d00, d10, d11 = _hermite(t, n_nodes, interval)
     a = off + k
     b = a + 1
     for i in range(N_DOF):
@@ -80,15 +85,7 @@ def _forcing(t, ftab, off, n_nodes, interval, out):
 @njit(cache=True, inline="always", fastmath=_FAST)
 def _rail_inputs(t, utab, off, n_nodes, interval, w, wd):
     """Rail heights w and velocities w' at the wheelsets at time t, from the input table."""
-    k, tau = _node(t, n_nodes, interval)
-    om = 1.0 - tau
-    h00 = (1.0 + 2.0 * tau) * om * om
-    h10 = tau * om * om * interval
-    h01 = tau * tau * (3.0 - 2.0 * tau)
-    h11 = tau * tau * (tau - 1.0) * interval
-    d00 = 6.0 * tau * (tau - 1.0) / interval
-    d10 = om * (1.0 - 3.0 * tau)
-    d11 = tau * (3.0 * tau - 2.0)
+    k, h00, h10, h01, h11, d00, d10, d11 = _hermite(t, n_nodes, interval)
     a = off + k
     b = a + 1
     for c in range(N_RAIL):
