@@ -36,7 +36,10 @@ def bench_single(repeat):
 
     sc = scenario("paper-sine")  # 10 s at dt = 1e-4 s: 100 000 RK4 steps
     simulate(sc)  # compile or load the cache
-    return _min_time(lambda: simulate(sc), repeat)
+    run = _min_time(lambda: simulate(sc), repeat)
+    with_dataset = _min_time(lambda: simulate(sc).dataset, repeat)
+    with_metrics = _min_time(lambda: simulate(sc).metrics(), repeat)
+    return run, with_dataset, with_metrics
 
 
 def bench_kernel_only(repeat):
@@ -109,7 +112,7 @@ def main():
            f"{platform.processor() or 'unknown cpu'}", "python": platform.python_version(),
            "numba": numba.__version__, "numpy": np.__version__,
            "threads": numba.config.NUMBA_NUM_THREADS}
-    res["single_run_s"] = bench_single(args.repeat)
+    res["single_run_s"], res["single_dataset_s"], res["single_metrics_s"] = bench_single(args.repeat)
     res["kernel_only_s"] = bench_kernel_only(args.repeat)
     for n in (64, 512):
         res[f"batch_{n}_sample_steps_per_s"], res[f"batch_{n}_s"] = bench_batch(n, max(2, args.repeat // 2))
@@ -122,6 +125,8 @@ def main():
     print(f"| one 10 s passive run, dt = 1e-4 s, `simulate()` after compilation | "
           f"{res['single_run_s'] * 1e3:.1f} ms | <= 20 ms |")
     print(f"| the same, compiled stepper alone | {res['kernel_only_s'] * 1e3:.1f} ms | |")
+    print(f"| the same, `simulate().dataset` (xarray Dataset assembled) | {res['single_dataset_s'] * 1e3:.1f} ms | |")
+    print(f"| the same, `simulate().metrics()` | {res['single_metrics_s'] * 1e3:.1f} ms | |")
     for n in (64, 512):
         print(f"| batch of {n} samples x 20 000 steps | {res[f'batch_{n}_sample_steps_per_s'] / 1e6:.2f} M "
               f"sample-steps/s ({res[f'batch_{n}_s']:.2f} s) | >= 2 M/s |")

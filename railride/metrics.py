@@ -64,18 +64,19 @@ def ride_metrics(ds: xr.Dataset, window=None) -> xr.DataArray:
     and roll (deg). ``window`` = (start, end) in seconds restricts the time range.
     """
     part = select_window(ds, window)
+    lead = ["sample"] if "sample" in part.dims else []
     values = []
-    for name, (channel, factor) in RESPONSES.items():
-        x = part[channel] * factor
-        # skipna=False: a NaN must surface as an error, not vanish from the mean
-        rms = np.sqrt((x**2).mean("time", skipna=False))
-        ptp = x.max("time", skipna=False) - x.min("time", skipna=False)
-        values.append(xr.concat([rms, ptp], dim="statistic"))
-    out = xr.concat(values, dim="response")
-    out = out.assign_coords(response=list(RESPONSES), statistic=list(STATISTICS))
-    out = out.transpose(*([d for d in ("sample",) if d in out.dims] + ["response", "statistic"]))
-    out.name = "ride_metrics"
-    if not np.all(np.isfinite(out.values)):
+    for channel, factor in RESPONSES.values():
+        x = part[channel].transpose(*lead, "time").values * factor
+        # NumPy, not xarray reductions: several times faster, and NaN propagates
+        values.append(np.stack([np.sqrt(np.mean(x**2, axis=-1)), np.ptp(x, axis=-1)], axis=-1))
+    data = np.stack(values, axis=-2)  # (..., response, statistic)
+    coords = {"response": list(RESPONSES), "statistic": list(STATISTICS)}
+    if lead:
+        coords["sample"] = part["sample"].values
+    out = xr.DataArray(data, dims=lead + ["response", "statistic"], coords=coords,
+                       name="ride_metrics")
+    if not np.all(np.isfinite(data)):
         raise RuntimeError("a ride metric is not finite: the run did not produce finite responses")
     return out
 

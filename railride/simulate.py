@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import json
 import math
 import platform
@@ -26,6 +27,17 @@ def _rk4_gain(z: np.ndarray) -> np.ndarray:
     return np.abs(1 + z + z**2 / 2 + z**3 / 6 + z**4 / 24)
 
 
+@functools.lru_cache(maxsize=256)
+def _vehicle(params: VehicleParams) -> Vehicle:
+    """Vehicles are derived from frozen parameters: build each one once."""
+    return Vehicle(params)
+
+
+@functools.lru_cache(maxsize=256)
+def _max_stable_dt(params: VehicleParams) -> float:
+    return max_stable_dt(_vehicle(params))
+
+
 def max_stable_dt(vehicle: Vehicle) -> float:
     """Largest RK4 step for which every mode of the passive vehicle is stable."""
     lam = np.linalg.eigvals(vehicle.state_matrix)
@@ -40,7 +52,7 @@ def max_stable_dt(vehicle: Vehicle) -> float:
 
 
 def _check_dt(vehicle: Vehicle, dt: float) -> None:
-    dt_max = max_stable_dt(vehicle)
+    dt_max = _max_stable_dt(vehicle.params)
     if dt > dt_max:
         fastest = max(vehicle.modes(), key=lambda m: m.frequency_hz)
         raise ValueError(
@@ -142,7 +154,7 @@ def simulate(scenario=None, params=None, *, dt: float = DEFAULT_DT,
     vehicles = {}
     for p in param_sets:
         if id(p) not in vehicles:
-            vehicles[id(p)] = Vehicle(p)
+            vehicles[id(p)] = _vehicle(p)
             _check_dt(vehicles[id(p)], dt)
     stride_f = 1.0 / (output_rate * dt)
     stride = int(round(stride_f))
@@ -220,11 +232,12 @@ def simulate(scenario=None, params=None, *, dt: float = DEFAULT_DT,
         raise RuntimeError(f"the simulation diverged ({which}): a response left +-{kernels.DIVERGED:g} "
                            f"or stopped being finite; check the parameters or reduce dt")
 
-    ds = _dataset(out, vehicles, param_sets, scenarios, dt, output_rate, rows, batch)
-    return RideResult(ds)
+    created = datetime.now(timezone.utc).isoformat(timespec="seconds")
+    return RideResult(build=functools.partial(_dataset, out, vehicles, param_sets, scenarios, dt,
+                                              output_rate, rows, batch, created))
 
 
-def _dataset(out, vehicles, param_sets, scenarios, dt, output_rate, rows, batch) -> xr.Dataset:
+def _dataset(out, vehicles, param_sets, scenarios, dt, output_rate, rows, batch, created) -> xr.Dataset:
     """Named channels in SI units; a ``sample`` dimension only for a batch."""
     from . import __version__
     import numba
@@ -233,7 +246,7 @@ def _dataset(out, vehicles, param_sets, scenarios, dt, output_rate, rows, batch)
     time = np.arange(rows) / output_rate
     T = np.stack([vehicles[id(p)].T for p in param_sets])  # (n, 9, 4)
     ksz = np.array([p.k_sz for p in param_sets])[:, None, None]
-    deflection = np.einsum("stj,sjc->stc", out["q"], T)
+    deflection = out["q"] @ T  # (n, time, 9) @ (n, 9, 4): T^T q at every sample
     shape = out["w"].shape[:2] + (4, 2)
     channels = {}  # name -> (extra dims, values with leading (sample, time), attrs)
     for i, name in enumerate(DOF_NAMES):
@@ -241,11 +254,11 @@ def _dataset(out, vehicles, param_sets, scenarios, dt, output_rate, rows, batch)
         channels[f"{name}_velocity"] = ((), out["v"][:, :, i], {"units": f"{DOF_UNITS[i]}/s"})
     channels["carbody_acceleration"] = ((), out["a"][:, :, 0], {
         "units": "m/s^2", "long_name": "carbody CG vertical acceleration"})
-    channels["carbody_corner_displacement"] = (("corner",), np.einsum("stj,sjc->stc", out["q"][:, :, :3], T[:, :3]), {
+    channels["carbody_corner_displacement"] = (("corner",), out["q"][:, :, :3] @ T[:, :3], {
         "units": "m", "long_name": "carbody vertical displacement above each secondary corner"})
     channels["secondary_deflection"] = (("corner",), deflection, {
         "units": "m", "long_name": "secondary vertical deflection, carbody minus bogie (extension +)"})
-    channels["secondary_deflection_velocity"] = (("corner",), np.einsum("stj,sjc->stc", out["v"], T), {
+    channels["secondary_deflection_velocity"] = (("corner",), out["v"] @ T, {
         "units": "m/s"})
     channels["secondary_spring_force"] = (("corner",), -ksz * deflection, {
         "units": "N", "long_name": "secondary vertical spring force on the carbody (up +)"})
@@ -281,7 +294,7 @@ def _dataset(out, vehicles, param_sets, scenarios, dt, output_rate, rows, batch)
         "scipy_version": scipy.__version__,
         "xarray_version": xr.__version__,
         "python_version": platform.python_version(),
-        "created_utc": datetime.now(timezone.utc).isoformat(timespec="seconds"),
+        "created_utc": created,
         "integrator": "classical RK4, fixed step",
         "dt_s": dt,
         "output_rate_hz": output_rate,
@@ -293,10 +306,24 @@ def _dataset(out, vehicles, param_sets, scenarios, dt, output_rate, rows, batch)
 
 
 class RideResult:
-    """Time histories (``.dataset``, an xarray Dataset) and the ride metrics of a run."""
+    """Time histories (``.dataset``, an xarray Dataset) and the ride metrics of a run.
 
-    def __init__(self, dataset: xr.Dataset):
-        self.dataset = dataset
+    The Dataset is assembled on first use, so a sweep that keeps only a few numbers per run
+    does not pay for building it.
+    """
+
+    def __init__(self, dataset: xr.Dataset | None = None, *, build=None):
+        if (dataset is None) == (build is None):
+            raise ValueError("RideResult needs a dataset or a build function, not both")
+        self._dataset = dataset
+        self._build = build
+
+    @property
+    def dataset(self) -> xr.Dataset:
+        if self._dataset is None:
+            self._dataset = self._build()
+            self._build = None
+        return self._dataset
 
     def __getitem__(self, name):
         return self.dataset[name]
