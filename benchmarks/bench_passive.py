@@ -101,6 +101,16 @@ def bench_cli(repeat):
     return cold, warm, imports
 
 
+def _cpu_name() -> str:
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor() or "unknown cpu"
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--repeat", type=int, default=5)
@@ -109,7 +119,7 @@ def main():
     import numba
 
     res = {"date": date.today().isoformat(), "machine": f"{platform.machine()}, {os.cpu_count()} cores, "
-           f"{platform.processor() or 'unknown cpu'}", "python": platform.python_version(),
+           f"{_cpu_name()}", "python": platform.python_version(),
            "numba": numba.__version__, "numpy": np.__version__,
            "threads": numba.config.NUMBA_NUM_THREADS}
     res["single_run_s"], res["single_dataset_s"], res["single_metrics_s"] = bench_single(args.repeat)
