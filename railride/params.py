@@ -16,14 +16,30 @@ from typing import Any
 from ._io import atomic_write_text
 
 
-def _p(unit: str, doc: str, rule: str = "positive") -> Any:
+def param(unit: str, doc: str, rule: str = "positive") -> Any:
+    """A parameter field: SI unit, meaning and validation rule (positive, nonnegative, finite)."""
     return field(metadata={"unit": unit, "doc": doc, "rule": rule})
 
 
 _RULES = {
     "positive": (lambda v: v > 0.0, "a finite number > 0"),
     "nonnegative": (lambda v: v >= 0.0, "a finite number >= 0"),
+    "finite": (lambda v: True, "a finite number"),
 }
+
+
+def validate_fields(obj, what: str) -> None:
+    """Check every field of a frozen parameter dataclass against the rule in its metadata and
+    store it as float; the error names the field, its value, its meaning and unit, and the rule."""
+    for f in dataclasses.fields(obj):
+        value = getattr(obj, f.name)
+        check, allowed = _RULES[f.metadata["rule"]]
+        ok = (not isinstance(value, bool) and isinstance(value, (int, float))
+              and math.isfinite(value) and check(float(value)))
+        if not ok:
+            raise ValueError(f"{what} {f.name!r} = {value!r} ({f.metadata['doc']}, "
+                             f"{f.metadata['unit']}): must be {allowed}")
+        object.__setattr__(obj, f.name, float(value))
 
 
 @dataclass(frozen=True)
@@ -34,51 +50,38 @@ class VehicleParams:
     as in the element table of spec section 3.
     """
 
-    m_c: float = _p("kg", "carbody mass")
-    m_b: float = _p("kg", "bogie mass (each bogie)")
-    I_cx: float = _p("kg m^2", "carbody roll moment of inertia")
-    I_cy: float = _p("kg m^2", "carbody pitch moment of inertia")
-    I_cz: float = _p("kg m^2", "carbody yaw moment of inertia (not used by the vertical model)")
-    I_bx: float = _p("kg m^2", "bogie roll moment of inertia")
-    I_by: float = _p("kg m^2", "bogie pitch moment of inertia")
-    I_bz: float = _p("kg m^2", "bogie yaw moment of inertia (not used by the vertical model)")
-    k_px: float = _p("N/m", "primary longitudinal stiffness, per axle box")
-    k_py: float = _p("N/m", "primary lateral stiffness, per axle box")
-    k_pz: float = _p("N/m", "primary vertical stiffness, per axle box")
-    c_px: float = _p("N s/m", "primary longitudinal damping, per axle box", "nonnegative")
-    c_py: float = _p("N s/m", "primary lateral damping, per axle box", "nonnegative")
-    c_pz: float = _p("N s/m", "primary vertical damping, per axle box", "nonnegative")
-    k_sx: float = _p("N/m", "secondary longitudinal stiffness, per bogie")
-    k_sy: float = _p("N/m", "secondary lateral stiffness, per bogie")
-    k_sz: float = _p("N/m", "secondary vertical stiffness, per corner")
-    c_sx: float = _p("N s/m", "secondary longitudinal damping, per bogie", "nonnegative")
-    c_sy: float = _p("N s/m", "secondary lateral damping, per bogie", "nonnegative")
-    c_sz: float = _p("N s/m", "secondary vertical (passive) damping, per corner", "nonnegative")
-    l: float = _p("m", "half bogie-centre spacing")
-    d_s: float = _p("m", "half lateral spacing of the secondary suspension")
-    d_p: float = _p("m", "half lateral spacing of the primary suspension")
-    a: float = _p("m", "half wheel-rail contact spacing")
-    b: float = _p("m", "half wheelbase")
-    h_cs: float = _p("m", "carbody CG height above the secondary suspension")
-    h_ts: float = _p("m", "bogie CG depth below the secondary suspension")
-    h_tp: float = _p("m", "bogie CG height above the primary suspension")
-    h_wp: float = _p("m", "wheelset CG depth below the primary suspension")
+    m_c: float = param("kg", "carbody mass")
+    m_b: float = param("kg", "bogie mass (each bogie)")
+    I_cx: float = param("kg m^2", "carbody roll moment of inertia")
+    I_cy: float = param("kg m^2", "carbody pitch moment of inertia")
+    I_cz: float = param("kg m^2", "carbody yaw moment of inertia (not used by the vertical model)")
+    I_bx: float = param("kg m^2", "bogie roll moment of inertia")
+    I_by: float = param("kg m^2", "bogie pitch moment of inertia")
+    I_bz: float = param("kg m^2", "bogie yaw moment of inertia (not used by the vertical model)")
+    k_px: float = param("N/m", "primary longitudinal stiffness, per axle box")
+    k_py: float = param("N/m", "primary lateral stiffness, per axle box")
+    k_pz: float = param("N/m", "primary vertical stiffness, per axle box")
+    c_px: float = param("N s/m", "primary longitudinal damping, per axle box", "nonnegative")
+    c_py: float = param("N s/m", "primary lateral damping, per axle box", "nonnegative")
+    c_pz: float = param("N s/m", "primary vertical damping, per axle box", "nonnegative")
+    k_sx: float = param("N/m", "secondary longitudinal stiffness, per bogie")
+    k_sy: float = param("N/m", "secondary lateral stiffness, per bogie")
+    k_sz: float = param("N/m", "secondary vertical stiffness, per corner")
+    c_sx: float = param("N s/m", "secondary longitudinal damping, per bogie", "nonnegative")
+    c_sy: float = param("N s/m", "secondary lateral damping, per bogie", "nonnegative")
+    c_sz: float = param("N s/m", "secondary vertical (passive) damping, per corner", "nonnegative")
+    l: float = param("m", "half bogie-centre spacing")
+    d_s: float = param("m", "half lateral spacing of the secondary suspension")
+    d_p: float = param("m", "half lateral spacing of the primary suspension")
+    a: float = param("m", "half wheel-rail contact spacing")
+    b: float = param("m", "half wheelbase")
+    h_cs: float = param("m", "carbody CG height above the secondary suspension")
+    h_ts: float = param("m", "bogie CG depth below the secondary suspension")
+    h_tp: float = param("m", "bogie CG height above the primary suspension")
+    h_wp: float = param("m", "wheelset CG depth below the primary suspension")
 
     def __post_init__(self) -> None:
-        for f in dataclasses.fields(self):
-            value = getattr(self, f.name)
-            check, allowed = _RULES[f.metadata["rule"]]
-            if isinstance(value, bool) or not isinstance(value, (int, float)):
-                raise ValueError(
-                    f"vehicle parameter {f.name!r} = {value!r} ({f.metadata['doc']}, "
-                    f"{f.metadata['unit']}): must be {allowed}"
-                )
-            if not (math.isfinite(value) and check(float(value))):
-                raise ValueError(
-                    f"vehicle parameter {f.name!r} = {value!r} ({f.metadata['doc']}, "
-                    f"{f.metadata['unit']}): must be {allowed}"
-                )
-            object.__setattr__(self, f.name, float(value))
+        validate_fields(self, "vehicle parameter")
 
     # -- presets --------------------------------------------------------------------------
     @classmethod
