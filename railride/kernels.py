@@ -18,6 +18,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
+from .dampers import LAW_BOUC_WEN, LAW_SPENCER, LAW_VISCOUS, N_DAMPER_STATES
+
 N_DOF = 9
 N_CORNER = 4
 N_WHEELSET = 4
@@ -30,9 +32,14 @@ DIVERGED = 1.0e3
 #: divergence check still sees them
 _FAST = {"reassoc", "contract", "nsz", "arcp"}
 
-#: how the secondary damper forces enter the equations (see `_acceleration`)
+#: damper laws: passive dashpots kept inside the damping matrix, or one of the laws of
+#: railride.dampers (forces computed at every stage)
 LAW_VISCOUS_IN_C = 0
-LAW_FORCE_INPUT = 1
+N_DS = N_CORNER * N_DAMPER_STATES  # damper states of the vehicle
+NS_MAX = 2 * N_DOF + N_DS  # state (q, q', damper states)
+#: sub-step so that (fastest damper rate) x (sub-step) stays below this
+SUBSTEP_LIMIT = 0.5
+MAX_SUBSTEPS = 1024
 
 STATUS_OK = 0
 STATUS_DIVERGED = 1
@@ -133,111 +140,181 @@ def _mv9(AT, x, n_cols, r, out):
 
 
 @njit(cache=True, inline="always", fastmath=_FAST)
-def _secondary_rates(TT, y, out):
-    """out = deflection rates of the four secondary corners, Ts q' (TT = Ts^T, (9, 4))."""
+def _corner_values(TT, s, offset, out):
+    """out[c] = sum_j TT[j, c] s[offset + j]: the secondary deflections (offset 0, from q) or
+    their rates (offset N_DOF, from q') at the four corners (TT = T, (9, 4))."""
     b0 = 0.0
     b1 = 0.0
     b2 = 0.0
     b3 = 0.0
     for j in range(N_DOF):
-        vj = y[N_DOF + j]
-        b0 += TT[j, 0] * vj
-        b1 += TT[j, 1] * vj
-        b2 += TT[j, 2] * vj
-        b3 += TT[j, 3] * vj
+        sj = s[offset + j]
+        b0 += TT[j, 0] * sj
+        b1 += TT[j, 1] * sj
+        b2 += TT[j, 2] * sj
+        b3 += TT[j, 3] * sj
     out[0] = b0
     out[1] = b1
     out[2] = b2
     out[3] = b3
 
 
-@njit(cache=True, inline="always", fastmath=_FAST)
-def _damper_forces(y, TT, c_sec, rates):
-    """Secondary damper forces f = -c (Ts q') into y[18:22]."""
-    _secondary_rates(TT, y, rates)
-    for c in range(N_CORNER):
-        y[2 * N_DOF + c] = -c_sec[c] * rates[c]
-
-
-@njit(cache=True, inline="always", fastmath=_FAST)
-def _acceleration(law, y, r, AT, TT, c_sec, rates, out):
-    """out = q'' for y = (q, q', f) with rail forcing r.
-
-    LAW_VISCOUS_IN_C: the viscous dampers are part of Av, so q'' = r + [Aq Av] (q, q') and f is
-    only computed when recorded. LAW_FORCE_INPUT: f = -c (Ts q') goes into y[18:22] first and
-    q'' = r + [Aq Av Bf] y (Av without the dampers).
-    """
-    if law == LAW_VISCOUS_IN_C:
-        _mv9(AT, y, 2 * N_DOF, r, out)
+@njit(cache=True, fastmath=_FAST)
+def _bouc_wen_rate(z, w, A, n, gamma, beta):
+    """z' = -gamma |w| z |z|^(n-1) - beta w |z|^n + A w (see railride.dampers)."""
+    az = abs(z)
+    if n == 1.0:
+        zn1 = 1.0
+    elif n == 2.0:
+        zn1 = az
     else:
-        _damper_forces(y, TT, c_sec, rates)
-        _mv9(AT, y, NY, r, out)
+        zn1 = az ** (n - 1.0)
+    return -gamma * abs(w) * z * zn1 - beta * w * zn1 * az + A * w
+
+
+@njit(cache=True, fastmath=_FAST)
+def damper_law(law, P, x, xd, z, y, u, v):
+    """Force F (tension +) and the rates (z', y', u') of one damper; P as `Damper.pack()`."""
+    if law == LAW_VISCOUS:
+        return P[2] * xd, 0.0, 0.0, 0.0
+    alpha = P[0] + P[1] * u
+    c0 = P[2] + P[3] * u
+    du = -P[9] * (u - v)
+    if law == LAW_BOUC_WEN:
+        dz = _bouc_wen_rate(z, xd, P[5], P[6], P[7], P[8])
+        return c0 * xd + P[4] * x + alpha * z, dz, 0.0, du
+    c1 = P[12] + P[13] * u
+    dy = (alpha * z + c0 * xd + P[4] * (x - y)) / (c0 + c1)
+    dz = _bouc_wen_rate(z, xd - dy, P[5], P[6], P[7], P[8])
+    return c1 * dy + P[14] * x, dz, dy, du
+
+
+@njit(cache=True, fastmath=_FAST)
+def damper_stiffness(law, P, xd, z, u):
+    """A bound on the fastest rate of the damper's internal states [1/s]
+    (same as railride.dampers.stiffness_estimate)."""
+    if law == LAW_VISCOUS or law == LAW_VISCOUS_IN_C:
+        return 0.0
+    gb = abs(P[7]) + abs(P[8])
+    n = P[6]
+    az = abs(z)
+    lam = n * gb * abs(xd) * (1.0 if n == 1.0 else az ** (n - 1.0)) + P[9]
+    if law == LAW_SPENCER:
+        cs = P[2] + P[3] * u + P[12] + P[13] * u
+        lam += ((P[5] + gb * az ** n) * (P[0] + P[1] * u) + P[4]) / cs
+    return lam
+
+
+@njit(cache=True)
+def substeps(lam, dt):
+    """Sub-steps (a power of two) that keep lam * dt / m <= SUBSTEP_LIMIT."""
+    m = 1
+    while lam * dt > SUBSTEP_LIMIT * m and m < MAX_SUBSTEPS:
+        m *= 2
+    return m
+
+
+@njit(cache=True, inline="always", fastmath=_FAST)
+def _derivative(law, s, r, AT, TT, P, vcmd, y, cx, cv, ks, acc):
+    """ks = d/dt of the state s = (q, q', damper states), with rail forcing r.
+
+    y receives the stage vector (q, q', f) and acc (a view of ks) q''. LAW_VISCOUS_IN_C: the
+    dampers are in Av, q'' = r + [Aq Av] (q, q'). Otherwise every corner's damper law gives its
+    force F from the corner deflection and rate, f = -F enters through Bf, and the damper
+    states (z, y, u) advance.
+    """
+    for i in range(N_DOF):
+        y[i] = s[i]
+        y[N_DOF + i] = s[N_DOF + i]
+        ks[i] = s[N_DOF + i]
+    if law == LAW_VISCOUS_IN_C:
+        _mv9(AT, y, 2 * N_DOF, r, acc)
+        return
+    _corner_values(TT, s, 0, cx)
+    _corner_values(TT, s, N_DOF, cv)
+    for c in range(N_CORNER):
+        b = 2 * N_DOF + N_DAMPER_STATES * c
+        F, dz, dyy, du = damper_law(law, P, cx[c], cv[c], s[b], s[b + 1], s[b + 2], vcmd[c])
+        y[2 * N_DOF + c] = -F
+        ks[b] = dz
+        ks[b + 1] = dyy
+        ks[b + 2] = du
+    _mv9(AT, y, NY, r, acc)
 
 
 @njit(cache=True, parallel=True, fastmath=_FAST)
-def run_batch(law, x, step0, n_steps, final, stride, dt, A, TS, c_sec,
+def run_batch(law, x, step0, n_steps, final, stride, dt, A, TS, c_sec, P, vcmd,
               utab, u_off, ftab, f_off, n_nodes, interval,
-              out_q, out_v, out_a, out_f, out_w, out_wd,
+              out_q, out_v, out_a, out_f, out_w, out_wd, out_d,
               status, fail_step):
-    """Advance every sample's state x[s] = (q, q') by n_steps RK4 steps of dt.
+    """Advance every sample's state x[s] = (q, q', damper states) by n_steps steps of dt.
 
     Per sample s: A[s] (NY, 9) maps y = (q, q', f) to q'' (Aq, Av, Bf side by side, stored
-    transposed), TS[s] (9, 4) maps q' to the secondary deflection rates, c_sec[s] holds the four
-    damping coefficients, and ``law`` says how the damper forces enter (LAW_VISCOUS_IN_C or
-    LAW_FORCE_INPUT). The rail inputs come as tables on the time grid k * interval[s] with
-    n_nodes[s] rows: utab rows from u_off[s] (w, w', for the record) and ftab rows from
-    f_off[s] (the forcing, see `_forcing`).
+    transposed), TS[s] (9, 4) is T (corner deflections T^T q). ``law`` is LAW_VISCOUS_IN_C
+    (passive dashpots inside Av; c_sec[s] only for recording their forces) or a damper law
+    (railride.dampers) with packed parameters P[s] and command voltages vcmd[s] (4 corners).
+    The rail inputs come as tables on the time grid k * interval[s] with n_nodes[s] rows: utab
+    rows from u_off[s] (w, w', for the record) and ftab rows from f_off[s] (see `_forcing`).
+
+    Each step is one classical RK4 step, or 2^k equal RK4 sub-steps when the dampers' internal
+    states are stiff at the step's start (`damper_stiffness` * dt > SUBSTEP_LIMIT).
 
     Steps are numbered globally from step0 (t = step * dt). At every step whose number is a
-    multiple of ``stride`` the state, acceleration, damper forces and rail inputs at that time
-    are written to row step // stride of the outputs; with ``final`` the state after the last
-    step is written too. A sample whose state leaves +-DIVERGED or stops being finite gets
-    status STATUS_DIVERGED and the step number in fail_step, and stops.
+    multiple of ``stride`` the state, acceleration, damper forces, rail inputs and damper states
+    at that time are written to row step // stride of the outputs (out_d only if it has rows);
+    with ``final`` the state after the last step is written too. A sample whose state leaves
+    +-DIVERGED or stops being finite gets status STATUS_DIVERGED and the step number in
+    fail_step, and stops.
     """
     n_samples = x.shape[0]
+    ns = 2 * N_DOF if law == LAW_VISCOUS_IN_C else NS_MAX
+    record_d = out_d.shape[1] > 1
     for smp in prange(n_samples):
         if status[smp] != STATUS_OK:
             continue
-        q = x[smp, :N_DOF].copy()
-        v = x[smp, N_DOF:].copy()
-        y = np.empty(NY)  # stage state (q, q', f)
-        rates = np.empty(N_CORNER)
-        k1v = np.empty(N_DOF)
-        k2v = np.empty(N_DOF)
-        k3v = np.empty(N_DOF)
-        k4v = np.empty(N_DOF)
-        k2q = np.empty(N_DOF)
-        k3q = np.empty(N_DOF)
-        r0 = np.empty(N_DOF)  # rail forcing at t, t + dt/2, t + dt
-        rm = np.empty(N_DOF)
-        r1 = np.empty(N_DOF)
+        s = x[smp].copy()
+        st = np.empty(NS_MAX)  # stage state
+        y = np.empty(NY)  # stage vector (q, q', f)
+        cx = np.empty(N_CORNER)
+        cv = np.empty(N_CORNER)
+        K = np.zeros((4, NS_MAX))  # the four stage rates
+        kk = np.zeros(NS_MAX)
+        acc = kk[N_DOF:2 * N_DOF]
+        R = np.empty((3, N_DOF))  # rail forcing at the sub-step's start, middle and end
+        rs = np.empty(N_DOF)
         w = np.empty(N_RAIL)
         wd = np.empty(N_RAIL)
-        at, tt, cs = A[smp], TS[smp], c_sec[smp]
+        at, tt, cs, pp, vc = A[smp], TS[smp], c_sec[smp], P[smp], vcmd[smp]
         uo, fo, nn, itv = u_off[smp], f_off[smp], n_nodes[smp], interval[smp]
-        h = 0.5 * dt
-        _forcing(step0 * dt, ftab, fo, nn, itv, r0)
+        _forcing(step0 * dt, ftab, fo, nn, itv, rs)
         last = n_steps + 1 if final else n_steps
         for n in range(last):
             step = step0 + n
             t = step * dt
-            for i in range(N_DOF):
-                y[i] = q[i]
-                y[N_DOF + i] = v[i]
-            _acceleration(law, y, r0, at, tt, cs, rates, k1v)
+            # rates at the step's start: for the record, the sub-step choice and stage 1
+            _derivative(law, s, rs, at, tt, pp, vc, y, cx, cv, kk, acc)
+            for i in range(NS_MAX):
+                K[0, i] = kk[i]
             if step % stride == 0:
                 row = step // stride
                 bad = False
                 for i in range(N_DOF):
-                    out_q[smp, row, i] = q[i]
-                    out_v[smp, row, i] = v[i]
-                    out_a[smp, row, i] = k1v[i]
-                    if not (abs(q[i]) < DIVERGED and abs(v[i]) < 1e3 * DIVERGED):
+                    out_q[smp, row, i] = s[i]
+                    out_v[smp, row, i] = s[N_DOF + i]
+                    out_a[smp, row, i] = acc[i]
+                    if not (abs(s[i]) < DIVERGED and abs(s[N_DOF + i]) < 1e3 * DIVERGED):
                         bad = True
                 if law == LAW_VISCOUS_IN_C:
-                    _damper_forces(y, tt, cs, rates)
+                    _corner_values(tt, s, N_DOF, cv)
+                    for c in range(N_CORNER):
+                        y[2 * N_DOF + c] = -cs[c] * cv[c]
                 for c in range(N_CORNER):
                     out_f[smp, row, c] = y[2 * N_DOF + c]
+                if record_d:
+                    for i in range(N_DS):
+                        out_d[smp, row, i] = s[2 * N_DOF + i]
+                        if not abs(s[2 * N_DOF + i]) < DIVERGED:
+                            bad = True
                 _rail_inputs(t, utab, uo, nn, itv, w, wd)
                 for c in range(N_RAIL):
                     out_w[smp, row, c] = w[c]
@@ -248,26 +325,110 @@ def run_batch(law, x, step0, n_steps, final, stride, dt, A, TS, c_sec,
                     break
             if n == n_steps:
                 break
-            _forcing(t + h, ftab, fo, nn, itv, rm)  # stages 2 and 3 share t + dt/2
-            _forcing(t + dt, ftab, fo, nn, itv, r1)
+            m = 1
+            if law != LAW_VISCOUS_IN_C:
+                lam = 0.0
+                for c in range(N_CORNER):
+                    b = 2 * N_DOF + N_DAMPER_STATES * c
+                    lam = max(lam, damper_stiffness(law, pp, cv[c], s[b], s[b + 2]))
+                m = substeps(lam, dt)
+            h = dt / m
             for i in range(N_DOF):
-                y[i] = q[i] + h * v[i]
-                k2q[i] = v[i] + h * k1v[i]
-                y[N_DOF + i] = k2q[i]
-            _acceleration(law, y, rm, at, tt, cs, rates, k2v)
+                R[0, i] = rs[i]
+            for sub in range(m):
+                ts = t + sub * h
+                _forcing(ts + 0.5 * h, ftab, fo, nn, itv, R[1])
+                _forcing(ts + h, ftab, fo, nn, itv, R[2])
+                # classical RK4: stage j at s + c_j h K[j-1], c = (0, 1/2, 1/2, 1), with the
+                # forcing at the sub-step's start, middle, middle and end
+                for stage in range(4):
+                    if stage == 0 and sub == 0:
+                        continue  # K[0] is the step-start rate computed above
+                    ch = h * (0.0 if stage == 0 else (0.5 if stage < 3 else 1.0))
+                    ridx = 0 if stage == 0 else (1 if stage < 3 else 2)
+                    prev = stage - 1 if stage > 0 else 0  # stage 0 adds 0 * K[0]
+                    for i in range(ns):
+                        st[i] = s[i] + ch * K[prev, i]
+                    for i in range(N_DOF):
+                        rs[i] = R[ridx, i]
+                    _derivative(law, st, rs, at, tt, pp, vc, y, cx, cv, kk, acc)
+                    for i in range(ns):
+                        K[stage, i] = kk[i]
+                for i in range(ns):
+                    s[i] += h / 6.0 * (K[0, i] + 2.0 * K[1, i] + 2.0 * K[2, i] + K[3, i])
+                for i in range(N_DOF):
+                    R[0, i] = R[2, i]
             for i in range(N_DOF):
-                y[i] = q[i] + h * k2q[i]
-                k3q[i] = v[i] + h * k2v[i]
-                y[N_DOF + i] = k3q[i]
-            _acceleration(law, y, rm, at, tt, cs, rates, k3v)
-            for i in range(N_DOF):
-                y[i] = q[i] + dt * k3q[i]
-                y[N_DOF + i] = v[i] + dt * k3v[i]
-            _acceleration(law, y, r1, at, tt, cs, rates, k4v)
-            for i in range(N_DOF):
-                q[i] += dt / 6.0 * (v[i] + 2.0 * k2q[i] + 2.0 * k3q[i] + y[N_DOF + i])
-                v[i] += dt / 6.0 * (k1v[i] + 2.0 * k2v[i] + 2.0 * k3v[i] + k4v[i])
-                r0[i] = r1[i]
-        for i in range(N_DOF):
-            x[smp, i] = q[i]
-            x[smp, N_DOF + i] = v[i]
+                rs[i] = R[2, i]
+        for i in range(ns):
+            x[smp, i] = s[i]
+
+
+@njit(cache=True, parallel=True, fastmath=_FAST)
+def rig_batch(law, P, n_steps, stride, dt, xtab, x_interval, tracking, vconst, fd, B, G, out):
+    """A damper on a test rig: every sample drives one damper (parameters P[s]) through the
+    extension x(t) of the table xtab (rows (x, x') on the grid k * x_interval, cubic Hermite).
+
+    The command voltage is vconst[s] (``tracking`` false) or the force-tracking law of spec
+    section 6, v = clip(G[s] (f_d - B[s] F) sgn(F), v_min, v_max), evaluated at every step from
+    the force F at the step's start and the desired force fd[s, step], and held over the step.
+    States: z, y, u and the dissipated energy E (E' = F x'). Row step // stride of out[s]
+    receives (t, x, x', F, z, y, u, v, E) at every step that is a multiple of stride, and after
+    the last step.
+    """
+    n_samples = P.shape[0]
+    n_rows = xtab.shape[0]
+    for smp in prange(n_samples):
+        pp = P[smp]
+        z = 0.0
+        yy = 0.0
+        u = vconst[smp] if not tracking else pp[10]
+        E = 0.0
+        kz = np.empty(4)  # stage rates of z, y, u, E
+        ky = np.empty(4)
+        ku = np.empty(4)
+        ke = np.empty(4)
+        for n in range(n_steps + 1):
+            t = n * dt
+            k, h00, h10, h01, h11, d00, d10, d11 = _hermite(t, n_rows, x_interval)
+            x = h00 * xtab[k, 0] + h10 * xtab[k, 1] + h01 * xtab[k + 1, 0] + h11 * xtab[k + 1, 1]
+            xd = d00 * (xtab[k, 0] - xtab[k + 1, 0]) + d10 * xtab[k, 1] + d11 * xtab[k + 1, 1]
+            F, dz, dy, du = damper_law(law, pp, x, xd, z, yy, u, 0.0)
+            if tracking:
+                sgn = 1.0 if F > 0.0 else (-1.0 if F < 0.0 else 0.0)
+                v = G[smp] * (fd[smp, n] - B[smp] * F) * sgn
+                v = min(max(v, pp[10]), pp[11])
+            else:
+                v = vconst[smp]
+            if n % stride == 0 or n == n_steps:
+                row = n // stride if n % stride == 0 else out.shape[1] - 1
+                out[smp, row, 0] = t
+                out[smp, row, 1] = x
+                out[smp, row, 2] = xd
+                out[smp, row, 3] = F
+                out[smp, row, 4] = z
+                out[smp, row, 5] = yy
+                out[smp, row, 6] = u
+                out[smp, row, 7] = v
+                out[smp, row, 8] = E
+            if n == n_steps:
+                break
+            m = substeps(damper_stiffness(law, pp, xd, z, u), dt)
+            h = dt / m
+            for sub in range(m):
+                tk = t + sub * h
+                # RK4 on (z, y, u, E) with the prescribed motion at the stage times
+                for stage in range(4):
+                    c = 0.0 if stage == 0 else (0.5 if stage < 3 else 1.0)
+                    zs = z if stage == 0 else z + c * h * kz[stage - 1]
+                    ys = yy if stage == 0 else yy + c * h * ky[stage - 1]
+                    us = u if stage == 0 else u + c * h * ku[stage - 1]
+                    k, h00, h10, h01, h11, d00, d10, d11 = _hermite(tk + c * h, n_rows, x_interval)
+                    xs = h00 * xtab[k, 0] + h10 * xtab[k, 1] + h01 * xtab[k + 1, 0] + h11 * xtab[k + 1, 1]
+                    xds = d00 * (xtab[k, 0] - xtab[k + 1, 0]) + d10 * xtab[k, 1] + d11 * xtab[k + 1, 1]
+                    Fs, kz[stage], ky[stage], ku[stage] = damper_law(law, pp, xs, xds, zs, ys, us, v)
+                    ke[stage] = Fs * xds
+                z += h / 6.0 * (kz[0] + 2.0 * kz[1] + 2.0 * kz[2] + kz[3])
+                yy += h / 6.0 * (ky[0] + 2.0 * ky[1] + 2.0 * ky[2] + ky[3])
+                u += h / 6.0 * (ku[0] + 2.0 * ku[1] + 2.0 * ku[2] + ku[3])
+                E += h / 6.0 * (ke[0] + 2.0 * ke[1] + 2.0 * ke[2] + ke[3])

@@ -12,7 +12,7 @@ from datetime import datetime, timezone
 import numpy as np
 import xarray as xr
 
-from . import kernels
+from . import dampers, kernels
 from .params import VehicleParams
 from .track import Scenario, scenario as named_scenario, wheelset_input_table
 from .vehicle import CORNER_NAMES, DOF_NAMES, DOF_UNITS, N_DOF, RAILS, WHEELSETS, Vehicle
@@ -34,13 +34,37 @@ def _vehicle(params: VehicleParams) -> Vehicle:
 
 
 @functools.lru_cache(maxsize=256)
-def _max_stable_dt(params: VehicleParams) -> float:
-    return max_stable_dt(_vehicle(params))
+def _max_stable_dt(params: VehicleParams, damper=None) -> float:
+    return max_stable_dt(_vehicle(params), damper)
 
 
-def max_stable_dt(vehicle: Vehicle) -> float:
-    """Largest RK4 step for which every mode of the passive vehicle is stable."""
-    lam = np.linalg.eigvals(vehicle.state_matrix)
+def _state_matrix(vehicle: Vehicle, damper=None) -> np.ndarray:
+    """The passive state matrix, or with MR dampers the vehicle linearised about their stiffest
+    state: pre-yield stiffness k0 + k1 + alpha(v_max) A and damping c0(v_max) + c1(v_max). Their
+    internal states are sub-stepped by the stepper and do not enter here."""
+    if damper is None:
+        return vehicle.state_matrix
+    if damper.law == dampers.LAW_VISCOUS:
+        k_eff, c_eff = 0.0, damper.c
+    else:
+        v = damper.v_max
+        k_eff = damper.k0 + getattr(damper, "k1", 0.0) + (damper.alpha_a + damper.alpha_b * v) * damper.A
+        c_eff = damper.c0a + damper.c0b * v + getattr(damper, "c1a", 0.0) + getattr(damper, "c1b", 0.0) * v
+    TT = vehicle.T @ vehicle.T.T
+    K = vehicle.K + k_eff * TT
+    C = vehicle.C0 + c_eff * TT
+    minv = 1.0 / np.diag(vehicle.M)[:, None]
+    A = np.zeros((2 * N_DOF, 2 * N_DOF))
+    A[:N_DOF, N_DOF:] = np.eye(N_DOF)
+    A[N_DOF:, :N_DOF] = -minv * K
+    A[N_DOF:, N_DOF:] = -minv * C
+    return A
+
+
+def max_stable_dt(vehicle: Vehicle, damper=None) -> float:
+    """Largest RK4 step for which every mode of the vehicle is stable (with MR dampers: of the
+    vehicle linearised about the dampers' stiffest state)."""
+    lam = np.linalg.eigvals(_state_matrix(vehicle, damper))
     lo, hi = 0.0, 10.0
     for _ in range(60):  # bisection on |R(lambda dt)| <= 1
         mid = 0.5 * (lo + hi)
@@ -51,29 +75,32 @@ def max_stable_dt(vehicle: Vehicle) -> float:
     return lo
 
 
-def _check_dt(vehicle: Vehicle, dt: float) -> None:
-    dt_max = _max_stable_dt(vehicle.params)
+def _check_dt(vehicle: Vehicle, dt: float, damper=None) -> None:
+    dt_max = _max_stable_dt(vehicle.params, damper)
     if dt > dt_max:
         fastest = max(vehicle.modes(), key=lambda m: m.frequency_hz)
         raise ValueError(
             f"dt = {dt:g} s is too large: fourth-order Runge-Kutta is unstable for this vehicle "
-            f"(fastest mode {fastest.label}, {fastest.frequency_hz:.1f} Hz); use dt <= {dt_max:.3g} s "
-            f"(the default {DEFAULT_DT:g} s is accurate)"
+            f"(fastest mode {fastest.label}, {fastest.frequency_hz:.1f} Hz"
+            + ("" if damper is None else f", stiffer with the {damper.model} dampers")
+            + f"); use dt <= {dt_max:.3g} s (the default {DEFAULT_DT:g} s is accurate)"
         )
 
 
-def _system_arrays(vehicle: Vehicle) -> dict[str, np.ndarray]:
+def _system_arrays(vehicle: Vehicle, passive: bool = True) -> dict[str, np.ndarray]:
     """The stepper's matrices: the equations of motion with M^-1 folded in, transposed
     (see `railride.kernels.run_batch`).
 
     ``A`` = [Aq Av Bf]^T acts on (q, q', f), ``TS`` = T maps q' to the secondary deflection
     rates. The passive viscous dampers are linear, so they stay in Av (law LAW_VISCOUS_IN_C):
-    the stepper then skips the force computation per stage. ``Bw``, ``Bwd`` map the rail
+    the stepper then skips the force computation per stage; with damper models (``passive``
+    false) Av leaves them out and their forces enter through Bf. ``Bw``, ``Bwd`` map the rail
     inputs to q'' and are applied to the input table once, before the run.
     """
     minv = 1.0 / np.diag(vehicle.M)[:, None]
     return {
-        "A": np.hstack([-minv * vehicle.K, -minv * vehicle.C, minv * vehicle.T]).T,
+        "A": np.hstack([-minv * vehicle.K, -minv * (vehicle.C if passive else vehicle.C0),
+                        minv * vehicle.T]).T,
         "TS": vehicle.T.copy(),
         "c_sec": np.full(4, vehicle.params.c_sz),
         "Bw": -minv * vehicle.K_w,
@@ -113,6 +140,32 @@ def _resolve_params(p) -> VehicleParams:
     raise ValueError(f"params = {p!r}: must be VehicleParams or a preset name")
 
 
+def _resolve_damper(damper):
+    if damper is None:
+        return None
+    if isinstance(damper, str):
+        return dampers.preset(damper)
+    if isinstance(damper, (dampers.Viscous, dampers.BoucWen, dampers.Spencer)):
+        return damper
+    raise ValueError(f"damper = {damper!r}: must be None (passive), a preset name "
+                     f"({', '.join(dampers.PRESETS)}) or a model from railride.dampers")
+
+
+def _command_voltages(damper, voltage, n: int) -> np.ndarray:
+    """(n, 4) constant command voltages, checked against the damper's range."""
+    if damper is None:
+        if voltage is not None:
+            raise ValueError("voltage applies to MR dampers only: give damper= as well "
+                             "(the passive suspension has no command)")
+        return np.zeros((n, 4))
+    if voltage is None:
+        voltage = damper.v_min
+    values = [voltage] * n if np.ndim(voltage) == 0 else list(voltage)
+    if len(values) != n:
+        raise ValueError(f"voltage: give one value or one per sample ({n}); got {len(values)}")
+    return np.repeat([[damper.check_voltage(v)] for v in values], 4, axis=1).astype(float)
+
+
 def _positive(name: str, value) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value <= 0:
         raise ValueError(f"{name} = {value!r}: must be a finite number > 0")
@@ -120,15 +173,20 @@ def _positive(name: str, value) -> float:
 
 
 def simulate(scenario=None, params=None, *, dt: float = DEFAULT_DT,
-             output_rate: float = DEFAULT_OUTPUT_RATE, initial_state=None,
-             progress=None) -> "RideResult":
-    """Simulate the passive vehicle on one or many scenarios.
+             output_rate: float = DEFAULT_OUTPUT_RATE, damper=None, voltage=None,
+             initial_state=None, progress=None) -> "RideResult":
+    """Simulate the vehicle on one or many scenarios.
 
     ``scenario`` is a `Scenario`, a scenario name (see `railride.track.scenario`) or a list of
     them; ``params`` is a `VehicleParams`, a preset name or a list. Lists run as one batch
     along a ``sample`` dimension (a single item is broadcast against a list). Every sample of a
     batch must share the duration. ``dt`` [s] is the fixed RK4 step and ``output_rate`` [Hz] the
     rate of the stored time histories; 1/(output_rate dt) must be a whole number.
+    ``damper`` None keeps the passive viscous secondary dampers (c_sz); a damper model from
+    `railride.dampers` (or a preset name: railway, dyke1996, spencer1997) replaces them at all
+    four corners, driven at the constant command ``voltage`` [V] (default: the model's v_min,
+    "passive-off"; a list gives one voltage per sample). The coil starts at that voltage and
+    the hysteretic states at 0.
     ``initial_state`` is (q, q') at t = 0 as 18 numbers in DOF order (m, rad, m/s, rad/s), or
     one row per sample; by default the vehicle starts at rest in equilibrium.
     ``progress(done_fraction)`` is called between chunks of a long run.
@@ -151,11 +209,13 @@ def simulate(scenario=None, params=None, *, dt: float = DEFAULT_DT,
     if any(abs(s.duration - duration) > 1e-12 * duration for s in scenarios):
         raise ValueError("every sample of a batch must have the same duration; got "
                          + ", ".join(sorted({f'{s.duration:g} s' for s in scenarios})))
+    damper = _resolve_damper(damper)
+    vcmd = _command_voltages(damper, voltage, n)
     vehicles = {}
     for p in param_sets:
         if id(p) not in vehicles:
             vehicles[id(p)] = _vehicle(p)
-            _check_dt(vehicles[id(p)], dt)
+            _check_dt(vehicles[id(p)], dt, damper)
     stride_f = 1.0 / (output_rate * dt)
     stride = int(round(stride_f))
     if stride < 1 or abs(stride - stride_f) > 1e-6 * stride_f:
@@ -168,7 +228,7 @@ def simulate(scenario=None, params=None, *, dt: float = DEFAULT_DT,
                          f"(1/{output_rate:g} Hz)")
     n_steps = n_out * stride
 
-    systems = {key: _system_arrays(v) for key, v in vehicles.items()}
+    systems = {key: _system_arrays(v, passive=damper is None) for key, v in vehicles.items()}
     arrays = {k: np.ascontiguousarray(np.stack([systems[id(p)][k] for p in param_sets]))
               for k in ("A", "TS", "c_sec")}
 
@@ -196,17 +256,21 @@ def simulate(scenario=None, params=None, *, dt: float = DEFAULT_DT,
     ftab = np.ascontiguousarray(np.concatenate(ftabs))
 
     rows = n_out + 1
-    x = np.zeros((n, 2 * N_DOF))
+    law = kernels.LAW_VISCOUS_IN_C if damper is None else damper.law
+    x = np.zeros((n, kernels.NS_MAX))
+    x[:, 2 * N_DOF + 2::dampers.N_DAMPER_STATES] = vcmd  # coils settled at the command
+    P = np.tile(damper.pack() if damper is not None else np.zeros(dampers.N_PACKED), (n, 1))
     if initial_state is not None:
         x0 = np.asarray(initial_state, dtype=float)
         if x0.shape not in ((2 * N_DOF,), (n, 2 * N_DOF)) or not np.all(np.isfinite(x0)):
             raise ValueError(f"initial_state must hold {2 * N_DOF} finite numbers (q then q') "
                              f"or one such row per sample; got shape {x0.shape}")
-        x[:] = x0
+        x[:, :2 * N_DOF] = x0
     out = {
         "q": np.empty((n, rows, N_DOF)), "v": np.empty((n, rows, N_DOF)),
         "a": np.empty((n, rows, N_DOF)), "f": np.empty((n, rows, 4)),
         "w": np.empty((n, rows, 8)), "wd": np.empty((n, rows, 8)),
+        "d": np.empty((n, rows if damper is not None else 1, kernels.N_DS)),
     }
     status = np.zeros(n, dtype=np.int64)
     fail_step = np.full(n, -1, dtype=np.int64)
@@ -216,10 +280,10 @@ def simulate(scenario=None, params=None, *, dt: float = DEFAULT_DT,
     while True:
         todo = min(chunk, n_steps - done)
         final = done + todo == n_steps
-        kernels.run_batch(kernels.LAW_VISCOUS_IN_C, x, done, todo, final, stride, dt,
-                          arrays["A"], arrays["TS"], arrays["c_sec"],
+        kernels.run_batch(law, x, done, todo, final, stride, dt,
+                          arrays["A"], arrays["TS"], arrays["c_sec"], P, vcmd,
                           utab, u_off, ftab, f_off, n_nodes, interval,
-                          out["q"], out["v"], out["a"], out["f"], out["w"], out["wd"],
+                          out["q"], out["v"], out["a"], out["f"], out["w"], out["wd"], out["d"],
                           status, fail_step)
         done += todo
         if progress is not None:
@@ -234,10 +298,11 @@ def simulate(scenario=None, params=None, *, dt: float = DEFAULT_DT,
 
     created = datetime.now(timezone.utc).isoformat(timespec="seconds")
     return RideResult(build=functools.partial(_dataset, out, vehicles, param_sets, scenarios, dt,
-                                              output_rate, rows, batch, created))
+                                              output_rate, rows, batch, created, damper, vcmd))
 
 
-def _dataset(out, vehicles, param_sets, scenarios, dt, output_rate, rows, batch, created) -> xr.Dataset:
+def _dataset(out, vehicles, param_sets, scenarios, dt, output_rate, rows, batch, created,
+             damper, vcmd) -> xr.Dataset:
     """Named channels in SI units; a ``sample`` dimension only for a batch."""
     from . import __version__
     import numba
@@ -264,6 +329,17 @@ def _dataset(out, vehicles, param_sets, scenarios, dt, output_rate, rows, batch,
         "units": "N", "long_name": "secondary vertical spring force on the carbody (up +)"})
     channels["secondary_damper_force"] = (("corner",), out["f"], {
         "units": "N", "long_name": "secondary vertical damper force on the carbody (up +)"})
+    if damper is not None:
+        d = out["d"]
+        channels["damper_hysteretic_z"] = (("corner",), d[:, :, 0::3], {
+            "units": "m", "long_name": "Bouc-Wen hysteretic variable z of each damper"})
+        if damper.law == dampers.LAW_SPENCER:
+            channels["damper_internal_displacement"] = (("corner",), d[:, :, 1::3], {
+                "units": "m", "long_name": "Spencer model internal displacement y"})
+        channels["damper_voltage"] = (("corner",), d[:, :, 2::3], {
+            "units": "V", "long_name": "damper coil voltage u after the coil lag"})
+        channels["damper_command_voltage"] = (("corner",), np.broadcast_to(vcmd[:, None, :], d[:, :, 2::3].shape), {
+            "units": "V", "long_name": "commanded damper voltage v"})
     channels["rail_displacement"] = (("wheelset", "rail"), out["w"].reshape(shape), {
         "units": "m", "long_name": "rail height under each wheel"})
     channels["rail_velocity"] = (("wheelset", "rail"), out["wd"].reshape(shape), {
@@ -298,7 +374,9 @@ def _dataset(out, vehicles, param_sets, scenarios, dt, output_rate, rows, batch,
         "integrator": "classical RK4, fixed step",
         "dt_s": dt,
         "output_rate_hz": output_rate,
-        "suspension": "passive viscous secondary dampers",
+        "suspension": ("passive viscous secondary dampers" if damper is None else
+                       f"{damper.model} secondary dampers at constant command voltage"),
+        "damper": json.dumps(None if damper is None else damper.to_dict()),
         "sign_convention": "z up; pitch + lowers the front; roll + raises the left side; "
                            "forces on the carbody, up +",
     }
