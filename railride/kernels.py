@@ -72,7 +72,7 @@ def _hermite(t, n_nodes, interval):
 
 
 @njit(cache=True, inline="always", fastmath=_FAST)
-def _forcing(t, ftab, off, n_nodes, interval, out):
+def _forcing(t, ftab, off, n_nodes, interval, out, ooff):
     """Rail forcing r = Bw w + Bwd w' at time t, from the forcing table.
 
     Hermite interpolation is linear in the node data, so interpolating the node values
@@ -84,7 +84,7 @@ def _forcing(t, ftab, off, n_nodes, interval, out):
     a = off + k
     b = a + 1
     for i in range(N_DOF):
-        out[i] = (h00 * ftab[a, i] + h10 * ftab[a, 9 + i] + h01 * ftab[b, i] + h11 * ftab[b, 9 + i]
+        out[ooff + i] = (h00 * ftab[a, i] + h10 * ftab[a, 9 + i] + h01 * ftab[b, i] + h11 * ftab[b, 9 + i]
                   + d00 * (ftab[a, 18 + i] - ftab[b, 18 + i]) + d10 * ftab[a, 27 + i]
                   + d11 * ftab[b, 27 + i])
 
@@ -101,22 +101,23 @@ def _rail_inputs(t, utab, off, n_nodes, interval, w, wd):
 
 
 @njit(cache=True, inline="always", fastmath=_FAST)
-def _mv9(AT, x, n_cols, r, out):
-    """out = r + A x for the 9 rows of q'', with A stored transposed (n_cols, 9).
+def _mv9(AT, x, n_cols, r, roff, out, ooff):
+    """out[ooff:ooff+9] = r[roff:roff+9] + A x for the 9 rows of q'', A stored transposed
+    (n_cols, 9). Offsets instead of slices: a slice made in the loop costs reference counting.
 
     The nine sums live in named locals on purpose: numba cannot tell LLVM that ``out`` does
     not alias the inputs, so an array accumulator is reloaded and stored at every column and
     the product becomes load-bound (about 3x slower, see docs/performance.md).
     """
-    a0 = r[0]
-    a1 = r[1]
-    a2 = r[2]
-    a3 = r[3]
-    a4 = r[4]
-    a5 = r[5]
-    a6 = r[6]
-    a7 = r[7]
-    a8 = r[8]
+    a0 = r[roff]
+    a1 = r[roff + 1]
+    a2 = r[roff + 2]
+    a3 = r[roff + 3]
+    a4 = r[roff + 4]
+    a5 = r[roff + 5]
+    a6 = r[roff + 6]
+    a7 = r[roff + 7]
+    a8 = r[roff + 8]
     for j in range(n_cols):
         xj = x[j]
         a0 += AT[j, 0] * xj
@@ -128,15 +129,15 @@ def _mv9(AT, x, n_cols, r, out):
         a6 += AT[j, 6] * xj
         a7 += AT[j, 7] * xj
         a8 += AT[j, 8] * xj
-    out[0] = a0
-    out[1] = a1
-    out[2] = a2
-    out[3] = a3
-    out[4] = a4
-    out[5] = a5
-    out[6] = a6
-    out[7] = a7
-    out[8] = a8
+    out[ooff] = a0
+    out[ooff + 1] = a1
+    out[ooff + 2] = a2
+    out[ooff + 3] = a3
+    out[ooff + 4] = a4
+    out[ooff + 5] = a5
+    out[ooff + 6] = a6
+    out[ooff + 7] = a7
+    out[ooff + 8] = a8
 
 
 @njit(cache=True, inline="always", fastmath=_FAST)
@@ -215,20 +216,20 @@ def substeps(lam, dt):
 
 
 @njit(cache=True, inline="always", fastmath=_FAST)
-def _derivative(law, s, r, AT, TT, P, vcmd, y, cx, cv, ks, acc):
-    """ks = d/dt of the state s = (q, q', damper states), with rail forcing r.
+def _derivative(law, s, R, roff, AT, TT, P, vcmd, y, cx, cv, K, koff):
+    """K[koff:koff+NS_MAX] = d/dt of the state s = (q, q', damper states), with the rail forcing
+    R[roff:roff+9].
 
-    y receives the stage vector (q, q', f) and acc (a view of ks) q''. LAW_VISCOUS_IN_C: the
-    dampers are in Av, q'' = r + [Aq Av] (q, q'). Otherwise every corner's damper law gives its
-    force F from the corner deflection and rate, f = -F enters through Bf, and the damper
-    states (z, y, u) advance.
+    y receives the stage vector (q, q', f). LAW_VISCOUS_IN_C: the dampers are in Av,
+    q'' = r + [Aq Av] (q, q'). Otherwise every corner's damper law gives its force F from the
+    corner deflection and rate, f = -F enters through Bf, and the damper states (z, y, u) advance.
     """
     for i in range(N_DOF):
         y[i] = s[i]
         y[N_DOF + i] = s[N_DOF + i]
-        ks[i] = s[N_DOF + i]
+        K[koff + i] = s[N_DOF + i]
     if law == LAW_VISCOUS_IN_C:
-        _mv9(AT, y, 2 * N_DOF, r, acc)
+        _mv9(AT, y, 2 * N_DOF, R, roff, K, koff + N_DOF)
         return
     _corner_values(TT, s, 0, cx)
     _corner_values(TT, s, N_DOF, cv)
@@ -236,10 +237,10 @@ def _derivative(law, s, r, AT, TT, P, vcmd, y, cx, cv, ks, acc):
         b = 2 * N_DOF + N_DAMPER_STATES * c
         F, dz, dyy, du = damper_law(law, P, cx[c], cv[c], s[b], s[b + 1], s[b + 2], vcmd[c])
         y[2 * N_DOF + c] = -F
-        ks[b] = dz
-        ks[b + 1] = dyy
-        ks[b + 2] = du
-    _mv9(AT, y, NY, r, acc)
+        K[koff + b] = dz
+        K[koff + b + 1] = dyy
+        K[koff + b + 2] = du
+    _mv9(AT, y, NY, R, roff, K, koff + N_DOF)
 
 
 @njit(cache=True, parallel=True, fastmath=_FAST)
@@ -267,7 +268,8 @@ def run_batch(law, x, step0, n_steps, final, stride, dt, A, TS, c_sec, P, vcmd,
     fail_step, and stops.
     """
     n_samples = x.shape[0]
-    ns = 2 * N_DOF if law == LAW_VISCOUS_IN_C else NS_MAX
+    has_states = law != LAW_VISCOUS_IN_C  # damper states to integrate
+    ns = NS_MAX if has_states else 2 * N_DOF
     record_d = out_d.shape[1] > 1
     for smp in prange(n_samples):
         if status[smp] != STATUS_OK:
@@ -277,31 +279,26 @@ def run_batch(law, x, step0, n_steps, final, stride, dt, A, TS, c_sec, P, vcmd,
         y = np.empty(NY)  # stage vector (q, q', f)
         cx = np.empty(N_CORNER)
         cv = np.empty(N_CORNER)
-        K = np.zeros((4, NS_MAX))  # the four stage rates
-        kk = np.zeros(NS_MAX)
-        acc = kk[N_DOF:2 * N_DOF]
-        R = np.empty((3, N_DOF))  # rail forcing at the sub-step's start, middle and end
-        rs = np.empty(N_DOF)
+        K = np.zeros(4 * NS_MAX)  # the four stage rates, one after another
+        R = np.empty(3 * N_DOF)  # rail forcing at the sub-step's start, middle and end
         w = np.empty(N_RAIL)
         wd = np.empty(N_RAIL)
         at, tt, cs, pp, vc = A[smp], TS[smp], c_sec[smp], P[smp], vcmd[smp]
         uo, fo, nn, itv = u_off[smp], f_off[smp], n_nodes[smp], interval[smp]
-        _forcing(step0 * dt, ftab, fo, nn, itv, rs)
+        _forcing(step0 * dt, ftab, fo, nn, itv, R, 0)
         last = n_steps + 1 if final else n_steps
         for n in range(last):
             step = step0 + n
             t = step * dt
             # rates at the step's start: for the record, the sub-step choice and stage 1
-            _derivative(law, s, rs, at, tt, pp, vc, y, cx, cv, kk, acc)
-            for i in range(NS_MAX):
-                K[0, i] = kk[i]
+            _derivative(law, s, R, 0, at, tt, pp, vc, y, cx, cv, K, 0)
             if step % stride == 0:
                 row = step // stride
                 bad = False
                 for i in range(N_DOF):
                     out_q[smp, row, i] = s[i]
                     out_v[smp, row, i] = s[N_DOF + i]
-                    out_a[smp, row, i] = acc[i]
+                    out_a[smp, row, i] = K[N_DOF + i]
                     if not (abs(s[i]) < DIVERGED and abs(s[N_DOF + i]) < 1e3 * DIVERGED):
                         bad = True
                 if law == LAW_VISCOUS_IN_C:
@@ -333,33 +330,33 @@ def run_batch(law, x, step0, n_steps, final, stride, dt, A, TS, c_sec, P, vcmd,
                     lam = max(lam, damper_stiffness(law, pp, cv[c], s[b], s[b + 2]))
                 m = substeps(lam, dt)
             h = dt / m
-            for i in range(N_DOF):
-                R[0, i] = rs[i]
             for sub in range(m):
                 ts = t + sub * h
-                _forcing(ts + 0.5 * h, ftab, fo, nn, itv, R[1])
-                _forcing(ts + h, ftab, fo, nn, itv, R[2])
-                # classical RK4: stage j at s + c_j h K[j-1], c = (0, 1/2, 1/2, 1), with the
+                _forcing(ts + 0.5 * h, ftab, fo, nn, itv, R, N_DOF)
+                _forcing(ts + h, ftab, fo, nn, itv, R, 2 * N_DOF)
+                # classical RK4: stage j at s + c_j h K_(j-1), c = (0, 1/2, 1/2, 1), with the
                 # forcing at the sub-step's start, middle, middle and end
                 for stage in range(4):
                     if stage == 0 and sub == 0:
-                        continue  # K[0] is the step-start rate computed above
+                        continue  # K_0 is the step-start rate computed above
                     ch = h * (0.0 if stage == 0 else (0.5 if stage < 3 else 1.0))
-                    ridx = 0 if stage == 0 else (1 if stage < 3 else 2)
-                    prev = stage - 1 if stage > 0 else 0  # stage 0 adds 0 * K[0]
-                    for i in range(ns):
-                        st[i] = s[i] + ch * K[prev, i]
-                    for i in range(N_DOF):
-                        rs[i] = R[ridx, i]
-                    _derivative(law, st, rs, at, tt, pp, vc, y, cx, cv, kk, acc)
-                    for i in range(ns):
-                        K[stage, i] = kk[i]
-                for i in range(ns):
-                    s[i] += h / 6.0 * (K[0, i] + 2.0 * K[1, i] + 2.0 * K[2, i] + K[3, i])
+                    roff = N_DOF * (0 if stage == 0 else (1 if stage < 3 else 2))
+                    prev = NS_MAX * (stage - 1 if stage > 0 else 0)  # stage 0 adds 0 * K_0
+                    for i in range(2 * N_DOF):  # constant trip counts: LLVM unrolls them
+                        st[i] = s[i] + ch * K[prev + i]
+                    if has_states:
+                        for i in range(2 * N_DOF, NS_MAX):
+                            st[i] = s[i] + ch * K[prev + i]
+                    _derivative(law, st, R, roff, at, tt, pp, vc, y, cx, cv, K, NS_MAX * stage)
+                for i in range(2 * N_DOF):
+                    s[i] += h / 6.0 * (K[i] + 2.0 * K[NS_MAX + i] + 2.0 * K[2 * NS_MAX + i]
+                                       + K[3 * NS_MAX + i])
+                if has_states:
+                    for i in range(2 * N_DOF, NS_MAX):
+                        s[i] += h / 6.0 * (K[i] + 2.0 * K[NS_MAX + i] + 2.0 * K[2 * NS_MAX + i]
+                                           + K[3 * NS_MAX + i])
                 for i in range(N_DOF):
-                    R[0, i] = R[2, i]
-            for i in range(N_DOF):
-                rs[i] = R[2, i]
+                    R[i] = R[2 * N_DOF + i]
         for i in range(ns):
             x[smp, i] = s[i]
 
