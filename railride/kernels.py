@@ -41,6 +41,11 @@ NS_MAX = 2 * N_DOF + N_DS  # state (q, q', damper states)
 SUBSTEP_LIMIT = 0.5
 MAX_SUBSTEPS = 1024
 
+#: how the damper rig sets the command voltage (see `rig_batch`)
+RIG_CONSTANT = 0
+RIG_COMMANDED = 1
+RIG_TRACKING = 2
+
 STATUS_OK = 0
 STATUS_DIVERGED = 1
 
@@ -362,13 +367,14 @@ def run_batch(law, x, step0, n_steps, final, stride, dt, A, TS, c_sec, P, vcmd,
 
 
 @njit(cache=True, parallel=True, fastmath=_FAST)
-def rig_batch(law, P, n_steps, stride, dt, xtab, x_interval, tracking, vconst, fd, B, G, out):
+def rig_batch(law, P, n_steps, stride, dt, xtab, x_interval, mode, vconst, series, B, G, out):
     """A damper on a test rig: every sample drives one damper (parameters P[s]) through the
     extension x(t) of the table xtab (rows (x, x') on the grid k * x_interval, cubic Hermite).
 
-    The command voltage is vconst[s] (``tracking`` false) or the force-tracking law of spec
-    section 6, v = clip(G[s] (f_d - B[s] F) sgn(F), v_min, v_max), evaluated at every step from
-    the force F at the step's start and the desired force fd[s, step], and held over the step.
+    The command voltage, held over each step, is vconst[s] (``mode`` RIG_CONSTANT), the series
+    series[s, step] (RIG_COMMANDED, clipped to [v_min, v_max]), or the force-tracking law of
+    spec section 6 (RIG_TRACKING), v = clip(G[s] (f_d - B[s] F) sgn(F), v_min, v_max), from the
+    force F at the step's start and the desired force f_d = series[s, step].
     States: z, y, u and the dissipated energy E (E' = F x'). Row step // stride of out[s]
     receives (t, x, x', F, z, y, u, v, E) at every step that is a multiple of stride, and after
     the last step.
@@ -379,7 +385,7 @@ def rig_batch(law, P, n_steps, stride, dt, xtab, x_interval, tracking, vconst, f
         pp = P[smp]
         z = 0.0
         yy = 0.0
-        u = vconst[smp] if not tracking else pp[10]
+        u = vconst[smp] if mode == RIG_CONSTANT else pp[10]
         E = 0.0
         kz = np.empty(4)  # stage rates of z, y, u, E
         ky = np.empty(4)
@@ -391,10 +397,11 @@ def rig_batch(law, P, n_steps, stride, dt, xtab, x_interval, tracking, vconst, f
             x = h00 * xtab[k, 0] + h10 * xtab[k, 1] + h01 * xtab[k + 1, 0] + h11 * xtab[k + 1, 1]
             xd = d00 * (xtab[k, 0] - xtab[k + 1, 0]) + d10 * xtab[k, 1] + d11 * xtab[k + 1, 1]
             F, dz, dy, du = damper_law(law, pp, x, xd, z, yy, u, 0.0)
-            if tracking:
+            if mode == RIG_TRACKING:
                 sgn = 1.0 if F > 0.0 else (-1.0 if F < 0.0 else 0.0)
-                v = G[smp] * (fd[smp, n] - B[smp] * F) * sgn
-                v = min(max(v, pp[10]), pp[11])
+                v = min(max(G[smp] * (series[smp, n] - B[smp] * F) * sgn, pp[10]), pp[11])
+            elif mode == RIG_COMMANDED:
+                v = min(max(series[smp, n], pp[10]), pp[11])
             else:
                 v = vconst[smp]
             if n % stride == 0 or n == n_steps:

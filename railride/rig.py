@@ -1,0 +1,307 @@
+"""A damper on a test rig: prescribed extension, constant or commanded voltage, or the force-
+tracking inner loop of spec section 6 (paper eq. 12-14, Fig. 6).
+
+Sign convention (railride.dampers): x is the extension [m], F the force the damper resists with,
+positive in tension [N]. A desired force for the inner loop uses the same convention.
+
+The rig uses the vehicle's integrator: classical RK4 at a fixed step dt (default 1e-4 s), split
+into 2^k sub-steps where the damper's internal states are stiff, with the motion tabulated on a
+grid of whole steps and interpolated by cubic Hermite polynomials (railride.track explains why).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+import xarray as xr
+
+from . import dampers, kernels
+
+DEFAULT_DT = 1e-4
+#: motion-table nodes per cycle of the fastest motion
+_NODES_PER_CYCLE = 400
+
+
+@dataclass(frozen=True)
+class SineMotion:
+    """x(t) = amplitude sin(2 pi frequency t + phase)."""
+
+    amplitude: float  # m
+    frequency: float  # Hz
+    phase_deg: float = 0.0
+
+    def __post_init__(self):
+        _check_number("amplitude", self.amplitude, "nonnegative", "m")
+        _check_number("frequency", self.frequency, "positive", "Hz")
+        _check_number("phase", self.phase_deg, "finite", "deg")
+
+    def evaluate(self, t):
+        w = 2 * np.pi * self.frequency
+        ph = np.deg2rad(self.phase_deg)
+        return self.amplitude * np.sin(w * t + ph), self.amplitude * w * np.cos(w * t + ph)
+
+    def spacing(self) -> float:
+        return 1.0 / (self.frequency * _NODES_PER_CYCLE)
+
+
+@dataclass(frozen=True, eq=False)
+class SampledMotion:
+    """A sampled extension history (t [s] increasing, x [m]), interpolated by PCHIP."""
+
+    t: np.ndarray
+    x: np.ndarray
+    _interp: tuple = field(default=(), repr=False)
+
+    def __post_init__(self):
+        from scipy.interpolate import PchipInterpolator
+
+        t = np.asarray(self.t, dtype=float)
+        x = np.asarray(self.x, dtype=float)
+        if t.ndim != 1 or t.shape != x.shape or t.size < 2:
+            raise ValueError("motion: t and x must be 1-D arrays of equal length >= 2")
+        if not (np.all(np.isfinite(t)) and np.all(np.isfinite(x))):
+            raise ValueError("motion: t and x must be finite")
+        if np.any(np.diff(t) <= 0) or t[0] > 0:
+            raise ValueError("motion: t must increase strictly and start at or before 0 s")
+        p = PchipInterpolator(t, x)
+        object.__setattr__(self, "t", t)
+        object.__setattr__(self, "x", x)
+        object.__setattr__(self, "_interp", (p, p.derivative()))
+
+    def evaluate(self, t):
+        t = np.minimum(t, self.t[-1])
+        return self._interp[0](t), self._interp[1](t)
+
+    def spacing(self) -> float:
+        return float(np.min(np.diff(self.t))) / 2
+
+    def end(self) -> float:
+        return float(self.t[-1])
+
+
+def _check_number(name, value, rule, unit):
+    ok = isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+    ok = ok and {"positive": value > 0, "nonnegative": value >= 0, "finite": True}[rule]
+    if not ok:
+        allowed = {"positive": "> 0", "nonnegative": ">= 0", "finite": "finite"}[rule]
+        raise ValueError(f"{name} = {value!r} {unit}: must be a finite number {allowed}".replace(
+            "a finite number finite", "a finite number"))
+    return float(value)
+
+
+def _motion_table(motion, duration: float, dt: float):
+    ratio = motion.spacing() / dt
+    m = 1 << max(0, int(math.floor(math.log2(ratio)))) if ratio >= 1 else 1
+    interval = m * dt
+    n = int(math.ceil((duration + dt) / interval)) + 2
+    t = np.arange(n) * interval
+    x, xd = motion.evaluate(t)
+    return np.ascontiguousarray(np.column_stack([x, xd])), interval
+
+
+def _resolve(damper):
+    return dampers.preset(damper) if isinstance(damper, str) else damper
+
+
+def drive(damper, motion, *, duration: float, voltage=None, command=None, desired_force=None,
+          B: float = 1.0, G: float | None = None, dt: float = DEFAULT_DT,
+          output_rate: float | None = None) -> xr.Dataset:
+    """Drive one damper through ``motion`` (SineMotion or SampledMotion) for ``duration`` s.
+
+    Give exactly one of: ``voltage`` (a constant [V], or a list: one run per voltage along the
+    ``voltage`` dimension), ``command`` (a function of time [s] -> command voltage [V], held
+    over each step) or ``desired_force`` (a function of time -> desired force [N], tension +;
+    the inner loop sets the voltage with gains B [-] and G [V/N]). Returns a Dataset with
+    time histories of x, x', F, z, y, u (coil voltage), v (command) and the energy dissipated
+    since t = 0.
+    """
+    damper = _resolve(damper)
+    duration = _check_number("duration", duration, "positive", "s")
+    dt = _check_number("dt", dt, "positive", "s")
+    given = [k for k, v in (("voltage", voltage), ("command", command),
+                            ("desired_force", desired_force)) if v is not None]
+    if len(given) != 1:
+        raise ValueError("give exactly one of voltage, command or desired_force")
+    if hasattr(motion, "end") and motion.end() < duration - 1e-12:
+        raise ValueError(f"motion: the samples end at {motion.end():g} s, before the run's {duration:g} s")
+    n_steps = int(round(duration / dt))
+    if abs(n_steps * dt - duration) > 1e-9 * duration or n_steps < 1:
+        raise ValueError(f"duration = {duration:g} s must be a whole number of steps dt = {dt:g} s")
+    output_rate = 1.0 / dt if output_rate is None else _check_number("output_rate", output_rate, "positive", "Hz")
+    stride = int(round(1.0 / (output_rate * dt)))
+    if stride < 1 or abs(stride * output_rate * dt - 1) > 1e-6:
+        raise ValueError(f"output_rate = {output_rate:g} Hz: 1/(output_rate dt) must be a whole number")
+    xtab, interval = _motion_table(motion, duration, dt)
+    t_steps = np.arange(n_steps + 1) * dt
+
+    if voltage is not None:
+        volts = [damper.check_voltage(v) for v in np.atleast_1d(voltage).tolist()]
+        mode, n = kernels.RIG_CONSTANT, len(volts)
+        series = np.zeros((n, 1))
+        vconst = np.array(volts)
+    else:
+        n, vconst = 1, np.zeros(1)
+        fn = command if command is not None else desired_force
+        series = np.asarray(np.broadcast_to(fn(t_steps), t_steps.shape), dtype=float)[None, :].copy()
+        if not np.all(np.isfinite(series)):
+            raise ValueError(f"{given[0]}: the function returned a non-finite value")
+        mode = kernels.RIG_COMMANDED if command is not None else kernels.RIG_TRACKING
+    if mode == kernels.RIG_TRACKING:
+        B = _check_number("B", B, "nonnegative", "")
+        G = _check_number("G", default_gain(damper) if G is None else G, "nonnegative", "V/N")
+    rows = n_steps // stride + (1 if n_steps % stride == 0 else 2)
+    out = np.zeros((n, rows, 9))
+    kernels.rig_batch(damper.law, np.tile(damper.pack(), (n, 1)), n_steps, stride, dt, xtab,
+                      interval, mode, vconst, series, np.full(n, float(B)), np.full(n, float(G or 0.0)), out)
+    if not np.all(np.isfinite(out)):
+        raise RuntimeError("the damper rig run diverged: a state stopped being finite")
+    names = ("x", "xd", "F", "z", "y", "u", "v", "E")
+    attrs = {
+        "x": ("m", "extension"), "xd": ("m/s", "extension rate"),
+        "F": ("N", "damper force, tension +"), "z": ("m", "hysteretic variable"),
+        "y": ("m", "Spencer internal displacement"), "u": ("V", "coil voltage after the lag"),
+        "v": ("V", "command voltage"), "E": ("J", "energy dissipated since t = 0"),
+    }
+    time = out[0, :, 0]
+    dims = ("voltage", "time") if voltage is not None else ("time",)
+    data = {}
+    for j, name in enumerate(names, start=1):
+        values = out[:, :, j] if voltage is not None else out[0, :, j]
+        unit, long = attrs[name]
+        data[name] = (dims, values, {"units": unit, "long_name": long})
+    coords = {"time": ("time", time, {"units": "s"})}
+    if voltage is not None:
+        coords["voltage"] = ("voltage", vconst, {"units": "V"})
+    else:
+        fn_name = "desired_force" if desired_force is not None else "command"
+        data[fn_name] = ("time", np.broadcast_to(fn(time), time.shape).astype(float),
+                         {"units": "N" if desired_force is not None else "V"})
+    ds = xr.Dataset(data, coords=coords)
+    ds.attrs.update(damper=str(damper.to_dict()), dt_s=dt, integrator="RK4 with stiffness sub-steps")
+    if mode == kernels.RIG_TRACKING:
+        ds.attrs.update(B=float(B), G_v_per_n=float(G))
+    return ds
+
+
+def default_gain(damper) -> float:
+    """G [V/N] that saturates the voltage at a force error of a tenth of the damper's range
+    (hand-set; the tuner of issue 5 replaces it)."""
+    f_max = abs(yield_force(damper, damper.v_max))
+    return damper.v_max / (0.1 * f_max) if f_max > 0 else 0.0
+
+
+def yield_force(damper, v: float) -> float:
+    """The yield force alpha(v) z_bound of a hysteretic damper (0 for a dashpot)."""
+    if damper.law == dampers.LAW_VISCOUS:
+        return 0.0
+    return (damper.alpha_a + damper.alpha_b * v) * damper.z_bound
+
+
+# -- hysteresis cycles ---------------------------------------------------------------------------
+@dataclass
+class Cycles:
+    """Steady-state cycles of a damper driven by a sine at several constant voltages."""
+
+    damper: object
+    motion: SineMotion
+    dataset: xr.Dataset  # the last cycle of each voltage (dims voltage, time)
+
+    def table(self) -> list[dict]:
+        """Per voltage: maximum and minimum force [N] and energy dissipated per cycle [J]."""
+        ds = self.dataset
+        rows = []
+        for v in ds.voltage.values:
+            cyc = ds.sel(voltage=v)
+            rows.append({
+                "voltage_v": float(v),
+                "force_max_n": float(cyc.F.max()),
+                "force_min_n": float(cyc.F.min()),
+                "energy_per_cycle_j": float(cyc.E.values[-1] - cyc.E.values[0]),
+            })
+        return rows
+
+    def to_dict(self) -> dict:
+        return {"damper": self.damper.to_dict(), "amplitude_m": self.motion.amplitude,
+                "frequency_hz": self.motion.frequency, "cycles": self.table()}
+
+    def plot(self, path=None):
+        from .report import plot_hysteresis
+        return plot_hysteresis(self, path)
+
+
+def cycles(damper, amplitude: float, frequency: float, voltages, *, n_cycles: int = 4,
+           dt: float = DEFAULT_DT, points_per_cycle: int = 400) -> Cycles:
+    """Drive ``damper`` with x = amplitude sin(2 pi frequency t) at each constant voltage for
+    ``n_cycles`` cycles and keep the last one, a steady state: the hysteretic and coil states
+    forget their start within a cycle or two."""
+    damper = _resolve(damper)
+    motion = SineMotion(amplitude, frequency)
+    if not (isinstance(n_cycles, int) and n_cycles >= 2):
+        raise ValueError(f"n_cycles = {n_cycles!r}: must be a whole number >= 2")
+    if np.ndim(voltages) == 0:
+        voltages = [voltages]
+    period = 1.0 / motion.frequency
+    steps_per_cycle = int(round(period / dt))
+    if abs(steps_per_cycle * dt - period) > 1e-9 * period:
+        # keep a whole number of steps per cycle so the last cycle is exact
+        dt = period / max(steps_per_cycle, 1)
+    stride = max(1, steps_per_cycle // points_per_cycle)
+    while steps_per_cycle % stride:
+        stride -= 1
+    ds = drive(damper, motion, duration=n_cycles * period, voltage=list(voltages), dt=dt,
+               output_rate=1.0 / (stride * dt))
+    last = ds.isel(time=slice(-(steps_per_cycle // stride) - 1, None))
+    return Cycles(damper, motion, last)
+
+
+# -- force tracking (paper Fig. 6) ----------------------------------------------------------------
+@dataclass
+class Tracking:
+    """Force tracking of a desired force by the inner loop on a prescribed motion."""
+
+    dataset: xr.Dataset
+    desired: str
+    window: tuple[float, float]
+
+    def metrics(self) -> dict:
+        ds = self.dataset.sel(time=slice(*self.window))
+        err = ds.F.values - ds.desired_force.values
+        rms_demand = float(np.sqrt(np.mean(ds.desired_force.values**2)))
+        rms_err = float(np.sqrt(np.mean(err**2)))
+        return {"rms_error_n": rms_err, "rms_demand_n": rms_demand,
+                "normalised_rms_error": rms_err / rms_demand if rms_demand > 0 else math.nan,
+                "window_s": list(self.window)}
+
+    def plot(self, path=None):
+        from .report import plot_tracking
+        return plot_tracking(self, path)
+
+
+def desired_force_signal(kind: str, amplitude: float, frequency: float):
+    """f_d(t) [N]: "sine" A sin(2 pi f t) or "sawtooth" rising from -A to A each period,
+    crossing 0 upwards at t = 0, 1/f, ..."""
+    amplitude = _check_number("amplitude", amplitude, "nonnegative", "N")
+    frequency = _check_number("frequency", frequency, "positive", "Hz")
+    if kind == "sine":
+        return lambda t: amplitude * np.sin(2 * np.pi * frequency * t)
+    if kind == "sawtooth":
+        return lambda t: amplitude * (2.0 * np.mod(frequency * t + 0.5, 1.0) - 1.0)
+    raise ValueError(f"desired = {kind!r}: allowed 'sine', 'sawtooth'")
+
+
+def track(damper="railway", desired: str = "sine", amplitude: float = 10e3, frequency: float = 1.0,
+          *, B: float = 1.0, G: float | None = None, stroke: float = 0.02,
+          n_cycles: int = 3, dt: float = DEFAULT_DT) -> Tracking:
+    """The inner loop of spec section 6 tracking a sine or sawtooth desired force (amplitude
+    [N], frequency [Hz]) while the damper is stroked by x = -stroke cos(2 pi f t), whose
+    velocity is in phase with a sine demand, so that the demand is dissipative where the
+    damper's range allows. Metrics leave out the first cycle (start-up)."""
+    damper = _resolve(damper)
+    fd = desired_force_signal(desired, amplitude, frequency)
+    stroke = _check_number("stroke", stroke, "positive", "m")
+    motion = SineMotion(stroke, frequency, phase_deg=-90.0)
+    period = 1.0 / frequency
+    ds = drive(damper, motion, duration=n_cycles * period, desired_force=fd, B=B, G=G, dt=dt)
+    return Tracking(ds, desired, (period, n_cycles * period))
