@@ -37,7 +37,7 @@ from .params import param, validate_fields
 LAW_VISCOUS = 1
 LAW_BOUC_WEN = 2
 LAW_SPENCER = 3
-#: length of the packed parameter vector handed to the stepper
+#: length of the packed parameter vector handed to the stepper (slot 15: the bound of |z|)
 N_PACKED = 16
 #: internal states per damper in the stepper: z, y (Spencer only), u
 N_DAMPER_STATES = 3
@@ -127,6 +127,7 @@ class BoucWen(_Damper):
         p = np.zeros(N_PACKED)
         p[:12] = [self.alpha_a, self.alpha_b, self.c0a, self.c0b, self.k0, self.A, self.n,
                   self.gamma, self.beta, self.eta, self.v_min, self.v_max]
+        p[15] = self.z_bound
         return p
 
     def rates(self, x, xd, z, y, u, v):
@@ -182,6 +183,7 @@ class Spencer(_Damper):
         p[:15] = [self.alpha_a, self.alpha_b, self.c0a, self.c0b, self.k0, self.A, self.n,
                   self.gamma, self.beta, self.eta, self.v_min, self.v_max,
                   self.c1a, self.c1b, self.k1]
+        p[15] = self.z_bound
         return p
 
     def rates(self, x, xd, z, y, u, v):
@@ -242,13 +244,16 @@ def preset(name: str):
 
 
 def stiffness_estimate(damper, xd: float, z: float, u: float) -> float:
-    """A bound on the fastest rate of the damper's internal states [1/s] (for sub-stepping)."""
+    """A bound on the fastest rate of the damper's internal states [1/s] (for sub-stepping):
+    the Jacobian of z' (and y') with |z| taken at least at its bound, since from z = 0 the rate
+    grows within a step."""
     if damper.law == LAW_VISCOUS:
         return 0.0
     gb = abs(damper.gamma) + abs(damper.beta)
-    lam = damper.n * gb * abs(xd) * abs(z) ** (damper.n - 1) + damper.eta
+    az = max(abs(z), damper.z_bound)
+    lam = damper.n * gb * abs(xd) * az ** (damper.n - 1) + damper.eta
     if damper.law == LAW_SPENCER:
         alpha = damper.alpha_a + damper.alpha_b * u
         cs = damper.c0a + damper.c0b * u + damper.c1a + damper.c1b * u
-        lam += (damper.A + gb * abs(z) ** damper.n) * alpha / cs + damper.k0 / cs
+        lam += ((damper.A + gb * az**damper.n) * alpha + damper.k0) / cs
     return lam

@@ -37,8 +37,9 @@ _FAST = {"reassoc", "contract", "nsz", "arcp"}
 LAW_VISCOUS_IN_C = 0
 N_DS = N_CORNER * N_DAMPER_STATES  # damper states of the vehicle
 NS_MAX = 2 * N_DOF + N_DS  # state (q, q', damper states)
-#: sub-step so that (fastest damper rate) x (sub-step) stays below this
+#: sub-steps resolve the fastest damper rate: rate x SUBSTEP_DT_REF / (sub-steps) <= this
 SUBSTEP_LIMIT = 0.5
+SUBSTEP_DT_REF = 1e-4
 MAX_SUBSTEPS = 1024
 
 #: how the damper rig sets the command voltage (see `rig_batch`)
@@ -198,12 +199,13 @@ def damper_law(law, P, x, xd, z, y, u, v):
 @njit(cache=True, fastmath=_FAST)
 def damper_stiffness(law, P, xd, z, u):
     """A bound on the fastest rate of the damper's internal states [1/s]
-    (same as railride.dampers.stiffness_estimate)."""
+    (same as railride.dampers.stiffness_estimate). |z| is taken at least at the bound of the
+    hysteretic variable (P[15]): starting from z = 0 the rate grows within the step."""
     if law == LAW_VISCOUS or law == LAW_VISCOUS_IN_C:
         return 0.0
     gb = abs(P[7]) + abs(P[8])
     n = P[6]
-    az = abs(z)
+    az = max(abs(z), P[15])
     lam = n * gb * abs(xd) * (1.0 if n == 1.0 else az ** (n - 1.0)) + P[9]
     if law == LAW_SPENCER:
         cs = P[2] + P[3] * u + P[12] + P[13] * u
@@ -213,9 +215,15 @@ def damper_stiffness(law, P, xd, z, u):
 
 @njit(cache=True)
 def substeps(lam, dt):
-    """Sub-steps (a power of two) that keep lam * dt / m <= SUBSTEP_LIMIT."""
+    """Sub-steps per step (a power of two) for a fastest damper rate lam [1/s].
+
+    The count depends on lam alone, lam * SUBSTEP_DT_REF / m <= SUBSTEP_LIMIT, so a smaller dt
+    gives proportionally smaller sub-steps and step halving refines the whole scheme; a floor
+    keeps lam * dt / m <= 2 * SUBSTEP_LIMIT for stability when dt is large.
+    """
     m = 1
-    while lam * dt > SUBSTEP_LIMIT * m and m < MAX_SUBSTEPS:
+    while (lam * SUBSTEP_DT_REF > SUBSTEP_LIMIT * m or lam * dt > 2.0 * SUBSTEP_LIMIT * m) \
+            and m < MAX_SUBSTEPS:
         m *= 2
     return m
 
