@@ -160,9 +160,7 @@ def _command_voltages(damper, voltage, n: int) -> np.ndarray:
         return np.zeros((n, 4))
     if voltage is None:
         voltage = damper.v_min
-    values = [voltage] * n if np.ndim(voltage) == 0 else list(voltage)
-    if len(values) != n:
-        raise ValueError(f"voltage: give one value or one per sample ({n}); got {len(values)}")
+    values = [voltage] * n if np.ndim(voltage) == 0 else list(voltage) * (n // len(voltage))
     return np.repeat([[damper.check_voltage(v)] for v in values], 4, axis=1).astype(float)
 
 
@@ -185,22 +183,24 @@ def simulate(scenario=None, params=None, *, dt: float = DEFAULT_DT,
     ``damper`` None keeps the passive viscous secondary dampers (c_sz); a damper model from
     `railride.dampers` (or a preset name: railway, dyke1996, spencer1997) replaces them at all
     four corners, driven at the constant command ``voltage`` [V] (default: the model's v_min,
-    "passive-off"; a list gives one voltage per sample). The coil starts at that voltage and
-    the hysteretic states at 0.
+    "passive-off"; a list runs one sample per voltage, like a list of scenarios). The coil starts
+    at that voltage and the hysteretic states at 0.
     ``initial_state`` is (q, q') at t = 0 as 18 numbers in DOF order (m, rad, m/s, rad/s), or
     one row per sample; by default the vehicle starts at rest in equilibrium.
     ``progress(done_fraction)`` is called between chunks of a long run.
     """
     dt = _positive("dt", dt)
     output_rate = _positive("output_rate", output_rate)
+    n_volt = 1 if voltage is None or np.ndim(voltage) == 0 else len(voltage)
     batch = not (isinstance(scenario, (Scenario, str)) or scenario is None) or not (
-        isinstance(params, (VehicleParams, str)) or params is None)
+        isinstance(params, (VehicleParams, str)) or params is None) or np.ndim(voltage) > 0
     scenarios = [_resolve_scenario(s) for s in _as_list(scenario)]
     param_sets = [_resolve_params(p) for p in _as_list(params)]
-    n = max(len(scenarios), len(param_sets))
-    if len(scenarios) not in (1, n) or len(param_sets) not in (1, n):
-        raise ValueError(f"a batch needs equally many scenarios and parameter sets, or one of either; "
-                         f"got {len(scenarios)} scenarios and {len(param_sets)} parameter sets")
+    n = max(len(scenarios), len(param_sets), n_volt)
+    if any(k not in (1, n) for k in (len(scenarios), len(param_sets), n_volt)):
+        raise ValueError(f"a batch needs equally many scenarios, parameter sets and voltages, or one "
+                         f"of each; got {len(scenarios)} scenarios, {len(param_sets)} parameter sets "
+                         f"and {n_volt} voltages")
     if n == 0:
         raise ValueError("an empty batch: give at least one scenario")
     scenarios = scenarios * (n // len(scenarios))

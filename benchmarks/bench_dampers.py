@@ -1,0 +1,66 @@
+"""MR damper benchmarks (issue 3): the vehicle with four MR dampers, the damper rig.
+
+Run:  python benchmarks/bench_dampers.py [--repeat N]
+Prints a Markdown table for docs/performance.md (wall-clock minima; no test asserts timings).
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+
+import numpy as np
+
+
+def _min_time(fn, repeat):
+    best = float("inf")
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        fn()
+        best = min(best, time.perf_counter() - t0)
+    return best
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__)
+    ap.add_argument("--repeat", type=int, default=5)
+    args = ap.parse_args()
+
+    from railride import rig
+    from railride.simulate import simulate
+    from railride.track import scenario
+
+    sc = scenario("paper-sine")  # 10 s at dt = 1e-4 s
+    rows = []
+    for damper, voltage, note in (("railway", 0.0, "passive-off"), ("railway", 2.25, "passive-on"),
+                                  ("dyke1996", 2.25, "small-scale damper")):
+        simulate(sc, damper=damper, voltage=voltage)
+        t = _min_time(lambda: simulate(sc, damper=damper, voltage=voltage), args.repeat)
+        rows.append((f"vehicle, four `{damper}` MR dampers at {voltage:g} V ({note}), 10 s, dt = 1e-4 s",
+                     f"{t * 1e3:.1f} ms", "<= 50 ms" if damper == "railway" else ""))
+    simulate(scenario("paper-sine", duration=1.0), damper="spencer1997", voltage=1.0)
+    t = _min_time(lambda: simulate(scenario("paper-sine", duration=1.0), damper="spencer1997",
+                                   voltage=1.0), max(1, args.repeat // 2))
+    rows.append(("vehicle, four `spencer1997` dampers at 1 V, 1 s (stiff: sub-stepped)", f"{t:.2f} s", ""))
+    sc_batch = scenario("paper-sine", duration=2.0)
+    volts = list(np.linspace(0.0, 2.25, 64))
+    simulate(sc_batch, damper="railway", voltage=volts)
+    t = _min_time(lambda: simulate(sc_batch, damper="railway", voltage=volts), max(1, args.repeat // 2))
+    rows.append(("batch of 64 voltages x 20 000 steps, `railway` dampers, both cores",
+                 f"{64 * 20_000 / t / 1e6:.2f} M sample-steps/s", ""))
+    for name in ("railway", "spencer1997"):
+        rig.cycles(name, 0.015, 2.5, [0.0])
+        t = _min_time(lambda: rig.cycles(name, 0.015, 2.5, [0.0, 0.75, 1.5, 2.25]), args.repeat)
+        rows.append((f"rig: `{name}`, 4 voltages x 4 cycles at 2.5 Hz, dt = 1e-4 s", f"{t * 1e3:.1f} ms", ""))
+    rig.track("railway")
+    t = _min_time(lambda: rig.track("railway"), args.repeat)
+    rows.append(("rig: force tracking, 3 cycles at 1 Hz", f"{t * 1e3:.1f} ms", ""))
+
+    print("| benchmark | result | target |")
+    print("|---|---|---|")
+    for r in rows:
+        print("| " + " | ".join(r) + " |")
+
+
+if __name__ == "__main__":
+    main()
