@@ -1,7 +1,9 @@
-"""The ``railride`` command line: ``railride modes`` and ``railride simulate``.
+"""The ``railride`` command line: ``railride modes``, ``railride simulate``, ``railride damper``
+and ``railride tracking``.
 
 A thin layer over the library: it parses options, calls `railride.vehicle`, `railride.track`,
-`railride.simulate`, `railride.metrics` and `railride.report`, and prints. See docs/cli.md.
+`railride.simulate`, `railride.metrics`, `railride.dampers`, `railride.rig` and
+`railride.report`, and prints. See docs/cli.md.
 
 Exit statuses: 0 success, 1 the simulation diverged, 2 bad input (usage errors, invalid values,
 unreadable files, an output folder that cannot be written). Errors print one line
@@ -23,13 +25,23 @@ import typer
 from . import __version__
 
 SCHEMA_SIMULATE = "railride.simulate/1"
+SCHEMA_DAMPER = "railride.damper/1"
+SCHEMA_TRACKING = "railride.tracking/1"
+
+#: --suspension values of `simulate`
+SUSPENSIONS = ("passive", "mr")
+#: --desired values of `tracking` (the signals of railride.rig.desired_force_signal)
+DESIRED_SIGNALS = ("sine", "sawtooth")
+#: the damper preset used when --model / --damper is not given
+DEFAULT_DAMPER = "railway"
 
 app = typer.Typer(
     add_completion=False,
     no_args_is_help=True,
     pretty_exceptions_show_locals=False,
     rich_markup_mode=None,
-    help="Vertical ride of a 9-DOF railway vehicle: modes and simulated ride metrics.",
+    help="Vertical ride of a 9-DOF railway vehicle: modes, simulated ride metrics, and MR "
+         "damper rig tests (hysteresis cycles, force tracking).",
 )
 
 
@@ -100,6 +112,77 @@ def _vehicle_params(params_file: Optional[Path], preset: Optional[str]):
         return VehicleParams.load(params_file), {"vehicle_params_file": str(params_file)}
     name = "paper" if preset is None else preset
     return VehicleParams.preset(name), {"vehicle_preset": name}
+
+
+def _check_number(option: str, value: float, unit: str, *, allow_zero: bool = False) -> float:
+    """A finite number > 0 (>= 0 with ``allow_zero``), else ValueError naming the option."""
+    ok = math.isfinite(value) and (value >= 0 if allow_zero else value > 0)
+    if not ok:
+        rule = ">= 0" if allow_zero else "> 0"
+        unit = f" {unit}" if unit else ""
+        raise ValueError(f"{option} = {value:g}{unit}: must be a finite number {rule}")
+    return float(value)
+
+
+def _check_cycles(option: str, value: int) -> int:
+    if value < 2:
+        raise ValueError(f"{option} = {value}: must be a whole number >= 2 (the first cycle is "
+                         "start-up)")
+    return value
+
+
+def _damper_preset(option: str, name: str):
+    """The damper preset ``name`` (railride.dampers.PRESETS), else ValueError naming the option."""
+    from . import dampers
+
+    if name not in dampers.PRESETS:
+        raise ValueError(f"{option} = {name!r}: unknown damper model; allowed: "
+                         f"{', '.join(dampers.PRESETS)}")
+    return dampers.preset(name)
+
+
+def _voltage(option: str, text: str, damper) -> float:
+    """One voltage [V]: a number, ``passive-off`` (v_min) or ``passive-on`` (v_max), checked
+    against the damper's range."""
+    text = text.strip()
+    keywords = {"passive-off": damper.v_min, "passive-on": damper.v_max}
+    if text in keywords:
+        return float(keywords[text])
+    try:
+        value = float(text)
+    except ValueError:
+        raise ValueError(f"{option} = {text!r}: not a number of volts (nor passive-off, "
+                         "passive-on)") from None
+    return damper.check_voltage(value, option)
+
+
+def _voltage_list(option: str, text: str, damper) -> list[float]:
+    """A comma-separated list of distinct voltages [V], each checked against the damper's range."""
+    items = text.split(",")
+    if any(not item.strip() for item in items):
+        raise ValueError(f"{option} = {text!r}: an empty item; give volts separated by commas, "
+                         "e.g. 0,1,2.25")
+    values = [_voltage(option, item, damper) for item in items]
+    seen = set()
+    for v in values:
+        if v in seen:
+            raise ValueError(f"{option} = {text!r}: {v:g} V is listed twice")
+        seen.add(v)
+    return values
+
+
+def _write_folder(out: Path, write) -> None:
+    """Run ``write()`` (a report.write_* call) with a status note; OSError -> status 2."""
+    try:
+        with _status(f"writing outputs to {out}..."):
+            paths = write()
+    except OSError as exc:
+        raise CliError(f"cannot write the output folder {out}: {exc.strerror or exc}", 2) from None
+    typer.echo(f"wrote {', '.join(p.name for p in paths)} to {out}", err=True)
+
+
+def _print_json(doc) -> None:
+    typer.echo(json.dumps(doc, indent=2, allow_nan=False))
 
 
 # -- options shared by both commands ------------------------------------------------------------
@@ -187,6 +270,12 @@ def _status(message: str):
     return _stderr_console().status(message)
 
 
+def _describe_suspension(record: dict) -> str:
+    if record.get("type") == "mr":
+        return f"MR, {record['damper']} dampers at {record['voltage_v']:g} V"
+    return "passive (viscous c_sz)"
+
+
 def _metrics_table(doc: dict):
     from rich.markup import escape
     from rich.table import Table
@@ -200,6 +289,7 @@ def _metrics_table(doc: dict):
         f"scenario {sc.get('name')}, speed {sc.get('speed_m_s'):g} m/s",
         f"duration {sc.get('duration_s'):g} s, dt {st['dt_s']:g} s, window {start:g}-{end:g} s",
         f"vehicle {vehicle}",
+        f"suspension {_describe_suspension(doc.get('suspension') or {'type': 'passive'})}",
     ])
     table = Table(title="Ride metrics (carbody CG)", caption=escape(caption))
     table.add_column("response")
@@ -240,6 +330,18 @@ def simulate(
         "--window", metavar="START:END",
         help="Time window of the metrics [s], e.g. 2:10; either side may be empty "
              "(default: the whole run).")] = None,
+    suspension: Annotated[str, typer.Option(
+        "--suspension", metavar="passive|mr",
+        help="Secondary vertical dampers: passive (viscous c_sz) or mr (an MR damper model at "
+             "each corner, constant command voltage).")] = "passive",
+    damper: Annotated[Optional[str], typer.Option(
+        "--damper", metavar="MODEL",
+        help="--suspension mr only: damper model railway, dyke1996 or spencer1997 "
+             "(default railway).")] = None,
+    voltage: Annotated[Optional[str], typer.Option(
+        "--voltage", metavar="V",
+        help="--suspension mr only: constant command voltage [V] within the damper's range, or "
+             "passive-off (v_min, the default) or passive-on (v_max).")] = None,
     params: ParamsOption = None,
     preset: PresetOption = None,
     format: FormatOption = OutputFormat.table,
@@ -248,18 +350,36 @@ def simulate(
         help="Also write ride.nc, ride.csv, metrics.json and body_responses.png into DIR "
              "(created if missing; all or nothing).")] = None,
 ) -> None:
-    """Simulate the passive vehicle on a track and print the ride metrics."""
+    """Simulate the vehicle on a track and print the ride metrics."""
     with _errors():
         doc, result = _run(scenario, amplitude, wavelength, rail_phase, speed, duration, dt,
-                           output_rate, window, params, preset, out)
+                           output_rate, window, params, preset, out, suspension, damper, voltage)
     if format is OutputFormat.json:
-        typer.echo(json.dumps(doc, indent=2, allow_nan=False))
+        _print_json(doc)
     else:
         _stdout_console().print(_metrics_table(doc))
 
 
+def _suspension(suspension: str, damper_name, voltage_text):
+    """(damper model or None, command voltage or None, the record for the JSON document)."""
+    if suspension not in SUSPENSIONS:
+        raise ValueError(f"--suspension = {suspension!r}: allowed {', '.join(SUSPENSIONS)}")
+    if suspension == "passive":
+        given = [o for o, v in (("--damper", damper_name), ("--voltage", voltage_text)) if v is not None]
+        if given:
+            verb = "applies" if len(given) == 1 else "apply"
+            raise ValueError(f"{' and '.join(given)} {verb} to --suspension mr only (the passive "
+                             "suspension has viscous dampers)")
+        return None, None, {"type": "passive"}
+    name = DEFAULT_DAMPER if damper_name is None else damper_name
+    model = _damper_preset("--damper", name)
+    volts = model.v_min if voltage_text is None else _voltage("--voltage", voltage_text, model)
+    return model, float(volts), {"type": "mr", "damper": name, "voltage_v": float(volts)}
+
+
 def _run(scenario_name, amplitude, wavelength, rail_phase, speed, duration, dt, output_rate,
-         window_text, params_file, preset, out):
+         window_text, params_file, preset, out, suspension="passive", damper_name=None,
+         voltage_text=None):
     from . import report
     from .metrics import check_window, parse_window, to_dict
     from .simulate import DEFAULT_DT, DEFAULT_OUTPUT_RATE, simulate as run_simulation
@@ -268,6 +388,7 @@ def _run(scenario_name, amplitude, wavelength, rail_phase, speed, duration, dt, 
     dt = DEFAULT_DT if dt is None else dt
     output_rate = DEFAULT_OUTPUT_RATE if output_rate is None else output_rate
     vehicle_params, vehicle_record = _vehicle_params(params_file, preset)
+    damper, voltage, suspension_record = _suspension(suspension, damper_name, voltage_text)
     window = parse_window(window_text) if window_text is not None else None
     scen = make_scenario(scenario_name, amplitude=amplitude, wavelength=wavelength,
                          rail_phase=rail_phase, speed=speed, duration=duration)
@@ -278,6 +399,7 @@ def _run(scenario_name, amplitude, wavelength, rail_phase, speed, duration, dt, 
 
     with _Progress(_stderr_is_terminal()) as progress:
         result = run_simulation(scen, vehicle_params, dt=dt, output_rate=output_rate,
+                                damper=damper, voltage=voltage,
                                 progress=progress if progress.enabled else None)
     metrics = result.metrics(window)
     doc = {
@@ -285,18 +407,197 @@ def _run(scenario_name, amplitude, wavelength, rail_phase, speed, duration, dt, 
         "railride_version": __version__,
         "scenario": scen.describe(),
         **vehicle_record,
+        "suspension": suspension_record,
         "settings": {"dt_s": float(dt), "output_rate_hz": float(output_rate),
                      "window_s": [float(start), float(end)]},
         "metrics": to_dict(metrics),
     }
     if out is not None:
-        try:
-            with _status(f"writing outputs to {out}..."):
-                report.write_outputs(result, out, doc)
-        except OSError as exc:
-            raise CliError(f"cannot write the output folder {out}: {exc.strerror or exc}", 2) from None
-        typer.echo(f"wrote {', '.join(report.OUTPUT_FILES)} to {out}", err=True)
+        _write_folder(out, lambda: report.write_outputs(result, out, doc))
     return doc, result
+
+
+# -- damper -------------------------------------------------------------------------------------
+@app.command()
+def damper(
+    model: Annotated[str, typer.Option(
+        "--model", metavar="MODEL",
+        help="Damper model: railway, dyke1996 or spencer1997.")] = DEFAULT_DAMPER,
+    amplitude: Annotated[float, typer.Option(
+        "--amplitude", metavar="M", help="Amplitude of the sine extension x [m], > 0.")] = ...,
+    frequency: Annotated[float, typer.Option(
+        "--frequency", metavar="HZ", help="Frequency of the sine extension [Hz], > 0.")] = ...,
+    voltage: Annotated[str, typer.Option(
+        "--voltage", metavar="V[,V...]",
+        help="Constant command voltages [V], comma-separated, each within the damper's range "
+             "(passive-off and passive-on stand for its lowest and highest voltage).")] = ...,
+    cycles: Annotated[int, typer.Option(
+        "--cycles", metavar="N",
+        help="Cycles driven per voltage, >= 2; the last one is reported (steady state).")] = 4,
+    format: FormatOption = OutputFormat.table,
+    out: Annotated[Optional[Path], typer.Option(
+        "--out", metavar="DIR",
+        help="Also write loops.png, cycles.csv and damper.json into DIR (created if missing; "
+             "all or nothing).")] = None,
+) -> None:
+    """Hysteresis cycles of an MR damper on a test rig.
+
+    The damper is stroked by x = A sin(2 pi f t) at each constant voltage; per voltage the
+    command prints the force range and the energy dissipated in the last (steady-state) cycle.
+    """
+    with _errors():
+        from . import report, rig
+
+        damper_model = _damper_preset("--model", model)
+        amplitude = _check_number("--amplitude", amplitude, "m")
+        frequency = _check_number("--frequency", frequency, "Hz")
+        volts = _voltage_list("--voltage", voltage, damper_model)
+        n_cycles = _check_cycles("--cycles", cycles)
+        if out is not None:
+            report.check_out_dir(out)
+        with _status("driving the damper..."):
+            result = rig.cycles(damper_model, amplitude, frequency, volts, n_cycles=n_cycles)
+        record = result.to_dict()
+        doc = {
+            "schema": SCHEMA_DAMPER,
+            "railride_version": __version__,
+            "damper": record["damper"],
+            "amplitude_m": float(record["amplitude_m"]),
+            "frequency_hz": float(record["frequency_hz"]),
+            "cycles": [{key: float(row[key]) for key in ("voltage_v", "force_max_n", "force_min_n",
+                                                       "energy_per_cycle_j")}
+                       for row in record["cycles"]],
+        }
+        title = (f"{model} damper ({damper_model.model} model), x = {amplitude * 1e3:g} mm "
+                 f"sin(2 pi {frequency:g} Hz t), cycle {n_cycles} of {n_cycles}")
+        if not all(math.isfinite(v) for row in doc["cycles"] for v in row.values()):
+            raise RuntimeError("the damper rig run gave a non-finite force or energy")
+        if out is not None:
+            _write_folder(out, lambda: report.write_damper_outputs(result, out, doc, title=title))
+    if format is OutputFormat.json:
+        _print_json(doc)
+        return
+    from rich.markup import escape
+    from rich.table import Table
+
+    table = Table(title=escape(f"Damper cycles: {model} ({damper_model.model} model)"),
+                  caption=escape(f"x = {amplitude:g} m sin(2 pi {frequency:g} Hz t); cycle "
+                                 f"{n_cycles} of {n_cycles} (steady state)\nforce F: tension +"))
+    table.add_column("voltage (V)", justify="right")
+    table.add_column("max force (kN)", justify="right")
+    table.add_column("min force (kN)", justify="right")
+    table.add_column("energy per cycle (J)", justify="right")
+    for row in doc["cycles"]:
+        table.add_row(f"{row['voltage_v']:g}", f"{row['force_max_n'] / 1e3:.3f}",
+                      f"{row['force_min_n'] / 1e3:.3f}", f"{row['energy_per_cycle_j']:.4g}")
+    _stdout_console().print(table)
+
+
+# -- tracking -----------------------------------------------------------------------------------
+@app.command()
+def tracking(
+    desired: Annotated[str, typer.Option(
+        "--desired", metavar="sine|sawtooth",
+        help="Desired force: sine, or sawtooth (rising from -A to A each period).")] = "sine",
+    amplitude: Annotated[float, typer.Option(
+        "--amplitude", metavar="N", help="Amplitude of the desired force [N], > 0.")] = 10e3,
+    frequency: Annotated[float, typer.Option(
+        "--frequency", metavar="HZ",
+        help="Frequency of the desired force and of the stroke [Hz], > 0.")] = 1.0,
+    gain_b: Annotated[float, typer.Option(
+        "--B", metavar="B", help="Inner-loop gain B on the measured force [-], >= 0.")] = 1.0,
+    gain_g: Annotated[Optional[float], typer.Option(
+        "--G", metavar="V/N",
+        help="Inner-loop gain G [V/N], >= 0 (default: the damper's default gain, which "
+             "saturates the voltage at a force error of a tenth of its range).")] = None,
+    model: Annotated[str, typer.Option(
+        "--model", metavar="MODEL",
+        help="Damper model: railway, dyke1996 or spencer1997.")] = DEFAULT_DAMPER,
+    stroke: Annotated[float, typer.Option(
+        "--stroke", metavar="M",
+        help="Amplitude of the prescribed extension x = -stroke cos(2 pi f t) [m], > 0.")] = 0.02,
+    cycles: Annotated[int, typer.Option(
+        "--cycles", metavar="N",
+        help="Cycles simulated, >= 2; the metrics leave out the first (start-up).")] = 3,
+    format: FormatOption = OutputFormat.table,
+    out: Annotated[Optional[Path], typer.Option(
+        "--out", metavar="DIR",
+        help="Also write tracking.png, tracking.csv and tracking.json into DIR (created if "
+             "missing; all or nothing).")] = None,
+) -> None:
+    """Force tracking of an MR damper by the inner loop.
+
+    The inner loop of spec section 6 sets the voltage so that a damper stroked by
+    x = -stroke cos(2 pi f t) follows a desired force; prints the RMS tracking error.
+    """
+    with _errors():
+        from . import report, rig
+
+        if desired not in DESIRED_SIGNALS:
+            raise ValueError(f"--desired = {desired!r}: allowed {', '.join(DESIRED_SIGNALS)}")
+        damper_model = _damper_preset("--model", model)
+        amplitude = _check_number("--amplitude", amplitude, "N")
+        frequency = _check_number("--frequency", frequency, "Hz")
+        gain_b = _check_number("--B", gain_b, "", allow_zero=True)
+        if gain_g is not None:
+            gain_g = _check_number("--G", gain_g, "V/N", allow_zero=True)
+        stroke = _check_number("--stroke", stroke, "m")
+        n_cycles = _check_cycles("--cycles", cycles)
+        if out is not None:
+            report.check_out_dir(out)
+        with _status("tracking..."):
+            result = rig.track(damper_model, desired, amplitude, frequency, B=gain_b, G=gain_g,
+                               stroke=stroke, n_cycles=n_cycles)
+        metrics = result.metrics()
+        attrs = result.dataset.attrs
+        doc = {
+            "schema": SCHEMA_TRACKING,
+            "railride_version": __version__,
+            "damper": damper_model.to_dict(),
+            "desired": desired,
+            "amplitude_n": amplitude,
+            "frequency_hz": frequency,
+            "stroke_m": stroke,
+            "B": float(attrs["B"]),  # the gains the inner loop used (G filled in if default)
+            "G_v_per_n": float(attrs["G_v_per_n"]),
+            "metrics": {
+                "rms_error_n": float(metrics["rms_error_n"]),
+                "rms_demand_n": float(metrics["rms_demand_n"]),
+                "normalised_rms_error": float(metrics["normalised_rms_error"]),
+                "window_s": [float(t) for t in metrics["window_s"]],
+            },
+        }
+        bad = [k for k, v in doc["metrics"].items() if k != "window_s" and not math.isfinite(v)]
+        if bad:  # checked before anything is written
+            raise RuntimeError(f"the tracking run gave a non-finite {', '.join(bad)}")
+        title = (f"{desired} demand {amplitude / 1e3:g} kN at {frequency:g} Hz, {model} damper, "
+                 f"B = {doc['B']:g}, G = {doc['G_v_per_n']:.3g} V/N: normalised RMS error "
+                 f"{doc['metrics']['normalised_rms_error']:.3f}")
+        if out is not None:
+            _write_folder(out, lambda: report.write_tracking_outputs(result, out, doc, title=title))
+    if format is OutputFormat.json:
+        _print_json(doc)
+        return
+    from rich.markup import escape
+    from rich.table import Table
+
+    m = doc["metrics"]
+    start, end = m["window_s"]
+    caption = "\n".join([
+        f"desired force amplitude {amplitude:g} N at {frequency:g} Hz",
+        f"stroke x = -{stroke:g} m cos(2 pi f t); force tension +",
+        f"metrics over {start:g}-{end:g} s (after the first cycle)",
+    ])
+    table = Table(title=escape(f"Force tracking: {desired} demand, {model} damper"),
+                  caption=escape(caption), min_width=56)
+    table.add_column("quantity")
+    table.add_column("value", justify="right")
+    table.add_row("RMS tracking error (N)", f"{m['rms_error_n']:.5g}")
+    table.add_row("RMS demand (N)", f"{m['rms_demand_n']:.5g}")
+    table.add_row("normalised error (-)", f"{m['normalised_rms_error']:.4f}")
+    table.add_row("B (-)", f"{doc['B']:g}")
+    table.add_row("G (V/N)" + (" default" if gain_g is None else ""), f"{doc['G_v_per_n']:.4g}")
+    _stdout_console().print(table)
 
 
 def main() -> None:

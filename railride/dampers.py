@@ -56,7 +56,9 @@ class _Damper:
         return dataclasses.replace(self, **changes)
 
     def to_dict(self) -> dict:
-        return {"model": self.model, **dataclasses.asdict(self)}
+        """The model, the preset it equals (or None) and every parameter."""
+        name = next((k for k, v in PRESETS.items() if v == self), None)
+        return {"model": self.model, "preset": name, **dataclasses.asdict(self)}
 
     @classmethod
     def describe(cls) -> list[tuple[str, str, str]]:

@@ -4,6 +4,9 @@
 * `plot_body_responses` draws the four carbody responses (acceleration, bounce, pitch, roll).
 * `write_outputs` writes ``ride.nc``, ``ride.csv``, ``metrics.json`` and ``body_responses.png``
   into a folder, all or nothing.
+* `plot_hysteresis` and `plot_tracking` draw the damper rig results of `railride.rig`;
+  `write_damper_outputs` and `write_tracking_outputs` write their folders.
+* `write_folder` is the all-or-nothing folder writer behind the three ``write_*`` functions.
 
 Figures are built on matplotlib's object API with the Agg canvas: nothing here touches pyplot's
 global figure list or the user's backend, so no window ever opens and saved figures do not pile
@@ -30,6 +33,12 @@ RECORD_VARIABLES = ("scenario", "vehicle_params")
 
 #: the files `write_outputs` produces, in the order they are written
 OUTPUT_FILES = ("ride.nc", "ride.csv", "metrics.json", "body_responses.png")
+#: the files `write_damper_outputs` produces, in the order they are written
+DAMPER_FILES = ("loops.png", "cycles.csv", "damper.json")
+#: the files `write_tracking_outputs` produces, in the order they are written
+TRACKING_FILES = ("tracking.png", "tracking.csv", "tracking.json")
+#: the time histories of a damper rig run (railride.rig), in CSV column order
+RIG_CHANNELS = ("x", "xd", "F", "z", "y", "u", "v", "E")
 
 #: (channel, factor to the plotted unit, axis label) of the four panels
 _PANELS = (
@@ -148,7 +157,8 @@ def describe_scenario(record: dict) -> str:
 def _title(ds: xr.Dataset) -> str:
     records = _records(ds, "scenario")
     if not records:
-        return "carbody responses"
+        suspension = _suspension_text(ds)
+        return f"carbody responses - {suspension}" if suspension else "carbody responses"
     texts = [describe_scenario(r) for r in records]
     if len(set(texts)) == 1:
         title = texts[0]
@@ -157,7 +167,22 @@ def _title(ds: xr.Dataset) -> str:
         title = "scenarios " + ", ".join(names)
     if "sample" in ds.dims:
         title = f"{title} ({ds.sizes['sample']} samples)"
+    suspension = _suspension_text(ds)
+    if suspension:
+        return (f"carbody responses - {title}\n{suspension}" if title
+                else f"carbody responses - {suspension}")
     return f"carbody responses - {title}" if title else "carbody responses"
+
+
+def _suspension_text(ds: xr.Dataset) -> str:
+    """"MR <model> dampers at <v> V" for a run with damper models, else ""."""
+    if "damper_command_voltage" not in ds.variables:
+        return ""
+    model = _rig_damper_model(ds) or "damper"
+    volts = np.unique(np.round(np.asarray(ds["damper_command_voltage"].values, dtype=float), 9))
+    if volts.size == 1:
+        return f"MR {model} dampers at {volts[0]:g} V"
+    return f"MR {model} dampers at {volts.min():g}-{volts.max():g} V"
 
 
 def plot_body_responses(ds: xr.Dataset, path=None):
@@ -201,6 +226,148 @@ def plot_body_responses(ds: xr.Dataset, path=None):
     return fig
 
 
+# -- damper rig (railride.rig) ----------------------------------------------------------------
+def _new_figure(figsize):
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=figsize, layout="constrained")
+    FigureCanvasAgg(fig)
+    return fig
+
+
+def _save_png(fig, path) -> None:
+    if path is not None:
+        atomic_write(Path(path), lambda tmp: fig.savefig(tmp, format="png", dpi=120))
+
+
+def _rig_damper_model(ds: xr.Dataset) -> str | None:
+    """The damper model name recorded in a rig Dataset's ``damper`` attribute, if readable."""
+    import ast
+
+    text = ds.attrs.get("damper")
+    if not isinstance(text, str):
+        return None
+    for parse in (json.loads, ast.literal_eval):
+        try:
+            record = parse(text)
+        except (ValueError, SyntaxError):
+            continue
+        if isinstance(record, dict) and isinstance(record.get("model"), str):
+            return record["model"]
+    return None
+
+
+def cycles_frame(cycles) -> pd.DataFrame:
+    """The steady-state cycles of `railride.rig.cycles` as one long table: columns ``voltage``
+    [V, the constant command of the run], ``time`` [s], then x [m], xd [m/s], F [N, tension +],
+    z, y [m], u, v [V], E [J, dissipated since the start of the run]; the voltages one after
+    another, in the order they were given."""
+    ds = _dataset(cycles)
+    missing = [c for c in RIG_CHANNELS if c not in ds.variables]
+    if missing or "voltage" not in ds.dims:
+        raise ValueError("expected the dataset of railride.rig.cycles (dims voltage, time; "
+                         f"channels {', '.join(RIG_CHANNELS)})")
+    frame = ds[list(RIG_CHANNELS)].to_dataframe(dim_order=["voltage", "time"])
+    return frame.reset_index()[["voltage", "time", *RIG_CHANNELS]]
+
+
+def plot_hysteresis(cycles, path=None, *, title: str | None = None):
+    """Force-displacement and force-velocity loops of `railride.rig.cycles`: the steady-state
+    (last) cycle at each voltage, one line per voltage, force in kN (tension +), extension in
+    mm, extension rate in m/s.
+
+    Saved as PNG at ``path`` when given (atomically). ``title`` replaces the default title
+    (the damper model and the motion). Returns the Agg `Figure` (never registered with pyplot).
+    """
+    from matplotlib import colormaps
+
+    ds = _dataset(cycles)
+    missing = [c for c in ("x", "xd", "F") if c not in ds.variables]
+    if missing or "voltage" not in ds.dims:
+        raise ValueError("expected the result of railride.rig.cycles (dims voltage, time; x, xd, F)")
+    fig = _new_figure((11.0, 4.8))
+    ax_x, ax_v = fig.subplots(1, 2, sharey=True)
+    volts = [float(v) for v in ds["voltage"].values]
+    cmap = colormaps["viridis"]
+    for i, v in enumerate(volts):
+        cyc = ds.isel(voltage=i)
+        colour = cmap(0.85 * i / max(1, len(volts) - 1))
+        force = cyc["F"].values / 1e3
+        ax_x.plot(cyc["x"].values * 1e3, force, color=colour, linewidth=1.2, label=f"{v:g} V")
+        ax_v.plot(cyc["xd"].values, force, color=colour, linewidth=1.2, label=f"{v:g} V")
+    ax_x.set_xlabel("extension x (mm)")
+    ax_v.set_xlabel("extension rate x' (m/s)")
+    ax_x.set_ylabel("damper force F (kN, tension +)")
+    ax_x.set_title("force - displacement", fontsize="medium")
+    ax_v.set_title("force - velocity", fontsize="medium")
+    for ax in (ax_x, ax_v):
+        ax.axhline(0.0, color="0.6", linewidth=0.5)
+        ax.axvline(0.0, color="0.6", linewidth=0.5)
+        ax.grid(True, linewidth=0.4, alpha=0.6)
+    ax_v.legend(title="command voltage", fontsize="small", loc="upper left")
+    if title is None:
+        damper = getattr(cycles, "damper", None)
+        motion = getattr(cycles, "motion", None)
+        model = getattr(damper, "model", None) or _rig_damper_model(ds) or "damper"
+        title = f"{model} damper, steady-state cycle"
+        if motion is not None:
+            title += (f", x = {motion.amplitude * 1e3:g} mm sin(2 pi {motion.frequency:g} Hz t)")
+    fig.suptitle(title, fontsize="medium")
+    _save_png(fig, path)
+    return fig
+
+
+def plot_tracking(tracking, path=None, *, title: str | None = None):
+    """Force tracking of `railride.rig.track`: top, the desired and the actual damper force
+    (kN, tension +) against time; bottom, the command voltage v and the coil voltage u (V).
+    The first cycle, left out of the metrics (start-up), is shaded.
+
+    Saved as PNG at ``path`` when given (atomically). ``title`` replaces the default title.
+    Returns the Agg `Figure`.
+    """
+    ds = _dataset(tracking)
+    missing = [c for c in ("F", "desired_force", "v", "u") if c not in ds.variables]
+    if missing:
+        raise ValueError(f"expected the result of railride.rig.track; missing {', '.join(missing)}")
+    fig = _new_figure((10.0, 6.5))
+    ax_f, ax_v = fig.subplots(2, 1, sharex=True, height_ratios=(3, 2))
+    time = ds["time"].values
+    ax_f.plot(time, ds["desired_force"].values / 1e3, color="0.15", linewidth=1.1,
+              linestyle="--", label="desired")
+    ax_f.plot(time, ds["F"].values / 1e3, color="tab:red", linewidth=1.1, label="actual")
+    ax_f.set_ylabel("damper force (kN, tension +)")
+    ax_f.legend(loc="upper right", fontsize="small", ncols=2)
+    ax_v.plot(time, ds["v"].values, color="tab:blue", linewidth=0.9, label="command v")
+    ax_v.plot(time, ds["u"].values, color="tab:orange", linewidth=1.2, label="coil u")
+    ax_v.set_ylabel("voltage (V)")
+    ax_v.set_xlabel("time (s)")
+    ax_v.legend(loc="upper right", fontsize="small", ncols=2)
+    window = getattr(tracking, "window", None)
+    for ax in (ax_f, ax_v):
+        ax.grid(True, linewidth=0.4, alpha=0.6)
+        if window is not None and window[0] > time[0]:
+            ax.axvspan(time[0], window[0], color="0.9", zorder=0)
+    ax_v.set_xlim(time[0], time[-1])
+    if title is None:
+        parts = [f"{getattr(tracking, 'desired', 'desired')} force tracking"]
+        model = _rig_damper_model(ds)
+        if model:
+            parts.append(f"{model} damper")
+        if "B" in ds.attrs and "G_v_per_n" in ds.attrs:
+            parts.append(f"B = {float(ds.attrs['B']):g}, G = {float(ds.attrs['G_v_per_n']):.3g} V/N")
+        if hasattr(tracking, "metrics"):
+            m = tracking.metrics()
+            if isinstance(m.get("normalised_rms_error"), float) and math.isfinite(m["normalised_rms_error"]):
+                parts.append(f"normalised RMS error {m['normalised_rms_error']:.3f}")
+        title = ", ".join(parts)
+    if window is not None and window[0] > time[0]:
+        title += "\n(shaded: start-up, left out of the metrics)"
+    fig.suptitle(title, fontsize="medium")
+    _save_png(fig, path)
+    return fig
+
+
 # -- NetCDF -----------------------------------------------------------------------------------
 def netcdf_ready(ds: xr.Dataset) -> xr.Dataset:
     """A copy of ``ds`` that scipy's netCDF3 writer accepts without losing data.
@@ -238,21 +405,19 @@ def check_out_dir(out_dir) -> Path:
     return out_dir
 
 
-def _write_staged(ds: xr.Dataset, stage: Path, metrics_doc: dict) -> None:
-    write_netcdf(ds, stage / "ride.nc")
-    to_frame(ds).to_csv(stage / "ride.csv")
-    text = json.dumps(metrics_doc, indent=2, allow_nan=False) + "\n"
-    (stage / "metrics.json").write_text(text, encoding="utf-8")
-    plot_body_responses(ds, stage / "body_responses.png")
+def _json_text(doc: dict) -> str:
+    """``doc`` as indented strict JSON (NaN or infinity raises ValueError)."""
+    return json.dumps(doc, indent=2, allow_nan=False) + "\n"
 
 
-def _move_into(stage: Path, out_dir: Path) -> None:
-    """Move the staged files into an existing ``out_dir``; on failure put everything back."""
+def _move_into(stage: Path, out_dir: Path, names) -> None:
+    """Move the staged files ``names`` into an existing ``out_dir``; on failure put everything
+    back."""
     backup = stage / ".previous"
     backup.mkdir()
     moved, saved = [], []
     try:
-        for name in OUTPUT_FILES:
+        for name in names:
             target = out_dir / name
             if target.exists() or target.is_symlink():
                 os.replace(target, backup / name)
@@ -273,20 +438,21 @@ def _move_into(stage: Path, out_dir: Path) -> None:
         raise
 
 
-def write_outputs(result, out_dir, metrics_doc: dict) -> list[Path]:
-    """Write the files of a run into ``out_dir``, all or nothing.
+def write_folder(out_dir, files) -> list[Path]:
+    """Write a set of files into ``out_dir``, all or nothing.
 
-    Files: ``ride.nc`` (the Dataset as NetCDF, see `netcdf_ready`), ``ride.csv`` (`to_frame`),
-    ``metrics.json`` (``metrics_doc`` as indented JSON; NaN or infinity is refused) and
-    ``body_responses.png`` (`plot_body_responses`). ``result`` is a `RideResult` or its Dataset.
-
-    Everything is first written into a hidden staging folder beside ``out_dir`` (same parent,
-    so renames are atomic). Only when all four files exist are they moved in: a missing
-    ``out_dir`` is created by renaming the staging folder; in an existing one, files of the
-    same names are replaced (other files stay) and restored if a move fails. On any error the
-    staging folder is removed and ``out_dir`` is left as it was. Returns the written paths.
+    ``files`` is a sequence of ``(name, write)`` pairs: ``write(path)`` must create the file
+    ``path``. Everything is first written, in the given order, into a hidden staging folder
+    beside ``out_dir`` (``.NAME.staging-XXXXXXXX``, same parent, so renames are atomic). Only
+    when every file exists are they moved in: a missing ``out_dir`` is created by renaming the
+    staging folder; in an existing one, files of the same names are replaced (other files stay)
+    and restored if a move fails. On any error the staging folder is removed and ``out_dir`` is
+    left as it was. Returns the written paths, in the given order.
     """
-    ds = _dataset(result)
+    files = list(files)
+    names = [name for name, _ in files]
+    if len(set(names)) != len(names) or any(Path(n).name != n or n.startswith(".") for n in names):
+        raise ValueError(f"write_folder: file names must be distinct plain names, got {names}")
     out_dir = check_out_dir(out_dir)
     parent = out_dir.absolute().parent
     parent.mkdir(parents=True, exist_ok=True)
@@ -302,7 +468,10 @@ def write_outputs(result, out_dir, metrics_doc: dict) -> list[Path]:
     if stage is None:
         raise OSError(f"cannot create a staging folder in {parent}")
     try:
-        _write_staged(ds, stage, metrics_doc)
+        for name, write in files:
+            write(stage / name)
+            if not (stage / name).is_file():
+                raise OSError(f"the writer of {name} created no file")
         if not out_dir.exists():
             try:
                 os.rename(stage, out_dir)  # a new folder appears complete, in one step
@@ -311,8 +480,53 @@ def write_outputs(result, out_dir, metrics_doc: dict) -> list[Path]:
                 if not out_dir.is_dir():  # not a race with another writer: a real failure
                     raise
         if stage is not None:
-            _move_into(stage, out_dir)
+            _move_into(stage, out_dir, names)
     finally:
         if stage is not None:
             shutil.rmtree(stage, ignore_errors=True)
-    return [out_dir / name for name in OUTPUT_FILES]
+    return [out_dir / name for name in names]
+
+
+def write_outputs(result, out_dir, metrics_doc: dict) -> list[Path]:
+    """Write the files of a run into ``out_dir``, all or nothing (`write_folder`).
+
+    Files: ``ride.nc`` (the Dataset as NetCDF, see `netcdf_ready`), ``ride.csv`` (`to_frame`),
+    ``metrics.json`` (``metrics_doc`` as indented JSON; NaN or infinity is refused) and
+    ``body_responses.png`` (`plot_body_responses`). ``result`` is a `RideResult` or its Dataset.
+    Returns the written paths.
+    """
+    ds = _dataset(result)
+    text = _json_text(metrics_doc)  # refuse NaN before any file is written
+    writers = {
+        "ride.nc": lambda path: write_netcdf(ds, path),
+        "ride.csv": lambda path: to_frame(ds).to_csv(path),
+        "metrics.json": lambda path: path.write_text(text, encoding="utf-8"),
+        "body_responses.png": lambda path: plot_body_responses(ds, path),
+    }
+    return write_folder(out_dir, [(name, writers[name]) for name in OUTPUT_FILES])
+
+
+def write_damper_outputs(cycles, out_dir, doc: dict, *, title: str | None = None) -> list[Path]:
+    """Write the hysteresis cycles of `railride.rig.cycles` into ``out_dir``, all or nothing:
+    ``loops.png`` (`plot_hysteresis`), ``cycles.csv`` (`cycles_frame`) and ``damper.json``
+    (``doc`` as indented strict JSON). Returns the written paths."""
+    text = _json_text(doc)
+    writers = {
+        "loops.png": lambda path: plot_hysteresis(cycles, path, title=title),
+        "cycles.csv": lambda path: cycles_frame(cycles).to_csv(path, index=False),
+        "damper.json": lambda path: path.write_text(text, encoding="utf-8"),
+    }
+    return write_folder(out_dir, [(name, writers[name]) for name in DAMPER_FILES])
+
+
+def write_tracking_outputs(tracking, out_dir, doc: dict, *, title: str | None = None) -> list[Path]:
+    """Write a force-tracking run of `railride.rig.track` into ``out_dir``, all or nothing:
+    ``tracking.png`` (`plot_tracking`), ``tracking.csv`` (`to_frame` of its Dataset: time, the
+    rig channels and ``desired_force``) and ``tracking.json`` (``doc``). Returns the paths."""
+    text = _json_text(doc)
+    writers = {
+        "tracking.png": lambda path: plot_tracking(tracking, path, title=title),
+        "tracking.csv": lambda path: to_frame(tracking.dataset).to_csv(path),
+        "tracking.json": lambda path: path.write_text(text, encoding="utf-8"),
+    }
+    return write_folder(out_dir, [(name, writers[name]) for name in TRACKING_FILES])

@@ -11,6 +11,7 @@ grid of whole steps and interpolated by cubic Hermite polynomials (railride.trac
 
 from __future__ import annotations
 
+import json
 import math
 from dataclasses import dataclass, field
 
@@ -179,7 +180,7 @@ def drive(damper, motion, *, duration: float, voltage=None, command=None, desire
         data[fn_name] = ("time", np.broadcast_to(fn(time), time.shape).astype(float),
                          {"units": "N" if desired_force is not None else "V"})
     ds = xr.Dataset(data, coords=coords)
-    ds.attrs.update(damper=str(damper.to_dict()), dt_s=dt, integrator="RK4 with stiffness sub-steps")
+    ds.attrs.update(damper=json.dumps(damper.to_dict()), dt_s=dt, integrator="RK4 with stiffness sub-steps")
     if mode == kernels.RIG_TRACKING:
         ds.attrs.update(B=float(B), G_v_per_n=float(G))
     return ds
@@ -237,13 +238,19 @@ def cycles(damper, amplitude: float, frequency: float, voltages, *, n_cycles: in
     ``n_cycles`` cycles and keep the last one, a steady state: the hysteretic and coil states
     forget their start within a cycle or two."""
     damper = _resolve(damper)
+    _check_number("amplitude", amplitude, "positive", "m")
     motion = SineMotion(amplitude, frequency)
     if not (isinstance(n_cycles, int) and n_cycles >= 2):
         raise ValueError(f"n_cycles = {n_cycles!r}: must be a whole number >= 2")
     if np.ndim(voltages) == 0:
         voltages = [voltages]
+    if len(set(float(v) for v in voltages)) != len(voltages):
+        raise ValueError(f"voltages = {list(voltages)!r}: each voltage once")
     period = 1.0 / motion.frequency
     steps_per_cycle = int(round(period / dt))
+    if steps_per_cycle < 100:
+        raise ValueError(f"frequency = {frequency!r} Hz: a cycle of {period:.3g} s is under 100 steps of "
+                         f"dt = {dt:g} s; lower the frequency or dt")
     if abs(steps_per_cycle * dt - period) > 1e-9 * period:
         # keep a whole number of steps per cycle so the last cycle is exact
         dt = period / max(steps_per_cycle, 1)
@@ -299,9 +306,18 @@ def track(damper="railway", desired: str = "sine", amplitude: float = 10e3, freq
     velocity is in phase with a sine demand, so that the demand is dissipative where the
     damper's range allows. Metrics leave out the first cycle (start-up)."""
     damper = _resolve(damper)
+    _check_number("amplitude", amplitude, "positive", "N")
     fd = desired_force_signal(desired, amplitude, frequency)
     stroke = _check_number("stroke", stroke, "positive", "m")
+    if not (isinstance(n_cycles, int) and n_cycles >= 2):
+        raise ValueError(f"n_cycles = {n_cycles!r}: must be a whole number >= 2 (the first is left out)")
     motion = SineMotion(stroke, frequency, phase_deg=-90.0)
     period = 1.0 / frequency
-    ds = drive(damper, motion, duration=n_cycles * period, desired_force=fd, B=B, G=G, dt=dt)
+    if period < 100 * dt:
+        raise ValueError(f"frequency = {frequency!r} Hz: a cycle of {period:.3g} s is under 100 steps of "
+                         f"dt = {dt:g} s; lower the frequency or dt")
+    # record at about 1 kHz, at least 200 points per cycle, on whole steps
+    stride = max(1, min(int(round(1e-3 / dt)), int(period / (200 * dt))))
+    ds = drive(damper, motion, duration=n_cycles * period, desired_force=fd, B=B, G=G, dt=dt,
+               output_rate=1.0 / (stride * dt))
     return Tracking(ds, desired, (period, n_cycles * period))

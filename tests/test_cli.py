@@ -90,7 +90,7 @@ def test_simulate_json_document():
     result = run("simulate", "--format", "json", "--duration", 2)
     assert result.exit_code == 0, result.output
     doc = json.loads(result.stdout)
-    assert list(doc) == ["schema", "railride_version", "scenario", "vehicle_preset", "settings", "metrics"]
+    assert list(doc) == ["schema", "railride_version", "scenario", "vehicle_preset", "suspension", "settings", "metrics"]
     assert doc["schema"] == "railride.simulate/1"
     assert doc["vehicle_preset"] == "paper"
     assert doc["scenario"]["name"] == "paper-sine" and doc["scenario"]["duration_s"] == 2.0
