@@ -27,7 +27,7 @@ def main():
     args = ap.parse_args()
 
     from railride import rig
-    from railride.simulate import simulate
+    from railride.simulation import simulate
     from railride.track import scenario
 
     sc = scenario("paper-sine")  # 10 s at dt = 1e-4 s

@@ -31,7 +31,7 @@ def _min_time(fn, repeat):
 
 
 def bench_single(repeat):
-    from railride.simulate import simulate
+    from railride.simulation import simulate
     from railride.track import scenario
 
     sc = scenario("paper-sine")  # 10 s at dt = 1e-4 s: 100 000 RK4 steps
@@ -45,7 +45,7 @@ def bench_single(repeat):
 def bench_kernel_only(repeat):
     """The compiled stepper alone, without building tables or the Dataset."""
     from railride import kernels
-    from railride.simulate import _forcing_table, _system_arrays
+    from railride.simulation import _forcing_table, _system_arrays
     from railride.track import scenario, wheelset_input_table
     from railride.vehicle import Vehicle
 
@@ -71,7 +71,7 @@ def bench_kernel_only(repeat):
 
 def bench_batch(n_samples, repeat):
     from railride.params import VehicleParams
-    from railride.simulate import simulate
+    from railride.simulation import simulate
     from railride.track import scenario
 
     base = VehicleParams.preset("paper")
@@ -97,7 +97,7 @@ def bench_cli(repeat):
     cold = time.perf_counter() - t0
     warm = _min_time(lambda: subprocess.run(cmd, check=True, capture_output=True), repeat)
     t0 = time.perf_counter()
-    subprocess.run([sys.executable, "-c", "import railride.simulate, railride.cli"], check=True)
+    subprocess.run([sys.executable, "-c", "import railride.simulation, railride.cli"], check=True)
     imports = time.perf_counter() - t0
     return cold, warm, imports
 

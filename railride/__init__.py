@@ -14,7 +14,7 @@ __version__ = "0.1.0"
 
 from .metrics import reduction, ride_metrics
 from .params import VehicleParams
-from .simulate import RideResult, simulate
+from .simulation import RideResult, simulate
 from .track import CosineBump, MeasuredTrack, Scenario, SineTrack, scenario
 from .vehicle import Vehicle
 

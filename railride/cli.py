@@ -2,7 +2,7 @@
 and ``railride tracking``.
 
 A thin layer over the library: it parses options, calls `railride.vehicle`, `railride.track`,
-`railride.simulate`, `railride.metrics`, `railride.dampers`, `railride.rig` and
+`railride.simulation`, `railride.metrics`, `railride.dampers`, `railride.rig` and
 `railride.report`, and prints. See docs/cli.md.
 
 Exit statuses: 0 success, 1 the simulation diverged, 2 bad input (usage errors, invalid values,
@@ -24,7 +24,7 @@ import typer
 
 from . import __version__
 
-SCHEMA_SIMULATE = "railride.simulate/1"
+SCHEMA_SIMULATE = "railride.simulation/1"
 SCHEMA_DAMPER = "railride.damper/1"
 SCHEMA_TRACKING = "railride.tracking/1"
 
@@ -382,7 +382,7 @@ def _run(scenario_name, amplitude, wavelength, rail_phase, speed, duration, dt, 
          voltage_text=None):
     from . import report
     from .metrics import check_window, parse_window, to_dict
-    from .simulate import DEFAULT_DT, DEFAULT_OUTPUT_RATE, simulate as run_simulation
+    from .simulation import DEFAULT_DT, DEFAULT_OUTPUT_RATE, simulate as run_simulation
     from .track import scenario as make_scenario
 
     dt = DEFAULT_DT if dt is None else dt

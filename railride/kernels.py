@@ -5,7 +5,7 @@ The stepper integrates, for each sample of a batch,
     q'' = Aq q + Av q' + Bw w + Bwd w' + Bf f,    f_i = -c_i (Ts q')_i
 
 with classical fourth-order Runge-Kutta at a fixed step. The matrices are the vehicle's
-(M^-1 folded in, see `simulate._system_arrays`), stored transposed so that a product runs
+(M^-1 folded in, see `simulation._system_arrays`), stored transposed so that a product runs
 down the columns with the nine row sums held in registers. The rail inputs w, w' and the
 forcing Bw w + Bwd w' come from tables on a time grid whose nodes fall on step boundaries,
 interpolated with cubic Hermite polynomials (see `railride.track.wheelset_input_table`).

@@ -84,7 +84,7 @@ def to_frame(ds: xr.Dataset) -> pd.DataFrame:
     """
     ds = _dataset(ds)
     if "time" not in ds.dims:
-        raise ValueError("the dataset has no time dimension: not a result of railride.simulate")
+        raise ValueError("the dataset has no time dimension: not a result of railride.simulation")
     lead = ["sample"] if "sample" in ds.dims else []
     n_rows = ds.sizes["time"] * (ds.sizes["sample"] if lead else 1)
     columns: dict[str, np.ndarray] = {}

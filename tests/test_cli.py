@@ -91,7 +91,7 @@ def test_simulate_json_document():
     assert result.exit_code == 0, result.output
     doc = json.loads(result.stdout)
     assert list(doc) == ["schema", "railride_version", "scenario", "vehicle_preset", "suspension", "settings", "metrics"]
-    assert doc["schema"] == "railride.simulate/1"
+    assert doc["schema"] == "railride.simulation/1"
     assert doc["vehicle_preset"] == "paper"
     assert doc["scenario"]["name"] == "paper-sine" and doc["scenario"]["duration_s"] == 2.0
     assert doc["scenario"]["speed_m_s"] == 55.56  # scenario default applied
@@ -217,7 +217,7 @@ def test_diverged_run_status_1(monkeypatch):
     import importlib
 
     # the module, not the function of the same name that railride/__init__.py re-exports
-    core = importlib.import_module("railride.simulate")
+    core = importlib.import_module("railride.simulation")
 
     def boom(*args, **kwargs):
         raise RuntimeError("the simulation diverged (sample 0 at t = 1 s)")

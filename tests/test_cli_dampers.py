@@ -202,7 +202,7 @@ def test_tracking_failure_leaves_out_absent(tmp_path):
 # -- simulate --suspension --------------------------------------------------------------------------
 def test_simulate_mr_json():
     doc = ok_json("simulate", "--suspension", "mr", "--voltage", 2.25, "--duration", 1)
-    assert doc["schema"] == "railride.simulate/1"
+    assert doc["schema"] == "railride.simulation/1"
     assert doc["suspension"] == {"type": "mr", "damper": "railway", "voltage_v": 2.25}
     assert list(doc).index("suspension") == list(doc).index("vehicle_preset") + 1
     for values in doc["metrics"].values():

@@ -9,7 +9,7 @@ from hypothesis import given, settings, strategies as st
 from railride import dampers, rig
 from railride.kernels import damper_law
 from railride.reference import rig_reference, simulate_reference
-from railride.simulate import simulate
+from railride.simulation import simulate
 from railride.track import scenario
 
 MODELS = {  # preset, stroke [m] and frequency [Hz] of a typical test

@@ -11,7 +11,7 @@ import pytest
 import xarray as xr
 
 from railride import report
-from railride.simulate import simulate
+from railride.simulation import simulate
 from railride.track import scenario
 
 DOC = {"schema": "test", "metrics": {"a": {"rms": 1.0, "ptp": 2.0}}}

@@ -6,7 +6,7 @@ import pytest
 
 from railride.params import VehicleParams
 from railride.reference import simulate_reference
-from railride.simulate import simulate
+from railride.simulation import simulate
 from railride.track import CosineBump, Scenario, SineTrack, scenario
 from railride.vehicle import DOF_NAMES, Vehicle
 

@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 
-from railride.simulate import simulate
+from railride.simulation import simulate
 from railride.track import (CosineBump, MeasuredTrack, Scenario, SineTrack, scenario,
                             wheelset_input_table)
 from railride.vehicle import Vehicle
