@@ -58,7 +58,7 @@ def bench_kernel_only(repeat):
     def run():
         x = np.zeros((1, kernels.NS_MAX))
         outs = [np.empty((1, rows, k)) for k in (9, 9, 9, 4, 8, 8)] + [np.empty((1, 1, kernels.N_DS))]
-        kernels.run_batch(kernels.LAW_VISCOUS_IN_C, x, 0, n_steps, True, stride, dt,
+        kernels.run_batch(0, 1, kernels.LAW_VISCOUS_IN_C, x, 0, n_steps, True, stride, dt,
                           sysm["A"][None], sysm["TS"][None], sysm["c_sec"][None],
                           np.zeros((1, 16)), np.zeros((1, 4)),
                           utab, np.zeros(1, np.int64), ftab, np.zeros(1, np.int64),

@@ -280,11 +280,11 @@ def simulate(scenario=None, params=None, *, dt: float = DEFAULT_DT,
     while True:
         todo = min(chunk, n_steps - done)
         final = done + todo == n_steps
-        kernels.run_batch(law, x, done, todo, final, stride, dt,
-                          arrays["A"], arrays["TS"], arrays["c_sec"], P, vcmd,
-                          utab, u_off, ftab, f_off, n_nodes, interval,
-                          out["q"], out["v"], out["a"], out["f"], out["w"], out["wd"], out["d"],
-                          status, fail_step)
+        kernels.run_parallel(kernels.run_batch, n, law, x, done, todo, final, stride, dt,
+                             arrays["A"], arrays["TS"], arrays["c_sec"], P, vcmd,
+                             utab, u_off, ftab, f_off, n_nodes, interval,
+                             out["q"], out["v"], out["a"], out["f"], out["w"], out["wd"], out["d"],
+                             status, fail_step)
         done += todo
         if progress is not None:
             progress(done / n_steps)
