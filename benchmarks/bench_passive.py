@@ -56,13 +56,16 @@ def bench_kernel_only(repeat):
     rows, n_steps, stride = 10001, 100_000, 10
 
     def run():
-        x = np.zeros((1, kernels.NS_MAX))
-        outs = [np.empty((1, rows, k)) for k in (9, 9, 9, 4, 8, 8)] + [np.empty((1, 1, kernels.N_DS))]
+        x = np.zeros((1, kernels.NX))
+        outs = ([np.empty((1, rows, k)) for k in (9, 9, 9, 4, 8, 8)]
+                + [np.empty((1, 1, kernels.N_DS)), np.empty((1, 1, 4)), np.empty((1, 1, 4))])
         kernels.run_batch(0, 1, kernels.LAW_VISCOUS_IN_C, x, 0, n_steps, True, stride, dt,
                           sysm["A"][None], sysm["TS"][None], sysm["c_sec"][None],
                           np.zeros((1, 16)), np.zeros((1, 4)),
                           utab, np.zeros(1, np.int64), ftab, np.zeros(1, np.int64),
-                          np.array([len(utab)]), np.array([itv]), *outs,
+                          np.array([len(utab)]), np.array([itv]),
+                          False, 1, np.zeros((1, 4, 6)), np.zeros((1, 4, 3)), np.zeros((1, 2)),
+                          np.zeros((0, 6)), *outs,
                           np.zeros(1, np.int64), np.zeros(1, np.int64))
 
     run()

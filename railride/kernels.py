@@ -42,6 +42,10 @@ _FAST = {"reassoc", "contract", "nsz", "arcp"}
 LAW_VISCOUS_IN_C = 0
 N_DS = N_CORNER * N_DAMPER_STATES  # damper states of the vehicle
 NS_MAX = 2 * N_DOF + N_DS  # state (q, q', damper states)
+XI = NS_MAX  # controller: integral of the sampled (z, phi, theta) ...
+FD_HELD = XI + 3  # ... the corner force demands in effect ...
+FD_NEXT = FD_HELD + N_CORNER  # ... and those computed at the last sample
+NX = FD_NEXT + N_CORNER  # columns of the state array x
 #: sub-steps resolve the fastest damper rate: rate x SUBSTEP_DT_REF / (sub-steps) <= this
 SUBSTEP_LIMIT = 0.5
 SUBSTEP_DT_REF = 1e-4
@@ -275,7 +279,8 @@ def _derivative(law, s, R, roff, AT, TT, P, vcmd, y, cx, cv, K, koff):
 @njit(cache=True, nogil=True, fastmath=_FAST, parallel=_NO_PARFORS)
 def run_batch(lo, hi, law, x, step0, n_steps, final, stride, dt, A, TS, c_sec, P, vcmd,
               utab, u_off, ftab, f_off, n_nodes, interval,
-              out_q, out_v, out_a, out_f, out_w, out_wd, out_d,
+              closed_loop, ctrl_stride, Gm, Hm, inner, noise,
+              out_q, out_v, out_a, out_f, out_w, out_wd, out_d, out_fd, out_vc,
               status, fail_step):
     """Advance the state x[s] = (q, q', damper states) of samples lo <= s < hi by n_steps
     steps of dt. Compiled without the GIL: `railride.simulation` runs sample ranges on threads.
@@ -288,11 +293,21 @@ def run_batch(lo, hi, law, x, step0, n_steps, final, stride, dt, A, TS, c_sec, P
     rows from u_off[s] (w, w', for the record) and ftab rows from f_off[s] (see `_forcing`).
 
     Each step is one classical RK4 step, or 2^k equal RK4 sub-steps when the dampers' internal
-    states are stiff at the step's start (`damper_stiffness` * dt > SUBSTEP_LIMIT).
+    states are stiff (`substeps`).
+
+    Open loop, each corner's command voltage is vcmd[s]. With ``closed_loop`` the controller
+    samples the carbody states (plus noise[k] at sample k, if noise has rows) every ctrl_stride
+    steps, integrates (z, phi, theta) by the rectangle rule, and computes the desired corner
+    forces f_d = Gm[s] m + Hm[s] xi, which take effect one controller period later and are held
+    (a computation delay of one sample). The inner loop, v = clip(G (f_d - B f) sgn(f), v_min,
+    v_max) with (B, G) = inner[s] and f the damper force on the carbody, runs at every step
+    from the force at the step's start. The controller's integrator and demands are states
+    x[s, NS_MAX:], so a run can continue across calls.
 
     Steps are numbered globally from step0 (t = step * dt). At every step whose number is a
-    multiple of ``stride`` the state, acceleration, damper forces, rail inputs and damper states
-    at that time are written to row step // stride of the outputs (out_d only if it has rows);
+    multiple of ``stride`` the state, acceleration, damper forces, rail inputs, damper states,
+    demanded forces and command voltages at that time are written to row step // stride of the
+    outputs (out_d, out_fd, out_vc only if they have rows);
     with ``final`` the state after the last step is written too. A sample whose state leaves
     +-DIVERGED or stops being finite gets status STATUS_DIVERGED and the step number in
     fail_step, and stops.
@@ -300,6 +315,7 @@ def run_batch(lo, hi, law, x, step0, n_steps, final, stride, dt, A, TS, c_sec, P
     has_states = law != LAW_VISCOUS_IN_C  # damper states to integrate
     ns = NS_MAX if has_states else 2 * N_DOF
     record_d = out_d.shape[1] > 1
+    record_c = out_fd.shape[1] > 1
     for smp in range(lo, hi):
         if status[smp] != STATUS_OK:
             continue
@@ -312,15 +328,49 @@ def run_batch(lo, hi, law, x, step0, n_steps, final, stride, dt, A, TS, c_sec, P
         R = np.empty(3 * N_DOF)  # rail forcing at the sub-step's start, middle and end
         w = np.empty(N_RAIL)
         wd = np.empty(N_RAIL)
-        at, tt, cs, pp, vc = A[smp], TS[smp], c_sec[smp], P[smp], vcmd[smp]
+        at, tt, cs, pp = A[smp], TS[smp], c_sec[smp], P[smp]
         uo, fo, nn, itv = u_off[smp], f_off[smp], n_nodes[smp], interval[smp]
+        vc = vcmd[smp].copy()  # command voltages, held over each step
+        meas = np.empty(6)  # the controller's sample of the carbody states
+        gm, hm = Gm[smp], Hm[smp]
+        tc = ctrl_stride * dt
+        n_noise = noise.shape[0]
         _forcing(step0 * dt, ftab, fo, nn, itv, R, 0)
         last = n_steps + 1 if final else n_steps
         for n in range(last):
             step = step0 + n
             t = step * dt
+            if closed_loop and step % ctrl_stride == 0:
+                k = step // ctrl_stride
+                for c in range(N_CORNER):  # the demand computed one period ago takes effect
+                    x[smp, FD_HELD + c] = x[smp, FD_NEXT + c]
+                for j in range(3):
+                    meas[j] = s[j]
+                    meas[3 + j] = s[N_DOF + j]
+                if k < n_noise:
+                    for j in range(6):
+                        meas[j] += noise[k, j]
+                for j in range(3):
+                    x[smp, XI + j] += tc * meas[j]
+                for c in range(N_CORNER):
+                    acc_fd = 0.0
+                    for j in range(6):
+                        acc_fd += gm[c, j] * meas[j]
+                    for j in range(3):
+                        acc_fd += hm[c, j] * x[smp, XI + j]
+                    x[smp, FD_NEXT + c] = acc_fd
             # rates at the step's start: for the record, the sub-step choice and stage 1
             _derivative(law, s, R, 0, at, tt, pp, vc, y, cx, cv, K, 0)
+            if closed_loop:
+                # inner loop from the damper forces at the step's start (they do not depend on
+                # the command, only on the coil state); then correct stage 1's coil rate
+                for c in range(N_CORNER):
+                    f = y[2 * N_DOF + c]
+                    sgn = 1.0 if f > 0.0 else (-1.0 if f < 0.0 else 0.0)
+                    v = inner[smp, 1] * (x[smp, FD_HELD + c] - inner[smp, 0] * f) * sgn
+                    vc[c] = min(max(v, pp[10]), pp[11])
+                    b = 2 * N_DOF + N_DAMPER_STATES * c + 2
+                    K[b] = -pp[9] * (s[b] - vc[c])
             if step % stride == 0:
                 row = step // stride
                 bad = False
@@ -345,6 +395,10 @@ def run_batch(lo, hi, law, x, step0, n_steps, final, stride, dt, A, TS, c_sec, P
                 for c in range(N_RAIL):
                     out_w[smp, row, c] = w[c]
                     out_wd[smp, row, c] = wd[c]
+                if record_c:
+                    for c in range(N_CORNER):
+                        out_fd[smp, row, c] = x[smp, FD_HELD + c]
+                        out_vc[smp, row, c] = vc[c]
                 if bad:
                     status[smp] = STATUS_DIVERGED
                     fail_step[smp] = step

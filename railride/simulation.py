@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import json
 import math
@@ -19,6 +20,7 @@ from .vehicle import CORNER_NAMES, DOF_NAMES, DOF_UNITS, N_DOF, RAILS, WHEELSETS
 
 DEFAULT_DT = 1e-4
 DEFAULT_OUTPUT_RATE = 1000.0
+DEFAULT_CONTROL_RATE = 1000.0
 #: sample-steps per kernel call when a progress callback is given
 _CHUNK_WORK = 2_000_000
 
@@ -164,6 +166,46 @@ def _command_voltages(damper, voltage, n: int) -> np.ndarray:
     return np.repeat([[damper.check_voltage(v)] for v in values], 4, axis=1).astype(float)
 
 
+def _as_controllers(controller):
+    """None (open loop) or the list of outer loops (None entries: no outer loop)."""
+    if controller is None:
+        return None
+    items = list(controller) if isinstance(controller, (list, tuple)) else [controller]
+    for c in items:
+        if c is not None and not hasattr(c, "gains"):
+            raise ValueError(f"controller = {c!r}: must be an outer loop from railride.control "
+                             "(PID, SAS) or None")
+    return items
+
+
+def _closed_loop(controllers, inner, control_rate, sensor_noise, damper, n, dt, duration):
+    """The closed-loop settings the stepper needs, checked; None for an open loop."""
+    from .control import GainSet, InnerLoop, SensorNoise
+
+    if controllers is None:
+        for name, value in (("inner", inner), ("sensor_noise", sensor_noise)):
+            if value is not None:
+                raise ValueError(f"{name} applies to a closed loop only: give controller= as well")
+        return None
+    if damper.law == dampers.LAW_VISCOUS:
+        raise ValueError("a controller needs MR dampers (a viscous damper has no command)")
+    inner = GainSet.default().inner if inner is None else inner
+    if not isinstance(inner, InnerLoop):
+        raise ValueError(f"inner = {inner!r}: must be a railride.control.InnerLoop")
+    rate = _positive("control_rate", control_rate)
+    stride_f = 1.0 / (rate * dt)
+    stride = int(round(stride_f))
+    if stride < 1 or abs(stride - stride_f) > 1e-6 * stride_f:
+        raise ValueError(f"control_rate = {rate:g} Hz with dt = {dt:g} s: the controller period "
+                         f"must be a whole number of steps")
+    ticks = int(round(duration / (stride * dt))) + 2
+    if sensor_noise is not None and not isinstance(sensor_noise, SensorNoise):
+        raise ValueError(f"sensor_noise = {sensor_noise!r}: must be a railride.control.SensorNoise")
+    noise = sensor_noise.samples(ticks) if sensor_noise is not None else np.zeros((0, 6))
+    return {"controllers": controllers, "inner": inner, "rate": rate, "stride": stride,
+            "noise": noise, "sensor_noise": sensor_noise}
+
+
 def _positive(name: str, value) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value <= 0:
         raise ValueError(f"{name} = {value!r}: must be a finite number > 0")
@@ -172,7 +214,8 @@ def _positive(name: str, value) -> float:
 
 def simulate(scenario=None, params=None, *, dt: float = DEFAULT_DT,
              output_rate: float = DEFAULT_OUTPUT_RATE, damper=None, voltage=None,
-             initial_state=None, progress=None) -> "RideResult":
+             controller=None, inner=None, control_rate: float = DEFAULT_CONTROL_RATE,
+             sensor_noise=None, initial_state=None, progress=None) -> "RideResult":
     """Simulate the vehicle on one or many scenarios.
 
     ``scenario`` is a `Scenario`, a scenario name (see `railride.track.scenario`) or a list of
@@ -185,6 +228,12 @@ def simulate(scenario=None, params=None, *, dt: float = DEFAULT_DT,
     four corners, driven at the constant command ``voltage`` [V] (default: the model's v_min,
     "passive-off"; a list runs one sample per voltage, like a list of scenarios). The coil starts
     at that voltage and the hysteretic states at 0.
+    ``controller`` closes the loop instead of a constant voltage: an outer loop from
+    `railride.control` (PID, SAS; a list runs one sample per controller, None in a list meaning
+    no outer loop, f_d = 0) sampling the carbody states at ``control_rate`` [Hz] (plus
+    ``sensor_noise``, a `control.SensorNoise`), and the inner loop ``inner`` (a
+    `control.InnerLoop`; default: the shipped gains) setting the voltages. A controller without
+    ``damper`` uses the `railway` MR dampers.
     ``initial_state`` is (q, q') at t = 0 as 18 numbers in DOF order (m, rad, m/s, rad/s), or
     one row per sample; by default the vehicle starts at rest in equilibrium.
     ``progress(done_fraction)`` is called between chunks of a long run.
@@ -192,15 +241,17 @@ def simulate(scenario=None, params=None, *, dt: float = DEFAULT_DT,
     dt = _positive("dt", dt)
     output_rate = _positive("output_rate", output_rate)
     n_volt = 1 if voltage is None or np.ndim(voltage) == 0 else len(voltage)
+    n_ctrl = len(controller) if isinstance(controller, (list, tuple)) else 1
     batch = not (isinstance(scenario, (Scenario, str)) or scenario is None) or not (
-        isinstance(params, (VehicleParams, str)) or params is None) or np.ndim(voltage) > 0
+        isinstance(params, (VehicleParams, str)) or params is None) or np.ndim(voltage) > 0 \
+        or isinstance(controller, (list, tuple))
     scenarios = [_resolve_scenario(s) for s in _as_list(scenario)]
     param_sets = [_resolve_params(p) for p in _as_list(params)]
-    n = max(len(scenarios), len(param_sets), n_volt)
-    if any(k not in (1, n) for k in (len(scenarios), len(param_sets), n_volt)):
-        raise ValueError(f"a batch needs equally many scenarios, parameter sets and voltages, or one "
-                         f"of each; got {len(scenarios)} scenarios, {len(param_sets)} parameter sets "
-                         f"and {n_volt} voltages")
+    n = max(len(scenarios), len(param_sets), n_volt, n_ctrl)
+    if any(k not in (1, n) for k in (len(scenarios), len(param_sets), n_volt, n_ctrl)):
+        raise ValueError(f"a batch needs equally many scenarios, parameter sets, voltages and "
+                         f"controllers, or one of each; got {len(scenarios)} scenarios, "
+                         f"{len(param_sets)} parameter sets, {n_volt} voltages and {n_ctrl} controllers")
     if n == 0:
         raise ValueError("an empty batch: give at least one scenario")
     scenarios = scenarios * (n // len(scenarios))
@@ -209,8 +260,15 @@ def simulate(scenario=None, params=None, *, dt: float = DEFAULT_DT,
     if any(abs(s.duration - duration) > 1e-12 * duration for s in scenarios):
         raise ValueError("every sample of a batch must have the same duration; got "
                          + ", ".join(sorted({f'{s.duration:g} s' for s in scenarios})))
+    controllers = _as_controllers(controller)
+    if controllers is not None:
+        if voltage is not None:
+            raise ValueError("give either voltage (open loop) or controller (closed loop), not both")
+        if damper is None:
+            damper = "railway"
     damper = _resolve_damper(damper)
     vcmd = _command_voltages(damper, voltage, n)
+    closed = _closed_loop(controllers, inner, control_rate, sensor_noise, damper, n, dt, duration)
     vehicles = {}
     for p in param_sets:
         if id(p) not in vehicles:
@@ -257,8 +315,14 @@ def simulate(scenario=None, params=None, *, dt: float = DEFAULT_DT,
 
     rows = n_out + 1
     law = kernels.LAW_VISCOUS_IN_C if damper is None else damper.law
-    x = np.zeros((n, kernels.NS_MAX))
-    x[:, 2 * N_DOF + 2::dampers.N_DAMPER_STATES] = vcmd  # coils settled at the command
+    gm = np.zeros((n, 4, 6))
+    hm = np.zeros((n, 4, 3))
+    if closed is not None:
+        for i, (c, p) in enumerate(zip(closed["controllers"] * (n // len(closed["controllers"])), param_sets)):
+            if c is not None:
+                gm[i], hm[i] = c.gains(vehicles[id(p)])
+    x = np.zeros((n, kernels.NX))
+    x[:, 2 * N_DOF + 2:kernels.NS_MAX:dampers.N_DAMPER_STATES] = vcmd  # coils settled at the command
     P = np.tile(damper.pack() if damper is not None else np.zeros(dampers.N_PACKED), (n, 1))
     if initial_state is not None:
         x0 = np.asarray(initial_state, dtype=float)
@@ -271,10 +335,17 @@ def simulate(scenario=None, params=None, *, dt: float = DEFAULT_DT,
         "a": np.empty((n, rows, N_DOF)), "f": np.empty((n, rows, 4)),
         "w": np.empty((n, rows, 8)), "wd": np.empty((n, rows, 8)),
         "d": np.empty((n, rows if damper is not None else 1, kernels.N_DS)),
+        "fd": np.zeros((n, rows if closed is not None else 1, 4)),
+        "vc": np.empty((n, rows if closed is not None else 1, 4)),
     }
     status = np.zeros(n, dtype=np.int64)
     fail_step = np.full(n, -1, dtype=np.int64)
 
+    if closed is None:
+        ctrl_stride, inner_gains, noise = 1, np.zeros((n, 2)), np.zeros((0, 6))
+    else:
+        ctrl_stride, noise = closed["stride"], closed["noise"]
+        inner_gains = np.tile([closed["inner"].B, closed["inner"].G], (n, 1))
     chunk = n_steps if progress is None else max(stride, (_CHUNK_WORK // n) // stride * stride)
     done = 0
     while True:
@@ -283,8 +354,9 @@ def simulate(scenario=None, params=None, *, dt: float = DEFAULT_DT,
         kernels.run_parallel(kernels.run_batch, n, law, x, done, todo, final, stride, dt,
                              arrays["A"], arrays["TS"], arrays["c_sec"], P, vcmd,
                              utab, u_off, ftab, f_off, n_nodes, interval,
+                             closed is not None, ctrl_stride, gm, hm, inner_gains, noise,
                              out["q"], out["v"], out["a"], out["f"], out["w"], out["wd"], out["d"],
-                             status, fail_step)
+                             out["fd"], out["vc"], status, fail_step)
         done += todo
         if progress is not None:
             progress(done / n_steps)
@@ -298,11 +370,12 @@ def simulate(scenario=None, params=None, *, dt: float = DEFAULT_DT,
 
     created = datetime.now(timezone.utc).isoformat(timespec="seconds")
     return RideResult(build=functools.partial(_dataset, out, vehicles, param_sets, scenarios, dt,
-                                              output_rate, rows, batch, created, damper, vcmd))
+                                              output_rate, rows, batch, created, damper, vcmd,
+                                              closed))
 
 
 def _dataset(out, vehicles, param_sets, scenarios, dt, output_rate, rows, batch, created,
-             damper, vcmd) -> xr.Dataset:
+             damper, vcmd, closed=None) -> xr.Dataset:
     """Named channels in SI units; a ``sample`` dimension only for a batch."""
     from . import __version__
     import numba
@@ -338,14 +411,25 @@ def _dataset(out, vehicles, param_sets, scenarios, dt, output_rate, rows, batch,
                 "units": "m", "long_name": "Spencer model internal displacement y"})
         channels["damper_voltage"] = (("corner",), d[:, :, 2::3], {
             "units": "V", "long_name": "damper coil voltage u after the coil lag"})
-        channels["damper_command_voltage"] = (("corner",), np.broadcast_to(vcmd[:, None, :], d[:, :, 2::3].shape), {
+        command = out["vc"] if closed is not None else np.broadcast_to(vcmd[:, None, :], d[:, :, 2::3].shape)
+        channels["damper_command_voltage"] = (("corner",), command, {
             "units": "V", "long_name": "commanded damper voltage v"})
+    if closed is not None:
+        channels["damper_demand_force"] = (("corner",), out["fd"], {
+            "units": "N", "long_name": "desired damper force on the carbody (up +) from the outer loop"})
     channels["rail_displacement"] = (("wheelset", "rail"), out["w"].reshape(shape), {
         "units": "m", "long_name": "rail height under each wheel"})
     channels["rail_velocity"] = (("wheelset", "rail"), out["wd"].reshape(shape), {
         "units": "m/s", "long_name": "rail vertical velocity under each wheel"})
     scen = np.array([json.dumps(s.describe()) for s in scenarios])
     pars = np.array([json.dumps(p.to_dict()) for p in param_sets])
+    if closed is not None:
+        ctrl = closed["controllers"] * (len(param_sets) // len(closed["controllers"]))
+        attrs_ctrl = {"control_rate_hz": closed["rate"], "inner_loop": json.dumps(closed["inner"].to_dict()),
+                      "sensor_noise": json.dumps(None if closed["sensor_noise"] is None
+                                                 else dataclasses.asdict(closed["sensor_noise"]))}
+        controller_names = np.array(["none" if c is None else c.name for c in ctrl])
+        controller_gains = np.array([json.dumps(None if c is None else c.to_dict()) for c in ctrl])
     if batch:
         data = {k: (("sample", "time") + d, v, a) for k, (d, v, a) in channels.items()}
         data["scenario"] = ("sample", scen)
@@ -354,6 +438,9 @@ def _dataset(out, vehicles, param_sets, scenarios, dt, output_rate, rows, batch,
         data = {k: (("time",) + d, v[0], a) for k, (d, v, a) in channels.items()}
         data["scenario"] = ((), scen[0])
         data["vehicle_params"] = ((), pars[0])
+    if closed is not None:
+        data["controller"] = ("sample", controller_names) if batch else ((), controller_names[0])
+        data["controller_gains"] = ("sample", controller_gains) if batch else ((), controller_gains[0])
     coords = {
         "time": ("time", time, {"units": "s"}),
         "corner": ("corner", list(CORNER_NAMES)),
@@ -375,11 +462,14 @@ def _dataset(out, vehicles, param_sets, scenarios, dt, output_rate, rows, batch,
         "dt_s": dt,
         "output_rate_hz": output_rate,
         "suspension": ("passive viscous secondary dampers" if damper is None else
-                       f"{damper.model} secondary dampers at constant command voltage"),
+                       f"{damper.model} secondary dampers at constant command voltage" if closed is None
+                       else f"{damper.model} secondary dampers, closed loop"),
         "damper": json.dumps(None if damper is None else damper.to_dict()),
         "sign_convention": "z up; pitch + lowers the front; roll + raises the left side; "
                            "forces on the carbody, up +",
     }
+    if closed is not None:
+        attrs.update(attrs_ctrl)
     return xr.Dataset(data, coords=coords, attrs=attrs)
 
 

@@ -1,0 +1,285 @@
+"""Outer-loop controllers and the force-tracking inner loop (spec sections 6-7).
+
+Every outer loop here is linear in the measured carbody states: with m = (z_c, phi_c, theta_c,
+z_c', phi_c', theta_c') and xi the time integral of (z_c, phi_c, theta_c), the desired corner
+forces (on the carbody, up +, corners 1R, 1L, 2R, 2L) are
+
+    f_d = G m + H xi.
+
+`Controller.gains(vehicle)` builds G (4 x 6) and H (4 x 3) from the gains and the vehicle's
+geometry; the compiled step applies them at the controller's sample rate, and the one place
+where the semi-active nonlinearity lives is the inner loop (`InnerLoop`), which turns f_d and
+the measured damper force into a voltage clipped to the damper's range.
+
+Corner displacements are z_i = (T_c^T q_c)_i, T_c the carbody rows of the secondary force map
+T (rows heave, pitch, roll). The decoupling transformation of the SAS distributes a demanded
+generalised force Q_d = (F_z, M_pitch, M_roll) over the corners with the right inverse
+T_c^+ = T_c^T (T_c T_c^T)^-1, computed from the geometry (the paper's printed eq. 18-19 are
+garbled, spec section 10).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import tomllib
+from dataclasses import dataclass
+from importlib import resources
+from pathlib import Path
+
+import numpy as np
+
+from .params import param, validate_fields
+from .vehicle import CORNER_NAMES, Vehicle
+
+
+def carbody_map(vehicle: Vehicle) -> np.ndarray:
+    """T_c (3 x 4): generalised force (heave, pitch, roll) on the carbody from corner forces."""
+    return vehicle.T[:3].copy()
+
+
+def decoupling(vehicle: Vehicle) -> np.ndarray:
+    """T_c^+ (4 x 3), the right inverse of T_c: corner forces for a generalised force demand."""
+    Tc = carbody_map(vehicle)
+    return Tc.T @ np.linalg.inv(Tc @ Tc.T)
+
+
+class _Gains:
+    name: str
+    label: str
+
+    def replace(self, **changes):
+        unknown = set(changes) - {f.name for f in dataclasses.fields(self)}
+        if unknown:
+            raise ValueError(f"unknown gain(s) {', '.join(sorted(unknown))} for {self.name}; allowed: "
+                             f"{', '.join(f.name for f in dataclasses.fields(self))}")
+        return dataclasses.replace(self, **changes)
+
+    def to_dict(self) -> dict:
+        return dataclasses.asdict(self)
+
+
+@dataclass(frozen=True)
+class InnerLoop(_Gains):
+    """Force tracking, spec section 6: v = clip(G (f_d - B f) sgn(f), v_min, v_max)."""
+
+    B: float = param("-", "feedback weight of the measured damper force", "nonnegative")
+    G: float = param("V/N", "gain from force error to voltage", "nonnegative")
+    name = "inner"
+    label = "inner loop"
+
+    def __post_init__(self):
+        validate_fields(self, "inner-loop gain")
+
+
+@dataclass(frozen=True)
+class PID(_Gains):
+    """Four identical decentralised PID loops on the carbody's corner displacements
+    (paper Fig. 4): f_d,i = -(kp z_i + ki int z_i dt + kd z_i')."""
+
+    kp: float = param("N/m", "proportional gain", "nonnegative")
+    ki: float = param("N/(m s)", "integral gain", "nonnegative")
+    kd: float = param("N s/m", "derivative gain", "nonnegative")
+    name = "pid"
+    label = "PID"
+
+    def __post_init__(self):
+        validate_fields(self, "PID gain")
+
+    def gains(self, vehicle: Vehicle) -> tuple[np.ndarray, np.ndarray]:
+        TcT = carbody_map(vehicle).T  # corner displacement from (z, phi, theta)
+        return -np.hstack([self.kp * TcT, self.kd * TcT]), -self.ki * TcT
+
+
+@dataclass(frozen=True)
+class Attitude(_Gains):
+    """SAS attitude loop (paper Fig. 3, 7): PD on carbody heave, pitch and roll giving
+    Q_d = -(kp_z z + kd_z z', kp_phi phi + kd_phi phi', kp_theta theta + kd_theta theta'),
+    distributed by the decoupling transformation f = T_c^+ Q_d."""
+
+    kp_z: float = param("N/m", "heave proportional gain", "nonnegative")
+    kd_z: float = param("N s/m", "heave derivative gain", "nonnegative")
+    kp_phi: float = param("N m/rad", "pitch proportional gain", "nonnegative")
+    kd_phi: float = param("N m s/rad", "pitch derivative gain", "nonnegative")
+    kp_theta: float = param("N m/rad", "roll proportional gain", "nonnegative")
+    kd_theta: float = param("N m s/rad", "roll derivative gain", "nonnegative")
+    name = "attitude"
+    label = "SAS attitude loop"
+
+    def __post_init__(self):
+        validate_fields(self, "SAS attitude gain")
+
+
+@dataclass(frozen=True)
+class Ride(_Gains):
+    """SAS ride loop: per-corner PD on the carbody corner's displacement and velocity,
+    subtracted from the decoupled attitude demand: f_d,i = f_DTS,i - (kp_i z_i + kd_i z_i')."""
+
+    kp_1R: float = param("N/m", "corner 1R proportional gain", "nonnegative")
+    kp_1L: float = param("N/m", "corner 1L proportional gain", "nonnegative")
+    kp_2R: float = param("N/m", "corner 2R proportional gain", "nonnegative")
+    kp_2L: float = param("N/m", "corner 2L proportional gain", "nonnegative")
+    kd_1R: float = param("N s/m", "corner 1R derivative gain", "nonnegative")
+    kd_1L: float = param("N s/m", "corner 1L derivative gain", "nonnegative")
+    kd_2R: float = param("N s/m", "corner 2R derivative gain", "nonnegative")
+    kd_2L: float = param("N s/m", "corner 2L derivative gain", "nonnegative")
+    name = "ride"
+    label = "SAS ride loop"
+
+    def __post_init__(self):
+        validate_fields(self, "SAS ride gain")
+
+    def kp(self) -> np.ndarray:
+        return np.array([getattr(self, f"kp_{c}") for c in CORNER_NAMES])
+
+    def kd(self) -> np.ndarray:
+        return np.array([getattr(self, f"kd_{c}") for c in CORNER_NAMES])
+
+
+@dataclass(frozen=True)
+class SAS:
+    """Stability Augmentation System: the attitude loop, with or without the ride loop
+    (6 + 8 = the paper's fourteen parameters)."""
+
+    attitude: Attitude
+    ride: Ride | None = None
+
+    @property
+    def name(self) -> str:
+        return "sas-attitude" if self.ride is None else "sas-attitude-ride"
+
+    @property
+    def label(self) -> str:
+        return "SAS (attitude)" if self.ride is None else "SAS (attitude+ride)"
+
+    def gains(self, vehicle: Vehicle) -> tuple[np.ndarray, np.ndarray]:
+        a = self.attitude
+        kp = np.diag([a.kp_z, a.kp_phi, a.kp_theta])
+        kd = np.diag([a.kd_z, a.kd_phi, a.kd_theta])
+        G = -decoupling(vehicle) @ np.hstack([kp, kd])
+        if self.ride is not None:
+            TcT = carbody_map(vehicle).T
+            G = G - np.hstack([self.ride.kp()[:, None] * TcT, self.ride.kd()[:, None] * TcT])
+        return G, np.zeros((4, 3))
+
+    def to_dict(self) -> dict:
+        out = {"attitude": self.attitude.to_dict()}
+        if self.ride is not None:
+            out["ride"] = self.ride.to_dict()
+        return out
+
+
+# -- gains files --------------------------------------------------------------------------------
+CONTROLLERS = ("passive", "pid", "sas-attitude", "sas-attitude-ride")
+LABELS = {"passive": "Passive", "pid": "PID", "sas-attitude": "SAS (attitude)",
+          "sas-attitude-ride": "SAS (attitude+ride)"}
+_TABLES = {"inner": InnerLoop, "pid": PID, "sas.attitude": Attitude, "sas.ride": Ride}
+
+
+@dataclass(frozen=True)
+class GainSet:
+    """Every controller's gains, as read from a gains file."""
+
+    inner: InnerLoop
+    pid: PID
+    attitude: Attitude
+    ride: Ride
+    source: str = "<built>"
+
+    def controller(self, name: str):
+        """The outer loop called ``name`` (None for the passive suspension)."""
+        if name == "passive":
+            return None
+        if name == "pid":
+            return self.pid
+        if name == "sas-attitude":
+            return SAS(self.attitude)
+        if name == "sas-attitude-ride":
+            return SAS(self.attitude, self.ride)
+        raise ValueError(f"unknown controller {name!r}; allowed: {', '.join(CONTROLLERS)}")
+
+    def to_toml(self) -> str:
+        lines = []
+        for key, obj in (("inner", self.inner), ("pid", self.pid), ("sas.attitude", self.attitude),
+                         ("sas.ride", self.ride)):
+            lines.append(f"[{key}]")
+            for f in dataclasses.fields(obj):
+                lines.append(f"{f.name} = {getattr(obj, f.name)!r}  # {f.metadata['unit']}")
+            lines.append("")
+        return "\n".join(lines)
+
+    @classmethod
+    def from_toml(cls, text: str, source: str = "<string>") -> "GainSet":
+        """Read [inner], [pid], [sas.attitude], [sas.ride]; every entry must be present, known,
+        numeric and not negative; the error names the file, the table and the entry."""
+        try:
+            data = tomllib.loads(text)
+        except tomllib.TOMLDecodeError as exc:
+            raise ValueError(f"{source}: not valid TOML: {exc}") from None
+        tables = {"inner": data.get("inner"), "pid": data.get("pid"),
+                  "sas.attitude": (data.get("sas") or {}).get("attitude"),
+                  "sas.ride": (data.get("sas") or {}).get("ride")}
+        unknown_top = sorted(set(data) - {"inner", "pid", "sas", "provenance"})
+        if unknown_top:
+            raise ValueError(f"{source}: unknown table(s) {', '.join(unknown_top)}; allowed: "
+                             "[inner], [pid], [sas.attitude], [sas.ride], [provenance]")
+        built = {}
+        for key, kind in _TABLES.items():
+            table = tables[key]
+            names = [f.name for f in dataclasses.fields(kind)]
+            if not isinstance(table, dict):
+                raise ValueError(f"{source}: missing table [{key}] with entries {', '.join(names)}")
+            unknown = sorted(set(table) - set(names))
+            if unknown:
+                raise ValueError(f"{source}: unknown entry {unknown[0]!r} in [{key}]; allowed: {', '.join(names)}")
+            missing = [n for n in names if n not in table]
+            if missing:
+                raise ValueError(f"{source}: missing entry {missing[0]!r} in [{key}]")
+            for n in names:
+                v = table[n]
+                if isinstance(v, bool) or not isinstance(v, (int, float)):
+                    raise ValueError(f"{source}: entry {n!r} in [{key}] = {v!r} is not a number")
+            try:
+                built[key] = kind(**table)
+            except ValueError as exc:
+                raise ValueError(f"{source}: [{key}] {exc}") from None
+        return cls(built["inner"], built["pid"], built["sas.attitude"], built["sas.ride"], source)
+
+    @classmethod
+    def load(cls, path: str | Path) -> "GainSet":
+        path = Path(path)
+        try:
+            text = path.read_text(encoding="utf-8")
+        except OSError as exc:
+            raise ValueError(f"cannot read gains file {path}: {exc.strerror}") from None
+        return cls.from_toml(text, source=str(path))
+
+    @classmethod
+    def default(cls) -> "GainSet":
+        """The shipped gains (railride/data/gains.toml; its header says where they come from)."""
+        text = resources.files("railride").joinpath("data/gains.toml").read_text(encoding="utf-8")
+        return cls.from_toml(text, source="railride/data/gains.toml")
+
+
+@dataclass(frozen=True)
+class SensorNoise:
+    """White noise added to every controller sample of the measured carbody states
+    (standard deviations), from a seeded generator: runs with the same seed see the same noise."""
+
+    displacement: float = param("m", "heave displacement noise", "nonnegative")
+    angle: float = param("rad", "pitch and roll angle noise", "nonnegative")
+    velocity: float = param("m/s", "heave velocity noise", "nonnegative")
+    angular_rate: float = param("rad/s", "pitch and roll rate noise", "nonnegative")
+    seed: int = param("-", "seed of the noise generator", "nonnegative")
+
+    def __post_init__(self):
+        seed = self.seed
+        validate_fields(self, "sensor noise")
+        if isinstance(seed, bool) or not float(seed).is_integer():
+            raise ValueError(f"sensor noise 'seed' = {seed!r}: must be a whole number >= 0")
+        object.__setattr__(self, "seed", int(seed))
+
+    def samples(self, n: int) -> np.ndarray:
+        """(n, 6) noise for m = (z, phi, theta, z', phi', theta')."""
+        sd = np.array([self.displacement, self.angle, self.angle,
+                       self.velocity, self.angular_rate, self.angular_rate])
+        return np.random.default_rng(self.seed).standard_normal((n, 6)) * sd
