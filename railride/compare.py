@@ -1,0 +1,160 @@
+"""The paper's comparison (its Table 1, Figs. 8-11): passive against PID, SAS (attitude) and
+SAS (attitude+ride) on one scenario, with what each controller asks of the dampers.
+
+`compare` runs the passive vehicle (viscous dashpots) and, in one batch, the controlled vehicles
+(MR dampers closed by the inner loop). The result keeps one Dataset per suspension and the
+metrics along a ``controller`` dimension.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+
+import numpy as np
+import xarray as xr
+
+from . import __version__, dampers
+from .control import CONTROLLERS, LABELS, GainSet
+from .metrics import STATISTICS, reduction, ride_metrics, select_window
+from .simulation import DEFAULT_CONTROL_RATE, DEFAULT_DT, DEFAULT_OUTPUT_RATE, simulate
+
+#: Table 1 of Harun et al. (RMS values), spec section 8: for display beside railride's results.
+PAPER_TABLE1 = {
+    "acceleration_m_s2": {"passive": 0.3195, "pid": 0.2601, "sas-attitude": 0.2567, "sas-attitude-ride": 0.2063},
+    "displacement_m": {"passive": 0.0349, "pid": 0.0265, "sas-attitude": 0.0225, "sas-attitude-ride": 0.0201},
+    "pitch_deg": {"passive": 0.9422, "pid": 0.3763, "sas-attitude": 0.2933, "sas-attitude-ride": 0.2273},
+    "roll_deg": {"passive": 2.005, "pid": 1.701, "sas-attitude": 1.2001, "sas-attitude-ride": 1.0035},
+}
+PAPER_REDUCTION = {
+    "acceleration_m_s2": {"pid": 18.6, "sas-attitude": 19.7, "sas-attitude-ride": 35.4},
+    "displacement_m": {"pid": 24.1, "sas-attitude": 35.5, "sas-attitude-ride": 42.4},
+    "pitch_deg": {"pid": 60.1, "sas-attitude": 68.9, "sas-attitude-ride": 75.9},
+    "roll_deg": {"pid": 15.2, "sas-attitude": 40.1, "sas-attitude-ride": 50.0},
+}
+
+
+def check_controllers(names) -> list[str]:
+    """The requested controllers in the paper's order; passive is always the baseline."""
+    names = [n.strip() for n in names if n.strip()]
+    unknown = [n for n in names if n not in CONTROLLERS]
+    if unknown:
+        raise ValueError(f"unknown controller {unknown[0]!r}; allowed: {', '.join(CONTROLLERS)}")
+    if not names:
+        raise ValueError(f"no controller given; allowed: {', '.join(CONTROLLERS)}")
+    return [n for n in CONTROLLERS if n in names or n == "passive"]
+
+
+@dataclass
+class Comparison:
+    """Results of `compare`: ``datasets[name]`` per suspension, ``metrics`` (controller,
+    response, statistic), RMS ``reductions`` against passive, and ``demands``: what each
+    suspension asks of its dampers."""
+
+    names: list[str]
+    datasets: dict
+    metrics: xr.DataArray
+    window: tuple | None
+    gains: GainSet
+    damper: str
+    settings: dict = field(default_factory=dict)
+
+    @property
+    def reductions(self) -> xr.DataArray:
+        """RMS reduction in % against passive, (passive - controlled) / passive x 100."""
+        base = self.metrics.sel(controller="passive")
+        return reduction(self.metrics, base)
+
+    def demands(self) -> dict:
+        """Per suspension, over the metrics window: RMS and peak damper force on the carbody [N],
+        RMS and peak secondary deflection (suspension travel) [m], and for the controlled ones
+        the mean command voltage [V] and the fraction of time at v_max."""
+        v_max = dampers.preset(self.damper).v_max if self.damper in dampers.PRESETS else np.inf
+        out = {}
+        for name, ds in self.datasets.items():
+            part = select_window(ds, self.window)
+            f = np.abs(part["secondary_damper_force"].values)
+            travel = np.abs(part["secondary_deflection"].values)
+            row = {"force_rms_n": float(np.sqrt(np.mean(f**2))), "force_max_n": float(f.max()),
+                   "travel_rms_m": float(np.sqrt(np.mean(travel**2))),
+                   "travel_max_m": float(travel.max())}
+            if "damper_command_voltage" in part:
+                v = part["damper_command_voltage"].values
+                row["voltage_mean_v"] = float(v.mean())
+                row["voltage_at_max_fraction"] = float((v >= v_max - 1e-12).mean())
+            out[name] = row
+        return out
+
+    def to_dict(self) -> dict:
+        """The JSON summary (schema railride.compare/1, docs/cli.md)."""
+        red = self.reductions
+        rows = []
+        demands = self.demands()
+        for name in self.names:
+            m = self.metrics.sel(controller=name)
+            row = {"name": name, "label": LABELS[name],
+                   "metrics": {str(r): {s: float(m.sel(response=r, statistic=s)) for s in STATISTICS}
+                               for r in m.response.values},
+                   "damper": demands[name]}
+            if name != "passive":
+                row["reduction_percent"] = {str(r): float(red.sel(controller=name, response=r, statistic="rms"))
+                                            for r in m.response.values}
+            row["paper"] = {r: {"rms": PAPER_TABLE1[r][name],
+                                **({"reduction_percent": PAPER_REDUCTION[r][name]} if name != "passive" else {})}
+                            for r in PAPER_TABLE1}
+            rows.append(row)
+        return {"schema": "railride.compare/1", "railride_version": __version__,
+                "settings": self.settings, "controllers": rows,
+                "gains": {"source": self.gains.source, "inner": self.gains.inner.to_dict(),
+                          **{n: self.gains.controller(n).to_dict() for n in self.names if n != "passive"}}}
+
+    def combined(self) -> xr.Dataset:
+        """All suspensions in one Dataset along ``controller`` (damper channels NaN for passive)."""
+        parts = []
+        for name in self.names:
+            ds = self.datasets[name].drop_vars(["scenario", "vehicle_params", "controller",
+                                                "controller_gains"], errors="ignore")
+            parts.append(ds.expand_dims(controller=[name]))
+        out = xr.concat(parts, dim="controller", join="outer", data_vars="all",
+                        combine_attrs="drop_conflicts")
+        first = self.datasets[self.names[0]]
+        out["scenario"] = first["scenario"]
+        out["vehicle_params"] = first["vehicle_params"]
+        out.attrs.update(title="railride controller comparison", gains_source=self.gains.source,
+                         settings=json.dumps(self.settings))
+        return out
+
+
+def compare(scenario, params=None, *, controllers=CONTROLLERS, gains: GainSet | None = None,
+            damper="railway", window=None, dt: float = DEFAULT_DT,
+            output_rate: float = DEFAULT_OUTPUT_RATE, control_rate: float = DEFAULT_CONTROL_RATE,
+            sensor_noise=None, progress=None) -> Comparison:
+    """Run the passive vehicle and each controller on ``scenario`` and collect the metrics.
+
+    ``controllers`` names from `railride.control.CONTROLLERS` (passive is always run as the
+    baseline); ``gains`` a `GainSet` (default: the shipped gains); ``window`` (start, end) s for
+    the metrics.
+    """
+    names = check_controllers(controllers)
+    gains = GainSet.default() if gains is None else gains
+    common = dict(dt=dt, output_rate=output_rate)
+    datasets = {"passive": simulate(scenario, params, **common).dataset}
+    if progress is not None:
+        progress(1 / 2)
+    controlled = [n for n in names if n != "passive"]
+    if controlled:
+        batch = simulate(scenario, params, damper=damper, controller=[gains.controller(n) for n in controlled],
+                         inner=gains.inner, control_rate=control_rate, sensor_noise=sensor_noise,
+                         **common).dataset
+        for i, n in enumerate(controlled):
+            datasets[n] = batch.isel(sample=i, drop=True)
+    if progress is not None:
+        progress(1.0)
+    metrics = xr.concat([ride_metrics(datasets[n], window) for n in names], dim="controller")
+    metrics = metrics.assign_coords(controller=names)
+    first = datasets["passive"]
+    settings = {"scenario": json.loads(str(first["scenario"].values)), "damper": str(damper),
+                "dt_s": dt, "output_rate_hz": output_rate, "control_rate_hz": control_rate,
+                "window_s": None if window is None else [float(w) for w in window],
+                "sensor_noise": None if sensor_noise is None else sensor_noise.__dict__}
+    return Comparison(names, datasets, metrics, window, gains, str(damper), settings)
