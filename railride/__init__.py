@@ -12,6 +12,7 @@ The public API, in the order a run needs it::
 
 __version__ = "0.1.0"
 
+from .compare import compare
 from .metrics import reduction, ride_metrics
 from .params import VehicleParams
 from .simulation import RideResult, simulate
@@ -20,5 +21,5 @@ from .vehicle import Vehicle
 
 __all__ = [
     "CosineBump", "MeasuredTrack", "RideResult", "Scenario", "SineTrack", "Vehicle",
-    "VehicleParams", "reduction", "ride_metrics", "scenario", "simulate",
+    "VehicleParams", "compare", "reduction", "ride_metrics", "scenario", "simulate",
 ]

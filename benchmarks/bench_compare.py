@@ -1,0 +1,56 @@
+"""`railride compare` wall-clock times (issue 4): the first run on a fresh install (numba's cache
+empty, so compilation is included) and a second run (cache warm).
+
+Run:  python benchmarks/bench_compare.py [--repeat N]
+Targets: first run <= 15 s, second run <= 3 s. Prints a Markdown table for docs/performance.md.
+"""
+
+from __future__ import annotations
+
+import argparse
+import shutil
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+
+def _clear_cache() -> None:
+    import railride
+
+    cache = Path(railride.__file__).parent / "__pycache__"
+    for f in list(cache.glob("*.nbi")) + list(cache.glob("*.nbc")):
+        f.unlink()
+
+
+def _timed(cmd) -> float:
+    t0 = time.perf_counter()
+    subprocess.run(cmd, check=True, capture_output=True)
+    return time.perf_counter() - t0
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__)
+    ap.add_argument("--repeat", type=int, default=3)
+    args = ap.parse_args()
+    exe = shutil.which("railride")
+    cmd = [exe, "compare"] if exe else [sys.executable, "-m", "railride.cli", "compare"]
+    firsts, seconds = [], []
+    for _ in range(args.repeat):
+        _clear_cache()
+        firsts.append(_timed(cmd))
+        seconds.append(_timed(cmd))
+    out_dir = Path("/tmp/railride-bench-compare")
+    shutil.rmtree(out_dir, ignore_errors=True)
+    with_out = _timed(cmd + ["--out", str(out_dir)])
+    print("| benchmark | result | target |")
+    print("|---|---|---|")
+    print(f"| `railride compare`, first run (numba cache empty: compilation included), best of {args.repeat} "
+          f"| {min(firsts):.1f} s (worst {max(firsts):.1f} s) | <= 15 s |")
+    print(f"| `railride compare`, second run (cache warm), best of {args.repeat} "
+          f"| {min(seconds):.2f} s (worst {max(seconds):.2f} s) | <= 3 s |")
+    print(f"| `railride compare --out DIR` (cache warm: NetCDF, CSV, JSON, six plots) | {with_out:.2f} s | |")
+
+
+if __name__ == "__main__":
+    main()
