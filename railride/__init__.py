@@ -12,7 +12,7 @@ The public API, in the order a run needs it::
 
 __version__ = "0.1.0"
 
-from .compare import compare
+from .comparison import compare
 from .metrics import reduction, ride_metrics
 from .params import VehicleParams
 from .simulation import RideResult, simulate

@@ -1,9 +1,9 @@
-"""The ``railride`` command line: ``railride modes``, ``railride simulate``, ``railride damper``
-and ``railride tracking``.
+"""The ``railride`` command line: ``railride compare``, ``railride modes``, ``railride simulate``,
+``railride damper`` and ``railride tracking``.
 
 A thin layer over the library: it parses options, calls `railride.vehicle`, `railride.track`,
-`railride.simulation`, `railride.metrics`, `railride.dampers`, `railride.rig` and
-`railride.report`, and prints. See docs/cli.md.
+`railride.simulation`, `railride.metrics`, `railride.dampers`, `railride.rig`,
+`railride.control`, `railride.comparison` and `railride.report`, and prints. See docs/cli.md.
 
 Exit statuses: 0 success, 1 the simulation diverged, 2 bad input (usage errors, invalid values,
 unreadable files, an output folder that cannot be written). Errors print one line
@@ -40,7 +40,8 @@ app = typer.Typer(
     no_args_is_help=True,
     pretty_exceptions_show_locals=False,
     rich_markup_mode=None,
-    help="Vertical ride of a 9-DOF railway vehicle: modes, simulated ride metrics, and MR "
+    help="Vertical ride of a 9-DOF railway vehicle: the paper's comparison of passive, PID and "
+         "SAS suspensions (start with `railride compare`), modes, simulated ride metrics, and MR "
          "damper rig tests (hysteresis cycles, force tracking).",
 )
 
@@ -94,6 +95,21 @@ def _stdout_console():
     from rich.console import Console
 
     return Console(file=sys.stdout, highlight=False)
+
+
+def _wide_stdout_console(width: int = 120):
+    """The stdout console for wide tables: the terminal's width on a terminal, else ``width``
+    columns (rich would assume 80 for a pipe or a file) unless COLUMNS says otherwise."""
+    import os
+
+    from rich.console import Console
+
+    try:
+        terminal = sys.stdout.isatty()
+    except (AttributeError, ValueError):
+        terminal = False
+    fixed = None if terminal or os.environ.get("COLUMNS") else width
+    return Console(file=sys.stdout, highlight=False, width=fixed)
 
 
 def _stderr_console():
@@ -197,6 +213,288 @@ FormatOption = Annotated[OutputFormat, typer.Option(
     "--format", case_sensitive=False, help="Output on stdout: a table or a JSON document.")]
 
 
+# -- compare ------------------------------------------------------------------------------------
+#: table labels of the four ride responses (keys of railride.metrics.RESPONSES)
+RESPONSE_LABELS = {"acceleration_m_s2": "acceleration (m/s^2)", "displacement_m": "displacement (m)",
+                   "pitch_deg": "pitch (deg)", "roll_deg": "roll (deg)"}
+
+
+def _controller_list(text: str) -> list[str]:
+    """--controllers: comma-separated names -> the suspensions to run, passive first."""
+    from .comparison import check_controllers
+    from .control import CONTROLLERS
+
+    items = [item.strip() for item in text.split(",")]
+    if any(not item for item in items):
+        raise ValueError(f"--controllers = {text!r}: an empty item; give names separated by "
+                         f"commas from {', '.join(CONTROLLERS)}")
+    try:
+        return check_controllers(items)
+    except ValueError as exc:
+        raise ValueError(f"--controllers = {text!r}: {exc}") from None
+
+
+def _gain_set(path: Optional[Path]):
+    """The shipped gains, or --gains FILE with the library's message (file, table, entry)."""
+    from .control import GainSet
+
+    if path is None:
+        return GainSet.default()
+    try:
+        return GainSet.load(path)
+    except ValueError as exc:
+        raise ValueError(f"--gains: {exc}") from None
+
+
+#: --sensor-noise items: (name, unit)
+_NOISE_ITEMS = (("Z", "m"), ("ANGLE", "rad"), ("VEL", "m/s"), ("RATE", "rad/s"))
+
+
+def _sensor_noise(text: Optional[str], seed: Optional[int]):
+    """--sensor-noise Z,ANGLE,VEL,RATE and --seed -> a control.SensorNoise, or None."""
+    from .control import SensorNoise
+
+    if text is None:
+        if seed is not None:
+            raise ValueError(f"--seed = {seed}: applies with --sensor-noise only (without it the "
+                             "measurements are ideal)")
+        return None
+    form = ",".join(n for n, _ in _NOISE_ITEMS)
+    units = ", ".join(u for _, u in _NOISE_ITEMS)
+    items = [item.strip() for item in text.split(",")]
+    if len(items) != len(_NOISE_ITEMS):
+        raise ValueError(f"--sensor-noise = {text!r}: expected four numbers {form} ({units}), "
+                         f"got {len(items)} item(s)")
+    values = []
+    for (name, unit), item in zip(_NOISE_ITEMS, items):
+        try:
+            value = float(item)
+        except ValueError:
+            raise ValueError(f"--sensor-noise = {text!r}: {name} = {item!r} is not a number "
+                             f"({unit})") from None
+        if not (math.isfinite(value) and value >= 0):
+            raise ValueError(f"--sensor-noise = {text!r}: {name} = {item}: must be a finite "
+                             f"number >= 0 ({unit}, a standard deviation)")
+        values.append(value)
+    if seed is not None and seed < 0:
+        raise ValueError(f"--seed = {seed}: must be a whole number >= 0")
+    return SensorNoise(*values, seed=0 if seed is None else seed)
+
+
+def _check_control_rate(rate: float, dt: float) -> float:
+    """--control-rate: > 0 and a whole number of RK4 steps per controller period."""
+    rate = _check_number("--control-rate", rate, "Hz")
+    stride = 1.0 / (rate * dt)
+    if round(stride) < 1 or abs(round(stride) - stride) > 1e-6 * stride:
+        raise ValueError(f"--control-rate = {rate:g} Hz with --dt = {dt:g} s: the controller "
+                         "period 1/rate must be a whole number of steps dt")
+    return rate
+
+
+def _fmt(value, spec: str) -> str:
+    return "-" if value is None else format(value, spec)
+
+
+def _reduction_text(value, spec: str = ".1f") -> str:
+    if value is None:
+        return ""
+    text = format(value, spec)
+    return f"[red]{text}[/red]" if value < 0 else text
+
+
+def _compare_tables(doc: dict, vehicle: str, shipped: bool):
+    """The three tables of `compare`: Table 1 beside the paper, peak-to-peak, damper demands."""
+    from rich.markup import escape
+    from rich.table import Table
+    from rich.text import Text
+
+    from .report import describe_scenario
+
+    rows = doc["controllers"]
+    settings = doc["settings"]
+    controlled = [r for r in rows if r["name"] != "passive"]
+
+    # 1. the paper's Table 1: RMS and reduction, railride above the paper
+    start, end = settings["window_s"] or (0.0, settings["scenario"].get("duration_s", 0.0))
+    info = [describe_scenario(settings["scenario"]),
+            f"dt {settings['dt_s']:g} s, RMS over {start:g}-{end:g} s, vehicle {vehicle}"]
+    if controlled:
+        noise = settings.get("sensor_noise")
+        noise_text = ("ideal measurements" if not noise else
+                      "sensor noise z {displacement:g} m, angle {angle:g} rad, velocity {velocity:g} m/s, "
+                      "rate {angular_rate:g} rad/s, seed {seed}".format(**noise))
+        info.append(f"{settings['damper']} MR dampers, controller {settings['control_rate_hz']:g} Hz, "
+                    f"{noise_text}")
+        info.append(f"gains file {doc['gains']['source']}" + (" (shipped)" if shipped else ""))
+    info.append("The paper's absolute values depend on settings it does not give (sine wavelength, "
+                "rail phase, damper, gains): compare the ranking and the size of the reductions, "
+                "not the digits. red. % = (passive - controlled) / passive x 100 (negative: worse "
+                "than passive, in red).")
+    table = Table(title="Ride comparison: RMS of the carbody responses beside the paper's Table 1")
+    table.add_column("response", min_width=12)
+    table.add_column("", no_wrap=True)
+    for r in rows:
+        table.add_column(escape(r["label"].replace(" (", "\n(")), justify="right", min_width=8)
+        if r["name"] != "passive":
+            table.add_column("red. %", justify="right", min_width=5)
+    for key, label in RESPONSE_LABELS.items():
+        ours, paper = [label, "railride"], ["", "[dim]paper[/dim]"]
+        for r in rows:
+            ours.append(f"{r['metrics'][key]['rms']:#.4g}")
+            p = r["paper"][key]
+            paper.append(f"[dim]{p['rms']:g}[/dim]")
+            if r["name"] != "passive":
+                ours.append(_reduction_text(r["reduction_percent"][key]))
+                paper.append(f"[dim]{p['reduction_percent']:.1f}[/dim]")
+        table.add_row(*ours)
+        table.add_row(*paper, end_section=True)
+
+    # 2. peak-to-peak
+    ptp = Table(title="Peak-to-peak of the carbody responses (railride)")
+    ptp.add_column("response")
+    for r in rows:
+        ptp.add_column(escape(r["label"]), justify="right", min_width=8)
+    for key, label in RESPONSE_LABELS.items():
+        ptp.add_row(label, *[f"{r['metrics'][key]['ptp']:#.4g}" for r in rows])
+
+    # 3. what each suspension asks of its dampers
+    demands = Table(title="What each suspension asks of its dampers")
+    demands.add_column("suspension", no_wrap=True)
+    for heading in ("RMS force\n(kN)", "max force\n(kN)", "RMS travel\n(mm)", "max travel\n(mm)",
+                    "mean voltage\n(V)", "time at v_max\n(%)"):
+        demands.add_column(heading, justify="right", min_width=6)
+    for r in rows:
+        d = r["damper"]
+        at_max = d.get("voltage_at_max_fraction")
+        demands.add_row(escape(r["label"]), f"{d['force_rms_n'] / 1e3:.2f}",
+                        f"{d['force_max_n'] / 1e3:.2f}", f"{d['travel_rms_m'] * 1e3:.1f}",
+                        f"{d['travel_max_m'] * 1e3:.1f}", _fmt(d.get("voltage_mean_v"), ".2f"),
+                        "-" if at_max is None else f"{at_max * 100:.1f}")
+    demands_note = ("All four corners, over the metric window. force: the secondary damper force on "
+                    "the carbody; travel: the secondary deflection (suspension travel); passive: "
+                    "the viscous dampers c_sz.")
+    return [table, Text("\n".join(info)), "", ptp, "", demands, Text(demands_note)]
+
+
+@app.command()
+def compare(
+    controllers: Annotated[str, typer.Option(
+        "--controllers", metavar="NAME[,NAME...]",
+        help="Suspensions to compare, comma-separated: passive, pid, sas-attitude, "
+             "sas-attitude-ride. Passive always runs as the baseline.")]
+        = "passive,pid,sas-attitude,sas-attitude-ride",
+    gains: Annotated[Optional[Path], typer.Option(
+        "--gains", metavar="FILE.toml",
+        help="Controller gains from a TOML file with [inner], [pid], [sas.attitude] and "
+             "[sas.ride] (default: the shipped railride/data/gains.toml).")] = None,
+    damper: Annotated[str, typer.Option(
+        "--damper", metavar="MODEL",
+        help="MR damper model of the controlled suspensions: railway, dyke1996 or "
+             "spencer1997.")] = DEFAULT_DAMPER,
+    control_rate: Annotated[float, typer.Option(
+        "--control-rate", metavar="HZ",
+        help="Sample rate of the outer-loop controllers [Hz]; 1/(rate x dt) must be a whole "
+             "number.")] = 1000.0,
+    sensor_noise: Annotated[Optional[str], typer.Option(
+        "--sensor-noise", metavar="Z,ANGLE,VEL,RATE",
+        help="White noise on the measured carbody states, standard deviations: heave [m], "
+             "pitch and roll angle [rad], heave velocity [m/s], pitch and roll rate [rad/s] "
+             "(default: ideal measurements).")] = None,
+    seed: Annotated[Optional[int], typer.Option(
+        "--seed", metavar="N",
+        help="Seed of the sensor noise, >= 0 (default 0); needs --sensor-noise.")] = None,
+    scenario: Annotated[str, typer.Option(
+        "--scenario", metavar="NAME",
+        help="paper-sine (the paper's sine rails), bump or file:PATH, as for simulate.")]
+        = "paper-sine",
+    amplitude: Annotated[Optional[float], typer.Option(
+        "--amplitude", metavar="M",
+        help="paper-sine: sine amplitude [m] (default 0.05). bump: bump height [m] "
+             "(default 0.02).")] = None,
+    wavelength: Annotated[Optional[float], typer.Option(
+        "--wavelength", metavar="M",
+        help="paper-sine: wavelength [m] (default 60). bump: bump length [m] (default 10).")] = None,
+    rail_phase: Annotated[Optional[float], typer.Option(
+        "--rail-phase", metavar="DEG",
+        help="paper-sine only: phase lag of the right rail [deg] (default 90).")] = None,
+    speed: Annotated[Optional[float], typer.Option(
+        "--speed", metavar="M/S", help="Vehicle speed [m/s] (default 55.56).")] = None,
+    duration: Annotated[Optional[float], typer.Option(
+        "--duration", metavar="S", help="Simulated time [s] (default 10).")] = None,
+    dt: Annotated[Optional[float], typer.Option(
+        "--dt", metavar="S", help="Fixed RK4 time step [s] (default 1e-4).")] = None,
+    output_rate: Annotated[Optional[float], typer.Option(
+        "--output-rate", metavar="HZ",
+        help="Sampling rate of the stored time histories [Hz] (default 1000).")] = None,
+    window: Annotated[Optional[str], typer.Option(
+        "--window", metavar="START:END",
+        help="Time window of the metrics [s], e.g. 2:10 (default: the whole run).")] = None,
+    params: ParamsOption = None,
+    preset: PresetOption = None,
+    format: FormatOption = OutputFormat.table,
+    out: Annotated[Optional[Path], typer.Option(
+        "--out", metavar="DIR",
+        help="Also write compare.json, compare.nc, compare.csv and the plots acceleration.png, "
+             "displacement.png, pitch.png, roll.png, damper_forces.png, voltages.png into DIR "
+             "(created if missing; all or nothing).")] = None,
+) -> None:
+    """Compare passive, PID and SAS suspensions on one scenario, as in the paper's Table 1.
+
+    Runs the passive vehicle (the baseline) and each controller (MR dampers closed by the
+    force-tracking inner loop) with the shipped gains, and prints the RMS of the carbody
+    responses with the reduction against passive beside the paper's values, the peak-to-peak
+    values and what each suspension asks of its dampers. Without options: the paper's
+    scenario paper-sine.
+    """
+    with _errors():
+        from . import report
+        from .comparison import compare as run_compare
+        from .metrics import check_window, parse_window
+        from .simulation import DEFAULT_DT, DEFAULT_OUTPUT_RATE
+        from .track import scenario as make_scenario
+
+        names = _controller_list(controllers)
+        gain_set = _gain_set(gains)
+        _damper_preset("--damper", damper)
+        noise = _sensor_noise(sensor_noise, seed)
+        dt = DEFAULT_DT if dt is None else dt
+        output_rate = DEFAULT_OUTPUT_RATE if output_rate is None else output_rate
+        control_rate = _check_control_rate(control_rate, _check_number("--dt", dt, "s"))
+        vehicle_params, vehicle_record = _vehicle_params(params, preset)
+        window_value = parse_window(window) if window is not None else None
+        scen = make_scenario(scenario, amplitude=amplitude, wavelength=wavelength,
+                             rail_phase=rail_phase, speed=speed, duration=duration)
+        if out is not None:
+            report.check_out_dir(out)
+        # check the window before the runs, and record it resolved
+        window_value = check_window(window_value or (0.0, math.inf), scen.duration)
+
+        controlled = [n for n in names if n != "passive"]
+
+        def describe(done: float) -> str:
+            if done < 0.5 or not controlled:
+                return "running the passive baseline..."
+            return f"running {', '.join(controlled)}..."
+
+        with _Progress(_stderr_is_terminal(), describe) as progress:
+            result = run_compare(scen, vehicle_params, controllers=names, gains=gain_set,
+                                 damper=damper, window=window_value, dt=dt,
+                                 output_rate=output_rate, control_rate=control_rate,
+                                 sensor_noise=noise,
+                                 progress=progress if progress.enabled else None)
+        doc = result.to_dict()
+        text = json.dumps(doc, indent=2, allow_nan=False)  # refuses NaN before anything is written
+        if out is not None:
+            _write_folder(out, lambda: report.write_compare_outputs(result, out, doc))
+    if format is OutputFormat.json:
+        typer.echo(text)
+        return
+    vehicle = vehicle_record.get("vehicle_preset") or vehicle_record.get("vehicle_params_file")
+    console = _wide_stdout_console()
+    for part in _compare_tables(doc, vehicle, shipped=gains is None):
+        console.print(part)
+
+
 # -- modes --------------------------------------------------------------------------------------
 @app.command()
 def modes(
@@ -231,10 +529,14 @@ def modes(
 
 # -- simulate -----------------------------------------------------------------------------------
 class _Progress:
-    """A progress bar on stderr, only when stderr is a terminal."""
+    """A progress bar on stderr, only when stderr is a terminal.
 
-    def __init__(self, enabled: bool):
+    ``describe(done)`` gives the bar's text for a done fraction (default: "simulating"); until
+    the first report, a stepper not yet compiled in this process says that it compiles."""
+
+    def __init__(self, enabled: bool, describe=None):
         self.enabled = enabled
+        self._describe = describe or (lambda done: "simulating")
         self._progress = None
         self._task = None
 
@@ -246,7 +548,8 @@ class _Progress:
         from . import kernels
 
         compiled = bool(getattr(kernels.run_batch, "signatures", True))
-        first = "simulating" if compiled else "compiling the stepper (first run only)..."
+        first = (self._describe(0.0) if compiled
+                 else "loading the stepper (the first run compiles it, up to a minute)...")
         self._progress = Progress(SpinnerColumn(), TextColumn("{task.description}"), BarColumn(),
                                   TextColumn("{task.percentage:>3.0f}%"), TimeElapsedColumn(),
                                   console=_stderr_console(), transient=True)
@@ -256,7 +559,7 @@ class _Progress:
 
     def __call__(self, done: float) -> None:
         if self._progress is not None:
-            self._progress.update(self._task, completed=done, description="simulating")
+            self._progress.update(self._task, completed=done, description=self._describe(done))
 
     def __exit__(self, *exc):
         if self._progress is not None:

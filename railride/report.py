@@ -6,7 +6,10 @@
   into a folder, all or nothing.
 * `plot_hysteresis` and `plot_tracking` draw the damper rig results of `railride.rig`;
   `write_damper_outputs` and `write_tracking_outputs` write their folders.
-* `write_folder` is the all-or-nothing folder writer behind the three ``write_*`` functions.
+* `plot_comparison_response`, `plot_comparison_damper_forces`, `plot_comparison_voltages` and
+  `comparison_frame` draw and tabulate a controller comparison (`railride.comparison`, the combined
+  Dataset with a ``controller`` dimension); `write_compare_outputs` writes its folder.
+* `write_folder` is the all-or-nothing folder writer behind the ``write_*`` functions.
 
 Figures are built on matplotlib's object API with the Agg canvas: nothing here touches pyplot's
 global figure list or the user's backend, so no window ever opens and saved figures do not pile
@@ -37,6 +40,9 @@ OUTPUT_FILES = ("ride.nc", "ride.csv", "metrics.json", "body_responses.png")
 DAMPER_FILES = ("loops.png", "cycles.csv", "damper.json")
 #: the files `write_tracking_outputs` produces, in the order they are written
 TRACKING_FILES = ("tracking.png", "tracking.csv", "tracking.json")
+#: the files `write_compare_outputs` produces, in the order they are written
+COMPARE_FILES = ("compare.json", "compare.nc", "compare.csv", "acceleration.png", "displacement.png",
+                 "pitch.png", "roll.png", "damper_forces.png", "voltages.png")
 #: the time histories of a damper rig run (railride.rig), in CSV column order
 RIG_CHANNELS = ("x", "xd", "F", "z", "y", "u", "v", "E")
 
@@ -366,6 +372,221 @@ def plot_tracking(tracking, path=None, *, title: str | None = None):
     fig.suptitle(title, fontsize="medium")
     _save_png(fig, path)
     return fig
+
+
+# -- controller comparison (railride.comparison) --------------------------------------------------
+#: response file stem -> (channel, factor to the plotted unit, axis label, title word)
+COMPARE_RESPONSES = {
+    "acceleration": ("carbody_acceleration", 1.0, "acceleration (m/s$^2$)", "carbody CG vertical acceleration"),
+    "displacement": ("carbody_bounce", 1.0, "displacement (m)", "carbody bounce displacement"),
+    "pitch": ("carbody_pitch", 180.0 / math.pi, "pitch (deg)", "carbody pitch angle"),
+    "roll": ("carbody_roll", 180.0 / math.pi, "roll (deg)", "carbody roll angle"),
+}
+#: line style and colour per suspension, as in the paper's Figs. 8-11 (passive dash-dot, PID
+#: dotted, SAS (attitude) dashed, SAS (attitude+ride) solid)
+COMPARE_STYLES = {
+    "passive": {"linestyle": "-.", "color": "0.25"},
+    "pid": {"linestyle": ":", "color": "tab:blue"},
+    "sas-attitude": {"linestyle": "--", "color": "tab:orange"},
+    "sas-attitude-ride": {"linestyle": "-", "color": "tab:red"},
+}
+#: the per-corner channels of `comparison_frame`, after the body responses
+COMPARE_CORNER_CHANNELS = ("secondary_damper_force", "damper_demand_force", "damper_command_voltage")
+
+
+def _comparison_dataset(comparison) -> xr.Dataset:
+    """A `Comparison` (its ``combined()``) or a combined Dataset -> the Dataset, checked."""
+    ds = comparison.combined() if hasattr(comparison, "combined") else comparison
+    if not isinstance(ds, xr.Dataset) or "controller" not in ds.dims or "time" not in ds.dims:
+        raise ValueError("expected a railride.comparison.Comparison or its combined() Dataset "
+                         "(dims controller, time)")
+    return ds
+
+
+def _controller_names(ds: xr.Dataset) -> list[str]:
+    return [_label(v) for v in ds["controller"].values]
+
+
+def _controller_label(name: str) -> str:
+    from .control import LABELS
+
+    return LABELS.get(name, name)
+
+
+def _style(name: str) -> dict:
+    return COMPARE_STYLES.get(name, {"linestyle": "-"})
+
+
+def comparison_title(ds: xr.Dataset) -> str:
+    """One line naming the scenario, the dampers and the gains of a combined comparison."""
+    ds = _comparison_dataset(ds)
+    parts = []
+    records = _records(ds, "scenario")
+    if records and records[0]:
+        parts.append(describe_scenario(records[0]))
+    try:
+        settings = json.loads(ds.attrs.get("settings", "{}"))
+    except (TypeError, ValueError):
+        settings = {}
+    if isinstance(settings, dict) and settings.get("damper") and any(
+            n != "passive" for n in _controller_names(ds)):
+        parts.append(f"{settings['damper']} MR dampers")
+    if ds.attrs.get("gains_source") and any(n != "passive" for n in _controller_names(ds)):
+        parts.append(f"gains {ds.attrs['gains_source']}")
+    return ", ".join(p for p in parts if p)
+
+
+def plot_comparison_response(comparison, response: str, path=None):
+    """One carbody response against time, one line per suspension in the paper's style (Figs.
+    8-11: passive dash-dot, PID dotted, SAS (attitude) dashed, SAS (attitude+ride) solid).
+
+    ``response`` is ``acceleration`` (m/s^2), ``displacement`` (bounce, m), ``pitch`` or
+    ``roll`` (both in degrees). ``comparison`` is a `railride.comparison.Comparison` or its
+    ``combined()`` Dataset. Saved as PNG at ``path`` when given (atomically); returns the Agg
+    `Figure`.
+    """
+    if response not in COMPARE_RESPONSES:
+        raise ValueError(f"response = {response!r}: allowed {', '.join(COMPARE_RESPONSES)}")
+    ds = _comparison_dataset(comparison)
+    channel, factor, ylabel, what = COMPARE_RESPONSES[response]
+    if channel not in ds.variables:
+        raise ValueError(f"the dataset lacks the channel {channel}")
+    fig = _new_figure((10.0, 4.6))
+    ax = fig.subplots()
+    time = ds["time"].values
+    for i, name in enumerate(_controller_names(ds)):
+        y = ds[channel].isel(controller=i).values * factor
+        ax.plot(time, y, linewidth=1.1, label=_controller_label(name), **_style(name))
+    ax.set_xlabel("time (s)")
+    ax.set_ylabel(ylabel)
+    ax.set_xlim(time[0], time[-1])
+    ax.grid(True, linewidth=0.4, alpha=0.6)
+    # above the axes, not over the lines
+    ax.legend(loc="lower center", bbox_to_anchor=(0.5, 1.0), fontsize="small", frameon=False,
+              ncols=min(4, ds.sizes["controller"]))
+    title = comparison_title(ds)
+    fig.suptitle(f"{what}" + (f"\n{title}" if title else ""), fontsize="medium")
+    _save_png(fig, path)
+    return fig
+
+
+def _corner_grid(ds: xr.Dataset, rows: list[str], figsize_row: float = 2.0):
+    corners = [_label(c) for c in ds["corner"].values]
+    fig = _new_figure((13.0, 1.2 + figsize_row * len(rows)))
+    axes = np.atleast_2d(fig.subplots(len(rows), len(corners), sharex=True, sharey=True,
+                                      squeeze=False))
+    for j, corner in enumerate(corners):
+        axes[0, j].set_title(f"corner {corner}", fontsize="medium")
+        axes[-1, j].set_xlabel("time (s)")
+    return fig, axes, corners
+
+
+def plot_comparison_damper_forces(comparison, path=None):
+    """The secondary damper force on the carbody (kN, up +) at each corner against time: one
+    row per suspension (passive: the viscous dampers), one column per corner (1R, 1L, 2R, 2L),
+    all panels on the same scale, solid lines in each suspension's colour. Saved as PNG at ``path`` when given; returns the `Figure`."""
+    ds = _comparison_dataset(comparison)
+    if "secondary_damper_force" not in ds.variables:
+        raise ValueError("the dataset lacks the channel secondary_damper_force")
+    names = _controller_names(ds)
+    fig, axes, corners = _corner_grid(ds, names)
+    time = ds["time"].values
+    force = ds["secondary_damper_force"].transpose("controller", "time", "corner").values / 1e3
+    for i, name in enumerate(names):
+        for j in range(len(corners)):
+            ax = axes[i, j]
+            ax.plot(time, force[i, :, j], linewidth=0.8, color=_style(name).get("color"))
+            ax.axhline(0.0, color="0.6", linewidth=0.5)
+            ax.grid(True, linewidth=0.4, alpha=0.6)
+        axes[i, 0].set_ylabel(f"{_controller_label(name)}\nforce (kN)")
+    axes[0, 0].set_xlim(time[0], time[-1])
+    title = comparison_title(ds)
+    fig.suptitle("secondary damper force on the carbody (kN, up +)" + (f"\n{title}" if title else ""),
+                 fontsize="medium")
+    _save_png(fig, path)
+    return fig
+
+
+def plot_comparison_voltages(comparison, path=None):
+    """The command voltage v (V) of each MR damper against time: one row per controlled
+    suspension, one column per corner. A comparison without a controlled suspension gets one
+    panel saying so. Saved as PNG at ``path`` when given; returns the `Figure`."""
+    ds = _comparison_dataset(comparison)
+    names = [n for n in _controller_names(ds) if n != "passive"]
+    title = comparison_title(ds)
+    if not names or "damper_command_voltage" not in ds.variables:
+        fig = _new_figure((8.0, 3.0))
+        ax = fig.subplots()
+        ax.text(0.5, 0.5, "passive suspension only: no command voltages", ha="center",
+                va="center", transform=ax.transAxes)
+        ax.set_axis_off()
+        fig.suptitle("MR damper command voltage" + (f"\n{title}" if title else ""),
+                     fontsize="medium")
+        _save_png(fig, path)
+        return fig
+    fig, axes, corners = _corner_grid(ds, names)
+    time = ds["time"].values
+    volts = ds["damper_command_voltage"].transpose("controller", "time", "corner")
+    all_names = _controller_names(ds)
+    top = np.nanmax(volts.values) if np.isfinite(volts.values).any() else 1.0
+    for i, name in enumerate(names):
+        v = volts.isel(controller=all_names.index(name)).values
+        for j in range(len(corners)):
+            ax = axes[i, j]
+            ax.plot(time, v[:, j], linewidth=0.7, color=_style(name).get("color"))
+            ax.grid(True, linewidth=0.4, alpha=0.6)
+        axes[i, 0].set_ylabel(f"{_controller_label(name)}\nvoltage (V)")
+    axes[0, 0].set_xlim(time[0], time[-1])
+    axes[0, 0].set_ylim(-0.05 * max(top, 1e-9), 1.08 * max(top, 1e-9))
+    fig.suptitle("MR damper command voltage v (V)" + (f"\n{title}" if title else ""),
+                 fontsize="medium")
+    _save_png(fig, path)
+    return fig
+
+
+def comparison_frame(comparison) -> pd.DataFrame:
+    """A comparison as one long table, the suspensions one after another: columns
+    ``controller``, ``time`` [s], the carbody responses ``carbody_acceleration`` [m/s^2],
+    ``carbody_bounce`` [m], ``carbody_pitch``, ``carbody_roll`` [rad], then per corner
+    (1R, 1L, 2R, 2L) ``secondary_damper_force_<corner>`` [N, on the carbody, up +],
+    ``damper_demand_force_<corner>`` [N, the outer loop's desired force, up +] and
+    ``damper_command_voltage_<corner>`` [V]; the last two are empty (NaN) for the passive
+    suspension and absent when no controlled suspension was run."""
+    ds = _comparison_dataset(comparison)
+    body = [c for c, _, _, _ in COMPARE_RESPONSES.values()]
+    missing = [c for c in body if c not in ds.variables]
+    if missing:
+        raise ValueError(f"the dataset lacks the channel(s) {', '.join(missing)}")
+    channels = body + [c for c in COMPARE_CORNER_CHANNELS if c in ds.variables]
+    frames = []
+    for i, name in enumerate(_controller_names(ds)):
+        frame = to_frame(ds[channels].isel(controller=i, drop=True)).reset_index()
+        frame.insert(0, "controller", name)
+        frames.append(frame)
+    return pd.concat(frames, ignore_index=True)
+
+
+def write_compare_outputs(comparison, out_dir, doc: dict) -> list[Path]:
+    """Write a controller comparison into ``out_dir``, all or nothing (`write_folder`):
+    ``compare.json`` (``doc``, the ``Comparison.to_dict()`` document, strict JSON),
+    ``compare.nc`` (``combined()`` as NetCDF, see `netcdf_ready`), ``compare.csv``
+    (`comparison_frame`), ``acceleration.png``, ``displacement.png``, ``pitch.png``,
+    ``roll.png`` (`plot_comparison_response`), ``damper_forces.png``
+    (`plot_comparison_damper_forces`) and ``voltages.png`` (`plot_comparison_voltages`).
+    ``comparison`` is a `railride.comparison.Comparison` or its combined Dataset. Returns the
+    written paths."""
+    text = _json_text(doc)
+    ds = _comparison_dataset(comparison)
+    writers = {
+        "compare.json": lambda path: path.write_text(text, encoding="utf-8"),
+        "compare.nc": lambda path: write_netcdf(ds, path),
+        "compare.csv": lambda path: comparison_frame(ds).to_csv(path, index=False),
+        "damper_forces.png": lambda path: plot_comparison_damper_forces(ds, path),
+        "voltages.png": lambda path: plot_comparison_voltages(ds, path),
+    }
+    for response in COMPARE_RESPONSES:
+        writers[f"{response}.png"] = (lambda r: lambda path: plot_comparison_response(ds, r, path))(response)
+    return write_folder(out_dir, [(name, writers[name]) for name in COMPARE_FILES])
 
 
 # -- NetCDF -----------------------------------------------------------------------------------

@@ -86,7 +86,7 @@ class Comparison:
         return out
 
     def to_dict(self) -> dict:
-        """The JSON summary (schema railride.compare/1, docs/cli.md)."""
+        """The JSON summary (schema railride.comparison/1, docs/cli.md)."""
         red = self.reductions
         rows = []
         demands = self.demands()
@@ -103,7 +103,7 @@ class Comparison:
                                 **({"reduction_percent": PAPER_REDUCTION[r][name]} if name != "passive" else {})}
                             for r in PAPER_TABLE1}
             rows.append(row)
-        return {"schema": "railride.compare/1", "railride_version": __version__,
+        return {"schema": "railride.comparison/1", "railride_version": __version__,
                 "settings": self.settings, "controllers": rows,
                 "gains": {"source": self.gains.source, "inner": self.gains.inner.to_dict(),
                           **{n: self.gains.controller(n).to_dict() for n in self.names if n != "passive"}}}
@@ -115,11 +115,15 @@ class Comparison:
             ds = self.datasets[name].drop_vars(["scenario", "vehicle_params", "controller",
                                                 "controller_gains"], errors="ignore")
             parts.append(ds.expand_dims(controller=[name]))
+        gains = [json.dumps(None if n == "passive" else self.gains.controller(n).to_dict())
+                 for n in self.names]
         out = xr.concat(parts, dim="controller", join="outer", data_vars="all",
                         combine_attrs="drop_conflicts")
         first = self.datasets[self.names[0]]
         out["scenario"] = first["scenario"]
         out["vehicle_params"] = first["vehicle_params"]
+        out["controller_gains"] = ("controller", np.array(gains))
+        out["inner_loop_gains"] = ((), json.dumps(self.gains.inner.to_dict()))
         out.attrs.update(title="railride controller comparison", gains_source=self.gains.source,
                          settings=json.dumps(self.settings))
         return out
@@ -137,23 +141,23 @@ def compare(scenario, params=None, *, controllers=CONTROLLERS, gains: GainSet | 
     """
     names = check_controllers(controllers)
     gains = GainSet.default() if gains is None else gains
-    common = dict(dt=dt, output_rate=output_rate)
-    datasets = {"passive": simulate(scenario, params, **common).dataset}
-    if progress is not None:
-        progress(1 / 2)
     controlled = [n for n in names if n != "passive"]
+    # progress by sample-steps: the passive run is one sample, the controlled batch the rest
+    share = 1.0 / (1 + len(controlled))
+    part = (lambda lo, w: (lambda done: progress(lo + w * done))) if progress is not None else None
+    common = dict(dt=dt, output_rate=output_rate)
+    datasets = {"passive": simulate(scenario, params, progress=part and part(0.0, share), **common).dataset}
     if controlled:
         batch = simulate(scenario, params, damper=damper, controller=[gains.controller(n) for n in controlled],
                          inner=gains.inner, control_rate=control_rate, sensor_noise=sensor_noise,
-                         **common).dataset
+                         progress=part and part(share, 1.0 - share), **common).dataset
         for i, n in enumerate(controlled):
             datasets[n] = batch.isel(sample=i, drop=True)
-    if progress is not None:
-        progress(1.0)
     metrics = xr.concat([ride_metrics(datasets[n], window) for n in names], dim="controller")
     metrics = metrics.assign_coords(controller=names)
     first = datasets["passive"]
-    settings = {"scenario": json.loads(str(first["scenario"].values)), "damper": str(damper),
+    settings = {"scenario": json.loads(str(first["scenario"].values)),
+                "vehicle_params": json.loads(str(first["vehicle_params"].values)), "damper": str(damper),
                 "dt_s": dt, "output_rate_hz": output_rate, "control_rate_hz": control_rate,
                 "window_s": None if window is None else [float(w) for w in window],
                 "sensor_noise": None if sensor_noise is None else sensor_noise.__dict__}

@@ -1,0 +1,300 @@
+"""`railride compare`: the JSON contract (railride.comparison/1), the tables, bad input, the --out
+folder."""
+
+from __future__ import annotations
+
+import json
+
+import pandas as pd
+import pytest
+import xarray as xr
+from typer.testing import CliRunner
+
+from railride.cli import app
+from railride.comparison import PAPER_REDUCTION, PAPER_TABLE1
+from railride.control import CONTROLLERS, LABELS, GainSet
+from railride.report import COMPARE_FILES
+
+runner = CliRunner()
+
+RESPONSES = ["acceleration_m_s2", "displacement_m", "pitch_deg", "roll_deg"]
+SHORT = ("compare", "--duration", 2)
+PNG = b"\x89PNG\r\n\x1a\n"
+
+
+def run(*args):
+    return runner.invoke(app, [str(a) for a in args])
+
+
+def ok_json(*args) -> dict:
+    result = run(*args, "--format", "json")
+    assert result.exit_code == 0, (result.stdout, result.stderr)
+    return json.loads(result.stdout)
+
+
+def assert_input_error(result, *fragments):
+    """Exit status 2, one line "error: ..." on stderr naming the fragments, no traceback."""
+    assert result.exit_code == 2, (result.exit_code, result.stdout, result.stderr)
+    assert isinstance(result.exception, SystemExit)
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: "), result.stderr
+    assert "Traceback" not in result.output
+    assert result.stdout == ""
+    for fragment in fragments:
+        assert fragment in lines[0], lines[0]
+
+
+def rms(doc, name, response="acceleration_m_s2"):
+    row = next(r for r in doc["controllers"] if r["name"] == name)
+    return row["metrics"][response]["rms"]
+
+
+@pytest.fixture(scope="module")
+def short_doc() -> dict:
+    return ok_json(*SHORT)
+
+
+@pytest.fixture
+def gains_text() -> str:
+    return GainSet.default().to_toml()
+
+
+def write(path, text):
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+# -- the JSON document ------------------------------------------------------------------------------
+def test_json_four_controllers_in_order(short_doc):
+    doc = short_doc
+    assert doc["schema"] == "railride.comparison/1"
+    assert [r["name"] for r in doc["controllers"]] == list(CONTROLLERS)
+    assert [r["label"] for r in doc["controllers"]] == [LABELS[n] for n in CONTROLLERS]
+    for row in doc["controllers"]:
+        assert list(row["metrics"]) == RESPONSES
+        for response in RESPONSES:
+            m = row["metrics"][response]
+            assert set(m) == {"rms", "ptp"} and m["rms"] > 0 and m["ptp"] > 0
+            assert row["paper"][response]["rms"] == PAPER_TABLE1[response][row["name"]]
+        if row["name"] == "passive":
+            assert "reduction_percent" not in row
+            assert all("reduction_percent" not in row["paper"][r] for r in RESPONSES)
+            assert "voltage_mean_v" not in row["damper"]
+        else:
+            assert list(row["reduction_percent"]) == RESPONSES
+            for response in RESPONSES:
+                base = rms(doc, "passive", response)
+                expected = (base - row["metrics"][response]["rms"]) / base * 100
+                assert row["reduction_percent"][response] == pytest.approx(expected)
+                assert row["paper"][response]["reduction_percent"] == PAPER_REDUCTION[response][row["name"]]
+            assert 0 <= row["damper"]["voltage_at_max_fraction"] <= 1
+        assert row["damper"]["force_rms_n"] > 0 and row["damper"]["travel_max_m"] > 0
+
+
+def test_json_settings_and_gains(short_doc):
+    settings = short_doc["settings"]
+    assert settings["scenario"]["name"] == "paper-sine" and settings["scenario"]["duration_s"] == 2.0
+    assert settings["damper"] == "railway"
+    assert settings["control_rate_hz"] == 1000.0 and settings["dt_s"] == 1e-4
+    assert settings["window_s"] == [0.0, 2.0]  # resolved, as in simulate
+    assert settings["sensor_noise"] is None
+    gains = short_doc["gains"]
+    assert gains["source"] == "railride/data/gains.toml"
+    assert set(gains) == {"source", "inner", "pid", "sas-attitude", "sas-attitude-ride"}
+
+
+def test_default_run_is_the_paper_scenario():
+    result = run("compare", "--format", "json")
+    assert result.exit_code == 0, result.output
+    doc = json.loads(result.stdout)
+    assert doc["settings"]["scenario"]["name"] == "paper-sine"
+    assert doc["settings"]["scenario"]["duration_s"] == 10.0
+    assert [r["name"] for r in doc["controllers"]] == list(CONTROLLERS)
+    assert result.stderr == ""  # no progress when stderr is not a terminal
+
+
+def test_controllers_pid_gives_passive_and_pid():
+    doc = ok_json(*SHORT, "--controllers", "pid")
+    assert [r["name"] for r in doc["controllers"]] == ["passive", "pid"]
+    assert set(doc["gains"]) == {"source", "inner", "pid"}
+
+
+def test_controllers_any_order_and_passive_only(short_doc):
+    doc = ok_json(*SHORT, "--controllers", "sas-attitude-ride, pid")
+    assert [r["name"] for r in doc["controllers"]] == ["passive", "pid", "sas-attitude-ride"]
+    assert rms(doc, "pid") == pytest.approx(rms(short_doc, "pid"))
+    doc = ok_json(*SHORT, "--controllers", "passive")
+    assert [r["name"] for r in doc["controllers"]] == ["passive"]
+
+
+def test_window_and_sensor_noise_recorded(short_doc):
+    doc = ok_json(*SHORT, "--controllers", "pid", "--window", "1:", "--sensor-noise",
+                  "1e-4,1e-5,1e-3,1e-4", "--seed", 7)
+    assert doc["settings"]["window_s"] == [1.0, 2.0]
+    assert doc["settings"]["sensor_noise"] == {"displacement": 1e-4, "angle": 1e-5, "velocity": 1e-3,
+                                               "angular_rate": 1e-4, "seed": 7}
+    assert rms(doc, "pid") != rms(short_doc, "pid")
+
+
+def test_gains_file_changes_the_result(tmp_path, gains_text, short_doc):
+    assert "kd = 450000.0" in gains_text
+    changed = write(tmp_path / "gains.toml", gains_text.replace("kd = 450000.0", "kd = 100000.0"))
+    doc = ok_json(*SHORT, "--gains", changed)
+    assert doc["gains"]["source"] == str(changed)
+    assert doc["gains"]["pid"]["kd"] == 100000.0
+    assert rms(doc, "pid") != pytest.approx(rms(short_doc, "pid"), rel=1e-6)
+    assert rms(doc, "passive") == rms(short_doc, "passive")
+    # the SAS gains are untouched
+    assert rms(doc, "sas-attitude") == pytest.approx(rms(short_doc, "sas-attitude"))
+
+
+def test_damper_option():
+    doc = ok_json(*SHORT, "--controllers", "pid", "--damper", "dyke1996")
+    assert doc["settings"]["damper"] == "dyke1996"
+
+
+# -- the tables -------------------------------------------------------------------------------------
+def test_table_output(tmp_path):
+    result = run(*SHORT, "--gains", write(tmp_path / "g.toml", GainSet.default().to_toml()))
+    assert result.exit_code == 0, result.output
+    out = result.stdout
+    for text in ("Ride comparison", "Peak-to-peak", "asks of its dampers", "acceleration (m/s^2)",
+                 "displacement (m)", "pitch (deg)", "roll (deg)", "red. %", "railride", "paper",
+                 "0.3195", "1.2001", "35.4", "RMS force", "time at v_max", "Passive",
+                 "SAS (attitude+ride)", "ranking", "g.toml"):
+        assert text in out, text
+    assert "…" not in out  # nothing truncated at the default width of a pipe
+    assert result.stderr == ""
+
+
+# -- --out ----------------------------------------------------------------------------------------
+def test_out_writes_all_files(tmp_path):
+    out = tmp_path / "cmp"
+    result = run(*SHORT, "--format", "json", "--out", out)
+    assert result.exit_code == 0, result.output
+    doc = json.loads(result.stdout)
+    assert sorted(p.name for p in out.iterdir()) == sorted(COMPARE_FILES)
+    assert json.loads((out / "compare.json").read_text()) == doc
+    with xr.open_dataset(out / "compare.nc", engine="scipy") as ds:
+        assert "controller" in ds.dims
+        assert [str(c) for c in ds["controller"].values] == list(CONTROLLERS)
+        assert ds.sizes["time"] == 2001
+        assert ds["carbody_bounce"].dims == ("controller", "time")
+        assert ds["damper_command_voltage"].sel(controller="passive").isnull().all()
+        assert ds["damper_command_voltage"].sel(controller="pid").notnull().all()
+    frame = pd.read_csv(out / "compare.csv")
+    assert list(frame.columns[:6]) == ["controller", "time", "carbody_acceleration", "carbody_bounce",
+                                       "carbody_pitch", "carbody_roll"]
+    for corner in ("1R", "1L", "2R", "2L"):
+        assert f"secondary_damper_force_{corner}" in frame and f"damper_command_voltage_{corner}" in frame
+    assert list(frame["controller"].unique()) == list(CONTROLLERS)
+    assert len(frame) == 4 * 2001
+    for name in COMPARE_FILES:
+        if name.endswith(".png"):
+            assert (out / name).read_bytes()[:8] == PNG, name
+    assert [p.name for p in tmp_path.iterdir()] == ["cmp"]  # no staging folder left
+    assert "wrote compare.json" in result.stderr
+
+
+def test_out_passive_only(tmp_path):
+    out = tmp_path / "passive"
+    assert run(*SHORT, "--controllers", "passive", "--out", out).exit_code == 0
+    assert sorted(p.name for p in out.iterdir()) == sorted(COMPARE_FILES)
+    assert (out / "voltages.png").read_bytes()[:8] == PNG
+
+
+# -- bad input --------------------------------------------------------------------------------------
+@pytest.mark.parametrize("args, fragments", [
+    (("--controllers", "pid,lqr"), ("--controllers", "'lqr'", "allowed")),
+    (("--controllers", "pid,,sas-attitude"), ("--controllers", "empty item")),
+    (("--controllers", ""), ("--controllers",)),
+    (("--seed", 3), ("--seed", "--sensor-noise")),
+    (("--sensor-noise", "1,2,3"), ("--sensor-noise", "'1,2,3'", "four numbers")),
+    (("--sensor-noise", "1,2,3,4,5"), ("--sensor-noise", "four numbers")),
+    (("--sensor-noise", "0,0,-1,0"), ("--sensor-noise", "VEL", ">= 0")),
+    (("--sensor-noise", "0,x,0,0"), ("--sensor-noise", "ANGLE", "'x'")),
+    (("--sensor-noise", "0,0,0,inf"), ("--sensor-noise", "RATE")),
+    (("--sensor-noise", "0,0,0,0", "--seed", -1), ("--seed", "-1")),
+    (("--damper", "mr9"), ("--damper", "'mr9'")),
+    (("--control-rate", 0), ("--control-rate",)),
+    (("--control-rate", 300), ("--control-rate", "300", "whole number")),
+    (("--speed", -3), ("speed", "-3")),
+    (("--window", "5:20"), ("window", "5:20")),
+    (("--window", "abc"), ("window",)),
+    (("--scenario", "nope"), ("scenario", "'nope'")),
+    (("--rail-phase", 10, "--scenario", "bump"), ("rail",)),
+    (("--dt", 0.05, "--control-rate", 20), ("dt", "too large")),
+    (("--preset", "nope"), ("nope",)),
+])
+def test_bad_input(tmp_path, args, fragments):
+    out = tmp_path / "out"
+    assert_input_error(run(*SHORT, *args, "--out", out), *fragments)
+    assert not out.exists() and list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("change, fragments", [
+    (None, ("--gains", "cannot read gains file", "absent.toml")),
+    (("kd = 450000.0", "# kd left out"), ("--gains", "missing entry 'kd' in [pid]")),
+    (("kd = 450000.0", "kd = 450000.0\nkx = 1.0"), ("--gains", "unknown entry 'kx' in [pid]")),
+    (("kd = 450000.0", 'kd = "lots"'), ("--gains", "'kd' in [pid]", "not a number")),
+    (("kd = 450000.0", "kd = -5.0"), ("--gains", "[pid]", "'kd' = -5.0", ">= 0")),
+    (("[pid]", "[pdi]"), ("--gains", "pdi")),
+    (("kd = 450000.0", "kd = ["), ("--gains", "not valid TOML")),
+])
+def test_bad_gains_file(tmp_path, gains_text, change, fragments):
+    if change is None:
+        path = tmp_path / "absent.toml"
+    else:
+        old, new = change
+        assert old in gains_text
+        path = write(tmp_path / "gains.toml", gains_text.replace(old, new, 1))
+    out = tmp_path / "out"
+    result = run(*SHORT, "--gains", path, "--out", out)
+    assert_input_error(result, *fragments, str(path))
+    assert not out.exists()
+
+
+def test_bad_input_leaves_existing_out_unchanged(tmp_path):
+    out = tmp_path / "existing"
+    out.mkdir()
+    (out / "compare.json").write_text("old")
+    assert_input_error(run(*SHORT, "--controllers", "nope", "--out", out))
+    assert_input_error(run(*SHORT, "--seed", 1, "--out", out))
+    assert [p.name for p in out.iterdir()] == ["compare.json"]
+    assert (out / "compare.json").read_text() == "old"
+
+
+def test_out_is_a_file(tmp_path):
+    target = write(tmp_path / "file.txt", "keep me")
+    assert_input_error(run(*SHORT, "--out", target), "not a folder")
+    assert target.read_text() == "keep me"
+
+
+def test_failing_plot_leaves_out_absent(tmp_path, monkeypatch):
+    from railride import report
+
+    def failing_png(*args, **kwargs):
+        raise OSError("disk full (simulated)")
+
+    monkeypatch.setattr(report, "plot_comparison_voltages", failing_png)
+    out = tmp_path / "absent"
+    assert_input_error(run(*SHORT, "--controllers", "pid", "--out", out),
+                       "cannot write the output folder", "simulated")
+    assert not out.exists() and list(tmp_path.iterdir()) == []
+
+
+def test_diverged_run_status_1(tmp_path, monkeypatch):
+    import importlib
+
+    # the module, not the function of the same name that railride/__init__.py re-exports
+    compare_module = importlib.import_module("railride.comparison")
+
+    def boom(*args, **kwargs):
+        raise RuntimeError("the simulation diverged (sample 1 at t = 1 s)")
+
+    monkeypatch.setattr(compare_module, "compare", boom)
+    out = tmp_path / "absent"
+    result = run(*SHORT, "--out", out)
+    assert result.exit_code == 1
+    assert result.stderr.strip() == "error: the simulation diverged (sample 1 at t = 1 s)"
+    assert not out.exists()
