@@ -65,15 +65,24 @@ def ride_metrics(ds: xr.Dataset, window=None) -> xr.DataArray:
     """
     part = select_window(ds, window)
     lead = ["sample"] if "sample" in part.dims else []
+    channels = [part[channel].transpose(*lead, "time").values for channel, _ in RESPONSES.values()]
+    return metrics_from_arrays(*channels, sample=part["sample"].values if lead else None)
+
+
+def metrics_from_arrays(acceleration, bounce, pitch, roll, sample=None) -> xr.DataArray:
+    """`ride_metrics` of channels given as arrays (..., time) in SI units (pitch, roll in rad),
+    already cut to the window: the one implementation behind both the Dataset path and the
+    fast path of `RideResult.metrics` that skips building the Dataset."""
     values = []
-    for channel, factor in RESPONSES.values():
-        x = part[channel].transpose(*lead, "time").values * factor
+    for x, (_, factor) in zip((acceleration, bounce, pitch, roll), RESPONSES.values()):
+        x = np.asarray(x) * factor
         # NumPy, not xarray reductions: several times faster, and NaN propagates
         values.append(np.stack([np.sqrt(np.mean(x**2, axis=-1)), np.ptp(x, axis=-1)], axis=-1))
     data = np.stack(values, axis=-2)  # (..., response, statistic)
+    lead = [] if data.ndim == 2 else ["sample"]
     coords = {"response": list(RESPONSES), "statistic": list(STATISTICS)}
     if lead:
-        coords["sample"] = part["sample"].values
+        coords["sample"] = np.arange(data.shape[0]) if sample is None else sample
     out = xr.DataArray(data, dims=lead + ["response", "statistic"], coords=coords,
                        name="ride_metrics")
     if not np.all(np.isfinite(data)):

@@ -369,7 +369,8 @@ def simulate(scenario=None, params=None, *, dt: float = DEFAULT_DT,
                            f"or stopped being finite; check the parameters or reduce dt")
 
     created = datetime.now(timezone.utc).isoformat(timespec="seconds")
-    return RideResult(build=functools.partial(_dataset, out, vehicles, param_sets, scenarios, dt,
+    raw = {"time": np.arange(rows) / output_rate, "q": out["q"], "a": out["a"], "batch": batch}
+    return RideResult(raw=raw, build=functools.partial(_dataset, out, vehicles, param_sets, scenarios, dt,
                                               output_rate, rows, batch, created, damper, vcmd,
                                               closed))
 
@@ -480,11 +481,12 @@ class RideResult:
     does not pay for building it.
     """
 
-    def __init__(self, dataset: xr.Dataset | None = None, *, build=None):
+    def __init__(self, dataset: xr.Dataset | None = None, *, build=None, raw=None):
         if (dataset is None) == (build is None):
             raise ValueError("RideResult needs a dataset or a build function, not both")
         self._dataset = dataset
         self._build = build
+        self._raw = raw
 
     @property
     def dataset(self) -> xr.Dataset:
@@ -504,9 +506,20 @@ class RideResult:
         return "sample" in self.dataset.dims
 
     def metrics(self, window=None) -> xr.DataArray:
-        """RMS and peak-to-peak of the four body responses; see `railride.metrics.ride_metrics`."""
-        from .metrics import ride_metrics
-        return ride_metrics(self.dataset, window)
+        """RMS and peak-to-peak of the four body responses; see `railride.metrics.ride_metrics`.
+        Computed from the raw arrays when the Dataset has not been built (sweeps)."""
+        from .metrics import check_window, metrics_from_arrays, ride_metrics
+        if self._dataset is not None or self._raw is None:
+            return ride_metrics(self.dataset, window)
+        t, q, a = self._raw["time"], self._raw["q"], self._raw["a"]
+        if window is not None:
+            start, end = check_window(window, float(t[-1]), float(t[0]))
+            keep = (t >= start - 1e-12) & (t <= end + 1e-12)
+            if keep.sum() < 2:
+                raise ValueError(f"window = {start:g}:{end:g} s holds fewer than two output samples")
+            q, a = q[:, keep], a[:, keep]
+        out = metrics_from_arrays(a[..., 0], q[..., 0], q[..., 1], q[..., 2])
+        return out if self._raw["batch"] else out.isel(sample=0, drop=True)
 
     def to_pandas(self):
         """The time histories as a DataFrame, one column per scalar channel."""
