@@ -1,0 +1,50 @@
+"""Tuning and sweep benchmarks (issue 5).
+
+Run:  python benchmarks/bench_tuning.py
+Prints a Markdown table for docs/performance.md (single wall-clock runs; the tests assert no
+timing). The two-phase study starts from the neutral reference gains (scaled from the passive
+suspension, railride.tuning.REFERENCE) so that it has the whole way to go.
+"""
+
+from __future__ import annotations
+
+import time
+
+from railride.control import PID, Attitude, GainSet, InnerLoop, Ride
+from railride.sweep import Case, run_cases
+from railride.tuning import REFERENCE, Objective, tune
+
+
+def reference_gains() -> GainSet:
+    pick = lambda table, cls: cls(**{f: REFERENCE[f"{table}.{f}"] for f in cls.__dataclass_fields__})
+    return GainSet(InnerLoop(1.0, 1.15e-3), pick("pid", PID), pick("attitude", Attitude),
+                   pick("ride", Ride), source="reference")
+
+
+def main():
+    run_cases([Case(scenario_options={"duration": 1.0}, suspension="pid")])  # compile
+    rows = []
+    for label, phases, start in (("two-phase study (attitude, then ride), from the reference gains", ("attitude", "ride"), reference_gains()),
+                                 ("two-phase study from the shipped gains", ("attitude", "ride"), None),
+                                 ("all four phases (inner, pid, attitude, ride) from the reference gains", ("inner", "pid", "attitude", "ride"), reference_gains())):
+        t0 = time.perf_counter()
+        res = tune(phases, gains=start, objective=Objective(penalty=10.0))
+        dt = time.perf_counter() - t0
+        n = len(res.runs)
+        rows.append((f"`tune`: {label}, `paper-sine` 10 s runs", f"{dt:.1f} s, {n} runs ({n / dt:.0f} runs/s), "
+                     f"objective {res.history[-1]['objective']:.3f}", "<= 120 s" if start is not None and "two-phase" in label else ""))
+    cases = [Case(scenario_options={"speed": 20.0 + 5 * i}, suspension=s)
+             for i in range(13) for s in ("passive", "pid", "sas-attitude", "sas-attitude-ride")]
+    t0 = time.perf_counter()
+    run_cases(cases)
+    dt = time.perf_counter() - t0
+    rows.append(("`sweep`: 13 speeds x 4 suspensions, 10 s runs, local executor",
+                 f"{len(cases) / dt:.1f} runs/s ({dt:.1f} s)", ""))
+    print("| benchmark | result | target |")
+    print("|---|---|---|")
+    for r in rows:
+        print("| " + " | ".join(r) + " |")
+
+
+if __name__ == "__main__":
+    main()
