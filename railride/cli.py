@@ -1,12 +1,14 @@
 """The ``railride`` command line: ``railride compare``, ``railride modes``, ``railride simulate``,
-``railride damper`` and ``railride tracking``.
+``railride damper``, ``railride tracking``, ``railride tune`` and ``railride sweep``.
 
 A thin layer over the library: it parses options, calls `railride.vehicle`, `railride.track`,
 `railride.simulation`, `railride.metrics`, `railride.dampers`, `railride.rig`,
-`railride.control`, `railride.comparison` and `railride.report`, and prints. See docs/cli.md.
+`railride.control`, `railride.comparison`, `railride.sweep`, `railride.tuning` and
+`railride.report`, and prints. See docs/cli.md.
 
 Exit statuses: 0 success, 1 the simulation diverged, 2 bad input (usage errors, invalid values,
-unreadable files, an output folder that cannot be written). Errors print one line
+unreadable files, an output folder that cannot be written), 130 `tune` or `sweep` interrupted by
+Ctrl-C (the finished runs stay in DIR/runs.csv for --resume). Errors print one line
 ``error: <message>`` on stderr, never a traceback.
 """
 
@@ -259,26 +261,32 @@ def _sensor_noise(text: Optional[str], seed: Optional[int]):
             raise ValueError(f"--seed = {seed}: applies with --sensor-noise only (without it the "
                              "measurements are ideal)")
         return None
+    values = _noise_items("--sensor-noise", text)
+    if seed is not None and seed < 0:
+        raise ValueError(f"--seed = {seed}: must be a whole number >= 0")
+    return SensorNoise(*values, seed=0 if seed is None else seed)
+
+
+def _noise_items(option: str, text: str) -> list[float]:
+    """Z,ANGLE,VEL,RATE: four standard deviations >= 0, else ValueError naming the option."""
     form = ",".join(n for n, _ in _NOISE_ITEMS)
     units = ", ".join(u for _, u in _NOISE_ITEMS)
     items = [item.strip() for item in text.split(",")]
     if len(items) != len(_NOISE_ITEMS):
-        raise ValueError(f"--sensor-noise = {text!r}: expected four numbers {form} ({units}), "
+        raise ValueError(f"{option} = {text!r}: expected four numbers {form} ({units}), "
                          f"got {len(items)} item(s)")
     values = []
     for (name, unit), item in zip(_NOISE_ITEMS, items):
         try:
             value = float(item)
         except ValueError:
-            raise ValueError(f"--sensor-noise = {text!r}: {name} = {item!r} is not a number "
+            raise ValueError(f"{option} = {text!r}: {name} = {item!r} is not a number "
                              f"({unit})") from None
         if not (math.isfinite(value) and value >= 0):
-            raise ValueError(f"--sensor-noise = {text!r}: {name} = {item}: must be a finite "
+            raise ValueError(f"{option} = {text!r}: {name} = {item}: must be a finite "
                              f"number >= 0 ({unit}, a standard deviation)")
         values.append(value)
-    if seed is not None and seed < 0:
-        raise ValueError(f"--seed = {seed}: must be a whole number >= 0")
-    return SensorNoise(*values, seed=0 if seed is None else seed)
+    return values
 
 
 def _check_control_rate(rate: float, dt: float) -> float:
@@ -901,6 +909,948 @@ def tracking(
     table.add_row("B (-)", f"{doc['B']:g}")
     table.add_row("G (V/N)" + (" default" if gain_g is None else ""), f"{doc['G_v_per_n']:.4g}")
     _stdout_console().print(table)
+
+
+# -- tune and sweep: many runs ------------------------------------------------------------------
+SCHEMA_TUNE = "railride.tune/1"
+SCHEMA_SWEEP = "railride.sweep/1"
+
+#: the controllers a gain table acts in (a --gain of `sweep` combines with these only)
+GAIN_CONTROLLERS = {"inner": ("pid", "sas-attitude", "sas-attitude-ride"), "pid": ("pid",),
+                    "attitude": ("sas-attitude", "sas-attitude-ride"),
+                    "ride": ("sas-attitude-ride",)}
+#: the controllers whose response a tuning phase changes (the before/after table of `tune`)
+PHASE_CONTROLLERS = GAIN_CONTROLLERS
+#: the scenario options a sweep can vary: (option, keyword of track.scenario, column, unit)
+SWEEP_AXES = (("--speed", "speed", "speed_m_s", "m/s"), ("--wavelength", "wavelength", "wavelength_m", "m"),
+              ("--amplitude", "amplitude", "amplitude_m", "m"),
+              ("--rail-phase", "rail_phase", "rail_phase_deg", "deg"))
+
+#: the keys of Scenario.describe() that each swept scenario option sets
+_SCENARIO_KEYS = {"speed": ("speed_m_s",), "wavelength": ("wavelength_m", "length_m"),
+                  "amplitude": ("amplitude_m", "height_m"), "rail_phase": ("rail_phase_deg",)}
+
+
+class SweepFormat(str, Enum):
+    table = "table"
+    json = "json"
+    csv = "csv"
+
+
+def _utc_now() -> str:
+    from datetime import datetime, timezone
+
+    return datetime.now(timezone.utc).replace(microsecond=0).isoformat().replace("+00:00", "Z")
+
+
+def _executor(workers: Optional[int], scheduler: Optional[str], scheduler_file: Optional[Path]):
+    """(executor, record for the JSON): Dask with --scheduler / --scheduler-file, else the local
+    executor, whose batches use --workers threads (numba's thread count, 1..cores)."""
+    from . import sweep as sweep_lib
+
+    if scheduler is not None and scheduler_file is not None:
+        raise ValueError("give either --scheduler ADDRESS or --scheduler-file FILE, not both")
+    if scheduler is not None or scheduler_file is not None:
+        if workers is not None:
+            raise ValueError(f"--workers = {workers}: applies to the local executor only; the "
+                             "threads of a Dask cluster are set where its workers start "
+                             "(dask worker --nthreads N)")
+        if scheduler is not None and not scheduler.strip():
+            raise ValueError("--scheduler = '': give the scheduler's address, e.g. "
+                             "tcp://host:8786")
+        with _status("connecting to the Dask scheduler..."):
+            executor = sweep_lib.DaskExecutor(
+                address=scheduler, scheduler_file=None if scheduler_file is None else str(scheduler_file))
+        where = scheduler if scheduler is not None else str(scheduler_file)
+        record = {"type": "dask", "scheduler": where}
+        with contextlib.suppress(Exception):
+            record["workers"] = len(executor.client.scheduler_info()["workers"])
+        return executor, record
+    import numba
+
+    cores = int(numba.config.NUMBA_NUM_THREADS)
+    if workers is not None:
+        if not 1 <= workers <= cores:
+            raise ValueError(f"--workers = {workers}: must be a whole number from 1 to {cores} "
+                             "(the cores of this machine)")
+        numba.set_num_threads(workers)
+    return sweep_lib.LocalExecutor(), {"type": "local", "threads": int(numba.get_num_threads())}
+
+
+def _run_table(out: Optional[Path], resume: bool):
+    """(RunTable, its path or None): DIR/runs.csv with --out, kept in memory without it."""
+    from . import report
+    from . import sweep as sweep_lib
+
+    if out is None:
+        if resume:
+            raise ValueError("--resume needs --out DIR: the run table it continues is "
+                             "DIR/runs.csv")
+        return sweep_lib.RunTable(), None
+    report.check_out_dir(out)
+    path = out / "runs.csv"
+    if path.exists() and not resume:
+        raise ValueError(f"--out {out}: {path} exists (the run table of an earlier run); add "
+                         "--resume to continue it, or choose another folder")
+    return sweep_lib.RunTable(path, resume=resume), path
+
+
+def _saved_runs(table, path: Optional[Path]) -> int:
+    """The rows of the run table on disk (what an interrupted run leaves), else in memory."""
+    if path is not None and path.exists():
+        import pandas as pd
+
+        try:
+            return len(pd.read_csv(path, usecols=["key"]))
+        except (OSError, ValueError):
+            pass
+    return len(table.frame)
+
+
+@contextlib.contextmanager
+def _interruptible(table, path: Optional[Path]):
+    """Ctrl-C: one line saying what was kept, status 130, no traceback."""
+    try:
+        yield
+    except KeyboardInterrupt:
+        n = _saved_runs(table, path)
+        if path is not None:
+            typer.echo(f"interrupted: {n} runs saved in {path}; run again with --resume to "
+                       "continue", err=True)
+        else:
+            typer.echo(f"interrupted: {n} runs done, none saved (with --out DIR the runs are kept "
+                       "in DIR/runs.csv and --resume continues them)", err=True)
+        raise typer.Exit(130) from None
+
+
+class _RunProgress:
+    """Progress of many runs, fed by the library's ``progress(done, total, runs_per_second)``
+    (once per batch of runs it asks for, then after each chunk). Counts the runs evaluated in
+    this session (``evaluated``); shows a bar on stderr only when stderr is a terminal.
+    ``log(text)`` prints a line on stderr (above the bar)."""
+
+    def __init__(self, enabled: bool, verb: str):
+        self.enabled = enabled
+        self.verb = verb
+        self.evaluated = 0
+        self._base = 0
+        self._progress = None
+        self._task = None
+
+    def __enter__(self):
+        if not self.enabled:
+            return self
+        from rich.progress import (BarColumn, MofNCompleteColumn, Progress, SpinnerColumn,
+                                   TextColumn, TimeElapsedColumn)
+
+        from . import kernels
+
+        compiled = bool(getattr(kernels.run_batch, "signatures", True))
+        first = (f"{self.verb}..." if compiled
+                 else "loading the stepper (the first run compiles it, up to a minute)...")
+        self._progress = Progress(SpinnerColumn(), TextColumn("{task.description}"), BarColumn(),
+                                  MofNCompleteColumn(), TextColumn("{task.fields[rate]}"),
+                                  TimeElapsedColumn(), console=_stderr_console(), transient=True)
+        self._progress.__enter__()
+        self._task = self._progress.add_task(first, total=None, rate="")
+        return self
+
+    def __call__(self, done: int, total: int, runs_per_second: float) -> None:
+        if done == 0:
+            self._base = self.evaluated
+        self.evaluated = self._base + int(done)
+        if self._progress is not None:
+            ok = math.isfinite(runs_per_second) and runs_per_second > 0
+            self._progress.update(self._task, completed=done, total=total,
+                                  description=f"{self.verb} ({self.evaluated} runs)",
+                                  rate=f"{runs_per_second:.1f} runs/s" if ok else "")
+
+    def log(self, text: str) -> None:
+        if self._progress is not None:
+            self._progress.console.print(text, markup=False, highlight=False)
+        else:
+            typer.echo(text, err=True)
+
+    def __exit__(self, *exc):
+        if self._progress is not None:
+            self._progress.__exit__(*exc)
+        return False
+
+
+def _scenario_options(**given) -> dict:
+    """The keyword arguments of track.scenario that were given (None: the scenario's default)."""
+    return {k: float(v) for k, v in given.items() if v is not None}
+
+
+def _check_int(option: str, value: int, minimum: int, what: str = "") -> int:
+    if value < minimum:
+        raise ValueError(f"{option} = {value}: must be a whole number >= {minimum}{what}")
+    return value
+
+
+def _objective(weights: str, penalty: float):
+    from .tuning import Objective
+
+    items = [item.strip() for item in weights.split(",")]
+    if len(items) != 4:
+        raise ValueError(f"--weights = {weights!r}: expected four numbers A,D,P,R (acceleration, "
+                         f"displacement, pitch, roll), got {len(items)} item(s)")
+    values = []
+    for name, item in zip(("A", "D", "P", "R"), items):
+        try:
+            value = float(item)
+        except ValueError:
+            raise ValueError(f"--weights = {weights!r}: {name} = {item!r} is not a number") from None
+        if not (math.isfinite(value) and value >= 0):
+            raise ValueError(f"--weights = {weights!r}: {name} = {item}: must be a finite number >= 0")
+        values.append(value)
+    if sum(values) == 0:
+        raise ValueError(f"--weights = {weights!r}: at least one weight must be > 0")
+    if not (math.isfinite(penalty) and penalty >= 0):
+        raise ValueError(f"--penalty = {penalty:g}: must be a finite number >= 0")
+    return Objective(tuple(values), float(penalty))
+
+
+def _phase_list(items: Optional[list[str]]) -> list[str]:
+    """--phase (repeatable, comma lists, `all`) -> the phases in the order they run."""
+    from .tuning import PHASES
+
+    if not items:
+        return ["attitude", "ride"]
+    wanted = set()
+    for text in items:
+        names = [n.strip() for n in text.split(",")]
+        if any(not n for n in names):
+            raise ValueError(f"--phase = {text!r}: an empty item; give phases separated by commas "
+                             f"from {', '.join(PHASES)}, all")
+        for n in names:
+            if n == "all":
+                wanted.update(PHASES)
+            elif n in PHASES:
+                wanted.add(n)
+            else:
+                raise ValueError(f"--phase = {text!r}: unknown phase {n!r}; allowed: "
+                                 f"{', '.join(PHASES)}, all")
+    return [p for p in PHASES if p in wanted]
+
+
+def _gain_changes(start, tuned, tables) -> tuple:
+    """The ("table.entry", value) pairs of ``tuned`` that differ from ``start``, in ``tables``."""
+    out = []
+    for table in tables:
+        a, b = getattr(start, table).to_dict(), getattr(tuned, table).to_dict()
+        out += [(f"{table}.{k}", float(b[k])) for k in a if b[k] != a[k]]
+    return tuple(sorted(out))
+
+
+#: the gain tables each controller reads
+_CONTROLLER_TABLES = {"pid": ("inner", "pid"), "sas-attitude": ("inner", "attitude"),
+                      "sas-attitude-ride": ("inner", "attitude", "ride")}
+
+
+def _before_after(result, start, phases, scenario_name, options, damper, executor, table, dt,
+                  progress) -> list[dict]:
+    """RMS of each controller the phases change, with the start and with the tuned gains, and
+    the reductions against passive. Through the run table: most of these runs are in it."""
+    from . import sweep as sweep_lib
+    from .control import CONTROLLERS
+    from .metrics import RESPONSES
+
+    names = [n for n in CONTROLLERS if any(n in PHASE_CONTROLLERS[p] for p in phases)]
+    cases = []
+    for n in names:
+        cases.append(sweep_lib.Case(scenario_name, options, suspension=n, damper=damper))
+        cases.append(sweep_lib.Case(scenario_name, options, suspension=n, damper=damper,
+                                    gains=_gain_changes(start, result.gains, _CONTROLLER_TABLES[n])))
+    frame = sweep_lib.run_cases(cases, executor=executor, table=table, base_gains=start, dt=dt,
+                                progress=progress)
+    passive = {r: float(result.passive[r]) for r in RESPONSES}
+    rows = []
+    for i, n in enumerate(names):
+        before, after = frame.iloc[2 * i], frame.iloc[2 * i + 1]
+        row = {"suspension": n, "before": {}, "after": {}, "reduction_before_percent": {},
+               "reduction_after_percent": {}}
+        for r in RESPONSES:
+            b, a = float(before[f"{r}_rms"]), float(after[f"{r}_rms"])
+            row["before"][r], row["after"][r] = b, a
+            p = passive[r]  # a zero passive RMS (e.g. roll on a symmetric bump): no reduction
+            row["reduction_before_percent"][r] = (p - b) / p * 100.0 if p else None
+            row["reduction_after_percent"][r] = (p - a) / p * 100.0 if p else None
+        rows.append(row)
+    return rows
+
+
+def _objective_text(objective) -> str:
+    w = ", ".join(f"{name} {v:g}" for name, v in zip(("acceleration", "displacement", "pitch", "roll"),
+                                                      objective.weights))
+    return (f"sum of w_k RMS_k / RMS_k(passive), weights {w}; penalty {objective.penalty:g} x "
+            "any ratio above 1")
+
+
+def _tuned_gains_text(doc: dict, gains, scenario_text: str, objective) -> str:
+    """gains.toml: a provenance header (comments and a [provenance] table, which gains files
+    may carry) and the tuned gains."""
+    s = doc["settings"]
+    last = {}
+    for h in doc["history"]:
+        last[h["phase"]] = h
+    finals = "; ".join(f"{p} {h['objective']:.4g} after pass {h['pass']}" for p, h in last.items())
+    phases = ", ".join(doc["phases"])
+    run_text = f"{scenario_text}, {doc['scenario'].get('duration_s', 0):g} s"
+    lines = [
+        "# railride controller gains, tuned by `railride tune` (the paper's sensitivity study,",
+        "# spec section 9; docs/cli.md). Read by `railride compare --gains FILE`.",
+        f"# date: {doc['date']}; railride {doc['railride_version']}",
+        f"# scenario: {run_text}, dt {s['dt_s']:g} s, {s['damper']} MR dampers",
+        f"# objective: {_objective_text(objective)}",
+        f"# phases: {phases}; {s['values']} values from 1/{s['span']:g} to {s['span']:g} x the "
+        f"current value (and 0) per gain, passes: at most {s['max_passes']}",
+        f"# start values: {s['start_gains']}",
+        f"# runs: {doc['runs']}; final objective: {finals}",
+        "# Units: SI. Forces are desired forces on the carbody (up +) at corners 1R, 1L, 2R, 2L.",
+        "",
+        "[provenance]",
+        f"method = {json.dumps('railride tune (one-at-a-time sensitivity study)')}",
+        f"date = {json.dumps(doc['date'])}",
+        f"railride_version = {json.dumps(doc['railride_version'])}",
+        f"scenario = {json.dumps(run_text)}",
+        f"damper = {json.dumps(s['damper'])}",
+        f"dt_s = {s['dt_s']!r}",
+        f"objective = {json.dumps(_objective_text(objective))}",
+        f"phases = {json.dumps(doc['phases'])}",
+        f"runs = {int(doc['runs'])}",
+        f"start_gains = {json.dumps(s['start_gains'])}",
+        "",
+        gains.to_toml(),
+    ]
+    return "\n".join(lines)
+
+
+def _tune_tables(doc: dict, start, tuned, scenario_text: str):
+    from rich.markup import escape
+    from rich.table import Table
+    from rich.text import Text
+
+    from .report import _gain_unit
+    from .tuning import PARAMETERS
+
+    parts = []
+    passes = Table(title="Tuning: the objective after each pass")
+    passes.add_column("phase")
+    passes.add_column("pass", justify="right")
+    passes.add_column("objective", justify="right")
+    passes.add_column("change %", justify="right")
+    previous = {}
+    for h in doc["history"]:
+        before = previous.get(h["phase"])
+        change = "" if before is None else f"{(h['objective'] - before) / abs(before) * 100:+.2f}"
+        passes.add_row(h["phase"], str(h["pass"]), f"{h['objective']:.4f}", change)
+        previous[h["phase"]] = h["objective"]
+    parts += [passes, Text("objective: " + _objective_text_from_doc(doc) + "; inner phase: the "
+                           "normalised force-tracking error on the damper rig"), ""]
+
+    gains = Table(title="Tuned gains")
+    gains.add_column("gain")
+    gains.add_column("unit")
+    gains.add_column("start", justify="right")
+    gains.add_column("tuned", justify="right")
+    gains.add_column("", no_wrap=True)
+    for phase in doc["phases"]:
+        for name in PARAMETERS[phase]:
+            table, _, entry = name.partition(".")
+            a, b = getattr(getattr(start, table), entry), getattr(getattr(tuned, table), entry)
+            gains.add_row(name, escape(_gain_unit(name) or ""), f"{a:.4g}", f"{b:.4g}",
+                          "" if math.isclose(a, b, rel_tol=1e-9, abs_tol=0.0) else "changed")
+        gains.add_section()
+    parts += [gains, ""]
+
+    rows = doc["before_after"]
+    if rows:
+        from .control import LABELS
+
+        table = Table(title="RMS of the carbody responses with the start and the tuned gains")
+        table.add_column("suspension", no_wrap=True)
+        table.add_column("response")
+        table.add_column("passive", justify="right")
+        table.add_column("start\ngains", justify="right")
+        table.add_column("red. %", justify="right")
+        table.add_column("tuned\ngains", justify="right")
+        table.add_column("red. %", justify="right")
+        for r in rows:
+            for i, (key, label) in enumerate(RESPONSE_LABELS.items()):
+                table.add_row(escape(LABELS[r["suspension"]]) if i == 0 else "", label,
+                              f"{doc['passive_rms'][key]:#.4g}", f"{r['before'][key]:#.4g}",
+                              _reduction_text(r["reduction_before_percent"][key]),
+                              f"{r['after'][key]:#.4g}",
+                              _reduction_text(r["reduction_after_percent"][key]),
+                              end_section=i == len(RESPONSE_LABELS) - 1)
+        parts.append(table)
+    s = doc["settings"]
+    parts.append(Text("\n".join([
+        f"{scenario_text}, {doc['scenario'].get('duration_s', 0):g} s, dt {s['dt_s']:g} s, "
+        f"{s['damper']} MR dampers; start gains {s['start_gains']}",
+        "red. % = (passive - controlled) / passive x 100 (negative: worse than passive, in red)",
+        f"{doc['runs']} runs in the run table, {doc['runs_evaluated']} evaluated now "
+        f"({doc['runs_per_second']:.1f} runs/s), wall time {doc['wall_time_s']:.1f} s",
+    ])))
+    return parts
+
+
+def _objective_text_from_doc(doc: dict) -> str:
+    from .tuning import Objective
+
+    o = doc["objective"]
+    return _objective_text(Objective(tuple(o["weights"].values()), o["penalty"]))
+
+
+@app.command("tune")
+def tune_command(
+    phase: Annotated[Optional[list[str]], typer.Option(
+        "--phase", metavar="PHASE[,PHASE...]",
+        help="Tuning phases, repeatable or comma-separated: inner (B, G on the damper rig's "
+             "force tracking), pid, attitude (the six SAS attitude gains, ride loop off), ride "
+             "(the eight ride gains, attitude fixed), all (= inner,pid,attitude,ride). They run "
+             "in that order. Default: attitude,ride (the paper's two phases).")] = None,
+    scenario: Annotated[str, typer.Option(
+        "--scenario", metavar="NAME",
+        help="paper-sine, bump or file:PATH, as for simulate.")] = "paper-sine",
+    amplitude: Annotated[Optional[float], typer.Option(
+        "--amplitude", metavar="M",
+        help="paper-sine: sine amplitude [m] (default 0.05). bump: bump height [m] "
+             "(default 0.02).")] = None,
+    wavelength: Annotated[Optional[float], typer.Option(
+        "--wavelength", metavar="M",
+        help="paper-sine: wavelength [m] (default 60). bump: bump length [m] (default 10).")] = None,
+    rail_phase: Annotated[Optional[float], typer.Option(
+        "--rail-phase", metavar="DEG",
+        help="paper-sine only: phase lag of the right rail [deg] (default 90).")] = None,
+    speed: Annotated[Optional[float], typer.Option(
+        "--speed", metavar="M/S", help="Vehicle speed [m/s] (default 55.56).")] = None,
+    duration: Annotated[Optional[float], typer.Option(
+        "--duration", metavar="S", help="Simulated time of each run [s] (default 10).")] = None,
+    dt: Annotated[Optional[float], typer.Option(
+        "--dt", metavar="S", help="Fixed RK4 time step [s] (default 1e-4).")] = None,
+    damper: Annotated[str, typer.Option(
+        "--damper", metavar="MODEL",
+        help="MR damper model: railway, dyke1996 or spencer1997.")] = DEFAULT_DAMPER,
+    gains: Annotated[Optional[Path], typer.Option(
+        "--gains", metavar="FILE.toml",
+        help="Start values: a gains file as for compare (default: the shipped gains).")] = None,
+    weights: Annotated[str, typer.Option(
+        "--weights", metavar="A,D,P,R",
+        help="Objective weights of the RMS ratios to passive: acceleration, displacement, pitch, "
+             "roll; >= 0, not all 0.")] = "1,1,1,1",
+    penalty: Annotated[float, typer.Option(
+        "--penalty", metavar="X",
+        help="Added to the objective: X times every RMS ratio above 1 (a response worse than "
+             "passive); >= 0.")] = 0.0,
+    values: Annotated[int, typer.Option(
+        "--values", metavar="N",
+        help="Log-spaced values per gain and pass, from 1/span to span times the current value "
+             "(0 and the current value are added); >= 3.")] = 13,
+    span: Annotated[float, typer.Option(
+        "--span", metavar="S", help="Range factor of each sweep, > 1.")] = 30.0,
+    passes: Annotated[int, typer.Option(
+        "--passes", metavar="N",
+        help="At most N passes per phase (a phase stops early when a pass improves the "
+             "objective by less than 0.1 %); >= 1.")] = 5,
+    workers: Annotated[Optional[int], typer.Option(
+        "--workers", metavar="N",
+        help="Local executor: threads of each batch, 1..cores (default: every core).")] = None,
+    scheduler: Annotated[Optional[str], typer.Option(
+        "--scheduler", metavar="ADDRESS",
+        help="Run on a Dask cluster: the scheduler's address, e.g. tcp://host:8786.")] = None,
+    scheduler_file: Annotated[Optional[Path], typer.Option(
+        "--scheduler-file", metavar="FILE",
+        help="Run on a Dask cluster whose scheduler wrote FILE (dask scheduler "
+             "--scheduler-file FILE).")] = None,
+    out: Annotated[Optional[Path], typer.Option(
+        "--out", metavar="DIR",
+        help="Keep the run table DIR/runs.csv (updated as runs finish) and write gains.toml, "
+             "sensitivity.png, curves.csv and tune.json into DIR at the end.")] = None,
+    resume: Annotated[bool, typer.Option(
+        "--resume",
+        help="Continue the study whose run table is DIR/runs.csv (needs --out): runs already "
+             "there are not evaluated again.")] = False,
+    format: FormatOption = OutputFormat.table,
+) -> None:
+    """Tune the controller gains by the paper's sensitivity study (spec section 9).
+
+    One gain at a time is swept over log-spaced values (and 0) with the others fixed; the best
+    value is kept; passes repeat until a pass gains less than 0.1 %. Each run is scored by the
+    sum of its RMS carbody responses relative to passive. Prints the objective per pass, the
+    tuned gains and the RMS with the start and the tuned gains. Ctrl-C stops; with --out,
+    --resume continues.
+    """
+    import time
+
+    with _errors():
+        from . import report, tuning
+        from .simulation import DEFAULT_DT
+        from .track import scenario as make_scenario
+
+        phases = _phase_list(phase)
+        _damper_preset("--damper", damper)
+        start = _gain_set(gains)
+        objective = _objective(weights, penalty)
+        _check_int("--values", values, 3)
+        if not (math.isfinite(span) and span > 1):
+            raise ValueError(f"--span = {span:g}: must be a finite number > 1")
+        _check_int("--passes", passes, 1)
+        dt = DEFAULT_DT if dt is None else _check_number("--dt", dt, "s")
+        options = _scenario_options(amplitude=amplitude, wavelength=wavelength,
+                                    rail_phase=rail_phase, speed=speed, duration=duration)
+        scen = make_scenario(scenario, **options)
+        scenario_text = report.describe_scenario(scen.describe())
+        table, table_path = _run_table(out, resume)
+        executor, executor_record = _executor(workers, scheduler, scheduler_file)
+    tol = _default_of(tuning.tune, "tol")
+    try:
+        with _interruptible(table, table_path), _errors():
+            with _RunProgress(_stderr_is_terminal(), "tuning") as progress:
+                t0 = time.perf_counter()
+                result = tuning.tune(phases, scenario=scenario, scenario_options=options,
+                                     gains=start, objective=objective, damper=damper,
+                                     executor=executor, table=table, n_values=values, span=span,
+                                     max_passes=passes, dt=dt, progress=progress, log=progress.log)
+                comparison = _before_after(result, start, phases, scenario, options, damper,
+                                           executor, table, dt, progress)
+                wall = time.perf_counter() - t0
+            from .metrics import RESPONSES
+
+            doc = {
+                "schema": SCHEMA_TUNE,
+                "railride_version": __version__,
+                "date": _utc_now(),
+                "phases": phases,
+                "scenario": scen.describe(),
+                "settings": {"damper": damper, "dt_s": float(dt), "values": values,
+                             "span": float(span), "max_passes": passes, "tolerance": tol,
+                             "start_gains": start.source},
+                "objective": {"weights": dict(zip(RESPONSES, objective.weights)),
+                              "penalty": float(objective.penalty)},
+                "passive_rms": {r: float(result.passive[r]) for r in RESPONSES},
+                "history": [{"phase": h["phase"], "pass": int(h["pass"]),
+                             "objective": float(h["objective"])} for h in result.history],
+                "gains": {"source": start.source, "inner": result.gains.inner.to_dict(),
+                          "pid": result.gains.pid.to_dict(),
+                          "attitude": result.gains.attitude.to_dict(),
+                          "ride": result.gains.ride.to_dict()},
+                "before_after": comparison,
+                "runs": len(table.frame),
+                "runs_evaluated": progress.evaluated,
+                "runs_per_second": progress.evaluated / wall if wall > 0 else 0.0,
+                "wall_time_s": wall,
+                "executor": executor_record,
+            }
+            text = json.dumps(doc, indent=2, allow_nan=False)
+            if out is not None:
+                gains_text = _tuned_gains_text(doc, result.gains, scenario_text, objective)
+                title = (f"Sensitivity of the tuning objective - {scenario_text}, "
+                         f"{scen.duration:g} s, {damper} dampers\n"
+                         f"phases {', '.join(phases)}; {_objective_text(objective)}")
+                _write_folder(out, lambda: report.write_tune_outputs(
+                    result.curves, out, doc, gains_text, title=title))
+    finally:
+        executor.close()
+    if format is OutputFormat.json:
+        typer.echo(text)
+        return
+    console = _wide_stdout_console()
+    for part in _tune_tables(doc, start, result.gains, scenario_text):
+        console.print(part)
+
+
+def _default_of(fn, name: str):
+    import inspect
+
+    return inspect.signature(fn).parameters[name].default
+
+
+# -- sweep ------------------------------------------------------------------------------------
+def _tidy(value: float) -> float:
+    """A range value without float noise (20:80:13 gives 25, not 25.000000000000004)."""
+    return float(f"{value:.12g}")
+
+
+def _parse_float(option: str, text: str, item: str, what: str = "") -> float:
+    try:
+        value = float(item)
+    except ValueError:
+        raise ValueError(f"{option} = {text!r}: {item.strip()!r} is not a number{what}") from None
+    if not math.isfinite(value):
+        raise ValueError(f"{option} = {text!r}: {item.strip()!r} is not a finite number")
+    return value
+
+
+def _value_list(option: str, text: str, *, integer: bool = False, parse=None) -> list:
+    """START:STOP:COUNT (linear, inclusive) or a,b,c -> distinct values, else ValueError naming
+    the option. ``parse(item)`` reads a list item (default: a number)."""
+    text = text.strip()
+    kind = "whole numbers" if integer else "numbers"
+    if ":" in text:
+        parts = text.split(":")
+        if len(parts) != 3:
+            raise ValueError(f"{option} = {text!r}: expected a range START:STOP:COUNT (e.g. "
+                             f"20:80:13) or a list a,b,c of {kind}")
+        start, stop = (_parse_float(option, text, p) for p in parts[:2])
+        try:
+            count = int(parts[2])
+        except ValueError:
+            raise ValueError(f"{option} = {text!r}: COUNT = {parts[2].strip()!r} is not a whole "
+                             "number") from None
+        if count < 1:
+            raise ValueError(f"{option} = {text!r}: COUNT = {count} must be >= 1")
+        import numpy as np
+
+        values = [_tidy(v) for v in np.linspace(start, stop, count)]
+    else:
+        items = text.split(",")
+        if any(not item.strip() for item in items):
+            raise ValueError(f"{option} = {text!r}: an empty item; give a range START:STOP:COUNT "
+                             f"or {kind} separated by commas")
+        values = [parse(item) if parse else _parse_float(option, text, item) for item in items]
+    if integer:
+        bad = [v for v in values if not float(v).is_integer()]
+        if bad:
+            raise ValueError(f"{option} = {text!r}: {bad[0]:g} is not a whole number")
+        values = [int(v) for v in values]
+    seen = set()
+    for v in values:
+        if v in seen:
+            raise ValueError(f"{option} = {text!r}: {v:g} is listed twice")
+        seen.add(v)
+    return values
+
+
+def _gain_option(text: str) -> tuple[str, list[float]]:
+    """--gain TABLE.ENTRY=VALUES -> ("table.entry", values)."""
+    from .tuning import PARAMETERS
+
+    name, sep, values_text = text.partition("=")
+    name = name.strip()
+    if name.startswith("sas."):  # the gains file's [sas.attitude] and [sas.ride]
+        name = name[len("sas."):]
+    known = [p for ps in PARAMETERS.values() for p in ps]
+    if not sep or not values_text.strip():
+        raise ValueError(f"--gain = {text!r}: expected TABLE.ENTRY=VALUES, e.g. pid.kd=1e4,1e5 "
+                         "or attitude.kp_z=0:4e5:5")
+    if name not in known:
+        table = name.partition(".")[0]
+        if table in PARAMETERS:
+            allowed = ", ".join(PARAMETERS[table])
+        else:
+            allowed = "inner.*, pid.*, attitude.*, ride.* (" + ", ".join(known[:5]) + ", ...)"
+        raise ValueError(f"--gain = {text!r}: unknown gain {name!r}; allowed: {allowed}")
+    values = _value_list(f"--gain {name}", values_text)
+    bad = [v for v in values if v < 0]
+    if bad:
+        raise ValueError(f"--gain = {text!r}: {bad[0]:g} is negative; gains are >= 0")
+    return name, values
+
+
+def _metric_columns() -> list[str]:
+    from .metrics import RESPONSES, STATISTICS
+
+    return [f"{r}_{s}" for s in STATISTICS for r in RESPONSES]
+
+
+def _sweep_table(rows: list[dict], grid_columns: list[str], caption: str):
+    from rich.markup import escape
+    from rich.table import Table
+
+    table = Table(title="Sweep: RMS of the carbody responses, one row per run",
+                  caption=escape(caption))
+    table.add_column("#", justify="right")
+    for c in grid_columns:
+        heading = {"speed_m_s": "speed\n(m/s)", "wavelength_m": "wavelength\n(m)",
+                   "amplitude_m": "amplitude\n(m)", "rail_phase_deg": "rail phase\n(deg)",
+                   "voltage_v": "voltage\n(V)"}.get(c, c)
+        table.add_column(escape(heading), justify="left" if c == "suspension" else "right",
+                         no_wrap=c == "suspension")
+    for key, label in RESPONSE_LABELS.items():
+        table.add_column(label.replace(" (", "\n("), justify="right")
+    for i, row in enumerate(rows, start=1):
+        cells = [str(i)]
+        for c in grid_columns:
+            v = row[c]
+            cells.append("-" if v is None else (escape(v) if isinstance(v, str) else f"{v:g}"))
+        cells += [f"{row[f'{k}_rms']:#.4g}" for k in RESPONSE_LABELS]
+        table.add_row(*cells)
+    return table
+
+
+@app.command("sweep")
+def sweep_command(
+    suspension: Annotated[str, typer.Option(
+        "--suspension", metavar="NAME[,NAME...]",
+        help="Suspensions, comma-separated: passive, mr (constant --voltage), pid, sas-attitude, "
+             "sas-attitude-ride.")] = "passive",
+    speed: Annotated[Optional[str], typer.Option(
+        "--speed", metavar="VALUES",
+        help="Vehicle speeds [m/s]: START:STOP:COUNT (linear, inclusive) or a,b,c "
+             "(default: the scenario's, 55.56).")] = None,
+    wavelength: Annotated[Optional[str], typer.Option(
+        "--wavelength", metavar="VALUES",
+        help="paper-sine: wavelengths [m]; bump: bump lengths [m]. A range or a list.")] = None,
+    amplitude: Annotated[Optional[str], typer.Option(
+        "--amplitude", metavar="VALUES",
+        help="paper-sine: sine amplitudes [m]; bump: heights [m]. A range or a list.")] = None,
+    rail_phase: Annotated[Optional[str], typer.Option(
+        "--rail-phase", metavar="VALUES",
+        help="paper-sine: phase lags of the right rail [deg]. A range or a list.")] = None,
+    voltage: Annotated[Optional[str], typer.Option(
+        "--voltage", metavar="VALUES",
+        help="mr only: constant command voltages [V] within the damper's range, a range or a list "
+             "(passive-off, passive-on allowed in a list; default: passive-off).")] = None,
+    gain: Annotated[Optional[list[str]], typer.Option(
+        "--gain", metavar="TABLE.ENTRY=VALUES",
+        help="Controllers only: values of one gain, e.g. pid.kd=1e4,1e5 or attitude.kp_z=0:4e5:5; "
+             "repeatable (each adds a grid axis). Tables inner, pid, attitude, ride.")] = None,
+    noise: Annotated[Optional[str], typer.Option(
+        "--noise", metavar="Z,ANGLE,VEL,RATE",
+        help="Controllers only: sensor noise, standard deviations [m, rad, m/s, rad/s].")] = None,
+    seed: Annotated[Optional[str], typer.Option(
+        "--seed", metavar="VALUES",
+        help="With --noise: seeds of the noise, whole numbers >= 0, a range or a list "
+             "(default 0).")] = None,
+    scenario: Annotated[str, typer.Option(
+        "--scenario", metavar="NAME",
+        help="paper-sine, bump or file:PATH, as for simulate.")] = "paper-sine",
+    duration: Annotated[Optional[float], typer.Option(
+        "--duration", metavar="S", help="Simulated time of each run [s] (default 10).")] = None,
+    dt: Annotated[Optional[float], typer.Option(
+        "--dt", metavar="S", help="Fixed RK4 time step [s] (default 1e-4).")] = None,
+    damper: Annotated[Optional[str], typer.Option(
+        "--damper", metavar="MODEL",
+        help="mr and controllers: MR damper model railway, dyke1996 or spencer1997 "
+             "(default railway).")] = None,
+    gains: Annotated[Optional[Path], typer.Option(
+        "--gains", metavar="FILE.toml",
+        help="Controllers: the base gains that --gain changes (default: the shipped "
+             "gains).")] = None,
+    window: Annotated[Optional[str], typer.Option(
+        "--window", metavar="START:END",
+        help="Time window of the metrics [s], e.g. 2:10 (default: the whole run).")] = None,
+    workers: Annotated[Optional[int], typer.Option(
+        "--workers", metavar="N",
+        help="Local executor: threads of each batch, 1..cores (default: every core).")] = None,
+    scheduler: Annotated[Optional[str], typer.Option(
+        "--scheduler", metavar="ADDRESS",
+        help="Run on a Dask cluster: the scheduler's address, e.g. tcp://host:8786.")] = None,
+    scheduler_file: Annotated[Optional[Path], typer.Option(
+        "--scheduler-file", metavar="FILE",
+        help="Run on a Dask cluster whose scheduler wrote FILE.")] = None,
+    out: Annotated[Optional[Path], typer.Option(
+        "--out", metavar="DIR",
+        help="Keep the run table DIR/runs.csv (updated as runs finish) and write sweep.json "
+             "into DIR at the end.")] = None,
+    resume: Annotated[bool, typer.Option(
+        "--resume",
+        help="Continue the sweep whose run table is DIR/runs.csv (needs --out): runs already "
+             "there are not evaluated again.")] = False,
+    format: Annotated[SweepFormat, typer.Option(
+        "--format", case_sensitive=False,
+        help="Output on stdout: a table, JSON (a list of row objects) or CSV.")] = SweepFormat.table,
+) -> None:
+    """Run a grid of cases: every combination of the given values (a cartesian product).
+
+    --voltage combines with mr only, --gain, --noise and --seed with the controllers they act
+    in; the other suspensions run once per scenario combination. Prints one row per run: the
+    grid values and the RMS of the four carbody responses.
+    """
+    import itertools
+    import time
+
+    with _errors():
+        from . import report
+        from . import sweep as sweep_lib
+        from .metrics import RESPONSES, check_window, parse_window
+        from .simulation import DEFAULT_DT
+        from .track import scenario as make_scenario
+
+        # suspensions
+        items = [s.strip() for s in suspension.split(",")]
+        if any(not s for s in items):
+            raise ValueError(f"--suspension = {suspension!r}: an empty item; give names separated "
+                             f"by commas from {', '.join(sweep_lib.SUSPENSIONS)}")
+        unknown = [s for s in items if s not in sweep_lib.SUSPENSIONS]
+        if unknown:
+            raise ValueError(f"--suspension = {suspension!r}: unknown suspension {unknown[0]!r}; "
+                             f"allowed: {', '.join(sweep_lib.SUSPENSIONS)}")
+        if len(set(items)) != len(items):
+            twice = next(s for s in items if items.count(s) > 1)
+            raise ValueError(f"--suspension = {suspension!r}: {twice} is listed twice")
+        suspensions = items
+        controllers = [s for s in suspensions if s in GAIN_CONTROLLERS["inner"]]
+        has_mr = "mr" in suspensions
+        listed = ", ".join(suspensions)
+
+        # what applies where
+        if voltage is not None and not has_mr:
+            raise ValueError(f"--voltage = {voltage!r}: applies to --suspension mr only "
+                             f"(--suspension is {listed})")
+        for option, given in (("--gain", gain), ("--noise", noise), ("--gains", gains)):
+            if given and not controllers:
+                value = given[0] if isinstance(given, list) else str(given)
+                raise ValueError(f"{option} = {value!r}: applies to the controllers pid, "
+                                 f"sas-attitude, sas-attitude-ride only (--suspension is {listed})")
+        if seed is not None and noise is None:
+            raise ValueError(f"--seed = {seed!r}: applies with --noise only (without it the "
+                             "measurements are ideal)")
+        if damper is not None and not (has_mr or controllers):
+            raise ValueError(f"--damper = {damper!r}: applies to mr and the controllers only "
+                             f"(--suspension is {listed})")
+        damper_name = DEFAULT_DAMPER if damper is None else damper
+        damper_model = _damper_preset("--damper", damper_name)
+
+        # the grid axes
+        axes = []  # (column, keyword, values)
+        for option, keyword, column, _ in SWEEP_AXES:
+            text = {"speed": speed, "wavelength": wavelength, "amplitude": amplitude,
+                    "rail_phase": rail_phase}[keyword]
+            if text is not None:
+                axes.append((option, keyword, column, _value_list(option, text)))
+        volts = []
+        if has_mr:
+            if voltage is None:
+                volts = [float(damper_model.v_min)]
+            else:
+                volts = _value_list("--voltage", voltage,
+                                    parse=lambda item: _voltage("--voltage", item, damper_model))
+                volts = [damper_model.check_voltage(v, "--voltage") for v in volts]
+        gain_axes = []  # (name, values)
+        for text in gain or []:
+            name, values = _gain_option(text)
+            if any(name == n for n, _ in gain_axes):
+                raise ValueError(f"--gain = {text!r}: {name} is given twice")
+            acts_in = GAIN_CONTROLLERS[name.partition(".")[0]]
+            if not any(c in acts_in for c in controllers):
+                raise ValueError(f"--gain = {text!r}: {name} acts in {', '.join(acts_in)} only, "
+                                 f"which --suspension ({listed}) does not list")
+            gain_axes.append((name, values))
+        noise_values = None if noise is None else tuple(_noise_items("--noise", noise))
+        seeds = [0] if seed is None else _value_list("--seed", seed, integer=True)
+        bad = [s for s in seeds if s < 0]
+        if bad:
+            raise ValueError(f"--seed = {seed!r}: {bad[0]} is negative; seeds are whole numbers >= 0")
+        base_gains = _gain_set(gains)
+        dt = DEFAULT_DT if dt is None else _check_number("--dt", dt, "s")
+        common = {} if duration is None else {"duration": float(duration)}
+
+        # every scenario of the grid must be valid before anything runs
+        combos = list(itertools.product(*[values for *_, values in axes]))
+        first_record = None
+        for combo in combos:
+            options = {**common, **{kw: v for (_, kw, _, _), v in zip(axes, combo)}}
+            try:
+                scen = make_scenario(scenario, **options)
+            except ValueError as exc:
+                given = ", ".join(f"{opt} {v:g}" for (opt, *_), v in zip(axes, combo))
+                raise ValueError(f"{given}: {exc}" if given else str(exc)) from None
+            first_record = first_record or scen.describe()
+        window_value = None
+        if window is not None:
+            window_value = check_window(parse_window(window), scen.duration)
+        # the scenario's fixed settings (the swept ones are grid axes)
+        swept = {key for _, kw, _, _ in axes for key in _SCENARIO_KEYS[kw]}
+        scenario_record = {k: v for k, v in first_record.items() if k not in swept}
+
+        # the cases, with the grid values each row reports
+        grid_columns = ["suspension"] + [column for _, _, column, _ in axes]
+        if has_mr:
+            grid_columns.append("voltage_v")
+        grid_columns += [name for name, _ in gain_axes]
+        if noise_values is not None:
+            grid_columns.append("seed")
+        cases, grid = [], []
+        for s in suspensions:
+            for combo in combos:
+                options = {**common, **{kw: v for (_, kw, _, _), v in zip(axes, combo)}}
+                base = {c: None for c in grid_columns}
+                base.update({"suspension": s, **{column: v for (_, _, column, _), v in zip(axes, combo)}})
+                if s == "passive":
+                    cases.append(sweep_lib.Case(scenario, options))
+                    grid.append(base)
+                elif s == "mr":
+                    for v in volts:
+                        cases.append(sweep_lib.Case(scenario, options, suspension="mr",
+                                                    damper=damper_name, voltage=v))
+                        grid.append({**base, "voltage_v": v})
+                else:
+                    mine = [(n, vs) for n, vs in gain_axes if s in GAIN_CONTROLLERS[n.partition(".")[0]]]
+                    for values in itertools.product(*[vs for _, vs in mine]):
+                        changes = tuple(zip([n for n, _ in mine], values))
+                        for sd in (seeds if noise_values is not None else [0]):
+                            cases.append(sweep_lib.Case(
+                                scenario, options, suspension=s, damper=damper_name,
+                                gains=changes, noise=noise_values or (), seed=sd))
+                            row = {**base, **dict(changes)}
+                            if noise_values is not None:
+                                row["seed"] = sd
+                            grid.append(row)
+        table, table_path = _run_table(out, resume)
+        executor, executor_record = _executor(workers, scheduler, scheduler_file)
+    try:
+        with _interruptible(table, table_path), _errors():
+            with _RunProgress(_stderr_is_terminal(), "sweeping") as progress:
+                t0 = time.perf_counter()
+                frame = sweep_lib.run_cases(cases, executor=executor, table=table,
+                                            base_gains=base_gains, dt=dt, window=window_value,
+                                            progress=progress)
+                wall = time.perf_counter() - t0
+            metrics = _metric_columns()
+            rows = []
+            for case, values, (_, result) in zip(cases, grid, frame.iterrows()):
+                rows.append({**values, **{m: float(result[m]) for m in metrics}, "key": case.key})
+            doc = {
+                "schema": SCHEMA_SWEEP,
+                "railride_version": __version__,
+                "date": _utc_now(),
+                "settings": {
+                    "scenario": scenario_record,
+                    "grid": {"suspension": suspensions,
+                             **{column: values for _, _, column, values in axes},
+                             **({"voltage_v": volts} if has_mr else {}),
+                             **{name: values for name, values in gain_axes},
+                             **({"seed": seeds} if noise_values is not None else {})},
+                    "damper": damper_name if (has_mr or controllers) else None,
+                    "gains_source": base_gains.source if controllers else None,
+                    "sensor_noise": None if noise_values is None else dict(
+                        zip(("displacement", "angle", "velocity", "angular_rate"), noise_values)),
+                    "dt_s": float(dt),
+                    "window_s": None if window_value is None else list(window_value),
+                },
+                "columns": grid_columns + metrics + ["key"],
+                "rows": rows,
+                "runs": len(table.frame),
+                "runs_evaluated": progress.evaluated,
+                "runs_per_second": progress.evaluated / wall if wall > 0 else 0.0,
+                "wall_time_s": wall,
+                "executor": executor_record,
+            }
+            text = json.dumps(rows, indent=2, allow_nan=False)  # refuses NaN before writing
+            if out is not None:
+                _write_folder(out, lambda: report.write_sweep_outputs(out, doc))
+    finally:
+        executor.close()
+    if format is SweepFormat.json:
+        typer.echo(text)
+        return
+    if format is SweepFormat.csv:
+        import pandas as pd
+
+        typer.echo(pd.DataFrame(rows, columns=doc["columns"]).to_csv(index=False), nl=False)
+        return
+    st = doc["settings"]
+    start, end = window_value or (0.0, scen.duration)
+    lines = [f"scenario at the first grid point: {report.describe_scenario(first_record)}, "
+             f"{scen.duration:g} s, dt {dt:g} s, RMS over {start:g}-{end:g} s"]
+    if st["damper"]:
+        lines.append(f"{st['damper']} MR dampers" + (f"; gains {st['gains_source']}" if controllers else ""))
+    lines.append(f"{len(rows)} runs: {doc['runs_evaluated']} evaluated now, "
+                 f"{len(rows) - doc['runs_evaluated']} from the run table; wall time {wall:.1f} s")
+    _wide_stdout_console().print(_sweep_table(rows, grid_columns, "\n".join(lines)))
 
 
 def main() -> None:

@@ -9,6 +9,9 @@
 * `plot_comparison_response`, `plot_comparison_damper_forces`, `plot_comparison_voltages` and
   `comparison_frame` draw and tabulate a controller comparison (`railride.comparison`, the combined
   Dataset with a ``controller`` dimension); `write_compare_outputs` writes its folder.
+* `curves_frame` and `plot_sensitivity` tabulate and draw the sensitivity curves of a tuning
+  study (`railride.tuning`); `write_tune_outputs` writes its folder (beside the run table
+  ``runs.csv`` that the library keeps up to date), `write_sweep_outputs` that of a sweep.
 * `write_folder` is the all-or-nothing folder writer behind the ``write_*`` functions.
 
 Figures are built on matplotlib's object API with the Agg canvas: nothing here touches pyplot's
@@ -43,6 +46,12 @@ TRACKING_FILES = ("tracking.png", "tracking.csv", "tracking.json")
 #: the files `write_compare_outputs` produces, in the order they are written
 COMPARE_FILES = ("compare.json", "compare.nc", "compare.csv", "acceleration.png", "displacement.png",
                  "pitch.png", "roll.png", "damper_forces.png", "voltages.png")
+#: the files `write_tune_outputs` produces, in the order they are written
+TUNE_FILES = ("gains.toml", "sensitivity.png", "curves.csv", "tune.json")
+#: the files `write_sweep_outputs` produces (the run table runs.csv is the library's)
+SWEEP_FILES = ("sweep.json",)
+#: the columns of `curves_frame` (curves.csv)
+CURVE_COLUMNS = ("phase", "pass", "parameter", "value", "objective", "chosen")
 #: the time histories of a damper rig run (railride.rig), in CSV column order
 RIG_CHANNELS = ("x", "xd", "F", "z", "y", "u", "v", "E")
 
@@ -587,6 +596,171 @@ def write_compare_outputs(comparison, out_dir, doc: dict) -> list[Path]:
     for response in COMPARE_RESPONSES:
         writers[f"{response}.png"] = (lambda r: lambda path: plot_comparison_response(ds, r, path))(response)
     return write_folder(out_dir, [(name, writers[name]) for name in COMPARE_FILES])
+
+
+# -- tuning and sweeps (railride.tuning, railride.sweep) ------------------------------------
+def curves_frame(curves) -> pd.DataFrame:
+    """The sensitivity curves of `railride.tuning.tune` (its ``curves``) as one long table:
+    columns ``phase``, ``pass`` (1, 2, ... within the phase), ``parameter`` ("table.entry"),
+    ``value`` (SI), ``objective`` (the tuning objective of that run; the normalised force
+    tracking error for the inner phase) and ``chosen`` (True on the value kept after that
+    parameter's sweep in that pass). One row per value, the curves in the order they ran."""
+    rows = []
+    for c in curves:
+        values = np.asarray(c.values, dtype=float)
+        objective = np.asarray(c.objective, dtype=float)
+        for v, o in zip(values, objective):
+            rows.append((str(c.phase), int(c.sweep_pass), str(c.parameter), float(v), float(o),
+                         bool(v == float(c.chosen))))
+    return pd.DataFrame(rows, columns=list(CURVE_COLUMNS))
+
+
+def _gain_unit(parameter: str) -> str | None:
+    """The unit of a "table.entry" gain (from railride.control), or None."""
+    import dataclasses
+
+    from . import control
+
+    classes = {"inner": control.InnerLoop, "pid": control.PID, "attitude": control.Attitude,
+               "ride": control.Ride}
+    table, _, entry = parameter.partition(".")
+    for f in dataclasses.fields(classes[table]) if table in classes else ():
+        if f.name == entry:
+            return f.metadata.get("unit")
+    return None
+
+
+def _zero_axis(ax, zero_x: float, edge: float, right: float) -> None:
+    """A log x axis whose left edge (below ``edge``) stands for the value 0, plotted at
+    ``zero_x``: shaded, with a tick "0"; decade ticks above ``edge``."""
+    from matplotlib.ticker import FixedLocator, NullFormatter
+
+    ax.axvspan(ax.get_xlim()[0], edge, color="0.9", zorder=0, linewidth=0)
+    lo, hi = math.ceil(math.log10(edge)), math.floor(math.log10(right))
+    decades = [10.0 ** k for k in range(lo, hi + 1)]
+    labels = [f"$10^{{{k}}}$" for k in range(lo, hi + 1)]
+    if not decades:  # a range within one decade: label its ends
+        decades = [edge * 2.0, right / 1.6]
+        labels = [f"{v:.3g}" for v in decades]
+    ax.set_xticks([zero_x, *decades], ["0", *labels])
+    minor = [j * 10.0 ** k for k in range(math.floor(math.log10(edge)), hi + 1) for j in range(2, 10)
+             if edge < j * 10.0 ** k < right]
+    ax.xaxis.set_minor_locator(FixedLocator(minor))
+    ax.xaxis.set_minor_formatter(NullFormatter())
+
+
+def plot_sensitivity(curves, path=None, *, title: str | None = None):
+    """The sensitivity curves of a tuning study: one panel per parameter (in the order tuned),
+    the objective against the parameter's value on a log axis, one line per pass (coloured by
+    pass). The value 0 (the gain switched off) cannot sit on a log axis: it is plotted at the
+    shaded left edge, on a tick labelled 0, as an open square joined by a dotted line. The value
+    kept after each pass is a star; a dashed red line marks the final choice, which the panel's
+    title gives. The inner-loop panels (B, G) show the normalised force-tracking error.
+
+    Saved as PNG at ``path`` when given (atomically); returns the Agg `Figure`.
+    """
+    from matplotlib import colormaps
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch
+
+    curves = list(curves)
+    if not curves:
+        raise ValueError("no sensitivity curves to plot")
+    parameters = list(dict.fromkeys(c.parameter for c in curves))
+    ncols = min(4, len(parameters))
+    nrows = math.ceil(len(parameters) / ncols)
+    fig = _new_figure((3.3 * ncols + 0.6, 2.6 * nrows + 1.0))
+    axes = fig.subplots(nrows, ncols, squeeze=False).ravel()
+    max_pass = max(int(c.sweep_pass) for c in curves)
+    cmap = colormaps["viridis"]
+
+    def colour(sweep_pass):
+        return cmap(0.85 * (sweep_pass - 1) / max(1, max_pass - 1))
+
+    any_zero = False
+    for ax, parameter in zip(axes, parameters):
+        mine = [c for c in curves if c.parameter == parameter]
+        values = [np.asarray(c.values, dtype=float) for c in mine]
+        chosen = [float(c.chosen) for c in mine]
+        positive = np.concatenate([v[v > 0] for v in values] + [np.array([x for x in chosen if x > 0])])
+        has_zero = any((v == 0).any() for v in values) or any(x == 0 for x in chosen)
+        any_zero = any_zero or has_zero
+        lo, hi = (positive.min(), positive.max()) if positive.size else (1.0, 1.0)
+        zero_x, edge = lo / 5.0, lo / 2.2
+
+        def x(v):
+            v = np.asarray(v, dtype=float)
+            return np.where(v > 0, v, zero_x)
+
+        for c, vals in zip(mine, values):
+            order = np.argsort(vals)
+            vals, obj = vals[order], np.asarray(c.objective, dtype=float)[order]
+            col, pos = colour(int(c.sweep_pass)), vals > 0
+            ax.plot(vals[pos], obj[pos], "-o", color=col, markersize=2.5, linewidth=1.1)
+            if (~pos).any():
+                ax.plot(x(vals[~pos]), obj[~pos], "s", color=col, markerfacecolor="none",
+                        markersize=4.5)
+                if pos.any():
+                    ax.plot([zero_x, vals[pos][0]], [obj[~pos][0], obj[pos][0]], ":", color=col,
+                            linewidth=1.0)
+            k = np.flatnonzero(vals == float(c.chosen))
+            if k.size:
+                ax.plot(x(c.chosen), obj[k[0]], "*", color=col, markersize=10,
+                        markeredgecolor="k", markeredgewidth=0.5, zorder=5)
+        final = chosen[-1]
+        ax.axvline(float(x(final)), color="tab:red", linestyle="--", linewidth=0.9, zorder=1)
+        ax.set_xscale("log")
+        ax.set_xlim((zero_x if has_zero else lo) / 1.8, hi * 1.8)
+        if has_zero:
+            _zero_axis(ax, zero_x, edge, hi * 1.8)
+        unit = _gain_unit(parameter)
+        ax.set_title(f"{parameter}" + (f" ({unit})" if unit else "") + f"\nchosen {final:.3g}",
+                     fontsize="small")
+        ax.set_ylabel("tracking error" if parameter.startswith("inner.") else "objective",
+                      fontsize="small")
+        ax.tick_params(labelsize="small")
+        ax.grid(True, which="major", linewidth=0.4, alpha=0.6)
+    for ax in axes[len(parameters):]:
+        ax.set_visible(False)
+    handles = [Line2D([], [], color=colour(k), marker="o", markersize=3, label=f"pass {k}")
+               for k in range(1, max_pass + 1)]
+    handles.append(Line2D([], [], color="0.3", marker="*", linestyle="none", markersize=9,
+                          markeredgecolor="k", markeredgewidth=0.5, label="kept in that pass"))
+    handles.append(Line2D([], [], color="tab:red", linestyle="--", label="final value"))
+    if any_zero:
+        handles.append(Patch(color="0.9", label="value 0 (gain off)"))
+    fig.legend(handles=handles, loc="outside lower center", ncols=min(len(handles), 6),
+               fontsize="small", frameon=False)
+    fig.suptitle(title or "Sensitivity of the tuning objective, one parameter at a time",
+                 fontsize="medium")
+    _save_png(fig, path)
+    return fig
+
+
+def write_tune_outputs(curves, out_dir, doc: dict, gains_text: str, *,
+                       title: str | None = None) -> list[Path]:
+    """Write the results of a tuning study into ``out_dir``, all or nothing (`write_folder`;
+    other files there, such as the run table ``runs.csv``, stay): ``gains.toml``
+    (``gains_text``, a gains file), ``sensitivity.png`` (`plot_sensitivity` of ``curves``),
+    ``curves.csv`` (`curves_frame`) and ``tune.json`` (``doc`` as indented strict JSON).
+    Returns the written paths."""
+    text = _json_text(doc)  # refuse NaN before any file is written
+    curves = list(curves)
+    frame = curves_frame(curves)
+    writers = {
+        "gains.toml": lambda path: path.write_text(gains_text, encoding="utf-8"),
+        "sensitivity.png": lambda path: plot_sensitivity(curves, path, title=title),
+        "curves.csv": lambda path: frame.to_csv(path, index=False),
+        "tune.json": lambda path: path.write_text(text, encoding="utf-8"),
+    }
+    return write_folder(out_dir, [(name, writers[name]) for name in TUNE_FILES])
+
+
+def write_sweep_outputs(out_dir, doc: dict) -> list[Path]:
+    """Write the summary of a sweep, ``sweep.json`` (``doc``), into ``out_dir`` beside the run
+    table ``runs.csv`` that `railride.sweep.run_cases` keeps there. Returns the written paths."""
+    text = _json_text(doc)
+    return write_folder(out_dir, [("sweep.json", lambda path: path.write_text(text, encoding="utf-8"))])
 
 
 # -- NetCDF -----------------------------------------------------------------------------------

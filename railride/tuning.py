@@ -103,7 +103,7 @@ def _candidates(current: float, parameter: str, n_values: int, span: float) -> l
 def tune(phases=("attitude", "ride"), *, scenario: str = "paper-sine", scenario_options=None,
          gains: GainSet | None = None, objective: Objective | None = None, damper: str = "railway",
          executor=None, table: RunTable | None = None, n_values: int = 13, span: float = 30.0,
-         max_passes: int = 5, tol: float = 1e-3, dt: float = 1e-4, progress=None,
+         max_passes: int = 5, tol: float = 1e-3, dt: float = 1e-4, window=None, progress=None,
          log=None) -> TuneResult:
     """The sensitivity study: the phases in order (from PHASES), each to convergence.
 
@@ -128,7 +128,7 @@ def tune(phases=("attitude", "ride"), *, scenario: str = "paper-sine", scenario_
 
     def run(cases):
         return run_cases(cases, executor=executor, table=table, base_gains=base, dt=dt,
-                         progress=progress)
+                         window=window, progress=progress)
 
     passive = _rms(run([Case(scenario, opts)]))[0]
     result.passive = dict(zip(RESPONSES, passive))
@@ -140,12 +140,9 @@ def tune(phases=("attitude", "ride"), *, scenario: str = "paper-sine", scenario_
     for phase in phases:
         params = PARAMETERS[phase]
         if phase == "inner":
-            best = _tune_inner(base, changes, params, n_values, span, max_passes, tol, result, log)
+            _tune_inner(base, changes, params, n_values, span, max_passes, tol, result, log, damper)
             continue
         suspension = SUSPENSION[phase]
-        if phase == "ride":
-            # the ride loop starts from off, as the paper tunes it after the attitude loop
-            pass
         def score(change_sets):
             cases = [Case(scenario, opts, suspension=suspension, damper=damper,
                           gains=tuple(sorted({**changes, **cs}.items()))) for cs in change_sets]
@@ -185,18 +182,18 @@ def tracking_objective(B: float, G: float, damper="railway") -> float:
                           for kind in ("sine", "sawtooth")]))
 
 
-def _tune_inner(base, changes, params, n_values, span, max_passes, tol, result, log):
+def _tune_inner(base, changes, params, n_values, span, max_passes, tol, result, log, damper):
     """B and G on the rig's force-tracking error (cheap: evaluated here, not on the executor)."""
     def value(p):
         return changes.get(p, getattr(base.inner, p.split(".")[1]))
 
-    best = tracking_objective(value("inner.B"), value("inner.G"))
+    best = tracking_objective(value("inner.B"), value("inner.G"), damper)
     for sweep_pass in range(1, max_passes + 1):
         start = best
         for p in params:
             vals = _candidates(value(p), p, n_values, span)
             obj = np.array([tracking_objective(**{**{"B": value("inner.B"), "G": value("inner.G")},
-                                                 p.split(".")[1]: v}) for v in vals])
+                                                 p.split(".")[1]: v}, damper=damper) for v in vals])
             k = int(np.argmin(obj))
             if obj[k] < best - 1e-12:
                 changes[p], best = vals[k], float(obj[k])

@@ -105,3 +105,15 @@ def test_a_gain_the_controller_does_not_use_has_no_sensitivity():
                       scenario_options={"duration": 0.5}, n=16)
     assert abs(res.total[1]) < 1e-9 and abs(res.first_order[1]) < 1e-9
     assert res.total[0] > 0.1
+
+
+def test_a_resumed_sweep_with_other_run_settings_runs_again(tmp_path):
+    cases = [Case(scenario_options=SHORT)]
+    path = tmp_path / "runs.csv"
+    run_cases(cases, table=RunTable(path))
+    ex = CountingExecutor()
+    run_cases(cases, table=RunTable(path, resume=True), executor=ex, dt=5e-5)
+    assert ex.cases == 1  # another dt is another run
+    ex = CountingExecutor()
+    run_cases(cases, table=RunTable(path, resume=True), executor=ex, dt=5e-5)
+    assert ex.cases == 0

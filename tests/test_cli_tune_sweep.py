@@ -1,0 +1,238 @@
+"""`railride tune` and `railride sweep`: the result folders, resume, the output formats, bad input,
+Ctrl-C. Short runs (1 s, few values, one pass) keep the file fast."""
+
+from __future__ import annotations
+
+import io
+import json
+
+import pandas as pd
+import pytest
+from typer.testing import CliRunner
+
+from railride.cli import app
+from railride.control import GainSet
+from railride.report import TUNE_FILES
+
+runner = CliRunner()
+
+RESPONSES = ["acceleration_m_s2", "displacement_m", "pitch_deg", "roll_deg"]
+TUNE = ("tune", "--phase", "pid", "--duration", 1, "--values", 4, "--passes", 1)
+SWEEP = ("sweep", "--duration", 1)
+PNG = b"\x89PNG\r\n\x1a\n"
+
+
+def run(*args):
+    return runner.invoke(app, [str(a) for a in args])
+
+
+def ok(*args):
+    result = run(*args)
+    assert result.exit_code == 0, (result.exit_code, result.stdout, result.stderr)
+    return result
+
+
+def assert_input_error(result, *fragments):
+    """Exit status 2, one line "error: ..." on stderr naming the fragments, no traceback."""
+    assert result.exit_code == 2, (result.exit_code, result.stdout, result.stderr)
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: "), result.stderr
+    assert "Traceback" not in result.output
+    assert result.stdout == ""
+    for fragment in fragments:
+        assert fragment in lines[0], lines[0]
+
+
+def table_rows(path) -> int:
+    return len(pd.read_csv(path))
+
+
+@pytest.fixture(scope="module")
+def tuned(tmp_path_factory):
+    """A finished tuning folder and the JSON printed by its run."""
+    out = tmp_path_factory.mktemp("tune") / "result"
+    result = ok(*TUNE, "--out", out, "--format", "json")
+    return out, json.loads(result.stdout)
+
+
+# -- tune ---------------------------------------------------------------------------------------
+def test_tune_folder_and_json(tuned):
+    out, doc = tuned
+    assert sorted(p.name for p in out.iterdir()) == sorted([*TUNE_FILES, "runs.csv"])
+    assert json.loads((out / "tune.json").read_text()) == doc
+    assert doc["schema"] == "railride.tune/1"
+    assert doc["phases"] == ["pid"]
+    assert doc["scenario"]["duration_s"] == 1.0
+    assert doc["objective"] == {"weights": dict.fromkeys(RESPONSES, 1.0), "penalty": 0.0}
+    assert list(doc["passive_rms"]) == RESPONSES
+    assert [(h["phase"], h["pass"]) for h in doc["history"]] == [("pid", 1)]
+    assert doc["runs"] == table_rows(out / "runs.csv") == doc["runs_evaluated"] > 0
+    assert doc["runs_per_second"] > 0 and doc["wall_time_s"] > 0
+    assert [r["suspension"] for r in doc["before_after"]] == ["pid"]
+    assert (out / "sensitivity.png").read_bytes().startswith(PNG)
+    curves = pd.read_csv(out / "curves.csv")
+    assert list(curves.columns[:5]) == ["phase", "pass", "parameter", "value", "objective"]
+    assert set(curves["parameter"]) == {"pid.kp", "pid.ki", "pid.kd"}
+    assert (curves["value"] == 0).any()  # 0 is always tried
+    chosen = curves[curves["chosen"]].set_index("parameter")["value"]
+    assert chosen.to_dict() == {k: doc["gains"]["pid"][k.split(".")[1]] for k in chosen.index}
+
+
+def test_tune_gains_file_loads_and_compare_accepts_it(tuned):
+    out, doc = tuned
+    text = (out / "gains.toml").read_text()
+    assert text.startswith("#") and "[provenance]" in text and "railride tune" in text
+    gains = GainSet.load(out / "gains.toml")
+    assert gains.pid.to_dict() == doc["gains"]["pid"]
+    assert gains.attitude.to_dict() == doc["gains"]["attitude"]
+    result = ok("compare", "--controllers", "pid", "--duration", 1, "--gains", out / "gains.toml",
+                "--format", "json")
+    compared = json.loads(result.stdout)
+    assert compared["gains"]["source"] == str(out / "gains.toml")
+    assert compared["gains"]["pid"] == doc["gains"]["pid"]
+
+
+def test_tune_resume_of_a_finished_folder_runs_nothing(tuned):
+    out, doc = tuned
+    before = table_rows(out / "runs.csv")
+    result = ok(*TUNE, "--out", out, "--resume", "--format", "json")
+    again = json.loads(result.stdout)
+    assert table_rows(out / "runs.csv") == before
+    assert again["runs_evaluated"] == 0 and again["runs"] == before
+    assert again["history"] == doc["history"] and again["gains"] == doc["gains"]
+
+
+def test_tune_existing_run_table_needs_resume(tuned):
+    out, _ = tuned
+    before = (out / "runs.csv").read_bytes()
+    assert_input_error(run(*TUNE, "--out", out), "runs.csv exists", "--resume")
+    assert (out / "runs.csv").read_bytes() == before
+
+
+def test_tune_table_output():
+    result = ok(*TUNE)
+    for fragment in ("objective after each pass", "Tuned gains", "pid.kd", "start", "tuned",
+                     "red. %", "acceleration (m/s^2)"):
+        assert fragment in result.stdout, fragment
+
+
+def test_tune_interrupted(tmp_path, monkeypatch):
+    """Ctrl-C: one line saying how many runs the table holds, status 130, no traceback."""
+    from railride import sweep
+
+    real = sweep.evaluate
+    calls = []
+
+    def interrupt_later(*args, **kwargs):  # the third chunk: the first gain's sweep
+        calls.append(1)
+        if len(calls) == 3:
+            raise KeyboardInterrupt
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(sweep, "evaluate", interrupt_later)
+    out = tmp_path / "run"
+    result = run(*TUNE, "--out", out)
+    assert result.exit_code == 130, (result.stdout, result.stderr)
+    n = table_rows(out / "runs.csv")
+    assert n == 2  # the passive run and the start gains
+    assert (f"interrupted: {n} runs saved in {out / 'runs.csv'}; run again with --resume to "
+            "continue") in result.stderr
+    assert "Traceback" not in result.output and result.stdout == ""
+    assert not (out / "tune.json").exists()
+    monkeypatch.setattr(sweep, "evaluate", real)
+    resumed = json.loads(ok(*TUNE, "--out", out, "--resume", "--format", "json").stdout)
+    assert resumed["runs"] == resumed["runs_evaluated"] + n
+
+
+@pytest.mark.parametrize("args, fragments", [
+    (("--phase", "lqr"), ("--phase", "lqr", "allowed")),
+    (("--phase", "pid,,ride"), ("--phase", "empty item")),
+    (("--weights", "1,1,1"), ("--weights", "four numbers")),
+    (("--weights", "1,1,x,1"), ("--weights", "'x'")),
+    (("--penalty", "-1"), ("--penalty",)),
+    (("--values", "2"), ("--values = 2",)),
+    (("--span", "1"), ("--span",)),
+    (("--passes", "0"), ("--passes = 0",)),
+    (("--damper", "mr9"), ("--damper", "mr9")),
+    (("--resume",), ("--resume needs --out",)),
+    (("--workers", "0"), ("--workers = 0",)),
+    (("--scheduler", "tcp://h:1", "--scheduler-file", "f"), ("--scheduler",)),
+])
+def test_tune_bad_input(args, fragments):
+    assert_input_error(run(*TUNE, *args), *fragments)
+
+
+# -- sweep --------------------------------------------------------------------------------------
+def test_sweep_speed_range_times_suspensions(tmp_path):
+    out = tmp_path / "sweep"
+    result = ok(*SWEEP, "--speed", "20:40:3", "--suspension", "passive,pid", "--out", out,
+                "--format", "json")
+    rows = json.loads(result.stdout)
+    assert [(r["suspension"], r["speed_m_s"]) for r in rows] == [
+        (s, v) for s in ("passive", "pid") for v in (20.0, 30.0, 40.0)]
+    for r in rows:
+        assert all(r[f"{k}_rms"] > 0 for k in RESPONSES)
+    doc = json.loads((out / "sweep.json").read_text())
+    assert doc["schema"] == "railride.sweep/1"
+    assert doc["rows"] == rows
+    assert doc["settings"]["grid"] == {"suspension": ["passive", "pid"],
+                                       "speed_m_s": [20.0, 30.0, 40.0]}
+    assert doc["columns"] == list(rows[0])
+    assert table_rows(out / "runs.csv") == doc["runs"] == doc["runs_evaluated"] == 6
+
+    # resume: nothing to run again; more speeds: only the new ones run
+    assert_input_error(run(*SWEEP, "--speed", "20:40:3", "--out", out), "--resume")
+    again = json.loads(ok(*SWEEP, "--speed", "20:40:3", "--suspension", "passive,pid",
+                          "--out", out, "--resume", "--format", "json").stdout)
+    assert again == rows
+    assert table_rows(out / "runs.csv") == 6
+    ok(*SWEEP, "--speed", "20:50:4", "--suspension", "passive,pid", "--out", out, "--resume")
+    doc = json.loads((out / "sweep.json").read_text())
+    assert doc["runs_evaluated"] == 2 and table_rows(out / "runs.csv") == 8
+
+
+def test_sweep_csv_and_table():
+    args = (*SWEEP, "--suspension", "passive,mr,pid", "--voltage", "0,2.25",
+            "--gain", "pid.kd=1e5,4.5e5", "--speed", "30,40")
+    frame = pd.read_csv(io.StringIO(ok(*args, "--format", "csv").stdout))
+    # passive once per speed, mr per voltage, pid per kd value: no cross terms
+    assert len(frame) == 2 + 2 * 2 + 2 * 2
+    assert list(frame.columns[:4]) == ["suspension", "speed_m_s", "voltage_v", "pid.kd"]
+    assert frame.loc[frame.suspension == "mr", "pid.kd"].isna().all()
+    assert frame.loc[frame.suspension == "pid", "voltage_v"].isna().all()
+    assert sorted(frame.loc[frame.suspension == "mr", "voltage_v"].unique()) == [0.0, 2.25]
+    table = ok(*args).stdout
+    assert "suspension" in table and "pid.kd" in table and "voltage" in table
+
+
+def test_sweep_noise_seeds():
+    rows = json.loads(ok(*SWEEP, "--suspension", "passive,pid", "--noise", "1e-4,1e-5,1e-3,1e-4",
+                         "--seed", "0:1:2", "--format", "json").stdout)
+    assert [(r["suspension"], r["seed"]) for r in rows] == [("passive", None), ("pid", 0), ("pid", 1)]
+    assert rows[1]["acceleration_m_s2_rms"] != rows[2]["acceleration_m_s2_rms"]
+
+
+@pytest.mark.parametrize("args, fragments", [
+    (("--speed", "20:40"), ("--speed", "START:STOP:COUNT")),
+    (("--speed", "20:40:0"), ("--speed", "COUNT = 0")),
+    (("--speed", "20:40:x"), ("--speed", "COUNT")),
+    (("--speed", "20,,40"), ("--speed", "empty item")),
+    (("--speed", "20,fast"), ("--speed", "'fast'")),
+    (("--wavelength", "60,60"), ("--wavelength", "twice")),
+    (("--suspension", "passive,lqr"), ("--suspension", "lqr")),
+    (("--voltage", "1"), ("--voltage", "mr only")),
+    (("--suspension", "mr", "--voltage", "9"), ("--voltage",)),
+    (("--gain", "pid.kd=1e4"), ("--gain", "controllers")),
+    (("--suspension", "pid", "--gain", "pid.kx=1"), ("--gain", "pid.kx")),
+    (("--suspension", "pid", "--gain", "lqr.q=1"), ("--gain", "lqr.q")),
+    (("--suspension", "pid", "--gain", "pid.kd"), ("--gain", "TABLE.ENTRY=VALUES")),
+    (("--suspension", "pid", "--gain", "ride.kp_1R=1"), ("--gain", "sas-attitude-ride")),
+    (("--suspension", "pid", "--gain", "pid.kd=1:2:0"), ("--gain", "COUNT = 0")),
+    (("--noise", "0,0,0,0"), ("--noise", "controllers")),
+    (("--suspension", "pid", "--seed", "1"), ("--seed", "--noise")),
+    (("--suspension", "pid", "--noise", "0,0,0,0", "--seed", "0.5"), ("--seed", "0.5")),
+    (("--resume",), ("--resume needs --out",)),
+    (("--workers", "0"), ("--workers = 0",)),
+])
+def test_sweep_bad_input(args, fragments):
+    assert_input_error(run(*SWEEP, *args), *fragments)
