@@ -180,13 +180,25 @@ class LocalExecutor:
 
 
 class DaskExecutor:
-    """Chunks run as tasks on a dask.distributed cluster (``address`` tcp://host:port or a
-    ``scheduler_file``). Needs the optional extra: pip install "railride[distributed]"."""
+    """Chunks run as tasks on a dask.distributed cluster (``address`` tcp://host:port, or the
+    ``scheduler_file`` that ``dask scheduler --scheduler-file`` writes). Needs the optional
+    extra: pip install "railride[distributed]"; every worker imports the same railride.
+
+    One chunk is one task and one compiled batch, on its share of the worker machine's cores:
+    numba's thread count there (NUMBA_NUM_THREADS, every core by default) divided by the Dask
+    threads of all the workers on that machine, at least 1. So batches do not multiply Dask's
+    threads: one ``dask worker --nthreads 1`` per machine gives each batch every core, a default
+    ``dask worker`` (a thread per core) one core to each of its batches (docs/distributed.md).
+
+    A scheduler that does not answer within ``timeout`` seconds, a scheduler file that does not
+    appear or has no address, are ValueErrors naming the address or file. `map` yields (chunk
+    index, rows) in the order chunks finish; a chunk lost with a dead worker is run again by the
+    scheduler."""
 
     name = "dask"
 
     def __init__(self, address: str | None = None, scheduler_file: str | None = None,
-                 timeout: float = 30.0):
+                 timeout: float = 10.0):
         try:
             from distributed import Client
         except ImportError:
@@ -194,18 +206,106 @@ class DaskExecutor:
                              "\"railride[distributed]\"") from None
         if (address is None) == (scheduler_file is None):
             raise ValueError("give a scheduler address (tcp://host:port) or a scheduler file")
+        if scheduler_file is not None:
+            address = self._address_from_file(scheduler_file, timeout)
+        self.address = address
+        where = f"{address}" + ("" if scheduler_file is None else f" (from {scheduler_file})")
         try:
-            self.client = Client(address, timeout=timeout) if address else \
-                Client(scheduler_file=scheduler_file, timeout=timeout)
-        except (OSError, TimeoutError) as exc:
-            raise ValueError(f"cannot reach the Dask scheduler at {address or scheduler_file}: {exc}") from None
+            self._handshake(address, timeout)
+            # not the default client: this executor's tasks only, the caller's Dask code untouched
+            self.client = Client(address, timeout=timeout, set_as_default=False)
+        except Exception as exc:  # refused, timed out, not a Dask scheduler, unknown scheme
+            why = str(exc) or "no answer (the scheduler's port, not its dashboard's?)"
+            raise ValueError(f"cannot reach the Dask scheduler at {where} within {timeout:g} s: "
+                             f"{type(exc).__name__}: {why}") from None
+
+    @staticmethod
+    def _address_from_file(path, timeout: float) -> str:
+        """The address in a scheduler file, waiting up to ``timeout`` for the scheduler to write it
+        (distributed's own Client would wait for a missing file forever)."""
+        deadline = time.monotonic() + timeout
+        while True:
+            try:
+                address = json.loads(Path(path).read_text())["address"]
+                if isinstance(address, str) and address:
+                    return address
+                problem = f"address = {address!r}"
+            except FileNotFoundError:
+                problem = "no such file"
+            except (OSError, ValueError, TypeError, KeyError) as exc:
+                problem = f"not a Dask scheduler file ({type(exc).__name__}: {exc})"
+            if time.monotonic() >= deadline:
+                raise ValueError(f"scheduler file {str(path)!r}: {problem} after {timeout:g} s")
+            time.sleep(0.1)
+
+    @staticmethod
+    def _handshake(address: str, timeout: float) -> None:
+        """Open and close one connection to a tcp ``address`` within ``timeout``: the Client
+        itself waits forever on a port that accepts but does not speak Dask (a dashboard's)."""
+        import asyncio
+        from concurrent.futures import ThreadPoolExecutor
+
+        try:
+            from distributed.comm import connect
+            from distributed.comm.addressing import parse_address
+            from distributed.comm.registry import get_backend
+        except ImportError:  # internals moved in another version: the Client alone then
+            return
+
+        scheme = parse_address(address)[0]
+        get_backend(scheme)  # an unknown scheme is a ValueError here, not a half-made Client
+        if scheme != "tcp":
+            return
+
+        async def once():
+            comm = await connect(address, timeout=timeout)
+            await comm.close()
+
+        # in a thread of its own: the caller may be inside an event loop (Jupyter)
+        with ThreadPoolExecutor(1) as pool:
+            pool.submit(lambda: asyncio.run(asyncio.wait_for(once(), timeout))).result()
 
     def map(self, fn, chunks):
-        from distributed import as_completed
+        import uuid
 
-        futures = {self.client.submit(fn, chunk, pure=False): i for i, chunk in enumerate(chunks)}
-        for fut in as_completed(futures):
-            yield futures[fut], fut.result()
+        from distributed import as_completed
+        from distributed.comm import get_address_host
+
+        # the Dask threads on each machine (by host address), so a task knows its share
+        nthreads = self.client.nthreads()
+        per_host: dict[str, int] = {}
+        for worker, n in nthreads.items():
+            host = get_address_host(worker)
+            per_host[host] = per_host.get(host, 0) + n
+        shares = {worker: per_host[get_address_host(worker)] for worker in nthreads}
+        tag = uuid.uuid4().hex[:8]
+        futures = {self.client.submit(self._run_chunk, fn, shares, chunk,
+                                      key=f"railride-chunk-{tag}-{i}"): i
+                   for i, chunk in enumerate(chunks)}
+        try:
+            for fut in as_completed(futures, loop=self.client.loop):
+                i = futures.pop(fut)
+                yield i, fut.result()
+        finally:  # stopped early (an error, Ctrl-C): drop what has not finished
+            if futures:
+                self.client.cancel(list(futures))
+
+    @staticmethod
+    def _run_chunk(fn, shares: dict, chunk):
+        """On a worker: ``fn(chunk)`` on numba's thread count divided by the Dask threads on this
+        machine (``shares``, as the map started; this worker's own for a worker that joined
+        later). The thread count is per thread (`numba.set_num_threads`), so restored after."""
+        import numba
+        from distributed import get_worker
+
+        worker = get_worker()
+        share = shares.get(worker.address, worker.state.nthreads)
+        before = numba.get_num_threads()
+        numba.set_num_threads(max(1, numba.config.NUMBA_NUM_THREADS // max(1, share)))
+        try:
+            return fn(chunk)
+        finally:
+            numba.set_num_threads(before)
 
     def close(self):
         self.client.close()
@@ -225,7 +325,8 @@ class RunTable:
                 raise ValueError(f"{self.path} exists: pass resume to continue that sweep, or "
                                  "choose another output folder")
             try:
-                self.frame = pd.read_csv(self.path)
+                # keys are hex digests: an all-digit one must stay text to be recognised
+                self.frame = pd.read_csv(self.path, dtype={"key": str})
             except (OSError, ValueError) as exc:
                 raise ValueError(f"cannot read the run table {self.path}: {exc}") from None
 
@@ -253,23 +354,32 @@ def run_cases(cases: list[Case], *, executor=None, table: RunTable | None = None
     executor = LocalExecutor() if executor is None else executor
     table = RunTable() if table is None else table
     done = table.done()
-    keys = [c.key for c in cases]
+    # a run's result depends on the case and on these settings: both go into its key, so a
+    # resumed sweep with another dt, window or base gain set does not reuse old rows
+    from .control import GainSet
+    base = GainSet.default() if base_gains is None else base_gains
+    settings = json.dumps({"dt": dt, "window": None if window is None else [float(w) for w in window],
+                           "base_gains": base.to_toml()}, sort_keys=True)
+    keys = [hashlib.sha1((c.key + settings).encode()).hexdigest()[:16] for c in cases]
     pending, seen = [], set()
+    key_of = {}
     for c, k in zip(cases, keys):
+        key_of[c.key] = k
         if k not in done and k not in seen:
             pending.append(c)
             seen.add(k)
     # group compatible cases so each chunk is one compiled batch
     pending.sort(key=lambda c: str(c.group))
     chunks = [pending[i:i + chunk] for i in range(0, len(pending), chunk)]
-    fn = functools.partial(evaluate, base_gains=base_gains, dt=dt, window=window)
+    fn = functools.partial(evaluate, base_gains=base, dt=dt, window=window)
     t0, n_done = time.perf_counter(), 0
     if progress is not None:
         progress(0, len(pending), 0.0)
     for _, rows in executor.map(fn, chunks):
-        table.add(rows)
         for row in rows:
+            row["key"] = key_of[row["key"]]  # the case's key with the run settings
             done[row["key"]] = row
+        table.add(rows)
         n_done += len(rows)
         if progress is not None:
             elapsed = time.perf_counter() - t0
