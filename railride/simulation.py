@@ -285,6 +285,13 @@ def simulate(scenario=None, params=None, *, dt: float = DEFAULT_DT,
         raise ValueError(f"duration = {duration:g} s must be a whole number of output intervals "
                          f"(1/{output_rate:g} Hz)")
     n_steps = n_out * stride
+    for sc in scenarios:  # a random track's shortest wavelength must show in the output
+        lam = getattr(sc.track, "min_wavelength", None)
+        if lam is not None and sc.speed / lam > output_rate / 2.5:
+            raise ValueError(
+                f"min_wavelength = {lam:g} m at {sc.speed:g} m/s is {sc.speed / lam:g} Hz, more than "
+                f"output_rate / 2.5 = {output_rate / 2.5:g} Hz can resolve: raise min_wavelength or "
+                f"output_rate")
 
     systems = {key: _system_arrays(v, passive=damper is None) for key, v in vehicles.items()}
     arrays = {k: np.ascontiguousarray(np.stack([systems[id(p)][k] for p in param_sets]))

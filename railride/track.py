@@ -256,22 +256,30 @@ class Scenario:
                 **self.track.describe()}
 
 
-SCENARIOS = ("paper-sine", "bump", "file:PATH")
+SCENARIOS = ("paper-sine", "bump", "file:PATH", "fra1..fra6", "german-low", "german-high")
 
 
 def scenario(name: str = "paper-sine", *, amplitude: float | None = None,
              wavelength: float | None = None, rail_phase: float | None = None,
-             speed: float | None = None, duration: float | None = None) -> Scenario:
+             speed: float | None = None, duration: float | None = None, seed: int | None = None,
+             min_wavelength: float | None = None, max_wavelength: float | None = None) -> Scenario:
     """A named scenario with optional overrides.
 
     ``paper-sine``: amplitude [m], wavelength [m], rail_phase [deg] of the sine (defaults 0.05 m,
     60 m, 90 deg). ``bump``: amplitude is the bump height [m] (negative for a dip, default 0.02 m)
     and wavelength its length [m] (default 10 m), starting at s = 10 m on both rails.
-    ``file:PATH``: a measured CSV profile (s, z_L, z_R). Speed defaults to 55.56 m/s and duration
-    to 10 s for every scenario.
+    ``file:PATH``: a measured CSV profile (s, z_L, z_R). ``fra1`` ... ``fra6``, ``german-low``,
+    ``german-high``: a random realisation of that spectrum (`RandomTrack`) with ``seed`` (default
+    0) over the wavelength band [min_wavelength, max_wavelength] (default 1 to 100 m). Speed
+    defaults to 55.56 m/s and duration to 10 s for every scenario.
     """
     common = {"speed": 55.56 if speed is None else speed,
               "duration": 10.0 if duration is None else duration}
+    random_only = [k for k, v in (("seed", seed), ("min_wavelength", min_wavelength),
+                                  ("max_wavelength", max_wavelength)) if v is not None]
+    if random_only and name not in SPECTRA:
+        raise ValueError(f"{', '.join(random_only)} applies to the random tracks "
+                         f"({', '.join(SPECTRA)}) only, not to {name}")
     if name == "paper-sine":
         track = SineTrack(amplitude=0.05 if amplitude is None else amplitude,
                           wavelength=60.0 if wavelength is None else wavelength,
@@ -281,6 +289,19 @@ def scenario(name: str = "paper-sine", *, amplitude: float | None = None,
             raise ValueError("rail_phase applies to paper-sine only, not to the bump scenario")
         track = CosineBump(height=0.02 if amplitude is None else amplitude,
                            length=10.0 if wavelength is None else wavelength)
+    elif name in SPECTRA:
+        given = [k for k, v in (("amplitude", amplitude), ("wavelength", wavelength),
+                                ("rail_phase", rail_phase)) if v is not None]
+        if given:
+            raise ValueError(f"{', '.join(given)} cannot be set for a random track ({name}); "
+                             "use min_wavelength, max_wavelength and seed")
+        V = _check("speed", common["speed"], "positive", "a finite number > 0 (m/s)")
+        T = _check("duration", common["duration"], "positive", "a finite number > 0 (s)")
+        # long enough that the realisation does not repeat within the run
+        track = RandomTrack(name, seed=0 if seed is None else seed,
+                            min_wavelength=1.0 if min_wavelength is None else min_wavelength,
+                            max_wavelength=100.0 if max_wavelength is None else max_wavelength,
+                            length=max(2000.0, V * T + 100.0))
     elif name.startswith("file:"):
         given = [k for k, v in (("amplitude", amplitude), ("wavelength", wavelength),
                                 ("rail_phase", rail_phase)) if v is not None]
@@ -325,3 +346,134 @@ def wheelset_input_table(scenario: Scenario, lag_distance: np.ndarray, dt: float
     table[:, 0:8:2], table[:, 1:8:2] = zl, zr
     table[:, 8:16:2], table[:, 9:16:2] = V * dzl, V * dzr
     return table, interval
+
+
+# -- random irregularity from standard spectra (spec section 4) ---------------------------------
+#: FRA track classes (Hamid and Yang 1981; the constants as in Garg and Dukkipati 1984,
+#: "Dynamics of Railway Vehicle Systems"): A_v [cm^2 rad/m] per class, k = 0.25,
+#: Omega_c = 0.8245 rad/m, Omega_s = 0.4380 rad/m.
+FRA_AV = {1: 1.2107, 2: 1.0181, 3: 0.6816, 4: 0.5376, 5: 0.2095, 6: 0.0339}
+FRA_K, FRA_OMEGA_C, FRA_OMEGA_S = 0.25, 0.8245, 0.4380
+#: German high-speed spectra (ERRI B176 form): A_v [m^2 rad/m] for low and high interference,
+#: Omega_c = 0.8246, Omega_r = 0.0206, Omega_s = 0.4380 rad/m.
+GERMAN_AV = {"low": 4.032e-7, "high": 1.080e-6}
+GERMAN_OMEGA_C, GERMAN_OMEGA_R, GERMAN_OMEGA_S = 0.8246, 0.0206, 0.4380
+SPECTRA = tuple([f"fra{c}" for c in FRA_AV] + ["german-low", "german-high"])
+
+
+def spectrum(name: str, wavenumber, component: str = "vertical") -> np.ndarray:
+    """One-sided displacement PSD [m^2/(rad/m)] of a standard track spectrum at wavenumbers
+    [rad/m] (Omega = 2 pi / wavelength).
+
+    ``component`` "vertical": the vertical profile z_v (mean of the two rails); "cross-level":
+    the height difference z_x = z_L - z_R between the rails (spec section 4: z_L = z_v + z_x/2,
+    z_R = z_v - z_x/2). Formulas (docs/track.md):
+
+    * FRA class c: S_v = k A_v Omega_c^2 / (Omega^2 (Omega^2 + Omega_c^2)),
+      S_x = 4 k A_v Omega_c^2 / ((Omega^2 + Omega_c^2)(Omega^2 + Omega_s^2)), in cm^2/(rad/m),
+      converted here to m^2/(rad/m).
+    * German low/high: S_v = A_v Omega_c^2 / ((Omega^2 + Omega_r^2)(Omega^2 + Omega_c^2)); the
+      published cross-level form (A_v / b^2) Omega_c^2 Omega^2 / ((Omega^2 + Omega_r^2)(Omega^2 +
+      Omega_c^2)(Omega^2 + Omega_s^2)) is the cross-level angle with b = 0.75 m half the contact
+      distance; the height difference is that angle times 2b, so S_x = 4 A_v Omega_c^2 Omega^2 /
+      (...), independent of b.
+    """
+    W = np.asarray(wavenumber, dtype=float)
+    if not np.all(np.isfinite(W)) or np.any(W <= 0):
+        raise ValueError("wavenumber must be finite and > 0 rad/m")
+    if component not in ("vertical", "cross-level"):
+        raise ValueError(f"component = {component!r}: allowed 'vertical', 'cross-level'")
+    W2 = W * W
+    if name.startswith("fra") and name[3:].isdigit() and int(name[3:]) in FRA_AV:
+        Av, k, Wc2, Ws2 = FRA_AV[int(name[3:])], FRA_K, FRA_OMEGA_C**2, FRA_OMEGA_S**2
+        cm2 = (k * Av * Wc2 / (W2 * (W2 + Wc2)) if component == "vertical"
+               else 4 * k * Av * Wc2 / ((W2 + Wc2) * (W2 + Ws2)))
+        return cm2 * 1e-4
+    if name in ("german-low", "german-high"):
+        Av = GERMAN_AV[name.split("-")[1]]
+        Wc2, Wr2, Ws2 = GERMAN_OMEGA_C**2, GERMAN_OMEGA_R**2, GERMAN_OMEGA_S**2
+        if component == "vertical":
+            return Av * Wc2 / ((W2 + Wr2) * (W2 + Wc2))
+        return 4 * Av * Wc2 * W2 / ((W2 + Wr2) * (W2 + Wc2) * (W2 + Ws2))
+    raise ValueError(f"unknown track spectrum {name!r}; allowed: {', '.join(SPECTRA)}")
+
+
+@dataclass(frozen=True, eq=False)
+class RandomTrack(RailProfile):
+    """A seeded realisation of a standard spectrum: vertical profile and cross-level,
+    independent, each a sum of harmonics on a uniform wavenumber grid over the band
+    [2 pi / max_wavelength, 2 pi / min_wavelength] with amplitudes sqrt(2 S(Omega_k) dOmega)
+    and random phases, synthesised by an inverse FFT on a uniform grid in s and interpolated by
+    cubic splines. The realisation is ``length`` long (runs beyond it are refused); it fades in
+    over the first ``lead_in`` metres (raised cosine) so the vehicle enters from level track
+    smoothly."""
+
+    name: str = "fra4"
+    seed: int = 0
+    min_wavelength: float = 1.0  # m
+    max_wavelength: float = 100.0  # m
+    length: float = 2000.0  # m, the realisation's period
+    lead_in: float = 20.0  # m
+    _interp: tuple = field(default=(), repr=False)
+
+    def __post_init__(self):
+        from scipy.interpolate import CubicSpline
+
+        spectrum(self.name, 1.0)  # an unknown name fails here
+        if isinstance(self.seed, bool) or not isinstance(self.seed, (int, np.integer)) or self.seed < 0:
+            raise ValueError(f"seed = {self.seed!r}: must be a whole number >= 0")
+        lo = _check("min_wavelength", self.min_wavelength, "positive", "a finite number > 0 (m)")
+        hi = _check("max_wavelength", self.max_wavelength, "positive", "a finite number > 0 (m)")
+        if not lo < hi:
+            raise ValueError(f"wavelength band [{lo:g}, {hi:g}] m: min_wavelength must be below max_wavelength")
+        length = _check("length", self.length, "positive", "a finite number > 0 (m)")
+        if length < hi:
+            raise ValueError(f"length = {length:g} m: must be at least max_wavelength = {hi:g} m")
+        lead = _check("lead_in", self.lead_in, "nonnegative", "a finite number >= 0 (m)")
+        ds = lo / 20.0  # 20 samples on the shortest wavelength
+        n = int(2 ** math.ceil(math.log2(length / ds)))
+        if n > 2**24:
+            raise ValueError(f"the realisation needs {n} samples ({length:g} m at {ds:g} m): shorten it "
+                             "or raise min_wavelength")
+        ds = length / n
+        dW = 2 * np.pi / length
+        k = np.arange(n // 2 + 1)
+        W = k * dW
+        band = (W >= 2 * np.pi / hi) & (W <= 2 * np.pi / lo)
+        rng = np.random.default_rng(self.seed)
+        s = np.arange(n) * ds
+        profiles = []
+        for component in ("vertical", "cross-level"):
+            S = np.zeros_like(W)
+            S[band] = spectrum(self.name, W[band], component)
+            amp = np.sqrt(2 * S * dW)  # one-sided: variance = sum S dW
+            phase = rng.uniform(0, 2 * np.pi, W.size)
+            # z(s) = sum amp cos(W s + phase) as the real part of an inverse FFT
+            profiles.append(np.fft.irfft(amp * np.exp(1j * phase) * (n / 2), n))
+        zv, zx = profiles
+        taper = np.where(s < lead, 0.5 * (1 - np.cos(np.pi * s / max(lead, 1e-12))), 1.0)
+        zl, zr = taper * (zv + zx / 2), taper * (zv - zx / 2)
+        # not periodic: a periodic spline would join the full-amplitude end to the faded-in
+        # start and ring there; runs stay within the length (scenario() makes it long enough)
+        splines = tuple(CubicSpline(s, z) for z in (zl, zr))
+        object.__setattr__(self, "_interp", (splines, zv, zx, s))
+
+    def end(self) -> float:
+        return float(self._interp[3][-1])
+
+    def _evaluate(self, s):
+        (sl, sr), *_ = self._interp
+        return sl(s), sr(s), sl(s, 1), sr(s, 1)
+
+    def samples(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(s, z_v, z_x) of the realisation before the lead-in taper, for checks."""
+        _, zv, zx, s = self._interp
+        return s, zv, zx
+
+    def table_spacing(self):
+        return self.min_wavelength / 20.0
+
+    def describe(self):
+        return {"profile": "random", "spectrum": self.name, "seed": int(self.seed),
+                "min_wavelength_m": self.min_wavelength, "max_wavelength_m": self.max_wavelength,
+                "length_m": self.length, "lead_in_m": self.lead_in}
