@@ -400,6 +400,10 @@ def _dataset(out, vehicles, param_sets, scenarios, dt, output_rate, rows, batch,
         channels[f"{name}_velocity"] = ((), out["v"][:, :, i], {"units": f"{DOF_UNITS[i]}/s"})
     channels["carbody_acceleration"] = ((), out["a"][:, :, 0], {
         "units": "m/s^2", "long_name": "carbody CG vertical acceleration"})
+    channels["carbody_pitch_acceleration"] = ((), out["a"][:, :, 1], {
+        "units": "rad/s^2", "long_name": "carbody pitch acceleration"})
+    channels["carbody_roll_acceleration"] = ((), out["a"][:, :, 2], {
+        "units": "rad/s^2", "long_name": "carbody roll acceleration"})
     channels["carbody_corner_displacement"] = (("corner",), out["q"][:, :, :3] @ T[:, :3], {
         "units": "m", "long_name": "carbody vertical displacement above each secondary corner"})
     channels["secondary_deflection"] = (("corner",), deflection, {
@@ -527,6 +531,13 @@ class RideResult:
             q, a = q[:, keep], a[:, keep]
         out = metrics_from_arrays(a[..., 0], q[..., 0], q[..., 1], q[..., 2])
         return out if self._raw["batch"] else out.isel(sample=0, drop=True)
+
+    def comfort(self, window=None, positions=("centre", "front", "rear"),
+                weightings=("Wk", "Wb")):
+        """Ride comfort on the carbody floor (ISO 2631-1 a_w and VDV, EN 12299 N_MV vertical
+        part, Sperling Wz); see `railride.comfort.ride_comfort` and docs/comfort.md."""
+        from .comfort import ride_comfort
+        return ride_comfort(self.dataset, positions=positions, window=window, weightings=weightings)
 
     def to_pandas(self):
         """The time histories as a DataFrame, one column per scalar channel."""
