@@ -42,8 +42,8 @@ def test_to_frame_single(result):
     np.testing.assert_array_equal(df["rail_displacement_3R"].values,
                                   ds["rail_displacement"].sel(wheelset=3, rail="R").values)
     np.testing.assert_array_equal(df.index.values, ds["time"].values)
-    # 18 DOF channels + acceleration + 5 corner channels x 4 + 2 rail channels x 8
-    assert df.shape[1] == 18 + 1 + 5 * 4 + 2 * 8
+    # 18 DOF channels + 3 carbody accelerations + 5 corner channels x 4 + 2 rail channels x 8
+    assert df.shape[1] == 18 + 3 + 5 * 4 + 2 * 8
     assert result.to_pandas().equals(df)
 
 
