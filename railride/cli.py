@@ -1,5 +1,6 @@
-"""The ``railride`` command line: ``railride compare``, ``railride modes``, ``railride simulate``,
-``railride damper``, ``railride tracking``, ``railride tune`` and ``railride sweep``.
+"""The ``railride`` command line: ``railride compare``, ``railride modes``, ``railride frf``,
+``railride simulate``, ``railride damper``, ``railride tracking``, ``railride tune`` and
+``railride sweep``.
 
 A thin layer over the library: it parses options, calls `railride.vehicle`, `railride.track`,
 `railride.simulation`, `railride.metrics`, `railride.dampers`, `railride.rig`,
@@ -43,8 +44,9 @@ app = typer.Typer(
     pretty_exceptions_show_locals=False,
     rich_markup_mode=None,
     help="Vertical ride of a 9-DOF railway vehicle: the paper's comparison of passive, PID and "
-         "SAS suspensions (start with `railride compare`), modes, simulated ride metrics, and MR "
-         "damper rig tests (hysteresis cycles, force tracking).",
+         "SAS suspensions (start with `railride compare`), modes and frequency responses, "
+         "simulated ride metrics on sine, bump, measured or random tracks, and MR damper rig "
+         "tests (hysteresis cycles, force tracking).",
 )
 
 
@@ -203,6 +205,104 @@ def _print_json(doc) -> None:
     typer.echo(json.dumps(doc, indent=2, allow_nan=False))
 
 
+# -- random-track scenarios (fra1..fra6, german-low, german-high) ---------------------------------
+#: the options of the random-track scenarios: (option, keyword of track.scenario, unit)
+TRACK_OPTIONS = (("--track-seed", "seed", ""), ("--min-wavelength", "min_wavelength", "m"),
+                 ("--max-wavelength", "max_wavelength", "m"))
+#: a random track's shortest wavelength must pass at speed / min_wavelength <= output rate /
+#: RESOLUTION (the rule railride.simulation.simulate applies; checked here first so that the
+#: message names the options and a sweep or tuning study fails before its first run)
+RESOLUTION = 2.5
+
+
+def _random_tracks() -> tuple:
+    from .track import SPECTRA
+
+    return SPECTRA
+
+
+def _track_options(scenario_name: str, seed: Optional[int], min_wavelength: Optional[float],
+                   max_wavelength: Optional[float]) -> dict:
+    """--track-seed, --min-wavelength, --max-wavelength -> the keyword arguments of
+    track.scenario that were given, checked with the options' names."""
+    given = {"seed": seed, "min_wavelength": min_wavelength, "max_wavelength": max_wavelength}
+    out = {}
+    for option, keyword, unit in TRACK_OPTIONS:
+        value = given[keyword]
+        if value is None:
+            continue
+        if keyword == "seed":
+            out[keyword] = _check_track_seed(option, value)
+        else:
+            out[keyword] = _check_number(option, value, unit)
+    if out and scenario_name not in _random_tracks():
+        option, keyword, unit = next(o for o in TRACK_OPTIONS if o[1] in out)
+        value = f"{out[keyword]:g}" + (f" {unit}" if unit else "")
+        raise ValueError(f"{option} = {value}: applies to the random-track scenarios "
+                         f"({', '.join(_random_tracks())}) only, not to --scenario "
+                         f"{scenario_name}")
+    return out
+
+
+def _check_track_seed(option: str, value) -> int:
+    if isinstance(value, bool) or int(value) != value or value < 0:
+        raise ValueError(f"{option} = {value}: must be a whole number >= 0 (the seed of the "
+                         "random track)")
+    return int(value)
+
+
+def _make_scenario(name: str, options: dict, output_rate: Optional[float] = None,
+                   rate_option: str = "--output-rate"):
+    """track.scenario(name, **options); a wavelength-band error names the options given, and a
+    random track whose shortest wavelength the output rate cannot resolve is refused here."""
+    from .track import scenario as make_scenario
+
+    if name in _random_tracks():
+        for option, keyword, unit in (("--amplitude", "amplitude", "m"),
+                                      ("--wavelength", "wavelength", "m"),
+                                      ("--rail-phase", "rail_phase", "deg")):
+            if options.get(keyword) is not None:
+                raise ValueError(f"{option} = {options[keyword]:g} {unit}: does not apply to a "
+                                 f"random track ({name}); its options are --track-seed, "
+                                 "--min-wavelength and --max-wavelength")
+    try:
+        scen = make_scenario(name, **options)
+    except ValueError as exc:
+        band = [(o, k, u) for o, k, u in TRACK_OPTIONS if k != "seed" and k in options]
+        if band and "wavelength" in str(exc):
+            given = ", ".join(f"{o} = {options[k]:g} {u}" for o, k, u in band)
+            raise ValueError(f"{given}: {exc}") from None
+        if str(exc).startswith("unknown scenario"):
+            raise ValueError(f"--scenario: {exc}") from None
+        raise
+    if output_rate is not None:
+        _check_resolvable(scen, options, output_rate, rate_option)
+    return scen
+
+
+def _check_resolvable(scen, options: dict, output_rate: float, rate_option: str) -> None:
+    lam = getattr(scen.track, "min_wavelength", None)
+    if lam is None or not (math.isfinite(output_rate) and output_rate > 0):
+        return  # not a random track; a bad rate is the library's to report
+    if scen.speed / lam > output_rate / RESOLUTION:
+        default = "" if "min_wavelength" in options else " (the default)"
+        raise ValueError(
+            f"--min-wavelength = {lam:g} m{default} at --speed {scen.speed:g} m/s is "
+            f"{scen.speed / lam:g} Hz, more than {rate_option} {output_rate:g} Hz / "
+            f"{RESOLUTION:g} = {output_rate / RESOLUTION:g} Hz can resolve: raise --min-wavelength "
+            f"or lower --speed" + (f" or raise {rate_option}" if rate_option.startswith("--") else ""))
+
+
+def _case_options(options: dict) -> dict:
+    """Scenario options for a sweep.Case: the track seed as a NumPy integer.
+
+    Case stores Python ints as floats, and a random track refuses a float seed; a NumPy
+    integer passes through Case unchanged (a workaround until Case keeps whole numbers)."""
+    import numpy as np
+
+    return {k: (np.int64(v) if k == "seed" else v) for k, v in options.items()}
+
+
 # -- options shared by both commands ------------------------------------------------------------
 ParamsOption = Annotated[Optional[Path], typer.Option(
     "--params", metavar="FILE.toml",
@@ -213,6 +313,21 @@ PresetOption = Annotated[Optional[str], typer.Option(
     help="Named vehicle parameter set (available: paper). Default: paper.")]
 FormatOption = Annotated[OutputFormat, typer.Option(
     "--format", case_sensitive=False, help="Output on stdout: a table or a JSON document.")]
+TrackSeedOption = Annotated[Optional[int], typer.Option(
+    "--track-seed", metavar="N",
+    help="Random tracks (fra1..fra6, german-low, german-high) only: the seed of the track's "
+         "realisation, a whole number >= 0; the same seed gives the same track (default 0).")]
+MinWavelengthOption = Annotated[Optional[float], typer.Option(
+    "--min-wavelength", metavar="M",
+    help="Random tracks only: shortest wavelength of the irregularity [m] (default 1); "
+         "speed / M must not exceed the output rate / 2.5.")]
+MaxWavelengthOption = Annotated[Optional[float], typer.Option(
+    "--max-wavelength", metavar="M",
+    help="Random tracks only: longest wavelength of the irregularity [m] (default 100).")]
+SCENARIO_HELP = ("paper-sine (the paper's sine rails), bump (a cosine bump on both rails), "
+                 "file:PATH (a measured CSV with columns s, z_L, z_R in metres), or a random "
+                 "track: fra1..fra6 (FRA classes; 6 is the best track) or german-low, "
+                 "german-high (see --track-seed, --min-wavelength, --max-wavelength).")
 
 
 # -- compare ------------------------------------------------------------------------------------
@@ -413,7 +528,8 @@ def compare(
         help="Seed of the sensor noise, >= 0 (default 0); needs --sensor-noise.")] = None,
     scenario: Annotated[str, typer.Option(
         "--scenario", metavar="NAME",
-        help="paper-sine (the paper's sine rails), bump or file:PATH, as for simulate.")]
+        help="paper-sine (the paper's sine rails), bump, file:PATH, fra1..fra6, german-low or "
+             "german-high, as for simulate.")]
         = "paper-sine",
     amplitude: Annotated[Optional[float], typer.Option(
         "--amplitude", metavar="M",
@@ -425,6 +541,9 @@ def compare(
     rail_phase: Annotated[Optional[float], typer.Option(
         "--rail-phase", metavar="DEG",
         help="paper-sine only: phase lag of the right rail [deg] (default 90).")] = None,
+    track_seed: TrackSeedOption = None,
+    min_wavelength: MinWavelengthOption = None,
+    max_wavelength: MaxWavelengthOption = None,
     speed: Annotated[Optional[float], typer.Option(
         "--speed", metavar="M/S", help="Vehicle speed [m/s] (default 55.56).")] = None,
     duration: Annotated[Optional[float], typer.Option(
@@ -443,8 +562,9 @@ def compare(
     out: Annotated[Optional[Path], typer.Option(
         "--out", metavar="DIR",
         help="Also write compare.json, compare.nc, compare.csv and the plots acceleration.png, "
-             "displacement.png, pitch.png, roll.png, damper_forces.png, voltages.png into DIR "
-             "(created if missing; all or nothing).")] = None,
+             "displacement.png, pitch.png, roll.png, damper_forces.png, voltages.png, and the "
+             "acceleration spectra psd.png, psd.csv into DIR (created if missing; all or "
+             "nothing).")] = None,
 ) -> None:
     """Compare passive, PID and SAS suspensions on one scenario, as in the paper's Table 1.
 
@@ -459,7 +579,6 @@ def compare(
         from .comparison import compare as run_compare
         from .metrics import check_window, parse_window
         from .simulation import DEFAULT_DT, DEFAULT_OUTPUT_RATE
-        from .track import scenario as make_scenario
 
         names = _controller_list(controllers)
         gain_set = _gain_set(gains)
@@ -470,8 +589,10 @@ def compare(
         control_rate = _check_control_rate(control_rate, _check_number("--dt", dt, "s"))
         vehicle_params, vehicle_record = _vehicle_params(params, preset)
         window_value = parse_window(window) if window is not None else None
-        scen = make_scenario(scenario, amplitude=amplitude, wavelength=wavelength,
-                             rail_phase=rail_phase, speed=speed, duration=duration)
+        track = _track_options(scenario, track_seed, min_wavelength, max_wavelength)
+        scen = _make_scenario(scenario, dict(amplitude=amplitude, wavelength=wavelength,
+                                             rail_phase=rail_phase, speed=speed,
+                                             duration=duration, **track), output_rate)
         if out is not None:
             report.check_out_dir(out)
         # check the window before the runs, and record it resolved
@@ -519,9 +640,12 @@ def modes(
     if format is OutputFormat.json:
         typer.echo(json.dumps(rows, indent=2, allow_nan=False))
         return
-    from rich.table import Table
+    _stdout_console().print(_modes_table(rows))
 
+
+def _modes_table(rows: list[dict]):
     from rich.markup import escape
+    from rich.table import Table
 
     table = Table(title="Modes of the passive vehicle")
     table.add_column("#", justify="right")
@@ -532,7 +656,142 @@ def modes(
     for i, r in enumerate(rows, start=1):
         table.add_row(str(i), escape(r["label"]), f"{r['frequency_hz']:.3f}",
                       f"{r['damped_frequency_hz']:.3f}", f"{r['damping_ratio']:.3f}")
-    _stdout_console().print(table)
+    return table
+
+
+# -- frf ----------------------------------------------------------------------------------------
+SCHEMA_FRF = "railride.frf/1"
+#: --rails values of `frf`
+FRF_RAILS = ("in-phase", "anti-phase", "both")
+
+
+class FrfFormat(str, Enum):
+    table = "table"
+    json = "json"
+    csv = "csv"
+
+
+#: table labels of the magnitudes `frf` summarises (keys of report.FRF_MAGNITUDES)
+FRF_LABELS = {"bounce_m_per_m": "bounce (m/m)", "pitch_deg_per_m": "pitch (deg/m)",
+              "roll_deg_per_m": "roll (deg/m)", "acceleration_m_s2_per_m": "acceleration ((m/s^2)/m)"}
+
+
+def _default_speed() -> float:
+    import dataclasses
+
+    from .track import Scenario
+
+    return float(next(f.default for f in dataclasses.fields(Scenario) if f.name == "speed"))
+
+
+@app.command()
+def frf(
+    speed: Annotated[Optional[float], typer.Option(
+        "--speed", metavar="M/S",
+        help="Vehicle speed [m/s]: sets the delays between the wheelsets (default 55.56).")] = None,
+    rails: Annotated[str, typer.Option(
+        "--rails", metavar="in-phase|anti-phase|both",
+        help="Rail pattern: in-phase (z_L = z_R: bounce and pitch), anti-phase (z_L = -z_R: "
+             "roll) or both.")] = "both",
+    fmin: Annotated[float, typer.Option(
+        "--fmin", metavar="HZ", help="Lowest frequency [Hz], > 0.")] = 0.1,
+    fmax: Annotated[float, typer.Option(
+        "--fmax", metavar="HZ", help="Highest frequency [Hz], > --fmin.")] = 30.0,
+    points: Annotated[int, typer.Option(
+        "--points", metavar="N", help="Frequencies, log-spaced from --fmin to --fmax, >= 2.")] = 400,
+    params: ParamsOption = None,
+    preset: PresetOption = None,
+    format: Annotated[FrfFormat, typer.Option(
+        "--format", case_sensitive=False,
+        help="Output on stdout: a summary table (peaks and modes), the JSON document, or the "
+             "CSV table of magnitudes and phases.")] = FrfFormat.table,
+    out: Annotated[Optional[Path], typer.Option(
+        "--out", metavar="DIR",
+        help="Also write frf.csv, frf.json, frf.png and modes.csv into DIR (created if missing; "
+             "all or nothing).")] = None,
+) -> None:
+    """Frequency responses of the passive vehicle: carbody bounce, pitch, roll and acceleration
+    per metre of rail amplitude, for in-phase and anti-phase rails.
+
+    Every wheelset sees the same rail pattern, delayed by its distance behind the leading one
+    divided by the speed. Prints the peak of each response and the modes.
+    """
+    with _errors():
+        import numpy as np
+
+        from . import report
+        from .vehicle import Vehicle
+
+        speed = _default_speed() if speed is None else _check_number("--speed", speed, "m/s")
+        if rails not in FRF_RAILS:
+            raise ValueError(f"--rails = {rails!r}: allowed {', '.join(FRF_RAILS)}")
+        fmin = _check_number("--fmin", fmin, "Hz")
+        fmax = _check_number("--fmax", fmax, "Hz")
+        if not fmax > fmin:
+            raise ValueError(f"--fmax = {fmax:g} Hz: must be above --fmin = {fmin:g} Hz")
+        _check_int("--points", points, 2)
+        vehicle_params, vehicle_record = _vehicle_params(params, preset)
+        if out is not None:
+            report.check_out_dir(out)
+        patterns = list(report.FRF_PATTERNS) if rails == "both" else [rails]
+        vehicle = Vehicle(vehicle_params)
+        frequency = np.geomspace(fmin, fmax, points)
+        frequency[0], frequency[-1] = fmin, fmax  # exactly, without rounding
+        frame = report.frf_frame({p: vehicle.frequency_response(frequency, speed, p)
+                                  for p in patterns})
+        modes = [m.to_dict() for m in vehicle.modes()]
+        magnitudes = [c for c in report.FRF_MAGNITUDES]
+        doc = {
+            "schema": SCHEMA_FRF,
+            "railride_version": __version__,
+            **vehicle_record,
+            "settings": {"speed_m_s": speed, "rails": patterns, "fmin_hz": fmin, "fmax_hz": fmax,
+                         "points": points},
+            "frequency_hz": [float(f) for f in frequency],
+            "responses": {p: {c: [float(v) for v in frame.loc[frame["pattern"] == p, c]]
+                              for c in magnitudes} for p in patterns},
+            "peaks": report.frf_peaks(frame),
+            "modes": modes,
+        }
+        text = json.dumps(doc, indent=2, allow_nan=False)  # refuses NaN before writing
+        if out is not None:
+            vehicle_name = vehicle_record.get("vehicle_preset") or vehicle_record.get(
+                "vehicle_params_file")
+            title = (f"Carbody frequency responses per metre of rail amplitude - V = {speed:g} m/s, "
+                     f"vehicle {vehicle_name}, passive suspension")
+            _write_folder(out, lambda: report.write_frf_outputs(frame, modes, out, doc,
+                                                                title=title))
+    if format is FrfFormat.json:
+        typer.echo(text)
+        return
+    if format is FrfFormat.csv:
+        typer.echo(frame.to_csv(index=False), nl=False)
+        return
+    from rich.table import Table
+    from rich.text import Text
+
+    table = Table(title="Peaks of the carbody frequency responses (passive vehicle)")
+    table.add_column("response (per m of rail)")
+    for p in patterns:
+        table.add_column(f"{p}\npeak", justify="right")
+        table.add_column(f"{p}\nat (Hz)", justify="right")
+    for column, label in FRF_LABELS.items():
+        cells = [label]
+        for p in patterns:
+            peak = doc["peaks"][p][column]
+            if peak["frequency_hz"] is None:
+                cells += ["0", "not excited"]
+            else:
+                cells += [f"{peak['magnitude']:#.4g}", f"{peak['frequency_hz']:.3g}"]
+        table.add_row(*cells)
+    vehicle_name = vehicle_record.get("vehicle_preset") or vehicle_record.get("vehicle_params_file")
+    note = Text(f"V = {speed:g} m/s, {points} frequencies from {fmin:g} to {fmax:g} Hz (log "
+                f"grid; the peak is the largest value on it), vehicle {vehicle_name}. in-phase: "
+                "z_L = z_R; anti-phase: z_L = -z_R; every wheelset sees the pattern delayed by "
+                "its distance behind the leading one / V.")
+    console = _wide_stdout_console(100)
+    for part in (table, note, "", _modes_table(modes)):
+        console.print(part)
 
 
 # -- simulate -----------------------------------------------------------------------------------
@@ -596,8 +855,12 @@ def _metrics_table(doc: dict):
     sc, st = doc["scenario"], doc["settings"]
     start, end = st["window_s"]
     vehicle = doc.get("vehicle_preset") or doc.get("vehicle_params_file")
+    random = ([f"random track: seed {sc.get('seed')}, wavelengths "
+               f"{sc.get('min_wavelength_m'):g}-{sc.get('max_wavelength_m'):g} m"]
+              if sc.get("profile") == "random" else [])
     caption = "\n".join([
         f"scenario {sc.get('name')}, speed {sc.get('speed_m_s'):g} m/s",
+        *random,
         f"duration {sc.get('duration_s'):g} s, dt {st['dt_s']:g} s, window {start:g}-{end:g} s",
         f"vehicle {vehicle}",
         f"suspension {_describe_suspension(doc.get('suspension') or {'type': 'passive'})}",
@@ -614,9 +877,7 @@ def _metrics_table(doc: dict):
 @app.command()
 def simulate(
     scenario: Annotated[str, typer.Option(
-        "--scenario", metavar="NAME",
-        help="paper-sine (the paper's sine rails), bump (a cosine bump on both rails) or "
-             "file:PATH (a measured CSV with columns s, z_L, z_R in metres).")] = "paper-sine",
+        "--scenario", metavar="NAME", help=SCENARIO_HELP)] = "paper-sine",
     amplitude: Annotated[Optional[float], typer.Option(
         "--amplitude", metavar="M",
         help="paper-sine: sine amplitude [m] (default 0.05). bump: bump height [m], negative "
@@ -627,6 +888,9 @@ def simulate(
     rail_phase: Annotated[Optional[float], typer.Option(
         "--rail-phase", metavar="DEG",
         help="paper-sine only: phase lag of the right rail [deg] (default 90).")] = None,
+    track_seed: TrackSeedOption = None,
+    min_wavelength: MinWavelengthOption = None,
+    max_wavelength: MaxWavelengthOption = None,
     speed: Annotated[Optional[float], typer.Option(
         "--speed", metavar="M/S", help="Vehicle speed [m/s] (default 55.56).")] = None,
     duration: Annotated[Optional[float], typer.Option(
@@ -663,8 +927,10 @@ def simulate(
 ) -> None:
     """Simulate the vehicle on a track and print the ride metrics."""
     with _errors():
+        track = _track_options(scenario, track_seed, min_wavelength, max_wavelength)
         doc, result = _run(scenario, amplitude, wavelength, rail_phase, speed, duration, dt,
-                           output_rate, window, params, preset, out, suspension, damper, voltage)
+                           output_rate, window, params, preset, out, suspension, damper, voltage,
+                           track=track)
     if format is OutputFormat.json:
         _print_json(doc)
     else:
@@ -690,19 +956,19 @@ def _suspension(suspension: str, damper_name, voltage_text):
 
 def _run(scenario_name, amplitude, wavelength, rail_phase, speed, duration, dt, output_rate,
          window_text, params_file, preset, out, suspension="passive", damper_name=None,
-         voltage_text=None):
+         voltage_text=None, track=None):
     from . import report
     from .metrics import check_window, parse_window, to_dict
     from .simulation import DEFAULT_DT, DEFAULT_OUTPUT_RATE, simulate as run_simulation
-    from .track import scenario as make_scenario
 
     dt = DEFAULT_DT if dt is None else dt
     output_rate = DEFAULT_OUTPUT_RATE if output_rate is None else output_rate
     vehicle_params, vehicle_record = _vehicle_params(params_file, preset)
     damper, voltage, suspension_record = _suspension(suspension, damper_name, voltage_text)
     window = parse_window(window_text) if window_text is not None else None
-    scen = make_scenario(scenario_name, amplitude=amplitude, wavelength=wavelength,
-                         rail_phase=rail_phase, speed=speed, duration=duration)
+    scen = _make_scenario(scenario_name, dict(amplitude=amplitude, wavelength=wavelength,
+                                              rail_phase=rail_phase, speed=speed,
+                                              duration=duration, **(track or {})), output_rate)
     if out is not None:
         report.check_out_dir(out)
     # check the window before the run, not after it
@@ -924,11 +1190,13 @@ PHASE_CONTROLLERS = GAIN_CONTROLLERS
 #: the scenario options a sweep can vary: (option, keyword of track.scenario, column, unit)
 SWEEP_AXES = (("--speed", "speed", "speed_m_s", "m/s"), ("--wavelength", "wavelength", "wavelength_m", "m"),
               ("--amplitude", "amplitude", "amplitude_m", "m"),
-              ("--rail-phase", "rail_phase", "rail_phase_deg", "deg"))
+              ("--rail-phase", "rail_phase", "rail_phase_deg", "deg"),
+              ("--track-seed", "seed", "track_seed", ""))
 
 #: the keys of Scenario.describe() that each swept scenario option sets
 _SCENARIO_KEYS = {"speed": ("speed_m_s",), "wavelength": ("wavelength_m", "length_m"),
-                  "amplitude": ("amplitude_m", "height_m"), "rail_phase": ("rail_phase_deg",)}
+                  "amplitude": ("amplitude_m", "height_m"), "rail_phase": ("rail_phase_deg",),
+                  "seed": ("seed",)}
 
 
 class SweepFormat(str, Enum):
@@ -1313,7 +1581,8 @@ def tune_command(
              "in that order. Default: attitude,ride (the paper's two phases).")] = None,
     scenario: Annotated[str, typer.Option(
         "--scenario", metavar="NAME",
-        help="paper-sine, bump or file:PATH, as for simulate.")] = "paper-sine",
+        help="paper-sine, bump, file:PATH, fra1..fra6, german-low or german-high, as for "
+             "simulate.")] = "paper-sine",
     amplitude: Annotated[Optional[float], typer.Option(
         "--amplitude", metavar="M",
         help="paper-sine: sine amplitude [m] (default 0.05). bump: bump height [m] "
@@ -1324,6 +1593,9 @@ def tune_command(
     rail_phase: Annotated[Optional[float], typer.Option(
         "--rail-phase", metavar="DEG",
         help="paper-sine only: phase lag of the right rail [deg] (default 90).")] = None,
+    track_seed: TrackSeedOption = None,
+    min_wavelength: MinWavelengthOption = None,
+    max_wavelength: MaxWavelengthOption = None,
     speed: Annotated[Optional[float], typer.Option(
         "--speed", metavar="M/S", help="Vehicle speed [m/s] (default 55.56).")] = None,
     duration: Annotated[Optional[float], typer.Option(
@@ -1386,8 +1658,7 @@ def tune_command(
 
     with _errors():
         from . import report, tuning
-        from .simulation import DEFAULT_DT
-        from .track import scenario as make_scenario
+        from .simulation import DEFAULT_DT, DEFAULT_OUTPUT_RATE
 
         phases = _phase_list(phase)
         _damper_preset("--damper", damper)
@@ -1400,7 +1671,10 @@ def tune_command(
         dt = DEFAULT_DT if dt is None else _check_number("--dt", dt, "s")
         options = _scenario_options(amplitude=amplitude, wavelength=wavelength,
                                     rail_phase=rail_phase, speed=speed, duration=duration)
-        scen = make_scenario(scenario, **options)
+        options.update(_track_options(scenario, track_seed, min_wavelength, max_wavelength))
+        # every run stores its time histories at the library's default rate
+        scen = _make_scenario(scenario, options, DEFAULT_OUTPUT_RATE, "the runs' output rate")
+        options = _case_options(options)
         scenario_text = report.describe_scenario(scen.describe())
         table, table_path = _run_table(out, resume)
         executor, executor_record = _executor(workers, scheduler, scheduler_file)
@@ -1565,7 +1839,8 @@ def _sweep_table(rows: list[dict], grid_columns: list[str], caption: str):
     for c in grid_columns:
         heading = {"speed_m_s": "speed\n(m/s)", "wavelength_m": "wavelength\n(m)",
                    "amplitude_m": "amplitude\n(m)", "rail_phase_deg": "rail phase\n(deg)",
-                   "voltage_v": "voltage\n(V)"}.get(c, c)
+                   "voltage_v": "voltage\n(V)", "track_seed": "track\nseed",
+                   "seed": "noise\nseed"}.get(c, c)
         table.add_column(escape(heading), justify="left" if c == "suspension" else "right",
                          no_wrap=c == "suspension")
     for key, label in RESPONSE_LABELS.items():
@@ -1612,11 +1887,18 @@ def sweep_command(
         help="Controllers only: sensor noise, standard deviations [m, rad, m/s, rad/s].")] = None,
     seed: Annotated[Optional[str], typer.Option(
         "--seed", metavar="VALUES",
-        help="With --noise: seeds of the noise, whole numbers >= 0, a range or a list "
-             "(default 0).")] = None,
+        help="With --noise: seeds of the sensor noise, whole numbers >= 0, a range or a list "
+             "(default 0). Not the track: see --track-seed.")] = None,
+    track_seed: Annotated[Optional[str], typer.Option(
+        "--track-seed", metavar="VALUES",
+        help="Random tracks only: seeds of the track's realisation, whole numbers >= 0, a "
+             "range or a list (default 0); a grid axis for every suspension.")] = None,
+    min_wavelength: MinWavelengthOption = None,
+    max_wavelength: MaxWavelengthOption = None,
     scenario: Annotated[str, typer.Option(
         "--scenario", metavar="NAME",
-        help="paper-sine, bump or file:PATH, as for simulate.")] = "paper-sine",
+        help="paper-sine, bump, file:PATH, fra1..fra6, german-low or german-high, as for "
+             "simulate.")] = "paper-sine",
     duration: Annotated[Optional[float], typer.Option(
         "--duration", metavar="S", help="Simulated time of each run [s] (default 10).")] = None,
     dt: Annotated[Optional[float], typer.Option(
@@ -1644,7 +1926,8 @@ def sweep_command(
     out: Annotated[Optional[Path], typer.Option(
         "--out", metavar="DIR",
         help="Keep the run table DIR/runs.csv (updated as runs finish) and write sweep.json "
-             "into DIR at the end.")] = None,
+             "(and sweep.png when one numeric axis has several values) into DIR at the "
+             "end.")] = None,
     resume: Annotated[bool, typer.Option(
         "--resume",
         help="Continue the sweep whose run table is DIR/runs.csv (needs --out): runs already "
@@ -1655,9 +1938,11 @@ def sweep_command(
 ) -> None:
     """Run a grid of cases: every combination of the given values (a cartesian product).
 
-    --voltage combines with mr only, --gain, --noise and --seed with the controllers they act
-    in; the other suspensions run once per scenario combination. Prints one row per run: the
-    grid values and the RMS of the four carbody responses.
+    The scenario axes (--speed, --wavelength, --amplitude, --rail-phase, --track-seed) apply
+    to every suspension; --voltage combines with mr only, --gain, --noise and --seed (the
+    sensor noise's) with the controllers they act in; the other suspensions run once per
+    scenario combination. Prints one row per run: the grid values and the RMS of the four
+    carbody responses.
     """
     import itertools
     import time
@@ -1666,8 +1951,7 @@ def sweep_command(
         from . import report
         from . import sweep as sweep_lib
         from .metrics import RESPONSES, check_window, parse_window
-        from .simulation import DEFAULT_DT
-        from .track import scenario as make_scenario
+        from .simulation import DEFAULT_DT, DEFAULT_OUTPUT_RATE
 
         # suspensions
         items = [s.strip() for s in suspension.split(",")]
@@ -1705,12 +1989,26 @@ def sweep_command(
         damper_model = _damper_preset("--damper", damper_name)
 
         # the grid axes
-        axes = []  # (column, keyword, values)
+        track = _track_options(scenario, None, min_wavelength, max_wavelength)
+        axes = []  # (option, keyword, column, values)
         for option, keyword, column, _ in SWEEP_AXES:
             text = {"speed": speed, "wavelength": wavelength, "amplitude": amplitude,
-                    "rail_phase": rail_phase}[keyword]
-            if text is not None:
-                axes.append((option, keyword, column, _value_list(option, text)))
+                    "rail_phase": rail_phase, "seed": track_seed}[keyword]
+            if text is None:
+                continue
+            if keyword == "seed":
+                values = _value_list(option, text, integer=True)
+                bad = [v for v in values if v < 0]
+                if bad:
+                    raise ValueError(f"--track-seed = {text!r}: {bad[0]} is negative; track "
+                                     "seeds are whole numbers >= 0")
+                if scenario not in _random_tracks():
+                    raise ValueError(f"--track-seed = {text!r}: applies to the random-track "
+                                     f"scenarios ({', '.join(_random_tracks())}) only, not to "
+                                     f"--scenario {scenario}")
+            else:
+                values = _value_list(option, text)
+            axes.append((option, keyword, column, values))
         volts = []
         if has_mr:
             if voltage is None:
@@ -1737,6 +2035,7 @@ def sweep_command(
         base_gains = _gain_set(gains)
         dt = DEFAULT_DT if dt is None else _check_number("--dt", dt, "s")
         common = {} if duration is None else {"duration": float(duration)}
+        common.update(track)
 
         # every scenario of the grid must be valid before anything runs
         combos = list(itertools.product(*[values for *_, values in axes]))
@@ -1744,8 +2043,12 @@ def sweep_command(
         for combo in combos:
             options = {**common, **{kw: v for (_, kw, _, _), v in zip(axes, combo)}}
             try:
-                scen = make_scenario(scenario, **options)
+                # every run stores its time histories at the library's default rate
+                scen = _make_scenario(scenario, options, DEFAULT_OUTPUT_RATE,
+                                      "the runs' output rate")
             except ValueError as exc:
+                if str(exc).startswith("--"):  # names its options and values already
+                    raise
                 given = ", ".join(f"{opt} {v:g}" for (opt, *_), v in zip(axes, combo))
                 raise ValueError(f"{given}: {exc}" if given else str(exc)) from None
             first_record = first_record or scen.describe()
@@ -1766,7 +2069,8 @@ def sweep_command(
         cases, grid = [], []
         for s in suspensions:
             for combo in combos:
-                options = {**common, **{kw: v for (_, kw, _, _), v in zip(axes, combo)}}
+                options = _case_options(
+                    {**common, **{kw: v for (_, kw, _, _), v in zip(axes, combo)}})
                 base = {c: None for c in grid_columns}
                 base.update({"suspension": s, **{column: v for (_, _, column, _), v in zip(axes, combo)}})
                 if s == "passive":

@@ -8,10 +8,14 @@
   `write_damper_outputs` and `write_tracking_outputs` write their folders.
 * `plot_comparison_response`, `plot_comparison_damper_forces`, `plot_comparison_voltages` and
   `comparison_frame` draw and tabulate a controller comparison (`railride.comparison`, the combined
-  Dataset with a ``controller`` dimension); `write_compare_outputs` writes its folder.
+  Dataset with a ``controller`` dimension); `comparison_psd` and `plot_comparison_psd` give the
+  Welch spectra of its carbody acceleration; `write_compare_outputs` writes its folder.
 * `curves_frame` and `plot_sensitivity` tabulate and draw the sensitivity curves of a tuning
   study (`railride.tuning`); `write_tune_outputs` writes its folder (beside the run table
-  ``runs.csv`` that the library keeps up to date), `write_sweep_outputs` that of a sweep.
+  ``runs.csv`` that the library keeps up to date), `write_sweep_outputs` that of a sweep (with
+  `plot_sweep`, the RMS against its one numeric axis).
+* `frf_frame`, `frf_peaks`, `modes_frame` and `plot_frf` tabulate and draw the frequency
+  responses of `railride.vehicle.Vehicle`; `write_frf_outputs` writes their folder.
 * `write_folder` is the all-or-nothing folder writer behind the ``write_*`` functions.
 
 Figures are built on matplotlib's object API with the Agg canvas: nothing here touches pyplot's
@@ -45,11 +49,16 @@ DAMPER_FILES = ("loops.png", "cycles.csv", "damper.json")
 TRACKING_FILES = ("tracking.png", "tracking.csv", "tracking.json")
 #: the files `write_compare_outputs` produces, in the order they are written
 COMPARE_FILES = ("compare.json", "compare.nc", "compare.csv", "acceleration.png", "displacement.png",
-                 "pitch.png", "roll.png", "damper_forces.png", "voltages.png")
+                 "pitch.png", "roll.png", "damper_forces.png", "voltages.png", "psd.png", "psd.csv")
 #: the files `write_tune_outputs` produces, in the order they are written
 TUNE_FILES = ("gains.toml", "sensitivity.png", "curves.csv", "tune.json")
-#: the files `write_sweep_outputs` produces (the run table runs.csv is the library's)
+#: the files `write_sweep_outputs` always produces (the run table runs.csv is the library's);
+#: ``sweep.png`` is added when the sweep has one numeric axis (`sweep_plot_axis`)
 SWEEP_FILES = ("sweep.json",)
+#: the files `write_frf_outputs` produces, in the order they are written
+FRF_FILES = ("frf.csv", "frf.json", "frf.png", "modes.csv")
+#: the Welch segment length of the acceleration spectra of `write_compare_outputs` [s]
+PSD_SEGMENT_S = 4.0
 #: the columns of `curves_frame` (curves.csv)
 CURVE_COLUMNS = ("phase", "pass", "parameter", "value", "objective", "chosen")
 #: the time histories of a damper rig run (railride.rig), in CSV column order
@@ -160,6 +169,19 @@ def describe_scenario(record: dict) -> str:
                      f"at s = {_num(record, 'start_m')} m ({record.get('rails', 'both')} rails)")
     elif profile == "measured":
         parts.append(f"measured profile {record.get('source', '?')}")
+    elif profile == "random":
+        spectrum = str(record.get("spectrum", "?"))
+        if spectrum.startswith("fra"):
+            text = f"random track, FRA class {spectrum[3:]}"
+        elif spectrum.startswith("german-"):
+            text = f"random track, German {spectrum.split('-', 1)[1]} interference"
+        else:
+            text = f"random track {spectrum}"
+        if "seed" in record:
+            text += f", seed {record['seed']}"
+        text += (f", wavelengths {_num(record, 'min_wavelength_m')}-"
+                 f"{_num(record, 'max_wavelength_m')} m")
+        parts.append(text)
     elif profile:
         parts.append(str(profile))
     if "speed_m_s" in record:
@@ -575,18 +597,93 @@ def comparison_frame(comparison) -> pd.DataFrame:
     return pd.concat(frames, ignore_index=True)
 
 
+def comparison_psd(comparison, window=None, segment: float = PSD_SEGMENT_S) -> pd.DataFrame:
+    """The PSD of the carbody CG vertical acceleration of each suspension, by Welch's method.
+
+    ``scipy.signal.welch`` over the time ``window`` (start, end) [s] (None: the whole run):
+    Hann-windowed segments of ``segment`` seconds (the whole window if shorter), overlapping by
+    half, each with its mean removed; one-sided density. Columns ``frequency_hz`` [Hz, from 0 in
+    steps of 1/segment] and one per suspension (its name) in (m/s^2)^2/Hz."""
+    from scipy.signal import welch
+
+    from .metrics import select_window
+
+    ds = _comparison_dataset(comparison)
+    if "carbody_acceleration" not in ds.variables:
+        raise ValueError("the dataset lacks the channel carbody_acceleration")
+    part = select_window(ds, None if window is None else tuple(window))
+    time = part["time"].values
+    # the output rate, without the float noise of the time stamps' differences
+    fs = float(f"{(time.size - 1) / (time[-1] - time[0]):.9g}")
+    nperseg = max(2, min(time.size, int(round(segment * fs))))
+    columns = {}
+    freq = None
+    for i, name in enumerate(_controller_names(ds)):
+        x = part["carbody_acceleration"].isel(controller=i).values
+        freq, pxx = welch(x, fs=fs, window="hann", nperseg=nperseg, noverlap=nperseg // 2,
+                          detrend="constant", scaling="density")
+        columns[name] = pxx
+    return pd.DataFrame({"frequency_hz": freq, **columns})
+
+
+def plot_comparison_psd(psd: pd.DataFrame, path=None, *, title: str | None = None):
+    """The acceleration spectra of `comparison_psd` on log-log axes, one line per suspension in
+    the paper's style; the 0 Hz bin is left out. Saved as PNG at ``path`` when given; returns
+    the `Figure`."""
+    fig = _new_figure((10.0, 5.4))
+    ax = fig.subplots()
+    f = psd["frequency_hz"].values
+    keep = f > 0
+    top = 0.0
+    for name in [c for c in psd.columns if c != "frequency_hz"]:
+        y = psd[name].values[keep]
+        y = np.where(y > 0, y, np.nan)  # a log axis cannot show 0
+        if np.isfinite(y).any():
+            top = max(top, float(np.nanmax(y)))
+        ax.loglog(f[keep], y, linewidth=1.1, label=_controller_label(name), **_style(name))
+    if top > 0:  # twelve decades below the highest peak: a pure sine's numerical floor is not news
+        ax.set_ylim(bottom=max(ax.get_ylim()[0], top * 1e-12))
+    ax.set_xlabel("frequency (Hz)")
+    ax.set_ylabel("PSD of acceleration ((m/s$^2$)$^2$/Hz)")
+    if keep.any():
+        ax.set_xlim(f[keep][0], f[keep][-1])
+    ax.grid(True, which="major", linewidth=0.5, alpha=0.7)
+    ax.grid(True, which="minor", linewidth=0.3, alpha=0.4)
+    ax.legend(loc="lower center", bbox_to_anchor=(0.5, 1.0), fontsize="small", frameon=False,
+              ncols=min(4, max(1, len(psd.columns) - 1)))
+    fig.suptitle(title or "PSD of the carbody CG vertical acceleration", fontsize="medium")
+    _save_png(fig, path)
+    return fig
+
+
 def write_compare_outputs(comparison, out_dir, doc: dict) -> list[Path]:
     """Write a controller comparison into ``out_dir``, all or nothing (`write_folder`):
     ``compare.json`` (``doc``, the ``Comparison.to_dict()`` document, strict JSON),
     ``compare.nc`` (``combined()`` as NetCDF, see `netcdf_ready`), ``compare.csv``
     (`comparison_frame`), ``acceleration.png``, ``displacement.png``, ``pitch.png``,
     ``roll.png`` (`plot_comparison_response`), ``damper_forces.png``
-    (`plot_comparison_damper_forces`) and ``voltages.png`` (`plot_comparison_voltages`).
+    (`plot_comparison_damper_forces`), ``voltages.png`` (`plot_comparison_voltages`), and the
+    acceleration spectra over the metric window ``doc["settings"]["window_s"]`` (None: the
+    whole run): ``psd.png`` (`plot_comparison_psd`) and ``psd.csv`` (`comparison_psd`).
     ``comparison`` is a `railride.comparison.Comparison` or its combined Dataset. Returns the
     written paths."""
     text = _json_text(doc)
     ds = _comparison_dataset(comparison)
+    settings = doc.get("settings") if isinstance(doc.get("settings"), dict) else {}
+    window = settings.get("window_s")
+    psd = comparison_psd(ds, window)
+    start, end = window if window is not None else (float(ds["time"][0]), float(ds["time"][-1]))
+    segment = min(PSD_SEGMENT_S, end - start)
+    psd_title = (f"PSD of the carbody CG vertical acceleration, {start:g}-{end:g} s (Welch, "
+                 f"{segment:g} s Hann segments, 50 % overlap)")
+    context = comparison_title(ds)
+    if context:
+        import textwrap
+
+        psd_title += "\n" + textwrap.fill(context, 120)
     writers = {
+        "psd.png": lambda path: plot_comparison_psd(psd, path, title=psd_title),
+        "psd.csv": lambda path: psd.to_csv(path, index=False),
         "compare.json": lambda path: path.write_text(text, encoding="utf-8"),
         "compare.nc": lambda path: write_netcdf(ds, path),
         "compare.csv": lambda path: comparison_frame(ds).to_csv(path, index=False),
@@ -756,11 +853,304 @@ def write_tune_outputs(curves, out_dir, doc: dict, gains_text: str, *,
     return write_folder(out_dir, [(name, writers[name]) for name in TUNE_FILES])
 
 
+#: axis labels of the sweep plot per grid column (gains: "table.entry (unit)")
+_SWEEP_AXIS_LABELS = {"speed_m_s": "speed (m/s)", "wavelength_m": "wavelength (m)",
+                      "amplitude_m": "amplitude (m)", "rail_phase_deg": "rail phase (deg)",
+                      "track_seed": "track seed", "voltage_v": "command voltage (V)",
+                      "seed": "sensor noise seed"}
+#: (RMS column, axis label) of the four panels of the sweep plot
+_SWEEP_PANELS = (("acceleration_m_s2_rms", "acceleration RMS (m/s$^2$)"),
+                 ("displacement_m_rms", "displacement RMS (m)"),
+                 ("pitch_deg_rms", "pitch RMS (deg)"), ("roll_deg_rms", "roll RMS (deg)"))
+
+
+def _is_number(value) -> bool:
+    return isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, bool)
+
+
+def sweep_plot_axis(doc: dict) -> str | None:
+    """The grid column `plot_sweep` draws against: the one axis of ``doc["settings"]["grid"]``
+    besides ``suspension`` with more than one value, if there is exactly one and its values are
+    numbers; else None."""
+    grid = (doc.get("settings") or {}).get("grid") or {}
+    several = [c for c, values in grid.items() if c != "suspension" and len(values) > 1]
+    if len(several) != 1 or not all(_is_number(v) for v in grid[several[0]]):
+        return None
+    return several[0]
+
+
+def _sweep_axis_label(column: str) -> str:
+    if column in _SWEEP_AXIS_LABELS:
+        return _SWEEP_AXIS_LABELS[column]
+    unit = _gain_unit(column) if "." in column else None
+    return f"{column} ({unit})" if unit else column
+
+
+def plot_sweep(doc: dict, path=None, *, axis: str | None = None):
+    """The RMS of the four carbody responses against the swept axis of a sweep (the
+    ``railride.sweep/1`` document ``doc``): four panels, one line per suspension in the paper's
+    style. A suspension the axis does not act on (passive against --voltage, say) ran once: a
+    thin horizontal line at its value. ``axis`` defaults to `sweep_plot_axis`. Saved as PNG at
+    ``path`` when given; returns the `Figure`."""
+    axis = axis or sweep_plot_axis(doc)
+    if axis is None:
+        raise ValueError("the sweep has no single numeric axis with several values to plot against")
+    rows = doc.get("rows") or []
+    suspensions = list(dict.fromkeys(r["suspension"] for r in rows))
+    fig = _new_figure((10.0, 7.2))
+    axes = fig.subplots(2, 2, sharex=True).ravel()
+    xs = [float(r[axis]) for r in rows if r.get(axis) is not None]
+    log_x = bool(xs) and min(xs) > 0 and max(xs) / min(xs) >= 100
+    styles = {**COMPARE_STYLES, "mr": {"linestyle": "-", "color": "tab:green"}}
+    labels = {"mr": "MR (constant voltage)"}
+    for ax, (column, ylabel) in zip(axes, _SWEEP_PANELS):
+        for name in suspensions:
+            mine = [r for r in rows if r["suspension"] == name]
+            style = styles.get(name, {"linestyle": "-"})
+            label = labels.get(name) or _controller_label(name)
+            on = sorted((float(r[axis]), float(r[column])) for r in mine if r.get(axis) is not None)
+            off = [float(r[column]) for r in mine if r.get(axis) is None]
+            if on:
+                x, y = zip(*on)
+                ax.plot(x, y, marker="o", markersize=3.5, linewidth=1.3, label=label, **style)
+            elif off:
+                ax.axhline(float(np.mean(off)), linewidth=1.0, alpha=0.8,
+                           label=f"{label} (not swept)", **style)
+        ax.set_ylabel(ylabel)
+        ax.set_ylim(bottom=0)
+        ax.grid(True, linewidth=0.4, alpha=0.6)
+        if log_x:
+            ax.set_xscale("log")
+    for ax in axes[2:]:
+        ax.set_xlabel(_sweep_axis_label(axis))
+    handles, names = axes[0].get_legend_handles_labels()
+    fig.legend(handles, names, loc="outside lower center", ncols=min(5, max(1, len(names))),
+               fontsize="small", frameon=False)
+    settings = doc.get("settings") or {}
+    context = describe_scenario(settings.get("scenario") or {})
+    duration = (settings.get("scenario") or {}).get("duration_s")
+    extra = [p for p in (f"{duration:g} s" if _is_number(duration) else "",
+                         f"{settings['damper']} MR dampers" if settings.get("damper") else "") if p]
+    if extra:
+        context = ", ".join([context, *extra]) if context else ", ".join(extra)
+    title = f"RMS of the carbody responses against {_sweep_axis_label(axis)}"
+    if context:
+        import textwrap
+
+        title += "\n" + textwrap.fill(context, 110)
+    fig.suptitle(title, fontsize="medium")
+    _save_png(fig, path)
+    return fig
+
+
 def write_sweep_outputs(out_dir, doc: dict) -> list[Path]:
-    """Write the summary of a sweep, ``sweep.json`` (``doc``), into ``out_dir`` beside the run
-    table ``runs.csv`` that `railride.sweep.run_cases` keeps there. Returns the written paths."""
+    """Write the summary of a sweep into ``out_dir`` beside the run table ``runs.csv`` that
+    `railride.sweep.run_cases` keeps there: ``sweep.json`` (``doc``) and, when the grid has one
+    numeric axis with several values (`sweep_plot_axis`), ``sweep.png`` (`plot_sweep`). Returns
+    the written paths."""
     text = _json_text(doc)
-    return write_folder(out_dir, [("sweep.json", lambda path: path.write_text(text, encoding="utf-8"))])
+    files = [("sweep.json", lambda path: path.write_text(text, encoding="utf-8"))]
+    axis = sweep_plot_axis(doc)
+    if axis is not None:
+        files.append(("sweep.png", lambda path: plot_sweep(doc, path, axis=axis)))
+    return write_folder(out_dir, files)
+
+
+# -- frequency responses (railride.vehicle.Vehicle.frequency_response) ---------------------------
+#: the rail patterns of `frf_frame`, in order
+FRF_PATTERNS = ("in-phase", "anti-phase")
+#: per carbody response: (name, channel of the frequency response, magnitude columns with their
+#: factor from the channel's unit, axis label of the plot (its unit), magnitude column plotted)
+FRF_RESPONSES = (
+    ("bounce", "carbody_bounce", (("bounce_m_per_m", 1.0),), "bounce (m/m)", "bounce_m_per_m"),
+    ("pitch", "carbody_pitch", (("pitch_rad_per_m", 1.0), ("pitch_deg_per_m", 180.0 / math.pi)),
+     "pitch (deg/m)", "pitch_deg_per_m"),
+    ("roll", "carbody_roll", (("roll_rad_per_m", 1.0), ("roll_deg_per_m", 180.0 / math.pi)),
+     "roll (deg/m)", "roll_deg_per_m"),
+    ("acceleration", "carbody_acceleration", (("acceleration_m_s2_per_m", 1.0),),
+     "acceleration ((m/s$^2$)/m)", "acceleration_m_s2_per_m"),
+)
+#: the magnitude columns of `frf_frame`, in order
+FRF_MAGNITUDES = tuple(c for *_, columns, _, _ in FRF_RESPONSES for c, _ in columns)
+#: a response whose largest magnitude is below this fraction of the largest over the patterns
+#: is "not excited" by that pattern (e.g. roll by in-phase rails: exactly 0 on a symmetric car)
+FRF_NOT_EXCITED = 1e-9
+#: the columns of `modes_frame` (modes.csv)
+MODE_COLUMNS = ("mode", "label", "frequency_hz", "damped_frequency_hz", "damping_ratio")
+
+
+def frf_frame(responses: dict) -> pd.DataFrame:
+    """The carbody frequency responses of `Vehicle.frequency_response` as one long table.
+
+    ``responses`` maps a rail pattern ("in-phase", "anti-phase") to its Dataset. One row per
+    pattern and frequency, the patterns one after another: ``pattern``, ``frequency_hz``, then
+    per response the magnitude per metre of rail amplitude and the phase [deg, (-180, 180],
+    against the left rail at the leading wheelset]: ``bounce_m_per_m``, ``bounce_phase_deg``,
+    ``pitch_rad_per_m``, ``pitch_deg_per_m``, ``pitch_phase_deg``, ``roll_rad_per_m``,
+    ``roll_deg_per_m``, ``roll_phase_deg``, ``acceleration_m_s2_per_m`` [(m/s^2)/m],
+    ``acceleration_phase_deg``."""
+    frames = []
+    for pattern, ds in responses.items():
+        columns = {"pattern": pattern, "frequency_hz": ds["frequency"].values.astype(float)}
+        for name, channel, mags, _, _ in FRF_RESPONSES:
+            h = np.asarray(ds[channel].values, dtype=complex)
+            for column, factor in mags:
+                columns[column] = np.abs(h) * factor
+            # a zero response (roll on in-phase rails) has phase 0, not -0 or 180
+            columns[f"{name}_phase_deg"] = np.where(np.abs(h) > 0, np.angle(h, deg=True), 0.0) + 0.0
+        frames.append(pd.DataFrame(columns))
+    return pd.concat(frames, ignore_index=True)
+
+
+def frf_peaks(frame: pd.DataFrame) -> dict:
+    """Per pattern and magnitude column of `frf_frame`: {"magnitude", "frequency_hz"} at the
+    largest magnitude on the grid; a response the pattern does not excite (`FRF_NOT_EXCITED`)
+    has "frequency_hz" None."""
+    out = {}
+    top = {c: float(frame[c].max()) for c in FRF_MAGNITUDES}
+    for pattern, part in frame.groupby("pattern", sort=False):
+        out[pattern] = {}
+        for c in FRF_MAGNITUDES:
+            values = part[c].values
+            k = int(np.argmax(values))
+            excited = values[k] > FRF_NOT_EXCITED * top[c] and values[k] > 0
+            out[pattern][c] = {"magnitude": float(values[k]),
+                               "frequency_hz": float(part["frequency_hz"].values[k]) if excited else None}
+    return out
+
+
+def modes_frame(modes) -> pd.DataFrame:
+    """The modes of `Vehicle.modes()` (Mode objects or their ``to_dict()``) as a table: ``mode``
+    (1, 2, ... by undamped frequency), ``label``, ``frequency_hz`` (undamped),
+    ``damped_frequency_hz``, ``damping_ratio``."""
+    rows = []
+    for i, m in enumerate(modes, start=1):
+        d = m if isinstance(m, dict) else m.to_dict()
+        rows.append((i, d["label"], float(d["frequency_hz"]), float(d["damped_frequency_hz"]),
+                     float(d["damping_ratio"])))
+    return pd.DataFrame(rows, columns=list(MODE_COLUMNS))
+
+
+#: line style per rail pattern of the frequency-response plot
+FRF_STYLES = {"in-phase": {"color": "tab:blue", "linestyle": "-"},
+              "anti-phase": {"color": "tab:red", "linestyle": "--"}}
+
+
+def plot_frf(frame: pd.DataFrame, modes=None, path=None, *, title: str | None = None):
+    """Magnitudes of the carbody frequency responses (`frf_frame`) against frequency on log-log
+    axes: one panel per response (bounce m/m, pitch and roll deg/m, acceleration (m/s^2)/m),
+    one line per rail pattern. ``modes`` (`modes_frame`, or Mode objects) are marked as dotted
+    vertical lines at their undamped natural frequencies, numbered at the top of each panel
+    (modes within 1 % of each other share a line) and listed below the plot. A response a
+    pattern does not excite is not drawn; the panel says so. Saved as PNG at ``path`` when
+    given; returns the `Figure`."""
+    if modes is not None and not isinstance(modes, pd.DataFrame):
+        modes = modes_frame(modes)
+    fig = _new_figure((11.0, 8.2))
+    axes = fig.subplots(2, 2, sharex=True).ravel()
+    patterns = list(dict.fromkeys(frame["pattern"]))
+    f_all = frame["frequency_hz"].values
+    lo, hi = float(f_all.min()), float(f_all.max())
+    groups = []  # (frequency, [mode numbers]) of the modes inside the plotted range
+    if modes is not None:
+        for _, m in modes.sort_values("frequency_hz").iterrows():
+            f = float(m["frequency_hz"])
+            if not lo <= f <= hi:
+                continue
+            if groups and f <= groups[-1][0] * 1.01:
+                groups[-1][1].append(int(m["mode"]))
+            else:
+                groups.append((f, [int(m["mode"])]))
+    # one label per cluster of lines closer than 10 % (they would overlap on the log axis)
+    labels_at = []  # (frequency, [mode numbers])
+    for f, numbers in groups:
+        if labels_at and f <= labels_at[-1][2] * 1.10:
+            labels_at[-1] = (labels_at[-1][0], labels_at[-1][1] + numbers, f)
+        else:
+            labels_at.append((f, list(numbers), f))
+    labels_at = [(math.sqrt(first * last), numbers) for first, numbers, last in labels_at]
+    for ax, (name, _, _, ylabel, column) in zip(axes, FRF_RESPONSES):
+        top = float(frame[column].max())
+        silent = []
+        for pattern in patterns:
+            part = frame[frame["pattern"] == pattern]
+            y = part[column].values
+            if not (top > 0 and y.max() > FRF_NOT_EXCITED * top):
+                silent.append(pattern)
+                continue
+            ax.loglog(part["frequency_hz"].values, np.where(y > 0, y, np.nan), linewidth=1.3,
+                      label=pattern, **FRF_STYLES.get(pattern, {}))
+        ax.set_xscale("log")
+        ax.set_xlim(lo, hi)
+        if all(p in silent for p in patterns):
+            ax.set_yscale("linear")
+        for f, _ in groups:
+            ax.axvline(f, color="0.45", linestyle=":", linewidth=0.9, zorder=0)
+        for f, numbers in labels_at:
+            ax.annotate(_mode_numbers(numbers), (f, 1.0), xycoords=("data", "axes fraction"),
+                        xytext=(0, 2), textcoords="offset points", ha="center", va="bottom",
+                        fontsize="x-small", color="0.3")
+        if silent:
+            everywhere = all(p in silent for p in patterns)
+            ax.text(0.5 if everywhere else 0.02, 0.5 if everywhere else 0.03,
+                    f"not excited by {' or '.join(silent)} rails", transform=ax.transAxes,
+                    fontsize="medium" if everywhere else "small", color="0.35",
+                    ha="center" if everywhere else "left")
+            if everywhere:
+                ax.set_yticks([])
+        ax.set_ylabel(ylabel)
+        ax.set_title(f"carbody {name}", fontsize="medium", pad=12)
+        ax.grid(True, which="major", linewidth=0.5, alpha=0.7)
+        ax.grid(True, which="minor", linewidth=0.3, alpha=0.35)
+    for ax in axes[2:]:
+        ax.set_xlabel("frequency (Hz)")
+    handles, labels = [], []
+    for ax in axes:
+        for h, lab in zip(*ax.get_legend_handles_labels()):
+            if lab not in labels:
+                handles.append(h)
+                labels.append(lab)
+    labels = [f"{lab} rails" if lab in FRF_PATTERNS else lab for lab in labels]
+    if groups:
+        from matplotlib.lines import Line2D
+
+        handles.append(Line2D([], [], color="0.45", linestyle=":", linewidth=0.9))
+        labels.append("undamped natural frequencies:")
+        shown = {n for _, numbers in groups for n in numbers}
+        for _, m in modes.iterrows():  # the modes in the plotted range, as text entries
+            if int(m["mode"]) in shown:
+                handles.append(Line2D([], [], linestyle="none"))
+                labels.append(f"{int(m['mode'])}: {m['label']}, {float(m['frequency_hz']):.3g} Hz")
+    fig.legend(handles, labels, loc="outside lower center", ncols=min(4, len(labels)),
+               fontsize="small", frameon=False, handlelength=2.2)
+    fig.suptitle(title or "Carbody frequency responses per metre of rail amplitude",
+                 fontsize="medium")
+    _save_png(fig, path)
+    return fig
+
+
+def _mode_numbers(numbers) -> str:
+    """[4, 5, 6, 7] -> "4-7", [8, 9] -> "8,9", [1] -> "1"."""
+    numbers = sorted(numbers)
+    if len(numbers) > 2 and numbers == list(range(numbers[0], numbers[-1] + 1)):
+        return f"{numbers[0]}-{numbers[-1]}"
+    return ",".join(str(n) for n in numbers)
+
+
+def write_frf_outputs(frame: pd.DataFrame, modes, out_dir, doc: dict, *,
+                      title: str | None = None) -> list[Path]:
+    """Write the frequency responses of `railride frf` into ``out_dir``, all or nothing:
+    ``frf.csv`` (`frf_frame` ``frame``), ``frf.json`` (``doc``, strict JSON), ``frf.png``
+    (`plot_frf`) and ``modes.csv`` (`modes_frame` of ``modes``). Returns the written paths."""
+    text = _json_text(doc)
+    table = modes if isinstance(modes, pd.DataFrame) else modes_frame(modes)
+    writers = {
+        "frf.csv": lambda path: frame.to_csv(path, index=False),
+        "frf.json": lambda path: path.write_text(text, encoding="utf-8"),
+        "frf.png": lambda path: plot_frf(frame, table, path, title=title),
+        "modes.csv": lambda path: table.to_csv(path, index=False),
+    }
+    return write_folder(out_dir, [(name, writers[name]) for name in FRF_FILES])
 
 
 # -- NetCDF -----------------------------------------------------------------------------------

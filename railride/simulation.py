@@ -21,6 +21,8 @@ from .vehicle import CORNER_NAMES, DOF_NAMES, DOF_UNITS, N_DOF, RAILS, WHEELSETS
 DEFAULT_DT = 1e-4
 DEFAULT_OUTPUT_RATE = 1000.0
 DEFAULT_CONTROL_RATE = 1000.0
+#: a random track's shortest wavelength must give at most output_rate / this [Hz]
+RESOLUTION = 2.5
 #: sample-steps per kernel call when a progress callback is given
 _CHUNK_WORK = 2_000_000
 
@@ -287,10 +289,10 @@ def simulate(scenario=None, params=None, *, dt: float = DEFAULT_DT,
     n_steps = n_out * stride
     for sc in scenarios:  # a random track's shortest wavelength must show in the output
         lam = getattr(sc.track, "min_wavelength", None)
-        if lam is not None and sc.speed / lam > output_rate / 2.5:
+        if lam is not None and sc.speed / lam > output_rate / RESOLUTION:
             raise ValueError(
                 f"min_wavelength = {lam:g} m at {sc.speed:g} m/s is {sc.speed / lam:g} Hz, more than "
-                f"output_rate / 2.5 = {output_rate / 2.5:g} Hz can resolve: raise min_wavelength or "
+                f"output_rate / {RESOLUTION:g} = {output_rate / RESOLUTION:g} Hz can resolve: raise min_wavelength or "
                 f"output_rate")
 
     systems = {key: _system_arrays(v, passive=damper is None) for key, v in vehicles.items()}

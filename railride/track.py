@@ -420,8 +420,12 @@ class RandomTrack(RailProfile):
         from scipy.interpolate import CubicSpline
 
         spectrum(self.name, 1.0)  # an unknown name fails here
-        if isinstance(self.seed, bool) or not isinstance(self.seed, (int, np.integer)) or self.seed < 0:
-            raise ValueError(f"seed = {self.seed!r}: must be a whole number >= 0")
+        seed = self.seed
+        # a whole float (3.0, as sweeps store numbers) is the same seed as 3
+        if isinstance(seed, bool) or not isinstance(seed, (int, float, np.integer, np.floating)) \
+                or not float(seed).is_integer() or seed < 0:
+            raise ValueError(f"seed = {seed!r}: must be a whole number >= 0")
+        object.__setattr__(self, "seed", int(seed))
         lo = _check("min_wavelength", self.min_wavelength, "positive", "a finite number > 0 (m)")
         hi = _check("max_wavelength", self.max_wavelength, "positive", "a finite number > 0 (m)")
         if not lo < hi:
