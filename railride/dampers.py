@@ -64,9 +64,6 @@ class _Damper:
     def describe(cls) -> list[tuple[str, str, str]]:
         return [(f.name, f.metadata["unit"], f.metadata["doc"]) for f in dataclasses.fields(cls)]
 
-    def clip_voltage(self, v):
-        return np.clip(v, self.v_min, self.v_max)
-
     def check_voltage(self, v: float, name: str = "voltage") -> float:
         if not (isinstance(v, (int, float)) and np.isfinite(v) and self.v_min <= v <= self.v_max):
             raise ValueError(f"{name} = {v!r} V: must lie in [{self.v_min:g}, {self.v_max:g}] V "

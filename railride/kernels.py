@@ -27,7 +27,6 @@ from .dampers import LAW_BOUC_WEN, LAW_SPENCER, LAW_VISCOUS, N_DAMPER_STATES
 
 N_DOF = 9
 N_CORNER = 4
-N_WHEELSET = 4
 N_RAIL = 8
 NY = 2 * N_DOF + N_CORNER  # length of the stage vector (q, q', f)
 #: a displacement or rotation beyond this (m or rad) is taken as divergence

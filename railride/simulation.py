@@ -118,7 +118,7 @@ def _forcing_table(utab: np.ndarray, Bw: np.ndarray, Bwd: np.ndarray) -> np.ndar
     return np.hstack([w @ Bw.T, wd @ Bw.T, w @ Bwd.T, wd @ Bwd.T])
 
 
-def _as_list(x, n_default=1):
+def _as_list(x):
     if x is None or isinstance(x, (Scenario, VehicleParams, str)):
         return [x]
     return list(x)
