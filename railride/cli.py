@@ -425,6 +425,79 @@ def _reduction_text(value, spec: str = ".1f") -> str:
     return f"[red]{text}[/red]" if value < 0 else text
 
 
+#: (index, row label, format) of the comfort tables of `simulate` and `compare`
+COMFORT_ROWS = (("aw_Wk", "a_w Wk (m/s^2)", ".4f"), ("vdv_Wk", "VDV Wk (m/s^1.75)", ".4f"),
+                ("aw_Wb", "a_w Wb (m/s^2)", ".4f"), ("N_MV_z", "N_MV,z (EN 12299)", ".3f"),
+                ("Wz", "Wz (Sperling)", ".3f"))
+#: where the comfort tables' positions are on the carbody floor
+POSITION_LABELS = {"centre": "carbody centre", "front": "above the front bogie",
+                   "rear": "above the rear bogie"}
+SHORT_POSITION_LABELS = {"centre": "centre", "front": "front bogie", "rear": "rear bogie"}
+ComfortOption = Annotated[bool, typer.Option(
+    "--comfort",
+    help="Also evaluate the ride comfort indices on the carbody floor at the centre and above "
+         "the bogies (ISO 2631-1 a_w and VDV, the vertical part of EN 12299 N_MV, Sperling's "
+         "Wz; docs/comfort.md) over the metrics window.")]
+
+
+def _comfort_caption(record: dict) -> str:
+    start, end = record["window_s"]
+    return "\n".join(["floor points at x = " + ", ".join(
+        f"{p['x_m']:g} m" for p in record["positions"].values()) + f"; window {start:g}-{end:g} s",
+                      *record["notes"]])
+
+
+def _comfort_table(record: dict):
+    """The comfort table of `simulate`: one row per index, one column per position."""
+    from rich.markup import escape
+    from rich.table import Table
+
+    positions = record["positions"]
+    table = Table(title="Ride comfort (carbody floor)", caption=escape(_comfort_caption(record)))
+    table.add_column("index")
+    for name in positions:
+        table.add_column(escape(POSITION_LABELS.get(name, name)), justify="right")
+    for key, label, spec in COMFORT_ROWS:
+        table.add_row(escape(label), *[format(p[key], spec) for p in positions.values()])
+    table.add_row("comfort class (N_MV,z)", *[p["N_MV_z_class"] for p in positions.values()])
+    return table
+
+
+def _compare_comfort_table(rows: list[dict]):
+    """The "ride comfort" table of `compare`: the indices at each position (rows), the
+    suspensions (columns) with the reduction against passive where meaningful."""
+    from rich.markup import escape
+    from rich.table import Table
+
+    first = rows[0]["comfort"]
+    table = Table(title="Ride comfort on the carbody floor: centre and above the bogies",
+                  caption=escape(_comfort_caption(first) + "\nred. % = (passive - controlled) / "
+                                 "passive x 100; none for Wz, which is not proportional to the "
+                                 "acceleration"))
+    table.add_column("position", no_wrap=True)
+    table.add_column("index", no_wrap=True)
+    for r in rows:
+        table.add_column(escape(r["label"].replace(" (", "\n(")), justify="right", min_width=8)
+        if r["name"] != "passive":
+            table.add_column("red. %", justify="right", min_width=5)
+    for pos in first["positions"]:
+        for n, (key, label, spec) in enumerate(COMFORT_ROWS):
+            cells = [escape(SHORT_POSITION_LABELS.get(pos, pos)) if n == 0 else "", escape(label)]
+            for r in rows:
+                cells.append(format(r["comfort"]["positions"][pos][key], spec))
+                if r["name"] != "passive":
+                    red = r["comfort"].get("reduction_percent", {}).get(pos, {}).get(key)
+                    cells.append(_reduction_text(red))
+            table.add_row(*cells)
+        cells = ["", "class (N_MV,z)"]
+        for r in rows:
+            cells.append(r["comfort"]["positions"][pos]["N_MV_z_class"])
+            if r["name"] != "passive":
+                cells.append("")
+        table.add_row(*cells, end_section=True)
+    return table
+
+
 def _compare_tables(doc: dict, vehicle: str, shipped: bool):
     """The three tables of `compare`: Table 1 beside the paper, peak-to-peak, damper demands."""
     from rich.markup import escape
@@ -496,7 +569,10 @@ def _compare_tables(doc: dict, vehicle: str, shipped: bool):
     demands_note = ("All four corners, over the metric window. force: the secondary damper force on "
                     "the carbody; travel: the secondary deflection (suspension travel); passive: "
                     "the viscous dampers c_sz.")
-    return [table, Text("\n".join(info)), "", ptp, "", demands, Text(demands_note)]
+    parts = [table, Text("\n".join(info)), "", ptp, "", demands, Text(demands_note)]
+    if all("comfort" in r for r in rows):
+        parts += ["", _compare_comfort_table(rows)]
+    return parts
 
 
 @app.command()
@@ -565,6 +641,7 @@ def compare(
              "displacement.png, pitch.png, roll.png, damper_forces.png, voltages.png, and the "
              "acceleration spectra psd.png, psd.csv into DIR (created if missing; all or "
              "nothing).")] = None,
+    comfort: ComfortOption = False,
 ) -> None:
     """Compare passive, PID and SAS suspensions on one scenario, as in the paper's Table 1.
 
@@ -609,7 +686,7 @@ def compare(
             result = run_compare(scen, vehicle_params, controllers=names, gains=gain_set,
                                  damper=damper, window=window_value, dt=dt,
                                  output_rate=output_rate, control_rate=control_rate,
-                                 sensor_noise=noise,
+                                 sensor_noise=noise, comfort=comfort,
                                  progress=progress if progress.enabled else None)
         doc = result.to_dict()
         text = json.dumps(doc, indent=2, allow_nan=False)  # refuses NaN before anything is written
@@ -924,17 +1001,21 @@ def simulate(
         "--out", metavar="DIR",
         help="Also write ride.nc, ride.csv, metrics.json and body_responses.png into DIR "
              "(created if missing; all or nothing).")] = None,
+    comfort: ComfortOption = False,
 ) -> None:
     """Simulate the vehicle on a track and print the ride metrics."""
     with _errors():
         track = _track_options(scenario, track_seed, min_wavelength, max_wavelength)
         doc, result = _run(scenario, amplitude, wavelength, rail_phase, speed, duration, dt,
                            output_rate, window, params, preset, out, suspension, damper, voltage,
-                           track=track)
+                           track=track, comfort=comfort)
     if format is OutputFormat.json:
         _print_json(doc)
     else:
-        _stdout_console().print(_metrics_table(doc))
+        console = _stdout_console()
+        console.print(_metrics_table(doc))
+        if "comfort" in doc:
+            console.print(_comfort_table(doc["comfort"]))
 
 
 def _suspension(suspension: str, damper_name, voltage_text):
@@ -956,7 +1037,7 @@ def _suspension(suspension: str, damper_name, voltage_text):
 
 def _run(scenario_name, amplitude, wavelength, rail_phase, speed, duration, dt, output_rate,
          window_text, params_file, preset, out, suspension="passive", damper_name=None,
-         voltage_text=None, track=None):
+         voltage_text=None, track=None, comfort=False):
     from . import report
     from .metrics import check_window, parse_window, to_dict
     from .simulation import DEFAULT_DT, DEFAULT_OUTPUT_RATE, simulate as run_simulation
@@ -989,6 +1070,9 @@ def _run(scenario_name, amplitude, wavelength, rail_phase, speed, duration, dt, 
                      "window_s": [float(start), float(end)]},
         "metrics": to_dict(metrics),
     }
+    if comfort:  # only then: the document stays as it was without --comfort
+        from .comparison import comfort_record
+        doc["comfort"] = comfort_record(result.comfort(window))
     if out is not None:
         _write_folder(out, lambda: report.write_outputs(result, out, doc))
     return doc, result
@@ -1829,6 +1913,12 @@ def _metric_columns() -> list[str]:
     return [f"{r}_{s}" for s in STATISTICS for r in RESPONSES]
 
 
+#: (column, heading) of the comfort indices the sweep table shows with --comfort
+SWEEP_COMFORT_TABLE = (("centre_aw_Wk", "a_w Wk\ncentre\n(m/s^2)"),
+                       ("centre_N_MV_z", "N_MV,z\ncentre"), ("front_N_MV_z", "N_MV,z\nfront"),
+                       ("rear_N_MV_z", "N_MV,z\nrear"))
+
+
 def _sweep_table(rows: list[dict], grid_columns: list[str], caption: str):
     from rich.markup import escape
     from rich.table import Table
@@ -1845,14 +1935,40 @@ def _sweep_table(rows: list[dict], grid_columns: list[str], caption: str):
                          no_wrap=c == "suspension")
     for key, label in RESPONSE_LABELS.items():
         table.add_column(label.replace(" (", "\n("), justify="right")
+    comfort = [(c, h) for c, h in SWEEP_COMFORT_TABLE if rows and c in rows[0]]
+    for _, heading in comfort:
+        table.add_column(escape(heading), justify="right")
     for i, row in enumerate(rows, start=1):
         cells = [str(i)]
         for c in grid_columns:
             v = row[c]
             cells.append("-" if v is None else (escape(v) if isinstance(v, str) else f"{v:g}"))
         cells += [f"{row[f'{k}_rms']:#.4g}" for k in RESPONSE_LABELS]
+        cells += [f"{row[c]:#.3g}" for c, _ in comfort]
         table.add_row(*cells)
     return table
+
+
+def _sweep_comfort_settings(duration: float, window) -> dict:
+    """settings.comfort of a sweep with --comfort: the columns, where the positions are and
+    what N_MV_z is (the same for every run of the grid, whose runs share one duration)."""
+    from .comfort import INDEX_UNITS, INTERVAL_S
+    from .sweep import COMFORT_INDICES, COMFORT_COLUMNS
+
+    start, end = window or (0.0, duration)
+    n = max(1, int((end - start + 1e-9) // INTERVAL_S))
+    unit = {i: INDEX_UNITS["aw" if i.startswith("aw_") else "vdv" if i.startswith("vdv_") else i]
+            for _, i in COMFORT_INDICES}
+    return {"columns": list(COMFORT_COLUMNS),
+            "units": {c: unit[i] for (_, i), c in zip(COMFORT_INDICES, COMFORT_COLUMNS)},
+            "positions": {"centre": "x = 0", "front": "x = +l (above the front bogie centre)",
+                          "rear": "x = -l (above the rear bogie centre)"},
+            "n_intervals": n,
+            "notes": ["N_MV_z is the vertical term of EN 12299 only: the model has no lateral "
+                      "or longitudinal motion",
+                      f"N_MV_z from {n} interval{'s' if n != 1 else ''} of 5 s"
+                      + (" (EN 12299 evaluates 60, 5 minutes): an indication only"
+                         if n < 60 else "")]}
 
 
 @app.command("sweep")
@@ -1935,6 +2051,11 @@ def sweep_command(
     format: Annotated[SweepFormat, typer.Option(
         "--format", case_sensitive=False,
         help="Output on stdout: a table, JSON (a list of row objects) or CSV.")] = SweepFormat.table,
+    comfort: Annotated[bool, typer.Option(
+        "--comfort",
+        help="Also evaluate the ride comfort indices of every run (columns centre_aw_Wk, "
+             "centre_N_MV_z, front_N_MV_z, rear_N_MV_z, centre_Wz, ...; docs/comfort.md) and, "
+             "with sweep.png, plot them against the axis in comfort.png.")] = False,
 ) -> None:
     """Run a grid of cases: every combination of the given values (a cartesian product).
 
@@ -2101,9 +2222,9 @@ def sweep_command(
                 t0 = time.perf_counter()
                 frame = sweep_lib.run_cases(cases, executor=executor, table=table,
                                             base_gains=base_gains, dt=dt, window=window_value,
-                                            progress=progress)
+                                            progress=progress, comfort=comfort)
                 wall = time.perf_counter() - t0
-            metrics = _metric_columns()
+            metrics = _metric_columns() + (list(sweep_lib.COMFORT_COLUMNS) if comfort else [])
             rows = []
             for case, values, (_, result) in zip(cases, grid, frame.iterrows()):
                 rows.append({**values, **{m: float(result[m]) for m in metrics}, "key": case.key})
@@ -2124,6 +2245,9 @@ def sweep_command(
                         zip(("displacement", "angle", "velocity", "angular_rate"), noise_values)),
                     "dt_s": float(dt),
                     "window_s": None if window_value is None else list(window_value),
+                    # only with --comfort: the document stays as it was without it
+                    **({"comfort": _sweep_comfort_settings(scen.duration, window_value)}
+                       if comfort else {}),
                 },
                 "columns": grid_columns + metrics + ["key"],
                 "rows": rows,

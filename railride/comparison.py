@@ -49,7 +49,9 @@ def check_controllers(names) -> list[str]:
 class Comparison:
     """Results of `compare`: ``datasets[name]`` per suspension, ``metrics`` (controller,
     response, statistic), RMS ``reductions`` against passive, and ``demands``: what each
-    suspension asks of its dampers."""
+    suspension asks of its dampers. ``comfort``: per suspension, the ride comfort indices
+    (`railride.comfort.ride_comfort` over the metrics window) when `compare` computed them,
+    else None."""
 
     names: list[str]
     datasets: dict
@@ -58,6 +60,7 @@ class Comparison:
     gains: GainSet
     damper: str
     settings: dict = field(default_factory=dict)
+    comfort: dict | None = None
 
     @property
     def reductions(self) -> xr.DataArray:
@@ -102,6 +105,9 @@ class Comparison:
             row["paper"] = {r: {"rms": PAPER_TABLE1[r][name],
                                 **({"reduction_percent": PAPER_REDUCTION[r][name]} if name != "passive" else {})}
                             for r in PAPER_TABLE1}
+            if self.comfort is not None:  # only when computed: the schema stays as it was
+                row["comfort"] = comfort_record(self.comfort[name],
+                                                None if name == "passive" else self.comfort["passive"])
             rows.append(row)
         return {"schema": "railride.comparison/1", "railride_version": __version__,
                 "settings": self.settings, "controllers": rows,
@@ -132,12 +138,13 @@ class Comparison:
 def compare(scenario, params=None, *, controllers=CONTROLLERS, gains: GainSet | None = None,
             damper="railway", window=None, dt: float = DEFAULT_DT,
             output_rate: float = DEFAULT_OUTPUT_RATE, control_rate: float = DEFAULT_CONTROL_RATE,
-            sensor_noise=None, progress=None) -> Comparison:
+            sensor_noise=None, progress=None, comfort: bool = False) -> Comparison:
     """Run the passive vehicle and each controller on ``scenario`` and collect the metrics.
 
     ``controllers`` names from `railride.control.CONTROLLERS` (passive is always run as the
     baseline); ``gains`` a `GainSet` (default: the shipped gains); ``window`` (start, end) s for
-    the metrics.
+    the metrics. ``comfort``: also the ride comfort indices of each suspension over the same
+    window (`Comparison.comfort`; ``controllers[i].comfort`` in `Comparison.to_dict`).
     """
     names = check_controllers(controllers)
     gains = GainSet.default() if gains is None else gains
@@ -161,4 +168,52 @@ def compare(scenario, params=None, *, controllers=CONTROLLERS, gains: GainSet | 
                 "dt_s": dt, "output_rate_hz": output_rate, "control_rate_hz": control_rate,
                 "window_s": None if window is None else [float(w) for w in window],
                 "sensor_noise": None if sensor_noise is None else sensor_noise.__dict__}
-    return Comparison(names, datasets, metrics, window, gains, str(damper), settings)
+    comfort_values = None
+    if comfort:
+        from .comfort import ride_comfort
+        comfort_values = {n: ride_comfort(datasets[n], window=window) for n in names}
+    return Comparison(names, datasets, metrics, window, gains, str(damper), settings,
+                      comfort_values)
+
+
+#: indices whose reduction against passive is given: a_w, VDV and N_MV_z scale with the
+#: acceleration; Sperling's Wz (a power 0.3 of it) does not, so a percentage says little
+COMFORT_REDUCED = ("aw_Wk", "vdv_Wk", "aw_Wb", "vdv_Wb", "N_MV_z")
+
+
+def comfort_record(comfort: xr.DataArray, passive: xr.DataArray | None = None) -> dict:
+    """The JSON record of one run's `railride.comfort.ride_comfort` (docs/cli.md): per position
+    its x and indices, with the EN 12299 label of N_MV_z; units, window, the number of 5 s
+    intervals behind N_MV_z and the notes. With ``passive`` (the baseline's indices), also
+    ``reduction_percent`` per position for `COMFORT_REDUCED`."""
+    from .comfort import comfort_class, to_dict
+
+    values = to_dict(comfort)
+    positions = {}
+    for p, indices in values.items():
+        entry = {"x_m": float(comfort["x_m"].sel(position=p))}
+        for i, v in indices.items():
+            entry[i] = v
+            if i == "N_MV_z":
+                entry["N_MV_z_class"] = comfort_class(v)
+        positions[p] = entry
+    n = int(comfort.attrs.get("n_intervals", 0))
+    # ride_comfort joins its notes with "; ": a short-run warning (which holds "; " itself)
+    # and, always last, that N_MV_z is the vertical term only
+    text = str(comfort.attrs.get("notes", ""))
+    cut = text.find("N_MV_z is the vertical term")
+    notes = [text] if cut < 0 else [t for t in (text[:cut].rstrip("; "), text[cut:]) if t]
+    notes.append(f"N_MV_z from {n} interval{'s' if n != 1 else ''} of 5 s"
+                 + (" (EN 12299 evaluates 60, 5 minutes): an indication only" if n < 60 else ""))
+    record = {"positions": positions,
+              "units": {str(i): str(u) for i, u in zip(comfort["index"].values,
+                                                       comfort["unit"].values)},
+              "window_s": json.loads(comfort.attrs["window_s"]),
+              "n_intervals": n, "notes": notes}
+    if passive is not None:
+        base = to_dict(passive)
+        record["reduction_percent"] = {
+            p: {i: (base[p][i] - v) / base[p][i] * 100.0 if base[p][i] > 0 else None
+                for i, v in indices.items() if i in COMFORT_REDUCED}
+            for p, indices in values.items()}
+    return record

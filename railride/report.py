@@ -53,7 +53,8 @@ COMPARE_FILES = ("compare.json", "compare.nc", "compare.csv", "acceleration.png"
 #: the files `write_tune_outputs` produces, in the order they are written
 TUNE_FILES = ("gains.toml", "sensitivity.png", "curves.csv", "tune.json")
 #: the files `write_sweep_outputs` always produces (the run table runs.csv is the library's);
-#: ``sweep.png`` is added when the sweep has one numeric axis (`sweep_plot_axis`)
+#: ``sweep.png`` is added when the sweep has one numeric axis (`sweep_plot_axis`), and with it
+#: ``comfort.png`` when the rows hold the comfort indices (`railride sweep --comfort`)
 SWEEP_FILES = ("sweep.json",)
 #: the files `write_frf_outputs` produces, in the order they are written
 FRF_FILES = ("frf.csv", "frf.json", "frf.png", "modes.csv")
@@ -886,6 +887,77 @@ def _sweep_axis_label(column: str) -> str:
     return f"{column} ({unit})" if unit else column
 
 
+#: (column, axis label) of the two panels of the sweep's comfort plot
+_SWEEP_COMFORT_PANELS = (("centre_N_MV_z", "N$_{MV,z}$, carbody centre (EN 12299, vertical part)"),
+                         ("centre_aw_Wk", "a$_w$ Wk, carbody centre (m/s$^2$)"))
+
+
+def _sweep_lines(ax, rows, axis, column, suspensions):
+    """One line per suspension of ``column`` against ``axis`` (a horizontal line for a
+    suspension the axis does not act on)."""
+    styles = {**COMPARE_STYLES, "mr": {"linestyle": "-", "color": "tab:green"}}
+    labels = {"mr": "MR (constant voltage)"}
+    for name in suspensions:
+        mine = [r for r in rows if r["suspension"] == name]
+        style = styles.get(name, {"linestyle": "-"})
+        label = labels.get(name) or _controller_label(name)
+        on = sorted((float(r[axis]), float(r[column])) for r in mine if r.get(axis) is not None)
+        off = [float(r[column]) for r in mine if r.get(axis) is None]
+        if on:
+            x, y = zip(*on)
+            ax.plot(x, y, marker="o", markersize=3.5, linewidth=1.3, label=label, **style)
+        elif off:
+            ax.axhline(float(np.mean(off)), linewidth=1.0, alpha=0.8,
+                       label=f"{label} (not swept)", **style)
+
+
+def plot_sweep_comfort(doc: dict, path=None, *, axis: str | None = None):
+    """The ride comfort of a sweep with comfort columns (``railride sweep --comfort``) against
+    its swept axis: N_MV,z and a_w (Wk) at the carbody centre, two panels, one line per
+    suspension as in `plot_sweep`; the N_MV,z panel marks the EN 12299 class bounds. Saved as
+    PNG at ``path`` when given; returns the `Figure`."""
+    from .comfort import COMFORT_SCALE
+
+    axis = axis or sweep_plot_axis(doc)
+    if axis is None:
+        raise ValueError("the sweep has no single numeric axis with several values to plot against")
+    rows = doc.get("rows") or []
+    if not rows or any(c not in rows[0] for c, _ in _SWEEP_COMFORT_PANELS):
+        raise ValueError("the sweep's rows hold no comfort indices (railride sweep --comfort)")
+    suspensions = list(dict.fromkeys(r["suspension"] for r in rows))
+    fig = _new_figure((10.0, 4.4))
+    axes = fig.subplots(1, 2, sharex=True)
+    xs = [float(r[axis]) for r in rows if r.get(axis) is not None]
+    log_x = bool(xs) and min(xs) > 0 and max(xs) / min(xs) >= 100
+    for ax, (column, ylabel) in zip(axes, _SWEEP_COMFORT_PANELS):
+        _sweep_lines(ax, rows, axis, column, suspensions)
+        ax.set_ylabel(ylabel, fontsize="small")
+        ax.set_ylim(bottom=0)
+        ax.grid(True, linewidth=0.4, alpha=0.6)
+        ax.set_xlabel(_sweep_axis_label(axis))
+        if log_x:
+            ax.set_xscale("log")
+    top = axes[0].get_ylim()[1]
+    for bound, label in COMFORT_SCALE:
+        if math.isfinite(bound) and bound < top:
+            axes[0].axhline(bound, color="0.5", linewidth=0.6, linestyle=":")
+            axes[0].annotate(f"{label} below", (0.99, bound), xycoords=("axes fraction", "data"),
+                             fontsize="x-small", color="0.4", va="top", ha="right")
+    handles, names = axes[0].get_legend_handles_labels()
+    fig.legend(handles, names, loc="outside lower center", ncols=min(5, max(1, len(names))),
+               fontsize="small", frameon=False)
+    settings = doc.get("settings") or {}
+    context = describe_scenario(settings.get("scenario") or {})
+    title = f"Ride comfort against {_sweep_axis_label(axis)}"
+    if context:
+        import textwrap
+
+        title += "\n" + textwrap.fill(context, 110)
+    fig.suptitle(title, fontsize="medium")
+    _save_png(fig, path)
+    return fig
+
+
 def plot_sweep(doc: dict, path=None, *, axis: str | None = None):
     """The RMS of the four carbody responses against the swept axis of a sweep (the
     ``railride.sweep/1`` document ``doc``): four panels, one line per suspension in the paper's
@@ -946,13 +1018,17 @@ def plot_sweep(doc: dict, path=None, *, axis: str | None = None):
 def write_sweep_outputs(out_dir, doc: dict) -> list[Path]:
     """Write the summary of a sweep into ``out_dir`` beside the run table ``runs.csv`` that
     `railride.sweep.run_cases` keeps there: ``sweep.json`` (``doc``) and, when the grid has one
-    numeric axis with several values (`sweep_plot_axis`), ``sweep.png`` (`plot_sweep`). Returns
-    the written paths."""
+    numeric axis with several values (`sweep_plot_axis`), ``sweep.png`` (`plot_sweep`) and, if
+    the rows hold the comfort indices, ``comfort.png`` (`plot_sweep_comfort`). Returns the
+    written paths."""
     text = _json_text(doc)
     files = [("sweep.json", lambda path: path.write_text(text, encoding="utf-8"))]
     axis = sweep_plot_axis(doc)
     if axis is not None:
         files.append(("sweep.png", lambda path: plot_sweep(doc, path, axis=axis)))
+        rows = doc.get("rows") or []
+        if rows and all(c in rows[0] for c, _ in _SWEEP_COMFORT_PANELS):
+            files.append(("comfort.png", lambda path: plot_sweep_comfort(doc, path, axis=axis)))
     return write_folder(out_dir, files)
 
 

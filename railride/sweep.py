@@ -29,6 +29,12 @@ from .metrics import RESPONSES, STATISTICS
 #: for 10 s at 1 kHz)
 CHUNK = 32
 SUSPENSIONS = ("passive", "mr", "pid", "sas-attitude", "sas-attitude-ride")
+#: (position, index) of `railride.comfort.ride_comfort` in a row with comfort, as the column
+#: ``<position>_<index>``
+COMFORT_INDICES = (("centre", "aw_Wk"), ("centre", "vdv_Wk"), ("centre", "aw_Wb"),
+                   ("centre", "N_MV_z"), ("centre", "Wz"), ("front", "aw_Wk"), ("front", "N_MV_z"),
+                   ("front", "Wz"), ("rear", "aw_Wk"), ("rear", "N_MV_z"), ("rear", "Wz"))
+COMFORT_COLUMNS = tuple(f"{p}_{i}" for p, i in COMFORT_INDICES)
 
 
 @dataclass(frozen=True)
@@ -101,10 +107,12 @@ def apply_gains(base, changes):
     return GainSet(tables["inner"], tables["pid"], tables["attitude"], tables["ride"], base.source)
 
 
-def evaluate(cases: list[Case], base_gains=None, dt: float = 1e-4, window=None) -> list[dict]:
+def evaluate(cases: list[Case], base_gains=None, dt: float = 1e-4, window=None,
+             comfort: bool = False) -> list[dict]:
     """Run ``cases`` (in compiled batches of compatible cases) and return one row per case:
-    its key, settings and the RMS and peak-to-peak of the four body responses. Runs in any
-    process: a Dask worker calls it too."""
+    its key, settings and the RMS and peak-to-peak of the four body responses; with
+    ``comfort``, also the ride comfort indices of `COMFORT_COLUMNS` (`railride.comfort.
+    ride_comfort` over the same window). Runs in any process: a Dask worker calls it too."""
     from .control import GainSet, SensorNoise
     from .params import VehicleParams
     from .simulation import simulate
@@ -135,14 +143,22 @@ def evaluate(cases: list[Case], base_gains=None, dt: float = 1e-4, window=None) 
                 gsets = [apply_gains(base_gains, c.gains) for c in part]
                 inners = {g.inner for g in gsets}
                 if len(inners) != 1:  # the inner loop is one setting per batch
-                    for c, g in zip(part, gsets):
-                        rows[cases.index(c)] = evaluate([c], base_gains, dt, window)[0]
+                    for i in idx[start:start + CHUNK]:  # positions, not lookups: cases may repeat
+                        rows[i] = evaluate([cases[i]], base_gains, dt, window, comfort)[0]
                     continue
                 noise, seed = group[3]
                 res = simulate(scs, pars, dt=dt, damper=group[2], inner=gsets[0].inner,
                                controller=[g.controller(c.suspension) for c, g in zip(part, gsets)],
                                sensor_noise=SensorNoise(*noise, seed=seed) if noise else None)
             m = res.metrics(window).values  # (sample, response, statistic)
+            cf = None
+            if comfort:
+                from .comfort import ride_comfort
+
+                ds = res.dataset
+                if "sample" not in ds.dims:
+                    ds = ds.expand_dims(sample=[0])
+                cf = ride_comfort(ds, window=window)
             for j, i in enumerate(idx[start:start + CHUNK]):
                 if i in rows:
                     continue
@@ -150,6 +166,9 @@ def evaluate(cases: list[Case], base_gains=None, dt: float = 1e-4, window=None) 
                 for r, resp in enumerate(RESPONSES):
                     for s, stat in enumerate(STATISTICS):
                         row[f"{resp}_{stat}"] = float(m[j, r, s])
+                if cf is not None:
+                    for (pos, index), column in zip(COMFORT_INDICES, COMFORT_COLUMNS):
+                        row[column] = float(cf.isel(sample=j).sel(position=pos, index=index))
                 rows[i] = row
     return [rows[i] for i in range(len(cases))]
 
@@ -344,8 +363,10 @@ class RunTable:
 
 
 def run_cases(cases: list[Case], *, executor=None, table: RunTable | None = None, base_gains=None,
-              dt: float = 1e-4, window=None, chunk: int = CHUNK, progress=None) -> pd.DataFrame:
+              dt: float = 1e-4, window=None, chunk: int = CHUNK, progress=None,
+              comfort: bool = False) -> pd.DataFrame:
     """Evaluate ``cases``, skipping those already in ``table``; returns their rows in order.
+    ``comfort``: the rows also hold the ride comfort indices (`evaluate`).
 
     ``progress(done, total, runs_per_second)`` is called after each chunk.
     """
@@ -358,8 +379,11 @@ def run_cases(cases: list[Case], *, executor=None, table: RunTable | None = None
     # resumed sweep with another dt, window or base gain set does not reuse old rows
     from .control import GainSet
     base = GainSet.default() if base_gains is None else base_gains
-    settings = json.dumps({"dt": dt, "window": None if window is None else [float(w) for w in window],
-                           "base_gains": base.to_toml()}, sort_keys=True)
+    settings = {"dt": dt, "window": None if window is None else [float(w) for w in window],
+                "base_gains": base.to_toml()}
+    if comfort:  # only then: the keys of sweeps without comfort stay as they were
+        settings["comfort"] = True
+    settings = json.dumps(settings, sort_keys=True)
     keys = [hashlib.sha1((c.key + settings).encode()).hexdigest()[:16] for c in cases]
     pending, seen = [], set()
     key_of = {}
@@ -371,7 +395,7 @@ def run_cases(cases: list[Case], *, executor=None, table: RunTable | None = None
     # group compatible cases so each chunk is one compiled batch
     pending.sort(key=lambda c: str(c.group))
     chunks = [pending[i:i + chunk] for i in range(0, len(pending), chunk)]
-    fn = functools.partial(evaluate, base_gains=base, dt=dt, window=window)
+    fn = functools.partial(evaluate, base_gains=base, dt=dt, window=window, comfort=comfort)
     t0, n_done = time.perf_counter(), 0
     if progress is not None:
         progress(0, len(pending), 0.0)
