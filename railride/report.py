@@ -973,21 +973,8 @@ def plot_sweep(doc: dict, path=None, *, axis: str | None = None):
     axes = fig.subplots(2, 2, sharex=True).ravel()
     xs = [float(r[axis]) for r in rows if r.get(axis) is not None]
     log_x = bool(xs) and min(xs) > 0 and max(xs) / min(xs) >= 100
-    styles = {**COMPARE_STYLES, "mr": {"linestyle": "-", "color": "tab:green"}}
-    labels = {"mr": "MR (constant voltage)"}
     for ax, (column, ylabel) in zip(axes, _SWEEP_PANELS):
-        for name in suspensions:
-            mine = [r for r in rows if r["suspension"] == name]
-            style = styles.get(name, {"linestyle": "-"})
-            label = labels.get(name) or _controller_label(name)
-            on = sorted((float(r[axis]), float(r[column])) for r in mine if r.get(axis) is not None)
-            off = [float(r[column]) for r in mine if r.get(axis) is None]
-            if on:
-                x, y = zip(*on)
-                ax.plot(x, y, marker="o", markersize=3.5, linewidth=1.3, label=label, **style)
-            elif off:
-                ax.axhline(float(np.mean(off)), linewidth=1.0, alpha=0.8,
-                           label=f"{label} (not swept)", **style)
+        _sweep_lines(ax, rows, axis, column, suspensions)
         ax.set_ylabel(ylabel)
         ax.set_ylim(bottom=0)
         ax.grid(True, linewidth=0.4, alpha=0.6)
