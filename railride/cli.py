@@ -1974,9 +1974,9 @@ def _sweep_comfort_settings(duration: float, window) -> dict:
 @app.command("sweep")
 def sweep_command(
     suspension: Annotated[str, typer.Option(
-        "--suspension", metavar="NAME[,NAME...]",
+        "--suspension", "--controllers", metavar="NAME[,NAME...]",
         help="Suspensions, comma-separated: passive, mr (constant --voltage), pid, sas-attitude, "
-             "sas-attitude-ride.")] = "passive",
+             "sas-attitude-ride. --controllers is the same option.")] = "passive",
     speed: Annotated[Optional[str], typer.Option(
         "--speed", metavar="VALUES",
         help="Vehicle speeds [m/s]: START:STOP:COUNT (linear, inclusive) or a,b,c "
@@ -2052,10 +2052,11 @@ def sweep_command(
         "--format", case_sensitive=False,
         help="Output on stdout: a table, JSON (a list of row objects) or CSV.")] = SweepFormat.table,
     comfort: Annotated[bool, typer.Option(
-        "--comfort",
-        help="Also evaluate the ride comfort indices of every run (columns centre_aw_Wk, "
+        "--comfort/--no-comfort",
+        help="Evaluate the ride comfort indices of every run (columns centre_aw_Wk, "
              "centre_N_MV_z, front_N_MV_z, rear_N_MV_z, centre_Wz, ...; docs/comfort.md) and, "
-             "with sweep.png, plot them against the axis in comfort.png.")] = False,
+             "with sweep.png, plot them against the axis in comfort.png (default: on; "
+             "--no-comfort for RMS and peak-to-peak only).")] = True,
 ) -> None:
     """Run a grid of cases: every combination of the given values (a cartesian product).
 

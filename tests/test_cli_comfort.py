@@ -101,9 +101,9 @@ def test_sweep_comfort(tmp_path):
     assert doc["settings"]["comfort"]["columns"] == list(COMFORT_COLUMNS)
     runs = pd.read_csv(out / "runs.csv", dtype={"key": str})
     assert set(COMFORT_COLUMNS) <= set(runs.columns) and len(runs) == 4
-    # the same grid without --comfort: no comfort columns, no comfort.png
+    # the same grid with --no-comfort: no comfort columns, no comfort.png
     plain_out = tmp_path / "plain"
-    ok(*args, "--out", plain_out)
+    ok(*args, "--no-comfort", "--out", plain_out)
     plain = json.loads((plain_out / "sweep.json").read_text())
     assert not (plain_out / "comfort.png").exists()
     assert "comfort" not in plain["settings"]

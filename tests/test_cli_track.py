@@ -242,7 +242,8 @@ def test_sweep_writes_the_plot_for_one_numeric_axis(tmp_path):
     out = tmp_path / "speeds"
     result = ok("sweep", "--speed", "20:40:3", "--duration", 1, "--out", out)
     assert "sweep.png" in result.stderr
-    assert sorted(p.name for p in out.iterdir()) == ["runs.csv", "sweep.json", "sweep.png"]
+    # comfort is on by default: its plot comes with the RMS one
+    assert sorted(p.name for p in out.iterdir()) == ["comfort.png", "runs.csv", "sweep.json", "sweep.png"]
     assert is_png(out / "sweep.png")
     # two axes with several values, or none: no plot
     other = tmp_path / "grid"
