@@ -71,6 +71,10 @@ WEIGHTINGS = {w.name: w for w in (
               "vertical (z) floor weighting of EN 12299 (railway ride comfort)",
               "EN 12299 (parameters as two third-party implementations give them, not read "
               "from the standard; ISO 8041 / ISO 2631-4 Wb differs: docs/comfort.md)"),
+    Weighting("Wb8041", 0.4, 100.0, 16.0, 16.0, 0.55, 2.5, 0.9, 4.0, 0.95, 1.024,
+              "vertical (z) railway weighting Wb in the ISO 8041 / ISO 2631-4 form",
+              "ISO 8041 as tabulated in the Larson Davis HVM200 manual (Table 3.1, 'source: "
+              "ISO 8041'); not read from the standard itself; docs/comfort.md"),
 )}
 
 

@@ -60,6 +60,15 @@ def test_wb_follows_its_asymptotes_not_2_56_times_them():
         assert weighting("Wb", f) == pytest.approx(line, rel=0.08)
 
 
+def test_iso_8041_wb_follows_the_same_asymptotes():
+    # the ISO 8041 / ISO 2631-4 form of Wb (other Q values) lies on the same BS 6841 lines
+    for f, line in ((1.0, 0.4), (1.6, 0.4), (8.0, 1.0), (10.0, 1.0), (40.0, 0.4), (63.0, 16 / 63)):
+        assert weighting("Wb8041", f) == pytest.approx(line, rel=0.08)
+    # and differs from the EN 12299 form by at most about 12 % (docs/comfort.md)
+    f = np.logspace(0, np.log10(80), 50)
+    assert np.max(np.abs(weighting("Wb8041", f) / weighting("Wb", f) - 1)) < 0.13
+
+
 def test_weighting_is_vectorised_and_zero_at_dc():
     f = np.array([[0.0, 1.0], [4.0, 8.0]])
     w = weighting("Wk", f)
