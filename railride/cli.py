@@ -313,6 +313,36 @@ PresetOption = Annotated[Optional[str], typer.Option(
     help="Named vehicle parameter set (available: paper). Default: paper.")]
 FormatOption = Annotated[OutputFormat, typer.Option(
     "--format", case_sensitive=False, help="Output on stdout: a table or a JSON document.")]
+# executor options shared by tune and sweep
+WorkersOption = Annotated[Optional[int], typer.Option(
+    "--workers", metavar="N",
+    help="Local executor: threads of each batch, 1..cores (default: every core).")]
+SchedulerOption = Annotated[Optional[str], typer.Option(
+    "--scheduler", metavar="ADDRESS",
+    help="Run on a Dask cluster: the scheduler's address, e.g. tcp://host:8786.")]
+SchedulerFileOption = Annotated[Optional[Path], typer.Option(
+    "--scheduler-file", metavar="FILE",
+    help="Run on a Dask cluster whose scheduler wrote FILE (dask scheduler --scheduler-file "
+         "FILE).")]
+# scenario and step options shared by simulate, compare and tune
+AmplitudeOption = Annotated[Optional[float], typer.Option(
+    "--amplitude", metavar="M",
+    help="paper-sine: sine amplitude [m] (default 0.05). bump: bump height [m], negative for a "
+         "dip (default 0.02).")]
+WavelengthOption = Annotated[Optional[float], typer.Option(
+    "--wavelength", metavar="M",
+    help="paper-sine: wavelength [m] (default 60). bump: bump length [m] (default 10).")]
+RailPhaseOption = Annotated[Optional[float], typer.Option(
+    "--rail-phase", metavar="DEG",
+    help="paper-sine only: phase lag of the right rail [deg] (default 90).")]
+SpeedOption = Annotated[Optional[float], typer.Option(
+    "--speed", metavar="M/S", help="Vehicle speed [m/s] (default 55.56).")]
+DtOption = Annotated[Optional[float], typer.Option(
+    "--dt", metavar="S", help="Fixed RK4 time step [s] (default 1e-4).")]
+OutputRateOption = Annotated[Optional[float], typer.Option(
+    "--output-rate", metavar="HZ",
+    help="Sampling rate of the stored time histories [Hz] (default 1000); 1/(rate x dt) must "
+         "be a whole number.")]
 TrackSeedOption = Annotated[Optional[int], typer.Option(
     "--track-seed", metavar="N",
     help="Random tracks (fra1..fra6, german-low, german-high) only: the seed of the track's "
@@ -607,28 +637,17 @@ def compare(
         help="paper-sine (the paper's sine rails), bump, file:PATH, fra1..fra6, german-low or "
              "german-high, as for simulate.")]
         = "paper-sine",
-    amplitude: Annotated[Optional[float], typer.Option(
-        "--amplitude", metavar="M",
-        help="paper-sine: sine amplitude [m] (default 0.05). bump: bump height [m] "
-             "(default 0.02).")] = None,
-    wavelength: Annotated[Optional[float], typer.Option(
-        "--wavelength", metavar="M",
-        help="paper-sine: wavelength [m] (default 60). bump: bump length [m] (default 10).")] = None,
-    rail_phase: Annotated[Optional[float], typer.Option(
-        "--rail-phase", metavar="DEG",
-        help="paper-sine only: phase lag of the right rail [deg] (default 90).")] = None,
+    amplitude: AmplitudeOption = None,
+    wavelength: WavelengthOption = None,
+    rail_phase: RailPhaseOption = None,
     track_seed: TrackSeedOption = None,
     min_wavelength: MinWavelengthOption = None,
     max_wavelength: MaxWavelengthOption = None,
-    speed: Annotated[Optional[float], typer.Option(
-        "--speed", metavar="M/S", help="Vehicle speed [m/s] (default 55.56).")] = None,
+    speed: SpeedOption = None,
     duration: Annotated[Optional[float], typer.Option(
         "--duration", metavar="S", help="Simulated time [s] (default 10).")] = None,
-    dt: Annotated[Optional[float], typer.Option(
-        "--dt", metavar="S", help="Fixed RK4 time step [s] (default 1e-4).")] = None,
-    output_rate: Annotated[Optional[float], typer.Option(
-        "--output-rate", metavar="HZ",
-        help="Sampling rate of the stored time histories [Hz] (default 1000).")] = None,
+    dt: DtOption = None,
+    output_rate: OutputRateOption = None,
     window: Annotated[Optional[str], typer.Option(
         "--window", metavar="START:END",
         help="Time window of the metrics [s], e.g. 2:10 (default: the whole run).")] = None,
@@ -955,29 +974,17 @@ def _metrics_table(doc: dict):
 def simulate(
     scenario: Annotated[str, typer.Option(
         "--scenario", metavar="NAME", help=SCENARIO_HELP)] = "paper-sine",
-    amplitude: Annotated[Optional[float], typer.Option(
-        "--amplitude", metavar="M",
-        help="paper-sine: sine amplitude [m] (default 0.05). bump: bump height [m], negative "
-             "for a dip (default 0.02).")] = None,
-    wavelength: Annotated[Optional[float], typer.Option(
-        "--wavelength", metavar="M",
-        help="paper-sine: wavelength [m] (default 60). bump: bump length [m] (default 10).")] = None,
-    rail_phase: Annotated[Optional[float], typer.Option(
-        "--rail-phase", metavar="DEG",
-        help="paper-sine only: phase lag of the right rail [deg] (default 90).")] = None,
+    amplitude: AmplitudeOption = None,
+    wavelength: WavelengthOption = None,
+    rail_phase: RailPhaseOption = None,
     track_seed: TrackSeedOption = None,
     min_wavelength: MinWavelengthOption = None,
     max_wavelength: MaxWavelengthOption = None,
-    speed: Annotated[Optional[float], typer.Option(
-        "--speed", metavar="M/S", help="Vehicle speed [m/s] (default 55.56).")] = None,
+    speed: SpeedOption = None,
     duration: Annotated[Optional[float], typer.Option(
         "--duration", metavar="S", help="Simulated time [s] (default 10).")] = None,
-    dt: Annotated[Optional[float], typer.Option(
-        "--dt", metavar="S", help="Fixed RK4 time step [s] (default 1e-4).")] = None,
-    output_rate: Annotated[Optional[float], typer.Option(
-        "--output-rate", metavar="HZ",
-        help="Sampling rate of the stored time histories [Hz] (default 1000); 1/(rate x dt) "
-             "must be a whole number.")] = None,
+    dt: DtOption = None,
+    output_rate: OutputRateOption = None,
     window: Annotated[Optional[str], typer.Option(
         "--window", metavar="START:END",
         help="Time window of the metrics [s], e.g. 2:10; either side may be empty "
@@ -1667,25 +1674,16 @@ def tune_command(
         "--scenario", metavar="NAME",
         help="paper-sine, bump, file:PATH, fra1..fra6, german-low or german-high, as for "
              "simulate.")] = "paper-sine",
-    amplitude: Annotated[Optional[float], typer.Option(
-        "--amplitude", metavar="M",
-        help="paper-sine: sine amplitude [m] (default 0.05). bump: bump height [m] "
-             "(default 0.02).")] = None,
-    wavelength: Annotated[Optional[float], typer.Option(
-        "--wavelength", metavar="M",
-        help="paper-sine: wavelength [m] (default 60). bump: bump length [m] (default 10).")] = None,
-    rail_phase: Annotated[Optional[float], typer.Option(
-        "--rail-phase", metavar="DEG",
-        help="paper-sine only: phase lag of the right rail [deg] (default 90).")] = None,
+    amplitude: AmplitudeOption = None,
+    wavelength: WavelengthOption = None,
+    rail_phase: RailPhaseOption = None,
     track_seed: TrackSeedOption = None,
     min_wavelength: MinWavelengthOption = None,
     max_wavelength: MaxWavelengthOption = None,
-    speed: Annotated[Optional[float], typer.Option(
-        "--speed", metavar="M/S", help="Vehicle speed [m/s] (default 55.56).")] = None,
+    speed: SpeedOption = None,
     duration: Annotated[Optional[float], typer.Option(
         "--duration", metavar="S", help="Simulated time of each run [s] (default 10).")] = None,
-    dt: Annotated[Optional[float], typer.Option(
-        "--dt", metavar="S", help="Fixed RK4 time step [s] (default 1e-4).")] = None,
+    dt: DtOption = None,
     damper: Annotated[str, typer.Option(
         "--damper", metavar="MODEL",
         help="MR damper model: railway, dyke1996 or spencer1997.")] = DEFAULT_DAMPER,
@@ -1710,16 +1708,9 @@ def tune_command(
         "--passes", metavar="N",
         help="At most N passes per phase (a phase stops early when a pass improves the "
              "objective by less than 0.1 %); >= 1.")] = 5,
-    workers: Annotated[Optional[int], typer.Option(
-        "--workers", metavar="N",
-        help="Local executor: threads of each batch, 1..cores (default: every core).")] = None,
-    scheduler: Annotated[Optional[str], typer.Option(
-        "--scheduler", metavar="ADDRESS",
-        help="Run on a Dask cluster: the scheduler's address, e.g. tcp://host:8786.")] = None,
-    scheduler_file: Annotated[Optional[Path], typer.Option(
-        "--scheduler-file", metavar="FILE",
-        help="Run on a Dask cluster whose scheduler wrote FILE (dask scheduler "
-             "--scheduler-file FILE).")] = None,
+    workers: WorkersOption = None,
+    scheduler: SchedulerOption = None,
+    scheduler_file: SchedulerFileOption = None,
     out: Annotated[Optional[Path], typer.Option(
         "--out", metavar="DIR",
         help="Keep the run table DIR/runs.csv (updated as runs finish) and write gains.toml, "
@@ -2017,8 +2008,7 @@ def sweep_command(
              "simulate.")] = "paper-sine",
     duration: Annotated[Optional[float], typer.Option(
         "--duration", metavar="S", help="Simulated time of each run [s] (default 10).")] = None,
-    dt: Annotated[Optional[float], typer.Option(
-        "--dt", metavar="S", help="Fixed RK4 time step [s] (default 1e-4).")] = None,
+    dt: DtOption = None,
     damper: Annotated[Optional[str], typer.Option(
         "--damper", metavar="MODEL",
         help="mr and controllers: MR damper model railway, dyke1996 or spencer1997 "
@@ -2030,15 +2020,9 @@ def sweep_command(
     window: Annotated[Optional[str], typer.Option(
         "--window", metavar="START:END",
         help="Time window of the metrics [s], e.g. 2:10 (default: the whole run).")] = None,
-    workers: Annotated[Optional[int], typer.Option(
-        "--workers", metavar="N",
-        help="Local executor: threads of each batch, 1..cores (default: every core).")] = None,
-    scheduler: Annotated[Optional[str], typer.Option(
-        "--scheduler", metavar="ADDRESS",
-        help="Run on a Dask cluster: the scheduler's address, e.g. tcp://host:8786.")] = None,
-    scheduler_file: Annotated[Optional[Path], typer.Option(
-        "--scheduler-file", metavar="FILE",
-        help="Run on a Dask cluster whose scheduler wrote FILE.")] = None,
+    workers: WorkersOption = None,
+    scheduler: SchedulerOption = None,
+    scheduler_file: SchedulerFileOption = None,
     out: Annotated[Optional[Path], typer.Option(
         "--out", metavar="DIR",
         help="Keep the run table DIR/runs.csv (updated as runs finish) and write sweep.json "

@@ -102,7 +102,8 @@ class BoucWen(_Damper):
     alpha_b: float = param("N/(m V)", "hysteretic force coefficient per volt", "nonnegative")
     c0a: float = param("N s/m", "viscous coefficient at 0 V", "nonnegative")
     c0b: float = param("N s/(m V)", "viscous coefficient per volt", "nonnegative")
-    k0: float = param("N/m", "stiffness (accumulator)", "nonnegative")
+    k0: float = param("N/m", "stiffness k0 (simple model: the accumulator; Spencer: in series "
+                             "with the hysteresis)", "nonnegative")
     A: float = param("-", "Bouc-Wen A: initial slope dz/dx")
     n: float = param("-", "Bouc-Wen exponent, >= 1")
     gamma: float = param("1/m^n", "Bouc-Wen gamma (multiplies |w| z |z|^(n-1))", "finite")
@@ -139,29 +140,19 @@ class BoucWen(_Damper):
 
 
 @dataclass(frozen=True)
-class Spencer(_Damper):
-    """Spencer et al. (1997) modified Bouc-Wen MR damper:
+class Spencer(BoucWen):
+    """Spencer et al. (1997) modified Bouc-Wen MR damper: the simple model's parameters plus a
+    dashpot c1 in series and an accumulator spring k1,
 
         F  = c1(u) y' + k1 x
         y' = (alpha(u) z + c0(u) x' + k0 (x - y)) / (c0(u) + c1(u))
         z' = Bouc-Wen of w = x' - y'
 
-    The dashpot c1 in series gives the force roll-off at low velocity that the simple model
+    where c0 is the high-velocity viscous coefficient and k0 the stiffness in series with the
+    hysteresis. The dashpot c1 gives the force roll-off at low velocity that the simple model
     lacks. x0 (accumulator preload position) is kept for the record; its preload is dropped.
     """
 
-    alpha_a: float = param("N/m", "hysteretic force coefficient at 0 V", "nonnegative")
-    alpha_b: float = param("N/(m V)", "hysteretic force coefficient per volt", "nonnegative")
-    c0a: float = param("N s/m", "high-velocity viscous coefficient at 0 V", "positive")
-    c0b: float = param("N s/(m V)", "high-velocity viscous coefficient per volt", "nonnegative")
-    k0: float = param("N/m", "stiffness in series with the hysteresis", "nonnegative")
-    A: float = param("-", "Bouc-Wen A")
-    n: float = param("-", "Bouc-Wen exponent, >= 1")
-    gamma: float = param("1/m^n", "Bouc-Wen gamma (multiplies |w| z |z|^(n-1))", "finite")
-    beta: float = param("1/m^n", "Bouc-Wen beta (multiplies w |z|^n)", "finite")
-    eta: float = param("1/s", "coil lag rate: u' = -eta (u - v)")
-    v_min: float = param("V", "lowest command voltage", "nonnegative")
-    v_max: float = param("V", "highest command voltage")
     c1a: float = param("N s/m", "low-velocity (series) viscous coefficient at 0 V", "positive")
     c1b: float = param("N s/(m V)", "low-velocity viscous coefficient per volt", "nonnegative")
     k1: float = param("N/m", "accumulator stiffness", "nonnegative")
@@ -169,20 +160,9 @@ class Spencer(_Damper):
     model = "spencer"
     law = LAW_SPENCER
 
-    def __post_init__(self):
-        validate_fields(self, "damper parameter")
-        _check_shape(self)
-
-    @property
-    def z_bound(self) -> float:
-        return (self.A / (self.gamma + self.beta)) ** (1.0 / self.n)
-
     def pack(self) -> np.ndarray:
-        p = np.zeros(N_PACKED)
-        p[:15] = [self.alpha_a, self.alpha_b, self.c0a, self.c0b, self.k0, self.A, self.n,
-                  self.gamma, self.beta, self.eta, self.v_min, self.v_max,
-                  self.c1a, self.c1b, self.k1]
-        p[15] = self.z_bound
+        p = super().pack()
+        p[12:15] = [self.c1a, self.c1b, self.k1]
         return p
 
     def rates(self, x, xd, z, y, u, v):

@@ -149,7 +149,7 @@ def _resolve_damper(damper):
         return None
     if isinstance(damper, str):
         return dampers.preset(damper)
-    if isinstance(damper, (dampers.Viscous, dampers.BoucWen, dampers.Spencer)):
+    if isinstance(damper, (dampers.Viscous, dampers.BoucWen)):  # Spencer is a BoucWen
         return damper
     raise ValueError(f"damper = {damper!r}: must be None (passive), a preset name "
                      f"({', '.join(dampers.PRESETS)}) or a model from railride.dampers")
