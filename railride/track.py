@@ -11,9 +11,10 @@ each wheelset: heights w_k and rail velocities w'_k. Between nodes the stepper i
 with cubic Hermite polynomials, which reproduce heights to O(Delta^4) and velocities to
 O(Delta^3). Because the nodes fall on step boundaries, every Runge-Kutta step sees a single
 smooth cubic and keeps its fourth order; halving dt doubles m and leaves the input unchanged.
-A profile that does not start at zero height (the paper sine with a rail phase, for instance)
-is 0 up to s = 0 and rises to its value within the first interval after a wheelset passes
-s = 0, as a smooth cubic ramp instead of an infinitely steep step.
+A profile that does not start at zero height (a measured profile, or the paper sine with its
+taper turned off) is 0 up to s = 0 and rises to its value within the first interval after a
+wheelset passes s = 0, as a smooth cubic ramp instead of an infinitely steep step. The paper sine
+by default enters through a raised-cosine taper over its first wavelength (`SineTrack`).
 """
 
 from __future__ import annotations
@@ -72,30 +73,47 @@ class RailProfile(ABC):
 
 @dataclass(frozen=True)
 class SineTrack(RailProfile):
-    """The paper's sine: z_L = A sin(2 pi s / lambda), z_R = A sin(2 pi s / lambda - psi)."""
+    """The paper's sine, entering through a raised-cosine taper of its amplitude:
+    z_L = r(s) A sin(2 pi s / lambda), z_R = r(s) A sin(2 pi s / lambda - psi), with
+    r(s) = (1 - cos(pi s / L)) / 2 for s < L = taper x lambda and r = 1 beyond.
+
+    The taper is what a vehicle sees running onto a section of periodic track: with psi = 90 deg
+    the right rail would otherwise start at -A, a 5 cm step at s = 0 that dominates peak values
+    and damper forces. r and r' vanish at s = 0, so heights and slopes are continuous there.
+    ``taper`` = 0 keeps the step (ramped over one input-grid interval, see the module notes).
+    """
 
     amplitude: float = 0.05  # m
     wavelength: float = 60.0  # m
     rail_phase_deg: float = 90.0  # deg, psi: right rail lags the left
+    taper: float = 1.0  # length of the entry taper, in wavelengths
 
     def __post_init__(self):
         object.__setattr__(self, "amplitude", _check("amplitude", self.amplitude, "nonnegative", "a finite number >= 0 (m)"))
         object.__setattr__(self, "wavelength", _check("wavelength", self.wavelength, "positive", "a finite number > 0 (m)"))
         object.__setattr__(self, "rail_phase_deg", _check("rail_phase", self.rail_phase_deg, "finite", "a finite angle in degrees"))
+        object.__setattr__(self, "taper", _check("taper", self.taper, "nonnegative", "a finite number >= 0 (wavelengths)"))
 
     def _evaluate(self, s):
         k = 2 * np.pi / self.wavelength
         psi = np.deg2rad(self.rail_phase_deg)
         A = self.amplitude
-        return (A * np.sin(k * s), A * np.sin(k * s - psi),
-                A * k * np.cos(k * s), A * k * np.cos(k * s - psi))
+        zl, zr = A * np.sin(k * s), A * np.sin(k * s - psi)
+        dzl, dzr = A * k * np.cos(k * s), A * k * np.cos(k * s - psi)
+        L = self.taper * self.wavelength
+        if L > 0:
+            inside = s < L
+            r = np.where(inside, 0.5 * (1 - np.cos(np.pi * s / L)), 1.0)
+            dr = np.where(inside, 0.5 * np.pi / L * np.sin(np.pi * s / L), 0.0)
+            zl, zr, dzl, dzr = r * zl, r * zr, r * dzl + dr * zl, r * dzr + dr * zr
+        return zl, zr, dzl, dzr
 
     def table_spacing(self):
         return self.wavelength / NODES_PER_FEATURE
 
     def describe(self):
         return {"profile": "sine", "amplitude_m": self.amplitude, "wavelength_m": self.wavelength,
-                "rail_phase_deg": self.rail_phase_deg}
+                "rail_phase_deg": self.rail_phase_deg, "taper_wavelengths": self.taper}
 
 
 @dataclass(frozen=True)
@@ -262,11 +280,12 @@ SCENARIOS = ("paper-sine", "bump", "file:PATH", "fra1..fra6", "german-low", "ger
 def scenario(name: str = "paper-sine", *, amplitude: float | None = None,
              wavelength: float | None = None, rail_phase: float | None = None,
              speed: float | None = None, duration: float | None = None, seed: int | None = None,
-             min_wavelength: float | None = None, max_wavelength: float | None = None) -> Scenario:
+             min_wavelength: float | None = None, max_wavelength: float | None = None,
+             taper: float | None = None) -> Scenario:
     """A named scenario with optional overrides.
 
     ``paper-sine``: amplitude [m], wavelength [m], rail_phase [deg] of the sine (defaults 0.05 m,
-    60 m, 90 deg). ``bump``: amplitude is the bump height [m] (negative for a dip, default 0.02 m)
+    60 m, 90 deg) and the length of its entry taper in wavelengths (default 1; 0 for none). ``bump``: amplitude is the bump height [m] (negative for a dip, default 0.02 m)
     and wavelength its length [m] (default 10 m), starting at s = 10 m on both rails.
     ``file:PATH``: a measured CSV profile (s, z_L, z_R). ``fra1`` ... ``fra6``, ``german-low``,
     ``german-high``: a random realisation of that spectrum (`RandomTrack`) with ``seed`` (default
@@ -280,10 +299,13 @@ def scenario(name: str = "paper-sine", *, amplitude: float | None = None,
     if random_only and name not in SPECTRA:
         raise ValueError(f"{', '.join(random_only)} applies to the random tracks "
                          f"({', '.join(SPECTRA)}) only, not to {name}")
+    if taper is not None and name != "paper-sine":
+        raise ValueError(f"taper applies to paper-sine only, not to {name}")
     if name == "paper-sine":
         track = SineTrack(amplitude=0.05 if amplitude is None else amplitude,
                           wavelength=60.0 if wavelength is None else wavelength,
-                          rail_phase_deg=90.0 if rail_phase is None else rail_phase)
+                          rail_phase_deg=90.0 if rail_phase is None else rail_phase,
+                          taper=1.0 if taper is None else taper)
     elif name == "bump":
         if rail_phase is not None:
             raise ValueError("rail_phase applies to paper-sine only, not to the bump scenario")

@@ -94,15 +94,18 @@ def element_table(p: VehicleParams) -> list[Element]:
             a = _point("carbody", x_b, y) - _point(bogie, 0.0, y)
             elements.append(Element(f"secondary vertical {bi}{side}", "secondary_vertical",
                                     p.k_sz, p.c_sz, a, zero_e))
-        # secondary lateral and longitudinal act through roll and pitch only
-        a = np.zeros(N_DOF)
-        a[2], a[o + 2] = p.h_cs, p.h_ts
-        elements.append(Element(f"secondary lateral {bi}", "secondary_lateral",
-                                p.k_sy, p.c_sy, a, zero_e))
-        a = np.zeros(N_DOF)
-        a[1], a[o + 1] = p.h_cs, p.h_ts
-        elements.append(Element(f"secondary longitudinal {bi}", "secondary_longitudinal",
-                                p.k_sx, p.c_sx, a, zero_e))
+        # secondary lateral and longitudinal act through roll and pitch only; one of each on
+        # each side of the bogie (the paper's eq. 2, 3, 5, 6 carry 2 k_sy, 2 k_sx per bogie and
+        # the appendix gives the values per side)
+        for side in ("R", "L"):
+            a = np.zeros(N_DOF)
+            a[2], a[o + 2] = p.h_cs, p.h_ts
+            elements.append(Element(f"secondary lateral {bi}{side}", "secondary_lateral",
+                                    p.k_sy, p.c_sy, a, zero_e))
+            a = np.zeros(N_DOF)
+            a[1], a[o + 1] = p.h_cs, p.h_ts
+            elements.append(Element(f"secondary longitudinal {bi}{side}", "secondary_longitudinal",
+                                    p.k_sx, p.c_sx, a, zero_e))
         for wheelset, x_axle in zip(wheelsets, (+p.b, -p.b)):
             for side, y in (("R", -p.d_p), ("L", +p.d_p)):
                 box = f"{wheelset}{side}"

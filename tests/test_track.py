@@ -8,7 +8,7 @@ from railride.vehicle import Vehicle
 
 
 def test_sine_rails_follow_the_spec_formula():
-    tr = SineTrack(amplitude=0.05, wavelength=60.0, rail_phase_deg=90.0)
+    tr = SineTrack(amplitude=0.05, wavelength=60.0, rail_phase_deg=90.0, taper=0.0)
     s = np.linspace(0.1, 200, 1000)
     zl, zr, dzl, dzr = tr.evaluate(s)
     assert np.allclose(zl, 0.05 * np.sin(2 * np.pi * s / 60))
@@ -17,6 +17,28 @@ def test_sine_rails_follow_the_spec_formula():
     assert np.allclose(tr.evaluate(s + 15.0)[1], zl, atol=1e-15)
     # slopes are the derivative of the heights
     assert np.allclose(dzl[1:-1], np.gradient(zl, s)[1:-1], rtol=0, atol=1e-5)
+
+
+def test_sine_enters_through_a_raised_cosine_taper_over_one_wavelength():
+    tr = SineTrack(amplitude=0.05, wavelength=60.0, rail_phase_deg=90.0)
+    plain = SineTrack(amplitude=0.05, wavelength=60.0, rail_phase_deg=90.0, taper=0.0)
+    s = np.linspace(0.01, 180.0, 18000)
+    zl, zr, dzl, dzr = tr.evaluate(s)
+    pl, pr, _, _ = plain.evaluate(s)
+    r = np.where(s < 60.0, np.sin(np.pi * s / 120.0) ** 2, 1.0)  # (1 - cos(pi s/L))/2
+    assert np.allclose(zl, r * pl, rtol=0, atol=1e-15) and np.allclose(zr, r * pr, rtol=0, atol=1e-15)
+    # no step: the right rail starts at 0, not at -A, and both heights and slopes are
+    # continuous at s = 0 and at the end of the taper
+    start = tr.evaluate(np.array([1e-6]))
+    assert all(abs(v[0]) < 1e-9 for v in start)
+    for v in (zl, zr, dzl, dzr):
+        assert np.abs(np.diff(v)).max() < 1e-4
+    # slopes are the derivative of the heights, taper included
+    assert np.allclose(dzr[1:-1], np.gradient(zr, s)[1:-1], rtol=0, atol=1e-6)
+    with pytest.raises(ValueError, match="taper = -1"):
+        SineTrack(taper=-1)
+    with pytest.raises(ValueError, match="taper applies to paper-sine only"):
+        scenario("bump", taper=1.0)
 
 
 def test_every_profile_is_level_before_the_start():
