@@ -1,6 +1,6 @@
 """The ``railride`` command line: ``railride compare``, ``railride modes``, ``railride frf``,
-``railride simulate``, ``railride damper``, ``railride tracking``, ``railride tune`` and
-``railride sweep``.
+``railride simulate``, ``railride damper``, ``railride tracking``, ``railride tune``,
+``railride pareto`` and ``railride sweep``.
 
 A thin layer over the library: it parses options, calls `railride.vehicle`, `railride.track`,
 `railride.simulation`, `railride.metrics`, `railride.dampers`, `railride.rig`,
@@ -8,8 +8,8 @@ A thin layer over the library: it parses options, calls `railride.vehicle`, `rai
 `railride.report`, and prints. See docs/cli.md.
 
 Exit statuses: 0 success, 1 the simulation diverged, 2 bad input (usage errors, invalid values,
-unreadable files, an output folder that cannot be written), 130 `tune` or `sweep` interrupted by
-Ctrl-C (the finished runs stay in DIR/runs.csv for --resume). Errors print one line
+unreadable files, an output folder that cannot be written), 130 `tune`, `pareto` or `sweep`
+interrupted by Ctrl-C (the finished runs stay in DIR/runs.csv for --resume). Errors print one line
 ``error: <message>`` on stderr, never a traceback.
 """
 
@@ -151,14 +151,31 @@ def _check_cycles(option: str, value: int) -> int:
     return value
 
 
-def _damper_preset(option: str, name: str):
-    """The damper preset ``name`` (railride.dampers.PRESETS), else ValueError naming the option."""
+def _damper_preset(option: str, name: str, *, rig: bool = False):
+    """The damper ``name`` (railride.dampers.NAMES: the MR presets and "ideal"), else ValueError
+    naming the option. ``rig``: the MR presets only (the ideal actuator has no force law to
+    drive on the rig)."""
     from . import dampers
 
-    if name not in dampers.PRESETS:
-        raise ValueError(f"{option} = {name!r}: unknown damper model; allowed: "
-                         f"{', '.join(dampers.PRESETS)}")
+    allowed = dampers.PRESETS if rig else dampers.NAMES
+    if name not in allowed:
+        why = (": the ideal actuator applies a vehicle controller's demand and has no force law "
+               "to drive on the rig" if name in dampers.IDEAL_NAMES else ": unknown damper model")
+        raise ValueError(f"{option} = {name!r}{why}; allowed: {', '.join(allowed)}")
     return dampers.preset(name)
+
+
+def _damper_scale(option: str, value: Optional[float], damper_name: str) -> float:
+    """--damper-scale: a finite number > 0 (default 1), not for the ideal actuator."""
+    if value is None:
+        return 1.0
+    from .dampers import IDEAL_NAMES
+
+    scale = _check_number(option, value, "")
+    if damper_name in IDEAL_NAMES:
+        raise ValueError(f"{option} = {scale:g}: the ideal actuator (--damper {damper_name}) applies "
+                         "the demand exactly and has no force capacity to scale")
+    return scale
 
 
 def _voltage(option: str, text: str, damper) -> float:
@@ -528,6 +545,17 @@ def _compare_comfort_table(rows: list[dict]):
     return table
 
 
+def _damper_text(settings: dict) -> str:
+    """"railway MR dampers", "railway MR dampers, force x 4" or "ideal actuators (force =
+    demand)" for the controlled suspensions of a compare or sweep document's settings."""
+    if settings.get("damper") == "ideal":
+        return "ideal actuators (force = demand)"
+    if settings.get("damper") == "ideal-damper":
+        return "ideal semi-active dampers (force = demand where it dissipates, else 0)"
+    scale = settings.get("damper_scale") or 1.0
+    return f"{settings['damper']} MR dampers" + (f", force x {scale:g}" if scale != 1.0 else "")
+
+
 def _compare_tables(doc: dict, vehicle: str, shipped: bool):
     """The three tables of `compare`: Table 1 beside the paper, peak-to-peak, damper demands."""
     from rich.markup import escape
@@ -549,7 +577,7 @@ def _compare_tables(doc: dict, vehicle: str, shipped: bool):
         noise_text = ("ideal measurements" if not noise else
                       "sensor noise z {displacement:g} m, angle {angle:g} rad, velocity {velocity:g} m/s, "
                       "rate {angular_rate:g} rad/s, seed {seed}".format(**noise))
-        info.append(f"{settings['damper']} MR dampers, controller {settings['control_rate_hz']:g} Hz, "
+        info.append(f"{_damper_text(settings)}, controller {settings['control_rate_hz']:g} Hz, "
                     f"{noise_text}")
         info.append(f"gains file {doc['gains']['source']}" + (" (shipped)" if shipped else ""))
     info.append("The paper's absolute values depend on settings it does not give (sine wavelength, "
@@ -598,7 +626,9 @@ def _compare_tables(doc: dict, vehicle: str, shipped: bool):
                         "-" if at_max is None else f"{at_max * 100:.1f}")
     demands_note = ("All four corners, over the metric window. force: the secondary damper force on "
                     "the carbody; travel: the secondary deflection (suspension travel); passive: "
-                    "the viscous dampers c_sz.")
+                    "the viscous dampers c_sz."
+                    + (" The ideal actuators have no voltage." if settings.get("damper")
+                       in ("ideal", "ideal-damper") and controlled else ""))
     parts = [table, Text("\n".join(info)), "", ptp, "", demands, Text(demands_note)]
     if all("comfort" in r for r in rows):
         parts += ["", _compare_comfort_table(rows)]
@@ -618,8 +648,13 @@ def compare(
              "[sas.ride] (default: the shipped railride/data/gains.toml).")] = None,
     damper: Annotated[str, typer.Option(
         "--damper", metavar="MODEL",
-        help="MR damper model of the controlled suspensions: railway, dyke1996 or "
-             "spencer1997.")] = DEFAULT_DAMPER,
+        help="Dampers of the controlled suspensions: the MR models railway, dyke1996 or "
+             "spencer1997, or ideal (an ideal actuator: force = the outer loop's demand, the "
+             "bound a semi-active damper approaches).")] = DEFAULT_DAMPER,
+    damper_scale: Annotated[Optional[float], typer.Option(
+        "--damper-scale", metavar="X",
+        help="Factor on the MR damper's force capacity, a finite number > 0 (every force "
+             "parameter times X; default 1). Not with --damper ideal.")] = None,
     control_rate: Annotated[float, typer.Option(
         "--control-rate", metavar="HZ",
         help="Sample rate of the outer-loop controllers [Hz]; 1/(rate x dt) must be a whole "
@@ -679,6 +714,7 @@ def compare(
         names = _controller_list(controllers)
         gain_set = _gain_set(gains)
         _damper_preset("--damper", damper)
+        scale = _damper_scale("--damper-scale", damper_scale, damper)
         noise = _sensor_noise(sensor_noise, seed)
         dt = DEFAULT_DT if dt is None else dt
         output_rate = DEFAULT_OUTPUT_RATE if output_rate is None else output_rate
@@ -703,7 +739,7 @@ def compare(
 
         with _Progress(_stderr_is_terminal(), describe) as progress:
             result = run_compare(scen, vehicle_params, controllers=names, gains=gain_set,
-                                 damper=damper, window=window_value, dt=dt,
+                                 damper=damper, damper_scale=scale, window=window_value, dt=dt,
                                  output_rate=output_rate, control_rate=control_rate,
                                  sensor_noise=noise, comfort=comfort,
                                  progress=progress if progress.enabled else None)
@@ -938,7 +974,9 @@ def _status(message: str):
 
 def _describe_suspension(record: dict) -> str:
     if record.get("type") == "mr":
-        return f"MR, {record['damper']} dampers at {record['voltage_v']:g} V"
+        scale = record.get("damper_scale", 1.0)
+        return (f"MR, {record['damper']} dampers" + (f" (force x {scale:g})" if scale != 1.0 else "")
+                + f" at {record['voltage_v']:g} V")
     return "passive (viscous c_sz)"
 
 
@@ -996,7 +1034,12 @@ def simulate(
     damper: Annotated[Optional[str], typer.Option(
         "--damper", metavar="MODEL",
         help="--suspension mr only: damper model railway, dyke1996 or spencer1997 "
-             "(default railway).")] = None,
+             "(default railway). The ideal actuator (ideal) needs a controller: see compare "
+             "and sweep.")] = None,
+    damper_scale: Annotated[Optional[float], typer.Option(
+        "--damper-scale", metavar="X",
+        help="--suspension mr only: factor on the damper's force capacity, a finite number > 0 "
+             "(every force parameter times X; default 1).")] = None,
     voltage: Annotated[Optional[str], typer.Option(
         "--voltage", metavar="V",
         help="--suspension mr only: constant command voltage [V] within the damper's range, or "
@@ -1015,7 +1058,7 @@ def simulate(
         track = _track_options(scenario, track_seed, min_wavelength, max_wavelength)
         doc, result = _run(scenario, amplitude, wavelength, rail_phase, speed, duration, dt,
                            output_rate, window, params, preset, out, suspension, damper, voltage,
-                           track=track, comfort=comfort)
+                           track=track, comfort=comfort, damper_scale=damper_scale)
     if format is OutputFormat.json:
         _print_json(doc)
     else:
@@ -1025,12 +1068,13 @@ def simulate(
             console.print(_comfort_table(doc["comfort"]))
 
 
-def _suspension(suspension: str, damper_name, voltage_text):
+def _suspension(suspension: str, damper_name, voltage_text, damper_scale=None):
     """(damper model or None, command voltage or None, the record for the JSON document)."""
     if suspension not in SUSPENSIONS:
         raise ValueError(f"--suspension = {suspension!r}: allowed {', '.join(SUSPENSIONS)}")
     if suspension == "passive":
-        given = [o for o, v in (("--damper", damper_name), ("--voltage", voltage_text)) if v is not None]
+        given = [o for o, v in (("--damper", damper_name), ("--damper-scale", damper_scale),
+                                ("--voltage", voltage_text)) if v is not None]
         if given:
             verb = "applies" if len(given) == 1 else "apply"
             raise ValueError(f"{' and '.join(given)} {verb} to --suspension mr only (the passive "
@@ -1038,13 +1082,23 @@ def _suspension(suspension: str, damper_name, voltage_text):
         return None, None, {"type": "passive"}
     name = DEFAULT_DAMPER if damper_name is None else damper_name
     model = _damper_preset("--damper", name)
+    if name in ("ideal", "ideal-damper"):  # simulate runs open loop: no demand for it to apply
+        raise ValueError(f"--damper = {name!r}: the ideal actuator applies a controller's demand and "
+                         "simulate runs no controller (a constant voltage); use railride compare "
+                         "--damper ideal or railride sweep --damper ideal with a controller")
+    scale = _damper_scale("--damper-scale", damper_scale, name)
+    if scale != 1.0:
+        model = model.scaled(scale)
     volts = model.v_min if voltage_text is None else _voltage("--voltage", voltage_text, model)
-    return model, float(volts), {"type": "mr", "damper": name, "voltage_v": float(volts)}
+    record = {"type": "mr", "damper": name, "voltage_v": float(volts)}
+    if damper_scale is not None:  # only then: the document stays as it was without the option
+        record["damper_scale"] = scale
+    return model, float(volts), record
 
 
 def _run(scenario_name, amplitude, wavelength, rail_phase, speed, duration, dt, output_rate,
          window_text, params_file, preset, out, suspension="passive", damper_name=None,
-         voltage_text=None, track=None, comfort=False):
+         voltage_text=None, track=None, comfort=False, damper_scale=None):
     from . import report
     from .metrics import check_window, parse_window, to_dict
     from .simulation import DEFAULT_DT, DEFAULT_OUTPUT_RATE, simulate as run_simulation
@@ -1052,7 +1106,8 @@ def _run(scenario_name, amplitude, wavelength, rail_phase, speed, duration, dt, 
     dt = DEFAULT_DT if dt is None else dt
     output_rate = DEFAULT_OUTPUT_RATE if output_rate is None else output_rate
     vehicle_params, vehicle_record = _vehicle_params(params_file, preset)
-    damper, voltage, suspension_record = _suspension(suspension, damper_name, voltage_text)
+    damper, voltage, suspension_record = _suspension(suspension, damper_name, voltage_text,
+                                                     damper_scale)
     window = parse_window(window_text) if window_text is not None else None
     scen = _make_scenario(scenario_name, dict(amplitude=amplitude, wavelength=wavelength,
                                               rail_phase=rail_phase, speed=speed,
@@ -1116,7 +1171,7 @@ def damper(
     with _errors():
         from . import report, rig
 
-        damper_model = _damper_preset("--model", model)
+        damper_model = _damper_preset("--model", model, rig=True)
         amplitude = _check_number("--amplitude", amplitude, "m")
         frequency = _check_number("--frequency", frequency, "Hz")
         volts = _voltage_list("--voltage", voltage, damper_model)
@@ -1203,7 +1258,7 @@ def tracking(
 
         if desired not in DESIRED_SIGNALS:
             raise ValueError(f"--desired = {desired!r}: allowed {', '.join(DESIRED_SIGNALS)}")
-        damper_model = _damper_preset("--model", model)
+        damper_model = _damper_preset("--model", model, rig=True)
         amplitude = _check_number("--amplitude", amplitude, "N")
         frequency = _check_number("--frequency", frequency, "Hz")
         gain_b = _check_number("--B", gain_b, "", allow_zero=True)
@@ -1269,7 +1324,7 @@ def tracking(
 
 
 # -- tune and sweep: many runs ------------------------------------------------------------------
-SCHEMA_TUNE = "railride.tune/1"
+SCHEMA_TUNE = "railride.tune/2"
 SCHEMA_SWEEP = "railride.sweep/1"
 
 #: the controllers a gain table acts in (a --gain of `sweep` combines with these only)
@@ -1447,9 +1502,53 @@ def _check_int(option: str, value: int, minimum: int, what: str = "") -> int:
     return value
 
 
-def _objective(weights: str, penalty: float):
-    from .tuning import Objective
+def _objective(kind: Optional[str], weights: Optional[str], bound: Optional[str],
+               penalty: Optional[str]):
+    """--objective, --weights, --bound, --penalty -> a tuning.Objective. Without --objective,
+    the library's DEFAULT_OBJECTIVE; an option not given keeps that default's value when the
+    kind is the default's (weights and bound belong to their kind only)."""
+    from .tuning import DEFAULT_OBJECTIVE, OBJECTIVE_KINDS, Objective
 
+    name = DEFAULT_OBJECTIVE.kind if kind is None else kind.strip()
+    if name not in OBJECTIVE_KINDS:
+        raise ValueError(f"--objective = {kind!r}: unknown objective; allowed: "
+                         f"{', '.join(OBJECTIVE_KINDS)}")
+    default = DEFAULT_OBJECTIVE if name == DEFAULT_OBJECTIVE.kind else Objective()
+    which = f"--objective is {name}" if kind is not None else f"the default objective is {name}"
+    w = default.weights if name == "weighted" else None
+    if weights is not None:
+        if name != "weighted":
+            raise ValueError(f"--weights = {weights!r}: applies to --objective weighted only "
+                             f"({which})")
+        w = _weights(weights)
+    if name == "weighted" and w is None:
+        raise ValueError("--objective weighted needs --weights A,D,P,R: four numbers >= 0, not "
+                         "all 0 (acceleration, displacement, pitch, roll)")
+    b = default.bound if name == "constrained" else None
+    if bound is not None:
+        if name != "constrained":
+            raise ValueError(f"--bound = {bound!r}: applies to --objective constrained only "
+                             f"({which})")
+        b = _parse_float("--bound", bound, bound, " (the largest RMS ratio to passive allowed)")
+        if b <= 0:
+            raise ValueError(f"--bound = {bound!r}: must be a finite number > 0 (the largest "
+                             "RMS ratio to passive allowed for every response)")
+    if name == "constrained" and b is None:
+        raise ValueError("--objective constrained needs --bound X: the largest RMS ratio to "
+                         "passive allowed for every response, a finite number > 0")
+    p = default.penalty
+    if penalty is not None:
+        p = _parse_float("--penalty", penalty, penalty)
+        if p < 0:
+            raise ValueError(f"--penalty = {penalty!r}: must be a finite number >= 0")
+    try:
+        return Objective(name, w, b, p)
+    except ValueError as exc:  # what the checks above cannot see, e.g. a bound too large
+        raise ValueError(f"--objective {name}: {exc}") from None
+
+
+def _weights(weights: str) -> tuple:
+    """--weights A,D,P,R -> four numbers >= 0, not all 0."""
     items = [item.strip() for item in weights.split(",")]
     if len(items) != 4:
         raise ValueError(f"--weights = {weights!r}: expected four numbers A,D,P,R (acceleration, "
@@ -1465,17 +1564,16 @@ def _objective(weights: str, penalty: float):
         values.append(value)
     if sum(values) == 0:
         raise ValueError(f"--weights = {weights!r}: at least one weight must be > 0")
-    if not (math.isfinite(penalty) and penalty >= 0):
-        raise ValueError(f"--penalty = {penalty:g}: must be a finite number >= 0")
-    return Objective(tuple(values), float(penalty))
+    return tuple(values)
 
 
 def _phase_list(items: Optional[list[str]]) -> list[str]:
-    """--phase (repeatable, comma lists, `all`) -> the phases in the order they run."""
-    from .tuning import PHASES
+    """--phase (repeatable, comma lists, `all`) -> the phases in the order they run; none
+    given: the library's default (all four)."""
+    from .tuning import PHASES, tune
 
     if not items:
-        return ["attitude", "ride"]
+        return list(_default_of(tune, "phases"))
     wanted = set()
     for text in items:
         names = [n.strip() for n in text.split(",")]
@@ -1540,10 +1638,16 @@ def _before_after(result, start, phases, scenario_name, options, damper, executo
 
 
 def _objective_text(objective) -> str:
-    w = ", ".join(f"{name} {v:g}" for name, v in zip(("acceleration", "displacement", "pitch", "roll"),
-                                                      objective.weights))
-    return (f"sum of w_k RMS_k / RMS_k(passive), weights {w}; penalty {objective.penalty:g} x "
-            "any ratio above 1")
+    """The objective's full statement (formula, weights, bound, penalty, infeasible rule)."""
+    return objective.describe()
+
+
+def _toml_inline(record: dict) -> str:
+    """A flat record of strings, numbers and booleans as a TOML inline table (JSON spells those
+    values as TOML does; None has no TOML form and is left out)."""
+    items = [f"{k} = {json.dumps(v)}" for k, v in record.items()
+             if v is not None and not isinstance(v, (dict, list))]
+    return "{" + ", ".join(items) + "}"
 
 
 def _tuned_gains_text(doc: dict, gains, scenario_text: str, objective) -> str:
@@ -1560,10 +1664,11 @@ def _tuned_gains_text(doc: dict, gains, scenario_text: str, objective) -> str:
         "# railride controller gains, tuned by `railride tune` (the paper's sensitivity study,",
         "# spec section 9; docs/cli.md). Read by `railride compare --gains FILE`.",
         f"# date: {doc['date']}; railride {doc['railride_version']}",
-        f"# scenario: {run_text}, dt {s['dt_s']:g} s, {s['damper']} MR dampers",
+        f"# scenario: {run_text}, dt {s['dt_s']:g} s, {_damper_text(s)}",
         f"# objective: {_objective_text(objective)}",
         f"# phases: {phases}; {s['values']} values from 1/{s['span']:g} to {s['span']:g} x the "
-        f"current value (and 0) per gain, passes: at most {s['max_passes']}",
+        f"current value (and 0) per gain, passes: at most {s['max_passes']}"
+        + ("; the ride phase starts from zero ride gains" if "ride" in doc["phases"] else ""),
         f"# start values: {s['start_gains']}",
         f"# runs: {doc['runs']}; final objective: {finals}",
         "# Units: SI. Forces are desired forces on the carbody (up +) at corners 1R, 1L, 2R, 2L.",
@@ -1576,6 +1681,8 @@ def _tuned_gains_text(doc: dict, gains, scenario_text: str, objective) -> str:
         f"damper = {json.dumps(s['damper'])}",
         f"dt_s = {s['dt_s']!r}",
         f"objective = {json.dumps(_objective_text(objective))}",
+        # the exact track, so a study judging these gains can tell whether it is the same one
+        f"scenario_record = {_toml_inline(doc['scenario'])}",
         f"phases = {json.dumps(doc['phases'])}",
         f"runs = {int(doc['runs'])}",
         f"start_gains = {json.dumps(s['start_gains'])}",
@@ -1599,11 +1706,18 @@ def _tune_tables(doc: dict, start, tuned, scenario_text: str):
     passes.add_column("pass", justify="right")
     passes.add_column("objective", justify="right")
     passes.add_column("change %", justify="right")
+    infeasible = doc["objective"].get("infeasible")  # constrained: J >= offset breaks the bound
+    if infeasible:
+        passes.add_column("within\nbound")
     previous = {}
     for h in doc["history"]:
         before = previous.get(h["phase"])
         change = "" if before is None else f"{(h['objective'] - before) / abs(before) * 100:+.2f}"
-        passes.add_row(h["phase"], str(h["pass"]), f"{h['objective']:.4f}", change)
+        cells = [h["phase"], str(h["pass"]), f"{h['objective']:.4f}", change]
+        if infeasible:
+            cells.append("" if h["phase"] == "inner" else
+                         "yes" if h["objective"] < infeasible["offset"] else "no")
+        passes.add_row(*cells)
         previous[h["phase"]] = h["objective"]
     parts += [passes, Text("objective: " + _objective_text_from_doc(doc) + "; inner phase: the "
                            "normalised force-tracking error on the damper rig"), ""]
@@ -1647,7 +1761,7 @@ def _tune_tables(doc: dict, start, tuned, scenario_text: str):
     s = doc["settings"]
     parts.append(Text("\n".join([
         f"{scenario_text}, {doc['scenario'].get('duration_s', 0):g} s, dt {s['dt_s']:g} s, "
-        f"{s['damper']} MR dampers; start gains {s['start_gains']}",
+        f"{_damper_text(s)}; start gains {s['start_gains']}",
         "red. % = (passive - controlled) / passive x 100 (negative: worse than passive, in red)",
         f"{doc['runs']} runs in the run table, {doc['runs_evaluated']} evaluated now "
         f"({doc['runs_per_second']:.1f} runs/s), wall time {doc['wall_time_s']:.1f} s",
@@ -1655,11 +1769,15 @@ def _tune_tables(doc: dict, start, tuned, scenario_text: str):
     return parts
 
 
-def _objective_text_from_doc(doc: dict) -> str:
-    from .tuning import Objective
+def _tune_start(path: Optional[Path]):
+    """--gains FILE, else the neutral reference gains (the library's default start)."""
+    from .control import GainSet
 
-    o = doc["objective"]
-    return _objective_text(Objective(tuple(o["weights"].values()), o["penalty"]))
+    return GainSet.reference() if path is None else _gain_set(path)
+
+
+def _objective_text_from_doc(doc: dict) -> str:
+    return doc["objective"]["statement"]
 
 
 @app.command("tune")
@@ -1668,8 +1786,8 @@ def tune_command(
         "--phase", metavar="PHASE[,PHASE...]",
         help="Tuning phases, repeatable or comma-separated: inner (B, G on the damper rig's "
              "force tracking), pid, attitude (the six SAS attitude gains, ride loop off), ride "
-             "(the eight ride gains, attitude fixed), all (= inner,pid,attitude,ride). They run "
-             "in that order. Default: attitude,ride (the paper's two phases).")] = None,
+             "(the eight ride gains from 0, attitude fixed), all (= inner,pid,attitude,ride). "
+             "They run in that order. Default: all.")] = None,
     scenario: Annotated[str, typer.Option(
         "--scenario", metavar="NAME",
         help="paper-sine, bump, file:PATH, fra1..fra6, german-low or german-high, as for "
@@ -1686,18 +1804,31 @@ def tune_command(
     dt: DtOption = None,
     damper: Annotated[str, typer.Option(
         "--damper", metavar="MODEL",
-        help="MR damper model: railway, dyke1996 or spencer1997.")] = DEFAULT_DAMPER,
+        help="MR damper model: railway, dyke1996 or spencer1997 (ideal, the ideal actuator, "
+             "without the inner phase).")] = DEFAULT_DAMPER,
     gains: Annotated[Optional[Path], typer.Option(
         "--gains", metavar="FILE.toml",
-        help="Start values: a gains file as for compare (default: the shipped gains).")] = None,
-    weights: Annotated[str, typer.Option(
+        help="Start values: a gains file as for compare (default: the neutral reference gains, "
+             "railride/data/reference_gains.toml).")] = None,
+    objective_kind: Annotated[Optional[str], typer.Option(
+        "--objective", metavar="KIND",
+        help="What each run's RMS ratios to passive r_k (acceleration, displacement, pitch, "
+             "roll) are scored by: sum (sum of r_k), weighted (sum of w_k r_k, --weights), "
+             "minimax (the largest r_k), constrained (sum of r_k with every r_k <= --bound). "
+             "Default: the library's DEFAULT_OBJECTIVE; the statement is printed with the "
+             "result.")] = None,
+    weights: Annotated[Optional[str], typer.Option(
         "--weights", metavar="A,D,P,R",
-        help="Objective weights of the RMS ratios to passive: acceleration, displacement, pitch, "
-             "roll; >= 0, not all 0.")] = "1,1,1,1",
-    penalty: Annotated[float, typer.Option(
+        help="--objective weighted: the weights of acceleration, displacement, pitch, roll; "
+             ">= 0, not all 0.")] = None,
+    bound: Annotated[Optional[str], typer.Option(
+        "--bound", metavar="X",
+        help="--objective constrained: the largest RMS ratio to passive allowed for every "
+             "response, > 0.")] = None,
+    penalty: Annotated[Optional[str], typer.Option(
         "--penalty", metavar="X",
-        help="Added to the objective: X times every RMS ratio above 1 (a response worse than "
-             "passive); >= 0.")] = 0.0,
+        help="Added to any objective: X times the sum of the RMS ratios above 1 (responses "
+             "worse than passive); >= 0 (default 0).")] = None,
     values: Annotated[int, typer.Option(
         "--values", metavar="N",
         help="Log-spaced values per gain and pass, from 1/span to span times the current value "
@@ -1725,9 +1856,9 @@ def tune_command(
 
     One gain at a time is swept over log-spaced values (and 0) with the others fixed; the best
     value is kept; passes repeat until a pass gains less than 0.1 %. Each run is scored by the
-    sum of its RMS carbody responses relative to passive. Prints the objective per pass, the
-    tuned gains and the RMS with the start and the tuned gains. Ctrl-C stops; with --out,
-    --resume continues.
+    objective (--objective) over its RMS carbody responses relative to passive. Prints the
+    objective per pass, the tuned gains and the RMS with the start and the tuned gains. Ctrl-C
+    stops; with --out, --resume continues.
     """
     import time
 
@@ -1737,8 +1868,12 @@ def tune_command(
 
         phases = _phase_list(phase)
         _damper_preset("--damper", damper)
-        start = _gain_set(gains)
-        objective = _objective(weights, penalty)
+        if damper == "ideal" and "inner" in phases:
+            raise ValueError("--damper = 'ideal' with the inner phase (--phase "
+                             f"{','.join(phases)}): the ideal actuator has no force tracking "
+                             "loop to tune; give --phase pid,attitude,ride")
+        start = _tune_start(gains)
+        objective = _objective(objective_kind, weights, bound, penalty)
         _check_int("--values", values, 3)
         if not (math.isfinite(span) and span > 1):
             raise ValueError(f"--span = {span:g}: must be a finite number > 1")
@@ -1776,8 +1911,7 @@ def tune_command(
                 "settings": {"damper": damper, "dt_s": float(dt), "values": values,
                              "span": float(span), "max_passes": passes, "tolerance": tol,
                              "start_gains": start.source},
-                "objective": {"weights": dict(zip(RESPONSES, objective.weights)),
-                              "penalty": float(objective.penalty)},
+                "objective": objective.to_dict(),
                 "passive_rms": {r: float(result.passive[r]) for r in RESPONSES},
                 "history": [{"phase": h["phase"], "pass": int(h["pass"]),
                              "objective": float(h["objective"])} for h in result.history],
@@ -1795,9 +1929,14 @@ def tune_command(
             text = json.dumps(doc, indent=2, allow_nan=False)
             if out is not None:
                 gains_text = _tuned_gains_text(doc, result.gains, scenario_text, objective)
-                title = (f"Sensitivity of the tuning objective - {scenario_text}, "
-                         f"{scen.duration:g} s, {damper} dampers\n"
-                         f"phases {', '.join(phases)}; {_objective_text(objective)}")
+                import textwrap
+
+                # the objective's statement is long: wrapped to fit the narrowest figure
+                title = "\n".join([
+                    (f"Sensitivity of the tuning objective - {scenario_text}, "
+                     f"{scen.duration:g} s, {damper} dampers"),
+                    *textwrap.wrap(f"phases {', '.join(phases)}; {_objective_text(objective)}",
+                                   100)])
                 _write_folder(out, lambda: report.write_tune_outputs(
                     result.curves, out, doc, gains_text, title=title))
     finally:
@@ -1807,6 +1946,145 @@ def tune_command(
         return
     console = _wide_stdout_console()
     for part in _tune_tables(doc, start, result.gains, scenario_text):
+        console.print(part)
+
+
+# -- pareto -------------------------------------------------------------------------------------
+def _pareto_table(doc: dict, caption: str):
+    """Counts, then the samples non-dominated over the four ratios by acceleration ratio."""
+    from rich.table import Table
+
+    from .pareto import PROJECTIONS
+
+    c = doc["counts"]
+    counts = Table(title="Pareto view: samples and non-dominated samples")
+    counts.add_column("samples (with the base gains)", justify="right")
+    counts.add_column("non-dominated\nover all four ratios", justify="right")
+    for x, y in PROJECTIONS:
+        counts.add_column(f"non-dominated in\n{x} and {y}", justify="right")
+    counts.add_row(str(c["samples"]), str(c["non_dominated"]),
+                   *[str(c[f"non_dominated_{x}_{y}"]) for x, y in PROJECTIONS])
+    front = sorted((r for r in doc["samples"] if r["non_dominated"]),
+                   key=lambda r: (r["acceleration_m_s2_ratio"] is None,
+                                  r["acceleration_m_s2_ratio"] or 0.0))
+    rows = Table(title="Non-dominated samples by acceleration ratio: RMS / RMS(passive)",
+                 caption=caption, caption_justify="left")
+    rows.add_column("sample", justify="right")
+    for label in RESPONSE_LABELS.values():
+        rows.add_column(label.split(" (")[0], justify="right")
+    rows.add_column("also non-dominated\nagainst acceleration in")
+    for r in front:
+        planes = ", ".join(y for x, y in PROJECTIONS if r[f"non_dominated_{x}_{y}"])
+        rows.add_row(f"{r['sample']}" + (" (base)" if r["base"] else ""),
+                     *[_fmt(r[f"{key}_ratio"], ".3f") for key in RESPONSE_LABELS], planes)
+    return [counts, "", rows]
+
+
+@app.command("pareto")
+def pareto_command(
+    suspension: Annotated[str, typer.Option(
+        "--suspension", metavar="NAME",
+        help="The controller whose gains are sampled: pid, sas-attitude or sas-attitude-ride "
+             "(every outer-loop gain it reads).")] = "sas-attitude-ride",
+    samples: Annotated[Optional[int], typer.Option(
+        "--samples", metavar="N",
+        help="Sobol' samples of the gains, a power of two (default 128); the base gains are "
+             "run too.")] = None,
+    seed: Annotated[int, typer.Option(
+        "--seed", metavar="S", help="Seed of the scrambled Sobol' sample, >= 0.")] = 0,
+    scenario: Annotated[str, typer.Option(
+        "--scenario", metavar="NAME",
+        help="paper-sine, bump, file:PATH, fra1..fra6, german-low or german-high, as for "
+             "simulate.")] = "paper-sine",
+    amplitude: AmplitudeOption = None,
+    wavelength: WavelengthOption = None,
+    rail_phase: RailPhaseOption = None,
+    track_seed: TrackSeedOption = None,
+    min_wavelength: MinWavelengthOption = None,
+    max_wavelength: MaxWavelengthOption = None,
+    speed: SpeedOption = None,
+    duration: Annotated[Optional[float], typer.Option(
+        "--duration", metavar="S", help="Simulated time of each run [s] (default 10).")] = None,
+    dt: DtOption = None,
+    damper: Annotated[str, typer.Option(
+        "--damper", metavar="MODEL",
+        help="Dampers of the controlled runs: railway, dyke1996, spencer1997 or ideal.")] = DEFAULT_DAMPER,
+    gains: Annotated[Optional[Path], typer.Option(
+        "--gains", metavar="FILE.toml",
+        help="Base gains: the gains not sampled (the inner loop's among them), and one sample "
+             "of their own (default: the shipped gains).")] = None,
+    workers: WorkersOption = None,
+    scheduler: SchedulerOption = None,
+    scheduler_file: SchedulerFileOption = None,
+    out: Annotated[Optional[Path], typer.Option(
+        "--out", metavar="DIR",
+        help="Keep the run table DIR/runs.csv (updated as runs finish) and write pareto.png, "
+             "pareto.csv and pareto.json into DIR at the end.")] = None,
+    resume: Annotated[bool, typer.Option(
+        "--resume",
+        help="Continue the study whose run table is DIR/runs.csv (needs --out).")] = False,
+    format: FormatOption = OutputFormat.table,
+) -> None:
+    """The trades a controller's gains offer: RMS ratios to passive of sampled gains.
+
+    Samples the gains in log10 over the box of the global optimiser (REFERENCE / 1000 to
+    REFERENCE x 100) by a scrambled Sobol' sequence, runs them and the base gains, and marks the
+    samples no other beats in every ratio (non-dominated). Prints the counts and the
+    non-dominated samples by acceleration ratio. Ctrl-C stops; with --out, --resume continues.
+    """
+    import time
+
+    with _errors():
+        from . import pareto as pareto_lib
+        from . import report
+        from .simulation import DEFAULT_DT, DEFAULT_OUTPUT_RATE
+
+        if suspension not in pareto_lib.CONTROLLER_PARAMETERS:
+            raise ValueError(f"--suspension = {suspension!r}: allowed "
+                             f"{', '.join(pareto_lib.CONTROLLER_PARAMETERS)}")
+        n = _default_of(pareto_lib.pareto, "n_samples") if samples is None else samples
+        if n < 1 or n & (n - 1):
+            raise ValueError(f"--samples = {n}: must be a power of two (1, 2, 4, ..., 128, "
+                             "...), which keeps the balance of the Sobol' sample")
+        _check_int("--seed", seed, 0)
+        _damper_preset("--damper", damper)
+        base = _gain_set(gains)
+        dt = DEFAULT_DT if dt is None else _check_number("--dt", dt, "s")
+        options = _scenario_options(amplitude=amplitude, wavelength=wavelength,
+                                    rail_phase=rail_phase, speed=speed, duration=duration)
+        options.update(_track_options(scenario, track_seed, min_wavelength, max_wavelength))
+        scen = _make_scenario(scenario, options, DEFAULT_OUTPUT_RATE, "the runs' output rate")
+        options = _case_options(options)
+        scenario_text = report.describe_scenario(scen.describe())
+        table, table_path = _run_table(out, resume)
+        executor, executor_record = _executor(workers, scheduler, scheduler_file)
+    try:
+        with _interruptible(table, table_path), _errors():
+            with _RunProgress(_stderr_is_terminal(), "sampling the gains") as progress:
+                t0 = time.perf_counter()
+                result = pareto_lib.pareto(suspension, n_samples=n, seed=seed, scenario=scenario,
+                                           scenario_options=options, gains=base, damper=damper,
+                                           executor=executor, table=table, dt=dt,
+                                           progress=progress)
+                wall = time.perf_counter() - t0
+            doc = result.to_dict()
+            if out is not None:
+                _write_folder(out, lambda: result.save(out))
+    finally:
+        executor.close()
+    if format is OutputFormat.json:
+        _print_json(doc)
+        return
+    st = doc["settings"]
+    lines = [(f"{scenario_text}, {scen.duration:g} s, dt {dt:g} s, {_damper_text(st)}; base "
+              f"gains {st['base_gains']}"),
+             f"{st['n_samples']} samples, seed {st['seed']}: {st['sampling']}",
+             (f"{doc['runs']} runs in the run table, {progress.evaluated} evaluated now, wall "
+              f"time {wall:.1f} s ({executor_record['type']})")]
+    if doc["note"]:
+        lines.append(doc["note"])
+    console = _wide_stdout_console()
+    for part in _pareto_table(doc, "\n".join(lines)):
         console.print(part)
 
 
@@ -1921,6 +2199,7 @@ def _sweep_table(rows: list[dict], grid_columns: list[str], caption: str):
         heading = {"speed_m_s": "speed\n(m/s)", "wavelength_m": "wavelength\n(m)",
                    "amplitude_m": "amplitude\n(m)", "rail_phase_deg": "rail phase\n(deg)",
                    "voltage_v": "voltage\n(V)", "track_seed": "track\nseed",
+                   "damper_scale": "damper\nscale",
                    "seed": "noise\nseed"}.get(c, c)
         table.add_column(escape(heading), justify="left" if c == "suspension" else "right",
                          no_wrap=c == "suspension")
@@ -2012,7 +2291,13 @@ def sweep_command(
     damper: Annotated[Optional[str], typer.Option(
         "--damper", metavar="MODEL",
         help="mr and controllers: MR damper model railway, dyke1996 or spencer1997 "
-             "(default railway).")] = None,
+             "(default railway); controllers only: ideal, an ideal actuator whose force is the "
+             "outer loop's demand.")] = None,
+    damper_scale: Annotated[Optional[str], typer.Option(
+        "--damper-scale", metavar="VALUES",
+        help="mr and controllers: factors on the MR damper's force capacity (every force "
+             "parameter times X), finite numbers > 0, a range or a list (default 1); a grid "
+             "axis. passive runs once, unscaled; not with --damper ideal.")] = None,
     gains: Annotated[Optional[Path], typer.Option(
         "--gains", metavar="FILE.toml",
         help="Controllers: the base gains that --gain changes (default: the shipped "
@@ -2091,8 +2376,23 @@ def sweep_command(
         if damper is not None and not (has_mr or controllers):
             raise ValueError(f"--damper = {damper!r}: applies to mr and the controllers only "
                              f"(--suspension is {listed})")
+        if damper_scale is not None and not (has_mr or controllers):
+            raise ValueError(f"--damper-scale = {damper_scale!r}: applies to mr and the "
+                             f"controllers only (--suspension is {listed})")
         damper_name = DEFAULT_DAMPER if damper is None else damper
         damper_model = _damper_preset("--damper", damper_name)
+        if damper_name in ("ideal", "ideal-damper") and has_mr:
+            raise ValueError(f"--damper = {damper_name!r}: applies to the controllers only; mr runs at a "
+                             f"constant voltage, which the ideal actuator has not (--suspension "
+                             f"is {listed})")
+        scales = [1.0]
+        if damper_scale is not None:
+            if damper_name in ("ideal", "ideal-damper"):
+                raise ValueError(f"--damper-scale = {damper_scale!r}: the ideal actuator "
+                                 f"(--damper {damper_name}) applies the demand exactly and has no force "
+                                 "capacity to scale")
+            scales = [_check_number("--damper-scale", v, "")
+                      for v in _value_list("--damper-scale", damper_scale)]
 
         # the grid axes
         track = _track_options(scenario, None, min_wavelength, max_wavelength)
@@ -2167,6 +2467,8 @@ def sweep_command(
 
         # the cases, with the grid values each row reports
         grid_columns = ["suspension"] + [column for _, _, column, _ in axes]
+        if damper_scale is not None:
+            grid_columns.append("damper_scale")
         if has_mr:
             grid_columns.append("voltage_v")
         grid_columns += [name for name, _ in gain_axes]
@@ -2183,22 +2485,29 @@ def sweep_command(
                     cases.append(sweep_lib.Case(scenario, options))
                     grid.append(base)
                 elif s == "mr":
-                    for v in volts:
-                        cases.append(sweep_lib.Case(scenario, options, suspension="mr",
-                                                    damper=damper_name, voltage=v))
-                        grid.append({**base, "voltage_v": v})
+                    for x in scales:
+                        for v in volts:
+                            cases.append(sweep_lib.Case(scenario, options, suspension="mr",
+                                                        damper=damper_name, voltage=v,
+                                                        damper_scale=x))
+                            grid.append({**base, "voltage_v": v,
+                                         **({"damper_scale": x} if damper_scale is not None else {})})
                 else:
                     mine = [(n, vs) for n, vs in gain_axes if s in GAIN_CONTROLLERS[n.partition(".")[0]]]
-                    for values in itertools.product(*[vs for _, vs in mine]):
-                        changes = tuple(zip([n for n, _ in mine], values))
-                        for sd in (seeds if noise_values is not None else [0]):
-                            cases.append(sweep_lib.Case(
-                                scenario, options, suspension=s, damper=damper_name,
-                                gains=changes, noise=noise_values or (), seed=sd))
-                            row = {**base, **dict(changes)}
-                            if noise_values is not None:
-                                row["seed"] = sd
-                            grid.append(row)
+                    for x in scales:
+                        for values in itertools.product(*[vs for _, vs in mine]):
+                            changes = tuple(zip([n for n, _ in mine], values))
+                            for sd in (seeds if noise_values is not None else [0]):
+                                cases.append(sweep_lib.Case(
+                                    scenario, options, suspension=s, damper=damper_name,
+                                    gains=changes, noise=noise_values or (), seed=sd,
+                                    damper_scale=x))
+                                row = {**base, **dict(changes)}
+                                if damper_scale is not None:
+                                    row["damper_scale"] = x
+                                if noise_values is not None:
+                                    row["seed"] = sd
+                                grid.append(row)
         table, table_path = _run_table(out, resume)
         executor, executor_record = _executor(workers, scheduler, scheduler_file)
     try:
@@ -2221,6 +2530,7 @@ def sweep_command(
                     "scenario": scenario_record,
                     "grid": {"suspension": suspensions,
                              **{column: values for _, _, column, values in axes},
+                             **({"damper_scale": scales} if damper_scale is not None else {}),
                              **({"voltage_v": volts} if has_mr else {}),
                              **{name: values for name, values in gain_axes},
                              **({"seed": seeds} if noise_values is not None else {})},
@@ -2260,7 +2570,7 @@ def sweep_command(
     lines = [f"scenario at the first grid point: {report.describe_scenario(first_record)}, "
              f"{scen.duration:g} s, dt {dt:g} s, RMS over {start:g}-{end:g} s"]
     if st["damper"]:
-        lines.append(f"{st['damper']} MR dampers" + (f"; gains {st['gains_source']}" if controllers else ""))
+        lines.append(_damper_text(st) + (f"; gains {st['gains_source']}" if controllers else ""))
     lines.append(f"{len(rows)} runs: {doc['runs_evaluated']} evaluated now, "
                  f"{len(rows) - doc['runs_evaluated']} from the run table; wall time {wall:.1f} s")
     _wide_stdout_console().print(_sweep_table(rows, grid_columns, "\n".join(lines)))

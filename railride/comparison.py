@@ -71,7 +71,8 @@ class Comparison:
     def demands(self) -> dict:
         """Per suspension, over the metrics window: RMS and peak damper force on the carbody [N],
         RMS and peak secondary deflection (suspension travel) [m], and for the controlled ones
-        the mean command voltage [V] and the fraction of time at v_max."""
+        with MR dampers the mean command voltage [V] and the fraction of time at v_max (the
+        ideal actuator has no voltage: those two entries are absent, as for passive)."""
         v_max = dampers.preset(self.damper).v_max if self.damper in dampers.PRESETS else np.inf
         out = {}
         for name, ds in self.datasets.items():
@@ -136,16 +137,22 @@ class Comparison:
 
 
 def compare(scenario, params=None, *, controllers=CONTROLLERS, gains: GainSet | None = None,
-            damper="railway", window=None, dt: float = DEFAULT_DT,
+            damper="railway", damper_scale: float = 1.0, window=None, dt: float = DEFAULT_DT,
             output_rate: float = DEFAULT_OUTPUT_RATE, control_rate: float = DEFAULT_CONTROL_RATE,
             sensor_noise=None, progress=None, comfort: bool = False) -> Comparison:
     """Run the passive vehicle and each controller on ``scenario`` and collect the metrics.
 
     ``controllers`` names from `railride.control.CONTROLLERS` (passive is always run as the
-    baseline); ``gains`` a `GainSet` (default: the shipped gains); ``window`` (start, end) s for
-    the metrics. ``comfort``: also the ride comfort indices of each suspension over the same
-    window (`Comparison.comfort`; ``controllers[i].comfort`` in `Comparison.to_dict`).
+    baseline); ``gains`` a `GainSet` (default: the shipped gains); ``damper`` the name of the
+    controlled suspensions' dampers (`railride.dampers.NAMES`: an MR preset or "ideal", the
+    ideal actuator) and ``damper_scale`` the factor on an MR damper's force capacity
+    (`BoucWen.scaled`; 1 for the ideal actuator); passive stays the viscous baseline.
+    ``window`` (start, end) s for the metrics. ``comfort``: also the ride comfort indices of
+    each suspension over the same window (`Comparison.comfort`; ``controllers[i].comfort`` in
+    `Comparison.to_dict`).
     """
+    model = damper_model(damper, damper_scale)
+    damper_scale = float(damper_scale)
     names = check_controllers(controllers)
     gains = GainSet.default() if gains is None else gains
     controlled = [n for n in names if n != "passive"]
@@ -155,7 +162,7 @@ def compare(scenario, params=None, *, controllers=CONTROLLERS, gains: GainSet | 
     common = dict(dt=dt, output_rate=output_rate)
     datasets = {"passive": simulate(scenario, params, progress=part and part(0.0, share), **common).dataset}
     if controlled:
-        batch = simulate(scenario, params, damper=damper, controller=[gains.controller(n) for n in controlled],
+        batch = simulate(scenario, params, damper=model, controller=[gains.controller(n) for n in controlled],
                          inner=gains.inner, control_rate=control_rate, sensor_noise=sensor_noise,
                          progress=part and part(share, 1.0 - share), **common).dataset
         for i, n in enumerate(controlled):
@@ -165,7 +172,7 @@ def compare(scenario, params=None, *, controllers=CONTROLLERS, gains: GainSet | 
     first = datasets["passive"]
     settings = {"scenario": json.loads(str(first["scenario"].values)),
                 "vehicle_params": json.loads(str(first["vehicle_params"].values)), "damper": str(damper),
-                "dt_s": dt, "output_rate_hz": output_rate, "control_rate_hz": control_rate,
+                "damper_scale": damper_scale, "dt_s": dt, "output_rate_hz": output_rate, "control_rate_hz": control_rate,
                 "window_s": None if window is None else [float(w) for w in window],
                 "sensor_noise": None if sensor_noise is None else sensor_noise.__dict__}
     comfort_values = None
@@ -174,6 +181,22 @@ def compare(scenario, params=None, *, controllers=CONTROLLERS, gains: GainSet | 
         comfort_values = {n: ride_comfort(datasets[n], window=window) for n in names}
     return Comparison(names, datasets, metrics, window, gains, str(damper), settings,
                       comfort_values)
+
+
+def damper_model(name: str, scale: float = 1.0):
+    """The damper called ``name`` (`railride.dampers.preset`) with its force capacity times
+    ``scale``; a scale other than 1 for the ideal actuator is a ValueError (it has none)."""
+    if not isinstance(name, str):
+        raise ValueError(f"damper = {name!r}: must be a name ({', '.join(dampers.NAMES)}); "
+                         "scale a preset with damper_scale")
+    scale = dampers.check_scale("damper_scale", scale)
+    model = dampers.preset(name)
+    if scale == 1.0:
+        return model
+    if model.law == dampers.LAW_IDEAL:
+        raise ValueError(f"damper_scale = {scale:g}: the ideal actuator applies the demand "
+                         "exactly and has no force capacity to scale (leave damper_scale at 1)")
+    return model.scaled(scale)
 
 
 #: indices whose reduction against passive is given: a_w, VDV and N_MV_z scale with the

@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import dataclasses
 import tomllib
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
 
@@ -177,13 +177,16 @@ _TABLES = {"inner": InnerLoop, "pid": PID, "sas.attitude": Attitude, "sas.ride":
 
 @dataclass(frozen=True)
 class GainSet:
-    """Every controller's gains, as read from a gains file."""
+    """Every controller's gains, as read from a gains file. ``provenance``: the file's
+    [provenance] table (how the gains were found), empty when it has none; it does not take part
+    in comparisons, so equal gains are equal whatever their history."""
 
     inner: InnerLoop
     pid: PID
     attitude: Attitude
     ride: Ride
     source: str = "<built>"
+    provenance: dict = field(default_factory=dict, compare=False, repr=False)
 
     def controller(self, name: str):
         """The outer loop called ``name`` (None for the passive suspension)."""
@@ -242,7 +245,11 @@ class GainSet:
                 built[key] = kind(**table)
             except ValueError as exc:
                 raise ValueError(f"{source}: [{key}] {exc}") from None
-        return cls(built["inner"], built["pid"], built["sas.attitude"], built["sas.ride"], source)
+        provenance = data.get("provenance", {})
+        if not isinstance(provenance, dict):
+            raise ValueError(f"{source}: [provenance] must be a table, not {provenance!r}")
+        return cls(built["inner"], built["pid"], built["sas.attitude"], built["sas.ride"], source,
+                   provenance)
 
     @classmethod
     def load(cls, path: str | Path) -> "GainSet":
@@ -256,8 +263,19 @@ class GainSet:
     @classmethod
     def default(cls) -> "GainSet":
         """The shipped gains (railride/data/gains.toml; its header says where they come from)."""
-        text = resources.files("railride").joinpath("data/gains.toml").read_text(encoding="utf-8")
-        return cls.from_toml(text, source="railride/data/gains.toml")
+        return cls._packaged("gains.toml")
+
+    @classmethod
+    def reference(cls) -> "GainSet":
+        """The neutral start of the tuning study (railride/data/reference_gains.toml): every gain
+        scaled from the passive suspension, the default start of `railride.tuning.tune` and
+        `railride tune`; installed with the package so the study can be repeated anywhere."""
+        return cls._packaged("reference_gains.toml")
+
+    @classmethod
+    def _packaged(cls, name: str) -> "GainSet":
+        text = resources.files("railride").joinpath(f"data/{name}").read_text(encoding="utf-8")
+        return cls.from_toml(text, source=f"railride/data/{name}")
 
 
 @dataclass(frozen=True)

@@ -22,6 +22,10 @@ terms act on x, not x - x0.
 
 Each law also has a plain NumPy reference here (`rates`), used by the tests to check the
 compiled version in `railride.kernels`.
+
+`Ideal` is no damper but the bound the MR dampers approach: a force actuator that applies the
+outer loop's demand exactly (closed loop only). `BoucWen.scaled` / `Spencer.scaled` give the
+same damper with its force capacity multiplied by a factor.
 """
 
 from __future__ import annotations
@@ -37,6 +41,7 @@ from .params import param, validate_fields
 LAW_VISCOUS = 1
 LAW_BOUC_WEN = 2
 LAW_SPENCER = 3
+LAW_IDEAL = 4
 #: length of the packed parameter vector handed to the stepper (slot 15: the bound of |z|)
 N_PACKED = 16
 #: internal states per damper in the stepper: z, y (Spencer only), u
@@ -57,7 +62,8 @@ class _Damper:
 
     def to_dict(self) -> dict:
         """The model, the preset it equals (or None) and every parameter."""
-        name = next((k for k, v in PRESETS.items() if v == self), None)
+        name = next((k for k, v in {**PRESETS, "ideal": IDEAL, "ideal-damper": IDEAL_DAMPER}.items()
+                     if v == self), None)
         return {"model": self.model, "preset": name, **dataclasses.asdict(self)}
 
     @classmethod
@@ -123,6 +129,16 @@ class BoucWen(_Damper):
         """Upper bound of |z| for gamma >= beta: (A / (gamma + beta))^(1/n) [m^(1/n)]."""
         return (self.A / (self.gamma + self.beta)) ** (1.0 / self.n)
 
+    #: the parameters that carry force: F scales with them at the same motion and voltage
+    FORCE_PARAMETERS = ("alpha_a", "alpha_b", "c0a", "c0b", "k0")
+
+    def scaled(self, factor: float):
+        """The same damper with its force capacity times ``factor`` (> 0): every force
+        parameter (`FORCE_PARAMETERS`) multiplied, so that for the same motion and voltage the
+        force is ``factor`` times as large and the internal states (z, y, u) are unchanged."""
+        factor = check_scale("factor", factor)
+        return self.replace(**{n: factor * getattr(self, n) for n in self.FORCE_PARAMETERS})
+
     def pack(self) -> np.ndarray:
         p = np.zeros(N_PACKED)
         p[:12] = [self.alpha_a, self.alpha_b, self.c0a, self.c0b, self.k0, self.A, self.n,
@@ -159,6 +175,8 @@ class Spencer(BoucWen):
     x0: float = param("m", "accumulator initial displacement (preload dropped)", "finite")
     model = "spencer"
     law = LAW_SPENCER
+    # y' is a ratio of force terms, unchanged when all of them scale; F = c1 y' + k1 x scales
+    FORCE_PARAMETERS = BoucWen.FORCE_PARAMETERS + ("c1a", "c1b", "k1")
 
     def pack(self) -> np.ndarray:
         p = super().pack()
@@ -174,6 +192,59 @@ class Spencer(BoucWen):
         yd = (alpha * z + c0 * xd + self.k0 * (x - y)) / (c0 + c1)
         zd = _bouc_wen_z_rate(z, xd - yd, self.A, self.n, self.gamma, self.beta)
         return c1 * yd + self.k1 * x, zd, yd, -self.eta * (u - v)
+
+
+@dataclass(frozen=True)
+class Ideal(_Damper):
+    """The ideal actuator: the corner force on the carbody equals the outer loop's demand f_d,
+    sampled and held like every demand, with no inner loop, voltage or clipping. It may push
+    energy in, which a damper cannot, and is the bound a semi-active damper approaches. It has
+    no states and no parameters, and works in a closed loop only (`simulate(controller=...)`).
+
+    In the stepper its command slot carries the held demand f_d (on the carbody, up +), so
+    F = -f_d in the damper's convention (tension +) and the force on the carbody is f = f_d.
+    """
+
+    #: True: the ideal *semi-active* damper ("ideal-damper"): the demand when it dissipates
+    #: energy (F x' >= 0), no force otherwise. The bound of any damper, MR or other, that can
+    #: only resist the relative motion across it.
+    dissipative: bool = False
+
+    law = LAW_IDEAL
+    v_min = 0.0
+    v_max = 0.0
+
+    @property
+    def model(self) -> str:
+        return "ideal-damper" if self.dissipative else "ideal"
+
+    def pack(self) -> np.ndarray:
+        p = np.zeros(N_PACKED)
+        p[0] = 1.0 if self.dissipative else 0.0
+        return p
+
+    def rates(self, x, xd, z, y, u, v):
+        """NumPy reference: F = -v with v the demand on the carbody (dissipative: 0 where
+        F x' < 0); no state moves."""
+        z = np.asarray(z, dtype=float)
+        F = -np.asarray(v, dtype=float) + 0.0 * z
+        if self.dissipative:
+            F = np.where(F * np.asarray(xd, dtype=float) < 0.0, 0.0, F)
+        return F, 0.0 * z, 0.0 * z, 0.0 * z
+
+    def scaled(self, factor: float):
+        raise ValueError(f"factor = {factor!r}: the ideal actuator applies the demand exactly and "
+                         "has no force capacity to scale")
+
+
+def check_scale(name: str, value) -> float:
+    """A force-capacity scale: a finite number > 0, else ValueError naming ``name``."""
+    ok = (not isinstance(value, bool) and isinstance(value, (int, float, np.integer, np.floating))
+          and np.isfinite(value) and value > 0)
+    if not ok:
+        raise ValueError(f"{name} = {value!r}: must be a finite number > 0 (the factor on the "
+                         "damper's force parameters)")
+    return float(value)
 
 
 def _check_shape(d) -> None:
@@ -199,8 +270,7 @@ DYKE1996 = BoucWen(alpha_a=1.0872e5, alpha_b=4.9616e5, c0a=4.40, c0b=44.0, k0=0.
 
 #: The vehicle default (spec section 5): dyke1996 with the force parameters alpha_a, alpha_b,
 #: c0a, c0b, k0 multiplied by 8, about 1.7 kN at 0 V and 20 kN at 2.25 V.
-RAILWAY = DYKE1996.replace(alpha_a=8 * DYKE1996.alpha_a, alpha_b=8 * DYKE1996.alpha_b,
-                           c0a=8 * DYKE1996.c0a, c0b=8 * DYKE1996.c0b, k0=8 * DYKE1996.k0)
+RAILWAY = DYKE1996.scaled(8)
 
 #: Spencer, Dyke, Sain & Carlson (1997), "Phenomenological model for magnetorheological
 #: dampers", J. Eng. Mech. 123(3), Table 1, converted from N, cm to SI: c0a 21.0 N s/cm,
@@ -211,22 +281,36 @@ SPENCER1997 = Spencer(alpha_a=1.40e4, alpha_b=6.95e4, c0a=2.10e3, c0b=3.50e2, k0
                       A=301.0, n=2.0, gamma=3.63e6, beta=3.63e6, eta=190.0, v_min=0.0,
                       v_max=2.25, c1a=2.83e4, c1b=2.95e2, k1=5.00e2, x0=0.143)
 
+#: the MR damper presets (the models the rig can drive)
 PRESETS = {"dyke1996": DYKE1996, "railway": RAILWAY, "spencer1997": SPENCER1997}
+#: the ideal actuator, by name "ideal" beside the presets (closed loop only)
+IDEAL = Ideal()
+#: the ideal semi-active damper, by name "ideal-damper" (closed loop only)
+IDEAL_DAMPER = Ideal(dissipative=True)
+#: the names of the ideal bounds (no voltage, no inner loop, closed loop only)
+IDEAL_NAMES = ("ideal", "ideal-damper")
+#: every name `preset` knows
+NAMES = (*PRESETS, *IDEAL_NAMES)
 
 
 def preset(name: str):
-    """A named damper: dyke1996, railway (the vehicle default) or spencer1997."""
+    """A named damper: dyke1996, railway (the vehicle default), spencer1997, or the ideal
+    actuator "ideal"."""
+    if name == "ideal":
+        return IDEAL
+    if name == "ideal-damper":
+        return IDEAL_DAMPER
     try:
         return PRESETS[name]
-    except KeyError:
-        raise ValueError(f"unknown damper model {name!r}; allowed: {', '.join(PRESETS)}") from None
+    except (KeyError, TypeError):
+        raise ValueError(f"unknown damper model {name!r}; allowed: {', '.join(NAMES)}") from None
 
 
 def stiffness_estimate(damper, xd: float, z: float, u: float) -> float:
     """A bound on the fastest rate of the damper's internal states [1/s] (for sub-stepping):
     the Jacobian of z' (and y') with |z| taken at least at its bound, since from z = 0 the rate
     grows within a step."""
-    if damper.law == LAW_VISCOUS:
+    if damper.law in (LAW_VISCOUS, LAW_IDEAL):
         return 0.0
     gb = abs(damper.gamma) + abs(damper.beta)
     az = max(abs(z), damper.z_bound)

@@ -23,7 +23,7 @@ import numpy as np
 from numba import njit
 from numba.core.errors import NumbaPerformanceWarning
 
-from .dampers import LAW_BOUC_WEN, LAW_SPENCER, LAW_VISCOUS, N_DAMPER_STATES
+from .dampers import LAW_BOUC_WEN, LAW_IDEAL, LAW_SPENCER, LAW_VISCOUS, N_DAMPER_STATES
 
 N_DOF = 9
 N_CORNER = 4
@@ -200,9 +200,14 @@ def _bouc_wen_rate(z, w, A, n, gamma, beta):
 
 @njit(cache=True, fastmath=_FAST)
 def damper_law(law, P, x, xd, z, y, u, v):
-    """Force F (tension +) and the rates (z', y', u') of one damper; P as `Damper.pack()`."""
+    """Force F (tension +) and the rates (z', y', u') of one damper; P as `Damper.pack()`.
+    LAW_IDEAL: v is the held demand on the carbody, so F = -v and the carbody gets f = v."""
     if law == LAW_VISCOUS:
         return P[2] * xd, 0.0, 0.0, 0.0
+    if law == LAW_IDEAL:  # P[0] > 0: dissipative only, no force where it would push energy in
+        if P[0] > 0.0 and v * xd > 0.0:
+            return 0.0, 0.0, 0.0, 0.0
+        return -v, 0.0, 0.0, 0.0
     alpha = P[0] + P[1] * u
     c0 = P[2] + P[3] * u
     du = -P[9] * (u - v)
@@ -220,7 +225,7 @@ def damper_stiffness(law, P, xd, z, u):
     """A bound on the fastest rate of the damper's internal states [1/s]
     (same as railride.dampers.stiffness_estimate). |z| is taken at least at the bound of the
     hysteretic variable (P[15]): starting from z = 0 the rate grows within the step."""
-    if law == LAW_VISCOUS or law == LAW_VISCOUS_IN_C:
+    if law == LAW_VISCOUS or law == LAW_VISCOUS_IN_C or law == LAW_IDEAL:
         return 0.0
     gb = abs(P[7]) + abs(P[8])
     n = P[6]
@@ -300,7 +305,9 @@ def run_batch(lo, hi, law, x, step0, n_steps, final, stride, dt, A, TS, c_sec, P
     forces f_d = Gm[s] m + Hm[s] xi, which take effect one controller period later and are held
     (a computation delay of one sample). The inner loop, v = clip(G (f_d - B f) sgn(f), v_min,
     v_max) with (B, G) = inner[s] and f the damper force on the carbody, runs at every step
-    from the force at the step's start. The controller's integrator and demands are states
+    from the force at the step's start. With LAW_IDEAL there is no inner loop: the command of
+    each corner is the held demand itself, which the ideal actuator applies (out_vc then
+    records the demand, not a voltage). The controller's integrator and demands are states
     x[s, NS_MAX:], so a run can continue across calls.
 
     Steps are numbered globally from step0 (t = step * dt). At every step whose number is a
@@ -311,7 +318,8 @@ def run_batch(lo, hi, law, x, step0, n_steps, final, stride, dt, A, TS, c_sec, P
     +-DIVERGED or stops being finite gets status STATUS_DIVERGED and the step number in
     fail_step, and stops.
     """
-    has_states = law != LAW_VISCOUS_IN_C  # damper states to integrate
+    # damper states to integrate (the ideal actuator has none: its law ignores them)
+    has_states = law != LAW_VISCOUS_IN_C and law != LAW_IDEAL
     ns = NS_MAX if has_states else 2 * N_DOF
     record_d = out_d.shape[1] > 1
     record_c = out_fd.shape[1] > 1
@@ -319,7 +327,7 @@ def run_batch(lo, hi, law, x, step0, n_steps, final, stride, dt, A, TS, c_sec, P
         if status[smp] != STATUS_OK:
             continue
         s = x[smp].copy()
-        st = np.empty(NS_MAX)  # stage state
+        st = np.zeros(NS_MAX)  # stage state (zeros: the states a law without any still reads)
         y = np.empty(NY)  # stage vector (q, q', f)
         cx = np.empty(N_CORNER)
         cv = np.empty(N_CORNER)
@@ -358,9 +366,14 @@ def run_batch(lo, hi, law, x, step0, n_steps, final, stride, dt, A, TS, c_sec, P
                     for j in range(3):
                         acc_fd += hm[c, j] * x[smp, XI + j]
                     x[smp, FD_NEXT + c] = acc_fd
+            if closed_loop and law == LAW_IDEAL:
+                # the ideal actuator applies the held demand itself (no inner loop); its force
+                # is the command, so it is set before the step-start rates use it
+                for c in range(N_CORNER):
+                    vc[c] = x[smp, FD_HELD + c]
             # rates at the step's start: for the record, the sub-step choice and stage 1
             _derivative(law, s, R, 0, at, tt, pp, vc, y, cx, cv, K, 0)
-            if closed_loop:
+            if closed_loop and law != LAW_IDEAL:
                 # inner loop from the damper forces at the step's start (they do not depend on
                 # the command, only on the coil state); then correct stage 1's coil rate
                 for c in range(N_CORNER):

@@ -10,6 +10,10 @@ lands in the run table.
 * `optimise`: SciPy's differential evolution (Storn and Price 1997) with ``vectorized=True``.
 * `sensitivity`: first-order and total Sobol indices by SciPy's `scipy.stats.sobol_indices`
   (Saltelli 2010 sampling, Jansen / Saltelli estimators), with the gains uniform in log10.
+
+Both minimise or analyse a named `railride.tuning.Objective` (default `DEFAULT_OBJECTIVE`); the
+results carry it (``objective_definition``) so its statement can be printed with them.
+`railride.pareto` samples the same search box.
 """
 
 from __future__ import annotations
@@ -23,18 +27,20 @@ import scipy.stats
 
 from .control import GainSet
 from .sweep import Case, RunTable, apply_gains, run_cases
-from .tuning import PARAMETERS, REFERENCE, Objective, SUSPENSION, _rms
+from .tuning import DEFAULT_OBJECTIVE, PARAMETERS, REFERENCE, Objective, _rms
 
 #: the paper's fourteen SAS parameters
 SAS_PARAMETERS = PARAMETERS["attitude"] + PARAMETERS["ride"]
 
 
 def _bounds(parameters):
+    """(low, high) log10 of each parameter: REFERENCE / 1000 to REFERENCE x 100."""
     return [(math.log10(REFERENCE[p] / 1e3), math.log10(REFERENCE[p] * 1e2)) for p in parameters]
 
 
 class _Evaluator:
-    """objective(log10 gains) for a batch of points, through run_cases."""
+    """objective(log10 gains) for a batch of points, through run_cases; `rms` gives the RMS
+    of the four responses instead (the Pareto view)."""
 
     def __init__(self, parameters, suspension, scenario, scenario_options, gains, objective,
                  damper, executor, table, dt, progress):
@@ -43,7 +49,7 @@ class _Evaluator:
         self.scenario = scenario
         self.opts = tuple(sorted((scenario_options or {}).items()))
         self.gains = GainSet.default() if gains is None else gains
-        self.objective = Objective() if objective is None else objective
+        self.objective = DEFAULT_OBJECTIVE if objective is None else objective
         self.damper = damper
         self.executor = executor
         self.table = RunTable() if table is None else table
@@ -63,8 +69,12 @@ class _Evaluator:
                      gains=tuple(zip(self.parameters, (10.0 ** p).tolist())))
                 for p in np.atleast_2d(points)]
 
+    def rms(self, cases: list[Case]) -> np.ndarray:
+        """(n, 4) RMS of acceleration, displacement, pitch, roll of ``cases``."""
+        return _rms(self._run(cases))
+
     def __call__(self, points: np.ndarray) -> np.ndarray:
-        return self.objective(_rms(self._run(self.cases(points))), self.passive)
+        return self.objective(self.rms(self.cases(points)), self.passive)
 
 
 @dataclass
@@ -76,6 +86,7 @@ class OptimiseResult:
     parameters: tuple
     log10_gains: np.ndarray
     message: str
+    objective_definition: Objective | None = None  # what ``objective`` is the value of
 
 
 def optimise(parameters=SAS_PARAMETERS, *, suspension: str = "sas-attitude-ride",
@@ -93,7 +104,7 @@ def optimise(parameters=SAS_PARAMETERS, *, suspension: str = "sas-attitude-ride"
         popsize=popsize, maxiter=maxiter, seed=seed, polish=False, tol=1e-4)
     tuned = apply_gains(ev.gains, tuple(zip(parameters, (10.0 ** res.x).tolist())))
     return OptimiseResult(tuned, float(res.fun), ev.n_runs, int(res.nit), tuple(parameters),
-                          res.x, str(res.message))
+                          res.x, str(res.message), ev.objective)
 
 
 @dataclass
@@ -102,6 +113,7 @@ class SensitivityResult:
     first_order: np.ndarray
     total: np.ndarray
     n_runs: int
+    objective_definition: Objective | None = None  # the function the indices decompose
 
     def table(self) -> list[dict]:
         return [{"parameter": p, "first_order": float(s), "total": float(t)}
@@ -123,4 +135,4 @@ def sensitivity(parameters=SAS_PARAMETERS, *, suspension: str = "sas-attitude-ri
     res = scipy.stats.sobol_indices(func=lambda x: ev(x.T), n=n, dists=dists,
                                     rng=np.random.default_rng(seed))
     return SensitivityResult(tuple(parameters), np.asarray(res.first_order),
-                             np.asarray(res.total_order), ev.n_runs)
+                             np.asarray(res.total_order), ev.n_runs, ev.objective)

@@ -435,6 +435,16 @@ def _comparison_dataset(comparison) -> xr.Dataset:
     return ds
 
 
+def _damper_words(settings: dict) -> str:
+    """The controlled suspensions' dampers of a compare or sweep ``settings`` record."""
+    if settings.get("damper") == "ideal":
+        return "ideal actuators"
+    if settings.get("damper") == "ideal-damper":
+        return "ideal semi-active dampers"
+    scale = settings.get("damper_scale") or 1.0
+    return f"{settings['damper']} MR dampers" + (f" (force x {scale:g})" if scale != 1.0 else "")
+
+
 def _controller_names(ds: xr.Dataset) -> list[str]:
     return [_label(v) for v in ds["controller"].values]
 
@@ -462,7 +472,7 @@ def comparison_title(ds: xr.Dataset) -> str:
         settings = {}
     if isinstance(settings, dict) and settings.get("damper") and any(
             n != "passive" for n in _controller_names(ds)):
-        parts.append(f"{settings['damper']} MR dampers")
+        parts.append(_damper_words(settings))
     if ds.attrs.get("gains_source") and any(n != "passive" for n in _controller_names(ds)):
         parts.append(f"gains {ds.attrs['gains_source']}")
     return ", ".join(p for p in parts if p)
@@ -549,7 +559,8 @@ def plot_comparison_voltages(comparison, path=None):
     if not names or "damper_command_voltage" not in ds.variables:
         fig = _new_figure((8.0, 3.0))
         ax = fig.subplots()
-        ax.text(0.5, 0.5, "passive suspension only: no command voltages", ha="center",
+        why = "passive suspension only" if not names else "ideal actuators"
+        ax.text(0.5, 0.5, f"{why}: no command voltages", ha="center",
                 va="center", transform=ax.transAxes)
         ax.set_axis_off()
         fig.suptitle("MR damper command voltage" + (f"\n{title}" if title else ""),
@@ -858,6 +869,7 @@ def write_tune_outputs(curves, out_dir, doc: dict, gains_text: str, *,
 _SWEEP_AXIS_LABELS = {"speed_m_s": "speed (m/s)", "wavelength_m": "wavelength (m)",
                       "amplitude_m": "amplitude (m)", "rail_phase_deg": "rail phase (deg)",
                       "track_seed": "track seed", "voltage_v": "command voltage (V)",
+                      "damper_scale": "damper force scale (-)",
                       "seed": "sensor noise seed"}
 #: (RMS column, axis label) of the four panels of the sweep plot
 _SWEEP_PANELS = (("acceleration_m_s2_rms", "acceleration RMS (m/s$^2$)"),
@@ -878,6 +890,13 @@ def sweep_plot_axis(doc: dict) -> str | None:
     if len(several) != 1 or not all(_is_number(v) for v in grid[several[0]]):
         return None
     return several[0]
+
+
+def _log_axis(axis: str, xs: list) -> bool:
+    """A logarithmic x axis for values spanning 100:1, or 4:1 for a factor (damper_scale, whose
+    grids are geometric)."""
+    ratio = 4 if axis == "damper_scale" else 100
+    return bool(xs) and min(xs) > 0 and max(xs) / min(xs) >= ratio
 
 
 def _sweep_axis_label(column: str) -> str:
@@ -928,7 +947,7 @@ def plot_sweep_comfort(doc: dict, path=None, *, axis: str | None = None):
     fig = _new_figure((10.0, 4.4))
     axes = fig.subplots(1, 2, sharex=True)
     xs = [float(r[axis]) for r in rows if r.get(axis) is not None]
-    log_x = bool(xs) and min(xs) > 0 and max(xs) / min(xs) >= 100
+    log_x = _log_axis(axis, xs)
     for ax, (column, ylabel) in zip(axes, _SWEEP_COMFORT_PANELS):
         _sweep_lines(ax, rows, axis, column, suspensions)
         ax.set_ylabel(ylabel, fontsize="small")
@@ -972,7 +991,7 @@ def plot_sweep(doc: dict, path=None, *, axis: str | None = None):
     fig = _new_figure((10.0, 7.2))
     axes = fig.subplots(2, 2, sharex=True).ravel()
     xs = [float(r[axis]) for r in rows if r.get(axis) is not None]
-    log_x = bool(xs) and min(xs) > 0 and max(xs) / min(xs) >= 100
+    log_x = _log_axis(axis, xs)
     for ax, (column, ylabel) in zip(axes, _SWEEP_PANELS):
         _sweep_lines(ax, rows, axis, column, suspensions)
         ax.set_ylabel(ylabel)
@@ -989,7 +1008,7 @@ def plot_sweep(doc: dict, path=None, *, axis: str | None = None):
     context = describe_scenario(settings.get("scenario") or {})
     duration = (settings.get("scenario") or {}).get("duration_s")
     extra = [p for p in (f"{duration:g} s" if _is_number(duration) else "",
-                         f"{settings['damper']} MR dampers" if settings.get("damper") else "") if p]
+                         _damper_words(settings) if settings.get("damper") else "") if p]
     if extra:
         context = ", ".join([context, *extra]) if context else ", ".join(extra)
     title = f"RMS of the carbody responses against {_sweep_axis_label(axis)}"

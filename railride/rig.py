@@ -103,7 +103,13 @@ def _motion_table(motion, duration: float, dt: float):
 
 
 def _resolve(damper):
-    return dampers.preset(damper) if isinstance(damper, str) else damper
+    damper = dampers.preset(damper) if isinstance(damper, str) else damper
+    if getattr(damper, "law", None) == dampers.LAW_IDEAL:
+        # its force is a controller's demand, not a function of the motion: nothing to test
+        raise ValueError("damper = 'ideal': the ideal actuator has no force law of its own to "
+                         "drive on the rig (it applies a vehicle controller's demand); allowed: "
+                         f"{', '.join(dampers.PRESETS)} or a model from railride.dampers")
+    return damper
 
 
 def drive(damper, motion, *, duration: float, voltage=None, command=None, desired_force=None,

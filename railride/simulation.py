@@ -48,7 +48,10 @@ def _state_matrix(vehicle: Vehicle, damper=None) -> np.ndarray:
     internal states are sub-stepped by the stepper and do not enter here."""
     if damper is None:
         return vehicle.state_matrix
-    if damper.law == dampers.LAW_VISCOUS:
+    if damper.law == dampers.LAW_IDEAL:
+        # its force is the held demand, a forcing term to the integrator: C0 without a damper
+        k_eff, c_eff = 0.0, 0.0
+    elif damper.law == dampers.LAW_VISCOUS:
         k_eff, c_eff = 0.0, damper.c
     else:
         v = damper.v_max
@@ -86,7 +89,7 @@ def _check_dt(vehicle: Vehicle, dt: float, damper=None) -> None:
         raise ValueError(
             f"dt = {dt:g} s is too large: fourth-order Runge-Kutta is unstable for this vehicle "
             f"(fastest mode {fastest.label}, {fastest.frequency_hz:.1f} Hz"
-            + ("" if damper is None else f", stiffer with the {damper.model} dampers")
+            + ("" if not _has_states(damper) else f", stiffer with the {damper.model} dampers")
             + f"); use dt <= {dt_max:.3g} s (the default {DEFAULT_DT:g} s is accurate)"
         )
 
@@ -149,10 +152,15 @@ def _resolve_damper(damper):
         return None
     if isinstance(damper, str):
         return dampers.preset(damper)
-    if isinstance(damper, (dampers.Viscous, dampers.BoucWen)):  # Spencer is a BoucWen
+    if isinstance(damper, (dampers.Viscous, dampers.BoucWen, dampers.Ideal)):  # Spencer is a BoucWen
         return damper
-    raise ValueError(f"damper = {damper!r}: must be None (passive), a preset name "
-                     f"({', '.join(dampers.PRESETS)}) or a model from railride.dampers")
+    raise ValueError(f"damper = {damper!r}: must be None (passive), a name "
+                     f"({', '.join(dampers.NAMES)}) or a model from railride.dampers")
+
+
+def _has_states(damper) -> bool:
+    """Damper models with internal states and a voltage (not passive, not the ideal actuator)."""
+    return damper is not None and damper.law != dampers.LAW_IDEAL
 
 
 def _command_voltages(damper, voltage, n: int) -> np.ndarray:
@@ -162,6 +170,8 @@ def _command_voltages(damper, voltage, n: int) -> np.ndarray:
             raise ValueError("voltage applies to MR dampers only: give damper= as well "
                              "(the passive suspension has no command)")
         return np.zeros((n, 4))
+    if damper.law == dampers.LAW_IDEAL:
+        return np.zeros((n, 4))  # checked in simulate: closed loop only, no voltage
     if voltage is None:
         voltage = damper.v_min
     values = [voltage] * n if np.ndim(voltage) == 0 else list(voltage) * (n // len(voltage))
@@ -190,7 +200,8 @@ def _closed_loop(controllers, inner, control_rate, sensor_noise, damper, n, dt, 
                 raise ValueError(f"{name} applies to a closed loop only: give controller= as well")
         return None
     if damper.law == dampers.LAW_VISCOUS:
-        raise ValueError("a controller needs MR dampers (a viscous damper has no command)")
+        raise ValueError("a controller needs MR dampers or the ideal actuator (a viscous damper "
+                         "has no command)")
     inner = GainSet.default().inner if inner is None else inner
     if not isinstance(inner, InnerLoop):
         raise ValueError(f"inner = {inner!r}: must be a railride.control.InnerLoop")
@@ -235,7 +246,10 @@ def simulate(scenario=None, params=None, *, dt: float = DEFAULT_DT,
     no outer loop, f_d = 0) sampling the carbody states at ``control_rate`` [Hz] (plus
     ``sensor_noise``, a `control.SensorNoise`), and the inner loop ``inner`` (a
     `control.InnerLoop`; default: the shipped gains) setting the voltages. A controller without
-    ``damper`` uses the `railway` MR dampers.
+    ``damper`` uses the `railway` MR dampers. ``damper="ideal"`` (`dampers.Ideal`) makes each
+    corner force equal to the held demand f_d, with no inner loop and no voltage (closed loop
+    only: without ``controller`` it is a ValueError); its Dataset has no voltage channels.
+    A scaled MR damper is ``dampers.preset("railway").scaled(4)``.
     ``initial_state`` is (q, q') at t = 0 as 18 numbers in DOF order (m, rad, m/s, rad/s), or
     one row per sample; by default the vehicle starts at rest in equilibrium.
     ``progress(done_fraction)`` is called between chunks of a long run.
@@ -269,6 +283,10 @@ def simulate(scenario=None, params=None, *, dt: float = DEFAULT_DT,
         if damper is None:
             damper = "railway"
     damper = _resolve_damper(damper)
+    if damper is not None and damper.law == dampers.LAW_IDEAL and controllers is None:
+        raise ValueError("damper = 'ideal': the ideal actuator applies an outer loop's demand "
+                         "and needs controller= (PID or SAS); it has no voltage to set"
+                         + (f" (got voltage = {voltage!r})" if voltage is not None else ""))
     vcmd = _command_voltages(damper, voltage, n)
     closed = _closed_loop(controllers, inner, control_rate, sensor_noise, damper, n, dt, duration)
     vehicles = {}
@@ -343,7 +361,7 @@ def simulate(scenario=None, params=None, *, dt: float = DEFAULT_DT,
         "q": np.empty((n, rows, N_DOF)), "v": np.empty((n, rows, N_DOF)),
         "a": np.empty((n, rows, N_DOF)), "f": np.empty((n, rows, 4)),
         "w": np.empty((n, rows, 8)), "wd": np.empty((n, rows, 8)),
-        "d": np.empty((n, rows if damper is not None else 1, kernels.N_DS)),
+        "d": np.empty((n, rows if _has_states(damper) else 1, kernels.N_DS)),
         "fd": np.zeros((n, rows if closed is not None else 1, 4)),
         "vc": np.empty((n, rows if closed is not None else 1, 4)),
     }
@@ -416,7 +434,7 @@ def _dataset(out, vehicles, param_sets, scenarios, dt, output_rate, rows, batch,
         "units": "N", "long_name": "secondary vertical spring force on the carbody (up +)"})
     channels["secondary_damper_force"] = (("corner",), out["f"], {
         "units": "N", "long_name": "secondary vertical damper force on the carbody (up +)"})
-    if damper is not None:
+    if _has_states(damper):  # the ideal actuator has no states and no voltage
         d = out["d"]
         channels["damper_hysteretic_z"] = (("corner",), d[:, :, 0::3], {
             "units": "m", "long_name": "Bouc-Wen hysteretic variable z of each damper"})
@@ -439,7 +457,8 @@ def _dataset(out, vehicles, param_sets, scenarios, dt, output_rate, rows, batch,
     pars = np.array([json.dumps(p.to_dict()) for p in param_sets])
     if closed is not None:
         ctrl = closed["controllers"] * (len(param_sets) // len(closed["controllers"]))
-        attrs_ctrl = {"control_rate_hz": closed["rate"], "inner_loop": json.dumps(closed["inner"].to_dict()),
+        inner = None if damper.law == dampers.LAW_IDEAL else closed["inner"].to_dict()  # none in use
+        attrs_ctrl = {"control_rate_hz": closed["rate"], "inner_loop": json.dumps(inner),
                       "sensor_noise": json.dumps(None if closed["sensor_noise"] is None
                                                  else dataclasses.asdict(closed["sensor_noise"]))}
         controller_names = np.array(["none" if c is None else c.name for c in ctrl])
@@ -476,6 +495,8 @@ def _dataset(out, vehicles, param_sets, scenarios, dt, output_rate, rows, batch,
         "dt_s": dt,
         "output_rate_hz": output_rate,
         "suspension": ("passive viscous secondary dampers" if damper is None else
+                       "ideal secondary force actuators (force = held demand), closed loop"
+                       if damper.law == dampers.LAW_IDEAL else
                        f"{damper.model} secondary dampers at constant command voltage" if closed is None
                        else f"{damper.model} secondary dampers, closed loop"),
         "damper": json.dumps(None if damper is None else damper.to_dict()),

@@ -44,7 +44,10 @@ class Case:
     "table.entry" (e.g. "pid.kp", "attitude.kd_z", "ride.kp_1R", "inner.G"). ``suspension`` is
     passive, mr (constant ``voltage``) or a controller name; a controller may see sensor noise
     (``noise``: standard deviations displacement [m], angle [rad], velocity [m/s], angular rate
-    [rad/s]) drawn with ``seed``."""
+    [rad/s]) drawn with ``seed``. ``damper`` names the dampers of mr and the controllers
+    (`railride.dampers.NAMES`; "ideal", the ideal actuator, with a controller only) and
+    ``damper_scale`` multiplies an MR damper's force capacity (`BoucWen.scaled`); it must stay 1
+    for passive and the ideal actuator, which have none to scale."""
 
     scenario: str = "paper-sine"
     scenario_options: tuple = ()
@@ -55,10 +58,22 @@ class Case:
     gains: tuple = ()
     noise: tuple = ()
     seed: int = 0
+    damper_scale: float = 1.0
 
     def __post_init__(self):
+        from . import dampers
+
         if self.suspension not in SUSPENSIONS:
             raise ValueError(f"suspension = {self.suspension!r}; allowed: {', '.join(SUSPENSIONS)}")
+        model = dampers.preset(self.damper)  # an unknown name fails here, not in a batch
+        object.__setattr__(self, "damper_scale", dampers.check_scale("damper_scale", self.damper_scale))
+        if self.damper_scale != 1.0 and (self.suspension == "passive" or model.law == dampers.LAW_IDEAL):
+            what = "the passive viscous dampers" if self.suspension == "passive" else "the ideal actuator"
+            raise ValueError(f"damper_scale = {self.damper_scale:g}: {what} have no force capacity "
+                             "to scale; it applies to MR dampers only")
+        if self.suspension == "mr" and model.law == dampers.LAW_IDEAL:
+            raise ValueError(f"damper = {self.damper!r} with suspension = 'mr': the ideal actuator applies a "
+                             "controller's demand and has no constant voltage; use a controller")
         for name in ("scenario_options", "vehicle", "gains"):
             value = getattr(self, name)
             if isinstance(value, dict):
@@ -79,6 +94,8 @@ class Case:
         d = asdict(self)
         for name in ("scenario_options", "vehicle", "gains"):
             d[name] = dict(d[name])
+        if d["damper_scale"] == 1.0:  # so the keys of unscaled runs stay as they were
+            del d["damper_scale"]
         return d
 
     @property
@@ -88,7 +105,8 @@ class Case:
         kind = "passive" if self.suspension == "passive" else ("mr" if self.suspension == "mr" else "closed")
         # sensor noise is one setting per batch
         return (duration, kind, self.damper if kind != "passive" else "",
-                (self.noise, self.seed) if kind == "closed" else ())
+                (self.noise, self.seed) if kind == "closed" else (),
+                self.damper_scale if kind != "passive" else 1.0)
 
 
 def apply_gains(base, changes):
@@ -113,6 +131,7 @@ def evaluate(cases: list[Case], base_gains=None, dt: float = 1e-4, window=None,
     its key, settings and the RMS and peak-to-peak of the four body responses; with
     ``comfort``, also the ride comfort indices of `COMFORT_COLUMNS` (`railride.comfort.
     ride_comfort` over the same window). Runs in any process: a Dask worker calls it too."""
+    from .comparison import damper_model
     from .control import GainSet, SensorNoise
     from .params import VehicleParams
     from .simulation import simulate
@@ -135,10 +154,11 @@ def evaluate(cases: list[Case], base_gains=None, dt: float = 1e-4, window=None,
                 scs.append(scenarios[skey])
             pars = [VehicleParams.preset("paper").replace(**dict(c.vehicle)) for c in part]
             kind = group[1]
+            damper = damper_model(group[2], group[4]) if kind != "passive" else None
             if kind == "passive":
                 res = simulate(scs, pars, dt=dt)
             elif kind == "mr":
-                res = simulate(scs, pars, dt=dt, damper=group[2], voltage=[c.voltage for c in part])
+                res = simulate(scs, pars, dt=dt, damper=damper, voltage=[c.voltage for c in part])
             else:
                 gsets = [apply_gains(base_gains, c.gains) for c in part]
                 inners = {g.inner for g in gsets}
@@ -147,7 +167,7 @@ def evaluate(cases: list[Case], base_gains=None, dt: float = 1e-4, window=None,
                         rows[i] = evaluate([cases[i]], base_gains, dt, window, comfort)[0]
                     continue
                 noise, seed = group[3]
-                res = simulate(scs, pars, dt=dt, damper=group[2], inner=gsets[0].inner,
+                res = simulate(scs, pars, dt=dt, damper=damper, inner=gsets[0].inner,
                                controller=[g.controller(c.suspension) for c, g in zip(part, gsets)],
                                sensor_noise=SensorNoise(*noise, seed=seed) if noise else None)
             m = res.metrics(window).values  # (sample, response, statistic)
@@ -175,7 +195,7 @@ def evaluate(cases: list[Case], base_gains=None, dt: float = 1e-4, window=None,
 
 def _flat(c: Case) -> dict:
     d = {"scenario": c.scenario, "suspension": c.suspension, "damper": c.damper,
-         "voltage": np.nan if c.voltage is None else c.voltage,
+         "damper_scale": c.damper_scale, "voltage": np.nan if c.voltage is None else c.voltage,
          "noise": json.dumps(list(c.noise)) if c.noise else "", "seed": c.seed}
     d.update({f"scenario.{k}": v for k, v in c.scenario_options})
     d.update({f"vehicle.{k}": v for k, v in c.vehicle})

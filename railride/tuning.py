@@ -2,14 +2,15 @@
 
 One parameter at a time is swept over a logarithmic range (and 0) while the others stay fixed;
 the best value is kept; passes repeat until a whole pass improves the objective by less than a
-tolerance. Phases follow the paper: the six SAS attitude gains with the ride loop off, then the
-eight ride gains with the attitude loop fixed; PID's three gains the same way; the inner loop's
-B and G on the force-tracking error of the damper rig.
+tolerance. Phases follow the paper: PID's three gains; the six SAS attitude gains with the ride
+loop off, then the eight ride gains with the attitude loop fixed, starting from zero ride gains
+(the paper's phase 2); the inner loop's B and G on the force-tracking error of the damper rig.
 
-The objective of a vehicle run is sum_k w_k RMS_k / RMS_k(passive) over the four carbody
-responses (acceleration, displacement, pitch, roll), weights settable, plus ``penalty`` times
-any ratio above 1 (0 by default: the paper's plain sum; the shipped gains use 10 so that no
-response gets worse than passive).
+A vehicle run is scored by a named `Objective` over the four RMS ratios to passive, r_k =
+RMS_k / RMS_k(passive) (acceleration, displacement, pitch, roll): ``sum``, ``weighted``,
+``minimax`` or ``constrained``, plus an optional penalty on ratios above 1. `DEFAULT_OBJECTIVE`
+is the one home of the default; `Objective.describe` states an objective in full, and every
+output of a study prints that statement.
 
 Every vehicle evaluation goes through `railride.sweep.run_cases`, so it can run on a Dask
 cluster and lands in the run table; the study itself is deterministic given the results, so a
@@ -24,7 +25,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from .control import GainSet, InnerLoop
+from .control import GainSet
 from .metrics import RESPONSES
 from .sweep import Case, RunTable, apply_gains, run_cases
 
@@ -37,33 +38,182 @@ PARAMETERS = {
     "ride": tuple(f"ride.{k}_{c}" for k in ("kp", "kd") for c in ("1R", "1L", "2R", "2L")),
 }
 SUSPENSION = {"pid": "pid", "attitude": "sas-attitude", "ride": "sas-attitude-ride"}
-#: where a sweep starts for a gain that is 0 (scaled from the passive suspension, see gains.toml)
-REFERENCE = {"pid.kp": 1e5, "pid.ki": 1e5, "pid.kd": 8e4, "attitude.kp_z": 4e5, "attitude.kd_z": 3.2e5,
-             "attitude.kp_phi": 3.24e7, "attitude.kd_phi": 2.6e7, "attitude.kp_theta": 4e5,
-             "attitude.kd_theta": 3.2e5, "inner.B": 1.0, "inner.G": 1e-3,
-             **{f"ride.kp_{c}": 5e4 for c in ("1R", "1L", "2R", "2L")},
-             **{f"ride.kd_{c}": 4e4 for c in ("1R", "1L", "2R", "2L")}}
+
+
+def _reference() -> dict:
+    g = GainSet.reference()
+    return {f"{table}.{k}": float(v) for table in PARAMETERS
+            for k, v in getattr(g, table).to_dict().items()}
+
+
+#: the neutral gains of railride/data/reference_gains.toml (`GainSet.reference`), by
+#: "table.entry": where the sweep of a gain that is 0 is centred, and the centre of the search
+#: box of the global methods
+REFERENCE = _reference()
+
+#: the objectives, in the order the docs list them
+OBJECTIVE_KINDS = ("sum", "weighted", "minimax", "constrained")
+#: the ratios' names in the order of the weights
+RATIO_NAMES = ("acceleration", "displacement", "pitch", "roll")
+#: constrained: an infeasible candidate scores INFEASIBLE_OFFSET + INFEASIBLE_SCALE x excess;
+#: the offset rises (by powers of ten) above the largest J a feasible candidate can have
+INFEASIBLE_OFFSET = 1000.0
+INFEASIBLE_SCALE = 1000.0
+
+
+def _number(name: str, value, rule: str, ok) -> float:
+    """``value`` as a float if it is a real number (not a bool, not text) passing ``ok``."""
+    number = not isinstance(value, (bool, str, bytes))
+    try:
+        x = float(value) if number else math.nan
+    except (TypeError, ValueError):
+        x = math.nan
+    if not (math.isfinite(x) and ok(x)):
+        raise ValueError(f"objective {name} = {value!r}: {rule}")
+    return x
 
 
 @dataclass(frozen=True)
 class Objective:
-    """sum_k w_k RMS_k / RMS_k(passive) + penalty * sum_k max(0, RMS_k / RMS_k(passive) - 1)."""
+    """A score J of a vehicle run from its RMS ratios to passive, r_k = RMS_k / RMS_k(passive),
+    k = acceleration, displacement, pitch, roll; lower is better, J(passive) = 4 for the sums.
 
-    weights: tuple = (1.0, 1.0, 1.0, 1.0)  # acceleration, displacement, pitch, roll
+    ``kind``:
+
+    * ``sum``: J = sum_k r_k;
+    * ``weighted``: J = sum_k w_k r_k, ``weights`` four numbers >= 0, not all 0;
+    * ``minimax``: J = max_k r_k, the worst ratio (candidates with the same worst ratio tie,
+      whatever their other ratios);
+    * ``constrained``: J = sum_k r_k if every r_k <= ``bound`` (> 0); otherwise the candidate
+      is infeasible and J = offset + 1000 E, E = sum_k max(0, r_k - bound) its total excess, the
+      offset 1000 (or the next power of ten above the largest J a feasible candidate can reach):
+      every infeasible candidate ranks after every feasible one, and among themselves by E.
+
+    ``penalty`` (>= 0, default 0) adds penalty x sum_k max(0, r_k - 1) to every kind (to the
+    feasible ones of ``constrained``). ``weights`` is for ``weighted`` only and ``bound`` for
+    ``constrained`` only. `describe` is the statement printed with every result.
+    `DEFAULT_OBJECTIVE` is the tuner's default; ``Objective()`` is the plain sum.
+    """
+
+    kind: str = "sum"
+    weights: tuple | None = None  # acceleration, displacement, pitch, roll
+    bound: float | None = None
     penalty: float = 0.0
 
     def __post_init__(self):
-        w = tuple(float(x) for x in self.weights)
-        if len(w) != 4 or not all(math.isfinite(x) and x >= 0 for x in w) or sum(w) == 0:
-            raise ValueError(f"objective weights = {self.weights!r}: four numbers >= 0, not all 0 "
-                             "(acceleration, displacement, pitch, roll)")
-        if not (math.isfinite(self.penalty) and self.penalty >= 0):
-            raise ValueError(f"objective penalty = {self.penalty!r}: a number >= 0")
-        object.__setattr__(self, "weights", w)
+        if self.kind not in OBJECTIVE_KINDS:
+            raise ValueError(f"objective kind = {self.kind!r}: unknown; allowed: "
+                             f"{', '.join(OBJECTIVE_KINDS)}")
+        rule = ("four numbers >= 0, not all 0 (acceleration, displacement, pitch, roll), for "
+                "kind 'weighted'")
+        if self.kind == "weighted":
+            if self.weights is None:
+                raise ValueError(f"objective weights = None: {rule}")
+            try:
+                w = tuple(self.weights)
+            except TypeError:
+                raise ValueError(f"objective weights = {self.weights!r}: {rule}") from None
+            if len(w) != 4:
+                raise ValueError(f"objective weights = {self.weights!r}: {rule}")
+            w = tuple(_number("weights", x, rule, lambda v: v >= 0) for x in w)
+            if sum(w) == 0:
+                raise ValueError(f"objective weights = {self.weights!r}: {rule}")
+            object.__setattr__(self, "weights", w)
+        elif self.weights is not None:
+            raise ValueError(f"objective weights = {self.weights!r}: for kind 'weighted' only "
+                             f"(kind is {self.kind!r})")
+        if self.kind == "constrained":
+            if self.bound is None:
+                raise ValueError("objective bound = None: kind 'constrained' needs a bound, a "
+                                 "finite number > 0 (the largest RMS ratio to passive allowed)")
+            object.__setattr__(self, "bound", _number(
+                "bound", self.bound, "a finite number > 0 (the largest RMS ratio to passive "
+                "allowed)", lambda v: v > 0))
+        elif self.bound is not None:
+            raise ValueError(f"objective bound = {self.bound!r}: for kind 'constrained' only "
+                             f"(kind is {self.kind!r})")
+        object.__setattr__(self, "penalty", _number("penalty", self.penalty,
+                                                    "a finite number >= 0", lambda v: v >= 0))
+        if self.kind == "constrained" and not math.isfinite(self.feasible_max):
+            raise ValueError(f"objective bound = {self.bound!r} with penalty = {self.penalty!r}: "
+                             "too large to rank infeasible candidates after feasible ones")
+
+    @property
+    def feasible_max(self) -> float:
+        """constrained: the largest J a feasible candidate can have (every r_k at the bound)."""
+        if self.kind != "constrained":
+            return math.inf
+        return 4.0 * self.bound + 4.0 * self.penalty * max(0.0, self.bound - 1.0)
+
+    @property
+    def infeasible_offset(self) -> float | None:
+        """constrained: the J of an infeasible candidate with a vanishing excess (None for the
+        other kinds): INFEASIBLE_OFFSET, or the next power of ten above `feasible_max`."""
+        if self.kind != "constrained":
+            return None
+        offset = INFEASIBLE_OFFSET
+        while offset <= self.feasible_max:
+            offset *= 10.0
+        return offset
+
+    def score(self, ratio) -> np.ndarray:
+        """J of RMS ratios to passive, ``ratio`` (..., 4)."""
+        r = np.asarray(ratio, dtype=float)
+        if r.shape[-1:] != (4,):
+            raise ValueError(f"ratios of shape {r.shape}: the last axis must hold the four "
+                             "responses")
+        if self.kind == "weighted":
+            j = r @ np.array(self.weights)
+        elif self.kind == "minimax":
+            j = r.max(axis=-1)
+        else:
+            j = r.sum(axis=-1)
+        if self.penalty:
+            j = j + self.penalty * np.clip(r - 1.0, 0.0, None).sum(axis=-1)
+        if self.kind == "constrained":
+            excess = np.clip(r - self.bound, 0.0, None).sum(axis=-1)
+            j = np.where(excess > 0, self.infeasible_offset + INFEASIBLE_SCALE * excess, j)
+        return j
 
     def __call__(self, rms: np.ndarray, passive: np.ndarray) -> np.ndarray:
-        ratio = np.asarray(rms) / passive
-        return ratio @ np.array(self.weights) + self.penalty * np.clip(ratio - 1, 0, None).sum(axis=-1)
+        """J of RMS values (..., 4) against the passive RMS (4,)."""
+        return self.score(np.asarray(rms, dtype=float) / np.asarray(passive, dtype=float))
+
+    def describe(self) -> str:
+        """The whole objective in one line: formula, weights, bound, penalty, infeasible rule."""
+        r = "r_k = RMS_k / RMS_k(passive), k = acceleration, displacement, pitch, roll"
+        if self.kind == "sum":
+            text = f"sum: J = sum_k r_k (every weight 1), {r}"
+        elif self.kind == "weighted":
+            w = ", ".join(f"{n} {v:g}" for n, v in zip(RATIO_NAMES, self.weights))
+            text = f"weighted: J = sum_k w_k r_k, weights {w}, {r}"
+        elif self.kind == "minimax":
+            text = (f"minimax: J = max_k r_k (the worst ratio; equal worst ratios tie), {r}")
+        else:
+            b = f"{self.bound:g}"
+            text = (f"constrained: J = sum_k r_k subject to r_k <= {b} for every k, {r}; an "
+                    f"infeasible candidate scores J = {self.infeasible_offset:g} + "
+                    f"{INFEASIBLE_SCALE:g} x E, E = sum_k max(0, r_k - {b}), ranking it after "
+                    f"every feasible one (J <= {self.feasible_max:g}) and by its excess")
+        if self.penalty:
+            text += f"; plus penalty {self.penalty:g} x sum_k max(0, r_k - 1)"
+            if self.kind == "constrained":
+                text += " on feasible candidates"
+        return text
+
+    def to_dict(self) -> dict:
+        """Every setting of the objective and its statement (for JSON documents)."""
+        return {"kind": self.kind,
+                "weights": None if self.weights is None else dict(zip(RESPONSES, self.weights)),
+                "bound": self.bound, "penalty": self.penalty,
+                "infeasible": None if self.kind != "constrained" else {
+                    "offset": self.infeasible_offset, "scale": INFEASIBLE_SCALE,
+                    "feasible_max": self.feasible_max},
+                "statement": self.describe()}
+
+
+#: the tuner's default objective (`tune`, `railride.optimise`, `railride tune`)
+DEFAULT_OBJECTIVE = Objective(kind="minimax")
 
 
 @dataclass
@@ -85,6 +235,7 @@ class TuneResult:
     history: list[dict] = field(default_factory=list)  # objective after each pass of each phase
     runs: pd.DataFrame | None = None
     passive: dict | None = None
+    objective: Objective | None = None  # what the vehicle phases minimised
 
 
 def _rms(rows: pd.DataFrame) -> np.ndarray:
@@ -101,31 +252,38 @@ def _candidates(current: float, parameter: str, n_values: int, span: float) -> l
     return vals
 
 
-def tune(phases=("attitude", "ride"), *, scenario: str = "paper-sine", scenario_options=None,
+def tune(phases=PHASES, *, scenario: str = "paper-sine", scenario_options=None,
          gains: GainSet | None = None, objective: Objective | None = None, damper: str = "railway",
          executor=None, table: RunTable | None = None, n_values: int = 13, span: float = 30.0,
          max_passes: int = 5, tol: float = 1e-3, dt: float = 1e-4, window=None, progress=None,
          log=None) -> TuneResult:
-    """The sensitivity study: the phases in order (from PHASES), each to convergence.
+    """The sensitivity study: the phases in order (from PHASES; default all four, so PID and SAS
+    are tuned by the same procedure and budget), each to convergence, from ``gains`` (default
+    the neutral `GainSet.reference`), minimising ``objective`` (default `DEFAULT_OBJECTIVE`).
 
     ``n_values`` log-spaced values from 1/span to span times the current value (and 0) per
     parameter; a pass ends when every parameter of the phase was swept; a phase ends when a pass
-    improves the objective by less than ``tol`` (relative) or after ``max_passes``.
+    improves the objective by less than ``tol`` (relative) or after ``max_passes``. The ride
+    phase starts from zero ride gains, as the paper's phase 2 (the ride loop is added to a tuned
+    attitude loop), whatever ``gains`` holds for them.
     ``progress(done, total, runs_per_second)`` after each chunk; ``log(text)`` after each pass.
     """
-    gains = GainSet.default() if gains is None else gains
-    objective = Objective() if objective is None else objective
+    gains = GainSet.reference() if gains is None else gains
+    objective = DEFAULT_OBJECTIVE if objective is None else objective
     opts = tuple(sorted((scenario_options or {}).items()))
     table = RunTable() if table is None else table
     unknown = [p for p in phases if p not in PHASES]
     if unknown:
         raise ValueError(f"unknown phase {unknown[0]!r}; allowed: {', '.join(PHASES)}, all")
+    if "inner" in phases and damper == "ideal":
+        raise ValueError("damper = 'ideal' with phase 'inner': the ideal actuator has no force "
+                         "tracking loop to tune; leave out the inner phase")
     if not (isinstance(n_values, int) and n_values >= 3):
         raise ValueError(f"n_values = {n_values!r}: a whole number >= 3")
     if not (span > 1):
         raise ValueError(f"span = {span!r}: must be > 1")
     base = gains
-    result = TuneResult(gains)
+    result = TuneResult(gains, objective=objective)
 
     def run(cases):
         return run_cases(cases, executor=executor, table=table, base_gains=base, dt=dt,
@@ -144,7 +302,10 @@ def tune(phases=("attitude", "ride"), *, scenario: str = "paper-sine", scenario_
             _tune_inner(base, changes, params, n_values, span, max_passes, tol, result, log, damper)
             continue
         suspension = SUSPENSION[phase]
-        def score(change_sets):
+        if phase == "ride":  # the paper's phase 2: the ride loop joins with zero gains
+            changes.update(dict.fromkeys(params, 0.0))
+
+        def score(change_sets, suspension=suspension):
             cases = [Case(scenario, opts, suspension=suspension, damper=damper,
                           gains=tuple(sorted({**changes, **cs}.items()))) for cs in change_sets]
             return objective(_rms(run(cases)), passive)
@@ -193,7 +354,7 @@ def _tune_inner(base, changes, params, n_values, span, max_passes, tol, result, 
         start = best
         for p in params:
             vals = _candidates(value(p), p, n_values, span)
-            obj = np.array([tracking_objective(**{**{"B": value("inner.B"), "G": value("inner.G")},
+            obj = np.array([tracking_objective(**{"B": value("inner.B"), "G": value("inner.G"),
                                                  p.split(".")[1]: v}, damper=damper) for v in vals])
             k = int(np.argmin(obj))
             if obj[k] < best - 1e-12:

@@ -13,6 +13,7 @@ from typer.testing import CliRunner
 from railride.cli import app
 from railride.control import GainSet
 from railride.report import TUNE_FILES
+from railride.tuning import DEFAULT_OBJECTIVE
 
 runner = CliRunner()
 
@@ -60,10 +61,14 @@ def test_tune_folder_and_json(tuned):
     out, doc = tuned
     assert sorted(p.name for p in out.iterdir()) == sorted([*TUNE_FILES, "runs.csv"])
     assert json.loads((out / "tune.json").read_text()) == doc
-    assert doc["schema"] == "railride.tune/1"
+    assert doc["schema"] == "railride.tune/2"
     assert doc["phases"] == ["pid"]
     assert doc["scenario"]["duration_s"] == 1.0
-    assert doc["objective"] == {"weights": dict.fromkeys(RESPONSES, 1.0), "penalty": 0.0}
+    # no --objective: the library's default, stated in full
+    assert doc["objective"]["kind"] == DEFAULT_OBJECTIVE.kind
+    assert doc["objective"]["penalty"] == DEFAULT_OBJECTIVE.penalty
+    assert doc["objective"]["statement"].startswith(f"{DEFAULT_OBJECTIVE.kind}: J = ")
+    assert doc["settings"]["start_gains"] == "railride/data/reference_gains.toml"
     assert list(doc["passive_rms"]) == RESPONSES
     assert [(h["phase"], h["pass"]) for h in doc["history"]] == [("pid", 1)]
     assert doc["runs"] == table_rows(out / "runs.csv") == doc["runs_evaluated"] > 0
@@ -116,6 +121,30 @@ def test_tune_table_output():
         assert fragment in result.stdout, fragment
 
 
+def test_tune_states_its_objective_in_every_output(tmp_path):
+    import tomllib
+
+    out = tmp_path / "run"
+    args = (*TUNE, "--objective", "weighted", "--weights", "1,0.5,2,1", "--penalty", "3")
+    doc = json.loads(ok(*args, "--out", out, "--format", "json").stdout)
+    o = doc["objective"]
+    assert (o["kind"], o["penalty"], o["bound"]) == ("weighted", 3.0, None)
+    assert o["weights"] == dict(zip(RESPONSES, (1.0, 0.5, 2.0, 1.0)))
+    statement = o["statement"]
+    for fragment in ("acceleration 1, displacement 0.5, pitch 2, roll 1", "penalty 3 x"):
+        assert fragment in statement
+    text = (out / "gains.toml").read_text()
+    assert f"# objective: {statement}\n" in text
+    provenance = tomllib.loads(text)["provenance"]
+    assert provenance["objective"] == statement
+    assert provenance["scenario_record"] == doc["scenario"]
+    table = " ".join(ok(*args).stdout.split())  # rich wraps the caption: compare words
+    assert f"objective: {statement}" in table
+
+    constrained = ok(*TUNE, "--objective", "constrained", "--bound", "0.05").stdout
+    assert "within" in constrained and "J = 1000 + 1000 x E" in " ".join(constrained.split())
+
+
 def test_tune_interrupted(tmp_path, monkeypatch):
     """Ctrl-C: one line saying how many runs the table holds, status 130, no traceback."""
     from railride import sweep
@@ -147,9 +176,22 @@ def test_tune_interrupted(tmp_path, monkeypatch):
 @pytest.mark.parametrize("args, fragments", [
     (("--phase", "lqr"), ("--phase", "lqr", "allowed")),
     (("--phase", "pid,,ride"), ("--phase", "empty item")),
-    (("--weights", "1,1,1"), ("--weights", "four numbers")),
-    (("--weights", "1,1,x,1"), ("--weights", "'x'")),
+    (("--objective", "weighted", "--weights", "1,1,1"), ("--weights", "four numbers")),
+    (("--objective", "weighted", "--weights", "1,1,x,1"), ("--weights", "'x'")),
+    (("--objective", "weighted", "--weights", "1,-1,1,1"), ("--weights", "-1", ">= 0")),
+    (("--objective", "weighted", "--weights", "0,0,0,0"), ("--weights", "> 0")),
+    (("--objective", "weighted"), ("--objective weighted", "--weights")),
+    (("--objective", "sum", "--weights", "1,1,2,1"), ("--weights", "weighted only", "sum")),
+    (("--objective", "best"), ("--objective", "'best'", "sum, weighted, minimax, constrained")),
+    (("--objective", "constrained"), ("--objective constrained", "--bound")),
+    (("--objective", "constrained", "--bound", "0"), ("--bound", "'0'", "> 0")),
+    (("--objective", "constrained", "--bound", "-1.2"), ("--bound", "> 0")),
+    (("--objective", "constrained", "--bound", "x"), ("--bound", "'x'", "not a number")),
+    (("--objective", "constrained", "--bound", "inf"), ("--bound", "finite")),
+    (("--objective", "minimax", "--bound", "1.2"), ("--bound", "constrained only", "minimax")),
     (("--penalty", "-1"), ("--penalty",)),
+    (("--penalty", "ten"), ("--penalty", "'ten'", "not a number")),
+    (("--phase", "inner,pid", "--damper", "ideal"), ("--damper", "ideal", "inner")),
     (("--values", "2"), ("--values = 2",)),
     (("--span", "1"), ("--span",)),
     (("--passes", "0"), ("--passes = 0",)),

@@ -8,7 +8,15 @@ from railride.optimise import optimise, sensitivity
 from railride.simulation import simulate
 from railride.sweep import Case, RunTable, apply_gains, run_cases
 from railride.track import scenario
-from railride.tuning import Objective, tracking_objective, tune
+from railride.tuning import (
+    DEFAULT_OBJECTIVE,
+    INFEASIBLE_OFFSET,
+    PARAMETERS,
+    REFERENCE,
+    Objective,
+    tracking_objective,
+    tune,
+)
 
 SHORT = {"duration": 1.0}
 
@@ -72,7 +80,8 @@ def test_sensitivity_study_never_worsens_the_objective_and_records_curves():
                      base_gains=start)
     rms = rows[[f"{r}_rms" for r in ("acceleration_m_s2", "displacement_m", "pitch_deg", "roll_deg")]].to_numpy()
     passive = np.array(list(res.passive.values()))
-    assert Objective()(rms, passive)[0] == pytest.approx(history[-1], rel=1e-12)
+    assert res.objective is DEFAULT_OBJECTIVE  # no objective given: the one default
+    assert res.objective(rms, passive)[0] == pytest.approx(history[-1], rel=1e-12)
 
 
 def test_inner_loop_objective_prefers_feedback():
@@ -80,14 +89,120 @@ def test_inner_loop_objective_prefers_feedback():
     assert tracking_objective(1.0, 1.15e-3) < tracking_objective(1.0, 1e-9)
 
 
-def test_objective_weights_and_penalty():
-    passive = np.array([1.0, 1.0, 1.0, 1.0])
-    rms = np.array([[0.5, 0.5, 1.5, 1.0]])
-    assert Objective()(rms, passive)[0] == pytest.approx(3.5)
-    assert Objective(weights=(1, 0, 0, 0))(rms, passive)[0] == pytest.approx(0.5)
-    assert Objective(penalty=10.0)(rms, passive)[0] == pytest.approx(3.5 + 5.0)
-    with pytest.raises(ValueError, match="weights"):
-        Objective(weights=(1, 2))
+def test_objective_kinds_against_hand_computed_values():
+    passive = np.array([2.0, 1.0, 0.5, 4.0])
+    rms = np.array([[1.0, 0.5, 0.75, 2.0],    # ratios 0.5, 0.5, 1.5, 0.5
+                    [2.0, 1.0, 0.5, 4.0]])    # passive itself: ratios 1, 1, 1, 1
+    cases = [
+        (Objective(), [3.0, 4.0]),
+        (Objective("weighted", (1, 0, 2, 1)), [0.5 + 0 + 3.0 + 0.5, 4.0]),
+        (Objective("minimax"), [1.5, 1.0]),
+        (Objective("sum", penalty=10.0), [3.0 + 10 * 0.5, 4.0]),
+        (Objective("minimax", penalty=2.0), [1.5 + 2 * 0.5, 1.0]),
+        (Objective("constrained", bound=2.0), [3.0, 4.0]),             # both within the bound
+        (Objective("constrained", bound=1.2), [1000 + 1000 * 0.3, 4.0]),  # 1.5 is 0.3 over
+    ]
+    for objective, expected in cases:
+        assert objective(rms, passive) == pytest.approx(expected, rel=1e-12), objective.kind
+        assert objective(rms[0], passive) == pytest.approx(expected[0], rel=1e-12)  # one run
+
+
+def test_minimax_sees_only_the_worst_ratio():
+    ratios = np.array([[0.9, 0.1, 0.1, 0.1], [0.9, 0.9, 0.9, 0.9], [0.2, 0.2, 0.2, 0.91]])
+    j = Objective("minimax").score(ratios)
+    assert j[0] == j[1] == 0.9  # a tie, however much better the other three ratios are
+    assert j[2] > j[0]
+    assert "tie" in Objective("minimax").describe()
+
+
+def test_constrained_ranks_infeasible_candidates_after_feasible_ones_by_excess():
+    ratios = np.array([
+        [1.2, 1.2, 1.2, 1.2],      # feasible, at the bound: the worst feasible sum
+        [0.1, 0.1, 0.1, 1.21],     # infeasible by 0.01, with the smallest sum
+        [1.22, 1.22, 0.0, 0.0],    # infeasible by 0.04
+        [1.3, 0.1, 0.1, 0.1],      # infeasible by 0.1
+        [1.0, 1.0, 1.0, 1.0],      # feasible
+    ])
+    for penalty in (0.0, 10.0):
+        objective = Objective("constrained", bound=1.2, penalty=penalty)
+        j = objective.score(ratios)
+        assert list(np.argsort(j)) == [4, 0, 1, 2, 3]
+        assert j[0] == pytest.approx(4.8 + penalty * 0.8)  # feasible: sum and penalty
+        assert j[1] == pytest.approx(INFEASIBLE_OFFSET + 1000 * 0.01)
+        assert j[3] == pytest.approx(INFEASIBLE_OFFSET + 1000 * 0.1)
+    # a bound so loose that a feasible J could pass 1000: the offset rises above it
+    loose = Objective("constrained", bound=300.0)
+    j = loose.score(np.array([[300.0] * 4, [0.0, 0.0, 0.0, 300.001]]))
+    assert j[0] == pytest.approx(1200.0) and j[1] > j[0]
+    assert f"J = {loose.infeasible_offset:g} + 1000 x E" in loose.describe()
+
+
+def test_every_setting_of_an_objective_is_in_its_statement():
+    text = Objective("weighted", (1, 0.5, 2, 1), penalty=3.0).describe()
+    for fragment in ("weighted", "acceleration 1, displacement 0.5, pitch 2, roll 1",
+                     "penalty 3 x sum_k max(0, r_k - 1)"):
+        assert fragment in text
+    text = Objective("constrained", bound=1.2).describe()
+    assert "r_k <= 1.2" in text and "J = 1000 + 1000 x E" in text and "max(0, r_k - 1.2)" in text
+    assert "penalty" not in Objective("sum").describe()  # none to state
+    d = Objective("constrained", bound=1.2, penalty=1.0).to_dict()
+    assert (d["kind"], d["bound"], d["penalty"], d["weights"]) == ("constrained", 1.2, 1.0, None)
+    assert d["infeasible"]["offset"] == 1000.0 and d["statement"].startswith("constrained: J")
+
+
+@pytest.mark.parametrize("kwargs, fragments", [
+    ({"kind": "best"}, ("kind", "'best'", "sum, weighted, minimax, constrained")),
+    ({"kind": "weighted"}, ("weights = None", "four numbers")),
+    ({"kind": "weighted", "weights": (1, 2)}, ("weights", "four numbers")),
+    ({"kind": "weighted", "weights": (1, -1, 0, 0)}, ("weights", ">= 0")),
+    ({"kind": "weighted", "weights": (0, 0, 0, 0)}, ("weights", "not all 0")),
+    ({"kind": "weighted", "weights": ("a", 1, 1, 1)}, ("weights", "'a'")),
+    ({"kind": "sum", "weights": (1, 1, 2, 1)}, ("weights", "'weighted' only")),
+    ({"kind": "constrained"}, ("bound = None", "> 0")),
+    ({"kind": "constrained", "bound": 0.0}, ("bound = 0.0", "> 0")),
+    ({"kind": "constrained", "bound": float("nan")}, ("bound", "finite")),
+    ({"kind": "constrained", "bound": "1.2"}, ("bound = '1.2'",)),
+    ({"kind": "minimax", "bound": 1.2}, ("bound = 1.2", "'constrained' only")),
+    ({"penalty": -1.0}, ("penalty = -1.0", ">= 0")),
+    ({"penalty": float("inf")}, ("penalty", "finite")),
+])
+def test_objective_refuses_bad_settings(kwargs, fragments):
+    with pytest.raises(ValueError) as info:
+        Objective(**kwargs)
+    for fragment in fragments:
+        assert fragment in str(info.value), str(info.value)
+
+
+def test_the_ride_phase_starts_from_zero_ride_gains():
+    start = GainSet.reference()
+    start = GainSet(start.inner, start.pid, start.attitude,
+                    start.ride.replace(**dict.fromkeys(start.ride.to_dict(), 7e4)), "test")
+    res = tune(("ride",), scenario_options={"duration": 0.5}, gains=start, n_values=3,
+               max_passes=1)
+    first = res.curves[0]
+    # swept around REFERENCE (the centre for a gain at 0), not around the start's 7e4
+    assert first.values.max() == pytest.approx(REFERENCE[first.parameter] * 30, rel=1e-3)
+    assert 7e4 not in first.values
+    for name, value in res.gains.ride.to_dict().items():
+        tried = {v for c in res.curves if c.parameter == f"ride.{name}" for v in c.values}
+        assert value in tried and value != 7e4
+
+
+def test_tune_starts_from_the_reference_gains_and_refuses_ideal_with_inner():
+    res = tune(("pid",), scenario_options={"duration": 0.5}, n_values=3, max_passes=1)
+    assert res.gains.attitude == GainSet.reference().attitude  # untuned: as they started
+    with pytest.raises(ValueError, match="ideal.*inner"):
+        tune(("inner", "pid"), damper="ideal")
+
+
+def test_reference_gains_ship_with_the_package():
+    from importlib import resources
+
+    assert resources.files("railride").joinpath("data/reference_gains.toml").is_file()
+    ref = GainSet.reference()
+    assert ref.source == "railride/data/reference_gains.toml"
+    # every tunable gain has a nonzero centre for its sweep and for the global search box
+    assert all(REFERENCE[p] > 0 for ps in PARAMETERS.values() for p in ps)
 
 
 def test_global_optimiser_reports_the_objective_of_the_gains_it_returns():
