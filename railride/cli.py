@@ -556,6 +556,22 @@ def _damper_text(settings: dict) -> str:
     return f"{settings['damper']} MR dampers" + (f", force x {scale:g}" if scale != 1.0 else "")
 
 
+def _trade_off_lines(doc: dict) -> list[str]:
+    """One line per trade-off of `Comparison.trade_offs`: what a controller loses for what it
+    wins, against passive and against each other controller."""
+    labels = {r["name"]: r["label"] for r in doc["controllers"]}
+    words = {k: v.split(" (")[0] for k, v in RESPONSE_LABELS.items()}
+    lines = []
+    for t in doc.get("trade_offs", []):
+        if not t["worse_on"]:
+            continue
+        a, b = labels[t["controller"]], labels.get(t["than"], t["than"])
+        better = ", ".join(words[r] for r in t["better_on"]) or "nothing"
+        worse = ", ".join(words[r] for r in t["worse_on"])
+        lines.append(f"trade-off: {a} beats {b} on {better} but is worse on {worse}")
+    return lines
+
+
 def _compare_tables(doc: dict, vehicle: str, shipped: bool):
     """The three tables of `compare`: Table 1 beside the paper, peak-to-peak, damper demands."""
     from rich.markup import escape
@@ -580,6 +596,14 @@ def _compare_tables(doc: dict, vehicle: str, shipped: bool):
         info.append(f"{_damper_text(settings)}, controller {settings['control_rate_hz']:g} Hz, "
                     f"{noise_text}")
         info.append(f"gains file {doc['gains']['source']}" + (" (shipped)" if shipped else ""))
+        tuning = doc.get("tuning") or {}
+        if tuning.get("objective"):
+            info.append(f"gains tuned with objective {tuning['objective']}"
+                        + (f" by `{tuning['command']}`" if tuning.get("command") else ""))
+        if tuning.get("in_sample"):
+            info.append("The gains were tuned on this same single track: the reductions are "
+                        "in-sample, not a test on another track.")
+        info += _trade_off_lines(doc)
     info.append("The paper's absolute values depend on settings it does not give (sine wavelength, "
                 "rail phase, damper, gains): compare the ranking and the size of the reductions, "
                 "not the digits. red. % = (passive - controlled) / passive x 100 (negative: worse "
@@ -614,19 +638,21 @@ def _compare_tables(doc: dict, vehicle: str, shipped: bool):
     # 3. what each suspension asks of its dampers
     demands = Table(title="What each suspension asks of its dampers")
     demands.add_column("suspension", no_wrap=True)
-    for heading in ("RMS force\n(kN)", "max force\n(kN)", "RMS travel\n(mm)", "max travel\n(mm)",
-                    "mean voltage\n(V)", "time at v_max\n(%)"):
+    for heading in ("RMS demand\n(kN)", "RMS force\n(kN)", "max force\n(kN)", "RMS travel\n(mm)",
+                    "max travel\n(mm)", "mean voltage\n(V)", "time at v_max\n(%)"):
         demands.add_column(heading, justify="right", min_width=6)
     for r in rows:
         d = r["damper"]
         at_max = d.get("voltage_at_max_fraction")
-        demands.add_row(escape(r["label"]), f"{d['force_rms_n'] / 1e3:.2f}",
+        demand = d.get("demand_rms_n")
+        demands.add_row(escape(r["label"]), "-" if demand is None else f"{demand / 1e3:.2f}",
+                        f"{d['force_rms_n'] / 1e3:.2f}",
                         f"{d['force_max_n'] / 1e3:.2f}", f"{d['travel_rms_m'] * 1e3:.1f}",
                         f"{d['travel_max_m'] * 1e3:.1f}", _fmt(d.get("voltage_mean_v"), ".2f"),
                         "-" if at_max is None else f"{at_max * 100:.1f}")
-    demands_note = ("All four corners, over the metric window. force: the secondary damper force on "
-                    "the carbody; travel: the secondary deflection (suspension travel); passive: "
-                    "the viscous dampers c_sz."
+    demands_note = ("All four corners, over the metric window. demand: the force the outer loop "
+                    "asks for; force: the secondary damper force on the carbody; travel: the "
+                    "secondary deflection (suspension travel); passive: the viscous dampers c_sz."
                     + (" The ideal actuators have no voltage." if settings.get("damper")
                        in ("ideal", "ideal-damper") and controlled else ""))
     parts = [table, Text("\n".join(info)), "", ptp, "", demands, Text(demands_note)]
@@ -1606,7 +1632,7 @@ _CONTROLLER_TABLES = {"pid": ("inner", "pid"), "sas-attitude": ("inner", "attitu
 
 
 def _before_after(result, start, phases, scenario_name, options, damper, executor, table, dt,
-                  progress) -> list[dict]:
+                  progress, damper_scale=1.0) -> list[dict]:
     """RMS of each controller the phases change, with the start and with the tuned gains, and
     the reductions against passive. Through the run table: most of these runs are in it."""
     from . import sweep as sweep_lib
@@ -1616,8 +1642,10 @@ def _before_after(result, start, phases, scenario_name, options, damper, executo
     names = [n for n in CONTROLLERS if any(n in PHASE_CONTROLLERS[p] for p in phases)]
     cases = []
     for n in names:
-        cases.append(sweep_lib.Case(scenario_name, options, suspension=n, damper=damper))
         cases.append(sweep_lib.Case(scenario_name, options, suspension=n, damper=damper,
+                                    damper_scale=damper_scale))
+        cases.append(sweep_lib.Case(scenario_name, options, suspension=n, damper=damper,
+                                    damper_scale=damper_scale,
                                     gains=_gain_changes(start, result.gains, _CONTROLLER_TABLES[n])))
     frame = sweep_lib.run_cases(cases, executor=executor, table=table, base_gains=start, dt=dt,
                                 progress=progress)
@@ -1650,6 +1678,26 @@ def _toml_inline(record: dict) -> str:
     return "{" + ", ".join(items) + "}"
 
 
+def _command_line(ctx: typer.Context, exclude=()) -> str:
+    """The railride command being run, with the options given on the command line (not their
+    defaults), for the record: reproducing a result needs only this line."""
+    import shlex
+
+    words = ["railride", ctx.info_name or ""]
+    for param in ctx.command.params:
+        source = ctx.get_parameter_source(param.name)
+        if param.name in exclude or getattr(source, "name", "") != "COMMANDLINE":
+            continue
+        value = ctx.params[param.name]
+        flag = max(param.opts, key=len)
+        if isinstance(value, bool):
+            words.append(flag if value else (param.secondary_opts or [flag])[0])
+            continue
+        for item in value if isinstance(value, (list, tuple)) else [value]:
+            words += [flag, str(getattr(item, "value", item))]
+    return shlex.join(w for w in words if w)
+
+
 def _tuned_gains_text(doc: dict, gains, scenario_text: str, objective) -> str:
     """gains.toml: a provenance header (comments and a [provenance] table, which gains files
     may carry) and the tuned gains."""
@@ -1662,7 +1710,8 @@ def _tuned_gains_text(doc: dict, gains, scenario_text: str, objective) -> str:
     run_text = f"{scenario_text}, {doc['scenario'].get('duration_s', 0):g} s"
     lines = [
         "# railride controller gains, tuned by `railride tune` (the paper's sensitivity study,",
-        "# spec section 9; docs/cli.md). Read by `railride compare --gains FILE`.",
+        "# its section V; docs/tuning.md). Read by `railride compare --gains FILE`.",
+        f"# command: {doc['command']}",
         f"# date: {doc['date']}; railride {doc['railride_version']}",
         f"# scenario: {run_text}, dt {s['dt_s']:g} s, {_damper_text(s)}",
         f"# objective: {_objective_text(objective)}",
@@ -1679,7 +1728,9 @@ def _tuned_gains_text(doc: dict, gains, scenario_text: str, objective) -> str:
         f"railride_version = {json.dumps(doc['railride_version'])}",
         f"scenario = {json.dumps(run_text)}",
         f"damper = {json.dumps(s['damper'])}",
+        f"damper_scale = {s.get('damper_scale', 1.0)!r}",
         f"dt_s = {s['dt_s']!r}",
+        f"command = {json.dumps(doc['command'])}",
         f"objective = {json.dumps(_objective_text(objective))}",
         # the exact track, so a study judging these gains can tell whether it is the same one
         f"scenario_record = {_toml_inline(doc['scenario'])}",
@@ -1782,6 +1833,7 @@ def _objective_text_from_doc(doc: dict) -> str:
 
 @app.command("tune")
 def tune_command(
+    ctx: typer.Context,
     phase: Annotated[Optional[list[str]], typer.Option(
         "--phase", metavar="PHASE[,PHASE...]",
         help="Tuning phases, repeatable or comma-separated: inner (B, G on the damper rig's "
@@ -1806,6 +1858,11 @@ def tune_command(
         "--damper", metavar="MODEL",
         help="MR damper model: railway, dyke1996 or spencer1997 (ideal, the ideal actuator, "
              "without the inner phase).")] = DEFAULT_DAMPER,
+    damper_scale: Annotated[Optional[float], typer.Option(
+        "--damper-scale", metavar="X",
+        help="Factor on the MR damper's force capacity, a finite number > 0 (every force "
+             "parameter times X; default 1); the inner phase tracks demands scaled alike. Not "
+             "with an ideal damper.")] = None,
     gains: Annotated[Optional[Path], typer.Option(
         "--gains", metavar="FILE.toml",
         help="Start values: a gains file as for compare (default: the neutral reference gains, "
@@ -1862,12 +1919,14 @@ def tune_command(
     """
     import time
 
+    command = _command_line(ctx, exclude=("out", "resume", "format"))
     with _errors():
         from . import report, tuning
         from .simulation import DEFAULT_DT, DEFAULT_OUTPUT_RATE
 
         phases = _phase_list(phase)
         _damper_preset("--damper", damper)
+        scale = _damper_scale("--damper-scale", damper_scale, damper)
         if damper == "ideal" and "inner" in phases:
             raise ValueError("--damper = 'ideal' with the inner phase (--phase "
                              f"{','.join(phases)}): the ideal actuator has no force tracking "
@@ -1895,10 +1954,11 @@ def tune_command(
                 t0 = time.perf_counter()
                 result = tuning.tune(phases, scenario=scenario, scenario_options=options,
                                      gains=start, objective=objective, damper=damper,
+                                     damper_scale=scale,
                                      executor=executor, table=table, n_values=values, span=span,
                                      max_passes=passes, dt=dt, progress=progress, log=progress.log)
                 comparison = _before_after(result, start, phases, scenario, options, damper,
-                                           executor, table, dt, progress)
+                                           executor, table, dt, progress, scale)
                 wall = time.perf_counter() - t0
             from .metrics import RESPONSES
 
@@ -1908,7 +1968,7 @@ def tune_command(
                 "date": _utc_now(),
                 "phases": phases,
                 "scenario": scen.describe(),
-                "settings": {"damper": damper, "dt_s": float(dt), "values": values,
+                "settings": {"damper": damper, "damper_scale": scale, "dt_s": float(dt), "values": values,
                              "span": float(span), "max_passes": passes, "tolerance": tol,
                              "start_gains": start.source},
                 "objective": objective.to_dict(),
@@ -1925,6 +1985,7 @@ def tune_command(
                 "runs_per_second": progress.evaluated / wall if wall > 0 else 0.0,
                 "wall_time_s": wall,
                 "executor": executor_record,
+                "command": command,
             }
             text = json.dumps(doc, indent=2, allow_nan=False)
             if out is not None:
@@ -2213,8 +2274,8 @@ def _sweep_table(rows: list[dict], grid_columns: list[str], caption: str):
         for c in grid_columns:
             v = row[c]
             cells.append("-" if v is None else (escape(v) if isinstance(v, str) else f"{v:g}"))
-        cells += [f"{row[f'{k}_rms']:#.4g}" for k in RESPONSE_LABELS]
-        cells += [f"{row[c]:#.3g}" for c, _ in comfort]
+        cells += [_fmt(row[f"{k}_rms"], "#.4g") for k in RESPONSE_LABELS]
+        cells += [_fmt(row[c], "#.3g") for c, _ in comfort]
         table.add_row(*cells)
     return table
 
@@ -2520,8 +2581,12 @@ def sweep_command(
                 wall = time.perf_counter() - t0
             metrics = _metric_columns() + (list(sweep_lib.COMFORT_COLUMNS) if comfort else [])
             rows = []
-            for case, values, (_, result) in zip(cases, grid, frame.iterrows()):
-                rows.append({**values, **{m: float(result[m]) for m in metrics}, "key": case.key})
+            diverged = frame["diverged_at_s"].notna() if "diverged_at_s" in frame else [False] * len(cases)
+            for case, values, (_, result), bad in zip(cases, grid, frame.iterrows(), diverged):
+                row = {**values, **{m: None if bad else float(result[m]) for m in metrics}}
+                if any(diverged):  # a run that diverged has no metrics, but the time it went
+                    row["diverged_at_s"] = float(result["diverged_at_s"]) if bad else None
+                rows.append({**row, "key": case.key})
             doc = {
                 "schema": SCHEMA_SWEEP,
                 "railride_version": __version__,
@@ -2544,7 +2609,8 @@ def sweep_command(
                     **({"comfort": _sweep_comfort_settings(scen.duration, window_value)}
                        if comfort else {}),
                 },
-                "columns": grid_columns + metrics + ["key"],
+                "columns": grid_columns + metrics + (["diverged_at_s"] if any(diverged) else [])
+                + ["key"],
                 "rows": rows,
                 "runs": len(table.frame),
                 "runs_evaluated": progress.evaluated,
@@ -2573,6 +2639,10 @@ def sweep_command(
         lines.append(_damper_text(st) + (f"; gains {st['gains_source']}" if controllers else ""))
     lines.append(f"{len(rows)} runs: {doc['runs_evaluated']} evaluated now, "
                  f"{len(rows) - doc['runs_evaluated']} from the run table; wall time {wall:.1f} s")
+    n_bad = sum(r.get("diverged_at_s") is not None for r in rows)
+    if n_bad:
+        lines.append(f"{n_bad} run{'s' if n_bad > 1 else ''} diverged (a response left +-1000 or "
+                     "stopped being finite): no metrics, shown as -; see diverged_at_s in the JSON")
     _wide_stdout_console().print(_sweep_table(rows, grid_columns, "\n".join(lines)))
 
 

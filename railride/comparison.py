@@ -82,12 +82,43 @@ class Comparison:
             row = {"force_rms_n": float(np.sqrt(np.mean(f**2))), "force_max_n": float(f.max()),
                    "travel_rms_m": float(np.sqrt(np.mean(travel**2))),
                    "travel_max_m": float(travel.max())}
+            if "damper_demand_force" in part:  # what the outer loop asked for
+                fd = np.abs(part["damper_demand_force"].values)
+                row["demand_rms_n"] = float(np.sqrt(np.mean(fd**2)))
+                row["demand_max_n"] = float(fd.max())
             if "damper_command_voltage" in part:
                 v = part["damper_command_voltage"].values
                 row["voltage_mean_v"] = float(v.mean())
                 row["voltage_at_max_fraction"] = float((v >= v_max - 1e-12).mean())
             out[name] = row
         return out
+
+    def trade_offs(self) -> list[dict]:
+        """Where a suspension wins one response by losing another: for each controller, the
+        responses (RMS) it makes worse than passive, and for each pair of controllers, the
+        responses on which each beats the other. Pairs where one is at least as good on every
+        response are listed with an empty ``worse_on``."""
+        rms = self.metrics.sel(statistic="rms")
+        responses = [str(r) for r in rms.response.values]
+        out = []
+        controlled = [n for n in self.names if n != "passive"]
+        base = rms.sel(controller="passive").values
+        for n in controlled:
+            worse = [r for r, a, b in zip(responses, rms.sel(controller=n).values, base) if a > b]
+            out.append({"controller": n, "than": "passive", "better_on": [r for r in responses if r not in worse],
+                        "worse_on": worse})
+        for i, a in enumerate(controlled):
+            for b in controlled[i + 1:]:
+                va, vb = rms.sel(controller=a).values, rms.sel(controller=b).values
+                out.append({"controller": a, "than": b,
+                            "better_on": [r for r, x, y in zip(responses, va, vb) if x < y],
+                            "worse_on": [r for r, x, y in zip(responses, va, vb) if x > y]})
+        return out
+
+    @property
+    def in_sample(self) -> bool:
+        """Whether the gains were tuned on this very track (their provenance says so)."""
+        return self.gains.tuned_on(self.settings.get("scenario"))
 
     def to_dict(self) -> dict:
         """The JSON summary (schema railride.comparison/1, docs/cli.md)."""
@@ -112,6 +143,10 @@ class Comparison:
             rows.append(row)
         return {"schema": "railride.comparison/1", "railride_version": __version__,
                 "settings": self.settings, "controllers": rows,
+                "trade_offs": self.trade_offs(),
+                "tuning": {"objective": self.gains.provenance.get("objective"),
+                           "command": self.gains.provenance.get("command"),
+                           "in_sample": self.in_sample},
                 "gains": {"source": self.gains.source, "inner": self.gains.inner.to_dict(),
                           **{n: self.gains.controller(n).to_dict() for n in self.names if n != "passive"}}}
 

@@ -188,6 +188,11 @@ class GainSet:
     source: str = "<built>"
     provenance: dict = field(default_factory=dict, compare=False, repr=False)
 
+    def tuned_on(self, record: dict) -> bool:
+        """Whether these gains were tuned on the track ``record`` (`Scenario.describe`), as the
+        file's [provenance] scenario record says: judged there, they are judged in-sample."""
+        return self.provenance.get("scenario_record") == record
+
     def controller(self, name: str):
         """The outer loop called ``name`` (None for the passive suspension)."""
         if name == "passive":

@@ -57,22 +57,27 @@ def select_window(ds: xr.Dataset, window) -> xr.Dataset:
     return part
 
 
-def ride_metrics(ds: xr.Dataset, window=None) -> xr.DataArray:
+def ride_metrics(ds: xr.Dataset, window=None, diverged=None) -> xr.DataArray:
     """RMS and peak-to-peak per response, dims (response, statistic) plus ``sample`` in a batch.
 
     Responses: carbody CG vertical acceleration (m/s^2), bounce displacement (m), pitch (deg)
-    and roll (deg). ``window`` = (start, end) in seconds restricts the time range.
+    and roll (deg). ``window`` = (start, end) in seconds restricts the time range. ``diverged``:
+    per sample, whether the run diverged (its metrics are NaN; see `metrics_from_arrays`).
     """
     part = select_window(ds, window)
     lead = ["sample"] if "sample" in part.dims else []
     channels = [part[channel].transpose(*lead, "time").values for channel, _ in RESPONSES.values()]
-    return metrics_from_arrays(*channels, sample=part["sample"].values if lead else None)
+    return metrics_from_arrays(*channels, sample=part["sample"].values if lead else None,
+                               diverged=diverged)
 
 
-def metrics_from_arrays(acceleration, bounce, pitch, roll, sample=None) -> xr.DataArray:
+def metrics_from_arrays(acceleration, bounce, pitch, roll, sample=None, diverged=None) -> xr.DataArray:
     """`ride_metrics` of channels given as arrays (..., time) in SI units (pitch, roll in rad),
     already cut to the window: the one implementation behind both the Dataset path and the
-    fast path of `RideResult.metrics` that skips building the Dataset."""
+    fast path of `RideResult.metrics` that skips building the Dataset.
+
+    A metric that is not finite raises RuntimeError, except for the samples marked in
+    ``diverged`` (bool per sample: runs that diverged, whose metrics are NaN by design)."""
     values = []
     for x, (_, factor) in zip((acceleration, bounce, pitch, roll), RESPONSES.values()):
         x = np.asarray(x) * factor
@@ -85,7 +90,11 @@ def metrics_from_arrays(acceleration, bounce, pitch, roll, sample=None) -> xr.Da
         coords["sample"] = np.arange(data.shape[0]) if sample is None else sample
     out = xr.DataArray(data, dims=lead + ["response", "statistic"], coords=coords,
                        name="ride_metrics")
-    if not np.all(np.isfinite(data)):
+    finite = np.isfinite(data)
+    if diverged is not None:
+        mask = np.atleast_1d(np.asarray(diverged, dtype=bool))
+        finite |= mask[:, None, None] if data.ndim == 3 else bool(mask.any())
+    if not np.all(finite):
         raise RuntimeError("a ride metric is not finite: the run did not produce finite responses")
     return out
 

@@ -202,19 +202,10 @@ def _parameters(suspension: str, parameters) -> tuple:
     return parameters
 
 
-def _track_text(record: dict) -> str:
-    from .report import describe_scenario
-
-    return f"{describe_scenario(record)}, {record.get('duration_s', 0):g} s"
-
-
 def in_sample_note(gains: GainSet, record: dict) -> str | None:
     """A note when ``gains`` were tuned on the track ``record`` (`Scenario.describe`) that judges
-    them (read from the gains file's [provenance]: its scenario record, else its text)."""
-    prov = gains.provenance or {}
-    tuned = prov.get("scenario_record")
-    same = tuned == record if isinstance(tuned, dict) else prov.get("scenario") == _track_text(record)
-    if not same:
+    them (`GainSet.tuned_on`)."""
+    if not gains.tuned_on(record):
         return None
     return (f"The base gains ({gains.source}) were tuned on this same single track and are judged "
             f"on it: their place here is in-sample, not a test on another track.")

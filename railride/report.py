@@ -920,8 +920,10 @@ def _sweep_lines(ax, rows, axis, column, suspensions):
         mine = [r for r in rows if r["suspension"] == name]
         style = styles.get(name, {"linestyle": "-"})
         label = labels.get(name) or _controller_label(name)
-        on = sorted((float(r[axis]), float(r[column])) for r in mine if r.get(axis) is not None)
-        off = [float(r[column]) for r in mine if r.get(axis) is None]
+        # a run that diverged has no metrics (None): it leaves a gap, not a point
+        on = sorted((float(r[axis]), float(r[column])) for r in mine
+                    if r.get(axis) is not None and r[column] is not None)
+        off = [float(r[column]) for r in mine if r.get(axis) is None and r[column] is not None]
         if on:
             x, y = zip(*on)
             ax.plot(x, y, marker="o", markersize=3.5, linewidth=1.3, label=label, **style)

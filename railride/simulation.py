@@ -228,7 +228,8 @@ def _positive(name: str, value) -> float:
 def simulate(scenario=None, params=None, *, dt: float = DEFAULT_DT,
              output_rate: float = DEFAULT_OUTPUT_RATE, damper=None, voltage=None,
              controller=None, inner=None, control_rate: float = DEFAULT_CONTROL_RATE,
-             sensor_noise=None, initial_state=None, progress=None) -> "RideResult":
+             sensor_noise=None, initial_state=None, progress=None,
+             on_divergence: str = "raise") -> "RideResult":
     """Simulate the vehicle on one or many scenarios.
 
     ``scenario`` is a `Scenario`, a scenario name (see `railride.track.scenario`) or a list of
@@ -253,9 +254,16 @@ def simulate(scenario=None, params=None, *, dt: float = DEFAULT_DT,
     ``initial_state`` is (q, q') at t = 0 as 18 numbers in DOF order (m, rad, m/s, rad/s), or
     one row per sample; by default the vehicle starts at rest in equilibrium.
     ``progress(done_fraction)`` is called between chunks of a long run.
+    A sample whose response leaves +-1000 (m or rad) or stops being finite has diverged: with
+    ``on_divergence="raise"`` (the default) the run stops with a RuntimeError giving the sample
+    and the time; with ``"mark"`` (what studies use) the other samples stand, the diverged
+    one's histories are NaN from that time on, and `RideResult.diverged_at` gives the time.
     """
     dt = _positive("dt", dt)
     output_rate = _positive("output_rate", output_rate)
+    if on_divergence not in ("raise", "mark"):
+        raise ValueError(f"on_divergence = {on_divergence!r}: allowed 'raise' (stop with an error) "
+                         "or 'mark' (keep the other samples; see RideResult.diverged_at)")
     n_volt = 1 if voltage is None or np.ndim(voltage) == 0 else len(voltage)
     n_ctrl = len(controller) if isinstance(controller, (list, tuple)) else 1
     batch = not (isinstance(scenario, (Scenario, str)) or scenario is None) or not (
@@ -389,14 +397,24 @@ def simulate(scenario=None, params=None, *, dt: float = DEFAULT_DT,
             progress(done / n_steps)
         if final:
             break
+    diverged_at = np.full(n, np.nan)
     if np.any(status != kernels.STATUS_OK):
         bad = np.flatnonzero(status != kernels.STATUS_OK)
         which = ", ".join(f"sample {i} at t = {fail_step[i] * dt:.4g} s" for i in bad[:5])
-        raise RuntimeError(f"the simulation diverged ({which}): a response left +-{kernels.DIVERGED:g} "
-                           f"or stopped being finite; check the parameters or reduce dt")
+        message = (f"the simulation diverged ({which}): a response left +-{kernels.DIVERGED:g} "
+                   f"or stopped being finite; check the parameters or reduce dt")
+        if on_divergence != "mark":
+            raise RuntimeError(message)
+        for i in bad:  # the stepper stopped there: what follows is not a response
+            diverged_at[i] = fail_step[i] * dt
+            first = fail_step[i] // stride
+            for key in out:
+                if out[key].shape[1] > 1:
+                    out[key][i, first:] = np.nan
 
     created = datetime.now(timezone.utc).isoformat(timespec="seconds")
-    raw = {"time": np.arange(rows) / output_rate, "q": out["q"], "a": out["a"], "batch": batch}
+    raw = {"time": np.arange(rows) / output_rate, "q": out["q"], "a": out["a"], "batch": batch,
+           "diverged_at": diverged_at}
     return RideResult(raw=raw, build=functools.partial(_dataset, out, vehicles, param_sets, scenarios, dt,
                                               output_rate, rows, batch, created, damper, vcmd,
                                               closed))
@@ -536,6 +554,14 @@ class RideResult:
         return f"RideResult(\n{self.dataset!r}\n)"
 
     @property
+    def diverged_at(self) -> np.ndarray:
+        """Per sample, the time [s] at which the run diverged, NaN where it did not (only a run
+        with ``on_divergence="mark"`` can hold a diverged sample)."""
+        if self._raw is not None and "diverged_at" in self._raw:
+            return self._raw["diverged_at"]
+        return np.full(self.dataset.sizes.get("sample", 1), np.nan)
+
+    @property
     def is_batch(self) -> bool:
         return "sample" in self.dataset.dims
 
@@ -543,8 +569,9 @@ class RideResult:
         """RMS and peak-to-peak of the four body responses; see `railride.metrics.ride_metrics`.
         Computed from the raw arrays when the Dataset has not been built (sweeps)."""
         from .metrics import check_window, metrics_from_arrays, ride_metrics
+        diverged = np.isfinite(self.diverged_at)  # NaN: did not diverge
         if self._dataset is not None or self._raw is None:
-            return ride_metrics(self.dataset, window)
+            return ride_metrics(self.dataset, window, diverged=diverged)
         t, q, a = self._raw["time"], self._raw["q"], self._raw["a"]
         if window is not None:
             start, end = check_window(window, float(t[-1]), float(t[0]))
@@ -552,7 +579,7 @@ class RideResult:
             if keep.sum() < 2:
                 raise ValueError(f"window = {start:g}:{end:g} s holds fewer than two output samples")
             q, a = q[:, keep], a[:, keep]
-        out = metrics_from_arrays(a[..., 0], q[..., 0], q[..., 1], q[..., 2])
+        out = metrics_from_arrays(a[..., 0], q[..., 0], q[..., 1], q[..., 2], diverged=diverged)
         return out if self._raw["batch"] else out.isel(sample=0, drop=True)
 
     def comfort(self, window=None, positions=("centre", "front", "rear"),

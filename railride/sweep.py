@@ -156,9 +156,10 @@ def evaluate(cases: list[Case], base_gains=None, dt: float = 1e-4, window=None,
             kind = group[1]
             damper = damper_model(group[2], group[4]) if kind != "passive" else None
             if kind == "passive":
-                res = simulate(scs, pars, dt=dt)
+                res = simulate(scs, pars, dt=dt, on_divergence="mark")
             elif kind == "mr":
-                res = simulate(scs, pars, dt=dt, damper=damper, voltage=[c.voltage for c in part])
+                res = simulate(scs, pars, dt=dt, damper=damper, voltage=[c.voltage for c in part],
+                               on_divergence="mark")
             else:
                 gsets = [apply_gains(base_gains, c.gains) for c in part]
                 inners = {g.inner for g in gsets}
@@ -169,8 +170,12 @@ def evaluate(cases: list[Case], base_gains=None, dt: float = 1e-4, window=None,
                 noise, seed = group[3]
                 res = simulate(scs, pars, dt=dt, damper=damper, inner=gsets[0].inner,
                                controller=[g.controller(c.suspension) for c, g in zip(part, gsets)],
-                               sensor_noise=SensorNoise(*noise, seed=seed) if noise else None)
+                               sensor_noise=SensorNoise(*noise, seed=seed) if noise else None,
+                               on_divergence="mark")
+            # a diverged run keeps its row, with NaN metrics and the time it diverged: the other
+            # runs of the study go on
             m = res.metrics(window).values  # (sample, response, statistic)
+            diverged_at = res.diverged_at
             cf = None
             if comfort:
                 from .comfort import ride_comfort
@@ -178,17 +183,20 @@ def evaluate(cases: list[Case], base_gains=None, dt: float = 1e-4, window=None,
                 ds = res.dataset
                 if "sample" not in ds.dims:
                     ds = ds.expand_dims(sample=[0])
-                cf = ride_comfort(ds, window=window)
+                ok = np.flatnonzero(np.isnan(diverged_at))  # a diverged run has no comfort
+                cf = ride_comfort(ds.isel(sample=ok), window=window) if ok.size else None
             for j, i in enumerate(idx[start:start + CHUNK]):
                 if i in rows:
                     continue
-                row = {"key": cases[i].key, **_flat(cases[i])}
+                row = {"key": cases[i].key, **_flat(cases[i]), "diverged_at_s": float(diverged_at[j])}
                 for r, resp in enumerate(RESPONSES):
                     for s, stat in enumerate(STATISTICS):
                         row[f"{resp}_{stat}"] = float(m[j, r, s])
-                if cf is not None:
+                if comfort:
                     for (pos, index), column in zip(COMFORT_INDICES, COMFORT_COLUMNS):
-                        row[column] = float(cf.isel(sample=j).sel(position=pos, index=index))
+                        row[column] = (float(cf.isel(sample=int(np.searchsorted(ok, j)))
+                                             .sel(position=pos, index=index))
+                                       if np.isnan(diverged_at[j]) else np.nan)
                 rows[i] = row
     return [rows[i] for i in range(len(cases))]
 

@@ -157,7 +157,8 @@ class Objective:
         return offset
 
     def score(self, ratio) -> np.ndarray:
-        """J of RMS ratios to passive, ``ratio`` (..., 4)."""
+        """J of RMS ratios to passive, ``ratio`` (..., 4). A run that diverged has NaN ratios
+        and scores +inf: after every run that did not."""
         r = np.asarray(ratio, dtype=float)
         if r.shape[-1:] != (4,):
             raise ValueError(f"ratios of shape {r.shape}: the last axis must hold the four "
@@ -173,7 +174,7 @@ class Objective:
         if self.kind == "constrained":
             excess = np.clip(r - self.bound, 0.0, None).sum(axis=-1)
             j = np.where(excess > 0, self.infeasible_offset + INFEASIBLE_SCALE * excess, j)
-        return j
+        return np.where(np.isnan(r).any(axis=-1), np.inf, j)
 
     def __call__(self, rms: np.ndarray, passive: np.ndarray) -> np.ndarray:
         """J of RMS values (..., 4) against the passive RMS (4,)."""
@@ -199,7 +200,7 @@ class Objective:
             text += f"; plus penalty {self.penalty:g} x sum_k max(0, r_k - 1)"
             if self.kind == "constrained":
                 text += " on feasible candidates"
-        return text
+        return text + "; a run that diverged scores J = inf"
 
     def to_dict(self) -> dict:
         """Every setting of the objective and its statement (for JSON documents)."""
@@ -256,7 +257,7 @@ def tune(phases=PHASES, *, scenario: str = "paper-sine", scenario_options=None,
          gains: GainSet | None = None, objective: Objective | None = None, damper: str = "railway",
          executor=None, table: RunTable | None = None, n_values: int = 13, span: float = 30.0,
          max_passes: int = 5, tol: float = 1e-3, dt: float = 1e-4, window=None, progress=None,
-         log=None) -> TuneResult:
+         log=None, damper_scale: float = 1.0) -> TuneResult:
     """The sensitivity study: the phases in order (from PHASES; default all four, so PID and SAS
     are tuned by the same procedure and budget), each to convergence, from ``gains`` (default
     the neutral `GainSet.reference`), minimising ``objective`` (default `DEFAULT_OBJECTIVE`).
@@ -265,7 +266,9 @@ def tune(phases=PHASES, *, scenario: str = "paper-sine", scenario_options=None,
     parameter; a pass ends when every parameter of the phase was swept; a phase ends when a pass
     improves the objective by less than ``tol`` (relative) or after ``max_passes``. The ride
     phase starts from zero ride gains, as the paper's phase 2 (the ride loop is added to a tuned
-    attitude loop), whatever ``gains`` holds for them.
+    attitude loop), whatever ``gains`` holds for them. ``damper_scale`` scales the MR dampers'
+    force capacity (`railride.dampers.BoucWen.scaled`); the inner phase then tracks demands
+    scaled alike, so a damper k times larger is tuned on the same relative task.
     ``progress(done, total, runs_per_second)`` after each chunk; ``log(text)`` after each pass.
     """
     gains = GainSet.reference() if gains is None else gains
@@ -275,9 +278,12 @@ def tune(phases=PHASES, *, scenario: str = "paper-sine", scenario_options=None,
     unknown = [p for p in phases if p not in PHASES]
     if unknown:
         raise ValueError(f"unknown phase {unknown[0]!r}; allowed: {', '.join(PHASES)}, all")
-    if "inner" in phases and damper == "ideal":
-        raise ValueError("damper = 'ideal' with phase 'inner': the ideal actuator has no force "
+    from . import dampers
+
+    if "inner" in phases and damper in dampers.IDEAL_NAMES:
+        raise ValueError(f"damper = {damper!r} with phase 'inner': the ideal actuator has no force "
                          "tracking loop to tune; leave out the inner phase")
+    damper_scale = dampers.check_scale("damper_scale", damper_scale)
     if not (isinstance(n_values, int) and n_values >= 3):
         raise ValueError(f"n_values = {n_values!r}: a whole number >= 3")
     if not (span > 1):
@@ -299,7 +305,8 @@ def tune(phases=PHASES, *, scenario: str = "paper-sine", scenario_options=None,
     for phase in phases:
         params = PARAMETERS[phase]
         if phase == "inner":
-            _tune_inner(base, changes, params, n_values, span, max_passes, tol, result, log, damper)
+            _tune_inner(base, changes, params, n_values, span, max_passes, tol, result, log, damper,
+                        damper_scale)
             continue
         suspension = SUSPENSION[phase]
         if phase == "ride":  # the paper's phase 2: the ride loop joins with zero gains
@@ -307,6 +314,7 @@ def tune(phases=PHASES, *, scenario: str = "paper-sine", scenario_options=None,
 
         def score(change_sets, suspension=suspension):
             cases = [Case(scenario, opts, suspension=suspension, damper=damper,
+                          damper_scale=damper_scale,
                           gains=tuple(sorted({**changes, **cs}.items()))) for cs in change_sets]
             return objective(_rms(run(cases)), passive)
         best = float(score([{}])[0])
@@ -335,27 +343,33 @@ def _table(gains: GainSet, parameter: str):
             "ride": gains.ride}[parameter.split(".")[0]]
 
 
-def tracking_objective(B: float, G: float, damper="railway") -> float:
+def tracking_objective(B: float, G: float, damper="railway", damper_scale: float = 1.0) -> float:
     """The inner loop's objective: normalised RMS tracking error, averaged over the paper's
-    sine and sawtooth demands (Fig. 6) at 10 kN, 1 Hz on the damper rig."""
+    sine and sawtooth demands (Fig. 6) at 10 kN x ``damper_scale``, 1 Hz on the damper rig."""
+    from . import dampers
     from .rig import track
 
-    return float(np.mean([track(damper, kind, 10e3, 1.0, B=B, G=G).metrics()["normalised_rms_error"]
-                          for kind in ("sine", "sawtooth")]))
+    model = dampers.preset(damper) if isinstance(damper, str) else damper
+    if damper_scale != 1.0:
+        model = model.scaled(damper_scale)
+    return float(np.mean([track(model, kind, 10e3 * damper_scale, 1.0, B=B, G=G)
+                          .metrics()["normalised_rms_error"] for kind in ("sine", "sawtooth")]))
 
 
-def _tune_inner(base, changes, params, n_values, span, max_passes, tol, result, log, damper):
+def _tune_inner(base, changes, params, n_values, span, max_passes, tol, result, log, damper,
+                damper_scale=1.0):
     """B and G on the rig's force-tracking error (cheap: evaluated here, not on the executor)."""
     def value(p):
         return changes.get(p, getattr(base.inner, p.split(".")[1]))
 
-    best = tracking_objective(value("inner.B"), value("inner.G"), damper)
+    best = tracking_objective(value("inner.B"), value("inner.G"), damper, damper_scale)
     for sweep_pass in range(1, max_passes + 1):
         start = best
         for p in params:
             vals = _candidates(value(p), p, n_values, span)
             obj = np.array([tracking_objective(**{"B": value("inner.B"), "G": value("inner.G"),
-                                                 p.split(".")[1]: v}, damper=damper) for v in vals])
+                                                 p.split(".")[1]: v}, damper=damper,
+                                              damper_scale=damper_scale) for v in vals])
             k = int(np.argmin(obj))
             if obj[k] < best - 1e-12:
                 changes[p], best = vals[k], float(obj[k])

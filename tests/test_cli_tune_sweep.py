@@ -278,3 +278,18 @@ def test_sweep_noise_seeds():
 ])
 def test_sweep_bad_input(args, fragments):
     assert_input_error(run(*SWEEP, *args), *fragments)
+
+
+def test_sweep_goes_on_past_a_diverged_run(tmp_path):
+    # pid.kp = 1e12 on the ideal actuator diverges within the first steps; the other runs stand
+    result = ok("sweep", "--suspension", "pid", "--damper", "ideal", "--gain", "pid.kp=1e5,1e12",
+                "--duration", 1, "--out", tmp_path / "sw", "--format", "json")
+    rows = json.loads(result.stdout)
+    good, bad = rows
+    assert good["diverged_at_s"] is None and good["acceleration_m_s2_rms"] > 0
+    assert 0 < bad["diverged_at_s"] < 1 and bad["acceleration_m_s2_rms"] is None
+    doc = json.loads((tmp_path / "sw" / "sweep.json").read_text())
+    assert "diverged_at_s" in doc["columns"]
+    table = run("sweep", "--suspension", "pid", "--damper", "ideal", "--gain", "pid.kp=1e5,1e12",
+                "--duration", 1)
+    assert table.exit_code == 0 and "1 run diverged" in table.stdout

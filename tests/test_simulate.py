@@ -174,3 +174,40 @@ def test_bad_input_raises_a_clear_value_error(kwargs, match):
 def test_a_run_that_diverges_stops_and_says_so():
     with pytest.raises(RuntimeError, match="diverged"):
         simulate(scenario("paper-sine", amplitude=1e5, duration=1.0))
+
+
+# -- a run that diverges ------------------------------------------------------------------------
+def test_a_diverged_sample_is_marked_and_the_others_stand():
+    from railride.control import PID, GainSet
+
+    g = GainSet.default()
+    unstable = PID(kp=1e12, ki=0.0, kd=1e11)  # on the ideal actuator: far past any stable gain
+    sc = scenario("paper-sine", duration=1.0)
+    alone = simulate(sc, damper="ideal", controller=g.pid).metrics()
+    res = simulate(sc, damper="ideal", controller=[g.pid, unstable, g.pid], on_divergence="mark")
+    m = res.metrics()
+    assert np.isnan(res.diverged_at[[0, 2]]).all() and 0 < res.diverged_at[1] < 1.0
+    assert np.isnan(m.isel(sample=1).values).all()
+    for i in (0, 2):  # the batch neighbours are untouched by the diverged sample
+        np.testing.assert_array_equal(m.isel(sample=i, drop=True).values, alone.values)
+    with pytest.raises(RuntimeError, match=r"diverged \(sample 1 at t = "):
+        simulate(sc, damper="ideal", controller=[g.pid, unstable])
+    with pytest.raises(ValueError, match="on_divergence = 'skip'"):
+        simulate(sc, on_divergence="skip")
+
+
+def test_a_study_goes_on_past_a_diverged_run():
+    from railride.sweep import Case, run_cases
+    from railride.tuning import Objective
+
+    opts = {"duration": 1.0}
+    rows = run_cases([Case("paper-sine", opts, suspension="pid", damper="ideal",
+                           gains={"pid.kp": 1e12, "pid.kd": 1e11}),
+                      Case("paper-sine", opts, suspension="pid", damper="ideal")])
+    assert rows["diverged_at_s"].iloc[0] > 0 and np.isnan(rows["diverged_at_s"].iloc[1])
+    assert np.isnan(rows["acceleration_m_s2_rms"].iloc[0])
+    assert np.isfinite(rows["acceleration_m_s2_rms"].iloc[1])
+    # a tuner never picks it: a diverged run scores +inf under every objective
+    for kind in ("sum", "minimax"):
+        j = Objective(kind=kind).score(np.array([[np.nan] * 4, [5.0] * 4]))
+        assert j[0] == np.inf and np.isfinite(j[1])

@@ -232,3 +232,45 @@ def test_a_resumed_sweep_with_other_run_settings_runs_again(tmp_path):
     ex = CountingExecutor()
     run_cases(cases, table=RunTable(path, resume=True), executor=ex, dt=5e-5)
     assert ex.cases == 0
+
+
+# -- the shipped gains ---------------------------------------------------------------------------
+@pytest.fixture(scope="module")
+def shipped_ratios():
+    """RMS ratios to passive of the three controllers with the shipped gains on paper-sine."""
+    from railride.comparison import compare
+
+    cmp = compare("paper-sine")
+    rms = cmp.metrics.sel(statistic="rms")
+    return {n: rms.sel(controller=n).values / rms.sel(controller="passive").values
+            for n in ("pid", "sas-attitude", "sas-attitude-ride")}
+
+
+def test_shipped_gains_make_no_response_worse_than_passive(shipped_ratios):
+    for name, r in shipped_ratios.items():
+        assert np.all(r < 1.0), (name, r)
+
+
+def test_shipped_ride_loop_does_not_worsen_the_worst_response(shipped_ratios):
+    # the paper's phase 2 starts from zero ride gains, so the ride loop can only lower the worst
+    # ratio that the minimax objective sees
+    assert shipped_ratios["sas-attitude-ride"].max() <= shipped_ratios["sas-attitude"].max() + 1e-12
+
+
+def test_tune_defaults_reproduce_the_shipped_gains():
+    # `railride tune` with no option, from an installed package: the reference start is packaged
+    shipped = GainSet.default()
+    assert shipped.provenance["command"] == "railride tune"
+    tuned = tune().gains
+    for table in ("inner", "pid", "attitude", "ride"):
+        assert getattr(tuned, table) == getattr(shipped, table), table
+
+
+def test_tune_with_a_scaled_damper_tunes_the_inner_loop_for_it():
+    # a damper k times larger, tracking demands k times larger, wants G / k: the tracking error
+    # is the same function of G k (the force, and so the error, scales with k)
+    G = 2e-3
+    assert tracking_objective(1.0, G / 4, damper_scale=4.0) == pytest.approx(
+        tracking_objective(1.0, G), rel=1e-9)
+    with pytest.raises(ValueError, match="damper_scale = -1"):
+        tune(("pid",), damper_scale=-1, scenario_options=SHORT)
