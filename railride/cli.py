@@ -627,6 +627,33 @@ def _compare_tables(doc: dict, vehicle: str, shipped: bool):
         table.add_row(*ours)
         table.add_row(*paper, end_section=True)
 
+    # 1b. the same gains on the ideal devices: what a damper, and an actuator, could reach
+    bounds_parts = []
+    if doc.get("bounds"):
+        bt = Table(title="RMS reduction % beside the bounds: the same control laws and gains on "
+                         "ideal devices")
+        bt.add_column("response", min_width=20, no_wrap=True)
+        short = {"pid": "PID", "sas-attitude": "SAS att.", "sas-attitude-ride": "SAS att.+ride"}
+        for r in controlled:
+            for head in ("MR", "ideal\ndamper", "ideal\nactuator"):
+                name = short.get(r["name"], r["label"])
+                bt.add_column(escape(f"{name}\n{head}") if head == "MR" else f"\n{head}",
+                              justify="right", min_width=7)
+        for key, label in RESPONSE_LABELS.items():
+            cells = [label]
+            for r in controlled:
+                cells.append(_reduction_text(r["reduction_percent"][key]))
+                for device in ("ideal-damper", "ideal"):
+                    value = doc["bounds"][device][r["name"]]["reduction_percent"][key]
+                    cells.append("diverged" if value is None else _reduction_text(value))
+            bt.add_row(*cells)
+        bounds_parts = ["", bt, Text(
+            "ideal damper: the demand where it dissipates energy, no force where it would push "
+            "energy in (no force limit, no lag, no hysteresis): the best any semi-active damper "
+            "could do with these gains. ideal actuator: the demand, always (an active "
+            "suspension). The gains were tuned for the MR dampers; tuned for the ideal devices "
+            "the bounds lie further out (docs/results.md).")]
+
     # 2. peak-to-peak
     ptp = Table(title="Peak-to-peak of the carbody responses (railride)")
     ptp.add_column("response")
@@ -655,7 +682,7 @@ def _compare_tables(doc: dict, vehicle: str, shipped: bool):
                     "secondary deflection (suspension travel); passive: the viscous dampers c_sz."
                     + (" The ideal actuators have no voltage." if settings.get("damper")
                        in ("ideal", "ideal-damper") and controlled else ""))
-    parts = [table, Text("\n".join(info)), "", ptp, "", demands, Text(demands_note)]
+    parts = [table, Text("\n".join(info)), *bounds_parts, "", ptp, "", demands, Text(demands_note)]
     if all("comfort" in r for r in rows):
         parts += ["", _compare_comfort_table(rows)]
     return parts
@@ -721,6 +748,11 @@ def compare(
              "displacement.png, pitch.png, roll.png, damper_forces.png, voltages.png, and the "
              "acceleration spectra psd.png, psd.csv into DIR (created if missing; all or "
              "nothing).")] = None,
+    bounds: Annotated[bool, typer.Option(
+        "--bounds/--no-bounds",
+        help="Also run the same control laws and gains on the ideal semi-active damper and the "
+             "ideal actuator, and print their reductions beside the MR dampers' (default on; "
+             "MR dampers only).")] = True,
     comfort: ComfortOption = False,
 ) -> None:
     """Compare passive, PID and SAS suspensions on one scenario, as in the paper's Table 1.
@@ -767,7 +799,7 @@ def compare(
             result = run_compare(scen, vehicle_params, controllers=names, gains=gain_set,
                                  damper=damper, damper_scale=scale, window=window_value, dt=dt,
                                  output_rate=output_rate, control_rate=control_rate,
-                                 sensor_noise=noise, comfort=comfort,
+                                 sensor_noise=noise, comfort=comfort, bounds=bounds,
                                  progress=progress if progress.enabled else None)
         doc = result.to_dict()
         text = json.dumps(doc, indent=2, allow_nan=False)  # refuses NaN before anything is written

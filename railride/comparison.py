@@ -61,6 +61,9 @@ class Comparison:
     damper: str
     settings: dict = field(default_factory=dict)
     comfort: dict | None = None
+    #: per ideal device ("ideal-damper", "ideal") and controller: the ride metrics of the same
+    #: gains on that device, and the time it diverged (NaN if it did not); None if not run
+    bounds: dict | None = None
 
     @property
     def reductions(self) -> xr.DataArray:
@@ -115,6 +118,26 @@ class Comparison:
                             "worse_on": [r for r, x, y in zip(responses, va, vb) if x > y]})
         return out
 
+    def _bounds_record(self) -> dict | None:
+        """The JSON of `bounds`: per device and controller, the RMS of each response and its
+        reduction against passive (None for a run that diverged), and diverged_at_s."""
+        if not self.bounds:
+            return None
+        base = self.metrics.sel(controller="passive", statistic="rms")
+        out = {}
+        for device, runs in self.bounds.items():
+            out[device] = {}
+            for name, run in runs.items():
+                rms = run["metrics"].sel(statistic="rms")
+                ok = not np.isfinite(run["diverged_at_s"])
+                out[device][name] = {
+                    "rms": {str(r): float(rms.sel(response=r)) if ok else None for r in rms.response.values},
+                    "reduction_percent": {str(r): float((base.sel(response=r) - rms.sel(response=r))
+                                                        / base.sel(response=r) * 100.0) if ok else None
+                                          for r in rms.response.values},
+                    "diverged_at_s": None if ok else run["diverged_at_s"]}
+        return out
+
     @property
     def in_sample(self) -> bool:
         """Whether the gains were tuned on this very track (their provenance says so)."""
@@ -144,6 +167,7 @@ class Comparison:
         return {"schema": "railride.comparison/1", "railride_version": __version__,
                 "settings": self.settings, "controllers": rows,
                 "trade_offs": self.trade_offs(),
+                "bounds": self._bounds_record(),
                 "tuning": {"objective": self.gains.provenance.get("objective"),
                            "command": self.gains.provenance.get("command"),
                            "in_sample": self.in_sample},
@@ -174,7 +198,7 @@ class Comparison:
 def compare(scenario, params=None, *, controllers=CONTROLLERS, gains: GainSet | None = None,
             damper="railway", damper_scale: float = 1.0, window=None, dt: float = DEFAULT_DT,
             output_rate: float = DEFAULT_OUTPUT_RATE, control_rate: float = DEFAULT_CONTROL_RATE,
-            sensor_noise=None, progress=None, comfort: bool = False) -> Comparison:
+            sensor_noise=None, progress=None, comfort: bool = False, bounds: bool = True) -> Comparison:
     """Run the passive vehicle and each controller on ``scenario`` and collect the metrics.
 
     ``controllers`` names from `railride.control.CONTROLLERS` (passive is always run as the
@@ -184,24 +208,39 @@ def compare(scenario, params=None, *, controllers=CONTROLLERS, gains: GainSet | 
     (`BoucWen.scaled`; 1 for the ideal actuator); passive stays the viscous baseline.
     ``window`` (start, end) s for the metrics. ``comfort``: also the ride comfort indices of
     each suspension over the same window (`Comparison.comfort`; ``controllers[i].comfort`` in
-    `Comparison.to_dict`).
+    `Comparison.to_dict`). ``bounds`` (with MR dampers): also run the same control laws and
+    gains on the two ideal devices, the ideal semi-active damper ("ideal-damper") and the ideal
+    actuator ("ideal"), so that every reduction is shown beside what those would reach
+    (`Comparison.bounds`).
     """
     model = damper_model(damper, damper_scale)
     damper_scale = float(damper_scale)
     names = check_controllers(controllers)
     gains = GainSet.default() if gains is None else gains
     controlled = [n for n in names if n != "passive"]
-    # progress by sample-steps: the passive run is one sample, the controlled batch the rest
-    share = 1.0 / (1 + len(controlled))
+    bound_devices = [d for d in BOUND_DEVICES if bounds and controlled and model.law != dampers.LAW_IDEAL]
+    # progress by sample-steps: the passive run is one sample, the controlled batches the rest
+    share = 1.0 / (1 + len(controlled) * (1 + len(bound_devices)))
     part = (lambda lo, w: (lambda done: progress(lo + w * done))) if progress is not None else None
     common = dict(dt=dt, output_rate=output_rate)
     datasets = {"passive": simulate(scenario, params, progress=part and part(0.0, share), **common).dataset}
     if controlled:
         batch = simulate(scenario, params, damper=model, controller=[gains.controller(n) for n in controlled],
                          inner=gains.inner, control_rate=control_rate, sensor_noise=sensor_noise,
-                         progress=part and part(share, 1.0 - share), **common).dataset
+                         progress=part and part(share, share * len(controlled)), **common).dataset
         for i, n in enumerate(controlled):
             datasets[n] = batch.isel(sample=i, drop=True)
+    bound_values = {}
+    for k, device in enumerate(bound_devices):
+        # the ideal actuator may not be stable with gains tuned for a damper: marked, not fatal
+        res = simulate(scenario, params, damper=device, controller=[gains.controller(n) for n in controlled],
+                       control_rate=control_rate, sensor_noise=sensor_noise, on_divergence="mark",
+                       progress=part and part(share * (1 + len(controlled) * (1 + k)),
+                                              share * len(controlled)), **common)
+        m = res.metrics(window)
+        bound_values[device] = {n: {"metrics": m.isel(sample=i, drop=True),
+                                    "diverged_at_s": float(res.diverged_at[i])}
+                                for i, n in enumerate(controlled)}
     metrics = xr.concat([ride_metrics(datasets[n], window) for n in names], dim="controller")
     metrics = metrics.assign_coords(controller=names)
     first = datasets["passive"]
@@ -215,7 +254,12 @@ def compare(scenario, params=None, *, controllers=CONTROLLERS, gains: GainSet | 
         from .comfort import ride_comfort
         comfort_values = {n: ride_comfort(datasets[n], window=window) for n in names}
     return Comparison(names, datasets, metrics, window, gains, str(damper), settings,
-                      comfort_values)
+                      comfort_values, bound_values or None)
+
+
+#: the ideal devices `compare` runs beside the MR dampers: the best a damper could do with the
+#: same control laws and gains, and what a force actuator would do
+BOUND_DEVICES = ("ideal-damper", "ideal")
 
 
 def damper_model(name: str, scale: float = 1.0):

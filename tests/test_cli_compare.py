@@ -307,3 +307,45 @@ def test_diverged_run_status_1(tmp_path, monkeypatch):
     assert result.exit_code == 1
     assert result.stderr.strip() == "error: the simulation diverged (sample 1 at t = 1 s)"
     assert not out.exists()
+
+
+# -- trade-offs and bounds ------------------------------------------------------------------------
+def test_trade_offs_name_every_response_a_controller_loses(short_doc):
+    rows = {r["name"]: r for r in short_doc["controllers"]}
+    rms = {n: {k: r["metrics"][k]["rms"] for k in RESPONSES} for n, r in rows.items()}
+    seen = set()
+    for t in short_doc["trade_offs"]:
+        a, b = t["controller"], t["than"]
+        seen.add((a, b))
+        assert sorted(t["worse_on"]) == sorted(k for k in RESPONSES if rms[a][k] > rms[b][k])
+        assert sorted(t["better_on"]) == sorted(k for k in RESPONSES if rms[a][k] < rms[b][k])
+    controlled = [n for n in rows if n != "passive"]
+    assert seen == {(n, "passive") for n in controlled} | {
+        (a, b) for i, a in enumerate(controlled) for b in controlled[i + 1:]}
+
+
+def test_bounds_are_the_same_gains_on_the_ideal_devices(short_doc):
+    from railride.simulation import simulate
+    from railride.track import scenario
+
+    gains = GainSet.default()
+    sc = scenario("paper-sine", duration=2.0)
+    passive = simulate(sc).metrics().sel(statistic="rms")
+    for device in ("ideal-damper", "ideal"):
+        m = simulate(sc, damper=device, controller=gains.controller("sas-attitude")).metrics()
+        got = short_doc["bounds"][device]["sas-attitude"]
+        for k in RESPONSES:
+            assert got["rms"][k] == pytest.approx(float(m.sel(statistic="rms", response=k)), rel=1e-12)
+            red = float((passive.sel(response=k) - m.sel(statistic="rms", response=k))
+                        / passive.sel(response=k) * 100)
+            assert got["reduction_percent"][k] == pytest.approx(red, rel=1e-9)
+
+
+def test_compare_table_shows_the_trade_offs_and_the_bounds(short_doc):
+    result = run(*SHORT)
+    assert result.exit_code == 0, result.stderr
+    assert "beside the bounds" in result.stdout and "ideal damper:" in result.stdout
+    losing = [t for t in short_doc["trade_offs"] if t["worse_on"]]
+    assert losing  # with the shipped gains, PID beats SAS on pitch and loses the rest
+    assert result.stdout.count("trade-off:") == len(losing)
+    assert "beside the bounds" not in run(*SHORT, "--no-bounds").stdout
