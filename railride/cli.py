@@ -546,14 +546,9 @@ def _compare_comfort_table(rows: list[dict]):
 
 
 def _damper_text(settings: dict) -> str:
-    """"railway MR dampers", "railway MR dampers, force x 4" or "ideal actuators (force =
-    demand)" for the controlled suspensions of a compare or sweep document's settings."""
-    if settings.get("damper") == "ideal":
-        return "ideal actuators (force = demand)"
-    if settings.get("damper") == "ideal-damper":
-        return "ideal semi-active dampers (force = demand where it dissipates, else 0)"
-    scale = settings.get("damper_scale") or 1.0
-    return f"{settings['damper']} MR dampers" + (f", force x {scale:g}" if scale != 1.0 else "")
+    from .report import describe_dampers
+
+    return describe_dampers(settings, detail=True)
 
 
 def _trade_off_lines(doc: dict) -> list[str]:

@@ -435,12 +435,15 @@ def _comparison_dataset(comparison) -> xr.Dataset:
     return ds
 
 
-def _damper_words(settings: dict) -> str:
-    """The controlled suspensions' dampers of a compare or sweep ``settings`` record."""
-    if settings.get("damper") == "ideal":
-        return "ideal actuators"
-    if settings.get("damper") == "ideal-damper":
-        return "ideal semi-active dampers"
+def describe_dampers(settings: dict, detail: bool = False) -> str:
+    """The controlled suspensions' dampers of a compare, sweep or tune ``settings`` record:
+    "railway MR dampers (force x 4)", "ideal actuators"; ``detail`` adds what an ideal device
+    does."""
+    ideal = {"ideal": ("ideal actuators", "force = demand"),
+             "ideal-damper": ("ideal semi-active dampers", "force = demand where it dissipates, else 0")}
+    if settings.get("damper") in ideal:
+        words, what = ideal[settings["damper"]]
+        return f"{words} ({what})" if detail else words
     scale = settings.get("damper_scale") or 1.0
     return f"{settings['damper']} MR dampers" + (f" (force x {scale:g})" if scale != 1.0 else "")
 
@@ -472,7 +475,7 @@ def comparison_title(ds: xr.Dataset) -> str:
         settings = {}
     if isinstance(settings, dict) and settings.get("damper") and any(
             n != "passive" for n in _controller_names(ds)):
-        parts.append(_damper_words(settings))
+        parts.append(describe_dampers(settings))
     if ds.attrs.get("gains_source") and any(n != "passive" for n in _controller_names(ds)):
         parts.append(f"gains {ds.attrs['gains_source']}")
     return ", ".join(p for p in parts if p)
@@ -1010,7 +1013,7 @@ def plot_sweep(doc: dict, path=None, *, axis: str | None = None):
     context = describe_scenario(settings.get("scenario") or {})
     duration = (settings.get("scenario") or {}).get("duration_s")
     extra = [p for p in (f"{duration:g} s" if _is_number(duration) else "",
-                         _damper_words(settings) if settings.get("damper") else "") if p]
+                         describe_dampers(settings) if settings.get("damper") else "") if p]
     if extra:
         context = ", ".join([context, *extra]) if context else ", ".join(extra)
     title = f"RMS of the carbody responses against {_sweep_axis_label(axis)}"

@@ -1,15 +1,19 @@
 """How big a damper does the controller need? (docs/results.md, "Damper authority").
 
 For each force scale of the `railway` MR dampers (every force parameter times the scale, so the
-0 V force grows with it), the controllers are re-tuned by `railride tune`'s defaults (all four
-phases from the neutral reference gains, minimax objective; the inner phase tracks demands
-scaled alike), then judged on `paper-sine`. The same procedure and budget tune the two bounds:
+0 V force grows with it: `--damper-scale`), the controllers are re-tuned by `railride tune`'s
+defaults (all four phases from the neutral reference gains, minimax objective; the inner phase
+tracks demands scaled alike), then judged on `paper-sine`. A second series scales only the
+field-dependent part (alpha_b, c0b) and keeps the 0 V force: the experiment that checks whether
+the off-state force is what stops the larger dampers (these variants are registered as presets
+in this script only). The same procedure and budget tune the two bounds:
 the ideal semi-active damper (`ideal-damper`: the demand where it dissipates, no force where it
 would push energy in) and the ideal actuator (`ideal`: the demand, always), without the inner
 phase, which they do not have. A second table keeps the shipped gains (tuned at scale 1) and
 only changes the damper. Writes authority.csv and authority.png next to this file.
 
     python docs/results/authority_study.py          # about 4 minutes on 2 cores
+    python docs/results/authority_study.py --plot   # only redraw the figure from the CSV
 """
 
 from __future__ import annotations
@@ -21,6 +25,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from railride import dampers
 from railride.control import GainSet
 from railride.metrics import RESPONSES
 from railride.sweep import Case, run_cases
@@ -28,6 +33,15 @@ from railride.tuning import PHASES, tune
 
 HERE = Path(__file__).parent
 SCALES = (0.5, 1.0, 2.0, 4.0, 8.0, 16.0)
+FIELD_SCALES = (2.0, 4.0, 8.0, 16.0)
+
+
+def field_variant(k: float) -> str:
+    """Register railway with its field-dependent force parameters times k, 0 V force kept."""
+    name = f"railway-field-x{k:g}"
+    r = dampers.RAILWAY
+    dampers.PRESETS[name] = r.replace(alpha_b=r.alpha_b * k, c0b=r.c0b * k)
+    return name
 CONTROLLERS = ("pid", "sas-attitude", "sas-attitude-ride")
 
 
@@ -42,17 +56,19 @@ def ratios(gains: GainSet, damper: str, scale: float) -> dict:
 def main() -> None:
     records = []
     shipped = GainSet.default()
-    devices = [("railway", s, PHASES) for s in SCALES]
-    devices += [("ideal-damper", 1.0, PHASES[1:]), ("ideal", 1.0, PHASES[1:])]
-    for damper, scale, phases in devices:
+    devices = [("railway", s, s, PHASES) for s in SCALES]
+    devices += [(field_variant(k), 1.0, k, PHASES) for k in FIELD_SCALES]
+    devices += [("ideal-damper", 1.0, 1.0, PHASES[1:]), ("ideal", 1.0, 1.0, PHASES[1:])]
+    for damper, scale, factor, phases in devices:
         t0 = time.perf_counter()
         tuned = tune(phases, damper=damper, damper_scale=scale).gains
+        series = "field" if damper.startswith("railway-field") else damper
         for gains_name, gains in (("tuned for this damper", tuned), ("shipped", shipped)):
             for c, r in ratios(gains, damper, scale).items():
-                records.append({"damper": damper, "damper_scale": scale, "gains": gains_name,
+                records.append({"damper": damper, "series": series, "factor": factor, "gains": gains_name,
                                 "controller": c, **{f"{k}_ratio": float(v) for k, v in zip(RESPONSES, r)},
                                 "worst_ratio": float(r.max()), "inner_G": gains.inner.G})
-        print(f"{damper} x{scale:g}: {time.perf_counter() - t0:.0f} s", file=sys.stderr)
+        print(f"{damper} x{factor:g}: {time.perf_counter() - t0:.0f} s", file=sys.stderr)
     frame = pd.DataFrame.from_records(records)
     frame.to_csv(HERE / "authority.csv", index=False, float_format="%.5g")
     plot(frame)
@@ -66,23 +82,27 @@ def plot(frame: pd.DataFrame) -> None:
     fig, axes = plt.subplots(1, 3, figsize=(13, 4.2), sharey=True, constrained_layout=True)
     labels = {"pid": "PID", "sas-attitude": "SAS (attitude)", "sas-attitude-ride": "SAS (attitude+ride)"}
     for ax, c in zip(axes, CONTROLLERS):
-        part = frame[(frame.controller == c) & (frame.damper == "railway")]
-        for gains_name, style in (("tuned for this damper", "-o"), ("shipped", "--s")):
-            p = part[part.gains == gains_name]
-            ax.plot(p.damper_scale, p.worst_ratio, style, label=f"MR, worst of 4 ({gains_name})")
-            if gains_name == "tuned for this damper":
-                ax.plot(p.damper_scale, p.acceleration_m_s2_ratio, ":^", label="MR, acceleration (tuned)")
-        for damper, color in (("ideal-damper", "tab:green"), ("ideal", "tab:red")):
+        mine = frame[frame.controller == c]
+        whole = mine[mine.series == "railway"]
+        tuned = whole[whole.gains == "tuned for this damper"]
+        ax.plot(tuned.factor, tuned.worst_ratio, "-o", label="whole damper x k, tuned for it")
+        p = whole[whole.gains == "shipped"]
+        ax.plot(p.factor, p.worst_ratio, "--s", ms=4, label="whole damper x k, shipped gains")
+        one = tuned[tuned.factor == 1.0]
+        field = pd.concat([one, mine[(mine.series == "field") & (mine.gains == "tuned for this damper")]])
+        ax.plot(field.factor, field.worst_ratio, "-^", label="field part x k (0 V force kept), tuned")
+        for damper, color in (("ideal-damper", "tab:purple"), ("ideal", "tab:red")):
             b = frame[(frame.controller == c) & (frame.damper == damper)
                       & (frame.gains == "tuned for this damper")]
             ax.axhline(float(b.worst_ratio.iloc[0]), color=color, lw=1,
-                       label=f"{damper}, worst of 4 (tuned)")
+                       label=f"{damper}, tuned for it")
         ax.axhline(1.0, color="k", lw=0.8)
         ax.set_xscale("log", base=2)
-        ax.set_xlabel("MR damper force scale (1 = railway, about 20 kN at 2.25 V)")
+        ax.set_ylim(0.0, 1.6)
+        ax.set_xlabel("force scale k (1 = railway: 1.7 kN at 0 V, 20 kN at 2.25 V)")
         ax.set_title(labels[c])
         ax.grid(alpha=0.3)
-    axes[0].set_ylabel("RMS ratio to passive (lower is better)")
+    axes[0].set_ylabel("worst of the four RMS ratios to passive")
     axes[0].legend(fontsize=7)
     fig.suptitle("Damper authority on paper-sine: each damper size tuned by railride tune's defaults "
                  "(tuned and judged on the same track)", fontsize=10)
@@ -90,4 +110,7 @@ def plot(frame: pd.DataFrame) -> None:
 
 
 if __name__ == "__main__":
-    main()
+    if sys.argv[1:] == ["--plot"]:  # redraw from authority.csv
+        plot(pd.read_csv(HERE / "authority.csv"))
+    else:
+        main()
