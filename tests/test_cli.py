@@ -10,30 +10,12 @@ import sys
 import numpy as np
 import pytest
 import xarray as xr
-from typer.testing import CliRunner
 
-from railride.cli import app
+from clihelp import assert_input_error, run
 
-runner = CliRunner()
 
 METRIC_KEYS = {"acceleration_m_s2", "displacement_m", "pitch_deg", "roll_deg"}
 MODE_KEYS = {"label", "frequency_hz", "damped_frequency_hz", "damping_ratio"}
-
-
-def run(*args):
-    return runner.invoke(app, [str(a) for a in args])
-
-
-def assert_input_error(result, fragment=None):
-    """Exit status 2, one line "error: ..." on stderr, no traceback, nothing on stdout."""
-    assert result.exit_code == 2, (result.exit_code, result.stdout, result.stderr)
-    assert isinstance(result.exception, SystemExit)
-    lines = result.stderr.strip().splitlines()
-    assert len(lines) == 1 and lines[0].startswith("error: "), result.stderr
-    assert "Traceback" not in result.output
-    assert result.stdout == ""
-    if fragment is not None:
-        assert fragment in lines[0], lines[0]
 
 
 def write_track(path, rows):

@@ -9,24 +9,15 @@ import math
 
 import pandas as pd
 import pytest
-from typer.testing import CliRunner
 
-from railride.cli import app
 from railride.comfort import comfort_class
 from railride.sweep import COMFORT_COLUMNS
+from clihelp import PNG, ok
 
-runner = CliRunner()
 
 TRACK = ("--scenario", "fra4", "--track-seed", 1, "--duration", 6)
 POSITIONS = {"centre", "front", "rear"}
 INDICES = ("aw_Wk", "vdv_Wk", "aw_Wb", "N_MV_z", "Wz")
-PNG = b"\x89PNG\r\n\x1a\n"
-
-
-def ok(*args):
-    result = runner.invoke(app, [str(a) for a in args])
-    assert result.exit_code == 0, (result.exit_code, result.stdout, result.stderr)
-    return result
 
 
 def check_record(record: dict) -> None:

@@ -9,40 +9,15 @@ import re
 import pandas as pd
 import pytest
 import xarray as xr
-from typer.testing import CliRunner
 
-from railride.cli import app
 from railride.comparison import PAPER_REDUCTION, PAPER_TABLE1
 from railride.control import CONTROLLERS, LABELS, GainSet
 from railride.report import COMPARE_FILES
+from clihelp import PNG, assert_input_error, ok_json, run
 
-runner = CliRunner()
 
 RESPONSES = ["acceleration_m_s2", "displacement_m", "pitch_deg", "roll_deg"]
 SHORT = ("compare", "--duration", 2)
-PNG = b"\x89PNG\r\n\x1a\n"
-
-
-def run(*args):
-    return runner.invoke(app, [str(a) for a in args])
-
-
-def ok_json(*args) -> dict:
-    result = run(*args, "--format", "json")
-    assert result.exit_code == 0, (result.stdout, result.stderr)
-    return json.loads(result.stdout)
-
-
-def assert_input_error(result, *fragments):
-    """Exit status 2, one line "error: ..." on stderr naming the fragments, no traceback."""
-    assert result.exit_code == 2, (result.exit_code, result.stdout, result.stderr)
-    assert isinstance(result.exception, SystemExit)
-    lines = result.stderr.strip().splitlines()
-    assert len(lines) == 1 and lines[0].startswith("error: "), result.stderr
-    assert "Traceback" not in result.output
-    assert result.stdout == ""
-    for fragment in fragments:
-        assert fragment in lines[0], lines[0]
 
 
 def rms(doc, name, response="acceleration_m_s2"):

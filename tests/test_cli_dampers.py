@@ -8,37 +8,13 @@ import math
 
 import pandas as pd
 import pytest
-from typer.testing import CliRunner
 
-from railride.cli import app
+from clihelp import assert_input_error, ok_json, run
 
-runner = CliRunner()
 
 CYCLE_KEYS = {"voltage_v", "force_max_n", "force_min_n", "energy_per_cycle_j"}
 METRIC_KEYS = {"rms_error_n", "rms_demand_n", "normalised_rms_error", "window_s"}
 DAMPER = ("damper", "--amplitude", 0.01, "--frequency", 2, "--cycles", 2)
-
-
-def run(*args):
-    return runner.invoke(app, [str(a) for a in args])
-
-
-def ok_json(*args) -> dict:
-    result = run(*args, "--format", "json")
-    assert result.exit_code == 0, (result.stdout, result.stderr)
-    return json.loads(result.stdout)
-
-
-def assert_input_error(result, *fragments):
-    """Exit status 2, one line "error: ..." on stderr naming the fragments, no traceback."""
-    assert result.exit_code == 2, (result.exit_code, result.stdout, result.stderr)
-    assert isinstance(result.exception, SystemExit)
-    lines = result.stderr.strip().splitlines()
-    assert len(lines) == 1 and lines[0].startswith("error: "), result.stderr
-    assert "Traceback" not in result.output
-    assert result.stdout == ""
-    for fragment in fragments:
-        assert fragment in lines[0], lines[0]
 
 
 # -- damper ---------------------------------------------------------------------------------------

@@ -6,33 +6,10 @@ import json
 
 import pandas as pd
 import pytest
-from typer.testing import CliRunner
 
-from railride.cli import app
+from clihelp import assert_input_error, ok, run
 
-runner = CliRunner()
 PARETO = ("pareto", "--suspension", "pid", "--samples", 4, "--duration", 1)
-
-
-def run(*args):
-    return runner.invoke(app, [str(a) for a in args])
-
-
-def ok(*args):
-    result = run(*args)
-    assert result.exit_code == 0, (result.exit_code, result.stdout, result.stderr)
-    return result
-
-
-def assert_input_error(result, *fragments):
-    """Exit status 2, one line "error: ..." on stderr naming the fragments, no traceback."""
-    assert result.exit_code == 2, (result.exit_code, result.stdout, result.stderr)
-    lines = result.stderr.strip().splitlines()
-    assert len(lines) == 1 and lines[0].startswith("error: "), result.stderr
-    assert "Traceback" not in result.output
-    assert result.stdout == ""
-    for fragment in fragments:
-        assert fragment in lines[0], lines[0]
 
 
 def test_pareto_folder_json_and_resume(tmp_path):

@@ -9,44 +9,12 @@ import json
 import numpy as np
 import pandas as pd
 import pytest
-from typer.testing import CliRunner
 
-from railride.cli import app
 from railride.report import COMPARE_FILES, FRF_FILES, FRF_MAGNITUDES, FRF_PATTERNS
+from clihelp import assert_input_error, is_png, ok, ok_json, run
 
-runner = CliRunner()
 
-PNG = b"\x89PNG\r\n\x1a\n"
 RANDOM = ("simulate", "--scenario", "fra4", "--duration", 1, "--format", "json")
-
-
-def run(*args):
-    return runner.invoke(app, [str(a) for a in args])
-
-
-def ok(*args):
-    result = run(*args)
-    assert result.exit_code == 0, (result.exit_code, result.stdout, result.stderr)
-    return result
-
-
-def ok_json(*args):
-    return json.loads(ok(*args, "--format", "json").stdout)
-
-
-def assert_input_error(result, *fragments):
-    """Exit status 2, one line "error: ..." on stderr naming the fragments, no traceback."""
-    assert result.exit_code == 2, (result.exit_code, result.stdout, result.stderr)
-    lines = result.stderr.strip().splitlines()
-    assert len(lines) == 1 and lines[0].startswith("error: "), result.stderr
-    assert "Traceback" not in result.output
-    assert result.stdout == ""
-    for fragment in fragments:
-        assert fragment in lines[0], lines[0]
-
-
-def is_png(path) -> bool:
-    return path.is_file() and path.read_bytes()[:8] == PNG
 
 
 # -- random tracks --------------------------------------------------------------------------------

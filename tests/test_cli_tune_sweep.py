@@ -8,40 +8,16 @@ import json
 
 import pandas as pd
 import pytest
-from typer.testing import CliRunner
 
-from railride.cli import app
 from railride.control import GainSet
 from railride.report import TUNE_FILES
 from railride.tuning import DEFAULT_OBJECTIVE
+from clihelp import PNG, assert_input_error, ok, run
 
-runner = CliRunner()
 
 RESPONSES = ["acceleration_m_s2", "displacement_m", "pitch_deg", "roll_deg"]
 TUNE = ("tune", "--phase", "pid", "--duration", 1, "--values", 4, "--passes", 1)
 SWEEP = ("sweep", "--duration", 1)
-PNG = b"\x89PNG\r\n\x1a\n"
-
-
-def run(*args):
-    return runner.invoke(app, [str(a) for a in args])
-
-
-def ok(*args):
-    result = run(*args)
-    assert result.exit_code == 0, (result.exit_code, result.stdout, result.stderr)
-    return result
-
-
-def assert_input_error(result, *fragments):
-    """Exit status 2, one line "error: ..." on stderr naming the fragments, no traceback."""
-    assert result.exit_code == 2, (result.exit_code, result.stdout, result.stderr)
-    lines = result.stderr.strip().splitlines()
-    assert len(lines) == 1 and lines[0].startswith("error: "), result.stderr
-    assert "Traceback" not in result.output
-    assert result.stdout == ""
-    for fragment in fragments:
-        assert fragment in lines[0], lines[0]
 
 
 def table_rows(path) -> int:

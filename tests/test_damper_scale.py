@@ -8,14 +8,13 @@ import math
 
 import numpy as np
 import pytest
-from typer.testing import CliRunner
 
 from railride import dampers, rig
-from railride.cli import app
 from railride.comparison import compare
 from railride.simulation import simulate
 from railride.sweep import Case, run_cases
 from railride.track import scenario
+from clihelp import assert_input_error, run
 
 SHORT = {"duration": 1.0}
 
@@ -124,20 +123,6 @@ def test_run_cases_runs_the_scaled_damper():
 
 
 # -- the command line -----------------------------------------------------------------------------
-runner = CliRunner()
-
-
-def run(*args):
-    return runner.invoke(app, [str(a) for a in args])
-
-
-def assert_input_error(result, *fragments):
-    assert result.exit_code == 2, (result.exit_code, result.stdout, result.stderr)
-    lines = result.stderr.strip().splitlines()
-    assert len(lines) == 1 and lines[0].startswith("error: "), result.stderr
-    assert "Traceback" not in result.output and result.stdout == ""
-    for fragment in fragments:
-        assert fragment in lines[0], lines[0]
 
 
 @pytest.mark.parametrize("command", [("compare",), ("simulate", "--suspension", "mr"),

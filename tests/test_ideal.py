@@ -11,7 +11,6 @@ import json
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
-from typer.testing import CliRunner
 
 from railride import dampers, rig
 from railride.cli import app
@@ -21,6 +20,7 @@ from railride.params import VehicleParams
 from railride.simulation import simulate
 from railride.track import CosineBump, Scenario
 from railride.vehicle import Vehicle
+from clihelp import runner
 
 PARAMS = VehicleParams.preset("paper")
 #: bump on the left rail only: heave, pitch and roll all move
@@ -198,9 +198,6 @@ def test_the_ideal_actuator_has_no_force_capacity_to_scale():
         dampers.preset("ideal").scaled(2.0)
     with pytest.raises(ValueError, match="damper_scale = 2.*ideal"):
         compare(BUMP, PARAMS, damper="ideal", damper_scale=2.0)
-
-
-runner = CliRunner()
 
 
 def _input_error(args, *fragments):
