@@ -165,13 +165,17 @@ def _damper_preset(option: str, name: str, *, rig: bool = False):
     return dampers.preset(name)
 
 
-def _damper_scale(option: str, value: Optional[float], damper_name: str) -> float:
+def _damper_scale(option: str, value: Optional[str], damper_name: str) -> float:
     """--damper-scale: a finite number > 0 (default 1), not for the ideal actuator."""
     if value is None:
         return 1.0
     from .dampers import IDEAL_NAMES
 
-    scale = _check_number(option, value, "")
+    try:  # read as text, so that a word gets the one-line error too
+        number = float(value)
+    except ValueError:
+        raise ValueError(f"{option} = {value!r}: must be a finite number > 0") from None
+    scale = _check_number(option, number, "")
     if damper_name in IDEAL_NAMES:
         raise ValueError(f"{option} = {scale:g}: the ideal actuator (--damper {damper_name}) applies "
                          "the demand exactly and has no force capacity to scale")
@@ -699,7 +703,7 @@ def compare(
         help="Dampers of the controlled suspensions: the MR models railway, dyke1996 or "
              "spencer1997, or ideal (an ideal actuator: force = the outer loop's demand, the "
              "bound a semi-active damper approaches).")] = DEFAULT_DAMPER,
-    damper_scale: Annotated[Optional[float], typer.Option(
+    damper_scale: Annotated[Optional[str], typer.Option(
         "--damper-scale", metavar="X",
         help="Factor on the MR damper's force capacity, a finite number > 0 (every force "
              "parameter times X; default 1). Not with --damper ideal.")] = None,
@@ -1089,7 +1093,7 @@ def simulate(
         help="--suspension mr only: damper model railway, dyke1996 or spencer1997 "
              "(default railway). The ideal actuator (ideal) needs a controller: see compare "
              "and sweep.")] = None,
-    damper_scale: Annotated[Optional[float], typer.Option(
+    damper_scale: Annotated[Optional[str], typer.Option(
         "--damper-scale", metavar="X",
         help="--suspension mr only: factor on the damper's force capacity, a finite number > 0 "
              "(every force parameter times X; default 1).")] = None,
@@ -1303,7 +1307,7 @@ def tracking(
 ) -> None:
     """Force tracking of an MR damper by the inner loop.
 
-    The inner loop of spec section 6 sets the voltage so that a damper stroked by
+    The inner loop (paper eq. 12-14) sets the voltage so that a damper stroked by
     x = -stroke cos(2 pi f t) follows a desired force; prints the RMS tracking error.
     """
     with _errors():
@@ -1885,7 +1889,7 @@ def tune_command(
         "--damper", metavar="MODEL",
         help="MR damper model: railway, dyke1996 or spencer1997 (ideal, the ideal actuator, "
              "without the inner phase).")] = DEFAULT_DAMPER,
-    damper_scale: Annotated[Optional[float], typer.Option(
+    damper_scale: Annotated[Optional[str], typer.Option(
         "--damper-scale", metavar="X",
         help="Factor on the MR damper's force capacity, a finite number > 0 (every force "
              "parameter times X; default 1); the inner phase tracks demands scaled alike. Not "
@@ -1936,7 +1940,7 @@ def tune_command(
              "there are not evaluated again.")] = False,
     format: FormatOption = OutputFormat.table,
 ) -> None:
-    """Tune the controller gains by the paper's sensitivity study (spec section 9).
+    """Tune the controller gains by the paper's sensitivity study (its section V).
 
     One gain at a time is swept over log-spaced values (and 0) with the others fixed; the best
     value is kept; passes repeat until a pass gains less than 0.1 %. Each run is scored by the
