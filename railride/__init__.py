@@ -3,11 +3,11 @@
 The public API, in the order a run needs it::
 
     import railride as rr
-    params = rr.VehicleParams.preset("paper")          # parameters (spec section 2)
+    params = rr.VehicleParams.preset("paper")          # parameters (the paper's appendix)
     vehicle = rr.Vehicle(params)                      # M, C, K, modes, frequency response
-    sc = rr.scenario("paper-sine", speed=55.56)        # track and run (spec section 4)
+    sc = rr.scenario("paper-sine", speed=55.56)        # track and run (docs/model.md, Track input)
     result = rr.simulate(sc, params)                  # time histories (xarray) + metrics
-    result.metrics()                                  # RMS and peak-to-peak (spec section 8)
+    result.metrics()                                  # RMS, peak-to-peak (docs/model.md, Metrics)
 """
 
 __version__ = "0.1.0"

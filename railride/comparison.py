@@ -19,7 +19,7 @@ from .control import CONTROLLERS, LABELS, GainSet
 from .metrics import STATISTICS, reduction, ride_metrics, select_window
 from .simulation import DEFAULT_CONTROL_RATE, DEFAULT_DT, DEFAULT_OUTPUT_RATE, simulate
 
-#: Table 1 of Harun et al. (RMS values), spec section 8: for display beside railride's results.
+#: Table 1 of Harun et al. (RMS values): for display beside railride's results.
 PAPER_TABLE1 = {
     "acceleration_m_s2": {"passive": 0.3195, "pid": 0.2601, "sas-attitude": 0.2567, "sas-attitude-ride": 0.2063},
     "displacement_m": {"passive": 0.0349, "pid": 0.0265, "sas-attitude": 0.0225, "sas-attitude-ride": 0.0201},

@@ -1,4 +1,4 @@
-"""Outer-loop controllers and the force-tracking inner loop (spec sections 6-7).
+"""Outer-loop controllers and the force-tracking inner loop (docs/control.md).
 
 Every outer loop here is linear in the measured carbody states: with m = (z_c, phi_c, theta_c,
 z_c', phi_c', theta_c') and xi the time integral of (z_c, phi_c, theta_c), the desired corner
@@ -15,7 +15,7 @@ Corner displacements are z_i = (T_c^T q_c)_i, T_c the carbody rows of the second
 T (rows heave, pitch, roll). The decoupling transformation of the SAS distributes a demanded
 generalised force Q_d = (F_z, M_pitch, M_roll) over the corners with the right inverse
 T_c^+ = T_c^T (T_c T_c^T)^-1, computed from the geometry (the paper's printed eq. 18-19 are
-garbled, spec section 10).
+garbled).
 """
 
 from __future__ import annotations
@@ -60,7 +60,7 @@ class _Gains:
 
 @dataclass(frozen=True)
 class InnerLoop(_Gains):
-    """Force tracking, spec section 6: v = clip(G (f_d - B f) sgn(f), v_min, v_max)."""
+    """Force tracking, paper eq. 12-14: v = clip(G (f_d - B f) sgn(f), v_min, v_max)."""
 
     B: float = param("-", "feedback weight of the measured damper force", "nonnegative")
     G: float = param("V/N", "gain from force error to voltage", "nonnegative")

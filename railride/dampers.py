@@ -1,11 +1,11 @@
-"""Secondary vertical damper models (spec section 5): viscous, simple Bouc-Wen MR, Spencer MR.
+"""Secondary vertical damper models (docs/dampers.md): viscous, simple Bouc-Wen MR, Spencer MR.
 
 Sign convention, for every model: x is the damper's extension (the secondary deflection delta,
 carbody minus bogie, so x' > 0 when the carbody rises relative to the bogie) and F is the force
 the damper resists with, positive in tension: F = c x' for a dashpot. The force on the carbody
-is f = -F (spec section 5), on the bogie +F.
+is f = -F, on the bogie +F.
 
-Bouc-Wen form used here (spec; Spencer et al. 1997; Dyke et al. 1996):
+Bouc-Wen form used here (Spencer et al. 1997; Dyke et al. 1996):
 
     z' = -gamma |w| z |z|^(n-1) - beta w |z|^n + A w,
 
@@ -17,7 +17,7 @@ before using it here. For gamma >= beta and gamma + beta > 0 the hysteretic vari
 
 Voltage dependence and coil lag: u' = -eta (u - v), v the commanded voltage in [v_min, v_max];
 alpha = alpha_a + alpha_b u, c0 = c0a + c0b u (Spencer also c1 = c1a + c1b u). The preload
-k x0 of a gas accumulator balances at static equilibrium and is dropped (spec), so the spring
+k x0 of a gas accumulator balances at static equilibrium and is dropped, so the spring
 terms act on x, not x - x0.
 
 Each law also has a plain NumPy reference here (`rates`), used by the tests to check the
@@ -101,7 +101,7 @@ class Viscous(_Damper):
 
 @dataclass(frozen=True)
 class BoucWen(_Damper):
-    """Simple Bouc-Wen MR damper (paper eq. 10-11, spec section 5):
+    """Simple Bouc-Wen MR damper (paper eq. 10-11, with |x'| where eq. 11 prints |x|):
     F = c0(u) x' + k0 x + alpha(u) z."""
 
     alpha_a: float = param("N/m", "hysteretic force coefficient at 0 V", "nonnegative")
@@ -263,12 +263,12 @@ def _bouc_wen_z_rate(z, w, A, n, gamma, beta):
 
 
 # -- presets ------------------------------------------------------------------------------------
-#: Dyke, Spencer, Sain & Carlson (1996), simple Bouc-Wen fit of their small-scale damper, as
-#: given in spec section 5 (gamma, beta in 1/m for n = 1).
+#: Dyke, Spencer, Sain & Carlson (1996), simple Bouc-Wen fit of their small-scale damper
+#: (gamma, beta in 1/m for n = 1).
 DYKE1996 = BoucWen(alpha_a=1.0872e5, alpha_b=4.9616e5, c0a=4.40, c0b=44.0, k0=0.0,
                    A=1.2, n=1.0, gamma=300.0, beta=300.0, eta=50.0, v_min=0.0, v_max=2.25)
 
-#: The vehicle default (spec section 5): dyke1996 with the force parameters alpha_a, alpha_b,
+#: The vehicle default (docs/dampers.md, Presets): dyke1996 with the force parameters alpha_a, alpha_b,
 #: c0a, c0b, k0 multiplied by 8, about 1.7 kN at 0 V and 20 kN at 2.25 V.
 RAILWAY = DYKE1996.scaled(8)
 

@@ -463,7 +463,7 @@ def rig_batch(law, P, n_steps, stride, dt, xtab, x_interval, mode, vconst, serie
 
     The command voltage, held over each step, is vconst[s] (``mode`` RIG_CONSTANT), the series
     series[s, step] (RIG_COMMANDED, clipped to [v_min, v_max]), or the force-tracking law of
-    spec section 6 (RIG_TRACKING), v = clip(G[s] (f_d - B[s] F) sgn(F), v_min, v_max), from the
+    paper eq. 12-14 (RIG_TRACKING), v = clip(G[s] (f_d - B[s] F) sgn(F), v_min, v_max), from the
     force F at the step's start and the desired force f_d = series[s, step].
     States: z, y, u and the dissipated energy E (E' = F x'). Row step // stride of out[s]
     receives (t, x, x', F, z, y, u, v, E) at every step that is a multiple of stride, and after

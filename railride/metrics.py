@@ -1,4 +1,4 @@
-"""Ride metrics of spec section 8: RMS and peak-to-peak of the four carbody responses.
+"""Ride metrics (docs/model.md, Metrics): RMS and peak-to-peak of the four carbody responses.
 
 RMS is taken about zero, not about the mean, as in the paper's Table 1: every channel is a
 perturbation from static equilibrium, so the mean belongs to the response.

@@ -1,7 +1,8 @@
 """Vehicle parameter sets: frozen, validated at construction, named presets, TOML round trip.
 
-Symbols follow ``shared/spec/model.md`` section 2 (the paper's appendix). Every field carries its
-SI unit and the rule it must satisfy in its metadata; `VehicleParams.describe()` lists them.
+Symbols follow the appendix of Harun et al. (the paper; see docs/model.md, Parameters). Every
+field carries its SI unit and the rule it must satisfy in its metadata;
+`VehicleParams.describe()` lists them.
 """
 
 from __future__ import annotations
@@ -44,10 +45,10 @@ def validate_fields(obj, what: str) -> None:
 
 @dataclass(frozen=True)
 class VehicleParams:
-    """Parameters of the 9-DOF vertical vehicle model (SI units, spec section 2).
+    """Parameters of the 9-DOF vertical vehicle model (SI units, the paper's appendix).
 
     Suspension values are per element: one spring and one damper at each corner or axle box,
-    as in the element table of spec section 3.
+    as in the element table of docs/model.md, Equations.
     """
 
     m_c: float = param("kg", "carbody mass")
@@ -173,7 +174,7 @@ class VehicleParams:
         return cls.from_toml(text, source=str(path))
 
 
-#: The paper's appendix (Harun et al.), as restated in spec section 2.
+#: The paper's appendix (Harun et al.), in SI units.
 PAPER = VehicleParams(
     m_c=3.96e4, m_b=3.25e3,
     I_cx=8.85e4, I_cy=2.46e6, I_cz=2.5e6,

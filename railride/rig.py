@@ -1,5 +1,5 @@
 """A damper on a test rig: prescribed extension, constant or commanded voltage, or the force-
-tracking inner loop of spec section 6 (paper eq. 12-14, Fig. 6).
+tracking inner loop (paper eq. 12-14, Fig. 6).
 
 Sign convention (railride.dampers): x is the extension [m], F the force the damper resists with,
 positive in tension [N]. A desired force for the inner loop uses the same convention.
@@ -194,7 +194,7 @@ def drive(damper, motion, *, duration: float, voltage=None, command=None, desire
 
 def default_gain(damper) -> float:
     """G [V/N] that saturates the voltage at a force error of a tenth of the damper's range
-    (hand-set; the tuner of issue 5 replaces it)."""
+    (hand-set; the tuning study replaces it)."""
     f_max = abs(yield_force(damper, damper.v_max))
     return damper.v_max / (0.1 * f_max) if f_max > 0 else 0.0
 
@@ -307,7 +307,7 @@ def desired_force_signal(kind: str, amplitude: float, frequency: float):
 def track(damper="railway", desired: str = "sine", amplitude: float = 10e3, frequency: float = 1.0,
           *, B: float = 1.0, G: float | None = None, stroke: float = 0.02,
           n_cycles: int = 3, dt: float = DEFAULT_DT) -> Tracking:
-    """The inner loop of spec section 6 tracking a sine or sawtooth desired force (amplitude
+    """The inner loop (paper eq. 12-14) tracking a sine or sawtooth desired force (amplitude
     [N], frequency [Hz]) while the damper is stroked by x = -stroke cos(2 pi f t), whose
     velocity is in phase with a sine demand, so that the demand is dissipative where the
     damper's range allows. Metrics leave out the first cycle (start-up)."""

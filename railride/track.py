@@ -1,4 +1,4 @@
-"""Rail profiles, scenarios and the wheelset delays (spec section 4).
+"""Rail profiles, scenarios and the wheelset delays (docs/model.md, Track input).
 
 A profile gives the left and right rail heights z_L(s), z_R(s) [m] and their slopes along the
 track. Before s = 0 every profile is 0: the vehicle starts at rest on level track. Wheelset j is at
@@ -370,7 +370,7 @@ def wheelset_input_table(scenario: Scenario, lag_distance: np.ndarray, dt: float
     return table, interval
 
 
-# -- random irregularity from standard spectra (spec section 4) ---------------------------------
+# -- random irregularity from standard spectra (docs/track.md) -----------------------------------
 #: FRA track classes (Hamid and Yang 1981; the constants as in Garg and Dukkipati 1984,
 #: "Dynamics of Railway Vehicle Systems"): A_v [cm^2 rad/m] per class, k = 0.25,
 #: Omega_c = 0.8245 rad/m, Omega_s = 0.4380 rad/m.
@@ -388,7 +388,7 @@ def spectrum(name: str, wavenumber, component: str = "vertical") -> np.ndarray:
     [rad/m] (Omega = 2 pi / wavelength).
 
     ``component`` "vertical": the vertical profile z_v (mean of the two rails); "cross-level":
-    the height difference z_x = z_L - z_R between the rails (spec section 4: z_L = z_v + z_x/2,
+    the height difference z_x = z_L - z_R between the rails (z_L = z_v + z_x/2,
     z_R = z_v - z_x/2). Formulas (docs/track.md):
 
     * FRA class c: S_v = k A_v Omega_c^2 / (Omega^2 (Omega^2 + Omega_c^2)),

@@ -1,4 +1,4 @@
-"""Controller tuning by the paper's sensitivity study (spec section 9).
+"""Controller tuning by the paper's sensitivity study (its section V).
 
 One parameter at a time is swept over a logarithmic range (and 0) while the others stay fixed;
 the best value is kept; passes repeat until a whole pass improves the objective by less than a

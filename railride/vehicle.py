@@ -1,4 +1,4 @@
-"""The 9-DOF vehicle assembled from the element table of spec section 3.
+"""The 9-DOF vehicle assembled from the element table of docs/model.md, Equations.
 
 Every suspension element is a spring k and a damper c on a deflection that is linear in the
 DOFs q and the rail inputs w: delta = a.q + e.w.  The equations of motion
@@ -83,7 +83,7 @@ def _wheelset_roll(wheelset: int, half_gauge: float) -> np.ndarray:
 
 
 def element_table(p: VehicleParams) -> list[Element]:
-    """The element list of spec section 3, in code."""
+    """The element list of docs/model.md, Equations, in code."""
     elements: list[Element] = []
     zero_e = np.zeros(N_RAIL_INPUT)
     bogies = (("front_bogie", +p.l, (1, 2)), ("rear_bogie", -p.l, (3, 4)))

@@ -34,7 +34,7 @@ def test_damper_json_one_cycle_per_voltage():
         assert values == sorted(values) and values[0] < values[-1], key
     mins = [c["force_min_n"] for c in doc["cycles"]]
     assert mins == sorted(mins, reverse=True)
-    # the railway preset: about 1.7 kN at 0 V and 20 kN at 2.25 V (spec section 5)
+    # the railway preset: about 1.7 kN at 0 V and 20 kN at 2.25 V (docs/dampers.md, Presets)
     assert 1.2e3 < doc["cycles"][0]["force_max_n"] < 2.5e3
     assert 15e3 < doc["cycles"][-1]["force_max_n"] < 25e3
 

@@ -60,7 +60,7 @@ def test_scaled_multiplies_the_force_parameters_and_nothing_else():
         want = 2.5 * getattr(spencer, name) if name in force else getattr(spencer, name)
         assert getattr(scaled, name) == want, name
     assert type(scaled) is dampers.Spencer and scaled.to_dict()["preset"] is None
-    # the railway preset is the published small-scale damper times 8 (spec section 5)
+    # the railway preset is the published small-scale damper times 8 (docs/dampers.md, Presets)
     railway, dyke = dampers.preset("railway"), dampers.preset("dyke1996")
     assert railway.alpha_a == 8 * 1.0872e5 and railway.c0b == 8 * 44.0 and railway.A == dyke.A
 

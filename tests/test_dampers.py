@@ -31,13 +31,13 @@ def steady(request):
     return name, d, rig.cycles(d, amp, f, _voltages(d))
 
 
-def test_presets_follow_the_spec():
+def test_presets_follow_the_published_values():
     d, r = dampers.DYKE1996, dampers.RAILWAY
     for name in ("alpha_a", "alpha_b", "c0a", "c0b", "k0"):
         assert getattr(r, name) == 8 * getattr(d, name)
     for name in ("A", "n", "gamma", "beta", "eta", "v_min", "v_max"):
         assert getattr(r, name) == getattr(d, name)
-    # about 1.7 kN at 0 V and 20 kN at 2.25 V (spec section 5): alpha(v) times the bound of z
+    # about 1.7 kN at 0 V and 20 kN at 2.25 V (docs/dampers.md, Presets): alpha(v) times the bound of z
     assert r.alpha_a * r.z_bound == pytest.approx(1.74e3, rel=0.01)
     assert (r.alpha_a + 2.25 * r.alpha_b) * r.z_bound == pytest.approx(19.6e3, rel=0.01)
     s = dampers.SPENCER1997  # Table 1 of Spencer et al. (1997), in N and cm

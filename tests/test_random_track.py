@@ -1,4 +1,4 @@
-"""Random track irregularity from standard spectra (spec section 4)."""
+"""Random track irregularity from standard spectra."""
 
 import numpy as np
 import pytest

@@ -7,7 +7,7 @@ from railride.track import (CosineBump, MeasuredTrack, Scenario, SineTrack, scen
 from railride.vehicle import Vehicle
 
 
-def test_sine_rails_follow_the_spec_formula():
+def test_sine_rails_follow_the_paper_formula():
     tr = SineTrack(amplitude=0.05, wavelength=60.0, rail_phase_deg=90.0, taper=0.0)
     s = np.linspace(0.1, 200, 1000)
     zl, zr, dzl, dzr = tr.evaluate(s)

@@ -28,7 +28,7 @@ def test_rigid_heave_with_the_rails_loads_no_element():
         assert abs(el.a @ q + el.e @ w) < 1e-12, el.name
 
 
-def test_secondary_force_map_has_the_spec_carbody_rows():
+def test_secondary_force_map_has_the_carbody_rows_of_the_geometry():
     v = Vehicle(P)
     assert np.allclose(v.T[0], [1, 1, 1, 1])
     assert np.allclose(v.T[1], [-P.l, -P.l, P.l, P.l])
