@@ -1,4 +1,4 @@
-"""`railride compare` wall-clock times (issue 4): the first run on a fresh install (numba's cache
+"""`railride compare` wall-clock times: the first run on a fresh install (numba's cache
 empty, so compilation is included) and a second run (cache warm).
 
 Run:  python benchmarks/bench_compare.py [--repeat N]

@@ -1,4 +1,4 @@
-"""MR damper benchmarks (issue 3): the vehicle with four MR dampers, the damper rig.
+"""MR damper benchmarks: the vehicle with four MR dampers, the damper rig.
 
 Run:  python benchmarks/bench_dampers.py [--repeat N]
 Prints a Markdown table for docs/performance.md (wall-clock minima; no test asserts timings).

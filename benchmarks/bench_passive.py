@@ -1,4 +1,4 @@
-"""Passive ride benchmarks (issue 2): single run, batch throughput, CLI cold start.
+"""Passive ride benchmarks: single run, batch throughput, CLI cold start.
 
 Run:  python benchmarks/bench_passive.py [--repeat N] [--json FILE]
 Prints a Markdown table for docs/performance.md. Timings are wall-clock minima over repeats;

@@ -1,11 +1,11 @@
-"""Tuning and sweep benchmarks (issue 5).
+"""Tuning and sweep benchmarks.
 
 Run:  python benchmarks/bench_tuning.py
 Prints a Markdown table for docs/performance.md (single wall-clock runs; the tests assert no
-timing). The two-phase study starts from the neutral reference gains (scaled from the passive
-suspension, GainSet.reference(), railride/data/reference_gains.toml) so that it has the whole
-way to go. The objective is the one the benchmark numbers were measured with: the sum, penalty
-10.
+timing). The studies start from the neutral reference gains (scaled from the passive
+suspension, GainSet.reference(), railride/data/reference_gains.toml) so that they have the
+whole way to go, with the default objective (minimax): the last row is `railride tune` as
+shipped.
 """
 
 from __future__ import annotations
@@ -14,7 +14,7 @@ import time
 
 from railride.control import GainSet
 from railride.sweep import Case, run_cases
-from railride.tuning import Objective, tune
+from railride.tuning import tune
 
 
 def reference_gains() -> GainSet:
@@ -28,7 +28,7 @@ def main():
                                  ("two-phase study from the shipped gains", ("attitude", "ride"), None),
                                  ("all four phases (inner, pid, attitude, ride) from the reference gains", ("inner", "pid", "attitude", "ride"), reference_gains())):
         t0 = time.perf_counter()
-        res = tune(phases, gains=start, objective=Objective(kind="sum", penalty=10.0))
+        res = tune(phases, gains=start)
         dt = time.perf_counter() - t0
         n = len(res.runs)
         rows.append((f"`tune`: {label}, `paper-sine` 10 s runs", f"{dt:.1f} s, {n} runs ({n / dt:.0f} runs/s), "

@@ -177,8 +177,8 @@ def _damper_scale(option: str, value: Optional[str], damper_name: str) -> float:
         raise ValueError(f"{option} = {value!r}: must be a finite number > 0") from None
     scale = _check_number(option, number, "")
     if damper_name in IDEAL_NAMES:
-        raise ValueError(f"{option} = {scale:g}: the ideal actuator (--damper {damper_name}) applies "
-                         "the demand exactly and has no force capacity to scale")
+        raise ValueError(f"{option} = {scale:g}: the ideal device (--damper {damper_name}) applies "
+                         "the demand itself and has no force capacity to scale")
     return scale
 
 
@@ -597,8 +597,8 @@ def _compare_tables(doc: dict, vehicle: str, shipped: bool):
         info.append(f"gains file {doc['gains']['source']}" + (" (shipped)" if shipped else ""))
         tuning = doc.get("tuning") or {}
         if tuning.get("objective"):
-            info.append(f"gains tuned with objective {tuning['objective']}"
-                        + (f" by `{tuning['command']}`" if tuning.get("command") else ""))
+            info.append((f"gains tuned by `{tuning['command']}`, " if tuning.get("command") else
+                         "gains tuned ") + f"objective {tuning['objective']}")
         if tuning.get("in_sample"):
             info.append("The gains were tuned on this same single track: the reductions are "
                         "in-sample, not a test on another track.")
@@ -679,7 +679,7 @@ def _compare_tables(doc: dict, vehicle: str, shipped: bool):
     demands_note = ("All four corners, over the metric window. demand: the force the outer loop "
                     "asks for; force: the secondary damper force on the carbody; travel: the "
                     "secondary deflection (suspension travel); passive: the viscous dampers c_sz."
-                    + (" The ideal actuators have no voltage." if settings.get("damper")
+                    + (" The ideal devices have no voltage." if settings.get("damper")
                        in ("ideal", "ideal-damper") and controlled else ""))
     parts = [table, Text("\n".join(info)), *bounds_parts, "", ptp, "", demands, Text(demands_note)]
     if all("comfort" in r for r in rows):
@@ -701,8 +701,9 @@ def compare(
     damper: Annotated[str, typer.Option(
         "--damper", metavar="MODEL",
         help="Dampers of the controlled suspensions: the MR models railway, dyke1996 or "
-             "spencer1997, or ideal (an ideal actuator: force = the outer loop's demand, the "
-             "bound a semi-active damper approaches).")] = DEFAULT_DAMPER,
+             "spencer1997; ideal-damper (the ideal semi-active damper: the demand where it "
+             "dissipates, else 0, the bound of any damper) or ideal (an ideal actuator: force = "
+             "the outer loop's demand).")] = DEFAULT_DAMPER,
     damper_scale: Annotated[Optional[str], typer.Option(
         "--damper-scale", metavar="X",
         help="Factor on the MR damper's force capacity, a finite number > 0 (every force "
@@ -1887,8 +1888,8 @@ def tune_command(
     dt: DtOption = None,
     damper: Annotated[str, typer.Option(
         "--damper", metavar="MODEL",
-        help="MR damper model: railway, dyke1996 or spencer1997 (ideal, the ideal actuator, "
-             "without the inner phase).")] = DEFAULT_DAMPER,
+        help="MR damper model: railway, dyke1996 or spencer1997 (ideal-damper or ideal, the "
+             "ideal devices, without the inner phase).")] = DEFAULT_DAMPER,
     damper_scale: Annotated[Optional[str], typer.Option(
         "--damper-scale", metavar="X",
         help="Factor on the MR damper's force capacity, a finite number > 0 (every force "
@@ -2100,7 +2101,8 @@ def pareto_command(
     dt: DtOption = None,
     damper: Annotated[str, typer.Option(
         "--damper", metavar="MODEL",
-        help="Dampers of the controlled runs: railway, dyke1996, spencer1997 or ideal.")] = DEFAULT_DAMPER,
+        help="Dampers of the controlled runs: railway, dyke1996, spencer1997, ideal-damper or "
+             "ideal.")] = DEFAULT_DAMPER,
     gains: Annotated[Optional[Path], typer.Option(
         "--gains", metavar="FILE.toml",
         help="Base gains: the gains not sampled (the inner loop's among them), and one sample "
@@ -2383,8 +2385,8 @@ def sweep_command(
     damper: Annotated[Optional[str], typer.Option(
         "--damper", metavar="MODEL",
         help="mr and controllers: MR damper model railway, dyke1996 or spencer1997 "
-             "(default railway); controllers only: ideal, an ideal actuator whose force is the "
-             "outer loop's demand.")] = None,
+             "(default railway); controllers only: ideal-damper (the ideal semi-active damper) or "
+             "ideal (an ideal actuator whose force is the outer loop's demand).")] = None,
     damper_scale: Annotated[Optional[str], typer.Option(
         "--damper-scale", metavar="VALUES",
         help="mr and controllers: factors on the MR damper's force capacity (every force "
@@ -2480,8 +2482,8 @@ def sweep_command(
         scales = [1.0]
         if damper_scale is not None:
             if damper_name in ("ideal", "ideal-damper"):
-                raise ValueError(f"--damper-scale = {damper_scale!r}: the ideal actuator "
-                                 f"(--damper {damper_name}) applies the demand exactly and has no force "
+                raise ValueError(f"--damper-scale = {damper_scale!r}: the ideal device "
+                                 f"(--damper {damper_name}) applies the demand itself and has no force "
                                  "capacity to scale")
             scales = [_check_number("--damper-scale", v, "")
                       for v in _value_list("--damper-scale", damper_scale)]
@@ -2668,7 +2670,7 @@ def sweep_command(
              f"{scen.duration:g} s, dt {dt:g} s, RMS over {start:g}-{end:g} s"]
     if st["damper"]:
         lines.append(_damper_text(st) + (f"; gains {st['gains_source']}" if controllers else ""))
-    lines.append(f"{len(rows)} runs: {doc['runs_evaluated']} evaluated now, "
+    lines.append(f"{len(rows)} run{'s' if len(rows) != 1 else ''}: {doc['runs_evaluated']} evaluated now, "
                  f"{len(rows) - doc['runs_evaluated']} from the run table; wall time {wall:.1f} s")
     n_bad = sum(r.get("diverged_at_s") is not None for r in rows)
     if n_bad:

@@ -28,6 +28,10 @@ from .metrics import RESPONSES, STATISTICS
 #: samples per compiled batch: bounds the memory of the time histories (about 5 MB a sample
 #: for 10 s at 1 kHz)
 CHUNK = 32
+#: raised whenever the physics change the metrics of a run with the same settings, so that run
+#: tables from before do not resume into the new model. 2: two secondary lateral and two
+#: longitudinal springs per bogie, and the paper sine's entry taper.
+MODEL_REVISION = 2
 SUSPENSIONS = ("passive", "mr", "pid", "sas-attitude", "sas-attitude-ride")
 #: (position, index) of `railride.comfort.ride_comfort` in a row with comfort, as the column
 #: ``<position>_<index>``
@@ -86,15 +90,18 @@ class Case:
 
     @property
     def key(self) -> str:
-        """A stable identity for the run table (same settings, same key, in any session)."""
-        text = json.dumps(self.to_dict(), sort_keys=True, default=str)
+        """A stable identity for the run table (same settings and model, same key, in any
+        session). The model revision is part of it, so a run table from an earlier model is
+        not taken for this one's on resume."""
+        text = json.dumps({**self.to_dict(), "model_revision": MODEL_REVISION}, sort_keys=True,
+                          default=str)
         return hashlib.sha1(text.encode()).hexdigest()[:16]
 
     def to_dict(self) -> dict:
         d = asdict(self)
         for name in ("scenario_options", "vehicle", "gains"):
             d[name] = dict(d[name])
-        if d["damper_scale"] == 1.0:  # so the keys of unscaled runs stay as they were
+        if d["damper_scale"] == 1.0:  # the default is left out: a scale appears only when set
             del d["damper_scale"]
         return d
 

@@ -274,3 +274,13 @@ def test_tune_with_a_scaled_damper_tunes_the_inner_loop_for_it():
         tracking_objective(1.0, G), rel=1e-9)
     with pytest.raises(ValueError, match="damper_scale = -1"):
         tune(("pid",), damper_scale=-1, scenario_options=SHORT)
+
+
+def test_run_keys_change_with_the_model_revision(monkeypatch):
+    # a run table from an earlier model must not resume into this one
+    import railride.sweep as sweep_module
+
+    c = Case(suspension="pid", gains={"pid.kd": 1e5})
+    before = c.key
+    monkeypatch.setattr(sweep_module, "MODEL_REVISION", sweep_module.MODEL_REVISION + 1)
+    assert c.key != before
