@@ -38,6 +38,14 @@ def main():
         t = _min_time(lambda: simulate(sc, damper=damper, voltage=voltage), args.repeat)
         rows.append((f"vehicle, four `{damper}` MR dampers at {voltage:g} V ({note}), 10 s, dt = 1e-4 s",
                      f"{t * 1e3:.1f} ms", "<= 50 ms" if damper == "railway" else ""))
+    # the closed loop: SAS (attitude+ride) with the shipped gains on each device
+    from railride.control import GainSet
+
+    sas = GainSet.default().controller("sas-attitude-ride")
+    for damper in ("railway", "ideal-damper", "ideal"):
+        simulate(sc, damper=damper, controller=sas)
+        t = _min_time(lambda: simulate(sc, damper=damper, controller=sas), args.repeat)
+        rows.append((f"vehicle, SAS (attitude+ride) closed loop, `{damper}`, 10 s", f"{t * 1e3:.1f} ms", ""))
     simulate(scenario("paper-sine", duration=1.0), damper="spencer1997", voltage=1.0)
     t = _min_time(lambda: simulate(scenario("paper-sine", duration=1.0), damper="spencer1997",
                                    voltage=1.0), max(1, args.repeat // 2))

@@ -123,18 +123,18 @@ class Comparison:
         reduction against passive (None for a run that diverged), and diverged_at_s."""
         if not self.bounds:
             return None
-        base = self.metrics.sel(controller="passive", statistic="rms")
+        responses = [str(r) for r in self.metrics.response.values]
+        base = self.metrics.sel(controller="passive", statistic="rms").values
         out = {}
         for device, runs in self.bounds.items():
             out[device] = {}
             for name, run in runs.items():
-                rms = run["metrics"].sel(statistic="rms")
+                rms = run["metrics"].sel(statistic="rms").values  # in the order of `responses`
                 ok = not np.isfinite(run["diverged_at_s"])
+                red = (base - rms) / base * 100.0
                 out[device][name] = {
-                    "rms": {str(r): float(rms.sel(response=r)) if ok else None for r in rms.response.values},
-                    "reduction_percent": {str(r): float((base.sel(response=r) - rms.sel(response=r))
-                                                        / base.sel(response=r) * 100.0) if ok else None
-                                          for r in rms.response.values},
+                    "rms": {r: float(v) if ok else None for r, v in zip(responses, rms)},
+                    "reduction_percent": {r: float(v) if ok else None for r, v in zip(responses, red)},
                     "diverged_at_s": None if ok else run["diverged_at_s"]}
         return out
 
