@@ -10,7 +10,7 @@ The public API, in the order a run needs it::
     result.metrics()                                  # RMS, peak-to-peak (docs/model.md, Metrics)
 """
 
-__version__ = "0.1.0"
+__version__ = "0.2.0"
 
 from .comparison import compare
 from .metrics import reduction, ride_metrics

@@ -2435,7 +2435,7 @@ def sweep_command(
     with _errors():
         from . import report
         from . import sweep as sweep_lib
-        from .metrics import RESPONSES, check_window, parse_window
+        from .metrics import check_window, parse_window
         from .simulation import DEFAULT_DT, DEFAULT_OUTPUT_RATE
 
         # suspensions

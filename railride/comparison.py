@@ -246,7 +246,8 @@ def compare(scenario, params=None, *, controllers=CONTROLLERS, gains: GainSet | 
     first = datasets["passive"]
     settings = {"scenario": json.loads(str(first["scenario"].values)),
                 "vehicle_params": json.loads(str(first["vehicle_params"].values)), "damper": str(damper),
-                "damper_scale": damper_scale, "dt_s": dt, "output_rate_hz": output_rate, "control_rate_hz": control_rate,
+                "damper_scale": damper_scale, "dt_s": dt, "output_rate_hz": output_rate,
+                "control_rate_hz": control_rate,
                 "window_s": None if window is None else [float(w) for w in window],
                 "sensor_noise": None if sensor_noise is None else sensor_noise.__dict__}
     comfort_values = None

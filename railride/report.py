@@ -529,7 +529,8 @@ def _corner_grid(ds: xr.Dataset, rows: list[str], figsize_row: float = 2.0):
 def plot_comparison_damper_forces(comparison, path=None):
     """The secondary damper force on the carbody (kN, up +) at each corner against time: one
     row per suspension (passive: the viscous dampers), one column per corner (1R, 1L, 2R, 2L),
-    all panels on the same scale, solid lines in each suspension's colour. Saved as PNG at ``path`` when given; returns the `Figure`."""
+    all panels on the same scale, solid lines in each suspension's colour. Saved as PNG at
+    ``path`` when given; returns the `Figure`."""
     ds = _comparison_dataset(comparison)
     if "secondary_damper_force" not in ds.variables:
         raise ValueError("the dataset lacks the channel secondary_damper_force")

@@ -7,7 +7,6 @@ import functools
 import json
 import math
 import platform
-from collections.abc import Sequence
 from datetime import datetime, timezone
 
 import numpy as np

@@ -89,10 +89,12 @@ class SineTrack(RailProfile):
     taper: float = 1.0  # length of the entry taper, in wavelengths
 
     def __post_init__(self):
-        object.__setattr__(self, "amplitude", _check("amplitude", self.amplitude, "nonnegative", "a finite number >= 0 (m)"))
-        object.__setattr__(self, "wavelength", _check("wavelength", self.wavelength, "positive", "a finite number > 0 (m)"))
-        object.__setattr__(self, "rail_phase_deg", _check("rail_phase", self.rail_phase_deg, "finite", "a finite angle in degrees"))
-        object.__setattr__(self, "taper", _check("taper", self.taper, "nonnegative", "a finite number >= 0 (wavelengths)"))
+        checks = (("amplitude", "amplitude", "nonnegative", "a finite number >= 0 (m)"),
+                  ("wavelength", "wavelength", "positive", "a finite number > 0 (m)"),
+                  ("rail_phase_deg", "rail_phase", "finite", "a finite angle in degrees"),
+                  ("taper", "taper", "nonnegative", "a finite number >= 0 (wavelengths)"))
+        for field_name, name, rule, allowed in checks:
+            object.__setattr__(self, field_name, _check(name, getattr(self, field_name), rule, allowed))
 
     def _evaluate(self, s):
         k = 2 * np.pi / self.wavelength
@@ -127,7 +129,8 @@ class CosineBump(RailProfile):
     rails: str = "both"  # "both", "left" or "right"
 
     def __post_init__(self):
-        object.__setattr__(self, "height", _check("height", self.height, "finite", "a finite number (m; < 0 for a dip)"))
+        object.__setattr__(self, "height", _check("height", self.height, "finite",
+                                                  "a finite number (m; < 0 for a dip)"))
         object.__setattr__(self, "length", _check("length", self.length, "positive", "a finite number > 0 (m)"))
         object.__setattr__(self, "start", _check("start", self.start, "nonnegative", "a finite number >= 0 (m)"))
         if self.rails not in ("both", "left", "right"):
@@ -180,13 +183,15 @@ class MeasuredTrack(RailProfile):
         for name, col in (("s", s), ("z_L", zl), ("z_R", zr)):
             bad = np.flatnonzero(~np.isfinite(col))
             if bad.size:
-                raise ValueError(f"{src}: column {name} has a non-finite value {col[bad[0]]!r} at data row {bad[0] + 1}")
+                raise ValueError(f"{src}: column {name} has a non-finite value {col[bad[0]]!r} "
+                                 f"at data row {bad[0] + 1}")
         steps = np.diff(s)
         if np.any(steps <= 0):
             i = int(np.flatnonzero(steps <= 0)[0])
             raise ValueError(f"{src}: s must increase strictly; data row {i + 2} has s = {s[i + 1]!r} after {s[i]!r}")
         if s[0] > 0:
-            raise ValueError(f"{src}: the profile must start at s <= 0 m (the vehicle starts at s = 0); it starts at {s[0]!r} m")
+            raise ValueError(f"{src}: the profile must start at s <= 0 m (the vehicle starts at s = 0); "
+                             f"it starts at {s[0]!r} m")
         object.__setattr__(self, "s", s)
         object.__setattr__(self, "z_L", zl)
         object.__setattr__(self, "z_R", zr)
@@ -234,7 +239,8 @@ class MeasuredTrack(RailProfile):
 
     def _evaluate(self, s):
         if np.any(s > self.s[-1] + 1e-9):
-            raise ValueError(f"{self.source}: the profile ends at s = {self.s[-1]:g} m but the run reaches s = {float(np.max(s)):.1f} m")
+            raise ValueError(f"{self.source}: the profile ends at s = {self.s[-1]:g} m but the run "
+                             f"reaches s = {float(np.max(s)):.1f} m")
         return tuple(f(s) for f in self._interp)
 
     def end(self):
@@ -285,7 +291,8 @@ def scenario(name: str = "paper-sine", *, amplitude: float | None = None,
     """A named scenario with optional overrides.
 
     ``paper-sine``: amplitude [m], wavelength [m], rail_phase [deg] of the sine (defaults 0.05 m,
-    60 m, 90 deg) and the length of its entry taper in wavelengths (default 1; 0 for none). ``bump``: amplitude is the bump height [m] (negative for a dip, default 0.02 m)
+    60 m, 90 deg) and the length of its entry taper in wavelengths (default 1; 0 for none).
+    ``bump``: amplitude is the bump height [m] (negative for a dip, default 0.02 m)
     and wavelength its length [m] (default 10 m), starting at s = 10 m on both rails.
     ``file:PATH``: a measured CSV profile (s, z_L, z_R). ``fra1`` ... ``fra6``, ``german-low``,
     ``german-high``: a random realisation of that spectrum (`RandomTrack`) with ``seed`` (default

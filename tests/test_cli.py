@@ -57,7 +57,9 @@ def test_modes_params_file(tmp_path):
     stiff.write_text('[vehicle]\npreset = "paper"\nk_sz = 5.8e5\n', encoding="utf-8")
     base = json.loads(run("modes", "--format", "json").stdout)
     other = json.loads(run("modes", "--format", "json", "--params", stiff).stdout)
-    bounce = lambda ms: next(m["frequency_hz"] for m in ms if m["label"] == "carbody bounce")
+    def bounce(ms):
+        return next(m["frequency_hz"] for m in ms if m["label"] == "carbody bounce")
+
     assert bounce(other) > bounce(base) * 1.2
 
 
@@ -72,7 +74,8 @@ def test_simulate_json_document():
     result = run("simulate", "--format", "json", "--duration", 2)
     assert result.exit_code == 0, result.output
     doc = json.loads(result.stdout)
-    assert list(doc) == ["schema", "railride_version", "scenario", "vehicle_preset", "suspension", "settings", "metrics"]
+    assert list(doc) == ["schema", "railride_version", "scenario", "vehicle_preset", "suspension",
+                         "settings", "metrics"]
     assert doc["schema"] == "railride.simulation/1"
     assert doc["vehicle_preset"] == "paper"
     assert doc["scenario"]["name"] == "paper-sine" and doc["scenario"]["duration_s"] == 2.0

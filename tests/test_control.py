@@ -121,8 +121,10 @@ def test_a_step_demand_appears_one_controller_period_later_and_is_held(rate):
 
 def test_sensor_noise_is_seeded():
     g = GainSet.default()
-    run = lambda seed: simulate(scenario("paper-sine", duration=1.0), controller=g.controller("pid"),
-                                sensor_noise=SensorNoise(1e-3, 1e-4, 1e-3, 1e-4, seed=seed)).dataset
+    def run(seed):
+        return simulate(scenario("paper-sine", duration=1.0), controller=g.controller("pid"),
+                        sensor_noise=SensorNoise(1e-3, 1e-4, 1e-3, 1e-4, seed=seed)).dataset
+
     a, b, c = run(1), run(1), run(2)
     assert np.array_equal(a.carbody_bounce.values, b.carbody_bounce.values)
     assert not np.array_equal(a.carbody_bounce.values, c.carbody_bounce.values)
@@ -139,7 +141,8 @@ def test_gains_file_round_trip(tmp_path):
 @pytest.mark.parametrize("edit, match", [
     (lambda t: t.replace("kd = ", "# kd = "), r"missing entry 'kd' in \[pid\]"),
     (lambda t: t.replace("[pid]\n", "[pid]\nkf = 1.0\n"), r"unknown entry 'kf' in \[pid\]"),
-    (lambda t: re.sub(r"kp_z = [0-9.e+]+", 'kp_z = "high"', t), r"entry 'kp_z' in \[sas.attitude\] = 'high' is not a number"),
+    (lambda t: re.sub(r"kp_z = [0-9.e+]+", 'kp_z = "high"', t),
+     r"entry 'kp_z' in \[sas.attitude\] = 'high' is not a number"),
     (lambda t: re.sub(r"kd_2L = [0-9.e+]+", "kd_2L = -5.0", t), r"\[sas.ride\] SAS ride gain 'kd_2L' = -5.0"),
     (lambda t: t.replace("[inner]", "[inner2]"), r"unknown table"),
     (lambda t: t + "\n[[", r"not valid TOML"),
