@@ -1,0 +1,64 @@
+"""The scripts in examples/ run as a user would run them (python examples/x.py --out DIR) and
+print their summary."""
+
+from __future__ import annotations
+
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def run_example(name: str, out: Path, *args: str) -> str:
+    """Run examples/<name>.py from the repository root; return its standard output."""
+    proc = subprocess.run([sys.executable, f"examples/{name}.py", "--out", str(out), *args],
+                          cwd=ROOT, capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, f"{name} failed:\n{proc.stdout}\n{proc.stderr}"
+    return proc.stdout
+
+
+@pytest.mark.parametrize("name", ["paper_comparison", "speed_sweep_random_track",
+                                  "custom_vehicle", "damper_size"])
+def test_example_has_a_docstring_and_uses_no_private_names(name):
+    text = (ROOT / "examples" / f"{name}.py").read_text()
+    assert text.startswith('"""')
+    assert not re.search(r"\brailride(\.\w+)*\._", text)
+    assert not re.search(r"import _|\._[a-z]", text)
+
+
+def test_paper_comparison(tmp_path):
+    out = run_example("paper_comparison", tmp_path / "cmp")
+    # the table: one reduction per controller on each response, as "( 16.8%)"
+    assert re.search(r"^acceleration\s+\d\.\d+(\s+\d\.\d+\s+\(\s*-?\d+\.\d%\)){3}$", out, re.M)
+    assert "ideal-damper" in out and "Trade-offs" in out
+    assert "tuned on this same track (in-sample)" in out
+    assert (tmp_path / "cmp" / "comparison.json").is_file()
+
+
+def test_speed_sweep_random_track(tmp_path):
+    out = run_example("speed_sweep_random_track", tmp_path / "sweep")
+    for v in (20, 30, 40, 50, 60):
+        assert re.search(rf"^\s+{v}\s+\d\.\d{{4}}\s+\d\.\d{{4}}\s+-?\d+\.\d%$", out, re.M), v
+    assert (tmp_path / "sweep" / "rms_vs_speed.png").stat().st_size > 0
+    assert (tmp_path / "sweep" / "sweep.csv").is_file()
+
+
+def test_custom_vehicle(tmp_path):
+    out = run_example("custom_vehicle", tmp_path / "veh")
+    assert "k_sz 290000 -> 200000" in out
+    assert re.search(r"^carbody bounce\s+0\.\d{3}\s+\d\.\d{3}\s+0\.\d{3}\s+\d\.\d{3}$", out, re.M)
+    assert re.search(r"^acceleration \[m/s\^2\]\s+\d\.\d+ \(", out, re.M)
+    assert (tmp_path / "veh" / "custom_vehicle.toml").is_file()
+
+
+def test_damper_size(tmp_path):
+    out = run_example("damper_size", tmp_path / "size")
+    for name in ("railway x 0.5", "railway x 1", "railway x 2", "railway x 4", "ideal-damper", "ideal"):
+        assert re.search(rf"^{re.escape(name)}\s+(\d\.\d{{3}}\s+){{4}}\d\.\d{{3}}$|^{re.escape(name)}\s+diverged",
+                         out, re.M), name
+    assert "Best MR size here" in out
+    assert (tmp_path / "size" / "damper_size.csv").is_file()
