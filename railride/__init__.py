@@ -8,18 +8,25 @@ The public API, in the order a run needs it::
     sc = rr.scenario("paper-sine", speed=55.56)        # track and run (docs/model.md, Track input)
     result = rr.simulate(sc, params)                  # time histories (xarray) + metrics
     result.metrics()                                  # RMS, peak-to-peak (docs/model.md, Metrics)
+    rr.compare(sc)                                    # the paper's comparison, with the bounds
+    rr.tune()                                         # the sensitivity study (shipped gains)
 """
 
 __version__ = "0.2.0"
 
-from .comparison import compare
+from . import dampers
+from .comparison import Comparison, compare
+from .control import GainSet
 from .metrics import reduction, ride_metrics
 from .params import VehicleParams
+from .pareto import ParetoResult, pareto
 from .simulation import RideResult, simulate
 from .track import CosineBump, MeasuredTrack, Scenario, SineTrack, scenario
+from .tuning import Objective, tune
 from .vehicle import Vehicle
 
 __all__ = [
-    "CosineBump", "MeasuredTrack", "RideResult", "Scenario", "SineTrack", "Vehicle",
-    "VehicleParams", "compare", "reduction", "ride_metrics", "scenario", "simulate",
+    "Comparison", "CosineBump", "GainSet", "MeasuredTrack", "Objective", "ParetoResult",
+    "RideResult", "Scenario", "SineTrack", "Vehicle", "VehicleParams", "compare", "dampers",
+    "pareto", "reduction", "ride_metrics", "scenario", "simulate", "tune",
 ]

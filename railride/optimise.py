@@ -23,7 +23,6 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.optimize
-import scipy.stats
 
 from .control import GainSet
 from .sweep import Case, RunTable, apply_gains, run_cases
@@ -131,6 +130,8 @@ def sensitivity(parameters=SAS_PARAMETERS, *, suspension: str = "sas-attitude-ri
         raise ValueError(f"n = {n!r}: a power of two >= 2")
     ev = _Evaluator(parameters, suspension, scenario, scenario_options, gains, objective, damper,
                     executor, table, dt, progress)
+    import scipy.stats  # here, not at import: scipy.stats costs half a second to load
+
     dists = [scipy.stats.uniform(lo, hi - lo) for lo, hi in _bounds(parameters)]
     res = scipy.stats.sobol_indices(func=lambda x: ev(x.T), n=n, dists=dists,
                                     rng=np.random.default_rng(seed))

@@ -21,7 +21,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import pandas as pd
-import scipy.stats.qmc
 
 from .control import GainSet
 from .metrics import RESPONSES
@@ -235,6 +234,8 @@ def pareto(suspension: str = "sas-attitude-ride", *, n_samples: int = 128, seed:
     ev = _Evaluator(params, suspension, scenario, scenario_options, base, None, damper, executor,
                     table, dt, progress)
     bounds = np.array(_bounds(params))
+    import scipy.stats.qmc  # here, not at import: scipy.stats costs half a second to load
+
     unit = scipy.stats.qmc.Sobol(len(params), scramble=True, seed=seed).random_base2(
         int(math.log2(n_samples)))
     points = scipy.stats.qmc.scale(unit, bounds[:, 0], bounds[:, 1])
