@@ -26,6 +26,7 @@ from typing import Annotated, Optional
 import typer
 
 from . import __version__
+from .defaults import DEFAULT_CONTROL_RATE, DEFAULT_DAMPER
 
 SCHEMA_SIMULATE = "railride.simulation/1"
 SCHEMA_DAMPER = "railride.damper/1"
@@ -35,8 +36,6 @@ SCHEMA_TRACKING = "railride.tracking/1"
 SUSPENSIONS = ("passive", "mr")
 #: --desired values of `tracking` (the signals of railride.rig.desired_force_signal)
 DESIRED_SIGNALS = ("sine", "sawtooth")
-#: the damper preset used when --model / --damper is not given
-DEFAULT_DAMPER = "railway"
 
 app = typer.Typer(
     add_completion=False,
@@ -711,7 +710,7 @@ def compare(
     control_rate: Annotated[float, typer.Option(
         "--control-rate", metavar="HZ",
         help="Sample rate of the outer-loop controllers [Hz]; 1/(rate x dt) must be a whole "
-             "number.")] = 1000.0,
+             "number.")] = DEFAULT_CONTROL_RATE,
     sensor_noise: Annotated[Optional[str], typer.Option(
         "--sensor-noise", metavar="Z,ANGLE,VEL,RATE",
         help="White noise on the measured carbody states, standard deviations: heave [m], "
@@ -766,8 +765,8 @@ def compare(
     with _errors():
         from . import report
         from .comparison import compare as run_compare
+        from .defaults import DEFAULT_DT, DEFAULT_OUTPUT_RATE
         from .metrics import check_window, parse_window
-        from .simulation import DEFAULT_DT, DEFAULT_OUTPUT_RATE
 
         names = _controller_list(controllers)
         gain_set = _gain_set(gains)
@@ -1158,8 +1157,9 @@ def _run(scenario_name, amplitude, wavelength, rail_phase, speed, duration, dt, 
          window_text, params_file, preset, out, suspension="passive", damper_name=None,
          voltage_text=None, track=None, comfort=False, damper_scale=None):
     from . import report
+    from .defaults import DEFAULT_DT, DEFAULT_OUTPUT_RATE
     from .metrics import check_window, parse_window, to_dict
-    from .simulation import DEFAULT_DT, DEFAULT_OUTPUT_RATE, simulate as run_simulation
+    from .simulation import simulate as run_simulation
 
     dt = DEFAULT_DT if dt is None else dt
     output_rate = DEFAULT_OUTPUT_RATE if output_rate is None else output_rate
@@ -1512,8 +1512,7 @@ class _RunProgress:
     def __enter__(self):
         if not self.enabled:
             return self
-        from rich.progress import (BarColumn, MofNCompleteColumn, Progress, SpinnerColumn,
-                                   TextColumn, TimeElapsedColumn)
+        from rich.progress import BarColumn, MofNCompleteColumn, Progress, SpinnerColumn, TextColumn, TimeElapsedColumn
 
         from . import kernels
 
@@ -1954,7 +1953,7 @@ def tune_command(
     command = _command_line(ctx, exclude=("out", "resume", "format"))
     with _errors():
         from . import report, tuning
-        from .simulation import DEFAULT_DT, DEFAULT_OUTPUT_RATE
+        from .defaults import DEFAULT_DT, DEFAULT_OUTPUT_RATE
 
         phases = _phase_list(phase)
         _damper_preset("--damper", damper)
@@ -2129,14 +2128,14 @@ def pareto_command(
     import time
 
     with _errors():
-        from . import pareto as pareto_lib
+        from .pareto import CONTROLLER_PARAMETERS, pareto as run_pareto
         from . import report
-        from .simulation import DEFAULT_DT, DEFAULT_OUTPUT_RATE
+        from .defaults import DEFAULT_DT, DEFAULT_OUTPUT_RATE
 
-        if suspension not in pareto_lib.CONTROLLER_PARAMETERS:
+        if suspension not in CONTROLLER_PARAMETERS:
             raise ValueError(f"--suspension = {suspension!r}: allowed "
-                             f"{', '.join(pareto_lib.CONTROLLER_PARAMETERS)}")
-        n = _default_of(pareto_lib.pareto, "n_samples") if samples is None else samples
+                             f"{', '.join(CONTROLLER_PARAMETERS)}")
+        n = _default_of(run_pareto, "n_samples") if samples is None else samples
         if n < 1 or n & (n - 1):
             raise ValueError(f"--samples = {n}: must be a power of two (1, 2, 4, ..., 128, "
                              "...), which keeps the balance of the Sobol' sample")
@@ -2156,7 +2155,7 @@ def pareto_command(
         with _interruptible(table, table_path), _errors():
             with _RunProgress(_stderr_is_terminal(), "sampling the gains") as progress:
                 t0 = time.perf_counter()
-                result = pareto_lib.pareto(suspension, n_samples=n, seed=seed, scenario=scenario,
+                result = run_pareto(suspension, n_samples=n, seed=seed, scenario=scenario,
                                            scenario_options=options, gains=base, damper=damper,
                                            executor=executor, table=table, dt=dt,
                                            progress=progress)
@@ -2317,7 +2316,7 @@ def _sweep_comfort_settings(duration: float, window) -> dict:
     """settings.comfort of a sweep with --comfort: the columns, where the positions are and
     what N_MV_z is (the same for every run of the grid, whose runs share one duration)."""
     from .comfort import INDEX_UNITS, INTERVAL_S
-    from .sweep import COMFORT_INDICES, COMFORT_COLUMNS
+    from .sweep import COMFORT_COLUMNS, COMFORT_INDICES
 
     start, end = window or (0.0, duration)
     n = max(1, int((end - start + 1e-9) // INTERVAL_S))
@@ -2435,8 +2434,8 @@ def sweep_command(
     with _errors():
         from . import report
         from . import sweep as sweep_lib
+        from .defaults import DEFAULT_DT, DEFAULT_OUTPUT_RATE
         from .metrics import check_window, parse_window
-        from .simulation import DEFAULT_DT, DEFAULT_OUTPUT_RATE
 
         # suspensions
         items = [s.strip() for s in suspension.split(",")]

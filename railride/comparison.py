@@ -16,8 +16,9 @@ import xarray as xr
 
 from . import __version__, dampers
 from .control import CONTROLLERS, LABELS, GainSet
+from .defaults import DEFAULT_CONTROL_RATE, DEFAULT_DAMPER, DEFAULT_DT, DEFAULT_OUTPUT_RATE
 from .metrics import STATISTICS, reduction, ride_metrics, select_window
-from .simulation import DEFAULT_CONTROL_RATE, DEFAULT_DT, DEFAULT_OUTPUT_RATE, simulate
+from .simulation import simulate
 
 #: Table 1 of Harun et al. (RMS values): for display beside railride's results.
 PAPER_TABLE1 = {
@@ -196,7 +197,7 @@ class Comparison:
 
 
 def compare(scenario, params=None, *, controllers=CONTROLLERS, gains: GainSet | None = None,
-            damper="railway", damper_scale: float = 1.0, window=None, dt: float = DEFAULT_DT,
+            damper=DEFAULT_DAMPER, damper_scale: float = 1.0, window=None, dt: float = DEFAULT_DT,
             output_rate: float = DEFAULT_OUTPUT_RATE, control_rate: float = DEFAULT_CONTROL_RATE,
             sensor_noise=None, progress=None, comfort: bool = False, bounds: bool = True) -> Comparison:
     """Run the passive vehicle and each controller on ``scenario`` and collect the metrics.

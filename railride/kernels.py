@@ -531,8 +531,9 @@ def rig_batch(law, P, n_steps, stride, dt, xtab, x_interval, mode, vconst, serie
 def run_parallel(kernel, n_samples: int, *args) -> None:
     """Call ``kernel(lo, hi, *args)`` on sample ranges that cover 0..n_samples, one range per
     thread (numba's thread count as set by `numba.set_num_threads`, at most one per sample)."""
-    import numba
     from concurrent.futures import ThreadPoolExecutor
+
+    import numba
 
     n_threads = max(1, min(n_samples, numba.get_num_threads()))
     if n_threads == 1:

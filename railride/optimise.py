@@ -25,6 +25,7 @@ import numpy as np
 import scipy.optimize
 
 from .control import GainSet
+from .defaults import DEFAULT_DAMPER, DEFAULT_DT
 from .sweep import Case, RunTable, apply_gains, run_cases
 from .tuning import DEFAULT_OBJECTIVE, PARAMETERS, REFERENCE, Objective, _rms
 
@@ -90,9 +91,9 @@ class OptimiseResult:
 
 def optimise(parameters=SAS_PARAMETERS, *, suspension: str = "sas-attitude-ride",
              scenario: str = "paper-sine", scenario_options=None, gains: GainSet | None = None,
-             objective: Objective | None = None, damper: str = "railway", executor=None,
+             objective: Objective | None = None, damper: str = DEFAULT_DAMPER, executor=None,
              table: RunTable | None = None, popsize: int = 8, maxiter: int = 30, seed: int = 0,
-             dt: float = 1e-4, progress=None) -> OptimiseResult:
+             dt: float = DEFAULT_DT, progress=None) -> OptimiseResult:
     """Differential evolution over ``parameters`` (names as in `railride.tuning.PARAMETERS`)
     at once. ``popsize`` times the number of parameters runs per generation; ``seed`` makes the
     search repeatable."""
@@ -121,8 +122,8 @@ class SensitivityResult:
 
 def sensitivity(parameters=SAS_PARAMETERS, *, suspension: str = "sas-attitude-ride",
                 scenario: str = "paper-sine", scenario_options=None, gains: GainSet | None = None,
-                objective: Objective | None = None, damper: str = "railway", executor=None,
-                table: RunTable | None = None, n: int = 64, seed: int = 0, dt: float = 1e-4,
+                objective: Objective | None = None, damper: str = DEFAULT_DAMPER, executor=None,
+                table: RunTable | None = None, n: int = 64, seed: int = 0, dt: float = DEFAULT_DT,
                 progress=None) -> SensitivityResult:
     """Sobol indices of the objective with every parameter uniform in log10 over the search
     bounds: n (d + 2) runs for d parameters (``n`` a power of two)."""

@@ -23,6 +23,7 @@ import numpy as np
 import pandas as pd
 
 from .control import GainSet
+from .defaults import DEFAULT_DAMPER, DEFAULT_DT
 from .metrics import RESPONSES
 from .optimise import _bounds, _Evaluator
 from .sweep import Case, RunTable
@@ -212,8 +213,8 @@ def in_sample_note(gains: GainSet, record: dict) -> str | None:
 
 def pareto(suspension: str = "sas-attitude-ride", *, n_samples: int = 128, seed: int = 0,
            scenario: str = "paper-sine", scenario_options=None, gains: GainSet | None = None,
-           damper: str = "railway", executor=None, table: RunTable | None = None,
-           dt: float = 1e-4, progress=None, parameters=None) -> ParetoResult:
+           damper: str = DEFAULT_DAMPER, executor=None, table: RunTable | None = None,
+           dt: float = DEFAULT_DT, progress=None, parameters=None) -> ParetoResult:
     """Sample the gains of ``suspension`` (pid, sas-attitude, sas-attitude-ride; by default all
     it reads, or ``parameters``) and return the RMS ratios to passive of each sample.
 

@@ -19,8 +19,8 @@ import numpy as np
 import xarray as xr
 
 from . import dampers, kernels
+from .defaults import DEFAULT_DAMPER, DEFAULT_DT
 
-DEFAULT_DT = 1e-4
 #: motion-table nodes per cycle of the fastest motion
 _NODES_PER_CYCLE = 400
 
@@ -304,7 +304,7 @@ def desired_force_signal(kind: str, amplitude: float, frequency: float):
     raise ValueError(f"desired = {kind!r}: allowed 'sine', 'sawtooth'")
 
 
-def track(damper="railway", desired: str = "sine", amplitude: float = 10e3, frequency: float = 1.0,
+def track(damper=DEFAULT_DAMPER, desired: str = "sine", amplitude: float = 10e3, frequency: float = 1.0,
           *, B: float = 1.0, G: float | None = None, stroke: float = 0.02,
           n_cycles: int = 3, dt: float = DEFAULT_DT) -> Tracking:
     """The inner loop (paper eq. 12-14) tracking a sine or sawtooth desired force (amplitude

@@ -13,13 +13,12 @@ import numpy as np
 import xarray as xr
 
 from . import dampers, kernels
+from .defaults import DEFAULT_CONTROL_RATE, DEFAULT_DAMPER, DEFAULT_DT, DEFAULT_OUTPUT_RATE  # noqa: F401 (re-exported)
 from .params import VehicleParams
-from .track import Scenario, scenario as named_scenario, wheelset_input_table
+from .track import Scenario, wheelset_input_table
+from .track import scenario as named_scenario
 from .vehicle import CORNER_NAMES, DOF_NAMES, DOF_UNITS, N_DOF, RAILS, WHEELSETS, Vehicle
 
-DEFAULT_DT = 1e-4
-DEFAULT_OUTPUT_RATE = 1000.0
-DEFAULT_CONTROL_RATE = 1000.0
 #: a random track's shortest wavelength must give at most output_rate / this [Hz]
 RESOLUTION = 2.5
 #: sample-steps per kernel call when a progress callback is given
@@ -288,7 +287,7 @@ def simulate(scenario=None, params=None, *, dt: float = DEFAULT_DT,
         if voltage is not None:
             raise ValueError("give either voltage (open loop) or controller (closed loop), not both")
         if damper is None:
-            damper = "railway"
+            damper = DEFAULT_DAMPER
     damper = _resolve_damper(damper)
     if damper is not None and damper.law == dampers.LAW_IDEAL and controllers is None:
         raise ValueError("damper = 'ideal': the ideal actuator applies an outer loop's demand "
@@ -422,9 +421,10 @@ def simulate(scenario=None, params=None, *, dt: float = DEFAULT_DT,
 def _dataset(out, vehicles, param_sets, scenarios, dt, output_rate, rows, batch, created,
              damper, vcmd, closed=None) -> xr.Dataset:
     """Named channels in SI units; a ``sample`` dimension only for a batch."""
-    from . import __version__
     import numba
     import scipy
+
+    from . import __version__
 
     time = np.arange(rows) / output_rate
     T = np.stack([vehicles[id(p)].T for p in param_sets])  # (n, 9, 4)

@@ -23,6 +23,7 @@ import numpy as np
 import pandas as pd
 
 from ._io import atomic_write
+from .defaults import DEFAULT_DAMPER, DEFAULT_DT
 from .metrics import RESPONSES, STATISTICS
 
 #: samples per compiled batch: bounds the memory of the time histories (about 5 MB a sample
@@ -57,7 +58,7 @@ class Case:
     scenario_options: tuple = ()
     vehicle: tuple = ()
     suspension: str = "passive"
-    damper: str = "railway"
+    damper: str = DEFAULT_DAMPER
     voltage: float | None = None
     gains: tuple = ()
     noise: tuple = ()
@@ -132,7 +133,7 @@ def apply_gains(base, changes):
     return GainSet(tables["inner"], tables["pid"], tables["attitude"], tables["ride"], base.source)
 
 
-def evaluate(cases: list[Case], base_gains=None, dt: float = 1e-4, window=None,
+def evaluate(cases: list[Case], base_gains=None, dt: float = DEFAULT_DT, window=None,
              comfort: bool = False) -> list[dict]:
     """Run ``cases`` (in compiled batches of compatible cases) and return one row per case:
     its key, settings and the RMS and peak-to-peak of the four body responses; with
@@ -398,7 +399,7 @@ class RunTable:
 
 
 def run_cases(cases: list[Case], *, executor=None, table: RunTable | None = None, base_gains=None,
-              dt: float = 1e-4, window=None, chunk: int = CHUNK, progress=None,
+              dt: float = DEFAULT_DT, window=None, chunk: int = CHUNK, progress=None,
               comfort: bool = False) -> pd.DataFrame:
     """Evaluate ``cases``, skipping those already in ``table``; returns their rows in order.
     ``comfort``: the rows also hold the ride comfort indices (`evaluate`).

@@ -26,6 +26,7 @@ import numpy as np
 import pandas as pd
 
 from .control import GainSet
+from .defaults import DEFAULT_DAMPER, DEFAULT_DT
 from .metrics import RESPONSES
 from .sweep import Case, RunTable, apply_gains, run_cases
 
@@ -254,9 +255,9 @@ def _candidates(current: float, parameter: str, n_values: int, span: float) -> l
 
 
 def tune(phases=PHASES, *, scenario: str = "paper-sine", scenario_options=None,
-         gains: GainSet | None = None, objective: Objective | None = None, damper: str = "railway",
+         gains: GainSet | None = None, objective: Objective | None = None, damper: str = DEFAULT_DAMPER,
          executor=None, table: RunTable | None = None, n_values: int = 13, span: float = 30.0,
-         max_passes: int = 5, tol: float = 1e-3, dt: float = 1e-4, window=None, progress=None,
+         max_passes: int = 5, tol: float = 1e-3, dt: float = DEFAULT_DT, window=None, progress=None,
          log=None, damper_scale: float = 1.0) -> TuneResult:
     """The sensitivity study: the phases in order (from PHASES; default all four, so PID and SAS
     are tuned by the same procedure and budget), each to convergence, from ``gains`` (default
@@ -343,7 +344,7 @@ def _table(gains: GainSet, parameter: str):
             "ride": gains.ride}[parameter.split(".")[0]]
 
 
-def tracking_objective(B: float, G: float, damper="railway", damper_scale: float = 1.0) -> float:
+def tracking_objective(B: float, G: float, damper=DEFAULT_DAMPER, damper_scale: float = 1.0) -> float:
     """The inner loop's objective: normalised RMS tracking error, averaged over the paper's
     sine and sawtooth demands (Fig. 6) at 10 kN x ``damper_scale``, 1 Hz on the damper rig."""
     from . import dampers

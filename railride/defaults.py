@@ -1,0 +1,10 @@
+"""The defaults of a run, in one place: every module and the command line read them here."""
+
+#: fixed RK4 step [s]: resolves the MR dampers' hysteresis (docs/model.md, Integration)
+DEFAULT_DT = 1e-4
+#: rate of the stored time histories [Hz]
+DEFAULT_OUTPUT_RATE = 1000.0
+#: sample rate of the outer-loop controllers [Hz]
+DEFAULT_CONTROL_RATE = 1000.0
+#: the MR damper of a vehicle run when none is named
+DEFAULT_DAMPER = "railway"
