@@ -62,3 +62,13 @@ def test_damper_size(tmp_path):
                          out, re.M), name
     assert "Best MR size here" in out
     assert (tmp_path / "size" / "damper_size.csv").is_file()
+
+
+def test_readme_python_block_runs():
+    # the README's Python example, as a user would paste it; the tuning line (30 s) is left out,
+    # tune() has its own tests
+    text = (Path(__file__).resolve().parents[1] / "README.md").read_text(encoding="utf-8")
+    code = text.split("```python", 1)[1].split("```", 1)[0]
+    kept = "\n".join(line for line in code.splitlines() if "rr.tune(" not in line)
+    assert "rr.compare(" in kept and "rr.simulate(" in kept
+    exec(compile(kept, "README.md", "exec"), {})
