@@ -1382,15 +1382,12 @@ def tracking(
 
 
 # -- tune and sweep: many runs ------------------------------------------------------------------
-SCHEMA_TUNE = "railride.tune/2"
 SCHEMA_SWEEP = "railride.sweep/1"
 
 #: the controllers a gain table acts in (a --gain of `sweep` combines with these only)
 GAIN_CONTROLLERS = {"inner": ("pid", "sas-attitude", "sas-attitude-ride"), "pid": ("pid",),
                     "attitude": ("sas-attitude", "sas-attitude-ride"),
                     "ride": ("sas-attitude-ride",)}
-#: the controllers whose response a tuning phase changes (the before/after table of `tune`)
-PHASE_CONTROLLERS = GAIN_CONTROLLERS
 #: the scenario options a sweep can vary: (option, keyword of track.scenario, column, unit)
 SWEEP_AXES = (("--speed", "speed", "speed_m_s", "m/s"), ("--wavelength", "wavelength", "wavelength_m", "m"),
               ("--amplitude", "amplitude", "amplitude_m", "m"),
@@ -1648,67 +1645,6 @@ def _phase_list(items: Optional[list[str]]) -> list[str]:
     return [p for p in PHASES if p in wanted]
 
 
-def _gain_changes(start, tuned, tables) -> tuple:
-    """The ("table.entry", value) pairs of ``tuned`` that differ from ``start``, in ``tables``."""
-    out = []
-    for table in tables:
-        a, b = getattr(start, table).to_dict(), getattr(tuned, table).to_dict()
-        out += [(f"{table}.{k}", float(b[k])) for k in a if b[k] != a[k]]
-    return tuple(sorted(out))
-
-
-#: the gain tables each controller reads
-_CONTROLLER_TABLES = {"pid": ("inner", "pid"), "sas-attitude": ("inner", "attitude"),
-                      "sas-attitude-ride": ("inner", "attitude", "ride")}
-
-
-def _before_after(result, start, phases, scenario_name, options, damper, executor, table, dt,
-                  progress, damper_scale=1.0) -> list[dict]:
-    """RMS of each controller the phases change, with the start and with the tuned gains, and
-    the reductions against passive. Through the run table: most of these runs are in it."""
-    from . import sweep as sweep_lib
-    from .control import CONTROLLERS
-    from .metrics import RESPONSES
-
-    names = [n for n in CONTROLLERS if any(n in PHASE_CONTROLLERS[p] for p in phases)]
-    cases = []
-    for n in names:
-        cases.append(sweep_lib.Case(scenario_name, options, suspension=n, damper=damper,
-                                    damper_scale=damper_scale))
-        cases.append(sweep_lib.Case(scenario_name, options, suspension=n, damper=damper,
-                                    damper_scale=damper_scale,
-                                    gains=_gain_changes(start, result.gains, _CONTROLLER_TABLES[n])))
-    frame = sweep_lib.run_cases(cases, executor=executor, table=table, base_gains=start, dt=dt,
-                                progress=progress)
-    passive = {r: float(result.passive[r]) for r in RESPONSES}
-    rows = []
-    for i, n in enumerate(names):
-        before, after = frame.iloc[2 * i], frame.iloc[2 * i + 1]
-        row = {"suspension": n, "before": {}, "after": {}, "reduction_before_percent": {},
-               "reduction_after_percent": {}}
-        for r in RESPONSES:
-            b, a = float(before[f"{r}_rms"]), float(after[f"{r}_rms"])
-            row["before"][r], row["after"][r] = b, a
-            p = passive[r]  # a zero passive RMS (e.g. roll on a symmetric bump): no reduction
-            row["reduction_before_percent"][r] = (p - b) / p * 100.0 if p else None
-            row["reduction_after_percent"][r] = (p - a) / p * 100.0 if p else None
-        rows.append(row)
-    return rows
-
-
-def _objective_text(objective) -> str:
-    """The objective's full statement (formula, weights, bound, penalty, infeasible rule)."""
-    return objective.describe()
-
-
-def _toml_inline(record: dict) -> str:
-    """A flat record of strings, numbers and booleans as a TOML inline table (JSON spells those
-    values as TOML does; None has no TOML form and is left out)."""
-    items = [f"{k} = {json.dumps(v)}" for k, v in record.items()
-             if v is not None and not isinstance(v, (dict, list))]
-    return "{" + ", ".join(items) + "}"
-
-
 def _command_line(ctx: typer.Context, exclude=()) -> str:
     """The railride command being run, with the options given on the command line (not their
     defaults), for the record: reproducing a result needs only this line."""
@@ -1727,51 +1663,6 @@ def _command_line(ctx: typer.Context, exclude=()) -> str:
         for item in value if isinstance(value, (list, tuple)) else [value]:
             words += [flag, str(getattr(item, "value", item))]
     return shlex.join(w for w in words if w)
-
-
-def _tuned_gains_text(doc: dict, gains, scenario_text: str, objective) -> str:
-    """gains.toml: a provenance header (comments and a [provenance] table, which gains files
-    may carry) and the tuned gains."""
-    s = doc["settings"]
-    last = {}
-    for h in doc["history"]:
-        last[h["phase"]] = h
-    finals = "; ".join(f"{p} {h['objective']:.4g} after pass {h['pass']}" for p, h in last.items())
-    phases = ", ".join(doc["phases"])
-    run_text = f"{scenario_text}, {doc['scenario'].get('duration_s', 0):g} s"
-    lines = [
-        "# railride controller gains, tuned by `railride tune` (the paper's sensitivity study,",
-        "# its section V; docs/tuning.md). Read by `railride compare --gains FILE`.",
-        f"# command: {doc['command']}",
-        f"# date: {doc['date']}; railride {doc['railride_version']}",
-        f"# scenario: {run_text}, dt {s['dt_s']:g} s, {_damper_text(s)}",
-        f"# objective: {_objective_text(objective)}",
-        f"# phases: {phases}; {s['values']} values from 1/{s['span']:g} to {s['span']:g} x the "
-        f"current value (and 0) per gain, passes: at most {s['max_passes']}"
-        + ("; the ride phase starts from zero ride gains" if "ride" in doc["phases"] else ""),
-        f"# start values: {s['start_gains']}",
-        f"# runs: {doc['runs']}; final objective: {finals}",
-        "# Units: SI. Forces are desired forces on the carbody (up +) at corners 1R, 1L, 2R, 2L.",
-        "",
-        "[provenance]",
-        f"method = {json.dumps('railride tune (one-at-a-time sensitivity study)')}",
-        f"date = {json.dumps(doc['date'])}",
-        f"railride_version = {json.dumps(doc['railride_version'])}",
-        f"scenario = {json.dumps(run_text)}",
-        f"damper = {json.dumps(s['damper'])}",
-        f"damper_scale = {s.get('damper_scale', 1.0)!r}",
-        f"dt_s = {s['dt_s']!r}",
-        f"command = {json.dumps(doc['command'])}",
-        f"objective = {json.dumps(_objective_text(objective))}",
-        # the exact track, so a study judging these gains can tell whether it is the same one
-        f"scenario_record = {_toml_inline(doc['scenario'])}",
-        f"phases = {json.dumps(doc['phases'])}",
-        f"runs = {int(doc['runs'])}",
-        f"start_gains = {json.dumps(s['start_gains'])}",
-        "",
-        gains.to_toml(),
-    ]
-    return "\n".join(lines)
 
 
 def _tune_tables(doc: dict, start, tuned, scenario_text: str):
@@ -1978,7 +1869,6 @@ def tune_command(
         scenario_text = report.describe_scenario(scen.describe())
         table, table_path = _run_table(out, resume)
         executor, executor_record = _executor(workers, scheduler, scheduler_file)
-    tol = _default_of(tuning.tune, "tol")
     try:
         with _interruptible(table, table_path), _errors():
             with _RunProgress(_stderr_is_terminal(), "tuning") as progress:
@@ -1988,56 +1878,22 @@ def tune_command(
                                      damper_scale=scale,
                                      executor=executor, table=table, n_values=values, span=span,
                                      max_passes=passes, dt=dt, progress=progress, log=progress.log)
-                comparison = _before_after(result, start, phases, scenario, options, damper,
-                                           executor, table, dt, progress, scale)
                 wall = time.perf_counter() - t0
-            from .metrics import RESPONSES
-
-            doc = {
-                "schema": SCHEMA_TUNE,
-                "railride_version": __version__,
-                "date": _utc_now(),
-                "phases": phases,
-                "scenario": scen.describe(),
-                "settings": {"damper": damper, "damper_scale": scale, "dt_s": float(dt), "values": values,
-                             "span": float(span), "max_passes": passes, "tolerance": tol,
-                             "start_gains": start.source},
-                "objective": objective.to_dict(),
-                "passive_rms": {r: float(result.passive[r]) for r in RESPONSES},
-                "history": [{"phase": h["phase"], "pass": int(h["pass"]),
-                             "objective": float(h["objective"])} for h in result.history],
-                "gains": {"source": start.source, "inner": result.gains.inner.to_dict(),
-                          "pid": result.gains.pid.to_dict(),
-                          "attitude": result.gains.attitude.to_dict(),
-                          "ride": result.gains.ride.to_dict()},
-                "before_after": comparison,
-                "runs": len(table.frame),
-                "runs_evaluated": progress.evaluated,
-                "runs_per_second": progress.evaluated / wall if wall > 0 else 0.0,
-                "wall_time_s": wall,
-                "executor": executor_record,
-                "command": command,
-            }
+            # the facts of this command line, after the library's document
+            facts = {"runs_evaluated": progress.evaluated,
+                     "runs_per_second": progress.evaluated / wall if wall > 0 else 0.0,
+                     "wall_time_s": wall, "executor": executor_record, "command": command}
+            doc = {**result.to_dict(), **facts}
             text = json.dumps(doc, indent=2, allow_nan=False)
             if out is not None:
-                gains_text = _tuned_gains_text(doc, result.gains, scenario_text, objective)
-                import textwrap
-
-                # the objective's statement is long: wrapped to fit the narrowest figure
-                title = "\n".join([
-                    (f"Sensitivity of the tuning objective - {scenario_text}, "
-                     f"{scen.duration:g} s, {damper} dampers"),
-                    *textwrap.wrap(f"phases {', '.join(phases)}; {_objective_text(objective)}",
-                                   100)])
-                _write_folder(out, lambda: report.write_tune_outputs(
-                    result.curves, out, doc, gains_text, title=title))
+                _write_folder(out, lambda: result.save(out, command, extra=facts))
     finally:
         executor.close()
     if format is OutputFormat.json:
         typer.echo(text)
         return
     console = _wide_stdout_console()
-    for part in _tune_tables(doc, start, result.gains, scenario_text):
+    for part in _tune_tables(doc, result.start, result.gains, scenario_text):
         console.print(part)
 
 

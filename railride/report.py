@@ -762,7 +762,7 @@ def _zero_axis(ax, zero_x: float, edge: float, right: float) -> None:
     ax.xaxis.set_minor_formatter(NullFormatter())
 
 
-def plot_sensitivity(curves, path=None, *, title: str | None = None):
+def plot_sensitivity(curves, path=None, *, title: str | None = None, ax=None):
     """The sensitivity curves of a tuning study: one panel per parameter (in the order tuned),
     the objective against the parameter's value on a log axis, one line per pass (coloured by
     pass). The value 0 (the gain switched off) cannot sit on a log axis: it is plotted at the
@@ -770,7 +770,9 @@ def plot_sensitivity(curves, path=None, *, title: str | None = None):
     kept after each pass is a star; a dashed red line marks the final choice, which the panel's
     title gives. The inner-loop panels (B, G) show the normalised force-tracking error.
 
-    Saved as PNG at ``path`` when given (atomically); returns the Agg `Figure`.
+    ``ax``: one Axes per parameter to draw in (the legend goes into the first, and ``title``
+    is left out), or None for a new Agg figure. Saved as PNG at ``path`` when given
+    (atomically); returns the figure.
     """
     from matplotlib import colormaps
     from matplotlib.lines import Line2D
@@ -780,10 +782,18 @@ def plot_sensitivity(curves, path=None, *, title: str | None = None):
     if not curves:
         raise ValueError("no sensitivity curves to plot")
     parameters = list(dict.fromkeys(c.parameter for c in curves))
-    ncols = min(4, len(parameters))
-    nrows = math.ceil(len(parameters) / ncols)
-    fig = _new_figure((3.3 * ncols + 0.6, 2.6 * nrows + 1.0))
-    axes = fig.subplots(nrows, ncols, squeeze=False).ravel()
+    new_figure = ax is None
+    if new_figure:
+        ncols = min(4, len(parameters))
+        nrows = math.ceil(len(parameters) / ncols)
+        fig = _new_figure((3.3 * ncols + 0.6, 2.6 * nrows + 1.0))
+        axes = fig.subplots(nrows, ncols, squeeze=False).ravel()
+    else:
+        axes = list(np.ravel(ax))
+        if len(axes) != len(parameters):
+            raise ValueError(f"ax: {len(parameters)} Axes (one per parameter: "
+                             f"{', '.join(parameters)}), got {len(axes)}")
+        fig = axes[0].figure
     max_pass = max(int(c.sweep_pass) for c in curves)
     cmap = colormaps["viridis"]
 
@@ -842,6 +852,10 @@ def plot_sensitivity(curves, path=None, *, title: str | None = None):
     handles.append(Line2D([], [], color="tab:red", linestyle="--", label="final value"))
     if any_zero:
         handles.append(Patch(color="0.9", label="value 0 (gain off)"))
+    if not new_figure:
+        axes[0].legend(handles=handles, loc="best", fontsize="x-small")
+        _save_png(fig, path)
+        return fig
     fig.legend(handles=handles, loc="outside lower center", ncols=min(len(handles), 6),
                fontsize="small", frameon=False)
     fig.suptitle(title or "Sensitivity of the tuning objective, one parameter at a time",

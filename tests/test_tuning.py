@@ -196,6 +196,81 @@ def test_tune_starts_from_the_reference_gains_and_refuses_ideal_with_inner():
         tune(("inner", "pid"), damper="ideal")
 
 
+# -- the result protocol of TuneResult -------------------------------------------------------------
+@pytest.fixture(scope="module")
+def short_tune():
+    return tune(("pid",), scenario_options={"duration": 1.0}, n_values=3, max_passes=1)
+
+
+def test_tune_result_to_dict_is_the_tune_document(short_tune):
+    import json
+
+    res = short_tune
+    doc = res.to_dict()
+    assert json.loads(json.dumps(doc, allow_nan=False)) == doc
+    assert list(doc) == ["schema", "railride_version", "date", "phases", "scenario", "settings",
+                         "objective", "passive_rms", "history", "gains", "before_after", "runs"]
+    assert doc["schema"] == "railride.tune/2" and doc["phases"] == ["pid"]
+    assert doc["scenario"]["duration_s"] == 1.0
+    assert doc["settings"] == {"damper": "railway", "damper_scale": 1.0, "dt_s": 1e-4,
+                               "values": 3, "span": 30.0, "max_passes": 1, "tolerance": 1e-3,
+                               "start_gains": "railride/data/reference_gains.toml"}
+    assert doc["objective"] == DEFAULT_OBJECTIVE.to_dict()
+    assert doc["gains"]["pid"] == res.gains.pid.to_dict()
+    assert doc["runs"] == res.n_runs == len(res.runs)
+    # the before/after rows: the start gains' run and the tuned gains' run of PID
+    [row] = doc["before_after"]
+    assert row["suspension"] == "pid"
+    rows = run_cases([Case(scenario_options=SHORT, suspension="pid")], base_gains=res.start)
+    assert row["before"]["acceleration_m_s2"] == rows["acceleration_m_s2_rms"].iloc[0]
+    # the tuned gains' run scores what the study reports
+    assert res.objective(np.array(list(row["after"].values())),
+                         np.array(list(res.passive.values()))) == pytest.approx(
+        res.history[-1]["objective"], rel=1e-12)
+
+
+def test_tune_result_table_and_figure(short_tune):
+    from matplotlib.figure import Figure
+
+    res = short_tune
+    frame = res.to_pandas()
+    assert len(frame) == sum(len(c.values) for c in res.curves)
+    assert list(frame.columns) == ["phase", "pass", "parameter", "value", "objective", "chosen"]
+    fig = res.plot()
+    assert isinstance(fig, Figure)
+    mine = Figure()
+    axes = mine.subplots(1, 3)
+    assert res.plot(ax=axes) is mine
+    with pytest.raises(ValueError, match="3 Axes"):
+        res.plot(ax=axes[:2])
+
+
+def test_tune_result_saves_its_folder(short_tune, tmp_path):
+    import json
+
+    res = short_tune
+    paths = res.save(tmp_path / "out")
+    assert [p.name for p in paths] == ["gains.toml", "sensitivity.png", "curves.csv", "tune.json"]
+    assert json.loads((tmp_path / "out" / "tune.json").read_text()) == res.to_dict()
+    loaded = GainSet.load(tmp_path / "out" / "gains.toml")
+    for table in ("inner", "pid", "attitude", "ride"):
+        assert getattr(loaded, table) == getattr(res.gains, table), table
+    assert loaded.provenance["objective"] == res.objective.describe()
+    assert loaded.provenance["scenario_record"] == res.scenario
+    assert "command" not in loaded.provenance  # none given: a library call
+    text = res.gains_toml(command="railride tune --phase pid")
+    assert "# command: railride tune --phase pid\n" in text
+    assert GainSet.from_toml(text).provenance["command"] == "railride tune --phase pid"
+    extra = res.save(tmp_path / "out", extra={"command": "x"})[-1]
+    assert json.loads(extra.read_text()) == {**res.to_dict(), "command": "x"}
+
+
+def test_tune_without_before_after():
+    res = tune(("pid",), scenario_options={"duration": 0.5}, n_values=3, max_passes=1,
+               before_after=False)
+    assert res.before_after == [] and res.to_dict()["before_after"] == []
+
+
 def test_reference_gains_ship_with_the_package():
     from importlib import resources
 
