@@ -22,7 +22,8 @@ from .params import VehicleParams
 from .pareto import ParetoResult, pareto
 from .simulation import RideResult, simulate
 from .track import CosineBump, MeasuredTrack, Scenario, SineTrack, scenario
-from .tuning import Objective, tune
+from .objectives import Objective
+from .tuning import tune
 from .vehicle import Vehicle
 
 __all__ = [

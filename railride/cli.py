@@ -1561,7 +1561,7 @@ def _objective(kind: Optional[str], weights: Optional[str], bound: Optional[str]
     """--objective, --weights, --bound, --penalty -> a tuning.Objective. Without --objective,
     the library's DEFAULT_OBJECTIVE; an option not given keeps that default's value when the
     kind is the default's (weights and bound belong to their kind only)."""
-    from .tuning import DEFAULT_OBJECTIVE, OBJECTIVE_KINDS, Objective
+    from .objectives import DEFAULT_OBJECTIVE, OBJECTIVE_KINDS, Objective
 
     name = DEFAULT_OBJECTIVE.kind if kind is None else kind.strip()
     if name not in OBJECTIVE_KINDS:

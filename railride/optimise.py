@@ -27,7 +27,8 @@ import scipy.optimize
 from .control import GainSet
 from .defaults import DEFAULT_DAMPER, DEFAULT_DT
 from .sweep import Case, RunTable, apply_gains, run_cases
-from .tuning import DEFAULT_OBJECTIVE, PARAMETERS, REFERENCE, Objective, _rms
+from .objectives import DEFAULT_OBJECTIVE, Objective
+from .tuning import PARAMETERS, REFERENCE, _rms
 
 #: the paper's fourteen SAS parameters
 SAS_PARAMETERS = PARAMETERS["attitude"] + PARAMETERS["ride"]
