@@ -7,7 +7,7 @@ an executor (`LocalExecutor`: this machine, the batch over both cores; `DaskExec
 dask.distributed cluster) and appends every finished chunk to a `RunTable` on disk, written
 atomically; a sweep started again with the same table skips the runs it already has, so an
 interrupted sweep resumes where it stopped. The metrics of a case do not depend on the executor
-or on the batch it ran in (a batch equals its single runs, tests/test_simulate.py).
+or on the batch it ran in (a batch equals its single runs, tests/physics/test_simulate.py).
 """
 
 from __future__ import annotations

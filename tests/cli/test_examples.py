@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def run_example(name: str, out: Path, *args: str) -> str:
@@ -67,7 +67,7 @@ def test_damper_size(tmp_path):
 def test_readme_python_block_runs():
     # the README's Python example, as a user would paste it; the tuning line (30 s) is left out,
     # tune() has its own tests
-    text = (Path(__file__).resolve().parents[1] / "README.md").read_text(encoding="utf-8")
+    text = (Path(__file__).resolve().parents[2] / "README.md").read_text(encoding="utf-8")
     code = text.split("```python", 1)[1].split("```", 1)[0]
     kept = "\n".join(line for line in code.splitlines() if "rr.tune(" not in line)
     assert "rr.compare(" in kept and "rr.simulate(" in kept
