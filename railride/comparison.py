@@ -175,6 +175,33 @@ class Comparison:
                 "gains": {"source": self.gains.source, "inner": self.gains.inner.to_dict(),
                           **{n: self.gains.controller(n).to_dict() for n in self.names if n != "passive"}}}
 
+    def to_pandas(self):
+        """The metrics as one long table: a row per suspension, response and statistic, with
+        the reduction against passive (NaN for passive itself)."""
+        import pandas as pd
+
+        keys = ["controller", "response", "statistic"]
+        values = self.metrics.to_dataframe(name="value").reset_index()[keys + ["value"]]
+        red = reduction(self.metrics, self.metrics.sel(controller="passive", drop=True))
+        red = red.to_dataframe(name="reduction_percent").reset_index()[keys + ["reduction_percent"]]
+        frame = pd.merge(values, red, on=keys, how="left")
+        frame.loc[frame["controller"] == "passive", "reduction_percent"] = float("nan")
+        return frame
+
+    def plot(self, ax=None, response: str = "acceleration"):
+        """One carbody response against time, one line per suspension (the paper's Figs. 8-11);
+        into ``ax`` when given. Returns the figure."""
+        from .report import plot_comparison_response
+
+        return plot_comparison_response(self, response, ax=ax)
+
+    def save(self, folder):
+        """The `railride compare --out` folder (JSON, NetCDF, CSV and the figures), written all
+        or nothing. Returns the written paths."""
+        from .report import write_compare_outputs
+
+        return write_compare_outputs(self, folder, self.to_dict())
+
     def combined(self) -> xr.Dataset:
         """All suspensions in one Dataset along ``controller`` (damper channels NaN for passive)."""
         parts = []

@@ -481,14 +481,14 @@ def comparison_title(ds: xr.Dataset) -> str:
     return ", ".join(p for p in parts if p)
 
 
-def plot_comparison_response(comparison, response: str, path=None):
+def plot_comparison_response(comparison, response: str, path=None, ax=None):
     """One carbody response against time, one line per suspension in the paper's style (Figs.
     8-11: passive dash-dot, PID dotted, SAS (attitude) dashed, SAS (attitude+ride) solid).
 
     ``response`` is ``acceleration`` (m/s^2), ``displacement`` (bounce, m), ``pitch`` or
     ``roll`` (both in degrees). ``comparison`` is a `railride.comparison.Comparison` or its
-    ``combined()`` Dataset. Saved as PNG at ``path`` when given (atomically); returns the Agg
-    `Figure`.
+    ``combined()`` Dataset. Drawn into ``ax`` when given (no title then: the caller owns the
+    figure); saved as PNG at ``path`` when given (atomically); returns the `Figure`.
     """
     if response not in COMPARE_RESPONSES:
         raise ValueError(f"response = {response!r}: allowed {', '.join(COMPARE_RESPONSES)}")
@@ -496,8 +496,10 @@ def plot_comparison_response(comparison, response: str, path=None):
     channel, factor, ylabel, what = COMPARE_RESPONSES[response]
     if channel not in ds.variables:
         raise ValueError(f"the dataset lacks the channel {channel}")
-    fig = _new_figure((10.0, 4.6))
-    ax = fig.subplots()
+    own = ax is None
+    fig = _new_figure((10.0, 4.6)) if own else ax.figure
+    if own:
+        ax = fig.subplots()
     time = ds["time"].values
     for i, name in enumerate(_controller_names(ds)):
         y = ds[channel].isel(controller=i).values * factor
@@ -510,7 +512,8 @@ def plot_comparison_response(comparison, response: str, path=None):
     ax.legend(loc="lower center", bbox_to_anchor=(0.5, 1.0), fontsize="small", frameon=False,
               ncols=min(4, ds.sizes["controller"]))
     title = comparison_title(ds)
-    fig.suptitle(f"{what}" + (f"\n{title}" if title else ""), fontsize="medium")
+    if own:
+        fig.suptitle(f"{what}" + (f"\n{title}" if title else ""), fontsize="medium")
     _save_png(fig, path)
     return fig
 
