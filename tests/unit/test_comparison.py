@@ -33,8 +33,11 @@ def test_plot_draws_into_the_given_axes(short):
     import matplotlib.pyplot as plt
 
     fig, ax = plt.subplots()
-    assert short.plot(ax=ax, response="pitch") is fig
-    assert len(ax.lines) == 3  # one per suspension
+    try:
+        assert short.plot(ax=ax, response="pitch") is fig
+        assert len(ax.lines) == 3  # one per suspension
+    finally:
+        plt.close(fig)  # pyplot's registry stays empty for the other tests
     assert short.plot().axes  # its own figure otherwise
     with pytest.raises(ValueError, match="response = 'yaw'"):
         short.plot(response="yaw")
