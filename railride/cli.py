@@ -26,6 +26,7 @@ from typing import Annotated, Optional
 import typer
 
 from . import __version__
+from .dampers import IDEAL_NAMES
 from .defaults import DEFAULT_CONTROL_RATE, DEFAULT_DAMPER
 
 SCHEMA_SIMULATE = "railride.simulation/1"
@@ -168,8 +169,6 @@ def _damper_scale(option: str, value: Optional[str], damper_name: str) -> float:
     """--damper-scale: a finite number > 0 (default 1), not for the ideal actuator."""
     if value is None:
         return 1.0
-    from .dampers import IDEAL_NAMES
-
     try:  # read as text, so that a word gets the one-line error too
         number = float(value)
     except ValueError:
@@ -679,7 +678,7 @@ def _compare_tables(doc: dict, vehicle: str, shipped: bool):
                     "asks for; force: the secondary damper force on the carbody; travel: the "
                     "secondary deflection (suspension travel); passive: the viscous dampers c_sz."
                     + (" The ideal devices have no voltage." if settings.get("damper")
-                       in ("ideal", "ideal-damper") and controlled else ""))
+                       in IDEAL_NAMES and controlled else ""))
     parts = [table, Text("\n".join(info)), *bounds_parts, "", ptp, "", demands, Text(demands_note)]
     if all("comfort" in r for r in rows):
         parts += ["", _compare_comfort_table(rows)]
@@ -1139,7 +1138,7 @@ def _suspension(suspension: str, damper_name, voltage_text, damper_scale=None):
         return None, None, {"type": "passive"}
     name = DEFAULT_DAMPER if damper_name is None else damper_name
     model = _damper_preset("--damper", name)
-    if name in ("ideal", "ideal-damper"):  # simulate runs open loop: no demand for it to apply
+    if name in IDEAL_NAMES:  # simulate runs open loop: no demand for it to apply
         raise ValueError(f"--damper = {name!r}: the ideal actuator applies a controller's demand and "
                          "simulate runs no controller (a constant voltage); use railride compare "
                          "--damper ideal or railride sweep --damper ideal with a controller")
@@ -1849,9 +1848,9 @@ def tune_command(
         phases = _phase_list(phase)
         _damper_preset("--damper", damper)
         scale = _damper_scale("--damper-scale", damper_scale, damper)
-        if damper == "ideal" and "inner" in phases:
-            raise ValueError("--damper = 'ideal' with the inner phase (--phase "
-                             f"{','.join(phases)}): the ideal actuator has no force tracking "
+        if damper in IDEAL_NAMES and "inner" in phases:
+            raise ValueError(f"--damper = {damper!r} with the inner phase (--phase "
+                             f"{','.join(phases)}): an ideal device has no force tracking "
                              "loop to tune; give --phase pid,attitude,ride")
         start = _tune_start(gains)
         objective = _objective(objective_kind, weights, bound, penalty)
@@ -2330,13 +2329,13 @@ def sweep_command(
                              f"controllers only (--suspension is {listed})")
         damper_name = DEFAULT_DAMPER if damper is None else damper
         damper_model = _damper_preset("--damper", damper_name)
-        if damper_name in ("ideal", "ideal-damper") and has_mr:
+        if damper_name in IDEAL_NAMES and has_mr:
             raise ValueError(f"--damper = {damper_name!r}: applies to the controllers only; mr runs at a "
                              f"constant voltage, which the ideal actuator has not (--suspension "
                              f"is {listed})")
         scales = [1.0]
         if damper_scale is not None:
-            if damper_name in ("ideal", "ideal-damper"):
+            if damper_name in IDEAL_NAMES:
                 raise ValueError(f"--damper-scale = {damper_scale!r}: the ideal device "
                                  f"(--damper {damper_name}) applies the demand itself and has no force "
                                  "capacity to scale")

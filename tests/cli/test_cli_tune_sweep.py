@@ -168,6 +168,7 @@ def test_tune_interrupted(tmp_path, monkeypatch):
     (("--penalty", "-1"), ("--penalty",)),
     (("--penalty", "ten"), ("--penalty", "'ten'", "not a number")),
     (("--phase", "inner,pid", "--damper", "ideal"), ("--damper", "ideal", "inner")),
+    (("--phase", "inner,pid", "--damper", "ideal-damper"), ("--damper", "ideal-damper", "inner")),
     (("--values", "2"), ("--values = 2",)),
     (("--span", "1"), ("--span",)),
     (("--passes", "0"), ("--passes = 0",)),
