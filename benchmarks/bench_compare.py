@@ -35,11 +35,12 @@ def main():
     args = ap.parse_args()
     exe = shutil.which("railride")
     cmd = [exe, "compare"] if exe else [sys.executable, "-m", "railride.cli", "compare"]
-    firsts, seconds = [], []
+    firsts, seconds, no_bounds = [], [], []
     for _ in range(args.repeat):
         _clear_cache()
         firsts.append(_timed(cmd))
         seconds.append(_timed(cmd))
+        no_bounds.append(_timed(cmd + ["--no-bounds"]))  # what the ideal-device runs cost
     out_dir = Path("/tmp/railride-bench-compare")
     shutil.rmtree(out_dir, ignore_errors=True)
     with_out = _timed(cmd + ["--out", str(out_dir)])
@@ -49,6 +50,8 @@ def main():
           f"| {min(firsts):.1f} s (worst {max(firsts):.1f} s) | <= 15 s |")
     print(f"| `railride compare`, second run (cache warm), best of {args.repeat} "
           f"| {min(seconds):.2f} s (worst {max(seconds):.2f} s) | <= 3 s |")
+    print(f"| `railride compare --no-bounds`, cache warm, best of {args.repeat} "
+          f"| {min(no_bounds):.2f} s (worst {max(no_bounds):.2f} s) | |")
     print(f"| `railride compare --out DIR` (cache warm: NetCDF, CSV, JSON, six plots) | {with_out:.2f} s | |")
 
 
