@@ -23,6 +23,7 @@ import numpy as np
 import xarray as xr
 from scipy import signal as sp_signal
 
+from . import validation
 from .metrics import check_window
 
 # -- frequency weightings ---------------------------------------------------------------------
@@ -149,11 +150,7 @@ def min_rate_hz(name: str) -> float:
 
 
 def _check_rate(rate_hz) -> float:
-    ok = (not isinstance(rate_hz, bool) and isinstance(rate_hz, (int, float, np.number))
-          and math.isfinite(rate_hz) and rate_hz > 0)
-    if not ok:
-        raise ValueError(f"rate_hz = {rate_hz!r}: the sample rate must be a finite number > 0 Hz")
-    return float(rate_hz)
+    return validation.number("rate_hz", rate_hz, "positive", allowed="a finite number > 0 (Hz, the sample rate)")
 
 
 @functools.lru_cache(maxsize=64)

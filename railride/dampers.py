@@ -35,7 +35,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .params import param, validate_fields
+from . import validation
+from .validation import param, validate_fields
 
 #: law codes shared with the compiled stepper (railride.kernels)
 LAW_VISCOUS = 1
@@ -239,12 +240,8 @@ class Ideal(_Damper):
 
 def check_scale(name: str, value) -> float:
     """A force-capacity scale: a finite number > 0, else ValueError naming ``name``."""
-    ok = (not isinstance(value, bool) and isinstance(value, (int, float, np.integer, np.floating))
-          and np.isfinite(value) and value > 0)
-    if not ok:
-        raise ValueError(f"{name} = {value!r}: must be a finite number > 0 (the factor on the "
-                         "damper's force parameters)")
-    return float(value)
+    return validation.number(name, value, "positive",
+                             allowed="a finite number > 0 (the factor on the damper's force parameters)")
 
 
 def _check_shape(d) -> None:

@@ -8,39 +8,12 @@ field carries its SI unit and the rule it must satisfy in its metadata;
 from __future__ import annotations
 
 import dataclasses
-import math
 import tomllib
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
 
 from ._io import atomic_write_text
-
-
-def param(unit: str, doc: str, rule: str = "positive") -> Any:
-    """A parameter field: SI unit, meaning and validation rule (positive, nonnegative, finite)."""
-    return field(metadata={"unit": unit, "doc": doc, "rule": rule})
-
-
-_RULES = {
-    "positive": (lambda v: v > 0.0, "a finite number > 0"),
-    "nonnegative": (lambda v: v >= 0.0, "a finite number >= 0"),
-    "finite": (lambda v: True, "a finite number"),
-}
-
-
-def validate_fields(obj, what: str) -> None:
-    """Check every field of a frozen parameter dataclass against the rule in its metadata and
-    store it as float; the error names the field, its value, its meaning and unit, and the rule."""
-    for f in dataclasses.fields(obj):
-        value = getattr(obj, f.name)
-        check, allowed = _RULES[f.metadata["rule"]]
-        ok = (not isinstance(value, bool) and isinstance(value, (int, float))
-              and math.isfinite(value) and check(float(value)))
-        if not ok:
-            raise ValueError(f"{what} {f.name!r} = {value!r} ({f.metadata['doc']}, "
-                             f"{f.metadata['unit']}): must be {allowed}")
-        object.__setattr__(obj, f.name, float(value))
+from .validation import param, rule_words, validate_fields
 
 
 @dataclass(frozen=True)
@@ -112,7 +85,7 @@ class VehicleParams:
     def describe(cls) -> list[tuple[str, str, str, str]]:
         """(name, unit, meaning, rule) for every field."""
         return [
-            (f.name, f.metadata["unit"], f.metadata["doc"], _RULES[f.metadata["rule"]][1])
+            (f.name, f.metadata["unit"], f.metadata["doc"], rule_words(f.metadata["rule"]))
             for f in dataclasses.fields(cls)
         ]
 

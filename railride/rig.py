@@ -18,7 +18,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import xarray as xr
 
-from . import dampers, kernels
+from . import dampers, kernels, validation
 from .defaults import DEFAULT_DAMPER, DEFAULT_DT
 
 #: motion-table nodes per cycle of the fastest motion
@@ -83,13 +83,7 @@ class SampledMotion:
 
 
 def _check_number(name, value, rule, unit):
-    ok = isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
-    ok = ok and {"positive": value > 0, "nonnegative": value >= 0, "finite": True}[rule]
-    if not ok:
-        allowed = {"positive": "> 0", "nonnegative": ">= 0", "finite": "finite"}[rule]
-        raise ValueError(f"{name} = {value!r} {unit}: must be a finite number {allowed}".replace(
-            "a finite number finite", "a finite number"))
-    return float(value)
+    return validation.number(name, value, rule, unit)
 
 
 def _motion_table(motion, duration: float, dt: float):

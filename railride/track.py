@@ -27,19 +27,15 @@ from pathlib import Path
 
 import numpy as np
 
+from . import validation
+
 #: nodes per shortest feature (wavelength, bump length) in the stepper's table
 NODES_PER_FEATURE = 200
 MAX_TABLE_NODES = 2_000_000
 
 
 def _check(name: str, value, rule: str, allowed: str) -> float:
-    ok = isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
-    if ok:
-        value = float(value)
-        ok = {"positive": value > 0, "nonnegative": value >= 0, "finite": True}[rule]
-    if not ok:
-        raise ValueError(f"{name} = {value!r}: must be {allowed}")
-    return value
+    return validation.number(name, value, rule, allowed=allowed)
 
 
 class RailProfile(ABC):

@@ -26,6 +26,7 @@ import scipy.linalg
 import scipy.optimize
 import xarray as xr
 
+from . import validation
 from .params import VehicleParams
 
 DOF_NAMES = (
@@ -218,8 +219,7 @@ class Vehicle:
         f = np.atleast_1d(np.asarray(frequency_hz, dtype=float))
         if not np.all(np.isfinite(f)) or np.any(f < 0):
             raise ValueError(f"frequency_hz must be finite and >= 0, got {frequency_hz!r}")
-        if not (np.isfinite(speed) and speed > 0):
-            raise ValueError(f"speed = {speed!r} m/s: must be a finite number > 0")
+        speed = validation.number("speed", speed, "positive", "m/s")
         if isinstance(rails, str):
             patterns = {"in-phase": (1.0, 1.0), "anti-phase": (1.0, -1.0)}
             if rails not in patterns:
