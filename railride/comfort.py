@@ -119,7 +119,7 @@ def _analog_zpk(w: Weighting, omega=lambda f: 2.0 * math.pi * f):
         w3 = omega(w.f3)
         zeros.append(-w3)
         gain *= w4 * w4 / w3
-    if w.f5 is not None:                                   # Hs, exactly as in Annex A
+    if w.f5 is not None and w.f6 is not None and w.Q5 is not None and w.Q6 is not None:  # Hs (Annex A)
         zeros += list(_quadratic(omega(w.f5), w.Q5))
         poles += list(_quadratic(omega(w.f6), w.Q6))
     return np.array(zeros, complex), np.array(poles, complex), gain

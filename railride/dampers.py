@@ -32,6 +32,7 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 
@@ -52,7 +53,12 @@ N_DAMPER_STATES = 3
 class _Damper:
     """Shared behaviour of the damper parameter sets."""
 
+    # declared for the type checker: every subclass is a frozen dataclass with these
+    __dataclass_fields__: ClassVar[dict]
     law: int
+    model: ClassVar[str]
+    v_min: float
+    v_max: float
 
     def replace(self, **changes):
         unknown = set(changes) - {f.name for f in dataclasses.fields(self)}
@@ -131,7 +137,7 @@ class BoucWen(_Damper):
         return (self.A / (self.gamma + self.beta)) ** (1.0 / self.n)
 
     #: the parameters that carry force: F scales with them at the same motion and voltage
-    FORCE_PARAMETERS = ("alpha_a", "alpha_b", "c0a", "c0b", "k0")
+    FORCE_PARAMETERS: ClassVar[tuple[str, ...]] = ("alpha_a", "alpha_b", "c0a", "c0b", "k0")
 
     def scaled(self, factor: float):
         """The same damper with its force capacity times ``factor`` (> 0): every force
@@ -216,7 +222,7 @@ class Ideal(_Damper):
     v_max = 0.0
 
     @property
-    def model(self) -> str:
+    def model(self) -> str:  # type: ignore[override]  # a class constant elsewhere
         return "ideal-damper" if self.dissipative else "ideal"
 
     def pack(self) -> np.ndarray:

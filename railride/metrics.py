@@ -7,6 +7,7 @@ perturbation from static equilibrium, so the mean belongs to the response.
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 import xarray as xr
@@ -66,8 +67,9 @@ def ride_metrics(ds: xr.Dataset, window=None, diverged=None) -> xr.DataArray:
     """
     part = select_window(ds, window)
     lead = ["sample"] if "sample" in part.dims else []
-    channels = [part[channel].transpose(*lead, "time").values for channel, _ in RESPONSES.values()]
-    return metrics_from_arrays(*channels, sample=part["sample"].values if lead else None,
+    acceleration, bounce, pitch, roll = (part[channel].transpose(*lead, "time").values
+                                         for channel, _ in RESPONSES.values())
+    return metrics_from_arrays(acceleration, bounce, pitch, roll, sample=part["sample"].values if lead else None,
                                diverged=diverged)
 
 
@@ -85,7 +87,7 @@ def metrics_from_arrays(acceleration, bounce, pitch, roll, sample=None, diverged
         values.append(np.stack([np.sqrt(np.mean(x**2, axis=-1)), np.ptp(x, axis=-1)], axis=-1))
     data = np.stack(values, axis=-2)  # (..., response, statistic)
     lead = [] if data.ndim == 2 else ["sample"]
-    coords = {"response": list(RESPONSES), "statistic": list(STATISTICS)}
+    coords: dict[str, Any] = {"response": list(RESPONSES), "statistic": list(STATISTICS)}
     if lead:
         coords["sample"] = np.arange(data.shape[0]) if sample is None else sample
     out = xr.DataArray(data, dims=lead + ["response", "statistic"], coords=coords,

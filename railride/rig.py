@@ -14,6 +14,7 @@ from __future__ import annotations
 import json
 import math
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 import xarray as xr
@@ -167,7 +168,7 @@ def drive(damper, motion, *, duration: float, voltage=None, command=None, desire
     }
     time = out[0, :, 0]
     dims = ("voltage", "time") if voltage is not None else ("time",)
-    data = {}
+    data: dict[str, tuple] = {}
     for j, name in enumerate(names, start=1):
         values = out[:, :, j] if voltage is not None else out[0, :, j]
         unit, long = attrs[name]
@@ -182,7 +183,7 @@ def drive(damper, motion, *, duration: float, voltage=None, command=None, desire
     ds = xr.Dataset(data, coords=coords)
     ds.attrs.update(damper=json.dumps(damper.to_dict()), dt_s=dt, integrator="RK4 with stiffness sub-steps")
     if mode == kernels.RIG_TRACKING:
-        ds.attrs.update(B=float(B), G_v_per_n=float(G))
+        ds.attrs.update(B=float(B), G_v_per_n=float(G or 0.0))
     return ds
 
 
@@ -205,7 +206,7 @@ def yield_force(damper, v: float) -> float:
 class Cycles:
     """Steady-state cycles of a damper driven by a sine at several constant voltages."""
 
-    damper: object
+    damper: Any  # a damper model of railride.dampers
     motion: SineMotion
     dataset: xr.Dataset  # the last cycle of each voltage (dims voltage, time)
 

@@ -207,11 +207,11 @@ class MeasuredTrack(RailProfile):
         except UnicodeDecodeError:
             raise ValueError(f"track file {path}: not a UTF-8 text CSV") from None
         # keep file line numbers for the messages; skip blank and comment lines
-        rows = [(n, r) for n, r in enumerate(rows, start=1)
-                if r and any(c.strip() for c in r) and not r[0].lstrip().startswith("#")]
-        if not rows:
+        numbered = [(n, r) for n, r in enumerate(rows, start=1)
+                    if r and any(c.strip() for c in r) and not r[0].lstrip().startswith("#")]
+        if not numbered:
             raise ValueError(f"track file {path}: empty; expected a header 's,z_L,z_R' and data rows")
-        head = rows[0][1]
+        head = numbered[0][1]
         header = [c.split("[")[0].strip().lower() for c in head]
         idx = {}
         for want in ("s", "z_l", "z_r"):
@@ -221,8 +221,8 @@ class MeasuredTrack(RailProfile):
                     f"{head!r}; expected columns s [m], z_L [m], z_R [m]"
                 )
             idx[want] = header.index(want)
-        data = {k: [] for k in idx}
-        for lineno, row in rows[1:]:
+        data: dict[str, list[float]] = {k: [] for k in idx}
+        for lineno, row in numbered[1:]:
             for k, j in idx.items():
                 try:
                     data[k].append(float(row[j]))
@@ -304,6 +304,7 @@ def scenario(name: str = "paper-sine", *, amplitude: float | None = None,
                          f"({', '.join(SPECTRA)}) only, not to {name}")
     if taper is not None and name != "paper-sine":
         raise ValueError(f"taper applies to paper-sine only, not to {name}")
+    track: RailProfile
     if name == "paper-sine":
         track = SineTrack(amplitude=0.05 if amplitude is None else amplitude,
                           wavelength=60.0 if wavelength is None else wavelength,
