@@ -12,7 +12,7 @@ import xarray as xr
 
 from railride.comparison import PAPER_REDUCTION, PAPER_TABLE1
 from railride.control import CONTROLLERS, LABELS, GainSet
-from railride.report import COMPARE_FILES
+from railride.files import COMPARE_FILES
 from clihelp import PNG, assert_input_error, ok_json, run
 
 
@@ -255,12 +255,12 @@ def test_out_is_a_file(tmp_path):
 
 
 def test_failing_plot_leaves_out_absent(tmp_path, monkeypatch):
-    from railride import report
+    from railride import files
 
     def failing_png(*args, **kwargs):
         raise OSError("disk full (simulated)")
 
-    monkeypatch.setattr(report, "plot_comparison_voltages", failing_png)
+    monkeypatch.setattr(files, "plot_comparison_voltages", failing_png)
     out = tmp_path / "absent"
     assert_input_error(run(*SHORT, "--controllers", "pid", "--out", out),
                        "cannot write the output folder", "simulated")

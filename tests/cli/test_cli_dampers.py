@@ -242,12 +242,12 @@ def test_diverged_rig_run_status_1(tmp_path, monkeypatch):
 
 
 def test_failing_plot_leaves_out_absent(tmp_path, monkeypatch):
-    from railride import report
+    from railride import files
 
     def failing_png(*args, **kwargs):
         raise OSError("disk full (simulated)")
 
-    monkeypatch.setattr(report, "plot_tracking", failing_png)
+    monkeypatch.setattr(files, "plot_tracking", failing_png)
     out = tmp_path / "absent"
     result = run("tracking", "--cycles", 2, "--out", out)
     assert_input_error(result, "cannot write the output folder", "simulated")

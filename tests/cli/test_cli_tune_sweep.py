@@ -10,7 +10,7 @@ import pandas as pd
 import pytest
 
 from railride.control import GainSet
-from railride.report import TUNE_FILES
+from railride.files import TUNE_FILES
 from railride.tuning import DEFAULT_OBJECTIVE
 from clihelp import PNG, assert_input_error, ok, run
 

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import railride as rr
-from railride.report import COMPARE_FILES
+from railride.files import COMPARE_FILES
 
 matplotlib.use("Agg")
 

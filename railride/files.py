@@ -1,0 +1,341 @@
+"""Result folders: every file railride writes, all or nothing.
+
+* `write_folder` is the all-or-nothing folder writer behind the ``write_*`` functions;
+  `check_out_dir` rejects an output location that cannot be a folder before any work is done.
+* `write_netcdf` writes a Dataset as netCDF3 (`netcdf_ready`); `json_text` is the strict JSON
+  of the documents.
+* One ``write_*`` function per result: `write_outputs` (a ride), `write_damper_outputs` and
+  `write_tracking_outputs` (the damper rig), `write_compare_outputs` (a controller
+  comparison), `write_tune_outputs` (a tuning study), `write_sweep_outputs` (a sweep),
+  `write_frf_outputs` (frequency responses) and `write_pareto_outputs` (the Pareto view), each
+  writing the files of its ``*_FILES`` tuple: tables from `railride.tables`, analysis from
+  `railride.analysis`, figures from `railride.plots` saved as PNG.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import secrets
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import xarray as xr
+
+from .analysis import PSD_SEGMENT_S, comparison_psd
+from .labels import CARBODY_RESPONSES, psd_title
+from .plots import save_png
+from .plots.comparison import (plot_comparison_damper_forces, plot_comparison_psd, plot_comparison_response,
+                               plot_comparison_voltages)
+from .plots.frf import plot_frf
+from .plots.pareto import plot_pareto
+from .plots.ride import plot_body_responses
+from .plots.rig import plot_hysteresis, plot_tracking
+from .plots.sweep import has_comfort, plot_sweep, plot_sweep_comfort, sweep_plot_axis
+from .plots.tuning import plot_sensitivity
+from .tables import comparison_frame, curves_frame, cycles_frame, modes_frame, to_frame
+
+#: the files `write_outputs` produces, in the order they are written
+OUTPUT_FILES = ("ride.nc", "ride.csv", "metrics.json", "body_responses.png")
+#: the files `write_damper_outputs` produces, in the order they are written
+DAMPER_FILES = ("loops.png", "cycles.csv", "damper.json")
+#: the files `write_tracking_outputs` produces, in the order they are written
+TRACKING_FILES = ("tracking.png", "tracking.csv", "tracking.json")
+#: the files `write_compare_outputs` produces, in the order they are written
+COMPARE_FILES = ("compare.json", "compare.nc", "compare.csv", "acceleration.png", "displacement.png",
+                 "pitch.png", "roll.png", "damper_forces.png", "voltages.png", "psd.png", "psd.csv")
+#: the files `write_tune_outputs` produces, in the order they are written
+TUNE_FILES = ("gains.toml", "sensitivity.png", "curves.csv", "tune.json")
+#: the files `write_sweep_outputs` always produces (the run table runs.csv is the library's);
+#: ``sweep.png`` is added when the sweep has one numeric axis (`sweep_plot_axis`), and with it
+#: ``comfort.png`` when the rows hold the comfort indices (`railride sweep --comfort`)
+SWEEP_FILES = ("sweep.json",)
+#: the files `write_frf_outputs` produces, in the order they are written
+FRF_FILES = ("frf.csv", "frf.json", "frf.png", "modes.csv")
+#: the files `write_pareto_outputs` produces, in the order they are written
+PARETO_FILES = ("pareto.png", "pareto.csv", "pareto.json")
+
+
+# -- NetCDF and JSON ------------------------------------------------------------------------------
+def netcdf_ready(ds: xr.Dataset) -> xr.Dataset:
+    """A copy of ``ds`` that scipy's netCDF3 writer accepts without losing data.
+
+    netCDF3 has no 64-bit integers: integer variables (the ``sample`` and ``wheelset``
+    coordinates) are stored as int32, which holds them exactly. Text (the JSON records
+    ``scenario`` and ``vehicle_params``) is stored as UTF-8 and reads back unchanged.
+    """
+    out = ds.copy()
+    for name, var in ds.variables.items():
+        if var.dtype.kind in "iu" and var.dtype != np.int32:
+            if var.size and (var.values.min() < np.iinfo(np.int32).min
+                             or var.values.max() > np.iinfo(np.int32).max):
+                raise ValueError(f"{name}: integers beyond int32 cannot be stored in netCDF3")
+            out[name] = var.astype(np.int32)
+    return out
+
+
+def write_netcdf(ds: xr.Dataset, path: Path) -> None:
+    """Write ``ds`` to ``path`` as netCDF3 (scipy engine, no extra dependency)."""
+    netcdf_ready(ds).to_netcdf(path, engine="scipy")
+
+
+def json_text(doc: dict) -> str:
+    """``doc`` as indented strict JSON (NaN or infinity raises ValueError)."""
+    return json.dumps(doc, indent=2, allow_nan=False) + "\n"
+
+
+# -- the output folder ----------------------------------------------------------------------------
+def check_out_dir(out_dir) -> Path:
+    """Reject an output location that cannot be a folder, before any work is done."""
+    out_dir = Path(out_dir)
+    if out_dir.exists() and not out_dir.is_dir():
+        raise ValueError(f"output folder {out_dir} exists and is not a folder")
+    for parent in out_dir.absolute().parents:
+        if parent.exists():
+            if not parent.is_dir():
+                raise ValueError(f"output folder {out_dir}: {parent} is not a folder")
+            break
+    return out_dir
+
+
+def _move_into(stage: Path, out_dir: Path, names) -> None:
+    """Move the staged files ``names`` into an existing ``out_dir``; on failure put everything
+    back."""
+    backup = stage / ".previous"
+    backup.mkdir()
+    moved, saved = [], []
+    try:
+        for name in names:
+            target = out_dir / name
+            if target.exists() or target.is_symlink():
+                os.replace(target, backup / name)
+                saved.append(name)
+            os.replace(stage / name, target)
+            moved.append(name)
+    except BaseException:
+        for name in moved:
+            try:
+                os.replace(out_dir / name, stage / name)
+            except OSError:
+                pass
+        for name in saved:
+            try:
+                os.replace(backup / name, out_dir / name)
+            except OSError:
+                pass
+        raise
+
+
+def write_folder(out_dir, files) -> list[Path]:
+    """Write a set of files into ``out_dir``, all or nothing.
+
+    ``files`` is a sequence of ``(name, write)`` pairs: ``write(path)`` must create the file
+    ``path``. Everything is first written, in the given order, into a hidden staging folder
+    beside ``out_dir`` (``.NAME.staging-XXXXXXXX``, same parent, so renames are atomic). Only
+    when every file exists are they moved in: a missing ``out_dir`` is created by renaming the
+    staging folder; in an existing one, files of the same names are replaced (other files stay)
+    and restored if a move fails. On any error the staging folder is removed and ``out_dir`` is
+    left as it was. Returns the written paths, in the given order.
+    """
+    files = list(files)
+    names = [name for name, _ in files]
+    if len(set(names)) != len(names) or any(Path(n).name != n or n.startswith(".") for n in names):
+        raise ValueError(f"write_folder: file names must be distinct plain names, got {names}")
+    out_dir = check_out_dir(out_dir)
+    parent = out_dir.absolute().parent
+    parent.mkdir(parents=True, exist_ok=True)
+    stage = None
+    for _ in range(100):
+        candidate = parent / f".{out_dir.name}.staging-{secrets.token_hex(4)}"
+        try:
+            candidate.mkdir()
+        except FileExistsError:
+            continue
+        stage = candidate
+        break
+    if stage is None:
+        raise OSError(f"cannot create a staging folder in {parent}")
+    try:
+        for name, write in files:
+            write(stage / name)
+            if not (stage / name).is_file():
+                raise OSError(f"the writer of {name} created no file")
+        if not out_dir.exists():
+            try:
+                os.rename(stage, out_dir)  # a new folder appears complete, in one step
+                stage = None
+            except OSError:
+                if not out_dir.is_dir():  # not a race with another writer: a real failure
+                    raise
+        if stage is not None:
+            _move_into(stage, out_dir, names)
+    finally:
+        if stage is not None:
+            shutil.rmtree(stage, ignore_errors=True)
+    return [out_dir / name for name in names]
+
+
+def _text(text: str):
+    return lambda path: path.write_text(text, encoding="utf-8")
+
+
+def _png(draw):
+    """A writer that saves the figure ``draw()`` returns."""
+    return lambda path: save_png(draw(), path)
+
+
+def _csv(frame: pd.DataFrame, index: bool = False):
+    return lambda path: frame.to_csv(path, index=index)
+
+
+def _expect(value, name: str, module: str, cls: str) -> None:
+    """ValueError unless ``value`` is a railride.<module>.<cls>; imported only here, when
+    called: the result modules pull in the compiled engine."""
+    import importlib
+
+    if not isinstance(value, getattr(importlib.import_module(f"railride.{module}"), cls)):
+        raise ValueError(f"{name}: expected a railride.{module}.{cls}, got {type(value).__name__}")
+
+
+# -- one writer per result ------------------------------------------------------------------------
+def write_outputs(result, out_dir, metrics_doc: dict) -> list[Path]:
+    """Write the files of a run, a `railride.simulation.RideResult`, into ``out_dir``, all or
+    nothing (`write_folder`): ``ride.nc`` (its Dataset as NetCDF, see `netcdf_ready`),
+    ``ride.csv`` (`railride.tables.to_frame`), ``metrics.json`` (``metrics_doc`` as indented
+    JSON; NaN or infinity is refused) and ``body_responses.png``
+    (`railride.plots.ride.plot_body_responses`). Returns the written paths."""
+    _expect(result, "result", "simulation", "RideResult")
+    ds = result.dataset
+    text = json_text(metrics_doc)  # refuse NaN before any file is written
+    writers = {
+        "ride.nc": lambda path: write_netcdf(ds, path),
+        "ride.csv": lambda path: to_frame(ds).to_csv(path),
+        "metrics.json": _text(text),
+        "body_responses.png": _png(lambda: plot_body_responses(ds)),
+    }
+    return write_folder(out_dir, [(name, writers[name]) for name in OUTPUT_FILES])
+
+
+def write_damper_outputs(cycles, out_dir, doc: dict, *, title: str | None = None) -> list[Path]:
+    """Write the `railride.rig.Cycles` of `railride.rig.cycles` into ``out_dir``, all or
+    nothing: ``loops.png`` (`plot_hysteresis`), ``cycles.csv`` (`cycles_frame`) and
+    ``damper.json`` (``doc`` as indented strict JSON). Returns the written paths."""
+    text = json_text(doc)
+    writers = {
+        "loops.png": _png(lambda: plot_hysteresis(cycles, title=title)),
+        "cycles.csv": lambda path: cycles_frame(cycles.dataset).to_csv(path, index=False),
+        "damper.json": _text(text),
+    }
+    return write_folder(out_dir, [(name, writers[name]) for name in DAMPER_FILES])
+
+
+def write_tracking_outputs(tracking, out_dir, doc: dict, *, title: str | None = None) -> list[Path]:
+    """Write a force-tracking run of `railride.rig.track` (a `railride.rig.Tracking`) into
+    ``out_dir``, all or nothing: ``tracking.png`` (`plot_tracking`), ``tracking.csv``
+    (`to_frame` of its Dataset: time, the rig channels and ``desired_force``) and
+    ``tracking.json`` (``doc``). Returns the paths."""
+    text = json_text(doc)
+    writers = {
+        "tracking.png": _png(lambda: plot_tracking(tracking, title=title)),
+        "tracking.csv": lambda path: to_frame(tracking.dataset).to_csv(path),
+        "tracking.json": _text(text),
+    }
+    return write_folder(out_dir, [(name, writers[name]) for name in TRACKING_FILES])
+
+
+def write_compare_outputs(comparison, out_dir, doc: dict) -> list[Path]:
+    """Write a `railride.comparison.Comparison` into ``out_dir``, all or nothing
+    (`write_folder`): ``compare.json`` (``doc``, the ``Comparison.to_dict()`` document, strict
+    JSON), ``compare.nc`` (``combined()`` as NetCDF, see `netcdf_ready`), ``compare.csv``
+    (`comparison_frame`), ``acceleration.png``, ``displacement.png``, ``pitch.png``,
+    ``roll.png`` (`plot_comparison_response`), ``damper_forces.png``
+    (`plot_comparison_damper_forces`), ``voltages.png`` (`plot_comparison_voltages`), and the
+    acceleration spectra over the metric window ``doc["settings"]["window_s"]`` (None: the
+    whole run): ``psd.png`` (`plot_comparison_psd`) and ``psd.csv``
+    (`railride.analysis.comparison_psd`). Returns the written paths."""
+    _expect(comparison, "comparison", "comparison", "Comparison")
+    text = json_text(doc)
+    ds = comparison.combined()
+    settings = doc.get("settings") if isinstance(doc.get("settings"), dict) else {}
+    window = settings.get("window_s")
+    psd = comparison_psd(ds, window)
+    title = psd_title(ds, window, PSD_SEGMENT_S)
+    writers = {
+        "psd.png": _png(lambda: plot_comparison_psd(psd, title=title)),
+        "psd.csv": _csv(psd),
+        "compare.json": _text(text),
+        "compare.nc": lambda path: write_netcdf(ds, path),
+        "compare.csv": lambda path: comparison_frame(ds).to_csv(path, index=False),
+        "damper_forces.png": _png(lambda: plot_comparison_damper_forces(comparison)),
+        "voltages.png": _png(lambda: plot_comparison_voltages(comparison)),
+    }
+    for response in CARBODY_RESPONSES:
+        writers[f"{response}.png"] = (lambda r: _png(lambda: plot_comparison_response(comparison, r)))(response)
+    return write_folder(out_dir, [(name, writers[name]) for name in COMPARE_FILES])
+
+
+def write_tune_outputs(curves, out_dir, doc: dict, gains_text: str, *,
+                       title: str | None = None) -> list[Path]:
+    """Write the results of a tuning study into ``out_dir``, all or nothing (`write_folder`;
+    other files there, such as the run table ``runs.csv``, stay): ``gains.toml``
+    (``gains_text``, a gains file), ``sensitivity.png`` (`plot_sensitivity` of ``curves``,
+    ``TuneResult.curves``), ``curves.csv`` (`curves_frame`) and ``tune.json`` (``doc`` as
+    indented strict JSON). Returns the written paths."""
+    text = json_text(doc)  # refuse NaN before any file is written
+    curves = list(curves)
+    frame = curves_frame(curves)
+    writers = {
+        "gains.toml": _text(gains_text),
+        "sensitivity.png": _png(lambda: plot_sensitivity(curves, title=title)),
+        "curves.csv": _csv(frame),
+        "tune.json": _text(text),
+    }
+    return write_folder(out_dir, [(name, writers[name]) for name in TUNE_FILES])
+
+
+def write_sweep_outputs(out_dir, doc: dict) -> list[Path]:
+    """Write the summary of a sweep into ``out_dir`` beside the run table ``runs.csv`` that
+    `railride.sweep.run_cases` keeps there: ``sweep.json`` (``doc``) and, when the grid has one
+    numeric axis with several values (`sweep_plot_axis`), ``sweep.png`` (`plot_sweep`) and, if
+    the rows hold the comfort indices, ``comfort.png`` (`plot_sweep_comfort`). Returns the
+    written paths."""
+    files = [("sweep.json", _text(json_text(doc)))]
+    axis = sweep_plot_axis(doc)
+    if axis is not None:
+        files.append(("sweep.png", _png(lambda: plot_sweep(doc, axis=axis))))
+        if has_comfort(doc):
+            files.append(("comfort.png", _png(lambda: plot_sweep_comfort(doc, axis=axis))))
+    return write_folder(out_dir, files)
+
+
+def write_frf_outputs(frame: pd.DataFrame, modes, out_dir, doc: dict, *,
+                      title: str | None = None) -> list[Path]:
+    """Write the frequency responses of `railride frf` into ``out_dir``, all or nothing:
+    ``frf.csv`` (``frame``, `railride.analysis.frf_frame`), ``frf.json`` (``doc``, strict
+    JSON), ``frf.png`` (`plot_frf`) and ``modes.csv`` (`modes_frame` of ``modes``, the records
+    ``Mode.to_dict()`` of `Vehicle.modes()`). Returns the written paths."""
+    text = json_text(doc)
+    table = modes_frame(modes)
+    writers = {
+        "frf.csv": _csv(frame),
+        "frf.json": _text(text),
+        "frf.png": _png(lambda: plot_frf(frame, table, title=title)),
+        "modes.csv": _csv(table),
+    }
+    return write_folder(out_dir, [(name, writers[name]) for name in FRF_FILES])
+
+
+def write_pareto_outputs(result, out_dir) -> list[Path]:
+    """Write a `railride.pareto.ParetoResult` into ``out_dir``, all or nothing (other files,
+    such as a run table, stay): ``pareto.png`` (`plot_pareto`), ``pareto.csv``
+    (``to_pandas()``) and ``pareto.json`` (``to_dict()``). Returns the paths."""
+    text = json_text(result.to_dict())  # refuse NaN before any file is written
+    frame = result.to_pandas()
+    writers = {
+        "pareto.png": _png(lambda: plot_pareto(result)),
+        "pareto.csv": _csv(frame),
+        "pareto.json": _text(text),
+    }
+    return write_folder(out_dir, [(name, writers[name]) for name in PARETO_FILES])

@@ -1,0 +1,181 @@
+"""A controller comparison (`railride.comparison.Comparison`): the carbody responses, the
+damper forces and the command voltages against time, one line or row per suspension in the
+paper's style (its Figs. 8-11), and the acceleration spectra of `railride.analysis.comparison_psd`.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from ..labels import CARBODY_RESPONSES, comparison_title, controller_names, coordinate_label
+from ._style import given_axes, new_figure, suspension_label, suspension_style
+
+
+def _combined(comparison):
+    """The combined Dataset of a `Comparison` (dims controller, time, ...)."""
+    from ..comparison import Comparison
+
+    if not isinstance(comparison, Comparison):
+        raise ValueError("comparison: expected a railride.comparison.Comparison, "
+                         f"got {type(comparison).__name__}")
+    return comparison.combined()
+
+
+def plot_comparison_response(comparison, response: str, ax=None):
+    """One carbody response of a `railride.comparison.Comparison` against time, one line per
+    suspension in the paper's style (Figs. 8-11: passive dash-dot, PID dotted, SAS (attitude)
+    dashed, SAS (attitude+ride) solid).
+
+    ``response`` is ``acceleration`` (m/s^2), ``displacement`` (bounce, m), ``pitch`` or
+    ``roll`` (both in degrees). Drawn into ``ax`` when given (no title then: the caller owns the
+    figure), else into a new figure; returns the `Figure`.
+    """
+    if response not in CARBODY_RESPONSES:
+        raise ValueError(f"response = {response!r}: allowed {', '.join(CARBODY_RESPONSES)}")
+    ds = _combined(comparison)
+    channel, factor, ylabel, what = CARBODY_RESPONSES[response]
+    if channel not in ds.variables:
+        raise ValueError(f"the dataset lacks the channel {channel}")
+    own = ax is None
+    fig = new_figure((10.0, 4.6)) if own else ax.figure
+    if own:
+        ax = fig.subplots()
+    time = ds["time"].values
+    for i, name in enumerate(controller_names(ds)):
+        y = ds[channel].isel(controller=i).values * factor
+        ax.plot(time, y, linewidth=1.1, label=suspension_label(name), **suspension_style(name))
+    ax.set_xlabel("time (s)")
+    ax.set_ylabel(ylabel)
+    ax.set_xlim(time[0], time[-1])
+    ax.grid(True, linewidth=0.4, alpha=0.6)
+    # above the axes, not over the lines
+    ax.legend(loc="lower center", bbox_to_anchor=(0.5, 1.0), fontsize="small", frameon=False,
+              ncols=min(4, ds.sizes["controller"]))
+    if own:
+        title = comparison_title(ds)
+        fig.suptitle(f"{what}" + (f"\n{title}" if title else ""), fontsize="medium")
+    return fig
+
+
+def _corner_grid(ds, rows: list[str], ax):
+    """The (rows x corners) Axes: ``ax`` reshaped, or a new figure's grid sharing both axes."""
+    corners = [coordinate_label(c) for c in ds["corner"].values]
+    if ax is None:
+        fig = new_figure((13.0, 1.2 + 2.0 * len(rows)))
+        axes = np.atleast_2d(fig.subplots(len(rows), len(corners), sharex=True, sharey=True,
+                                          squeeze=False))
+    else:
+        flat = given_axes(ax, len(rows) * len(corners),
+                          f"{len(rows)} suspension(s) x {len(corners)} corners, row by row")
+        axes = np.array(flat, dtype=object).reshape(len(rows), len(corners))
+        fig = flat[0].figure
+    for j, corner in enumerate(corners):
+        axes[0, j].set_title(f"corner {corner}", fontsize="medium")
+        axes[-1, j].set_xlabel("time (s)")
+    return fig, axes, corners
+
+
+def plot_comparison_damper_forces(comparison, ax=None):
+    """The secondary damper force on the carbody (kN, up +) at each corner of a
+    `railride.comparison.Comparison` against time: one row per suspension (passive: the viscous
+    dampers), one column per corner (1R, 1L, 2R, 2L), all panels on the same scale, solid lines
+    in each suspension's colour. ``ax``: the suspensions x 4 corners Axes, row by row (no title
+    then), or None for a new figure. Returns the `Figure`."""
+    ds = _combined(comparison)
+    if "secondary_damper_force" not in ds.variables:
+        raise ValueError("the dataset lacks the channel secondary_damper_force")
+    names = controller_names(ds)
+    fig, axes, corners = _corner_grid(ds, names, ax)
+    time = ds["time"].values
+    force = ds["secondary_damper_force"].transpose("controller", "time", "corner").values / 1e3
+    for i, name in enumerate(names):
+        for j in range(len(corners)):
+            a = axes[i, j]
+            a.plot(time, force[i, :, j], linewidth=0.8, color=suspension_style(name).get("color"))
+            a.axhline(0.0, color="0.6", linewidth=0.5)
+            a.grid(True, linewidth=0.4, alpha=0.6)
+        axes[i, 0].set_ylabel(f"{suspension_label(name)}\nforce (kN)")
+    axes[0, 0].set_xlim(time[0], time[-1])
+    if ax is None:
+        title = comparison_title(ds)
+        fig.suptitle("secondary damper force on the carbody (kN, up +)" + (f"\n{title}" if title else ""),
+                     fontsize="medium")
+    return fig
+
+
+def plot_comparison_voltages(comparison, ax=None):
+    """The command voltage v (V) of each MR damper of a `railride.comparison.Comparison`
+    against time: one row per controlled suspension, one column per corner. A comparison
+    without a controlled suspension (or with ideal devices) gets one panel saying so. ``ax``:
+    those Axes, row by row (no title then), or None for a new figure. Returns the `Figure`."""
+    ds = _combined(comparison)
+    names = [n for n in controller_names(ds) if n != "passive"]
+    if not names or "damper_command_voltage" not in ds.variables:
+        if ax is None:
+            fig = new_figure((8.0, 3.0))
+            a = fig.subplots()
+        else:
+            a = given_axes(ax, 1, "no command voltages to draw: one panel saying so")[0]
+            fig = a.figure
+        why = "passive suspension only" if not names else "ideal actuators"
+        a.text(0.5, 0.5, f"{why}: no command voltages", ha="center", va="center",
+               transform=a.transAxes)
+        a.set_axis_off()
+        if ax is None:
+            title = comparison_title(ds)
+            fig.suptitle("MR damper command voltage" + (f"\n{title}" if title else ""),
+                         fontsize="medium")
+        return fig
+    fig, axes, corners = _corner_grid(ds, names, ax)
+    time = ds["time"].values
+    volts = ds["damper_command_voltage"].transpose("controller", "time", "corner")
+    all_names = controller_names(ds)
+    top = np.nanmax(volts.values) if np.isfinite(volts.values).any() else 1.0
+    for i, name in enumerate(names):
+        v = volts.isel(controller=all_names.index(name)).values
+        for j in range(len(corners)):
+            a = axes[i, j]
+            a.plot(time, v[:, j], linewidth=0.7, color=suspension_style(name).get("color"))
+            a.grid(True, linewidth=0.4, alpha=0.6)
+        axes[i, 0].set_ylabel(f"{suspension_label(name)}\nvoltage (V)")
+    axes[0, 0].set_xlim(time[0], time[-1])
+    axes[0, 0].set_ylim(-0.05 * max(top, 1e-9), 1.08 * max(top, 1e-9))
+    if ax is None:
+        title = comparison_title(ds)
+        fig.suptitle("MR damper command voltage v (V)" + (f"\n{title}" if title else ""),
+                     fontsize="medium")
+    return fig
+
+
+def plot_comparison_psd(psd: pd.DataFrame, ax=None, *, title: str | None = None):
+    """The acceleration spectra of `railride.analysis.comparison_psd` (its DataFrame) on log-log
+    axes, one line per suspension in the paper's style; the 0 Hz bin is left out. Drawn into
+    ``ax`` when given (no title then), else into a new figure titled ``title``; returns the
+    `Figure`."""
+    own = ax is None
+    fig = new_figure((10.0, 5.4)) if own else ax.figure
+    if own:
+        ax = fig.subplots()
+    f = psd["frequency_hz"].values
+    keep = f > 0
+    top = 0.0
+    for name in [c for c in psd.columns if c != "frequency_hz"]:
+        y = psd[name].values[keep]
+        y = np.where(y > 0, y, np.nan)  # a log axis cannot show 0
+        if np.isfinite(y).any():
+            top = max(top, float(np.nanmax(y)))
+        ax.loglog(f[keep], y, linewidth=1.1, label=suspension_label(name), **suspension_style(name))
+    if top > 0:  # twelve decades below the highest peak: a pure sine's numerical floor is not news
+        ax.set_ylim(bottom=max(ax.get_ylim()[0], top * 1e-12))
+    ax.set_xlabel("frequency (Hz)")
+    ax.set_ylabel("PSD of acceleration ((m/s$^2$)$^2$/Hz)")
+    if keep.any():
+        ax.set_xlim(f[keep][0], f[keep][-1])
+    ax.grid(True, which="major", linewidth=0.5, alpha=0.7)
+    ax.grid(True, which="minor", linewidth=0.3, alpha=0.4)
+    ax.legend(loc="lower center", bbox_to_anchor=(0.5, 1.0), fontsize="small", frameon=False,
+              ncols=min(4, max(1, len(psd.columns) - 1)))
+    if own:
+        fig.suptitle(title or "PSD of the carbody CG vertical acceleration", fontsize="medium")
+    return fig

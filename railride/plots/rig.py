@@ -1,0 +1,129 @@
+"""The damper rig (`railride.rig`): hysteresis cycles and force tracking."""
+
+from __future__ import annotations
+
+import math
+
+from ..labels import damper_model_name
+from ._style import given_axes, new_figure, save_png
+
+
+def _expect(value, name: str, kind: str):
+    from .. import rig
+
+    if not isinstance(value, getattr(rig, kind)):
+        raise ValueError(f"{name}: expected a railride.rig.{kind}, got {type(value).__name__}")
+
+
+def plot_hysteresis(cycles, path=None, *, title: str | None = None, ax=None):
+    """Force-displacement and force-velocity loops of the `railride.rig.Cycles` of
+    `railride.rig.cycles`: the steady-state (last) cycle at each voltage, one line per voltage,
+    force in kN (tension +), extension in mm, extension rate in m/s.
+
+    ``ax``: two Axes to draw in (no title then), or None for a new figure titled ``title``
+    (default: the damper model and the motion). Saved as PNG at ``path`` when given
+    (atomically). Returns the `Figure`.
+    """
+    from matplotlib import colormaps
+
+    _expect(cycles, "cycles", "Cycles")
+    ds = cycles.dataset
+    missing = [c for c in ("x", "xd", "F") if c not in ds.variables]
+    if missing or "voltage" not in ds.dims:
+        raise ValueError("expected the result of railride.rig.cycles (dims voltage, time; x, xd, F)")
+    if ax is None:
+        fig = new_figure((11.0, 4.8))
+        ax_x, ax_v = fig.subplots(1, 2, sharey=True)
+    else:
+        ax_x, ax_v = given_axes(ax, 2, "force against displacement, against velocity")
+        fig = ax_x.figure
+    volts = [float(v) for v in ds["voltage"].values]
+    cmap = colormaps["viridis"]
+    for i, v in enumerate(volts):
+        cyc = ds.isel(voltage=i)
+        colour = cmap(0.85 * i / max(1, len(volts) - 1))
+        force = cyc["F"].values / 1e3
+        ax_x.plot(cyc["x"].values * 1e3, force, color=colour, linewidth=1.2, label=f"{v:g} V")
+        ax_v.plot(cyc["xd"].values, force, color=colour, linewidth=1.2, label=f"{v:g} V")
+    ax_x.set_xlabel("extension x (mm)")
+    ax_v.set_xlabel("extension rate x' (m/s)")
+    ax_x.set_ylabel("damper force F (kN, tension +)")
+    ax_x.set_title("force - displacement", fontsize="medium")
+    ax_v.set_title("force - velocity", fontsize="medium")
+    for a in (ax_x, ax_v):
+        a.axhline(0.0, color="0.6", linewidth=0.5)
+        a.axvline(0.0, color="0.6", linewidth=0.5)
+        a.grid(True, linewidth=0.4, alpha=0.6)
+    ax_v.legend(title="command voltage", fontsize="small", loc="upper left")
+    if ax is None:
+        if title is None:
+            model = getattr(cycles.damper, "model", None) or damper_model_name(ds) or "damper"
+            title = f"{model} damper, steady-state cycle"
+            motion = cycles.motion
+            if motion is not None:
+                title += f", x = {motion.amplitude * 1e3:g} mm sin(2 pi {motion.frequency:g} Hz t)"
+        fig.suptitle(title, fontsize="medium")
+    save_png(fig, path)
+    return fig
+
+
+def plot_tracking(tracking, path=None, *, title: str | None = None, ax=None):
+    """Force tracking of `railride.rig.track` (a `railride.rig.Tracking`): top, the desired and
+    the actual damper force (kN, tension +) against time; bottom, the command voltage v and the
+    coil voltage u (V). The first cycle, left out of the metrics (start-up), is shaded.
+
+    ``ax``: two Axes to draw in (no title then), or None for a new figure titled ``title``
+    (default: the desired force, the damper, the gains and the error). Saved as PNG at ``path``
+    when given (atomically). Returns the `Figure`.
+    """
+    _expect(tracking, "tracking", "Tracking")
+    ds = tracking.dataset
+    missing = [c for c in ("F", "desired_force", "v", "u") if c not in ds.variables]
+    if missing:
+        raise ValueError(f"expected the result of railride.rig.track; missing {', '.join(missing)}")
+    if ax is None:
+        fig = new_figure((10.0, 6.5))
+        ax_f, ax_v = fig.subplots(2, 1, sharex=True, height_ratios=(3, 2))
+    else:
+        ax_f, ax_v = given_axes(ax, 2, "forces, voltages")
+        fig = ax_f.figure
+    time = ds["time"].values
+    ax_f.plot(time, ds["desired_force"].values / 1e3, color="0.15", linewidth=1.1,
+              linestyle="--", label="desired")
+    ax_f.plot(time, ds["F"].values / 1e3, color="tab:red", linewidth=1.1, label="actual")
+    ax_f.set_ylabel("damper force (kN, tension +)")
+    ax_f.legend(loc="upper right", fontsize="small", ncols=2)
+    ax_v.plot(time, ds["v"].values, color="tab:blue", linewidth=0.9, label="command v")
+    ax_v.plot(time, ds["u"].values, color="tab:orange", linewidth=1.2, label="coil u")
+    ax_v.set_ylabel("voltage (V)")
+    ax_v.set_xlabel("time (s)")
+    ax_v.legend(loc="upper right", fontsize="small", ncols=2)
+    window = tracking.window
+    start_up = window is not None and window[0] > time[0]
+    for a in (ax_f, ax_v):
+        a.grid(True, linewidth=0.4, alpha=0.6)
+        if start_up:
+            a.axvspan(time[0], window[0], color="0.9", zorder=0)
+    ax_v.set_xlim(time[0], time[-1])
+    if ax is None:
+        if title is None:
+            title = _tracking_title(tracking)
+        if start_up:
+            title += "\n(shaded: start-up, left out of the metrics)"
+        fig.suptitle(title, fontsize="medium")
+    save_png(fig, path)
+    return fig
+
+
+def _tracking_title(tracking) -> str:
+    ds = tracking.dataset
+    parts = [f"{tracking.desired} force tracking"]
+    model = damper_model_name(ds)
+    if model:
+        parts.append(f"{model} damper")
+    if "B" in ds.attrs and "G_v_per_n" in ds.attrs:
+        parts.append(f"B = {float(ds.attrs['B']):g}, G = {float(ds.attrs['G_v_per_n']):.3g} V/N")
+    error = tracking.metrics().get("normalised_rms_error")
+    if isinstance(error, float) and math.isfinite(error):
+        parts.append(f"normalised RMS error {error:.3f}")
+    return ", ".join(parts)
