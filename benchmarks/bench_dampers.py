@@ -28,32 +28,32 @@ def main():
 
     from railride import rig
     from railride.simulation import simulate
+    from railride.suspension import Suspension
     from railride.track import scenario
 
     sc = scenario("paper-sine")  # 10 s at dt = 1e-4 s
     rows = []
     for damper, voltage, note in (("railway", 0.0, "passive-off"), ("railway", 2.25, "passive-on"),
                                   ("dyke1996", 2.25, "small-scale damper")):
-        simulate(sc, damper=damper, voltage=voltage)
-        t = _min_time(lambda: simulate(sc, damper=damper, voltage=voltage), args.repeat)
+        mr = Suspension.semi_active(damper, voltage=voltage)
+        simulate(sc, suspension=mr)
+        t = _min_time(lambda: simulate(sc, suspension=mr), args.repeat)
         rows.append((f"vehicle, four `{damper}` MR dampers at {voltage:g} V ({note}), 10 s, dt = 1e-4 s",
                      f"{t * 1e3:.1f} ms", "<= 50 ms" if damper == "railway" else ""))
     # the closed loop: SAS (attitude+ride) with the shipped gains on each device
-    from railride.control import GainSet
-
-    sas = GainSet.default().controller("sas-attitude-ride")
     for damper in ("railway", "ideal-damper", "ideal"):
-        simulate(sc, damper=damper, controller=sas)
-        t = _min_time(lambda: simulate(sc, damper=damper, controller=sas), args.repeat)
+        sas = Suspension.named("sas-attitude-ride", damper=damper)
+        simulate(sc, suspension=sas)
+        t = _min_time(lambda: simulate(sc, suspension=sas), args.repeat)
         rows.append((f"vehicle, SAS (attitude+ride) closed loop, `{damper}`, 10 s", f"{t * 1e3:.1f} ms", ""))
-    simulate(scenario("paper-sine", duration=1.0), damper="spencer1997", voltage=1.0)
-    t = _min_time(lambda: simulate(scenario("paper-sine", duration=1.0), damper="spencer1997",
-                                   voltage=1.0), max(1, args.repeat // 2))
+    spencer = Suspension.semi_active("spencer1997", voltage=1.0)
+    simulate(scenario("paper-sine", duration=1.0), suspension=spencer)
+    t = _min_time(lambda: simulate(scenario("paper-sine", duration=1.0), suspension=spencer), max(1, args.repeat // 2))
     rows.append(("vehicle, four `spencer1997` dampers at 1 V, 1 s (stiff: sub-stepped)", f"{t:.2f} s", ""))
     sc_batch = scenario("paper-sine", duration=2.0)
-    volts = list(np.linspace(0.0, 2.25, 64))
-    simulate(sc_batch, damper="railway", voltage=volts)
-    t = _min_time(lambda: simulate(sc_batch, damper="railway", voltage=volts), max(1, args.repeat // 2))
+    batch = [Suspension.semi_active("railway", voltage=float(v)) for v in np.linspace(0.0, 2.25, 64)]
+    simulate(sc_batch, suspension=batch)
+    t = _min_time(lambda: simulate(sc_batch, suspension=batch), max(1, args.repeat // 2))
     rows.append(("batch of 64 voltages x 20 000 steps, `railway` dampers, both cores",
                  f"{64 * 20_000 / t / 1e6:.2f} M sample-steps/s", ""))
     for name in ("railway", "spencer1997"):

@@ -15,7 +15,6 @@ import tempfile
 from pathlib import Path
 
 import railride as rr
-from railride import dampers
 from railride.control import GainSet
 
 RESPONSES = ("acceleration_m_s2", "displacement_m", "pitch_deg", "roll_deg")
@@ -38,21 +37,20 @@ def main():
 
     sc = rr.scenario("paper-sine")
     gains = GainSet.default()  # the shipped gains, tuned for the `railway` dampers at x 1
-    controller = gains.controller("sas-attitude-ride")
     passive = rr.simulate(sc).metrics().sel(statistic="rms", response=list(RESPONSES)).values
 
     rows = []
     # MR dampers: every force parameter scaled, so at the same motion and voltage the force is
     # k times as large (the force at 0 V grows with it too).
     for k in SCALES:
-        damper = dampers.preset("railway").scaled(k)
-        res = rr.simulate(sc, damper=damper, controller=controller, inner=gains.inner)
+        res = rr.simulate(sc, suspension=rr.Suspension.named("sas-attitude-ride", gains, damper_scale=k))
         rows.append((f"railway x {k:g}", rms_ratios(res, passive), None))
     # The same gains on the ideal semi-active damper (demand where it dissipates, no limit)
     # and the ideal actuator (force = demand). These may diverge with gains tuned for an MR
     # damper: mark it instead of stopping.
     for name in ("ideal-damper", "ideal"):
-        res = rr.simulate(sc, damper=name, controller=controller, on_divergence="mark")
+        res = rr.simulate(sc, suspension=rr.Suspension.named("sas-attitude-ride", gains, damper=name),
+                          on_divergence="mark")
         diverged = float(res.diverged_at[0])
         rows.append((name, rms_ratios(res, passive), None if math.isnan(diverged) else diverged))
 

@@ -7,6 +7,7 @@ The public API, in the order a run needs it::
     vehicle = rr.Vehicle(params)                      # M, C, K, modes, frequency response
     sc = rr.scenario("paper-sine", speed=55.56)        # track and run (docs/model.md, Track input)
     result = rr.simulate(sc, params)                  # time histories (xarray) + metrics
+    rr.simulate(sc, params, rr.Suspension.named("sas-attitude-ride"))  # a controlled secondary
     result.metrics()                                  # RMS, peak-to-peak (docs/model.md, Metrics)
     rr.compare(sc)                                    # the paper's comparison, with the bounds
     rr.tune()                                         # the sensitivity study (shipped gains)
@@ -21,6 +22,8 @@ from .metrics import reduction, ride_metrics
 from .params import VehicleParams
 from .pareto import ParetoResult, pareto
 from .simulation import RideResult, simulate
+from .solver import SolverSettings
+from .suspension import Suspension
 from .track import CosineBump, MeasuredTrack, Scenario, SineTrack, scenario
 from .objectives import Objective
 from .tuning import tune
@@ -28,6 +31,7 @@ from .vehicle import Vehicle
 
 __all__ = [
     "Comparison", "CosineBump", "GainSet", "MeasuredTrack", "Objective", "ParetoResult",
-    "RideResult", "Scenario", "SineTrack", "Vehicle", "VehicleParams", "compare", "dampers",
-    "pareto", "reduction", "ride_metrics", "scenario", "simulate", "tune",
+    "RideResult", "Scenario", "SineTrack", "SolverSettings", "Suspension", "Vehicle",
+    "VehicleParams", "compare", "dampers", "pareto", "reduction", "ride_metrics", "scenario",
+    "simulate", "tune",
 ]

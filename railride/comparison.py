@@ -16,9 +16,11 @@ import xarray as xr
 
 from . import __version__, dampers
 from .control import CONTROLLERS, LABELS, GainSet
-from .defaults import DEFAULT_CONTROL_RATE, DEFAULT_DAMPER, DEFAULT_DT, DEFAULT_OUTPUT_RATE
+from .defaults import DEFAULT_DAMPER
 from .metrics import STATISTICS, reduction, ride_metrics, select_window
 from .simulation import simulate
+from .solver import SolverSettings, _with_keywords
+from .suspension import Suspension, damper_model
 
 #: Table 1 of Harun et al. (RMS values): for display beside railride's results.
 PAPER_TABLE1 = {
@@ -65,6 +67,8 @@ class Comparison:
     #: per ideal device ("ideal-damper", "ideal") and controller: the ride metrics of the same
     #: gains on that device, and the time it diverged (NaN if it did not); None if not run
     bounds: dict | None = None
+    #: how the runs were integrated (also in ``settings``: dt_s, output_rate_hz, control_rate_hz)
+    solver: SolverSettings | None = None
 
     @property
     def reductions(self) -> xr.DataArray:
@@ -224,23 +228,28 @@ class Comparison:
 
 
 def compare(scenario, params=None, *, controllers=CONTROLLERS, gains: GainSet | None = None,
-            damper=DEFAULT_DAMPER, damper_scale: float = 1.0, window=None, dt: float = DEFAULT_DT,
-            output_rate: float = DEFAULT_OUTPUT_RATE, control_rate: float = DEFAULT_CONTROL_RATE,
-            sensor_noise=None, progress=None, comfort: bool = False, bounds: bool = True) -> Comparison:
+            damper=DEFAULT_DAMPER, damper_scale: float = 1.0, window=None, solver=None,
+            sensor_noise=None, progress=None, comfort: bool = False, bounds: bool = True,
+            dt=None, output_rate=None, control_rate=None) -> Comparison:
     """Run the passive vehicle and each controller on ``scenario`` and collect the metrics.
 
     ``controllers`` names from `railride.control.CONTROLLERS` (passive is always run as the
     baseline); ``gains`` a `GainSet` (default: the shipped gains); ``damper`` the name of the
     controlled suspensions' dampers (`railride.dampers.NAMES`: an MR preset or "ideal", the
     ideal actuator) and ``damper_scale`` the factor on an MR damper's force capacity
-    (`BoucWen.scaled`; 1 for the ideal actuator); passive stays the viscous baseline.
-    ``window`` (start, end) s for the metrics. ``comfort``: also the ride comfort indices of
-    each suspension over the same window (`Comparison.comfort`; ``controllers[i].comfort`` in
-    `Comparison.to_dict`). ``bounds`` (with MR dampers): also run the same control laws and
-    gains on the two ideal devices, the ideal semi-active damper ("ideal-damper") and the ideal
-    actuator ("ideal"), so that every reduction is shown beside what those would reach
-    (`Comparison.bounds`).
+    (`BoucWen.scaled`; 1 for the ideal actuator); passive stays the viscous baseline. Each
+    suspension is `Suspension.named` (controller name, gains, damper, scale, ``sensor_noise``).
+    ``window`` (start, end) s for the metrics; ``solver`` the `SolverSettings` of every run
+    (default: the defaults), recorded in ``settings``. ``comfort``: also the ride comfort
+    indices of each suspension over the same window (`Comparison.comfort`;
+    ``controllers[i].comfort`` in `Comparison.to_dict`). ``bounds`` (with MR dampers): also
+    run the same control laws and gains on the two ideal devices, the ideal semi-active damper
+    ("ideal-damper") and the ideal actuator ("ideal"), so that every reduction is shown beside
+    what those would reach (`Comparison.bounds`). ``dt``, ``output_rate``, ``control_rate``:
+    the solver's settings as the command line still gives them (not with ``solver``).
     """
+    # TEMPORARY: removed when the CLI moves onto Suspension (dt, output_rate, control_rate)
+    solver = _with_keywords(solver, dt, output_rate, control_rate)
     model = damper_model(damper, damper_scale)
     damper_scale = float(damper_scale)
     names = check_controllers(controllers)
@@ -250,21 +259,23 @@ def compare(scenario, params=None, *, controllers=CONTROLLERS, gains: GainSet | 
     # progress by sample-steps: the passive run is one sample, the controlled batches the rest
     share = 1.0 / (1 + len(controlled) * (1 + len(bound_devices)))
     part = (lambda lo, w: (lambda done: progress(lo + w * done))) if progress is not None else None
-    common = dict(dt=dt, output_rate=output_rate)
-    datasets = {"passive": simulate(scenario, params, progress=part and part(0.0, share), **common).dataset}
+    datasets = {"passive": simulate(scenario, params, Suspension.passive(), solver=solver,
+                                    progress=part and part(0.0, share)).dataset}
     if controlled:
-        batch = simulate(scenario, params, damper=model, controller=[gains.controller(n) for n in controlled],
-                         inner=gains.inner, control_rate=control_rate, sensor_noise=sensor_noise,
-                         progress=part and part(share, share * len(controlled)), **common).dataset
+        batch = simulate(scenario, params, [Suspension.named(n, gains, damper, damper_scale,
+                                                             sensor_noise=sensor_noise)
+                                            for n in controlled],
+                         solver=solver, progress=part and part(share, share * len(controlled))).dataset
         for i, n in enumerate(controlled):
             datasets[n] = batch.isel(sample=i, drop=True)
     bound_values = {}
     for k, device in enumerate(bound_devices):
         # the ideal actuator may not be stable with gains tuned for a damper: marked, not fatal
-        res = simulate(scenario, params, damper=device, controller=[gains.controller(n) for n in controlled],
-                       control_rate=control_rate, sensor_noise=sensor_noise, on_divergence="mark",
+        res = simulate(scenario, params, [Suspension.named(n, gains, device, sensor_noise=sensor_noise)
+                                          for n in controlled],
+                       solver=solver, on_divergence="mark",
                        progress=part and part(share * (1 + len(controlled) * (1 + k)),
-                                              share * len(controlled)), **common)
+                                              share * len(controlled)))
         m = res.metrics(window)
         bound_values[device] = {n: {"metrics": m.isel(sample=i, drop=True),
                                     "diverged_at_s": float(res.diverged_at[i])}
@@ -274,8 +285,7 @@ def compare(scenario, params=None, *, controllers=CONTROLLERS, gains: GainSet | 
     first = datasets["passive"]
     settings = {"scenario": json.loads(str(first["scenario"].values)),
                 "vehicle_params": json.loads(str(first["vehicle_params"].values)), "damper": str(damper),
-                "damper_scale": damper_scale, "dt_s": dt, "output_rate_hz": output_rate,
-                "control_rate_hz": control_rate,
+                "damper_scale": damper_scale, **solver.to_dict(),
                 "window_s": None if window is None else [float(w) for w in window],
                 "sensor_noise": None if sensor_noise is None else sensor_noise.__dict__}
     comfort_values = None
@@ -283,28 +293,12 @@ def compare(scenario, params=None, *, controllers=CONTROLLERS, gains: GainSet | 
         from .comfort import ride_comfort
         comfort_values = {n: ride_comfort(datasets[n], window=window) for n in names}
     return Comparison(names, datasets, metrics, window, gains, str(damper), settings,
-                      comfort_values, bound_values or None)
+                      comfort_values, bound_values or None, solver)
 
 
 #: the ideal devices `compare` runs beside the MR dampers: the best a damper could do with the
 #: same control laws and gains, and what a force actuator would do
 BOUND_DEVICES = ("ideal-damper", "ideal")
-
-
-def damper_model(name: str, scale: float = 1.0):
-    """The damper called ``name`` (`railride.dampers.preset`) with its force capacity times
-    ``scale``; a scale other than 1 for the ideal actuator is a ValueError (it has none)."""
-    if not isinstance(name, str):
-        raise ValueError(f"damper = {name!r}: must be a name ({', '.join(dampers.NAMES)}); "
-                         "scale a preset with damper_scale")
-    scale = dampers.check_scale("damper_scale", scale)
-    model = dampers.preset(name)
-    if scale == 1.0:
-        return model
-    if model.law == dampers.LAW_IDEAL:
-        raise ValueError(f"damper_scale = {scale:g}: the ideal actuator applies the demand "
-                         "exactly and has no force capacity to scale (leave damper_scale at 1)")
-    return model.scaled(scale)
 
 
 #: indices whose reduction against passive is given: a_w, VDV and N_MV_z scale with the

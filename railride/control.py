@@ -25,6 +25,7 @@ import tomllib
 from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
+from typing import Callable, ClassVar, NamedTuple
 
 import numpy as np
 
@@ -168,10 +169,38 @@ class SAS:
         return out
 
 
+@dataclass(frozen=True)
+class ZeroDemand:
+    """A closed loop without an outer loop: the demand f_d is 0 at every corner, so the inner
+    loop holds the MR dampers at their lowest force (and the ideal devices apply none)."""
+
+    name = "none"
+    label = "no outer loop"
+
+    def gains(self, vehicle: Vehicle) -> tuple[np.ndarray, np.ndarray]:
+        return np.zeros((4, 6)), np.zeros((4, 3))
+
+    def to_dict(self) -> None:
+        return None  # no gains: a result records null
+
+
 # -- gains files --------------------------------------------------------------------------------
-CONTROLLERS = ("passive", "pid", "sas-attitude", "sas-attitude-ride")
-LABELS = {"passive": "Passive", "pid": "PID", "sas-attitude": "SAS (attitude)",
-          "sas-attitude-ride": "SAS (attitude+ride)"}
+class _OuterLoop(NamedTuple):
+    tables: tuple  # the gain tables it reads besides the inner loop's
+    build: Callable  # GainSet -> the outer loop
+    label: str
+
+
+#: the outer loops a gains file defines, by name in the paper's order: a new controller is a class
+#: with ``gains(vehicle)``, ``name`` and ``to_dict()``, and an entry here
+_OUTER_LOOPS = {
+    "pid": _OuterLoop(("pid",), lambda g: g.pid, "PID"),
+    "sas-attitude": _OuterLoop(("attitude",), lambda g: SAS(g.attitude), "SAS (attitude)"),
+    "sas-attitude-ride": _OuterLoop(("attitude", "ride"), lambda g: SAS(g.attitude, g.ride),
+                                    "SAS (attitude+ride)"),
+}
+CONTROLLERS = ("passive", *_OUTER_LOOPS)
+LABELS = {"passive": "Passive", **{name: loop.label for name, loop in _OUTER_LOOPS.items()}}
 _TABLES = {"inner": InnerLoop, "pid": PID, "sas.attitude": Attitude, "sas.ride": Ride}
 
 
@@ -188,6 +217,60 @@ class GainSet:
     source: str = "<built>"
     provenance: dict = field(default_factory=dict, compare=False, repr=False)
 
+    #: the gain tables, as a "table.entry" name spells them (the file's [sas.attitude] is "attitude")
+    TABLES: ClassVar[tuple] = ("inner", "pid", "attitude", "ride")
+
+    @classmethod
+    def entry_names(cls, table: str) -> tuple[str, ...]:
+        """The "table.entry" names of ``table``, in the order of its fields."""
+        kind = {"inner": InnerLoop, "pid": PID, "attitude": Attitude, "ride": Ride}[cls._table_name(table)]
+        return tuple(f"{table}.{f.name}" for f in dataclasses.fields(kind))
+
+    @staticmethod
+    def tables_read(controller: str) -> tuple[str, ...]:
+        """The tables the outer loop ``controller`` and its inner loop read."""
+        if controller not in _OUTER_LOOPS:
+            raise ValueError(f"controller = {controller!r}: allowed {', '.join(_OUTER_LOOPS)}")
+        return ("inner", *_OUTER_LOOPS[controller].tables)
+
+    @classmethod
+    def _table_name(cls, table: str) -> str:
+        if table not in cls.TABLES:
+            raise ValueError(f"gain table {table!r}: allowed {', '.join(cls.TABLES)}")
+        return table
+
+    def table(self, name: str):
+        """The gains of table ``name`` (one of `TABLES`)."""
+        return getattr(self, self._table_name(name))
+
+    def value(self, entry: str) -> float:
+        """The gain called "table.entry", e.g. "pid.kp"."""
+        table, _, name = entry.partition(".")
+        if table not in self.TABLES or not name:
+            raise ValueError(f"gain {entry!r}: expected table.entry with table one of {', '.join(self.TABLES)}")
+        gains = self.table(table)
+        if name not in gains.to_dict():
+            raise ValueError(f"unknown gain {entry!r}; allowed: {', '.join(self.entry_names(table))}")
+        return float(getattr(gains, name))
+
+    def entries(self, tables=TABLES) -> dict[str, float]:
+        """Every gain of ``tables`` by its "table.entry" name."""
+        return {f"{t}.{k}": float(v) for t in tables for k, v in self.table(t).to_dict().items()}
+
+    def apply(self, changes) -> "GainSet":
+        """These gains with ``changes``, ("table.entry", value) pairs (or a dict), applied; the
+        source stays, the provenance does not (they are other gains)."""
+        grouped: dict[str, dict] = {}
+        for name, value in (changes.items() if isinstance(changes, dict) else changes):
+            table, _, entry = name.partition(".")
+            if table not in self.TABLES or not entry:
+                raise ValueError(f"gain {name!r}: expected table.entry with table one of {', '.join(self.TABLES)}")
+            grouped.setdefault(table, {})[entry] = value
+        tables = {t: self.table(t) for t in self.TABLES}
+        for table, entries in grouped.items():
+            tables[table] = tables[table].replace(**entries)
+        return GainSet(tables["inner"], tables["pid"], tables["attitude"], tables["ride"], self.source)
+
     def tuned_on(self, record: dict) -> bool:
         """Whether these gains were tuned on the track ``record`` (`Scenario.describe`), as the
         file's [provenance] scenario record says: judged there, they are judged in-sample."""
@@ -197,13 +280,9 @@ class GainSet:
         """The outer loop called ``name`` (None for the passive suspension)."""
         if name == "passive":
             return None
-        if name == "pid":
-            return self.pid
-        if name == "sas-attitude":
-            return SAS(self.attitude)
-        if name == "sas-attitude-ride":
-            return SAS(self.attitude, self.ride)
-        raise ValueError(f"unknown controller {name!r}; allowed: {', '.join(CONTROLLERS)}")
+        if name not in _OUTER_LOOPS:
+            raise ValueError(f"unknown controller {name!r}; allowed: {', '.join(CONTROLLERS)}")
+        return _OUTER_LOOPS[name].build(self)
 
     def to_toml(self) -> str:
         lines = []

@@ -206,7 +206,7 @@ class Ideal(_Damper):
     """The ideal actuator: the corner force on the carbody equals the outer loop's demand f_d,
     sampled and held like every demand, with no inner loop, voltage or clipping. It may push
     energy in, which a damper cannot, and is the bound a semi-active damper approaches. It has
-    no states and no parameters, and works in a closed loop only (`simulate(controller=...)`).
+    no states and no parameters, and works in a closed loop only (`railride.Suspension.ideal`).
 
     In the stepper its command slot carries the held demand f_d (on the carbody, up +), so
     F = -f_d in the damper's convention (tension +) and the force on the carbody is f = f_d.

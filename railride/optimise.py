@@ -25,8 +25,9 @@ import numpy as np
 import scipy.optimize
 
 from .control import GainSet
-from .defaults import DEFAULT_DAMPER, DEFAULT_DT
-from .sweep import Case, RunTable, apply_gains, run_cases
+from .defaults import DEFAULT_DAMPER
+from .solver import SolverSettings
+from .sweep import Case, RunTable, run_cases
 from .objectives import DEFAULT_OBJECTIVE, Objective
 from .tuning import PARAMETERS, REFERENCE, _rms
 
@@ -44,7 +45,7 @@ class _Evaluator:
     of the four responses instead (the Pareto view)."""
 
     def __init__(self, parameters, suspension, scenario, scenario_options, gains, objective,
-                 damper, executor, table, dt, progress):
+                 damper, executor, table, progress, params=None, solver=None):
         self.parameters = tuple(parameters)
         self.suspension = suspension
         self.scenario = scenario
@@ -54,7 +55,8 @@ class _Evaluator:
         self.damper = damper
         self.executor = executor
         self.table = RunTable() if table is None else table
-        self.dt = dt
+        self.params = params
+        self.solver = SolverSettings.of(solver)
         self.progress = progress
         self.n_runs = 0
         self.passive = _rms(self._run([Case(scenario, self.opts)]))[0]
@@ -62,7 +64,7 @@ class _Evaluator:
     def _run(self, cases):
         self.n_runs += len(cases)
         return run_cases(cases, executor=self.executor, table=self.table, base_gains=self.gains,
-                         dt=self.dt, progress=self.progress)
+                         params=self.params, solver=self.solver, progress=self.progress)
 
     def cases(self, points: np.ndarray) -> list[Case]:
         """points (n, d) of log10 gains."""
@@ -94,16 +96,17 @@ def optimise(parameters=SAS_PARAMETERS, *, suspension: str = "sas-attitude-ride"
              scenario: str = "paper-sine", scenario_options=None, gains: GainSet | None = None,
              objective: Objective | None = None, damper: str = DEFAULT_DAMPER, executor=None,
              table: RunTable | None = None, popsize: int = 8, maxiter: int = 30, seed: int = 0,
-             dt: float = DEFAULT_DT, progress=None) -> OptimiseResult:
+             params=None, solver=None, progress=None) -> OptimiseResult:
     """Differential evolution over ``parameters`` (names as in `railride.tuning.PARAMETERS`)
     at once. ``popsize`` times the number of parameters runs per generation; ``seed`` makes the
-    search repeatable."""
+    search repeatable. ``params``: the vehicle (`VehicleParams` or a preset name, default
+    "paper"); ``solver``: the `SolverSettings` of every run."""
     ev = _Evaluator(parameters, suspension, scenario, scenario_options, gains, objective, damper,
-                    executor, table, dt, progress)
+                    executor, table, progress, params, solver)
     res = scipy.optimize.differential_evolution(
         lambda x: ev(x.T), _bounds(parameters), vectorized=True, updating="deferred",
         popsize=popsize, maxiter=maxiter, seed=seed, polish=False, tol=1e-4)
-    tuned = apply_gains(ev.gains, tuple(zip(parameters, (10.0 ** res.x).tolist())))
+    tuned = ev.gains.apply(tuple(zip(parameters, (10.0 ** res.x).tolist())))
     return OptimiseResult(tuned, float(res.fun), ev.n_runs, int(res.nit), tuple(parameters),
                           res.x, str(res.message), ev.objective)
 
@@ -124,14 +127,15 @@ class SensitivityResult:
 def sensitivity(parameters=SAS_PARAMETERS, *, suspension: str = "sas-attitude-ride",
                 scenario: str = "paper-sine", scenario_options=None, gains: GainSet | None = None,
                 objective: Objective | None = None, damper: str = DEFAULT_DAMPER, executor=None,
-                table: RunTable | None = None, n: int = 64, seed: int = 0, dt: float = DEFAULT_DT,
+                table: RunTable | None = None, n: int = 64, seed: int = 0, params=None, solver=None,
                 progress=None) -> SensitivityResult:
     """Sobol indices of the objective with every parameter uniform in log10 over the search
-    bounds: n (d + 2) runs for d parameters (``n`` a power of two)."""
+    bounds: n (d + 2) runs for d parameters (``n`` a power of two). ``params`` and ``solver``
+    as for `optimise`."""
     if n < 2 or n & (n - 1):
         raise ValueError(f"n = {n!r}: a power of two >= 2")
     ev = _Evaluator(parameters, suspension, scenario, scenario_options, gains, objective, damper,
-                    executor, table, dt, progress)
+                    executor, table, progress, params, solver)
     import scipy.stats  # here, not at import: scipy.stats costs half a second to load
 
     dists = [scipy.stats.uniform(lo, hi - lo) for lo, hi in _bounds(parameters)]

@@ -22,20 +22,20 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from .control import GainSet
-from .defaults import DEFAULT_DAMPER, DEFAULT_DT
+from .control import CONTROLLERS, GainSet
+from .defaults import DEFAULT_DAMPER
 from .metrics import RESPONSES
 from .optimise import _bounds, _Evaluator
+from .solver import _with_keywords
 from .sweep import Case, RunTable
-from .tuning import PARAMETERS
 
 SCHEMA = "railride.pareto/1"
 #: the files `ParetoResult.save` writes, in this order
 FILES = ("pareto.png", "pareto.csv", "pareto.json")
 #: the gains each controller reads (the inner loop stays at the base gains: it is one setting
 #: per compiled batch)
-CONTROLLER_PARAMETERS = {"pid": PARAMETERS["pid"], "sas-attitude": PARAMETERS["attitude"],
-                         "sas-attitude-ride": PARAMETERS["attitude"] + PARAMETERS["ride"]}
+CONTROLLER_PARAMETERS = {n: sum((GainSet.entry_names(t) for t in GainSet.tables_read(n) if t != "inner"), ())
+                         for n in CONTROLLERS[1:]}
 #: the ratios, by their short names, in the order of RESPONSES
 RATIOS = ("acceleration", "displacement", "pitch", "roll")
 #: the planes of the plot, each with its own non-dominated flag
@@ -214,7 +214,7 @@ def in_sample_note(gains: GainSet, record: dict) -> str | None:
 def pareto(suspension: str = "sas-attitude-ride", *, n_samples: int = 128, seed: int = 0,
            scenario: str = "paper-sine", scenario_options=None, gains: GainSet | None = None,
            damper: str = DEFAULT_DAMPER, executor=None, table: RunTable | None = None,
-           dt: float = DEFAULT_DT, progress=None, parameters=None) -> ParetoResult:
+           params=None, solver=None, progress=None, parameters=None, dt=None) -> ParetoResult:
     """Sample the gains of ``suspension`` (pid, sas-attitude, sas-attitude-ride; by default all
     it reads, or ``parameters``) and return the RMS ratios to passive of each sample.
 
@@ -222,31 +222,37 @@ def pareto(suspension: str = "sas-attitude-ride", *, n_samples: int = 128, seed:
     REFERENCE / 1000 and REFERENCE x 100 (the box of `railride.optimise`), the other gains at
     ``gains`` (default the shipped `GainSet.default`), which are also run as sample 0. One call
     of `run_cases`: 32-run batches, ``table`` to resume, ``executor`` for Dask;
-    ``progress(done, total, runs_per_second)`` after each chunk.
+    ``progress(done, total, runs_per_second)`` after each chunk. ``params``: the vehicle
+    (`VehicleParams` or a preset name, default "paper"); ``solver``: the `SolverSettings` of
+    every run (``dt``: the step alone, as the command line still gives it); recorded in
+    ``settings`` where they differ from the defaults.
     """
+    from .simulation import _resolve_params
+    from .sweep import other_settings
     from .track import scenario as make_scenario
 
-    params = _parameters(suspension, parameters)
+    solver = _with_keywords(solver, dt)  # TEMPORARY: dt= removed when the CLI moves onto Suspension
+    vehicle = _resolve_params(params)
+    names = _parameters(suspension, parameters)
     n_samples = _power_of_two("n_samples", n_samples)
     seed = _seed("seed", seed)
     base = GainSet.default() if gains is None else gains
     record = make_scenario(scenario, **dict(scenario_options or {})).describe()
     table = RunTable() if table is None else table
-    ev = _Evaluator(params, suspension, scenario, scenario_options, base, None, damper, executor,
-                    table, dt, progress)
-    bounds = np.array(_bounds(params))
+    ev = _Evaluator(names, suspension, scenario, scenario_options, base, None, damper, executor,
+                    table, progress, vehicle, solver)
+    bounds = np.array(_bounds(names))
     import scipy.stats.qmc  # here, not at import: scipy.stats costs half a second to load
 
-    unit = scipy.stats.qmc.Sobol(len(params), scramble=True, seed=seed).random_base2(
+    unit = scipy.stats.qmc.Sobol(len(names), scramble=True, seed=seed).random_base2(
         int(math.log2(n_samples)))
     points = scipy.stats.qmc.scale(unit, bounds[:, 0], bounds[:, 1])
     base_case = Case(scenario, ev.opts, suspension=suspension, damper=damper)
     rms = ev.rms([base_case, *ev.cases(points)])
-    values = {p: float(getattr(getattr(base, p.partition(".")[0]), p.partition(".")[2]))
-              for p in params}
-    gains_si = np.vstack([[values[p] for p in params], 10.0 ** points])
+    gains_si = np.vstack([[base.value(p) for p in names], 10.0 ** points])
     settings = {"n_samples": n_samples, "seed": seed, "sampling": SAMPLING, "damper": damper,
-                "dt_s": float(dt), "base_gains": base.source,
-                "base_gains_tuned_on": (base.provenance or {}).get("scenario")}
-    return ParetoResult(suspension, params, bounds, gains_si, rms, np.asarray(ev.passive, float),
+                "dt_s": solver.dt, "base_gains": base.source,
+                "base_gains_tuned_on": (base.provenance or {}).get("scenario"),
+                **other_settings(vehicle, solver)}
+    return ParetoResult(suspension, names, bounds, gains_si, rms, np.asarray(ev.passive, float),
                         record, settings, in_sample_note(base, record), len(table.frame))

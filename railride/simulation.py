@@ -5,16 +5,19 @@ from __future__ import annotations
 import dataclasses
 import functools
 import json
-import math
 import platform
 from datetime import datetime, timezone
+from typing import Any
 
 import numpy as np
 import xarray as xr
 
 from . import dampers, kernels
+from .control import ZeroDemand
 from .defaults import DEFAULT_CONTROL_RATE, DEFAULT_DAMPER, DEFAULT_DT, DEFAULT_OUTPUT_RATE  # noqa: F401 (re-exported)
 from .params import VehicleParams
+from .solver import SolverSettings, _with_keywords
+from .suspension import Suspension, batch_conflict
 from .track import Scenario, wheelset_input_table
 from .track import scenario as named_scenario
 from .vehicle import CORNER_NAMES, DOF_NAMES, DOF_UNITS, N_DOF, RAILS, WHEELSETS, Vehicle
@@ -120,7 +123,7 @@ def _forcing_table(utab: np.ndarray, Bw: np.ndarray, Bwd: np.ndarray) -> np.ndar
 
 
 def _as_list(x):
-    if x is None or isinstance(x, (Scenario, VehicleParams, str)):
+    if x is None or isinstance(x, (Scenario, VehicleParams, str)) or not hasattr(x, "__iter__"):
         return [x]
     return list(x)
 
@@ -142,18 +145,8 @@ def _resolve_params(p) -> VehicleParams:
         return VehicleParams.preset(p)
     if isinstance(p, VehicleParams):
         return p
-    raise ValueError(f"params = {p!r}: must be VehicleParams or a preset name")
-
-
-def _resolve_damper(damper):
-    if damper is None:
-        return None
-    if isinstance(damper, str):
-        return dampers.preset(damper)
-    if isinstance(damper, (dampers.Viscous, dampers.BoucWen, dampers.Ideal)):  # Spencer is a BoucWen
-        return damper
-    raise ValueError(f"damper = {damper!r}: must be None (passive), a name "
-                     f"({', '.join(dampers.NAMES)}) or a model from railride.dampers")
+    hint = " (a Suspension is the third argument, suspension=)" if isinstance(p, Suspension) else ""
+    raise ValueError(f"params = {p!r}: must be VehicleParams or a preset name{hint}")
 
 
 def _has_states(damper) -> bool:
@@ -161,94 +154,94 @@ def _has_states(damper) -> bool:
     return damper is not None and damper.law != dampers.LAW_IDEAL
 
 
-def _command_voltages(damper, voltage, n: int) -> np.ndarray:
-    """(n, 4) constant command voltages, checked against the damper's range."""
-    if damper is None:
-        if voltage is not None:
-            raise ValueError("voltage applies to MR dampers only: give damper= as well "
-                             "(the passive suspension has no command)")
-        return np.zeros((n, 4))
-    if damper.law == dampers.LAW_IDEAL:
-        return np.zeros((n, 4))  # checked in simulate: closed loop only, no voltage
-    if voltage is None:
-        voltage = damper.v_min
-    values = [voltage] * n if np.ndim(voltage) == 0 else list(voltage) * (n // len(voltage))
-    return np.repeat([[damper.check_voltage(v)] for v in values], 4, axis=1).astype(float)
-
-
-def _as_controllers(controller):
-    """None (open loop) or the list of outer loops (None entries: no outer loop)."""
-    if controller is None:
-        return None
-    items = list(controller) if isinstance(controller, (list, tuple)) else [controller]
-    for c in items:
-        if c is not None and not hasattr(c, "gains"):
-            raise ValueError(f"controller = {c!r}: must be an outer loop from railride.control "
-                             "(PID, SAS) or None")
+def _as_suspensions(suspension) -> list[Suspension]:
+    items = list(suspension) if isinstance(suspension, (list, tuple)) else [suspension]
+    items = [Suspension() if s is None else s for s in items]
+    for s in items:
+        if not isinstance(s, Suspension):
+            raise ValueError(f"suspension = {s!r}: must be a railride.Suspension, a list of them, "
+                             "or None (passive)")
     return items
 
 
-def _closed_loop(controllers, inner, control_rate, sensor_noise, damper, n, dt, duration):
-    """The closed-loop settings the stepper needs, checked; None for an open loop."""
-    from .control import GainSet, InnerLoop, SensorNoise
+def _command_voltage(s: Suspension) -> float:
+    """The command a sample's coils start at (and hold, in open loop): the set voltage, v_min
+    under a closed loop; 0 where there is no coil."""
+    if s.voltage is not None:
+        return s.voltage
+    return s.damper.v_min if _has_states(s.damper) else 0.0
 
-    if controllers is None:
-        for name, value in (("inner", inner), ("sensor_noise", sensor_noise)):
-            if value is not None:
-                raise ValueError(f"{name} applies to a closed loop only: give controller= as well")
+
+def _closed_loop(suspensions: list[Suspension], solver: SolverSettings, duration: float):
+    """The closed-loop settings the stepper needs (every sample's outer loop, the shared inner
+    loop and sensor noise); None for an open loop."""
+    first = suspensions[0]
+    if not first.closed_loop:
         return None
-    if damper.law == dampers.LAW_VISCOUS:
-        raise ValueError("a controller needs MR dampers or the ideal actuator (a viscous damper "
-                         "has no command)")
-    inner = GainSet.default().inner if inner is None else inner
-    if not isinstance(inner, InnerLoop):
-        raise ValueError(f"inner = {inner!r}: must be a railride.control.InnerLoop")
-    rate = _positive("control_rate", control_rate)
-    stride_f = 1.0 / (rate * dt)
-    stride = int(round(stride_f))
-    if stride < 1 or abs(stride - stride_f) > 1e-6 * stride_f:
-        raise ValueError(f"control_rate = {rate:g} Hz with dt = {dt:g} s: the controller period "
-                         f"must be a whole number of steps")
-    ticks = int(round(duration / (stride * dt))) + 2
-    if sensor_noise is not None and not isinstance(sensor_noise, SensorNoise):
-        raise ValueError(f"sensor_noise = {sensor_noise!r}: must be a railride.control.SensorNoise")
-    noise = sensor_noise.samples(ticks) if sensor_noise is not None else np.zeros((0, 6))
-    return {"controllers": controllers, "inner": inner, "rate": rate, "stride": stride,
-            "noise": noise, "sensor_noise": sensor_noise}
+    stride = solver.control_steps()
+    ticks = int(round(duration / (stride * solver.dt))) + 2
+    noise = first.sensor_noise
+    return {"controllers": [s.controller for s in suspensions], "inner": first.inner,
+            "rate": solver.control_rate, "stride": stride,
+            "noise": noise.samples(ticks) if noise is not None else np.zeros((0, 6)),
+            "sensor_noise": noise}
 
 
-def _positive(name: str, value) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value <= 0:
-        raise ValueError(f"{name} = {value!r}: must be a finite number > 0")
-    return float(value)
+#: the keywords simulate took before Suspension and SolverSettings
+_KEYWORDS = ("dt", "output_rate", "control_rate", "damper", "voltage", "controller", "inner",
+             "sensor_noise")
 
 
-def simulate(scenario=None, params=None, *, dt: float = DEFAULT_DT,
-             output_rate: float = DEFAULT_OUTPUT_RATE, damper=None, voltage=None,
-             controller=None, inner=None, control_rate: float = DEFAULT_CONTROL_RATE,
-             sensor_noise=None, initial_state=None, progress=None,
-             on_divergence: str = "raise") -> "RideResult":
+# TEMPORARY: removed when the CLI moves onto Suspension
+def _from_keywords(suspension, solver, keywords: dict):
+    """(suspension, solver) from simulate's former keywords: dt, output_rate, control_rate;
+    damper, voltage (a list: one sample each), controller (a list: one sample each, None in it
+    a closed loop with no outer loop), inner, sensor_noise. A controller without damper uses
+    DEFAULT_DAMPER; an inner loop given with an ideal device is not used, as before."""
+    unknown = sorted(set(keywords) - set(_KEYWORDS))
+    if unknown:
+        raise TypeError(f"simulate() got an unexpected keyword argument {unknown[0]!r}")
+    solver = _with_keywords(solver, **{k: keywords.pop(k) for k in ("dt", "output_rate", "control_rate")
+                                       if k in keywords})
+    given: dict[str, Any] = {k: v for k, v in keywords.items() if v is not None}
+    if not given:
+        return suspension, solver
+    if suspension is not None:
+        raise ValueError(f"give suspension= or {', '.join(given)}=, not both")
+    damper, inner, noise = given.get("damper"), given.get("inner"), given.get("sensor_noise")
+    voltage: Any = given.get("voltage")
+    controller: Any = given.get("controller")
+    if controller is None:
+        many = np.ndim(voltage) > 0
+        items = [Suspension(damper, v, None, inner, noise) for v in (list(voltage) if many else [voltage])]
+        return (items if many else items[0]), solver
+    if voltage is not None:
+        raise ValueError("give either voltage (open loop) or controller (closed loop), not both")
+    damper = DEFAULT_DAMPER if damper is None else damper
+    model = dampers.preset(damper) if isinstance(damper, str) else damper
+    if getattr(model, "law", None) == dampers.LAW_IDEAL:
+        inner = None
+    many = isinstance(controller, (list, tuple))
+    items = [Suspension(model, None, ZeroDemand() if c is None else c, inner, noise)
+             for c in (controller if many else [controller])]
+    return (items if many else items[0]), solver
+
+
+def simulate(scenario=None, params=None, suspension=None, *, solver=None, initial_state=None,
+             progress=None, on_divergence: str = "raise", **keywords) -> "RideResult":
     """Simulate the vehicle on one or many scenarios.
 
     ``scenario`` is a `Scenario`, a scenario name (see `railride.track.scenario`) or a list of
-    them; ``params`` is a `VehicleParams`, a preset name or a list. Lists run as one batch
-    along a ``sample`` dimension (a single item is broadcast against a list). Every sample of a
-    batch must share the duration. ``dt`` [s] is the fixed RK4 step and ``output_rate`` [Hz] the
-    rate of the stored time histories; 1/(output_rate dt) must be a whole number.
-    ``damper`` None keeps the passive viscous secondary dampers (c_sz); a damper model from
-    `railride.dampers` (or a preset name: railway, dyke1996, spencer1997) replaces them at all
-    four corners, driven at the constant command ``voltage`` [V] (default: the model's v_min,
-    "passive-off"; a list runs one sample per voltage, like a list of scenarios). The coil starts
-    at that voltage and the hysteretic states at 0.
-    ``controller`` closes the loop instead of a constant voltage: an outer loop from
-    `railride.control` (PID, SAS; a list runs one sample per controller, None in a list meaning
-    no outer loop, f_d = 0) sampling the carbody states at ``control_rate`` [Hz] (plus
-    ``sensor_noise``, a `control.SensorNoise`), and the inner loop ``inner`` (a
-    `control.InnerLoop`; default: the shipped gains) setting the voltages. A controller without
-    ``damper`` uses the `railway` MR dampers. ``damper="ideal"`` (`dampers.Ideal`) makes each
-    corner force equal to the held demand f_d, with no inner loop and no voltage (closed loop
-    only: without ``controller`` it is a ValueError); its Dataset has no voltage channels.
-    A scaled MR damper is ``dampers.preset("railway").scaled(4)``.
+    them; ``params`` is a `VehicleParams`, a preset name or a list; ``suspension`` a
+    `railride.Suspension` (None: passive, the viscous dampers c_sz) or a list. Lists run as one
+    batch along a ``sample`` dimension (a single item is broadcast against a list). Every
+    sample of a batch must share the duration, and the suspensions of a batch one damper model,
+    inner loop and sensor noise (`railride.suspension.batch_conflict`): a batch varies the
+    constant voltages or the outer loops. MR dampers start with their coils at the command
+    (v_min under a closed loop) and their hysteretic states at 0. A closed loop samples the
+    carbody states at the solver's control rate.
+    ``solver`` (`railride.SolverSettings`, default: its defaults) holds the fixed RK4 step dt
+    [s], the output rate [Hz] of the stored time histories and the controllers' rate [Hz].
     ``initial_state`` is (q, q') at t = 0 as 18 numbers in DOF order (m, rad, m/s, rad/s), or
     one row per sample; by default the vehicle starts at rest in equilibrium.
     ``progress(done_fraction)`` is called between chunks of a long run.
@@ -256,55 +249,49 @@ def simulate(scenario=None, params=None, *, dt: float = DEFAULT_DT,
     ``on_divergence="raise"`` (the default) the run stops with a RuntimeError giving the sample
     and the time; with ``"mark"`` (what studies use) the other samples stand, the diverged
     one's histories are NaN from that time on, and `RideResult.diverged_at` gives the time.
+
+    The keywords dt, output_rate, control_rate, damper, voltage, controller, inner and
+    sensor_noise of earlier versions still work for now (the command line uses them).
     """
-    dt = _positive("dt", dt)
-    output_rate = _positive("output_rate", output_rate)
+    if keywords:
+        suspension, solver = _from_keywords(suspension, solver, keywords)
+    solver = SolverSettings.of(solver)
+    dt, output_rate = solver.dt, solver.output_rate
     if on_divergence not in ("raise", "mark"):
         raise ValueError(f"on_divergence = {on_divergence!r}: allowed 'raise' (stop with an error) "
                          "or 'mark' (keep the other samples; see RideResult.diverged_at)")
-    n_volt = 1 if voltage is None or np.ndim(voltage) == 0 else len(voltage)
-    n_ctrl = len(controller) if isinstance(controller, (list, tuple)) else 1
     batch = not (isinstance(scenario, (Scenario, str)) or scenario is None) or not (
-        isinstance(params, (VehicleParams, str)) or params is None) or np.ndim(voltage) > 0 \
-        or isinstance(controller, (list, tuple))
+        isinstance(params, (VehicleParams, str)) or params is None) or isinstance(suspension, (list, tuple))
     scenarios = [_resolve_scenario(s) for s in _as_list(scenario)]
     param_sets = [_resolve_params(p) for p in _as_list(params)]
-    n = max(len(scenarios), len(param_sets), n_volt, n_ctrl)
-    if any(k not in (1, n) for k in (len(scenarios), len(param_sets), n_volt, n_ctrl)):
-        raise ValueError(f"a batch needs equally many scenarios, parameter sets, voltages and "
-                         f"controllers, or one of each; got {len(scenarios)} scenarios, "
-                         f"{len(param_sets)} parameter sets, {n_volt} voltages and {n_ctrl} controllers")
+    suspensions = _as_suspensions(suspension)
+    counts = (len(scenarios), len(param_sets), len(suspensions))
+    n = max(counts)
+    if any(k not in (1, n) for k in counts):
+        raise ValueError(f"a batch needs equally many scenarios, parameter sets and suspensions, "
+                         f"or one of each; got {counts[0]} scenarios, {counts[1]} parameter sets "
+                         f"and {counts[2]} suspensions")
     if n == 0:
         raise ValueError("an empty batch: give at least one scenario")
     scenarios = scenarios * (n // len(scenarios))
     param_sets = param_sets * (n // len(param_sets))
+    suspensions = suspensions * (n // len(suspensions))
     duration = scenarios[0].duration
     if any(abs(s.duration - duration) > 1e-12 * duration for s in scenarios):
         raise ValueError("every sample of a batch must have the same duration; got "
                          + ", ".join(sorted({f'{s.duration:g} s' for s in scenarios})))
-    controllers = _as_controllers(controller)
-    if controllers is not None:
-        if voltage is not None:
-            raise ValueError("give either voltage (open loop) or controller (closed loop), not both")
-        if damper is None:
-            damper = DEFAULT_DAMPER
-    damper = _resolve_damper(damper)
-    if damper is not None and damper.law == dampers.LAW_IDEAL and controllers is None:
-        raise ValueError("damper = 'ideal': the ideal actuator applies an outer loop's demand "
-                         "and needs controller= (PID or SAS); it has no voltage to set"
-                         + (f" (got voltage = {voltage!r})" if voltage is not None else ""))
-    vcmd = _command_voltages(damper, voltage, n)
-    closed = _closed_loop(controllers, inner, control_rate, sensor_noise, damper, n, dt, duration)
+    conflict = batch_conflict(suspensions)
+    if conflict is not None:
+        raise ValueError(conflict)
+    damper = suspensions[0].damper
+    vcmd = np.array([[_command_voltage(s)] * 4 for s in suspensions], dtype=float)
+    closed = _closed_loop(suspensions, solver, duration)
     vehicles = {}
     for p in param_sets:
         if id(p) not in vehicles:
             vehicles[id(p)] = _vehicle(p)
             _check_dt(vehicles[id(p)], dt, damper)
-    stride_f = 1.0 / (output_rate * dt)
-    stride = int(round(stride_f))
-    if stride < 1 or abs(stride - stride_f) > 1e-6 * stride_f:
-        raise ValueError(f"output_rate = {output_rate:g} Hz with dt = {dt:g} s: the output interval "
-                         f"1/output_rate must be a whole number of steps (at most one sample per step)")
+    stride = solver.output_steps
     n_out_f = duration * output_rate
     n_out = int(round(n_out_f))
     if abs(n_out - n_out_f) > 1e-6 * max(1.0, n_out_f) or n_out < 1:
@@ -351,9 +338,8 @@ def simulate(scenario=None, params=None, *, dt: float = DEFAULT_DT,
     gm = np.zeros((n, 4, 6))
     hm = np.zeros((n, 4, 3))
     if closed is not None:
-        for i, (c, p) in enumerate(zip(closed["controllers"] * (n // len(closed["controllers"])), param_sets)):
-            if c is not None:
-                gm[i], hm[i] = c.gains(vehicles[id(p)])
+        for i, (c, p) in enumerate(zip(closed["controllers"], param_sets)):
+            gm[i], hm[i] = c.gains(vehicles[id(p)])
     x = np.zeros((n, kernels.NX))
     x[:, 2 * N_DOF + 2:kernels.NS_MAX:dampers.N_DAMPER_STATES] = vcmd  # coils settled at the command
     P = np.tile(damper.pack() if damper is not None else np.zeros(dampers.N_PACKED), (n, 1))
@@ -378,7 +364,8 @@ def simulate(scenario=None, params=None, *, dt: float = DEFAULT_DT,
         ctrl_stride, inner_gains, noise = 1, np.zeros((n, 2)), np.zeros((0, 6))
     else:
         ctrl_stride, noise = closed["stride"], closed["noise"]
-        inner_gains = np.tile([closed["inner"].B, closed["inner"].G], (n, 1))
+        inner = closed["inner"]  # none for the ideal devices: the stepper does not read it
+        inner_gains = np.zeros((n, 2)) if inner is None else np.tile([inner.B, inner.G], (n, 1))
     chunk = n_steps if progress is None else max(stride, (_CHUNK_WORK // n) // stride * stride)
     done = 0
     while True:
@@ -414,18 +401,20 @@ def simulate(scenario=None, params=None, *, dt: float = DEFAULT_DT,
     raw = {"time": np.arange(rows) / output_rate, "q": out["q"], "a": out["a"], "batch": batch,
            "diverged_at": diverged_at}
     return RideResult(raw=raw, build=functools.partial(_dataset, out, vehicles, param_sets, scenarios, dt,
-                                              output_rate, rows, batch, created, damper, vcmd,
-                                              closed))
+                                              output_rate, rows, batch, created, suspensions[0], vcmd,
+                                              closed),
+                      suspension=suspensions if batch else suspensions[0], solver=solver)
 
 
 def _dataset(out, vehicles, param_sets, scenarios, dt, output_rate, rows, batch, created,
-             damper, vcmd, closed=None) -> xr.Dataset:
+             suspension, vcmd, closed=None) -> xr.Dataset:
     """Named channels in SI units; a ``sample`` dimension only for a batch."""
     import numba
     import scipy
 
     from . import __version__
 
+    damper = suspension.damper
     time = np.arange(rows) / output_rate
     T = np.stack([vehicles[id(p)].T for p in param_sets])  # (n, 9, 4)
     ksz = np.array([p.k_sz for p in param_sets])[:, None, None]
@@ -473,13 +462,13 @@ def _dataset(out, vehicles, param_sets, scenarios, dt, output_rate, rows, batch,
     scen = np.array([json.dumps(s.describe()) for s in scenarios])
     pars = np.array([json.dumps(p.to_dict()) for p in param_sets])
     if closed is not None:
-        ctrl = closed["controllers"] * (len(param_sets) // len(closed["controllers"]))
-        inner = None if damper.law == dampers.LAW_IDEAL else closed["inner"].to_dict()  # none in use
+        ctrl = closed["controllers"]
+        inner = None if closed["inner"] is None else closed["inner"].to_dict()  # the ideal devices: none
         attrs_ctrl = {"control_rate_hz": closed["rate"], "inner_loop": json.dumps(inner),
                       "sensor_noise": json.dumps(None if closed["sensor_noise"] is None
                                                  else dataclasses.asdict(closed["sensor_noise"]))}
-        controller_names = np.array(["none" if c is None else c.name for c in ctrl])
-        controller_gains = np.array([json.dumps(None if c is None else c.to_dict()) for c in ctrl])
+        controller_names = np.array([c.name for c in ctrl])
+        controller_gains = np.array([json.dumps(c.to_dict()) for c in ctrl])
     if batch:
         data = {k: (("sample", "time") + d, v, a) for k, (d, v, a) in channels.items()}
         data["scenario"] = ("sample", scen)
@@ -511,11 +500,7 @@ def _dataset(out, vehicles, param_sets, scenarios, dt, output_rate, rows, batch,
         "integrator": "classical RK4, fixed step",
         "dt_s": dt,
         "output_rate_hz": output_rate,
-        "suspension": ("passive viscous secondary dampers" if damper is None else
-                       "ideal secondary force actuators (force = held demand), closed loop"
-                       if damper.law == dampers.LAW_IDEAL else
-                       f"{damper.model} secondary dampers at constant command voltage" if closed is None
-                       else f"{damper.model} secondary dampers, closed loop"),
+        "suspension": suspension.describe(),
         "damper": json.dumps(None if damper is None else damper.to_dict()),
         "sign_convention": "z up; pitch + lowers the front; roll + raises the left side; "
                            "forces on the carbody, up +",
@@ -532,12 +517,16 @@ class RideResult:
     does not pay for building it.
     """
 
-    def __init__(self, dataset: xr.Dataset | None = None, *, build=None, raw=None):
+    def __init__(self, dataset: xr.Dataset | None = None, *, build=None, raw=None, suspension=None,
+                 solver=None):
         if (dataset is None) == (build is None):
             raise ValueError("RideResult needs a dataset or a build function, not both")
         self._dataset = dataset
         self._build = build
         self._raw = raw
+        #: the `Suspension` of the run (a list of them for a batch) and its `SolverSettings`
+        self.suspension = suspension
+        self.solver = solver
 
     @property
     def dataset(self) -> xr.Dataset:

@@ -23,8 +23,10 @@ import numpy as np
 import pandas as pd
 
 from ._io import atomic_write
-from .defaults import DEFAULT_DAMPER, DEFAULT_DT
+from .defaults import DEFAULT_CONTROL_RATE, DEFAULT_DAMPER, DEFAULT_OUTPUT_RATE
 from .metrics import RESPONSES, STATISTICS
+from .solver import SolverSettings, _with_keywords
+from .suspension import NAMES, Suspension, batch_conflict
 
 #: samples per compiled batch: bounds the memory of the time histories (about 5 MB a sample
 #: for 10 s at 1 kHz)
@@ -33,7 +35,8 @@ CHUNK = 32
 #: tables from before do not resume into the new model. 2: two secondary lateral and two
 #: longitudinal springs per bogie, and the paper sine's entry taper.
 MODEL_REVISION = 2
-SUSPENSIONS = ("passive", "mr", "pid", "sas-attitude", "sas-attitude-ride")
+#: the suspensions a case can name (`Suspension.named`)
+SUSPENSIONS = NAMES
 #: (position, index) of `railride.comfort.ride_comfort` in a row with comfort, as the column
 #: ``<position>_<index>``
 COMFORT_INDICES = (("centre", "aw_Wk"), ("centre", "vdv_Wk"), ("centre", "aw_Wb"),
@@ -45,14 +48,16 @@ COMFORT_COLUMNS = tuple(f"{p}_{i}" for p, i in COMFORT_INDICES)
 @dataclass(frozen=True)
 class Case:
     """One run. ``scenario_options`` are keyword arguments of `railride.track.scenario`,
-    ``vehicle`` changes to the `paper` parameters, ``gains`` changes to the base gain set as
-    "table.entry" (e.g. "pid.kp", "attitude.kd_z", "ride.kp_1R", "inner.G"). ``suspension`` is
-    passive, mr (constant ``voltage``) or a controller name; a controller may see sensor noise
-    (``noise``: standard deviations displacement [m], angle [rad], velocity [m/s], angular rate
-    [rad/s]) drawn with ``seed``. ``damper`` names the dampers of mr and the controllers
-    (`railride.dampers.NAMES`; "ideal", the ideal actuator, with a controller only) and
-    ``damper_scale`` multiplies an MR damper's force capacity (`BoucWen.scaled`); it must stay 1
-    for passive and the ideal actuator, which have none to scale."""
+    ``vehicle`` changes to the study's vehicle parameters (`run_cases`' ``params``, default the
+    `paper` preset), ``gains`` changes to the base gain set as "table.entry" (e.g. "pid.kp",
+    "attitude.kd_z", "ride.kp_1R", "inner.G"). ``suspension`` is passive, mr (constant
+    ``voltage``) or a controller name; a controller may see sensor noise (``noise``: standard
+    deviations displacement [m], angle [rad], velocity [m/s], angular rate [rad/s]) drawn with
+    ``seed``. ``damper`` names the dampers of mr and the controllers (`railride.dampers.NAMES`;
+    "ideal", the ideal actuator, with a controller only) and ``damper_scale`` multiplies an MR
+    damper's force capacity (`BoucWen.scaled`); it must stay 1 for passive and the ideal
+    actuator, which have none to scale. `to_suspension` gives the run's `Suspension`
+    (`Suspension.named`, which also checks these settings when the case is made)."""
 
     scenario: str = "paper-sine"
     scenario_options: tuple = ()
@@ -70,15 +75,7 @@ class Case:
 
         if self.suspension not in SUSPENSIONS:
             raise ValueError(f"suspension = {self.suspension!r}; allowed: {', '.join(SUSPENSIONS)}")
-        model = dampers.preset(self.damper)  # an unknown name fails here, not in a batch
         object.__setattr__(self, "damper_scale", dampers.check_scale("damper_scale", self.damper_scale))
-        if self.damper_scale != 1.0 and (self.suspension == "passive" or model.law == dampers.LAW_IDEAL):
-            what = "the passive viscous dampers" if self.suspension == "passive" else "the ideal actuator"
-            raise ValueError(f"damper_scale = {self.damper_scale:g}: {what} have no force capacity "
-                             "to scale; it applies to MR dampers only")
-        if self.suspension == "mr" and model.law == dampers.LAW_IDEAL:
-            raise ValueError(f"damper = {self.damper!r} with suspension = 'mr': the ideal actuator applies a "
-                             "controller's demand and has no constant voltage; use a controller")
         for name in ("scenario_options", "vehicle", "gains"):
             value = getattr(self, name)
             if isinstance(value, dict):
@@ -88,6 +85,32 @@ class Case:
         object.__setattr__(self, "noise", tuple(float(v) for v in self.noise))
         if self.noise and len(self.noise) != 4:
             raise ValueError(f"noise = {self.noise!r}: four standard deviations or none")
+        self._named(None)  # the suspension's checks, here rather than in a batch
+
+    @property
+    def closed_loop(self) -> bool:
+        return self.suspension not in ("passive", "mr")
+
+    def _named(self, gains) -> Suspension:
+        from .control import SensorNoise
+
+        # noise reaches the controllers only (passive and mr runs ignore it, as they always did)
+        noise = None
+        if self.noise and self.closed_loop:
+            displacement, angle, velocity, angular_rate = self.noise
+            noise = SensorNoise(displacement, angle, velocity, angular_rate, seed=self.seed)
+        return Suspension.named(self.suspension, gains, self.damper, self.damper_scale, self.voltage,
+                                noise)
+
+    def to_suspension(self, base_gains=None) -> Suspension:
+        """The run's `Suspension`: `Suspension.named` with the case's gain changes applied to
+        ``base_gains`` (default the shipped `GainSet.default`)."""
+        from .control import GainSet
+
+        if not self.closed_loop:
+            return self._named(None)
+        base = GainSet.default() if base_gains is None else base_gains
+        return self._named(base.apply(self.gains))
 
     @property
     def key(self) -> str:
@@ -117,35 +140,21 @@ class Case:
                 self.damper_scale if kind != "passive" else 1.0)
 
 
-def apply_gains(base, changes):
-    """A GainSet with "table.entry" changes applied."""
-    from .control import GainSet
-
-    tables = {"inner": base.inner, "pid": base.pid, "attitude": base.attitude, "ride": base.ride}
-    grouped: dict[str, dict] = {}
-    for name, value in changes:
-        table, _, entry = name.partition(".")
-        if table not in tables or not entry:
-            raise ValueError(f"gain {name!r}: expected table.entry with table one of {', '.join(tables)}")
-        grouped.setdefault(table, {})[entry] = value
-    for table, entries in grouped.items():
-        tables[table] = tables[table].replace(**entries)
-    return GainSet(tables["inner"], tables["pid"], tables["attitude"], tables["ride"], base.source)
-
-
-def evaluate(cases: list[Case], base_gains=None, dt: float = DEFAULT_DT, window=None,
+def evaluate(cases: list[Case], base_gains=None, *, params=None, solver=None, window=None,
              comfort: bool = False) -> list[dict]:
     """Run ``cases`` (in compiled batches of compatible cases) and return one row per case:
     its key, settings and the RMS and peak-to-peak of the four body responses; with
     ``comfort``, also the ride comfort indices of `COMFORT_COLUMNS` (`railride.comfort.
-    ride_comfort` over the same window). Runs in any process: a Dask worker calls it too."""
-    from .comparison import damper_model
-    from .control import GainSet, SensorNoise
-    from .params import VehicleParams
-    from .simulation import simulate
+    ride_comfort` over the same window). ``params``: the vehicle the cases' ``vehicle`` changes
+    apply to (`VehicleParams` or a preset name, default "paper"); ``solver``: the
+    `SolverSettings` of every run. Runs in any process: a Dask worker calls it too."""
+    from .control import GainSet
+    from .simulation import _resolve_params, simulate
     from .track import scenario as make_scenario
 
     base_gains = GainSet.default() if base_gains is None else base_gains
+    vehicle = _resolve_params(params)
+    solver = SolverSettings.of(solver)
     scenarios: dict = {}
     rows: dict[int, dict] = {}
     by_group: dict[tuple, list[int]] = {}
@@ -160,26 +169,14 @@ def evaluate(cases: list[Case], base_gains=None, dt: float = DEFAULT_DT, window=
                 if skey not in scenarios:
                     scenarios[skey] = make_scenario(c.scenario, **dict(c.scenario_options))
                 scs.append(scenarios[skey])
-            pars = [VehicleParams.preset("paper").replace(**dict(c.vehicle)) for c in part]
-            kind = group[1]
-            damper = damper_model(group[2], group[4]) if kind != "passive" else None
-            if kind == "passive":
-                res = simulate(scs, pars, dt=dt, on_divergence="mark")
-            elif kind == "mr":
-                res = simulate(scs, pars, dt=dt, damper=damper, voltage=[c.voltage for c in part],
-                               on_divergence="mark")
-            else:
-                gsets = [apply_gains(base_gains, c.gains) for c in part]
-                inners = {g.inner for g in gsets}
-                if len(inners) != 1:  # the inner loop is one setting per batch
-                    for i in idx[start:start + CHUNK]:  # positions, not lookups: cases may repeat
-                        rows[i] = evaluate([cases[i]], base_gains, dt, window, comfort)[0]
-                    continue
-                noise, seed = group[3]
-                res = simulate(scs, pars, dt=dt, damper=damper, inner=gsets[0].inner,
-                               controller=[g.controller(c.suspension) for c, g in zip(part, gsets)],
-                               sensor_noise=SensorNoise(*noise, seed=seed) if noise else None,
-                               on_divergence="mark")
+            pars = [vehicle.replace(**dict(c.vehicle)) for c in part]
+            suspensions = [c.to_suspension(base_gains) for c in part]
+            if batch_conflict(suspensions) is not None:  # the inner loop is one setting per batch
+                for i in idx[start:start + CHUNK]:  # positions, not lookups: cases may repeat
+                    rows[i] = evaluate([cases[i]], base_gains, params=vehicle, solver=solver,
+                                       window=window, comfort=comfort)[0]
+                continue
+            res = simulate(scs, pars, suspensions, solver=solver, on_divergence="mark")
             # a diverged run keeps its row, with NaN metrics and the time it diverged: the other
             # runs of the study go on
             m = res.metrics(window).values  # (sample, response, statistic)
@@ -218,6 +215,22 @@ def _flat(c: Case) -> dict:
     d.update({f"gain.{k}": v for k, v in c.gains})
     d["case"] = json.dumps(c.to_dict(), sort_keys=True, default=str)
     return d
+
+
+def other_settings(vehicle, solver: SolverSettings) -> dict:
+    """The settings of a study besides its step that differ from the defaults: the solver's
+    output and control rates, the vehicle when it is not the paper's. Only those enter a run's
+    key and a study's record, so that the keys and records of default studies stay as they were."""
+    from .params import VehicleParams
+
+    out = {}
+    if solver.output_rate != DEFAULT_OUTPUT_RATE:
+        out["output_rate_hz"] = solver.output_rate
+    if solver.control_rate != DEFAULT_CONTROL_RATE:
+        out["control_rate_hz"] = solver.control_rate
+    if vehicle != VehicleParams.preset("paper"):
+        out["vehicle_params"] = vehicle.to_dict()
+    return out
 
 
 # -- executors ---------------------------------------------------------------------------------
@@ -399,24 +412,31 @@ class RunTable:
 
 
 def run_cases(cases: list[Case], *, executor=None, table: RunTable | None = None, base_gains=None,
-              dt: float = DEFAULT_DT, window=None, chunk: int = CHUNK, progress=None,
-              comfort: bool = False) -> pd.DataFrame:
+              params=None, solver=None, window=None, chunk: int = CHUNK, progress=None,
+              comfort: bool = False, dt=None) -> pd.DataFrame:
     """Evaluate ``cases``, skipping those already in ``table``; returns their rows in order.
-    ``comfort``: the rows also hold the ride comfort indices (`evaluate`).
+    ``params``: the vehicle (`VehicleParams` or a preset name, default "paper") the cases'
+    ``vehicle`` changes apply to; ``solver``: the `SolverSettings` of every run (``dt``, the
+    step alone, as the command line still gives it). ``comfort``: the rows also hold the ride
+    comfort indices (`evaluate`).
 
     ``progress(done, total, runs_per_second)`` is called after each chunk.
     """
     import functools
 
+    from .simulation import _resolve_params
+
+    solver = _with_keywords(solver, dt)  # TEMPORARY: dt= removed when the CLI moves onto Suspension
+    vehicle = _resolve_params(params)
     executor = LocalExecutor() if executor is None else executor
     table = RunTable() if table is None else table
     done = table.done()
     # a run's result depends on the case and on these settings: both go into its key, so a
-    # resumed sweep with another dt, window or base gain set does not reuse old rows
+    # resumed sweep with another step, window, base gain set or vehicle does not reuse old rows
     from .control import GainSet
     base = GainSet.default() if base_gains is None else base_gains
-    settings = {"dt": dt, "window": None if window is None else [float(w) for w in window],
-                "base_gains": base.to_toml()}
+    settings = {"dt": solver.dt, "window": None if window is None else [float(w) for w in window],
+                "base_gains": base.to_toml(), **other_settings(vehicle, solver)}
     if comfort:  # only then: the keys of sweeps without comfort stay as they were
         settings["comfort"] = True
     settings = json.dumps(settings, sort_keys=True)
@@ -431,7 +451,8 @@ def run_cases(cases: list[Case], *, executor=None, table: RunTable | None = None
     # group compatible cases so each chunk is one compiled batch
     pending.sort(key=lambda c: str(c.group))
     chunks = [pending[i:i + chunk] for i in range(0, len(pending), chunk)]
-    fn = functools.partial(evaluate, base_gains=base, dt=dt, window=window, comfort=comfort)
+    fn = functools.partial(evaluate, base_gains=base, params=vehicle, solver=solver, window=window,
+                           comfort=comfort)
     t0, n_done = time.perf_counter(), 0
     if progress is not None:
         progress(0, len(pending), 0.0)

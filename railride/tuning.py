@@ -30,8 +30,8 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from .control import GainSet
-from .defaults import DEFAULT_DAMPER, DEFAULT_DT
+from .control import CONTROLLERS, GainSet
+from .defaults import DEFAULT_DAMPER
 from .metrics import RESPONSES
 from .objectives import (  # noqa: F401 (re-exported: the objectives' old home)
     DEFAULT_OBJECTIVE,
@@ -41,38 +41,28 @@ from .objectives import (  # noqa: F401 (re-exported: the objectives' old home)
     RATIO_NAMES,
     Objective,
 )
-from .sweep import Case, RunTable, apply_gains, run_cases
+from .solver import _with_keywords
+from .sweep import Case, RunTable, run_cases
 
-PHASES = ("inner", "pid", "attitude", "ride")
-PARAMETERS = {
-    "inner": ("inner.B", "inner.G"),
-    "pid": ("pid.kp", "pid.ki", "pid.kd"),
-    "attitude": ("attitude.kp_z", "attitude.kd_z", "attitude.kp_phi", "attitude.kd_phi",
-                 "attitude.kp_theta", "attitude.kd_theta"),
-    "ride": tuple(f"ride.{k}_{c}" for k in ("kp", "kd") for c in ("1R", "1L", "2R", "2L")),
-}
-SUSPENSION = {"pid": "pid", "attitude": "sas-attitude", "ride": "sas-attitude-ride"}
+#: one phase per gain table, in the paper's order
+PHASES = GainSet.TABLES
+#: the gains each phase tunes, by "table.entry"
+PARAMETERS = {phase: GainSet.entry_names(phase) for phase in PHASES}
 #: the controllers whose response a phase changes (the before/after rows of `TuneResult`)
-PHASE_CONTROLLERS = {"inner": ("pid", "sas-attitude", "sas-attitude-ride"), "pid": ("pid",),
-                     "attitude": ("sas-attitude", "sas-attitude-ride"),
-                     "ride": ("sas-attitude-ride",)}
+PHASE_CONTROLLERS = {phase: tuple(n for n in CONTROLLERS[1:] if phase in GainSet.tables_read(n))
+                     for phase in PHASES}
+#: the suspension a vehicle phase is scored with: the first controller that reads its table
+SUSPENSION = {phase: names[0] for phase, names in PHASE_CONTROLLERS.items() if phase != "inner"}
 #: the gain tables each controller reads
-CONTROLLER_TABLES = {"pid": ("inner", "pid"), "sas-attitude": ("inner", "attitude"),
-                     "sas-attitude-ride": ("inner", "attitude", "ride")}
+CONTROLLER_TABLES = {n: GainSet.tables_read(n) for n in CONTROLLERS[1:]}
 #: the schema of `TuneResult.to_dict` (tune.json)
 SCHEMA = "railride.tune/2"
-
-
-def _reference() -> dict:
-    g = GainSet.reference()
-    return {f"{table}.{k}": float(v) for table in PARAMETERS
-            for k, v in getattr(g, table).to_dict().items()}
 
 
 #: the neutral gains of railride/data/reference_gains.toml (`GainSet.reference`), by
 #: "table.entry": where the sweep of a gain that is 0 is centred, and the centre of the search
 #: box of the global methods
-REFERENCE = _reference()
+REFERENCE = GainSet.reference().entries()
 
 
 
@@ -275,8 +265,8 @@ def _candidates(current: float, parameter: str, n_values: int, span: float) -> l
 def tune(phases=PHASES, *, scenario: str = "paper-sine", scenario_options=None,
          gains: GainSet | None = None, objective: Objective | None = None, damper: str = DEFAULT_DAMPER,
          executor=None, table: RunTable | None = None, n_values: int = 13, span: float = 30.0,
-         max_passes: int = 5, tol: float = 1e-3, dt: float = DEFAULT_DT, window=None, progress=None,
-         log=None, damper_scale: float = 1.0, before_after: bool = True) -> TuneResult:
+         max_passes: int = 5, tol: float = 1e-3, params=None, solver=None, window=None, progress=None,
+         log=None, damper_scale: float = 1.0, before_after: bool = True, dt=None) -> TuneResult:
     """The sensitivity study: the phases in order (from PHASES; default all four, so PID and SAS
     are tuned by the same procedure and budget), each to convergence, from ``gains`` (default
     the neutral `GainSet.reference`), minimising ``objective`` (default `DEFAULT_OBJECTIVE`).
@@ -287,15 +277,22 @@ def tune(phases=PHASES, *, scenario: str = "paper-sine", scenario_options=None,
     phase starts from zero ride gains, as the paper's phase 2 (the ride loop is added to a tuned
     attitude loop), whatever ``gains`` holds for them. ``damper_scale`` scales the MR dampers'
     force capacity (`railride.dampers.BoucWen.scaled`); the inner phase then tracks demands
-    scaled alike, so a damper k times larger is tuned on the same relative task.
+    scaled alike, so a damper k times larger is tuned on the same relative task. ``params``:
+    the vehicle (`VehicleParams` or a preset name, default "paper"); ``solver``: the
+    `SolverSettings` of every vehicle run (``dt``: the step alone, as the command line still
+    gives it); both are recorded in ``settings`` where they differ from the defaults.
     ``progress(done, total, runs_per_second)`` after each chunk; ``log(text)`` after each pass.
 
     ``before_after``: at the end, run each controller the phases change with the start and with
     the tuned gains (`TuneResult.before_after`; through the run table, where most of these runs
     already are). Returns a `TuneResult` (``to_dict``, ``to_pandas``, ``plot``, ``save``).
     """
+    from .simulation import _resolve_params
+    from .sweep import other_settings
     from .track import scenario as make_scenario
 
+    solver = _with_keywords(solver, dt)  # TEMPORARY: dt= removed when the CLI moves onto Suspension
+    vehicle = _resolve_params(params)
     gains = GainSet.reference() if gains is None else gains
     objective = DEFAULT_OBJECTIVE if objective is None else objective
     opts = tuple(sorted((scenario_options or {}).items()))
@@ -317,20 +314,21 @@ def tune(phases=PHASES, *, scenario: str = "paper-sine", scenario_options=None,
     base = gains
     result = TuneResult(gains, objective=objective, start=gains, phases=tuple(phases),
                         scenario=record, settings={
-                            "damper": damper, "damper_scale": damper_scale, "dt_s": float(dt),
+                            "damper": damper, "damper_scale": damper_scale, "dt_s": solver.dt,
                             "values": n_values, "span": float(span), "max_passes": max_passes,
-                            "tolerance": tol, "start_gains": gains.source})
+                            "tolerance": tol, "start_gains": gains.source,
+                            **other_settings(vehicle, solver)})
 
     def run(cases):
-        return run_cases(cases, executor=executor, table=table, base_gains=base, dt=dt,
-                         window=window, progress=progress)
+        return run_cases(cases, executor=executor, table=table, base_gains=base, params=vehicle,
+                         solver=solver, window=window, progress=progress)
 
     passive = _rms(run([Case(scenario, opts)]))[0]
     result.passive = dict(zip(RESPONSES, passive))
     changes: dict[str, float] = {}
 
     def current_value(p):
-        return changes.get(p, getattr(_table(base, p), p.split(".")[1]))
+        return changes.get(p, base.value(p))
 
     for phase in phases:
         params = PARAMETERS[phase]
@@ -363,7 +361,7 @@ def tune(phases=PHASES, *, scenario: str = "paper-sine", scenario_options=None,
                 log(f"{phase} pass {sweep_pass}: objective {best:.4f}")
             if start - best < tol * abs(start):
                 break
-    result.gains = apply_gains(base, tuple(changes.items()))
+    result.gains = base.apply(tuple(changes.items()))
     if before_after:
         result.before_after = _before_after(result, run, scenario, opts, damper, damper_scale)
     result.runs = table.frame
@@ -375,7 +373,7 @@ def _gain_changes(start: GainSet, tuned: GainSet, tables) -> tuple:
     """The ("table.entry", value) pairs of ``tuned`` that differ from ``start``, in ``tables``."""
     out = []
     for table in tables:
-        a, b = getattr(start, table).to_dict(), getattr(tuned, table).to_dict()
+        a, b = start.table(table).to_dict(), tuned.table(table).to_dict()
         out += [(f"{table}.{k}", float(b[k])) for k in a if b[k] != a[k]]
     return tuple(sorted(out))
 
@@ -383,8 +381,6 @@ def _gain_changes(start: GainSet, tuned: GainSet, tables) -> tuple:
 def _before_after(result: TuneResult, run, scenario, opts, damper, damper_scale) -> list[dict]:
     """RMS of each controller the phases change, with the start and with the tuned gains, and
     the reductions against passive; ``run`` evaluates cases through the study's run table."""
-    from .control import CONTROLLERS
-
     names = [n for n in CONTROLLERS if any(n in PHASE_CONTROLLERS[p] for p in result.phases)]
     cases = []
     for n in names:
@@ -408,11 +404,6 @@ def _before_after(result: TuneResult, run, scenario, opts, damper, damper_scale)
     return rows
 
 
-def _table(gains: GainSet, parameter: str):
-    return {"inner": gains.inner, "pid": gains.pid, "attitude": gains.attitude,
-            "ride": gains.ride}[parameter.split(".")[0]]
-
-
 def tracking_objective(B: float, G: float, damper=DEFAULT_DAMPER, damper_scale: float = 1.0) -> float:
     """The inner loop's objective: normalised RMS tracking error, averaged over the paper's
     sine and sawtooth demands (Fig. 6) at 10 kN x ``damper_scale``, 1 Hz on the damper rig."""
@@ -430,7 +421,7 @@ def _tune_inner(base, changes, params, n_values, span, max_passes, tol, result, 
                 damper_scale=1.0):
     """B and G on the rig's force-tracking error (cheap: evaluated here, not on the executor)."""
     def value(p):
-        return changes.get(p, getattr(base.inner, p.split(".")[1]))
+        return changes.get(p, base.value(p))
 
     best = tracking_objective(value("inner.B"), value("inner.G"), damper, damper_scale)
     for sweep_pass in range(1, max_passes + 1):

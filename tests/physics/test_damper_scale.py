@@ -12,6 +12,7 @@ import pytest
 from railride import dampers, rig
 from railride.comparison import compare
 from railride.simulation import simulate
+from railride.suspension import Suspension
 from railride.sweep import Case, run_cases
 from railride.track import scenario
 from clihelp import assert_input_error, run
@@ -114,8 +115,8 @@ def test_run_cases_runs_the_scaled_damper():
              for x in (1.0, 2.0)]
     rows = run_cases(cases)
     assert list(rows["damper_scale"]) == [1.0, 2.0]
-    direct = simulate(scenario("paper-sine", **SHORT), damper=dampers.preset("railway").scaled(2.0),
-                      voltage=1.0).metrics()
+    direct = simulate(scenario("paper-sine", **SHORT),
+                      suspension=Suspension.semi_active(dampers.preset("railway").scaled(2.0), voltage=1.0)).metrics()
     got = rows.iloc[1]["acceleration_m_s2_rms"]
     assert got == pytest.approx(float(direct.sel(response="acceleration_m_s2", statistic="rms")),
                                 rel=1e-12)

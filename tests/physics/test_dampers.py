@@ -10,6 +10,7 @@ from railride import dampers, rig
 from railride.kernels import damper_law
 from railride.reference import rig_reference, simulate_reference
 from railride.simulation import simulate
+from railride.suspension import Suspension
 from railride.track import scenario
 
 MODELS = {  # preset, stroke [m] and frequency [Hz] of a typical test
@@ -150,7 +151,7 @@ def test_compiled_law_equals_the_numpy_law(name, x, xd, z, y, u, v):
 def test_vehicle_with_mr_dampers_equals_the_numpy_reference():
     sc = scenario("bump", speed=40.0, duration=1.0)
     ref = simulate_reference(sc, damper=dampers.RAILWAY, voltage=1.5)
-    ds = simulate(sc, damper="railway", voltage=1.5).dataset
+    ds = simulate(sc, suspension=Suspension.semi_active("railway", voltage=1.5)).dataset
     for i, name in enumerate(("carbody_bounce", "carbody_pitch", "front_bogie_bounce")):
         scale = np.abs(ref["q"][:, i if i < 2 else 3]).max()
         assert np.abs(ds[name].values - ref["q"][:, i if i < 2 else 3]).max() < 1e-6 * scale, name
@@ -162,13 +163,14 @@ def test_viscous_model_as_a_force_equals_the_passive_dashpots():
     # two code paths: dashpots inside the damping matrix, or a damper law feeding forces
     sc = scenario("paper-sine", duration=2.0)
     a = simulate(sc).dataset
-    b = simulate(sc, damper=dampers.Viscous(c=8e4)).dataset
+    b = simulate(sc, suspension=Suspension.passive(dampers.Viscous(c=8e4))).dataset
     for name in ("carbody_bounce", "carbody_roll", "secondary_damper_force"):
         assert np.allclose(a[name], b[name], rtol=0, atol=1e-9 * float(abs(a[name]).max()))
 
 
 def test_mr_vehicle_records_damper_states_and_respects_the_bound():
-    ds = simulate(scenario("paper-sine", duration=2.0), damper="railway", voltage=2.25).dataset
+    ds = simulate(scenario("paper-sine", duration=2.0),
+                  suspension=Suspension.semi_active("railway", voltage=2.25)).dataset
     assert float(abs(ds.damper_hysteretic_z).max()) <= dampers.RAILWAY.z_bound * (1 + 1e-9)
     assert np.allclose(ds.damper_voltage, 2.25) and np.allclose(ds.damper_command_voltage, 2.25)
     # the damper force on the carbody opposes the deflection rate on average: it dissipates
@@ -183,8 +185,8 @@ def test_mr_vehicle_records_damper_states_and_respects_the_bound():
     ({"voltage": 1.0}, "MR dampers only"),
 ])
 def test_bad_damper_input_is_refused(kwargs, match):
-    with pytest.raises(ValueError, match=match):
-        simulate(scenario(duration=1.0), **kwargs)
+    with pytest.raises(ValueError, match=match):  # the suspension's checks, at construction
+        Suspension(**kwargs)
 
 
 @pytest.mark.parametrize("change, match", [

@@ -1,4 +1,4 @@
-"""The ideal actuator (`damper="ideal"`): the corner force is the outer loop's held demand.
+"""The ideal actuator (`Suspension.ideal`, damper "ideal"): the corner force is the outer loop's held demand.
 
 Checked against the recorded states (the demand is G m + H xi of the previous controller sample,
 held for a period) and against a linear closed-loop model assembled here from the vehicle
@@ -15,9 +15,11 @@ from scipy.integrate import solve_ivp
 from railride import dampers, rig
 from railride.cli import app
 from railride.comparison import compare
-from railride.control import PID, SAS, Attitude, GainSet
+from railride.control import PID, SAS, Attitude, GainSet, ZeroDemand
 from railride.params import VehicleParams
 from railride.simulation import simulate
+from railride.solver import SolverSettings
+from railride.suspension import Suspension
 from railride.track import CosineBump, Scenario
 from railride.vehicle import Vehicle
 from clihelp import runner
@@ -40,7 +42,7 @@ def ideal_batch():
     stable on the ideal actuator at this slow rate, whatever gains are shipped."""
     g = GainSet.reference()
     ctrls = [g.controller(n) for n in ("pid", "sas-attitude", "sas-attitude-ride")]
-    res = simulate(BUMP, PARAMS, damper="ideal", controller=ctrls, control_rate=250.0)
+    res = simulate(BUMP, PARAMS, [Suspension.ideal(c) for c in ctrls], solver=SolverSettings(control_rate=250.0))
     return ctrls, res.dataset
 
 
@@ -84,7 +86,7 @@ def test_ideal_demand_is_the_previous_sample_held_for_a_period(ideal_batch):
 
 
 def test_ideal_without_an_outer_loop_applies_no_force():
-    res = simulate(BUMP, PARAMS, damper="ideal", controller=[None], control_rate=1000.0)
+    res = simulate(BUMP, PARAMS, [Suspension.ideal(ZeroDemand())], solver=SolverSettings(control_rate=1000.0))
     assert np.all(res.dataset["secondary_damper_force"].values == 0.0)
 
 
@@ -113,8 +115,7 @@ def test_ideal_skyhook_matches_a_linear_closed_loop_model_integrated_by_solve_iv
     l, d_s = float(vehicle.T[1, 2]), float(vehicle.T[2, 1])  # rear pitch arm, left roll arm
     ctrl = SAS(Attitude(kp_z=0.0, kd_z=c, kp_phi=0.0, kd_phi=c * l**2, kp_theta=0.0,
                         kd_theta=c * d_s**2))
-    ds = simulate(BUMP, PARAMS, dt=dt, damper="ideal", controller=ctrl,
-                  control_rate=1.0 / dt).dataset
+    ds = simulate(BUMP, PARAMS, Suspension.ideal(ctrl), solver=SolverSettings(dt=dt, control_rate=1.0 / dt)).dataset
     t = ds["time"].values
 
     M, K, C0, Kw, Cw, T = vehicle.M, vehicle.K, vehicle.C0, vehicle.K_w, vehicle.C_w, vehicle.T
@@ -180,8 +181,8 @@ def test_compare_with_the_ideal_actuator_records_it_and_has_no_voltages():
     ({"damper": "ideal", "voltage": 1.0, "controller": PID(1.0, 0.0, 1.0)}, "either voltage"),
 ])
 def test_ideal_actuator_without_a_controller_is_refused(kwargs, match):
-    with pytest.raises(ValueError, match=match):
-        simulate(BUMP, PARAMS, **kwargs)
+    with pytest.raises(ValueError, match=match):  # the suspension's checks, at construction
+        Suspension(**kwargs)
 
 
 def test_the_rig_refuses_the_ideal_actuator():
@@ -247,7 +248,8 @@ def test_cli_compare_with_the_ideal_actuator(tmp_path):
 def test_ideal_damper_applies_the_demand_only_where_it_dissipates():
     g = GainSet.reference()
     ctrls = [g.controller(n) for n in ("pid", "sas-attitude", "sas-attitude-ride")]
-    ds = simulate(BUMP, PARAMS, damper="ideal-damper", controller=ctrls, control_rate=250.0).dataset
+    ds = simulate(BUMP, PARAMS, [Suspension.ideal(c, dissipative=True) for c in ctrls],
+                  solver=SolverSettings(control_rate=250.0)).dataset
     f = ds["secondary_damper_force"].values
     fd = ds["damper_demand_force"].values
     xd = ds["secondary_deflection_velocity"].values

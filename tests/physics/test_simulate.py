@@ -7,6 +7,8 @@ import pytest
 from railride.params import VehicleParams
 from railride.reference import simulate_reference
 from railride.simulation import simulate
+from railride.solver import SolverSettings
+from railride.suspension import Suspension
 from railride.track import CosineBump, Scenario, SineTrack, scenario
 from railride.vehicle import DOF_NAMES, Vehicle
 
@@ -21,7 +23,7 @@ def _q(ds):
 
 def test_compiled_stepper_equals_the_numpy_reference():
     ref = simulate_reference(BUMP, P, dt=1e-4, output_every=10)
-    ds = simulate(BUMP, P, dt=1e-4, output_rate=1000).dataset
+    ds = simulate(BUMP, P, solver=SolverSettings(dt=1e-4, output_rate=1000)).dataset
     q = _q(ds)
     assert np.allclose(ds.time.values, ref["time"])
     scale = np.abs(ref["q"]).max(axis=0)
@@ -36,10 +38,10 @@ def test_compiled_stepper_equals_the_numpy_reference():
 def test_batch_equals_the_single_runs():
     scen = [scenario("paper-sine", duration=2.0), BUMP.__class__(BUMP.track, 40.0, 2.0, "bump")]
     pars = [P, P.replace(c_sz=4e4, m_c=3.5e4)]
-    batch = simulate(scen, pars, dt=1e-4).dataset
+    batch = simulate(scen, pars, solver=SolverSettings(dt=1e-4)).dataset
     assert batch.sizes["sample"] == 2
     for i in range(2):
-        single = simulate(scen[i], pars[i], dt=1e-4).dataset
+        single = simulate(scen[i], pars[i], solver=SolverSettings(dt=1e-4)).dataset
         for name in ("carbody_bounce", "carbody_roll", "carbody_acceleration",
                      "secondary_damper_force", "rail_displacement"):
             assert np.allclose(batch[name].isel(sample=i).values, single[name].values,
@@ -63,7 +65,8 @@ def test_steady_state_sine_response_equals_the_frequency_response():
 @pytest.mark.parametrize("track", [CosineBump(0.02, 10.0, 5.0, "left"), SineTrack(0.05, 60.0, 30.0)])
 def test_fourth_order_convergence_under_step_halving(track):
     sc = Scenario(track, speed=40.0, duration=1.5)
-    runs = {dt: simulate(sc, P, dt=dt, output_rate=250).dataset for dt in (4e-4, 2e-4, 1e-4, 2.5e-5)}
+    runs = {dt: simulate(sc, P, solver=SolverSettings(dt=dt, output_rate=250)).dataset
+            for dt in (4e-4, 2e-4, 1e-4, 2.5e-5)}
     fine = runs[2.5e-5]
     errors = []
     for dt in (4e-4, 2e-4, 1e-4):
@@ -106,8 +109,8 @@ def test_dampers_dissipate_exactly_the_energy_the_vehicle_loses():
     state = np.zeros(18)
     state[[0, 2, 4, 8]] = [0.02, 0.01, 0.003, -0.004]
     state[9 + 1] = 0.01
-    ds = simulate(scenario("paper-sine", amplitude=0.0, duration=3.0), P, dt=1e-4,
-                  output_rate=10000, initial_state=state).dataset
+    ds = simulate(scenario("paper-sine", amplitude=0.0, duration=3.0), P,
+                  solver=SolverSettings(dt=1e-4, output_rate=10000), initial_state=state).dataset
     q, v = _q(ds), np.stack([ds[f"{n}_velocity"].values for n in DOF_NAMES], axis=-1)
     energy = 0.5 * np.einsum("ti,ij,tj->t", v, veh.M, v) + 0.5 * np.einsum("ti,ij,tj->t", q, veh.K, q)
     power = np.einsum("ti,ij,tj->t", v, veh.C, v)
@@ -157,6 +160,7 @@ def test_result_channels_units_and_provenance():
 
 @pytest.mark.parametrize("kwargs, match", [
     ({"dt": 0.05}, "too large"),
+    ({"dt": 0.05, "output_rate": 20.0}, "too large: fourth-order Runge-Kutta is unstable"),
     ({"dt": -1e-4}, "dt"),
     ({"dt": float("nan")}, "dt"),
     ({"output_rate": 3000.0}, "whole number of steps"),
@@ -167,8 +171,9 @@ def test_result_channels_units_and_provenance():
 ])
 def test_bad_input_raises_a_clear_value_error(kwargs, match):
     kwargs.setdefault("scenario", scenario(duration=1.0))
-    with pytest.raises(ValueError, match=match):
-        simulate(**kwargs)
+    steps = {k: kwargs.pop(k) for k in ("dt", "output_rate") if k in kwargs}
+    with pytest.raises(ValueError, match=match):  # SolverSettings checks the steps, simulate the rest
+        simulate(solver=SolverSettings(**steps) if steps else None, **kwargs)
 
 
 def test_a_run_that_diverges_stops_and_says_so():
@@ -183,15 +188,15 @@ def test_a_diverged_sample_is_marked_and_the_others_stand():
     g = GainSet.default()
     unstable = PID(kp=1e12, ki=0.0, kd=1e11)  # on the ideal actuator: far past any stable gain
     sc = scenario("paper-sine", duration=1.0)
-    alone = simulate(sc, damper="ideal", controller=g.pid).metrics()
-    res = simulate(sc, damper="ideal", controller=[g.pid, unstable, g.pid], on_divergence="mark")
+    alone = simulate(sc, suspension=Suspension.ideal(g.pid)).metrics()
+    res = simulate(sc, suspension=[Suspension.ideal(c) for c in (g.pid, unstable, g.pid)], on_divergence="mark")
     m = res.metrics()
     assert np.isnan(res.diverged_at[[0, 2]]).all() and 0 < res.diverged_at[1] < 1.0
     assert np.isnan(m.isel(sample=1).values).all()
     for i in (0, 2):  # the batch neighbours are untouched by the diverged sample
         np.testing.assert_array_equal(m.isel(sample=i, drop=True).values, alone.values)
     with pytest.raises(RuntimeError, match=r"diverged \(sample 1 at t = "):
-        simulate(sc, damper="ideal", controller=[g.pid, unstable])
+        simulate(sc, suspension=[Suspension.ideal(g.pid), Suspension.ideal(unstable)])
     with pytest.raises(ValueError, match="on_divergence = 'skip'"):
         simulate(sc, on_divergence="skip")
 

@@ -11,6 +11,8 @@ from railride.control import (PID, SAS, Attitude, GainSet, InnerLoop, Ride, Sens
                               carbody_map, decoupling)
 from railride.params import VehicleParams
 from railride.simulation import simulate
+from railride.solver import SolverSettings
+from railride.suspension import Suspension
 from railride.track import scenario
 from railride.vehicle import Vehicle
 
@@ -62,8 +64,8 @@ SINE = scenario("paper-sine", duration=3.0)
 def test_voltage_stays_in_range_and_is_minimal_when_the_demand_opposes_the_damper():
     g = GainSet.default()
     noise = SensorNoise(1e-3, 1e-4, 5e-3, 5e-4, seed=7)
-    ds = simulate(SINE, controller=[g.controller("pid"), g.controller("sas-attitude-ride")],
-                  output_rate=10000, sensor_noise=noise).dataset
+    ds = simulate(SINE, suspension=[Suspension.named(n, g, sensor_noise=noise) for n in ("pid", "sas-attitude-ride")],
+                  solver=SolverSettings(output_rate=10000)).dataset
     d = dampers.RAILWAY
     v = ds.damper_command_voltage.values
     assert v.min() >= d.v_min and v.max() <= d.v_max
@@ -75,8 +77,8 @@ def test_voltage_stays_in_range_and_is_minimal_when_the_demand_opposes_the_dampe
 
 def test_all_gains_zero_is_passive_off():
     zero = PID(0.0, 0.0, 0.0)
-    a = simulate(SINE, controller=zero).dataset
-    b = simulate(SINE, damper="railway", voltage=0.0).dataset
+    a = simulate(SINE, suspension=Suspension.semi_active(controller=zero)).dataset
+    b = simulate(SINE, suspension=Suspension.semi_active("railway", voltage=0.0)).dataset
     for name in ("carbody_bounce", "carbody_roll", "secondary_damper_force", "damper_voltage"):
         assert np.array_equal(a[name].values, b[name].values), name
     assert np.all(a.damper_command_voltage.values == 0.0)
@@ -86,8 +88,8 @@ def test_all_gains_zero_is_passive_off():
 def test_every_controller_keeps_the_response_bounded(sc):
     g = GainSet.default()
     names = ("pid", "sas-attitude", "sas-attitude-ride")
-    ds = simulate(sc, controller=[g.controller(n) for n in names]).dataset
-    passive_off = simulate(sc, damper="railway", voltage=0.0).dataset
+    ds = simulate(sc, suspension=[Suspension.named(n, g) for n in names]).dataset
+    passive_off = simulate(sc, suspension=Suspension.semi_active("railway", voltage=0.0)).dataset
     # within twice the uncontrolled (0 V) response, or a small floor where that is ~0 (the
     # corner-specific ride gains roll the carbody a little even on a symmetric bump)
     for name, floor in (("carbody_bounce", 1e-3), ("carbody_pitch", 1e-3), ("carbody_roll", 1e-3)):
@@ -103,8 +105,9 @@ def test_a_step_demand_appears_one_controller_period_later_and_is_held(rate):
     kp, z0 = 1e5, 0.01
     state = np.zeros(18)
     state[0] = z0  # carbody lifted at t = 0, level track
-    ds = simulate(scenario("paper-sine", amplitude=0.0, duration=0.01), controller=PID(kp, 0.0, 0.0),
-                  control_rate=rate, output_rate=10000, initial_state=state).dataset
+    ds = simulate(scenario("paper-sine", amplitude=0.0, duration=0.01),
+                  suspension=Suspension.semi_active(controller=PID(kp, 0.0, 0.0)),
+                  solver=SolverSettings(control_rate=rate, output_rate=10000), initial_state=state).dataset
     fd = ds.damper_demand_force.values  # (time, corner)
     t = ds.time.values
     period = 1.0 / rate
@@ -122,8 +125,9 @@ def test_a_step_demand_appears_one_controller_period_later_and_is_held(rate):
 def test_sensor_noise_is_seeded():
     g = GainSet.default()
     def run(seed):
-        return simulate(scenario("paper-sine", duration=1.0), controller=g.controller("pid"),
-                        sensor_noise=SensorNoise(1e-3, 1e-4, 1e-3, 1e-4, seed=seed)).dataset
+        noise = SensorNoise(1e-3, 1e-4, 1e-3, 1e-4, seed=seed)
+        return simulate(scenario("paper-sine", duration=1.0),
+                        suspension=Suspension.named("pid", g, sensor_noise=noise)).dataset
 
     a, b, c = run(1), run(1), run(2)
     assert np.array_equal(a.carbody_bounce.values, b.carbody_bounce.values)
@@ -157,10 +161,11 @@ def test_controller_input_errors():
     with pytest.raises(ValueError, match="unknown controller 'lqr'"):
         GainSet.default().controller("lqr")
     with pytest.raises(ValueError, match="either voltage"):
-        simulate(SINE, controller=PID(1, 0, 0), voltage=1.0)
+        Suspension.semi_active(controller=PID(1, 0, 0), voltage=1.0)
     with pytest.raises(ValueError, match="control_rate"):
-        simulate(SINE, controller=PID(1, 0, 0), control_rate=3000.0)
+        simulate(SINE, suspension=Suspension.semi_active(controller=PID(1, 0, 0)),
+                 solver=SolverSettings(control_rate=3000.0))
     with pytest.raises(ValueError, match="closed loop only"):
-        simulate(SINE, inner=InnerLoop(1.0, 1e-3))
+        Suspension(inner=InnerLoop(1.0, 1e-3))
     with pytest.raises(ValueError, match="PID gain 'kp' = -1"):
         PID(-1.0, 0.0, 0.0)

@@ -6,7 +6,9 @@ import pytest
 from railride.control import GainSet
 from railride.optimise import optimise, sensitivity
 from railride.simulation import simulate
-from railride.sweep import Case, RunTable, apply_gains, run_cases
+from railride.solver import SolverSettings
+from railride.suspension import Suspension
+from railride.sweep import Case, RunTable, run_cases
 from railride.track import scenario
 from railride.tuning import (
     DEFAULT_OBJECTIVE,
@@ -47,8 +49,7 @@ def test_a_swept_case_equals_the_direct_run():
     case = Case(scenario_options={"speed": 40.0, **SHORT}, suspension="pid", gains={"pid.kd": 2e5})
     row = run_cases([case]).iloc[0]
     direct = simulate(scenario("paper-sine", speed=40.0, **SHORT),
-                      controller=apply_gains(g, (("pid.kd", 2e5),)).controller("pid"),
-                      inner=g.inner).metrics()
+                      suspension=Suspension.named("pid", g.apply((("pid.kd", 2e5),)))).metrics()
     expected = float(direct.sel(response="acceleration_m_s2", statistic="rms"))
     assert row["acceleration_m_s2_rms"] == pytest.approx(expected, rel=1e-12)
     assert row["roll_deg_ptp"] == pytest.approx(float(direct.sel(response="roll_deg", statistic="ptp")), rel=1e-12)
@@ -285,7 +286,8 @@ def test_global_optimiser_reports_the_objective_of_the_gains_it_returns():
     res = optimise(("attitude.kd_z", "attitude.kd_phi"), suspension="sas-attitude",
                    scenario_options={"duration": 0.5}, popsize=3, maxiter=2, seed=1)
     ev = optimise.__globals__["_Evaluator"](res.parameters, "sas-attitude", "paper-sine",
-                                            {"duration": 0.5}, None, None, "railway", None, None, 1e-4, None)
+                                            {"duration": 0.5}, None, None, "railway", None, None, None,
+                                            solver=SolverSettings(dt=1e-4))
     assert ev(res.log10_gains[None, :])[0] == pytest.approx(res.objective, rel=1e-12)
     assert res.gains.attitude.kd_z == pytest.approx(10 ** res.log10_gains[0])
 
@@ -303,10 +305,10 @@ def test_a_resumed_sweep_with_other_run_settings_runs_again(tmp_path):
     path = tmp_path / "runs.csv"
     run_cases(cases, table=RunTable(path))
     ex = CountingExecutor()
-    run_cases(cases, table=RunTable(path, resume=True), executor=ex, dt=5e-5)
+    run_cases(cases, table=RunTable(path, resume=True), executor=ex, solver=SolverSettings(dt=5e-5))
     assert ex.cases == 1  # another dt is another run
     ex = CountingExecutor()
-    run_cases(cases, table=RunTable(path, resume=True), executor=ex, dt=5e-5)
+    run_cases(cases, table=RunTable(path, resume=True), executor=ex, solver=SolverSettings(dt=5e-5))
     assert ex.cases == 0
 
 

@@ -1,0 +1,89 @@
+"""How a run is integrated: the `SolverSettings` value (docs/model.md, Integration).
+
+A module of its own, not a part of `railride.simulation`: the studies and the command line check
+and record these settings without loading the compiled stepper.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from . import validation
+from .defaults import DEFAULT_CONTROL_RATE, DEFAULT_DT, DEFAULT_OUTPUT_RATE
+
+
+def _steps(steps: float) -> int | None:
+    """``steps`` as a whole number >= 1, or None when it is not one (to a part in a million)."""
+    whole = int(round(steps))
+    return whole if whole >= 1 and abs(whole - steps) <= 1e-6 * steps else None
+
+
+@dataclass(frozen=True)
+class SolverSettings:
+    """The fixed RK4 step ``dt`` [s], the rate of the stored time histories ``output_rate``
+    [Hz] and the sample rate of the outer-loop controllers ``control_rate`` [Hz].
+
+    Checked at construction: each a finite number > 0, and the output interval 1/output_rate
+    a whole number of steps (at most one output sample per step). The controller period
+    1/control_rate must be a whole number of steps too, but only a closed loop samples it:
+    `control_steps` checks it when one runs (a passive run at dt = 4e-4 s keeps the default
+    control rate, 2.5 steps per period, without an error). Whether ``dt`` is small enough for
+    the vehicle is checked by `railride.simulation.simulate`, which knows the vehicle.
+    """
+
+    dt: float = DEFAULT_DT
+    output_rate: float = DEFAULT_OUTPUT_RATE
+    control_rate: float = DEFAULT_CONTROL_RATE
+
+    def __post_init__(self):
+        for name, unit in (("dt", "s"), ("output_rate", "Hz"), ("control_rate", "Hz")):
+            object.__setattr__(self, name, validation.number(name, getattr(self, name), "positive", unit))
+        if self.dt * self.output_rate > 1.0 + 1e-6:
+            raise ValueError(f"dt = {self.dt:g} s is too large for output_rate = {self.output_rate:g} Hz: "
+                             f"at most one output sample per step; use dt <= {1.0 / self.output_rate:g} s "
+                             "or a lower output_rate")
+        if _steps(1.0 / (self.output_rate * self.dt)) is None:
+            raise ValueError(f"output_rate = {self.output_rate:g} Hz with dt = {self.dt:g} s: the output "
+                             "interval 1/output_rate must be a whole number of steps (at most one "
+                             "sample per step)")
+
+    @property
+    def output_steps(self) -> int:
+        """Steps per output sample."""
+        steps = _steps(1.0 / (self.output_rate * self.dt))
+        assert steps is not None  # checked at construction
+        return steps
+
+    def control_steps(self) -> int:
+        """Steps per controller period; a ValueError naming control_rate and dt when the period
+        is not a whole number of steps (the check a closed loop needs)."""
+        steps = _steps(1.0 / (self.control_rate * self.dt))
+        if steps is None:
+            raise ValueError(f"control_rate = {self.control_rate:g} Hz with dt = {self.dt:g} s: the "
+                             "controller period must be a whole number of steps")
+        return steps
+
+    def to_dict(self) -> dict:
+        """The settings as a result records them (SI units in the names)."""
+        return {"dt_s": self.dt, "output_rate_hz": self.output_rate,
+                "control_rate_hz": self.control_rate}
+
+    @classmethod
+    def of(cls, solver) -> "SolverSettings":
+        """``solver`` itself, or the defaults for None."""
+        if solver is None:
+            return cls()
+        if not isinstance(solver, cls):
+            raise ValueError(f"solver = {solver!r}: must be a railride.SolverSettings or None "
+                             "(the defaults)")
+        return solver
+
+
+def _with_keywords(solver, dt=None, output_rate=None, control_rate=None) -> SolverSettings:
+    """``solver`` from the step keywords the command line still passes to the studies.
+    TEMPORARY: removed when the CLI moves onto Suspension."""
+    given = {k: v for k, v in (("dt", dt), ("output_rate", output_rate),
+                               ("control_rate", control_rate)) if v is not None}
+    if given and solver is not None:
+        raise ValueError(f"give solver= or {', '.join(given)}=, not both")
+    return SolverSettings(**given) if given else SolverSettings.of(solver)
