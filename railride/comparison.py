@@ -195,14 +195,14 @@ class Comparison:
     def plot(self, ax=None, response: str = "acceleration"):
         """One carbody response against time, one line per suspension (the paper's Figs. 8-11);
         into ``ax`` when given. Returns the figure."""
-        from .report import plot_comparison_response
+        from .plots.comparison import plot_comparison_response
 
         return plot_comparison_response(self, response, ax=ax)
 
     def save(self, folder):
         """The `railride compare --out` folder (JSON, NetCDF, CSV and the figures), written all
         or nothing. Returns the written paths."""
-        from .report import write_compare_outputs
+        from .files import write_compare_outputs
 
         return write_compare_outputs(self, folder, self.to_dict())
 

@@ -24,6 +24,7 @@ import pandas as pd
 
 from .control import CONTROLLERS, GainSet
 from .defaults import DEFAULT_DAMPER
+from .files import PARETO_FILES
 from .metrics import RESPONSES
 from .optimise import _bounds, _Evaluator
 from .solver import _with_keywords
@@ -31,7 +32,7 @@ from .sweep import Case, RunTable
 
 SCHEMA = "railride.pareto/1"
 #: the files `ParetoResult.save` writes, in this order
-FILES = ("pareto.png", "pareto.csv", "pareto.json")
+FILES = PARETO_FILES  # the files `ParetoResult.save` writes
 #: the gains each controller reads (the inner loop stays at the base gains: it is one setting
 #: per compiled batch)
 CONTROLLER_PARAMETERS = {n: sum((GainSet.entry_names(t) for t in GainSet.tables_read(n) if t != "inner"), ())
@@ -124,7 +125,7 @@ class ParetoResult:
         """The `railride.pareto/1` document (docs/cli.md): settings, the search box, the passive
         RMS, counts, and every sample as a row of `to_pandas`."""
         from . import __version__
-        from .report import _gain_unit
+        from .labels import gain_unit
 
         frame = self.to_pandas()
         flags = ["non_dominated"] + [f"non_dominated_{x}_{y}" for x, y in PROJECTIONS]
@@ -135,7 +136,7 @@ class ParetoResult:
             "suspension": self.suspension,
             "scenario": self.scenario,
             "settings": self.settings,
-            "parameters": [{"name": p, "unit": _gain_unit(p), "low": float(10.0 ** lo),
+            "parameters": [{"name": p, "unit": gain_unit(p), "low": float(10.0 ** lo),
                             "high": float(10.0 ** hi), "base": float(self.gains[0, j])}
                            for j, (p, (lo, hi)) in enumerate(zip(self.parameters, self.bounds))],
             "passive_rms": dict(zip(RESPONSES, map(float, self.passive))),
@@ -149,16 +150,16 @@ class ParetoResult:
     def plot(self, ax=None):
         """Acceleration ratio against pitch ratio, and against roll ratio (two panels; ``ax``
         None for a new figure, or two Axes). Returns the figure."""
-        from .report_pareto import plot_pareto
+        from .plots.pareto import plot_pareto
 
         return plot_pareto(self, ax)
 
     def save(self, folder) -> list:
         """pareto.png, pareto.csv, pareto.json into ``folder``, all or nothing (each file
         replaced atomically; other files, such as a run table, stay). Returns the paths."""
-        from .report_pareto import write_pareto
+        from .files import write_pareto_outputs
 
-        return write_pareto(self, folder)
+        return write_pareto_outputs(self, folder)
 
 
 def _plain(value):

@@ -229,7 +229,7 @@ class Cycles:
                 "frequency_hz": self.motion.frequency, "cycles": self.table()}
 
     def plot(self, path=None):
-        from .report import plot_hysteresis
+        from .plots.rig import plot_hysteresis
         return plot_hysteresis(self, path)
 
 
@@ -283,7 +283,7 @@ class Tracking:
                 "window_s": list(self.window)}
 
     def plot(self, path=None):
-        from .report import plot_tracking
+        from .plots.rig import plot_tracking
         return plot_tracking(self, path)
 
 

@@ -579,10 +579,10 @@ class RideResult:
 
     def to_pandas(self):
         """The time histories as a DataFrame, one column per scalar channel."""
-        from .report import to_frame
+        from .tables import to_frame
         return to_frame(self.dataset)
 
     def plot(self, path=None):
         """Plot the four body responses; save to ``path`` if given, return the figure."""
-        from .report import plot_body_responses
+        from .plots.ride import plot_body_responses
         return plot_body_responses(self.dataset, path)

@@ -143,7 +143,7 @@ class TuneResult:
         [provenance] table (scenario and its record, damper, step, objective, phases, runs,
         start gains, date; ``command``, the command line that ran the study, when given), which
         `GainSet.load` keeps as ``provenance``."""
-        from .report import describe_dampers
+        from .labels import describe_dampers
 
         s = self.settings
         last = {}
@@ -194,7 +194,7 @@ class TuneResult:
         """The sensitivity curves as one long table, one row per value tried (curves.csv):
         ``phase``, ``pass``, ``parameter``, ``value``, ``objective``, ``chosen``
         (`railride.report.curves_frame`)."""
-        from .report import curves_frame
+        from .tables import curves_frame
 
         return curves_frame(self.curves)
 
@@ -203,7 +203,7 @@ class TuneResult:
         the objective against its value, one line per pass. ``ax``: one Axes per parameter, in
         the order tuned, or None for a new figure (titled with the scenario and the objective).
         Returns the figure."""
-        from .report import plot_sensitivity
+        from .plots.tuning import plot_sensitivity
 
         return plot_sensitivity(self.curves, title=self._title(), ax=ax)
 
@@ -212,14 +212,14 @@ class TuneResult:
         (`to_pandas`) and tune.json (`to_dict`, then the entries of ``extra``, such as a command
         line's facts) into ``folder``, all or nothing (each file replaced atomically; other
         files, such as the run table runs.csv, stay). Returns the paths."""
-        from .report import write_tune_outputs
+        from .files import write_tune_outputs
 
         doc = {**self.to_dict(), **(extra or {})}
         return write_tune_outputs(self.curves, folder, doc, self.gains_toml(command),
                                   title=self._title())
 
     def _scenario_text(self) -> str:
-        from .report import describe_scenario
+        from .labels import describe_scenario
 
         return describe_scenario(self.scenario)
 

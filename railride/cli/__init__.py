@@ -1,0 +1,30 @@
+"""The ``railride`` command line: ``railride compare``, ``railride modes``, ``railride frf``,
+``railride simulate``, ``railride damper``, ``railride tracking``, ``railride tune``,
+``railride pareto`` and ``railride sweep``.
+
+A thin layer over the library: it parses options, calls `railride.vehicle`, `railride.track`,
+`railride.simulation`, `railride.metrics`, `railride.dampers`, `railride.rig`,
+`railride.control`, `railride.comparison`, `railride.sweep`, `railride.tuning` and
+`railride.report`, and prints. See docs/cli.md. One module per command (`rig` holds `damper`
+and `tracking`); `_options` declares the options several commands share, `_parsing` the
+checks of their values, `_common` the errors, consoles and run machinery, `_render` the
+shared tables.
+
+Exit statuses: 0 success, 1 the simulation diverged, 2 bad input (usage errors, invalid values,
+unreadable files, an output folder that cannot be written), 130 `tune`, `pareto` or `sweep`
+interrupted by Ctrl-C (the finished runs stay in DIR/runs.csv for --resume). Errors print one line
+``error: <message>`` on stderr, never a traceback.
+"""
+
+from __future__ import annotations
+
+# the commands register on `app` when imported, and `railride --help` lists them in this order
+from . import compare, modes, frf, simulate, rig, tune, pareto, sweep  # noqa: F401
+from ._app import app
+
+__all__ = ["app", "main"]
+
+
+def main() -> None:
+    """Entry point of the ``railride`` console script."""
+    app(prog_name="railride")

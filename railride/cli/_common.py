@@ -1,0 +1,296 @@
+"""What every command shares besides parsing: the error contract (one line ``error: ...`` and an
+exit status, never a traceback), the consoles, progress bars and status notes on stderr, and
+the machinery of the many-run commands (executors, run tables, Ctrl-C)."""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import math
+import sys
+from pathlib import Path
+from typing import Optional
+
+import typer
+
+
+# -- errors ---------------------------------------------------------------------------------------
+class CliError(Exception):
+    """A problem to report as ``error: ...`` with an exit status."""
+
+    def __init__(self, message: str, status: int):
+        super().__init__(message)
+        self.status = status
+
+
+def _one_line(exc: BaseException) -> str:
+    text = " ".join(str(exc).split())
+    return text or type(exc).__name__
+
+
+@contextlib.contextmanager
+def errors():
+    """ValueError -> status 2, RuntimeError -> 1, OSError -> 2: one line on stderr, no traceback."""
+    try:
+        yield
+    except CliError as exc:
+        status, message = exc.status, _one_line(exc)
+    except ValueError as exc:
+        status, message = 2, _one_line(exc)
+    except RuntimeError as exc:
+        status, message = 1, _one_line(exc)
+    except OSError as exc:
+        where = f" ({exc.filename})" if getattr(exc, "filename", None) else ""
+        status, message = 2, f"{exc.strerror or exc}{where}"
+    else:
+        return
+    typer.echo(f"error: {message}", err=True)
+    raise typer.Exit(status)
+
+
+# -- consoles and output --------------------------------------------------------------------------
+def stderr_is_terminal() -> bool:
+    try:
+        return sys.stderr.isatty()
+    except (AttributeError, ValueError):
+        return False
+
+
+def stdout_console():
+    from rich.console import Console
+
+    return Console(file=sys.stdout, highlight=False)
+
+
+def wide_stdout_console(width: int = 120):
+    """The stdout console for wide tables: the terminal's width on a terminal, else ``width``
+    columns (rich would assume 80 for a pipe or a file) unless COLUMNS says otherwise."""
+    import os
+
+    from rich.console import Console
+
+    try:
+        terminal = sys.stdout.isatty()
+    except (AttributeError, ValueError):
+        terminal = False
+    fixed = None if terminal or os.environ.get("COLUMNS") else width
+    return Console(file=sys.stdout, highlight=False, width=fixed)
+
+
+def stderr_console():
+    from rich.console import Console
+
+    return Console(file=sys.stderr, highlight=False)
+
+
+def status_note(message: str):
+    if not stderr_is_terminal():
+        return contextlib.nullcontext()
+    return stderr_console().status(message)
+
+
+def write_folder(out: Path, write) -> None:
+    """Run ``write()`` (a report.write_* call) with a status note; OSError -> status 2."""
+    try:
+        with status_note(f"writing outputs to {out}..."):
+            paths = write()
+    except OSError as exc:
+        raise CliError(f"cannot write the output folder {out}: {exc.strerror or exc}", 2) from None
+    typer.echo(f"wrote {', '.join(p.name for p in paths)} to {out}", err=True)
+
+
+def print_json(doc) -> None:
+    typer.echo(json.dumps(doc, indent=2, allow_nan=False))
+
+
+def _first_message(verb_text: str) -> str:
+    """The bar's first text: until the stepper is compiled in this process, that it compiles."""
+    from .. import kernels
+
+    compiled = bool(getattr(kernels.run_batch, "signatures", True))
+    return verb_text if compiled else "loading the stepper (the first run compiles it, up to a minute)..."
+
+
+class ProgressBar:
+    """A progress bar on stderr, only when stderr is a terminal.
+
+    ``describe(done)`` gives the bar's text for a done fraction (default: "simulating"); until
+    the first report, a stepper not yet compiled in this process says that it compiles."""
+
+    def __init__(self, enabled: bool, describe=None):
+        self.enabled = enabled
+        self._describe = describe or (lambda done: "simulating")
+        self._progress = None
+        self._task = None
+
+    def __enter__(self):
+        if not self.enabled:
+            return self
+        from rich.progress import BarColumn, Progress, SpinnerColumn, TextColumn, TimeElapsedColumn
+
+        first = _first_message(self._describe(0.0))
+        self._progress = Progress(SpinnerColumn(), TextColumn("{task.description}"), BarColumn(),
+                                  TextColumn("{task.percentage:>3.0f}%"), TimeElapsedColumn(),
+                                  console=stderr_console(), transient=True)
+        self._progress.__enter__()
+        self._task = self._progress.add_task(first, total=1.0)
+        return self
+
+    def __call__(self, done: float) -> None:
+        if self._progress is not None:
+            self._progress.update(self._task, completed=done, description=self._describe(done))
+
+    def __exit__(self, *exc):
+        if self._progress is not None:
+            self._progress.__exit__(*exc)
+        return False
+
+
+# -- many runs: tune, pareto and sweep ------------------------------------------------------------
+class RunProgress:
+    """Progress of many runs, fed by the library's ``progress(done, total, runs_per_second)``
+    (once per batch of runs it asks for, then after each chunk). Counts the runs evaluated in
+    this session (``evaluated``); shows a bar on stderr only when stderr is a terminal.
+    ``log(text)`` prints a line on stderr (above the bar)."""
+
+    def __init__(self, enabled: bool, verb: str):
+        self.enabled = enabled
+        self.verb = verb
+        self.evaluated = 0
+        self._base = 0
+        self._progress = None
+        self._task = None
+
+    def __enter__(self):
+        if not self.enabled:
+            return self
+        from rich.progress import BarColumn, MofNCompleteColumn, Progress, SpinnerColumn, TextColumn, TimeElapsedColumn
+
+        first = _first_message(f"{self.verb}...")
+        self._progress = Progress(SpinnerColumn(), TextColumn("{task.description}"), BarColumn(),
+                                  MofNCompleteColumn(), TextColumn("{task.fields[rate]}"),
+                                  TimeElapsedColumn(), console=stderr_console(), transient=True)
+        self._progress.__enter__()
+        self._task = self._progress.add_task(first, total=None, rate="")
+        return self
+
+    def __call__(self, done: int, total: int, runs_per_second: float) -> None:
+        if done == 0:
+            self._base = self.evaluated
+        self.evaluated = self._base + int(done)
+        if self._progress is not None:
+            ok = math.isfinite(runs_per_second) and runs_per_second > 0
+            self._progress.update(self._task, completed=done, total=total,
+                                  description=f"{self.verb} ({self.evaluated} runs)",
+                                  rate=f"{runs_per_second:.1f} runs/s" if ok else "")
+
+    def log(self, text: str) -> None:
+        if self._progress is not None:
+            self._progress.console.print(text, markup=False, highlight=False)
+        else:
+            typer.echo(text, err=True)
+
+    def __exit__(self, *exc):
+        if self._progress is not None:
+            self._progress.__exit__(*exc)
+        return False
+
+
+def make_executor(workers: Optional[int], scheduler: Optional[str], scheduler_file: Optional[Path]):
+    """(executor, record for the JSON): Dask with --scheduler / --scheduler-file, else the local
+    executor, whose batches use --workers threads (numba's thread count, 1..cores)."""
+    from .. import sweep as sweep_lib
+
+    if scheduler is not None and scheduler_file is not None:
+        raise ValueError("give either --scheduler ADDRESS or --scheduler-file FILE, not both")
+    if scheduler is not None or scheduler_file is not None:
+        if workers is not None:
+            raise ValueError(f"--workers = {workers}: applies to the local executor only; the "
+                             "threads of a Dask cluster are set where its workers start "
+                             "(dask worker --nthreads N)")
+        if scheduler is not None and not scheduler.strip():
+            raise ValueError("--scheduler = '': give the scheduler's address, e.g. "
+                             "tcp://host:8786")
+        with status_note("connecting to the Dask scheduler..."):
+            executor = sweep_lib.DaskExecutor(
+                address=scheduler, scheduler_file=None if scheduler_file is None else str(scheduler_file))
+        where = scheduler if scheduler is not None else str(scheduler_file)
+        record = {"type": "dask", "scheduler": where}
+        with contextlib.suppress(Exception):
+            record["workers"] = len(executor.client.scheduler_info()["workers"])
+        return executor, record
+    import numba
+
+    cores = int(numba.config.NUMBA_NUM_THREADS)
+    if workers is not None:
+        if not 1 <= workers <= cores:
+            raise ValueError(f"--workers = {workers}: must be a whole number from 1 to {cores} "
+                             "(the cores of this machine)")
+        numba.set_num_threads(workers)
+    return sweep_lib.LocalExecutor(), {"type": "local", "threads": int(numba.get_num_threads())}
+
+
+def open_run_table(out: Optional[Path], resume: bool):
+    """(RunTable, its path or None): DIR/runs.csv with --out, kept in memory without it."""
+    from .. import report
+    from .. import sweep as sweep_lib
+
+    if out is None:
+        if resume:
+            raise ValueError("--resume needs --out DIR: the run table it continues is "
+                             "DIR/runs.csv")
+        return sweep_lib.RunTable(), None
+    report.check_out_dir(out)
+    path = out / "runs.csv"
+    if path.exists() and not resume:
+        raise ValueError(f"--out {out}: {path} exists (the run table of an earlier run); add "
+                         "--resume to continue it, or choose another folder")
+    return sweep_lib.RunTable(path, resume=resume), path
+
+
+def _saved_runs(table, path: Optional[Path]) -> int:
+    """The rows of the run table on disk (what an interrupted run leaves), else in memory."""
+    if path is not None and path.exists():
+        import pandas as pd
+
+        try:
+            return len(pd.read_csv(path, usecols=["key"]))
+        except (OSError, ValueError):
+            pass
+    return len(table.frame)
+
+
+@contextlib.contextmanager
+def interruptible(table, path: Optional[Path]):
+    """Ctrl-C: one line saying what was kept, status 130, no traceback."""
+    try:
+        yield
+    except KeyboardInterrupt:
+        n = _saved_runs(table, path)
+        if path is not None:
+            typer.echo(f"interrupted: {n} runs saved in {path}; run again with --resume to "
+                       "continue", err=True)
+        else:
+            typer.echo(f"interrupted: {n} runs done, none saved (with --out DIR the runs are kept "
+                       "in DIR/runs.csv and --resume continues them)", err=True)
+        raise typer.Exit(130) from None
+
+
+def command_line(ctx: typer.Context, exclude=()) -> str:
+    """The railride command being run, with the options given on the command line (not their
+    defaults), for the record: reproducing a result needs only this line."""
+    import shlex
+
+    words = ["railride", ctx.info_name or ""]
+    for param in ctx.command.params:
+        source = ctx.get_parameter_source(param.name)
+        if param.name in exclude or getattr(source, "name", "") != "COMMANDLINE":
+            continue
+        value = ctx.params[param.name]
+        flag = max(param.opts, key=len)
+        if isinstance(value, bool):
+            words.append(flag if value else (param.secondary_opts or [flag])[0])
+            continue
+        for item in value if isinstance(value, (list, tuple)) else [value]:
+            words += [flag, str(getattr(item, "value", item))]
+    return shlex.join(w for w in words if w)

@@ -1,0 +1,111 @@
+"""Rich tables and text that several commands print: the response labels and number formats,
+the ride comfort tables, the damper description and the modes table."""
+
+from __future__ import annotations
+
+#: table labels of the four ride responses (keys of railride.metrics.RESPONSES)
+RESPONSE_LABELS = {"acceleration_m_s2": "acceleration (m/s^2)", "displacement_m": "displacement (m)",
+                   "pitch_deg": "pitch (deg)", "roll_deg": "roll (deg)"}
+
+
+def fmt(value, spec: str) -> str:
+    return "-" if value is None else format(value, spec)
+
+
+def reduction_text(value, spec: str = ".1f") -> str:
+    if value is None:
+        return ""
+    text = format(value, spec)
+    return f"[red]{text}[/red]" if value < 0 else text
+
+
+def damper_text(settings: dict) -> str:
+    from ..report import describe_dampers
+
+    return describe_dampers(settings, detail=True)
+
+
+# -- ride comfort: simulate and compare ---------------------------------------------------------
+#: (index, row label, format) of the comfort tables of `simulate` and `compare`
+COMFORT_ROWS = (("aw_Wk", "a_w Wk (m/s^2)", ".4f"), ("vdv_Wk", "VDV Wk (m/s^1.75)", ".4f"),
+                ("aw_Wb", "a_w Wb (m/s^2)", ".4f"), ("N_MV_z", "N_MV,z (EN 12299)", ".3f"),
+                ("Wz", "Wz (Sperling)", ".3f"))
+#: where the comfort tables' positions are on the carbody floor
+POSITION_LABELS = {"centre": "carbody centre", "front": "above the front bogie",
+                   "rear": "above the rear bogie"}
+SHORT_POSITION_LABELS = {"centre": "centre", "front": "front bogie", "rear": "rear bogie"}
+
+
+def _comfort_caption(record: dict) -> str:
+    start, end = record["window_s"]
+    return "\n".join(["floor points at x = " + ", ".join(
+        f"{p['x_m']:g} m" for p in record["positions"].values()) + f"; window {start:g}-{end:g} s",
+                      *record["notes"]])
+
+
+def comfort_table(record: dict):
+    """The comfort table of `simulate`: one row per index, one column per position."""
+    from rich.markup import escape
+    from rich.table import Table
+
+    positions = record["positions"]
+    table = Table(title="Ride comfort (carbody floor)", caption=escape(_comfort_caption(record)))
+    table.add_column("index")
+    for name in positions:
+        table.add_column(escape(POSITION_LABELS.get(name, name)), justify="right")
+    for key, label, spec in COMFORT_ROWS:
+        table.add_row(escape(label), *[format(p[key], spec) for p in positions.values()])
+    table.add_row("comfort class (N_MV,z)", *[p["N_MV_z_class"] for p in positions.values()])
+    return table
+
+
+def compare_comfort_table(rows: list[dict]):
+    """The "ride comfort" table of `compare`: the indices at each position (rows), the
+    suspensions (columns) with the reduction against passive where meaningful."""
+    from rich.markup import escape
+    from rich.table import Table
+
+    first = rows[0]["comfort"]
+    table = Table(title="Ride comfort on the carbody floor: centre and above the bogies",
+                  caption=escape(_comfort_caption(first) + "\nred. % = (passive - controlled) / "
+                                 "passive x 100; none for Wz, which is not proportional to the "
+                                 "acceleration"))
+    table.add_column("position", no_wrap=True)
+    table.add_column("index", no_wrap=True)
+    for r in rows:
+        table.add_column(escape(r["label"].replace(" (", "\n(")), justify="right", min_width=8)
+        if r["name"] != "passive":
+            table.add_column("red. %", justify="right", min_width=5)
+    for pos in first["positions"]:
+        for n, (key, label, spec) in enumerate(COMFORT_ROWS):
+            cells = [escape(SHORT_POSITION_LABELS.get(pos, pos)) if n == 0 else "", escape(label)]
+            for r in rows:
+                cells.append(format(r["comfort"]["positions"][pos][key], spec))
+                if r["name"] != "passive":
+                    red = r["comfort"].get("reduction_percent", {}).get(pos, {}).get(key)
+                    cells.append(reduction_text(red))
+            table.add_row(*cells)
+        cells = ["", "class (N_MV,z)"]
+        for r in rows:
+            cells.append(r["comfort"]["positions"][pos]["N_MV_z_class"])
+            if r["name"] != "passive":
+                cells.append("")
+        table.add_row(*cells, end_section=True)
+    return table
+
+
+# -- modes: modes and frf -----------------------------------------------------------------------
+def modes_table(rows: list[dict]):
+    from rich.markup import escape
+    from rich.table import Table
+
+    table = Table(title="Modes of the passive vehicle")
+    table.add_column("#", justify="right")
+    table.add_column("mode", no_wrap=True)
+    table.add_column("undamped (Hz)", justify="right")
+    table.add_column("damped (Hz)", justify="right")
+    table.add_column("damping ratio", justify="right")
+    for i, r in enumerate(rows, start=1):
+        table.add_row(str(i), escape(r["label"]), f"{r['frequency_hz']:.3f}",
+                      f"{r['damped_frequency_hz']:.3f}", f"{r['damping_ratio']:.3f}")
+    return table

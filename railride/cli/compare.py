@@ -1,0 +1,296 @@
+"""``railride compare``: passive, PID and SAS suspensions on one scenario beside the paper's
+Table 1 (railride.comparison.compare), with the tables it prints."""
+
+from __future__ import annotations
+
+import json
+import math
+from typing import Annotated, Optional
+
+import typer
+
+from ..dampers import IDEAL_NAMES
+from ..defaults import DEFAULT_CONTROL_RATE, DEFAULT_DAMPER
+from ._app import app
+from ._common import ProgressBar, errors, stderr_is_terminal, wide_stdout_console, write_folder
+from ._options import (AmplitudeOption, ComfortOption, CompareDamperOption, CompareDamperScaleOption,
+                       CompareGainsOption, CompareOutOption, CompareScenarioOption, ControlRateOption,
+                       DtOption, DurationOption, FormatOption, MaxWavelengthOption, MinWavelengthOption,
+                       OutputFormat, OutputRateOption, ParamsOption, PresetOption, RailPhaseOption,
+                       SpeedOption, TrackSeedOption, WavelengthOption, WindowOption)
+from ._parsing import (check_damper_scale, check_number, damper_preset, load_gains, make_scenario, parse_noise,
+                       track_options, vehicle_from_options)
+from ._render import RESPONSE_LABELS, compare_comfort_table, damper_text, fmt, reduction_text
+
+
+def _controller_list(text: str) -> list[str]:
+    """--controllers: comma-separated names -> the suspensions to run, passive first."""
+    from ..comparison import check_controllers
+    from ..control import CONTROLLERS
+
+    items = [item.strip() for item in text.split(",")]
+    if any(not item for item in items):
+        raise ValueError(f"--controllers = {text!r}: an empty item; give names separated by "
+                         f"commas from {', '.join(CONTROLLERS)}")
+    try:
+        return check_controllers(items)
+    except ValueError as exc:
+        raise ValueError(f"--controllers = {text!r}: {exc}") from None
+
+
+def _sensor_noise(text: Optional[str], seed: Optional[int]):
+    """--sensor-noise Z,ANGLE,VEL,RATE and --seed -> a control.SensorNoise, or None."""
+    from ..control import SensorNoise
+
+    if text is None:
+        if seed is not None:
+            raise ValueError(f"--seed = {seed}: applies with --sensor-noise only (without it the "
+                             "measurements are ideal)")
+        return None
+    values = parse_noise("--sensor-noise", text)
+    if seed is not None and seed < 0:
+        raise ValueError(f"--seed = {seed}: must be a whole number >= 0")
+    return SensorNoise(*values, seed=0 if seed is None else seed)
+
+
+def _check_control_rate(rate: float, dt: float) -> float:
+    """--control-rate: > 0 and a whole number of RK4 steps per controller period."""
+    rate = check_number("--control-rate", rate, "Hz")
+    stride = 1.0 / (rate * dt)
+    if round(stride) < 1 or abs(round(stride) - stride) > 1e-6 * stride:
+        raise ValueError(f"--control-rate = {rate:g} Hz with --dt = {dt:g} s: the controller "
+                         "period 1/rate must be a whole number of steps dt")
+    return rate
+
+
+def _trade_off_lines(doc: dict) -> list[str]:
+    """One line per trade-off of `Comparison.trade_offs`: what a controller loses for what it
+    wins, against passive and against each other controller."""
+    labels = {r["name"]: r["label"] for r in doc["controllers"]}
+    words = {k: v.split(" (")[0] for k, v in RESPONSE_LABELS.items()}
+    lines = []
+    for t in doc.get("trade_offs", []):
+        if not t["worse_on"]:
+            continue
+        a, b = labels[t["controller"]], labels.get(t["than"], t["than"])
+        better = ", ".join(words[r] for r in t["better_on"]) or "nothing"
+        worse = ", ".join(words[r] for r in t["worse_on"])
+        lines.append(f"trade-off: {a} beats {b} on {better} but is worse on {worse}")
+    return lines
+
+
+def _compare_tables(doc: dict, vehicle: str, shipped: bool):
+    """The three tables of `compare`: Table 1 beside the paper, peak-to-peak, damper demands."""
+    from rich.markup import escape
+    from rich.table import Table
+    from rich.text import Text
+
+    from ..report import describe_scenario
+
+    rows = doc["controllers"]
+    settings = doc["settings"]
+    controlled = [r for r in rows if r["name"] != "passive"]
+
+    # 1. the paper's Table 1: RMS and reduction, railride above the paper
+    start, end = settings["window_s"] or (0.0, settings["scenario"].get("duration_s", 0.0))
+    info = [describe_scenario(settings["scenario"]),
+            f"dt {settings['dt_s']:g} s, RMS over {start:g}-{end:g} s, vehicle {vehicle}"]
+    if controlled:
+        noise = settings.get("sensor_noise")
+        noise_text = ("ideal measurements" if not noise else
+                      "sensor noise z {displacement:g} m, angle {angle:g} rad, velocity {velocity:g} m/s, "
+                      "rate {angular_rate:g} rad/s, seed {seed}".format(**noise))
+        info.append(f"{damper_text(settings)}, controller {settings['control_rate_hz']:g} Hz, "
+                    f"{noise_text}")
+        info.append(f"gains file {doc['gains']['source']}" + (" (shipped)" if shipped else ""))
+        tuning = doc.get("tuning") or {}
+        if tuning.get("objective"):
+            info.append((f"gains tuned by `{tuning['command']}`, " if tuning.get("command") else
+                         "gains tuned ") + f"objective {tuning['objective']}")
+        if tuning.get("in_sample"):
+            info.append("The gains were tuned on this same single track: the reductions are "
+                        "in-sample, not a test on another track.")
+        info += _trade_off_lines(doc)
+    info.append("The paper's absolute values depend on settings it does not give (sine wavelength, "
+                "rail phase, damper, gains): compare the ranking and the size of the reductions, "
+                "not the digits. red. % = (passive - controlled) / passive x 100 (negative: worse "
+                "than passive, in red).")
+    table = Table(title="Ride comparison: RMS of the carbody responses beside the paper's Table 1")
+    table.add_column("response", min_width=12)
+    table.add_column("", no_wrap=True)
+    for r in rows:
+        table.add_column(escape(r["label"].replace(" (", "\n(")), justify="right", min_width=8)
+        if r["name"] != "passive":
+            table.add_column("red. %", justify="right", min_width=5)
+    for key, label in RESPONSE_LABELS.items():
+        ours, paper = [label, "railride"], ["", "[dim]paper[/dim]"]
+        for r in rows:
+            ours.append(f"{r['metrics'][key]['rms']:#.4g}")
+            p = r["paper"][key]
+            paper.append(f"[dim]{p['rms']:g}[/dim]")
+            if r["name"] != "passive":
+                ours.append(reduction_text(r["reduction_percent"][key]))
+                paper.append(f"[dim]{p['reduction_percent']:.1f}[/dim]")
+        table.add_row(*ours)
+        table.add_row(*paper, end_section=True)
+
+    # 1b. the same gains on the ideal devices: what a damper, and an actuator, could reach
+    bounds_parts = []
+    if doc.get("bounds"):
+        bt = Table(title="RMS reduction % beside the bounds: the same control laws and gains on "
+                         "ideal devices")
+        bt.add_column("response", min_width=20, no_wrap=True)
+        short = {"pid": "PID", "sas-attitude": "SAS att.", "sas-attitude-ride": "SAS att.+ride"}
+        for r in controlled:
+            for head in ("MR", "ideal\ndamper", "ideal\nactuator"):
+                name = short.get(r["name"], r["label"])
+                bt.add_column(escape(f"{name}\n{head}") if head == "MR" else f"\n{head}",
+                              justify="right", min_width=7)
+        for key, label in RESPONSE_LABELS.items():
+            cells = [label]
+            for r in controlled:
+                cells.append(reduction_text(r["reduction_percent"][key]))
+                for device in ("ideal-damper", "ideal"):
+                    value = doc["bounds"][device][r["name"]]["reduction_percent"][key]
+                    cells.append("diverged" if value is None else reduction_text(value))
+            bt.add_row(*cells)
+        bounds_parts = ["", bt, Text(
+            "ideal damper: the demand where it dissipates energy, no force where it would push "
+            "energy in (no force limit, no lag, no hysteresis): the best any semi-active damper "
+            "could do with these gains. ideal actuator: the demand, always (an active "
+            "suspension). The gains were tuned for the MR dampers; tuned for the ideal devices "
+            "the bounds lie further out (docs/results.md).")]
+
+    # 2. peak-to-peak
+    ptp = Table(title="Peak-to-peak of the carbody responses (railride)")
+    ptp.add_column("response")
+    for r in rows:
+        ptp.add_column(escape(r["label"]), justify="right", min_width=8)
+    for key, label in RESPONSE_LABELS.items():
+        ptp.add_row(label, *[f"{r['metrics'][key]['ptp']:#.4g}" for r in rows])
+
+    # 3. what each suspension asks of its dampers
+    demands = Table(title="What each suspension asks of its dampers")
+    demands.add_column("suspension", no_wrap=True)
+    for heading in ("RMS demand\n(kN)", "RMS force\n(kN)", "max force\n(kN)", "RMS travel\n(mm)",
+                    "max travel\n(mm)", "mean voltage\n(V)", "time at v_max\n(%)"):
+        demands.add_column(heading, justify="right", min_width=6)
+    for r in rows:
+        d = r["damper"]
+        at_max = d.get("voltage_at_max_fraction")
+        demand = d.get("demand_rms_n")
+        demands.add_row(escape(r["label"]), "-" if demand is None else f"{demand / 1e3:.2f}",
+                        f"{d['force_rms_n'] / 1e3:.2f}",
+                        f"{d['force_max_n'] / 1e3:.2f}", f"{d['travel_rms_m'] * 1e3:.1f}",
+                        f"{d['travel_max_m'] * 1e3:.1f}", fmt(d.get("voltage_mean_v"), ".2f"),
+                        "-" if at_max is None else f"{at_max * 100:.1f}")
+    demands_note = ("All four corners, over the metric window. demand: the force the outer loop "
+                    "asks for; force: the secondary damper force on the carbody; travel: the "
+                    "secondary deflection (suspension travel); passive: the viscous dampers c_sz."
+                    + (" The ideal devices have no voltage." if settings.get("damper")
+                       in IDEAL_NAMES and controlled else ""))
+    parts = [table, Text("\n".join(info)), *bounds_parts, "", ptp, "", demands, Text(demands_note)]
+    if all("comfort" in r for r in rows):
+        parts += ["", compare_comfort_table(rows)]
+    return parts
+
+
+@app.command()
+def compare(
+    controllers: Annotated[str, typer.Option(
+        "--controllers", metavar="NAME[,NAME...]",
+        help="Suspensions to compare, comma-separated: passive, pid, sas-attitude, "
+             "sas-attitude-ride. Passive always runs as the baseline.")]
+        = "passive,pid,sas-attitude,sas-attitude-ride",
+    gains: CompareGainsOption = None,
+    damper: CompareDamperOption = DEFAULT_DAMPER,
+    damper_scale: CompareDamperScaleOption = None,
+    control_rate: ControlRateOption = DEFAULT_CONTROL_RATE,
+    sensor_noise: Annotated[Optional[str], typer.Option(
+        "--sensor-noise", metavar="Z,ANGLE,VEL,RATE",
+        help="White noise on the measured carbody states, standard deviations: heave [m], "
+             "pitch and roll angle [rad], heave velocity [m/s], pitch and roll rate [rad/s] "
+             "(default: ideal measurements).")] = None,
+    seed: Annotated[Optional[int], typer.Option(
+        "--seed", metavar="N",
+        help="Seed of the sensor noise, >= 0 (default 0); needs --sensor-noise.")] = None,
+    scenario: CompareScenarioOption = "paper-sine",
+    amplitude: AmplitudeOption = None,
+    wavelength: WavelengthOption = None,
+    rail_phase: RailPhaseOption = None,
+    track_seed: TrackSeedOption = None,
+    min_wavelength: MinWavelengthOption = None,
+    max_wavelength: MaxWavelengthOption = None,
+    speed: SpeedOption = None,
+    duration: DurationOption = None,
+    dt: DtOption = None,
+    output_rate: OutputRateOption = None,
+    window: WindowOption = None,
+    params: ParamsOption = None,
+    preset: PresetOption = None,
+    format: FormatOption = OutputFormat.table,
+    out: CompareOutOption = None,
+    bounds: Annotated[bool, typer.Option(
+        "--bounds/--no-bounds",
+        help="Also run the same control laws and gains on the ideal semi-active damper and the "
+             "ideal actuator, and print their reductions beside the MR dampers' (default on; "
+             "MR dampers only).")] = True,
+    comfort: ComfortOption = False,
+) -> None:
+    """Compare passive, PID and SAS suspensions on one scenario, as in the paper's Table 1.
+
+    Runs the passive vehicle (the baseline) and each controller (MR dampers closed by the
+    force-tracking inner loop) with the shipped gains, and prints the RMS of the carbody
+    responses with the reduction against passive beside the paper's values, the peak-to-peak
+    values and what each suspension asks of its dampers. Without options: the paper's
+    scenario paper-sine.
+    """
+    with errors():
+        from .. import report
+        from ..comparison import compare as run_compare
+        from ..defaults import DEFAULT_DT, DEFAULT_OUTPUT_RATE
+        from ..metrics import check_window, parse_window
+
+        names = _controller_list(controllers)
+        gain_set = load_gains(gains)
+        damper_preset("--damper", damper)
+        scale = check_damper_scale("--damper-scale", damper_scale, damper)
+        noise = _sensor_noise(sensor_noise, seed)
+        dt = DEFAULT_DT if dt is None else dt
+        output_rate = DEFAULT_OUTPUT_RATE if output_rate is None else output_rate
+        control_rate = _check_control_rate(control_rate, check_number("--dt", dt, "s"))
+        vehicle_params, vehicle_record = vehicle_from_options(params, preset)
+        window_value = parse_window(window) if window is not None else None
+        track = track_options(scenario, track_seed, min_wavelength, max_wavelength)
+        scen = make_scenario(scenario, dict(amplitude=amplitude, wavelength=wavelength,
+                                            rail_phase=rail_phase, speed=speed,
+                                            duration=duration, **track), output_rate)
+        if out is not None:
+            report.check_out_dir(out)
+        # check the window before the runs, and record it resolved
+        window_value = check_window(window_value or (0.0, math.inf), scen.duration)
+
+        controlled = [n for n in names if n != "passive"]
+
+        def describe(done: float) -> str:
+            if done < 0.5 or not controlled:
+                return "running the passive baseline..."
+            return f"running {', '.join(controlled)}..."
+
+        with ProgressBar(stderr_is_terminal(), describe) as progress:
+            result = run_compare(scen, vehicle_params, controllers=names, gains=gain_set,
+                                 damper=damper, damper_scale=scale, window=window_value, dt=dt,
+                                 output_rate=output_rate, control_rate=control_rate,
+                                 sensor_noise=noise, comfort=comfort, bounds=bounds,
+                                 progress=progress if progress.enabled else None)
+        doc = result.to_dict()
+        text = json.dumps(doc, indent=2, allow_nan=False)  # refuses NaN before anything is written
+        if out is not None:
+            write_folder(out, lambda: report.write_compare_outputs(result, out, doc))
+    if format is OutputFormat.json:
+        typer.echo(text)
+        return
+    vehicle = vehicle_record.get("vehicle_preset") or vehicle_record.get("vehicle_params_file")
+    console = wide_stdout_console()
+    for part in _compare_tables(doc, vehicle, shipped=gains is None):
+        console.print(part)

@@ -1,0 +1,141 @@
+"""``railride pareto``: the trades a controller's gains offer (railride.pareto), with its
+tables."""
+
+from __future__ import annotations
+
+from typing import Annotated, Optional
+
+import typer
+
+from ..defaults import DEFAULT_DAMPER
+from ._app import app
+from ._common import (RunProgress, errors, interruptible, make_executor, open_run_table, print_json,
+                      stderr_is_terminal, wide_stdout_console, write_folder)
+from ._options import (AmplitudeOption, DtOption, FormatOption, MaxWavelengthOption, MinWavelengthOption,
+                       OutputFormat, ParetoDamperOption, ParetoGainsOption, ParetoOutOption, ParetoResumeOption,
+                       RailPhaseOption, RunDurationOption, RunsScenarioOption, SchedulerFileOption, SchedulerOption,
+                       SpeedOption, TrackSeedOption, WavelengthOption, WorkersOption)
+from ._parsing import check_int, check_number, damper_preset, default_of, load_gains, study_scenario
+from ._render import RESPONSE_LABELS, damper_text, fmt
+
+
+def _pareto_table(doc: dict, caption: str):
+    """Counts, then the samples non-dominated over the four ratios by acceleration ratio."""
+    from rich.table import Table
+
+    from ..pareto import PROJECTIONS
+
+    c = doc["counts"]
+    counts = Table(title="Pareto view: samples and non-dominated samples")
+    counts.add_column("samples (with the base gains)", justify="right")
+    counts.add_column("non-dominated\nover all four ratios", justify="right")
+    for x, y in PROJECTIONS:
+        counts.add_column(f"non-dominated in\n{x} and {y}", justify="right")
+    counts.add_row(str(c["samples"]), str(c["non_dominated"]),
+                   *[str(c[f"non_dominated_{x}_{y}"]) for x, y in PROJECTIONS])
+    front = sorted((r for r in doc["samples"] if r["non_dominated"]),
+                   key=lambda r: (r["acceleration_m_s2_ratio"] is None,
+                                  r["acceleration_m_s2_ratio"] or 0.0))
+    rows = Table(title="Non-dominated samples by acceleration ratio: RMS / RMS(passive)",
+                 caption=caption, caption_justify="left")
+    rows.add_column("sample", justify="right")
+    for label in RESPONSE_LABELS.values():
+        rows.add_column(label.split(" (")[0], justify="right")
+    rows.add_column("also non-dominated\nagainst acceleration in")
+    for r in front:
+        planes = ", ".join(y for x, y in PROJECTIONS if r[f"non_dominated_{x}_{y}"])
+        rows.add_row(f"{r['sample']}" + (" (base)" if r["base"] else ""),
+                     *[fmt(r[f"{key}_ratio"], ".3f") for key in RESPONSE_LABELS], planes)
+    return [counts, "", rows]
+
+
+@app.command("pareto")
+def pareto_command(
+    suspension: Annotated[str, typer.Option(
+        "--suspension", metavar="NAME",
+        help="The controller whose gains are sampled: pid, sas-attitude or sas-attitude-ride "
+             "(every outer-loop gain it reads).")] = "sas-attitude-ride",
+    samples: Annotated[Optional[int], typer.Option(
+        "--samples", metavar="N",
+        help="Sobol' samples of the gains, a power of two (default 128); the base gains are "
+             "run too.")] = None,
+    seed: Annotated[int, typer.Option(
+        "--seed", metavar="S", help="Seed of the scrambled Sobol' sample, >= 0.")] = 0,
+    scenario: RunsScenarioOption = "paper-sine",
+    amplitude: AmplitudeOption = None,
+    wavelength: WavelengthOption = None,
+    rail_phase: RailPhaseOption = None,
+    track_seed: TrackSeedOption = None,
+    min_wavelength: MinWavelengthOption = None,
+    max_wavelength: MaxWavelengthOption = None,
+    speed: SpeedOption = None,
+    duration: RunDurationOption = None,
+    dt: DtOption = None,
+    damper: ParetoDamperOption = DEFAULT_DAMPER,
+    gains: ParetoGainsOption = None,
+    workers: WorkersOption = None,
+    scheduler: SchedulerOption = None,
+    scheduler_file: SchedulerFileOption = None,
+    out: ParetoOutOption = None,
+    resume: ParetoResumeOption = False,
+    format: FormatOption = OutputFormat.table,
+) -> None:
+    """The trades a controller's gains offer: RMS ratios to passive of sampled gains.
+
+    Samples the gains in log10 over the box of the global optimiser (REFERENCE / 1000 to
+    REFERENCE x 100) by a scrambled Sobol' sequence, runs them and the base gains, and marks the
+    samples no other beats in every ratio (non-dominated). Prints the counts and the
+    non-dominated samples by acceleration ratio. Ctrl-C stops; with --out, --resume continues.
+    """
+    import time
+
+    with errors():
+        from .. import report
+        from ..defaults import DEFAULT_DT
+        from ..pareto import CONTROLLER_PARAMETERS, pareto as run_pareto
+
+        if suspension not in CONTROLLER_PARAMETERS:
+            raise ValueError(f"--suspension = {suspension!r}: allowed "
+                             f"{', '.join(CONTROLLER_PARAMETERS)}")
+        n = default_of(run_pareto, "n_samples") if samples is None else samples
+        if n < 1 or n & (n - 1):
+            raise ValueError(f"--samples = {n}: must be a power of two (1, 2, 4, ..., 128, "
+                             "...), which keeps the balance of the Sobol' sample")
+        check_int("--seed", seed, 0)
+        damper_preset("--damper", damper)
+        base = load_gains(gains)
+        dt = DEFAULT_DT if dt is None else check_number("--dt", dt, "s")
+        scen, options = study_scenario(scenario, amplitude=amplitude, wavelength=wavelength,
+                                       rail_phase=rail_phase, speed=speed, duration=duration,
+                                       track_seed=track_seed, min_wavelength=min_wavelength,
+                                       max_wavelength=max_wavelength)
+        scenario_text = report.describe_scenario(scen.describe())
+        table, table_path = open_run_table(out, resume)
+        executor, executor_record = make_executor(workers, scheduler, scheduler_file)
+    try:
+        with interruptible(table, table_path), errors():
+            with RunProgress(stderr_is_terminal(), "sampling the gains") as progress:
+                t0 = time.perf_counter()
+                result = run_pareto(suspension, n_samples=n, seed=seed, scenario=scenario,
+                                    scenario_options=options, gains=base, damper=damper,
+                                    executor=executor, table=table, dt=dt, progress=progress)
+                wall = time.perf_counter() - t0
+            doc = result.to_dict()
+            if out is not None:
+                write_folder(out, lambda: result.save(out))
+    finally:
+        executor.close()
+    if format is OutputFormat.json:
+        print_json(doc)
+        return
+    st = doc["settings"]
+    lines = [(f"{scenario_text}, {scen.duration:g} s, dt {dt:g} s, {damper_text(st)}; base "
+              f"gains {st['base_gains']}"),
+             f"{st['n_samples']} samples, seed {st['seed']}: {st['sampling']}",
+             (f"{doc['runs']} runs in the run table, {progress.evaluated} evaluated now, wall "
+              f"time {wall:.1f} s ({executor_record['type']})")]
+    if doc["note"]:
+        lines.append(doc["note"])
+    console = wide_stdout_console()
+    for part in _pareto_table(doc, "\n".join(lines)):
+        console.print(part)

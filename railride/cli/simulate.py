@@ -1,0 +1,179 @@
+"""``railride simulate``: one run of the vehicle on a track (railride.simulation.simulate), its
+ride metrics and the simulation document."""
+
+from __future__ import annotations
+
+from typing import Annotated, Optional
+
+import typer
+
+from .. import __version__
+from ..dampers import IDEAL_NAMES
+from ..defaults import DEFAULT_DAMPER
+from ._app import app
+from ._common import ProgressBar, errors, print_json, stderr_is_terminal, stdout_console, write_folder
+from ._options import (AmplitudeOption, ComfortOption, DtOption, DurationOption, FormatOption, MaxWavelengthOption,
+                       MinWavelengthOption, OutputFormat, OutputRateOption, ParamsOption, PresetOption,
+                       RailPhaseOption, ScenarioOption, SimulateDamperOption, SimulateDamperScaleOption,
+                       SimulateOutOption, SimulateWindowOption, SpeedOption, TrackSeedOption, WavelengthOption)
+from ._parsing import (check_damper_scale, damper_preset, make_scenario, parse_voltage, track_options,
+                       vehicle_from_options)
+from ._render import comfort_table
+
+SCHEMA_SIMULATE = "railride.simulation/1"
+#: --suspension values of `simulate`
+SUSPENSIONS = ("passive", "mr")
+
+
+def _describe_suspension(record: dict) -> str:
+    if record.get("type") == "mr":
+        scale = record.get("damper_scale", 1.0)
+        return (f"MR, {record['damper']} dampers" + (f" (force x {scale:g})" if scale != 1.0 else "")
+                + f" at {record['voltage_v']:g} V")
+    return "passive (viscous c_sz)"
+
+
+def _metrics_table(doc: dict):
+    from rich.markup import escape
+    from rich.table import Table
+
+    labels = {"acceleration_m_s2": "acceleration (m/s^2)", "displacement_m": "displacement (m)",
+              "pitch_deg": "pitch (deg)", "roll_deg": "roll (deg)"}
+    sc, st = doc["scenario"], doc["settings"]
+    start, end = st["window_s"]
+    vehicle = doc.get("vehicle_preset") or doc.get("vehicle_params_file")
+    random = ([f"random track: seed {sc.get('seed')}, wavelengths "
+               f"{sc.get('min_wavelength_m'):g}-{sc.get('max_wavelength_m'):g} m"]
+              if sc.get("profile") == "random" else [])
+    caption = "\n".join([
+        f"scenario {sc.get('name')}, speed {sc.get('speed_m_s'):g} m/s",
+        *random,
+        f"duration {sc.get('duration_s'):g} s, dt {st['dt_s']:g} s, window {start:g}-{end:g} s",
+        f"vehicle {vehicle}",
+        f"suspension {_describe_suspension(doc.get('suspension') or {'type': 'passive'})}",
+    ])
+    table = Table(title="Ride metrics (carbody CG)", caption=escape(caption))
+    table.add_column("response")
+    table.add_column("RMS", justify="right")
+    table.add_column("peak-to-peak", justify="right")
+    for key, values in doc["metrics"].items():
+        table.add_row(labels.get(key, key), f"{values['rms']:.5g}", f"{values['ptp']:.5g}")
+    return table
+
+
+@app.command()
+def simulate(
+    scenario: ScenarioOption = "paper-sine",
+    amplitude: AmplitudeOption = None,
+    wavelength: WavelengthOption = None,
+    rail_phase: RailPhaseOption = None,
+    track_seed: TrackSeedOption = None,
+    min_wavelength: MinWavelengthOption = None,
+    max_wavelength: MaxWavelengthOption = None,
+    speed: SpeedOption = None,
+    duration: DurationOption = None,
+    dt: DtOption = None,
+    output_rate: OutputRateOption = None,
+    window: SimulateWindowOption = None,
+    suspension: Annotated[str, typer.Option(
+        "--suspension", metavar="passive|mr",
+        help="Secondary vertical dampers: passive (viscous c_sz) or mr (an MR damper model at "
+             "each corner, constant command voltage).")] = "passive",
+    damper: SimulateDamperOption = None,
+    damper_scale: SimulateDamperScaleOption = None,
+    voltage: Annotated[Optional[str], typer.Option(
+        "--voltage", metavar="V",
+        help="--suspension mr only: constant command voltage [V] within the damper's range, or "
+             "passive-off (v_min, the default) or passive-on (v_max).")] = None,
+    params: ParamsOption = None,
+    preset: PresetOption = None,
+    format: FormatOption = OutputFormat.table,
+    out: SimulateOutOption = None,
+    comfort: ComfortOption = False,
+) -> None:
+    """Simulate the vehicle on a track and print the ride metrics."""
+    with errors():
+        track = track_options(scenario, track_seed, min_wavelength, max_wavelength)
+        doc, result = _run(scenario, amplitude, wavelength, rail_phase, speed, duration, dt,
+                           output_rate, window, params, preset, out, suspension, damper, voltage,
+                           track=track, comfort=comfort, damper_scale=damper_scale)
+    if format is OutputFormat.json:
+        print_json(doc)
+    else:
+        console = stdout_console()
+        console.print(_metrics_table(doc))
+        if "comfort" in doc:
+            console.print(comfort_table(doc["comfort"]))
+
+
+def _suspension(suspension: str, damper_name, voltage_text, damper_scale=None):
+    """(damper model or None, command voltage or None, the record for the JSON document)."""
+    if suspension not in SUSPENSIONS:
+        raise ValueError(f"--suspension = {suspension!r}: allowed {', '.join(SUSPENSIONS)}")
+    if suspension == "passive":
+        given = [o for o, v in (("--damper", damper_name), ("--damper-scale", damper_scale),
+                                ("--voltage", voltage_text)) if v is not None]
+        if given:
+            verb = "applies" if len(given) == 1 else "apply"
+            raise ValueError(f"{' and '.join(given)} {verb} to --suspension mr only (the passive "
+                             "suspension has viscous dampers)")
+        return None, None, {"type": "passive"}
+    name = DEFAULT_DAMPER if damper_name is None else damper_name
+    model = damper_preset("--damper", name)
+    if name in IDEAL_NAMES:  # simulate runs open loop: no demand for it to apply
+        raise ValueError(f"--damper = {name!r}: the ideal actuator applies a controller's demand and "
+                         "simulate runs no controller (a constant voltage); use railride compare "
+                         "--damper ideal or railride sweep --damper ideal with a controller")
+    scale = check_damper_scale("--damper-scale", damper_scale, name)
+    if scale != 1.0:
+        model = model.scaled(scale)
+    volts = model.v_min if voltage_text is None else parse_voltage("--voltage", voltage_text, model)
+    record = {"type": "mr", "damper": name, "voltage_v": float(volts)}
+    if damper_scale is not None:  # only then: the document stays as it was without the option
+        record["damper_scale"] = scale
+    return model, float(volts), record
+
+
+def _run(scenario_name, amplitude, wavelength, rail_phase, speed, duration, dt, output_rate,
+         window_text, params_file, preset, out, suspension="passive", damper_name=None,
+         voltage_text=None, track=None, comfort=False, damper_scale=None):
+    from .. import report
+    from ..defaults import DEFAULT_DT, DEFAULT_OUTPUT_RATE
+    from ..metrics import check_window, parse_window, to_dict
+    from ..simulation import simulate as run_simulation
+
+    dt = DEFAULT_DT if dt is None else dt
+    output_rate = DEFAULT_OUTPUT_RATE if output_rate is None else output_rate
+    vehicle_params, vehicle_record = vehicle_from_options(params_file, preset)
+    damper, voltage, suspension_record = _suspension(suspension, damper_name, voltage_text,
+                                                     damper_scale)
+    window = parse_window(window_text) if window_text is not None else None
+    scen = make_scenario(scenario_name, dict(amplitude=amplitude, wavelength=wavelength,
+                                             rail_phase=rail_phase, speed=speed,
+                                             duration=duration, **(track or {})), output_rate)
+    if out is not None:
+        report.check_out_dir(out)
+    # check the window before the run, not after it
+    start, end = (0.0, scen.duration) if window is None else check_window(window, scen.duration)
+
+    with ProgressBar(stderr_is_terminal()) as progress:
+        result = run_simulation(scen, vehicle_params, dt=dt, output_rate=output_rate,
+                                damper=damper, voltage=voltage,
+                                progress=progress if progress.enabled else None)
+    metrics = result.metrics(window)
+    doc = {
+        "schema": SCHEMA_SIMULATE,
+        "railride_version": __version__,
+        "scenario": scen.describe(),
+        **vehicle_record,
+        "suspension": suspension_record,
+        "settings": {"dt_s": float(dt), "output_rate_hz": float(output_rate),
+                     "window_s": [float(start), float(end)]},
+        "metrics": to_dict(metrics),
+    }
+    if comfort:  # only then: the document stays as it was without --comfort
+        from ..comparison import comfort_record
+        doc["comfort"] = comfort_record(result.comfort(window))
+    if out is not None:
+        write_folder(out, lambda: report.write_outputs(result, out, doc))
+    return doc, result

@@ -1,0 +1,309 @@
+"""``railride tune``: the paper's sensitivity study of the controller gains (railride.tuning),
+the parsing of its objective and phases, and its tables."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+from typing import Annotated, Optional
+
+import typer
+
+from ..dampers import IDEAL_NAMES
+from ..defaults import DEFAULT_DAMPER
+from ._app import app
+from ._common import (RunProgress, command_line, errors, interruptible, make_executor, open_run_table,
+                      stderr_is_terminal, wide_stdout_console, write_folder)
+from ._options import (AmplitudeOption, BoundOption, DtOption, FormatOption, MaxWavelengthOption,
+                       MinWavelengthOption, ObjectiveOption, OutputFormat, PenaltyOption, RailPhaseOption,
+                       RunDurationOption, RunsScenarioOption, SchedulerFileOption, SchedulerOption, SpeedOption,
+                       TrackSeedOption, TuneDamperOption, TuneDamperScaleOption, TuneGainsOption, TuneOutOption,
+                       TuneResumeOption, WavelengthOption, WeightsOption, WorkersOption)
+from ._parsing import (check_damper_scale, check_int, check_number, damper_preset, default_of, load_gains,
+                       parse_float, study_scenario)
+from ._render import RESPONSE_LABELS, damper_text, reduction_text
+
+
+def _objective(kind: Optional[str], weights: Optional[str], bound: Optional[str],
+               penalty: Optional[str]):
+    """--objective, --weights, --bound, --penalty -> a tuning.Objective. Without --objective,
+    the library's DEFAULT_OBJECTIVE; an option not given keeps that default's value when the
+    kind is the default's (weights and bound belong to their kind only)."""
+    from ..objectives import DEFAULT_OBJECTIVE, OBJECTIVE_KINDS, Objective
+
+    name = DEFAULT_OBJECTIVE.kind if kind is None else kind.strip()
+    if name not in OBJECTIVE_KINDS:
+        raise ValueError(f"--objective = {kind!r}: unknown objective; allowed: "
+                         f"{', '.join(OBJECTIVE_KINDS)}")
+    default = DEFAULT_OBJECTIVE if name == DEFAULT_OBJECTIVE.kind else Objective()
+    which = f"--objective is {name}" if kind is not None else f"the default objective is {name}"
+    w = default.weights if name == "weighted" else None
+    if weights is not None:
+        if name != "weighted":
+            raise ValueError(f"--weights = {weights!r}: applies to --objective weighted only "
+                             f"({which})")
+        w = _weights(weights)
+    if name == "weighted" and w is None:
+        raise ValueError("--objective weighted needs --weights A,D,P,R: four numbers >= 0, not "
+                         "all 0 (acceleration, displacement, pitch, roll)")
+    b = default.bound if name == "constrained" else None
+    if bound is not None:
+        if name != "constrained":
+            raise ValueError(f"--bound = {bound!r}: applies to --objective constrained only "
+                             f"({which})")
+        b = parse_float("--bound", bound, bound, " (the largest RMS ratio to passive allowed)")
+        if b <= 0:
+            raise ValueError(f"--bound = {bound!r}: must be a finite number > 0 (the largest "
+                             "RMS ratio to passive allowed for every response)")
+    if name == "constrained" and b is None:
+        raise ValueError("--objective constrained needs --bound X: the largest RMS ratio to "
+                         "passive allowed for every response, a finite number > 0")
+    p = default.penalty
+    if penalty is not None:
+        p = parse_float("--penalty", penalty, penalty)
+        if p < 0:
+            raise ValueError(f"--penalty = {penalty!r}: must be a finite number >= 0")
+    try:
+        return Objective(name, w, b, p)
+    except ValueError as exc:  # what the checks above cannot see, e.g. a bound too large
+        raise ValueError(f"--objective {name}: {exc}") from None
+
+
+def _weights(weights: str) -> tuple:
+    """--weights A,D,P,R -> four numbers >= 0, not all 0."""
+    items = [item.strip() for item in weights.split(",")]
+    if len(items) != 4:
+        raise ValueError(f"--weights = {weights!r}: expected four numbers A,D,P,R (acceleration, "
+                         f"displacement, pitch, roll), got {len(items)} item(s)")
+    values = []
+    for name, item in zip(("A", "D", "P", "R"), items):
+        try:
+            value = float(item)
+        except ValueError:
+            raise ValueError(f"--weights = {weights!r}: {name} = {item!r} is not a number") from None
+        if not (math.isfinite(value) and value >= 0):
+            raise ValueError(f"--weights = {weights!r}: {name} = {item}: must be a finite number >= 0")
+        values.append(value)
+    if sum(values) == 0:
+        raise ValueError(f"--weights = {weights!r}: at least one weight must be > 0")
+    return tuple(values)
+
+
+def _phase_list(items: Optional[list[str]]) -> list[str]:
+    """--phase (repeatable, comma lists, `all`) -> the phases in the order they run; none
+    given: the library's default (all four)."""
+    from ..tuning import PHASES, tune
+
+    if not items:
+        return list(default_of(tune, "phases"))
+    wanted = set()
+    for text in items:
+        names = [n.strip() for n in text.split(",")]
+        if any(not n for n in names):
+            raise ValueError(f"--phase = {text!r}: an empty item; give phases separated by commas "
+                             f"from {', '.join(PHASES)}, all")
+        for n in names:
+            if n == "all":
+                wanted.update(PHASES)
+            elif n in PHASES:
+                wanted.add(n)
+            else:
+                raise ValueError(f"--phase = {text!r}: unknown phase {n!r}; allowed: "
+                                 f"{', '.join(PHASES)}, all")
+    return [p for p in PHASES if p in wanted]
+
+
+def _tune_start(path: Optional[Path]):
+    """--gains FILE, else the neutral reference gains (the library's default start)."""
+    from ..control import GainSet
+
+    return GainSet.reference() if path is None else load_gains(path)
+
+
+def _objective_text_from_doc(doc: dict) -> str:
+    return doc["objective"]["statement"]
+
+
+def _tune_tables(doc: dict, start, tuned, scenario_text: str):
+    from rich.markup import escape
+    from rich.table import Table
+    from rich.text import Text
+
+    from ..report import _gain_unit
+    from ..tuning import PARAMETERS
+
+    parts = []
+    passes = Table(title="Tuning: the objective after each pass")
+    passes.add_column("phase")
+    passes.add_column("pass", justify="right")
+    passes.add_column("objective", justify="right")
+    passes.add_column("change %", justify="right")
+    infeasible = doc["objective"].get("infeasible")  # constrained: J >= offset breaks the bound
+    if infeasible:
+        passes.add_column("within\nbound")
+    previous = {}
+    for h in doc["history"]:
+        before = previous.get(h["phase"])
+        change = "" if before is None else f"{(h['objective'] - before) / abs(before) * 100:+.2f}"
+        cells = [h["phase"], str(h["pass"]), f"{h['objective']:.4f}", change]
+        if infeasible:
+            cells.append("" if h["phase"] == "inner" else
+                         "yes" if h["objective"] < infeasible["offset"] else "no")
+        passes.add_row(*cells)
+        previous[h["phase"]] = h["objective"]
+    parts += [passes, Text("objective: " + _objective_text_from_doc(doc) + "; inner phase: the "
+                           "normalised force-tracking error on the damper rig"), ""]
+
+    gains = Table(title="Tuned gains")
+    gains.add_column("gain")
+    gains.add_column("unit")
+    gains.add_column("start", justify="right")
+    gains.add_column("tuned", justify="right")
+    gains.add_column("", no_wrap=True)
+    for phase in doc["phases"]:
+        for name in PARAMETERS[phase]:
+            table, _, entry = name.partition(".")
+            a, b = getattr(getattr(start, table), entry), getattr(getattr(tuned, table), entry)
+            gains.add_row(name, escape(_gain_unit(name) or ""), f"{a:.4g}", f"{b:.4g}",
+                          "" if math.isclose(a, b, rel_tol=1e-9, abs_tol=0.0) else "changed")
+        gains.add_section()
+    parts += [gains, ""]
+
+    rows = doc["before_after"]
+    if rows:
+        from ..control import LABELS
+
+        table = Table(title="RMS of the carbody responses with the start and the tuned gains")
+        table.add_column("suspension", no_wrap=True)
+        table.add_column("response")
+        table.add_column("passive", justify="right")
+        table.add_column("start\ngains", justify="right")
+        table.add_column("red. %", justify="right")
+        table.add_column("tuned\ngains", justify="right")
+        table.add_column("red. %", justify="right")
+        for r in rows:
+            for i, (key, label) in enumerate(RESPONSE_LABELS.items()):
+                table.add_row(escape(LABELS[r["suspension"]]) if i == 0 else "", label,
+                              f"{doc['passive_rms'][key]:#.4g}", f"{r['before'][key]:#.4g}",
+                              reduction_text(r["reduction_before_percent"][key]),
+                              f"{r['after'][key]:#.4g}",
+                              reduction_text(r["reduction_after_percent"][key]),
+                              end_section=i == len(RESPONSE_LABELS) - 1)
+        parts.append(table)
+    s = doc["settings"]
+    parts.append(Text("\n".join([
+        f"{scenario_text}, {doc['scenario'].get('duration_s', 0):g} s, dt {s['dt_s']:g} s, "
+        f"{damper_text(s)}; start gains {s['start_gains']}",
+        "red. % = (passive - controlled) / passive x 100 (negative: worse than passive, in red)",
+        f"{doc['runs']} runs in the run table, {doc['runs_evaluated']} evaluated now "
+        f"({doc['runs_per_second']:.1f} runs/s), wall time {doc['wall_time_s']:.1f} s",
+    ])))
+    return parts
+
+
+@app.command("tune")
+def tune_command(
+    ctx: typer.Context,
+    phase: Annotated[Optional[list[str]], typer.Option(
+        "--phase", metavar="PHASE[,PHASE...]",
+        help="Tuning phases, repeatable or comma-separated: inner (B, G on the damper rig's "
+             "force tracking), pid, attitude (the six SAS attitude gains, ride loop off), ride "
+             "(the eight ride gains from 0, attitude fixed), all (= inner,pid,attitude,ride). "
+             "They run in that order. Default: all.")] = None,
+    scenario: RunsScenarioOption = "paper-sine",
+    amplitude: AmplitudeOption = None,
+    wavelength: WavelengthOption = None,
+    rail_phase: RailPhaseOption = None,
+    track_seed: TrackSeedOption = None,
+    min_wavelength: MinWavelengthOption = None,
+    max_wavelength: MaxWavelengthOption = None,
+    speed: SpeedOption = None,
+    duration: RunDurationOption = None,
+    dt: DtOption = None,
+    damper: TuneDamperOption = DEFAULT_DAMPER,
+    damper_scale: TuneDamperScaleOption = None,
+    gains: TuneGainsOption = None,
+    objective_kind: ObjectiveOption = None,
+    weights: WeightsOption = None,
+    bound: BoundOption = None,
+    penalty: PenaltyOption = None,
+    values: Annotated[int, typer.Option(
+        "--values", metavar="N",
+        help="Log-spaced values per gain and pass, from 1/span to span times the current value "
+             "(0 and the current value are added); >= 3.")] = 13,
+    span: Annotated[float, typer.Option(
+        "--span", metavar="S", help="Range factor of each sweep, > 1.")] = 30.0,
+    passes: Annotated[int, typer.Option(
+        "--passes", metavar="N",
+        help="At most N passes per phase (a phase stops early when a pass improves the "
+             "objective by less than 0.1 %); >= 1.")] = 5,
+    workers: WorkersOption = None,
+    scheduler: SchedulerOption = None,
+    scheduler_file: SchedulerFileOption = None,
+    out: TuneOutOption = None,
+    resume: TuneResumeOption = False,
+    format: FormatOption = OutputFormat.table,
+) -> None:
+    """Tune the controller gains by the paper's sensitivity study (its section V).
+
+    One gain at a time is swept over log-spaced values (and 0) with the others fixed; the best
+    value is kept; passes repeat until a pass gains less than 0.1 %. Each run is scored by the
+    objective (--objective) over its RMS carbody responses relative to passive. Prints the
+    objective per pass, the tuned gains and the RMS with the start and the tuned gains. Ctrl-C
+    stops; with --out, --resume continues.
+    """
+    import time
+
+    command = command_line(ctx, exclude=("out", "resume", "format"))
+    with errors():
+        from .. import report, tuning
+        from ..defaults import DEFAULT_DT
+
+        phases = _phase_list(phase)
+        damper_preset("--damper", damper)
+        scale = check_damper_scale("--damper-scale", damper_scale, damper)
+        if damper in IDEAL_NAMES and "inner" in phases:
+            raise ValueError(f"--damper = {damper!r} with the inner phase (--phase "
+                             f"{','.join(phases)}): an ideal device has no force tracking "
+                             "loop to tune; give --phase pid,attitude,ride")
+        start = _tune_start(gains)
+        objective = _objective(objective_kind, weights, bound, penalty)
+        check_int("--values", values, 3)
+        if not (math.isfinite(span) and span > 1):
+            raise ValueError(f"--span = {span:g}: must be a finite number > 1")
+        check_int("--passes", passes, 1)
+        dt = DEFAULT_DT if dt is None else check_number("--dt", dt, "s")
+        scen, options = study_scenario(scenario, amplitude=amplitude, wavelength=wavelength,
+                                       rail_phase=rail_phase, speed=speed, duration=duration,
+                                       track_seed=track_seed, min_wavelength=min_wavelength,
+                                       max_wavelength=max_wavelength)
+        scenario_text = report.describe_scenario(scen.describe())
+        table, table_path = open_run_table(out, resume)
+        executor, executor_record = make_executor(workers, scheduler, scheduler_file)
+    try:
+        with interruptible(table, table_path), errors():
+            with RunProgress(stderr_is_terminal(), "tuning") as progress:
+                t0 = time.perf_counter()
+                result = tuning.tune(phases, scenario=scenario, scenario_options=options,
+                                     gains=start, objective=objective, damper=damper,
+                                     damper_scale=scale,
+                                     executor=executor, table=table, n_values=values, span=span,
+                                     max_passes=passes, dt=dt, progress=progress, log=progress.log)
+                wall = time.perf_counter() - t0
+            # the facts of this command line, after the library's document
+            facts = {"runs_evaluated": progress.evaluated,
+                     "runs_per_second": progress.evaluated / wall if wall > 0 else 0.0,
+                     "wall_time_s": wall, "executor": executor_record, "command": command}
+            doc = {**result.to_dict(), **facts}
+            text = json.dumps(doc, indent=2, allow_nan=False)
+            if out is not None:
+                write_folder(out, lambda: result.save(out, command, extra=facts))
+    finally:
+        executor.close()
+    if format is OutputFormat.json:
+        typer.echo(text)
+        return
+    console = wide_stdout_console()
+    for part in _tune_tables(doc, result.start, result.gains, scenario_text):
+        console.print(part)
