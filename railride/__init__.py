@@ -11,6 +11,8 @@ The public API, in the order a run needs it::
     result.metrics()                                  # RMS, peak-to-peak (docs/model.md, Metrics)
     rr.compare(sc)                                    # the paper's comparison, with the bounds
     rr.tune()                                         # the sensitivity study (shipped gains)
+    rr.run_sweep(rr.sweep.grid(["passive", "pid"], speed=[20, 40, 60]))  # every combination
+    rr.frequency_responses(params)                    # carbody FRFs, their peaks, the modes
 """
 
 __version__ = "0.2.0"
@@ -18,20 +20,22 @@ __version__ = "0.2.0"
 from . import dampers
 from .comparison import Comparison, compare
 from .control import GainSet
+from .frf import FrfResult, frequency_responses
 from .metrics import reduction, ride_metrics
 from .params import VehicleParams
 from .pareto import ParetoResult, pareto
 from .simulation import RideResult, simulate
 from .solver import SolverSettings
 from .suspension import Suspension
+from .sweep import SweepResult, run_sweep
 from .track import CosineBump, MeasuredTrack, Scenario, SineTrack, scenario
 from .objectives import Objective
 from .tuning import tune
 from .vehicle import Vehicle
 
 __all__ = [
-    "Comparison", "CosineBump", "GainSet", "MeasuredTrack", "Objective", "ParetoResult",
-    "RideResult", "Scenario", "SineTrack", "SolverSettings", "Suspension", "Vehicle",
-    "VehicleParams", "compare", "dampers", "pareto", "reduction", "ride_metrics", "scenario",
-    "simulate", "tune",
+    "Comparison", "CosineBump", "FrfResult", "GainSet", "MeasuredTrack", "Objective", "ParetoResult",
+    "RideResult", "Scenario", "SineTrack", "SolverSettings", "Suspension", "SweepResult", "Vehicle",
+    "VehicleParams", "compare", "dampers", "frequency_responses", "pareto", "reduction", "ride_metrics", "scenario",
+    "run_sweep", "simulate", "tune",
 ]

@@ -9,6 +9,7 @@ metrics along a ``controller`` dimension.
 from __future__ import annotations
 
 import json
+from typing import Any
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -18,8 +19,8 @@ from . import __version__, dampers
 from .control import CONTROLLERS, LABELS, GainSet
 from .defaults import DEFAULT_DAMPER
 from .metrics import STATISTICS, reduction, ride_metrics, select_window
-from .simulation import simulate
-from .solver import SolverSettings, _with_keywords
+from .simulation import _resolve_scenario, simulate
+from .solver import SolverSettings, check_resolution
 from .suspension import Suspension, damper_model
 
 #: Table 1 of Harun et al. (RMS values): for display beside railride's results.
@@ -130,7 +131,7 @@ class Comparison:
             return None
         responses = [str(r) for r in self.metrics.response.values]
         base = self.metrics.sel(controller="passive", statistic="rms").values
-        out = {}
+        out: dict[str, dict] = {}
         for device, runs in self.bounds.items():
             out[device] = {}
             for name, run in runs.items():
@@ -229,8 +230,7 @@ class Comparison:
 
 def compare(scenario, params=None, *, controllers=CONTROLLERS, gains: GainSet | None = None,
             damper=DEFAULT_DAMPER, damper_scale: float = 1.0, window=None, solver=None,
-            sensor_noise=None, progress=None, comfort: bool = False, bounds: bool = True,
-            dt=None, output_rate=None, control_rate=None) -> Comparison:
+            sensor_noise=None, progress=None, comfort: bool = False, bounds: bool = True) -> Comparison:
     """Run the passive vehicle and each controller on ``scenario`` and collect the metrics.
 
     ``controllers`` names from `railride.control.CONTROLLERS` (passive is always run as the
@@ -245,14 +245,16 @@ def compare(scenario, params=None, *, controllers=CONTROLLERS, gains: GainSet | 
     ``controllers[i].comfort`` in `Comparison.to_dict`). ``bounds`` (with MR dampers): also
     run the same control laws and gains on the two ideal devices, the ideal semi-active damper
     ("ideal-damper") and the ideal actuator ("ideal"), so that every reduction is shown beside
-    what those would reach (`Comparison.bounds`). ``dt``, ``output_rate``, ``control_rate``:
-    the solver's settings as the command line still gives them (not with ``solver``).
+    what those would reach (`Comparison.bounds`). Every setting is checked before the first run.
     """
-    # TEMPORARY: removed when the CLI moves onto Suspension (dt, output_rate, control_rate)
-    solver = _with_keywords(solver, dt, output_rate, control_rate)
+    solver = SolverSettings.of(solver)
     model = damper_model(damper, damper_scale)
     damper_scale = float(damper_scale)
     names = check_controllers(controllers)
+    scenario = _resolve_scenario(scenario)
+    check_resolution(scenario, solver.output_rate)
+    if len(names) > 1:
+        solver.control_steps()  # the controlled runs sample at the control rate
     gains = GainSet.default() if gains is None else gains
     controlled = [n for n in names if n != "passive"]
     bound_devices = [d for d in BOUND_DEVICES if bounds and controlled and model.law != dampers.LAW_IDEAL]
@@ -316,7 +318,7 @@ def comfort_record(comfort: xr.DataArray, passive: xr.DataArray | None = None) -
     values = to_dict(comfort)
     positions = {}
     for p, indices in values.items():
-        entry = {"x_m": float(comfort["x_m"].sel(position=p))}
+        entry: dict[str, Any] = {"x_m": float(comfort["x_m"].sel(position=p))}
         for i, v in indices.items():
             entry[i] = v
             if i == "N_MV_z":

@@ -45,6 +45,8 @@ def decoupling(vehicle: Vehicle) -> np.ndarray:
 
 
 class _Gains:
+    # declared for the type checker: every subclass is a frozen dataclass with these
+    __dataclass_fields__: ClassVar[dict]
     name: str
     label: str
 
@@ -271,7 +273,7 @@ class GainSet:
             tables[table] = tables[table].replace(**entries)
         return GainSet(tables["inner"], tables["pid"], tables["attitude"], tables["ride"], self.source)
 
-    def tuned_on(self, record: dict) -> bool:
+    def tuned_on(self, record: dict | None) -> bool:
         """Whether these gains were tuned on the track ``record`` (`Scenario.describe`), as the
         file's [provenance] scenario record says: judged there, they are judged in-sample."""
         return self.provenance.get("scenario_record") == record

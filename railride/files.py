@@ -295,18 +295,20 @@ def write_tune_outputs(curves, out_dir, doc: dict, gains_text: str, *,
     return write_folder(out_dir, [(name, writers[name]) for name in TUNE_FILES])
 
 
-def write_sweep_outputs(out_dir, doc: dict) -> list[Path]:
-    """Write the summary of a sweep into ``out_dir`` beside the run table ``runs.csv`` that
-    `railride.sweep.run_cases` keeps there: ``sweep.json`` (``doc``) and, when the grid has one
-    numeric axis with several values (`sweep_plot_axis`), ``sweep.png`` (`plot_sweep`) and, if
-    the rows hold the comfort indices, ``comfort.png`` (`plot_sweep_comfort`). Returns the
-    written paths."""
-    files = [("sweep.json", _text(json_text(doc)))]
-    axis = sweep_plot_axis(doc)
+def write_sweep_outputs(result, out_dir, doc: dict | None = None) -> list[Path]:
+    """Write a `railride.sweep.SweepResult` into ``out_dir`` beside the run table ``runs.csv``
+    that `railride.sweep.run_cases` keeps there, all or nothing: ``sweep.json`` (``doc``,
+    default ``result.to_dict()``) and, when the grid has one numeric axis with several values
+    (`sweep_plot_axis`), ``sweep.png`` (`plot_sweep`) and, if the rows hold the comfort indices,
+    ``comfort.png`` (`plot_sweep_comfort`). Returns the written paths."""
+    _expect(result, "result", "sweep", "SweepResult")
+    text = json_text(result.to_dict() if doc is None else doc)  # refuse NaN before any file is written
+    files = [("sweep.json", _text(text))]
+    axis = sweep_plot_axis(result)
     if axis is not None:
-        files.append(("sweep.png", _png(lambda: plot_sweep(doc, axis=axis))))
-        if has_comfort(doc):
-            files.append(("comfort.png", _png(lambda: plot_sweep_comfort(doc, axis=axis))))
+        files.append(("sweep.png", _png(lambda: plot_sweep(result, axis=axis))))
+        if has_comfort(result):
+            files.append(("comfort.png", _png(lambda: plot_sweep_comfort(result, axis=axis))))
     return write_folder(out_dir, files)
 
 

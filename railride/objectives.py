@@ -107,7 +107,9 @@ class Objective:
         """constrained: the largest J a feasible candidate can have (every r_k at the bound)."""
         if self.kind != "constrained":
             return math.inf
-        return 4.0 * self.bound + 4.0 * self.penalty * max(0.0, self.bound - 1.0)
+        bound = self.bound
+        assert bound is not None  # a constrained objective has one, checked at construction
+        return 4.0 * bound + 4.0 * self.penalty * max(0.0, bound - 1.0)
 
     @property
     def infeasible_offset(self) -> float | None:
@@ -150,7 +152,7 @@ class Objective:
         if self.kind == "sum":
             text = f"sum: J = sum_k r_k (every weight 1), {r}"
         elif self.kind == "weighted":
-            w = ", ".join(f"{n} {v:g}" for n, v in zip(RATIO_NAMES, self.weights))
+            w = ", ".join(f"{n} {v:g}" for n, v in zip(RATIO_NAMES, self.weights or ()))
             text = f"weighted: J = sum_k w_k r_k, weights {w}, {r}"
         elif self.kind == "minimax":
             text = (f"minimax: J = max_k r_k (the worst ratio; equal worst ratios tie), {r}")

@@ -12,16 +12,19 @@ lands in the run table.
   (Saltelli 2010 sampling, Jansen / Saltelli estimators), with the gains uniform in log10.
 
 Both minimise or analyse a named `railride.tuning.Objective` (default `DEFAULT_OBJECTIVE`); the
-results carry it (``objective_definition``) so its statement can be printed with them.
+results carry it (``objective_definition``) so its statement can be printed with them, and
+follow the result protocol (``to_dict``, ``to_pandas``, ``plot(ax=None)``, ``save(folder)``):
+`OptimiseResult` with the convergence of the search, `SensitivityResult` with the indices.
 `railride.pareto` samples the same search box.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
+import pandas as pd
 import scipy.optimize
 
 from .control import GainSet
@@ -33,6 +36,12 @@ from .tuning import PARAMETERS, REFERENCE, _rms
 
 #: the paper's fourteen SAS parameters
 SAS_PARAMETERS = PARAMETERS["attitude"] + PARAMETERS["ride"]
+#: the schemas of the documents of `OptimiseResult.to_dict` and `SensitivityResult.to_dict`
+SCHEMA_OPTIMISE = "railride.optimise/1"
+SCHEMA_SENSITIVITY = "railride.sensitivity/1"
+#: the files `OptimiseResult.save` and `SensitivityResult.save` write, in this order
+OPTIMISE_FILES = ("optimise.png", "optimise.csv", "optimise.json")
+SENSITIVITY_FILES = ("sobol.png", "sobol.csv", "sobol.json")
 
 
 def _bounds(parameters):
@@ -42,7 +51,9 @@ def _bounds(parameters):
 
 class _Evaluator:
     """objective(log10 gains) for a batch of points, through run_cases; `rms` gives the RMS
-    of the four responses instead (the Pareto view)."""
+    of the four responses instead (the Pareto view). ``batches`` records, per call of the
+    objective, the runs done so far and the lowest objective of the batch (the optimiser calls
+    it once per generation)."""
 
     def __init__(self, parameters, suspension, scenario, scenario_options, gains, objective,
                  damper, executor, table, progress, params=None, solver=None):
@@ -59,6 +70,7 @@ class _Evaluator:
         self.solver = SolverSettings.of(solver)
         self.progress = progress
         self.n_runs = 0
+        self.batches: list[tuple[int, float]] = []
         self.passive = _rms(self._run([Case(scenario, self.opts)]))[0]
 
     def _run(self, cases):
@@ -77,11 +89,61 @@ class _Evaluator:
         return _rms(self._run(cases))
 
     def __call__(self, points: np.ndarray) -> np.ndarray:
-        return self.objective(self.rms(self.cases(points)), self.passive)
+        values = self.objective(self.rms(self.cases(points)), self.passive)
+        self.batches.append((self.n_runs, float(np.min(values))))
+        return values
+
+    def record(self, **settings) -> tuple[dict, dict]:
+        """(the scenario's record, the study's settings with ``settings`` first)."""
+        from .params import VehicleParams
+        from .sweep import other_settings
+        from .track import scenario as make_scenario
+
+        scenario = make_scenario(self.scenario, **dict(self.opts)).describe()
+        vehicle = (self.params if isinstance(self.params, VehicleParams)
+                   else VehicleParams.preset(self.params or "paper"))
+        return scenario, {**settings, "damper": self.damper, "dt_s": self.solver.dt,
+                          "base_gains": self.gains.source, **other_settings(vehicle, self.solver)}
 
 
-@dataclass
+def _parameter_rows(parameters) -> list[dict]:
+    """Each parameter with its unit and the search box in SI."""
+    from .labels import gain_unit
+
+    return [{"name": p, "unit": gain_unit(p), "low": float(10.0 ** lo), "high": float(10.0 ** hi)}
+            for p, (lo, hi) in zip(parameters, _bounds(parameters))]
+
+
+def _save(result, folder, files) -> list:
+    """The ``files`` (png, csv, json) of a result into ``folder``, all or nothing
+    (`railride.files.write_folder`): ``plot()``, ``to_pandas()`` and ``to_dict()``."""
+    from .files import json_text, write_folder
+    from .plots import save_png
+
+    text = json_text(result.to_dict())  # refuse NaN before any file is written
+    frame = result.to_pandas()
+    png, csv, doc = files
+    return write_folder(folder, [
+        (png, lambda path: save_png(result.plot(), path)),
+        (csv, lambda path: frame.to_csv(path, index=False)),
+        (doc, lambda path: path.write_text(text, encoding="utf-8")),
+    ])
+
+
+@dataclass(frozen=True, eq=False)
 class OptimiseResult:
+    """The result of `optimise`: the tuned ``gains`` (the base gains with ``parameters`` at
+    10 ** ``log10_gains``), the ``objective`` they reach (of ``objective_definition``), the
+    ``n_runs`` evaluated (with the passive run), the ``generations`` and SciPy's ``message``.
+    ``convergence`` (generations + 1, 2): per generation (0 the initial population) the runs
+    done by its end and the lowest objective in it. ``suspension``, ``scenario`` (the
+    `Scenario.describe` record) and ``settings``: what it ran with.
+
+    The result protocol: `to_dict` (the ``railride.optimise/1`` document), `to_pandas` (the
+    convergence table), `plot` (the convergence), `save` (optimise.png, optimise.csv,
+    optimise.json).
+    """
+
     gains: GainSet
     objective: float
     n_runs: int
@@ -90,6 +152,58 @@ class OptimiseResult:
     log10_gains: np.ndarray
     message: str
     objective_definition: Objective | None = None  # what ``objective`` is the value of
+    convergence: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
+    suspension: str | None = None
+    scenario: dict = field(default_factory=dict)
+    settings: dict = field(default_factory=dict)
+
+    def to_pandas(self) -> pd.DataFrame:
+        """One row per generation (0 the initial population): ``generation``, ``runs`` done by
+        its end, ``objective`` the lowest in it and ``best`` the lowest so far."""
+        c = np.asarray(self.convergence, dtype=float).reshape(-1, 2)
+        return pd.DataFrame({"generation": np.arange(len(c)), "runs": c[:, 0].astype(int),
+                             "objective": c[:, 1], "best": np.minimum.accumulate(c[:, 1])})
+
+    def to_dict(self) -> dict:
+        """The ``railride.optimise/1`` document: the settings, the objective, each parameter with
+        its search box and tuned value, the gains and the convergence (None for an objective
+        that is not finite: a generation whose runs all diverged)."""
+        from . import __version__
+
+        rows = _parameter_rows(self.parameters)
+        for row, lg in zip(rows, np.asarray(self.log10_gains, dtype=float)):
+            row.update(value=float(10.0 ** lg), log10_value=float(lg))
+        g = self.gains
+        return {
+            "schema": SCHEMA_OPTIMISE,
+            "railride_version": __version__,
+            "suspension": self.suspension,
+            "scenario": self.scenario,
+            "settings": self.settings,
+            "objective": None if self.objective_definition is None else self.objective_definition.to_dict(),
+            "objective_value": _finite(self.objective),
+            "parameters": rows,
+            "generations": int(self.generations),
+            "runs": int(self.n_runs),
+            "message": self.message,
+            "gains": {"source": g.source, "inner": g.inner.to_dict(), "pid": g.pid.to_dict(),
+                      "attitude": g.attitude.to_dict(), "ride": g.ride.to_dict()},
+            "convergence": [{"generation": int(r.generation), "runs": int(r.runs),
+                             "objective": _finite(r.objective), "best": _finite(r.best)}
+                            for r in self.to_pandas().itertuples()],
+        }
+
+    def plot(self, ax=None):
+        """The objective against generation (`railride.plots.optimise.plot_convergence`); ``ax``
+        None for a new figure, or one Axes. Returns the figure."""
+        from .plots.optimise import plot_convergence
+
+        return plot_convergence(self, ax=ax)
+
+    def save(self, folder) -> list:
+        """optimise.png, optimise.csv and optimise.json into ``folder``, all or nothing (other
+        files stay). Returns the paths."""
+        return _save(self, folder, OPTIMISE_FILES)
 
 
 def optimise(parameters=SAS_PARAMETERS, *, suspension: str = "sas-attitude-ride",
@@ -107,21 +221,76 @@ def optimise(parameters=SAS_PARAMETERS, *, suspension: str = "sas-attitude-ride"
         lambda x: ev(x.T), _bounds(parameters), vectorized=True, updating="deferred",
         popsize=popsize, maxiter=maxiter, seed=seed, polish=False, tol=1e-4)
     tuned = ev.gains.apply(tuple(zip(parameters, (10.0 ** res.x).tolist())))
+    record, settings = ev.record(popsize=popsize, maxiter=maxiter, seed=seed)
     return OptimiseResult(tuned, float(res.fun), ev.n_runs, int(res.nit), tuple(parameters),
-                          res.x, str(res.message), ev.objective)
+                          res.x, str(res.message), ev.objective, np.array(ev.batches, dtype=float),
+                          suspension, record, settings)
 
 
-@dataclass
+@dataclass(frozen=True, eq=False)
 class SensitivityResult:
+    """The result of `sensitivity`: per parameter the ``first_order`` and ``total`` Sobol
+    indices of the objective (``objective_definition``), from ``n_runs`` runs (with the passive
+    run). ``suspension``, ``scenario`` (the `Scenario.describe` record) and ``settings``: what
+    it ran with.
+
+    The result protocol: `to_dict` (the ``railride.sensitivity/1`` document), `to_pandas` (the
+    indices), `plot` (the indices as bars), `save` (sobol.png, sobol.csv, sobol.json).
+    """
+
     parameters: tuple
     first_order: np.ndarray
     total: np.ndarray
     n_runs: int
     objective_definition: Objective | None = None  # the function the indices decompose
+    suspension: str | None = None
+    scenario: dict = field(default_factory=dict)
+    settings: dict = field(default_factory=dict)
 
     def table(self) -> list[dict]:
         return [{"parameter": p, "first_order": float(s), "total": float(t)}
                 for p, s, t in zip(self.parameters, self.first_order, self.total)]
+
+    def to_pandas(self) -> pd.DataFrame:
+        """One row per parameter: ``parameter``, ``first_order``, ``total``."""
+        return pd.DataFrame(self.table(), columns=["parameter", "first_order", "total"])
+
+    def to_dict(self) -> dict:
+        """The ``railride.sensitivity/1`` document: the settings, the objective and each
+        parameter with its search box and indices (None for a NaN)."""
+        from . import __version__
+
+        rows = _parameter_rows(self.parameters)
+        for row, s, t in zip(rows, self.first_order, self.total):
+            row.update(first_order=_finite(s), total=_finite(t))
+        return {
+            "schema": SCHEMA_SENSITIVITY,
+            "railride_version": __version__,
+            "suspension": self.suspension,
+            "scenario": self.scenario,
+            "settings": self.settings,
+            "objective": None if self.objective_definition is None else self.objective_definition.to_dict(),
+            "runs": int(self.n_runs),
+            "parameters": rows,
+        }
+
+    def plot(self, ax=None):
+        """The first-order and total indices of each parameter as bars
+        (`railride.plots.optimise.plot_indices`); ``ax`` None for a new figure, or one Axes.
+        Returns the figure."""
+        from .plots.optimise import plot_indices
+
+        return plot_indices(self, ax=ax)
+
+    def save(self, folder) -> list:
+        """sobol.png, sobol.csv and sobol.json into ``folder``, all or nothing (other files
+        stay). Returns the paths."""
+        return _save(self, folder, SENSITIVITY_FILES)
+
+
+def _finite(value) -> float | None:
+    value = float(value)
+    return value if math.isfinite(value) else None
 
 
 def sensitivity(parameters=SAS_PARAMETERS, *, suspension: str = "sas-attitude-ride",
@@ -141,5 +310,7 @@ def sensitivity(parameters=SAS_PARAMETERS, *, suspension: str = "sas-attitude-ri
     dists = [scipy.stats.uniform(lo, hi - lo) for lo, hi in _bounds(parameters)]
     res = scipy.stats.sobol_indices(func=lambda x: ev(x.T), n=n, dists=dists,
                                     rng=np.random.default_rng(seed))
+    record, settings = ev.record(n=n, seed=seed)
     return SensitivityResult(tuple(parameters), np.asarray(res.first_order),
-                             np.asarray(res.total_order), ev.n_runs, ev.objective)
+                             np.asarray(res.total_order), ev.n_runs, ev.objective, suspension,
+                             record, settings)

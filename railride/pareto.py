@@ -27,7 +27,8 @@ from .defaults import DEFAULT_DAMPER
 from .files import PARETO_FILES
 from .metrics import RESPONSES
 from .optimise import _bounds, _Evaluator
-from .solver import _with_keywords
+from . import validation
+from .solver import SolverSettings, check_resolution
 from .sweep import Case, RunTable
 
 SCHEMA = "railride.pareto/1"
@@ -176,14 +177,8 @@ def _power_of_two(name: str, value) -> int:
     ok = (not isinstance(value, bool) and isinstance(value, (int, np.integer)) and value >= 1
           and not value & (value - 1))
     if not ok:
-        raise ValueError(f"{name} = {value!r}: a power of two (1, 2, 4, ..., 128, ...), which "
+        raise ValueError(f"{name} = {value!r}: must be a power of two (1, 2, 4, ..., 128, ...), which "
                          "keeps the balance of the Sobol' sample")
-    return int(value)
-
-
-def _seed(name: str, value) -> int:
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 0:
-        raise ValueError(f"{name} = {value!r}: a whole number >= 0")
     return int(value)
 
 
@@ -215,7 +210,7 @@ def in_sample_note(gains: GainSet, record: dict) -> str | None:
 def pareto(suspension: str = "sas-attitude-ride", *, n_samples: int = 128, seed: int = 0,
            scenario: str = "paper-sine", scenario_options=None, gains: GainSet | None = None,
            damper: str = DEFAULT_DAMPER, executor=None, table: RunTable | None = None,
-           params=None, solver=None, progress=None, parameters=None, dt=None) -> ParetoResult:
+           params=None, solver=None, progress=None, parameters=None) -> ParetoResult:
     """Sample the gains of ``suspension`` (pid, sas-attitude, sas-attitude-ride; by default all
     it reads, or ``parameters``) and return the RMS ratios to passive of each sample.
 
@@ -225,20 +220,24 @@ def pareto(suspension: str = "sas-attitude-ride", *, n_samples: int = 128, seed:
     of `run_cases`: 32-run batches, ``table`` to resume, ``executor`` for Dask;
     ``progress(done, total, runs_per_second)`` after each chunk. ``params``: the vehicle
     (`VehicleParams` or a preset name, default "paper"); ``solver``: the `SolverSettings` of
-    every run (``dt``: the step alone, as the command line still gives it); recorded in
-    ``settings`` where they differ from the defaults.
+    every run; recorded in ``settings`` where they differ from the defaults. Every setting is
+    checked before the first run.
     """
     from .simulation import _resolve_params
+    from .suspension import damper_model
     from .sweep import other_settings
     from .track import scenario as make_scenario
 
-    solver = _with_keywords(solver, dt)  # TEMPORARY: dt= removed when the CLI moves onto Suspension
+    solver = SolverSettings.of(solver)
     vehicle = _resolve_params(params)
     names = _parameters(suspension, parameters)
     n_samples = _power_of_two("n_samples", n_samples)
-    seed = _seed("seed", seed)
+    seed = validation.integer("seed", seed, 0)
+    damper_model(damper)  # a known name
     base = GainSet.default() if gains is None else gains
-    record = make_scenario(scenario, **dict(scenario_options or {})).describe()
+    scen = make_scenario(scenario, **dict(scenario_options or {}))
+    check_resolution(scen, solver.output_rate)
+    record = scen.describe()
     table = RunTable() if table is None else table
     ev = _Evaluator(names, suspension, scenario, scenario_options, base, None, damper, executor,
                     table, progress, vehicle, solver)

@@ -7,6 +7,10 @@ positive in tension [N]. A desired force for the inner loop uses the same conven
 The rig uses the vehicle's integrator: classical RK4 at a fixed step dt (default 1e-4 s), split
 into 2^k sub-steps where the damper's internal states are stiff, with the motion tabulated on a
 grid of whole steps and interpolated by cubic Hermite polynomials (railride.track explains why).
+
+`drive` returns the time histories as a Dataset; the two studies return result objects with the
+result protocol (``to_dict``, ``to_pandas``, ``plot(ax=None)``, ``save(folder)``): `cycles` the
+steady-state hysteresis `Cycles`, `track` the force `Tracking` with its `TrackingMetrics`.
 """
 
 from __future__ import annotations
@@ -24,6 +28,13 @@ from .defaults import DEFAULT_DAMPER, DEFAULT_DT
 
 #: motion-table nodes per cycle of the fastest motion
 _NODES_PER_CYCLE = 400
+#: the desired forces of `track` (`desired_force_signal`)
+DESIRED_SIGNALS = ("sine", "sawtooth")
+#: the schemas of the documents of `Cycles.to_dict` and `Tracking.to_dict`
+SCHEMA_DAMPER = "railride.damper/1"
+SCHEMA_TRACKING = "railride.tracking/1"
+#: why the first cycle does not count (in the error for too few cycles)
+START_UP = "the first cycle is start-up"
 
 
 @dataclass(frozen=True)
@@ -202,13 +213,21 @@ def yield_force(damper, v: float) -> float:
 
 
 # -- hysteresis cycles ---------------------------------------------------------------------------
-@dataclass
+@dataclass(frozen=True, eq=False)
 class Cycles:
-    """Steady-state cycles of a damper driven by a sine at several constant voltages."""
+    """Steady-state cycles of a damper driven by a sine at several constant voltages, the result
+    of `cycles`: ``dataset`` holds the last of ``n_cycles`` cycles of each voltage (dims
+    voltage, time; channels as `drive` gives them).
+
+    The result protocol: `to_dict` (the ``railride.damper/1`` document), `to_pandas` (the
+    cycles as one long table, cycles.csv), `plot` (the force-displacement and force-velocity
+    loops), `save` (loops.png, cycles.csv, damper.json); `table` the summary per voltage.
+    """
 
     damper: Any  # a damper model of railride.dampers
     motion: SineMotion
-    dataset: xr.Dataset  # the last cycle of each voltage (dims voltage, time)
+    dataset: xr.Dataset
+    n_cycles: int  # cycles driven per voltage; the last is kept
 
     def table(self) -> list[dict]:
         """Per voltage: maximum and minimum force [N] and energy dissipated per cycle [J]."""
@@ -225,12 +244,34 @@ class Cycles:
         return rows
 
     def to_dict(self) -> dict:
-        return {"damper": self.damper.to_dict(), "amplitude_m": self.motion.amplitude,
-                "frequency_hz": self.motion.frequency, "cycles": self.table()}
+        """The ``railride.damper/1`` document (docs/cli.md): the damper's parameters, the motion
+        and `table`."""
+        from . import __version__
 
-    def plot(self, path=None):
+        return {"schema": SCHEMA_DAMPER, "railride_version": __version__,
+                "damper": self.damper.to_dict(), "amplitude_m": float(self.motion.amplitude),
+                "frequency_hz": float(self.motion.frequency), "cycles": self.table()}
+
+    def to_pandas(self):
+        """The last cycle of each voltage as one long table (`railride.tables.cycles_frame`):
+        voltage, time and the rig channels."""
+        from .tables import cycles_frame
+
+        return cycles_frame(self.dataset)
+
+    def plot(self, ax=None):
+        """The loops (`railride.plots.rig.plot_hysteresis`); ``ax`` None for a new figure, or
+        two Axes. Returns the figure."""
         from .plots.rig import plot_hysteresis
-        return plot_hysteresis(self, path)
+
+        return plot_hysteresis(self, ax=ax)
+
+    def save(self, folder) -> list:
+        """loops.png, cycles.csv and damper.json into ``folder``, all or nothing (other files
+        stay). Returns the paths."""
+        from .files import write_damper_outputs
+
+        return write_damper_outputs(self, folder, self.to_dict())
 
 
 def cycles(damper, amplitude: float, frequency: float, voltages, *, n_cycles: int = 4,
@@ -241,8 +282,8 @@ def cycles(damper, amplitude: float, frequency: float, voltages, *, n_cycles: in
     damper = _resolve(damper)
     _check_number("amplitude", amplitude, "positive", "m")
     motion = SineMotion(amplitude, frequency)
-    if not (isinstance(n_cycles, int) and n_cycles >= 2):
-        raise ValueError(f"n_cycles = {n_cycles!r}: must be a whole number >= 2")
+    n_cycles = validation.integer("n_cycles", n_cycles, 2, what=START_UP)
+    dt = _check_number("dt", dt, "positive", "s")
     if np.ndim(voltages) == 0:
         voltages = [voltages]
     if len(set(float(v) for v in voltages)) != len(voltages):
@@ -261,30 +302,96 @@ def cycles(damper, amplitude: float, frequency: float, voltages, *, n_cycles: in
     ds = drive(damper, motion, duration=n_cycles * period, voltage=list(voltages), dt=dt,
                output_rate=1.0 / (stride * dt))
     last = ds.isel(time=slice(-(steps_per_cycle // stride) - 1, None))
-    return Cycles(damper, motion, last)
+    return Cycles(damper, motion, last, n_cycles)
 
 
 # -- force tracking (paper Fig. 6) ----------------------------------------------------------------
-@dataclass
-class Tracking:
-    """Force tracking of a desired force by the inner loop on a prescribed motion."""
+@dataclass(frozen=True)
+class TrackingMetrics:
+    """How well the inner loop followed the demand over ``window_s`` (start, end) [s]: the RMS
+    of the tracking error F - f_d and of the demand f_d [N], and their ratio (0 is perfect
+    tracking, 1 as bad as no force at all; NaN for a zero demand)."""
 
-    dataset: xr.Dataset
+    rms_error_n: float
+    rms_demand_n: float
+    normalised_rms_error: float
+    window_s: tuple[float, float]
+
+    def __post_init__(self):
+        for name in ("rms_error_n", "rms_demand_n", "normalised_rms_error"):
+            object.__setattr__(self, name, float(getattr(self, name)))
+        start, end = self.window_s
+        object.__setattr__(self, "window_s", (float(start), float(end)))
+
+    def to_dict(self) -> dict:
+        """The ``metrics`` of the ``railride.tracking/1`` document."""
+        return {"rms_error_n": self.rms_error_n, "rms_demand_n": self.rms_demand_n,
+                "normalised_rms_error": self.normalised_rms_error, "window_s": list(self.window_s)}
+
+
+@dataclass(frozen=True, eq=False)
+class Tracking:
+    """Force tracking by the inner loop (paper eq. 12-14), the result of `track`: the
+    ``desired`` signal (`DESIRED_SIGNALS`) of ``amplitude`` [N] at ``frequency`` [Hz] on a
+    ``stroke`` [m] of the ``damper``, with the gains the loop used, ``B`` [-] and ``G`` [V/N]
+    (the default filled in); ``dataset`` the time histories of `drive` with ``desired_force``,
+    ``window`` (start, end) [s] the span of the metrics (every cycle but the first).
+
+    The result protocol: `to_dict` (the ``railride.tracking/1`` document), `to_pandas` (the
+    time histories, tracking.csv), `plot` (forces and voltages), `save` (tracking.png,
+    tracking.csv, tracking.json); `metrics` the `TrackingMetrics`.
+    """
+
+    damper: Any  # a damper model of railride.dampers
     desired: str
+    amplitude: float
+    frequency: float
+    stroke: float
+    B: float
+    G: float
+    dataset: xr.Dataset
     window: tuple[float, float]
 
-    def metrics(self) -> dict:
+    def metrics(self) -> TrackingMetrics:
+        """The tracking error over `window`."""
         ds = self.dataset.sel(time=slice(*self.window))
         err = ds.F.values - ds.desired_force.values
         rms_demand = float(np.sqrt(np.mean(ds.desired_force.values**2)))
         rms_err = float(np.sqrt(np.mean(err**2)))
-        return {"rms_error_n": rms_err, "rms_demand_n": rms_demand,
-                "normalised_rms_error": rms_err / rms_demand if rms_demand > 0 else math.nan,
-                "window_s": list(self.window)}
+        return TrackingMetrics(rms_err, rms_demand, rms_err / rms_demand if rms_demand > 0 else math.nan,
+                               self.window)
 
-    def plot(self, path=None):
+    def to_dict(self) -> dict:
+        """The ``railride.tracking/1`` document (docs/cli.md): the damper's parameters, the
+        demand, the stroke, the gains and `metrics`."""
+        from . import __version__
+
+        return {"schema": SCHEMA_TRACKING, "railride_version": __version__,
+                "damper": self.damper.to_dict(), "desired": self.desired,
+                "amplitude_n": float(self.amplitude), "frequency_hz": float(self.frequency),
+                "stroke_m": float(self.stroke), "B": float(self.B), "G_v_per_n": float(self.G),
+                "metrics": self.metrics().to_dict()}
+
+    def to_pandas(self):
+        """The time histories as one table indexed by time (`railride.tables.to_frame`): the rig
+        channels and ``desired_force``."""
+        from .tables import to_frame
+
+        return to_frame(self.dataset)
+
+    def plot(self, ax=None):
+        """Forces and voltages against time (`railride.plots.rig.plot_tracking`); ``ax`` None
+        for a new figure, or two Axes. Returns the figure."""
         from .plots.rig import plot_tracking
-        return plot_tracking(self, path)
+
+        return plot_tracking(self, ax=ax)
+
+    def save(self, folder) -> list:
+        """tracking.png, tracking.csv and tracking.json into ``folder``, all or nothing (other
+        files stay). Returns the paths."""
+        from .files import write_tracking_outputs
+
+        return write_tracking_outputs(self, folder, self.to_dict())
 
 
 def desired_force_signal(kind: str, amplitude: float, frequency: float):
@@ -292,11 +399,10 @@ def desired_force_signal(kind: str, amplitude: float, frequency: float):
     crossing 0 upwards at t = 0, 1/f, ..."""
     amplitude = _check_number("amplitude", amplitude, "nonnegative", "N")
     frequency = _check_number("frequency", frequency, "positive", "Hz")
+    validation.choice("desired", kind, DESIRED_SIGNALS)
     if kind == "sine":
         return lambda t: amplitude * np.sin(2 * np.pi * frequency * t)
-    if kind == "sawtooth":
-        return lambda t: amplitude * (2.0 * np.mod(frequency * t + 0.5, 1.0) - 1.0)
-    raise ValueError(f"desired = {kind!r}: allowed 'sine', 'sawtooth'")
+    return lambda t: amplitude * (2.0 * np.mod(frequency * t + 0.5, 1.0) - 1.0)
 
 
 def track(damper=DEFAULT_DAMPER, desired: str = "sine", amplitude: float = 10e3, frequency: float = 1.0,
@@ -305,13 +411,15 @@ def track(damper=DEFAULT_DAMPER, desired: str = "sine", amplitude: float = 10e3,
     """The inner loop (paper eq. 12-14) tracking a sine or sawtooth desired force (amplitude
     [N], frequency [Hz]) while the damper is stroked by x = -stroke cos(2 pi f t), whose
     velocity is in phase with a sine demand, so that the demand is dissipative where the
-    damper's range allows. Metrics leave out the first cycle (start-up)."""
+    damper's range allows. ``G`` None: `default_gain`. Metrics leave out the first cycle
+    (start-up)."""
     damper = _resolve(damper)
-    _check_number("amplitude", amplitude, "positive", "N")
+    amplitude = _check_number("amplitude", amplitude, "positive", "N")
     fd = desired_force_signal(desired, amplitude, frequency)
+    frequency = float(frequency)
     stroke = _check_number("stroke", stroke, "positive", "m")
-    if not (isinstance(n_cycles, int) and n_cycles >= 2):
-        raise ValueError(f"n_cycles = {n_cycles!r}: must be a whole number >= 2 (the first is left out)")
+    n_cycles = validation.integer("n_cycles", n_cycles, 2, what=START_UP)
+    dt = _check_number("dt", dt, "positive", "s")
     motion = SineMotion(stroke, frequency, phase_deg=-90.0)
     period = 1.0 / frequency
     if period < 100 * dt:
@@ -321,4 +429,6 @@ def track(damper=DEFAULT_DAMPER, desired: str = "sine", amplitude: float = 10e3,
     stride = max(1, min(int(round(1e-3 / dt)), int(period / (200 * dt))))
     ds = drive(damper, motion, duration=n_cycles * period, desired_force=fd, B=B, G=G, dt=dt,
                output_rate=1.0 / (stride * dt))
-    return Tracking(ds, desired, (period, n_cycles * period))
+    # the gains as the loop used them (G filled in when None)
+    return Tracking(damper, desired, amplitude, frequency, stroke, float(ds.attrs["B"]),
+                    float(ds.attrs["G_v_per_n"]), ds, (period, n_cycles * period))

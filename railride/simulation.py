@@ -13,17 +13,16 @@ import numpy as np
 import xarray as xr
 
 from . import dampers, kernels
-from .control import ZeroDemand
-from .defaults import DEFAULT_CONTROL_RATE, DEFAULT_DAMPER, DEFAULT_DT, DEFAULT_OUTPUT_RATE  # noqa: F401 (re-exported)
-from .params import VehicleParams
-from .solver import SolverSettings, _with_keywords
+from .defaults import DEFAULT_DT
+from .params import PRESETS, VehicleParams
+from .solver import SolverSettings, check_resolution
 from .suspension import Suspension, batch_conflict
 from .track import Scenario, wheelset_input_table
 from .track import scenario as named_scenario
 from .vehicle import CORNER_NAMES, DOF_NAMES, DOF_UNITS, N_DOF, RAILS, WHEELSETS, Vehicle
 
-#: a random track's shortest wavelength must give at most output_rate / this [Hz]
-RESOLUTION = 2.5
+#: the schema of `RideResult.to_dict`, the document of ``railride simulate``
+SCHEMA = "railride.simulation/1"
 #: sample-steps per kernel call when a progress callback is given
 _CHUNK_WORK = 2_000_000
 
@@ -187,48 +186,8 @@ def _closed_loop(suspensions: list[Suspension], solver: SolverSettings, duration
             "sensor_noise": noise}
 
 
-#: the keywords simulate took before Suspension and SolverSettings
-_KEYWORDS = ("dt", "output_rate", "control_rate", "damper", "voltage", "controller", "inner",
-             "sensor_noise")
-
-
-# TEMPORARY: removed when the CLI moves onto Suspension
-def _from_keywords(suspension, solver, keywords: dict):
-    """(suspension, solver) from simulate's former keywords: dt, output_rate, control_rate;
-    damper, voltage (a list: one sample each), controller (a list: one sample each, None in it
-    a closed loop with no outer loop), inner, sensor_noise. A controller without damper uses
-    DEFAULT_DAMPER; an inner loop given with an ideal device is not used, as before."""
-    unknown = sorted(set(keywords) - set(_KEYWORDS))
-    if unknown:
-        raise TypeError(f"simulate() got an unexpected keyword argument {unknown[0]!r}")
-    solver = _with_keywords(solver, **{k: keywords.pop(k) for k in ("dt", "output_rate", "control_rate")
-                                       if k in keywords})
-    given: dict[str, Any] = {k: v for k, v in keywords.items() if v is not None}
-    if not given:
-        return suspension, solver
-    if suspension is not None:
-        raise ValueError(f"give suspension= or {', '.join(given)}=, not both")
-    damper, inner, noise = given.get("damper"), given.get("inner"), given.get("sensor_noise")
-    voltage: Any = given.get("voltage")
-    controller: Any = given.get("controller")
-    if controller is None:
-        many = np.ndim(voltage) > 0
-        items = [Suspension(damper, v, None, inner, noise) for v in (list(voltage) if many else [voltage])]
-        return (items if many else items[0]), solver
-    if voltage is not None:
-        raise ValueError("give either voltage (open loop) or controller (closed loop), not both")
-    damper = DEFAULT_DAMPER if damper is None else damper
-    model = dampers.preset(damper) if isinstance(damper, str) else damper
-    if getattr(model, "law", None) == dampers.LAW_IDEAL:
-        inner = None
-    many = isinstance(controller, (list, tuple))
-    items = [Suspension(model, None, ZeroDemand() if c is None else c, inner, noise)
-             for c in (controller if many else [controller])]
-    return (items if many else items[0]), solver
-
-
 def simulate(scenario=None, params=None, suspension=None, *, solver=None, initial_state=None,
-             progress=None, on_divergence: str = "raise", **keywords) -> "RideResult":
+             progress=None, on_divergence: str = "raise") -> "RideResult":
     """Simulate the vehicle on one or many scenarios.
 
     ``scenario`` is a `Scenario`, a scenario name (see `railride.track.scenario`) or a list of
@@ -249,12 +208,7 @@ def simulate(scenario=None, params=None, suspension=None, *, solver=None, initia
     ``on_divergence="raise"`` (the default) the run stops with a RuntimeError giving the sample
     and the time; with ``"mark"`` (what studies use) the other samples stand, the diverged
     one's histories are NaN from that time on, and `RideResult.diverged_at` gives the time.
-
-    The keywords dt, output_rate, control_rate, damper, voltage, controller, inner and
-    sensor_noise of earlier versions still work for now (the command line uses them).
     """
-    if keywords:
-        suspension, solver = _from_keywords(suspension, solver, keywords)
     solver = SolverSettings.of(solver)
     dt, output_rate = solver.dt, solver.output_rate
     if on_divergence not in ("raise", "mark"):
@@ -299,12 +253,7 @@ def simulate(scenario=None, params=None, suspension=None, *, solver=None, initia
                          f"(1/{output_rate:g} Hz)")
     n_steps = n_out * stride
     for sc in scenarios:  # a random track's shortest wavelength must show in the output
-        lam = getattr(sc.track, "min_wavelength", None)
-        if lam is not None and sc.speed / lam > output_rate / RESOLUTION:
-            raise ValueError(
-                f"min_wavelength = {lam:g} m at {sc.speed:g} m/s is {sc.speed / lam:g} Hz, more than "
-                f"output_rate / {RESOLUTION:g} = {output_rate / RESOLUTION:g} Hz can resolve: raise min_wavelength or "
-                f"output_rate")
+        check_resolution(sc, output_rate)
 
     systems = {key: _system_arrays(v, passive=damper is None) for key, v in vehicles.items()}
     arrays = {k: np.ascontiguousarray(np.stack([systems[id(p)][k] for p in param_sets]))
@@ -312,7 +261,10 @@ def simulate(scenario=None, params=None, suspension=None, *, solver=None, initia
 
     # rail inputs depend on the scenario and the wheelset spacing, the forcing also on the
     # vehicle: tables are shared between the samples that agree on those
-    utabs, ftabs, u_index, f_index = [], [], {}, {}
+    utabs: list[np.ndarray] = []
+    ftabs: list[np.ndarray] = []
+    u_index: dict[tuple, tuple] = {}
+    f_index: dict[tuple, int] = {}
     u_off, f_off, n_nodes, interval = (np.zeros(n, dtype=np.int64), np.zeros(n, dtype=np.int64),
                                        np.zeros(n, dtype=np.int64), np.zeros(n))
     for i, (sc, p) in enumerate(zip(scenarios, param_sets)):
@@ -390,12 +342,12 @@ def simulate(scenario=None, params=None, suspension=None, *, solver=None, initia
                    f"or stopped being finite; check the parameters or reduce dt")
         if on_divergence != "mark":
             raise RuntimeError(message)
-        for i in bad:  # the stepper stopped there: what follows is not a response
+        for i in bad.tolist():  # the stepper stopped there: what follows is not a response
             diverged_at[i] = fail_step[i] * dt
-            first = fail_step[i] // stride
+            cut = fail_step[i] // stride
             for key in out:
                 if out[key].shape[1] > 1:
-                    out[key][i, first:] = np.nan
+                    out[key][i, cut:] = np.nan
 
     created = datetime.now(timezone.utc).isoformat(timespec="seconds")
     raw = {"time": np.arange(rows) / output_rate, "q": out["q"], "a": out["a"], "batch": batch,
@@ -403,7 +355,9 @@ def simulate(scenario=None, params=None, suspension=None, *, solver=None, initia
     return RideResult(raw=raw, build=functools.partial(_dataset, out, vehicles, param_sets, scenarios, dt,
                                               output_rate, rows, batch, created, suspensions[0], vcmd,
                                               closed),
-                      suspension=suspensions if batch else suspensions[0], solver=solver)
+                      suspension=suspensions if batch else suspensions[0], solver=solver,
+                      scenario=scenarios if batch else scenarios[0],
+                      params=param_sets if batch else param_sets[0])
 
 
 def _dataset(out, vehicles, param_sets, scenarios, dt, output_rate, rows, batch, created,
@@ -420,7 +374,8 @@ def _dataset(out, vehicles, param_sets, scenarios, dt, output_rate, rows, batch,
     ksz = np.array([p.k_sz for p in param_sets])[:, None, None]
     deflection = out["q"] @ T  # (n, time, 9) @ (n, 9, 4): T^T q at every sample
     shape = out["w"].shape[:2] + (4, 2)
-    channels = {}  # name -> (extra dims, values with leading (sample, time), attrs)
+    # name -> (extra dims, values with leading (sample, time), attrs)
+    channels: dict[str, tuple[tuple[str, ...], Any, dict[str, str]]] = {}
     for i, name in enumerate(DOF_NAMES):
         channels[name] = ((), out["q"][:, :, i], {"units": DOF_UNITS[i]})
         channels[f"{name}_velocity"] = ((), out["v"][:, :, i], {"units": f"{DOF_UNITS[i]}/s"})
@@ -469,6 +424,7 @@ def _dataset(out, vehicles, param_sets, scenarios, dt, output_rate, rows, batch,
                                                  else dataclasses.asdict(closed["sensor_noise"]))}
         controller_names = np.array([c.name for c in ctrl])
         controller_gains = np.array([json.dumps(c.to_dict()) for c in ctrl])
+    data: dict[str, tuple]  # name -> (dims, values[, attrs]), as xr.Dataset takes them
     if batch:
         data = {k: (("sample", "time") + d, v, a) for k, (d, v, a) in channels.items()}
         data["scenario"] = ("sample", scen)
@@ -514,11 +470,12 @@ class RideResult:
     """Time histories (``.dataset``, an xarray Dataset) and the ride metrics of a run.
 
     The Dataset is assembled on first use, so a sweep that keeps only a few numbers per run
-    does not pay for building it.
+    does not pay for building it. A single run follows the result protocol: `to_dict` (the
+    JSON document), `to_pandas`, `plot` and `save`.
     """
 
     def __init__(self, dataset: xr.Dataset | None = None, *, build=None, raw=None, suspension=None,
-                 solver=None):
+                 solver=None, scenario=None, params=None):
         if (dataset is None) == (build is None):
             raise ValueError("RideResult needs a dataset or a build function, not both")
         self._dataset = dataset
@@ -527,6 +484,9 @@ class RideResult:
         #: the `Suspension` of the run (a list of them for a batch) and its `SolverSettings`
         self.suspension = suspension
         self.solver = solver
+        #: the `Scenario` and `VehicleParams` of the run (lists for a batch)
+        self.scenario = scenario
+        self.params = params
 
     @property
     def dataset(self) -> xr.Dataset:
@@ -551,6 +511,8 @@ class RideResult:
 
     @property
     def is_batch(self) -> bool:
+        if self._raw is not None:
+            return bool(self._raw["batch"])
         return "sample" in self.dataset.dims
 
     def metrics(self, window=None) -> xr.DataArray:
@@ -577,12 +539,89 @@ class RideResult:
         from .comfort import ride_comfort
         return ride_comfort(self.dataset, positions=positions, window=window, weightings=weightings)
 
+    def to_dict(self, window=None, *, comfort: bool = False, vehicle: dict | None = None) -> dict:
+        """The JSON document of a single run (`SCHEMA`, docs/cli.md): the scenario, the vehicle,
+        the suspension, the step and output rate with the metrics window, and the ride metrics
+        over ``window`` (start, end) s (default: the whole run); with ``comfort`` also the ride
+        comfort indices over it. ``vehicle`` names the vehicle as the caller chose it (e.g.
+        ``{"vehicle_params_file": "car.toml"}``); by default ``{"vehicle_preset": name}`` for a
+        preset's parameters, else ``{"vehicle_params": {...}}``. A batch has no such document:
+        select a sample first."""
+        from . import __version__
+        from .metrics import check_window, to_dict
+
+        if self.is_batch:
+            raise ValueError("to_dict describes a single run; this result is a batch of "
+                             f"{self.dataset.sizes['sample']} samples")
+        record = self._record("scenario", self.scenario)
+        duration = float(record["duration_s"]) if "duration_s" in record else float(self.dataset["time"][-1])
+        start, end = (0.0, duration) if window is None else check_window(window, duration)
+        solver = self.solver if self.solver is not None else SolverSettings(
+            self.dataset.attrs["dt_s"], self.dataset.attrs["output_rate_hz"])
+        doc = {
+            "schema": SCHEMA,
+            "railride_version": __version__,
+            "scenario": record,
+            **(self._vehicle_record() if vehicle is None else vehicle),
+            "suspension": _suspension_record(self.suspension),
+            "settings": {"dt_s": float(solver.dt), "output_rate_hz": float(solver.output_rate),
+                         "window_s": [float(start), float(end)]},
+            "metrics": to_dict(self.metrics(window)),
+        }
+        if comfort:
+            from .comparison import comfort_record
+            doc["comfort"] = comfort_record(self.comfort(window))
+        return doc
+
+    def _record(self, name: str, value) -> dict:
+        """The JSON record of the run's scenario or parameters: from the value the run kept,
+        else from the Dataset."""
+        if value is not None:
+            return value.describe() if name == "scenario" else value.to_dict()
+        return json.loads(str(self.dataset[name].values))
+
+    def _vehicle_record(self) -> dict:
+        params = self.params
+        name = next((k for k, v in PRESETS.items() if v == params), None) if params is not None else None
+        if name is not None:
+            return {"vehicle_preset": name}
+        return {"vehicle_params": self._record("vehicle_params", params)}
+
     def to_pandas(self):
         """The time histories as a DataFrame, one column per scalar channel."""
         from .tables import to_frame
         return to_frame(self.dataset)
 
-    def plot(self, path=None):
-        """Plot the four body responses; save to ``path`` if given, return the figure."""
+    def plot(self, ax=None):
+        """The four body responses against time (`railride.plots.ride.plot_body_responses`);
+        ``ax``: four Axes to draw in, or None for a new figure. Returns the figure."""
         from .plots.ride import plot_body_responses
-        return plot_body_responses(self.dataset, path)
+        return plot_body_responses(self.dataset, ax=ax)
+
+    def save(self, folder, window=None, *, comfort: bool = False, vehicle: dict | None = None) -> list:
+        """Write ride.nc, ride.csv, metrics.json (`to_dict` with these arguments) and
+        body_responses.png into ``folder``, all or nothing (`railride.files.write_outputs`).
+        Returns the written paths."""
+        from .files import write_outputs
+        return write_outputs(self, folder, self.to_dict(window, comfort=comfort, vehicle=vehicle))
+
+
+def _suspension_record(suspension) -> dict:
+    """The ``suspension`` of the simulation document: ``{"type": "passive"}``, or for MR dampers
+    at a constant voltage the type "mr", the damper's name, the voltage and, when the preset was
+    scaled, its ``damper_scale``; a closed loop is typed by its outer loop's name and adds its
+    controller, inner loop and sensor noise (`Suspension.to_dict`)."""
+    if suspension is None:
+        return {"type": "passive"}
+    if suspension.kind == "passive":
+        return {"type": "passive"} if suspension.damper is None else {
+            "type": "passive", "damper": suspension.damper.to_dict()}
+    record: dict[str, Any] = {"type": suspension.name, "damper": suspension.damper_name}
+    if suspension.voltage is not None:
+        record["voltage_v"] = float(suspension.voltage)
+    if suspension.damper_scale != 1.0:
+        record["damper_scale"] = suspension.damper_scale
+    if suspension.closed_loop:
+        full = suspension.to_dict()
+        record.update({k: full[k] for k in ("controller", "inner_loop", "sensor_noise")})
+    return record

@@ -1,4 +1,5 @@
-"""How a run is integrated: the `SolverSettings` value (docs/model.md, Integration).
+"""How a run is integrated: the `SolverSettings` value (docs/model.md, Integration), and what
+its output rate can resolve (`check_resolution`).
 
 A module of its own, not a part of `railride.simulation`: the studies and the command line check
 and record these settings without loading the compiled stepper.
@@ -10,6 +11,10 @@ from dataclasses import dataclass
 
 from . import validation
 from .defaults import DEFAULT_CONTROL_RATE, DEFAULT_DT, DEFAULT_OUTPUT_RATE
+
+#: a random track's shortest wavelength must pass at speed / min_wavelength <= output_rate /
+#: RESOLUTION: a component above that shows in the stored histories only as a few samples a cycle
+RESOLUTION = 2.5
 
 
 def _steps(steps: float) -> int | None:
@@ -77,6 +82,21 @@ class SolverSettings:
             raise ValueError(f"solver = {solver!r}: must be a railride.SolverSettings or None "
                              "(the defaults)")
         return solver
+
+
+def check_resolution(scenario, output_rate: float) -> None:
+    """ValueError when the stored time histories at ``output_rate`` [Hz] cannot resolve the
+    shortest wavelength of ``scenario``'s random track (`RESOLUTION`); other tracks pass. The
+    simulation checks every scenario it runs; the studies and the command line ask before their
+    first run."""
+    lam = getattr(scenario.track, "min_wavelength", None)
+    if lam is None or not scenario.speed / lam > output_rate / RESOLUTION:
+        return
+    raise ValueError(
+        f"min_wavelength = {lam:g} m at speed {scenario.speed:g} m/s passes at "
+        f"{scenario.speed / lam:g} Hz, more than output_rate {output_rate:g} Hz / {RESOLUTION:g} = "
+        f"{output_rate / RESOLUTION:g} Hz can resolve: raise min_wavelength, lower the speed or "
+        "raise output_rate")
 
 
 def _with_keywords(solver, dt=None, output_rate=None, control_rate=None) -> SolverSettings:

@@ -83,7 +83,10 @@ class Suspension:
     outer loop; anything with ``gains(vehicle)``, ``name`` and ``to_dict()``); it makes the
     loop closed. ``inner``: the MR dampers' force-tracking loop (`control.InnerLoop`, default
     the shipped gains). ``sensor_noise``: `control.SensorNoise` on the controller's
-    measurements. Use the constructors `passive`, `semi_active`, `ideal` and `named`.
+    measurements. ``damper_scale``: the factor `semi_active` and `named` applied to the preset
+    they were given by name, kept for the records of results (`damper_name`); it is not part of
+    the value (a suspension equals one given the scaled model itself). Use the constructors
+    `passive`, `semi_active`, `ideal` and `named`.
 
     Refused with a ValueError naming the field: a voltage with a controller, or without MR
     dampers; a controller on the viscous dampers or on none; an ideal device without a controller or with
@@ -96,10 +99,12 @@ class Suspension:
     controller: Any = None
     inner: InnerLoop | None = None
     sensor_noise: SensorNoise | None = None
+    damper_scale: float = dataclasses.field(default=1.0, compare=False, repr=False)
 
     def __post_init__(self):
         model = _model(self.damper)
         object.__setattr__(self, "damper", model)
+        object.__setattr__(self, "damper_scale", dampers.check_scale("damper_scale", self.damper_scale))
         c = self.controller
         if c is not None and not (hasattr(c, "gains") and hasattr(c, "name")):
             raise ValueError(f"controller = {c!r}: must be an outer loop from railride.control "
@@ -169,7 +174,7 @@ class Suspension:
             raise ValueError(f"damper = {damper!r}: a semi-active suspension has MR dampers ("
                              f"{', '.join(dampers.PRESETS)} or a BoucWen / Spencer model); the "
                              "ideal devices are Suspension.ideal, the dashpots Suspension.passive")
-        return cls(model, voltage, controller, inner, sensor_noise)
+        return cls(model, voltage, controller, inner, sensor_noise, damper_scale)
 
     @classmethod
     def ideal(cls, controller, dissipative: bool = False, sensor_noise=None) -> "Suspension":
@@ -208,13 +213,14 @@ class Suspension:
             raise ValueError(f"damper = {damper!r} with suspension 'mr': the ideal actuator applies a "
                              "controller's demand and has no constant voltage; use a controller")
         model = damper_model(damper, damper_scale)
+        scale = float(damper_scale)
         if name == "mr":
-            return cls(model, voltage, None, None, sensor_noise)
+            return cls(model, voltage, None, None, sensor_noise, scale)
         gains = _shipped_gains() if gains is None else gains
         controller = gains.controller(name)
         if model.law == dampers.LAW_IDEAL:
-            return cls(model, voltage, controller, None, sensor_noise)
-        return cls(model, voltage, controller, gains.inner, sensor_noise)
+            return cls(model, voltage, controller, None, sensor_noise, scale)
+        return cls(model, voltage, controller, gains.inner, sensor_noise, scale)
 
     # -- what it is ----------------------------------------------------------------------------
     @property
@@ -235,6 +241,19 @@ class Suspension:
         if self.closed_loop:
             return self.controller.name
         return "passive" if self.kind == "passive" else "mr"
+
+    @property
+    def damper_name(self) -> str | None:
+        """The damper by the name it was given: the preset (`dampers.NAMES`) that, scaled by
+        `damper_scale`, is the model; else the model's name ("bouc-wen"); None when passive
+        on the vehicle's c_sz."""
+        if self.damper is None:
+            return None
+        if self.damper_scale != 1.0:
+            for name, preset in dampers.PRESETS.items():
+                if preset.scaled(self.damper_scale) == self.damper:
+                    return name
+        return _damper_name(self.damper)
 
     @property
     def label(self) -> str:

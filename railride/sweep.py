@@ -1,13 +1,18 @@
-"""Many runs at once: cases, batches, executors and a table of finished runs.
+"""Many runs at once: cases, their batches, and the sweep study over a grid of them.
 
 A `Case` is one run described by plain settings (scenario and its options, vehicle parameter
 changes, suspension, gain changes), so it can travel to a Dask worker and has a stable key.
 `run_cases` groups compatible cases into batches for the compiled stepper, hands the chunks to
-an executor (`LocalExecutor`: this machine, the batch over both cores; `DaskExecutor`: a
-dask.distributed cluster) and appends every finished chunk to a `RunTable` on disk, written
-atomically; a sweep started again with the same table skips the runs it already has, so an
-interrupted sweep resumes where it stopped. The metrics of a case do not depend on the executor
-or on the batch it ran in (a batch equals its single runs, tests/physics/test_simulate.py).
+an executor (`railride.executors`: `LocalExecutor`, this machine, the batch over both cores;
+`DaskExecutor`, a dask.distributed cluster) and appends every finished chunk to a `RunTable` on
+disk, written atomically; a sweep started again with the same table skips the runs it already
+has, so an interrupted sweep resumes where it stopped. The metrics of a case do not depend on
+the executor or on the batch it ran in (a batch equals its single runs,
+tests/physics/test_simulate.py).
+
+The sweep study: `grid` (`railride.sweep_grid`) turns the values of each axis into the cases
+of every combination, checked before the first run; `run_sweep` runs them and returns a
+`SweepResult` (the ``railride.sweep/1`` document, a table, the figures, a result folder).
 """
 
 from __future__ import annotations
@@ -16,17 +21,17 @@ import hashlib
 import json
 import math
 import time
-from dataclasses import asdict, dataclass
-from pathlib import Path
+from dataclasses import asdict, dataclass, field
 
 import numpy as np
 import pandas as pd
 
-from ._io import atomic_write
 from .defaults import DEFAULT_CONTROL_RATE, DEFAULT_DAMPER, DEFAULT_OUTPUT_RATE
+from .executors import DaskExecutor, LocalExecutor, RunTable  # noqa: F401 (their home before)
 from .metrics import RESPONSES, STATISTICS
 from .solver import SolverSettings, _with_keywords
 from .suspension import NAMES, Suspension, batch_conflict
+from .sweep_grid import SweepGrid, grid  # noqa: F401 (the grid of the sweep study, here too)
 
 #: samples per compiled batch: bounds the memory of the time histories (about 5 MB a sample
 #: for 10 s at 1 kHz)
@@ -43,6 +48,8 @@ COMFORT_INDICES = (("centre", "aw_Wk"), ("centre", "vdv_Wk"), ("centre", "aw_Wb"
                    ("centre", "N_MV_z"), ("centre", "Wz"), ("front", "aw_Wk"), ("front", "N_MV_z"),
                    ("front", "Wz"), ("rear", "aw_Wk"), ("rear", "N_MV_z"), ("rear", "Wz"))
 COMFORT_COLUMNS = tuple(f"{p}_{i}" for p, i in COMFORT_INDICES)
+#: the schema of `SweepResult.to_dict` (sweep.json)
+SCHEMA = "railride.sweep/1"
 
 
 @dataclass(frozen=True)
@@ -233,184 +240,6 @@ def other_settings(vehicle, solver: SolverSettings) -> dict:
     return out
 
 
-# -- executors ---------------------------------------------------------------------------------
-class LocalExecutor:
-    """Chunks run one after another in this process; each chunk's batch uses every core."""
-
-    name = "local"
-
-    def map(self, fn, chunks):
-        for i, chunk in enumerate(chunks):
-            yield i, fn(chunk)
-
-    def close(self):
-        pass
-
-
-class DaskExecutor:
-    """Chunks run as tasks on a dask.distributed cluster (``address`` tcp://host:port, or the
-    ``scheduler_file`` that ``dask scheduler --scheduler-file`` writes). Needs the optional
-    extra: pip install "railride[distributed]"; every worker imports the same railride.
-
-    One chunk is one task and one compiled batch, on its share of the worker machine's cores:
-    numba's thread count there (NUMBA_NUM_THREADS, every core by default) divided by the Dask
-    threads of all the workers on that machine, at least 1. So batches do not multiply Dask's
-    threads: one ``dask worker --nthreads 1`` per machine gives each batch every core, a default
-    ``dask worker`` (a thread per core) one core to each of its batches (docs/distributed.md).
-
-    A scheduler that does not answer within ``timeout`` seconds, a scheduler file that does not
-    appear or has no address, are ValueErrors naming the address or file. `map` yields (chunk
-    index, rows) in the order chunks finish; a chunk lost with a dead worker is run again by the
-    scheduler."""
-
-    name = "dask"
-
-    def __init__(self, address: str | None = None, scheduler_file: str | None = None,
-                 timeout: float = 10.0):
-        try:
-            from distributed import Client
-        except ImportError:
-            raise ValueError("the Dask executor needs dask.distributed: pip install "
-                             "\"railride[distributed]\"") from None
-        if (address is None) == (scheduler_file is None):
-            raise ValueError("give a scheduler address (tcp://host:port) or a scheduler file")
-        if scheduler_file is not None:
-            address = self._address_from_file(scheduler_file, timeout)
-        self.address = address
-        where = f"{address}" + ("" if scheduler_file is None else f" (from {scheduler_file})")
-        try:
-            self._handshake(address, timeout)
-            # not the default client: this executor's tasks only, the caller's Dask code untouched
-            self.client = Client(address, timeout=timeout, set_as_default=False)
-        except Exception as exc:  # refused, timed out, not a Dask scheduler, unknown scheme
-            why = str(exc) or "no answer (the scheduler's port, not its dashboard's?)"
-            raise ValueError(f"cannot reach the Dask scheduler at {where} within {timeout:g} s: "
-                             f"{type(exc).__name__}: {why}") from None
-
-    @staticmethod
-    def _address_from_file(path, timeout: float) -> str:
-        """The address in a scheduler file, waiting up to ``timeout`` for the scheduler to write it
-        (distributed's own Client would wait for a missing file forever)."""
-        deadline = time.monotonic() + timeout
-        while True:
-            try:
-                address = json.loads(Path(path).read_text())["address"]
-                if isinstance(address, str) and address:
-                    return address
-                problem = f"address = {address!r}"
-            except FileNotFoundError:
-                problem = "no such file"
-            except (OSError, ValueError, TypeError, KeyError) as exc:
-                problem = f"not a Dask scheduler file ({type(exc).__name__}: {exc})"
-            if time.monotonic() >= deadline:
-                raise ValueError(f"scheduler file {str(path)!r}: {problem} after {timeout:g} s")
-            time.sleep(0.1)
-
-    @staticmethod
-    def _handshake(address: str, timeout: float) -> None:
-        """Open and close one connection to a tcp ``address`` within ``timeout``: the Client
-        itself waits forever on a port that accepts but does not speak Dask (a dashboard's)."""
-        import asyncio
-        from concurrent.futures import ThreadPoolExecutor
-
-        try:
-            from distributed.comm import connect
-            from distributed.comm.addressing import parse_address
-            from distributed.comm.registry import get_backend
-        except ImportError:  # internals moved in another version: the Client alone then
-            return
-
-        scheme = parse_address(address)[0]
-        get_backend(scheme)  # an unknown scheme is a ValueError here, not a half-made Client
-        if scheme != "tcp":
-            return
-
-        async def once():
-            comm = await connect(address, timeout=timeout)
-            await comm.close()
-
-        # in a thread of its own: the caller may be inside an event loop (Jupyter)
-        with ThreadPoolExecutor(1) as pool:
-            pool.submit(lambda: asyncio.run(asyncio.wait_for(once(), timeout))).result()
-
-    def map(self, fn, chunks):
-        import uuid
-
-        from distributed import as_completed
-        from distributed.comm import get_address_host
-
-        # the Dask threads on each machine (by host address), so a task knows its share
-        nthreads = self.client.nthreads()
-        per_host: dict[str, int] = {}
-        for worker, n in nthreads.items():
-            host = get_address_host(worker)
-            per_host[host] = per_host.get(host, 0) + n
-        shares = {worker: per_host[get_address_host(worker)] for worker in nthreads}
-        tag = uuid.uuid4().hex[:8]
-        futures = {self.client.submit(self._run_chunk, fn, shares, chunk,
-                                      key=f"railride-chunk-{tag}-{i}"): i
-                   for i, chunk in enumerate(chunks)}
-        try:
-            for fut in as_completed(futures, loop=self.client.loop):
-                i = futures.pop(fut)
-                yield i, fut.result()
-        finally:  # stopped early (an error, Ctrl-C): drop what has not finished
-            if futures:
-                self.client.cancel(list(futures))
-
-    @staticmethod
-    def _run_chunk(fn, shares: dict, chunk):
-        """On a worker: ``fn(chunk)`` on numba's thread count divided by the Dask threads on this
-        machine (``shares``, as the map started; this worker's own for a worker that joined
-        later). The thread count is per thread (`numba.set_num_threads`), so restored after."""
-        import numba
-        from distributed import get_worker
-
-        worker = get_worker()
-        share = shares.get(worker.address, worker.state.nthreads)
-        before = numba.get_num_threads()
-        numba.set_num_threads(max(1, numba.config.NUMBA_NUM_THREADS // max(1, share)))
-        try:
-            return fn(chunk)
-        finally:
-            numba.set_num_threads(before)
-
-    def close(self):
-        self.client.close()
-
-
-# -- the table of finished runs ----------------------------------------------------------------
-class RunTable:
-    """Every finished run, one row each, kept in a CSV file rewritten atomically after each
-    chunk: a reader never sees half a file, and an interrupted sweep loses at most the chunks
-    in flight."""
-
-    def __init__(self, path: str | Path | None = None, resume: bool = False):
-        self.path = None if path is None else Path(path)
-        self.frame = pd.DataFrame()
-        if self.path is not None and self.path.exists():
-            if not resume:
-                raise ValueError(f"{self.path} exists: pass resume to continue that sweep, or "
-                                 "choose another output folder")
-            try:
-                # keys are hex digests: an all-digit one must stay text to be recognised
-                self.frame = pd.read_csv(self.path, dtype={"key": str})
-            except (OSError, ValueError) as exc:
-                raise ValueError(f"cannot read the run table {self.path}: {exc}") from None
-
-    def done(self) -> dict[str, dict]:
-        if self.frame.empty:
-            return {}
-        return {row["key"]: row for row in self.frame.to_dict("records")}
-
-    def add(self, rows: list[dict]) -> None:
-        if not rows:
-            return
-        self.frame = pd.concat([self.frame, pd.DataFrame(rows)], ignore_index=True)
-        if self.path is not None:
-            atomic_write(self.path, lambda p: self.frame.to_csv(p, index=False))
-
-
 def run_cases(cases: list[Case], *, executor=None, table: RunTable | None = None, base_gains=None,
               params=None, solver=None, window=None, chunk: int = CHUNK, progress=None,
               comfort: bool = False, dt=None) -> pd.DataFrame:
@@ -466,3 +295,157 @@ def run_cases(cases: list[Case], *, executor=None, table: RunTable | None = None
             elapsed = time.perf_counter() - t0
             progress(n_done, len(pending), n_done / elapsed if elapsed > 0 else math.inf)
     return pd.DataFrame([done[k] for k in keys])
+
+
+# -- the sweep study -------------------------------------------------------------------------------
+def metric_columns() -> list[str]:
+    """The metric columns of every run: ``<response>_<statistic>``, statistic by statistic."""
+    return [f"{r}_{s}" for s in STATISTICS for r in RESPONSES]
+
+
+@dataclass(frozen=True, eq=False)
+class SweepResult:
+    """The runs of a sweep (`run_sweep`): ``grid`` (the cases, their grid values and the
+    settings), ``frame`` (the rows of `run_cases`, one per case, in the grid's order),
+    ``comfort`` (whether they hold the comfort indices, `COMFORT_COLUMNS`), ``vehicle`` (the
+    `VehicleParams` of the runs), ``runs`` (rows of the run table at the end) and ``date``
+    (when the sweep finished, UTC, ISO 8601)."""
+
+    grid: SweepGrid
+    frame: pd.DataFrame = field(repr=False)
+    comfort: bool = False
+    vehicle: object = None
+    runs: int = 0
+    date: str = ""
+
+    def metric_columns(self) -> list[str]:
+        return metric_columns() + (list(COMFORT_COLUMNS) if self.comfort else [])
+
+    @property
+    def diverged(self) -> np.ndarray:
+        """True for each case whose run diverged (no metrics, the time in ``diverged_at_s``)."""
+        if "diverged_at_s" not in self.frame:
+            return np.zeros(len(self.grid.cases), dtype=bool)
+        return self.frame["diverged_at_s"].notna().to_numpy()
+
+    def columns(self) -> list[str]:
+        """The columns of `to_pandas`: the grid's, the metrics, ``diverged_at_s`` when a run
+        diverged, and ``key`` (`Case.key`)."""
+        return (list(self.grid.columns) + self.metric_columns()
+                + (["diverged_at_s"] if self.diverged.any() else []) + ["key"])
+
+    def rows(self) -> list[dict]:
+        """One row per run: its grid values (None where an axis does not act), its metrics
+        (None for a run that diverged) and its case's key."""
+        metrics, diverged = self.metric_columns(), self.diverged
+        rows = []
+        for case, values, (_, result), bad in zip(self.grid.cases, self.grid.values, self.frame.iterrows(),
+                                                  diverged):
+            row = {**values, **{m: None if bad else float(result[m]) for m in metrics}}
+            if diverged.any():  # a run that diverged has no metrics, but the time it went
+                row["diverged_at_s"] = float(result["diverged_at_s"]) if bad else None
+            rows.append({**row, "key": case.key})
+        return rows
+
+    def settings(self) -> dict:
+        """What the sweep ran: the scenario's fixed settings, each axis and its values, the
+        damper, the base gains' source, the sensor noise, the step and the metrics window;
+        with comfort, what its columns are (`comfort_settings`); a solver's rates and a vehicle
+        other than the defaults (`other_settings`)."""
+        from .params import VehicleParams
+
+        g = self.grid
+        vehicle = VehicleParams.preset("paper") if self.vehicle is None else self.vehicle
+        return {
+            "scenario": g.scenario_record(),
+            "grid": g.grid_values(),
+            "damper": g.damper if ("mr" in g.suspensions or g.controllers) else None,
+            "gains_source": g.base_gains.source if g.controllers else None,
+            "sensor_noise": None if g.noise is None else dict(
+                zip(("displacement", "angle", "velocity", "angular_rate"), g.noise)),
+            "dt_s": float(g.solver.dt),
+            "window_s": None if g.window is None else list(g.window),
+            **({"comfort": comfort_settings(g.duration, g.window)} if self.comfort else {}),
+            **other_settings(vehicle, g.solver),
+        }
+
+    def to_dict(self) -> dict:
+        """The ``railride.sweep/1`` document (docs/cli.md): the settings, the columns, every
+        run as a row of `rows`, and the rows of the run table."""
+        from . import __version__
+
+        return {"schema": SCHEMA, "railride_version": __version__, "date": self.date,
+                "settings": self.settings(), "columns": self.columns(), "rows": self.rows(),
+                "runs": int(self.runs)}
+
+    def to_pandas(self) -> pd.DataFrame:
+        """One row per run, the columns of `columns` (empty where an axis does not act)."""
+        return pd.DataFrame(self.rows(), columns=self.columns())
+
+    def plot(self, ax=None, *, comfort: bool = False, axis: str | None = None):
+        """The RMS of the four carbody responses against the swept axis (four panels,
+        `railride.plots.sweep.plot_sweep`), or with ``comfort`` N_MV,z and a_w Wk against it
+        (two panels, `plot_sweep_comfort`). ``ax``: the Axes to draw in, or None for a new
+        figure. Returns the figure."""
+        from .plots.sweep import plot_sweep, plot_sweep_comfort
+
+        return (plot_sweep_comfort if comfort else plot_sweep)(self, ax, axis=axis)
+
+    def save(self, folder, *, extra: dict | None = None) -> list:
+        """sweep.json (`to_dict`, then the entries of ``extra``, such as a command line's
+        facts) and, when the grid has one numeric axis with several values, sweep.png and,
+        with comfort, comfort.png into ``folder``, all or nothing (other files, such as the run
+        table runs.csv, stay). Returns the paths."""
+        from .files import write_sweep_outputs
+
+        return write_sweep_outputs(self, folder, {**self.to_dict(), **(extra or {})})
+
+
+def comfort_settings(duration: float, window) -> dict:
+    """``settings.comfort`` of a sweep with comfort: the columns and their units, where the
+    positions are and what N_MV_z is (the same for every run of a grid: they share one
+    duration)."""
+    from .comfort import INDEX_UNITS, INTERVAL_S
+
+    start, end = window or (0.0, duration)
+    n = max(1, int((end - start + 1e-9) // INTERVAL_S))
+    unit = {i: INDEX_UNITS["aw" if i.startswith("aw_") else "vdv" if i.startswith("vdv_") else i]
+            for _, i in COMFORT_INDICES}
+    return {"columns": list(COMFORT_COLUMNS),
+            "units": {c: unit[i] for (_, i), c in zip(COMFORT_INDICES, COMFORT_COLUMNS)},
+            "positions": {"centre": "x = 0", "front": "x = +l (above the front bogie centre)",
+                          "rear": "x = -l (above the rear bogie centre)"},
+            "n_intervals": n,
+            "notes": ["N_MV_z is the vertical term of EN 12299 only: the model has no lateral "
+                      "or longitudinal motion",
+                      f"N_MV_z from {n} interval{'s' if n != 1 else ''} of 5 s"
+                      + (" (EN 12299 evaluates 60, 5 minutes): an indication only"
+                         if n < 60 else "")]}
+
+
+def run_sweep(grid: SweepGrid, *, executor=None, table: RunTable | None = None,  # noqa: F811 (`grid`'s grid)
+              params=None, progress=None, comfort: bool = True) -> SweepResult:
+    """Run every case of ``grid`` (`railride.sweep.grid`) and return a `SweepResult`.
+
+    One call of `run_cases`: compiled batches of 32 runs, on ``executor`` (default
+    `LocalExecutor`; `DaskExecutor` for a cluster), skipping the runs already in ``table``
+    (a `RunTable`; one kept on disk makes the sweep resumable), ``progress(done, total,
+    runs_per_second)`` after each chunk. ``params``: the vehicle (`VehicleParams` or a preset
+    name, default "paper"). ``comfort``: also the ride comfort indices of every run over the
+    grid's window (`railride.comfort.ride_comfort`). The runs use the grid's base gains, solver
+    settings and metrics window.
+    """
+    from datetime import datetime, timezone
+
+    from .simulation import _resolve_params
+
+    if not isinstance(grid, SweepGrid):
+        raise ValueError(f"grid = {type(grid).__name__}: must be a railride.sweep.SweepGrid "
+                         "(railride.sweep.grid makes one)")
+    vehicle = _resolve_params(params)
+    table = RunTable() if table is None else table
+    frame = run_cases(list(grid.cases), executor=executor, table=table, base_gains=grid.base_gains,
+                      params=vehicle, solver=grid.solver, window=grid.window, progress=progress,
+                      comfort=bool(comfort))
+    date = datetime.now(timezone.utc).replace(microsecond=0).isoformat().replace("+00:00", "Z")
+    return SweepResult(grid, frame, bool(comfort), vehicle, len(table.frame), date)

@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import json
 import math
+from typing import Any
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -41,7 +42,8 @@ from .objectives import (  # noqa: F401 (re-exported: the objectives' old home)
     RATIO_NAMES,
     Objective,
 )
-from .solver import _with_keywords
+from . import validation
+from .solver import SolverSettings, check_resolution
 from .sweep import Case, RunTable, run_cases
 
 #: one phase per gain table, in the paper's order
@@ -99,9 +101,9 @@ class TuneResult:
     curves: list[Curve] = field(default_factory=list)
     history: list[dict] = field(default_factory=list)  # objective after each pass of each phase
     runs: pd.DataFrame | None = None
-    passive: dict | None = None
-    objective: Objective | None = None  # what the vehicle phases minimised
-    start: GainSet | None = None
+    passive: dict = field(default_factory=dict)  # RMS of the passive run, by response
+    objective: Objective = DEFAULT_OBJECTIVE  # what the vehicle phases minimised
+    start: GainSet | None = None  # None: the gains are the start
     phases: tuple = ()
     scenario: dict = field(default_factory=dict)
     settings: dict = field(default_factory=dict)
@@ -266,7 +268,7 @@ def tune(phases=PHASES, *, scenario: str = "paper-sine", scenario_options=None,
          gains: GainSet | None = None, objective: Objective | None = None, damper: str = DEFAULT_DAMPER,
          executor=None, table: RunTable | None = None, n_values: int = 13, span: float = 30.0,
          max_passes: int = 5, tol: float = 1e-3, params=None, solver=None, window=None, progress=None,
-         log=None, damper_scale: float = 1.0, before_after: bool = True, dt=None) -> TuneResult:
+         log=None, damper_scale: float = 1.0, before_after: bool = True) -> TuneResult:
     """The sensitivity study: the phases in order (from PHASES; default all four, so PID and SAS
     are tuned by the same procedure and budget), each to convergence, from ``gains`` (default
     the neutral `GainSet.reference`), minimising ``objective`` (default `DEFAULT_OBJECTIVE`).
@@ -279,8 +281,8 @@ def tune(phases=PHASES, *, scenario: str = "paper-sine", scenario_options=None,
     force capacity (`railride.dampers.BoucWen.scaled`); the inner phase then tracks demands
     scaled alike, so a damper k times larger is tuned on the same relative task. ``params``:
     the vehicle (`VehicleParams` or a preset name, default "paper"); ``solver``: the
-    `SolverSettings` of every vehicle run (``dt``: the step alone, as the command line still
-    gives it); both are recorded in ``settings`` where they differ from the defaults.
+    `SolverSettings` of every vehicle run; both are recorded in ``settings`` where they differ
+    from the defaults. Every setting is checked before the first run.
     ``progress(done, total, runs_per_second)`` after each chunk; ``log(text)`` after each pass.
 
     ``before_after``: at the end, run each controller the phases change with the start and with
@@ -288,10 +290,11 @@ def tune(phases=PHASES, *, scenario: str = "paper-sine", scenario_options=None,
     already are). Returns a `TuneResult` (``to_dict``, ``to_pandas``, ``plot``, ``save``).
     """
     from .simulation import _resolve_params
+    from .suspension import damper_model
     from .sweep import other_settings
     from .track import scenario as make_scenario
 
-    solver = _with_keywords(solver, dt)  # TEMPORARY: dt= removed when the CLI moves onto Suspension
+    solver = SolverSettings.of(solver)
     vehicle = _resolve_params(params)
     gains = GainSet.reference() if gains is None else gains
     objective = DEFAULT_OBJECTIVE if objective is None else objective
@@ -302,15 +305,18 @@ def tune(phases=PHASES, *, scenario: str = "paper-sine", scenario_options=None,
         raise ValueError(f"unknown phase {unknown[0]!r}; allowed: {', '.join(PHASES)}, all")
     from . import dampers
 
+    damper_model(damper, damper_scale)  # a known name, and a scale it has
     if "inner" in phases and damper in dampers.IDEAL_NAMES:
         raise ValueError(f"damper = {damper!r} with phase 'inner': the ideal actuator has no force "
                          "tracking loop to tune; leave out the inner phase")
     damper_scale = dampers.check_scale("damper_scale", damper_scale)
-    if not (isinstance(n_values, int) and n_values >= 3):
-        raise ValueError(f"n_values = {n_values!r}: a whole number >= 3")
-    if not (span > 1):
-        raise ValueError(f"span = {span!r}: must be > 1")
-    record = make_scenario(scenario, **dict(scenario_options or {})).describe()
+    validation.integer("n_values", n_values, 3)
+    validation.integer("max_passes", max_passes, 1)
+    if not validation.number("span", span, "finite", allowed="a finite number > 1") > 1:
+        raise ValueError(f"span = {validation.shown(span)}: must be a finite number > 1")
+    scen = make_scenario(scenario, **dict(scenario_options or {}))
+    check_resolution(scen, solver.output_rate)
+    record = scen.describe()
     base = gains
     result = TuneResult(gains, objective=objective, start=gains, phases=tuple(phases),
                         scenario=record, settings={
@@ -386,14 +392,15 @@ def _before_after(result: TuneResult, run, scenario, opts, damper, damper_scale)
     for n in names:
         cases.append(Case(scenario, opts, suspension=n, damper=damper, damper_scale=damper_scale))
         cases.append(Case(scenario, opts, suspension=n, damper=damper, damper_scale=damper_scale,
-                          gains=_gain_changes(result.start, result.gains, CONTROLLER_TABLES[n])))
+                          gains=_gain_changes(result.start or result.gains, result.gains,
+                                              CONTROLLER_TABLES[n])))
     frame = run(cases)
     passive = {r: float(result.passive[r]) for r in RESPONSES}
     rows = []
     for i, n in enumerate(names):
         before, after = frame.iloc[2 * i], frame.iloc[2 * i + 1]
-        row = {"suspension": n, "before": {}, "after": {}, "reduction_before_percent": {},
-               "reduction_after_percent": {}}
+        row: dict[str, Any] = {"suspension": n, "before": {}, "after": {}, "reduction_before_percent": {},
+                               "reduction_after_percent": {}}
         for r in RESPONSES:
             b, a = float(before[f"{r}_rms"]), float(after[f"{r}_rms"])
             row["before"][r], row["after"][r] = b, a
@@ -414,7 +421,7 @@ def tracking_objective(B: float, G: float, damper=DEFAULT_DAMPER, damper_scale: 
     if damper_scale != 1.0:
         model = model.scaled(damper_scale)
     return float(np.mean([track(model, kind, 10e3 * damper_scale, 1.0, B=B, G=G)
-                          .metrics()["normalised_rms_error"] for kind in ("sine", "sawtooth")]))
+                          .metrics().normalised_rms_error for kind in ("sine", "sawtooth")]))
 
 
 def _tune_inner(base, changes, params, n_values, span, max_passes, tol, result, log, damper,

@@ -9,7 +9,7 @@ import json
 import math
 import sys
 from pathlib import Path
-from typing import Optional
+from typing import Any, Optional
 
 import typer
 
@@ -46,6 +46,36 @@ def errors():
         return
     typer.echo(f"error: {message}", err=True)
     raise typer.Exit(status)
+
+
+@contextlib.contextmanager
+def option_names(fields: dict, defaults=()):
+    """The library's errors in the command's words: in a ValueError raised inside, each field
+    ``name = ...`` (or ``<=``, ``>=``) of ``fields`` (library name -> option) is named by its
+    option instead (``amplitude = 0.0: ...`` -> ``--amplitude = 0.0: ...``); a name with an underscore,
+    which reads as no word, wherever it stands (``raise output_rate``). A field in
+    ``defaults`` (its option not given) gets "(the default)" after its value. Use inside
+    `errors`."""
+    try:
+        yield
+    except ValueError as exc:
+        text = reworded(str(exc), fields, defaults)
+        if text == str(exc):
+            raise
+        raise ValueError(text) from exc
+
+
+def reworded(text: str, fields: dict, defaults=()) -> str:
+    """``text`` with the library's field names replaced by the options' (see `option_names`)."""
+    import re
+
+    for name, option in fields.items():
+        field = rf"(?<![\w'./-]){re.escape(name)}"
+        if name in defaults:  # the value, and its unit when the library gives one
+            text = re.sub(rf"{field}( = [^\s:;,]+(?: (?:s|Hz|m|m/s|V))?)(?=[\s:;,]|$)",
+                          rf"{name}\1 (the default)", text)
+        text = re.sub(field + (r"(?![\w-])" if "_" in name else "(?= [<>]?= )"), option, text)
+    return text
 
 
 # -- consoles and output --------------------------------------------------------------------------
@@ -90,7 +120,8 @@ def status_note(message: str):
 
 
 def write_folder(out: Path, write) -> None:
-    """Run ``write()`` (a report.write_* call) with a status note; OSError -> status 2."""
+    """Run ``write()`` (a `railride.files` writer or a result's ``save``) with a status note;
+    OSError -> status 2."""
     try:
         with status_note(f"writing outputs to {out}..."):
             paths = write()
@@ -215,13 +246,13 @@ def make_executor(workers: Optional[int], scheduler: Optional[str], scheduler_fi
             executor = sweep_lib.DaskExecutor(
                 address=scheduler, scheduler_file=None if scheduler_file is None else str(scheduler_file))
         where = scheduler if scheduler is not None else str(scheduler_file)
-        record = {"type": "dask", "scheduler": where}
+        record: dict[str, Any] = {"type": "dask", "scheduler": where}
         with contextlib.suppress(Exception):
             record["workers"] = len(executor.client.scheduler_info()["workers"])
         return executor, record
     import numba
 
-    cores = int(numba.config.NUMBA_NUM_THREADS)
+    cores = int(numba.config.NUMBA_NUM_THREADS)  # type: ignore[attr-defined]  # set at import
     if workers is not None:
         if not 1 <= workers <= cores:
             raise ValueError(f"--workers = {workers}: must be a whole number from 1 to {cores} "
@@ -232,15 +263,15 @@ def make_executor(workers: Optional[int], scheduler: Optional[str], scheduler_fi
 
 def open_run_table(out: Optional[Path], resume: bool):
     """(RunTable, its path or None): DIR/runs.csv with --out, kept in memory without it."""
-    from .. import report
     from .. import sweep as sweep_lib
+    from ..files import check_out_dir
 
     if out is None:
         if resume:
             raise ValueError("--resume needs --out DIR: the run table it continues is "
                              "DIR/runs.csv")
         return sweep_lib.RunTable(), None
-    report.check_out_dir(out)
+    check_out_dir(out)
     path = out / "runs.csv"
     if path.exists() and not resume:
         raise ValueError(f"--out {out}: {path} exists (the run table of an earlier run); add "

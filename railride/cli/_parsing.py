@@ -9,26 +9,8 @@ import math
 from pathlib import Path
 from typing import Optional
 
-from ..dampers import IDEAL_NAMES
-
 
 # -- numbers and lists ----------------------------------------------------------------------------
-def check_number(option: str, value: float, unit: str, *, allow_zero: bool = False) -> float:
-    """A finite number > 0 (>= 0 with ``allow_zero``), else ValueError naming the option."""
-    ok = math.isfinite(value) and (value >= 0 if allow_zero else value > 0)
-    if not ok:
-        rule = ">= 0" if allow_zero else "> 0"
-        unit = f" {unit}" if unit else ""
-        raise ValueError(f"{option} = {value:g}{unit}: must be a finite number {rule}")
-    return float(value)
-
-
-def check_int(option: str, value: int, minimum: int, what: str = "") -> int:
-    if value < minimum:
-        raise ValueError(f"{option} = {value}: must be a whole number >= {minimum}{what}")
-    return value
-
-
 def parse_float(option: str, text: str, item: str, what: str = "") -> float:
     try:
         value = float(item)
@@ -91,13 +73,38 @@ def default_of(fn, name: str):
     return inspect.signature(fn).parameters[name].default
 
 
+# -- solver settings ------------------------------------------------------------------------------
+#: the library's names of the step and rate options, for its errors (`_common.option_names`)
+SOLVER_FIELDS = {"dt": "--dt", "output_rate": "--output-rate", "control_rate": "--control-rate"}
+
+
+def solver_from_options(**given):
+    """--dt, --output-rate, --control-rate (None: not given) -> a railride.SolverSettings, the
+    others at their defaults; the settings check themselves."""
+    from ..solver import SolverSettings
+
+    return SolverSettings(**{k: v for k, v in given.items() if v is not None})
+
+
+def not_given(**given) -> list[str]:
+    """The names of the options left at their defaults (None), for `_common.option_names`."""
+    return [k for k, v in given.items() if v is None]
+
+
 # -- vehicle, dampers, gains, sensor noise --------------------------------------------------------
+def vehicle_source(params_file: Optional[Path], preset: Optional[str]):
+    """--params FILE or --preset NAME as the library takes a vehicle: the file's path, the
+    preset's name, or None (the default preset)."""
+    if params_file is not None and preset is not None:
+        raise ValueError("give either --params FILE or --preset NAME, not both")
+    return params_file if params_file is not None else preset
+
+
 def vehicle_from_options(params_file: Optional[Path], preset: Optional[str]):
     """(VehicleParams, the record for the JSON document)."""
     from ..params import VehicleParams
 
-    if params_file is not None and preset is not None:
-        raise ValueError("give either --params FILE or --preset NAME, not both")
+    vehicle_source(params_file, preset)
     if params_file is not None:
         return VehicleParams.load(params_file), {"vehicle_params_file": str(params_file)}
     name = "paper" if preset is None else preset
@@ -118,19 +125,17 @@ def damper_preset(option: str, name: str, *, rig: bool = False):
     return dampers.preset(name)
 
 
-def check_damper_scale(option: str, value: Optional[str], damper_name: str) -> float:
-    """--damper-scale: a finite number > 0 (default 1), not for the ideal actuator."""
-    if value is None:
+def parse_scale(option: str, text: Optional[str]) -> float:
+    """--damper-scale as a number (default 1; read as text, so that a word gets the one-line
+    error too); its value is the damper's to check."""
+    if text is None:
         return 1.0
-    try:  # read as text, so that a word gets the one-line error too
-        number = float(value)
-    except ValueError:
-        raise ValueError(f"{option} = {value!r}: must be a finite number > 0") from None
-    scale = check_number(option, number, "")
-    if damper_name in IDEAL_NAMES:
-        raise ValueError(f"{option} = {scale:g}: the ideal device (--damper {damper_name}) applies "
-                         "the demand itself and has no force capacity to scale")
-    return scale
+    for kind in (int, float):  # as typed: the damper's message then shows 2, not 2.0
+        try:
+            return kind(text)
+        except ValueError:
+            pass
+    raise ValueError(f"{option} = {text!r}: must be a finite number > 0")
 
 
 def parse_voltage(option: str, text: str, damper) -> float:
@@ -205,10 +210,8 @@ def parse_noise(option: str, text: str) -> list[float]:
 #: the options of the random-track scenarios: (option, keyword of track.scenario, unit)
 TRACK_OPTIONS = (("--track-seed", "seed", ""), ("--min-wavelength", "min_wavelength", "m"),
                  ("--max-wavelength", "max_wavelength", "m"))
-#: a random track's shortest wavelength must pass at speed / min_wavelength <= output rate /
-#: RESOLUTION (the rule railride.simulation.simulate applies; checked here first so that the
-#: message names the options and a sweep or tuning study fails before its first run)
-RESOLUTION = 2.5
+#: the library's names of the random-track options, for its errors (`_common.option_names`)
+TRACK_FIELDS = {keyword: option for option, keyword, _ in TRACK_OPTIONS}
 
 
 def random_tracks() -> tuple:
@@ -220,17 +223,9 @@ def random_tracks() -> tuple:
 def track_options(scenario_name: str, seed: Optional[int], min_wavelength: Optional[float],
                   max_wavelength: Optional[float]) -> dict:
     """--track-seed, --min-wavelength, --max-wavelength -> the keyword arguments of
-    track.scenario that were given, checked with the options' names."""
+    track.scenario that were given (their values are the track's to check, `make_scenario`)."""
     given = {"seed": seed, "min_wavelength": min_wavelength, "max_wavelength": max_wavelength}
-    out = {}
-    for option, keyword, unit in TRACK_OPTIONS:
-        value = given[keyword]
-        if value is None:
-            continue
-        if keyword == "seed":
-            out[keyword] = _check_track_seed(option, value)
-        else:
-            out[keyword] = check_number(option, value, unit)
+    out = {k: v for k, v in given.items() if v is not None}
     if out and scenario_name not in random_tracks():
         option, keyword, unit = next(o for o in TRACK_OPTIONS if o[1] in out)
         value = f"{out[keyword]:g}" + (f" {unit}" if unit else "")
@@ -240,17 +235,12 @@ def track_options(scenario_name: str, seed: Optional[int], min_wavelength: Optio
     return out
 
 
-def _check_track_seed(option: str, value) -> int:
-    if isinstance(value, bool) or int(value) != value or value < 0:
-        raise ValueError(f"{option} = {value}: must be a whole number >= 0 (the seed of the "
-                         "random track)")
-    return int(value)
-
-
 def make_scenario(name: str, options: dict, output_rate: Optional[float] = None,
                   rate_option: str = "--output-rate"):
-    """track.scenario(name, **options); a wavelength-band error names the options given, and a
-    random track whose shortest wavelength the output rate cannot resolve is refused here."""
+    """track.scenario(name, **options), and with ``output_rate`` [Hz] the library's check that
+    it resolves the track (`railride.solver.check_resolution`; ``rate_option`` names the option
+    that sets the rate, or says what does). The library's errors name the options."""
+    from ..solver import check_resolution
     from ..track import scenario as library_scenario
 
     if name in random_tracks():
@@ -261,32 +251,24 @@ def make_scenario(name: str, options: dict, output_rate: Optional[float] = None,
                 raise ValueError(f"{option} = {options[keyword]:g} {unit}: does not apply to a "
                                  f"random track ({name}); its options are --track-seed, "
                                  "--min-wavelength and --max-wavelength")
+    from ._common import option_names
+
+    fields = {**TRACK_FIELDS, **({"output_rate": rate_option} if rate_option.startswith("--") else {})}
+    defaults = [k for k in TRACK_FIELDS if k not in options]
     try:
-        scen = library_scenario(name, **options)
+        with option_names(fields, defaults):
+            scen = library_scenario(name, **options)
+            if output_rate is not None:
+                check_resolution(scen, output_rate)
     except ValueError as exc:
         band = [(o, k, u) for o, k, u in TRACK_OPTIONS if k != "seed" and k in options]
-        if band and "wavelength" in str(exc):
+        if band and str(exc).startswith("wavelength band"):
             given = ", ".join(f"{o} = {options[k]:g} {u}" for o, k, u in band)
             raise ValueError(f"{given}: {exc}") from None
         if str(exc).startswith("unknown scenario"):
             raise ValueError(f"--scenario: {exc}") from None
         raise
-    if output_rate is not None:
-        _check_resolvable(scen, options, output_rate, rate_option)
     return scen
-
-
-def _check_resolvable(scen, options: dict, output_rate: float, rate_option: str) -> None:
-    lam = getattr(scen.track, "min_wavelength", None)
-    if lam is None or not (math.isfinite(output_rate) and output_rate > 0):
-        return  # not a random track; a bad rate is the library's to report
-    if scen.speed / lam > output_rate / RESOLUTION:
-        default = "" if "min_wavelength" in options else " (the default)"
-        raise ValueError(
-            f"--min-wavelength = {lam:g} m{default} at --speed {scen.speed:g} m/s is "
-            f"{scen.speed / lam:g} Hz, more than {rate_option} {output_rate:g} Hz / "
-            f"{RESOLUTION:g} = {output_rate / RESOLUTION:g} Hz can resolve: raise --min-wavelength "
-            f"or lower --speed" + (f" or raise {rate_option}" if rate_option.startswith("--") else ""))
 
 
 def _scenario_options(**given) -> dict:
@@ -309,11 +291,8 @@ def study_scenario(name: str, *, amplitude: Optional[float], wavelength: Optiona
                    track_seed: Optional[int], min_wavelength: Optional[float],
                    max_wavelength: Optional[float]):
     """(scenario, its options for sweep.Case) of the runs of a study (tune, pareto), checked
-    before the first run; every run stores its time histories at the library's default rate."""
-    from ..defaults import DEFAULT_OUTPUT_RATE
-
+    before the first run (whether the runs' output rate resolves it is the study's check)."""
     options = _scenario_options(amplitude=amplitude, wavelength=wavelength, rail_phase=rail_phase,
                                 speed=speed, duration=duration)
     options.update(track_options(name, track_seed, min_wavelength, max_wavelength))
-    scen = make_scenario(name, options, DEFAULT_OUTPUT_RATE, "the runs' output rate")
-    return scen, case_options(options)
+    return make_scenario(name, options), case_options(options)

@@ -20,7 +20,7 @@ def reduction_text(value, spec: str = ".1f") -> str:
 
 
 def damper_text(settings: dict) -> str:
-    from ..report import describe_dampers
+    from ..labels import describe_dampers
 
     return describe_dampers(settings, detail=True)
 

@@ -12,15 +12,18 @@ import typer
 from ..dampers import IDEAL_NAMES
 from ..defaults import DEFAULT_CONTROL_RATE, DEFAULT_DAMPER
 from ._app import app
-from ._common import ProgressBar, errors, stderr_is_terminal, wide_stdout_console, write_folder
+from ._common import ProgressBar, errors, option_names, stderr_is_terminal, wide_stdout_console, write_folder
 from ._options import (AmplitudeOption, ComfortOption, CompareDamperOption, CompareDamperScaleOption,
                        CompareGainsOption, CompareOutOption, CompareScenarioOption, ControlRateOption,
                        DtOption, DurationOption, FormatOption, MaxWavelengthOption, MinWavelengthOption,
                        OutputFormat, OutputRateOption, ParamsOption, PresetOption, RailPhaseOption,
                        SpeedOption, TrackSeedOption, WavelengthOption, WindowOption)
-from ._parsing import (check_damper_scale, check_number, damper_preset, load_gains, make_scenario, parse_noise,
-                       track_options, vehicle_from_options)
+from ._parsing import (SOLVER_FIELDS, damper_preset, load_gains, make_scenario, not_given, parse_noise, parse_scale,
+                       solver_from_options, track_options, vehicle_from_options)
 from ._render import RESPONSE_LABELS, compare_comfort_table, damper_text, fmt, reduction_text
+
+#: the library's names of compare's options, for its errors
+COMPARE_FIELDS = {**SOLVER_FIELDS, "damper": "--damper", "damper_scale": "--damper-scale"}
 
 
 def _controller_list(text: str) -> list[str]:
@@ -47,20 +50,9 @@ def _sensor_noise(text: Optional[str], seed: Optional[int]):
             raise ValueError(f"--seed = {seed}: applies with --sensor-noise only (without it the "
                              "measurements are ideal)")
         return None
-    values = parse_noise("--sensor-noise", text)
-    if seed is not None and seed < 0:
-        raise ValueError(f"--seed = {seed}: must be a whole number >= 0")
-    return SensorNoise(*values, seed=0 if seed is None else seed)
-
-
-def _check_control_rate(rate: float, dt: float) -> float:
-    """--control-rate: > 0 and a whole number of RK4 steps per controller period."""
-    rate = check_number("--control-rate", rate, "Hz")
-    stride = 1.0 / (rate * dt)
-    if round(stride) < 1 or abs(round(stride) - stride) > 1e-6 * stride:
-        raise ValueError(f"--control-rate = {rate:g} Hz with --dt = {dt:g} s: the controller "
-                         "period 1/rate must be a whole number of steps dt")
-    return rate
+    z, angle, velocity, rate = parse_noise("--sensor-noise", text)
+    with option_names({"'seed'": "--seed"}):  # as the noise's field check quotes it
+        return SensorNoise(z, angle, velocity, rate, seed=0 if seed is None else seed)
 
 
 def _trade_off_lines(doc: dict) -> list[str]:
@@ -85,7 +77,7 @@ def _compare_tables(doc: dict, vehicle: str, shipped: bool):
     from rich.table import Table
     from rich.text import Text
 
-    from ..report import describe_scenario
+    from ..labels import describe_scenario
 
     rows = doc["controllers"]
     settings = doc["settings"]
@@ -245,28 +237,25 @@ def compare(
     values and what each suspension asks of its dampers. Without options: the paper's
     scenario paper-sine.
     """
-    with errors():
-        from .. import report
+    with errors(), option_names(COMPARE_FIELDS, not_given(dt=dt, output_rate=output_rate)):
         from ..comparison import compare as run_compare
-        from ..defaults import DEFAULT_DT, DEFAULT_OUTPUT_RATE
+        from ..files import check_out_dir, write_compare_outputs
         from ..metrics import check_window, parse_window
 
         names = _controller_list(controllers)
         gain_set = load_gains(gains)
         damper_preset("--damper", damper)
-        scale = check_damper_scale("--damper-scale", damper_scale, damper)
+        scale = parse_scale("--damper-scale", damper_scale)
         noise = _sensor_noise(sensor_noise, seed)
-        dt = DEFAULT_DT if dt is None else dt
-        output_rate = DEFAULT_OUTPUT_RATE if output_rate is None else output_rate
-        control_rate = _check_control_rate(control_rate, check_number("--dt", dt, "s"))
+        solver = solver_from_options(dt=dt, output_rate=output_rate, control_rate=control_rate)
         vehicle_params, vehicle_record = vehicle_from_options(params, preset)
         window_value = parse_window(window) if window is not None else None
         track = track_options(scenario, track_seed, min_wavelength, max_wavelength)
         scen = make_scenario(scenario, dict(amplitude=amplitude, wavelength=wavelength,
                                             rail_phase=rail_phase, speed=speed,
-                                            duration=duration, **track), output_rate)
+                                            duration=duration, **track), solver.output_rate)
         if out is not None:
-            report.check_out_dir(out)
+            check_out_dir(out)
         # check the window before the runs, and record it resolved
         window_value = check_window(window_value or (0.0, math.inf), scen.duration)
 
@@ -279,14 +268,13 @@ def compare(
 
         with ProgressBar(stderr_is_terminal(), describe) as progress:
             result = run_compare(scen, vehicle_params, controllers=names, gains=gain_set,
-                                 damper=damper, damper_scale=scale, window=window_value, dt=dt,
-                                 output_rate=output_rate, control_rate=control_rate,
-                                 sensor_noise=noise, comfort=comfort, bounds=bounds,
+                                 damper=damper, damper_scale=scale, window=window_value,
+                                 solver=solver, sensor_noise=noise, comfort=comfort, bounds=bounds,
                                  progress=progress if progress.enabled else None)
         doc = result.to_dict()
         text = json.dumps(doc, indent=2, allow_nan=False)  # refuses NaN before anything is written
         if out is not None:
-            write_folder(out, lambda: report.write_compare_outputs(result, out, doc))
+            write_folder(out, lambda: write_compare_outputs(result, out, doc))
     if format is OutputFormat.json:
         typer.echo(text)
         return

@@ -1,15 +1,11 @@
-"""``railride modes``: natural frequencies and damping of the passive vehicle."""
+"""``railride modes``: natural frequencies and damping of the passive vehicle (railride.frf)."""
 
 from __future__ import annotations
 
-import json
-
-import typer
-
 from ._app import app
-from ._common import errors, stdout_console
+from ._common import errors, print_json, stdout_console
 from ._options import FormatOption, OutputFormat, ParamsOption, PresetOption
-from ._parsing import vehicle_from_options
+from ._parsing import vehicle_source
 from ._render import modes_table
 
 
@@ -21,11 +17,10 @@ def modes(
 ) -> None:
     """Natural frequencies and damping of the passive vehicle (9 modes, ascending frequency)."""
     with errors():
-        from ..vehicle import Vehicle
+        from ..frf import modes as vehicle_modes
 
-        vehicle_params, _ = vehicle_from_options(params, preset)
-        rows = [m.to_dict() for m in Vehicle(vehicle_params).modes()]
+        rows = vehicle_modes(vehicle_source(params, preset)).to_list()
     if format is OutputFormat.json:
-        typer.echo(json.dumps(rows, indent=2, allow_nan=False))
+        print_json(rows)
         return
     stdout_console().print(modes_table(rows))

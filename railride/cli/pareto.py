@@ -9,14 +9,20 @@ import typer
 
 from ..defaults import DEFAULT_DAMPER
 from ._app import app
-from ._common import (RunProgress, errors, interruptible, make_executor, open_run_table, print_json,
+from ._common import (RunProgress, errors, interruptible, make_executor, open_run_table, option_names, print_json,
                       stderr_is_terminal, wide_stdout_console, write_folder)
 from ._options import (AmplitudeOption, DtOption, FormatOption, MaxWavelengthOption, MinWavelengthOption,
                        OutputFormat, ParetoDamperOption, ParetoGainsOption, ParetoOutOption, ParetoResumeOption,
                        RailPhaseOption, RunDurationOption, RunsScenarioOption, SchedulerFileOption, SchedulerOption,
                        SpeedOption, TrackSeedOption, WavelengthOption, WorkersOption)
-from ._parsing import check_int, check_number, damper_preset, default_of, load_gains, study_scenario
+from ._parsing import (SOLVER_FIELDS, TRACK_FIELDS, damper_preset, default_of, load_gains, not_given,
+                       solver_from_options, study_scenario)
 from ._render import RESPONSE_LABELS, damper_text, fmt
+
+#: the library's names of pareto's options, for its errors (the track's seed is named while the
+#: scenario is built, the sample's after)
+PARETO_FIELDS = {"dt": SOLVER_FIELDS["dt"], **TRACK_FIELDS, "suspension": "--suspension",
+                 "n_samples": "--samples", "seed": "--seed"}
 
 
 def _pareto_table(doc: dict, caption: str):
@@ -89,36 +95,29 @@ def pareto_command(
     """
     import time
 
-    with errors():
-        from .. import report
-        from ..defaults import DEFAULT_DT
-        from ..pareto import CONTROLLER_PARAMETERS, pareto as run_pareto
+    defaults = not_given(dt=dt, min_wavelength=min_wavelength, max_wavelength=max_wavelength)
+    with errors(), option_names(PARETO_FIELDS, defaults):
+        from ..labels import describe_scenario
+        from ..pareto import pareto as run_pareto
 
-        if suspension not in CONTROLLER_PARAMETERS:
-            raise ValueError(f"--suspension = {suspension!r}: allowed "
-                             f"{', '.join(CONTROLLER_PARAMETERS)}")
         n = default_of(run_pareto, "n_samples") if samples is None else samples
-        if n < 1 or n & (n - 1):
-            raise ValueError(f"--samples = {n}: must be a power of two (1, 2, 4, ..., 128, "
-                             "...), which keeps the balance of the Sobol' sample")
-        check_int("--seed", seed, 0)
         damper_preset("--damper", damper)
         base = load_gains(gains)
-        dt = DEFAULT_DT if dt is None else check_number("--dt", dt, "s")
+        solver = solver_from_options(dt=dt)
         scen, options = study_scenario(scenario, amplitude=amplitude, wavelength=wavelength,
                                        rail_phase=rail_phase, speed=speed, duration=duration,
                                        track_seed=track_seed, min_wavelength=min_wavelength,
                                        max_wavelength=max_wavelength)
-        scenario_text = report.describe_scenario(scen.describe())
+        scenario_text = describe_scenario(scen.describe())
         table, table_path = open_run_table(out, resume)
         executor, executor_record = make_executor(workers, scheduler, scheduler_file)
     try:
-        with interruptible(table, table_path), errors():
+        with interruptible(table, table_path), errors(), option_names(PARETO_FIELDS, defaults):
             with RunProgress(stderr_is_terminal(), "sampling the gains") as progress:
                 t0 = time.perf_counter()
                 result = run_pareto(suspension, n_samples=n, seed=seed, scenario=scenario,
                                     scenario_options=options, gains=base, damper=damper,
-                                    executor=executor, table=table, dt=dt, progress=progress)
+                                    executor=executor, table=table, solver=solver, progress=progress)
                 wall = time.perf_counter() - t0
             doc = result.to_dict()
             if out is not None:
@@ -129,7 +128,7 @@ def pareto_command(
         print_json(doc)
         return
     st = doc["settings"]
-    lines = [(f"{scenario_text}, {scen.duration:g} s, dt {dt:g} s, {damper_text(st)}; base "
+    lines = [(f"{scenario_text}, {scen.duration:g} s, dt {solver.dt:g} s, {damper_text(st)}; base "
               f"gains {st['base_gains']}"),
              f"{st['n_samples']} samples, seed {st['seed']}: {st['sampling']}",
              (f"{doc['runs']} runs in the run table, {progress.evaluated} evaluated now, wall "

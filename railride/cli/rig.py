@@ -1,31 +1,23 @@
 """``railride damper`` and ``railride tracking``: an MR damper on the test rig (railride.rig),
-its hysteresis cycles and the inner loop's force tracking, with their tables and documents."""
+its hysteresis cycles and the inner loop's force tracking, with their tables."""
 
 from __future__ import annotations
 
-import math
 from typing import Annotated, Optional
 
 import typer
 
-from .. import __version__
 from ..defaults import DEFAULT_DAMPER
 from ._app import app
-from ._common import errors, print_json, status_note, stdout_console, write_folder
+from ._common import errors, option_names, print_json, status_note, stdout_console, write_folder
 from ._options import DamperOutOption, FormatOption, OutputFormat, RigModelOption, TrackingOutOption
-from ._parsing import check_number, damper_preset, parse_voltages
+from ._parsing import damper_preset, parse_voltages
 
-SCHEMA_DAMPER = "railride.damper/1"
-SCHEMA_TRACKING = "railride.tracking/1"
-#: --desired values of `tracking` (the signals of railride.rig.desired_force_signal)
-DESIRED_SIGNALS = ("sine", "sawtooth")
-
-
-def _check_cycles(option: str, value: int) -> int:
-    if value < 2:
-        raise ValueError(f"{option} = {value}: must be a whole number >= 2 (the first cycle is "
-                         "start-up)")
-    return value
+#: the library's names of the options of `damper` and `tracking`, for its errors
+DAMPER_OPTIONS = {"amplitude": "--amplitude", "frequency": "--frequency", "voltage": "--voltage",
+                  "voltages": "--voltage", "n_cycles": "--cycles"}
+TRACKING_OPTIONS = {"desired": "--desired", "amplitude": "--amplitude", "frequency": "--frequency",
+                    "B": "--B", "G": "--G", "stroke": "--stroke", "n_cycles": "--cycles"}
 
 
 # -- damper -------------------------------------------------------------------------------------
@@ -51,52 +43,33 @@ def damper(
     The damper is stroked by x = A sin(2 pi f t) at each constant voltage; per voltage the
     command prints the force range and the energy dissipated in the last (steady-state) cycle.
     """
-    with errors():
-        from .. import report, rig
+    with errors(), option_names(DAMPER_OPTIONS):
+        from .. import rig
+        from ..files import check_out_dir
 
         damper_model = damper_preset("--model", model, rig=True)
-        amplitude = check_number("--amplitude", amplitude, "m")
-        frequency = check_number("--frequency", frequency, "Hz")
         volts = parse_voltages("--voltage", voltage, damper_model)
-        n_cycles = _check_cycles("--cycles", cycles)
         if out is not None:
-            report.check_out_dir(out)
+            check_out_dir(out)
         with status_note("driving the damper..."):
-            result = rig.cycles(damper_model, amplitude, frequency, volts, n_cycles=n_cycles)
-        doc = _damper_document(result.to_dict())
-        title = (f"{model} damper ({damper_model.model} model), x = {amplitude * 1e3:g} mm "
-                 f"sin(2 pi {frequency:g} Hz t), cycle {n_cycles} of {n_cycles}")
-        if not all(math.isfinite(v) for row in doc["cycles"] for v in row.values()):
-            raise RuntimeError("the damper rig run gave a non-finite force or energy")
+            result = rig.cycles(damper_model, amplitude, frequency, volts, n_cycles=cycles)
+        doc = result.to_dict()
         if out is not None:
-            write_folder(out, lambda: report.write_damper_outputs(result, out, doc, title=title))
+            write_folder(out, lambda: result.save(out))
     if format is OutputFormat.json:
         print_json(doc)
         return
-    stdout_console().print(_damper_table(doc, model, damper_model.model, amplitude, frequency, n_cycles))
+    stdout_console().print(_damper_table(doc, model, result))
 
 
-def _damper_document(record: dict) -> dict:
-    """The JSON document of `damper` (damper.json) from rig.cycles(...).to_dict()."""
-    return {
-        "schema": SCHEMA_DAMPER,
-        "railride_version": __version__,
-        "damper": record["damper"],
-        "amplitude_m": float(record["amplitude_m"]),
-        "frequency_hz": float(record["frequency_hz"]),
-        "cycles": [{key: float(row[key]) for key in ("voltage_v", "force_max_n", "force_min_n",
-                                                     "energy_per_cycle_j")}
-                   for row in record["cycles"]],
-    }
-
-
-def _damper_table(doc: dict, name: str, model: str, amplitude: float, frequency: float, n_cycles: int):
+def _damper_table(doc: dict, name: str, result):
     from rich.markup import escape
     from rich.table import Table
 
-    table = Table(title=escape(f"Damper cycles: {name} ({model} model)"),
-                  caption=escape(f"x = {amplitude:g} m sin(2 pi {frequency:g} Hz t); cycle "
-                                 f"{n_cycles} of {n_cycles} (steady state)\nforce F: tension +"))
+    n = result.n_cycles
+    table = Table(title=escape(f"Damper cycles: {name} ({result.damper.model} model)"),
+                  caption=escape(f"x = {result.motion.amplitude:g} m sin(2 pi {result.motion.frequency:g} Hz "
+                                 f"t); cycle {n} of {n} (steady state)\nforce F: tension +"))
     table.add_column("voltage (V)", justify="right")
     table.add_column("max force (kN)", justify="right")
     table.add_column("min force (kN)", justify="right")
@@ -139,61 +112,23 @@ def tracking(
     The inner loop (paper eq. 12-14) sets the voltage so that a damper stroked by
     x = -stroke cos(2 pi f t) follows a desired force; prints the RMS tracking error.
     """
-    with errors():
-        from .. import report, rig
+    with errors(), option_names(TRACKING_OPTIONS):
+        from .. import rig
+        from ..files import check_out_dir
 
-        if desired not in DESIRED_SIGNALS:
-            raise ValueError(f"--desired = {desired!r}: allowed {', '.join(DESIRED_SIGNALS)}")
         damper_model = damper_preset("--model", model, rig=True)
-        amplitude = check_number("--amplitude", amplitude, "N")
-        frequency = check_number("--frequency", frequency, "Hz")
-        gain_b = check_number("--B", gain_b, "", allow_zero=True)
-        if gain_g is not None:
-            gain_g = check_number("--G", gain_g, "V/N", allow_zero=True)
-        stroke = check_number("--stroke", stroke, "m")
-        n_cycles = _check_cycles("--cycles", cycles)
         if out is not None:
-            report.check_out_dir(out)
+            check_out_dir(out)
         with status_note("tracking..."):
             result = rig.track(damper_model, desired, amplitude, frequency, B=gain_b, G=gain_g,
-                               stroke=stroke, n_cycles=n_cycles)
-        doc = _tracking_document(result, damper_model, desired, amplitude, frequency, stroke)
-        bad = [k for k, v in doc["metrics"].items() if k != "window_s" and not math.isfinite(v)]
-        if bad:  # checked before anything is written
-            raise RuntimeError(f"the tracking run gave a non-finite {', '.join(bad)}")
-        title = (f"{desired} demand {amplitude / 1e3:g} kN at {frequency:g} Hz, {model} damper, "
-                 f"B = {doc['B']:g}, G = {doc['G_v_per_n']:.3g} V/N: normalised RMS error "
-                 f"{doc['metrics']['normalised_rms_error']:.3f}")
+                               stroke=stroke, n_cycles=cycles)
+        doc = result.to_dict()
         if out is not None:
-            write_folder(out, lambda: report.write_tracking_outputs(result, out, doc, title=title))
+            write_folder(out, lambda: result.save(out))
     if format is OutputFormat.json:
         print_json(doc)
         return
     stdout_console().print(_tracking_table(doc, model, default_g=gain_g is None))
-
-
-def _tracking_document(result, damper_model, desired: str, amplitude: float, frequency: float,
-                       stroke: float) -> dict:
-    """The JSON document of `tracking` (tracking.json) from a rig.track result."""
-    metrics = result.metrics()
-    attrs = result.dataset.attrs
-    return {
-        "schema": SCHEMA_TRACKING,
-        "railride_version": __version__,
-        "damper": damper_model.to_dict(),
-        "desired": desired,
-        "amplitude_n": amplitude,
-        "frequency_hz": frequency,
-        "stroke_m": stroke,
-        "B": float(attrs["B"]),  # the gains the inner loop used (G filled in if default)
-        "G_v_per_n": float(attrs["G_v_per_n"]),
-        "metrics": {
-            "rms_error_n": float(metrics["rms_error_n"]),
-            "rms_demand_n": float(metrics["rms_demand_n"]),
-            "normalised_rms_error": float(metrics["normalised_rms_error"]),
-            "window_s": [float(t) for t in metrics["window_s"]],
-        },
-    }
 
 
 def _tracking_table(doc: dict, model: str, *, default_g: bool):

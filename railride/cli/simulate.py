@@ -1,5 +1,5 @@
-"""``railride simulate``: one run of the vehicle on a track (railride.simulation.simulate), its
-ride metrics and the simulation document."""
+"""``railride simulate``: one run of the vehicle on a track (railride.simulation.simulate) and its
+ride metrics, printed as a table or as the run's document (`RideResult.to_dict`)."""
 
 from __future__ import annotations
 
@@ -7,22 +7,24 @@ from typing import Annotated, Optional
 
 import typer
 
-from .. import __version__
-from ..dampers import IDEAL_NAMES
+from .. import validation
 from ..defaults import DEFAULT_DAMPER
 from ._app import app
-from ._common import ProgressBar, errors, print_json, stderr_is_terminal, stdout_console, write_folder
+from ._common import (ProgressBar, errors, option_names, print_json, stderr_is_terminal, stdout_console,
+                      write_folder)
 from ._options import (AmplitudeOption, ComfortOption, DtOption, DurationOption, FormatOption, MaxWavelengthOption,
                        MinWavelengthOption, OutputFormat, OutputRateOption, ParamsOption, PresetOption,
                        RailPhaseOption, ScenarioOption, SimulateDamperOption, SimulateDamperScaleOption,
                        SimulateOutOption, SimulateWindowOption, SpeedOption, TrackSeedOption, WavelengthOption)
-from ._parsing import (check_damper_scale, damper_preset, make_scenario, parse_voltage, track_options,
-                       vehicle_from_options)
+from ._parsing import (SOLVER_FIELDS, damper_preset, make_scenario, not_given, parse_scale, parse_voltage,
+                       solver_from_options, track_options, vehicle_from_options)
 from ._render import comfort_table
 
-SCHEMA_SIMULATE = "railride.simulation/1"
-#: --suspension values of `simulate`
+#: --suspension values of `simulate` (`railride.Suspension.named`: passive, or MR dampers at a voltage)
 SUSPENSIONS = ("passive", "mr")
+#: the library's names of simulate's options, for its errors
+SIMULATE_FIELDS = {"dt": SOLVER_FIELDS["dt"], "output_rate": SOLVER_FIELDS["output_rate"],
+                   "damper": "--damper", "damper_scale": "--damper-scale", "voltage": "--voltage"}
 
 
 def _describe_suspension(record: dict) -> str:
@@ -106,74 +108,53 @@ def simulate(
             console.print(comfort_table(doc["comfort"]))
 
 
-def _suspension(suspension: str, damper_name, voltage_text, damper_scale=None):
-    """(damper model or None, command voltage or None, the record for the JSON document)."""
-    if suspension not in SUSPENSIONS:
-        raise ValueError(f"--suspension = {suspension!r}: allowed {', '.join(SUSPENSIONS)}")
-    if suspension == "passive":
+def _suspension(name: str, damper_name, voltage_text, damper_scale=None):
+    """--suspension, --damper, --damper-scale, --voltage -> a railride.Suspension."""
+    from ..suspension import Suspension
+
+    validation.choice("--suspension", name, SUSPENSIONS)
+    if name == "passive":
         given = [o for o, v in (("--damper", damper_name), ("--damper-scale", damper_scale),
                                 ("--voltage", voltage_text)) if v is not None]
         if given:
             verb = "applies" if len(given) == 1 else "apply"
             raise ValueError(f"{' and '.join(given)} {verb} to --suspension mr only (the passive "
                              "suspension has viscous dampers)")
-        return None, None, {"type": "passive"}
-    name = DEFAULT_DAMPER if damper_name is None else damper_name
-    model = damper_preset("--damper", name)
-    if name in IDEAL_NAMES:  # simulate runs open loop: no demand for it to apply
-        raise ValueError(f"--damper = {name!r}: the ideal actuator applies a controller's demand and "
-                         "simulate runs no controller (a constant voltage); use railride compare "
-                         "--damper ideal or railride sweep --damper ideal with a controller")
-    scale = check_damper_scale("--damper-scale", damper_scale, name)
-    if scale != 1.0:
-        model = model.scaled(scale)
-    volts = model.v_min if voltage_text is None else parse_voltage("--voltage", voltage_text, model)
-    record = {"type": "mr", "damper": name, "voltage_v": float(volts)}
-    if damper_scale is not None:  # only then: the document stays as it was without the option
-        record["damper_scale"] = scale
-    return model, float(volts), record
+        return Suspension.passive()
+    damper = DEFAULT_DAMPER if damper_name is None else damper_name
+    damper_preset("--damper", damper)
+    scale = parse_scale("--damper-scale", damper_scale)
+    suspension = Suspension.named("mr", damper=damper, damper_scale=scale)
+    if voltage_text is None:  # the coils at v_min, "passive-off"
+        return suspension
+    volts = parse_voltage("--voltage", voltage_text, suspension.damper)
+    return Suspension.named("mr", damper=damper, damper_scale=scale, voltage=volts)
 
 
 def _run(scenario_name, amplitude, wavelength, rail_phase, speed, duration, dt, output_rate,
          window_text, params_file, preset, out, suspension="passive", damper_name=None,
          voltage_text=None, track=None, comfort=False, damper_scale=None):
-    from .. import report
-    from ..defaults import DEFAULT_DT, DEFAULT_OUTPUT_RATE
-    from ..metrics import check_window, parse_window, to_dict
+    from ..files import check_out_dir, write_outputs
+    from ..metrics import check_window, parse_window
     from ..simulation import simulate as run_simulation
 
-    dt = DEFAULT_DT if dt is None else dt
-    output_rate = DEFAULT_OUTPUT_RATE if output_rate is None else output_rate
-    vehicle_params, vehicle_record = vehicle_from_options(params_file, preset)
-    damper, voltage, suspension_record = _suspension(suspension, damper_name, voltage_text,
-                                                     damper_scale)
-    window = parse_window(window_text) if window_text is not None else None
-    scen = make_scenario(scenario_name, dict(amplitude=amplitude, wavelength=wavelength,
-                                             rail_phase=rail_phase, speed=speed,
-                                             duration=duration, **(track or {})), output_rate)
-    if out is not None:
-        report.check_out_dir(out)
-    # check the window before the run, not after it
-    start, end = (0.0, scen.duration) if window is None else check_window(window, scen.duration)
+    with option_names(SIMULATE_FIELDS, not_given(dt=dt, output_rate=output_rate)):
+        solver = solver_from_options(dt=dt, output_rate=output_rate)
+        vehicle_params, vehicle_record = vehicle_from_options(params_file, preset)
+        secondary = _suspension(suspension, damper_name, voltage_text, damper_scale)
+        window = parse_window(window_text) if window_text is not None else None
+        scen = make_scenario(scenario_name, dict(amplitude=amplitude, wavelength=wavelength,
+                                                 rail_phase=rail_phase, speed=speed,
+                                                 duration=duration, **(track or {})), solver.output_rate)
+        if out is not None:
+            check_out_dir(out)
+        if window is not None:  # check the window before the run, not after it
+            check_window(window, scen.duration)
 
-    with ProgressBar(stderr_is_terminal()) as progress:
-        result = run_simulation(scen, vehicle_params, dt=dt, output_rate=output_rate,
-                                damper=damper, voltage=voltage,
-                                progress=progress if progress.enabled else None)
-    metrics = result.metrics(window)
-    doc = {
-        "schema": SCHEMA_SIMULATE,
-        "railride_version": __version__,
-        "scenario": scen.describe(),
-        **vehicle_record,
-        "suspension": suspension_record,
-        "settings": {"dt_s": float(dt), "output_rate_hz": float(output_rate),
-                     "window_s": [float(start), float(end)]},
-        "metrics": to_dict(metrics),
-    }
-    if comfort:  # only then: the document stays as it was without --comfort
-        from ..comparison import comfort_record
-        doc["comfort"] = comfort_record(result.comfort(window))
+        with ProgressBar(stderr_is_terminal()) as progress:
+            result = run_simulation(scen, vehicle_params, secondary, solver=solver,
+                                    progress=progress if progress.enabled else None)
+        doc = result.to_dict(window, comfort=comfort, vehicle=vehicle_record)
     if out is not None:
-        write_folder(out, lambda: report.write_outputs(result, out, doc))
+        write_folder(out, lambda: write_outputs(result, out, doc))
     return doc, result

@@ -1,49 +1,36 @@
-"""``railride sweep``: a grid of cases (every combination of the given values) run by
-railride.sweep.run_cases, with its table and document.
+"""``railride sweep``: a grid of cases (railride.sweep.grid: every combination of the given
+values) run by railride.sweep.run_sweep, with its table.
 
-The grid builder (the section "the grid") turns the options into the cases and the grid values
-each row reports, checking every option and every scenario of the grid before the first run."""
+The command reads its options into the grid's Python values (lists of numbers and names, the
+gain axes), calls the library and renders the result: the checks of the grid, its cases and the
+sweep's document (`SweepResult.to_dict`) are the library's."""
 
 from __future__ import annotations
 
-import dataclasses
-import itertools
 import json
 from enum import Enum
 from typing import Annotated, Optional
 
 import typer
 
-from .. import __version__
-from ..dampers import IDEAL_NAMES
 from ..defaults import DEFAULT_DAMPER
+from ..suspension import NAMES as SUSPENSIONS
 from ._app import app
-from ._common import (RunProgress, errors, interruptible, make_executor, open_run_table, stderr_is_terminal,
-                      wide_stdout_console, write_folder)
+from ._common import (RunProgress, errors, interruptible, make_executor, open_run_table, option_names,
+                      stderr_is_terminal, wide_stdout_console, write_folder)
 from ._options import (DtOption, MaxWavelengthOption, MinWavelengthOption, RunDurationOption, RunsScenarioOption,
                        SchedulerFileOption, SchedulerOption, SweepComfortOption, SweepDamperOption,
                        SweepDamperScaleOption, SweepGainsOption, SweepOutOption, SweepResumeOption, WindowOption,
                        WorkersOption)
-from ._parsing import (case_options, check_number, damper_preset, load_gains, make_scenario, parse_noise,
-                       parse_voltage, random_tracks, track_options, value_list)
+from ._parsing import SOLVER_FIELDS, load_gains, parse_noise, solver_from_options, value_list
 from ._render import RESPONSE_LABELS, damper_text, fmt
 
-SCHEMA_SWEEP = "railride.sweep/1"
-
-#: the controllers a gain table acts in (a --gain of `sweep` combines with these only)
-GAIN_CONTROLLERS = {"inner": ("pid", "sas-attitude", "sas-attitude-ride"), "pid": ("pid",),
-                    "attitude": ("sas-attitude", "sas-attitude-ride"),
-                    "ride": ("sas-attitude-ride",)}
-#: the scenario options a sweep can vary: (option, keyword of track.scenario, column, unit)
-SWEEP_AXES = (("--speed", "speed", "speed_m_s", "m/s"), ("--wavelength", "wavelength", "wavelength_m", "m"),
-              ("--amplitude", "amplitude", "amplitude_m", "m"),
-              ("--rail-phase", "rail_phase", "rail_phase_deg", "deg"),
-              ("--track-seed", "seed", "track_seed", ""))
-
-#: the keys of Scenario.describe() that each swept scenario option sets
-_SCENARIO_KEYS = {"speed": ("speed_m_s",), "wavelength": ("wavelength_m", "length_m"),
-                  "amplitude": ("amplitude_m", "height_m"), "rail_phase": ("rail_phase_deg",),
-                  "seed": ("seed",)}
+#: how the errors of railride.sweep.grid name its keywords: by this command's options
+OPTION_NAMES = {"suspensions": "--suspension", "speed": "--speed", "wavelength": "--wavelength",
+                "amplitude": "--amplitude", "rail_phase": "--rail-phase", "track_seed": "--track-seed",
+                "min_wavelength": "--min-wavelength", "max_wavelength": "--max-wavelength",
+                "scenario": "--scenario", "voltage": "--voltage", "gains": "--gain", "base_gains": "--gains",
+                "noise": "--noise", "seed": "--seed", "damper": "--damper", "damper_scale": "--damper-scale"}
 
 #: (column, heading) of the comfort indices the sweep table shows with --comfort
 SWEEP_COMFORT_TABLE = (("centre_aw_Wk", "a_w Wk\ncentre\n(m/s^2)"),
@@ -125,420 +112,124 @@ def sweep_command(
     import time
 
     with errors():
-        from .. import report
-        from .. import sweep as sweep_lib
+        from ..sweep import grid as make_grid, run_sweep
 
-        grid = _build_grid(suspension=suspension, scenario=scenario, speed=speed,
-                           wavelength=wavelength, amplitude=amplitude, rail_phase=rail_phase,
-                           track_seed=track_seed, min_wavelength=min_wavelength,
-                           max_wavelength=max_wavelength, duration=duration, voltage=voltage,
-                           gain=gain, noise=noise, seed=seed, damper=damper,
-                           damper_scale=damper_scale, gains=gains, dt=dt, window=window)
+        values, texts = _parse(suspension=suspension, speed=speed, wavelength=wavelength, amplitude=amplitude,
+                               rail_phase=rail_phase, track_seed=track_seed, voltage=voltage, gain=gain,
+                               noise=noise, seed=seed, damper=damper, damper_scale=damper_scale, gains=gains,
+                               dt=dt, window=window)
+        grid = make_grid(scenario=scenario, duration=duration, min_wavelength=min_wavelength,
+                         max_wavelength=max_wavelength, names=OPTION_NAMES, texts=texts, **values)
         table, table_path = open_run_table(out, resume)
         executor, executor_record = make_executor(workers, scheduler, scheduler_file)
     try:
         with interruptible(table, table_path), errors():
             with RunProgress(stderr_is_terminal(), "sweeping") as progress:
                 t0 = time.perf_counter()
-                frame = sweep_lib.run_cases(grid.cases, executor=executor, table=table,
-                                            base_gains=grid.base_gains, dt=grid.dt, window=grid.window,
-                                            progress=progress, comfort=comfort)
+                result = run_sweep(grid, executor=executor, table=table, progress=progress, comfort=comfort)
                 wall = time.perf_counter() - t0
-            metrics = _metric_columns() + (list(sweep_lib.COMFORT_COLUMNS) if comfort else [])
-            rows, diverged = _rows(grid, frame, metrics)
-            doc = {
-                **_sweep_document(grid, rows, metrics, diverged=diverged, comfort=comfort),
-                "runs": len(table.frame),
-                "runs_evaluated": progress.evaluated,
-                "runs_per_second": progress.evaluated / wall if wall > 0 else 0.0,
-                "wall_time_s": wall,
-                "executor": executor_record,
-            }
-            text = json.dumps(rows, indent=2, allow_nan=False)  # refuses NaN before writing
+            # the command's own facts, after the library's document
+            facts = {"runs_evaluated": progress.evaluated,
+                     "runs_per_second": progress.evaluated / wall if wall > 0 else 0.0,
+                     "wall_time_s": wall, "executor": executor_record}
+            doc = {**result.to_dict(), **facts}
+            text = json.dumps(doc["rows"], indent=2, allow_nan=False)  # refuses NaN before writing
             if out is not None:
-                write_folder(out, lambda: report.write_sweep_outputs(out, doc))
+                write_folder(out, lambda: result.save(out, extra=facts))
     finally:
         executor.close()
     if format is SweepFormat.json:
         typer.echo(text)
         return
     if format is SweepFormat.csv:
-        import pandas as pd
-
-        typer.echo(pd.DataFrame(rows, columns=doc["columns"]).to_csv(index=False), nl=False)
+        typer.echo(result.to_pandas().to_csv(index=False), nl=False)
         return
-    wide_stdout_console().print(_sweep_table(rows, grid.columns, _caption(grid, doc, rows, wall)))
+    wide_stdout_console().print(_sweep_table(doc["rows"], list(grid.columns), _caption(grid, doc, wall)))
 
 
-# -- the grid -----------------------------------------------------------------------------------
-@dataclasses.dataclass(frozen=True)
-class _Grid:
-    """The cases of a sweep, the grid values each row reports (``rows``, one per case, keys
-    ``columns``) and the settings the document records."""
+# -- reading the options ------------------------------------------------------------------------
+def _parse(*, suspension, speed, wavelength, amplitude, rail_phase, track_seed, voltage, gain, noise, seed,
+           damper, damper_scale, gains, dt, window) -> tuple[dict, dict]:
+    """(the keyword arguments of railride.sweep.grid, the text each was read from): only the
+    syntax of the options is checked here; what their values may be is the grid's to check."""
+    from ..metrics import parse_window
 
-    scenario: str
-    suspensions: list
-    #: the suspensions among them that run an outer-loop controller
-    controllers: list
-    has_mr: bool
-    damper_name: str
-    #: whether --damper-scale was given (a grid axis then)
-    scaled: bool
-    scales: list
-    #: (option, keyword of track.scenario, column, values) of each swept scenario option
-    axes: list
-    volts: list
-    #: (gain name, values) of each --gain
-    gain_axes: list
-    noise_values: Optional[tuple]
-    seeds: list
-    base_gains: object
-    dt: float
-    window: Optional[tuple]
-    #: the scenario of the first grid point, described, and the last one built (for its duration)
-    first_record: dict
-    scen: object
-    columns: list
-    cases: list
-    rows: list
-
-
-def _build_grid(*, suspension, scenario, speed, wavelength, amplitude, rail_phase, track_seed,
-                min_wavelength, max_wavelength, duration, voltage, gain, noise, seed, damper,
-                damper_scale, gains, dt, window) -> _Grid:
-    """The options -> a _Grid, every option and every scenario of the grid checked."""
-    from ..defaults import DEFAULT_DT
-    from ..metrics import check_window, parse_window
-
-    suspensions = _suspension_list(suspension)
-    controllers = [s for s in suspensions if s in GAIN_CONTROLLERS["inner"]]
-    has_mr = "mr" in suspensions
-    listed = ", ".join(suspensions)
-    _check_applies(listed, has_mr, controllers, voltage=voltage, gain=gain, noise=noise,
-                   gains=gains, seed=seed, damper=damper, damper_scale=damper_scale)
-    damper_name, damper_model, scales = _dampers(damper, damper_scale, has_mr, listed)
-    track = track_options(scenario, None, min_wavelength, max_wavelength)
-    axes = _scenario_axes(scenario, speed=speed, wavelength=wavelength, amplitude=amplitude,
-                          rail_phase=rail_phase, track_seed=track_seed)
-    volts = _voltages(voltage, damper_model) if has_mr else []
-    gain_axes = _gain_axes(gain, controllers, listed)
-    noise_values = None if noise is None else tuple(parse_noise("--noise", noise))
-    seeds = [0] if seed is None else value_list("--seed", seed, integer=True)
-    bad = [s for s in seeds if s < 0]
-    if bad:
-        raise ValueError(f"--seed = {seed!r}: {bad[0]} is negative; seeds are whole numbers >= 0")
-    base_gains = load_gains(gains)
-    dt = DEFAULT_DT if dt is None else check_number("--dt", dt, "s")
-    common = {} if duration is None else {"duration": float(duration)}
-    common.update(track)
-    combos, first_record, scen = _scenarios(scenario, axes, common)
-    window_value = None
-    if window is not None:
-        window_value = check_window(parse_window(window), scen.duration)
-
-    columns = ["suspension"] + [column for _, _, column, _ in axes]
-    if damper_scale is not None:
-        columns.append("damper_scale")
-    if has_mr:
-        columns.append("voltage_v")
-    columns += [name for name, _ in gain_axes]
-    if noise_values is not None:
-        columns.append("seed")
-    grid = _Grid(scenario=scenario, suspensions=suspensions, controllers=controllers,
-                 has_mr=has_mr, damper_name=damper_name, scaled=damper_scale is not None,
-                 scales=scales, axes=axes, volts=volts, gain_axes=gain_axes,
-                 noise_values=noise_values, seeds=seeds, base_gains=base_gains, dt=dt,
-                 window=window_value, first_record=first_record, scen=scen, columns=columns,
-                 cases=[], rows=[])
-    cases, rows = _cases(grid, combos, common)
-    return dataclasses.replace(grid, cases=cases, rows=rows)
+    with option_names({"dt": SOLVER_FIELDS["dt"]}):  # the runs' output rate is not an option here
+        solver = None if dt is None else solver_from_options(dt=dt)
+    values = {"suspensions": _names("--suspension", suspension), "damper": damper,
+              "noise": None if noise is None else tuple(parse_noise("--noise", noise)),
+              "base_gains": None if gains is None else load_gains(gains), "solver": solver,
+              "window": None if window is None else parse_window(window)}
+    for option, key, text in (("--speed", "speed", speed), ("--wavelength", "wavelength", wavelength),
+                              ("--amplitude", "amplitude", amplitude), ("--rail-phase", "rail_phase", rail_phase),
+                              ("--damper-scale", "damper_scale", damper_scale)):
+        values[key] = None if text is None else value_list(option, text)
+    for option, key, text in (("--track-seed", "track_seed", track_seed), ("--seed", "seed", seed)):
+        values[key] = None if text is None else value_list(option, text, integer=True)
+    values["voltage"] = None if voltage is None else value_list("--voltage", voltage, parse=_voltage_item(damper))
+    values["gains"], gain_texts = {}, {}
+    for text in gain or []:
+        name, axis = _gain_option(text)
+        if name in values["gains"]:
+            raise ValueError(f"--gain = {text!r}: {name} is given twice")
+        values["gains"][name], gain_texts[name] = axis, text
+    texts = {"suspensions": suspension, "voltage": voltage, "noise": noise, "seed": seed, "damper": damper,
+             "damper_scale": damper_scale, "track_seed": track_seed,
+             "base_gains": None if gains is None else str(gains), "gains": gain_texts or None}
+    return values, {key: text for key, text in texts.items() if text is not None}
 
 
-def _suspension_list(text: str) -> list[str]:
-    """--suspension: comma-separated, known, each once."""
-    from ..sweep import SUSPENSIONS
-
+def _names(option: str, text: str) -> list[str]:
+    """NAME[,NAME...] -> the names, not empty (which names are allowed is the grid's check)."""
     items = [s.strip() for s in text.split(",")]
     if any(not s for s in items):
-        raise ValueError(f"--suspension = {text!r}: an empty item; give names separated "
-                         f"by commas from {', '.join(SUSPENSIONS)}")
-    unknown = [s for s in items if s not in SUSPENSIONS]
-    if unknown:
-        raise ValueError(f"--suspension = {text!r}: unknown suspension {unknown[0]!r}; "
-                         f"allowed: {', '.join(SUSPENSIONS)}")
-    if len(set(items)) != len(items):
-        twice = next(s for s in items if items.count(s) > 1)
-        raise ValueError(f"--suspension = {text!r}: {twice} is listed twice")
+        raise ValueError(f"{option} = {text!r}: an empty item; give names separated by commas from "
+                         f"{', '.join(SUSPENSIONS)}")
     return items
 
 
-def _check_applies(listed: str, has_mr: bool, controllers: list, *, voltage, gain, noise, gains,
-                   seed, damper, damper_scale) -> None:
-    """What applies where: --voltage to mr, --gain, --noise and --gains to the controllers,
-    --seed with --noise, --damper and --damper-scale to mr and the controllers."""
-    if voltage is not None and not has_mr:
-        raise ValueError(f"--voltage = {voltage!r}: applies to --suspension mr only "
-                         f"(--suspension is {listed})")
-    for option, given in (("--gain", gain), ("--noise", noise), ("--gains", gains)):
-        if given and not controllers:
-            value = given[0] if isinstance(given, list) else str(given)
-            raise ValueError(f"{option} = {value!r}: applies to the controllers pid, "
-                             f"sas-attitude, sas-attitude-ride only (--suspension is {listed})")
-    if seed is not None and noise is None:
-        raise ValueError(f"--seed = {seed!r}: applies with --noise only (without it the "
-                         "measurements are ideal)")
-    if damper is not None and not (has_mr or controllers):
-        raise ValueError(f"--damper = {damper!r}: applies to mr and the controllers only "
-                         f"(--suspension is {listed})")
-    if damper_scale is not None and not (has_mr or controllers):
-        raise ValueError(f"--damper-scale = {damper_scale!r}: applies to mr and the "
-                         f"controllers only (--suspension is {listed})")
+def _voltage_item(damper: Optional[str]):
+    """The reader of a --voltage item: volts, or passive-off / passive-on from the MR damper's
+    range (the word itself for a damper the grid refuses with mr)."""
+    from ..dampers import PRESETS
+    from ..sweep_grid import VOLTAGE_WORDS, voltage_value
 
+    model = PRESETS.get(DEFAULT_DAMPER if damper is None else damper)
 
-def _dampers(damper: Optional[str], damper_scale: Optional[str], has_mr: bool, listed: str):
-    """(damper name, its model, the force scales of the grid)."""
-    damper_name = DEFAULT_DAMPER if damper is None else damper
-    damper_model = damper_preset("--damper", damper_name)
-    if damper_name in IDEAL_NAMES and has_mr:
-        raise ValueError(f"--damper = {damper_name!r}: applies to the controllers only; mr runs at a "
-                         f"constant voltage, which the ideal actuator has not (--suspension "
-                         f"is {listed})")
-    scales = [1.0]
-    if damper_scale is not None:
-        if damper_name in IDEAL_NAMES:
-            raise ValueError(f"--damper-scale = {damper_scale!r}: the ideal device "
-                             f"(--damper {damper_name}) applies the demand itself and has no force "
-                             "capacity to scale")
-        scales = [check_number("--damper-scale", v, "")
-                  for v in value_list("--damper-scale", damper_scale)]
-    return damper_name, damper_model, scales
-
-
-def _scenario_axes(scenario: str, **texts) -> list:
-    """The swept scenario options (SWEEP_AXES, keyword -> its text or None): a list of
-    (option, keyword, column, values)."""
-    axes = []
-    for option, keyword, column, _ in SWEEP_AXES:
-        text = texts["track_seed" if keyword == "seed" else keyword]
-        if text is None:
-            continue
-        if keyword == "seed":
-            values = value_list(option, text, integer=True)
-            bad = [v for v in values if v < 0]
-            if bad:
-                raise ValueError(f"--track-seed = {text!r}: {bad[0]} is negative; track "
-                                 "seeds are whole numbers >= 0")
-            if scenario not in random_tracks():
-                raise ValueError(f"--track-seed = {text!r}: applies to the random-track "
-                                 f"scenarios ({', '.join(random_tracks())}) only, not to "
-                                 f"--scenario {scenario}")
-        else:
-            values = value_list(option, text)
-        axes.append((option, keyword, column, values))
-    return axes
-
-
-def _voltages(voltage: Optional[str], damper_model) -> list[float]:
-    """The voltages of mr: --voltage, else v_min (passive-off)."""
-    if voltage is None:
-        return [float(damper_model.v_min)]
-    volts = value_list("--voltage", voltage,
-                       parse=lambda item: parse_voltage("--voltage", item, damper_model))
-    return [damper_model.check_voltage(v, "--voltage") for v in volts]
-
-
-def _gain_axes(gain: Optional[list[str]], controllers: list, listed: str) -> list:
-    """The --gain options: a list of (gain name, values), each name once and acting in a
-    controller of --suspension."""
-    gain_axes = []
-    for text in gain or []:
-        name, values = _gain_option(text)
-        if any(name == n for n, _ in gain_axes):
-            raise ValueError(f"--gain = {text!r}: {name} is given twice")
-        acts_in = GAIN_CONTROLLERS[name.partition(".")[0]]
-        if not any(c in acts_in for c in controllers):
-            raise ValueError(f"--gain = {text!r}: {name} acts in {', '.join(acts_in)} only, "
-                             f"which --suspension ({listed}) does not list")
-        gain_axes.append((name, values))
-    return gain_axes
+    def read(item: str):
+        item = item.strip()
+        if item in VOLTAGE_WORDS:
+            return item if model is None else voltage_value(item, model)
+        try:
+            return float(item)
+        except ValueError:
+            raise ValueError(f"--voltage = {item!r}: not a number of volts (nor passive-off, "
+                             "passive-on)") from None
+    return read
 
 
 def _gain_option(text: str) -> tuple[str, list[float]]:
-    """--gain TABLE.ENTRY=VALUES -> ("table.entry", values)."""
-    from ..tuning import PARAMETERS
-
+    """--gain TABLE.ENTRY=VALUES -> ("table.entry", values); the gains file's sas.attitude.* and
+    sas.ride.* read as attitude.* and ride.*."""
     name, sep, values_text = text.partition("=")
     name = name.strip()
-    if name.startswith("sas."):  # the gains file's [sas.attitude] and [sas.ride]
+    if name.startswith("sas."):
         name = name[len("sas."):]
-    known = [p for ps in PARAMETERS.values() for p in ps]
     if not sep or not values_text.strip():
         raise ValueError(f"--gain = {text!r}: expected TABLE.ENTRY=VALUES, e.g. pid.kd=1e4,1e5 "
                          "or attitude.kp_z=0:4e5:5")
-    if name not in known:
-        table = name.partition(".")[0]
-        if table in PARAMETERS:
-            allowed = ", ".join(PARAMETERS[table])
-        else:
-            allowed = "inner.*, pid.*, attitude.*, ride.* (" + ", ".join(known[:5]) + ", ...)"
-        raise ValueError(f"--gain = {text!r}: unknown gain {name!r}; allowed: {allowed}")
-    values = value_list(f"--gain {name}", values_text)
-    bad = [v for v in values if v < 0]
-    if bad:
-        raise ValueError(f"--gain = {text!r}: {bad[0]:g} is negative; gains are >= 0")
-    return name, values
+    return name, value_list(f"--gain {name}", values_text)
 
 
-def _scenarios(scenario: str, axes: list, common: dict):
-    """(the combinations of the axes' values, the first scenario described, the last scenario):
-    every scenario of the grid must be valid before anything runs."""
-    from ..defaults import DEFAULT_OUTPUT_RATE
-
-    combos = list(itertools.product(*[values for *_, values in axes]))
-    first_record = None
-    for combo in combos:
-        options = {**common, **{kw: v for (_, kw, _, _), v in zip(axes, combo)}}
-        try:
-            # every run stores its time histories at the library's default rate
-            scen = make_scenario(scenario, options, DEFAULT_OUTPUT_RATE, "the runs' output rate")
-        except ValueError as exc:
-            if str(exc).startswith("--"):  # names its options and values already
-                raise
-            given = ", ".join(f"{opt} {v:g}" for (opt, *_), v in zip(axes, combo))
-            raise ValueError(f"{given}: {exc}" if given else str(exc)) from None
-        first_record = first_record or scen.describe()
-    return combos, first_record, scen
-
-
-def _cases(grid: _Grid, combos: list, common: dict) -> tuple[list, list]:
-    """(the cases, the grid values of each): for each suspension and scenario combination, passive
-    once, mr per scale and voltage, a controller per scale, gain combination and noise seed."""
-    from .. import sweep as sweep_lib
-
-    cases, rows = [], []
-    for s in grid.suspensions:
-        for combo in combos:
-            options = case_options({**common, **{kw: v for (_, kw, _, _), v in zip(grid.axes, combo)}})
-            base = {c: None for c in grid.columns}
-            base.update({"suspension": s, **{column: v for (_, _, column, _), v in zip(grid.axes, combo)}})
-            if s == "passive":
-                cases.append(sweep_lib.Case(grid.scenario, options))
-                rows.append(base)
-            elif s == "mr":
-                for x in grid.scales:
-                    for v in grid.volts:
-                        cases.append(sweep_lib.Case(grid.scenario, options, suspension="mr",
-                                                    damper=grid.damper_name, voltage=v,
-                                                    damper_scale=x))
-                        rows.append({**base, "voltage_v": v,
-                                     **({"damper_scale": x} if grid.scaled else {})})
-            else:
-                mine = [(n, vs) for n, vs in grid.gain_axes if s in GAIN_CONTROLLERS[n.partition(".")[0]]]
-                for x in grid.scales:
-                    for values in itertools.product(*[vs for _, vs in mine]):
-                        changes = tuple(zip([n for n, _ in mine], values))
-                        for sd in (grid.seeds if grid.noise_values is not None else [0]):
-                            cases.append(sweep_lib.Case(
-                                grid.scenario, options, suspension=s, damper=grid.damper_name,
-                                gains=changes, noise=grid.noise_values or (), seed=sd,
-                                damper_scale=x))
-                            row = {**base, **dict(changes)}
-                            if grid.scaled:
-                                row["damper_scale"] = x
-                            if grid.noise_values is not None:
-                                row["seed"] = sd
-                            rows.append(row)
-    return cases, rows
-
-
-# -- the results ----------------------------------------------------------------------------------
-def _metric_columns() -> list[str]:
-    from ..metrics import RESPONSES, STATISTICS
-
-    return [f"{r}_{s}" for s in STATISTICS for r in RESPONSES]
-
-
-def _rows(grid: _Grid, frame, metrics: list[str]):
-    """(one row per case: its grid values, metrics and key; whether any run diverged)."""
-    rows = []
-    diverged = frame["diverged_at_s"].notna() if "diverged_at_s" in frame else [False] * len(grid.cases)
-    for case, values, (_, result), bad in zip(grid.cases, grid.rows, frame.iterrows(), diverged):
-        row = {**values, **{m: None if bad else float(result[m]) for m in metrics}}
-        if any(diverged):  # a run that diverged has no metrics, but the time it went
-            row["diverged_at_s"] = float(result["diverged_at_s"]) if bad else None
-        rows.append({**row, "key": case.key})
-    return rows, any(diverged)
-
-
-def _utc_now() -> str:
-    from datetime import datetime, timezone
-
-    return datetime.now(timezone.utc).replace(microsecond=0).isoformat().replace("+00:00", "Z")
-
-
-def _sweep_document(grid: _Grid, rows: list[dict], metrics: list[str], *, diverged: bool,
-                    comfort: bool) -> dict:
-    """The JSON document of `sweep` (sweep.json) up to its run counts and timing."""
-    # the scenario's fixed settings (the swept ones are grid axes)
-    swept = {key for _, kw, _, _ in grid.axes for key in _SCENARIO_KEYS[kw]}
-    scenario_record = {k: v for k, v in grid.first_record.items() if k not in swept}
-    return {
-        "schema": SCHEMA_SWEEP,
-        "railride_version": __version__,
-        "date": _utc_now(),
-        "settings": {
-            "scenario": scenario_record,
-            "grid": {"suspension": grid.suspensions,
-                     **{column: values for _, _, column, values in grid.axes},
-                     **({"damper_scale": grid.scales} if grid.scaled else {}),
-                     **({"voltage_v": grid.volts} if grid.has_mr else {}),
-                     **{name: values for name, values in grid.gain_axes},
-                     **({"seed": grid.seeds} if grid.noise_values is not None else {})},
-            "damper": grid.damper_name if (grid.has_mr or grid.controllers) else None,
-            "gains_source": grid.base_gains.source if grid.controllers else None,
-            "sensor_noise": None if grid.noise_values is None else dict(
-                zip(("displacement", "angle", "velocity", "angular_rate"), grid.noise_values)),
-            "dt_s": float(grid.dt),
-            "window_s": None if grid.window is None else list(grid.window),
-            # only with --comfort: the document stays as it was without it
-            **({"comfort": _sweep_comfort_settings(grid.scen.duration, grid.window)}
-               if comfort else {}),
-        },
-        "columns": grid.columns + metrics + (["diverged_at_s"] if diverged else []) + ["key"],
-        "rows": rows,
-    }
-
-
-def _sweep_comfort_settings(duration: float, window) -> dict:
-    """settings.comfort of a sweep with --comfort: the columns, where the positions are and
-    what N_MV_z is (the same for every run of the grid, whose runs share one duration)."""
-    from ..comfort import INDEX_UNITS, INTERVAL_S
-    from ..sweep import COMFORT_COLUMNS, COMFORT_INDICES
-
-    start, end = window or (0.0, duration)
-    n = max(1, int((end - start + 1e-9) // INTERVAL_S))
-    unit = {i: INDEX_UNITS["aw" if i.startswith("aw_") else "vdv" if i.startswith("vdv_") else i]
-            for _, i in COMFORT_INDICES}
-    return {"columns": list(COMFORT_COLUMNS),
-            "units": {c: unit[i] for (_, i), c in zip(COMFORT_INDICES, COMFORT_COLUMNS)},
-            "positions": {"centre": "x = 0", "front": "x = +l (above the front bogie centre)",
-                          "rear": "x = -l (above the rear bogie centre)"},
-            "n_intervals": n,
-            "notes": ["N_MV_z is the vertical term of EN 12299 only: the model has no lateral "
-                      "or longitudinal motion",
-                      f"N_MV_z from {n} interval{'s' if n != 1 else ''} of 5 s"
-                      + (" (EN 12299 evaluates 60, 5 minutes): an indication only"
-                         if n < 60 else "")]}
-
-
-def _caption(grid: _Grid, doc: dict, rows: list[dict], wall: float) -> str:
+# -- the table --------------------------------------------------------------------------------------
+def _caption(grid, doc: dict, wall: float) -> str:
     """The sweep table's caption: the scenario, the dampers and gains, the runs."""
-    from ..report import describe_scenario
+    from ..labels import describe_scenario
 
-    st = doc["settings"]
-    start, end = grid.window or (0.0, grid.scen.duration)
-    lines = [f"scenario at the first grid point: {describe_scenario(grid.first_record)}, "
-             f"{grid.scen.duration:g} s, dt {grid.dt:g} s, RMS over {start:g}-{end:g} s"]
+    st, rows = doc["settings"], doc["rows"]
+    start, end = grid.window or (0.0, grid.duration)
+    lines = [f"scenario at the first grid point: {describe_scenario(grid.first_scenario)}, "
+             f"{grid.duration:g} s, dt {grid.solver.dt:g} s, RMS over {start:g}-{end:g} s"]
     if st["damper"]:
         lines.append(damper_text(st) + (f"; gains {st['gains_source']}" if grid.controllers else ""))
     lines.append(f"{len(rows)} run{'s' if len(rows) != 1 else ''}: {doc['runs_evaluated']} evaluated now, "

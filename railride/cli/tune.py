@@ -10,19 +10,22 @@ from typing import Annotated, Optional
 
 import typer
 
-from ..dampers import IDEAL_NAMES
 from ..defaults import DEFAULT_DAMPER
 from ._app import app
 from ._common import (RunProgress, command_line, errors, interruptible, make_executor, open_run_table,
-                      stderr_is_terminal, wide_stdout_console, write_folder)
+                      option_names, stderr_is_terminal, wide_stdout_console, write_folder)
 from ._options import (AmplitudeOption, BoundOption, DtOption, FormatOption, MaxWavelengthOption,
                        MinWavelengthOption, ObjectiveOption, OutputFormat, PenaltyOption, RailPhaseOption,
                        RunDurationOption, RunsScenarioOption, SchedulerFileOption, SchedulerOption, SpeedOption,
                        TrackSeedOption, TuneDamperOption, TuneDamperScaleOption, TuneGainsOption, TuneOutOption,
                        TuneResumeOption, WavelengthOption, WeightsOption, WorkersOption)
-from ._parsing import (check_damper_scale, check_int, check_number, damper_preset, default_of, load_gains,
-                       parse_float, study_scenario)
+from ._parsing import (SOLVER_FIELDS, TRACK_FIELDS, damper_preset, default_of, load_gains, not_given, parse_float,
+                       parse_scale, solver_from_options, study_scenario)
 from ._render import RESPONSE_LABELS, damper_text, reduction_text
+
+#: the library's names of tune's options, for its errors
+TUNE_FIELDS = {"dt": SOLVER_FIELDS["dt"], **TRACK_FIELDS, "damper": "--damper", "damper_scale": "--damper-scale",
+               "n_values": "--values", "max_passes": "--passes", "span": "--span"}
 
 
 def _objective(kind: Optional[str], weights: Optional[str], bound: Optional[str],
@@ -97,7 +100,7 @@ def _phase_list(items: Optional[list[str]]) -> list[str]:
 
     if not items:
         return list(default_of(tune, "phases"))
-    wanted = set()
+    wanted: set[str] = set()
     for text in items:
         names = [n.strip() for n in text.split(",")]
         if any(not n for n in names):
@@ -130,7 +133,7 @@ def _tune_tables(doc: dict, start, tuned, scenario_text: str):
     from rich.table import Table
     from rich.text import Text
 
-    from ..report import _gain_unit
+    from ..labels import gain_unit
     from ..tuning import PARAMETERS
 
     parts = []
@@ -142,7 +145,7 @@ def _tune_tables(doc: dict, start, tuned, scenario_text: str):
     infeasible = doc["objective"].get("infeasible")  # constrained: J >= offset breaks the bound
     if infeasible:
         passes.add_column("within\nbound")
-    previous = {}
+    previous: dict[str, float] = {}
     for h in doc["history"]:
         before = previous.get(h["phase"])
         change = "" if before is None else f"{(h['objective'] - before) / abs(before) * 100:+.2f}"
@@ -163,9 +166,10 @@ def _tune_tables(doc: dict, start, tuned, scenario_text: str):
     gains.add_column("", no_wrap=True)
     for phase in doc["phases"]:
         for name in PARAMETERS[phase]:
-            table, _, entry = name.partition(".")
-            a, b = getattr(getattr(start, table), entry), getattr(getattr(tuned, table), entry)
-            gains.add_row(name, escape(_gain_unit(name) or ""), f"{a:.4g}", f"{b:.4g}",
+            table_name, _, entry = name.partition(".")
+            a = getattr(getattr(start, table_name), entry)
+            b = getattr(getattr(tuned, table_name), entry)
+            gains.add_row(name, escape(gain_unit(name) or ""), f"{a:.4g}", f"{b:.4g}",
                           "" if math.isclose(a, b, rel_tol=1e-9, abs_tol=0.0) else "changed")
         gains.add_section()
     parts += [gains, ""]
@@ -256,40 +260,34 @@ def tune_command(
     import time
 
     command = command_line(ctx, exclude=("out", "resume", "format"))
-    with errors():
-        from .. import report, tuning
-        from ..defaults import DEFAULT_DT
+    defaults = not_given(dt=dt, min_wavelength=min_wavelength, max_wavelength=max_wavelength,
+                         seed=track_seed)
+    with errors(), option_names(TUNE_FIELDS, defaults):
+        from .. import tuning
+        from ..labels import describe_scenario
 
         phases = _phase_list(phase)
         damper_preset("--damper", damper)
-        scale = check_damper_scale("--damper-scale", damper_scale, damper)
-        if damper in IDEAL_NAMES and "inner" in phases:
-            raise ValueError(f"--damper = {damper!r} with the inner phase (--phase "
-                             f"{','.join(phases)}): an ideal device has no force tracking "
-                             "loop to tune; give --phase pid,attitude,ride")
+        scale = parse_scale("--damper-scale", damper_scale)
         start = _tune_start(gains)
         objective = _objective(objective_kind, weights, bound, penalty)
-        check_int("--values", values, 3)
-        if not (math.isfinite(span) and span > 1):
-            raise ValueError(f"--span = {span:g}: must be a finite number > 1")
-        check_int("--passes", passes, 1)
-        dt = DEFAULT_DT if dt is None else check_number("--dt", dt, "s")
+        solver = solver_from_options(dt=dt)
         scen, options = study_scenario(scenario, amplitude=amplitude, wavelength=wavelength,
                                        rail_phase=rail_phase, speed=speed, duration=duration,
                                        track_seed=track_seed, min_wavelength=min_wavelength,
                                        max_wavelength=max_wavelength)
-        scenario_text = report.describe_scenario(scen.describe())
+        scenario_text = describe_scenario(scen.describe())
         table, table_path = open_run_table(out, resume)
         executor, executor_record = make_executor(workers, scheduler, scheduler_file)
     try:
-        with interruptible(table, table_path), errors():
+        with interruptible(table, table_path), errors(), option_names(TUNE_FIELDS, defaults):
             with RunProgress(stderr_is_terminal(), "tuning") as progress:
                 t0 = time.perf_counter()
                 result = tuning.tune(phases, scenario=scenario, scenario_options=options,
                                      gains=start, objective=objective, damper=damper,
                                      damper_scale=scale,
                                      executor=executor, table=table, n_values=values, span=span,
-                                     max_passes=passes, dt=dt, progress=progress, log=progress.log)
+                                     max_passes=passes, solver=solver, progress=progress, log=progress.log)
                 wall = time.perf_counter() - t0
             # the facts of this command line, after the library's document
             facts = {"runs_evaluated": progress.evaluated,

@@ -21,8 +21,8 @@ def plot_hysteresis(cycles, path=None, *, title: str | None = None, ax=None):
     force in kN (tension +), extension in mm, extension rate in m/s.
 
     ``ax``: two Axes to draw in (no title then), or None for a new figure titled ``title``
-    (default: the damper model and the motion). Saved as PNG at ``path`` when given
-    (atomically). Returns the `Figure`.
+    (default: the damper, the motion and the cycle shown, as `railride damper --out` has it).
+    Saved as PNG at ``path`` when given (atomically). Returns the `Figure`.
     """
     from matplotlib import colormaps
 
@@ -56,15 +56,30 @@ def plot_hysteresis(cycles, path=None, *, title: str | None = None, ax=None):
         a.grid(True, linewidth=0.4, alpha=0.6)
     ax_v.legend(title="command voltage", fontsize="small", loc="upper left")
     if ax is None:
-        if title is None:
-            model = getattr(cycles.damper, "model", None) or damper_model_name(ds) or "damper"
-            title = f"{model} damper, steady-state cycle"
-            motion = cycles.motion
-            if motion is not None:
-                title += f", x = {motion.amplitude * 1e3:g} mm sin(2 pi {motion.frequency:g} Hz t)"
-        fig.suptitle(title, fontsize="medium")
+        fig.suptitle(_cycles_title(cycles) if title is None else title, fontsize="medium")
     save_png(fig, path)
     return fig
+
+
+def _damper_words(damper, ds) -> str:
+    """"railway damper (bouc-wen model)" for a preset, "bouc-wen damper" for another model."""
+    model = getattr(damper, "model", None) or damper_model_name(ds)
+    preset = damper.to_dict().get("preset") if hasattr(damper, "to_dict") else None
+    if preset:
+        return f"{preset} damper ({model} model)" if model else f"{preset} damper"
+    return f"{model} damper" if model else "damper"
+
+
+def _cycles_title(cycles) -> str:
+    """The damper, the motion and the cycle shown: "railway damper (bouc-wen model), x = 10 mm
+    sin(2 pi 1 Hz t), cycle 4 of 4"."""
+    parts = [_damper_words(cycles.damper, cycles.dataset)]
+    motion = cycles.motion
+    if motion is not None:
+        parts.append(f"x = {motion.amplitude * 1e3:g} mm sin(2 pi {motion.frequency:g} Hz t)")
+    n = getattr(cycles, "n_cycles", None)
+    parts.append(f"cycle {n} of {n}" if n else "steady-state cycle")
+    return ", ".join(parts)
 
 
 def plot_tracking(tracking, path=None, *, title: str | None = None, ax=None):
@@ -73,8 +88,8 @@ def plot_tracking(tracking, path=None, *, title: str | None = None, ax=None):
     coil voltage u (V). The first cycle, left out of the metrics (start-up), is shaded.
 
     ``ax``: two Axes to draw in (no title then), or None for a new figure titled ``title``
-    (default: the desired force, the damper, the gains and the error). Saved as PNG at ``path``
-    when given (atomically). Returns the `Figure`.
+    (default: the demand, the damper, the gains and the error, as `railride tracking --out` has
+    it). Saved as PNG at ``path`` when given (atomically). Returns the `Figure`.
     """
     _expect(tracking, "tracking", "Tracking")
     ds = tracking.dataset
@@ -116,14 +131,10 @@ def plot_tracking(tracking, path=None, *, title: str | None = None, ax=None):
 
 
 def _tracking_title(tracking) -> str:
-    ds = tracking.dataset
-    parts = [f"{tracking.desired} force tracking"]
-    model = damper_model_name(ds)
-    if model:
-        parts.append(f"{model} damper")
-    if "B" in ds.attrs and "G_v_per_n" in ds.attrs:
-        parts.append(f"B = {float(ds.attrs['B']):g}, G = {float(ds.attrs['G_v_per_n']):.3g} V/N")
-    error = tracking.metrics().get("normalised_rms_error")
-    if isinstance(error, float) and math.isfinite(error):
-        parts.append(f"normalised RMS error {error:.3f}")
-    return ", ".join(parts)
+    """The demand, the damper, the gains and the error: "sine demand 10 kN at 1 Hz, railway
+    damper, B = 1, G = 0.00115 V/N: normalised RMS error 0.202"."""
+    damper = _damper_words(tracking.damper, tracking.dataset).split(" (")[0]
+    head = (f"{tracking.desired} demand {tracking.amplitude / 1e3:g} kN at {tracking.frequency:g} Hz, "
+            f"{damper}, B = {tracking.B:g}, G = {tracking.G:.3g} V/N")
+    error = tracking.metrics().normalised_rms_error
+    return head + (f": normalised RMS error {error:.3f}" if math.isfinite(error) else "")

@@ -1,5 +1,5 @@
-"""A sweep (`railride.sweep`, the ``railride.sweep/1`` document of `railride sweep`): the RMS
-of the carbody responses and the ride comfort against its one swept numeric axis."""
+"""A sweep (a `railride.sweep.SweepResult`): the RMS of the carbody responses and the ride
+comfort against its one swept numeric axis."""
 
 from __future__ import annotations
 
@@ -7,6 +7,7 @@ import math
 import textwrap
 
 import numpy as np
+import pandas as pd
 
 from ..labels import describe_dampers, describe_scenario, grid_axis_label
 from ._style import given_axes, new_figure, suspension_label, suspension_style
@@ -24,21 +25,21 @@ def _is_number(value) -> bool:
     return isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, bool)
 
 
-def sweep_plot_axis(doc: dict) -> str | None:
-    """The grid column `plot_sweep` draws against: the one axis of ``doc["settings"]["grid"]``
-    besides ``suspension`` with more than one value, if there is exactly one and its values are
-    numbers; else None."""
-    grid = (doc.get("settings") or {}).get("grid") or {}
+def sweep_plot_axis(result) -> str | None:
+    """The grid column `plot_sweep` draws against: the one axis of the sweep ``result``
+    (`SweepGrid.grid_values`) besides ``suspension`` with more than one value, if there is
+    exactly one and its values are numbers; else None."""
+    grid = result.grid.grid_values()
     several = [c for c, values in grid.items() if c != "suspension" and len(values) > 1]
     if len(several) != 1 or not all(_is_number(v) for v in grid[several[0]]):
         return None
     return several[0]
 
 
-def has_comfort(doc: dict) -> bool:
-    """Whether the rows of a sweep document hold the comfort indices (`railride sweep --comfort`)."""
-    rows = doc.get("rows") or []
-    return bool(rows) and all(c in rows[0] for c, _ in COMFORT_PANELS)
+def has_comfort(result) -> bool:
+    """Whether the sweep ``result`` has runs and their rows hold the comfort indices (`run_sweep`
+    with comfort, `railride sweep --comfort`)."""
+    return len(result.grid.cases) > 0 and all(c in result.metric_columns() for c, _ in COMFORT_PANELS)
 
 
 def _log_axis(axis: str, xs: list) -> bool:
@@ -48,17 +49,16 @@ def _log_axis(axis: str, xs: list) -> bool:
     return bool(xs) and min(xs) > 0 and max(xs) / min(xs) >= ratio
 
 
-def _sweep_lines(ax, rows, axis, column, suspensions):
+def _sweep_lines(ax, frame, axis, column, suspensions):
     """One line per suspension of ``column`` against ``axis`` (a horizontal line for a
-    suspension the axis does not act on)."""
+    suspension the axis does not act on), from the rows ``frame`` (`SweepResult.to_pandas`)."""
     for name in suspensions:
-        mine = [r for r in rows if r["suspension"] == name]
+        mine = frame[frame["suspension"] == name]
         style = suspension_style(name)
         label = suspension_label(name)
-        # a run that diverged has no metrics (None): it leaves a gap, not a point
-        on = sorted((float(r[axis]), float(r[column])) for r in mine
-                    if r.get(axis) is not None and r[column] is not None)
-        off = [float(r[column]) for r in mine if r.get(axis) is None and r[column] is not None]
+        # a run that diverged has no metrics (empty): it leaves a gap, not a point
+        on = sorted((float(x), float(y)) for x, y in zip(mine[axis], mine[column]) if pd.notna(x) and pd.notna(y))
+        off = [float(y) for x, y in zip(mine[axis], mine[column]) if pd.isna(x) and pd.notna(y)]
         if on:
             x, y = zip(*on)
             ax.plot(x, y, marker="o", markersize=3.5, linewidth=1.3, label=label, **style)
@@ -67,24 +67,25 @@ def _sweep_lines(ax, rows, axis, column, suspensions):
                        label=f"{label} (not swept)", **style)
 
 
-def _swept_axis(doc: dict, axis: str | None) -> str:
-    axis = axis or sweep_plot_axis(doc)
+def _swept_axis(result, axis: str | None) -> str:
+    axis = axis or sweep_plot_axis(result)
     if axis is None:
         raise ValueError("the sweep has no single numeric axis with several values to plot against")
     return axis
 
 
-def _panels(doc: dict, axis: str, panels, ax, figsize, shape):
-    """The rows, the suspensions, the figure and the Axes of the panels ``panels``."""
-    rows = doc.get("rows") or []
-    suspensions = list(dict.fromkeys(r["suspension"] for r in rows))
+def _panels(result, panels, ax, figsize, shape):
+    """The rows (`SweepResult.to_pandas`), the suspensions, the figure and the Axes of the
+    panels ``panels``."""
+    frame = result.to_pandas()
+    suspensions = list(dict.fromkeys(frame["suspension"]))
     if ax is None:
         fig = new_figure(figsize)
         axes = list(np.ravel(fig.subplots(*shape, sharex=True)))
     else:
         axes = given_axes(ax, len(panels), "one per panel: " + ", ".join(c for c, _ in panels))
         fig = axes[0].figure
-    return rows, suspensions, fig, axes
+    return frame, suspensions, fig, axes
 
 
 def _title(fig, axes, text: str, context: str) -> None:
@@ -97,19 +98,19 @@ def _title(fig, axes, text: str, context: str) -> None:
     fig.suptitle(text, fontsize="medium")
 
 
-def plot_sweep(doc: dict, ax=None, *, axis: str | None = None):
+def plot_sweep(result, ax=None, *, axis: str | None = None):
     """The RMS of the four carbody responses against the swept axis of a sweep (the
-    ``railride.sweep/1`` document ``doc``): four panels, one line per suspension in the paper's
+    `railride.sweep.SweepResult` ``result``): four panels, one line per suspension in the paper's
     style. A suspension the axis does not act on (passive against --voltage, say) ran once: a
     thin horizontal line at its value. ``axis`` defaults to `sweep_plot_axis`. ``ax``: four
     Axes to draw in (legend in the first, no title), or None for a new figure. Returns the
     `Figure`."""
-    axis = _swept_axis(doc, axis)
-    rows, suspensions, fig, axes = _panels(doc, axis, RMS_PANELS, ax, (10.0, 7.2), (2, 2))
-    xs = [float(r[axis]) for r in rows if r.get(axis) is not None]
+    axis = _swept_axis(result, axis)
+    frame, suspensions, fig, axes = _panels(result, RMS_PANELS, ax, (10.0, 7.2), (2, 2))
+    xs = [float(x) for x in frame[axis] if pd.notna(x)]
     log_x = _log_axis(axis, xs)
     for a, (column, ylabel) in zip(axes, RMS_PANELS):
-        _sweep_lines(a, rows, axis, column, suspensions)
+        _sweep_lines(a, frame, axis, column, suspensions)
         a.set_ylabel(ylabel)
         a.set_ylim(bottom=0)
         a.grid(True, linewidth=0.4, alpha=0.6)
@@ -120,7 +121,7 @@ def plot_sweep(doc: dict, ax=None, *, axis: str | None = None):
     if ax is not None:
         axes[0].legend(fontsize="small")
         return fig
-    settings = doc.get("settings") or {}
+    settings = result.settings()
     context = describe_scenario(settings.get("scenario") or {})
     duration = (settings.get("scenario") or {}).get("duration_s")
     extra = [p for p in (f"{duration:g} s" if _is_number(duration) else "",
@@ -131,22 +132,23 @@ def plot_sweep(doc: dict, ax=None, *, axis: str | None = None):
     return fig
 
 
-def plot_sweep_comfort(doc: dict, ax=None, *, axis: str | None = None):
-    """The ride comfort of a sweep with comfort columns (``railride sweep --comfort``) against
+def plot_sweep_comfort(result, ax=None, *, axis: str | None = None):
+    """The ride comfort of a sweep with comfort columns (`railride.sweep.SweepResult` of
+    `run_sweep` with comfort, ``railride sweep --comfort``) against
     its swept axis: N_MV,z and a_w (Wk) at the carbody centre, two panels, one line per
     suspension as in `plot_sweep`; the N_MV,z panel marks the EN 12299 class bounds. ``ax``:
     two Axes to draw in (legend in the first, no title), or None for a new figure. Returns the
     `Figure`."""
     from ..comfort import COMFORT_SCALE
 
-    axis = _swept_axis(doc, axis)
-    if not has_comfort(doc):
-        raise ValueError("the sweep's rows hold no comfort indices (railride sweep --comfort)")
-    rows, suspensions, fig, axes = _panels(doc, axis, COMFORT_PANELS, ax, (10.0, 4.4), (1, 2))
-    xs = [float(r[axis]) for r in rows if r.get(axis) is not None]
+    axis = _swept_axis(result, axis)
+    if not has_comfort(result):
+        raise ValueError("the sweep's rows hold no comfort indices (run_sweep with comfort, railride sweep --comfort)")
+    frame, suspensions, fig, axes = _panels(result, COMFORT_PANELS, ax, (10.0, 4.4), (1, 2))
+    xs = [float(x) for x in frame[axis] if pd.notna(x)]
     log_x = _log_axis(axis, xs)
     for a, (column, ylabel) in zip(axes, COMFORT_PANELS):
-        _sweep_lines(a, rows, axis, column, suspensions)
+        _sweep_lines(a, frame, axis, column, suspensions)
         a.set_ylabel(ylabel, fontsize="small")
         a.set_ylim(bottom=0)
         a.grid(True, linewidth=0.4, alpha=0.6)
@@ -162,7 +164,6 @@ def plot_sweep_comfort(doc: dict, ax=None, *, axis: str | None = None):
     if ax is not None:
         axes[0].legend(fontsize="small")
         return fig
-    settings = doc.get("settings") or {}
-    context = describe_scenario(settings.get("scenario") or {})
+    context = describe_scenario(result.grid.scenario_record())
     _title(fig, axes, f"Ride comfort against {grid_axis_label(axis)}", context)
     return fig

@@ -147,7 +147,36 @@ def test_dt_too_large():
     assert_input_error(run("simulate", "--duration", 2, "--dt", 0.05), "too large")
     assert_input_error(run("simulate", "--duration", 2, "--dt", 0.05, "--output-rate", 20), "too large")
     # a stable step that does not fit the output rate is bad input too
-    assert_input_error(run("simulate", "--duration", 2, "--dt", 0.002), "output_rate")
+    assert_input_error(run("simulate", "--duration", 2, "--dt", 0.002), "--output-rate")
+
+
+def test_library_errors_name_the_options():
+    # the library checks the settings; the command line names its options in the message
+    assert_input_error(run("simulate", "--duration", 2, "--dt", 0.002),
+                       "error: --dt = 0.002 s is too large for --output-rate = 1000 Hz (the default): at "
+                       "most one output sample per step; use --dt <= 0.001 s or a lower --output-rate")
+    from railride.cli._common import reworded
+
+    fields = {"dt": "--dt", "output_rate": "--output-rate", "'seed'": "--seed"}
+    # a plain name where it names a value, a name with an underscore wherever it stands (not in
+    # a formula), a field quoted as the parameter checks quote it
+    assert reworded("the dt of a run; dt = 1 s, dt <= 2 s", fields) == "the dt of a run; --dt = 1 s, --dt <= 2 s"
+    assert reworded("raise output_rate; 1/output_rate", fields) == "raise --output-rate; 1/output_rate"
+    assert reworded("sensor noise 'seed' = -1: must be", fields) == "sensor noise --seed = -1: must be"
+    assert reworded("output_rate = 300 Hz with dt = 0.0001 s: whole", fields, ["dt"]) == \
+        "--output-rate = 300 Hz with --dt = 0.0001 s (the default): whole"
+
+
+def test_the_document_is_the_library_one():
+    from railride.simulation import simulate
+    from railride.suspension import Suspension
+    from railride.track import scenario
+
+    doc = json.loads(run("simulate", "--suspension", "mr", "--voltage", 1, "--damper-scale", 2,
+                         "--duration", 1, "--format", "json").stdout)
+    library = simulate(scenario("paper-sine", duration=1.0), "paper",
+                       Suspension.named("mr", damper_scale=2.0, voltage=1.0)).to_dict()
+    assert doc == library and doc["suspension"]["damper_scale"] == 2.0
 
 
 def test_window_outside_run():
@@ -156,7 +185,7 @@ def test_window_outside_run():
 
 @pytest.mark.parametrize("rate", ["nan", "-1000", "0"])
 def test_bad_output_rate_with_window(rate):
-    assert_input_error(run("simulate", "--duration", 1, "--window", "0:1", "--output-rate", rate), "output_rate")
+    assert_input_error(run("simulate", "--duration", 1, "--window", "0:1", "--output-rate", rate), "--output-rate")
 
 
 @pytest.mark.parametrize("window", ["abc", "1:2:3", "2:1"])

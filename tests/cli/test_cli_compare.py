@@ -301,13 +301,14 @@ def test_trade_offs_name_every_response_a_controller_loses(short_doc):
 
 def test_bounds_are_the_same_gains_on_the_ideal_devices(short_doc):
     from railride.simulation import simulate
+    from railride.suspension import Suspension
     from railride.track import scenario
 
     gains = GainSet.default()
     sc = scenario("paper-sine", duration=2.0)
     passive = simulate(sc).metrics().sel(statistic="rms")
     for device in ("ideal-damper", "ideal"):
-        m = simulate(sc, damper=device, controller=gains.controller("sas-attitude")).metrics()
+        m = simulate(sc, suspension=Suspension(device, controller=gains.controller("sas-attitude"))).metrics()
         got = short_doc["bounds"][device]["sas-attitude"]
         for k in RESPONSES:
             assert got["rms"][k] == pytest.approx(float(m.sel(statistic="rms", response=k)), rel=1e-12)

@@ -78,6 +78,14 @@ def test_damper_bad_motion(option, value):
     assert_input_error(result, option, value)
 
 
+def test_library_errors_are_named_by_the_options():
+    # the library checks (a cycle too short for the step), the command names its options
+    result = run("damper", "--amplitude", 0.01, "--frequency", 1000, "--voltage", "1")
+    assert_input_error(result, "--frequency = 1000.0 Hz", "under 100 steps")
+    assert_input_error(run("tracking", "--frequency", 200), "--frequency = 200.0 Hz", "under 100 steps")
+    assert_input_error(run("tracking", "--G", "-1"), "--G = -1.0", ">= 0 (V/N)")
+
+
 def test_damper_missing_required_option():
     result = run("damper", "--amplitude", 0.01, "--frequency", 1)
     assert result.exit_code == 2 and "--voltage" in result.output

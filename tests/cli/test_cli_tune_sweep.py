@@ -210,6 +210,26 @@ def test_sweep_speed_range_times_suspensions(tmp_path):
     assert doc["runs_evaluated"] == 2 and table_rows(out / "runs.csv") == 8
 
 
+def test_sweep_prints_the_library_result(tmp_path):
+    """The command's JSON, CSV and sweep.json are the library's SweepResult of the same grid;
+    the command adds only its own facts (runs evaluated, timing, executor)."""
+    from railride.sweep import grid, run_sweep
+
+    out = tmp_path / "sweep"
+    args = (*SWEEP, "--suspension", "passive,mr,pid", "--speed", "30,40", "--voltage", "0,passive-on",
+            "--gain", "pid.kd=1e5,4.5e5", "--damper-scale", "1,2")
+    rows = json.loads(ok(*args, "--out", out, "--format", "json").stdout)
+    doc = json.loads((out / "sweep.json").read_text())
+    result = run_sweep(grid(["passive", "mr", "pid"], speed=[30, 40], voltage=[0, "passive-on"],
+                            gains={"pid.kd": [1e5, 4.5e5]}, damper_scale=[1, 2], duration=1))
+    mine = result.to_dict()
+    assert mine["rows"] == rows
+    facts = ["runs_evaluated", "runs_per_second", "wall_time_s", "executor"]
+    assert list(doc) == [*mine, *facts]
+    assert {k: doc[k] for k in mine if k != "date"} == {k: v for k, v in mine.items() if k != "date"}
+    assert ok(*args, "--format", "csv").stdout == result.to_pandas().to_csv(index=False)
+
+
 def test_sweep_csv_and_table():
     args = (*SWEEP, "--suspension", "passive,mr,pid", "--voltage", "0,2.25",
             "--gain", "pid.kd=1e5,4.5e5", "--speed", "30,40")

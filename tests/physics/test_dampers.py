@@ -204,10 +204,10 @@ def test_bad_damper_parameters_name_the_field(change, match):
 def test_force_tracking_follows_a_sine_and_says_what_it_cannot():
     sine = rig.track("railway", "sine", 10e3, 1.0).metrics()
     saw = rig.track("railway", "sawtooth", 10e3, 1.0).metrics()
-    assert 0 < sine["normalised_rms_error"] < 0.3
+    assert 0 < sine.normalised_rms_error < 0.3
     # the sawtooth's jumps come at stroke reversals, where the force cannot change sign faster
     # than the stroke lets the hysteretic variable turn: much worse tracking
-    assert saw["normalised_rms_error"] > 2 * sine["normalised_rms_error"]
+    assert saw.normalised_rms_error > 2 * sine.normalised_rms_error
     # the voltage never leaves [v_min, v_max]
     ds = rig.track("railway", "sine", 30e3, 1.0).dataset
     assert float(ds.v.min()) >= 0.0 and float(ds.v.max()) <= 2.25

@@ -24,7 +24,8 @@ from distributed import Client  # noqa: E402
 
 from railride.control import GainSet  # noqa: E402
 from railride.metrics import RESPONSES, STATISTICS  # noqa: E402
-from railride.sweep import Case, DaskExecutor, LocalExecutor, RunTable, run_cases  # noqa: E402
+from railride.executors import DaskExecutor, LocalExecutor, RunTable  # noqa: E402
+from railride.sweep import Case, SweepResult, grid, run_cases, run_sweep  # noqa: E402
 
 #: seconds for the scheduler file and for the workers to come up (imports on a slow machine)
 STARTUP = 60.0
@@ -153,12 +154,17 @@ def local():
 def _run(cases, executor, **kwargs):
     """run_cases in a thread that may take at most SWEEP seconds (a hung cluster fails the test
     instead of hanging the suite)."""
-    out = {}
     kwargs.setdefault("base_gains", BASE)
+    return _within(lambda: run_cases(cases, executor=executor, **kwargs))
+
+
+def _within(call):
+    """``call()`` in a thread that may take at most SWEEP seconds."""
+    out = {}
 
     def target():
         try:
-            out["frame"] = run_cases(cases, executor=executor, **kwargs)
+            out["frame"] = call()
         except BaseException as exc:  # re-raised below
             out["error"] = exc
 
@@ -240,6 +246,17 @@ def test_a_sweep_by_address_equals_the_local_one(cluster, local):
     finally:
         executor.close()
     pd.testing.assert_frame_equal(dask, local, check_exact=True)
+
+
+def test_the_sweep_study_on_the_cluster_equals_the_local_one(cluster, local):
+    g = grid(["passive", "pid"], speed=[30.0, 40.0, 50.0, 55.56], duration=1.0, base_gains=BASE)
+    assert [c.to_dict() for c in g.cases] == [c.to_dict() for c in _cases()]
+    executor = DaskExecutor(scheduler_file=cluster.scheduler_file, timeout=10)
+    try:
+        result = _within(lambda: run_sweep(g, executor=executor, comfort=False))
+    finally:
+        executor.close()
+    pd.testing.assert_frame_equal(result.to_pandas(), SweepResult(g, local).to_pandas(), check_exact=True)
 
 
 def test_a_resumed_run_table_runs_only_what_is_missing(cluster, local, tmp_path):

@@ -4,6 +4,7 @@ and returns their figure, and that none is left registered with pyplot."""
 from __future__ import annotations
 
 import numpy as np
+import pandas as pd
 import pytest
 from matplotlib.figure import Figure
 
@@ -18,6 +19,9 @@ from railride.plots.pareto import plot_pareto
 from railride.plots.ride import plot_body_responses
 from railride.plots.rig import plot_hysteresis, plot_tracking
 from railride.plots.sweep import plot_sweep, plot_sweep_comfort
+from railride.sweep import COMFORT_COLUMNS, SweepResult
+from railride.sweep import grid as sweep_grid
+from railride.sweep import metric_columns as sweep_metric_columns
 from railride.plots.tuning import plot_sensitivity
 from railride.simulation import simulate
 from railride.tables import modes_frame
@@ -45,15 +49,14 @@ def results(result):
     tracking = rig.track(n_cycles=2)
     curves = [Curve("pid", 1, "pid.kp", np.array([0.0, 1e3, 1e4]), np.array([1.0, 0.8, 0.9]), 1e3),
               Curve("pid", 1, "pid.kd", np.array([1e2, 1e3]), np.array([0.7, 0.75]), 1e2)]
-    rows = [{"suspension": "passive", "voltage_v": None, "acceleration_m_s2_rms": 0.3,
-             "displacement_m_rms": 0.03, "pitch_deg_rms": 0.9, "roll_deg_rms": 2.0,
-             "centre_N_MV_z": 1.2, "centre_aw_Wk": 0.2}]
-    rows += [{"suspension": "mr", "voltage_v": v, "acceleration_m_s2_rms": 0.3 + v / 10,
-              "displacement_m_rms": 0.03, "pitch_deg_rms": 0.8, "roll_deg_rms": 1.9,
-              "centre_N_MV_z": 1.0 + v, "centre_aw_Wk": 0.2} for v in (0.0, 1.0, 2.0)]
-    sweep = {"settings": {"grid": {"suspension": ["passive", "mr"], "voltage_v": [0.0, 1.0, 2.0]},
-                          "scenario": {"name": "paper-sine", "duration_s": 2.0}, "damper": "railway"},
-             "rows": rows}
+    # a sweep's result without its runs: the grid's cases, and metrics made up for them
+    runs = [{"acceleration_m_s2_rms": 0.3, "displacement_m_rms": 0.03, "pitch_deg_rms": 0.9,
+             "roll_deg_rms": 2.0, "centre_N_MV_z": 1.2, "centre_aw_Wk": 0.2}]
+    runs += [{"acceleration_m_s2_rms": 0.3 + v / 10, "displacement_m_rms": 0.03, "pitch_deg_rms": 0.8,
+              "roll_deg_rms": 1.9, "centre_N_MV_z": 1.0 + v, "centre_aw_Wk": 0.2} for v in (0.0, 1.0, 2.0)]
+    columns = sweep_metric_columns() + list(COMFORT_COLUMNS)
+    sweep = SweepResult(sweep_grid(["passive", "mr"], voltage=[0.0, 1.0, 2.0], duration=2.0),
+                        pd.DataFrame([{**dict.fromkeys(columns, 0.0), **r} for r in runs]), comfort=True)
     vehicle = Vehicle(rr.VehicleParams.preset("paper"))
     frequency = np.geomspace(0.2, 20.0, 40)
     frf = frf_frame({p: vehicle.frequency_response(frequency, 20.0, p) for p in FRF_PATTERNS})

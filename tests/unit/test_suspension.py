@@ -1,5 +1,6 @@
 """`Suspension` and `SolverSettings`: the checks at construction, the named suspensions against
-the keyword form of `simulate` they replace, batches, and the gain tables of `GainSet`."""
+the same suspensions spelled with the plain constructor, batches, and the gain tables of
+`GainSet`."""
 
 import dataclasses
 import json
@@ -121,16 +122,17 @@ def test_a_suspension_is_a_frozen_value():
     assert Suspension.named("mr", damper_scale=2.0).damper == dampers.RAILWAY.scaled(2.0)
 
 
-# -- the same runs as the keyword form ------------------------------------------------------------
-def _keywords(name, damper, scale):
-    """The keyword form of `simulate` for the suspension `Suspension.named` calls ``name``."""
+# -- the same runs as the plain constructor ---------------------------------------------------------
+def _plain(name, damper, scale):
+    """The suspension `Suspension.named` calls ``name``, spelled with the plain constructor: the
+    damper model, the voltage, the outer loop and the inner loop."""
     if name == "passive":
-        return {}
+        return Suspension()
     model = dampers.preset(damper) if scale == 1.0 else dampers.preset(damper).scaled(scale)
     if name == "mr":
-        return {"damper": model, "voltage": 1.0}
+        return Suspension(model, voltage=1.0)
     ideal = damper in dampers.IDEAL_NAMES
-    return {"damper": model, "controller": G.controller(name), **({} if ideal else {"inner": G.inner})}
+    return Suspension(model, controller=G.controller(name), inner=None if ideal else G.inner)
 
 
 #: every name on every device it runs on (the slow Spencer model: open loop and one closed loop)
@@ -141,20 +143,21 @@ NAMED = [(n, d, x) for n in NAMES for d, x in (("railway", 1.0), ("railway", 2.0
 
 
 @pytest.mark.parametrize("name, damper, scale", NAMED)
-def test_named_suspensions_run_as_the_keyword_form_did(name, damper, scale):
+def test_named_suspensions_run_as_the_plain_constructor(name, damper, scale):
     sc = scenario("paper-sine", duration=0.2) if damper == "spencer1997" else SC
     voltage = 1.0 if name == "mr" else None
     new = simulate(sc, suspension=Suspension.named(name, G, damper, scale, voltage)).dataset
-    old = simulate(sc, **_keywords(name, damper, scale)).dataset  # TEMPORARY: the bridge
-    _same(new, old)
+    plain = simulate(sc, suspension=_plain(name, damper, scale)).dataset
+    _same(new, plain)
 
 
-def test_a_closed_loop_with_noise_and_another_solver_runs_as_the_keyword_form_did():
+def test_a_closed_loop_with_noise_and_another_solver_runs_as_the_plain_constructor():
     solver = SolverSettings(dt=5e-5, output_rate=500.0, control_rate=400.0)
     new = simulate(SC, suspension=Suspension.named("sas-attitude", G, sensor_noise=NOISE), solver=solver)
-    old = simulate(SC, controller=G.controller("sas-attitude"), inner=G.inner, sensor_noise=NOISE,
-                   dt=5e-5, output_rate=500.0, control_rate=400.0)
-    _same(new.dataset, old.dataset)
+    plain = simulate(SC, suspension=Suspension("railway", controller=G.controller("sas-attitude"),
+                                               inner=G.inner, sensor_noise=NOISE),
+                     solver=SolverSettings(dt=5e-5, output_rate=500.0, control_rate=400.0))
+    _same(new.dataset, plain.dataset)
     assert new.solver == solver and new.suspension.name == "sas-attitude"
     assert new.dataset.attrs["control_rate_hz"] == 400.0 and new.dataset.attrs["dt_s"] == 5e-5
 
@@ -169,10 +172,11 @@ def test_passive_keeps_its_invariants():
     np.testing.assert_allclose(force, -VehicleParams.preset("paper").c_sz * rate, rtol=1e-12, atol=1e-9)
 
 
-def test_the_bridge_refuses_two_spellings_at_once():
-    with pytest.raises(ValueError, match="give suspension= or damper=, not both"):
+def test_simulate_has_one_spelling():
+    # the keywords of earlier versions are gone: a suspension and solver settings, or nothing
+    with pytest.raises(TypeError, match="'damper'"):
         simulate(SC, None, Suspension.passive(), damper="railway")
-    with pytest.raises(ValueError, match="give solver= or dt=, not both"):
+    with pytest.raises(TypeError, match="'dt'"):
         simulate(SC, solver=SolverSettings(), dt=1e-4)
     with pytest.raises(TypeError, match="'volts'"):
         simulate(SC, volts=1.0)

@@ -1,0 +1,196 @@
+"""Where the runs of a study go and where they are kept: executors and the run table.
+
+An executor runs chunks of cases (`railride.sweep.evaluate` on each) and yields their rows:
+`LocalExecutor` on this machine, one chunk after another, each batch over every core;
+`DaskExecutor` on a dask.distributed cluster. `RunTable` keeps every finished run in a CSV
+file rewritten atomically after each chunk, so an interrupted study resumes where it stopped
+(`railride.sweep.run_cases`).
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from pathlib import Path
+
+import pandas as pd
+
+from ._io import atomic_write
+
+
+# -- executors ---------------------------------------------------------------------------------
+class LocalExecutor:
+    """Chunks run one after another in this process; each chunk's batch uses every core."""
+
+    name = "local"
+
+    def map(self, fn, chunks):
+        for i, chunk in enumerate(chunks):
+            yield i, fn(chunk)
+
+    def close(self):
+        pass
+
+
+class DaskExecutor:
+    """Chunks run as tasks on a dask.distributed cluster (``address`` tcp://host:port, or the
+    ``scheduler_file`` that ``dask scheduler --scheduler-file`` writes). Needs the optional
+    extra: pip install "railride[distributed]"; every worker imports the same railride.
+
+    One chunk is one task and one compiled batch, on its share of the worker machine's cores:
+    numba's thread count there (NUMBA_NUM_THREADS, every core by default) divided by the Dask
+    threads of all the workers on that machine, at least 1. So batches do not multiply Dask's
+    threads: one ``dask worker --nthreads 1`` per machine gives each batch every core, a default
+    ``dask worker`` (a thread per core) one core to each of its batches (docs/distributed.md).
+
+    A scheduler that does not answer within ``timeout`` seconds, a scheduler file that does not
+    appear or has no address, are ValueErrors naming the address or file. `map` yields (chunk
+    index, rows) in the order chunks finish; a chunk lost with a dead worker is run again by the
+    scheduler."""
+
+    name = "dask"
+
+    def __init__(self, address: str | None = None, scheduler_file: str | None = None,
+                 timeout: float = 10.0):
+        try:
+            from distributed import Client
+        except ImportError:
+            raise ValueError("the Dask executor needs dask.distributed: pip install "
+                             "\"railride[distributed]\"") from None
+        if (address is None) == (scheduler_file is None):
+            raise ValueError("give a scheduler address (tcp://host:port) or a scheduler file")
+        if scheduler_file is not None:
+            address = self._address_from_file(scheduler_file, timeout)
+        self.address = address
+        where = f"{address}" + ("" if scheduler_file is None else f" (from {scheduler_file})")
+        try:
+            self._handshake(address, timeout)
+            # not the default client: this executor's tasks only, the caller's Dask code untouched
+            self.client = Client(address, timeout=timeout, set_as_default=False)
+        except Exception as exc:  # refused, timed out, not a Dask scheduler, unknown scheme
+            why = str(exc) or "no answer (the scheduler's port, not its dashboard's?)"
+            raise ValueError(f"cannot reach the Dask scheduler at {where} within {timeout:g} s: "
+                             f"{type(exc).__name__}: {why}") from None
+
+    @staticmethod
+    def _address_from_file(path, timeout: float) -> str:
+        """The address in a scheduler file, waiting up to ``timeout`` for the scheduler to write it
+        (distributed's own Client would wait for a missing file forever)."""
+        deadline = time.monotonic() + timeout
+        while True:
+            try:
+                address = json.loads(Path(path).read_text())["address"]
+                if isinstance(address, str) and address:
+                    return address
+                problem = f"address = {address!r}"
+            except FileNotFoundError:
+                problem = "no such file"
+            except (OSError, ValueError, TypeError, KeyError) as exc:
+                problem = f"not a Dask scheduler file ({type(exc).__name__}: {exc})"
+            if time.monotonic() >= deadline:
+                raise ValueError(f"scheduler file {str(path)!r}: {problem} after {timeout:g} s")
+            time.sleep(0.1)
+
+    @staticmethod
+    def _handshake(address: str, timeout: float) -> None:
+        """Open and close one connection to a tcp ``address`` within ``timeout``: the Client
+        itself waits forever on a port that accepts but does not speak Dask (a dashboard's)."""
+        import asyncio
+        from concurrent.futures import ThreadPoolExecutor
+
+        try:
+            from distributed.comm import connect
+            from distributed.comm.addressing import parse_address
+            from distributed.comm.registry import get_backend
+        except ImportError:  # internals moved in another version: the Client alone then
+            return
+
+        scheme = parse_address(address)[0]
+        get_backend(scheme)  # an unknown scheme is a ValueError here, not a half-made Client
+        if scheme != "tcp":
+            return
+
+        async def once():
+            comm = await connect(address, timeout=timeout)
+            await comm.close()
+
+        # in a thread of its own: the caller may be inside an event loop (Jupyter)
+        with ThreadPoolExecutor(1) as pool:
+            pool.submit(lambda: asyncio.run(asyncio.wait_for(once(), timeout))).result()
+
+    def map(self, fn, chunks):
+        import uuid
+
+        from distributed import as_completed
+        from distributed.comm import get_address_host
+
+        # the Dask threads on each machine (by host address), so a task knows its share
+        nthreads = self.client.nthreads()
+        per_host: dict[str, int] = {}
+        for worker, n in nthreads.items():
+            host = get_address_host(worker)
+            per_host[host] = per_host.get(host, 0) + n
+        shares = {worker: per_host[get_address_host(worker)] for worker in nthreads}
+        tag = uuid.uuid4().hex[:8]
+        futures = {self.client.submit(self._run_chunk, fn, shares, chunk,
+                                      key=f"railride-chunk-{tag}-{i}"): i
+                   for i, chunk in enumerate(chunks)}
+        try:
+            for fut in as_completed(futures, loop=self.client.loop):
+                i = futures.pop(fut)
+                yield i, fut.result()
+        finally:  # stopped early (an error, Ctrl-C): drop what has not finished
+            if futures:
+                self.client.cancel(list(futures))
+
+    @staticmethod
+    def _run_chunk(fn, shares: dict, chunk):
+        """On a worker: ``fn(chunk)`` on numba's thread count divided by the Dask threads on this
+        machine (``shares``, as the map started; this worker's own for a worker that joined
+        later). The thread count is per thread (`numba.set_num_threads`), so restored after."""
+        import numba
+        from distributed import get_worker
+
+        worker = get_worker()
+        share = shares.get(worker.address, worker.state.nthreads)
+        before = numba.get_num_threads()
+        numba.set_num_threads(max(1, numba.config.NUMBA_NUM_THREADS // max(1, share)))
+        try:
+            return fn(chunk)
+        finally:
+            numba.set_num_threads(before)
+
+    def close(self):
+        self.client.close()
+
+
+# -- the table of finished runs ----------------------------------------------------------------
+class RunTable:
+    """Every finished run, one row each, kept in a CSV file rewritten atomically after each
+    chunk: a reader never sees half a file, and an interrupted sweep loses at most the chunks
+    in flight."""
+
+    def __init__(self, path: str | Path | None = None, resume: bool = False):
+        self.path = None if path is None else Path(path)
+        self.frame = pd.DataFrame()
+        if self.path is not None and self.path.exists():
+            if not resume:
+                raise ValueError(f"{self.path} exists: pass resume to continue that sweep, or "
+                                 "choose another output folder")
+            try:
+                # keys are hex digests: an all-digit one must stay text to be recognised
+                self.frame = pd.read_csv(self.path, dtype={"key": str})
+            except (OSError, ValueError) as exc:
+                raise ValueError(f"cannot read the run table {self.path}: {exc}") from None
+
+    def done(self) -> dict[str, dict]:
+        if self.frame.empty:
+            return {}
+        return {row["key"]: row for row in self.frame.to_dict("records")}
+
+    def add(self, rows: list[dict]) -> None:
+        if not rows:
+            return
+        self.frame = pd.concat([self.frame, pd.DataFrame(rows)], ignore_index=True)
+        if self.path is not None:
+            atomic_write(self.path, lambda p: self.frame.to_csv(p, index=False))

@@ -1,0 +1,212 @@
+"""Frequency responses and modes of the passive vehicle, as studies with result objects.
+
+`frequency_responses` computes the steady-state response of the carbody to rails moving as
+z(t) = 1 m x sin(2 pi f t) on a log-spaced grid of frequencies, for in-phase rails (z_L = z_R:
+bounce and pitch) and anti-phase rails (z_L = -z_R: roll), every wheelset seeing the pattern
+delayed by its distance behind the leading one divided by the speed
+(`railride.vehicle.Vehicle.frequency_response`). It returns an `FrfResult`: the responses, their
+table and peaks (`railride.analysis.frf_frame`, `frf_peaks`) and the `Modes` of the vehicle.
+
+`modes` gives the `Modes` alone: the nine modes of `Vehicle.modes`, by undamped frequency.
+
+The vehicle is named as the command line names it: a preset name, a parameters file (TOML, see
+`VehicleParams.load`) or the `VehicleParams` themselves; the documents record which.
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+
+from . import validation
+from .analysis import FRF_MAGNITUDES, FRF_PATTERNS, frf_frame, frf_peaks
+from .files import FRF_FILES
+from .params import PRESETS, VehicleParams
+
+SCHEMA = "railride.frf/1"
+#: the ``rails`` of `frequency_responses`: one rail pattern, or both
+RAILS = (*FRF_PATTERNS, "both")
+#: the files `FrfResult.save` writes, in this order
+FILES = FRF_FILES
+
+
+def _vehicle(params) -> tuple[VehicleParams, str | Path | None]:
+    """(the parameters, where they came from: a preset name, a file, or None for values)."""
+    if params is None:
+        params = "paper"
+    if isinstance(params, str):
+        return VehicleParams.preset(params), params
+    if isinstance(params, os.PathLike):
+        return VehicleParams.load(Path(params)), Path(params)
+    if isinstance(params, VehicleParams):
+        return params, next((name for name, p in PRESETS.items() if p == params), None)
+    raise ValueError(f"params = {params!r}: must be VehicleParams, a preset name "
+                     f"({', '.join(PRESETS)}) or the path of a parameters file")
+
+
+@dataclass(frozen=True, eq=False)
+class Modes:
+    """The modes of the passive vehicle (`railride.vehicle.Mode`), by undamped frequency: a
+    sequence of `Mode` with its table (`to_pandas`) and records (`to_list`)."""
+
+    modes: tuple
+
+    def __iter__(self):
+        return iter(self.modes)
+
+    def __len__(self) -> int:
+        return len(self.modes)
+
+    def __getitem__(self, index):
+        return self.modes[index]
+
+    def to_list(self) -> list[dict]:
+        """The records of the modes (``Mode.to_dict()``): the JSON array of ``railride modes
+        --format json`` and the ``modes`` of the ``railride.frf/1`` document."""
+        return [m.to_dict() for m in self.modes]
+
+    def to_pandas(self):
+        """The modal table (`railride.tables.modes_frame`, modes.csv): mode number, label,
+        undamped and damped frequency [Hz], damping ratio."""
+        from .tables import modes_frame
+
+        return modes_frame(self.to_list())
+
+
+def modes(params=None) -> Modes:
+    """The nine modes of the passive vehicle ``params`` (`VehicleParams`, a preset name or the
+    path of a parameters file; default "paper"), by undamped natural frequency."""
+    from .vehicle import Vehicle
+
+    vehicle, _ = _vehicle(params)
+    return Modes(tuple(Vehicle(vehicle).modes()))
+
+
+@dataclass(frozen=True, eq=False)
+class FrfResult:
+    """The carbody frequency responses of `frequency_responses`: ``responses`` per rail pattern
+    (the complex Datasets of `Vehicle.frequency_response` over ``frequency`` [Hz], per metre of
+    rail amplitude) at ``speed`` [m/s], the log grid they were computed on (``fmin``, ``fmax``
+    [Hz], ``points``), the vehicle ``params`` and where they came from (``source``: a preset
+    name, a parameters file, or None for values not equal to a preset), and its ``modes``.
+
+    The result protocol: `to_dict` (the ``railride.frf/1`` document), `to_pandas` (the table of
+    magnitudes and phases, frf.csv), `plot` (magnitudes against frequency with the modes
+    marked), `save` (frf.csv, frf.json, frf.png, modes.csv); `peaks` the peak of each response.
+    """
+
+    params: VehicleParams
+    source: str | Path | None
+    speed: float
+    frequency: np.ndarray
+    responses: dict[str, xr.Dataset]
+    modes: Modes
+    fmin: float
+    fmax: float
+    points: int
+
+    @property
+    def patterns(self) -> tuple[str, ...]:
+        return tuple(self.responses)
+
+    @property
+    def vehicle_name(self) -> str:
+        """The preset name or the parameters file, as the figure's title gives the vehicle."""
+        return "custom parameters" if self.source is None else str(self.source)
+
+    def to_pandas(self):
+        """One row per rail pattern and frequency: magnitudes and phases of the carbody
+        responses (`railride.analysis.frf_frame`)."""
+        return frf_frame(self.responses)
+
+    def peaks(self) -> dict:
+        """Per pattern and magnitude column, the largest magnitude on the grid and its frequency
+        (None where the pattern does not excite the response; `railride.analysis.frf_peaks`)."""
+        return frf_peaks(self.to_pandas())
+
+    def to_dict(self) -> dict:
+        """The ``railride.frf/1`` document (docs/cli.md): the vehicle, the settings, the grid,
+        the magnitudes per pattern, the peaks and the modes."""
+        from . import __version__
+
+        frame = frf_frame(self.responses)
+        vehicle: dict[str, object]
+        if isinstance(self.source, str):
+            vehicle = {"vehicle_preset": self.source}
+        elif self.source is not None:
+            vehicle = {"vehicle_params_file": str(self.source)}
+        else:
+            vehicle = {"vehicle_params": self.params.to_dict()}
+        return {
+            "schema": SCHEMA,
+            "railride_version": __version__,
+            **vehicle,
+            "settings": {"speed_m_s": self.speed, "rails": list(self.patterns), "fmin_hz": self.fmin,
+                         "fmax_hz": self.fmax, "points": self.points},
+            "frequency_hz": [float(f) for f in self.frequency],
+            "responses": {p: {c: [float(v) for v in frame.loc[frame["pattern"] == p, c]]
+                              for c in FRF_MAGNITUDES} for p in self.patterns},
+            "peaks": frf_peaks(frame),
+            "modes": self.modes.to_list(),
+        }
+
+    def title(self) -> str:
+        """The title of the figure: the speed, the vehicle and the suspension."""
+        return (f"Carbody frequency responses per metre of rail amplitude - V = {self.speed:g} m/s, "
+                f"vehicle {self.vehicle_name}, passive suspension")
+
+    def plot(self, ax=None):
+        """Magnitudes against frequency, one panel per response, with the modes marked
+        (`railride.plots.frf.plot_frf`); ``ax`` None for a new figure, or four Axes. Returns
+        the figure."""
+        from .plots.frf import plot_frf
+
+        return plot_frf(self.to_pandas(), self.modes.to_pandas(), ax=ax, title=self.title())
+
+    def save(self, folder) -> list:
+        """frf.csv, frf.json, frf.png and modes.csv into ``folder``, all or nothing (other files
+        stay). Returns the paths."""
+        from .files import write_frf_outputs
+
+        return write_frf_outputs(self.to_pandas(), self.modes.to_list(), folder, self.to_dict(),
+                                 title=self.title())
+
+
+def frequency_responses(params=None, *, speed: float | None = None, rails: str = "both",
+                        fmin: float = 0.1, fmax: float = 30.0, points: int = 400) -> FrfResult:
+    """The carbody frequency responses of the passive vehicle ``params`` (`VehicleParams`, a
+    preset name or the path of a parameters file; default "paper") at ``speed`` [m/s] (default
+    the scenarios' default speed), for ``rails`` "in-phase", "anti-phase" or "both", on
+    ``points`` (>= 2) frequencies log-spaced from ``fmin`` to ``fmax`` [Hz] (both exactly on the
+    grid). Returns an `FrfResult` with the vehicle's modes."""
+    from .vehicle import Vehicle
+
+    speed = _default_speed() if speed is None else validation.number("speed", speed, "positive", "m/s")
+    validation.choice("rails", rails, RAILS)
+    fmin = validation.number("fmin", fmin, "positive", "Hz")
+    fmax = validation.number("fmax", fmax, "positive", "Hz")
+    if not fmax > fmin:
+        raise ValueError(f"fmax = {fmax:g} Hz: must be above fmin = {fmin:g} Hz")
+    points = validation.integer("points", points, 2)
+    vehicle_params, source = _vehicle(params)
+    patterns = list(FRF_PATTERNS) if rails == "both" else [rails]
+    vehicle = Vehicle(vehicle_params)
+    frequency = np.geomspace(fmin, fmax, points)
+    frequency[0], frequency[-1] = fmin, fmax  # exactly, without rounding
+    responses = {p: vehicle.frequency_response(frequency, speed, p) for p in patterns}
+    return FrfResult(vehicle_params, source, speed, frequency, responses,
+                     Modes(tuple(vehicle.modes())), fmin, fmax, points)
+
+
+def _default_speed() -> float:
+    """The default speed of a `railride.track.Scenario` [m/s]."""
+    import dataclasses
+
+    from .track import Scenario
+
+    speed = next(f for f in dataclasses.fields(Scenario) if f.name == "speed")
+    return float(speed.default)  # type: ignore[arg-type]  # a plain default, never MISSING

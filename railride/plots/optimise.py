@@ -1,0 +1,84 @@
+"""The global methods of `railride.optimise`: the convergence of the differential evolution and
+the Sobol indices of the objective."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ._style import given_axes, new_figure
+
+
+def _expect(value, name: str, kind: str):
+    from .. import optimise
+
+    if not isinstance(value, getattr(optimise, kind)):
+        raise ValueError(f"{name}: expected a railride.optimise.{kind}, got {type(value).__name__}")
+
+
+def _objective_label(definition) -> str:
+    kind = getattr(definition, "kind", None)
+    return f"objective J ({kind})" if kind else "objective J"
+
+
+def plot_convergence(result, ax=None, *, title: str | None = None):
+    """The search of `railride.optimise.optimise` (an `OptimiseResult`): per generation
+    (0 the initial population) the lowest objective among its runs (dots) and the lowest so far
+    (a step line), against the generation. ``ax``: one Axes to draw in (no title then), or None
+    for a new figure titled ``title`` (default: the suspension, the generations, the runs and
+    the objective reached). Returns the `Figure`."""
+    from matplotlib.ticker import MaxNLocator
+
+    _expect(result, "result", "OptimiseResult")
+    frame = result.to_pandas()
+    if ax is None:
+        fig = new_figure((8.0, 4.8))
+        a = fig.subplots()
+    else:
+        (a,) = given_axes(ax, 1, "the objective against generation")
+        fig = a.figure
+    a.plot(frame["generation"], frame["objective"], "o", color="0.55", markersize=4,
+           label="lowest in the generation")
+    a.step(frame["generation"], frame["best"], where="post", color="tab:red", linewidth=1.4,
+           label="lowest so far")
+    a.xaxis.set_major_locator(MaxNLocator(integer=True))
+    a.set_xlabel("generation (0: the initial population)")
+    a.set_ylabel(_objective_label(result.objective_definition))
+    a.grid(True, linewidth=0.4, alpha=0.6)
+    a.legend(fontsize="small")
+    if ax is None:
+        fig.suptitle(title or (f"Differential evolution: {result.suspension or 'controller'}, "
+                               f"{len(result.parameters)} gains, {result.generations} generations, "
+                               f"{result.n_runs} runs; J = {result.objective:.4g}"), fontsize="medium")
+    return fig
+
+
+def plot_indices(result, ax=None, *, title: str | None = None):
+    """The Sobol indices of `railride.optimise.sensitivity` (a `SensitivityResult`): per gain,
+    a bar of its first-order index (its effect alone) and one of its total index (with every
+    interaction), horizontal, the gains top to bottom in their order. ``ax``: one Axes to draw
+    in (no title then), or None for a new figure titled ``title`` (default: the suspension and
+    the runs). Returns the `Figure`."""
+    _expect(result, "result", "SensitivityResult")
+    names = list(result.parameters)
+    y = np.arange(len(names))
+    if ax is None:
+        fig = new_figure((8.0, 1.2 + 0.45 * len(names)))
+        a = fig.subplots()
+    else:
+        (a,) = given_axes(ax, 1, "the indices of every gain")
+        fig = a.figure
+    height = 0.38
+    a.barh(y - height / 2, np.asarray(result.first_order, dtype=float), height, color="tab:blue",
+           label="first order")
+    a.barh(y + height / 2, np.asarray(result.total, dtype=float), height, color="tab:orange",
+           label="total")
+    a.set_yticks(y, names)
+    a.invert_yaxis()  # the first gain on top
+    a.axvline(0.0, color="0.4", linewidth=0.6)
+    a.set_xlabel(f"Sobol index of the {_objective_label(result.objective_definition)}")
+    a.grid(True, axis="x", linewidth=0.4, alpha=0.6)
+    a.legend(fontsize="small")
+    if ax is None:
+        fig.suptitle(title or (f"Sobol indices: {result.suspension or 'controller'}, gains uniform "
+                               f"in log10 over the search box, {result.n_runs} runs"), fontsize="medium")
+    return fig

@@ -1,0 +1,141 @@
+"""`RideResult`'s result protocol (`to_dict`, `to_pandas`, `plot`, `save`), the damper a
+suspension was named by, the output rate's resolution of a random track, and the studies'
+checks before their first run."""
+
+import json
+
+import matplotlib
+import numpy as np
+import pytest
+
+from railride import dampers
+from railride.comparison import compare
+from railride.files import OUTPUT_FILES
+from railride.metrics import to_dict as metrics_record
+from railride.params import VehicleParams
+from railride.pareto import pareto
+from railride.simulation import SCHEMA, RideResult, simulate
+from railride.solver import RESOLUTION, SolverSettings, check_resolution
+from railride.suspension import Suspension
+from railride.track import scenario
+from railride.tuning import tune
+
+matplotlib.use("Agg")
+
+SC = scenario("paper-sine", duration=0.5)
+
+
+@pytest.fixture(scope="module")
+def mr():
+    return simulate(SC, suspension=Suspension.named("mr", damper="dyke1996", damper_scale=2.0, voltage=1.0))
+
+
+# -- to_dict ------------------------------------------------------------------------------------
+def test_the_document_of_a_run(mr):
+    doc = mr.to_dict((0.1, 0.5))
+    assert list(doc) == ["schema", "railride_version", "scenario", "vehicle_preset", "suspension",
+                         "settings", "metrics"]
+    assert doc["schema"] == SCHEMA == "railride.simulation/1"
+    assert doc["scenario"] == SC.describe() and doc["vehicle_preset"] == "paper"
+    assert doc["suspension"] == {"type": "mr", "damper": "dyke1996", "voltage_v": 1.0, "damper_scale": 2.0}
+    assert doc["settings"] == {"dt_s": 1e-4, "output_rate_hz": 1000.0, "window_s": [0.1, 0.5]}
+    assert doc["metrics"] == metrics_record(mr.metrics((0.1, 0.5)))
+    json.dumps(doc, allow_nan=False)
+    # the whole run by default; comfort on request; the vehicle as the caller names it
+    whole = mr.to_dict(comfort=True, vehicle={"vehicle_params_file": "car.toml"})
+    assert whole["settings"]["window_s"] == [0.0, 0.5] and "comfort" in whole
+    assert list(whole)[3] == "vehicle_params_file" and "vehicle_preset" not in whole
+
+
+def test_the_document_names_the_vehicle_and_the_suspension():
+    soft = VehicleParams.preset("paper").replace(k_sz=3e5)
+    passive = simulate(SC, soft)
+    doc = passive.to_dict()
+    assert doc["suspension"] == {"type": "passive"}
+    assert doc["vehicle_params"] == soft.to_dict() and "vehicle_preset" not in doc
+    # a Dataset alone (a result read back) gives the same document
+    again = RideResult(passive.dataset).to_dict()
+    assert again == doc
+    closed = simulate(SC, suspension=Suspension.named("pid")).to_dict()["suspension"]
+    assert closed["type"] == "pid" and closed["damper"] == "railway" and "voltage_v" not in closed
+    assert closed["controller"]["name"] == "pid" and closed["inner_loop"] is not None
+    with pytest.raises(ValueError, match="to_dict describes a single run"):
+        simulate([SC, SC]).to_dict()
+
+
+def test_plot_pandas_and_save(mr, tmp_path):
+    import matplotlib.pyplot as plt
+
+    fig = mr.plot()
+    assert len(fig.axes) == 4
+    mine, axes = plt.subplots(4, 1)
+    assert mr.plot(ax=axes) is mine
+    plt.close("all")
+    assert "carbody_bounce" in mr.to_pandas().columns
+    paths = mr.save(tmp_path / "ride", (0.1, 0.5))
+    assert [p.name for p in paths] == list(OUTPUT_FILES)
+    assert json.loads((tmp_path / "ride" / "metrics.json").read_text()) == mr.to_dict((0.1, 0.5))
+
+
+# -- the damper a suspension was named by -----------------------------------------------------------
+def test_a_suspension_keeps_the_name_and_scale_of_its_damper():
+    scaled = Suspension.named("mr", damper="dyke1996", damper_scale=8.0)
+    assert scaled.damper == dampers.RAILWAY and scaled.damper_scale == 8.0
+    assert scaled.damper_name == "dyke1996"  # as named, though the model is railway's
+    assert scaled == Suspension.semi_active(dampers.RAILWAY)  # the scale is a record, not the value
+    assert Suspension.semi_active("railway", damper_scale=0.5).damper_name == "railway"
+    assert Suspension(dampers.RAILWAY.scaled(3.0)).damper_name == "bouc-wen"  # a model given as such
+    assert Suspension.named("pid", damper="ideal").damper_name == "ideal"
+    assert Suspension.passive().damper_name is None
+    with pytest.raises(ValueError, match="damper_scale = 0"):
+        Suspension("railway", damper_scale=0)
+
+
+# -- what an output rate resolves ---------------------------------------------------------------------
+def test_the_output_rate_must_resolve_a_random_track():
+    fine = scenario("fra4", min_wavelength=0.1, duration=1.0)  # 556 Hz at 55.56 m/s
+    with pytest.raises(ValueError, match=r"min_wavelength = 0.1 m at speed 55.56 m/s passes at 555.6 Hz, "
+                                         r"more than output_rate 1000 Hz / 2.5 = 400 Hz"):
+        check_resolution(fine, 1000.0)
+    check_resolution(fine, 555.6 * RESOLUTION)
+    check_resolution(scenario("paper-sine", speed=300.0), 10.0)  # no random track, nothing to resolve
+    with pytest.raises(ValueError, match="output_rate 1000 Hz"):
+        simulate(fine)
+
+
+# -- the studies check their settings before the first run ------------------------------------------
+@pytest.mark.parametrize("run, match", [
+    (lambda: compare(SC, controllers=["pid"], solver=SolverSettings(control_rate=300.0)),
+     "control_rate = 300 Hz with dt = 0.0001 s"),
+    (lambda: compare(scenario("fra4", min_wavelength=0.1), controllers=["pid"]), "min_wavelength = 0.1 m"),
+    (lambda: compare(SC, damper="ideal", damper_scale=2.0), "damper_scale = 2"),
+    (lambda: tune(("pid",), max_passes=0), "max_passes = 0: must be a whole number >= 1"),
+    (lambda: tune(("pid",), n_values=2), "n_values = 2: must be a whole number >= 3"),
+    (lambda: tune(("pid",), span=float("inf")), "span = inf: must be a finite number > 1"),
+    (lambda: tune(("pid",), span=1.0), "span = 1.0: must be a finite number > 1"),
+    (lambda: tune(("pid",), damper="mr9"), "unknown damper model 'mr9'"),
+    (lambda: tune(("pid",), damper="ideal", damper_scale=2.0), "damper_scale = 2"),
+    (lambda: tune(("pid",), scenario="fra4", scenario_options={"min_wavelength": 0.1}), "min_wavelength = 0.1 m"),
+    (lambda: pareto("pid", seed=-1), "seed = -1: must be a whole number >= 0"),
+    (lambda: pareto("pid", n_samples=3), "n_samples = 3: must be a power of two"),
+    (lambda: pareto("pid", damper="mr9"), "unknown damper model 'mr9'"),
+    (lambda: pareto("pid", scenario="fra4", scenario_options={"min_wavelength": 0.1}), "min_wavelength = 0.1 m"),
+])
+def test_the_studies_refuse_bad_settings_before_running(run, match, monkeypatch):
+    from railride import simulation
+
+    def no_run(*args, **kwargs):
+        raise AssertionError("a run started before the settings were checked")
+
+    monkeypatch.setattr(simulation, "simulate", no_run)
+    monkeypatch.setattr("railride.comparison.simulate", no_run)
+    with pytest.raises(ValueError, match=match):
+        run()
+
+
+def test_the_studies_take_solver_settings_only():
+    for call in (lambda: compare(SC, dt=1e-4), lambda: tune(("pid",), dt=1e-4),
+                 lambda: pareto("pid", dt=1e-4)):
+        with pytest.raises(TypeError, match="'dt'"):
+            call()
+    assert np.isfinite(simulate(SC, solver=SolverSettings(dt=5e-5)).metrics().values).all()
