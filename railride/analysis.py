@@ -104,7 +104,7 @@ def frf_peaks(frame: pd.DataFrame) -> dict:
     """Per pattern and magnitude column of `frf_frame`: {"magnitude", "frequency_hz"} at the
     largest magnitude on the grid; a response the pattern does not excite (`frf_excited`)
     has "frequency_hz" None."""
-    out = {}
+    out: dict[str, dict] = {}
     top = {c: float(frame[c].max()) for c in FRF_MAGNITUDES}
     for pattern, part in frame.groupby("pattern", sort=False):
         out[pattern] = {}

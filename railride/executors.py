@@ -61,6 +61,7 @@ class DaskExecutor:
             raise ValueError("give a scheduler address (tcp://host:port) or a scheduler file")
         if scheduler_file is not None:
             address = self._address_from_file(scheduler_file, timeout)
+        assert address is not None  # one of the two was given, checked above
         self.address = address
         where = f"{address}" + ("" if scheduler_file is None else f" (from {scheduler_file})")
         try:
@@ -154,7 +155,7 @@ class DaskExecutor:
         worker = get_worker()
         share = shares.get(worker.address, worker.state.nthreads)
         before = numba.get_num_threads()
-        numba.set_num_threads(max(1, numba.config.NUMBA_NUM_THREADS // max(1, share)))
+        numba.set_num_threads(max(1, numba.config.NUMBA_NUM_THREADS // max(1, share)))  # type: ignore[attr-defined]
         try:
             return fn(chunk)
         finally:

@@ -258,7 +258,8 @@ def write_compare_outputs(comparison, out_dir, doc: dict) -> list[Path]:
     _expect(comparison, "comparison", "comparison", "Comparison")
     text = json_text(doc)
     ds = comparison.combined()
-    settings = doc.get("settings") if isinstance(doc.get("settings"), dict) else {}
+    given = (doc or {}).get("settings")
+    settings = given if isinstance(given, dict) else {}
     window = settings.get("window_s")
     psd = comparison_psd(ds, window)
     title = psd_title(ds, window, PSD_SEGMENT_S)

@@ -208,7 +208,7 @@ def evaluate(cases: list[Case], base_gains=None, *, params=None, solver=None, wi
                     for (pos, index), column in zip(COMFORT_INDICES, COMFORT_COLUMNS):
                         row[column] = (float(cf.isel(sample=int(np.searchsorted(ok, j)))
                                              .sel(position=pos, index=index))
-                                       if np.isnan(diverged_at[j]) else np.nan)
+                                       if np.isnan(diverged_at[j]) and cf is not None else np.nan)
                 rows[i] = row
     return [rows[i] for i in range(len(cases))]
 
@@ -268,8 +268,8 @@ def run_cases(cases: list[Case], *, executor=None, table: RunTable | None = None
                 "base_gains": base.to_toml(), **other_settings(vehicle, solver)}
     if comfort:  # only then: the keys of sweeps without comfort stay as they were
         settings["comfort"] = True
-    settings = json.dumps(settings, sort_keys=True)
-    keys = [hashlib.sha1((c.key + settings).encode()).hexdigest()[:16] for c in cases]
+    settings_text = json.dumps(settings, sort_keys=True)
+    keys = [hashlib.sha1((c.key + settings_text).encode()).hexdigest()[:16] for c in cases]
     pending, seen = [], set()
     key_of = {}
     for c, k in zip(cases, keys):

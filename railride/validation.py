@@ -30,7 +30,7 @@ def is_number(value) -> bool:
 def shown(value) -> str:
     """``value`` as an error message shows it: NumPy scalars as the plain number they hold."""
     if is_number(value) and type(value) not in (int, float):
-        value = value.item()  # type: ignore[union-attr]
+        value = value.item()
     return repr(value)
 
 

@@ -23,15 +23,16 @@ TRACKING_OPTIONS = {"desired": "--desired", "amplitude": "--amplitude", "frequen
 # -- damper -------------------------------------------------------------------------------------
 @app.command()
 def damper(
+    *,  # keyword-only, so that the required options may follow ones with defaults
     model: RigModelOption = DEFAULT_DAMPER,
     amplitude: Annotated[float, typer.Option(
-        "--amplitude", metavar="M", help="Amplitude of the sine extension x [m], > 0.")] = ...,
+        "--amplitude", metavar="M", help="Amplitude of the sine extension x [m], > 0.")],
     frequency: Annotated[float, typer.Option(
-        "--frequency", metavar="HZ", help="Frequency of the sine extension [Hz], > 0.")] = ...,
+        "--frequency", metavar="HZ", help="Frequency of the sine extension [Hz], > 0.")],
     voltage: Annotated[str, typer.Option(
         "--voltage", metavar="V[,V...]",
         help="Constant command voltages [V], comma-separated, each within the damper's range "
-             "(passive-off and passive-on stand for its lowest and highest voltage).")] = ...,
+             "(passive-off and passive-on stand for its lowest and highest voltage).")],
     cycles: Annotated[int, typer.Option(
         "--cycles", metavar="N",
         help="Cycles driven per voltage, >= 2; the last one is reported (steady state).")] = 4,

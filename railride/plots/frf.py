@@ -28,7 +28,7 @@ def _mode_groups(modes: pd.DataFrame | None, lo: float, hi: float):
     """The modes inside [lo, hi] as (frequency, [mode numbers]) lines, modes within 1 % of each
     other sharing a line; and the labels of those lines, one per cluster of lines closer than
     10 % (they would overlap on the log axis), at the clusters' geometric centres."""
-    groups = []
+    groups: list[tuple[float, list[int]]] = []
     if modes is not None:
         for _, m in modes.sort_values("frequency_hz").iterrows():
             f = float(m["frequency_hz"])
@@ -38,7 +38,7 @@ def _mode_groups(modes: pd.DataFrame | None, lo: float, hi: float):
                 groups[-1][1].append(int(m["mode"]))
             else:
                 groups.append((f, [int(m["mode"])]))
-    labels_at = []  # (first frequency, [mode numbers], last frequency)
+    labels_at: list[tuple] = []  # (first frequency, [mode numbers], last frequency)
     for f, numbers in groups:
         if labels_at and f <= labels_at[-1][2] * 1.10:
             labels_at[-1] = (labels_at[-1][0], labels_at[-1][1] + numbers, f)

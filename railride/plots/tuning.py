@@ -113,7 +113,7 @@ def plot_sensitivity(curves, ax=None, *, title: str | None = None):
         any_zero = _draw_parameter(a, [c for c in curves if c.parameter == parameter], colour) or any_zero
     for a in axes[len(parameters):]:
         a.set_visible(False)
-    handles = [Line2D([], [], color=colour(k), marker="o", markersize=3, label=f"pass {k}")
+    handles: list = [Line2D([], [], color=colour(k), marker="o", markersize=3, label=f"pass {k}")
                for k in range(1, max_pass + 1)]
     handles.append(Line2D([], [], color="0.3", marker="*", linestyle="none", markersize=9,
                           markeredgecolor="k", markeredgewidth=0.5, label="kept in that pass"))
