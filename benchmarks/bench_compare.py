@@ -46,12 +46,18 @@ def main():
     with_out = _timed(cmd + ["--out", str(out_dir)])
     print("| benchmark | result | target |")
     print("|---|---|---|")
-    print(f"| `railride compare`, first run (numba cache empty: compilation included), best of {args.repeat} "
-          f"| {min(firsts):.1f} s (worst {max(firsts):.1f} s) | <= 15 s |")
-    print(f"| `railride compare`, second run (cache warm), best of {args.repeat} "
-          f"| {min(seconds):.2f} s (worst {max(seconds):.2f} s) | <= 3 s |")
-    print(f"| `railride compare --no-bounds`, cache warm, best of {args.repeat} "
-          f"| {min(no_bounds):.2f} s (worst {max(no_bounds):.2f} s) | |")
+    print(
+        f"| `railride compare`, first run (numba cache empty: compilation included), best of {args.repeat} "
+        f"| {min(firsts):.1f} s (worst {max(firsts):.1f} s) | <= 15 s |"
+    )
+    print(
+        f"| `railride compare`, second run (cache warm), best of {args.repeat} "
+        f"| {min(seconds):.2f} s (worst {max(seconds):.2f} s) | <= 3 s |"
+    )
+    print(
+        f"| `railride compare --no-bounds`, cache warm, best of {args.repeat} "
+        f"| {min(no_bounds):.2f} s (worst {max(no_bounds):.2f} s) | |"
+    )
     print(f"| `railride compare --out DIR` (cache warm: NetCDF, CSV, JSON, six plots) | {with_out:.2f} s | |")
 
 

@@ -33,13 +33,21 @@ def main():
 
     sc = scenario("paper-sine")  # 10 s at dt = 1e-4 s
     rows = []
-    for damper, voltage, note in (("railway", 0.0, "passive-off"), ("railway", 2.25, "passive-on"),
-                                  ("dyke1996", 2.25, "small-scale damper")):
+    for damper, voltage, note in (
+        ("railway", 0.0, "passive-off"),
+        ("railway", 2.25, "passive-on"),
+        ("dyke1996", 2.25, "small-scale damper"),
+    ):
         mr = Suspension.semi_active(damper, voltage=voltage)
         simulate(sc, suspension=mr)
         t = _min_time(lambda: simulate(sc, suspension=mr), args.repeat)
-        rows.append((f"vehicle, four `{damper}` MR dampers at {voltage:g} V ({note}), 10 s, dt = 1e-4 s",
-                     f"{t * 1e3:.1f} ms", "<= 50 ms" if damper == "railway" else ""))
+        rows.append(
+            (
+                f"vehicle, four `{damper}` MR dampers at {voltage:g} V ({note}), 10 s, dt = 1e-4 s",
+                f"{t * 1e3:.1f} ms",
+                "<= 50 ms" if damper == "railway" else "",
+            )
+        )
     # the closed loop: SAS (attitude+ride) with the shipped gains on each device
     for damper in ("railway", "ideal-damper", "ideal"):
         sas = Suspension.named("sas-attitude-ride", damper=damper)
@@ -54,8 +62,13 @@ def main():
     batch = [Suspension.semi_active("railway", voltage=float(v)) for v in np.linspace(0.0, 2.25, 64)]
     simulate(sc_batch, suspension=batch)
     t = _min_time(lambda: simulate(sc_batch, suspension=batch), max(1, args.repeat // 2))
-    rows.append(("batch of 64 voltages x 20 000 steps, `railway` dampers, both cores",
-                 f"{64 * 20_000 / t / 1e6:.2f} M sample-steps/s", ""))
+    rows.append(
+        (
+            "batch of 64 voltages x 20 000 steps, `railway` dampers, both cores",
+            f"{64 * 20_000 / t / 1e6:.2f} M sample-steps/s",
+            "",
+        )
+    )
     for name in ("railway", "spencer1997"):
         rig.cycles(name, 0.015, 2.5, [0.0])
         t = _min_time(lambda: rig.cycles(name, 0.015, 2.5, [0.0, 0.75, 1.5, 2.25]), args.repeat)

@@ -57,16 +57,42 @@ def bench_kernel_only(repeat):
 
     def run():
         x = np.zeros((1, kernels.NX))
-        outs = ([np.empty((1, rows, k)) for k in (9, 9, 9, 4, 8, 8)]
-                + [np.empty((1, 1, kernels.N_DS)), np.empty((1, 1, 4)), np.empty((1, 1, 4))])
-        kernels.run_batch(0, 1, kernels.LAW_VISCOUS_IN_C, x, 0, n_steps, True, stride, dt,
-                          sysm["A"][None], sysm["TS"][None], sysm["c_sec"][None],
-                          np.zeros((1, 16)), np.zeros((1, 4)),
-                          utab, np.zeros(1, np.int64), ftab, np.zeros(1, np.int64),
-                          np.array([len(utab)]), np.array([itv]),
-                          False, 1, np.zeros((1, 4, 6)), np.zeros((1, 4, 3)), np.zeros((1, 2)),
-                          np.zeros((0, 6)), *outs,
-                          np.zeros(1, np.int64), np.zeros(1, np.int64))
+        outs = [np.empty((1, rows, k)) for k in (9, 9, 9, 4, 8, 8)] + [
+            np.empty((1, 1, kernels.N_DS)),
+            np.empty((1, 1, 4)),
+            np.empty((1, 1, 4)),
+        ]
+        kernels.run_batch(
+            0,
+            1,
+            kernels.LAW_VISCOUS_IN_C,
+            x,
+            0,
+            n_steps,
+            True,
+            stride,
+            dt,
+            sysm["A"][None],
+            sysm["TS"][None],
+            sysm["c_sec"][None],
+            np.zeros((1, 16)),
+            np.zeros((1, 4)),
+            utab,
+            np.zeros(1, np.int64),
+            ftab,
+            np.zeros(1, np.int64),
+            np.array([len(utab)]),
+            np.array([itv]),
+            False,
+            1,
+            np.zeros((1, 4, 6)),
+            np.zeros((1, 4, 3)),
+            np.zeros((1, 2)),
+            np.zeros((0, 6)),
+            *outs,
+            np.zeros(1, np.int64),
+            np.zeros(1, np.int64),
+        )
 
     run()
     return _min_time(run, repeat)
@@ -90,8 +116,11 @@ def bench_cli(repeat):
     import railride
 
     exe = shutil.which("railride")
-    cmd = [exe, "simulate", "--format", "json"] if exe else [sys.executable, "-m", "railride.cli",
-                                                          "simulate", "--format", "json"]
+    cmd = (
+        [exe, "simulate", "--format", "json"]
+        if exe
+        else [sys.executable, "-m", "railride.cli", "simulate", "--format", "json"]
+    )
     pkg = Path(railride.__file__).parent
     for f in list((pkg / "__pycache__").glob("*.nbi")) + list((pkg / "__pycache__").glob("*.nbc")):
         f.unlink()
@@ -122,30 +151,36 @@ def main():
     args = ap.parse_args()
     import numba
 
-    res = {"date": date.today().isoformat(), "machine": f"{platform.machine()}, {os.cpu_count()} cores, "
-           f"{_cpu_name()}", "python": platform.python_version(),
-           "numba": numba.__version__, "numpy": np.__version__,
-           "threads": numba.config.NUMBA_NUM_THREADS}
+    res = {
+        "date": date.today().isoformat(),
+        "machine": f"{platform.machine()}, {os.cpu_count()} cores, {_cpu_name()}",
+        "python": platform.python_version(),
+        "numba": numba.__version__,
+        "numpy": np.__version__,
+        "threads": numba.config.NUMBA_NUM_THREADS,
+    }
     res["single_run_s"], res["single_dataset_s"], res["single_metrics_s"] = bench_single(args.repeat)
     res["kernel_only_s"] = bench_kernel_only(args.repeat)
     for n in (64, 512):
         res[f"batch_{n}_sample_steps_per_s"], res[f"batch_{n}_s"] = bench_batch(n, max(2, args.repeat // 2))
     res["cli_cold_s"], res["cli_warm_s"], res["import_s"] = bench_cli(max(2, args.repeat // 2))
 
-    print(f"{res['date']}, {res['machine']}, Python {res['python']}, numba {res['numba']}, "
-          f"{res['threads']} threads\n")
+    print(f"{res['date']}, {res['machine']}, Python {res['python']}, numba {res['numba']}, {res['threads']} threads\n")
     print("| benchmark | result | target |")
     print("|---|---|---|")
-    print(f"| one 10 s passive run, dt = 1e-4 s, `simulate()` after compilation | "
-          f"{res['single_run_s'] * 1e3:.1f} ms | <= 20 ms |")
+    print(
+        f"| one 10 s passive run, dt = 1e-4 s, `simulate()` after compilation | "
+        f"{res['single_run_s'] * 1e3:.1f} ms | <= 20 ms |"
+    )
     print(f"| the same, compiled stepper alone | {res['kernel_only_s'] * 1e3:.1f} ms | |")
     print(f"| the same, `simulate().dataset` (xarray Dataset assembled) | {res['single_dataset_s'] * 1e3:.1f} ms | |")
     print(f"| the same, `simulate().metrics()` | {res['single_metrics_s'] * 1e3:.1f} ms | |")
     for n in (64, 512):
-        print(f"| batch of {n} samples x 20 000 steps | {res[f'batch_{n}_sample_steps_per_s'] / 1e6:.2f} M "
-              f"sample-steps/s ({res[f'batch_{n}_s']:.2f} s) | >= 2 M/s |")
-    print(f"| `railride simulate`, first call (empty numba cache, compile included) | "
-          f"{res['cli_cold_s']:.1f} s | |")
+        print(
+            f"| batch of {n} samples x 20 000 steps | {res[f'batch_{n}_sample_steps_per_s'] / 1e6:.2f} M "
+            f"sample-steps/s ({res[f'batch_{n}_s']:.2f} s) | >= 2 M/s |"
+        )
+    print(f"| `railride simulate`, first call (empty numba cache, compile included) | {res['cli_cold_s']:.1f} s | |")
     print(f"| `railride simulate`, second call (numba cache) | {res['cli_warm_s']:.2f} s | |")
     print(f"| of which Python imports | {res['import_s']:.2f} s | |")
     if args.json:

@@ -23,14 +23,19 @@ k_sz = 2.0e5   # secondary vertical stiffness per corner, N/m (paper: 2.9e5)
 m_c = 4.5e4    # carbody mass, kg (paper: 3.96e4)
 """
 
-RESPONSES = {"acceleration_m_s2": "acceleration [m/s^2]", "displacement_m": "displacement [m]",
-             "pitch_deg": "pitch [deg]", "roll_deg": "roll [deg]"}
+RESPONSES = {
+    "acceleration_m_s2": "acceleration [m/s^2]",
+    "displacement_m": "displacement [m]",
+    "pitch_deg": "pitch [deg]",
+    "roll_deg": "roll [deg]",
+}
 
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--out", type=Path, default=None,
-                        help="folder for the output files (default: a temporary folder)")
+    parser.add_argument(
+        "--out", type=Path, default=None, help="folder for the output files (default: a temporary folder)"
+    )
     args = parser.parse_args()
     out = args.out or Path(tempfile.mkdtemp(prefix="railride-"))
     out.mkdir(parents=True, exist_ok=True)
@@ -63,9 +68,11 @@ def main():
     print("\npaper-sine, passive suspension: RMS (peak-to-peak)")
     print(f"{'response':<24}{'paper':>21}{'custom':>21}")
     for r, label in RESPONSES.items():
-        cells = "".join(f"{float(metrics.isel(sample=i).sel(response=r, statistic='rms')):>11.4g} "
-                        f"({float(metrics.isel(sample=i).sel(response=r, statistic='ptp')):7.4g})"
-                        for i in range(2))
+        cells = "".join(
+            f"{float(metrics.isel(sample=i).sel(response=r, statistic='rms')):>11.4g} "
+            f"({float(metrics.isel(sample=i).sel(response=r, statistic='ptp')):7.4g})"
+            for i in range(2)
+        )
         print(f"{label:<24}{cells}")
     print(f"\nWrote {path} and {out / 'custom_vehicle_full.toml'}")
 

@@ -29,8 +29,9 @@ def rms_ratios(result, passive_rms):
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--out", type=Path, default=None,
-                        help="folder for the output files (default: a temporary folder)")
+    parser.add_argument(
+        "--out", type=Path, default=None, help="folder for the output files (default: a temporary folder)"
+    )
     args = parser.parse_args()
     out = args.out or Path(tempfile.mkdtemp(prefix="railride-"))
     out.mkdir(parents=True, exist_ok=True)
@@ -49,8 +50,9 @@ def main():
     # and the ideal actuator (force = demand). These may diverge with gains tuned for an MR
     # damper: mark it instead of stopping.
     for name in ("ideal-damper", "ideal"):
-        res = rr.simulate(sc, suspension=rr.Suspension.named("sas-attitude-ride", gains, damper=name),
-                          on_divergence="mark")
+        res = rr.simulate(
+            sc, suspension=rr.Suspension.named("sas-attitude-ride", gains, damper=name), on_divergence="mark"
+        )
         diverged = float(res.diverged_at[0])
         rows.append((name, rms_ratios(res, passive), None if math.isnan(diverged) else diverged))
 
@@ -62,20 +64,26 @@ def main():
             continue
         print(f"{name:<16}" + "".join(f"{r:>7.3f}" for r in ratios) + f"{ratios.max():>8.3f}")
     # Does a bigger MR damper keep improving the worst response?
-    worst = [ratios.max() for name, ratios, _ in rows[:len(SCALES)]]
+    worst = [ratios.max() for name, ratios, _ in rows[: len(SCALES)]]
     best = min(range(len(SCALES)), key=lambda i: worst[i])
     keeps = all(b < a for a, b in zip(worst, worst[1:]))
-    print(f"\nBest MR size here: railway x {SCALES[best]:g} (worst ratio {worst[best]:.3f}); "
-          + ("the worst ratio keeps falling with size." if keeps else
-             "a bigger MR damper does not keep improving it with these gains.")
-          + "\nSee docs/results.md, 'Damper authority', for the study with re-tuned gains.")
+    print(
+        f"\nBest MR size here: railway x {SCALES[best]:g} (worst ratio {worst[best]:.3f}); "
+        + (
+            "the worst ratio keeps falling with size."
+            if keeps
+            else "a bigger MR damper does not keep improving it with these gains."
+        )
+        + "\nSee docs/results.md, 'Damper authority', for the study with re-tuned gains."
+    )
 
     with open(out / "damper_size.csv", "w", newline="") as f:
         writer = csv.writer(f)
         writer.writerow(["damper", *(f"{r}_rms_ratio" for r in RESPONSES), "worst", "diverged_at_s"])
         for name, ratios, diverged in rows:
-            writer.writerow([name, *(f"{r:.6g}" for r in ratios), f"{ratios.max():.6g}",
-                             "" if diverged is None else diverged])
+            writer.writerow(
+                [name, *(f"{r:.6g}" for r in ratios), f"{ratios.max():.6g}", "" if diverged is None else diverged]
+            )
     print(f"Wrote {out / 'damper_size.csv'}")
 
 

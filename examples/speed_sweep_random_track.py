@@ -23,8 +23,9 @@ SEED = 0  # the realisation of the random track: the same rails at every speed
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--out", type=Path, default=None,
-                        help="folder for the output files (default: a temporary folder)")
+    parser.add_argument(
+        "--out", type=Path, default=None, help="folder for the output files (default: a temporary folder)"
+    )
     args = parser.parse_args()
     out = args.out or Path(tempfile.mkdtemp(prefix="railride-"))
     out.mkdir(parents=True, exist_ok=True)
@@ -33,17 +34,17 @@ def main():
 
     # One Case per (suspension, speed). scenario_options are the keyword arguments of
     # railride.scenario("fra4", ...); run_cases groups compatible cases into compiled batches.
-    cases = [Case(scenario="fra4", suspension=s,
-                  scenario_options={"seed": SEED, "speed": v, "duration": duration})
-             for s in SUSPENSIONS for v in speeds]
+    cases = [
+        Case(scenario="fra4", suspension=s, scenario_options={"seed": SEED, "speed": v, "duration": duration})
+        for s in SUSPENSIONS
+        for v in speeds
+    ]
     table = run_cases(cases)  # a pandas DataFrame, one row per case, in the order of `cases`
     table.to_csv(out / "sweep.csv", index=False)
 
     # RMS carbody acceleration per suspension, indexed by speed.
-    acc = {s: table[table["suspension"] == s].set_index("scenario.speed")["acceleration_m_s2_rms"]
-           for s in SUSPENSIONS}
-    print(f"FRA class 4 random track (seed {SEED}), {duration:g} s per run: "
-          "carbody acceleration RMS [m/s^2]")
+    acc = {s: table[table["suspension"] == s].set_index("scenario.speed")["acceleration_m_s2_rms"] for s in SUSPENSIONS}
+    print(f"FRA class 4 random track (seed {SEED}), {duration:g} s per run: carbody acceleration RMS [m/s^2]")
     print(f"{'speed [m/s]':>12}{'passive':>10}{'SAS (att.+ride)':>17}{'reduction':>11}")
     for v in speeds:
         p, c = acc["passive"][v], acc["sas-attitude-ride"][v]

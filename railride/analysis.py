@@ -24,12 +24,27 @@ FRF_PATTERNS = ("in-phase", "anti-phase")
 #: factor from the channel's unit, axis label of the plot (its unit), magnitude column plotted)
 FRF_RESPONSES = (
     ("bounce", "carbody_bounce", (("bounce_m_per_m", 1.0),), "bounce (m/m)", "bounce_m_per_m"),
-    ("pitch", "carbody_pitch", (("pitch_rad_per_m", 1.0), ("pitch_deg_per_m", 180.0 / math.pi)),
-     "pitch (deg/m)", "pitch_deg_per_m"),
-    ("roll", "carbody_roll", (("roll_rad_per_m", 1.0), ("roll_deg_per_m", 180.0 / math.pi)),
-     "roll (deg/m)", "roll_deg_per_m"),
-    ("acceleration", "carbody_acceleration", (("acceleration_m_s2_per_m", 1.0),),
-     "acceleration ((m/s$^2$)/m)", "acceleration_m_s2_per_m"),
+    (
+        "pitch",
+        "carbody_pitch",
+        (("pitch_rad_per_m", 1.0), ("pitch_deg_per_m", 180.0 / math.pi)),
+        "pitch (deg/m)",
+        "pitch_deg_per_m",
+    ),
+    (
+        "roll",
+        "carbody_roll",
+        (("roll_rad_per_m", 1.0), ("roll_deg_per_m", 180.0 / math.pi)),
+        "roll (deg/m)",
+        "roll_deg_per_m",
+    ),
+    (
+        "acceleration",
+        "carbody_acceleration",
+        (("acceleration_m_s2_per_m", 1.0),),
+        "acceleration ((m/s$^2$)/m)",
+        "acceleration_m_s2_per_m",
+    ),
 )
 #: the magnitude columns of `frf_frame`, in order
 FRF_MAGNITUDES = tuple(c for *_, columns, _, _ in FRF_RESPONSES for c, _ in columns)
@@ -51,8 +66,7 @@ def comparison_psd(ds: xr.Dataset, window=None, segment: float = PSD_SEGMENT_S) 
     from .metrics import select_window
 
     if "controller" not in ds.dims or "time" not in ds.dims:
-        raise ValueError("expected the combined() Dataset of a railride.comparison.Comparison "
-                         "(dims controller, time)")
+        raise ValueError("expected the combined() Dataset of a railride.comparison.Comparison (dims controller, time)")
     if "carbody_acceleration" not in ds.variables:
         raise ValueError("the dataset lacks the channel carbody_acceleration")
     part = select_window(ds, None if window is None else tuple(window))
@@ -64,8 +78,9 @@ def comparison_psd(ds: xr.Dataset, window=None, segment: float = PSD_SEGMENT_S) 
     freq = None
     for i, name in enumerate(controller_names(ds)):
         x = part["carbody_acceleration"].isel(controller=i).values
-        freq, pxx = welch(x, fs=fs, window="hann", nperseg=nperseg, noverlap=nperseg // 2,
-                          detrend="constant", scaling="density")
+        freq, pxx = welch(
+            x, fs=fs, window="hann", nperseg=nperseg, noverlap=nperseg // 2, detrend="constant", scaling="density"
+        )
         columns[name] = pxx
     return pd.DataFrame({"frequency_hz": freq, **columns})
 
@@ -111,7 +126,8 @@ def frf_peaks(frame: pd.DataFrame) -> dict:
         for c in FRF_MAGNITUDES:
             values = part[c].values
             k = int(np.argmax(values))
-            out[pattern][c] = {"magnitude": float(values[k]),
-                               "frequency_hz": (float(part["frequency_hz"].values[k])
-                                                if frf_excited(values, top[c]) else None)}
+            out[pattern][c] = {
+                "magnitude": float(values[k]),
+                "frequency_hz": (float(part["frequency_hz"].values[k]) if frf_excited(values, top[c]) else None),
+            }
     return out

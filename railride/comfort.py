@@ -57,26 +57,80 @@ class Weighting:
     source: str
 
 
-_ISO = ("ISO 2631-1:1997 Annex A Table A.1 / ISO 8041; checked against ISO 2631-1 Table 3 (Wk, Wd) "
-        "and Table 4 (Wc, We)")
-WEIGHTINGS = {w.name: w for w in (
-    Weighting("Wk", 0.4, 100.0, 12.5, 12.5, 0.63, 2.37, 0.91, 3.35, 0.91, 1.0,
-              "vertical (z), seat surface and feet of a seated person (ISO 2631-1)", _ISO),
-    Weighting("Wd", 0.4, 100.0, 2.0, 2.0, 0.63, None, None, None, None, 1.0,
-              "horizontal (x, y); EN 12299 lateral and longitudinal floor weighting", _ISO),
-    Weighting("Wc", 0.4, 100.0, 8.0, 8.0, 0.63, None, None, None, None, 1.0,
-              "seat-back, fore-and-aft (ISO 2631-1)", _ISO),
-    Weighting("We", 0.4, 100.0, 1.0, 1.0, 0.63, None, None, None, None, 1.0,
-              "rotational vibration (ISO 2631-1)", _ISO),
-    Weighting("Wb", 0.4, 100.0, 16.0, 16.0, 0.63, 2.5, 0.8, 4.0, 0.8, 1.024,
-              "vertical (z) floor weighting of EN 12299 (railway ride comfort)",
-              "EN 12299 (parameters as two third-party implementations give them, not read "
-              "from the standard; ISO 8041 / ISO 2631-4 Wb differs: docs/comfort.md)"),
-    Weighting("Wb8041", 0.4, 100.0, 16.0, 16.0, 0.55, 2.5, 0.9, 4.0, 0.95, 1.024,
-              "vertical (z) railway weighting Wb in the ISO 8041 / ISO 2631-4 form",
-              "ISO 8041 as tabulated in the Larson Davis HVM200 manual (Table 3.1, 'source: "
-              "ISO 8041'); not read from the standard itself; docs/comfort.md"),
-)}
+_ISO = "ISO 2631-1:1997 Annex A Table A.1 / ISO 8041; checked against ISO 2631-1 Table 3 (Wk, Wd) and Table 4 (Wc, We)"
+WEIGHTINGS = {
+    w.name: w
+    for w in (
+        Weighting(
+            "Wk",
+            0.4,
+            100.0,
+            12.5,
+            12.5,
+            0.63,
+            2.37,
+            0.91,
+            3.35,
+            0.91,
+            1.0,
+            "vertical (z), seat surface and feet of a seated person (ISO 2631-1)",
+            _ISO,
+        ),
+        Weighting(
+            "Wd",
+            0.4,
+            100.0,
+            2.0,
+            2.0,
+            0.63,
+            None,
+            None,
+            None,
+            None,
+            1.0,
+            "horizontal (x, y); EN 12299 lateral and longitudinal floor weighting",
+            _ISO,
+        ),
+        Weighting(
+            "Wc", 0.4, 100.0, 8.0, 8.0, 0.63, None, None, None, None, 1.0, "seat-back, fore-and-aft (ISO 2631-1)", _ISO
+        ),
+        Weighting(
+            "We", 0.4, 100.0, 1.0, 1.0, 0.63, None, None, None, None, 1.0, "rotational vibration (ISO 2631-1)", _ISO
+        ),
+        Weighting(
+            "Wb",
+            0.4,
+            100.0,
+            16.0,
+            16.0,
+            0.63,
+            2.5,
+            0.8,
+            4.0,
+            0.8,
+            1.024,
+            "vertical (z) floor weighting of EN 12299 (railway ride comfort)",
+            "EN 12299 (parameters as two third-party implementations give them, not read "
+            "from the standard; ISO 8041 / ISO 2631-4 Wb differs: docs/comfort.md)",
+        ),
+        Weighting(
+            "Wb8041",
+            0.4,
+            100.0,
+            16.0,
+            16.0,
+            0.55,
+            2.5,
+            0.9,
+            4.0,
+            0.95,
+            1.024,
+            "vertical (z) railway weighting Wb in the ISO 8041 / ISO 2631-4 form",
+            "ISO 8041 as tabulated in the Larson Davis HVM200 manual (Table 3.1, 'source: "
+            "ISO 8041'); not read from the standard itself; docs/comfort.md",
+        ),
+    )
+}
 
 
 def get_weighting(name: str) -> Weighting:
@@ -95,8 +149,7 @@ def _check_frequency(frequency_hz) -> np.ndarray:
         raise ValueError(f"frequency_hz = {frequency_hz!r}: must be numbers in Hz") from None
     bad = ~np.isfinite(f) | (f < 0)
     if np.any(bad):
-        raise ValueError(f"frequency_hz = {f[bad].ravel()[0]!r}: frequencies must be finite "
-                         "numbers >= 0 Hz")
+        raise ValueError(f"frequency_hz = {f[bad].ravel()[0]!r}: frequencies must be finite numbers >= 0 Hz")
     return f
 
 
@@ -109,13 +162,13 @@ def _analog_zpk(w: Weighting, omega=lambda f: 2.0 * math.pi * f):
     """Zeros, poles and gain of W(s); ``omega(f)`` maps each characteristic frequency to its
     angular frequency (the bilinear design passes its pre-warped one)."""
     w1, w2, w4 = omega(w.f1), omega(w.f2), omega(w.f4)
-    zeros = [0.0, 0.0]                                     # Hh: s^2
+    zeros = [0.0, 0.0]  # Hh: s^2
     poles = [*_quadratic(w1, Q_BAND), *_quadratic(w2, Q_BAND)]
-    gain = w.K * w2 * w2                                   # Hl: w2^2
-    poles += list(_quadratic(w4, w.Q4))                    # Ht denominator, times w4^2
+    gain = w.K * w2 * w2  # Hl: w2^2
+    poles += list(_quadratic(w4, w.Q4))  # Ht denominator, times w4^2
     if math.isinf(w.f3):
         gain *= w4 * w4
-    else:                                                  # (1 + s/w3) = (s + w3) / w3
+    else:  # (1 + s/w3) = (s + w3) / w3
         w3 = omega(w.f3)
         zeros.append(-w3)
         gain *= w4 * w4 / w3
@@ -189,12 +242,14 @@ def weight(name: str, signal, rate_hz: float) -> np.ndarray:
         raise ValueError(
             f"rate_hz = {rate:g} Hz is too low for weighting {w.name}: its upper band limit is "
             f"f2 = {w.f2:g} Hz, and the digital filter needs rate_hz >= {MIN_RATE_FACTOR:g} f2 = "
-            f"{MIN_RATE_FACTOR * w.f2:g} Hz (docs/comfort.md, 'Digital filter')")
+            f"{MIN_RATE_FACTOR * w.f2:g} Hz (docs/comfort.md, 'Digital filter')"
+        )
     x = _check_signal(signal)
     return sp_signal.sosfilt(_sos(w.name, rate), x, axis=-1)
 
 
 # -- windows ------------------------------------------------------------------------------------
+
 
 def _window_slice(n: int, rate: float, window) -> slice:
     """Samples start <= i / rate < end of a signal of n samples (t = 0 at the first one)."""
@@ -216,6 +271,7 @@ def _weighted_part(acceleration, rate_hz, weighting_name, window) -> tuple[np.nd
 
 # -- ISO 2631-1 ---------------------------------------------------------------------------------
 
+
 def weighted_rms(acceleration, rate_hz: float, weighting: str = "Wk", window=None):
     """Frequency-weighted RMS acceleration a_w [m/s^2] (ISO 2631-1, 6.1):
     a_w = [ (1/T) integral a_w(t)^2 dt ]^(1/2), the mean over the samples in ``window``.
@@ -231,7 +287,7 @@ def vdv(acceleration, rate_hz: float, weighting: str = "Wk", window=None):
     """Vibration dose value VDV [m/s^1.75] (ISO 2631-1, 6.3.2):
     VDV = [ integral a_w(t)^4 dt ]^(1/4), the integral a rectangle sum with dt = 1/rate_hz."""
     x, rate = _weighted_part(acceleration, rate_hz, weighting, window)
-    return _scalar(np.sum(x ** 4, axis=-1) / rate) ** 0.25
+    return _scalar(np.sum(x**4, axis=-1) / rate) ** 0.25
 
 
 def _scalar(v):
@@ -244,8 +300,13 @@ def _scalar(v):
 #: length of the EN 12299 RMS intervals [s]
 INTERVAL_S = 5.0
 #: (upper bound, label) of the EN 12299 mean comfort scale, N below the bound
-COMFORT_SCALE = ((1.0, "very comfortable"), (2.0, "comfortable"), (4.0, "medium"),
-                 (5.0, "uncomfortable"), (math.inf, "very uncomfortable"))
+COMFORT_SCALE = (
+    (1.0, "very comfortable"),
+    (2.0, "comfortable"),
+    (4.0, "medium"),
+    (5.0, "uncomfortable"),
+    (math.inf, "very uncomfortable"),
+)
 
 
 class ShortRunWarning(UserWarning):
@@ -260,9 +321,12 @@ def comfort_intervals(acceleration, rate_hz: float, window=None) -> np.ndarray:
     per = int(round(INTERVAL_S * rate))
     n = x.shape[-1] // per
     if n == 0:
-        warnings.warn(f"only {x.shape[-1] / rate:g} s of signal: EN 12299 takes RMS values over "
-                      f"{INTERVAL_S:g} s intervals; one interval over the whole signal is used",
-                      ShortRunWarning, stacklevel=2)
+        warnings.warn(
+            f"only {x.shape[-1] / rate:g} s of signal: EN 12299 takes RMS values over "
+            f"{INTERVAL_S:g} s intervals; one interval over the whole signal is used",
+            ShortRunWarning,
+            stacklevel=2,
+        )
         return np.sqrt(np.mean(x * x, axis=-1))[..., None]
     parts = x[..., : n * per].reshape(x.shape[:-1] + (n, per))
     return np.sqrt(np.mean(parts * parts, axis=-1))
@@ -287,12 +351,12 @@ def comfort_class(n_mv: float) -> str:
 
 # -- Sperling -----------------------------------------------------------------------------------
 
+
 def sperling_correction(frequency_hz) -> np.ndarray:
     """Sperling's vertical frequency correction F(f): 0.325 f^2 up to 5.9 Hz (the source gives it
     from 0.5 Hz; continued below), 400/f^2 from 5.9 to 20 Hz, 1 above 20 Hz."""
     f = _check_frequency(frequency_hz)
-    return np.where(f <= 5.9, 0.325 * f * f,
-                    np.where(f <= 20.0, 400.0 / np.maximum(f, 5.9) ** 2, 1.0))
+    return np.where(f <= 5.9, 0.325 * f * f, np.where(f <= 20.0, 400.0 / np.maximum(f, 5.9) ** 2, 1.0))
 
 
 def sperling_wz(acceleration, rate_hz: float, window=None):
@@ -313,8 +377,8 @@ def sperling_wz(acceleration, rate_hz: float, window=None):
     if n % 2 == 0:
         amplitude[..., -1] = spectrum[..., -1]  # the Nyquist line has no mirror image
     a_cm = 100.0 * amplitude
-    total = np.sum(a_cm ** 3 * sperling_correction(f) / f, axis=-1)
-    return _scalar(0.896 * total ** 0.1)
+    total = np.sum(a_cm**3 * sperling_correction(f) / f, axis=-1)
+    return _scalar(0.896 * total**0.1)
 
 
 # -- on the simulated carbody -------------------------------------------------------------------
@@ -330,16 +394,16 @@ def _rate_of(time: np.ndarray) -> float:
     step = np.diff(time)
     dt = float(np.median(step))
     if not (dt > 0 and np.allclose(step, dt, rtol=1e-6, atol=0)):
-        raise ValueError("the time coordinate is not uniformly sampled: comfort indices need a "
-                         "constant output rate")
+        raise ValueError("the time coordinate is not uniformly sampled: comfort indices need a constant output rate")
     return 1.0 / dt
 
 
 def _half_lengths(ds: xr.Dataset) -> np.ndarray:
     """l [m] of every run (one per sample in a batch), from the ``vehicle_params`` record."""
     if "vehicle_params" not in ds:
-        raise ValueError("the Dataset has no vehicle_params record: give positions as "
-                         "{name: x in m} instead of 'front'/'rear'")
+        raise ValueError(
+            "the Dataset has no vehicle_params record: give positions as {name: x in m} instead of 'front'/'rear'"
+        )
     records = np.atleast_1d(ds["vehicle_params"].values)
     return np.array([float(json.loads(str(r))["l"]) for r in records])
 
@@ -356,19 +420,21 @@ def _positions(ds: xr.Dataset, positions, n_sample: int) -> tuple[list[str], np.
         if isinstance(spec, str):
             key = spec.strip().lower().replace("center", "centre")
             if key not in POSITION_KEYWORDS:
-                raise ValueError(f"position {spec!r}: allowed keywords are "
-                                 f"{', '.join(POSITION_KEYWORDS)}, or give {{name: x in m}}")
+                raise ValueError(
+                    f"position {spec!r}: allowed keywords are {', '.join(POSITION_KEYWORDS)}, or give {{name: x in m}}"
+                )
             if key == "centre":
                 x = np.zeros(n_sample)
             else:
                 half = _half_lengths(ds) if half is None else half
                 x = np.broadcast_to(half if key == "front" else -half, (n_sample,))
         else:
-            ok = (not isinstance(spec, bool) and isinstance(spec, (int, float, np.number))
-                  and math.isfinite(spec))
+            ok = not isinstance(spec, bool) and isinstance(spec, (int, float, np.number)) and math.isfinite(spec)
             if not ok:
-                raise ValueError(f"position {name!r} = {spec!r}: x must be a finite number of "
-                                 "metres from the carbody centre (front +)")
+                raise ValueError(
+                    f"position {name!r} = {spec!r}: x must be a finite number of "
+                    "metres from the carbody centre (front +)"
+                )
             x = np.full(n_sample, float(spec))
         names.append(str(name))
         xs.append(x)
@@ -406,16 +472,22 @@ def _floor(ds, positions):
         coords["sample"] = ds["sample"].values
     else:
         floor = floor[0]
-    da = xr.DataArray(floor, dims=lead + ["position", "time"], coords=coords,
-                      name="floor_acceleration",
-                      attrs={"units": "m/s^2", "pitch_acceleration": source,
-                             "long_name": "carbody floor vertical acceleration at (x, 0)"})
+    da = xr.DataArray(
+        floor,
+        dims=lead + ["position", "time"],
+        coords=coords,
+        name="floor_acceleration",
+        attrs={
+            "units": "m/s^2",
+            "pitch_acceleration": source,
+            "long_name": "carbody floor vertical acceleration at (x, 0)",
+        },
+    )
     da = da.assign_coords(x_m=x_coord)
     return da, rate
 
 
-def ride_comfort(ds: xr.Dataset, positions=POSITION_KEYWORDS, window=None,
-                 weightings=("Wk", "Wb")) -> xr.DataArray:
+def ride_comfort(ds: xr.Dataset, positions=POSITION_KEYWORDS, window=None, weightings=("Wk", "Wb")) -> xr.DataArray:
     """Comfort indices on the carbody floor, dims ([sample,] position, index).
 
     Positions: see `floor_acceleration` (default: centre, front and rear bogie centres).
@@ -456,16 +528,18 @@ def ride_comfort(ds: xr.Dataset, positions=POSITION_KEYWORDS, window=None,
     data = np.stack(values, axis=-1)
     if not np.all(np.isfinite(data)):
         raise RuntimeError("a comfort index is not finite: the run did not produce finite responses")
-    notes.append("N_MV_z is the vertical term of EN 12299 only: the model has no lateral or "
-                 "longitudinal motion")
+    notes.append("N_MV_z is the vertical term of EN 12299 only: the model has no lateral or longitudinal motion")
     dims = list(floor.dims[:-1]) + ["index"]
     coords = {k: v for k, v in floor.coords.items() if "time" not in v.dims}
     coords["index"] = names
     out = xr.DataArray(data, dims=dims, coords=coords, name="ride_comfort")
     out = out.assign_coords(unit=("index", units))
-    out.attrs = {"n_intervals": int(rms.shape[-1]), "notes": "; ".join(notes),
-                 "pitch_acceleration": floor.attrs["pitch_acceleration"],
-                 "window_s": json.dumps([float(start), float(end)])}
+    out.attrs = {
+        "n_intervals": int(rms.shape[-1]),
+        "notes": "; ".join(notes),
+        "pitch_acceleration": floor.attrs["pitch_acceleration"],
+        "window_s": json.dumps([float(start), float(end)]),
+    }
     return out
 
 
@@ -473,5 +547,7 @@ def to_dict(comfort: xr.DataArray) -> dict:
     """{position: {index: value}} of one run's `ride_comfort`."""
     if "sample" in comfort.dims:
         raise ValueError("to_dict takes the comfort indices of one run; select a sample first")
-    return {str(p): {str(i): float(comfort.sel(position=p, index=i)) for i in comfort["index"].values}
-            for p in comfort["position"].values}
+    return {
+        str(p): {str(i): float(comfort.sel(position=p, index=i)) for i in comfort["index"].values}
+        for p in comfort["position"].values
+    }

@@ -88,9 +88,12 @@ class Comparison:
             part = select_window(ds, self.window)
             f = np.abs(part["secondary_damper_force"].values)
             travel = np.abs(part["secondary_deflection"].values)
-            row = {"force_rms_n": float(np.sqrt(np.mean(f**2))), "force_max_n": float(f.max()),
-                   "travel_rms_m": float(np.sqrt(np.mean(travel**2))),
-                   "travel_max_m": float(travel.max())}
+            row = {
+                "force_rms_n": float(np.sqrt(np.mean(f**2))),
+                "force_max_n": float(f.max()),
+                "travel_rms_m": float(np.sqrt(np.mean(travel**2))),
+                "travel_max_m": float(travel.max()),
+            }
             if "damper_demand_force" in part:  # what the outer loop asked for
                 fd = np.abs(part["damper_demand_force"].values)
                 row["demand_rms_n"] = float(np.sqrt(np.mean(fd**2)))
@@ -114,14 +117,25 @@ class Comparison:
         base = rms.sel(controller="passive").values
         for n in controlled:
             worse = [r for r, a, b in zip(responses, rms.sel(controller=n).values, base) if a > b]
-            out.append({"controller": n, "than": "passive", "better_on": [r for r in responses if r not in worse],
-                        "worse_on": worse})
+            out.append(
+                {
+                    "controller": n,
+                    "than": "passive",
+                    "better_on": [r for r in responses if r not in worse],
+                    "worse_on": worse,
+                }
+            )
         for i, a in enumerate(controlled):
-            for b in controlled[i + 1:]:
+            for b in controlled[i + 1 :]:
                 va, vb = rms.sel(controller=a).values, rms.sel(controller=b).values
-                out.append({"controller": a, "than": b,
-                            "better_on": [r for r, x, y in zip(responses, va, vb) if x < y],
-                            "worse_on": [r for r, x, y in zip(responses, va, vb) if x > y]})
+                out.append(
+                    {
+                        "controller": a,
+                        "than": b,
+                        "better_on": [r for r, x, y in zip(responses, va, vb) if x < y],
+                        "worse_on": [r for r, x, y in zip(responses, va, vb) if x > y],
+                    }
+                )
         return out
 
     def _bounds_record(self) -> dict | None:
@@ -141,7 +155,8 @@ class Comparison:
                 out[device][name] = {
                     "rms": {r: float(v) if ok else None for r, v in zip(responses, rms)},
                     "reduction_percent": {r: float(v) if ok else None for r, v in zip(responses, red)},
-                    "diverged_at_s": None if ok else run["diverged_at_s"]}
+                    "diverged_at_s": None if ok else run["diverged_at_s"],
+                }
         return out
 
     @property
@@ -156,29 +171,48 @@ class Comparison:
         demands = self.demands()
         for name in self.names:
             m = self.metrics.sel(controller=name)
-            row = {"name": name, "label": LABELS[name],
-                   "metrics": {str(r): {s: float(m.sel(response=r, statistic=s)) for s in STATISTICS}
-                               for r in m.response.values},
-                   "damper": demands[name]}
+            row = {
+                "name": name,
+                "label": LABELS[name],
+                "metrics": {
+                    str(r): {s: float(m.sel(response=r, statistic=s)) for s in STATISTICS} for r in m.response.values
+                },
+                "damper": demands[name],
+            }
             if name != "passive":
-                row["reduction_percent"] = {str(r): float(red.sel(controller=name, response=r, statistic="rms"))
-                                            for r in m.response.values}
-            row["paper"] = {r: {"rms": PAPER_TABLE1[r][name],
-                                **({"reduction_percent": PAPER_REDUCTION[r][name]} if name != "passive" else {})}
-                            for r in PAPER_TABLE1}
+                row["reduction_percent"] = {
+                    str(r): float(red.sel(controller=name, response=r, statistic="rms")) for r in m.response.values
+                }
+            row["paper"] = {
+                r: {
+                    "rms": PAPER_TABLE1[r][name],
+                    **({"reduction_percent": PAPER_REDUCTION[r][name]} if name != "passive" else {}),
+                }
+                for r in PAPER_TABLE1
+            }
             if self.comfort is not None:  # only when computed: the schema stays as it was
-                row["comfort"] = comfort_record(self.comfort[name],
-                                                None if name == "passive" else self.comfort["passive"])
+                row["comfort"] = comfort_record(
+                    self.comfort[name], None if name == "passive" else self.comfort["passive"]
+                )
             rows.append(row)
-        return {"schema": "railride.comparison/1", "railride_version": __version__,
-                "settings": self.settings, "controllers": rows,
-                "trade_offs": self.trade_offs(),
-                "bounds": self._bounds_record(),
-                "tuning": {"objective": self.gains.provenance.get("objective"),
-                           "command": self.gains.provenance.get("command"),
-                           "in_sample": self.in_sample},
-                "gains": {"source": self.gains.source, "inner": self.gains.inner.to_dict(),
-                          **{n: self.gains.controller(n).to_dict() for n in self.names if n != "passive"}}}
+        return {
+            "schema": "railride.comparison/1",
+            "railride_version": __version__,
+            "settings": self.settings,
+            "controllers": rows,
+            "trade_offs": self.trade_offs(),
+            "bounds": self._bounds_record(),
+            "tuning": {
+                "objective": self.gains.provenance.get("objective"),
+                "command": self.gains.provenance.get("command"),
+                "in_sample": self.in_sample,
+            },
+            "gains": {
+                "source": self.gains.source,
+                "inner": self.gains.inner.to_dict(),
+                **{n: self.gains.controller(n).to_dict() for n in self.names if n != "passive"},
+            },
+        }
 
     def to_pandas(self):
         """The metrics as one long table: a row per suspension, response and statistic, with
@@ -211,26 +245,38 @@ class Comparison:
         """All suspensions in one Dataset along ``controller`` (damper channels NaN for passive)."""
         parts = []
         for name in self.names:
-            ds = self.datasets[name].drop_vars(["scenario", "vehicle_params", "controller",
-                                                "controller_gains"], errors="ignore")
+            ds = self.datasets[name].drop_vars(
+                ["scenario", "vehicle_params", "controller", "controller_gains"], errors="ignore"
+            )
             parts.append(ds.expand_dims(controller=[name]))
-        gains = [json.dumps(None if n == "passive" else self.gains.controller(n).to_dict())
-                 for n in self.names]
-        out = xr.concat(parts, dim="controller", join="outer", data_vars="all",
-                        combine_attrs="drop_conflicts")
+        gains = [json.dumps(None if n == "passive" else self.gains.controller(n).to_dict()) for n in self.names]
+        out = xr.concat(parts, dim="controller", join="outer", data_vars="all", combine_attrs="drop_conflicts")
         first = self.datasets[self.names[0]]
         out["scenario"] = first["scenario"]
         out["vehicle_params"] = first["vehicle_params"]
         out["controller_gains"] = ("controller", np.array(gains))
         out["inner_loop_gains"] = ((), json.dumps(self.gains.inner.to_dict()))
-        out.attrs.update(title="railride controller comparison", gains_source=self.gains.source,
-                         settings=json.dumps(self.settings))
+        out.attrs.update(
+            title="railride controller comparison", gains_source=self.gains.source, settings=json.dumps(self.settings)
+        )
         return out
 
 
-def compare(scenario, params=None, *, controllers=CONTROLLERS, gains: GainSet | None = None,
-            damper=DEFAULT_DAMPER, damper_scale: float = 1.0, window=None, solver=None,
-            sensor_noise=None, progress=None, comfort: bool = False, bounds: bool = True) -> Comparison:
+def compare(
+    scenario,
+    params=None,
+    *,
+    controllers=CONTROLLERS,
+    gains: GainSet | None = None,
+    damper=DEFAULT_DAMPER,
+    damper_scale: float = 1.0,
+    window=None,
+    solver=None,
+    sensor_noise=None,
+    progress=None,
+    comfort: bool = False,
+    bounds: bool = True,
+) -> Comparison:
     """Run the passive vehicle and each controller on ``scenario`` and collect the metrics.
 
     ``controllers`` names from `railride.control.CONTROLLERS` (passive is always run as the
@@ -260,42 +306,58 @@ def compare(scenario, params=None, *, controllers=CONTROLLERS, gains: GainSet | 
     bound_devices = [d for d in BOUND_DEVICES if bounds and controlled and model.law != dampers.LAW_IDEAL]
     # progress by sample-steps: the passive run is one sample, the controlled batches the rest
     share = 1.0 / (1 + len(controlled) * (1 + len(bound_devices)))
-    part = (lambda lo, w: (lambda done: progress(lo + w * done))) if progress is not None else None
-    datasets = {"passive": simulate(scenario, params, Suspension.passive(), solver=solver,
-                                    progress=part and part(0.0, share)).dataset}
+    part = (lambda lo, w: lambda done: progress(lo + w * done)) if progress is not None else None
+    datasets = {
+        "passive": simulate(
+            scenario, params, Suspension.passive(), solver=solver, progress=part and part(0.0, share)
+        ).dataset
+    }
     if controlled:
-        batch = simulate(scenario, params, [Suspension.named(n, gains, damper, damper_scale,
-                                                             sensor_noise=sensor_noise)
-                                            for n in controlled],
-                         solver=solver, progress=part and part(share, share * len(controlled))).dataset
+        batch = simulate(
+            scenario,
+            params,
+            [Suspension.named(n, gains, damper, damper_scale, sensor_noise=sensor_noise) for n in controlled],
+            solver=solver,
+            progress=part and part(share, share * len(controlled)),
+        ).dataset
         for i, n in enumerate(controlled):
             datasets[n] = batch.isel(sample=i, drop=True)
     bound_values = {}
     for k, device in enumerate(bound_devices):
         # the ideal actuator may not be stable with gains tuned for a damper: marked, not fatal
-        res = simulate(scenario, params, [Suspension.named(n, gains, device, sensor_noise=sensor_noise)
-                                          for n in controlled],
-                       solver=solver, on_divergence="mark",
-                       progress=part and part(share * (1 + len(controlled) * (1 + k)),
-                                              share * len(controlled)))
+        res = simulate(
+            scenario,
+            params,
+            [Suspension.named(n, gains, device, sensor_noise=sensor_noise) for n in controlled],
+            solver=solver,
+            on_divergence="mark",
+            progress=part and part(share * (1 + len(controlled) * (1 + k)), share * len(controlled)),
+        )
         m = res.metrics(window)
-        bound_values[device] = {n: {"metrics": m.isel(sample=i, drop=True),
-                                    "diverged_at_s": float(res.diverged_at[i])}
-                                for i, n in enumerate(controlled)}
+        bound_values[device] = {
+            n: {"metrics": m.isel(sample=i, drop=True), "diverged_at_s": float(res.diverged_at[i])}
+            for i, n in enumerate(controlled)
+        }
     metrics = xr.concat([ride_metrics(datasets[n], window) for n in names], dim="controller")
     metrics = metrics.assign_coords(controller=names)
     first = datasets["passive"]
-    settings = {"scenario": json.loads(str(first["scenario"].values)),
-                "vehicle_params": json.loads(str(first["vehicle_params"].values)), "damper": str(damper),
-                "damper_scale": damper_scale, **solver.to_dict(),
-                "window_s": None if window is None else [float(w) for w in window],
-                "sensor_noise": None if sensor_noise is None else sensor_noise.__dict__}
+    settings = {
+        "scenario": json.loads(str(first["scenario"].values)),
+        "vehicle_params": json.loads(str(first["vehicle_params"].values)),
+        "damper": str(damper),
+        "damper_scale": damper_scale,
+        **solver.to_dict(),
+        "window_s": None if window is None else [float(w) for w in window],
+        "sensor_noise": None if sensor_noise is None else sensor_noise.__dict__,
+    }
     comfort_values = None
     if comfort:
         from .comfort import ride_comfort
+
         comfort_values = {n: ride_comfort(datasets[n], window=window) for n in names}
-    return Comparison(names, datasets, metrics, window, gains, str(damper), settings,
-                      comfort_values, bound_values or None, solver)
+    return Comparison(
+        names, datasets, metrics, window, gains, str(damper), settings, comfort_values, bound_values or None, solver
+    )
 
 
 #: the ideal devices `compare` runs beside the MR dampers: the best a damper could do with the
@@ -330,17 +392,25 @@ def comfort_record(comfort: xr.DataArray, passive: xr.DataArray | None = None) -
     text = str(comfort.attrs.get("notes", ""))
     cut = text.find("N_MV_z is the vertical term")
     notes = [text] if cut < 0 else [t for t in (text[:cut].rstrip("; "), text[cut:]) if t]
-    notes.append(f"N_MV_z from {n} interval{'s' if n != 1 else ''} of 5 s"
-                 + (" (EN 12299 evaluates 60, 5 minutes): an indication only" if n < 60 else ""))
-    record = {"positions": positions,
-              "units": {str(i): str(u) for i, u in zip(comfort["index"].values,
-                                                       comfort["unit"].values)},
-              "window_s": json.loads(comfort.attrs["window_s"]),
-              "n_intervals": n, "notes": notes}
+    notes.append(
+        f"N_MV_z from {n} interval{'s' if n != 1 else ''} of 5 s"
+        + (" (EN 12299 evaluates 60, 5 minutes): an indication only" if n < 60 else "")
+    )
+    record = {
+        "positions": positions,
+        "units": {str(i): str(u) for i, u in zip(comfort["index"].values, comfort["unit"].values)},
+        "window_s": json.loads(comfort.attrs["window_s"]),
+        "n_intervals": n,
+        "notes": notes,
+    }
     if passive is not None:
         base = to_dict(passive)
         record["reduction_percent"] = {
-            p: {i: (base[p][i] - v) / base[p][i] * 100.0 if base[p][i] > 0 else None
-                for i, v in indices.items() if i in COMFORT_REDUCED}
-            for p, indices in values.items()}
+            p: {
+                i: (base[p][i] - v) / base[p][i] * 100.0 if base[p][i] > 0 else None
+                for i, v in indices.items()
+                if i in COMFORT_REDUCED
+            }
+            for p, indices in values.items()
+        }
     return record

@@ -53,8 +53,10 @@ class _Gains:
     def replace(self, **changes):
         unknown = set(changes) - {f.name for f in dataclasses.fields(self)}
         if unknown:
-            raise ValueError(f"unknown gain(s) {', '.join(sorted(unknown))} for {self.name}; allowed: "
-                             f"{', '.join(f.name for f in dataclasses.fields(self))}")
+            raise ValueError(
+                f"unknown gain(s) {', '.join(sorted(unknown))} for {self.name}; allowed: "
+                f"{', '.join(f.name for f in dataclasses.fields(self))}"
+            )
         return dataclasses.replace(self, **changes)
 
     def to_dict(self) -> dict:
@@ -198,8 +200,7 @@ class _OuterLoop(NamedTuple):
 _OUTER_LOOPS = {
     "pid": _OuterLoop(("pid",), lambda g: g.pid, "PID"),
     "sas-attitude": _OuterLoop(("attitude",), lambda g: SAS(g.attitude), "SAS (attitude)"),
-    "sas-attitude-ride": _OuterLoop(("attitude", "ride"), lambda g: SAS(g.attitude, g.ride),
-                                    "SAS (attitude+ride)"),
+    "sas-attitude-ride": _OuterLoop(("attitude", "ride"), lambda g: SAS(g.attitude, g.ride), "SAS (attitude+ride)"),
 }
 CONTROLLERS = ("passive", *_OUTER_LOOPS)
 LABELS = {"passive": "Passive", **{name: loop.label for name, loop in _OUTER_LOOPS.items()}}
@@ -263,7 +264,7 @@ class GainSet:
         """These gains with ``changes``, ("table.entry", value) pairs (or a dict), applied; the
         source stays, the provenance does not (they are other gains)."""
         grouped: dict[str, dict] = {}
-        for name, value in (changes.items() if isinstance(changes, dict) else changes):
+        for name, value in changes.items() if isinstance(changes, dict) else changes:
             table, _, entry = name.partition(".")
             if table not in self.TABLES or not entry:
                 raise ValueError(f"gain {name!r}: expected table.entry with table one of {', '.join(self.TABLES)}")
@@ -288,8 +289,12 @@ class GainSet:
 
     def to_toml(self) -> str:
         lines = []
-        for key, obj in (("inner", self.inner), ("pid", self.pid), ("sas.attitude", self.attitude),
-                         ("sas.ride", self.ride)):
+        for key, obj in (
+            ("inner", self.inner),
+            ("pid", self.pid),
+            ("sas.attitude", self.attitude),
+            ("sas.ride", self.ride),
+        ):
             lines.append(f"[{key}]")
             for f in dataclasses.fields(obj):
                 lines.append(f"{f.name} = {getattr(obj, f.name)!r}  # {f.metadata['unit']}")
@@ -304,13 +309,18 @@ class GainSet:
             data = tomllib.loads(text)
         except tomllib.TOMLDecodeError as exc:
             raise ValueError(f"{source}: not valid TOML: {exc}") from None
-        tables = {"inner": data.get("inner"), "pid": data.get("pid"),
-                  "sas.attitude": (data.get("sas") or {}).get("attitude"),
-                  "sas.ride": (data.get("sas") or {}).get("ride")}
+        tables = {
+            "inner": data.get("inner"),
+            "pid": data.get("pid"),
+            "sas.attitude": (data.get("sas") or {}).get("attitude"),
+            "sas.ride": (data.get("sas") or {}).get("ride"),
+        }
         unknown_top = sorted(set(data) - {"inner", "pid", "sas", "provenance"})
         if unknown_top:
-            raise ValueError(f"{source}: unknown table(s) {', '.join(unknown_top)}; allowed: "
-                             "[inner], [pid], [sas.attitude], [sas.ride], [provenance]")
+            raise ValueError(
+                f"{source}: unknown table(s) {', '.join(unknown_top)}; allowed: "
+                "[inner], [pid], [sas.attitude], [sas.ride], [provenance]"
+            )
         built = {}
         for key, kind in _TABLES.items():
             table = tables[key]
@@ -334,8 +344,7 @@ class GainSet:
         provenance = data.get("provenance", {})
         if not isinstance(provenance, dict):
             raise ValueError(f"{source}: [provenance] must be a table, not {provenance!r}")
-        return cls(built["inner"], built["pid"], built["sas.attitude"], built["sas.ride"], source,
-                   provenance)
+        return cls(built["inner"], built["pid"], built["sas.attitude"], built["sas.ride"], source, provenance)
 
     @classmethod
     def load(cls, path: str | Path) -> "GainSet":
@@ -384,6 +393,5 @@ class SensorNoise:
 
     def samples(self, n: int) -> np.ndarray:
         """(n, 6) noise for m = (z, phi, theta, z', phi', theta')."""
-        sd = np.array([self.displacement, self.angle, self.angle,
-                       self.velocity, self.angular_rate, self.angular_rate])
+        sd = np.array([self.displacement, self.angle, self.angle, self.velocity, self.angular_rate, self.angular_rate])
         return np.random.default_rng(self.seed).standard_normal((n, 6)) * sd

@@ -63,14 +63,17 @@ class _Damper:
     def replace(self, **changes):
         unknown = set(changes) - {f.name for f in dataclasses.fields(self)}
         if unknown:
-            raise ValueError(f"unknown damper parameter(s) {', '.join(sorted(unknown))}; allowed: "
-                             f"{', '.join(f.name for f in dataclasses.fields(self))}")
+            raise ValueError(
+                f"unknown damper parameter(s) {', '.join(sorted(unknown))}; allowed: "
+                f"{', '.join(f.name for f in dataclasses.fields(self))}"
+            )
         return dataclasses.replace(self, **changes)
 
     def to_dict(self) -> dict:
         """The model, the preset it equals (or None) and every parameter."""
-        name = next((k for k, v in {**PRESETS, "ideal": IDEAL, "ideal-damper": IDEAL_DAMPER}.items()
-                     if v == self), None)
+        name = next(
+            (k for k, v in {**PRESETS, "ideal": IDEAL, "ideal-damper": IDEAL_DAMPER}.items() if v == self), None
+        )
         return {"model": self.model, "preset": name, **dataclasses.asdict(self)}
 
     @classmethod
@@ -79,8 +82,9 @@ class _Damper:
 
     def check_voltage(self, v: float, name: str = "voltage") -> float:
         if not (isinstance(v, (int, float)) and np.isfinite(v) and self.v_min <= v <= self.v_max):
-            raise ValueError(f"{name} = {v!r} V: must lie in [{self.v_min:g}, {self.v_max:g}] V "
-                             f"for this {self.model} damper")
+            raise ValueError(
+                f"{name} = {v!r} V: must lie in [{self.v_min:g}, {self.v_max:g}] V for this {self.model} damper"
+            )
         return float(v)
 
 
@@ -115,8 +119,9 @@ class BoucWen(_Damper):
     alpha_b: float = param("N/(m V)", "hysteretic force coefficient per volt", "nonnegative")
     c0a: float = param("N s/m", "viscous coefficient at 0 V", "nonnegative")
     c0b: float = param("N s/(m V)", "viscous coefficient per volt", "nonnegative")
-    k0: float = param("N/m", "stiffness k0 (simple model: the accumulator; Spencer: in series "
-                             "with the hysteresis)", "nonnegative")
+    k0: float = param(
+        "N/m", "stiffness k0 (simple model: the accumulator; Spencer: in series with the hysteresis)", "nonnegative"
+    )
     A: float = param("-", "Bouc-Wen A: initial slope dz/dx")
     n: float = param("-", "Bouc-Wen exponent, >= 1")
     gamma: float = param("1/m^n", "Bouc-Wen gamma (multiplies |w| z |z|^(n-1))", "finite")
@@ -148,8 +153,20 @@ class BoucWen(_Damper):
 
     def pack(self) -> np.ndarray:
         p = np.zeros(N_PACKED)
-        p[:12] = [self.alpha_a, self.alpha_b, self.c0a, self.c0b, self.k0, self.A, self.n,
-                  self.gamma, self.beta, self.eta, self.v_min, self.v_max]
+        p[:12] = [
+            self.alpha_a,
+            self.alpha_b,
+            self.c0a,
+            self.c0b,
+            self.k0,
+            self.A,
+            self.n,
+            self.gamma,
+            self.beta,
+            self.eta,
+            self.v_min,
+            self.v_max,
+        ]
         p[15] = self.z_bound
         return p
 
@@ -240,22 +257,26 @@ class Ideal(_Damper):
         return F, 0.0 * z, 0.0 * z, 0.0 * z
 
     def scaled(self, factor: float):
-        raise ValueError(f"factor = {factor!r}: the ideal actuator applies the demand exactly and "
-                         "has no force capacity to scale")
+        raise ValueError(
+            f"factor = {factor!r}: the ideal actuator applies the demand exactly and has no force capacity to scale"
+        )
 
 
 def check_scale(name: str, value) -> float:
     """A force-capacity scale: a finite number > 0, else ValueError naming ``name``."""
-    return validation.number(name, value, "positive",
-                             allowed="a finite number > 0 (the factor on the damper's force parameters)")
+    return validation.number(
+        name, value, "positive", allowed="a finite number > 0 (the factor on the damper's force parameters)"
+    )
 
 
 def _check_shape(d) -> None:
     if d.n < 1:
         raise ValueError(f"damper parameter 'n' = {d.n!r}: must be >= 1")
     if d.gamma + d.beta <= 0:
-        raise ValueError(f"damper parameters gamma = {d.gamma!r}, beta = {d.beta!r}: gamma + beta must be "
-                         "> 0, or the hysteretic variable grows without bound")
+        raise ValueError(
+            f"damper parameters gamma = {d.gamma!r}, beta = {d.beta!r}: gamma + beta must be "
+            "> 0, or the hysteretic variable grows without bound"
+        )
     if d.v_max <= d.v_min:
         raise ValueError(f"damper voltage range [{d.v_min!r}, {d.v_max!r}] V: v_max must exceed v_min")
 
@@ -268,8 +289,20 @@ def _bouc_wen_z_rate(z, w, A, n, gamma, beta):
 # -- presets ------------------------------------------------------------------------------------
 #: Dyke, Spencer, Sain & Carlson (1996), simple Bouc-Wen fit of their small-scale damper
 #: (gamma, beta in 1/m for n = 1).
-DYKE1996 = BoucWen(alpha_a=1.0872e5, alpha_b=4.9616e5, c0a=4.40, c0b=44.0, k0=0.0,
-                   A=1.2, n=1.0, gamma=300.0, beta=300.0, eta=50.0, v_min=0.0, v_max=2.25)
+DYKE1996 = BoucWen(
+    alpha_a=1.0872e5,
+    alpha_b=4.9616e5,
+    c0a=4.40,
+    c0b=44.0,
+    k0=0.0,
+    A=1.2,
+    n=1.0,
+    gamma=300.0,
+    beta=300.0,
+    eta=50.0,
+    v_min=0.0,
+    v_max=2.25,
+)
 
 #: The vehicle default (docs/dampers.md, Presets): dyke1996 with the force parameters alpha_a, alpha_b,
 #: c0a, c0b, k0 multiplied by 8, about 1.7 kN at 0 V and 20 kN at 2.25 V.
@@ -280,9 +313,24 @@ RAILWAY = DYKE1996.scaled(8)
 #: c0b 3.50 N s/(cm V), k0 46.9 N/cm, c1a 283 N s/cm, c1b 2.95 N s/(cm V), k1 5.00 N/cm,
 #: x0 14.3 cm, alpha_a 140 N/cm, alpha_b 695 N/(cm V), gamma = beta = 363 cm^-2, A = 301,
 #: n = 2, eta = 190 1/s; the prototype's command range 0-2.25 V.
-SPENCER1997 = Spencer(alpha_a=1.40e4, alpha_b=6.95e4, c0a=2.10e3, c0b=3.50e2, k0=4.69e3,
-                      A=301.0, n=2.0, gamma=3.63e6, beta=3.63e6, eta=190.0, v_min=0.0,
-                      v_max=2.25, c1a=2.83e4, c1b=2.95e2, k1=5.00e2, x0=0.143)
+SPENCER1997 = Spencer(
+    alpha_a=1.40e4,
+    alpha_b=6.95e4,
+    c0a=2.10e3,
+    c0b=3.50e2,
+    k0=4.69e3,
+    A=301.0,
+    n=2.0,
+    gamma=3.63e6,
+    beta=3.63e6,
+    eta=190.0,
+    v_min=0.0,
+    v_max=2.25,
+    c1a=2.83e4,
+    c1b=2.95e2,
+    k1=5.00e2,
+    x0=0.143,
+)
 
 #: the MR damper presets (the models the rig can drive)
 PRESETS = {"dyke1996": DYKE1996, "railway": RAILWAY, "spencer1997": SPENCER1997}

@@ -50,13 +50,11 @@ class DaskExecutor:
 
     name = "dask"
 
-    def __init__(self, address: str | None = None, scheduler_file: str | None = None,
-                 timeout: float = 10.0):
+    def __init__(self, address: str | None = None, scheduler_file: str | None = None, timeout: float = 10.0):
         try:
             from distributed import Client
         except ImportError:
-            raise ValueError("the Dask executor needs dask.distributed: pip install "
-                             "\"railride[distributed]\"") from None
+            raise ValueError('the Dask executor needs dask.distributed: pip install "railride[distributed]"') from None
         if (address is None) == (scheduler_file is None):
             raise ValueError("give a scheduler address (tcp://host:port) or a scheduler file")
         if scheduler_file is not None:
@@ -70,8 +68,9 @@ class DaskExecutor:
             self.client = Client(address, timeout=timeout, set_as_default=False)
         except Exception as exc:  # refused, timed out, not a Dask scheduler, unknown scheme
             why = str(exc) or "no answer (the scheduler's port, not its dashboard's?)"
-            raise ValueError(f"cannot reach the Dask scheduler at {where} within {timeout:g} s: "
-                             f"{type(exc).__name__}: {why}") from None
+            raise ValueError(
+                f"cannot reach the Dask scheduler at {where} within {timeout:g} s: {type(exc).__name__}: {why}"
+            ) from None
 
     @staticmethod
     def _address_from_file(path, timeout: float) -> str:
@@ -133,9 +132,10 @@ class DaskExecutor:
             per_host[host] = per_host.get(host, 0) + n
         shares = {worker: per_host[get_address_host(worker)] for worker in nthreads}
         tag = uuid.uuid4().hex[:8]
-        futures = {self.client.submit(self._run_chunk, fn, shares, chunk,
-                                      key=f"railride-chunk-{tag}-{i}"): i
-                   for i, chunk in enumerate(chunks)}
+        futures = {
+            self.client.submit(self._run_chunk, fn, shares, chunk, key=f"railride-chunk-{tag}-{i}"): i
+            for i, chunk in enumerate(chunks)
+        }
         try:
             for fut in as_completed(futures, loop=self.client.loop):
                 i = futures.pop(fut)
@@ -176,8 +176,9 @@ class RunTable:
         self.frame = pd.DataFrame()
         if self.path is not None and self.path.exists():
             if not resume:
-                raise ValueError(f"{self.path} exists: pass resume to continue that sweep, or "
-                                 "choose another output folder")
+                raise ValueError(
+                    f"{self.path} exists: pass resume to continue that sweep, or choose another output folder"
+                )
             try:
                 # keys are hex digests: an all-digit one must stay text to be recognised
                 self.frame = pd.read_csv(self.path, dtype={"key": str})

@@ -27,8 +27,12 @@ import xarray as xr
 from .analysis import PSD_SEGMENT_S, comparison_psd
 from .labels import CARBODY_RESPONSES, psd_title
 from .plots import save_png
-from .plots.comparison import (plot_comparison_damper_forces, plot_comparison_psd, plot_comparison_response,
-                               plot_comparison_voltages)
+from .plots.comparison import (
+    plot_comparison_damper_forces,
+    plot_comparison_psd,
+    plot_comparison_response,
+    plot_comparison_voltages,
+)
 from .plots.frf import plot_frf
 from .plots.pareto import plot_pareto
 from .plots.ride import plot_body_responses
@@ -44,8 +48,19 @@ DAMPER_FILES = ("loops.png", "cycles.csv", "damper.json")
 #: the files `write_tracking_outputs` produces, in the order they are written
 TRACKING_FILES = ("tracking.png", "tracking.csv", "tracking.json")
 #: the files `write_compare_outputs` produces, in the order they are written
-COMPARE_FILES = ("compare.json", "compare.nc", "compare.csv", "acceleration.png", "displacement.png",
-                 "pitch.png", "roll.png", "damper_forces.png", "voltages.png", "psd.png", "psd.csv")
+COMPARE_FILES = (
+    "compare.json",
+    "compare.nc",
+    "compare.csv",
+    "acceleration.png",
+    "displacement.png",
+    "pitch.png",
+    "roll.png",
+    "damper_forces.png",
+    "voltages.png",
+    "psd.png",
+    "psd.csv",
+)
 #: the files `write_tune_outputs` produces, in the order they are written
 TUNE_FILES = ("gains.toml", "sensitivity.png", "curves.csv", "tune.json")
 #: the files `write_sweep_outputs` always produces (the run table runs.csv is the library's);
@@ -69,8 +84,7 @@ def netcdf_ready(ds: xr.Dataset) -> xr.Dataset:
     out = ds.copy()
     for name, var in ds.variables.items():
         if var.dtype.kind in "iu" and var.dtype != np.int32:
-            if var.size and (var.values.min() < np.iinfo(np.int32).min
-                             or var.values.max() > np.iinfo(np.int32).max):
+            if var.size and (var.values.min() < np.iinfo(np.int32).min or var.values.max() > np.iinfo(np.int32).max):
                 raise ValueError(f"{name}: integers beyond int32 cannot be stored in netCDF3")
             out[name] = var.astype(np.int32)
     return out
@@ -277,8 +291,7 @@ def write_compare_outputs(comparison, out_dir, doc: dict) -> list[Path]:
     return write_folder(out_dir, [(name, writers[name]) for name in COMPARE_FILES])
 
 
-def write_tune_outputs(curves, out_dir, doc: dict, gains_text: str, *,
-                       title: str | None = None) -> list[Path]:
+def write_tune_outputs(curves, out_dir, doc: dict, gains_text: str, *, title: str | None = None) -> list[Path]:
     """Write the results of a tuning study into ``out_dir``, all or nothing (`write_folder`;
     other files there, such as the run table ``runs.csv``, stay): ``gains.toml``
     (``gains_text``, a gains file), ``sensitivity.png`` (`plot_sensitivity` of ``curves``,
@@ -313,8 +326,7 @@ def write_sweep_outputs(result, out_dir, doc: dict | None = None) -> list[Path]:
     return write_folder(out_dir, files)
 
 
-def write_frf_outputs(frame: pd.DataFrame, modes, out_dir, doc: dict, *,
-                      title: str | None = None) -> list[Path]:
+def write_frf_outputs(frame: pd.DataFrame, modes, out_dir, doc: dict, *, title: str | None = None) -> list[Path]:
     """Write the frequency responses of `railride frf` into ``out_dir``, all or nothing:
     ``frf.csv`` (``frame``, `railride.analysis.frf_frame`), ``frf.json`` (``doc``, strict
     JSON), ``frf.png`` (`plot_frf`) and ``modes.csv`` (`modes_frame` of ``modes``, the records

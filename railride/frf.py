@@ -44,8 +44,10 @@ def _vehicle(params) -> tuple[VehicleParams, str | Path | None]:
         return VehicleParams.load(Path(params)), Path(params)
     if isinstance(params, VehicleParams):
         return params, next((name for name, p in PRESETS.items() if p == params), None)
-    raise ValueError(f"params = {params!r}: must be VehicleParams, a preset name "
-                     f"({', '.join(PRESETS)}) or the path of a parameters file")
+    raise ValueError(
+        f"params = {params!r}: must be VehicleParams, a preset name "
+        f"({', '.join(PRESETS)}) or the path of a parameters file"
+    )
 
 
 @dataclass(frozen=True, eq=False)
@@ -145,19 +147,28 @@ class FrfResult:
             "schema": SCHEMA,
             "railride_version": __version__,
             **vehicle,
-            "settings": {"speed_m_s": self.speed, "rails": list(self.patterns), "fmin_hz": self.fmin,
-                         "fmax_hz": self.fmax, "points": self.points},
+            "settings": {
+                "speed_m_s": self.speed,
+                "rails": list(self.patterns),
+                "fmin_hz": self.fmin,
+                "fmax_hz": self.fmax,
+                "points": self.points,
+            },
             "frequency_hz": [float(f) for f in self.frequency],
-            "responses": {p: {c: [float(v) for v in frame.loc[frame["pattern"] == p, c]]
-                              for c in FRF_MAGNITUDES} for p in self.patterns},
+            "responses": {
+                p: {c: [float(v) for v in frame.loc[frame["pattern"] == p, c]] for c in FRF_MAGNITUDES}
+                for p in self.patterns
+            },
             "peaks": frf_peaks(frame),
             "modes": self.modes.to_list(),
         }
 
     def title(self) -> str:
         """The title of the figure: the speed, the vehicle and the suspension."""
-        return (f"Carbody frequency responses per metre of rail amplitude - V = {self.speed:g} m/s, "
-                f"vehicle {self.vehicle_name}, passive suspension")
+        return (
+            f"Carbody frequency responses per metre of rail amplitude - V = {self.speed:g} m/s, "
+            f"vehicle {self.vehicle_name}, passive suspension"
+        )
 
     def plot(self, ax=None):
         """Magnitudes against frequency, one panel per response, with the modes marked
@@ -172,12 +183,18 @@ class FrfResult:
         stay). Returns the paths."""
         from .files import write_frf_outputs
 
-        return write_frf_outputs(self.to_pandas(), self.modes.to_list(), folder, self.to_dict(),
-                                 title=self.title())
+        return write_frf_outputs(self.to_pandas(), self.modes.to_list(), folder, self.to_dict(), title=self.title())
 
 
-def frequency_responses(params=None, *, speed: float | None = None, rails: str = "both",
-                        fmin: float = 0.1, fmax: float = 30.0, points: int = 400) -> FrfResult:
+def frequency_responses(
+    params=None,
+    *,
+    speed: float | None = None,
+    rails: str = "both",
+    fmin: float = 0.1,
+    fmax: float = 30.0,
+    points: int = 400,
+) -> FrfResult:
     """The carbody frequency responses of the passive vehicle ``params`` (`VehicleParams`, a
     preset name or the path of a parameters file; default "paper") at ``speed`` [m/s] (default
     the scenarios' default speed), for ``rails`` "in-phase", "anti-phase" or "both", on
@@ -198,8 +215,9 @@ def frequency_responses(params=None, *, speed: float | None = None, rails: str =
     frequency = np.geomspace(fmin, fmax, points)
     frequency[0], frequency[-1] = fmin, fmax  # exactly, without rounding
     responses = {p: vehicle.frequency_response(frequency, speed, p) for p in patterns}
-    return FrfResult(vehicle_params, source, speed, frequency, responses,
-                     Modes(tuple(vehicle.modes())), fmin, fmax, points)
+    return FrfResult(
+        vehicle_params, source, speed, frequency, responses, Modes(tuple(vehicle.modes())), fmin, fmax, points
+    )
 
 
 def _default_speed() -> float:

@@ -60,11 +60,20 @@ RIG_TRACKING = 2
 #: than with the plain pipeline (19 ms against 50 ms for 10 s of the passive vehicle; measured,
 #: the responsible pass not traced). ``parallel=True`` with ``prange`` compiled in 12 s against
 #: 6 s; see docs/performance.md.
-_NO_PARFORS = dict(comprehension=False, reduction=False, inplace_binop=False, setitem=False,
-                   numpy=False, stencil=False, fusion=False, prange=False)
+_NO_PARFORS = dict(
+    comprehension=False,
+    reduction=False,
+    inplace_binop=False,
+    setitem=False,
+    numpy=False,
+    stencil=False,
+    fusion=False,
+    prange=False,
+)
 # ... which numba reports as a missed opportunity: that is the intent here
-warnings.filterwarnings("ignore", message=r"(?s).*keyword argument 'parallel=True' was specified",
-                        category=NumbaPerformanceWarning)
+warnings.filterwarnings(
+    "ignore", message=r"(?s).*keyword argument 'parallel=True' was specified", category=NumbaPerformanceWarning
+)
 
 STATUS_OK = 0
 STATUS_DIVERGED = 1
@@ -86,14 +95,16 @@ def _hermite(t, n_nodes, interval):
     if tau > 1.0:
         tau = 1.0
     om = 1.0 - tau
-    return (k,
-            (1.0 + 2.0 * tau) * om * om,
-            tau * om * om * interval,
-            tau * tau * (3.0 - 2.0 * tau),
-            tau * tau * (tau - 1.0) * interval,
-            6.0 * tau * (tau - 1.0) / interval,
-            om * (1.0 - 3.0 * tau),
-            tau * (3.0 * tau - 2.0))
+    return (
+        k,
+        (1.0 + 2.0 * tau) * om * om,
+        tau * om * om * interval,
+        tau * tau * (3.0 - 2.0 * tau),
+        tau * tau * (tau - 1.0) * interval,
+        6.0 * tau * (tau - 1.0) / interval,
+        om * (1.0 - 3.0 * tau),
+        tau * (3.0 * tau - 2.0),
+    )
 
 
 @njit(cache=True, inline="always", fastmath=_FAST)
@@ -109,9 +120,15 @@ def _forcing(t, ftab, off, n_nodes, interval, out, ooff):
     a = off + k
     b = a + 1
     for i in range(N_DOF):
-        out[ooff + i] = (h00 * ftab[a, i] + h10 * ftab[a, 9 + i] + h01 * ftab[b, i] + h11 * ftab[b, 9 + i]
-                  + d00 * (ftab[a, 18 + i] - ftab[b, 18 + i]) + d10 * ftab[a, 27 + i]
-                  + d11 * ftab[b, 27 + i])
+        out[ooff + i] = (
+            h00 * ftab[a, i]
+            + h10 * ftab[a, 9 + i]
+            + h01 * ftab[b, i]
+            + h11 * ftab[b, 9 + i]
+            + d00 * (ftab[a, 18 + i] - ftab[b, 18 + i])
+            + d10 * ftab[a, 27 + i]
+            + d11 * ftab[b, 27 + i]
+        )
 
 
 @njit(cache=True, inline="always", fastmath=_FAST)
@@ -233,7 +250,7 @@ def damper_stiffness(law, P, xd, z, u):
     lam = n * gb * abs(xd) * (1.0 if n == 1.0 else az ** (n - 1.0)) + P[9]
     if law == LAW_SPENCER:
         cs = P[2] + P[3] * u + P[12] + P[13] * u
-        lam += ((P[5] + gb * az ** n) * (P[0] + P[1] * u) + P[4]) / cs
+        lam += ((P[5] + gb * az**n) * (P[0] + P[1] * u) + P[4]) / cs
     return lam
 
 
@@ -246,8 +263,7 @@ def substeps(lam, dt):
     keeps lam * dt / m <= 2 * SUBSTEP_LIMIT for stability when dt is large.
     """
     m = 1
-    while (lam * SUBSTEP_DT_REF > SUBSTEP_LIMIT * m or lam * dt > 2.0 * SUBSTEP_LIMIT * m) \
-            and m < MAX_SUBSTEPS:
+    while (lam * SUBSTEP_DT_REF > SUBSTEP_LIMIT * m or lam * dt > 2.0 * SUBSTEP_LIMIT * m) and m < MAX_SUBSTEPS:
         m *= 2
     return m
 
@@ -281,11 +297,45 @@ def _derivative(law, s, R, roff, AT, TT, P, vcmd, y, cx, cv, K, koff):
 
 
 @njit(cache=True, nogil=True, fastmath=_FAST, parallel=_NO_PARFORS)
-def run_batch(lo, hi, law, x, step0, n_steps, final, stride, dt, A, TS, c_sec, P, vcmd,
-              utab, u_off, ftab, f_off, n_nodes, interval,
-              closed_loop, ctrl_stride, Gm, Hm, inner, noise,
-              out_q, out_v, out_a, out_f, out_w, out_wd, out_d, out_fd, out_vc,
-              status, fail_step):
+def run_batch(
+    lo,
+    hi,
+    law,
+    x,
+    step0,
+    n_steps,
+    final,
+    stride,
+    dt,
+    A,
+    TS,
+    c_sec,
+    P,
+    vcmd,
+    utab,
+    u_off,
+    ftab,
+    f_off,
+    n_nodes,
+    interval,
+    closed_loop,
+    ctrl_stride,
+    Gm,
+    Hm,
+    inner,
+    noise,
+    out_q,
+    out_v,
+    out_a,
+    out_f,
+    out_w,
+    out_wd,
+    out_d,
+    out_fd,
+    out_vc,
+    status,
+    fail_step,
+):
     """Advance the state x[s] = (q, q', damper states) of samples lo <= s < hi by n_steps
     steps of dt. Compiled without the GIL: `railride.simulation` runs sample ranges on threads.
 
@@ -444,12 +494,10 @@ def run_batch(lo, hi, law, x, step0, n_steps, final, stride, dt, A, TS, c_sec, P
                             st[i] = s[i] + ch * K[prev + i]
                     _derivative(law, st, R, roff, at, tt, pp, vc, y, cx, cv, K, NS_MAX * stage)
                 for i in range(2 * N_DOF):
-                    s[i] += h / 6.0 * (K[i] + 2.0 * K[NS_MAX + i] + 2.0 * K[2 * NS_MAX + i]
-                                       + K[3 * NS_MAX + i])
+                    s[i] += h / 6.0 * (K[i] + 2.0 * K[NS_MAX + i] + 2.0 * K[2 * NS_MAX + i] + K[3 * NS_MAX + i])
                 if has_states:
                     for i in range(2 * N_DOF, NS_MAX):
-                        s[i] += h / 6.0 * (K[i] + 2.0 * K[NS_MAX + i] + 2.0 * K[2 * NS_MAX + i]
-                                           + K[3 * NS_MAX + i])
+                        s[i] += h / 6.0 * (K[i] + 2.0 * K[NS_MAX + i] + 2.0 * K[2 * NS_MAX + i] + K[3 * NS_MAX + i])
                 for i in range(N_DOF):
                     R[i] = R[2 * N_DOF + i]
         for i in range(ns):

@@ -23,11 +23,16 @@ CARBODY_RESPONSES = {
     "roll": ("carbody_roll", 180.0 / math.pi, "roll (deg)", "carbody roll angle"),
 }
 #: axis labels of the grid columns of a sweep (gains: "table.entry (unit)", see `grid_axis_label`)
-GRID_AXIS_LABELS = {"speed_m_s": "speed (m/s)", "wavelength_m": "wavelength (m)",
-                    "amplitude_m": "amplitude (m)", "rail_phase_deg": "rail phase (deg)",
-                    "track_seed": "track seed", "voltage_v": "command voltage (V)",
-                    "damper_scale": "damper force scale (-)",
-                    "seed": "sensor noise seed"}
+GRID_AXIS_LABELS = {
+    "speed_m_s": "speed (m/s)",
+    "wavelength_m": "wavelength (m)",
+    "amplitude_m": "amplitude (m)",
+    "rail_phase_deg": "rail phase (deg)",
+    "track_seed": "track seed",
+    "voltage_v": "command voltage (V)",
+    "damper_scale": "damper force scale (-)",
+    "seed": "sensor noise seed",
+}
 
 
 def coordinate_label(value) -> str:
@@ -88,11 +93,15 @@ def describe_scenario(record: dict) -> str:
     parts = []
     profile = record.get("profile")
     if profile == "sine":
-        parts.append(f"sine A = {_num(record, 'amplitude_m')} m, wavelength {_num(record, 'wavelength_m')} m, "
-                     f"rail phase {_num(record, 'rail_phase_deg')} deg")
+        parts.append(
+            f"sine A = {_num(record, 'amplitude_m')} m, wavelength {_num(record, 'wavelength_m')} m, "
+            f"rail phase {_num(record, 'rail_phase_deg')} deg"
+        )
     elif profile == "cosine-bump":
-        parts.append(f"cosine bump h = {_num(record, 'height_m')} m, length {_num(record, 'length_m')} m "
-                     f"at s = {_num(record, 'start_m')} m ({record.get('rails', 'both')} rails)")
+        parts.append(
+            f"cosine bump h = {_num(record, 'height_m')} m, length {_num(record, 'length_m')} m "
+            f"at s = {_num(record, 'start_m')} m ({record.get('rails', 'both')} rails)"
+        )
     elif profile == "measured":
         parts.append(f"measured profile {record.get('source', '?')}")
     elif profile == "random":
@@ -105,8 +114,7 @@ def describe_scenario(record: dict) -> str:
             text = f"random track {spectrum}"
         if "seed" in record:
             text += f", seed {record['seed']}"
-        text += (f", wavelengths {_num(record, 'min_wavelength_m')}-"
-                 f"{_num(record, 'max_wavelength_m')} m")
+        text += f", wavelengths {_num(record, 'min_wavelength_m')}-{_num(record, 'max_wavelength_m')} m"
         parts.append(text)
     elif profile:
         parts.append(str(profile))
@@ -121,8 +129,10 @@ def describe_dampers(settings: dict, detail: bool = False) -> str:
     """The controlled suspensions' dampers of a compare, sweep or tune ``settings`` record:
     "railway MR dampers (force x 4)", "ideal actuators"; ``detail`` adds what an ideal device
     does."""
-    ideal = {"ideal": ("ideal actuators", "force = demand"),
-             "ideal-damper": ("ideal semi-active dampers", "force = demand where it dissipates, else 0")}
+    ideal = {
+        "ideal": ("ideal actuators", "force = demand"),
+        "ideal-damper": ("ideal semi-active dampers", "force = demand where it dissipates, else 0"),
+    }
     if settings.get("damper") in ideal:
         words, what = ideal[settings["damper"]]
         return f"{words} ({what})" if detail else words
@@ -131,7 +141,7 @@ def describe_dampers(settings: dict, detail: bool = False) -> str:
 
 
 def describe_suspension(ds: xr.Dataset) -> str:
-    """"MR <model> dampers at <v> V" for a ride result Dataset with damper models, else ""."""
+    """ "MR <model> dampers at <v> V" for a ride result Dataset with damper models, else ""."""
     if "damper_command_voltage" not in ds.variables:
         return ""
     model = damper_model_name(ds) or "damper"
@@ -165,8 +175,10 @@ def psd_title(ds: xr.Dataset, window, segment: float) -> str:
     ``window`` (start, end) [s] (None: the whole run), Welch segments of at most ``segment`` s."""
     start, end = window if window is not None else (float(ds["time"][0]), float(ds["time"][-1]))
     segment = min(segment, end - start)
-    title = (f"PSD of the carbody CG vertical acceleration, {start:g}-{end:g} s (Welch, "
-             f"{segment:g} s Hann segments, 50 % overlap)")
+    title = (
+        f"PSD of the carbody CG vertical acceleration, {start:g}-{end:g} s (Welch, "
+        f"{segment:g} s Hann segments, 50 % overlap)"
+    )
     context = comparison_title(ds)
     if context:
         title += "\n" + textwrap.fill(context, 120)
@@ -180,8 +192,7 @@ def gain_unit(parameter: str) -> str | None:
 
     from . import control  # here, not above: control pulls in the vehicle model
 
-    classes = {"inner": control.InnerLoop, "pid": control.PID, "attitude": control.Attitude,
-               "ride": control.Ride}
+    classes = {"inner": control.InnerLoop, "pid": control.PID, "attitude": control.Attitude, "ride": control.Ride}
     table, _, entry = parameter.partition(".")
     for f in dataclasses.fields(classes[table]) if table in classes else ():
         if f.name == entry:

@@ -23,7 +23,7 @@ STATISTICS = ("rms", "ptp")
 
 
 def parse_window(text: str) -> tuple[float, float]:
-    """"START:END" in seconds; either side may be empty (start of run, end of run)."""
+    """ "START:END" in seconds; either side may be empty (start of run, end of run)."""
     parts = text.split(":")
     if len(parts) != 2:
         raise ValueError(f"window = {text!r}: expected START:END in seconds, e.g. 2:10")
@@ -42,8 +42,9 @@ def check_window(window, t_end: float, t_start: float = 0.0) -> tuple[float, flo
     if math.isinf(end) and end > 0:
         end = t_end
     if not (math.isfinite(start) and math.isfinite(end) and t_start <= start < end <= t_end + 1e-9):
-        raise ValueError(f"window = {start:g}:{end:g} s: must satisfy {t_start:g} <= START < END <= {t_end:g} "
-                         "(inside the run)")
+        raise ValueError(
+            f"window = {start:g}:{end:g} s: must satisfy {t_start:g} <= START < END <= {t_end:g} (inside the run)"
+        )
     return float(start), float(end)
 
 
@@ -67,10 +68,12 @@ def ride_metrics(ds: xr.Dataset, window=None, diverged=None) -> xr.DataArray:
     """
     part = select_window(ds, window)
     lead = ["sample"] if "sample" in part.dims else []
-    acceleration, bounce, pitch, roll = (part[channel].transpose(*lead, "time").values
-                                         for channel, _ in RESPONSES.values())
-    return metrics_from_arrays(acceleration, bounce, pitch, roll, sample=part["sample"].values if lead else None,
-                               diverged=diverged)
+    acceleration, bounce, pitch, roll = (
+        part[channel].transpose(*lead, "time").values for channel, _ in RESPONSES.values()
+    )
+    return metrics_from_arrays(
+        acceleration, bounce, pitch, roll, sample=part["sample"].values if lead else None, diverged=diverged
+    )
 
 
 def metrics_from_arrays(acceleration, bounce, pitch, roll, sample=None, diverged=None) -> xr.DataArray:
@@ -90,8 +93,7 @@ def metrics_from_arrays(acceleration, bounce, pitch, roll, sample=None, diverged
     coords: dict[str, Any] = {"response": list(RESPONSES), "statistic": list(STATISTICS)}
     if lead:
         coords["sample"] = np.arange(data.shape[0]) if sample is None else sample
-    out = xr.DataArray(data, dims=lead + ["response", "statistic"], coords=coords,
-                       name="ride_metrics")
+    out = xr.DataArray(data, dims=lead + ["response", "statistic"], coords=coords, name="ride_metrics")
     finite = np.isfinite(data)
     if diverged is not None:
         mask = np.atleast_1d(np.asarray(diverged, dtype=bool))
@@ -114,5 +116,4 @@ def to_dict(metrics: xr.DataArray) -> dict:
     """{response: {rms, ptp}} for one run (the JSON schema of docs/cli.md)."""
     if "sample" in metrics.dims:
         raise ValueError("to_dict takes the metrics of one run; select a sample first")
-    return {r: {s: float(metrics.sel(response=r, statistic=s)) for s in STATISTICS}
-            for r in metrics.response.values}
+    return {r: {s: float(metrics.sel(response=r, statistic=s)) for s in STATISTICS} for r in metrics.response.values}

@@ -66,10 +66,8 @@ class Objective:
 
     def __post_init__(self):
         if self.kind not in OBJECTIVE_KINDS:
-            raise ValueError(f"objective kind = {self.kind!r}: unknown; allowed: "
-                             f"{', '.join(OBJECTIVE_KINDS)}")
-        rule = ("four numbers >= 0, not all 0 (acceleration, displacement, pitch, roll), for "
-                "kind 'weighted'")
+            raise ValueError(f"objective kind = {self.kind!r}: unknown; allowed: {', '.join(OBJECTIVE_KINDS)}")
+        rule = "four numbers >= 0, not all 0 (acceleration, displacement, pitch, roll), for kind 'weighted'"
         if self.kind == "weighted":
             if self.weights is None:
                 raise ValueError(f"objective weights = None: {rule}")
@@ -84,23 +82,31 @@ class Objective:
                 raise ValueError(f"objective weights = {self.weights!r}: {rule}")
             object.__setattr__(self, "weights", w)
         elif self.weights is not None:
-            raise ValueError(f"objective weights = {self.weights!r}: for kind 'weighted' only "
-                             f"(kind is {self.kind!r})")
+            raise ValueError(f"objective weights = {self.weights!r}: for kind 'weighted' only (kind is {self.kind!r})")
         if self.kind == "constrained":
             if self.bound is None:
-                raise ValueError("objective bound = None: kind 'constrained' needs a bound, a "
-                                 "finite number > 0 (the largest RMS ratio to passive allowed)")
-            object.__setattr__(self, "bound", _number(
-                "bound", self.bound, "a finite number > 0 (the largest RMS ratio to passive "
-                "allowed)", lambda v: v > 0))
+                raise ValueError(
+                    "objective bound = None: kind 'constrained' needs a bound, a "
+                    "finite number > 0 (the largest RMS ratio to passive allowed)"
+                )
+            object.__setattr__(
+                self,
+                "bound",
+                _number(
+                    "bound",
+                    self.bound,
+                    "a finite number > 0 (the largest RMS ratio to passive allowed)",
+                    lambda v: v > 0,
+                ),
+            )
         elif self.bound is not None:
-            raise ValueError(f"objective bound = {self.bound!r}: for kind 'constrained' only "
-                             f"(kind is {self.kind!r})")
-        object.__setattr__(self, "penalty", _number("penalty", self.penalty,
-                                                    "a finite number >= 0", lambda v: v >= 0))
+            raise ValueError(f"objective bound = {self.bound!r}: for kind 'constrained' only (kind is {self.kind!r})")
+        object.__setattr__(self, "penalty", _number("penalty", self.penalty, "a finite number >= 0", lambda v: v >= 0))
         if self.kind == "constrained" and not math.isfinite(self.feasible_max):
-            raise ValueError(f"objective bound = {self.bound!r} with penalty = {self.penalty!r}: "
-                             "too large to rank infeasible candidates after feasible ones")
+            raise ValueError(
+                f"objective bound = {self.bound!r} with penalty = {self.penalty!r}: "
+                "too large to rank infeasible candidates after feasible ones"
+            )
 
     @property
     def feasible_max(self) -> float:
@@ -127,8 +133,7 @@ class Objective:
         and scores +inf: after every run that did not."""
         r = np.asarray(ratio, dtype=float)
         if r.shape[-1:] != (4,):
-            raise ValueError(f"ratios of shape {r.shape}: the last axis must hold the four "
-                             "responses")
+            raise ValueError(f"ratios of shape {r.shape}: the last axis must hold the four responses")
         if self.kind == "weighted":
             j = r @ np.array(self.weights)
         elif self.kind == "minimax":
@@ -155,13 +160,15 @@ class Objective:
             w = ", ".join(f"{n} {v:g}" for n, v in zip(RATIO_NAMES, self.weights or ()))
             text = f"weighted: J = sum_k w_k r_k, weights {w}, {r}"
         elif self.kind == "minimax":
-            text = (f"minimax: J = max_k r_k (the worst ratio; equal worst ratios tie), {r}")
+            text = f"minimax: J = max_k r_k (the worst ratio; equal worst ratios tie), {r}"
         else:
             b = f"{self.bound:g}"
-            text = (f"constrained: J = sum_k r_k subject to r_k <= {b} for every k, {r}; an "
-                    f"infeasible candidate scores J = {self.infeasible_offset:g} + "
-                    f"{INFEASIBLE_SCALE:g} x E, E = sum_k max(0, r_k - {b}), ranking it after "
-                    f"every feasible one (J <= {self.feasible_max:g}) and by its excess")
+            text = (
+                f"constrained: J = sum_k r_k subject to r_k <= {b} for every k, {r}; an "
+                f"infeasible candidate scores J = {self.infeasible_offset:g} + "
+                f"{INFEASIBLE_SCALE:g} x E, E = sum_k max(0, r_k - {b}), ranking it after "
+                f"every feasible one (J <= {self.feasible_max:g}) and by its excess"
+            )
         if self.penalty:
             text += f"; plus penalty {self.penalty:g} x sum_k max(0, r_k - 1)"
             if self.kind == "constrained":
@@ -170,13 +177,16 @@ class Objective:
 
     def to_dict(self) -> dict:
         """Every setting of the objective and its statement (for JSON documents)."""
-        return {"kind": self.kind,
-                "weights": None if self.weights is None else dict(zip(RESPONSES, self.weights)),
-                "bound": self.bound, "penalty": self.penalty,
-                "infeasible": None if self.kind != "constrained" else {
-                    "offset": self.infeasible_offset, "scale": INFEASIBLE_SCALE,
-                    "feasible_max": self.feasible_max},
-                "statement": self.describe()}
+        return {
+            "kind": self.kind,
+            "weights": None if self.weights is None else dict(zip(RESPONSES, self.weights)),
+            "bound": self.bound,
+            "penalty": self.penalty,
+            "infeasible": None
+            if self.kind != "constrained"
+            else {"offset": self.infeasible_offset, "scale": INFEASIBLE_SCALE, "feasible_max": self.feasible_max},
+            "statement": self.describe(),
+        }
 
 
 #: the tuner's default objective (`tune`, `railride.optimise`, `railride tune`)

@@ -55,8 +55,21 @@ class _Evaluator:
     objective, the runs done so far and the lowest objective of the batch (the optimiser calls
     it once per generation)."""
 
-    def __init__(self, parameters, suspension, scenario, scenario_options, gains, objective,
-                 damper, executor, table, progress, params=None, solver=None):
+    def __init__(
+        self,
+        parameters,
+        suspension,
+        scenario,
+        scenario_options,
+        gains,
+        objective,
+        damper,
+        executor,
+        table,
+        progress,
+        params=None,
+        solver=None,
+    ):
         self.parameters = tuple(parameters)
         self.suspension = suspension
         self.scenario = scenario
@@ -75,14 +88,28 @@ class _Evaluator:
 
     def _run(self, cases):
         self.n_runs += len(cases)
-        return run_cases(cases, executor=self.executor, table=self.table, base_gains=self.gains,
-                         params=self.params, solver=self.solver, progress=self.progress)
+        return run_cases(
+            cases,
+            executor=self.executor,
+            table=self.table,
+            base_gains=self.gains,
+            params=self.params,
+            solver=self.solver,
+            progress=self.progress,
+        )
 
     def cases(self, points: np.ndarray) -> list[Case]:
         """points (n, d) of log10 gains."""
-        return [Case(self.scenario, self.opts, suspension=self.suspension, damper=self.damper,
-                     gains=tuple(zip(self.parameters, (10.0 ** p).tolist())))
-                for p in np.atleast_2d(points)]
+        return [
+            Case(
+                self.scenario,
+                self.opts,
+                suspension=self.suspension,
+                damper=self.damper,
+                gains=tuple(zip(self.parameters, (10.0**p).tolist())),
+            )
+            for p in np.atleast_2d(points)
+        ]
 
     def rms(self, cases: list[Case]) -> np.ndarray:
         """(n, 4) RMS of acceleration, displacement, pitch, roll of ``cases``."""
@@ -100,18 +127,26 @@ class _Evaluator:
         from .track import scenario as make_scenario
 
         scenario = make_scenario(self.scenario, **dict(self.opts)).describe()
-        vehicle = (self.params if isinstance(self.params, VehicleParams)
-                   else VehicleParams.preset(self.params or "paper"))
-        return scenario, {**settings, "damper": self.damper, "dt_s": self.solver.dt,
-                          "base_gains": self.gains.source, **other_settings(vehicle, self.solver)}
+        vehicle = (
+            self.params if isinstance(self.params, VehicleParams) else VehicleParams.preset(self.params or "paper")
+        )
+        return scenario, {
+            **settings,
+            "damper": self.damper,
+            "dt_s": self.solver.dt,
+            "base_gains": self.gains.source,
+            **other_settings(vehicle, self.solver),
+        }
 
 
 def _parameter_rows(parameters) -> list[dict]:
     """Each parameter with its unit and the search box in SI."""
     from .labels import gain_unit
 
-    return [{"name": p, "unit": gain_unit(p), "low": float(10.0 ** lo), "high": float(10.0 ** hi)}
-            for p, (lo, hi) in zip(parameters, _bounds(parameters))]
+    return [
+        {"name": p, "unit": gain_unit(p), "low": float(10.0**lo), "high": float(10.0**hi)}
+        for p, (lo, hi) in zip(parameters, _bounds(parameters))
+    ]
 
 
 def _save(result, folder, files) -> list:
@@ -123,11 +158,14 @@ def _save(result, folder, files) -> list:
     text = json_text(result.to_dict())  # refuse NaN before any file is written
     frame = result.to_pandas()
     png, csv, doc = files
-    return write_folder(folder, [
-        (png, lambda path: save_png(result.plot(), path)),
-        (csv, lambda path: frame.to_csv(path, index=False)),
-        (doc, lambda path: path.write_text(text, encoding="utf-8")),
-    ])
+    return write_folder(
+        folder,
+        [
+            (png, lambda path: save_png(result.plot(), path)),
+            (csv, lambda path: frame.to_csv(path, index=False)),
+            (doc, lambda path: path.write_text(text, encoding="utf-8")),
+        ],
+    )
 
 
 @dataclass(frozen=True, eq=False)
@@ -161,8 +199,14 @@ class OptimiseResult:
         """One row per generation (0 the initial population): ``generation``, ``runs`` done by
         its end, ``objective`` the lowest in it and ``best`` the lowest so far."""
         c = np.asarray(self.convergence, dtype=float).reshape(-1, 2)
-        return pd.DataFrame({"generation": np.arange(len(c)), "runs": c[:, 0].astype(int),
-                             "objective": c[:, 1], "best": np.minimum.accumulate(c[:, 1])})
+        return pd.DataFrame(
+            {
+                "generation": np.arange(len(c)),
+                "runs": c[:, 0].astype(int),
+                "objective": c[:, 1],
+                "best": np.minimum.accumulate(c[:, 1]),
+            }
+        )
 
     def to_dict(self) -> dict:
         """The ``railride.optimise/1`` document: the settings, the objective, each parameter with
@@ -172,7 +216,7 @@ class OptimiseResult:
 
         rows = _parameter_rows(self.parameters)
         for row, lg in zip(rows, np.asarray(self.log10_gains, dtype=float)):
-            row.update(value=float(10.0 ** lg), log10_value=float(lg))
+            row.update(value=float(10.0**lg), log10_value=float(lg))
         g = self.gains
         return {
             "schema": SCHEMA_OPTIMISE,
@@ -186,11 +230,22 @@ class OptimiseResult:
             "generations": int(self.generations),
             "runs": int(self.n_runs),
             "message": self.message,
-            "gains": {"source": g.source, "inner": g.inner.to_dict(), "pid": g.pid.to_dict(),
-                      "attitude": g.attitude.to_dict(), "ride": g.ride.to_dict()},
-            "convergence": [{"generation": int(r.generation), "runs": int(r.runs),
-                             "objective": _finite(r.objective), "best": _finite(r.best)}
-                            for r in self.to_pandas().itertuples()],
+            "gains": {
+                "source": g.source,
+                "inner": g.inner.to_dict(),
+                "pid": g.pid.to_dict(),
+                "attitude": g.attitude.to_dict(),
+                "ride": g.ride.to_dict(),
+            },
+            "convergence": [
+                {
+                    "generation": int(r.generation),
+                    "runs": int(r.runs),
+                    "objective": _finite(r.objective),
+                    "best": _finite(r.best),
+                }
+                for r in self.to_pandas().itertuples()
+            ],
         }
 
     def plot(self, ax=None):
@@ -206,25 +261,69 @@ class OptimiseResult:
         return _save(self, folder, OPTIMISE_FILES)
 
 
-def optimise(parameters=SAS_PARAMETERS, *, suspension: str = "sas-attitude-ride",
-             scenario: str = "paper-sine", scenario_options=None, gains: GainSet | None = None,
-             objective: Objective | None = None, damper: str = DEFAULT_DAMPER, executor=None,
-             table: RunTable | None = None, popsize: int = 8, maxiter: int = 30, seed: int = 0,
-             params=None, solver=None, progress=None) -> OptimiseResult:
+def optimise(
+    parameters=SAS_PARAMETERS,
+    *,
+    suspension: str = "sas-attitude-ride",
+    scenario: str = "paper-sine",
+    scenario_options=None,
+    gains: GainSet | None = None,
+    objective: Objective | None = None,
+    damper: str = DEFAULT_DAMPER,
+    executor=None,
+    table: RunTable | None = None,
+    popsize: int = 8,
+    maxiter: int = 30,
+    seed: int = 0,
+    params=None,
+    solver=None,
+    progress=None,
+) -> OptimiseResult:
     """Differential evolution over ``parameters`` (names as in `railride.tuning.PARAMETERS`)
     at once. ``popsize`` times the number of parameters runs per generation; ``seed`` makes the
     search repeatable. ``params``: the vehicle (`VehicleParams` or a preset name, default
     "paper"); ``solver``: the `SolverSettings` of every run."""
-    ev = _Evaluator(parameters, suspension, scenario, scenario_options, gains, objective, damper,
-                    executor, table, progress, params, solver)
+    ev = _Evaluator(
+        parameters,
+        suspension,
+        scenario,
+        scenario_options,
+        gains,
+        objective,
+        damper,
+        executor,
+        table,
+        progress,
+        params,
+        solver,
+    )
     res = scipy.optimize.differential_evolution(
-        lambda x: ev(x.T), _bounds(parameters), vectorized=True, updating="deferred",
-        popsize=popsize, maxiter=maxiter, seed=seed, polish=False, tol=1e-4)
-    tuned = ev.gains.apply(tuple(zip(parameters, (10.0 ** res.x).tolist())))
+        lambda x: ev(x.T),
+        _bounds(parameters),
+        vectorized=True,
+        updating="deferred",
+        popsize=popsize,
+        maxiter=maxiter,
+        seed=seed,
+        polish=False,
+        tol=1e-4,
+    )
+    tuned = ev.gains.apply(tuple(zip(parameters, (10.0**res.x).tolist())))
     record, settings = ev.record(popsize=popsize, maxiter=maxiter, seed=seed)
-    return OptimiseResult(tuned, float(res.fun), ev.n_runs, int(res.nit), tuple(parameters),
-                          res.x, str(res.message), ev.objective, np.array(ev.batches, dtype=float),
-                          suspension, record, settings)
+    return OptimiseResult(
+        tuned,
+        float(res.fun),
+        ev.n_runs,
+        int(res.nit),
+        tuple(parameters),
+        res.x,
+        str(res.message),
+        ev.objective,
+        np.array(ev.batches, dtype=float),
+        suspension,
+        record,
+        settings,
+    )
 
 
 @dataclass(frozen=True, eq=False)
@@ -248,8 +347,10 @@ class SensitivityResult:
     settings: dict = field(default_factory=dict)
 
     def table(self) -> list[dict]:
-        return [{"parameter": p, "first_order": float(s), "total": float(t)}
-                for p, s, t in zip(self.parameters, self.first_order, self.total)]
+        return [
+            {"parameter": p, "first_order": float(s), "total": float(t)}
+            for p, s, t in zip(self.parameters, self.first_order, self.total)
+        ]
 
     def to_pandas(self) -> pd.DataFrame:
         """One row per parameter: ``parameter``, ``first_order``, ``total``."""
@@ -293,24 +394,54 @@ def _finite(value) -> float | None:
     return value if math.isfinite(value) else None
 
 
-def sensitivity(parameters=SAS_PARAMETERS, *, suspension: str = "sas-attitude-ride",
-                scenario: str = "paper-sine", scenario_options=None, gains: GainSet | None = None,
-                objective: Objective | None = None, damper: str = DEFAULT_DAMPER, executor=None,
-                table: RunTable | None = None, n: int = 64, seed: int = 0, params=None, solver=None,
-                progress=None) -> SensitivityResult:
+def sensitivity(
+    parameters=SAS_PARAMETERS,
+    *,
+    suspension: str = "sas-attitude-ride",
+    scenario: str = "paper-sine",
+    scenario_options=None,
+    gains: GainSet | None = None,
+    objective: Objective | None = None,
+    damper: str = DEFAULT_DAMPER,
+    executor=None,
+    table: RunTable | None = None,
+    n: int = 64,
+    seed: int = 0,
+    params=None,
+    solver=None,
+    progress=None,
+) -> SensitivityResult:
     """Sobol indices of the objective with every parameter uniform in log10 over the search
     bounds: n (d + 2) runs for d parameters (``n`` a power of two). ``params`` and ``solver``
     as for `optimise`."""
     if n < 2 or n & (n - 1):
         raise ValueError(f"n = {n!r}: a power of two >= 2")
-    ev = _Evaluator(parameters, suspension, scenario, scenario_options, gains, objective, damper,
-                    executor, table, progress, params, solver)
+    ev = _Evaluator(
+        parameters,
+        suspension,
+        scenario,
+        scenario_options,
+        gains,
+        objective,
+        damper,
+        executor,
+        table,
+        progress,
+        params,
+        solver,
+    )
     import scipy.stats  # here, not at import: scipy.stats costs half a second to load
 
     dists = [scipy.stats.uniform(lo, hi - lo) for lo, hi in _bounds(parameters)]
-    res = scipy.stats.sobol_indices(func=lambda x: ev(x.T), n=n, dists=dists,
-                                    rng=np.random.default_rng(seed))
+    res = scipy.stats.sobol_indices(func=lambda x: ev(x.T), n=n, dists=dists, rng=np.random.default_rng(seed))
     record, settings = ev.record(n=n, seed=seed)
-    return SensitivityResult(tuple(parameters), np.asarray(res.first_order),
-                             np.asarray(res.total_order), ev.n_runs, ev.objective, suspension,
-                             record, settings)
+    return SensitivityResult(
+        tuple(parameters),
+        np.asarray(res.first_order),
+        np.asarray(res.total_order),
+        ev.n_runs,
+        ev.objective,
+        suspension,
+        record,
+        settings,
+    )

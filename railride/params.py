@@ -64,9 +64,7 @@ class VehicleParams:
         try:
             return PRESETS[name]
         except KeyError:
-            raise ValueError(
-                f"unknown vehicle preset {name!r}; allowed: {', '.join(sorted(PRESETS))}"
-            ) from None
+            raise ValueError(f"unknown vehicle preset {name!r}; allowed: {', '.join(sorted(PRESETS))}") from None
 
     def replace(self, **changes: float) -> "VehicleParams":
         """A copy with some fields changed (validated like any new set)."""
@@ -124,8 +122,7 @@ class VehicleParams:
         unknown = sorted(set(table) - set(names))
         if unknown:
             raise ValueError(
-                f"{source}: unknown vehicle parameter(s) {', '.join(unknown)}; "
-                f"allowed: {', '.join(names)}"
+                f"{source}: unknown vehicle parameter(s) {', '.join(unknown)}; allowed: {', '.join(names)}"
             )
         if base_name is not None:
             return cls.preset(str(base_name)).replace(**table)
@@ -133,7 +130,7 @@ class VehicleParams:
         if missing:
             raise ValueError(
                 f"{source}: missing vehicle parameter(s) {', '.join(missing)} "
-                "(list them all, or start from a base with preset = \"paper\")"
+                '(list them all, or start from a base with preset = "paper")'
             )
         return cls(**table)
 
@@ -149,15 +146,35 @@ class VehicleParams:
 
 #: The paper's appendix (Harun et al.), in SI units.
 PAPER = VehicleParams(
-    m_c=3.96e4, m_b=3.25e3,
-    I_cx=8.85e4, I_cy=2.46e6, I_cz=2.5e6,
-    I_bx=3.06e3, I_by=3.02e3, I_bz=4.27e3,
-    k_px=4e6, k_py=3.25e6, k_pz=7e6,
-    c_px=0.0, c_py=0.0, c_pz=1.5e4,
-    k_sx=1.5e5, k_sy=1.5e5, k_sz=2.9e5,
-    c_sx=0.0, c_sy=5e4, c_sz=8e4,
-    l=9.0, d_s=1.0, d_p=1.0, a=1.0, b=1.25,
-    h_cs=1.207, h_ts=0.217, h_tp=0.452, h_wp=0.18,
+    m_c=3.96e4,
+    m_b=3.25e3,
+    I_cx=8.85e4,
+    I_cy=2.46e6,
+    I_cz=2.5e6,
+    I_bx=3.06e3,
+    I_by=3.02e3,
+    I_bz=4.27e3,
+    k_px=4e6,
+    k_py=3.25e6,
+    k_pz=7e6,
+    c_px=0.0,
+    c_py=0.0,
+    c_pz=1.5e4,
+    k_sx=1.5e5,
+    k_sy=1.5e5,
+    k_sz=2.9e5,
+    c_sx=0.0,
+    c_sy=5e4,
+    c_sz=8e4,
+    l=9.0,
+    d_s=1.0,
+    d_p=1.0,
+    a=1.0,
+    b=1.25,
+    h_cs=1.207,
+    h_ts=0.217,
+    h_tp=0.452,
+    h_wp=0.18,
 )
 
 PRESETS: dict[str, VehicleParams] = {"paper": PAPER}

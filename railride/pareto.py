@@ -36,14 +36,17 @@ SCHEMA = "railride.pareto/1"
 FILES = PARETO_FILES  # the files `ParetoResult.save` writes
 #: the gains each controller reads (the inner loop stays at the base gains: it is one setting
 #: per compiled batch)
-CONTROLLER_PARAMETERS = {n: sum((GainSet.entry_names(t) for t in GainSet.tables_read(n) if t != "inner"), ())
-                         for n in CONTROLLERS[1:]}
+CONTROLLER_PARAMETERS = {
+    n: sum((GainSet.entry_names(t) for t in GainSet.tables_read(n) if t != "inner"), ()) for n in CONTROLLERS[1:]
+}
 #: the ratios, by their short names, in the order of RESPONSES
 RATIOS = ("acceleration", "displacement", "pitch", "roll")
 #: the planes of the plot, each with its own non-dominated flag
 PROJECTIONS = (("acceleration", "pitch"), ("acceleration", "roll"))
-SAMPLING = ("scrambled Sobol' sequence (scipy.stats.qmc.Sobol), uniform in log10 of each gain "
-            "between REFERENCE / 1000 and REFERENCE x 100")
+SAMPLING = (
+    "scrambled Sobol' sequence (scipy.stats.qmc.Sobol), uniform in log10 of each gain "
+    "between REFERENCE / 1000 and REFERENCE x 100"
+)
 
 
 def non_dominated(points) -> np.ndarray:
@@ -137,9 +140,16 @@ class ParetoResult:
             "suspension": self.suspension,
             "scenario": self.scenario,
             "settings": self.settings,
-            "parameters": [{"name": p, "unit": gain_unit(p), "low": float(10.0 ** lo),
-                            "high": float(10.0 ** hi), "base": float(self.gains[0, j])}
-                           for j, (p, (lo, hi)) in enumerate(zip(self.parameters, self.bounds))],
+            "parameters": [
+                {
+                    "name": p,
+                    "unit": gain_unit(p),
+                    "low": float(10.0**lo),
+                    "high": float(10.0**hi),
+                    "base": float(self.gains[0, j]),
+                }
+                for j, (p, (lo, hi)) in enumerate(zip(self.parameters, self.bounds))
+            ],
             "passive_rms": dict(zip(RESPONSES, map(float, self.passive))),
             "counts": {"samples": len(frame), **{f: int(frame[f].sum()) for f in flags}},
             "note": self.note,
@@ -174,11 +184,12 @@ def _plain(value):
 
 
 def _power_of_two(name: str, value) -> int:
-    ok = (not isinstance(value, bool) and isinstance(value, (int, np.integer)) and value >= 1
-          and not value & (value - 1))
+    ok = not isinstance(value, bool) and isinstance(value, (int, np.integer)) and value >= 1 and not value & (value - 1)
     if not ok:
-        raise ValueError(f"{name} = {value!r}: must be a power of two (1, 2, 4, ..., 128, ...), which "
-                         "keeps the balance of the Sobol' sample")
+        raise ValueError(
+            f"{name} = {value!r}: must be a power of two (1, 2, 4, ..., 128, ...), which "
+            "keeps the balance of the Sobol' sample"
+        )
     return int(value)
 
 
@@ -191,8 +202,7 @@ def _parameters(suspension: str, parameters) -> tuple:
     parameters = tuple(parameters)
     for p in parameters:
         if p not in allowed:
-            raise ValueError(f"parameter {p!r}: not a gain of {suspension}; allowed: "
-                             f"{', '.join(allowed)}")
+            raise ValueError(f"parameter {p!r}: not a gain of {suspension}; allowed: {', '.join(allowed)}")
     if not parameters or len(set(parameters)) != len(parameters):
         raise ValueError(f"parameters = {parameters!r}: one or more distinct gains of {suspension}")
     return parameters
@@ -203,14 +213,28 @@ def in_sample_note(gains: GainSet, record: dict) -> str | None:
     them (`GainSet.tuned_on`)."""
     if not gains.tuned_on(record):
         return None
-    return (f"The base gains ({gains.source}) were tuned on this same single track and are judged "
-            f"on it: their place here is in-sample, not a test on another track.")
+    return (
+        f"The base gains ({gains.source}) were tuned on this same single track and are judged "
+        f"on it: their place here is in-sample, not a test on another track."
+    )
 
 
-def pareto(suspension: str = "sas-attitude-ride", *, n_samples: int = 128, seed: int = 0,
-           scenario: str = "paper-sine", scenario_options=None, gains: GainSet | None = None,
-           damper: str = DEFAULT_DAMPER, executor=None, table: RunTable | None = None,
-           params=None, solver=None, progress=None, parameters=None) -> ParetoResult:
+def pareto(
+    suspension: str = "sas-attitude-ride",
+    *,
+    n_samples: int = 128,
+    seed: int = 0,
+    scenario: str = "paper-sine",
+    scenario_options=None,
+    gains: GainSet | None = None,
+    damper: str = DEFAULT_DAMPER,
+    executor=None,
+    table: RunTable | None = None,
+    params=None,
+    solver=None,
+    progress=None,
+    parameters=None,
+) -> ParetoResult:
     """Sample the gains of ``suspension`` (pid, sas-attitude, sas-attitude-ride; by default all
     it reads, or ``parameters``) and return the RMS ratios to passive of each sample.
 
@@ -239,20 +263,36 @@ def pareto(suspension: str = "sas-attitude-ride", *, n_samples: int = 128, seed:
     check_resolution(scen, solver.output_rate)
     record = scen.describe()
     table = RunTable() if table is None else table
-    ev = _Evaluator(names, suspension, scenario, scenario_options, base, None, damper, executor,
-                    table, progress, vehicle, solver)
+    ev = _Evaluator(
+        names, suspension, scenario, scenario_options, base, None, damper, executor, table, progress, vehicle, solver
+    )
     bounds = np.array(_bounds(names))
     import scipy.stats.qmc  # here, not at import: scipy.stats costs half a second to load
 
-    unit = scipy.stats.qmc.Sobol(len(names), scramble=True, seed=seed).random_base2(
-        int(math.log2(n_samples)))
+    unit = scipy.stats.qmc.Sobol(len(names), scramble=True, seed=seed).random_base2(int(math.log2(n_samples)))
     points = scipy.stats.qmc.scale(unit, bounds[:, 0], bounds[:, 1])
     base_case = Case(scenario, ev.opts, suspension=suspension, damper=damper)
     rms = ev.rms([base_case, *ev.cases(points)])
-    gains_si = np.vstack([[base.value(p) for p in names], 10.0 ** points])
-    settings = {"n_samples": n_samples, "seed": seed, "sampling": SAMPLING, "damper": damper,
-                "dt_s": solver.dt, "base_gains": base.source,
-                "base_gains_tuned_on": (base.provenance or {}).get("scenario"),
-                **other_settings(vehicle, solver)}
-    return ParetoResult(suspension, names, bounds, gains_si, rms, np.asarray(ev.passive, float),
-                        record, settings, in_sample_note(base, record), len(table.frame))
+    gains_si = np.vstack([[base.value(p) for p in names], 10.0**points])
+    settings = {
+        "n_samples": n_samples,
+        "seed": seed,
+        "sampling": SAMPLING,
+        "damper": damper,
+        "dt_s": solver.dt,
+        "base_gains": base.source,
+        "base_gains_tuned_on": (base.provenance or {}).get("scenario"),
+        **other_settings(vehicle, solver),
+    }
+    return ParetoResult(
+        suspension,
+        names,
+        bounds,
+        gains_si,
+        rms,
+        np.asarray(ev.passive, float),
+        record,
+        settings,
+        in_sample_note(base, record),
+        len(table.frame),
+    )

@@ -26,9 +26,14 @@ def _substeps(lam: float, dt: float) -> int:
     return m
 
 
-def simulate_reference(scenario: Scenario, params: VehicleParams | None = None,
-                       dt: float = 1e-4, output_every: int = 10, damper=None,
-                       voltage: float | None = None) -> dict[str, np.ndarray]:
+def simulate_reference(
+    scenario: Scenario,
+    params: VehicleParams | None = None,
+    dt: float = 1e-4,
+    output_every: int = 10,
+    damper=None,
+    voltage: float | None = None,
+) -> dict[str, np.ndarray]:
     """RK4 in NumPy. Returns time, q, q' and carbody acceleration every ``output_every`` steps.
 
     Without ``damper`` the secondary dashpots are c_sz; with a model from railride.dampers its
@@ -80,8 +85,9 @@ def simulate_reference(scenario: Scenario, params: VehicleParams | None = None,
         m = 1
         if damper is not None:
             rates = T.T @ state[9:18]
-            lam = max(dampers.stiffness_estimate(damper, rates[c], state[18 + 3 * c], state[20 + 3 * c])
-                      for c in range(4))
+            lam = max(
+                dampers.stiffness_estimate(damper, rates[c], state[18 + 3 * c], state[20 + 3 * c]) for c in range(4)
+            )
             m = _substeps(lam, dt)
         h = dt / m
         for sub in range(m):
@@ -92,12 +98,12 @@ def simulate_reference(scenario: Scenario, params: VehicleParams | None = None,
             k3 = rhs(ts + h / 2, state + h / 2 * k2)
             k4 = rhs(ts + h, state + h * k3)
             state = state + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
-    return {"time": np.array(times), "q": np.array(qs), "v": np.array(vs),
-            "carbody_acceleration": np.array(accs)}
+    return {"time": np.array(times), "q": np.array(qs), "v": np.array(vs), "carbody_acceleration": np.array(accs)}
 
 
-def rig_reference(damper, amplitude: float, frequency: float, voltage: float,
-                  duration: float, dt: float = 1e-4) -> dict[str, np.ndarray]:
+def rig_reference(
+    damper, amplitude: float, frequency: float, voltage: float, duration: float, dt: float = 1e-4
+) -> dict[str, np.ndarray]:
     """A damper driven by x = amplitude sin(2 pi frequency t) at a constant voltage: RK4 in
     NumPy on (z, y, u, E) with the stepper's sub-step rule. Returns t, x, F, z, u, E per step."""
     w = 2 * np.pi * frequency

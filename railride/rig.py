@@ -112,15 +112,27 @@ def _resolve(damper):
     damper = dampers.preset(damper) if isinstance(damper, str) else damper
     if getattr(damper, "law", None) == dampers.LAW_IDEAL:
         # its force is a controller's demand, not a function of the motion: nothing to test
-        raise ValueError("damper = 'ideal': the ideal actuator has no force law of its own to "
-                         "drive on the rig (it applies a vehicle controller's demand); allowed: "
-                         f"{', '.join(dampers.PRESETS)} or a model from railride.dampers")
+        raise ValueError(
+            "damper = 'ideal': the ideal actuator has no force law of its own to "
+            "drive on the rig (it applies a vehicle controller's demand); allowed: "
+            f"{', '.join(dampers.PRESETS)} or a model from railride.dampers"
+        )
     return damper
 
 
-def drive(damper, motion, *, duration: float, voltage=None, command=None, desired_force=None,
-          B: float = 1.0, G: float | None = None, dt: float = DEFAULT_DT,
-          output_rate: float | None = None) -> xr.Dataset:
+def drive(
+    damper,
+    motion,
+    *,
+    duration: float,
+    voltage=None,
+    command=None,
+    desired_force=None,
+    B: float = 1.0,
+    G: float | None = None,
+    dt: float = DEFAULT_DT,
+    output_rate: float | None = None,
+) -> xr.Dataset:
     """Drive one damper through ``motion`` (SineMotion or SampledMotion) for ``duration`` s.
 
     Give exactly one of: ``voltage`` (a constant [V], or a list: one run per voltage along the
@@ -133,8 +145,9 @@ def drive(damper, motion, *, duration: float, voltage=None, command=None, desire
     damper = _resolve(damper)
     duration = _check_number("duration", duration, "positive", "s")
     dt = _check_number("dt", dt, "positive", "s")
-    given = [k for k, v in (("voltage", voltage), ("command", command),
-                            ("desired_force", desired_force)) if v is not None]
+    given = [
+        k for k, v in (("voltage", voltage), ("command", command), ("desired_force", desired_force)) if v is not None
+    ]
     if len(given) != 1:
         raise ValueError("give exactly one of voltage, command or desired_force")
     if hasattr(motion, "end") and motion.end() < duration - 1e-12:
@@ -166,16 +179,33 @@ def drive(damper, motion, *, duration: float, voltage=None, command=None, desire
         G = _check_number("G", default_gain(damper) if G is None else G, "nonnegative", "V/N")
     rows = n_steps // stride + (1 if n_steps % stride == 0 else 2)
     out = np.zeros((n, rows, 9))
-    kernels.rig_batch(damper.law, np.tile(damper.pack(), (n, 1)), n_steps, stride, dt, xtab,
-                      interval, mode, vconst, series, np.full(n, float(B)), np.full(n, float(G or 0.0)), out)
+    kernels.rig_batch(
+        damper.law,
+        np.tile(damper.pack(), (n, 1)),
+        n_steps,
+        stride,
+        dt,
+        xtab,
+        interval,
+        mode,
+        vconst,
+        series,
+        np.full(n, float(B)),
+        np.full(n, float(G or 0.0)),
+        out,
+    )
     if not np.all(np.isfinite(out)):
         raise RuntimeError("the damper rig run diverged: a state stopped being finite")
     names = ("x", "xd", "F", "z", "y", "u", "v", "E")
     attrs = {
-        "x": ("m", "extension"), "xd": ("m/s", "extension rate"),
-        "F": ("N", "damper force, tension +"), "z": ("m", "hysteretic variable"),
-        "y": ("m", "Spencer internal displacement"), "u": ("V", "coil voltage after the lag"),
-        "v": ("V", "command voltage"), "E": ("J", "energy dissipated since t = 0"),
+        "x": ("m", "extension"),
+        "xd": ("m/s", "extension rate"),
+        "F": ("N", "damper force, tension +"),
+        "z": ("m", "hysteretic variable"),
+        "y": ("m", "Spencer internal displacement"),
+        "u": ("V", "coil voltage after the lag"),
+        "v": ("V", "command voltage"),
+        "E": ("J", "energy dissipated since t = 0"),
     }
     time = out[0, :, 0]
     dims = ("voltage", "time") if voltage is not None else ("time",)
@@ -189,8 +219,11 @@ def drive(damper, motion, *, duration: float, voltage=None, command=None, desire
         coords["voltage"] = ("voltage", vconst, {"units": "V"})
     else:
         fn_name = "desired_force" if desired_force is not None else "command"
-        data[fn_name] = ("time", np.broadcast_to(fn(time), time.shape).astype(float),
-                         {"units": "N" if desired_force is not None else "V"})
+        data[fn_name] = (
+            "time",
+            np.broadcast_to(fn(time), time.shape).astype(float),
+            {"units": "N" if desired_force is not None else "V"},
+        )
     ds = xr.Dataset(data, coords=coords)
     ds.attrs.update(damper=json.dumps(damper.to_dict()), dt_s=dt, integrator="RK4 with stiffness sub-steps")
     if mode == kernels.RIG_TRACKING:
@@ -235,12 +268,14 @@ class Cycles:
         rows = []
         for v in ds.voltage.values:
             cyc = ds.sel(voltage=v)
-            rows.append({
-                "voltage_v": float(v),
-                "force_max_n": float(cyc.F.max()),
-                "force_min_n": float(cyc.F.min()),
-                "energy_per_cycle_j": float(cyc.E.values[-1] - cyc.E.values[0]),
-            })
+            rows.append(
+                {
+                    "voltage_v": float(v),
+                    "force_max_n": float(cyc.F.max()),
+                    "force_min_n": float(cyc.F.min()),
+                    "energy_per_cycle_j": float(cyc.E.values[-1] - cyc.E.values[0]),
+                }
+            )
         return rows
 
     def to_dict(self) -> dict:
@@ -248,9 +283,14 @@ class Cycles:
         and `table`."""
         from . import __version__
 
-        return {"schema": SCHEMA_DAMPER, "railride_version": __version__,
-                "damper": self.damper.to_dict(), "amplitude_m": float(self.motion.amplitude),
-                "frequency_hz": float(self.motion.frequency), "cycles": self.table()}
+        return {
+            "schema": SCHEMA_DAMPER,
+            "railride_version": __version__,
+            "damper": self.damper.to_dict(),
+            "amplitude_m": float(self.motion.amplitude),
+            "frequency_hz": float(self.motion.frequency),
+            "cycles": self.table(),
+        }
 
     def to_pandas(self):
         """The last cycle of each voltage as one long table (`railride.tables.cycles_frame`):
@@ -274,8 +314,16 @@ class Cycles:
         return write_damper_outputs(self, folder, self.to_dict())
 
 
-def cycles(damper, amplitude: float, frequency: float, voltages, *, n_cycles: int = 4,
-           dt: float = DEFAULT_DT, points_per_cycle: int = 400) -> Cycles:
+def cycles(
+    damper,
+    amplitude: float,
+    frequency: float,
+    voltages,
+    *,
+    n_cycles: int = 4,
+    dt: float = DEFAULT_DT,
+    points_per_cycle: int = 400,
+) -> Cycles:
     """Drive ``damper`` with x = amplitude sin(2 pi frequency t) at each constant voltage for
     ``n_cycles`` cycles and keep the last one, a steady state: the hysteretic and coil states
     forget their start within a cycle or two."""
@@ -291,16 +339,19 @@ def cycles(damper, amplitude: float, frequency: float, voltages, *, n_cycles: in
     period = 1.0 / motion.frequency
     steps_per_cycle = int(round(period / dt))
     if steps_per_cycle < 100:
-        raise ValueError(f"frequency = {frequency!r} Hz: a cycle of {period:.3g} s is under 100 steps of "
-                         f"dt = {dt:g} s; lower the frequency or dt")
+        raise ValueError(
+            f"frequency = {frequency!r} Hz: a cycle of {period:.3g} s is under 100 steps of "
+            f"dt = {dt:g} s; lower the frequency or dt"
+        )
     if abs(steps_per_cycle * dt - period) > 1e-9 * period:
         # keep a whole number of steps per cycle so the last cycle is exact
         dt = period / max(steps_per_cycle, 1)
     stride = max(1, steps_per_cycle // points_per_cycle)
     while steps_per_cycle % stride:
         stride -= 1
-    ds = drive(damper, motion, duration=n_cycles * period, voltage=list(voltages), dt=dt,
-               output_rate=1.0 / (stride * dt))
+    ds = drive(
+        damper, motion, duration=n_cycles * period, voltage=list(voltages), dt=dt, output_rate=1.0 / (stride * dt)
+    )
     last = ds.isel(time=slice(-(steps_per_cycle // stride) - 1, None))
     return Cycles(damper, motion, last, n_cycles)
 
@@ -325,8 +376,12 @@ class TrackingMetrics:
 
     def to_dict(self) -> dict:
         """The ``metrics`` of the ``railride.tracking/1`` document."""
-        return {"rms_error_n": self.rms_error_n, "rms_demand_n": self.rms_demand_n,
-                "normalised_rms_error": self.normalised_rms_error, "window_s": list(self.window_s)}
+        return {
+            "rms_error_n": self.rms_error_n,
+            "rms_demand_n": self.rms_demand_n,
+            "normalised_rms_error": self.normalised_rms_error,
+            "window_s": list(self.window_s),
+        }
 
 
 @dataclass(frozen=True, eq=False)
@@ -358,19 +413,25 @@ class Tracking:
         err = ds.F.values - ds.desired_force.values
         rms_demand = float(np.sqrt(np.mean(ds.desired_force.values**2)))
         rms_err = float(np.sqrt(np.mean(err**2)))
-        return TrackingMetrics(rms_err, rms_demand, rms_err / rms_demand if rms_demand > 0 else math.nan,
-                               self.window)
+        return TrackingMetrics(rms_err, rms_demand, rms_err / rms_demand if rms_demand > 0 else math.nan, self.window)
 
     def to_dict(self) -> dict:
         """The ``railride.tracking/1`` document (docs/cli.md): the damper's parameters, the
         demand, the stroke, the gains and `metrics`."""
         from . import __version__
 
-        return {"schema": SCHEMA_TRACKING, "railride_version": __version__,
-                "damper": self.damper.to_dict(), "desired": self.desired,
-                "amplitude_n": float(self.amplitude), "frequency_hz": float(self.frequency),
-                "stroke_m": float(self.stroke), "B": float(self.B), "G_v_per_n": float(self.G),
-                "metrics": self.metrics().to_dict()}
+        return {
+            "schema": SCHEMA_TRACKING,
+            "railride_version": __version__,
+            "damper": self.damper.to_dict(),
+            "desired": self.desired,
+            "amplitude_n": float(self.amplitude),
+            "frequency_hz": float(self.frequency),
+            "stroke_m": float(self.stroke),
+            "B": float(self.B),
+            "G_v_per_n": float(self.G),
+            "metrics": self.metrics().to_dict(),
+        }
 
     def to_pandas(self):
         """The time histories as one table indexed by time (`railride.tables.to_frame`): the rig
@@ -405,9 +466,18 @@ def desired_force_signal(kind: str, amplitude: float, frequency: float):
     return lambda t: amplitude * (2.0 * np.mod(frequency * t + 0.5, 1.0) - 1.0)
 
 
-def track(damper=DEFAULT_DAMPER, desired: str = "sine", amplitude: float = 10e3, frequency: float = 1.0,
-          *, B: float = 1.0, G: float | None = None, stroke: float = 0.02,
-          n_cycles: int = 3, dt: float = DEFAULT_DT) -> Tracking:
+def track(
+    damper=DEFAULT_DAMPER,
+    desired: str = "sine",
+    amplitude: float = 10e3,
+    frequency: float = 1.0,
+    *,
+    B: float = 1.0,
+    G: float | None = None,
+    stroke: float = 0.02,
+    n_cycles: int = 3,
+    dt: float = DEFAULT_DT,
+) -> Tracking:
     """The inner loop (paper eq. 12-14) tracking a sine or sawtooth desired force (amplitude
     [N], frequency [Hz]) while the damper is stroked by x = -stroke cos(2 pi f t), whose
     velocity is in phase with a sine demand, so that the demand is dissipative where the
@@ -423,12 +493,24 @@ def track(damper=DEFAULT_DAMPER, desired: str = "sine", amplitude: float = 10e3,
     motion = SineMotion(stroke, frequency, phase_deg=-90.0)
     period = 1.0 / frequency
     if period < 100 * dt:
-        raise ValueError(f"frequency = {frequency!r} Hz: a cycle of {period:.3g} s is under 100 steps of "
-                         f"dt = {dt:g} s; lower the frequency or dt")
+        raise ValueError(
+            f"frequency = {frequency!r} Hz: a cycle of {period:.3g} s is under 100 steps of "
+            f"dt = {dt:g} s; lower the frequency or dt"
+        )
     # record at about 1 kHz, at least 200 points per cycle, on whole steps
     stride = max(1, min(int(round(1e-3 / dt)), int(period / (200 * dt))))
-    ds = drive(damper, motion, duration=n_cycles * period, desired_force=fd, B=B, G=G, dt=dt,
-               output_rate=1.0 / (stride * dt))
+    ds = drive(
+        damper, motion, duration=n_cycles * period, desired_force=fd, B=B, G=G, dt=dt, output_rate=1.0 / (stride * dt)
+    )
     # the gains as the loop used them (G filled in when None)
-    return Tracking(damper, desired, amplitude, frequency, stroke, float(ds.attrs["B"]),
-                    float(ds.attrs["G_v_per_n"]), ds, (period, n_cycles * period))
+    return Tracking(
+        damper,
+        desired,
+        amplitude,
+        frequency,
+        stroke,
+        float(ds.attrs["B"]),
+        float(ds.attrs["G_v_per_n"]),
+        ds,
+        (period, n_cycles * period),
+    )

@@ -106,8 +106,7 @@ def _system_arrays(vehicle: Vehicle, passive: bool = True) -> dict[str, np.ndarr
     """
     minv = 1.0 / np.diag(vehicle.M)[:, None]
     return {
-        "A": np.hstack([-minv * vehicle.K, -minv * (vehicle.C if passive else vehicle.C0),
-                        minv * vehicle.T]).T,
+        "A": np.hstack([-minv * vehicle.K, -minv * (vehicle.C if passive else vehicle.C0), minv * vehicle.T]).T,
         "TS": vehicle.T.copy(),
         "c_sec": np.full(4, vehicle.params.c_sz),
         "Bw": -minv * vehicle.K_w,
@@ -158,8 +157,7 @@ def _as_suspensions(suspension) -> list[Suspension]:
     items = [Suspension() if s is None else s for s in items]
     for s in items:
         if not isinstance(s, Suspension):
-            raise ValueError(f"suspension = {s!r}: must be a railride.Suspension, a list of them, "
-                             "or None (passive)")
+            raise ValueError(f"suspension = {s!r}: must be a railride.Suspension, a list of them, or None (passive)")
     return items
 
 
@@ -180,14 +178,26 @@ def _closed_loop(suspensions: list[Suspension], solver: SolverSettings, duration
     stride = solver.control_steps()
     ticks = int(round(duration / (stride * solver.dt))) + 2
     noise = first.sensor_noise
-    return {"controllers": [s.controller for s in suspensions], "inner": first.inner,
-            "rate": solver.control_rate, "stride": stride,
-            "noise": noise.samples(ticks) if noise is not None else np.zeros((0, 6)),
-            "sensor_noise": noise}
+    return {
+        "controllers": [s.controller for s in suspensions],
+        "inner": first.inner,
+        "rate": solver.control_rate,
+        "stride": stride,
+        "noise": noise.samples(ticks) if noise is not None else np.zeros((0, 6)),
+        "sensor_noise": noise,
+    }
 
 
-def simulate(scenario=None, params=None, suspension=None, *, solver=None, initial_state=None,
-             progress=None, on_divergence: str = "raise") -> "RideResult":
+def simulate(
+    scenario=None,
+    params=None,
+    suspension=None,
+    *,
+    solver=None,
+    initial_state=None,
+    progress=None,
+    on_divergence: str = "raise",
+) -> "RideResult":
     """Simulate the vehicle on one or many scenarios.
 
     ``scenario`` is a `Scenario`, a scenario name (see `railride.track.scenario`) or a list of
@@ -212,19 +222,26 @@ def simulate(scenario=None, params=None, suspension=None, *, solver=None, initia
     solver = SolverSettings.of(solver)
     dt, output_rate = solver.dt, solver.output_rate
     if on_divergence not in ("raise", "mark"):
-        raise ValueError(f"on_divergence = {on_divergence!r}: allowed 'raise' (stop with an error) "
-                         "or 'mark' (keep the other samples; see RideResult.diverged_at)")
-    batch = not (isinstance(scenario, (Scenario, str)) or scenario is None) or not (
-        isinstance(params, (VehicleParams, str)) or params is None) or isinstance(suspension, (list, tuple))
+        raise ValueError(
+            f"on_divergence = {on_divergence!r}: allowed 'raise' (stop with an error) "
+            "or 'mark' (keep the other samples; see RideResult.diverged_at)"
+        )
+    batch = (
+        not (isinstance(scenario, (Scenario, str)) or scenario is None)
+        or not (isinstance(params, (VehicleParams, str)) or params is None)
+        or isinstance(suspension, (list, tuple))
+    )
     scenarios = [_resolve_scenario(s) for s in _as_list(scenario)]
     param_sets = [_resolve_params(p) for p in _as_list(params)]
     suspensions = _as_suspensions(suspension)
     counts = (len(scenarios), len(param_sets), len(suspensions))
     n = max(counts)
     if any(k not in (1, n) for k in counts):
-        raise ValueError(f"a batch needs equally many scenarios, parameter sets and suspensions, "
-                         f"or one of each; got {counts[0]} scenarios, {counts[1]} parameter sets "
-                         f"and {counts[2]} suspensions")
+        raise ValueError(
+            f"a batch needs equally many scenarios, parameter sets and suspensions, "
+            f"or one of each; got {counts[0]} scenarios, {counts[1]} parameter sets "
+            f"and {counts[2]} suspensions"
+        )
     if n == 0:
         raise ValueError("an empty batch: give at least one scenario")
     scenarios = scenarios * (n // len(scenarios))
@@ -232,8 +249,10 @@ def simulate(scenario=None, params=None, suspension=None, *, solver=None, initia
     suspensions = suspensions * (n // len(suspensions))
     duration = scenarios[0].duration
     if any(abs(s.duration - duration) > 1e-12 * duration for s in scenarios):
-        raise ValueError("every sample of a batch must have the same duration; got "
-                         + ", ".join(sorted({f'{s.duration:g} s' for s in scenarios})))
+        raise ValueError(
+            "every sample of a batch must have the same duration; got "
+            + ", ".join(sorted({f"{s.duration:g} s" for s in scenarios}))
+        )
     conflict = batch_conflict(suspensions)
     if conflict is not None:
         raise ValueError(conflict)
@@ -249,15 +268,13 @@ def simulate(scenario=None, params=None, suspension=None, *, solver=None, initia
     n_out_f = duration * output_rate
     n_out = int(round(n_out_f))
     if abs(n_out - n_out_f) > 1e-6 * max(1.0, n_out_f) or n_out < 1:
-        raise ValueError(f"duration = {duration:g} s must be a whole number of output intervals "
-                         f"(1/{output_rate:g} Hz)")
+        raise ValueError(f"duration = {duration:g} s must be a whole number of output intervals (1/{output_rate:g} Hz)")
     n_steps = n_out * stride
     for sc in scenarios:  # a random track's shortest wavelength must show in the output
         check_resolution(sc, output_rate)
 
     systems = {key: _system_arrays(v, passive=damper is None) for key, v in vehicles.items()}
-    arrays = {k: np.ascontiguousarray(np.stack([systems[id(p)][k] for p in param_sets]))
-              for k in ("A", "TS", "c_sec")}
+    arrays = {k: np.ascontiguousarray(np.stack([systems[id(p)][k] for p in param_sets])) for k in ("A", "TS", "c_sec")}
 
     # rail inputs depend on the scenario and the wheelset spacing, the forcing also on the
     # vehicle: tables are shared between the samples that agree on those
@@ -265,8 +282,12 @@ def simulate(scenario=None, params=None, suspension=None, *, solver=None, initia
     ftabs: list[np.ndarray] = []
     u_index: dict[tuple, tuple] = {}
     f_index: dict[tuple, int] = {}
-    u_off, f_off, n_nodes, interval = (np.zeros(n, dtype=np.int64), np.zeros(n, dtype=np.int64),
-                                       np.zeros(n, dtype=np.int64), np.zeros(n))
+    u_off, f_off, n_nodes, interval = (
+        np.zeros(n, dtype=np.int64),
+        np.zeros(n, dtype=np.int64),
+        np.zeros(n, dtype=np.int64),
+        np.zeros(n),
+    )
     for i, (sc, p) in enumerate(zip(scenarios, param_sets)):
         lag = vehicles[id(p)].wheelset_lag_distance
         ukey = (id(sc), tuple(lag))
@@ -293,18 +314,23 @@ def simulate(scenario=None, params=None, suspension=None, *, solver=None, initia
         for i, (c, p) in enumerate(zip(closed["controllers"], param_sets)):
             gm[i], hm[i] = c.gains(vehicles[id(p)])
     x = np.zeros((n, kernels.NX))
-    x[:, 2 * N_DOF + 2:kernels.NS_MAX:dampers.N_DAMPER_STATES] = vcmd  # coils settled at the command
+    x[:, 2 * N_DOF + 2 : kernels.NS_MAX : dampers.N_DAMPER_STATES] = vcmd  # coils settled at the command
     P = np.tile(damper.pack() if damper is not None else np.zeros(dampers.N_PACKED), (n, 1))
     if initial_state is not None:
         x0 = np.asarray(initial_state, dtype=float)
         if x0.shape not in ((2 * N_DOF,), (n, 2 * N_DOF)) or not np.all(np.isfinite(x0)):
-            raise ValueError(f"initial_state must hold {2 * N_DOF} finite numbers (q then q') "
-                             f"or one such row per sample; got shape {x0.shape}")
-        x[:, :2 * N_DOF] = x0
+            raise ValueError(
+                f"initial_state must hold {2 * N_DOF} finite numbers (q then q') "
+                f"or one such row per sample; got shape {x0.shape}"
+            )
+        x[:, : 2 * N_DOF] = x0
     out = {
-        "q": np.empty((n, rows, N_DOF)), "v": np.empty((n, rows, N_DOF)),
-        "a": np.empty((n, rows, N_DOF)), "f": np.empty((n, rows, 4)),
-        "w": np.empty((n, rows, 8)), "wd": np.empty((n, rows, 8)),
+        "q": np.empty((n, rows, N_DOF)),
+        "v": np.empty((n, rows, N_DOF)),
+        "a": np.empty((n, rows, N_DOF)),
+        "f": np.empty((n, rows, 4)),
+        "w": np.empty((n, rows, 8)),
+        "wd": np.empty((n, rows, 8)),
         "d": np.empty((n, rows if _has_states(damper) else 1, kernels.N_DS)),
         "fd": np.zeros((n, rows if closed is not None else 1, 4)),
         "vc": np.empty((n, rows if closed is not None else 1, 4)),
@@ -323,12 +349,45 @@ def simulate(scenario=None, params=None, suspension=None, *, solver=None, initia
     while True:
         todo = min(chunk, n_steps - done)
         final = done + todo == n_steps
-        kernels.run_parallel(kernels.run_batch, n, law, x, done, todo, final, stride, dt,
-                             arrays["A"], arrays["TS"], arrays["c_sec"], P, vcmd,
-                             utab, u_off, ftab, f_off, n_nodes, interval,
-                             closed is not None, ctrl_stride, gm, hm, inner_gains, noise,
-                             out["q"], out["v"], out["a"], out["f"], out["w"], out["wd"], out["d"],
-                             out["fd"], out["vc"], status, fail_step)
+        kernels.run_parallel(
+            kernels.run_batch,
+            n,
+            law,
+            x,
+            done,
+            todo,
+            final,
+            stride,
+            dt,
+            arrays["A"],
+            arrays["TS"],
+            arrays["c_sec"],
+            P,
+            vcmd,
+            utab,
+            u_off,
+            ftab,
+            f_off,
+            n_nodes,
+            interval,
+            closed is not None,
+            ctrl_stride,
+            gm,
+            hm,
+            inner_gains,
+            noise,
+            out["q"],
+            out["v"],
+            out["a"],
+            out["f"],
+            out["w"],
+            out["wd"],
+            out["d"],
+            out["fd"],
+            out["vc"],
+            status,
+            fail_step,
+        )
         done += todo
         if progress is not None:
             progress(done / n_steps)
@@ -338,8 +397,10 @@ def simulate(scenario=None, params=None, suspension=None, *, solver=None, initia
     if np.any(status != kernels.STATUS_OK):
         bad = np.flatnonzero(status != kernels.STATUS_OK)
         which = ", ".join(f"sample {i} at t = {fail_step[i] * dt:.4g} s" for i in bad[:5])
-        message = (f"the simulation diverged ({which}): a response left +-{kernels.DIVERGED:g} "
-                   f"or stopped being finite; check the parameters or reduce dt")
+        message = (
+            f"the simulation diverged ({which}): a response left +-{kernels.DIVERGED:g} "
+            f"or stopped being finite; check the parameters or reduce dt"
+        )
         if on_divergence != "mark":
             raise RuntimeError(message)
         for i in bad.tolist():  # the stepper stopped there: what follows is not a response
@@ -350,18 +411,40 @@ def simulate(scenario=None, params=None, suspension=None, *, solver=None, initia
                     out[key][i, cut:] = np.nan
 
     created = datetime.now(timezone.utc).isoformat(timespec="seconds")
-    raw = {"time": np.arange(rows) / output_rate, "q": out["q"], "a": out["a"], "batch": batch,
-           "diverged_at": diverged_at}
-    return RideResult(raw=raw, build=functools.partial(_dataset, out, vehicles, param_sets, scenarios, dt,
-                                              output_rate, rows, batch, created, suspensions[0], vcmd,
-                                              closed),
-                      suspension=suspensions if batch else suspensions[0], solver=solver,
-                      scenario=scenarios if batch else scenarios[0],
-                      params=param_sets if batch else param_sets[0])
+    raw = {
+        "time": np.arange(rows) / output_rate,
+        "q": out["q"],
+        "a": out["a"],
+        "batch": batch,
+        "diverged_at": diverged_at,
+    }
+    return RideResult(
+        raw=raw,
+        build=functools.partial(
+            _dataset,
+            out,
+            vehicles,
+            param_sets,
+            scenarios,
+            dt,
+            output_rate,
+            rows,
+            batch,
+            created,
+            suspensions[0],
+            vcmd,
+            closed,
+        ),
+        suspension=suspensions if batch else suspensions[0],
+        solver=solver,
+        scenario=scenarios if batch else scenarios[0],
+        params=param_sets if batch else param_sets[0],
+    )
 
 
-def _dataset(out, vehicles, param_sets, scenarios, dt, output_rate, rows, batch, created,
-             suspension, vcmd, closed=None) -> xr.Dataset:
+def _dataset(
+    out, vehicles, param_sets, scenarios, dt, output_rate, rows, batch, created, suspension, vcmd, closed=None
+) -> xr.Dataset:
     """Named channels in SI units; a ``sample`` dimension only for a batch."""
     import numba
     import scipy
@@ -379,49 +462,94 @@ def _dataset(out, vehicles, param_sets, scenarios, dt, output_rate, rows, batch,
     for i, name in enumerate(DOF_NAMES):
         channels[name] = ((), out["q"][:, :, i], {"units": DOF_UNITS[i]})
         channels[f"{name}_velocity"] = ((), out["v"][:, :, i], {"units": f"{DOF_UNITS[i]}/s"})
-    channels["carbody_acceleration"] = ((), out["a"][:, :, 0], {
-        "units": "m/s^2", "long_name": "carbody CG vertical acceleration"})
-    channels["carbody_pitch_acceleration"] = ((), out["a"][:, :, 1], {
-        "units": "rad/s^2", "long_name": "carbody pitch acceleration"})
-    channels["carbody_roll_acceleration"] = ((), out["a"][:, :, 2], {
-        "units": "rad/s^2", "long_name": "carbody roll acceleration"})
-    channels["carbody_corner_displacement"] = (("corner",), out["q"][:, :, :3] @ T[:, :3], {
-        "units": "m", "long_name": "carbody vertical displacement above each secondary corner"})
-    channels["secondary_deflection"] = (("corner",), deflection, {
-        "units": "m", "long_name": "secondary vertical deflection, carbody minus bogie (extension +)"})
-    channels["secondary_deflection_velocity"] = (("corner",), out["v"] @ T, {
-        "units": "m/s"})
-    channels["secondary_spring_force"] = (("corner",), -ksz * deflection, {
-        "units": "N", "long_name": "secondary vertical spring force on the carbody (up +)"})
-    channels["secondary_damper_force"] = (("corner",), out["f"], {
-        "units": "N", "long_name": "secondary vertical damper force on the carbody (up +)"})
+    channels["carbody_acceleration"] = (
+        (),
+        out["a"][:, :, 0],
+        {"units": "m/s^2", "long_name": "carbody CG vertical acceleration"},
+    )
+    channels["carbody_pitch_acceleration"] = (
+        (),
+        out["a"][:, :, 1],
+        {"units": "rad/s^2", "long_name": "carbody pitch acceleration"},
+    )
+    channels["carbody_roll_acceleration"] = (
+        (),
+        out["a"][:, :, 2],
+        {"units": "rad/s^2", "long_name": "carbody roll acceleration"},
+    )
+    channels["carbody_corner_displacement"] = (
+        ("corner",),
+        out["q"][:, :, :3] @ T[:, :3],
+        {"units": "m", "long_name": "carbody vertical displacement above each secondary corner"},
+    )
+    channels["secondary_deflection"] = (
+        ("corner",),
+        deflection,
+        {"units": "m", "long_name": "secondary vertical deflection, carbody minus bogie (extension +)"},
+    )
+    channels["secondary_deflection_velocity"] = (("corner",), out["v"] @ T, {"units": "m/s"})
+    channels["secondary_spring_force"] = (
+        ("corner",),
+        -ksz * deflection,
+        {"units": "N", "long_name": "secondary vertical spring force on the carbody (up +)"},
+    )
+    channels["secondary_damper_force"] = (
+        ("corner",),
+        out["f"],
+        {"units": "N", "long_name": "secondary vertical damper force on the carbody (up +)"},
+    )
     if _has_states(damper):  # the ideal actuator has no states and no voltage
         d = out["d"]
-        channels["damper_hysteretic_z"] = (("corner",), d[:, :, 0::3], {
-            "units": "m", "long_name": "Bouc-Wen hysteretic variable z of each damper"})
+        channels["damper_hysteretic_z"] = (
+            ("corner",),
+            d[:, :, 0::3],
+            {"units": "m", "long_name": "Bouc-Wen hysteretic variable z of each damper"},
+        )
         if damper.law == dampers.LAW_SPENCER:
-            channels["damper_internal_displacement"] = (("corner",), d[:, :, 1::3], {
-                "units": "m", "long_name": "Spencer model internal displacement y"})
-        channels["damper_voltage"] = (("corner",), d[:, :, 2::3], {
-            "units": "V", "long_name": "damper coil voltage u after the coil lag"})
+            channels["damper_internal_displacement"] = (
+                ("corner",),
+                d[:, :, 1::3],
+                {"units": "m", "long_name": "Spencer model internal displacement y"},
+            )
+        channels["damper_voltage"] = (
+            ("corner",),
+            d[:, :, 2::3],
+            {"units": "V", "long_name": "damper coil voltage u after the coil lag"},
+        )
         command = out["vc"] if closed is not None else np.broadcast_to(vcmd[:, None, :], d[:, :, 2::3].shape)
-        channels["damper_command_voltage"] = (("corner",), command, {
-            "units": "V", "long_name": "commanded damper voltage v"})
+        channels["damper_command_voltage"] = (
+            ("corner",),
+            command,
+            {"units": "V", "long_name": "commanded damper voltage v"},
+        )
     if closed is not None:
-        channels["damper_demand_force"] = (("corner",), out["fd"], {
-            "units": "N", "long_name": "desired damper force on the carbody (up +) from the outer loop"})
-    channels["rail_displacement"] = (("wheelset", "rail"), out["w"].reshape(shape), {
-        "units": "m", "long_name": "rail height under each wheel"})
-    channels["rail_velocity"] = (("wheelset", "rail"), out["wd"].reshape(shape), {
-        "units": "m/s", "long_name": "rail vertical velocity under each wheel"})
+        channels["damper_demand_force"] = (
+            ("corner",),
+            out["fd"],
+            {"units": "N", "long_name": "desired damper force on the carbody (up +) from the outer loop"},
+        )
+    channels["rail_displacement"] = (
+        ("wheelset", "rail"),
+        out["w"].reshape(shape),
+        {"units": "m", "long_name": "rail height under each wheel"},
+    )
+    channels["rail_velocity"] = (
+        ("wheelset", "rail"),
+        out["wd"].reshape(shape),
+        {"units": "m/s", "long_name": "rail vertical velocity under each wheel"},
+    )
     scen = np.array([json.dumps(s.describe()) for s in scenarios])
     pars = np.array([json.dumps(p.to_dict()) for p in param_sets])
     if closed is not None:
         ctrl = closed["controllers"]
         inner = None if closed["inner"] is None else closed["inner"].to_dict()  # the ideal devices: none
-        attrs_ctrl = {"control_rate_hz": closed["rate"], "inner_loop": json.dumps(inner),
-                      "sensor_noise": json.dumps(None if closed["sensor_noise"] is None
-                                                 else dataclasses.asdict(closed["sensor_noise"]))}
+        attrs_ctrl = {
+            "control_rate_hz": closed["rate"],
+            "inner_loop": json.dumps(inner),
+            "sensor_noise": json.dumps(
+                None if closed["sensor_noise"] is None else dataclasses.asdict(closed["sensor_noise"])
+            ),
+        }
         controller_names = np.array([c.name for c in ctrl])
         controller_gains = np.array([json.dumps(c.to_dict()) for c in ctrl])
     data: dict[str, tuple]  # name -> (dims, values[, attrs]), as xr.Dataset takes them
@@ -458,8 +586,7 @@ def _dataset(out, vehicles, param_sets, scenarios, dt, output_rate, rows, batch,
         "output_rate_hz": output_rate,
         "suspension": suspension.describe(),
         "damper": json.dumps(None if damper is None else damper.to_dict()),
-        "sign_convention": "z up; pitch + lowers the front; roll + raises the left side; "
-                           "forces on the carbody, up +",
+        "sign_convention": "z up; pitch + lowers the front; roll + raises the left side; forces on the carbody, up +",
     }
     if closed is not None:
         attrs.update(attrs_ctrl)
@@ -474,8 +601,17 @@ class RideResult:
     JSON document), `to_pandas`, `plot` and `save`.
     """
 
-    def __init__(self, dataset: xr.Dataset | None = None, *, build=None, raw=None, suspension=None,
-                 solver=None, scenario=None, params=None):
+    def __init__(
+        self,
+        dataset: xr.Dataset | None = None,
+        *,
+        build=None,
+        raw=None,
+        suspension=None,
+        solver=None,
+        scenario=None,
+        params=None,
+    ):
         if (dataset is None) == (build is None):
             raise ValueError("RideResult needs a dataset or a build function, not both")
         self._dataset = dataset
@@ -519,6 +655,7 @@ class RideResult:
         """RMS and peak-to-peak of the four body responses; see `railride.metrics.ride_metrics`.
         Computed from the raw arrays when the Dataset has not been built (sweeps)."""
         from .metrics import check_window, metrics_from_arrays, ride_metrics
+
         diverged = np.isfinite(self.diverged_at)  # NaN: did not diverge
         if self._dataset is not None or self._raw is None:
             return ride_metrics(self.dataset, window, diverged=diverged)
@@ -532,11 +669,11 @@ class RideResult:
         out = metrics_from_arrays(a[..., 0], q[..., 0], q[..., 1], q[..., 2], diverged=diverged)
         return out if self._raw["batch"] else out.isel(sample=0, drop=True)
 
-    def comfort(self, window=None, positions=("centre", "front", "rear"),
-                weightings=("Wk", "Wb")):
+    def comfort(self, window=None, positions=("centre", "front", "rear"), weightings=("Wk", "Wb")):
         """Ride comfort on the carbody floor (ISO 2631-1 a_w and VDV, EN 12299 N_MV vertical
         part, Sperling Wz); see `railride.comfort.ride_comfort` and docs/comfort.md."""
         from .comfort import ride_comfort
+
         return ride_comfort(self.dataset, positions=positions, window=window, weightings=weightings)
 
     def to_dict(self, window=None, *, comfort: bool = False, vehicle: dict | None = None) -> dict:
@@ -551,25 +688,33 @@ class RideResult:
         from .metrics import check_window, to_dict
 
         if self.is_batch:
-            raise ValueError("to_dict describes a single run; this result is a batch of "
-                             f"{self.dataset.sizes['sample']} samples")
+            raise ValueError(
+                f"to_dict describes a single run; this result is a batch of {self.dataset.sizes['sample']} samples"
+            )
         record = self._record("scenario", self.scenario)
         duration = float(record["duration_s"]) if "duration_s" in record else float(self.dataset["time"][-1])
         start, end = (0.0, duration) if window is None else check_window(window, duration)
-        solver = self.solver if self.solver is not None else SolverSettings(
-            self.dataset.attrs["dt_s"], self.dataset.attrs["output_rate_hz"])
+        solver = (
+            self.solver
+            if self.solver is not None
+            else SolverSettings(self.dataset.attrs["dt_s"], self.dataset.attrs["output_rate_hz"])
+        )
         doc = {
             "schema": SCHEMA,
             "railride_version": __version__,
             "scenario": record,
             **(self._vehicle_record() if vehicle is None else vehicle),
             "suspension": _suspension_record(self.suspension),
-            "settings": {"dt_s": float(solver.dt), "output_rate_hz": float(solver.output_rate),
-                         "window_s": [float(start), float(end)]},
+            "settings": {
+                "dt_s": float(solver.dt),
+                "output_rate_hz": float(solver.output_rate),
+                "window_s": [float(start), float(end)],
+            },
             "metrics": to_dict(self.metrics(window)),
         }
         if comfort:
             from .comparison import comfort_record
+
             doc["comfort"] = comfort_record(self.comfort(window))
         return doc
 
@@ -590,12 +735,14 @@ class RideResult:
     def to_pandas(self):
         """The time histories as a DataFrame, one column per scalar channel."""
         from .tables import to_frame
+
         return to_frame(self.dataset)
 
     def plot(self, ax=None):
         """The four body responses against time (`railride.plots.ride.plot_body_responses`);
         ``ax``: four Axes to draw in, or None for a new figure. Returns the figure."""
         from .plots.ride import plot_body_responses
+
         return plot_body_responses(self.dataset, ax=ax)
 
     def save(self, folder, window=None, *, comfort: bool = False, vehicle: dict | None = None) -> list:
@@ -603,6 +750,7 @@ class RideResult:
         body_responses.png into ``folder``, all or nothing (`railride.files.write_outputs`).
         Returns the written paths."""
         from .files import write_outputs
+
         return write_outputs(self, folder, self.to_dict(window, comfort=comfort, vehicle=vehicle))
 
 
@@ -614,8 +762,11 @@ def _suspension_record(suspension) -> dict:
     if suspension is None:
         return {"type": "passive"}
     if suspension.kind == "passive":
-        return {"type": "passive"} if suspension.damper is None else {
-            "type": "passive", "damper": suspension.damper.to_dict()}
+        return (
+            {"type": "passive"}
+            if suspension.damper is None
+            else {"type": "passive", "damper": suspension.damper.to_dict()}
+        )
     record: dict[str, Any] = {"type": suspension.name, "damper": suspension.damper_name}
     if suspension.voltage is not None:
         record["voltage_v"] = float(suspension.voltage)

@@ -44,13 +44,17 @@ class SolverSettings:
         for name, unit in (("dt", "s"), ("output_rate", "Hz"), ("control_rate", "Hz")):
             object.__setattr__(self, name, validation.number(name, getattr(self, name), "positive", unit))
         if self.dt * self.output_rate > 1.0 + 1e-6:
-            raise ValueError(f"dt = {self.dt:g} s is too large for output_rate = {self.output_rate:g} Hz: "
-                             f"at most one output sample per step; use dt <= {1.0 / self.output_rate:g} s "
-                             "or a lower output_rate")
+            raise ValueError(
+                f"dt = {self.dt:g} s is too large for output_rate = {self.output_rate:g} Hz: "
+                f"at most one output sample per step; use dt <= {1.0 / self.output_rate:g} s "
+                "or a lower output_rate"
+            )
         if _steps(1.0 / (self.output_rate * self.dt)) is None:
-            raise ValueError(f"output_rate = {self.output_rate:g} Hz with dt = {self.dt:g} s: the output "
-                             "interval 1/output_rate must be a whole number of steps (at most one "
-                             "sample per step)")
+            raise ValueError(
+                f"output_rate = {self.output_rate:g} Hz with dt = {self.dt:g} s: the output "
+                "interval 1/output_rate must be a whole number of steps (at most one "
+                "sample per step)"
+            )
 
     @property
     def output_steps(self) -> int:
@@ -64,14 +68,15 @@ class SolverSettings:
         is not a whole number of steps (the check a closed loop needs)."""
         steps = _steps(1.0 / (self.control_rate * self.dt))
         if steps is None:
-            raise ValueError(f"control_rate = {self.control_rate:g} Hz with dt = {self.dt:g} s: the "
-                             "controller period must be a whole number of steps")
+            raise ValueError(
+                f"control_rate = {self.control_rate:g} Hz with dt = {self.dt:g} s: the "
+                "controller period must be a whole number of steps"
+            )
         return steps
 
     def to_dict(self) -> dict:
         """The settings as a result records them (SI units in the names)."""
-        return {"dt_s": self.dt, "output_rate_hz": self.output_rate,
-                "control_rate_hz": self.control_rate}
+        return {"dt_s": self.dt, "output_rate_hz": self.output_rate, "control_rate_hz": self.control_rate}
 
     @classmethod
     def of(cls, solver) -> "SolverSettings":
@@ -79,8 +84,7 @@ class SolverSettings:
         if solver is None:
             return cls()
         if not isinstance(solver, cls):
-            raise ValueError(f"solver = {solver!r}: must be a railride.SolverSettings or None "
-                             "(the defaults)")
+            raise ValueError(f"solver = {solver!r}: must be a railride.SolverSettings or None (the defaults)")
         return solver
 
 
@@ -96,14 +100,5 @@ def check_resolution(scenario, output_rate: float) -> None:
         f"min_wavelength = {lam:g} m at speed {scenario.speed:g} m/s passes at "
         f"{scenario.speed / lam:g} Hz, more than output_rate {output_rate:g} Hz / {RESOLUTION:g} = "
         f"{output_rate / RESOLUTION:g} Hz can resolve: raise min_wavelength, lower the speed or "
-        "raise output_rate")
-
-
-def _with_keywords(solver, dt=None, output_rate=None, control_rate=None) -> SolverSettings:
-    """``solver`` from the step keywords the command line still passes to the studies.
-    TEMPORARY: removed when the CLI moves onto Suspension."""
-    given = {k: v for k, v in (("dt", dt), ("output_rate", output_rate),
-                               ("control_rate", control_rate)) if v is not None}
-    if given and solver is not None:
-        raise ValueError(f"give solver= or {', '.join(given)}=, not both")
-    return SolverSettings(**given) if given else SolverSettings.of(solver)
+        "raise output_rate"
+    )

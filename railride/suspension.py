@@ -37,15 +37,18 @@ def damper_model(name: str, damper_scale: float = 1.0):
     """The damper called ``name`` (`railride.dampers.preset`) with its force capacity times
     ``damper_scale``; a scale other than 1 for an ideal device is a ValueError (it has none)."""
     if not isinstance(name, str):
-        raise ValueError(f"damper = {name!r}: must be a name ({', '.join(dampers.NAMES)}); "
-                         "scale a preset with damper_scale")
+        raise ValueError(
+            f"damper = {name!r}: must be a name ({', '.join(dampers.NAMES)}); scale a preset with damper_scale"
+        )
     scale = dampers.check_scale("damper_scale", damper_scale)
     model = dampers.preset(name)
     if scale == 1.0:
         return model
     if model.law == dampers.LAW_IDEAL:
-        raise ValueError(f"damper_scale = {scale:g}: the ideal actuator applies the demand "
-                         "exactly and has no force capacity to scale (leave damper_scale at 1)")
+        raise ValueError(
+            f"damper_scale = {scale:g}: the ideal actuator applies the demand "
+            "exactly and has no force capacity to scale (leave damper_scale at 1)"
+        )
     return model.scaled(scale)
 
 
@@ -68,8 +71,10 @@ def _model(damper):
         return dampers.preset(damper)
     if isinstance(damper, (dampers.Viscous, dampers.BoucWen, dampers.Ideal)):  # Spencer is a BoucWen
         return damper
-    raise ValueError(f"damper = {damper!r}: must be None (passive), a name "
-                     f"({', '.join(dampers.NAMES)}) or a model from railride.dampers")
+    raise ValueError(
+        f"damper = {damper!r}: must be None (passive), a name "
+        f"({', '.join(dampers.NAMES)}) or a model from railride.dampers"
+    )
 
 
 @dataclass(frozen=True)
@@ -107,8 +112,9 @@ class Suspension:
         object.__setattr__(self, "damper_scale", dampers.check_scale("damper_scale", self.damper_scale))
         c = self.controller
         if c is not None and not (hasattr(c, "gains") and hasattr(c, "name")):
-            raise ValueError(f"controller = {c!r}: must be an outer loop from railride.control "
-                             "(PID, SAS, ZeroDemand) or None")
+            raise ValueError(
+                f"controller = {c!r}: must be an outer loop from railride.control (PID, SAS, ZeroDemand) or None"
+            )
         if self.inner is not None and not isinstance(self.inner, InnerLoop):
             raise ValueError(f"inner = {self.inner!r}: must be a railride.control.InnerLoop")
         if self.sensor_noise is not None and not isinstance(self.sensor_noise, SensorNoise):
@@ -119,30 +125,41 @@ class Suspension:
                 if getattr(self, name) is not None:
                     raise ValueError(f"{name} applies to a closed loop only: give controller= as well")
             if ideal:
-                raise ValueError(f"damper = {model.model!r}: the ideal actuator applies an outer loop's "
-                                 "demand and needs controller= (PID or SAS); it has no voltage to set"
-                                 + (f" (got voltage = {self.voltage!r})" if self.voltage is not None else ""))
+                raise ValueError(
+                    f"damper = {model.model!r}: the ideal actuator applies an outer loop's "
+                    "demand and needs controller= (PID or SAS); it has no voltage to set"
+                    + (f" (got voltage = {self.voltage!r})" if self.voltage is not None else "")
+                )
             if model is None or model.law == dampers.LAW_VISCOUS:
                 if self.voltage is not None:
-                    raise ValueError(f"voltage = {self.voltage!r}: applies to MR dampers only, give "
-                                     "damper= as well (the passive suspension has no command)")
+                    raise ValueError(
+                        f"voltage = {self.voltage!r}: applies to MR dampers only, give "
+                        "damper= as well (the passive suspension has no command)"
+                    )
                 return
             voltage = model.v_min if self.voltage is None else self.voltage
             object.__setattr__(self, "voltage", model.check_voltage(voltage))
             return
         if self.voltage is not None:
-            raise ValueError(f"voltage = {self.voltage!r} with controller = {c.name!r}: give either "
-                             "voltage (open loop) or controller (closed loop), not both")
+            raise ValueError(
+                f"voltage = {self.voltage!r} with controller = {c.name!r}: give either "
+                "voltage (open loop) or controller (closed loop), not both"
+            )
         if model is None:
-            raise ValueError(f"controller = {c.name!r} with damper = None: a closed loop needs MR "
-                             "dampers or an ideal device (Suspension.semi_active or Suspension.ideal)")
+            raise ValueError(
+                f"controller = {c.name!r} with damper = None: a closed loop needs MR "
+                "dampers or an ideal device (Suspension.semi_active or Suspension.ideal)"
+            )
         if model.law == dampers.LAW_VISCOUS:
-            raise ValueError(f"controller = {c.name!r}: a controller needs MR dampers or the ideal "
-                             "actuator (a viscous damper has no command)")
+            raise ValueError(
+                f"controller = {c.name!r}: a controller needs MR dampers or the ideal "
+                "actuator (a viscous damper has no command)"
+            )
         if ideal:
             if self.inner is not None:
-                raise ValueError(f"inner = {self.inner!r}: the ideal devices apply the demand "
-                                 "themselves and have no inner loop")
+                raise ValueError(
+                    f"inner = {self.inner!r}: the ideal devices apply the demand themselves and have no inner loop"
+                )
         elif self.inner is None:
             object.__setattr__(self, "inner", _shipped_gains().inner)
 
@@ -152,13 +169,22 @@ class Suspension:
         """The passive viscous secondary dampers: the vehicle's c_sz, or ``damper`` (a
         `dampers.Viscous`) in their place."""
         if damper is not None and not isinstance(damper, dampers.Viscous):
-            raise ValueError(f"damper = {damper!r}: the passive suspension takes a "
-                             "railride.dampers.Viscous or None (the vehicle's c_sz)")
+            raise ValueError(
+                f"damper = {damper!r}: the passive suspension takes a "
+                "railride.dampers.Viscous or None (the vehicle's c_sz)"
+            )
         return cls(damper)
 
     @classmethod
-    def semi_active(cls, damper=DEFAULT_DAMPER, voltage=None, controller=None, inner=None,
-                    sensor_noise=None, damper_scale: float = 1.0) -> "Suspension":
+    def semi_active(
+        cls,
+        damper=DEFAULT_DAMPER,
+        voltage=None,
+        controller=None,
+        inner=None,
+        sensor_noise=None,
+        damper_scale: float = 1.0,
+    ) -> "Suspension":
         """MR dampers (a name of `dampers.PRESETS` or a `BoucWen` / `Spencer` model; a name
         scaled by ``damper_scale``, `BoucWen.scaled`) at the constant ``voltage`` [V]
         (default v_min), or closed by ``controller`` and the inner loop ``inner`` (default the
@@ -167,13 +193,16 @@ class Suspension:
             model = damper_model(damper, damper_scale)
         else:
             if dampers.check_scale("damper_scale", damper_scale) != 1.0:
-                raise ValueError(f"damper_scale = {damper_scale!r}: scales a damper given by name; "
-                                 "scale a model with its scaled()")
+                raise ValueError(
+                    f"damper_scale = {damper_scale!r}: scales a damper given by name; scale a model with its scaled()"
+                )
             model = _model(damper)
         if model is None or model.law not in (dampers.LAW_BOUC_WEN, dampers.LAW_SPENCER):
-            raise ValueError(f"damper = {damper!r}: a semi-active suspension has MR dampers ("
-                             f"{', '.join(dampers.PRESETS)} or a BoucWen / Spencer model); the "
-                             "ideal devices are Suspension.ideal, the dashpots Suspension.passive")
+            raise ValueError(
+                f"damper = {damper!r}: a semi-active suspension has MR dampers ("
+                f"{', '.join(dampers.PRESETS)} or a BoucWen / Spencer model); the "
+                "ideal devices are Suspension.ideal, the dashpots Suspension.passive"
+            )
         return cls(model, voltage, controller, inner, sensor_noise, damper_scale)
 
     @classmethod
@@ -181,16 +210,24 @@ class Suspension:
         """An ideal device under ``controller``: the ideal actuator (force = demand), or with
         ``dissipative`` the ideal semi-active damper (the demand where it dissipates, else 0)."""
         if controller is None:
-            raise ValueError("controller = None: an ideal device applies an outer loop's demand; "
-                             "give one (PID, SAS, or ZeroDemand for none)")
+            raise ValueError(
+                "controller = None: an ideal device applies an outer loop's demand; "
+                "give one (PID, SAS, or ZeroDemand for none)"
+            )
         if not isinstance(dissipative, bool):
             raise ValueError(f"dissipative = {dissipative!r}: must be True or False")
-        return cls(dampers.IDEAL_DAMPER if dissipative else dampers.IDEAL, None, controller, None,
-                   sensor_noise)
+        return cls(dampers.IDEAL_DAMPER if dissipative else dampers.IDEAL, None, controller, None, sensor_noise)
 
     @classmethod
-    def named(cls, name: str, gains: GainSet | None = None, damper=DEFAULT_DAMPER,
-              damper_scale: float = 1.0, voltage=None, sensor_noise=None) -> "Suspension":
+    def named(
+        cls,
+        name: str,
+        gains: GainSet | None = None,
+        damper=DEFAULT_DAMPER,
+        damper_scale: float = 1.0,
+        voltage=None,
+        sensor_noise=None,
+    ) -> "Suspension":
         """The suspension the package calls ``name`` (`NAMES`): "passive"; "mr", the MR
         ``damper`` (a name, scaled by ``damper_scale``) at the constant ``voltage``; or an outer
         loop of ``gains`` (default the shipped `GainSet.default`) with its inner loop on the
@@ -203,15 +240,20 @@ class Suspension:
         if name == "passive":
             scale = dampers.check_scale("damper_scale", damper_scale)
             if scale != 1.0:
-                raise ValueError(f"damper_scale = {scale:g}: the passive viscous dampers have no force "
-                                 "capacity to scale; it applies to MR dampers only")
+                raise ValueError(
+                    f"damper_scale = {scale:g}: the passive viscous dampers have no force "
+                    "capacity to scale; it applies to MR dampers only"
+                )
             if voltage is not None:
-                raise ValueError(f"voltage = {voltage!r}: applies to suspension 'mr' only (the "
-                                 "passive suspension has no command)")
+                raise ValueError(
+                    f"voltage = {voltage!r}: applies to suspension 'mr' only (the passive suspension has no command)"
+                )
             return cls(None, None, None, None, sensor_noise)
         if name == "mr" and model.law == dampers.LAW_IDEAL:
-            raise ValueError(f"damper = {damper!r} with suspension 'mr': the ideal actuator applies a "
-                             "controller's demand and has no constant voltage; use a controller")
+            raise ValueError(
+                f"damper = {damper!r} with suspension 'mr': the ideal actuator applies a "
+                "controller's demand and has no constant voltage; use a controller"
+            )
         model = damper_model(damper, damper_scale)
         scale = float(damper_scale)
         if name == "mr":
@@ -225,7 +267,7 @@ class Suspension:
     # -- what it is ----------------------------------------------------------------------------
     @property
     def kind(self) -> str:
-        """"passive", "semi-active" or "ideal" (`KINDS`)."""
+        """ "passive", "semi-active" or "ideal" (`KINDS`)."""
         if self.damper is None or self.damper.law == dampers.LAW_VISCOUS:
             return "passive"
         return "ideal" if self.damper.law == dampers.LAW_IDEAL else "semi-active"
@@ -279,18 +321,23 @@ class Suspension:
         """The JSON record of the suspension: kind, name, the damper model, voltage, outer and
         inner loop gains, sensor noise (None where it has none)."""
         c = self.controller
-        return {"kind": self.kind, "name": self.name, "label": self.label,
-                "damper": None if self.damper is None else self.damper.to_dict(),
-                "voltage_v": self.voltage,
-                "controller": None if c is None else {"name": c.name, "gains": c.to_dict()},
-                "inner_loop": None if self.inner is None else self.inner.to_dict(),
-                "sensor_noise": None if self.sensor_noise is None else dataclasses.asdict(self.sensor_noise)}
+        return {
+            "kind": self.kind,
+            "name": self.name,
+            "label": self.label,
+            "damper": None if self.damper is None else self.damper.to_dict(),
+            "voltage_v": self.voltage,
+            "controller": None if c is None else {"name": c.name, "gains": c.to_dict()},
+            "inner_loop": None if self.inner is None else self.inner.to_dict(),
+            "sensor_noise": None if self.sensor_noise is None else dataclasses.asdict(self.sensor_noise),
+        }
 
 
 def batch_conflict(suspensions) -> str | None:
     """Why ``suspensions`` cannot run as one batch, or None if they can: a batch shares one
     damper model, inner loop and sensor noise, and is all open or all closed loop (the
     voltages and the outer loops may differ)."""
+
     def shown(field, value):  # a damper by its preset name or model, the rest as they print
         if field == "damper" and value is not None:
             return repr(_damper_name(value))
@@ -301,7 +348,9 @@ def batch_conflict(suspensions) -> str | None:
         for field in ("damper", "closed_loop", "inner", "sensor_noise"):
             a, b = getattr(first, field), getattr(s, field)
             if a != b:
-                return (f"a batch of suspensions shares one damper model, inner loop and sensor "
-                        f"noise, and is all open or all closed loop; suspension {i} has {field} = "
-                        f"{shown(field, b)}, suspension 0 has {shown(field, a)}: run them separately")
+                return (
+                    f"a batch of suspensions shares one damper model, inner loop and sensor "
+                    f"noise, and is all open or all closed loop; suspension {i} has {field} = "
+                    f"{shown(field, b)}, suspension 0 has {shown(field, a)}: run them separately"
+                )
     return None

@@ -29,7 +29,7 @@ import pandas as pd
 from .defaults import DEFAULT_CONTROL_RATE, DEFAULT_DAMPER, DEFAULT_OUTPUT_RATE
 from .executors import DaskExecutor, LocalExecutor, RunTable  # noqa: F401 (their home before)
 from .metrics import RESPONSES, STATISTICS
-from .solver import SolverSettings, _with_keywords
+from .solver import SolverSettings
 from .suspension import NAMES, Suspension, batch_conflict
 from .sweep_grid import SweepGrid, grid  # noqa: F401 (the grid of the sweep study, here too)
 
@@ -44,9 +44,19 @@ MODEL_REVISION = 2
 SUSPENSIONS = NAMES
 #: (position, index) of `railride.comfort.ride_comfort` in a row with comfort, as the column
 #: ``<position>_<index>``
-COMFORT_INDICES = (("centre", "aw_Wk"), ("centre", "vdv_Wk"), ("centre", "aw_Wb"),
-                   ("centre", "N_MV_z"), ("centre", "Wz"), ("front", "aw_Wk"), ("front", "N_MV_z"),
-                   ("front", "Wz"), ("rear", "aw_Wk"), ("rear", "N_MV_z"), ("rear", "Wz"))
+COMFORT_INDICES = (
+    ("centre", "aw_Wk"),
+    ("centre", "vdv_Wk"),
+    ("centre", "aw_Wb"),
+    ("centre", "N_MV_z"),
+    ("centre", "Wz"),
+    ("front", "aw_Wk"),
+    ("front", "N_MV_z"),
+    ("front", "Wz"),
+    ("rear", "aw_Wk"),
+    ("rear", "N_MV_z"),
+    ("rear", "Wz"),
+)
 COMFORT_COLUMNS = tuple(f"{p}_{i}" for p, i in COMFORT_INDICES)
 #: the schema of `SweepResult.to_dict` (sweep.json)
 SCHEMA = "railride.sweep/1"
@@ -87,8 +97,9 @@ class Case:
             value = getattr(self, name)
             if isinstance(value, dict):
                 value = tuple(sorted(value.items()))
-            object.__setattr__(self, name, tuple((str(k), float(v) if isinstance(v, (int, float)) else v)
-                                                 for k, v in value))
+            object.__setattr__(
+                self, name, tuple((str(k), float(v) if isinstance(v, (int, float)) else v) for k, v in value)
+            )
         object.__setattr__(self, "noise", tuple(float(v) for v in self.noise))
         if self.noise and len(self.noise) != 4:
             raise ValueError(f"noise = {self.noise!r}: four standard deviations or none")
@@ -106,8 +117,7 @@ class Case:
         if self.noise and self.closed_loop:
             displacement, angle, velocity, angular_rate = self.noise
             noise = SensorNoise(displacement, angle, velocity, angular_rate, seed=self.seed)
-        return Suspension.named(self.suspension, gains, self.damper, self.damper_scale, self.voltage,
-                                noise)
+        return Suspension.named(self.suspension, gains, self.damper, self.damper_scale, self.voltage, noise)
 
     def to_suspension(self, base_gains=None) -> Suspension:
         """The run's `Suspension`: `Suspension.named` with the case's gain changes applied to
@@ -124,8 +134,7 @@ class Case:
         """A stable identity for the run table (same settings and model, same key, in any
         session). The model revision is part of it, so a run table from an earlier model is
         not taken for this one's on resume."""
-        text = json.dumps({**self.to_dict(), "model_revision": MODEL_REVISION}, sort_keys=True,
-                          default=str)
+        text = json.dumps({**self.to_dict(), "model_revision": MODEL_REVISION}, sort_keys=True, default=str)
         return hashlib.sha1(text.encode()).hexdigest()[:16]
 
     def to_dict(self) -> dict:
@@ -142,13 +151,18 @@ class Case:
         duration = dict(self.scenario_options).get("duration", 10.0)
         kind = "passive" if self.suspension == "passive" else ("mr" if self.suspension == "mr" else "closed")
         # sensor noise is one setting per batch
-        return (duration, kind, self.damper if kind != "passive" else "",
-                (self.noise, self.seed) if kind == "closed" else (),
-                self.damper_scale if kind != "passive" else 1.0)
+        return (
+            duration,
+            kind,
+            self.damper if kind != "passive" else "",
+            (self.noise, self.seed) if kind == "closed" else (),
+            self.damper_scale if kind != "passive" else 1.0,
+        )
 
 
-def evaluate(cases: list[Case], base_gains=None, *, params=None, solver=None, window=None,
-             comfort: bool = False) -> list[dict]:
+def evaluate(
+    cases: list[Case], base_gains=None, *, params=None, solver=None, window=None, comfort: bool = False
+) -> list[dict]:
     """Run ``cases`` (in compiled batches of compatible cases) and return one row per case:
     its key, settings and the RMS and peak-to-peak of the four body responses; with
     ``comfort``, also the ride comfort indices of `COMFORT_COLUMNS` (`railride.comfort.
@@ -169,7 +183,7 @@ def evaluate(cases: list[Case], base_gains=None, *, params=None, solver=None, wi
         by_group.setdefault(c.group, []).append(i)
     for group, idx in by_group.items():
         for start in range(0, len(idx), CHUNK):
-            part = [cases[i] for i in idx[start:start + CHUNK]]
+            part = [cases[i] for i in idx[start : start + CHUNK]]
             scs = []
             for c in part:
                 skey = (c.scenario, c.scenario_options)
@@ -179,9 +193,10 @@ def evaluate(cases: list[Case], base_gains=None, *, params=None, solver=None, wi
             pars = [vehicle.replace(**dict(c.vehicle)) for c in part]
             suspensions = [c.to_suspension(base_gains) for c in part]
             if batch_conflict(suspensions) is not None:  # the inner loop is one setting per batch
-                for i in idx[start:start + CHUNK]:  # positions, not lookups: cases may repeat
-                    rows[i] = evaluate([cases[i]], base_gains, params=vehicle, solver=solver,
-                                       window=window, comfort=comfort)[0]
+                for i in idx[start : start + CHUNK]:  # positions, not lookups: cases may repeat
+                    rows[i] = evaluate(
+                        [cases[i]], base_gains, params=vehicle, solver=solver, window=window, comfort=comfort
+                    )[0]
                 continue
             res = simulate(scs, pars, suspensions, solver=solver, on_divergence="mark")
             # a diverged run keeps its row, with NaN metrics and the time it diverged: the other
@@ -197,7 +212,7 @@ def evaluate(cases: list[Case], base_gains=None, *, params=None, solver=None, wi
                     ds = ds.expand_dims(sample=[0])
                 ok = np.flatnonzero(np.isnan(diverged_at))  # a diverged run has no comfort
                 cf = ride_comfort(ds.isel(sample=ok), window=window) if ok.size else None
-            for j, i in enumerate(idx[start:start + CHUNK]):
+            for j, i in enumerate(idx[start : start + CHUNK]):
                 if i in rows:
                     continue
                 row = {"key": cases[i].key, **_flat(cases[i]), "diverged_at_s": float(diverged_at[j])}
@@ -206,17 +221,25 @@ def evaluate(cases: list[Case], base_gains=None, *, params=None, solver=None, wi
                         row[f"{resp}_{stat}"] = float(m[j, r, s])
                 if comfort:
                     for (pos, index), column in zip(COMFORT_INDICES, COMFORT_COLUMNS):
-                        row[column] = (float(cf.isel(sample=int(np.searchsorted(ok, j)))
-                                             .sel(position=pos, index=index))
-                                       if np.isnan(diverged_at[j]) and cf is not None else np.nan)
+                        row[column] = (
+                            float(cf.isel(sample=int(np.searchsorted(ok, j))).sel(position=pos, index=index))
+                            if np.isnan(diverged_at[j]) and cf is not None
+                            else np.nan
+                        )
                 rows[i] = row
     return [rows[i] for i in range(len(cases))]
 
 
 def _flat(c: Case) -> dict:
-    d = {"scenario": c.scenario, "suspension": c.suspension, "damper": c.damper,
-         "damper_scale": c.damper_scale, "voltage": np.nan if c.voltage is None else c.voltage,
-         "noise": json.dumps(list(c.noise)) if c.noise else "", "seed": c.seed}
+    d = {
+        "scenario": c.scenario,
+        "suspension": c.suspension,
+        "damper": c.damper,
+        "damper_scale": c.damper_scale,
+        "voltage": np.nan if c.voltage is None else c.voltage,
+        "noise": json.dumps(list(c.noise)) if c.noise else "",
+        "seed": c.seed,
+    }
     d.update({f"scenario.{k}": v for k, v in c.scenario_options})
     d.update({f"vehicle.{k}": v for k, v in c.vehicle})
     d.update({f"gain.{k}": v for k, v in c.gains})
@@ -240,14 +263,23 @@ def other_settings(vehicle, solver: SolverSettings) -> dict:
     return out
 
 
-def run_cases(cases: list[Case], *, executor=None, table: RunTable | None = None, base_gains=None,
-              params=None, solver=None, window=None, chunk: int = CHUNK, progress=None,
-              comfort: bool = False, dt=None) -> pd.DataFrame:
+def run_cases(
+    cases: list[Case],
+    *,
+    executor=None,
+    table: RunTable | None = None,
+    base_gains=None,
+    params=None,
+    solver=None,
+    window=None,
+    chunk: int = CHUNK,
+    progress=None,
+    comfort: bool = False,
+) -> pd.DataFrame:
     """Evaluate ``cases``, skipping those already in ``table``; returns their rows in order.
     ``params``: the vehicle (`VehicleParams` or a preset name, default "paper") the cases'
-    ``vehicle`` changes apply to; ``solver``: the `SolverSettings` of every run (``dt``, the
-    step alone, as the command line still gives it). ``comfort``: the rows also hold the ride
-    comfort indices (`evaluate`).
+    ``vehicle`` changes apply to; ``solver``: the `SolverSettings` of every run. ``comfort``:
+    the rows also hold the ride comfort indices (`evaluate`).
 
     ``progress(done, total, runs_per_second)`` is called after each chunk.
     """
@@ -255,7 +287,7 @@ def run_cases(cases: list[Case], *, executor=None, table: RunTable | None = None
 
     from .simulation import _resolve_params
 
-    solver = _with_keywords(solver, dt)  # TEMPORARY: dt= removed when the CLI moves onto Suspension
+    solver = SolverSettings.of(solver)
     vehicle = _resolve_params(params)
     executor = LocalExecutor() if executor is None else executor
     table = RunTable() if table is None else table
@@ -263,9 +295,14 @@ def run_cases(cases: list[Case], *, executor=None, table: RunTable | None = None
     # a run's result depends on the case and on these settings: both go into its key, so a
     # resumed sweep with another step, window, base gain set or vehicle does not reuse old rows
     from .control import GainSet
+
     base = GainSet.default() if base_gains is None else base_gains
-    settings = {"dt": solver.dt, "window": None if window is None else [float(w) for w in window],
-                "base_gains": base.to_toml(), **other_settings(vehicle, solver)}
+    settings = {
+        "dt": solver.dt,
+        "window": None if window is None else [float(w) for w in window],
+        "base_gains": base.to_toml(),
+        **other_settings(vehicle, solver),
+    }
     if comfort:  # only then: the keys of sweeps without comfort stay as they were
         settings["comfort"] = True
     settings_text = json.dumps(settings, sort_keys=True)
@@ -279,9 +316,8 @@ def run_cases(cases: list[Case], *, executor=None, table: RunTable | None = None
             seen.add(k)
     # group compatible cases so each chunk is one compiled batch
     pending.sort(key=lambda c: str(c.group))
-    chunks = [pending[i:i + chunk] for i in range(0, len(pending), chunk)]
-    fn = functools.partial(evaluate, base_gains=base, params=vehicle, solver=solver, window=window,
-                           comfort=comfort)
+    chunks = [pending[i : i + chunk] for i in range(0, len(pending), chunk)]
+    fn = functools.partial(evaluate, base_gains=base, params=vehicle, solver=solver, window=window, comfort=comfort)
     t0, n_done = time.perf_counter(), 0
     if progress is not None:
         progress(0, len(pending), 0.0)
@@ -331,16 +367,19 @@ class SweepResult:
     def columns(self) -> list[str]:
         """The columns of `to_pandas`: the grid's, the metrics, ``diverged_at_s`` when a run
         diverged, and ``key`` (`Case.key`)."""
-        return (list(self.grid.columns) + self.metric_columns()
-                + (["diverged_at_s"] if self.diverged.any() else []) + ["key"])
+        return (
+            list(self.grid.columns)
+            + self.metric_columns()
+            + (["diverged_at_s"] if self.diverged.any() else [])
+            + ["key"]
+        )
 
     def rows(self) -> list[dict]:
         """One row per run: its grid values (None where an axis does not act), its metrics
         (None for a run that diverged) and its case's key."""
         metrics, diverged = self.metric_columns(), self.diverged
         rows = []
-        for case, values, (_, result), bad in zip(self.grid.cases, self.grid.values, self.frame.iterrows(),
-                                                  diverged):
+        for case, values, (_, result), bad in zip(self.grid.cases, self.grid.values, self.frame.iterrows(), diverged):
             row = {**values, **{m: None if bad else float(result[m]) for m in metrics}}
             if diverged.any():  # a run that diverged has no metrics, but the time it went
                 row["diverged_at_s"] = float(result["diverged_at_s"]) if bad else None
@@ -361,8 +400,9 @@ class SweepResult:
             "grid": g.grid_values(),
             "damper": g.damper if ("mr" in g.suspensions or g.controllers) else None,
             "gains_source": g.base_gains.source if g.controllers else None,
-            "sensor_noise": None if g.noise is None else dict(
-                zip(("displacement", "angle", "velocity", "angular_rate"), g.noise)),
+            "sensor_noise": None
+            if g.noise is None
+            else dict(zip(("displacement", "angle", "velocity", "angular_rate"), g.noise)),
             "dt_s": float(g.solver.dt),
             "window_s": None if g.window is None else list(g.window),
             **({"comfort": comfort_settings(g.duration, g.window)} if self.comfort else {}),
@@ -374,9 +414,15 @@ class SweepResult:
         run as a row of `rows`, and the rows of the run table."""
         from . import __version__
 
-        return {"schema": SCHEMA, "railride_version": __version__, "date": self.date,
-                "settings": self.settings(), "columns": self.columns(), "rows": self.rows(),
-                "runs": int(self.runs)}
+        return {
+            "schema": SCHEMA,
+            "railride_version": __version__,
+            "date": self.date,
+            "settings": self.settings(),
+            "columns": self.columns(),
+            "rows": self.rows(),
+            "runs": int(self.runs),
+        }
 
     def to_pandas(self) -> pd.DataFrame:
         """One row per run, the columns of `columns` (empty where an axis does not act)."""
@@ -409,22 +455,36 @@ def comfort_settings(duration: float, window) -> dict:
 
     start, end = window or (0.0, duration)
     n = max(1, int((end - start + 1e-9) // INTERVAL_S))
-    unit = {i: INDEX_UNITS["aw" if i.startswith("aw_") else "vdv" if i.startswith("vdv_") else i]
-            for _, i in COMFORT_INDICES}
-    return {"columns": list(COMFORT_COLUMNS),
-            "units": {c: unit[i] for (_, i), c in zip(COMFORT_INDICES, COMFORT_COLUMNS)},
-            "positions": {"centre": "x = 0", "front": "x = +l (above the front bogie centre)",
-                          "rear": "x = -l (above the rear bogie centre)"},
-            "n_intervals": n,
-            "notes": ["N_MV_z is the vertical term of EN 12299 only: the model has no lateral "
-                      "or longitudinal motion",
-                      f"N_MV_z from {n} interval{'s' if n != 1 else ''} of 5 s"
-                      + (" (EN 12299 evaluates 60, 5 minutes): an indication only"
-                         if n < 60 else "")]}
+    unit = {
+        i: INDEX_UNITS["aw" if i.startswith("aw_") else "vdv" if i.startswith("vdv_") else i]
+        for _, i in COMFORT_INDICES
+    }
+    return {
+        "columns": list(COMFORT_COLUMNS),
+        "units": {c: unit[i] for (_, i), c in zip(COMFORT_INDICES, COMFORT_COLUMNS)},
+        "positions": {
+            "centre": "x = 0",
+            "front": "x = +l (above the front bogie centre)",
+            "rear": "x = -l (above the rear bogie centre)",
+        },
+        "n_intervals": n,
+        "notes": [
+            "N_MV_z is the vertical term of EN 12299 only: the model has no lateral or longitudinal motion",
+            f"N_MV_z from {n} interval{'s' if n != 1 else ''} of 5 s"
+            + (" (EN 12299 evaluates 60, 5 minutes): an indication only" if n < 60 else ""),
+        ],
+    }
 
 
-def run_sweep(grid: SweepGrid, *, executor=None, table: RunTable | None = None,  # noqa: F811 (`grid`'s grid)
-              params=None, progress=None, comfort: bool = True) -> SweepResult:
+def run_sweep(
+    grid: SweepGrid,  # noqa: F811 (the argument shadows the function `grid` on purpose)
+    *,
+    executor=None,
+    table: RunTable | None = None,
+    params=None,
+    progress=None,
+    comfort: bool = True,
+) -> SweepResult:
     """Run every case of ``grid`` (`railride.sweep.grid`) and return a `SweepResult`.
 
     One call of `run_cases`: compiled batches of 32 runs, on ``executor`` (default
@@ -440,12 +500,21 @@ def run_sweep(grid: SweepGrid, *, executor=None, table: RunTable | None = None, 
     from .simulation import _resolve_params
 
     if not isinstance(grid, SweepGrid):
-        raise ValueError(f"grid = {type(grid).__name__}: must be a railride.sweep.SweepGrid "
-                         "(railride.sweep.grid makes one)")
+        raise ValueError(
+            f"grid = {type(grid).__name__}: must be a railride.sweep.SweepGrid (railride.sweep.grid makes one)"
+        )
     vehicle = _resolve_params(params)
     table = RunTable() if table is None else table
-    frame = run_cases(list(grid.cases), executor=executor, table=table, base_gains=grid.base_gains,
-                      params=vehicle, solver=grid.solver, window=grid.window, progress=progress,
-                      comfort=bool(comfort))
+    frame = run_cases(
+        list(grid.cases),
+        executor=executor,
+        table=table,
+        base_gains=grid.base_gains,
+        params=vehicle,
+        solver=grid.solver,
+        window=grid.window,
+        progress=progress,
+        comfort=bool(comfort),
+    )
     date = datetime.now(timezone.utc).replace(microsecond=0).isoformat().replace("+00:00", "Z")
     return SweepResult(grid, frame, bool(comfort), vehicle, len(table.frame), date)

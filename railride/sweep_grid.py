@@ -25,15 +25,22 @@ from .solver import SolverSettings
 
 #: the scenario options a sweep can vary: (keyword of `grid`, keyword of
 #: `railride.track.scenario`, grid column, unit)
-SCENARIO_AXES = (("speed", "speed", "speed_m_s", "m/s"), ("wavelength", "wavelength", "wavelength_m", "m"),
-                 ("amplitude", "amplitude", "amplitude_m", "m"),
-                 ("rail_phase", "rail_phase", "rail_phase_deg", "deg"),
-                 ("track_seed", "seed", "track_seed", ""))
+SCENARIO_AXES = (
+    ("speed", "speed", "speed_m_s", "m/s"),
+    ("wavelength", "wavelength", "wavelength_m", "m"),
+    ("amplitude", "amplitude", "amplitude_m", "m"),
+    ("rail_phase", "rail_phase", "rail_phase_deg", "deg"),
+    ("track_seed", "seed", "track_seed", ""),
+)
 #: the keys of `Scenario.describe` that each swept scenario option sets (in the grid, not in
 #: the scenario record)
-SCENARIO_KEYS = {"speed": ("speed_m_s",), "wavelength": ("wavelength_m", "length_m"),
-                 "amplitude": ("amplitude_m", "height_m"), "rail_phase": ("rail_phase_deg",),
-                 "seed": ("seed",)}
+SCENARIO_KEYS = {
+    "speed": ("speed_m_s",),
+    "wavelength": ("wavelength_m", "length_m"),
+    "amplitude": ("amplitude_m", "height_m"),
+    "rail_phase": ("rail_phase_deg",),
+    "seed": ("seed",),
+}
 #: the controllers that read each gain table (a gain axis combines with these only)
 GAIN_CONTROLLERS = {t: tuple(c for c in CONTROLLERS[1:] if t in GainSet.tables_read(c)) for t in GainSet.TABLES}
 #: the voltages named by words: passive-off is the damper's lowest voltage, passive-on its highest
@@ -94,12 +101,14 @@ class SweepGrid:
     def grid_values(self) -> dict:
         """Each axis and its values (column -> list): the suspensions, the swept scenario
         options, the damper scales, voltages, gains and noise seeds where they are axes."""
-        return {"suspension": list(self.suspensions),
-                **{column: list(values) for _, column, values in self.axes},
-                **({"damper_scale": list(self.damper_scales)} if self.damper_scales is not None else {}),
-                **({"voltage_v": list(self.voltages)} if self.voltages is not None else {}),
-                **{name: list(values) for name, values in self.gains},
-                **({"seed": list(self.seeds)} if self.noise is not None else {})}
+        return {
+            "suspension": list(self.suspensions),
+            **{column: list(values) for _, column, values in self.axes},
+            **({"damper_scale": list(self.damper_scales)} if self.damper_scales is not None else {}),
+            **({"voltage_v": list(self.voltages)} if self.voltages is not None else {}),
+            **{name: list(values) for name, values in self.gains},
+            **({"seed": list(self.seeds)} if self.noise is not None else {}),
+        }
 
 
 @dataclasses.dataclass(frozen=True)
@@ -149,16 +158,18 @@ def _numbers(words: _Words, key: str, values, rule: str = "finite", unit: str = 
     """Every value obeying ``rule``, as floats."""
     for v in values:
         if not _obeys(v, rule):
-            raise ValueError(f"{words.name(key)} = {_g(v)}{' ' + unit if unit else ''}: must be "
-                             f"{validation.rule_words(rule)}")
+            raise ValueError(
+                f"{words.name(key)} = {_g(v)}{' ' + unit if unit else ''}: must be {validation.rule_words(rule)}"
+            )
     return [float(v) for v in values]
 
 
 def _seeds(words: _Words, key: str, values, what: str) -> list[int]:
     for v in values:
         if isinstance(v, bool) or not isinstance(v, numbers.Integral):
-            raise ValueError(f"{words.given(key, values)}: {_g(v)} is not a whole number; {what} are whole "
-                             "numbers >= 0")
+            raise ValueError(
+                f"{words.given(key, values)}: {_g(v)} is not a whole number; {what} are whole numbers >= 0"
+            )
         if v < 0:
             raise ValueError(f"{words.given(key, values)}: {v} is negative; {what} are whole numbers >= 0")
     return [int(v) for v in values]
@@ -172,12 +183,30 @@ def voltage_value(value, damper) -> float:
     return float(value) if validation.is_number(value) else value
 
 
-def grid(suspensions="passive", *, scenario: str = "paper-sine", speed=None, wavelength=None,
-         amplitude=None, rail_phase=None, track_seed=None, duration: float | None = None,
-         min_wavelength: float | None = None, max_wavelength: float | None = None, voltage=None,
-         gains: Mapping | None = None, noise=None, seed=None, damper: str | None = None,
-         damper_scale=None, base_gains: GainSet | None = None, solver: SolverSettings | None = None,
-         window=None, names: Mapping | None = None, texts: Mapping | None = None) -> SweepGrid:
+def grid(
+    suspensions="passive",
+    *,
+    scenario: str = "paper-sine",
+    speed=None,
+    wavelength=None,
+    amplitude=None,
+    rail_phase=None,
+    track_seed=None,
+    duration: float | None = None,
+    min_wavelength: float | None = None,
+    max_wavelength: float | None = None,
+    voltage=None,
+    gains: Mapping | None = None,
+    noise=None,
+    seed=None,
+    damper: str | None = None,
+    damper_scale=None,
+    base_gains: GainSet | None = None,
+    solver: SolverSettings | None = None,
+    window=None,
+    names: Mapping | None = None,
+    texts: Mapping | None = None,
+) -> SweepGrid:
     """The cases of a sweep: every combination of the given values (a cartesian product).
 
     ``suspensions``: a name or a list of names (passive, mr, pid, sas-attitude,
@@ -209,31 +238,57 @@ def grid(suspensions="passive", *, scenario: str = "paper-sine", speed=None, wav
     has_mr = "mr" in suspensions
     voltage, damper_scale = _values(words, "voltage", voltage), _values(words, "damper_scale", damper_scale)
     seed = _values(words, "seed", seed)
-    _check_applies(words, listed, has_mr, controllers, voltage=voltage, gains=gains, noise=noise,
-                   base_gains=base_gains, seed=seed, damper=damper, damper_scale=damper_scale)
+    _check_applies(
+        words,
+        listed,
+        has_mr,
+        controllers,
+        voltage=voltage,
+        gains=gains,
+        noise=noise,
+        base_gains=base_gains,
+        seed=seed,
+        damper=damper,
+        damper_scale=damper_scale,
+    )
     damper_name = DEFAULT_DAMPER if damper is None else damper
     if damper_name not in dampers.NAMES:
-        raise ValueError(f"{words.given('damper', damper_name)}: unknown damper model; allowed: "
-                         f"{', '.join(dampers.NAMES)}")
+        raise ValueError(
+            f"{words.given('damper', damper_name)}: unknown damper model; allowed: {', '.join(dampers.NAMES)}"
+        )
     if damper_name in dampers.IDEAL_NAMES and has_mr:
-        raise ValueError(f"{words.given('damper', damper_name)}: applies to the controllers only; mr runs at a "
-                         "constant voltage, which the ideal actuator has not "
-                         f"({words.name('suspensions')} is {listed})")
+        raise ValueError(
+            f"{words.given('damper', damper_name)}: applies to the controllers only; mr runs at a "
+            "constant voltage, which the ideal actuator has not "
+            f"({words.name('suspensions')} is {listed})"
+        )
     scales = None
     if damper_scale is not None:
         if damper_name in dampers.IDEAL_NAMES:
-            raise ValueError(f"{words.given('damper_scale', damper_scale)}: the ideal device "
-                             f"({words.name('damper')} {damper_name}) applies the demand itself and has no "
-                             "force capacity to scale")
+            raise ValueError(
+                f"{words.given('damper_scale', damper_scale)}: the ideal device "
+                f"({words.name('damper')} {damper_name}) applies the demand itself and has no "
+                "force capacity to scale"
+            )
         scales = _numbers(words, "damper_scale", damper_scale, "positive")
     band = _band(words, scenario, min_wavelength, max_wavelength)
-    axes = _scenario_axes(words, scenario, speed=speed, wavelength=wavelength, amplitude=amplitude,
-                          rail_phase=rail_phase, track_seed=track_seed)
+    axes = _scenario_axes(
+        words,
+        scenario,
+        speed=speed,
+        wavelength=wavelength,
+        amplitude=amplitude,
+        rail_phase=rail_phase,
+        track_seed=track_seed,
+    )
     volts = None
     if has_mr:
         model = dampers.preset(damper_name)
-        volts = ([float(model.v_min)] if voltage is None else
-                 [model.check_voltage(voltage_value(v, model), words.name("voltage")) for v in voltage])
+        volts = (
+            [float(model.v_min)]
+            if voltage is None
+            else [model.check_voltage(voltage_value(v, model), words.name("voltage")) for v in voltage]
+        )
     gain_axes = _gain_axes(words, gains, controllers, listed)
     noise = None if noise is None else tuple(float(v) for v in noise)
     seeds = [0] if seed is None else _seeds(words, "seed", seed, "seeds")
@@ -241,8 +296,9 @@ def grid(suspensions="passive", *, scenario: str = "paper-sine", speed=None, wav
     solver = SolverSettings.of(solver)
     common = {} if duration is None else {"duration": float(duration)}
     common.update(band)
-    combos, record, run_duration = _scenarios(words, scenario, axes, common, min_wavelength is not None,
-                                              solver.output_rate)
+    combos, record, run_duration = _scenarios(
+        words, scenario, axes, common, min_wavelength is not None, solver.output_rate
+    )
     window = None if window is None else check_window(tuple(window), run_duration)
 
     columns = ["suspension"] + [column for _, column, _ in axes]
@@ -253,14 +309,25 @@ def grid(suspensions="passive", *, scenario: str = "paper-sine", speed=None, wav
     columns += [name for name, _ in gain_axes]
     if noise is not None:
         columns.append("seed")
-    made = SweepGrid(scenario=scenario, suspensions=tuple(suspensions),
-                     axes=tuple((kw, column, tuple(values)) for kw, column, values in axes),
-                     damper=damper_name, damper_scales=None if scales is None else tuple(scales),
-                     voltages=None if volts is None else tuple(volts),
-                     gains=tuple((n, tuple(vs)) for n, vs in gain_axes), noise=noise, seeds=tuple(seeds),
-                     base_gains=base_gains, solver=solver, window=window,
-                     first_scenario=record,
-                     duration=run_duration, columns=tuple(columns), cases=(), values=())
+    made = SweepGrid(
+        scenario=scenario,
+        suspensions=tuple(suspensions),
+        axes=tuple((kw, column, tuple(values)) for kw, column, values in axes),
+        damper=damper_name,
+        damper_scales=None if scales is None else tuple(scales),
+        voltages=None if volts is None else tuple(volts),
+        gains=tuple((n, tuple(vs)) for n, vs in gain_axes),
+        noise=noise,
+        seeds=tuple(seeds),
+        base_gains=base_gains,
+        solver=solver,
+        window=window,
+        first_scenario=record,
+        duration=run_duration,
+        columns=tuple(columns),
+        cases=(),
+        values=(),
+    )
     cases, values = _cases(made, combos, common)
     return dataclasses.replace(made, cases=tuple(cases), values=tuple(values))
 
@@ -274,8 +341,9 @@ def _suspensions(words: _Words, given) -> tuple[str, list[str]]:
         raise ValueError(f"{words.given('suspensions', items)}: give one or more of {', '.join(NAMES)}")
     unknown = [s for s in items if s not in NAMES]
     if unknown:
-        raise ValueError(f"{words.given('suspensions', given)}: unknown suspension {unknown[0]!r}; "
-                         f"allowed: {', '.join(NAMES)}")
+        raise ValueError(
+            f"{words.given('suspensions', given)}: unknown suspension {unknown[0]!r}; allowed: {', '.join(NAMES)}"
+        )
     twice = [s for s in items if items.count(s) > 1]
     if twice:
         raise ValueError(f"{words.given('suspensions', given)}: {twice[0]} is listed twice")
@@ -287,16 +355,20 @@ def _check_applies(words: _Words, listed: str, has_mr: bool, controllers: list, 
     noise seeds with noise, the damper and its scales to mr and the controllers."""
     among = f"({words.name('suspensions')} is {listed})"
     if given["voltage"] is not None and not has_mr:
-        raise ValueError(f"{words.given('voltage', given['voltage'])}: applies to {words.name('suspensions')} "
-                         f"mr only {among}")
+        raise ValueError(
+            f"{words.given('voltage', given['voltage'])}: applies to {words.name('suspensions')} mr only {among}"
+        )
     for key in ("gains", "noise", "base_gains"):
         if given[key] is not None and not controllers and (key != "gains" or given[key]):
             shown = getattr(given[key], "source", given[key])  # a GainSet by its file
-            raise ValueError(f"{words.given(key, shown)}: applies to the controllers "
-                             f"{', '.join(CONTROLLERS[1:])} only {among}")
+            raise ValueError(
+                f"{words.given(key, shown)}: applies to the controllers {', '.join(CONTROLLERS[1:])} only {among}"
+            )
     if given["seed"] is not None and given["noise"] is None:
-        raise ValueError(f"{words.given('seed', given['seed'])}: applies with {words.name('noise')} only "
-                         "(without it the measurements are ideal)")
+        raise ValueError(
+            f"{words.given('seed', given['seed'])}: applies with {words.name('noise')} only "
+            "(without it the measurements are ideal)"
+        )
     for key in ("damper", "damper_scale"):
         if given[key] is not None and not (has_mr or controllers):
             raise ValueError(f"{words.given(key, given[key])}: applies to mr and the controllers only {among}")
@@ -313,8 +385,10 @@ def _band(words: _Words, scenario: str, min_wavelength, max_wavelength) -> dict:
             out[key] = _numbers(words, key, [value], "positive", unit)[0]
     if out and scenario not in SPECTRA:
         key, unit = next(b for b in _BAND if b[0] in out)
-        raise ValueError(f"{words.name(key)} = {out[key]:g} {unit}: applies to the random-track scenarios "
-                         f"({', '.join(SPECTRA)}) only, not to {words.name('scenario')} {scenario}")
+        raise ValueError(
+            f"{words.name(key)} = {out[key]:g} {unit}: applies to the random-track scenarios "
+            f"({', '.join(SPECTRA)}) only, not to {words.name('scenario')} {scenario}"
+        )
     return out
 
 
@@ -330,14 +404,18 @@ def _scenario_axes(words: _Words, scenario: str, **given) -> list:
         if keyword == "seed":
             values = _seeds(words, key, values, "track seeds")
             if scenario not in SPECTRA:
-                raise ValueError(f"{words.given(key, values)}: applies to the random-track scenarios "
-                                 f"({', '.join(SPECTRA)}) only, not to {words.name('scenario')} {scenario}")
+                raise ValueError(
+                    f"{words.given(key, values)}: applies to the random-track scenarios "
+                    f"({', '.join(SPECTRA)}) only, not to {words.name('scenario')} {scenario}"
+                )
         else:
             values = _numbers(words, key, values, unit=unit)
             if scenario in SPECTRA and key != "speed":
-                raise ValueError(f"{words.name(key)} = {values[0]:g} {unit}: does not apply to a random track "
-                                 f"({scenario}); its options are {words.name('track_seed')}, "
-                                 f"{words.name('min_wavelength')} and {words.name('max_wavelength')}")
+                raise ValueError(
+                    f"{words.name(key)} = {values[0]:g} {unit}: does not apply to a random track "
+                    f"({scenario}); its options are {words.name('track_seed')}, "
+                    f"{words.name('min_wavelength')} and {words.name('max_wavelength')}"
+                )
         axes.append((keyword, column, values))
     return axes
 
@@ -352,24 +430,29 @@ def _gain_axes(words: _Words, gains: Mapping | None, controllers: list, listed: 
         given = words.given("gains", values, name)
         if name not in known:
             table = str(name).partition(".")[0]
-            allowed = (", ".join(GainSet.entry_names(table)) if table in GainSet.TABLES else
-                       "inner.*, pid.*, attitude.*, ride.* (" + ", ".join(known[:5]) + ", ...)")
+            allowed = (
+                ", ".join(GainSet.entry_names(table))
+                if table in GainSet.TABLES
+                else "inner.*, pid.*, attitude.*, ride.* (" + ", ".join(known[:5]) + ", ...)"
+            )
             raise ValueError(f"{given}: unknown gain {name!r}; allowed: {allowed}")
         bad = [v for v in values if not _obeys(v, "nonnegative")]
         if bad:
             finite = _obeys(bad[0], "finite")
-            raise ValueError(f"{given}: {_g(bad[0])} is {'negative' if finite else 'not a finite number'}; "
-                             "gains are >= 0")
+            raise ValueError(
+                f"{given}: {_g(bad[0])} is {'negative' if finite else 'not a finite number'}; gains are >= 0"
+            )
         acts_in = GAIN_CONTROLLERS[name.partition(".")[0]]
         if not any(c in acts_in for c in controllers):
-            raise ValueError(f"{given}: {name} acts in {', '.join(acts_in)} only, which "
-                             f"{words.name('suspensions')} ({listed}) does not list")
+            raise ValueError(
+                f"{given}: {name} acts in {', '.join(acts_in)} only, which "
+                f"{words.name('suspensions')} ({listed}) does not list"
+            )
         axes.append((name, [float(v) for v in values]))
     return axes
 
 
-def _scenarios(words: _Words, scenario: str, axes: list, common: dict, min_given: bool,
-               output_rate: float):
+def _scenarios(words: _Words, scenario: str, axes: list, common: dict, min_given: bool, output_rate: float):
     """(the combinations of the axes' values, the first scenario described, the runs'
     duration): every scenario of the grid must be valid before anything runs, and a random
     track's shortest wavelength must show at the runs' output rate (as `simulate` requires)."""
@@ -413,7 +496,8 @@ def _check_resolvable(words: _Words, scen, min_given: bool, output_rate: float) 
         raise ValueError(
             f"{mw} = {lam:g} m{'' if min_given else ' (the default)'} at {speed} {scen.speed:g} m/s is "
             f"{scen.speed / lam:g} Hz, more than the runs' output rate {output_rate:g} Hz / {RESOLUTION:g} = "
-            f"{output_rate / RESOLUTION:g} Hz can resolve: raise {mw} or lower {speed}") from None
+            f"{output_rate / RESOLUTION:g} Hz can resolve: raise {mw} or lower {speed}"
+        ) from None
 
 
 def _cases(g: SweepGrid, combos: list, common: dict) -> tuple[list, list]:
@@ -437,17 +521,28 @@ def _cases(g: SweepGrid, combos: list, common: dict) -> tuple[list, list]:
             elif s == "mr":
                 for x in g.damper_scales or (1.0,):
                     for v in g.voltages or ():
-                        cases.append(Case(g.scenario, options, suspension="mr", damper=g.damper, voltage=v,
-                                          damper_scale=x))
+                        cases.append(
+                            Case(g.scenario, options, suspension="mr", damper=g.damper, voltage=v, damper_scale=x)
+                        )
                         values.append({**base, "voltage_v": v, **({"damper_scale": x} if scaled else {})})
             else:
                 mine = [(n, vs) for n, vs in g.gains if s in GAIN_CONTROLLERS[n.partition(".")[0]]]
                 for x in g.damper_scales or (1.0,):
                     for gains in itertools.product(*[vs for _, vs in mine]):
                         changes = tuple(zip([n for n, _ in mine], gains))
-                        for sd in (g.seeds if g.noise is not None else (0,)):
-                            cases.append(Case(g.scenario, options, suspension=s, damper=g.damper, gains=changes,
-                                              noise=g.noise or (), seed=sd, damper_scale=x))
+                        for sd in g.seeds if g.noise is not None else (0,):
+                            cases.append(
+                                Case(
+                                    g.scenario,
+                                    options,
+                                    suspension=s,
+                                    damper=g.damper,
+                                    gains=changes,
+                                    noise=g.noise or (),
+                                    seed=sd,
+                                    damper_scale=x,
+                                )
+                            )
                             row = {**base, **dict(changes)}
                             if scaled:
                                 row["damper_scale"] = x

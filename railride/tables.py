@@ -62,8 +62,9 @@ def to_frame(ds: xr.Dataset) -> pd.DataFrame:
         if not extra:
             columns[str(name)] = values[:, 0]
             continue
-        labels = [[coordinate_label(v) for v in (ds[d].values if d in ds.coords else range(ds.sizes[d]))]
-                  for d in extra]
+        labels = [
+            [coordinate_label(v) for v in (ds[d].values if d in ds.coords else range(ds.sizes[d]))] for d in extra
+        ]
         for j, combo in enumerate(np.ndindex(*[len(lab) for lab in labels])):
             suffix = "".join(labels[k][i] for k, i in enumerate(combo))
             columns[f"{name}_{suffix}"] = values[:, j]
@@ -82,8 +83,9 @@ def cycles_frame(ds: xr.Dataset) -> pd.DataFrame:
     run]; the voltages one after another, in the order they were given."""
     missing = [c for c in RIG_CHANNELS if c not in ds.variables]
     if missing or "voltage" not in ds.dims:
-        raise ValueError("expected the dataset of railride.rig.cycles (dims voltage, time; "
-                         f"channels {', '.join(RIG_CHANNELS)})")
+        raise ValueError(
+            f"expected the dataset of railride.rig.cycles (dims voltage, time; channels {', '.join(RIG_CHANNELS)})"
+        )
     frame = ds[list(RIG_CHANNELS)].to_dataframe(dim_order=["voltage", "time"])
     return frame.reset_index()[["voltage", "time", *RIG_CHANNELS]]
 
@@ -98,8 +100,7 @@ def comparison_frame(ds: xr.Dataset) -> pd.DataFrame:
     ``damper_command_voltage_<corner>`` [V]; the last two are empty (NaN) for the passive
     suspension and absent when no controlled suspension was run."""
     if "controller" not in ds.dims or "time" not in ds.dims:
-        raise ValueError("expected the combined() Dataset of a railride.comparison.Comparison "
-                         "(dims controller, time)")
+        raise ValueError("expected the combined() Dataset of a railride.comparison.Comparison (dims controller, time)")
     body = [channel for channel, _, _, _ in CARBODY_RESPONSES.values()]
     missing = [c for c in body if c not in ds.variables]
     if missing:
@@ -125,8 +126,9 @@ def curves_frame(curves) -> pd.DataFrame:
         values = np.asarray(c.values, dtype=float)
         objective = np.asarray(c.objective, dtype=float)
         for v, o in zip(values, objective):
-            rows.append((str(c.phase), int(c.sweep_pass), str(c.parameter), float(v), float(o),
-                         bool(v == float(c.chosen))))
+            rows.append(
+                (str(c.phase), int(c.sweep_pass), str(c.parameter), float(v), float(o), bool(v == float(c.chosen)))
+            )
     return pd.DataFrame(rows, columns=list(CURVE_COLUMNS))
 
 
@@ -136,6 +138,7 @@ def modes_frame(modes) -> pd.DataFrame:
     ``frequency_hz`` (undamped), ``damped_frequency_hz``, ``damping_ratio``."""
     rows = []
     for i, d in enumerate(modes, start=1):
-        rows.append((i, d["label"], float(d["frequency_hz"]), float(d["damped_frequency_hz"]),
-                     float(d["damping_ratio"])))
+        rows.append(
+            (i, d["label"], float(d["frequency_hz"]), float(d["damped_frequency_hz"]), float(d["damping_ratio"]))
+        )
     return pd.DataFrame(rows, columns=list(MODE_COLUMNS))

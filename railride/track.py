@@ -67,6 +67,7 @@ class RailProfile(ABC):
                 o[on] = v
         return tuple(out)
 
+
 @dataclass(frozen=True)
 class SineTrack(RailProfile):
     """The paper's sine, entering through a raised-cosine taper of its amplitude:
@@ -85,10 +86,12 @@ class SineTrack(RailProfile):
     taper: float = 1.0  # length of the entry taper, in wavelengths
 
     def __post_init__(self):
-        checks = (("amplitude", "amplitude", "nonnegative", "a finite number >= 0 (m)"),
-                  ("wavelength", "wavelength", "positive", "a finite number > 0 (m)"),
-                  ("rail_phase_deg", "rail_phase", "finite", "a finite angle in degrees"),
-                  ("taper", "taper", "nonnegative", "a finite number >= 0 (wavelengths)"))
+        checks = (
+            ("amplitude", "amplitude", "nonnegative", "a finite number >= 0 (m)"),
+            ("wavelength", "wavelength", "positive", "a finite number > 0 (m)"),
+            ("rail_phase_deg", "rail_phase", "finite", "a finite angle in degrees"),
+            ("taper", "taper", "nonnegative", "a finite number >= 0 (wavelengths)"),
+        )
         for field_name, name, rule, allowed in checks:
             object.__setattr__(self, field_name, _check(name, getattr(self, field_name), rule, allowed))
 
@@ -110,8 +113,13 @@ class SineTrack(RailProfile):
         return self.wavelength / NODES_PER_FEATURE
 
     def describe(self):
-        return {"profile": "sine", "amplitude_m": self.amplitude, "wavelength_m": self.wavelength,
-                "rail_phase_deg": self.rail_phase_deg, "taper_wavelengths": self.taper}
+        return {
+            "profile": "sine",
+            "amplitude_m": self.amplitude,
+            "wavelength_m": self.wavelength,
+            "rail_phase_deg": self.rail_phase_deg,
+            "taper_wavelengths": self.taper,
+        }
 
 
 @dataclass(frozen=True)
@@ -125,8 +133,9 @@ class CosineBump(RailProfile):
     rails: str = "both"  # "both", "left" or "right"
 
     def __post_init__(self):
-        object.__setattr__(self, "height", _check("height", self.height, "finite",
-                                                  "a finite number (m; < 0 for a dip)"))
+        object.__setattr__(
+            self, "height", _check("height", self.height, "finite", "a finite number (m; < 0 for a dip)")
+        )
         object.__setattr__(self, "length", _check("length", self.length, "positive", "a finite number > 0 (m)"))
         object.__setattr__(self, "start", _check("start", self.start, "nonnegative", "a finite number >= 0 (m)"))
         if self.rails not in ("both", "left", "right"):
@@ -140,15 +149,19 @@ class CosineBump(RailProfile):
         zero = np.zeros_like(s)
         left = self.rails in ("both", "left")
         right = self.rails in ("both", "right")
-        return (z if left else zero, z if right else zero,
-                dz if left else zero, dz if right else zero)
+        return (z if left else zero, z if right else zero, dz if left else zero, dz if right else zero)
 
     def table_spacing(self):
         return self.length / NODES_PER_FEATURE
 
     def describe(self):
-        return {"profile": "cosine-bump", "height_m": self.height, "length_m": self.length,
-                "start_m": self.start, "rails": self.rails}
+        return {
+            "profile": "cosine-bump",
+            "height_m": self.height,
+            "length_m": self.length,
+            "start_m": self.start,
+            "rails": self.rails,
+        }
 
 
 @dataclass(frozen=True, eq=False)
@@ -179,15 +192,17 @@ class MeasuredTrack(RailProfile):
         for name, col in (("s", s), ("z_L", zl), ("z_R", zr)):
             bad = np.flatnonzero(~np.isfinite(col))
             if bad.size:
-                raise ValueError(f"{src}: column {name} has a non-finite value {col[bad[0]]!r} "
-                                 f"at data row {bad[0] + 1}")
+                raise ValueError(
+                    f"{src}: column {name} has a non-finite value {col[bad[0]]!r} at data row {bad[0] + 1}"
+                )
         steps = np.diff(s)
         if np.any(steps <= 0):
             i = int(np.flatnonzero(steps <= 0)[0])
             raise ValueError(f"{src}: s must increase strictly; data row {i + 2} has s = {s[i + 1]!r} after {s[i]!r}")
         if s[0] > 0:
-            raise ValueError(f"{src}: the profile must start at s <= 0 m (the vehicle starts at s = 0); "
-                             f"it starts at {s[0]!r} m")
+            raise ValueError(
+                f"{src}: the profile must start at s <= 0 m (the vehicle starts at s = 0); it starts at {s[0]!r} m"
+            )
         object.__setattr__(self, "s", s)
         object.__setattr__(self, "z_L", zl)
         object.__setattr__(self, "z_R", zr)
@@ -207,8 +222,11 @@ class MeasuredTrack(RailProfile):
         except UnicodeDecodeError:
             raise ValueError(f"track file {path}: not a UTF-8 text CSV") from None
         # keep file line numbers for the messages; skip blank and comment lines
-        numbered = [(n, r) for n, r in enumerate(rows, start=1)
-                    if r and any(c.strip() for c in r) and not r[0].lstrip().startswith("#")]
+        numbered = [
+            (n, r)
+            for n, r in enumerate(rows, start=1)
+            if r and any(c.strip() for c in r) and not r[0].lstrip().startswith("#")
+        ]
         if not numbered:
             raise ValueError(f"track file {path}: empty; expected a header 's,z_L,z_R' and data rows")
         head = numbered[0][1]
@@ -235,8 +253,10 @@ class MeasuredTrack(RailProfile):
 
     def _evaluate(self, s):
         if np.any(s > self.s[-1] + 1e-9):
-            raise ValueError(f"{self.source}: the profile ends at s = {self.s[-1]:g} m but the run "
-                             f"reaches s = {float(np.max(s)):.1f} m")
+            raise ValueError(
+                f"{self.source}: the profile ends at s = {self.s[-1]:g} m but the run "
+                f"reaches s = {float(np.max(s)):.1f} m"
+            )
         return tuple(f(s) for f in self._interp)
 
     def end(self):
@@ -246,8 +266,7 @@ class MeasuredTrack(RailProfile):
         return float(np.min(np.diff(self.s))) / 2
 
     def describe(self):
-        return {"profile": "measured", "source": self.source, "rows": int(self.s.size),
-                "s_end_m": float(self.s[-1])}
+        return {"profile": "measured", "source": self.source, "rows": int(self.s.size), "s_end_m": float(self.s[-1])}
 
 
 @dataclass(frozen=True)
@@ -272,18 +291,25 @@ class Scenario:
             )
 
     def describe(self) -> dict:
-        return {"name": self.name, "speed_m_s": self.speed, "duration_s": self.duration,
-                **self.track.describe()}
+        return {"name": self.name, "speed_m_s": self.speed, "duration_s": self.duration, **self.track.describe()}
 
 
 SCENARIOS = ("paper-sine", "bump", "file:PATH", "fra1..fra6", "german-low", "german-high")
 
 
-def scenario(name: str = "paper-sine", *, amplitude: float | None = None,
-             wavelength: float | None = None, rail_phase: float | None = None,
-             speed: float | None = None, duration: float | None = None, seed: int | None = None,
-             min_wavelength: float | None = None, max_wavelength: float | None = None,
-             taper: float | None = None) -> Scenario:
+def scenario(
+    name: str = "paper-sine",
+    *,
+    amplitude: float | None = None,
+    wavelength: float | None = None,
+    rail_phase: float | None = None,
+    speed: float | None = None,
+    duration: float | None = None,
+    seed: int | None = None,
+    min_wavelength: float | None = None,
+    max_wavelength: float | None = None,
+    taper: float | None = None,
+) -> Scenario:
     """A named scenario with optional overrides.
 
     ``paper-sine``: amplitude [m], wavelength [m], rail_phase [deg] of the sine (defaults 0.05 m,
@@ -295,45 +321,62 @@ def scenario(name: str = "paper-sine", *, amplitude: float | None = None,
     0) over the wavelength band [min_wavelength, max_wavelength] (default 1 to 100 m). Speed
     defaults to 55.56 m/s and duration to 10 s for every scenario.
     """
-    common = {"speed": 55.56 if speed is None else speed,
-              "duration": 10.0 if duration is None else duration}
-    random_only = [k for k, v in (("seed", seed), ("min_wavelength", min_wavelength),
-                                  ("max_wavelength", max_wavelength)) if v is not None]
+    common = {"speed": 55.56 if speed is None else speed, "duration": 10.0 if duration is None else duration}
+    random_only = [
+        k
+        for k, v in (("seed", seed), ("min_wavelength", min_wavelength), ("max_wavelength", max_wavelength))
+        if v is not None
+    ]
     if random_only and name not in SPECTRA:
-        raise ValueError(f"{', '.join(random_only)} applies to the random tracks "
-                         f"({', '.join(SPECTRA)}) only, not to {name}")
+        raise ValueError(
+            f"{', '.join(random_only)} applies to the random tracks ({', '.join(SPECTRA)}) only, not to {name}"
+        )
     if taper is not None and name != "paper-sine":
         raise ValueError(f"taper applies to paper-sine only, not to {name}")
     track: RailProfile
     if name == "paper-sine":
-        track = SineTrack(amplitude=0.05 if amplitude is None else amplitude,
-                          wavelength=60.0 if wavelength is None else wavelength,
-                          rail_phase_deg=90.0 if rail_phase is None else rail_phase,
-                          taper=1.0 if taper is None else taper)
+        track = SineTrack(
+            amplitude=0.05 if amplitude is None else amplitude,
+            wavelength=60.0 if wavelength is None else wavelength,
+            rail_phase_deg=90.0 if rail_phase is None else rail_phase,
+            taper=1.0 if taper is None else taper,
+        )
     elif name == "bump":
         if rail_phase is not None:
             raise ValueError("rail_phase applies to paper-sine only, not to the bump scenario")
-        track = CosineBump(height=0.02 if amplitude is None else amplitude,
-                           length=10.0 if wavelength is None else wavelength)
+        track = CosineBump(
+            height=0.02 if amplitude is None else amplitude, length=10.0 if wavelength is None else wavelength
+        )
     elif name in SPECTRA:
-        given = [k for k, v in (("amplitude", amplitude), ("wavelength", wavelength),
-                                ("rail_phase", rail_phase)) if v is not None]
+        given = [
+            k
+            for k, v in (("amplitude", amplitude), ("wavelength", wavelength), ("rail_phase", rail_phase))
+            if v is not None
+        ]
         if given:
-            raise ValueError(f"{', '.join(given)} cannot be set for a random track ({name}); "
-                             "use min_wavelength, max_wavelength and seed")
+            raise ValueError(
+                f"{', '.join(given)} cannot be set for a random track ({name}); "
+                "use min_wavelength, max_wavelength and seed"
+            )
         V = _check("speed", common["speed"], "positive", "a finite number > 0 (m/s)")
         T = _check("duration", common["duration"], "positive", "a finite number > 0 (s)")
         # long enough that the realisation does not repeat within the run
-        track = RandomTrack(name, seed=0 if seed is None else seed,
-                            min_wavelength=1.0 if min_wavelength is None else min_wavelength,
-                            max_wavelength=100.0 if max_wavelength is None else max_wavelength,
-                            length=max(2000.0, V * T + 100.0))
+        track = RandomTrack(
+            name,
+            seed=0 if seed is None else seed,
+            min_wavelength=1.0 if min_wavelength is None else min_wavelength,
+            max_wavelength=100.0 if max_wavelength is None else max_wavelength,
+            length=max(2000.0, V * T + 100.0),
+        )
     elif name.startswith("file:"):
-        given = [k for k, v in (("amplitude", amplitude), ("wavelength", wavelength),
-                                ("rail_phase", rail_phase)) if v is not None]
+        given = [
+            k
+            for k, v in (("amplitude", amplitude), ("wavelength", wavelength), ("rail_phase", rail_phase))
+            if v is not None
+        ]
         if given:
             raise ValueError(f"{', '.join(given)} cannot be set for a measured profile ({name})")
-        path = name[len("file:"):]
+        path = name[len("file:") :]
         if not path:
             raise ValueError("scenario 'file:' needs a path, as in file:track.csv")
         track = MeasuredTrack.from_csv(path)
@@ -342,8 +385,9 @@ def scenario(name: str = "paper-sine", *, amplitude: float | None = None,
     return Scenario(track=track, name=name, **common)
 
 
-def wheelset_input_table(scenario: Scenario, lag_distance: np.ndarray, dt: float,
-                         duration: float | None = None) -> tuple[np.ndarray, float]:
+def wheelset_input_table(
+    scenario: Scenario, lag_distance: np.ndarray, dt: float, duration: float | None = None
+) -> tuple[np.ndarray, float]:
     """Rail inputs at the wheelsets on the stepper's time grid.
 
     Returns ``(table, interval)``: table (n, 16) holds at t_k = k * interval the heights
@@ -412,8 +456,11 @@ def spectrum(name: str, wavenumber, component: str = "vertical") -> np.ndarray:
     W2 = W * W
     if name.startswith("fra") and name[3:].isdigit() and int(name[3:]) in FRA_AV:
         Av, k, Wc2, Ws2 = FRA_AV[int(name[3:])], FRA_K, FRA_OMEGA_C**2, FRA_OMEGA_S**2
-        cm2 = (k * Av * Wc2 / (W2 * (W2 + Wc2)) if component == "vertical"
-               else 4 * k * Av * Wc2 / ((W2 + Wc2) * (W2 + Ws2)))
+        cm2 = (
+            k * Av * Wc2 / (W2 * (W2 + Wc2))
+            if component == "vertical"
+            else 4 * k * Av * Wc2 / ((W2 + Wc2) * (W2 + Ws2))
+        )
         return cm2 * 1e-4
     if name in ("german-low", "german-high"):
         Av = GERMAN_AV[name.split("-")[1]]
@@ -448,8 +495,12 @@ class RandomTrack(RailProfile):
         spectrum(self.name, 1.0)  # an unknown name fails here
         seed = self.seed
         # a whole float (3.0, as sweeps store numbers) is the same seed as 3
-        if isinstance(seed, bool) or not isinstance(seed, (int, float, np.integer, np.floating)) \
-                or not float(seed).is_integer() or seed < 0:
+        if (
+            isinstance(seed, bool)
+            or not isinstance(seed, (int, float, np.integer, np.floating))
+            or not float(seed).is_integer()
+            or seed < 0
+        ):
             raise ValueError(f"seed = {seed!r}: must be a whole number >= 0")
         object.__setattr__(self, "seed", int(seed))
         lo = _check("min_wavelength", self.min_wavelength, "positive", "a finite number > 0 (m)")
@@ -463,8 +514,9 @@ class RandomTrack(RailProfile):
         ds = lo / 20.0  # 20 samples on the shortest wavelength
         n = int(2 ** math.ceil(math.log2(length / ds)))
         if n > 2**24:
-            raise ValueError(f"the realisation needs {n} samples ({length:g} m at {ds:g} m): shorten it "
-                             "or raise min_wavelength")
+            raise ValueError(
+                f"the realisation needs {n} samples ({length:g} m at {ds:g} m): shorten it or raise min_wavelength"
+            )
         ds = length / n
         dW = 2 * np.pi / length
         k = np.arange(n // 2 + 1)
@@ -504,6 +556,12 @@ class RandomTrack(RailProfile):
         return self.min_wavelength / 20.0
 
     def describe(self):
-        return {"profile": "random", "spectrum": self.name, "seed": int(self.seed),
-                "min_wavelength_m": self.min_wavelength, "max_wavelength_m": self.max_wavelength,
-                "length_m": self.length, "lead_in_m": self.lead_in}
+        return {
+            "profile": "random",
+            "spectrum": self.name,
+            "seed": int(self.seed),
+            "min_wavelength_m": self.min_wavelength,
+            "max_wavelength_m": self.max_wavelength,
+            "length_m": self.length,
+            "lead_in_m": self.lead_in,
+        }

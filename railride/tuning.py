@@ -51,8 +51,7 @@ PHASES = GainSet.TABLES
 #: the gains each phase tunes, by "table.entry"
 PARAMETERS = {phase: GainSet.entry_names(phase) for phase in PHASES}
 #: the controllers whose response a phase changes (the before/after rows of `TuneResult`)
-PHASE_CONTROLLERS = {phase: tuple(n for n in CONTROLLERS[1:] if phase in GainSet.tables_read(n))
-                     for phase in PHASES}
+PHASE_CONTROLLERS = {phase: tuple(n for n in CONTROLLERS[1:] if phase in GainSet.tables_read(n)) for phase in PHASES}
 #: the suspension a vehicle phase is scored with: the first controller that reads its table
 SUSPENSION = {phase: names[0] for phase, names in PHASE_CONTROLLERS.items() if phase != "inner"}
 #: the gain tables each controller reads
@@ -65,7 +64,6 @@ SCHEMA = "railride.tune/2"
 #: "table.entry": where the sweep of a gain that is 0 is centred, and the centre of the search
 #: box of the global methods
 REFERENCE = GainSet.reference().entries()
-
 
 
 @dataclass
@@ -131,11 +129,16 @@ class TuneResult:
             "settings": self.settings,
             "objective": self.objective.to_dict(),
             "passive_rms": {r: float(self.passive[r]) for r in RESPONSES},
-            "history": [{"phase": h["phase"], "pass": int(h["pass"]),
-                         "objective": float(h["objective"])} for h in self.history],
-            "gains": {"source": start.source, "inner": self.gains.inner.to_dict(),
-                      "pid": self.gains.pid.to_dict(), "attitude": self.gains.attitude.to_dict(),
-                      "ride": self.gains.ride.to_dict()},
+            "history": [
+                {"phase": h["phase"], "pass": int(h["pass"]), "objective": float(h["objective"])} for h in self.history
+            ],
+            "gains": {
+                "source": start.source,
+                "inner": self.gains.inner.to_dict(),
+                "pid": self.gains.pid.to_dict(),
+                "attitude": self.gains.attitude.to_dict(),
+                "ride": self.gains.ride.to_dict(),
+            },
             "before_after": self.before_after,
             "runs": self.n_runs,
         }
@@ -151,8 +154,7 @@ class TuneResult:
         last = {}
         for h in self.history:
             last[h["phase"]] = h
-        finals = "; ".join(f"{p} {h['objective']:.4g} after pass {h['pass']}"
-                           for p, h in last.items())
+        finals = "; ".join(f"{p} {h['objective']:.4g} after pass {h['pass']}" for p, h in last.items())
         doc = self.to_dict()
         run_text = f"{self._scenario_text()}, {self.scenario.get('duration_s', 0):g} s"
         statement = self.objective.describe()
@@ -166,8 +168,7 @@ class TuneResult:
             f"# objective: {statement}",
             f"# phases: {', '.join(doc['phases'])}; {s['values']} values from 1/{s['span']:g} to "
             f"{s['span']:g} x the current value (and 0) per gain, passes: at most "
-            f"{s['max_passes']}"
-            + ("; the ride phase starts from zero ride gains" if "ride" in doc["phases"] else ""),
+            f"{s['max_passes']}" + ("; the ride phase starts from zero ride gains" if "ride" in doc["phases"] else ""),
             f"# start values: {s['start_gains']}",
             f"# runs: {doc['runs']}; final objective: {finals}",
             "# Units: SI. Forces are desired forces on the carbody (up +) at corners 1R, 1L, 2R, 2L.",
@@ -195,13 +196,13 @@ class TuneResult:
     def to_pandas(self) -> pd.DataFrame:
         """The sensitivity curves as one long table, one row per value tried (curves.csv):
         ``phase``, ``pass``, ``parameter``, ``value``, ``objective``, ``chosen``
-        (`railride.report.curves_frame`)."""
+        (`railride.tables.curves_frame`)."""
         from .tables import curves_frame
 
         return curves_frame(self.curves)
 
     def plot(self, ax=None):
-        """The sensitivity figure (`railride.report.plot_sensitivity`): one panel per parameter,
+        """The sensitivity figure (`railride.plots.tuning.plot_sensitivity`): one panel per parameter,
         the objective against its value, one line per pass. ``ax``: one Axes per parameter, in
         the order tuned, or None for a new figure (titled with the scenario and the objective).
         Returns the figure."""
@@ -217,8 +218,7 @@ class TuneResult:
         from .files import write_tune_outputs
 
         doc = {**self.to_dict(), **(extra or {})}
-        return write_tune_outputs(self.curves, folder, doc, self.gains_toml(command),
-                                  title=self._title())
+        return write_tune_outputs(self.curves, folder, doc, self.gains_toml(command), title=self._title())
 
     def _scenario_text(self) -> str:
         from .labels import describe_scenario
@@ -230,17 +230,21 @@ class TuneResult:
         figure."""
         import textwrap
 
-        return "\n".join([
-            (f"Sensitivity of the tuning objective - {self._scenario_text()}, "
-             f"{self.scenario.get('duration_s', 0):g} s, {self.settings.get('damper')} dampers"),
-            *textwrap.wrap(f"phases {', '.join(self.phases)}; {self.objective.describe()}", 100)])
+        return "\n".join(
+            [
+                (
+                    f"Sensitivity of the tuning objective - {self._scenario_text()}, "
+                    f"{self.scenario.get('duration_s', 0):g} s, {self.settings.get('damper')} dampers"
+                ),
+                *textwrap.wrap(f"phases {', '.join(self.phases)}; {self.objective.describe()}", 100),
+            ]
+        )
 
 
 def _toml_inline(record: dict) -> str:
     """A flat record of strings, numbers and booleans as a TOML inline table (JSON spells those
     values as TOML does; None has no TOML form and is left out)."""
-    items = [f"{k} = {json.dumps(v)}" for k, v in record.items()
-             if v is not None and not isinstance(v, (dict, list))]
+    items = [f"{k} = {json.dumps(v)}" for k, v in record.items() if v is not None and not isinstance(v, (dict, list))]
     return "{" + ", ".join(items) + "}"
 
 
@@ -264,11 +268,28 @@ def _candidates(current: float, parameter: str, n_values: int, span: float) -> l
     return vals
 
 
-def tune(phases=PHASES, *, scenario: str = "paper-sine", scenario_options=None,
-         gains: GainSet | None = None, objective: Objective | None = None, damper: str = DEFAULT_DAMPER,
-         executor=None, table: RunTable | None = None, n_values: int = 13, span: float = 30.0,
-         max_passes: int = 5, tol: float = 1e-3, params=None, solver=None, window=None, progress=None,
-         log=None, damper_scale: float = 1.0, before_after: bool = True) -> TuneResult:
+def tune(
+    phases=PHASES,
+    *,
+    scenario: str = "paper-sine",
+    scenario_options=None,
+    gains: GainSet | None = None,
+    objective: Objective | None = None,
+    damper: str = DEFAULT_DAMPER,
+    executor=None,
+    table: RunTable | None = None,
+    n_values: int = 13,
+    span: float = 30.0,
+    max_passes: int = 5,
+    tol: float = 1e-3,
+    params=None,
+    solver=None,
+    window=None,
+    progress=None,
+    log=None,
+    damper_scale: float = 1.0,
+    before_after: bool = True,
+) -> TuneResult:
     """The sensitivity study: the phases in order (from PHASES; default all four, so PID and SAS
     are tuned by the same procedure and budget), each to convergence, from ``gains`` (default
     the neutral `GainSet.reference`), minimising ``objective`` (default `DEFAULT_OBJECTIVE`).
@@ -307,8 +328,10 @@ def tune(phases=PHASES, *, scenario: str = "paper-sine", scenario_options=None,
 
     damper_model(damper, damper_scale)  # a known name, and a scale it has
     if "inner" in phases and damper in dampers.IDEAL_NAMES:
-        raise ValueError(f"damper = {damper!r} with phase 'inner': the ideal actuator has no force "
-                         "tracking loop to tune; leave out the inner phase")
+        raise ValueError(
+            f"damper = {damper!r} with phase 'inner': the ideal actuator has no force "
+            "tracking loop to tune; leave out the inner phase"
+        )
     damper_scale = dampers.check_scale("damper_scale", damper_scale)
     validation.integer("n_values", n_values, 3)
     validation.integer("max_passes", max_passes, 1)
@@ -318,16 +341,36 @@ def tune(phases=PHASES, *, scenario: str = "paper-sine", scenario_options=None,
     check_resolution(scen, solver.output_rate)
     record = scen.describe()
     base = gains
-    result = TuneResult(gains, objective=objective, start=gains, phases=tuple(phases),
-                        scenario=record, settings={
-                            "damper": damper, "damper_scale": damper_scale, "dt_s": solver.dt,
-                            "values": n_values, "span": float(span), "max_passes": max_passes,
-                            "tolerance": tol, "start_gains": gains.source,
-                            **other_settings(vehicle, solver)})
+    result = TuneResult(
+        gains,
+        objective=objective,
+        start=gains,
+        phases=tuple(phases),
+        scenario=record,
+        settings={
+            "damper": damper,
+            "damper_scale": damper_scale,
+            "dt_s": solver.dt,
+            "values": n_values,
+            "span": float(span),
+            "max_passes": max_passes,
+            "tolerance": tol,
+            "start_gains": gains.source,
+            **other_settings(vehicle, solver),
+        },
+    )
 
     def run(cases):
-        return run_cases(cases, executor=executor, table=table, base_gains=base, params=vehicle,
-                         solver=solver, window=window, progress=progress)
+        return run_cases(
+            cases,
+            executor=executor,
+            table=table,
+            base_gains=base,
+            params=vehicle,
+            solver=solver,
+            window=window,
+            progress=progress,
+        )
 
     passive = _rms(run([Case(scenario, opts)]))[0]
     result.passive = dict(zip(RESPONSES, passive))
@@ -339,18 +382,26 @@ def tune(phases=PHASES, *, scenario: str = "paper-sine", scenario_options=None,
     for phase in phases:
         params = PARAMETERS[phase]
         if phase == "inner":
-            _tune_inner(base, changes, params, n_values, span, max_passes, tol, result, log, damper,
-                        damper_scale)
+            _tune_inner(base, changes, params, n_values, span, max_passes, tol, result, log, damper, damper_scale)
             continue
         suspension = SUSPENSION[phase]
         if phase == "ride":  # the paper's phase 2: the ride loop joins with zero gains
             changes.update(dict.fromkeys(params, 0.0))
 
         def score(change_sets, suspension=suspension):
-            cases = [Case(scenario, opts, suspension=suspension, damper=damper,
-                          damper_scale=damper_scale,
-                          gains=tuple(sorted({**changes, **cs}.items()))) for cs in change_sets]
+            cases = [
+                Case(
+                    scenario,
+                    opts,
+                    suspension=suspension,
+                    damper=damper,
+                    damper_scale=damper_scale,
+                    gains=tuple(sorted({**changes, **cs}.items())),
+                )
+                for cs in change_sets
+            ]
             return objective(_rms(run(cases)), passive)
+
         best = float(score([{}])[0])
         for sweep_pass in range(1, max_passes + 1):
             start = best
@@ -360,8 +411,7 @@ def tune(phases=PHASES, *, scenario: str = "paper-sine", scenario_options=None,
                 k = int(np.argmin(obj))
                 if obj[k] < best - 1e-12:
                     changes[p], best = vals[k], float(obj[k])
-                result.curves.append(Curve(phase, sweep_pass, p, np.array(vals), np.asarray(obj),
-                                           current_value(p)))
+                result.curves.append(Curve(phase, sweep_pass, p, np.array(vals), np.asarray(obj), current_value(p)))
             result.history.append({"phase": phase, "pass": sweep_pass, "objective": best})
             if log is not None:
                 log(f"{phase} pass {sweep_pass}: objective {best:.4f}")
@@ -391,16 +441,28 @@ def _before_after(result: TuneResult, run, scenario, opts, damper, damper_scale)
     cases = []
     for n in names:
         cases.append(Case(scenario, opts, suspension=n, damper=damper, damper_scale=damper_scale))
-        cases.append(Case(scenario, opts, suspension=n, damper=damper, damper_scale=damper_scale,
-                          gains=_gain_changes(result.start or result.gains, result.gains,
-                                              CONTROLLER_TABLES[n])))
+        cases.append(
+            Case(
+                scenario,
+                opts,
+                suspension=n,
+                damper=damper,
+                damper_scale=damper_scale,
+                gains=_gain_changes(result.start or result.gains, result.gains, CONTROLLER_TABLES[n]),
+            )
+        )
     frame = run(cases)
     passive = {r: float(result.passive[r]) for r in RESPONSES}
     rows = []
     for i, n in enumerate(names):
         before, after = frame.iloc[2 * i], frame.iloc[2 * i + 1]
-        row: dict[str, Any] = {"suspension": n, "before": {}, "after": {}, "reduction_before_percent": {},
-                               "reduction_after_percent": {}}
+        row: dict[str, Any] = {
+            "suspension": n,
+            "before": {},
+            "after": {},
+            "reduction_before_percent": {},
+            "reduction_after_percent": {},
+        }
         for r in RESPONSES:
             b, a = float(before[f"{r}_rms"]), float(after[f"{r}_rms"])
             row["before"][r], row["after"][r] = b, a
@@ -420,13 +482,19 @@ def tracking_objective(B: float, G: float, damper=DEFAULT_DAMPER, damper_scale: 
     model = dampers.preset(damper) if isinstance(damper, str) else damper
     if damper_scale != 1.0:
         model = model.scaled(damper_scale)
-    return float(np.mean([track(model, kind, 10e3 * damper_scale, 1.0, B=B, G=G)
-                          .metrics().normalised_rms_error for kind in ("sine", "sawtooth")]))
+    return float(
+        np.mean(
+            [
+                track(model, kind, 10e3 * damper_scale, 1.0, B=B, G=G).metrics().normalised_rms_error
+                for kind in ("sine", "sawtooth")
+            ]
+        )
+    )
 
 
-def _tune_inner(base, changes, params, n_values, span, max_passes, tol, result, log, damper,
-                damper_scale=1.0):
+def _tune_inner(base, changes, params, n_values, span, max_passes, tol, result, log, damper, damper_scale=1.0):
     """B and G on the rig's force-tracking error (cheap: evaluated here, not on the executor)."""
+
     def value(p):
         return changes.get(p, base.value(p))
 
@@ -435,9 +503,16 @@ def _tune_inner(base, changes, params, n_values, span, max_passes, tol, result, 
         start = best
         for p in params:
             vals = _candidates(value(p), p, n_values, span)
-            obj = np.array([tracking_objective(**{"B": value("inner.B"), "G": value("inner.G"),
-                                                 p.split(".")[1]: v}, damper=damper,
-                                              damper_scale=damper_scale) for v in vals])
+            obj = np.array(
+                [
+                    tracking_objective(
+                        **{"B": value("inner.B"), "G": value("inner.G"), p.split(".")[1]: v},
+                        damper=damper,
+                        damper_scale=damper_scale,
+                    )
+                    for v in vals
+                ]
+            )
             k = int(np.argmin(obj))
             if obj[k] < best - 1e-12:
                 changes[p], best = vals[k], float(obj[k])

@@ -52,8 +52,9 @@ def integer(name: str, value, minimum: int, maximum: int | None = None, what: st
     ok = ok and value >= minimum and (maximum is None or value <= maximum)
     if not ok:
         upper = f" and <= {maximum}" if maximum is not None else ""
-        raise ValueError(f"{name} = {shown(value)}: must be a whole number >= {minimum}{upper}"
-                         + (f" ({what})" if what else ""))
+        raise ValueError(
+            f"{name} = {shown(value)}: must be a whole number >= {minimum}{upper}" + (f" ({what})" if what else "")
+        )
     return int(value)
 
 
@@ -77,8 +78,9 @@ def validate_fields(obj, what: str) -> None:
         value = getattr(obj, f.name)
         words, test = RULES[f.metadata["rule"]]
         if not (is_number(value) and math.isfinite(float(value)) and test(float(value))):
-            raise ValueError(f"{what} {f.name!r} = {shown(value)} ({f.metadata['doc']}, "
-                             f"{f.metadata['unit']}): must be {words}")
+            raise ValueError(
+                f"{what} {f.name!r} = {shown(value)} ({f.metadata['doc']}, {f.metadata['unit']}): must be {words}"
+            )
         object.__setattr__(obj, f.name, float(value))
 
 

@@ -30,9 +30,15 @@ from . import validation
 from .params import VehicleParams
 
 DOF_NAMES = (
-    "carbody_bounce", "carbody_pitch", "carbody_roll",
-    "front_bogie_bounce", "front_bogie_pitch", "front_bogie_roll",
-    "rear_bogie_bounce", "rear_bogie_pitch", "rear_bogie_roll",
+    "carbody_bounce",
+    "carbody_pitch",
+    "carbody_roll",
+    "front_bogie_bounce",
+    "front_bogie_pitch",
+    "front_bogie_roll",
+    "rear_bogie_bounce",
+    "rear_bogie_pitch",
+    "rear_bogie_roll",
 )
 DOF_UNITS = ("m", "rad", "rad") * 3
 CORNER_NAMES = ("1R", "1L", "2R", "2L")
@@ -93,36 +99,34 @@ def element_table(p: VehicleParams) -> list[Element]:
         # secondary vertical, one per corner; R before L to match the force order
         for side, y in (("R", -p.d_s), ("L", +p.d_s)):
             a = _point("carbody", x_b, y) - _point(bogie, 0.0, y)
-            elements.append(Element(f"secondary vertical {bi}{side}", "secondary_vertical",
-                                    p.k_sz, p.c_sz, a, zero_e))
+            elements.append(Element(f"secondary vertical {bi}{side}", "secondary_vertical", p.k_sz, p.c_sz, a, zero_e))
         # secondary lateral and longitudinal act through roll and pitch only; one of each on
         # each side of the bogie (the paper's eq. 2, 3, 5, 6 carry 2 k_sy, 2 k_sx per bogie and
         # the appendix gives the values per side)
         for side in ("R", "L"):
             a = np.zeros(N_DOF)
             a[2], a[o + 2] = p.h_cs, p.h_ts
-            elements.append(Element(f"secondary lateral {bi}{side}", "secondary_lateral",
-                                    p.k_sy, p.c_sy, a, zero_e))
+            elements.append(Element(f"secondary lateral {bi}{side}", "secondary_lateral", p.k_sy, p.c_sy, a, zero_e))
             a = np.zeros(N_DOF)
             a[1], a[o + 1] = p.h_cs, p.h_ts
-            elements.append(Element(f"secondary longitudinal {bi}{side}", "secondary_longitudinal",
-                                    p.k_sx, p.c_sx, a, zero_e))
+            elements.append(
+                Element(f"secondary longitudinal {bi}{side}", "secondary_longitudinal", p.k_sx, p.c_sx, a, zero_e)
+            )
         for wheelset, x_axle in zip(wheelsets, (+p.b, -p.b)):
             for side, y in (("R", -p.d_p), ("L", +p.d_p)):
                 box = f"{wheelset}{side}"
                 a = _point(bogie, x_axle, y)
                 e = -_wheelset_point(wheelset, y, p.a)
-                elements.append(Element(f"primary vertical {box}", "primary_vertical",
-                                        p.k_pz, p.c_pz, a, e))
+                elements.append(Element(f"primary vertical {box}", "primary_vertical", p.k_pz, p.c_pz, a, e))
                 a = np.zeros(N_DOF)
                 a[o + 1] = p.h_tp
-                elements.append(Element(f"primary longitudinal {box}", "primary_longitudinal",
-                                        p.k_px, p.c_px, a, zero_e))
+                elements.append(
+                    Element(f"primary longitudinal {box}", "primary_longitudinal", p.k_px, p.c_px, a, zero_e)
+                )
                 a = np.zeros(N_DOF)
                 a[o + 2] = p.h_tp
                 e = p.h_wp * _wheelset_roll(wheelset, p.a)
-                elements.append(Element(f"primary lateral {box}", "primary_lateral",
-                                        p.k_py, p.c_py, a, e))
+                elements.append(Element(f"primary lateral {box}", "primary_lateral", p.k_py, p.c_py, a, e))
     return elements
 
 
@@ -201,9 +205,15 @@ class Vehicle:
         out = []
         for i in range(N_DOF):  # eigh sorts by frequency
             _, omega_d, zeta, _ = damped[match[i]]
-            out.append(Mode(_label(shapes[:, i], np.diag(self.M)),
-                            float(np.sqrt(max(w2[i], 0.0)) / (2 * np.pi)),
-                            float(omega_d / (2 * np.pi)), float(zeta), shapes[:, i]))
+            out.append(
+                Mode(
+                    _label(shapes[:, i], np.diag(self.M)),
+                    float(np.sqrt(max(w2[i], 0.0)) / (2 * np.pi)),
+                    float(omega_d / (2 * np.pi)),
+                    float(zeta),
+                    shapes[:, i],
+                )
+            )
         return out
 
     # -- frequency response -----------------------------------------------------------------
@@ -234,10 +244,9 @@ class Vehicle:
             delay = np.exp(-1j * w * lag)  # (4,)
             W = np.empty(N_RAIL_INPUT, dtype=complex)
             W[0::2], W[1::2] = cL * delay, cR * delay
-            Z = -w**2 * self.M + 1j * w * self.C + self.K
+            Z = -(w**2) * self.M + 1j * w * self.C + self.K
             H[n] = np.linalg.solve(Z, -(self.K_w + 1j * w * self.C_w) @ W)
-        ds = xr.Dataset(coords={"frequency": ("frequency", f, {"units": "Hz"}),
-                                "corner": list(CORNER_NAMES)})
+        ds = xr.Dataset(coords={"frequency": ("frequency", f, {"units": "Hz"}), "corner": list(CORNER_NAMES)})
         for i, name in enumerate(DOF_NAMES):
             ds[name] = ("frequency", H[:, i], {"units": f"{DOF_UNITS[i]}/m"})
         ds["carbody_acceleration"] = ("frequency", -(omega**2) * H[:, 0], {"units": "(m/s^2)/m"})
@@ -245,8 +254,12 @@ class Vehicle:
         corner_body = H[:, :3] @ self.T[:3]  # the carbody part alone: corner displacement
         ds["carbody_corner_displacement"] = (("frequency", "corner"), corner_body, {"units": "m/m"})
         ds["secondary_deflection"] = (("frequency", "corner"), corner, {"units": "m/m"})
-        ds.attrs.update(speed_m_s=speed, rail_L=str(cL), rail_R=str(cR),
-                        cross_level_angle_per_m=str((cL - cR) / (2 * self.params.a)))
+        ds.attrs.update(
+            speed_m_s=speed,
+            rail_L=str(cL),
+            rail_R=str(cR),
+            cross_level_angle_per_m=str((cL - cR) / (2 * self.params.a)),
+        )
         return ds
 
 

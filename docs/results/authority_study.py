@@ -54,12 +54,15 @@ def field_variant(k: float) -> str:
     r = dampers.RAILWAY
     dampers.PRESETS[name] = r.replace(alpha_b=r.alpha_b * k, c0b=r.c0b * k)
     return name
+
+
 CONTROLLERS = ("pid", "sas-attitude", "sas-attitude-ride")
 
 
 def ratios(gains: GainSet, damper: str, scale: float) -> dict:
-    cases = [Case("paper-sine")] + [Case("paper-sine", suspension=c, damper=damper, damper_scale=scale)
-                                    for c in CONTROLLERS]
+    cases = [Case("paper-sine")] + [
+        Case("paper-sine", suspension=c, damper=damper, damper_scale=scale) for c in CONTROLLERS
+    ]
     rows = run_cases(cases, base_gains=gains)
     rms = rows[[f"{r}_rms" for r in RESPONSES]].to_numpy()
     return {c: rms[i + 1] / rms[0] for i, c in enumerate(CONTROLLERS)}
@@ -75,13 +78,21 @@ def main() -> None:
     for damper, scale, factor, phases in devices:
         t0 = time.perf_counter()
         tuned = tune(phases, damper=damper, damper_scale=scale).gains
-        series = ("field" if damper.startswith("railway-field") else
-                  "probe" if damper.startswith("probe") else damper)
+        series = "field" if damper.startswith("railway-field") else "probe" if damper.startswith("probe") else damper
         for gains_name, gains in (("tuned for this damper", tuned), ("shipped", shipped)):
             for c, r in ratios(gains, damper, scale).items():
-                records.append({"damper": damper, "series": series, "factor": factor, "gains": gains_name,
-                                "controller": c, **{f"{k}_ratio": float(v) for k, v in zip(RESPONSES, r)},
-                                "worst_ratio": float(r.max()), "inner_G": gains.inner.G})
+                records.append(
+                    {
+                        "damper": damper,
+                        "series": series,
+                        "factor": factor,
+                        "gains": gains_name,
+                        "controller": c,
+                        **{f"{k}_ratio": float(v) for k, v in zip(RESPONSES, r)},
+                        "worst_ratio": float(r.max()),
+                        "inner_G": gains.inner.G,
+                    }
+                )
         print(f"{damper} x{factor:g}: {time.perf_counter() - t0:.0f} s", file=sys.stderr)
     frame = pd.DataFrame.from_records(records)
     frame.to_csv(HERE / "authority.csv", index=False, float_format="%.5g")
@@ -90,6 +101,7 @@ def main() -> None:
 
 def plot(frame: pd.DataFrame) -> None:
     import matplotlib
+
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
@@ -106,10 +118,8 @@ def plot(frame: pd.DataFrame) -> None:
         field = pd.concat([one, mine[(mine.series == "field") & (mine.gains == "tuned for this damper")]])
         ax.plot(field.factor, field.worst_ratio, "-^", label="field part x k (0 V force kept), tuned")
         for damper, color in (("ideal-damper", "tab:purple"), ("ideal", "tab:red")):
-            b = frame[(frame.controller == c) & (frame.damper == damper)
-                      & (frame.gains == "tuned for this damper")]
-            ax.axhline(float(b.worst_ratio.iloc[0]), color=color, lw=1,
-                       label=f"{damper}, tuned for it")
+            b = frame[(frame.controller == c) & (frame.damper == damper) & (frame.gains == "tuned for this damper")]
+            ax.axhline(float(b.worst_ratio.iloc[0]), color=color, lw=1, label=f"{damper}, tuned for it")
         ax.axhline(1.0, color="k", lw=0.8)
         ax.set_xscale("log", base=2)
         ax.set_ylim(0.0, 1.6)
@@ -118,8 +128,11 @@ def plot(frame: pd.DataFrame) -> None:
         ax.grid(alpha=0.3)
     axes[0].set_ylabel("worst of the four RMS ratios to passive")
     axes[0].legend(fontsize=7)
-    fig.suptitle("Damper authority on paper-sine: each damper size tuned by railride tune's defaults "
-                 "(tuned and judged on the same track)", fontsize=10)
+    fig.suptitle(
+        "Damper authority on paper-sine: each damper size tuned by railride tune's defaults "
+        "(tuned and judged on the same track)",
+        fontsize=10,
+    )
     fig.savefig(HERE / "authority.png", dpi=110)
 
 

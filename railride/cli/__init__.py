@@ -2,10 +2,9 @@
 ``railride simulate``, ``railride damper``, ``railride tracking``, ``railride tune``,
 ``railride pareto`` and ``railride sweep``.
 
-A thin layer over the library: it parses options, calls `railride.vehicle`, `railride.track`,
-`railride.simulation`, `railride.metrics`, `railride.dampers`, `railride.rig`,
-`railride.control`, `railride.comparison`, `railride.sweep`, `railride.tuning` and
-`railride.report`, and prints. See docs/cli.md. One module per command (`rig` holds `damper`
+A thin layer over the library: it parses options, calls the library's studies (`simulate`,
+`compare`, `frf`, `rig`, `tune`, `pareto`, `sweep`), writes their results through their
+`save()` and `railride.files`, and prints. See docs/cli.md. One module per command (`rig` holds `damper`
 and `tracking`); `_options` declares the options several commands share, `_parsing` the
 checks of their values, `_common` the errors, consoles and run machinery, `_render` the
 shared tables.

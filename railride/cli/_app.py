@@ -10,7 +10,7 @@ app = typer.Typer(
     pretty_exceptions_show_locals=False,
     rich_markup_mode=None,
     help="Vertical ride of a 9-DOF railway vehicle: the paper's comparison of passive, PID and "
-         "SAS suspensions (start with `railride compare`), modes and frequency responses, "
-         "simulated ride metrics on sine, bump, measured or random tracks, and MR damper rig "
-         "tests (hysteresis cycles, force tracking).",
+    "SAS suspensions (start with `railride compare`), modes and frequency responses, "
+    "simulated ride metrics on sine, bump, measured or random tracks, and MR damper rig "
+    "tests (hysteresis cycles, force tracking).",
 )

@@ -72,8 +72,9 @@ def reworded(text: str, fields: dict, defaults=()) -> str:
     for name, option in fields.items():
         field = rf"(?<![\w'./-]){re.escape(name)}"
         if name in defaults:  # the value, and its unit when the library gives one
-            text = re.sub(rf"{field}( = [^\s:;,]+(?: (?:s|Hz|m|m/s|V))?)(?=[\s:;,]|$)",
-                          rf"{name}\1 (the default)", text)
+            text = re.sub(
+                rf"{field}( = [^\s:;,]+(?: (?:s|Hz|m|m/s|V))?)(?=[\s:;,]|$)", rf"{name}\1 (the default)", text
+            )
         text = re.sub(field + (r"(?![\w-])" if "_" in name else "(?= [<>]?= )"), option, text)
     return text
 
@@ -160,9 +161,15 @@ class ProgressBar:
         from rich.progress import BarColumn, Progress, SpinnerColumn, TextColumn, TimeElapsedColumn
 
         first = _first_message(self._describe(0.0))
-        self._progress = Progress(SpinnerColumn(), TextColumn("{task.description}"), BarColumn(),
-                                  TextColumn("{task.percentage:>3.0f}%"), TimeElapsedColumn(),
-                                  console=stderr_console(), transient=True)
+        self._progress = Progress(
+            SpinnerColumn(),
+            TextColumn("{task.description}"),
+            BarColumn(),
+            TextColumn("{task.percentage:>3.0f}%"),
+            TimeElapsedColumn(),
+            console=stderr_console(),
+            transient=True,
+        )
         self._progress.__enter__()
         self._task = self._progress.add_task(first, total=1.0)
         return self
@@ -198,9 +205,16 @@ class RunProgress:
         from rich.progress import BarColumn, MofNCompleteColumn, Progress, SpinnerColumn, TextColumn, TimeElapsedColumn
 
         first = _first_message(f"{self.verb}...")
-        self._progress = Progress(SpinnerColumn(), TextColumn("{task.description}"), BarColumn(),
-                                  MofNCompleteColumn(), TextColumn("{task.fields[rate]}"),
-                                  TimeElapsedColumn(), console=stderr_console(), transient=True)
+        self._progress = Progress(
+            SpinnerColumn(),
+            TextColumn("{task.description}"),
+            BarColumn(),
+            MofNCompleteColumn(),
+            TextColumn("{task.fields[rate]}"),
+            TimeElapsedColumn(),
+            console=stderr_console(),
+            transient=True,
+        )
         self._progress.__enter__()
         self._task = self._progress.add_task(first, total=None, rate="")
         return self
@@ -211,9 +225,13 @@ class RunProgress:
         self.evaluated = self._base + int(done)
         if self._progress is not None:
             ok = math.isfinite(runs_per_second) and runs_per_second > 0
-            self._progress.update(self._task, completed=done, total=total,
-                                  description=f"{self.verb} ({self.evaluated} runs)",
-                                  rate=f"{runs_per_second:.1f} runs/s" if ok else "")
+            self._progress.update(
+                self._task,
+                completed=done,
+                total=total,
+                description=f"{self.verb} ({self.evaluated} runs)",
+                rate=f"{runs_per_second:.1f} runs/s" if ok else "",
+            )
 
     def log(self, text: str) -> None:
         if self._progress is not None:
@@ -236,15 +254,17 @@ def make_executor(workers: Optional[int], scheduler: Optional[str], scheduler_fi
         raise ValueError("give either --scheduler ADDRESS or --scheduler-file FILE, not both")
     if scheduler is not None or scheduler_file is not None:
         if workers is not None:
-            raise ValueError(f"--workers = {workers}: applies to the local executor only; the "
-                             "threads of a Dask cluster are set where its workers start "
-                             "(dask worker --nthreads N)")
+            raise ValueError(
+                f"--workers = {workers}: applies to the local executor only; the "
+                "threads of a Dask cluster are set where its workers start "
+                "(dask worker --nthreads N)"
+            )
         if scheduler is not None and not scheduler.strip():
-            raise ValueError("--scheduler = '': give the scheduler's address, e.g. "
-                             "tcp://host:8786")
+            raise ValueError("--scheduler = '': give the scheduler's address, e.g. tcp://host:8786")
         with status_note("connecting to the Dask scheduler..."):
             executor = sweep_lib.DaskExecutor(
-                address=scheduler, scheduler_file=None if scheduler_file is None else str(scheduler_file))
+                address=scheduler, scheduler_file=None if scheduler_file is None else str(scheduler_file)
+            )
         where = scheduler if scheduler is not None else str(scheduler_file)
         record: dict[str, Any] = {"type": "dask", "scheduler": where}
         with contextlib.suppress(Exception):
@@ -255,8 +275,9 @@ def make_executor(workers: Optional[int], scheduler: Optional[str], scheduler_fi
     cores = int(numba.config.NUMBA_NUM_THREADS)  # type: ignore[attr-defined]  # set at import
     if workers is not None:
         if not 1 <= workers <= cores:
-            raise ValueError(f"--workers = {workers}: must be a whole number from 1 to {cores} "
-                             "(the cores of this machine)")
+            raise ValueError(
+                f"--workers = {workers}: must be a whole number from 1 to {cores} (the cores of this machine)"
+            )
         numba.set_num_threads(workers)
     return sweep_lib.LocalExecutor(), {"type": "local", "threads": int(numba.get_num_threads())}
 
@@ -268,14 +289,15 @@ def open_run_table(out: Optional[Path], resume: bool):
 
     if out is None:
         if resume:
-            raise ValueError("--resume needs --out DIR: the run table it continues is "
-                             "DIR/runs.csv")
+            raise ValueError("--resume needs --out DIR: the run table it continues is DIR/runs.csv")
         return sweep_lib.RunTable(), None
     check_out_dir(out)
     path = out / "runs.csv"
     if path.exists() and not resume:
-        raise ValueError(f"--out {out}: {path} exists (the run table of an earlier run); add "
-                         "--resume to continue it, or choose another folder")
+        raise ValueError(
+            f"--out {out}: {path} exists (the run table of an earlier run); add "
+            "--resume to continue it, or choose another folder"
+        )
     return sweep_lib.RunTable(path, resume=resume), path
 
 
@@ -299,11 +321,13 @@ def interruptible(table, path: Optional[Path]):
     except KeyboardInterrupt:
         n = _saved_runs(table, path)
         if path is not None:
-            typer.echo(f"interrupted: {n} runs saved in {path}; run again with --resume to "
-                       "continue", err=True)
+            typer.echo(f"interrupted: {n} runs saved in {path}; run again with --resume to continue", err=True)
         else:
-            typer.echo(f"interrupted: {n} runs done, none saved (with --out DIR the runs are kept "
-                       "in DIR/runs.csv and --resume continues them)", err=True)
+            typer.echo(
+                f"interrupted: {n} runs done, none saved (with --out DIR the runs are kept "
+                "in DIR/runs.csv and --resume continues them)",
+                err=True,
+            )
         raise typer.Exit(130) from None
 
 

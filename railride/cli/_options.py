@@ -18,17 +18,23 @@ class OutputFormat(str, Enum):
     json = "json"
 
 
-FormatOption = Annotated[OutputFormat, typer.Option(
-    "--format", case_sensitive=False, help="Output on stdout: a table or a JSON document.")]
+FormatOption = Annotated[
+    OutputFormat, typer.Option("--format", case_sensitive=False, help="Output on stdout: a table or a JSON document.")
+]
 
 # -- vehicle ------------------------------------------------------------------------------------
-ParamsOption = Annotated[Optional[Path], typer.Option(
-    "--params", metavar="FILE.toml",
-    help="Vehicle parameters from a TOML file with a [vehicle] table (see docs/cli.md). "
-         "Exclusive with --preset.")]
-PresetOption = Annotated[Optional[str], typer.Option(
-    "--preset", metavar="NAME",
-    help="Named vehicle parameter set (available: paper). Default: paper.")]
+ParamsOption = Annotated[
+    Optional[Path],
+    typer.Option(
+        "--params",
+        metavar="FILE.toml",
+        help="Vehicle parameters from a TOML file with a [vehicle] table (see docs/cli.md). Exclusive with --preset.",
+    ),
+]
+PresetOption = Annotated[
+    Optional[str],
+    typer.Option("--preset", metavar="NAME", help="Named vehicle parameter set (available: paper). Default: paper."),
+]
 
 
 # -- scenario -----------------------------------------------------------------------------------
@@ -36,81 +42,135 @@ def _scenario(help: str):
     return Annotated[str, typer.Option("--scenario", metavar="NAME", help=help)]
 
 
-SCENARIO_HELP = ("paper-sine (the paper's sine rails), bump (a cosine bump on both rails), "
-                 "file:PATH (a measured CSV with columns s, z_L, z_R in metres), or a random "
-                 "track: fra1..fra6 (FRA classes; 6 is the best track) or german-low, "
-                 "german-high (see --track-seed, --min-wavelength, --max-wavelength).")
+SCENARIO_HELP = (
+    "paper-sine (the paper's sine rails), bump (a cosine bump on both rails), "
+    "file:PATH (a measured CSV with columns s, z_L, z_R in metres), or a random "
+    "track: fra1..fra6 (FRA classes; 6 is the best track) or german-low, "
+    "german-high (see --track-seed, --min-wavelength, --max-wavelength)."
+)
 #: simulate: every scenario explained
 ScenarioOption = _scenario(SCENARIO_HELP)
 CompareScenarioOption = _scenario(
-    "paper-sine (the paper's sine rails), bump, file:PATH, fra1..fra6, german-low or "
-    "german-high, as for simulate.")
+    "paper-sine (the paper's sine rails), bump, file:PATH, fra1..fra6, german-low or german-high, as for simulate."
+)
 #: tune, pareto and sweep
-RunsScenarioOption = _scenario(
-    "paper-sine, bump, file:PATH, fra1..fra6, german-low or german-high, as for simulate.")
+RunsScenarioOption = _scenario("paper-sine, bump, file:PATH, fra1..fra6, german-low or german-high, as for simulate.")
 
-AmplitudeOption = Annotated[Optional[float], typer.Option(
-    "--amplitude", metavar="M",
-    help="paper-sine: sine amplitude [m] (default 0.05). bump: bump height [m], negative for a "
-         "dip (default 0.02).")]
-WavelengthOption = Annotated[Optional[float], typer.Option(
-    "--wavelength", metavar="M",
-    help="paper-sine: wavelength [m] (default 60). bump: bump length [m] (default 10).")]
-RailPhaseOption = Annotated[Optional[float], typer.Option(
-    "--rail-phase", metavar="DEG",
-    help="paper-sine only: phase lag of the right rail [deg] (default 90).")]
-SpeedOption = Annotated[Optional[float], typer.Option(
-    "--speed", metavar="M/S", help="Vehicle speed [m/s] (default 55.56).")]
-FrfSpeedOption = Annotated[Optional[float], typer.Option(
-    "--speed", metavar="M/S",
-    help="Vehicle speed [m/s]: sets the delays between the wheelsets (default 55.56).")]
-TrackSeedOption = Annotated[Optional[int], typer.Option(
-    "--track-seed", metavar="N",
-    help="Random tracks (fra1..fra6, german-low, german-high) only: the seed of the track's "
-         "realisation, a whole number >= 0; the same seed gives the same track (default 0).")]
-MinWavelengthOption = Annotated[Optional[float], typer.Option(
-    "--min-wavelength", metavar="M",
-    help="Random tracks only: shortest wavelength of the irregularity [m] (default 1); "
-         "speed / M must not exceed the output rate / 2.5.")]
-MaxWavelengthOption = Annotated[Optional[float], typer.Option(
-    "--max-wavelength", metavar="M",
-    help="Random tracks only: longest wavelength of the irregularity [m] (default 100).")]
+AmplitudeOption = Annotated[
+    Optional[float],
+    typer.Option(
+        "--amplitude",
+        metavar="M",
+        help="paper-sine: sine amplitude [m] (default 0.05). bump: bump height [m], negative for a dip (default 0.02).",
+    ),
+]
+WavelengthOption = Annotated[
+    Optional[float],
+    typer.Option(
+        "--wavelength", metavar="M", help="paper-sine: wavelength [m] (default 60). bump: bump length [m] (default 10)."
+    ),
+]
+RailPhaseOption = Annotated[
+    Optional[float],
+    typer.Option(
+        "--rail-phase", metavar="DEG", help="paper-sine only: phase lag of the right rail [deg] (default 90)."
+    ),
+]
+SpeedOption = Annotated[
+    Optional[float], typer.Option("--speed", metavar="M/S", help="Vehicle speed [m/s] (default 55.56).")
+]
+FrfSpeedOption = Annotated[
+    Optional[float],
+    typer.Option(
+        "--speed", metavar="M/S", help="Vehicle speed [m/s]: sets the delays between the wheelsets (default 55.56)."
+    ),
+]
+TrackSeedOption = Annotated[
+    Optional[int],
+    typer.Option(
+        "--track-seed",
+        metavar="N",
+        help="Random tracks (fra1..fra6, german-low, german-high) only: the seed of the track's "
+        "realisation, a whole number >= 0; the same seed gives the same track (default 0).",
+    ),
+]
+MinWavelengthOption = Annotated[
+    Optional[float],
+    typer.Option(
+        "--min-wavelength",
+        metavar="M",
+        help="Random tracks only: shortest wavelength of the irregularity [m] (default 1); "
+        "speed / M must not exceed the output rate / 2.5.",
+    ),
+]
+MaxWavelengthOption = Annotated[
+    Optional[float],
+    typer.Option(
+        "--max-wavelength",
+        metavar="M",
+        help="Random tracks only: longest wavelength of the irregularity [m] (default 100).",
+    ),
+]
 
 # -- steps, windows, rates ----------------------------------------------------------------------
-DurationOption = Annotated[Optional[float], typer.Option(
-    "--duration", metavar="S", help="Simulated time [s] (default 10).")]
+DurationOption = Annotated[
+    Optional[float], typer.Option("--duration", metavar="S", help="Simulated time [s] (default 10).")
+]
 #: tune, pareto and sweep
-RunDurationOption = Annotated[Optional[float], typer.Option(
-    "--duration", metavar="S", help="Simulated time of each run [s] (default 10).")]
-DtOption = Annotated[Optional[float], typer.Option(
-    "--dt", metavar="S", help="Fixed RK4 time step [s] (default 1e-4).")]
-OutputRateOption = Annotated[Optional[float], typer.Option(
-    "--output-rate", metavar="HZ",
-    help="Sampling rate of the stored time histories [Hz] (default 1000); 1/(rate x dt) must "
-         "be a whole number.")]
-ControlRateOption = Annotated[float, typer.Option(
-    "--control-rate", metavar="HZ",
-    help="Sample rate of the outer-loop controllers [Hz]; 1/(rate x dt) must be a whole "
-         "number.")]
+RunDurationOption = Annotated[
+    Optional[float], typer.Option("--duration", metavar="S", help="Simulated time of each run [s] (default 10).")
+]
+DtOption = Annotated[Optional[float], typer.Option("--dt", metavar="S", help="Fixed RK4 time step [s] (default 1e-4).")]
+OutputRateOption = Annotated[
+    Optional[float],
+    typer.Option(
+        "--output-rate",
+        metavar="HZ",
+        help="Sampling rate of the stored time histories [Hz] (default 1000); 1/(rate x dt) must be a whole number.",
+    ),
+]
+ControlRateOption = Annotated[
+    float,
+    typer.Option(
+        "--control-rate",
+        metavar="HZ",
+        help="Sample rate of the outer-loop controllers [Hz]; 1/(rate x dt) must be a whole number.",
+    ),
+]
 #: compare and sweep
-WindowOption = Annotated[Optional[str], typer.Option(
-    "--window", metavar="START:END",
-    help="Time window of the metrics [s], e.g. 2:10 (default: the whole run).")]
-SimulateWindowOption = Annotated[Optional[str], typer.Option(
-    "--window", metavar="START:END",
-    help="Time window of the metrics [s], e.g. 2:10; either side may be empty "
-         "(default: the whole run).")]
-ComfortOption = Annotated[bool, typer.Option(
-    "--comfort",
-    help="Also evaluate the ride comfort indices on the carbody floor at the centre and above "
-         "the bogies (ISO 2631-1 a_w and VDV, the vertical part of EN 12299 N_MV, Sperling's "
-         "Wz; docs/comfort.md) over the metrics window.")]
-SweepComfortOption = Annotated[bool, typer.Option(
-    "--comfort/--no-comfort",
-    help="Evaluate the ride comfort indices of every run (columns centre_aw_Wk, "
-         "centre_N_MV_z, front_N_MV_z, rear_N_MV_z, centre_Wz, ...; docs/comfort.md) and, "
-         "with sweep.png, plot them against the axis in comfort.png (default: on; "
-         "--no-comfort for RMS and peak-to-peak only).")]
+WindowOption = Annotated[
+    Optional[str],
+    typer.Option(
+        "--window", metavar="START:END", help="Time window of the metrics [s], e.g. 2:10 (default: the whole run)."
+    ),
+]
+SimulateWindowOption = Annotated[
+    Optional[str],
+    typer.Option(
+        "--window",
+        metavar="START:END",
+        help="Time window of the metrics [s], e.g. 2:10; either side may be empty (default: the whole run).",
+    ),
+]
+ComfortOption = Annotated[
+    bool,
+    typer.Option(
+        "--comfort",
+        help="Also evaluate the ride comfort indices on the carbody floor at the centre and above "
+        "the bogies (ISO 2631-1 a_w and VDV, the vertical part of EN 12299 N_MV, Sperling's "
+        "Wz; docs/comfort.md) over the metrics window.",
+    ),
+]
+SweepComfortOption = Annotated[
+    bool,
+    typer.Option(
+        "--comfort/--no-comfort",
+        help="Evaluate the ride comfort indices of every run (columns centre_aw_Wk, "
+        "centre_N_MV_z, front_N_MV_z, rear_N_MV_z, centre_Wz, ...; docs/comfort.md) and, "
+        "with sweep.png, plot them against the axis in comfort.png (default: on; "
+        "--no-comfort for RMS and peak-to-peak only).",
+    ),
+]
 
 
 # -- dampers ------------------------------------------------------------------------------------
@@ -118,28 +178,45 @@ def _damper(kind, help: str):
     return Annotated[kind, typer.Option("--damper", metavar="MODEL", help=help)]
 
 
-CompareDamperOption = _damper(str, (
-    "Dampers of the controlled suspensions: the MR models railway, dyke1996 or "
-    "spencer1997; ideal-damper (the ideal semi-active damper: the demand where it "
-    "dissipates, else 0, the bound of any damper) or ideal (an ideal actuator: force = "
-    "the outer loop's demand)."))
-SimulateDamperOption = _damper(Optional[str], (
-    "--suspension mr only: damper model railway, dyke1996 or spencer1997 "
-    "(default railway). The ideal actuator (ideal) needs a controller: see compare "
-    "and sweep."))
-TuneDamperOption = _damper(str, (
-    "MR damper model: railway, dyke1996 or spencer1997 (ideal-damper or ideal, the "
-    "ideal devices, without the inner phase)."))
-ParetoDamperOption = _damper(str, (
-    "Dampers of the controlled runs: railway, dyke1996, spencer1997, ideal-damper or "
-    "ideal."))
-SweepDamperOption = _damper(Optional[str], (
-    "mr and controllers: MR damper model railway, dyke1996 or spencer1997 "
-    "(default railway); controllers only: ideal-damper (the ideal semi-active damper) or "
-    "ideal (an ideal actuator whose force is the outer loop's demand)."))
+CompareDamperOption = _damper(
+    str,
+    (
+        "Dampers of the controlled suspensions: the MR models railway, dyke1996 or "
+        "spencer1997; ideal-damper (the ideal semi-active damper: the demand where it "
+        "dissipates, else 0, the bound of any damper) or ideal (an ideal actuator: force = "
+        "the outer loop's demand)."
+    ),
+)
+SimulateDamperOption = _damper(
+    Optional[str],
+    (
+        "--suspension mr only: damper model railway, dyke1996 or spencer1997 "
+        "(default railway). The ideal actuator (ideal) needs a controller: see compare "
+        "and sweep."
+    ),
+)
+TuneDamperOption = _damper(
+    str,
+    (
+        "MR damper model: railway, dyke1996 or spencer1997 (ideal-damper or ideal, the "
+        "ideal devices, without the inner phase)."
+    ),
+)
+ParetoDamperOption = _damper(
+    str, ("Dampers of the controlled runs: railway, dyke1996, spencer1997, ideal-damper or ideal.")
+)
+SweepDamperOption = _damper(
+    Optional[str],
+    (
+        "mr and controllers: MR damper model railway, dyke1996 or spencer1997 "
+        "(default railway); controllers only: ideal-damper (the ideal semi-active damper) or "
+        "ideal (an ideal actuator whose force is the outer loop's demand)."
+    ),
+)
 #: damper and tracking: the damper on the rig
-RigModelOption = Annotated[str, typer.Option(
-    "--model", metavar="MODEL", help="Damper model: railway, dyke1996 or spencer1997.")]
+RigModelOption = Annotated[
+    str, typer.Option("--model", metavar="MODEL", help="Damper model: railway, dyke1996 or spencer1997.")
+]
 
 
 def _damper_scale(help: str, metavar: str = "X"):
@@ -149,18 +226,23 @@ def _damper_scale(help: str, metavar: str = "X"):
 
 CompareDamperScaleOption = _damper_scale(
     "Factor on the MR damper's force capacity, a finite number > 0 (every force "
-    "parameter times X; default 1). Not with --damper ideal.")
+    "parameter times X; default 1). Not with --damper ideal."
+)
 SimulateDamperScaleOption = _damper_scale(
     "--suspension mr only: factor on the damper's force capacity, a finite number > 0 "
-    "(every force parameter times X; default 1).")
+    "(every force parameter times X; default 1)."
+)
 TuneDamperScaleOption = _damper_scale(
     "Factor on the MR damper's force capacity, a finite number > 0 (every force "
     "parameter times X; default 1); the inner phase tracks demands scaled alike. Not "
-    "with an ideal damper.")
+    "with an ideal damper."
+)
 SweepDamperScaleOption = _damper_scale(
     "mr and controllers: factors on the MR damper's force capacity (every force "
     "parameter times X), finite numbers > 0, a range or a list (default 1); a grid "
-    "axis. passive runs once, unscaled; not with --damper ideal.", metavar="VALUES")
+    "axis. passive runs once, unscaled; not with --damper ideal.",
+    metavar="VALUES",
+)
 
 
 # -- gains and the tuning objective -------------------------------------------------------------
@@ -170,48 +252,77 @@ def _gains(help: str):
 
 CompareGainsOption = _gains(
     "Controller gains from a TOML file with [inner], [pid], [sas.attitude] and "
-    "[sas.ride] (default: the shipped railride/data/gains.toml).")
+    "[sas.ride] (default: the shipped railride/data/gains.toml)."
+)
 TuneGainsOption = _gains(
     "Start values: a gains file as for compare (default: the neutral reference gains, "
-    "railride/data/reference_gains.toml).")
+    "railride/data/reference_gains.toml)."
+)
 ParetoGainsOption = _gains(
     "Base gains: the gains not sampled (the inner loop's among them), and one sample "
-    "of their own (default: the shipped gains).")
-SweepGainsOption = _gains(
-    "Controllers: the base gains that --gain changes (default: the shipped "
-    "gains).")
+    "of their own (default: the shipped gains)."
+)
+SweepGainsOption = _gains("Controllers: the base gains that --gain changes (default: the shipped gains).")
 
-ObjectiveOption = Annotated[Optional[str], typer.Option(
-    "--objective", metavar="KIND",
-    help="What each run's RMS ratios to passive r_k (acceleration, displacement, pitch, "
-         "roll) are scored by: sum (sum of r_k), weighted (sum of w_k r_k, --weights), "
-         "minimax (the largest r_k), constrained (sum of r_k with every r_k <= --bound). "
-         "Default: the library's DEFAULT_OBJECTIVE; the statement is printed with the "
-         "result.")]
-WeightsOption = Annotated[Optional[str], typer.Option(
-    "--weights", metavar="A,D,P,R",
-    help="--objective weighted: the weights of acceleration, displacement, pitch, roll; "
-         ">= 0, not all 0.")]
-BoundOption = Annotated[Optional[str], typer.Option(
-    "--bound", metavar="X",
-    help="--objective constrained: the largest RMS ratio to passive allowed for every "
-         "response, > 0.")]
-PenaltyOption = Annotated[Optional[str], typer.Option(
-    "--penalty", metavar="X",
-    help="Added to any objective: X times the sum of the RMS ratios above 1 (responses "
-         "worse than passive); >= 0 (default 0).")]
+ObjectiveOption = Annotated[
+    Optional[str],
+    typer.Option(
+        "--objective",
+        metavar="KIND",
+        help="What each run's RMS ratios to passive r_k (acceleration, displacement, pitch, "
+        "roll) are scored by: sum (sum of r_k), weighted (sum of w_k r_k, --weights), "
+        "minimax (the largest r_k), constrained (sum of r_k with every r_k <= --bound). "
+        "Default: the library's DEFAULT_OBJECTIVE; the statement is printed with the "
+        "result.",
+    ),
+]
+WeightsOption = Annotated[
+    Optional[str],
+    typer.Option(
+        "--weights",
+        metavar="A,D,P,R",
+        help="--objective weighted: the weights of acceleration, displacement, pitch, roll; >= 0, not all 0.",
+    ),
+]
+BoundOption = Annotated[
+    Optional[str],
+    typer.Option(
+        "--bound",
+        metavar="X",
+        help="--objective constrained: the largest RMS ratio to passive allowed for every response, > 0.",
+    ),
+]
+PenaltyOption = Annotated[
+    Optional[str],
+    typer.Option(
+        "--penalty",
+        metavar="X",
+        help="Added to any objective: X times the sum of the RMS ratios above 1 (responses "
+        "worse than passive); >= 0 (default 0).",
+    ),
+]
 
 # -- executors: tune, pareto and sweep ----------------------------------------------------------
-WorkersOption = Annotated[Optional[int], typer.Option(
-    "--workers", metavar="N",
-    help="Local executor: threads of each batch, 1..cores (default: every core).")]
-SchedulerOption = Annotated[Optional[str], typer.Option(
-    "--scheduler", metavar="ADDRESS",
-    help="Run on a Dask cluster: the scheduler's address, e.g. tcp://host:8786.")]
-SchedulerFileOption = Annotated[Optional[Path], typer.Option(
-    "--scheduler-file", metavar="FILE",
-    help="Run on a Dask cluster whose scheduler wrote FILE (dask scheduler --scheduler-file "
-         "FILE).")]
+WorkersOption = Annotated[
+    Optional[int],
+    typer.Option(
+        "--workers", metavar="N", help="Local executor: threads of each batch, 1..cores (default: every core)."
+    ),
+]
+SchedulerOption = Annotated[
+    Optional[str],
+    typer.Option(
+        "--scheduler", metavar="ADDRESS", help="Run on a Dask cluster: the scheduler's address, e.g. tcp://host:8786."
+    ),
+]
+SchedulerFileOption = Annotated[
+    Optional[Path],
+    typer.Option(
+        "--scheduler-file",
+        metavar="FILE",
+        help="Run on a Dask cluster whose scheduler wrote FILE (dask scheduler --scheduler-file FILE).",
+    ),
+]
 
 
 # -- output folders -----------------------------------------------------------------------------
@@ -223,29 +334,33 @@ CompareOutOption = _out(
     "Also write compare.json, compare.nc, compare.csv and the plots acceleration.png, "
     "displacement.png, pitch.png, roll.png, damper_forces.png, voltages.png, and the "
     "acceleration spectra psd.png, psd.csv into DIR (created if missing; all or "
-    "nothing).")
+    "nothing)."
+)
 FrfOutOption = _out(
-    "Also write frf.csv, frf.json, frf.png and modes.csv into DIR (created if missing; "
-    "all or nothing).")
+    "Also write frf.csv, frf.json, frf.png and modes.csv into DIR (created if missing; all or nothing)."
+)
 SimulateOutOption = _out(
-    "Also write ride.nc, ride.csv, metrics.json and body_responses.png into DIR "
-    "(created if missing; all or nothing).")
+    "Also write ride.nc, ride.csv, metrics.json and body_responses.png into DIR (created if missing; all or nothing)."
+)
 DamperOutOption = _out(
-    "Also write loops.png, cycles.csv and damper.json into DIR (created if missing; "
-    "all or nothing).")
+    "Also write loops.png, cycles.csv and damper.json into DIR (created if missing; all or nothing)."
+)
 TrackingOutOption = _out(
-    "Also write tracking.png, tracking.csv and tracking.json into DIR (created if "
-    "missing; all or nothing).")
+    "Also write tracking.png, tracking.csv and tracking.json into DIR (created if missing; all or nothing)."
+)
 TuneOutOption = _out(
     "Keep the run table DIR/runs.csv (updated as runs finish) and write gains.toml, "
-    "sensitivity.png, curves.csv and tune.json into DIR at the end.")
+    "sensitivity.png, curves.csv and tune.json into DIR at the end."
+)
 ParetoOutOption = _out(
     "Keep the run table DIR/runs.csv (updated as runs finish) and write pareto.png, "
-    "pareto.csv and pareto.json into DIR at the end.")
+    "pareto.csv and pareto.json into DIR at the end."
+)
 SweepOutOption = _out(
     "Keep the run table DIR/runs.csv (updated as runs finish) and write sweep.json "
     "(and sweep.png when one numeric axis has several values) into DIR at the "
-    "end.")
+    "end."
+)
 
 
 def _resume(help: str):
@@ -253,10 +368,9 @@ def _resume(help: str):
 
 
 TuneResumeOption = _resume(
-    "Continue the study whose run table is DIR/runs.csv (needs --out): runs already "
-    "there are not evaluated again.")
-ParetoResumeOption = _resume(
-    "Continue the study whose run table is DIR/runs.csv (needs --out).")
+    "Continue the study whose run table is DIR/runs.csv (needs --out): runs already there are not evaluated again."
+)
+ParetoResumeOption = _resume("Continue the study whose run table is DIR/runs.csv (needs --out).")
 SweepResumeOption = _resume(
-    "Continue the sweep whose run table is DIR/runs.csv (needs --out): runs already "
-    "there are not evaluated again.")
+    "Continue the sweep whose run table is DIR/runs.csv (needs --out): runs already there are not evaluated again."
+)

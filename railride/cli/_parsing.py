@@ -34,14 +34,14 @@ def value_list(option: str, text: str, *, integer: bool = False, parse=None) -> 
     if ":" in text:
         parts = text.split(":")
         if len(parts) != 3:
-            raise ValueError(f"{option} = {text!r}: expected a range START:STOP:COUNT (e.g. "
-                             f"20:80:13) or a list a,b,c of {kind}")
+            raise ValueError(
+                f"{option} = {text!r}: expected a range START:STOP:COUNT (e.g. 20:80:13) or a list a,b,c of {kind}"
+            )
         start, stop = (parse_float(option, text, p) for p in parts[:2])
         try:
             count = int(parts[2])
         except ValueError:
-            raise ValueError(f"{option} = {text!r}: COUNT = {parts[2].strip()!r} is not a whole "
-                             "number") from None
+            raise ValueError(f"{option} = {text!r}: COUNT = {parts[2].strip()!r} is not a whole number") from None
         if count < 1:
             raise ValueError(f"{option} = {text!r}: COUNT = {count} must be >= 1")
         import numpy as np
@@ -50,8 +50,9 @@ def value_list(option: str, text: str, *, integer: bool = False, parse=None) -> 
     else:
         items = text.split(",")
         if any(not item.strip() for item in items):
-            raise ValueError(f"{option} = {text!r}: an empty item; give a range START:STOP:COUNT "
-                             f"or {kind} separated by commas")
+            raise ValueError(
+                f"{option} = {text!r}: an empty item; give a range START:STOP:COUNT or {kind} separated by commas"
+            )
         values = [parse(item) if parse else parse_float(option, text, item) for item in items]
     if integer:
         bad = [v for v in values if not float(v).is_integer()]
@@ -119,8 +120,11 @@ def damper_preset(option: str, name: str, *, rig: bool = False):
 
     allowed = dampers.PRESETS if rig else dampers.NAMES
     if name not in allowed:
-        why = (": the ideal actuator applies a vehicle controller's demand and has no force law "
-               "to drive on the rig" if name in dampers.IDEAL_NAMES else ": unknown damper model")
+        why = (
+            ": the ideal actuator applies a vehicle controller's demand and has no force law to drive on the rig"
+            if name in dampers.IDEAL_NAMES
+            else ": unknown damper model"
+        )
         raise ValueError(f"{option} = {name!r}{why}; allowed: {', '.join(allowed)}")
     return dampers.preset(name)
 
@@ -148,8 +152,7 @@ def parse_voltage(option: str, text: str, damper) -> float:
     try:
         value = float(text)
     except ValueError:
-        raise ValueError(f"{option} = {text!r}: not a number of volts (nor passive-off, "
-                         "passive-on)") from None
+        raise ValueError(f"{option} = {text!r}: not a number of volts (nor passive-off, passive-on)") from None
     return damper.check_voltage(value, option)
 
 
@@ -157,8 +160,7 @@ def parse_voltages(option: str, text: str, damper) -> list[float]:
     """A comma-separated list of distinct voltages [V], each checked against the damper's range."""
     items = text.split(",")
     if any(not item.strip() for item in items):
-        raise ValueError(f"{option} = {text!r}: an empty item; give volts separated by commas, "
-                         "e.g. 0,1,2.25")
+        raise ValueError(f"{option} = {text!r}: an empty item; give volts separated by commas, e.g. 0,1,2.25")
     values = [parse_voltage(option, item, damper) for item in items]
     seen = set()
     for v in values:
@@ -190,26 +192,28 @@ def parse_noise(option: str, text: str) -> list[float]:
     units = ", ".join(u for _, u in _NOISE_ITEMS)
     items = [item.strip() for item in text.split(",")]
     if len(items) != len(_NOISE_ITEMS):
-        raise ValueError(f"{option} = {text!r}: expected four numbers {form} ({units}), "
-                         f"got {len(items)} item(s)")
+        raise ValueError(f"{option} = {text!r}: expected four numbers {form} ({units}), got {len(items)} item(s)")
     values = []
     for (name, unit), item in zip(_NOISE_ITEMS, items):
         try:
             value = float(item)
         except ValueError:
-            raise ValueError(f"{option} = {text!r}: {name} = {item!r} is not a number "
-                             f"({unit})") from None
+            raise ValueError(f"{option} = {text!r}: {name} = {item!r} is not a number ({unit})") from None
         if not (math.isfinite(value) and value >= 0):
-            raise ValueError(f"{option} = {text!r}: {name} = {item}: must be a finite "
-                             f"number >= 0 ({unit}, a standard deviation)")
+            raise ValueError(
+                f"{option} = {text!r}: {name} = {item}: must be a finite number >= 0 ({unit}, a standard deviation)"
+            )
         values.append(value)
     return values
 
 
 # -- scenarios and random tracks (fra1..fra6, german-low, german-high) ----------------------------
 #: the options of the random-track scenarios: (option, keyword of track.scenario, unit)
-TRACK_OPTIONS = (("--track-seed", "seed", ""), ("--min-wavelength", "min_wavelength", "m"),
-                 ("--max-wavelength", "max_wavelength", "m"))
+TRACK_OPTIONS = (
+    ("--track-seed", "seed", ""),
+    ("--min-wavelength", "min_wavelength", "m"),
+    ("--max-wavelength", "max_wavelength", "m"),
+)
 #: the library's names of the random-track options, for its errors (`_common.option_names`)
 TRACK_FIELDS = {keyword: option for option, keyword, _ in TRACK_OPTIONS}
 
@@ -220,8 +224,9 @@ def random_tracks() -> tuple:
     return SPECTRA
 
 
-def track_options(scenario_name: str, seed: Optional[int], min_wavelength: Optional[float],
-                  max_wavelength: Optional[float]) -> dict:
+def track_options(
+    scenario_name: str, seed: Optional[int], min_wavelength: Optional[float], max_wavelength: Optional[float]
+) -> dict:
     """--track-seed, --min-wavelength, --max-wavelength -> the keyword arguments of
     track.scenario that were given (their values are the track's to check, `make_scenario`)."""
     given = {"seed": seed, "min_wavelength": min_wavelength, "max_wavelength": max_wavelength}
@@ -229,14 +234,15 @@ def track_options(scenario_name: str, seed: Optional[int], min_wavelength: Optio
     if out and scenario_name not in random_tracks():
         option, keyword, unit = next(o for o in TRACK_OPTIONS if o[1] in out)
         value = f"{out[keyword]:g}" + (f" {unit}" if unit else "")
-        raise ValueError(f"{option} = {value}: applies to the random-track scenarios "
-                         f"({', '.join(random_tracks())}) only, not to --scenario "
-                         f"{scenario_name}")
+        raise ValueError(
+            f"{option} = {value}: applies to the random-track scenarios "
+            f"({', '.join(random_tracks())}) only, not to --scenario "
+            f"{scenario_name}"
+        )
     return out
 
 
-def make_scenario(name: str, options: dict, output_rate: Optional[float] = None,
-                  rate_option: str = "--output-rate"):
+def make_scenario(name: str, options: dict, output_rate: Optional[float] = None, rate_option: str = "--output-rate"):
     """track.scenario(name, **options), and with ``output_rate`` [Hz] the library's check that
     it resolves the track (`railride.solver.check_resolution`; ``rate_option`` names the option
     that sets the rate, or says what does). The library's errors name the options."""
@@ -244,13 +250,17 @@ def make_scenario(name: str, options: dict, output_rate: Optional[float] = None,
     from ..track import scenario as library_scenario
 
     if name in random_tracks():
-        for option, keyword, unit in (("--amplitude", "amplitude", "m"),
-                                      ("--wavelength", "wavelength", "m"),
-                                      ("--rail-phase", "rail_phase", "deg")):
+        for option, keyword, unit in (
+            ("--amplitude", "amplitude", "m"),
+            ("--wavelength", "wavelength", "m"),
+            ("--rail-phase", "rail_phase", "deg"),
+        ):
             if options.get(keyword) is not None:
-                raise ValueError(f"{option} = {options[keyword]:g} {unit}: does not apply to a "
-                                 f"random track ({name}); its options are --track-seed, "
-                                 "--min-wavelength and --max-wavelength")
+                raise ValueError(
+                    f"{option} = {options[keyword]:g} {unit}: does not apply to a "
+                    f"random track ({name}); its options are --track-seed, "
+                    "--min-wavelength and --max-wavelength"
+                )
     from ._common import option_names
 
     fields = {**TRACK_FIELDS, **({"output_rate": rate_option} if rate_option.startswith("--") else {})}
@@ -286,13 +296,22 @@ def case_options(options: dict) -> dict:
     return {k: (np.int64(v) if k == "seed" else v) for k, v in options.items()}
 
 
-def study_scenario(name: str, *, amplitude: Optional[float], wavelength: Optional[float],
-                   rail_phase: Optional[float], speed: Optional[float], duration: Optional[float],
-                   track_seed: Optional[int], min_wavelength: Optional[float],
-                   max_wavelength: Optional[float]):
+def study_scenario(
+    name: str,
+    *,
+    amplitude: Optional[float],
+    wavelength: Optional[float],
+    rail_phase: Optional[float],
+    speed: Optional[float],
+    duration: Optional[float],
+    track_seed: Optional[int],
+    min_wavelength: Optional[float],
+    max_wavelength: Optional[float],
+):
     """(scenario, its options for sweep.Case) of the runs of a study (tune, pareto), checked
     before the first run (whether the runs' output rate resolves it is the study's check)."""
-    options = _scenario_options(amplitude=amplitude, wavelength=wavelength, rail_phase=rail_phase,
-                                speed=speed, duration=duration)
+    options = _scenario_options(
+        amplitude=amplitude, wavelength=wavelength, rail_phase=rail_phase, speed=speed, duration=duration
+    )
     options.update(track_options(name, track_seed, min_wavelength, max_wavelength))
     return make_scenario(name, options), case_options(options)

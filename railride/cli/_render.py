@@ -4,8 +4,12 @@ the ride comfort tables, the damper description and the modes table."""
 from __future__ import annotations
 
 #: table labels of the four ride responses (keys of railride.metrics.RESPONSES)
-RESPONSE_LABELS = {"acceleration_m_s2": "acceleration (m/s^2)", "displacement_m": "displacement (m)",
-                   "pitch_deg": "pitch (deg)", "roll_deg": "roll (deg)"}
+RESPONSE_LABELS = {
+    "acceleration_m_s2": "acceleration (m/s^2)",
+    "displacement_m": "displacement (m)",
+    "pitch_deg": "pitch (deg)",
+    "roll_deg": "roll (deg)",
+}
 
 
 def fmt(value, spec: str) -> str:
@@ -27,20 +31,28 @@ def damper_text(settings: dict) -> str:
 
 # -- ride comfort: simulate and compare ---------------------------------------------------------
 #: (index, row label, format) of the comfort tables of `simulate` and `compare`
-COMFORT_ROWS = (("aw_Wk", "a_w Wk (m/s^2)", ".4f"), ("vdv_Wk", "VDV Wk (m/s^1.75)", ".4f"),
-                ("aw_Wb", "a_w Wb (m/s^2)", ".4f"), ("N_MV_z", "N_MV,z (EN 12299)", ".3f"),
-                ("Wz", "Wz (Sperling)", ".3f"))
+COMFORT_ROWS = (
+    ("aw_Wk", "a_w Wk (m/s^2)", ".4f"),
+    ("vdv_Wk", "VDV Wk (m/s^1.75)", ".4f"),
+    ("aw_Wb", "a_w Wb (m/s^2)", ".4f"),
+    ("N_MV_z", "N_MV,z (EN 12299)", ".3f"),
+    ("Wz", "Wz (Sperling)", ".3f"),
+)
 #: where the comfort tables' positions are on the carbody floor
-POSITION_LABELS = {"centre": "carbody centre", "front": "above the front bogie",
-                   "rear": "above the rear bogie"}
+POSITION_LABELS = {"centre": "carbody centre", "front": "above the front bogie", "rear": "above the rear bogie"}
 SHORT_POSITION_LABELS = {"centre": "centre", "front": "front bogie", "rear": "rear bogie"}
 
 
 def _comfort_caption(record: dict) -> str:
     start, end = record["window_s"]
-    return "\n".join(["floor points at x = " + ", ".join(
-        f"{p['x_m']:g} m" for p in record["positions"].values()) + f"; window {start:g}-{end:g} s",
-                      *record["notes"]])
+    return "\n".join(
+        [
+            "floor points at x = "
+            + ", ".join(f"{p['x_m']:g} m" for p in record["positions"].values())
+            + f"; window {start:g}-{end:g} s",
+            *record["notes"],
+        ]
+    )
 
 
 def comfort_table(record: dict):
@@ -66,10 +78,14 @@ def compare_comfort_table(rows: list[dict]):
     from rich.table import Table
 
     first = rows[0]["comfort"]
-    table = Table(title="Ride comfort on the carbody floor: centre and above the bogies",
-                  caption=escape(_comfort_caption(first) + "\nred. % = (passive - controlled) / "
-                                 "passive x 100; none for Wz, which is not proportional to the "
-                                 "acceleration"))
+    table = Table(
+        title="Ride comfort on the carbody floor: centre and above the bogies",
+        caption=escape(
+            _comfort_caption(first) + "\nred. % = (passive - controlled) / "
+            "passive x 100; none for Wz, which is not proportional to the "
+            "acceleration"
+        ),
+    )
     table.add_column("position", no_wrap=True)
     table.add_column("index", no_wrap=True)
     for r in rows:
@@ -106,6 +122,11 @@ def modes_table(rows: list[dict]):
     table.add_column("damped (Hz)", justify="right")
     table.add_column("damping ratio", justify="right")
     for i, r in enumerate(rows, start=1):
-        table.add_row(str(i), escape(r["label"]), f"{r['frequency_hz']:.3f}",
-                      f"{r['damped_frequency_hz']:.3f}", f"{r['damping_ratio']:.3f}")
+        table.add_row(
+            str(i),
+            escape(r["label"]),
+            f"{r['frequency_hz']:.3f}",
+            f"{r['damped_frequency_hz']:.3f}",
+            f"{r['damping_ratio']:.3f}",
+        )
     return table

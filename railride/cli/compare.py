@@ -13,13 +13,42 @@ from ..dampers import IDEAL_NAMES
 from ..defaults import DEFAULT_CONTROL_RATE, DEFAULT_DAMPER
 from ._app import app
 from ._common import ProgressBar, errors, option_names, stderr_is_terminal, wide_stdout_console, write_folder
-from ._options import (AmplitudeOption, ComfortOption, CompareDamperOption, CompareDamperScaleOption,
-                       CompareGainsOption, CompareOutOption, CompareScenarioOption, ControlRateOption,
-                       DtOption, DurationOption, FormatOption, MaxWavelengthOption, MinWavelengthOption,
-                       OutputFormat, OutputRateOption, ParamsOption, PresetOption, RailPhaseOption,
-                       SpeedOption, TrackSeedOption, WavelengthOption, WindowOption)
-from ._parsing import (SOLVER_FIELDS, damper_preset, load_gains, make_scenario, not_given, parse_noise, parse_scale,
-                       solver_from_options, track_options, vehicle_from_options)
+from ._options import (
+    AmplitudeOption,
+    ComfortOption,
+    CompareDamperOption,
+    CompareDamperScaleOption,
+    CompareGainsOption,
+    CompareOutOption,
+    CompareScenarioOption,
+    ControlRateOption,
+    DtOption,
+    DurationOption,
+    FormatOption,
+    MaxWavelengthOption,
+    MinWavelengthOption,
+    OutputFormat,
+    OutputRateOption,
+    ParamsOption,
+    PresetOption,
+    RailPhaseOption,
+    SpeedOption,
+    TrackSeedOption,
+    WavelengthOption,
+    WindowOption,
+)
+from ._parsing import (
+    SOLVER_FIELDS,
+    damper_preset,
+    load_gains,
+    make_scenario,
+    not_given,
+    parse_noise,
+    parse_scale,
+    solver_from_options,
+    track_options,
+    vehicle_from_options,
+)
 from ._render import RESPONSE_LABELS, compare_comfort_table, damper_text, fmt, reduction_text
 
 #: the library's names of compare's options, for its errors
@@ -33,8 +62,9 @@ def _controller_list(text: str) -> list[str]:
 
     items = [item.strip() for item in text.split(",")]
     if any(not item for item in items):
-        raise ValueError(f"--controllers = {text!r}: an empty item; give names separated by "
-                         f"commas from {', '.join(CONTROLLERS)}")
+        raise ValueError(
+            f"--controllers = {text!r}: an empty item; give names separated by commas from {', '.join(CONTROLLERS)}"
+        )
     try:
         return check_controllers(items)
     except ValueError as exc:
@@ -47,8 +77,9 @@ def _sensor_noise(text: Optional[str], seed: Optional[int]):
 
     if text is None:
         if seed is not None:
-            raise ValueError(f"--seed = {seed}: applies with --sensor-noise only (without it the "
-                             "measurements are ideal)")
+            raise ValueError(
+                f"--seed = {seed}: applies with --sensor-noise only (without it the measurements are ideal)"
+            )
         return None
     z, angle, velocity, rate = parse_noise("--sensor-noise", text)
     with option_names({"'seed'": "--seed"}):  # as the noise's field check quotes it
@@ -85,28 +116,38 @@ def _compare_tables(doc: dict, vehicle: str, shipped: bool):
 
     # 1. the paper's Table 1: RMS and reduction, railride above the paper
     start, end = settings["window_s"] or (0.0, settings["scenario"].get("duration_s", 0.0))
-    info = [describe_scenario(settings["scenario"]),
-            f"dt {settings['dt_s']:g} s, RMS over {start:g}-{end:g} s, vehicle {vehicle}"]
+    info = [
+        describe_scenario(settings["scenario"]),
+        f"dt {settings['dt_s']:g} s, RMS over {start:g}-{end:g} s, vehicle {vehicle}",
+    ]
     if controlled:
         noise = settings.get("sensor_noise")
-        noise_text = ("ideal measurements" if not noise else
-                      "sensor noise z {displacement:g} m, angle {angle:g} rad, velocity {velocity:g} m/s, "
-                      "rate {angular_rate:g} rad/s, seed {seed}".format(**noise))
-        info.append(f"{damper_text(settings)}, controller {settings['control_rate_hz']:g} Hz, "
-                    f"{noise_text}")
+        noise_text = (
+            "ideal measurements"
+            if not noise
+            else "sensor noise z {displacement:g} m, angle {angle:g} rad, velocity {velocity:g} m/s, "
+            "rate {angular_rate:g} rad/s, seed {seed}".format(**noise)
+        )
+        info.append(f"{damper_text(settings)}, controller {settings['control_rate_hz']:g} Hz, {noise_text}")
         info.append(f"gains file {doc['gains']['source']}" + (" (shipped)" if shipped else ""))
         tuning = doc.get("tuning") or {}
         if tuning.get("objective"):
-            info.append((f"gains tuned by `{tuning['command']}`, " if tuning.get("command") else
-                         "gains tuned ") + f"objective {tuning['objective']}")
+            info.append(
+                (f"gains tuned by `{tuning['command']}`, " if tuning.get("command") else "gains tuned ")
+                + f"objective {tuning['objective']}"
+            )
         if tuning.get("in_sample"):
-            info.append("The gains were tuned on this same single track: the reductions are "
-                        "in-sample, not a test on another track.")
+            info.append(
+                "The gains were tuned on this same single track: the reductions are "
+                "in-sample, not a test on another track."
+            )
         info += _trade_off_lines(doc)
-    info.append("The paper's absolute values depend on settings it does not give (sine wavelength, "
-                "rail phase, damper, gains): compare the ranking and the size of the reductions, "
-                "not the digits. red. % = (passive - controlled) / passive x 100 (negative: worse "
-                "than passive, in red).")
+    info.append(
+        "The paper's absolute values depend on settings it does not give (sine wavelength, "
+        "rail phase, damper, gains): compare the ranking and the size of the reductions, "
+        "not the digits. red. % = (passive - controlled) / passive x 100 (negative: worse "
+        "than passive, in red)."
+    )
     table = Table(title="Ride comparison: RMS of the carbody responses beside the paper's Table 1")
     table.add_column("response", min_width=12)
     table.add_column("", no_wrap=True)
@@ -129,15 +170,13 @@ def _compare_tables(doc: dict, vehicle: str, shipped: bool):
     # 1b. the same gains on the ideal devices: what a damper, and an actuator, could reach
     bounds_parts = []
     if doc.get("bounds"):
-        bt = Table(title="RMS reduction % beside the bounds: the same control laws and gains on "
-                         "ideal devices")
+        bt = Table(title="RMS reduction % beside the bounds: the same control laws and gains on ideal devices")
         bt.add_column("response", min_width=20, no_wrap=True)
         short = {"pid": "PID", "sas-attitude": "SAS att.", "sas-attitude-ride": "SAS att.+ride"}
         for r in controlled:
             for head in ("MR", "ideal\ndamper", "ideal\nactuator"):
                 name = short.get(r["name"], r["label"])
-                bt.add_column(escape(f"{name}\n{head}") if head == "MR" else f"\n{head}",
-                              justify="right", min_width=7)
+                bt.add_column(escape(f"{name}\n{head}") if head == "MR" else f"\n{head}", justify="right", min_width=7)
         for key, label in RESPONSE_LABELS.items():
             cells = [label]
             for r in controlled:
@@ -146,12 +185,17 @@ def _compare_tables(doc: dict, vehicle: str, shipped: bool):
                     value = doc["bounds"][device][r["name"]]["reduction_percent"][key]
                     cells.append("diverged" if value is None else reduction_text(value))
             bt.add_row(*cells)
-        bounds_parts = ["", bt, Text(
-            "ideal damper: the demand where it dissipates energy, no force where it would push "
-            "energy in (no force limit, no lag, no hysteresis): the best any semi-active damper "
-            "could do with these gains. ideal actuator: the demand, always (an active "
-            "suspension). The gains were tuned for the MR dampers; tuned for the ideal devices "
-            "the bounds lie further out (docs/results.md).")]
+        bounds_parts = [
+            "",
+            bt,
+            Text(
+                "ideal damper: the demand where it dissipates energy, no force where it would push "
+                "energy in (no force limit, no lag, no hysteresis): the best any semi-active damper "
+                "could do with these gains. ideal actuator: the demand, always (an active "
+                "suspension). The gains were tuned for the MR dampers; tuned for the ideal devices "
+                "the bounds lie further out (docs/results.md)."
+            ),
+        ]
 
     # 2. peak-to-peak
     ptp = Table(title="Peak-to-peak of the carbody responses (railride)")
@@ -164,23 +208,36 @@ def _compare_tables(doc: dict, vehicle: str, shipped: bool):
     # 3. what each suspension asks of its dampers
     demands = Table(title="What each suspension asks of its dampers")
     demands.add_column("suspension", no_wrap=True)
-    for heading in ("RMS demand\n(kN)", "RMS force\n(kN)", "max force\n(kN)", "RMS travel\n(mm)",
-                    "max travel\n(mm)", "mean voltage\n(V)", "time at v_max\n(%)"):
+    for heading in (
+        "RMS demand\n(kN)",
+        "RMS force\n(kN)",
+        "max force\n(kN)",
+        "RMS travel\n(mm)",
+        "max travel\n(mm)",
+        "mean voltage\n(V)",
+        "time at v_max\n(%)",
+    ):
         demands.add_column(heading, justify="right", min_width=6)
     for r in rows:
         d = r["damper"]
         at_max = d.get("voltage_at_max_fraction")
         demand = d.get("demand_rms_n")
-        demands.add_row(escape(r["label"]), "-" if demand is None else f"{demand / 1e3:.2f}",
-                        f"{d['force_rms_n'] / 1e3:.2f}",
-                        f"{d['force_max_n'] / 1e3:.2f}", f"{d['travel_rms_m'] * 1e3:.1f}",
-                        f"{d['travel_max_m'] * 1e3:.1f}", fmt(d.get("voltage_mean_v"), ".2f"),
-                        "-" if at_max is None else f"{at_max * 100:.1f}")
-    demands_note = ("All four corners, over the metric window. demand: the force the outer loop "
-                    "asks for; force: the secondary damper force on the carbody; travel: the "
-                    "secondary deflection (suspension travel); passive: the viscous dampers c_sz."
-                    + (" The ideal devices have no voltage." if settings.get("damper")
-                       in IDEAL_NAMES and controlled else ""))
+        demands.add_row(
+            escape(r["label"]),
+            "-" if demand is None else f"{demand / 1e3:.2f}",
+            f"{d['force_rms_n'] / 1e3:.2f}",
+            f"{d['force_max_n'] / 1e3:.2f}",
+            f"{d['travel_rms_m'] * 1e3:.1f}",
+            f"{d['travel_max_m'] * 1e3:.1f}",
+            fmt(d.get("voltage_mean_v"), ".2f"),
+            "-" if at_max is None else f"{at_max * 100:.1f}",
+        )
+    demands_note = (
+        "All four corners, over the metric window. demand: the force the outer loop "
+        "asks for; force: the secondary damper force on the carbody; travel: the "
+        "secondary deflection (suspension travel); passive: the viscous dampers c_sz."
+        + (" The ideal devices have no voltage." if settings.get("damper") in IDEAL_NAMES and controlled else "")
+    )
     parts = [table, Text("\n".join(info)), *bounds_parts, "", ptp, "", demands, Text(demands_note)]
     if all("comfort" in r for r in rows):
         parts += ["", compare_comfort_table(rows)]
@@ -189,23 +246,33 @@ def _compare_tables(doc: dict, vehicle: str, shipped: bool):
 
 @app.command()
 def compare(
-    controllers: Annotated[str, typer.Option(
-        "--controllers", metavar="NAME[,NAME...]",
-        help="Suspensions to compare, comma-separated: passive, pid, sas-attitude, "
-             "sas-attitude-ride. Passive always runs as the baseline.")]
-        = "passive,pid,sas-attitude,sas-attitude-ride",
+    controllers: Annotated[
+        str,
+        typer.Option(
+            "--controllers",
+            metavar="NAME[,NAME...]",
+            help="Suspensions to compare, comma-separated: passive, pid, sas-attitude, "
+            "sas-attitude-ride. Passive always runs as the baseline.",
+        ),
+    ] = "passive,pid,sas-attitude,sas-attitude-ride",
     gains: CompareGainsOption = None,
     damper: CompareDamperOption = DEFAULT_DAMPER,
     damper_scale: CompareDamperScaleOption = None,
     control_rate: ControlRateOption = DEFAULT_CONTROL_RATE,
-    sensor_noise: Annotated[Optional[str], typer.Option(
-        "--sensor-noise", metavar="Z,ANGLE,VEL,RATE",
-        help="White noise on the measured carbody states, standard deviations: heave [m], "
-             "pitch and roll angle [rad], heave velocity [m/s], pitch and roll rate [rad/s] "
-             "(default: ideal measurements).")] = None,
-    seed: Annotated[Optional[int], typer.Option(
-        "--seed", metavar="N",
-        help="Seed of the sensor noise, >= 0 (default 0); needs --sensor-noise.")] = None,
+    sensor_noise: Annotated[
+        Optional[str],
+        typer.Option(
+            "--sensor-noise",
+            metavar="Z,ANGLE,VEL,RATE",
+            help="White noise on the measured carbody states, standard deviations: heave [m], "
+            "pitch and roll angle [rad], heave velocity [m/s], pitch and roll rate [rad/s] "
+            "(default: ideal measurements).",
+        ),
+    ] = None,
+    seed: Annotated[
+        Optional[int],
+        typer.Option("--seed", metavar="N", help="Seed of the sensor noise, >= 0 (default 0); needs --sensor-noise."),
+    ] = None,
     scenario: CompareScenarioOption = "paper-sine",
     amplitude: AmplitudeOption = None,
     wavelength: WavelengthOption = None,
@@ -222,11 +289,15 @@ def compare(
     preset: PresetOption = None,
     format: FormatOption = OutputFormat.table,
     out: CompareOutOption = None,
-    bounds: Annotated[bool, typer.Option(
-        "--bounds/--no-bounds",
-        help="Also run the same control laws and gains on the ideal semi-active damper and the "
-             "ideal actuator, and print their reductions beside the MR dampers' (default on; "
-             "MR dampers only).")] = True,
+    bounds: Annotated[
+        bool,
+        typer.Option(
+            "--bounds/--no-bounds",
+            help="Also run the same control laws and gains on the ideal semi-active damper and the "
+            "ideal actuator, and print their reductions beside the MR dampers' (default on; "
+            "MR dampers only).",
+        ),
+    ] = True,
     comfort: ComfortOption = False,
 ) -> None:
     """Compare passive, PID and SAS suspensions on one scenario, as in the paper's Table 1.
@@ -251,9 +322,18 @@ def compare(
         vehicle_params, vehicle_record = vehicle_from_options(params, preset)
         window_value = parse_window(window) if window is not None else None
         track = track_options(scenario, track_seed, min_wavelength, max_wavelength)
-        scen = make_scenario(scenario, dict(amplitude=amplitude, wavelength=wavelength,
-                                            rail_phase=rail_phase, speed=speed,
-                                            duration=duration, **track), solver.output_rate)
+        scen = make_scenario(
+            scenario,
+            dict(
+                amplitude=amplitude,
+                wavelength=wavelength,
+                rail_phase=rail_phase,
+                speed=speed,
+                duration=duration,
+                **track,
+            ),
+            solver.output_rate,
+        )
         if out is not None:
             check_out_dir(out)
         # check the window before the runs, and record it resolved
@@ -267,10 +347,20 @@ def compare(
             return f"running {', '.join(controlled)}..."
 
         with ProgressBar(stderr_is_terminal(), describe) as progress:
-            result = run_compare(scen, vehicle_params, controllers=names, gains=gain_set,
-                                 damper=damper, damper_scale=scale, window=window_value,
-                                 solver=solver, sensor_noise=noise, comfort=comfort, bounds=bounds,
-                                 progress=progress if progress.enabled else None)
+            result = run_compare(
+                scen,
+                vehicle_params,
+                controllers=names,
+                gains=gain_set,
+                damper=damper,
+                damper_scale=scale,
+                window=window_value,
+                solver=solver,
+                sensor_noise=noise,
+                comfort=comfort,
+                bounds=bounds,
+                progress=progress if progress.enabled else None,
+            )
         doc = result.to_dict()
         text = json.dumps(doc, indent=2, allow_nan=False)  # refuses NaN before anything is written
         if out is not None:

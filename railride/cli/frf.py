@@ -15,8 +15,7 @@ from ._parsing import vehicle_source
 from ._render import modes_table
 
 #: the library's names of the options of `frf`, for its errors
-FRF_OPTIONS = {"speed": "--speed", "rails": "--rails", "fmin": "--fmin", "fmax": "--fmax",
-               "points": "--points"}
+FRF_OPTIONS = {"speed": "--speed", "rails": "--rails", "fmin": "--fmin", "fmax": "--fmax", "points": "--points"}
 
 
 class FrfFormat(str, Enum):
@@ -26,29 +25,41 @@ class FrfFormat(str, Enum):
 
 
 #: table labels of the magnitudes `frf` summarises (keys of railride.analysis.FRF_MAGNITUDES)
-FRF_LABELS = {"bounce_m_per_m": "bounce (m/m)", "pitch_deg_per_m": "pitch (deg/m)",
-              "roll_deg_per_m": "roll (deg/m)", "acceleration_m_s2_per_m": "acceleration ((m/s^2)/m)"}
+FRF_LABELS = {
+    "bounce_m_per_m": "bounce (m/m)",
+    "pitch_deg_per_m": "pitch (deg/m)",
+    "roll_deg_per_m": "roll (deg/m)",
+    "acceleration_m_s2_per_m": "acceleration ((m/s^2)/m)",
+}
 
 
 @app.command()
 def frf(
     speed: FrfSpeedOption = None,
-    rails: Annotated[str, typer.Option(
-        "--rails", metavar="in-phase|anti-phase|both",
-        help="Rail pattern: in-phase (z_L = z_R: bounce and pitch), anti-phase (z_L = -z_R: "
-             "roll) or both.")] = "both",
-    fmin: Annotated[float, typer.Option(
-        "--fmin", metavar="HZ", help="Lowest frequency [Hz], > 0.")] = 0.1,
-    fmax: Annotated[float, typer.Option(
-        "--fmax", metavar="HZ", help="Highest frequency [Hz], > --fmin.")] = 30.0,
-    points: Annotated[int, typer.Option(
-        "--points", metavar="N", help="Frequencies, log-spaced from --fmin to --fmax, >= 2.")] = 400,
+    rails: Annotated[
+        str,
+        typer.Option(
+            "--rails",
+            metavar="in-phase|anti-phase|both",
+            help="Rail pattern: in-phase (z_L = z_R: bounce and pitch), anti-phase (z_L = -z_R: roll) or both.",
+        ),
+    ] = "both",
+    fmin: Annotated[float, typer.Option("--fmin", metavar="HZ", help="Lowest frequency [Hz], > 0.")] = 0.1,
+    fmax: Annotated[float, typer.Option("--fmax", metavar="HZ", help="Highest frequency [Hz], > --fmin.")] = 30.0,
+    points: Annotated[
+        int, typer.Option("--points", metavar="N", help="Frequencies, log-spaced from --fmin to --fmax, >= 2.")
+    ] = 400,
     params: ParamsOption = None,
     preset: PresetOption = None,
-    format: Annotated[FrfFormat, typer.Option(
-        "--format", case_sensitive=False,
-        help="Output on stdout: a summary table (peaks and modes), the JSON document, or the "
-             "CSV table of magnitudes and phases.")] = FrfFormat.table,
+    format: Annotated[
+        FrfFormat,
+        typer.Option(
+            "--format",
+            case_sensitive=False,
+            help="Output on stdout: a summary table (peaks and modes), the JSON document, or the "
+            "CSV table of magnitudes and phases.",
+        ),
+    ] = FrfFormat.table,
     out: FrfOutOption = None,
 ) -> None:
     """Frequency responses of the passive vehicle: carbody bounce, pitch, roll and acceleration
@@ -64,8 +75,7 @@ def frf(
         vehicle = vehicle_source(params, preset)
         if out is not None:
             check_out_dir(out)
-        result = frequency_responses(vehicle, speed=speed, rails=rails, fmin=fmin, fmax=fmax,
-                                     points=points)
+        result = frequency_responses(vehicle, speed=speed, rails=rails, fmin=fmin, fmax=fmax, points=points)
         doc = result.to_dict()
         if out is not None:
             write_folder(out, lambda: result.save(out))
@@ -101,9 +111,11 @@ def _frf_tables(doc: dict, vehicle: str) -> list:
             else:
                 cells += [f"{peak['magnitude']:#.4g}", f"{peak['frequency_hz']:.3g}"]
         table.add_row(*cells)
-    note = Text(f"V = {settings['speed_m_s']:g} m/s, {settings['points']} frequencies from "
-                f"{settings['fmin_hz']:g} to {settings['fmax_hz']:g} Hz (log grid; the peak is the "
-                f"largest value on it), vehicle {vehicle}. in-phase: z_L = z_R; "
-                "anti-phase: z_L = -z_R; every wheelset sees the pattern delayed by its distance "
-                "behind the leading one / V.")
+    note = Text(
+        f"V = {settings['speed_m_s']:g} m/s, {settings['points']} frequencies from "
+        f"{settings['fmin_hz']:g} to {settings['fmax_hz']:g} Hz (log grid; the peak is the "
+        f"largest value on it), vehicle {vehicle}. in-phase: z_L = z_R; "
+        "anti-phase: z_L = -z_R; every wheelset sees the pattern delayed by its distance "
+        "behind the leading one / V."
+    )
     return [table, note, "", modes_table(doc["modes"])]

@@ -9,20 +9,60 @@ import typer
 
 from ..defaults import DEFAULT_DAMPER
 from ._app import app
-from ._common import (RunProgress, errors, interruptible, make_executor, open_run_table, option_names, print_json,
-                      stderr_is_terminal, wide_stdout_console, write_folder)
-from ._options import (AmplitudeOption, DtOption, FormatOption, MaxWavelengthOption, MinWavelengthOption,
-                       OutputFormat, ParetoDamperOption, ParetoGainsOption, ParetoOutOption, ParetoResumeOption,
-                       RailPhaseOption, RunDurationOption, RunsScenarioOption, SchedulerFileOption, SchedulerOption,
-                       SpeedOption, TrackSeedOption, WavelengthOption, WorkersOption)
-from ._parsing import (SOLVER_FIELDS, TRACK_FIELDS, damper_preset, default_of, load_gains, not_given,
-                       solver_from_options, study_scenario)
+from ._common import (
+    RunProgress,
+    errors,
+    interruptible,
+    make_executor,
+    open_run_table,
+    option_names,
+    print_json,
+    stderr_is_terminal,
+    wide_stdout_console,
+    write_folder,
+)
+from ._options import (
+    AmplitudeOption,
+    DtOption,
+    FormatOption,
+    MaxWavelengthOption,
+    MinWavelengthOption,
+    OutputFormat,
+    ParetoDamperOption,
+    ParetoGainsOption,
+    ParetoOutOption,
+    ParetoResumeOption,
+    RailPhaseOption,
+    RunDurationOption,
+    RunsScenarioOption,
+    SchedulerFileOption,
+    SchedulerOption,
+    SpeedOption,
+    TrackSeedOption,
+    WavelengthOption,
+    WorkersOption,
+)
+from ._parsing import (
+    SOLVER_FIELDS,
+    TRACK_FIELDS,
+    damper_preset,
+    default_of,
+    load_gains,
+    not_given,
+    solver_from_options,
+    study_scenario,
+)
 from ._render import RESPONSE_LABELS, damper_text, fmt
 
 #: the library's names of pareto's options, for its errors (the track's seed is named while the
 #: scenario is built, the sample's after)
-PARETO_FIELDS = {"dt": SOLVER_FIELDS["dt"], **TRACK_FIELDS, "suspension": "--suspension",
-                 "n_samples": "--samples", "seed": "--seed"}
+PARETO_FIELDS = {
+    "dt": SOLVER_FIELDS["dt"],
+    **TRACK_FIELDS,
+    "suspension": "--suspension",
+    "n_samples": "--samples",
+    "seed": "--seed",
+}
 
 
 def _pareto_table(doc: dict, caption: str):
@@ -37,36 +77,50 @@ def _pareto_table(doc: dict, caption: str):
     counts.add_column("non-dominated\nover all four ratios", justify="right")
     for x, y in PROJECTIONS:
         counts.add_column(f"non-dominated in\n{x} and {y}", justify="right")
-    counts.add_row(str(c["samples"]), str(c["non_dominated"]),
-                   *[str(c[f"non_dominated_{x}_{y}"]) for x, y in PROJECTIONS])
-    front = sorted((r for r in doc["samples"] if r["non_dominated"]),
-                   key=lambda r: (r["acceleration_m_s2_ratio"] is None,
-                                  r["acceleration_m_s2_ratio"] or 0.0))
-    rows = Table(title="Non-dominated samples by acceleration ratio: RMS / RMS(passive)",
-                 caption=caption, caption_justify="left")
+    counts.add_row(
+        str(c["samples"]), str(c["non_dominated"]), *[str(c[f"non_dominated_{x}_{y}"]) for x, y in PROJECTIONS]
+    )
+    front = sorted(
+        (r for r in doc["samples"] if r["non_dominated"]),
+        key=lambda r: (r["acceleration_m_s2_ratio"] is None, r["acceleration_m_s2_ratio"] or 0.0),
+    )
+    rows = Table(
+        title="Non-dominated samples by acceleration ratio: RMS / RMS(passive)", caption=caption, caption_justify="left"
+    )
     rows.add_column("sample", justify="right")
     for label in RESPONSE_LABELS.values():
         rows.add_column(label.split(" (")[0], justify="right")
     rows.add_column("also non-dominated\nagainst acceleration in")
     for r in front:
         planes = ", ".join(y for x, y in PROJECTIONS if r[f"non_dominated_{x}_{y}"])
-        rows.add_row(f"{r['sample']}" + (" (base)" if r["base"] else ""),
-                     *[fmt(r[f"{key}_ratio"], ".3f") for key in RESPONSE_LABELS], planes)
+        rows.add_row(
+            f"{r['sample']}" + (" (base)" if r["base"] else ""),
+            *[fmt(r[f"{key}_ratio"], ".3f") for key in RESPONSE_LABELS],
+            planes,
+        )
     return [counts, "", rows]
 
 
 @app.command("pareto")
 def pareto_command(
-    suspension: Annotated[str, typer.Option(
-        "--suspension", metavar="NAME",
-        help="The controller whose gains are sampled: pid, sas-attitude or sas-attitude-ride "
-             "(every outer-loop gain it reads).")] = "sas-attitude-ride",
-    samples: Annotated[Optional[int], typer.Option(
-        "--samples", metavar="N",
-        help="Sobol' samples of the gains, a power of two (default 128); the base gains are "
-             "run too.")] = None,
-    seed: Annotated[int, typer.Option(
-        "--seed", metavar="S", help="Seed of the scrambled Sobol' sample, >= 0.")] = 0,
+    suspension: Annotated[
+        str,
+        typer.Option(
+            "--suspension",
+            metavar="NAME",
+            help="The controller whose gains are sampled: pid, sas-attitude or sas-attitude-ride "
+            "(every outer-loop gain it reads).",
+        ),
+    ] = "sas-attitude-ride",
+    samples: Annotated[
+        Optional[int],
+        typer.Option(
+            "--samples",
+            metavar="N",
+            help="Sobol' samples of the gains, a power of two (default 128); the base gains are run too.",
+        ),
+    ] = None,
+    seed: Annotated[int, typer.Option("--seed", metavar="S", help="Seed of the scrambled Sobol' sample, >= 0.")] = 0,
     scenario: RunsScenarioOption = "paper-sine",
     amplitude: AmplitudeOption = None,
     wavelength: WavelengthOption = None,
@@ -104,10 +158,17 @@ def pareto_command(
         damper_preset("--damper", damper)
         base = load_gains(gains)
         solver = solver_from_options(dt=dt)
-        scen, options = study_scenario(scenario, amplitude=amplitude, wavelength=wavelength,
-                                       rail_phase=rail_phase, speed=speed, duration=duration,
-                                       track_seed=track_seed, min_wavelength=min_wavelength,
-                                       max_wavelength=max_wavelength)
+        scen, options = study_scenario(
+            scenario,
+            amplitude=amplitude,
+            wavelength=wavelength,
+            rail_phase=rail_phase,
+            speed=speed,
+            duration=duration,
+            track_seed=track_seed,
+            min_wavelength=min_wavelength,
+            max_wavelength=max_wavelength,
+        )
         scenario_text = describe_scenario(scen.describe())
         table, table_path = open_run_table(out, resume)
         executor, executor_record = make_executor(workers, scheduler, scheduler_file)
@@ -115,9 +176,19 @@ def pareto_command(
         with interruptible(table, table_path), errors(), option_names(PARETO_FIELDS, defaults):
             with RunProgress(stderr_is_terminal(), "sampling the gains") as progress:
                 t0 = time.perf_counter()
-                result = run_pareto(suspension, n_samples=n, seed=seed, scenario=scenario,
-                                    scenario_options=options, gains=base, damper=damper,
-                                    executor=executor, table=table, solver=solver, progress=progress)
+                result = run_pareto(
+                    suspension,
+                    n_samples=n,
+                    seed=seed,
+                    scenario=scenario,
+                    scenario_options=options,
+                    gains=base,
+                    damper=damper,
+                    executor=executor,
+                    table=table,
+                    solver=solver,
+                    progress=progress,
+                )
                 wall = time.perf_counter() - t0
             doc = result.to_dict()
             if out is not None:
@@ -128,11 +199,14 @@ def pareto_command(
         print_json(doc)
         return
     st = doc["settings"]
-    lines = [(f"{scenario_text}, {scen.duration:g} s, dt {solver.dt:g} s, {damper_text(st)}; base "
-              f"gains {st['base_gains']}"),
-             f"{st['n_samples']} samples, seed {st['seed']}: {st['sampling']}",
-             (f"{doc['runs']} runs in the run table, {progress.evaluated} evaluated now, wall "
-              f"time {wall:.1f} s ({executor_record['type']})")]
+    lines = [
+        (f"{scenario_text}, {scen.duration:g} s, dt {solver.dt:g} s, {damper_text(st)}; base gains {st['base_gains']}"),
+        f"{st['n_samples']} samples, seed {st['seed']}: {st['sampling']}",
+        (
+            f"{doc['runs']} runs in the run table, {progress.evaluated} evaluated now, wall "
+            f"time {wall:.1f} s ({executor_record['type']})"
+        ),
+    ]
     if doc["note"]:
         lines.append(doc["note"])
     console = wide_stdout_console()

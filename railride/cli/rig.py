@@ -14,10 +14,22 @@ from ._options import DamperOutOption, FormatOption, OutputFormat, RigModelOptio
 from ._parsing import damper_preset, parse_voltages
 
 #: the library's names of the options of `damper` and `tracking`, for its errors
-DAMPER_OPTIONS = {"amplitude": "--amplitude", "frequency": "--frequency", "voltage": "--voltage",
-                  "voltages": "--voltage", "n_cycles": "--cycles"}
-TRACKING_OPTIONS = {"desired": "--desired", "amplitude": "--amplitude", "frequency": "--frequency",
-                    "B": "--B", "G": "--G", "stroke": "--stroke", "n_cycles": "--cycles"}
+DAMPER_OPTIONS = {
+    "amplitude": "--amplitude",
+    "frequency": "--frequency",
+    "voltage": "--voltage",
+    "voltages": "--voltage",
+    "n_cycles": "--cycles",
+}
+TRACKING_OPTIONS = {
+    "desired": "--desired",
+    "amplitude": "--amplitude",
+    "frequency": "--frequency",
+    "B": "--B",
+    "G": "--G",
+    "stroke": "--stroke",
+    "n_cycles": "--cycles",
+}
 
 
 # -- damper -------------------------------------------------------------------------------------
@@ -25,17 +37,27 @@ TRACKING_OPTIONS = {"desired": "--desired", "amplitude": "--amplitude", "frequen
 def damper(
     *,  # keyword-only, so that the required options may follow ones with defaults
     model: RigModelOption = DEFAULT_DAMPER,
-    amplitude: Annotated[float, typer.Option(
-        "--amplitude", metavar="M", help="Amplitude of the sine extension x [m], > 0.")],
-    frequency: Annotated[float, typer.Option(
-        "--frequency", metavar="HZ", help="Frequency of the sine extension [Hz], > 0.")],
-    voltage: Annotated[str, typer.Option(
-        "--voltage", metavar="V[,V...]",
-        help="Constant command voltages [V], comma-separated, each within the damper's range "
-             "(passive-off and passive-on stand for its lowest and highest voltage).")],
-    cycles: Annotated[int, typer.Option(
-        "--cycles", metavar="N",
-        help="Cycles driven per voltage, >= 2; the last one is reported (steady state).")] = 4,
+    amplitude: Annotated[
+        float, typer.Option("--amplitude", metavar="M", help="Amplitude of the sine extension x [m], > 0.")
+    ],
+    frequency: Annotated[
+        float, typer.Option("--frequency", metavar="HZ", help="Frequency of the sine extension [Hz], > 0.")
+    ],
+    voltage: Annotated[
+        str,
+        typer.Option(
+            "--voltage",
+            metavar="V[,V...]",
+            help="Constant command voltages [V], comma-separated, each within the damper's range "
+            "(passive-off and passive-on stand for its lowest and highest voltage).",
+        ),
+    ],
+    cycles: Annotated[
+        int,
+        typer.Option(
+            "--cycles", metavar="N", help="Cycles driven per voltage, >= 2; the last one is reported (steady state)."
+        ),
+    ] = 4,
     format: FormatOption = OutputFormat.table,
     out: DamperOutOption = None,
 ) -> None:
@@ -68,43 +90,70 @@ def _damper_table(doc: dict, name: str, result):
     from rich.table import Table
 
     n = result.n_cycles
-    table = Table(title=escape(f"Damper cycles: {name} ({result.damper.model} model)"),
-                  caption=escape(f"x = {result.motion.amplitude:g} m sin(2 pi {result.motion.frequency:g} Hz "
-                                 f"t); cycle {n} of {n} (steady state)\nforce F: tension +"))
+    table = Table(
+        title=escape(f"Damper cycles: {name} ({result.damper.model} model)"),
+        caption=escape(
+            f"x = {result.motion.amplitude:g} m sin(2 pi {result.motion.frequency:g} Hz "
+            f"t); cycle {n} of {n} (steady state)\nforce F: tension +"
+        ),
+    )
     table.add_column("voltage (V)", justify="right")
     table.add_column("max force (kN)", justify="right")
     table.add_column("min force (kN)", justify="right")
     table.add_column("energy per cycle (J)", justify="right")
     for row in doc["cycles"]:
-        table.add_row(f"{row['voltage_v']:g}", f"{row['force_max_n'] / 1e3:.3f}",
-                      f"{row['force_min_n'] / 1e3:.3f}", f"{row['energy_per_cycle_j']:.4g}")
+        table.add_row(
+            f"{row['voltage_v']:g}",
+            f"{row['force_max_n'] / 1e3:.3f}",
+            f"{row['force_min_n'] / 1e3:.3f}",
+            f"{row['energy_per_cycle_j']:.4g}",
+        )
     return table
 
 
 # -- tracking -----------------------------------------------------------------------------------
 @app.command()
 def tracking(
-    desired: Annotated[str, typer.Option(
-        "--desired", metavar="sine|sawtooth",
-        help="Desired force: sine, or sawtooth (rising from -A to A each period).")] = "sine",
-    amplitude: Annotated[float, typer.Option(
-        "--amplitude", metavar="N", help="Amplitude of the desired force [N], > 0.")] = 10e3,
-    frequency: Annotated[float, typer.Option(
-        "--frequency", metavar="HZ",
-        help="Frequency of the desired force and of the stroke [Hz], > 0.")] = 1.0,
-    gain_b: Annotated[float, typer.Option(
-        "--B", metavar="B", help="Inner-loop gain B on the measured force [-], >= 0.")] = 1.0,
-    gain_g: Annotated[Optional[float], typer.Option(
-        "--G", metavar="V/N",
-        help="Inner-loop gain G [V/N], >= 0 (default: the damper's default gain, which "
-             "saturates the voltage at a force error of a tenth of its range).")] = None,
+    desired: Annotated[
+        str,
+        typer.Option(
+            "--desired",
+            metavar="sine|sawtooth",
+            help="Desired force: sine, or sawtooth (rising from -A to A each period).",
+        ),
+    ] = "sine",
+    amplitude: Annotated[
+        float, typer.Option("--amplitude", metavar="N", help="Amplitude of the desired force [N], > 0.")
+    ] = 10e3,
+    frequency: Annotated[
+        float,
+        typer.Option("--frequency", metavar="HZ", help="Frequency of the desired force and of the stroke [Hz], > 0."),
+    ] = 1.0,
+    gain_b: Annotated[
+        float, typer.Option("--B", metavar="B", help="Inner-loop gain B on the measured force [-], >= 0.")
+    ] = 1.0,
+    gain_g: Annotated[
+        Optional[float],
+        typer.Option(
+            "--G",
+            metavar="V/N",
+            help="Inner-loop gain G [V/N], >= 0 (default: the damper's default gain, which "
+            "saturates the voltage at a force error of a tenth of its range).",
+        ),
+    ] = None,
     model: RigModelOption = DEFAULT_DAMPER,
-    stroke: Annotated[float, typer.Option(
-        "--stroke", metavar="M",
-        help="Amplitude of the prescribed extension x = -stroke cos(2 pi f t) [m], > 0.")] = 0.02,
-    cycles: Annotated[int, typer.Option(
-        "--cycles", metavar="N",
-        help="Cycles simulated, >= 2; the metrics leave out the first (start-up).")] = 3,
+    stroke: Annotated[
+        float,
+        typer.Option(
+            "--stroke", metavar="M", help="Amplitude of the prescribed extension x = -stroke cos(2 pi f t) [m], > 0."
+        ),
+    ] = 0.02,
+    cycles: Annotated[
+        int,
+        typer.Option(
+            "--cycles", metavar="N", help="Cycles simulated, >= 2; the metrics leave out the first (start-up)."
+        ),
+    ] = 3,
     format: FormatOption = OutputFormat.table,
     out: TrackingOutOption = None,
 ) -> None:
@@ -121,8 +170,9 @@ def tracking(
         if out is not None:
             check_out_dir(out)
         with status_note("tracking..."):
-            result = rig.track(damper_model, desired, amplitude, frequency, B=gain_b, G=gain_g,
-                               stroke=stroke, n_cycles=cycles)
+            result = rig.track(
+                damper_model, desired, amplitude, frequency, B=gain_b, G=gain_g, stroke=stroke, n_cycles=cycles
+            )
         doc = result.to_dict()
         if out is not None:
             write_folder(out, lambda: result.save(out))
@@ -138,13 +188,16 @@ def _tracking_table(doc: dict, model: str, *, default_g: bool):
 
     m = doc["metrics"]
     start, end = m["window_s"]
-    caption = "\n".join([
-        f"desired force amplitude {doc['amplitude_n']:g} N at {doc['frequency_hz']:g} Hz",
-        f"stroke x = -{doc['stroke_m']:g} m cos(2 pi f t); force tension +",
-        f"metrics over {start:g}-{end:g} s (after the first cycle)",
-    ])
-    table = Table(title=escape(f"Force tracking: {doc['desired']} demand, {model} damper"),
-                  caption=escape(caption), min_width=56)
+    caption = "\n".join(
+        [
+            f"desired force amplitude {doc['amplitude_n']:g} N at {doc['frequency_hz']:g} Hz",
+            f"stroke x = -{doc['stroke_m']:g} m cos(2 pi f t); force tension +",
+            f"metrics over {start:g}-{end:g} s (after the first cycle)",
+        ]
+    )
+    table = Table(
+        title=escape(f"Force tracking: {doc['desired']} demand, {model} damper"), caption=escape(caption), min_width=56
+    )
     table.add_column("quantity")
     table.add_column("value", justify="right")
     table.add_row("RMS tracking error (N)", f"{m['rms_error_n']:.5g}")

@@ -10,28 +10,62 @@ import typer
 from .. import validation
 from ..defaults import DEFAULT_DAMPER
 from ._app import app
-from ._common import (ProgressBar, errors, option_names, print_json, stderr_is_terminal, stdout_console,
-                      write_folder)
-from ._options import (AmplitudeOption, ComfortOption, DtOption, DurationOption, FormatOption, MaxWavelengthOption,
-                       MinWavelengthOption, OutputFormat, OutputRateOption, ParamsOption, PresetOption,
-                       RailPhaseOption, ScenarioOption, SimulateDamperOption, SimulateDamperScaleOption,
-                       SimulateOutOption, SimulateWindowOption, SpeedOption, TrackSeedOption, WavelengthOption)
-from ._parsing import (SOLVER_FIELDS, damper_preset, make_scenario, not_given, parse_scale, parse_voltage,
-                       solver_from_options, track_options, vehicle_from_options)
+from ._common import ProgressBar, errors, option_names, print_json, stderr_is_terminal, stdout_console, write_folder
+from ._options import (
+    AmplitudeOption,
+    ComfortOption,
+    DtOption,
+    DurationOption,
+    FormatOption,
+    MaxWavelengthOption,
+    MinWavelengthOption,
+    OutputFormat,
+    OutputRateOption,
+    ParamsOption,
+    PresetOption,
+    RailPhaseOption,
+    ScenarioOption,
+    SimulateDamperOption,
+    SimulateDamperScaleOption,
+    SimulateOutOption,
+    SimulateWindowOption,
+    SpeedOption,
+    TrackSeedOption,
+    WavelengthOption,
+)
+from ._parsing import (
+    SOLVER_FIELDS,
+    damper_preset,
+    make_scenario,
+    not_given,
+    parse_scale,
+    parse_voltage,
+    solver_from_options,
+    track_options,
+    vehicle_from_options,
+)
 from ._render import comfort_table
 
 #: --suspension values of `simulate` (`railride.Suspension.named`: passive, or MR dampers at a voltage)
 SUSPENSIONS = ("passive", "mr")
 #: the library's names of simulate's options, for its errors
-SIMULATE_FIELDS = {"dt": SOLVER_FIELDS["dt"], "output_rate": SOLVER_FIELDS["output_rate"],
-                   "damper": "--damper", "damper_scale": "--damper-scale", "voltage": "--voltage"}
+SIMULATE_FIELDS = {
+    "dt": SOLVER_FIELDS["dt"],
+    "output_rate": SOLVER_FIELDS["output_rate"],
+    "damper": "--damper",
+    "damper_scale": "--damper-scale",
+    "voltage": "--voltage",
+}
 
 
 def _describe_suspension(record: dict) -> str:
     if record.get("type") == "mr":
         scale = record.get("damper_scale", 1.0)
-        return (f"MR, {record['damper']} dampers" + (f" (force x {scale:g})" if scale != 1.0 else "")
-                + f" at {record['voltage_v']:g} V")
+        return (
+            f"MR, {record['damper']} dampers"
+            + (f" (force x {scale:g})" if scale != 1.0 else "")
+            + f" at {record['voltage_v']:g} V"
+        )
     return "passive (viscous c_sz)"
 
 
@@ -39,21 +73,32 @@ def _metrics_table(doc: dict):
     from rich.markup import escape
     from rich.table import Table
 
-    labels = {"acceleration_m_s2": "acceleration (m/s^2)", "displacement_m": "displacement (m)",
-              "pitch_deg": "pitch (deg)", "roll_deg": "roll (deg)"}
+    labels = {
+        "acceleration_m_s2": "acceleration (m/s^2)",
+        "displacement_m": "displacement (m)",
+        "pitch_deg": "pitch (deg)",
+        "roll_deg": "roll (deg)",
+    }
     sc, st = doc["scenario"], doc["settings"]
     start, end = st["window_s"]
     vehicle = doc.get("vehicle_preset") or doc.get("vehicle_params_file")
-    random = ([f"random track: seed {sc.get('seed')}, wavelengths "
-               f"{sc.get('min_wavelength_m'):g}-{sc.get('max_wavelength_m'):g} m"]
-              if sc.get("profile") == "random" else [])
-    caption = "\n".join([
-        f"scenario {sc.get('name')}, speed {sc.get('speed_m_s'):g} m/s",
-        *random,
-        f"duration {sc.get('duration_s'):g} s, dt {st['dt_s']:g} s, window {start:g}-{end:g} s",
-        f"vehicle {vehicle}",
-        f"suspension {_describe_suspension(doc.get('suspension') or {'type': 'passive'})}",
-    ])
+    random = (
+        [
+            f"random track: seed {sc.get('seed')}, wavelengths "
+            f"{sc.get('min_wavelength_m'):g}-{sc.get('max_wavelength_m'):g} m"
+        ]
+        if sc.get("profile") == "random"
+        else []
+    )
+    caption = "\n".join(
+        [
+            f"scenario {sc.get('name')}, speed {sc.get('speed_m_s'):g} m/s",
+            *random,
+            f"duration {sc.get('duration_s'):g} s, dt {st['dt_s']:g} s, window {start:g}-{end:g} s",
+            f"vehicle {vehicle}",
+            f"suspension {_describe_suspension(doc.get('suspension') or {'type': 'passive'})}",
+        ]
+    )
     table = Table(title="Ride metrics (carbody CG)", caption=escape(caption))
     table.add_column("response")
     table.add_column("RMS", justify="right")
@@ -77,16 +122,26 @@ def simulate(
     dt: DtOption = None,
     output_rate: OutputRateOption = None,
     window: SimulateWindowOption = None,
-    suspension: Annotated[str, typer.Option(
-        "--suspension", metavar="passive|mr",
-        help="Secondary vertical dampers: passive (viscous c_sz) or mr (an MR damper model at "
-             "each corner, constant command voltage).")] = "passive",
+    suspension: Annotated[
+        str,
+        typer.Option(
+            "--suspension",
+            metavar="passive|mr",
+            help="Secondary vertical dampers: passive (viscous c_sz) or mr (an MR damper model at "
+            "each corner, constant command voltage).",
+        ),
+    ] = "passive",
     damper: SimulateDamperOption = None,
     damper_scale: SimulateDamperScaleOption = None,
-    voltage: Annotated[Optional[str], typer.Option(
-        "--voltage", metavar="V",
-        help="--suspension mr only: constant command voltage [V] within the damper's range, or "
-             "passive-off (v_min, the default) or passive-on (v_max).")] = None,
+    voltage: Annotated[
+        Optional[str],
+        typer.Option(
+            "--voltage",
+            metavar="V",
+            help="--suspension mr only: constant command voltage [V] within the damper's range, or "
+            "passive-off (v_min, the default) or passive-on (v_max).",
+        ),
+    ] = None,
     params: ParamsOption = None,
     preset: PresetOption = None,
     format: FormatOption = OutputFormat.table,
@@ -96,9 +151,26 @@ def simulate(
     """Simulate the vehicle on a track and print the ride metrics."""
     with errors():
         track = track_options(scenario, track_seed, min_wavelength, max_wavelength)
-        doc, result = _run(scenario, amplitude, wavelength, rail_phase, speed, duration, dt,
-                           output_rate, window, params, preset, out, suspension, damper, voltage,
-                           track=track, comfort=comfort, damper_scale=damper_scale)
+        doc, result = _run(
+            scenario,
+            amplitude,
+            wavelength,
+            rail_phase,
+            speed,
+            duration,
+            dt,
+            output_rate,
+            window,
+            params,
+            preset,
+            out,
+            suspension,
+            damper,
+            voltage,
+            track=track,
+            comfort=comfort,
+            damper_scale=damper_scale,
+        )
     if format is OutputFormat.json:
         print_json(doc)
     else:
@@ -114,12 +186,16 @@ def _suspension(name: str, damper_name, voltage_text, damper_scale=None):
 
     validation.choice("--suspension", name, SUSPENSIONS)
     if name == "passive":
-        given = [o for o, v in (("--damper", damper_name), ("--damper-scale", damper_scale),
-                                ("--voltage", voltage_text)) if v is not None]
+        given = [
+            o
+            for o, v in (("--damper", damper_name), ("--damper-scale", damper_scale), ("--voltage", voltage_text))
+            if v is not None
+        ]
         if given:
             verb = "applies" if len(given) == 1 else "apply"
-            raise ValueError(f"{' and '.join(given)} {verb} to --suspension mr only (the passive "
-                             "suspension has viscous dampers)")
+            raise ValueError(
+                f"{' and '.join(given)} {verb} to --suspension mr only (the passive suspension has viscous dampers)"
+            )
         return Suspension.passive()
     damper = DEFAULT_DAMPER if damper_name is None else damper_name
     damper_preset("--damper", damper)
@@ -131,9 +207,26 @@ def _suspension(name: str, damper_name, voltage_text, damper_scale=None):
     return Suspension.named("mr", damper=damper, damper_scale=scale, voltage=volts)
 
 
-def _run(scenario_name, amplitude, wavelength, rail_phase, speed, duration, dt, output_rate,
-         window_text, params_file, preset, out, suspension="passive", damper_name=None,
-         voltage_text=None, track=None, comfort=False, damper_scale=None):
+def _run(
+    scenario_name,
+    amplitude,
+    wavelength,
+    rail_phase,
+    speed,
+    duration,
+    dt,
+    output_rate,
+    window_text,
+    params_file,
+    preset,
+    out,
+    suspension="passive",
+    damper_name=None,
+    voltage_text=None,
+    track=None,
+    comfort=False,
+    damper_scale=None,
+):
     from ..files import check_out_dir, write_outputs
     from ..metrics import check_window, parse_window
     from ..simulation import simulate as run_simulation
@@ -143,17 +236,27 @@ def _run(scenario_name, amplitude, wavelength, rail_phase, speed, duration, dt, 
         vehicle_params, vehicle_record = vehicle_from_options(params_file, preset)
         secondary = _suspension(suspension, damper_name, voltage_text, damper_scale)
         window = parse_window(window_text) if window_text is not None else None
-        scen = make_scenario(scenario_name, dict(amplitude=amplitude, wavelength=wavelength,
-                                                 rail_phase=rail_phase, speed=speed,
-                                                 duration=duration, **(track or {})), solver.output_rate)
+        scen = make_scenario(
+            scenario_name,
+            dict(
+                amplitude=amplitude,
+                wavelength=wavelength,
+                rail_phase=rail_phase,
+                speed=speed,
+                duration=duration,
+                **(track or {}),
+            ),
+            solver.output_rate,
+        )
         if out is not None:
             check_out_dir(out)
         if window is not None:  # check the window before the run, not after it
             check_window(window, scen.duration)
 
         with ProgressBar(stderr_is_terminal()) as progress:
-            result = run_simulation(scen, vehicle_params, secondary, solver=solver,
-                                    progress=progress if progress.enabled else None)
+            result = run_simulation(
+                scen, vehicle_params, secondary, solver=solver, progress=progress if progress.enabled else None
+            )
         doc = result.to_dict(window, comfort=comfort, vehicle=vehicle_record)
     if out is not None:
         write_folder(out, lambda: write_outputs(result, out, doc))

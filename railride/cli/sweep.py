@@ -16,26 +16,64 @@ import typer
 from ..defaults import DEFAULT_DAMPER
 from ..suspension import NAMES as SUSPENSIONS
 from ._app import app
-from ._common import (RunProgress, errors, interruptible, make_executor, open_run_table, option_names,
-                      stderr_is_terminal, wide_stdout_console, write_folder)
-from ._options import (DtOption, MaxWavelengthOption, MinWavelengthOption, RunDurationOption, RunsScenarioOption,
-                       SchedulerFileOption, SchedulerOption, SweepComfortOption, SweepDamperOption,
-                       SweepDamperScaleOption, SweepGainsOption, SweepOutOption, SweepResumeOption, WindowOption,
-                       WorkersOption)
+from ._common import (
+    RunProgress,
+    errors,
+    interruptible,
+    make_executor,
+    open_run_table,
+    option_names,
+    stderr_is_terminal,
+    wide_stdout_console,
+    write_folder,
+)
+from ._options import (
+    DtOption,
+    MaxWavelengthOption,
+    MinWavelengthOption,
+    RunDurationOption,
+    RunsScenarioOption,
+    SchedulerFileOption,
+    SchedulerOption,
+    SweepComfortOption,
+    SweepDamperOption,
+    SweepDamperScaleOption,
+    SweepGainsOption,
+    SweepOutOption,
+    SweepResumeOption,
+    WindowOption,
+    WorkersOption,
+)
 from ._parsing import SOLVER_FIELDS, load_gains, parse_noise, solver_from_options, value_list
 from ._render import RESPONSE_LABELS, damper_text, fmt
 
 #: how the errors of railride.sweep.grid name its keywords: by this command's options
-OPTION_NAMES = {"suspensions": "--suspension", "speed": "--speed", "wavelength": "--wavelength",
-                "amplitude": "--amplitude", "rail_phase": "--rail-phase", "track_seed": "--track-seed",
-                "min_wavelength": "--min-wavelength", "max_wavelength": "--max-wavelength",
-                "scenario": "--scenario", "voltage": "--voltage", "gains": "--gain", "base_gains": "--gains",
-                "noise": "--noise", "seed": "--seed", "damper": "--damper", "damper_scale": "--damper-scale"}
+OPTION_NAMES = {
+    "suspensions": "--suspension",
+    "speed": "--speed",
+    "wavelength": "--wavelength",
+    "amplitude": "--amplitude",
+    "rail_phase": "--rail-phase",
+    "track_seed": "--track-seed",
+    "min_wavelength": "--min-wavelength",
+    "max_wavelength": "--max-wavelength",
+    "scenario": "--scenario",
+    "voltage": "--voltage",
+    "gains": "--gain",
+    "base_gains": "--gains",
+    "noise": "--noise",
+    "seed": "--seed",
+    "damper": "--damper",
+    "damper_scale": "--damper-scale",
+}
 
 #: (column, heading) of the comfort indices the sweep table shows with --comfort
-SWEEP_COMFORT_TABLE = (("centre_aw_Wk", "a_w Wk\ncentre\n(m/s^2)"),
-                       ("centre_N_MV_z", "N_MV,z\ncentre"), ("front_N_MV_z", "N_MV,z\nfront"),
-                       ("rear_N_MV_z", "N_MV,z\nrear"))
+SWEEP_COMFORT_TABLE = (
+    ("centre_aw_Wk", "a_w Wk\ncentre\n(m/s^2)"),
+    ("centre_N_MV_z", "N_MV,z\ncentre"),
+    ("front_N_MV_z", "N_MV,z\nfront"),
+    ("rear_N_MV_z", "N_MV,z\nrear"),
+)
 
 
 class SweepFormat(str, Enum):
@@ -46,42 +84,91 @@ class SweepFormat(str, Enum):
 
 @app.command("sweep")
 def sweep_command(
-    suspension: Annotated[str, typer.Option(
-        "--suspension", "--controllers", metavar="NAME[,NAME...]",
-        help="Suspensions, comma-separated: passive, mr (constant --voltage), pid, sas-attitude, "
-             "sas-attitude-ride. --controllers is the same option.")] = "passive",
-    speed: Annotated[Optional[str], typer.Option(
-        "--speed", metavar="VALUES",
-        help="Vehicle speeds [m/s]: START:STOP:COUNT (linear, inclusive) or a,b,c "
-             "(default: the scenario's, 55.56).")] = None,
-    wavelength: Annotated[Optional[str], typer.Option(
-        "--wavelength", metavar="VALUES",
-        help="paper-sine: wavelengths [m]; bump: bump lengths [m]. A range or a list.")] = None,
-    amplitude: Annotated[Optional[str], typer.Option(
-        "--amplitude", metavar="VALUES",
-        help="paper-sine: sine amplitudes [m]; bump: heights [m]. A range or a list.")] = None,
-    rail_phase: Annotated[Optional[str], typer.Option(
-        "--rail-phase", metavar="VALUES",
-        help="paper-sine: phase lags of the right rail [deg]. A range or a list.")] = None,
-    voltage: Annotated[Optional[str], typer.Option(
-        "--voltage", metavar="VALUES",
-        help="mr only: constant command voltages [V] within the damper's range, a range or a list "
-             "(passive-off, passive-on allowed in a list; default: passive-off).")] = None,
-    gain: Annotated[Optional[list[str]], typer.Option(
-        "--gain", metavar="TABLE.ENTRY=VALUES",
-        help="Controllers only: values of one gain, e.g. pid.kd=1e4,1e5 or attitude.kp_z=0:4e5:5; "
-             "repeatable (each adds a grid axis). Tables inner, pid, attitude, ride.")] = None,
-    noise: Annotated[Optional[str], typer.Option(
-        "--noise", metavar="Z,ANGLE,VEL,RATE",
-        help="Controllers only: sensor noise, standard deviations [m, rad, m/s, rad/s].")] = None,
-    seed: Annotated[Optional[str], typer.Option(
-        "--seed", metavar="VALUES",
-        help="With --noise: seeds of the sensor noise, whole numbers >= 0, a range or a list "
-             "(default 0). Not the track: see --track-seed.")] = None,
-    track_seed: Annotated[Optional[str], typer.Option(
-        "--track-seed", metavar="VALUES",
-        help="Random tracks only: seeds of the track's realisation, whole numbers >= 0, a "
-             "range or a list (default 0); a grid axis for every suspension.")] = None,
+    suspension: Annotated[
+        str,
+        typer.Option(
+            "--suspension",
+            "--controllers",
+            metavar="NAME[,NAME...]",
+            help="Suspensions, comma-separated: passive, mr (constant --voltage), pid, sas-attitude, "
+            "sas-attitude-ride. --controllers is the same option.",
+        ),
+    ] = "passive",
+    speed: Annotated[
+        Optional[str],
+        typer.Option(
+            "--speed",
+            metavar="VALUES",
+            help="Vehicle speeds [m/s]: START:STOP:COUNT (linear, inclusive) or a,b,c "
+            "(default: the scenario's, 55.56).",
+        ),
+    ] = None,
+    wavelength: Annotated[
+        Optional[str],
+        typer.Option(
+            "--wavelength",
+            metavar="VALUES",
+            help="paper-sine: wavelengths [m]; bump: bump lengths [m]. A range or a list.",
+        ),
+    ] = None,
+    amplitude: Annotated[
+        Optional[str],
+        typer.Option(
+            "--amplitude",
+            metavar="VALUES",
+            help="paper-sine: sine amplitudes [m]; bump: heights [m]. A range or a list.",
+        ),
+    ] = None,
+    rail_phase: Annotated[
+        Optional[str],
+        typer.Option(
+            "--rail-phase", metavar="VALUES", help="paper-sine: phase lags of the right rail [deg]. A range or a list."
+        ),
+    ] = None,
+    voltage: Annotated[
+        Optional[str],
+        typer.Option(
+            "--voltage",
+            metavar="VALUES",
+            help="mr only: constant command voltages [V] within the damper's range, a range or a list "
+            "(passive-off, passive-on allowed in a list; default: passive-off).",
+        ),
+    ] = None,
+    gain: Annotated[
+        Optional[list[str]],
+        typer.Option(
+            "--gain",
+            metavar="TABLE.ENTRY=VALUES",
+            help="Controllers only: values of one gain, e.g. pid.kd=1e4,1e5 or attitude.kp_z=0:4e5:5; "
+            "repeatable (each adds a grid axis). Tables inner, pid, attitude, ride.",
+        ),
+    ] = None,
+    noise: Annotated[
+        Optional[str],
+        typer.Option(
+            "--noise",
+            metavar="Z,ANGLE,VEL,RATE",
+            help="Controllers only: sensor noise, standard deviations [m, rad, m/s, rad/s].",
+        ),
+    ] = None,
+    seed: Annotated[
+        Optional[str],
+        typer.Option(
+            "--seed",
+            metavar="VALUES",
+            help="With --noise: seeds of the sensor noise, whole numbers >= 0, a range or a list "
+            "(default 0). Not the track: see --track-seed.",
+        ),
+    ] = None,
+    track_seed: Annotated[
+        Optional[str],
+        typer.Option(
+            "--track-seed",
+            metavar="VALUES",
+            help="Random tracks only: seeds of the track's realisation, whole numbers >= 0, a "
+            "range or a list (default 0); a grid axis for every suspension.",
+        ),
+    ] = None,
     min_wavelength: MinWavelengthOption = None,
     max_wavelength: MaxWavelengthOption = None,
     scenario: RunsScenarioOption = "paper-sine",
@@ -96,9 +183,12 @@ def sweep_command(
     scheduler_file: SchedulerFileOption = None,
     out: SweepOutOption = None,
     resume: SweepResumeOption = False,
-    format: Annotated[SweepFormat, typer.Option(
-        "--format", case_sensitive=False,
-        help="Output on stdout: a table, JSON (a list of row objects) or CSV.")] = SweepFormat.table,
+    format: Annotated[
+        SweepFormat,
+        typer.Option(
+            "--format", case_sensitive=False, help="Output on stdout: a table, JSON (a list of row objects) or CSV."
+        ),
+    ] = SweepFormat.table,
     comfort: SweepComfortOption = True,
 ) -> None:
     """Run a grid of cases: every combination of the given values (a cartesian product).
@@ -114,12 +204,32 @@ def sweep_command(
     with errors():
         from ..sweep import grid as make_grid, run_sweep
 
-        values, texts = _parse(suspension=suspension, speed=speed, wavelength=wavelength, amplitude=amplitude,
-                               rail_phase=rail_phase, track_seed=track_seed, voltage=voltage, gain=gain,
-                               noise=noise, seed=seed, damper=damper, damper_scale=damper_scale, gains=gains,
-                               dt=dt, window=window)
-        grid = make_grid(scenario=scenario, duration=duration, min_wavelength=min_wavelength,
-                         max_wavelength=max_wavelength, names=OPTION_NAMES, texts=texts, **values)
+        values, texts = _parse(
+            suspension=suspension,
+            speed=speed,
+            wavelength=wavelength,
+            amplitude=amplitude,
+            rail_phase=rail_phase,
+            track_seed=track_seed,
+            voltage=voltage,
+            gain=gain,
+            noise=noise,
+            seed=seed,
+            damper=damper,
+            damper_scale=damper_scale,
+            gains=gains,
+            dt=dt,
+            window=window,
+        )
+        grid = make_grid(
+            scenario=scenario,
+            duration=duration,
+            min_wavelength=min_wavelength,
+            max_wavelength=max_wavelength,
+            names=OPTION_NAMES,
+            texts=texts,
+            **values,
+        )
         table, table_path = open_run_table(out, resume)
         executor, executor_record = make_executor(workers, scheduler, scheduler_file)
     try:
@@ -129,9 +239,12 @@ def sweep_command(
                 result = run_sweep(grid, executor=executor, table=table, progress=progress, comfort=comfort)
                 wall = time.perf_counter() - t0
             # the command's own facts, after the library's document
-            facts = {"runs_evaluated": progress.evaluated,
-                     "runs_per_second": progress.evaluated / wall if wall > 0 else 0.0,
-                     "wall_time_s": wall, "executor": executor_record}
+            facts = {
+                "runs_evaluated": progress.evaluated,
+                "runs_per_second": progress.evaluated / wall if wall > 0 else 0.0,
+                "wall_time_s": wall,
+                "executor": executor_record,
+            }
             doc = {**result.to_dict(), **facts}
             text = json.dumps(doc["rows"], indent=2, allow_nan=False)  # refuses NaN before writing
             if out is not None:
@@ -148,21 +261,45 @@ def sweep_command(
 
 
 # -- reading the options ------------------------------------------------------------------------
-def _parse(*, suspension, speed, wavelength, amplitude, rail_phase, track_seed, voltage, gain, noise, seed,
-           damper, damper_scale, gains, dt, window) -> tuple[dict, dict]:
+def _parse(
+    *,
+    suspension,
+    speed,
+    wavelength,
+    amplitude,
+    rail_phase,
+    track_seed,
+    voltage,
+    gain,
+    noise,
+    seed,
+    damper,
+    damper_scale,
+    gains,
+    dt,
+    window,
+) -> tuple[dict, dict]:
     """(the keyword arguments of railride.sweep.grid, the text each was read from): only the
     syntax of the options is checked here; what their values may be is the grid's to check."""
     from ..metrics import parse_window
 
     with option_names({"dt": SOLVER_FIELDS["dt"]}):  # the runs' output rate is not an option here
         solver = None if dt is None else solver_from_options(dt=dt)
-    values = {"suspensions": _names("--suspension", suspension), "damper": damper,
-              "noise": None if noise is None else tuple(parse_noise("--noise", noise)),
-              "base_gains": None if gains is None else load_gains(gains), "solver": solver,
-              "window": None if window is None else parse_window(window)}
-    for option, key, text in (("--speed", "speed", speed), ("--wavelength", "wavelength", wavelength),
-                              ("--amplitude", "amplitude", amplitude), ("--rail-phase", "rail_phase", rail_phase),
-                              ("--damper-scale", "damper_scale", damper_scale)):
+    values = {
+        "suspensions": _names("--suspension", suspension),
+        "damper": damper,
+        "noise": None if noise is None else tuple(parse_noise("--noise", noise)),
+        "base_gains": None if gains is None else load_gains(gains),
+        "solver": solver,
+        "window": None if window is None else parse_window(window),
+    }
+    for option, key, text in (
+        ("--speed", "speed", speed),
+        ("--wavelength", "wavelength", wavelength),
+        ("--amplitude", "amplitude", amplitude),
+        ("--rail-phase", "rail_phase", rail_phase),
+        ("--damper-scale", "damper_scale", damper_scale),
+    ):
         values[key] = None if text is None else value_list(option, text)
     for option, key, text in (("--track-seed", "track_seed", track_seed), ("--seed", "seed", seed)):
         values[key] = None if text is None else value_list(option, text, integer=True)
@@ -173,9 +310,17 @@ def _parse(*, suspension, speed, wavelength, amplitude, rail_phase, track_seed, 
         if name in values["gains"]:
             raise ValueError(f"--gain = {text!r}: {name} is given twice")
         values["gains"][name], gain_texts[name] = axis, text
-    texts = {"suspensions": suspension, "voltage": voltage, "noise": noise, "seed": seed, "damper": damper,
-             "damper_scale": damper_scale, "track_seed": track_seed,
-             "base_gains": None if gains is None else str(gains), "gains": gain_texts or None}
+    texts = {
+        "suspensions": suspension,
+        "voltage": voltage,
+        "noise": noise,
+        "seed": seed,
+        "damper": damper,
+        "damper_scale": damper_scale,
+        "track_seed": track_seed,
+        "base_gains": None if gains is None else str(gains),
+        "gains": gain_texts or None,
+    }
     return values, {key: text for key, text in texts.items() if text is not None}
 
 
@@ -183,8 +328,9 @@ def _names(option: str, text: str) -> list[str]:
     """NAME[,NAME...] -> the names, not empty (which names are allowed is the grid's check)."""
     items = [s.strip() for s in text.split(",")]
     if any(not s for s in items):
-        raise ValueError(f"{option} = {text!r}: an empty item; give names separated by commas from "
-                         f"{', '.join(SUSPENSIONS)}")
+        raise ValueError(
+            f"{option} = {text!r}: an empty item; give names separated by commas from {', '.join(SUSPENSIONS)}"
+        )
     return items
 
 
@@ -203,8 +349,8 @@ def _voltage_item(damper: Optional[str]):
         try:
             return float(item)
         except ValueError:
-            raise ValueError(f"--voltage = {item!r}: not a number of volts (nor passive-off, "
-                             "passive-on)") from None
+            raise ValueError(f"--voltage = {item!r}: not a number of volts (nor passive-off, passive-on)") from None
+
     return read
 
 
@@ -214,10 +360,11 @@ def _gain_option(text: str) -> tuple[str, list[float]]:
     name, sep, values_text = text.partition("=")
     name = name.strip()
     if name.startswith("sas."):
-        name = name[len("sas."):]
+        name = name[len("sas.") :]
     if not sep or not values_text.strip():
-        raise ValueError(f"--gain = {text!r}: expected TABLE.ENTRY=VALUES, e.g. pid.kd=1e4,1e5 "
-                         "or attitude.kp_z=0:4e5:5")
+        raise ValueError(
+            f"--gain = {text!r}: expected TABLE.ENTRY=VALUES, e.g. pid.kd=1e4,1e5 or attitude.kp_z=0:4e5:5"
+        )
     return name, value_list(f"--gain {name}", values_text)
 
 
@@ -228,16 +375,22 @@ def _caption(grid, doc: dict, wall: float) -> str:
 
     st, rows = doc["settings"], doc["rows"]
     start, end = grid.window or (0.0, grid.duration)
-    lines = [f"scenario at the first grid point: {describe_scenario(grid.first_scenario)}, "
-             f"{grid.duration:g} s, dt {grid.solver.dt:g} s, RMS over {start:g}-{end:g} s"]
+    lines = [
+        f"scenario at the first grid point: {describe_scenario(grid.first_scenario)}, "
+        f"{grid.duration:g} s, dt {grid.solver.dt:g} s, RMS over {start:g}-{end:g} s"
+    ]
     if st["damper"]:
         lines.append(damper_text(st) + (f"; gains {st['gains_source']}" if grid.controllers else ""))
-    lines.append(f"{len(rows)} run{'s' if len(rows) != 1 else ''}: {doc['runs_evaluated']} evaluated now, "
-                 f"{len(rows) - doc['runs_evaluated']} from the run table; wall time {wall:.1f} s")
+    lines.append(
+        f"{len(rows)} run{'s' if len(rows) != 1 else ''}: {doc['runs_evaluated']} evaluated now, "
+        f"{len(rows) - doc['runs_evaluated']} from the run table; wall time {wall:.1f} s"
+    )
     n_bad = sum(r.get("diverged_at_s") is not None for r in rows)
     if n_bad:
-        lines.append(f"{n_bad} run{'s' if n_bad > 1 else ''} diverged (a response left +-1000 or "
-                     "stopped being finite): no metrics, shown as -; see diverged_at_s in the JSON")
+        lines.append(
+            f"{n_bad} run{'s' if n_bad > 1 else ''} diverged (a response left +-1000 or "
+            "stopped being finite): no metrics, shown as -; see diverged_at_s in the JSON"
+        )
     return "\n".join(lines)
 
 
@@ -245,17 +398,20 @@ def _sweep_table(rows: list[dict], grid_columns: list[str], caption: str):
     from rich.markup import escape
     from rich.table import Table
 
-    table = Table(title="Sweep: RMS of the carbody responses, one row per run",
-                  caption=escape(caption))
+    table = Table(title="Sweep: RMS of the carbody responses, one row per run", caption=escape(caption))
     table.add_column("#", justify="right")
     for c in grid_columns:
-        heading = {"speed_m_s": "speed\n(m/s)", "wavelength_m": "wavelength\n(m)",
-                   "amplitude_m": "amplitude\n(m)", "rail_phase_deg": "rail phase\n(deg)",
-                   "voltage_v": "voltage\n(V)", "track_seed": "track\nseed",
-                   "damper_scale": "damper\nscale",
-                   "seed": "noise\nseed"}.get(c, c)
-        table.add_column(escape(heading), justify="left" if c == "suspension" else "right",
-                         no_wrap=c == "suspension")
+        heading = {
+            "speed_m_s": "speed\n(m/s)",
+            "wavelength_m": "wavelength\n(m)",
+            "amplitude_m": "amplitude\n(m)",
+            "rail_phase_deg": "rail phase\n(deg)",
+            "voltage_v": "voltage\n(V)",
+            "track_seed": "track\nseed",
+            "damper_scale": "damper\nscale",
+            "seed": "noise\nseed",
+        }.get(c, c)
+        table.add_column(escape(heading), justify="left" if c == "suspension" else "right", no_wrap=c == "suspension")
     for key, label in RESPONSE_LABELS.items():
         table.add_column(label.replace(" (", "\n("), justify="right")
     comfort = [(c, h) for c, h in SWEEP_COMFORT_TABLE if rows and c in rows[0]]

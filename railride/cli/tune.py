@@ -12,24 +12,71 @@ import typer
 
 from ..defaults import DEFAULT_DAMPER
 from ._app import app
-from ._common import (RunProgress, command_line, errors, interruptible, make_executor, open_run_table,
-                      option_names, stderr_is_terminal, wide_stdout_console, write_folder)
-from ._options import (AmplitudeOption, BoundOption, DtOption, FormatOption, MaxWavelengthOption,
-                       MinWavelengthOption, ObjectiveOption, OutputFormat, PenaltyOption, RailPhaseOption,
-                       RunDurationOption, RunsScenarioOption, SchedulerFileOption, SchedulerOption, SpeedOption,
-                       TrackSeedOption, TuneDamperOption, TuneDamperScaleOption, TuneGainsOption, TuneOutOption,
-                       TuneResumeOption, WavelengthOption, WeightsOption, WorkersOption)
-from ._parsing import (SOLVER_FIELDS, TRACK_FIELDS, damper_preset, default_of, load_gains, not_given, parse_float,
-                       parse_scale, solver_from_options, study_scenario)
+from ._common import (
+    RunProgress,
+    command_line,
+    errors,
+    interruptible,
+    make_executor,
+    open_run_table,
+    option_names,
+    stderr_is_terminal,
+    wide_stdout_console,
+    write_folder,
+)
+from ._options import (
+    AmplitudeOption,
+    BoundOption,
+    DtOption,
+    FormatOption,
+    MaxWavelengthOption,
+    MinWavelengthOption,
+    ObjectiveOption,
+    OutputFormat,
+    PenaltyOption,
+    RailPhaseOption,
+    RunDurationOption,
+    RunsScenarioOption,
+    SchedulerFileOption,
+    SchedulerOption,
+    SpeedOption,
+    TrackSeedOption,
+    TuneDamperOption,
+    TuneDamperScaleOption,
+    TuneGainsOption,
+    TuneOutOption,
+    TuneResumeOption,
+    WavelengthOption,
+    WeightsOption,
+    WorkersOption,
+)
+from ._parsing import (
+    SOLVER_FIELDS,
+    TRACK_FIELDS,
+    damper_preset,
+    default_of,
+    load_gains,
+    not_given,
+    parse_float,
+    parse_scale,
+    solver_from_options,
+    study_scenario,
+)
 from ._render import RESPONSE_LABELS, damper_text, reduction_text
 
 #: the library's names of tune's options, for its errors
-TUNE_FIELDS = {"dt": SOLVER_FIELDS["dt"], **TRACK_FIELDS, "damper": "--damper", "damper_scale": "--damper-scale",
-               "n_values": "--values", "max_passes": "--passes", "span": "--span"}
+TUNE_FIELDS = {
+    "dt": SOLVER_FIELDS["dt"],
+    **TRACK_FIELDS,
+    "damper": "--damper",
+    "damper_scale": "--damper-scale",
+    "n_values": "--values",
+    "max_passes": "--passes",
+    "span": "--span",
+}
 
 
-def _objective(kind: Optional[str], weights: Optional[str], bound: Optional[str],
-               penalty: Optional[str]):
+def _objective(kind: Optional[str], weights: Optional[str], bound: Optional[str], penalty: Optional[str]):
     """--objective, --weights, --bound, --penalty -> a tuning.Objective. Without --objective,
     the library's DEFAULT_OBJECTIVE; an option not given keeps that default's value when the
     kind is the default's (weights and bound belong to their kind only)."""
@@ -37,31 +84,34 @@ def _objective(kind: Optional[str], weights: Optional[str], bound: Optional[str]
 
     name = DEFAULT_OBJECTIVE.kind if kind is None else kind.strip()
     if name not in OBJECTIVE_KINDS:
-        raise ValueError(f"--objective = {kind!r}: unknown objective; allowed: "
-                         f"{', '.join(OBJECTIVE_KINDS)}")
+        raise ValueError(f"--objective = {kind!r}: unknown objective; allowed: {', '.join(OBJECTIVE_KINDS)}")
     default = DEFAULT_OBJECTIVE if name == DEFAULT_OBJECTIVE.kind else Objective()
     which = f"--objective is {name}" if kind is not None else f"the default objective is {name}"
     w = default.weights if name == "weighted" else None
     if weights is not None:
         if name != "weighted":
-            raise ValueError(f"--weights = {weights!r}: applies to --objective weighted only "
-                             f"({which})")
+            raise ValueError(f"--weights = {weights!r}: applies to --objective weighted only ({which})")
         w = _weights(weights)
     if name == "weighted" and w is None:
-        raise ValueError("--objective weighted needs --weights A,D,P,R: four numbers >= 0, not "
-                         "all 0 (acceleration, displacement, pitch, roll)")
+        raise ValueError(
+            "--objective weighted needs --weights A,D,P,R: four numbers >= 0, not "
+            "all 0 (acceleration, displacement, pitch, roll)"
+        )
     b = default.bound if name == "constrained" else None
     if bound is not None:
         if name != "constrained":
-            raise ValueError(f"--bound = {bound!r}: applies to --objective constrained only "
-                             f"({which})")
+            raise ValueError(f"--bound = {bound!r}: applies to --objective constrained only ({which})")
         b = parse_float("--bound", bound, bound, " (the largest RMS ratio to passive allowed)")
         if b <= 0:
-            raise ValueError(f"--bound = {bound!r}: must be a finite number > 0 (the largest "
-                             "RMS ratio to passive allowed for every response)")
+            raise ValueError(
+                f"--bound = {bound!r}: must be a finite number > 0 (the largest "
+                "RMS ratio to passive allowed for every response)"
+            )
     if name == "constrained" and b is None:
-        raise ValueError("--objective constrained needs --bound X: the largest RMS ratio to "
-                         "passive allowed for every response, a finite number > 0")
+        raise ValueError(
+            "--objective constrained needs --bound X: the largest RMS ratio to "
+            "passive allowed for every response, a finite number > 0"
+        )
     p = default.penalty
     if penalty is not None:
         p = parse_float("--penalty", penalty, penalty)
@@ -77,8 +127,10 @@ def _weights(weights: str) -> tuple:
     """--weights A,D,P,R -> four numbers >= 0, not all 0."""
     items = [item.strip() for item in weights.split(",")]
     if len(items) != 4:
-        raise ValueError(f"--weights = {weights!r}: expected four numbers A,D,P,R (acceleration, "
-                         f"displacement, pitch, roll), got {len(items)} item(s)")
+        raise ValueError(
+            f"--weights = {weights!r}: expected four numbers A,D,P,R (acceleration, "
+            f"displacement, pitch, roll), got {len(items)} item(s)"
+        )
     values = []
     for name, item in zip(("A", "D", "P", "R"), items):
         try:
@@ -104,16 +156,16 @@ def _phase_list(items: Optional[list[str]]) -> list[str]:
     for text in items:
         names = [n.strip() for n in text.split(",")]
         if any(not n for n in names):
-            raise ValueError(f"--phase = {text!r}: an empty item; give phases separated by commas "
-                             f"from {', '.join(PHASES)}, all")
+            raise ValueError(
+                f"--phase = {text!r}: an empty item; give phases separated by commas from {', '.join(PHASES)}, all"
+            )
         for n in names:
             if n == "all":
                 wanted.update(PHASES)
             elif n in PHASES:
                 wanted.add(n)
             else:
-                raise ValueError(f"--phase = {text!r}: unknown phase {n!r}; allowed: "
-                                 f"{', '.join(PHASES)}, all")
+                raise ValueError(f"--phase = {text!r}: unknown phase {n!r}; allowed: {', '.join(PHASES)}, all")
     return [p for p in PHASES if p in wanted]
 
 
@@ -151,12 +203,17 @@ def _tune_tables(doc: dict, start, tuned, scenario_text: str):
         change = "" if before is None else f"{(h['objective'] - before) / abs(before) * 100:+.2f}"
         cells = [h["phase"], str(h["pass"]), f"{h['objective']:.4f}", change]
         if infeasible:
-            cells.append("" if h["phase"] == "inner" else
-                         "yes" if h["objective"] < infeasible["offset"] else "no")
+            cells.append("" if h["phase"] == "inner" else "yes" if h["objective"] < infeasible["offset"] else "no")
         passes.add_row(*cells)
         previous[h["phase"]] = h["objective"]
-    parts += [passes, Text("objective: " + _objective_text_from_doc(doc) + "; inner phase: the "
-                           "normalised force-tracking error on the damper rig"), ""]
+    parts += [
+        passes,
+        Text(
+            "objective: " + _objective_text_from_doc(doc) + "; inner phase: the "
+            "normalised force-tracking error on the damper rig"
+        ),
+        "",
+    ]
 
     gains = Table(title="Tuned gains")
     gains.add_column("gain")
@@ -169,8 +226,13 @@ def _tune_tables(doc: dict, start, tuned, scenario_text: str):
             table_name, _, entry = name.partition(".")
             a = getattr(getattr(start, table_name), entry)
             b = getattr(getattr(tuned, table_name), entry)
-            gains.add_row(name, escape(gain_unit(name) or ""), f"{a:.4g}", f"{b:.4g}",
-                          "" if math.isclose(a, b, rel_tol=1e-9, abs_tol=0.0) else "changed")
+            gains.add_row(
+                name,
+                escape(gain_unit(name) or ""),
+                f"{a:.4g}",
+                f"{b:.4g}",
+                "" if math.isclose(a, b, rel_tol=1e-9, abs_tol=0.0) else "changed",
+            )
         gains.add_section()
     parts += [gains, ""]
 
@@ -188,33 +250,48 @@ def _tune_tables(doc: dict, start, tuned, scenario_text: str):
         table.add_column("red. %", justify="right")
         for r in rows:
             for i, (key, label) in enumerate(RESPONSE_LABELS.items()):
-                table.add_row(escape(LABELS[r["suspension"]]) if i == 0 else "", label,
-                              f"{doc['passive_rms'][key]:#.4g}", f"{r['before'][key]:#.4g}",
-                              reduction_text(r["reduction_before_percent"][key]),
-                              f"{r['after'][key]:#.4g}",
-                              reduction_text(r["reduction_after_percent"][key]),
-                              end_section=i == len(RESPONSE_LABELS) - 1)
+                table.add_row(
+                    escape(LABELS[r["suspension"]]) if i == 0 else "",
+                    label,
+                    f"{doc['passive_rms'][key]:#.4g}",
+                    f"{r['before'][key]:#.4g}",
+                    reduction_text(r["reduction_before_percent"][key]),
+                    f"{r['after'][key]:#.4g}",
+                    reduction_text(r["reduction_after_percent"][key]),
+                    end_section=i == len(RESPONSE_LABELS) - 1,
+                )
         parts.append(table)
     s = doc["settings"]
-    parts.append(Text("\n".join([
-        f"{scenario_text}, {doc['scenario'].get('duration_s', 0):g} s, dt {s['dt_s']:g} s, "
-        f"{damper_text(s)}; start gains {s['start_gains']}",
-        "red. % = (passive - controlled) / passive x 100 (negative: worse than passive, in red)",
-        f"{doc['runs']} runs in the run table, {doc['runs_evaluated']} evaluated now "
-        f"({doc['runs_per_second']:.1f} runs/s), wall time {doc['wall_time_s']:.1f} s",
-    ])))
+    parts.append(
+        Text(
+            "\n".join(
+                [
+                    f"{scenario_text}, {doc['scenario'].get('duration_s', 0):g} s, dt {s['dt_s']:g} s, "
+                    f"{damper_text(s)}; start gains {s['start_gains']}",
+                    "red. % = (passive - controlled) / passive x 100 (negative: worse than passive, in red)",
+                    f"{doc['runs']} runs in the run table, {doc['runs_evaluated']} evaluated now "
+                    f"({doc['runs_per_second']:.1f} runs/s), wall time {doc['wall_time_s']:.1f} s",
+                ]
+            )
+        )
+    )
     return parts
 
 
 @app.command("tune")
 def tune_command(
     ctx: typer.Context,
-    phase: Annotated[Optional[list[str]], typer.Option(
-        "--phase", metavar="PHASE[,PHASE...]",
-        help="Tuning phases, repeatable or comma-separated: inner (B, G on the damper rig's "
-             "force tracking), pid, attitude (the six SAS attitude gains, ride loop off), ride "
-             "(the eight ride gains from 0, attitude fixed), all (= inner,pid,attitude,ride). "
-             "They run in that order. Default: all.")] = None,
+    phase: Annotated[
+        Optional[list[str]],
+        typer.Option(
+            "--phase",
+            metavar="PHASE[,PHASE...]",
+            help="Tuning phases, repeatable or comma-separated: inner (B, G on the damper rig's "
+            "force tracking), pid, attitude (the six SAS attitude gains, ride loop off), ride "
+            "(the eight ride gains from 0, attitude fixed), all (= inner,pid,attitude,ride). "
+            "They run in that order. Default: all.",
+        ),
+    ] = None,
     scenario: RunsScenarioOption = "paper-sine",
     amplitude: AmplitudeOption = None,
     wavelength: WavelengthOption = None,
@@ -232,16 +309,25 @@ def tune_command(
     weights: WeightsOption = None,
     bound: BoundOption = None,
     penalty: PenaltyOption = None,
-    values: Annotated[int, typer.Option(
-        "--values", metavar="N",
-        help="Log-spaced values per gain and pass, from 1/span to span times the current value "
-             "(0 and the current value are added); >= 3.")] = 13,
-    span: Annotated[float, typer.Option(
-        "--span", metavar="S", help="Range factor of each sweep, > 1.")] = 30.0,
-    passes: Annotated[int, typer.Option(
-        "--passes", metavar="N",
-        help="At most N passes per phase (a phase stops early when a pass improves the "
-             "objective by less than 0.1 %); >= 1.")] = 5,
+    values: Annotated[
+        int,
+        typer.Option(
+            "--values",
+            metavar="N",
+            help="Log-spaced values per gain and pass, from 1/span to span times the current value "
+            "(0 and the current value are added); >= 3.",
+        ),
+    ] = 13,
+    span: Annotated[float, typer.Option("--span", metavar="S", help="Range factor of each sweep, > 1.")] = 30.0,
+    passes: Annotated[
+        int,
+        typer.Option(
+            "--passes",
+            metavar="N",
+            help="At most N passes per phase (a phase stops early when a pass improves the "
+            "objective by less than 0.1 %); >= 1.",
+        ),
+    ] = 5,
     workers: WorkersOption = None,
     scheduler: SchedulerOption = None,
     scheduler_file: SchedulerFileOption = None,
@@ -260,8 +346,7 @@ def tune_command(
     import time
 
     command = command_line(ctx, exclude=("out", "resume", "format"))
-    defaults = not_given(dt=dt, min_wavelength=min_wavelength, max_wavelength=max_wavelength,
-                         seed=track_seed)
+    defaults = not_given(dt=dt, min_wavelength=min_wavelength, max_wavelength=max_wavelength, seed=track_seed)
     with errors(), option_names(TUNE_FIELDS, defaults):
         from .. import tuning
         from ..labels import describe_scenario
@@ -272,10 +357,17 @@ def tune_command(
         start = _tune_start(gains)
         objective = _objective(objective_kind, weights, bound, penalty)
         solver = solver_from_options(dt=dt)
-        scen, options = study_scenario(scenario, amplitude=amplitude, wavelength=wavelength,
-                                       rail_phase=rail_phase, speed=speed, duration=duration,
-                                       track_seed=track_seed, min_wavelength=min_wavelength,
-                                       max_wavelength=max_wavelength)
+        scen, options = study_scenario(
+            scenario,
+            amplitude=amplitude,
+            wavelength=wavelength,
+            rail_phase=rail_phase,
+            speed=speed,
+            duration=duration,
+            track_seed=track_seed,
+            min_wavelength=min_wavelength,
+            max_wavelength=max_wavelength,
+        )
         scenario_text = describe_scenario(scen.describe())
         table, table_path = open_run_table(out, resume)
         executor, executor_record = make_executor(workers, scheduler, scheduler_file)
@@ -283,16 +375,32 @@ def tune_command(
         with interruptible(table, table_path), errors(), option_names(TUNE_FIELDS, defaults):
             with RunProgress(stderr_is_terminal(), "tuning") as progress:
                 t0 = time.perf_counter()
-                result = tuning.tune(phases, scenario=scenario, scenario_options=options,
-                                     gains=start, objective=objective, damper=damper,
-                                     damper_scale=scale,
-                                     executor=executor, table=table, n_values=values, span=span,
-                                     max_passes=passes, solver=solver, progress=progress, log=progress.log)
+                result = tuning.tune(
+                    phases,
+                    scenario=scenario,
+                    scenario_options=options,
+                    gains=start,
+                    objective=objective,
+                    damper=damper,
+                    damper_scale=scale,
+                    executor=executor,
+                    table=table,
+                    n_values=values,
+                    span=span,
+                    max_passes=passes,
+                    solver=solver,
+                    progress=progress,
+                    log=progress.log,
+                )
                 wall = time.perf_counter() - t0
             # the facts of this command line, after the library's document
-            facts = {"runs_evaluated": progress.evaluated,
-                     "runs_per_second": progress.evaluated / wall if wall > 0 else 0.0,
-                     "wall_time_s": wall, "executor": executor_record, "command": command}
+            facts = {
+                "runs_evaluated": progress.evaluated,
+                "runs_per_second": progress.evaluated / wall if wall > 0 else 0.0,
+                "wall_time_s": wall,
+                "executor": executor_record,
+                "command": command,
+            }
             doc = {**result.to_dict(), **facts}
             text = json.dumps(doc, indent=2, allow_nan=False)
             if out is not None:

@@ -17,8 +17,7 @@ def _combined(comparison):
     from ..comparison import Comparison
 
     if not isinstance(comparison, Comparison):
-        raise ValueError("comparison: expected a railride.comparison.Comparison, "
-                         f"got {type(comparison).__name__}")
+        raise ValueError(f"comparison: expected a railride.comparison.Comparison, got {type(comparison).__name__}")
     return comparison.combined()
 
 
@@ -50,8 +49,13 @@ def plot_comparison_response(comparison, response: str, ax=None):
     ax.set_xlim(time[0], time[-1])
     ax.grid(True, linewidth=0.4, alpha=0.6)
     # above the axes, not over the lines
-    ax.legend(loc="lower center", bbox_to_anchor=(0.5, 1.0), fontsize="small", frameon=False,
-              ncols=min(4, ds.sizes["controller"]))
+    ax.legend(
+        loc="lower center",
+        bbox_to_anchor=(0.5, 1.0),
+        fontsize="small",
+        frameon=False,
+        ncols=min(4, ds.sizes["controller"]),
+    )
     if own:
         title = comparison_title(ds)
         fig.suptitle(f"{what}" + (f"\n{title}" if title else ""), fontsize="medium")
@@ -63,11 +67,11 @@ def _corner_grid(ds, rows: list[str], ax):
     corners = [coordinate_label(c) for c in ds["corner"].values]
     if ax is None:
         fig = new_figure((13.0, 1.2 + 2.0 * len(rows)))
-        axes = np.atleast_2d(fig.subplots(len(rows), len(corners), sharex=True, sharey=True,
-                                          squeeze=False))
+        axes = np.atleast_2d(fig.subplots(len(rows), len(corners), sharex=True, sharey=True, squeeze=False))
     else:
-        flat = given_axes(ax, len(rows) * len(corners),
-                          f"{len(rows)} suspension(s) x {len(corners)} corners, row by row")
+        flat = given_axes(
+            ax, len(rows) * len(corners), f"{len(rows)} suspension(s) x {len(corners)} corners, row by row"
+        )
         axes = np.array(flat, dtype=object).reshape(len(rows), len(corners))
         fig = flat[0].figure
     for j, corner in enumerate(corners):
@@ -99,8 +103,9 @@ def plot_comparison_damper_forces(comparison, ax=None):
     axes[0, 0].set_xlim(time[0], time[-1])
     if ax is None:
         title = comparison_title(ds)
-        fig.suptitle("secondary damper force on the carbody (kN, up +)" + (f"\n{title}" if title else ""),
-                     fontsize="medium")
+        fig.suptitle(
+            "secondary damper force on the carbody (kN, up +)" + (f"\n{title}" if title else ""), fontsize="medium"
+        )
     return fig
 
 
@@ -119,13 +124,11 @@ def plot_comparison_voltages(comparison, ax=None):
             a = given_axes(ax, 1, "no command voltages to draw: one panel saying so")[0]
             fig = a.figure
         why = "passive suspension only" if not names else "ideal actuators"
-        a.text(0.5, 0.5, f"{why}: no command voltages", ha="center", va="center",
-               transform=a.transAxes)
+        a.text(0.5, 0.5, f"{why}: no command voltages", ha="center", va="center", transform=a.transAxes)
         a.set_axis_off()
         if ax is None:
             title = comparison_title(ds)
-            fig.suptitle("MR damper command voltage" + (f"\n{title}" if title else ""),
-                         fontsize="medium")
+            fig.suptitle("MR damper command voltage" + (f"\n{title}" if title else ""), fontsize="medium")
         return fig
     fig, axes, corners = _corner_grid(ds, names, ax)
     time = ds["time"].values
@@ -143,8 +146,7 @@ def plot_comparison_voltages(comparison, ax=None):
     axes[0, 0].set_ylim(-0.05 * max(top, 1e-9), 1.08 * max(top, 1e-9))
     if ax is None:
         title = comparison_title(ds)
-        fig.suptitle("MR damper command voltage v (V)" + (f"\n{title}" if title else ""),
-                     fontsize="medium")
+        fig.suptitle("MR damper command voltage v (V)" + (f"\n{title}" if title else ""), fontsize="medium")
     return fig
 
 
@@ -174,8 +176,13 @@ def plot_comparison_psd(psd: pd.DataFrame, ax=None, *, title: str | None = None)
         ax.set_xlim(f[keep][0], f[keep][-1])
     ax.grid(True, which="major", linewidth=0.5, alpha=0.7)
     ax.grid(True, which="minor", linewidth=0.3, alpha=0.4)
-    ax.legend(loc="lower center", bbox_to_anchor=(0.5, 1.0), fontsize="small", frameon=False,
-              ncols=min(4, max(1, len(psd.columns) - 1)))
+    ax.legend(
+        loc="lower center",
+        bbox_to_anchor=(0.5, 1.0),
+        fontsize="small",
+        frameon=False,
+        ncols=min(4, max(1, len(psd.columns) - 1)),
+    )
     if own:
         fig.suptitle(title or "PSD of the carbody CG vertical acceleration", fontsize="medium")
     return fig

@@ -12,8 +12,10 @@ from ..analysis import FRF_PATTERNS, FRF_RESPONSES, frf_excited
 from ._style import given_axes, new_figure
 
 #: line style per rail pattern
-FRF_STYLES = {"in-phase": {"color": "tab:blue", "linestyle": "-"},
-              "anti-phase": {"color": "tab:red", "linestyle": "--"}}
+FRF_STYLES = {
+    "in-phase": {"color": "tab:blue", "linestyle": "-"},
+    "anti-phase": {"color": "tab:red", "linestyle": "--"},
+}
 
 
 def _mode_numbers(numbers) -> str:
@@ -70,8 +72,7 @@ def _legend_entries(axes, modes, groups) -> tuple[list, list]:
     return handles, labels
 
 
-def plot_frf(frame: pd.DataFrame, modes: pd.DataFrame | None = None, ax=None, *,
-             title: str | None = None):
+def plot_frf(frame: pd.DataFrame, modes: pd.DataFrame | None = None, ax=None, *, title: str | None = None):
     """Magnitudes of the carbody frequency responses (`railride.analysis.frf_frame`) against
     frequency on log-log axes: one panel per response (bounce m/m, pitch and roll deg/m,
     acceleration (m/s^2)/m), one line per rail pattern. ``modes`` (`railride.tables.modes_frame`)
@@ -99,8 +100,13 @@ def plot_frf(frame: pd.DataFrame, modes: pd.DataFrame | None = None, ax=None, *,
             if not frf_excited(y, top):
                 silent.append(pattern)
                 continue
-            a.loglog(part["frequency_hz"].values, np.where(y > 0, y, np.nan), linewidth=1.3,
-                     label=pattern, **FRF_STYLES.get(pattern, {}))
+            a.loglog(
+                part["frequency_hz"].values,
+                np.where(y > 0, y, np.nan),
+                linewidth=1.3,
+                label=pattern,
+                **FRF_STYLES.get(pattern, {}),
+            )
         a.set_xscale("log")
         a.set_xlim(lo, hi)
         everywhere = all(p in silent for p in patterns)
@@ -109,14 +115,27 @@ def plot_frf(frame: pd.DataFrame, modes: pd.DataFrame | None = None, ax=None, *,
         for f, _ in groups:
             a.axvline(f, color="0.45", linestyle=":", linewidth=0.9, zorder=0)
         for f, numbers in labels_at:
-            a.annotate(_mode_numbers(numbers), (f, 1.0), xycoords=("data", "axes fraction"),
-                       xytext=(0, 2), textcoords="offset points", ha="center", va="bottom",
-                       fontsize="x-small", color="0.3")
+            a.annotate(
+                _mode_numbers(numbers),
+                (f, 1.0),
+                xycoords=("data", "axes fraction"),
+                xytext=(0, 2),
+                textcoords="offset points",
+                ha="center",
+                va="bottom",
+                fontsize="x-small",
+                color="0.3",
+            )
         if silent:
-            a.text(0.5 if everywhere else 0.02, 0.5 if everywhere else 0.03,
-                   f"not excited by {' or '.join(silent)} rails", transform=a.transAxes,
-                   fontsize="medium" if everywhere else "small", color="0.35",
-                   ha="center" if everywhere else "left")
+            a.text(
+                0.5 if everywhere else 0.02,
+                0.5 if everywhere else 0.03,
+                f"not excited by {' or '.join(silent)} rails",
+                transform=a.transAxes,
+                fontsize="medium" if everywhere else "small",
+                color="0.35",
+                ha="center" if everywhere else "left",
+            )
             if everywhere:
                 a.set_yticks([])
         a.set_ylabel(ylabel)
@@ -130,8 +149,14 @@ def plot_frf(frame: pd.DataFrame, modes: pd.DataFrame | None = None, ax=None, *,
         if handles:
             axes[0].legend(handles, labels, fontsize="x-small")
         return fig
-    fig.legend(handles, labels, loc="outside lower center", ncols=min(4, len(labels)),
-               fontsize="small", frameon=False, handlelength=2.2)
-    fig.suptitle(title or "Carbody frequency responses per metre of rail amplitude",
-                 fontsize="medium")
+    fig.legend(
+        handles,
+        labels,
+        loc="outside lower center",
+        ncols=min(4, len(labels)),
+        fontsize="small",
+        frameon=False,
+        handlelength=2.2,
+    )
+    fig.suptitle(title or "Carbody frequency responses per metre of rail amplitude", fontsize="medium")
     return fig

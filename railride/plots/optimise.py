@@ -36,19 +36,23 @@ def plot_convergence(result, ax=None, *, title: str | None = None):
     else:
         (a,) = given_axes(ax, 1, "the objective against generation")
         fig = a.figure
-    a.plot(frame["generation"], frame["objective"], "o", color="0.55", markersize=4,
-           label="lowest in the generation")
-    a.step(frame["generation"], frame["best"], where="post", color="tab:red", linewidth=1.4,
-           label="lowest so far")
+    a.plot(frame["generation"], frame["objective"], "o", color="0.55", markersize=4, label="lowest in the generation")
+    a.step(frame["generation"], frame["best"], where="post", color="tab:red", linewidth=1.4, label="lowest so far")
     a.xaxis.set_major_locator(MaxNLocator(integer=True))
     a.set_xlabel("generation (0: the initial population)")
     a.set_ylabel(_objective_label(result.objective_definition))
     a.grid(True, linewidth=0.4, alpha=0.6)
     a.legend(fontsize="small")
     if ax is None:
-        fig.suptitle(title or (f"Differential evolution: {result.suspension or 'controller'}, "
-                               f"{len(result.parameters)} gains, {result.generations} generations, "
-                               f"{result.n_runs} runs; J = {result.objective:.4g}"), fontsize="medium")
+        fig.suptitle(
+            title
+            or (
+                f"Differential evolution: {result.suspension or 'controller'}, "
+                f"{len(result.parameters)} gains, {result.generations} generations, "
+                f"{result.n_runs} runs; J = {result.objective:.4g}"
+            ),
+            fontsize="medium",
+        )
     return fig
 
 
@@ -68,10 +72,8 @@ def plot_indices(result, ax=None, *, title: str | None = None):
         (a,) = given_axes(ax, 1, "the indices of every gain")
         fig = a.figure
     height = 0.38
-    a.barh(y - height / 2, np.asarray(result.first_order, dtype=float), height, color="tab:blue",
-           label="first order")
-    a.barh(y + height / 2, np.asarray(result.total, dtype=float), height, color="tab:orange",
-           label="total")
+    a.barh(y - height / 2, np.asarray(result.first_order, dtype=float), height, color="tab:blue", label="first order")
+    a.barh(y + height / 2, np.asarray(result.total, dtype=float), height, color="tab:orange", label="total")
     a.set_yticks(y, names)
     a.invert_yaxis()  # the first gain on top
     a.axvline(0.0, color="0.4", linewidth=0.6)
@@ -79,6 +81,12 @@ def plot_indices(result, ax=None, *, title: str | None = None):
     a.grid(True, axis="x", linewidth=0.4, alpha=0.6)
     a.legend(fontsize="small")
     if ax is None:
-        fig.suptitle(title or (f"Sobol indices: {result.suspension or 'controller'}, gains uniform "
-                               f"in log10 over the search box, {result.n_runs} runs"), fontsize="medium")
+        fig.suptitle(
+            title
+            or (
+                f"Sobol indices: {result.suspension or 'controller'}, gains uniform "
+                f"in log10 over the search box, {result.n_runs} runs"
+            ),
+            fontsize="medium",
+        )
     return fig

@@ -27,17 +27,32 @@ def _draw_plane(a, result, x: str, y: str) -> None:
     rx, ry = ratios[:, RATIOS.index(x)], ratios[:, RATIOS.index(y)]
     plane = result.non_dominated_in(x, y)
     a.scatter(rx, ry, s=10, color="0.65", linewidths=0, label="sample", zorder=2)
-    a.scatter(rx[front], ry[front], s=16, color="tab:blue", linewidths=0, zorder=3,
-              label="non-dominated over all four ratios")
+    a.scatter(
+        rx[front], ry[front], s=16, color="tab:blue", linewidths=0, zorder=3, label="non-dominated over all four ratios"
+    )
     order = np.argsort(rx[plane])
-    a.step(rx[plane][order], ry[plane][order], where="post", color="tab:orange",
-           linewidth=1.2, zorder=4)
-    a.scatter(rx[plane], ry[plane], s=28, facecolors="none", edgecolors="tab:orange",
-              zorder=4, label="non-dominated in this plane")
-    a.plot([1.0], [1.0], "x", color="k", markersize=9, markeredgewidth=2, zorder=5,
-           label="passive (1, 1)")
-    a.plot([rx[0]], [ry[0]], "*", color="tab:red", markersize=14, markeredgecolor="k",
-           markeredgewidth=0.5, zorder=6, label=f"base gains ({result.settings.get('base_gains', '?')})")
+    a.step(rx[plane][order], ry[plane][order], where="post", color="tab:orange", linewidth=1.2, zorder=4)
+    a.scatter(
+        rx[plane],
+        ry[plane],
+        s=28,
+        facecolors="none",
+        edgecolors="tab:orange",
+        zorder=4,
+        label="non-dominated in this plane",
+    )
+    a.plot([1.0], [1.0], "x", color="k", markersize=9, markeredgewidth=2, zorder=5, label="passive (1, 1)")
+    a.plot(
+        [rx[0]],
+        [ry[0]],
+        "*",
+        color="tab:red",
+        markersize=14,
+        markeredgecolor="k",
+        markeredgewidth=0.5,
+        zorder=6,
+        label=f"base gains ({result.settings.get('base_gains', '?')})",
+    )
     a.axhline(1.0, color="k", linewidth=0.6, linestyle=":", zorder=1)
     a.axvline(1.0, color="k", linewidth=0.6, linestyle=":", zorder=1)
     # ratios span decades when the gains do: a log scale keeps both ends readable
@@ -72,16 +87,17 @@ def plot_pareto(result, ax=None):
         _draw_plane(a, result, x, y)
     axes[0].legend(loc="best", fontsize="x-small")
     st = result.settings
-    title = (f"{suspension_label(result.suspension)}: "
-             f"{len(result.ratios)} gain sets ({st.get('n_samples', '?')} Sobol' samples, seed "
-             f"{st.get('seed', '?')}, and the base gains), lower is better\n"
-             f"{describe_scenario(result.scenario)}, {result.scenario.get('duration_s', 0):g} s, "
-             f"{st.get('damper', '?')} dampers")
+    title = (
+        f"{suspension_label(result.suspension)}: "
+        f"{len(result.ratios)} gain sets ({st.get('n_samples', '?')} Sobol' samples, seed "
+        f"{st.get('seed', '?')}, and the base gains), lower is better\n"
+        f"{describe_scenario(result.scenario)}, {result.scenario.get('duration_s', 0):g} s, "
+        f"{st.get('damper', '?')} dampers"
+    )
     if ax is None:
         fig.suptitle(title, fontsize="medium")
         if result.note:
-            fig.text(0.5, 0.005, result.note, ha="center", va="bottom", fontsize="small",
-                     color="tab:red")
+            fig.text(0.5, 0.005, result.note, ha="center", va="bottom", fontsize="small", color="tab:red")
             fig.get_layout_engine().set(rect=(0, 0.04, 1, 0.96))
     else:
         axes[0].set_title(title, fontsize="small", loc="left")

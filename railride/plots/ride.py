@@ -9,7 +9,7 @@ from ._style import given_axes, new_figure, save_png
 
 
 def ride_title(ds: xr.Dataset) -> str:
-    """"carbody responses - <scenario>" with the dampers on a second line, for a result Dataset
+    """ "carbody responses - <scenario>" with the dampers on a second line, for a result Dataset
     (a batch of several scenarios names them and counts its samples)."""
     records = json_records(ds, "scenario")
     suspension = describe_suspension(ds)
@@ -24,8 +24,7 @@ def ride_title(ds: xr.Dataset) -> str:
     if "sample" in ds.dims:
         title = f"{title} ({ds.sizes['sample']} samples)"
     if suspension:
-        return (f"carbody responses - {title}\n{suspension}" if title
-                else f"carbody responses - {suspension}")
+        return f"carbody responses - {title}\n{suspension}" if title else f"carbody responses - {suspension}"
     return f"carbody responses - {title}" if title else "carbody responses"
 
 
@@ -51,8 +50,10 @@ def plot_body_responses(ds: xr.Dataset, path=None, *, ax=None):
     time = ds["time"].values
     samples = list(ds["sample"].values) if "sample" in ds.dims else [None]
     names = [r.get("name") for r in json_records(ds, "scenario")]
-    legend = {s: f"sample {s}" + (f": {names[i]}" if len(names) == len(samples) and names[i] else "")
-              for i, s in enumerate(samples)}
+    legend = {
+        s: f"sample {s}" + (f": {names[i]}" if len(names) == len(samples) and names[i] else "")
+        for i, s in enumerate(samples)
+    }
     for a, (channel, factor, label, _) in zip(axes, CARBODY_RESPONSES.values()):
         da = ds[channel]
         for s in samples:

@@ -62,7 +62,7 @@ def plot_hysteresis(cycles, path=None, *, title: str | None = None, ax=None):
 
 
 def _damper_words(damper, ds) -> str:
-    """"railway damper (bouc-wen model)" for a preset, "bouc-wen damper" for another model."""
+    """ "railway damper (bouc-wen model)" for a preset, "bouc-wen damper" for another model."""
     model = getattr(damper, "model", None) or damper_model_name(ds)
     preset = damper.to_dict().get("preset") if hasattr(damper, "to_dict") else None
     if preset:
@@ -103,8 +103,7 @@ def plot_tracking(tracking, path=None, *, title: str | None = None, ax=None):
         ax_f, ax_v = given_axes(ax, 2, "forces, voltages")
         fig = ax_f.figure
     time = ds["time"].values
-    ax_f.plot(time, ds["desired_force"].values / 1e3, color="0.15", linewidth=1.1,
-              linestyle="--", label="desired")
+    ax_f.plot(time, ds["desired_force"].values / 1e3, color="0.15", linewidth=1.1, linestyle="--", label="desired")
     ax_f.plot(time, ds["F"].values / 1e3, color="tab:red", linewidth=1.1, label="actual")
     ax_f.set_ylabel("damper force (kN, tension +)")
     ax_f.legend(loc="upper right", fontsize="small", ncols=2)
@@ -134,7 +133,9 @@ def _tracking_title(tracking) -> str:
     """The demand, the damper, the gains and the error: "sine demand 10 kN at 1 Hz, railway
     damper, B = 1, G = 0.00115 V/N: normalised RMS error 0.202"."""
     damper = _damper_words(tracking.damper, tracking.dataset).split(" (")[0]
-    head = (f"{tracking.desired} demand {tracking.amplitude / 1e3:g} kN at {tracking.frequency:g} Hz, "
-            f"{damper}, B = {tracking.B:g}, G = {tracking.G:.3g} V/N")
+    head = (
+        f"{tracking.desired} demand {tracking.amplitude / 1e3:g} kN at {tracking.frequency:g} Hz, "
+        f"{damper}, B = {tracking.B:g}, G = {tracking.G:.3g} V/N"
+    )
     error = tracking.metrics().normalised_rms_error
     return head + (f": normalised RMS error {error:.3f}" if math.isfinite(error) else "")

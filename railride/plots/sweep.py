@@ -13,12 +13,17 @@ from ..labels import describe_dampers, describe_scenario, grid_axis_label
 from ._style import given_axes, new_figure, suspension_label, suspension_style
 
 #: (RMS column, axis label) of the four panels of `plot_sweep`
-RMS_PANELS = (("acceleration_m_s2_rms", "acceleration RMS (m/s$^2$)"),
-              ("displacement_m_rms", "displacement RMS (m)"),
-              ("pitch_deg_rms", "pitch RMS (deg)"), ("roll_deg_rms", "roll RMS (deg)"))
+RMS_PANELS = (
+    ("acceleration_m_s2_rms", "acceleration RMS (m/s$^2$)"),
+    ("displacement_m_rms", "displacement RMS (m)"),
+    ("pitch_deg_rms", "pitch RMS (deg)"),
+    ("roll_deg_rms", "roll RMS (deg)"),
+)
 #: (column, axis label) of the two panels of `plot_sweep_comfort`
-COMFORT_PANELS = (("centre_N_MV_z", "N$_{MV,z}$, carbody centre (EN 12299, vertical part)"),
-                  ("centre_aw_Wk", "a$_w$ Wk, carbody centre (m/s$^2$)"))
+COMFORT_PANELS = (
+    ("centre_N_MV_z", "N$_{MV,z}$, carbody centre (EN 12299, vertical part)"),
+    ("centre_aw_Wk", "a$_w$ Wk, carbody centre (m/s$^2$)"),
+)
 
 
 def _is_number(value) -> bool:
@@ -63,8 +68,7 @@ def _sweep_lines(ax, frame, axis, column, suspensions):
             x, y = zip(*on)
             ax.plot(x, y, marker="o", markersize=3.5, linewidth=1.3, label=label, **style)
         elif off:
-            ax.axhline(float(np.mean(off)), linewidth=1.0, alpha=0.8,
-                       label=f"{label} (not swept)", **style)
+            ax.axhline(float(np.mean(off)), linewidth=1.0, alpha=0.8, label=f"{label} (not swept)", **style)
 
 
 def _swept_axis(result, axis: str | None) -> str:
@@ -91,8 +95,9 @@ def _panels(result, panels, ax, figsize, shape):
 def _title(fig, axes, text: str, context: str) -> None:
     """The legend below the panels and the title ``text`` with its wrapped ``context``."""
     handles, names = axes[0].get_legend_handles_labels()
-    fig.legend(handles, names, loc="outside lower center", ncols=min(5, max(1, len(names))),
-               fontsize="small", frameon=False)
+    fig.legend(
+        handles, names, loc="outside lower center", ncols=min(5, max(1, len(names))), fontsize="small", frameon=False
+    )
     if context:
         text += "\n" + textwrap.fill(context, 110)
     fig.suptitle(text, fontsize="medium")
@@ -124,8 +129,14 @@ def plot_sweep(result, ax=None, *, axis: str | None = None):
     settings = result.settings()
     context = describe_scenario(settings.get("scenario") or {})
     duration = (settings.get("scenario") or {}).get("duration_s")
-    extra = [p for p in (f"{duration:g} s" if _is_number(duration) else "",
-                         describe_dampers(settings) if settings.get("damper") else "") if p]
+    extra = [
+        p
+        for p in (
+            f"{duration:g} s" if _is_number(duration) else "",
+            describe_dampers(settings) if settings.get("damper") else "",
+        )
+        if p
+    ]
     if extra:
         context = ", ".join([context, *extra]) if context else ", ".join(extra)
     _title(fig, axes, f"RMS of the carbody responses against {grid_axis_label(axis)}", context)
@@ -159,8 +170,15 @@ def plot_sweep_comfort(result, ax=None, *, axis: str | None = None):
     for bound, label in COMFORT_SCALE:
         if math.isfinite(bound) and bound < top:
             axes[0].axhline(bound, color="0.5", linewidth=0.6, linestyle=":")
-            axes[0].annotate(f"{label} below", (0.99, bound), xycoords=("axes fraction", "data"),
-                             fontsize="x-small", color="0.4", va="top", ha="right")
+            axes[0].annotate(
+                f"{label} below",
+                (0.99, bound),
+                xycoords=("axes fraction", "data"),
+                fontsize="x-small",
+                color="0.4",
+                va="top",
+                ha="right",
+            )
     if ax is not None:
         axes[0].legend(fontsize="small")
         return fig

@@ -17,14 +17,18 @@ def _zero_axis(ax, zero_x: float, edge: float, right: float) -> None:
 
     ax.axvspan(ax.get_xlim()[0], edge, color="0.9", zorder=0, linewidth=0)
     lo, hi = math.ceil(math.log10(edge)), math.floor(math.log10(right))
-    decades = [10.0 ** k for k in range(lo, hi + 1)]
+    decades = [10.0**k for k in range(lo, hi + 1)]
     labels = [f"$10^{{{k}}}$" for k in range(lo, hi + 1)]
     if not decades:  # a range within one decade: label its ends
         decades = [edge * 2.0, right / 1.6]
         labels = [f"{v:.3g}" for v in decades]
     ax.set_xticks([zero_x, *decades], ["0", *labels])
-    minor = [j * 10.0 ** k for k in range(math.floor(math.log10(edge)), hi + 1) for j in range(2, 10)
-             if edge < j * 10.0 ** k < right]
+    minor = [
+        j * 10.0**k
+        for k in range(math.floor(math.log10(edge)), hi + 1)
+        for j in range(2, 10)
+        if edge < j * 10.0**k < right
+    ]
     ax.xaxis.set_minor_locator(FixedLocator(minor))
     ax.xaxis.set_minor_formatter(NullFormatter())
 
@@ -48,15 +52,21 @@ def _draw_parameter(ax, mine: list, colour) -> bool:
         col, pos = colour(int(c.sweep_pass)), vals > 0
         ax.plot(vals[pos], obj[pos], "-o", color=col, markersize=2.5, linewidth=1.1)
         if (~pos).any():
-            ax.plot(x(vals[~pos]), obj[~pos], "s", color=col, markerfacecolor="none",
-                    markersize=4.5)
+            ax.plot(x(vals[~pos]), obj[~pos], "s", color=col, markerfacecolor="none", markersize=4.5)
             if pos.any():
-                ax.plot([zero_x, vals[pos][0]], [obj[~pos][0], obj[pos][0]], ":", color=col,
-                        linewidth=1.0)
+                ax.plot([zero_x, vals[pos][0]], [obj[~pos][0], obj[pos][0]], ":", color=col, linewidth=1.0)
         k = np.flatnonzero(vals == float(c.chosen))
         if k.size:
-            ax.plot(x(c.chosen), obj[k[0]], "*", color=col, markersize=10,
-                    markeredgecolor="k", markeredgewidth=0.5, zorder=5)
+            ax.plot(
+                x(c.chosen),
+                obj[k[0]],
+                "*",
+                color=col,
+                markersize=10,
+                markeredgecolor="k",
+                markeredgewidth=0.5,
+                zorder=5,
+            )
     final = chosen[-1]
     ax.axvline(float(x(final)), color="tab:red", linestyle="--", linewidth=0.9, zorder=1)
     ax.set_xscale("log")
@@ -65,10 +75,8 @@ def _draw_parameter(ax, mine: list, colour) -> bool:
         _zero_axis(ax, zero_x, edge, hi * 1.8)
     parameter = mine[0].parameter
     unit = gain_unit(parameter)
-    ax.set_title(f"{parameter}" + (f" ({unit})" if unit else "") + f"\nchosen {final:.3g}",
-                 fontsize="small")
-    ax.set_ylabel("tracking error" if parameter.startswith("inner.") else "objective",
-                  fontsize="small")
+    ax.set_title(f"{parameter}" + (f" ({unit})" if unit else "") + f"\nchosen {final:.3g}", fontsize="small")
+    ax.set_ylabel("tracking error" if parameter.startswith("inner.") else "objective", fontsize="small")
     ax.tick_params(labelsize="small")
     ax.grid(True, which="major", linewidth=0.4, alpha=0.6)
     return has_zero
@@ -111,20 +119,30 @@ def plot_sensitivity(curves, ax=None, *, title: str | None = None):
     any_zero = False
     for a, parameter in zip(axes, parameters):
         any_zero = _draw_parameter(a, [c for c in curves if c.parameter == parameter], colour) or any_zero
-    for a in axes[len(parameters):]:
+    for a in axes[len(parameters) :]:
         a.set_visible(False)
-    handles: list = [Line2D([], [], color=colour(k), marker="o", markersize=3, label=f"pass {k}")
-               for k in range(1, max_pass + 1)]
-    handles.append(Line2D([], [], color="0.3", marker="*", linestyle="none", markersize=9,
-                          markeredgecolor="k", markeredgewidth=0.5, label="kept in that pass"))
+    handles: list = [
+        Line2D([], [], color=colour(k), marker="o", markersize=3, label=f"pass {k}") for k in range(1, max_pass + 1)
+    ]
+    handles.append(
+        Line2D(
+            [],
+            [],
+            color="0.3",
+            marker="*",
+            linestyle="none",
+            markersize=9,
+            markeredgecolor="k",
+            markeredgewidth=0.5,
+            label="kept in that pass",
+        )
+    )
     handles.append(Line2D([], [], color="tab:red", linestyle="--", label="final value"))
     if any_zero:
         handles.append(Patch(color="0.9", label="value 0 (gain off)"))
     if ax is not None:
         axes[0].legend(handles=handles, loc="best", fontsize="x-small")
         return fig
-    fig.legend(handles=handles, loc="outside lower center", ncols=min(len(handles), 6),
-               fontsize="small", frameon=False)
-    fig.suptitle(title or "Sensitivity of the tuning objective, one parameter at a time",
-                 fontsize="medium")
+    fig.legend(handles=handles, loc="outside lower center", ncols=min(len(handles), 6), fontsize="small", frameon=False)
+    fig.suptitle(title or "Sensitivity of the tuning objective, one parameter at a time", fontsize="medium")
     return fig

@@ -57,6 +57,7 @@ def test_modes_params_file(tmp_path):
     stiff.write_text('[vehicle]\npreset = "paper"\nk_sz = 5.8e5\n', encoding="utf-8")
     base = json.loads(run("modes", "--format", "json").stdout)
     other = json.loads(run("modes", "--format", "json", "--params", stiff).stdout)
+
     def bounce(ms):
         return next(m["frequency_hz"] for m in ms if m["label"] == "carbody bounce")
 
@@ -74,8 +75,15 @@ def test_simulate_json_document():
     result = run("simulate", "--format", "json", "--duration", 2)
     assert result.exit_code == 0, result.output
     doc = json.loads(result.stdout)
-    assert list(doc) == ["schema", "railride_version", "scenario", "vehicle_preset", "suspension",
-                         "settings", "metrics"]
+    assert list(doc) == [
+        "schema",
+        "railride_version",
+        "scenario",
+        "vehicle_preset",
+        "suspension",
+        "settings",
+        "metrics",
+    ]
     assert doc["schema"] == "railride.simulation/1"
     assert doc["vehicle_preset"] == "paper"
     assert doc["scenario"]["name"] == "paper-sine" and doc["scenario"]["duration_s"] == 2.0
@@ -88,8 +96,23 @@ def test_simulate_json_document():
 
 
 def test_simulate_window_and_overrides():
-    result = run("simulate", "--format", "json", "--duration", 2, "--window", "1:2",
-                 "--amplitude", 0.02, "--wavelength", 40, "--rail-phase", 0, "--speed", 40)
+    result = run(
+        "simulate",
+        "--format",
+        "json",
+        "--duration",
+        2,
+        "--window",
+        "1:2",
+        "--amplitude",
+        0.02,
+        "--wavelength",
+        40,
+        "--rail-phase",
+        0,
+        "--speed",
+        40,
+    )
     assert result.exit_code == 0, result.output
     doc = json.loads(result.stdout)
     assert doc["settings"]["window_s"] == [1.0, 2.0]
@@ -111,8 +134,9 @@ def test_simulate_table():
 def test_simulate_measured_file_and_params_file(good_track, tmp_path):
     params = tmp_path / "p.toml"
     params.write_text('[vehicle]\npreset = "paper"\nc_sz = 6e4\n', encoding="utf-8")
-    result = run("simulate", "--format", "json", "--duration", 1, "--scenario", f"file:{good_track}",
-                 "--params", params)
+    result = run(
+        "simulate", "--format", "json", "--duration", 1, "--scenario", f"file:{good_track}", "--params", params
+    )
     assert result.exit_code == 0, result.output
     doc = json.loads(result.stdout)
     assert doc["scenario"]["profile"] == "measured"
@@ -152,9 +176,11 @@ def test_dt_too_large():
 
 def test_library_errors_name_the_options():
     # the library checks the settings; the command line names its options in the message
-    assert_input_error(run("simulate", "--duration", 2, "--dt", 0.002),
-                       "error: --dt = 0.002 s is too large for --output-rate = 1000 Hz (the default): at "
-                       "most one output sample per step; use --dt <= 0.001 s or a lower --output-rate")
+    assert_input_error(
+        run("simulate", "--duration", 2, "--dt", 0.002),
+        "error: --dt = 0.002 s is too large for --output-rate = 1000 Hz (the default): at "
+        "most one output sample per step; use --dt <= 0.001 s or a lower --output-rate",
+    )
     from railride.cli._common import reworded
 
     fields = {"dt": "--dt", "output_rate": "--output-rate", "'seed'": "--seed"}
@@ -163,8 +189,10 @@ def test_library_errors_name_the_options():
     assert reworded("the dt of a run; dt = 1 s, dt <= 2 s", fields) == "the dt of a run; --dt = 1 s, --dt <= 2 s"
     assert reworded("raise output_rate; 1/output_rate", fields) == "raise --output-rate; 1/output_rate"
     assert reworded("sensor noise 'seed' = -1: must be", fields) == "sensor noise --seed = -1: must be"
-    assert reworded("output_rate = 300 Hz with dt = 0.0001 s: whole", fields, ["dt"]) == \
-        "--output-rate = 300 Hz with --dt = 0.0001 s (the default): whole"
+    assert (
+        reworded("output_rate = 300 Hz with dt = 0.0001 s: whole", fields, ["dt"])
+        == "--output-rate = 300 Hz with --dt = 0.0001 s (the default): whole"
+    )
 
 
 def test_the_document_is_the_library_one():
@@ -172,10 +200,14 @@ def test_the_document_is_the_library_one():
     from railride.suspension import Suspension
     from railride.track import scenario
 
-    doc = json.loads(run("simulate", "--suspension", "mr", "--voltage", 1, "--damper-scale", 2,
-                         "--duration", 1, "--format", "json").stdout)
-    library = simulate(scenario("paper-sine", duration=1.0), "paper",
-                       Suspension.named("mr", damper_scale=2.0, voltage=1.0)).to_dict()
+    doc = json.loads(
+        run(
+            "simulate", "--suspension", "mr", "--voltage", 1, "--damper-scale", 2, "--duration", 1, "--format", "json"
+        ).stdout
+    )
+    library = simulate(
+        scenario("paper-sine", duration=1.0), "paper", Suspension.named("mr", damper_scale=2.0, voltage=1.0)
+    ).to_dict()
     assert doc == library and doc["suspension"]["damper_scale"] == 2.0
 
 
@@ -288,8 +320,9 @@ def test_out_is_a_file(tmp_path):
 
 # -- the console script -----------------------------------------------------------------------------
 def test_module_entry_point_error_path():
-    proc = subprocess.run([sys.executable, "-m", "railride.cli", "simulate", "--speed", "-3"],
-                          capture_output=True, text=True, timeout=120)
+    proc = subprocess.run(
+        [sys.executable, "-m", "railride.cli", "simulate", "--speed", "-3"], capture_output=True, text=True, timeout=120
+    )
     assert proc.returncode == 2
     assert proc.stderr.strip().splitlines() == ["error: speed = -3.0: must be a finite number > 0 (m/s)"]
     assert proc.stdout == ""

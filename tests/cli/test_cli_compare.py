@@ -110,11 +110,17 @@ def test_controllers_any_order_and_passive_only(short_doc):
 
 
 def test_window_and_sensor_noise_recorded(short_doc):
-    doc = ok_json(*SHORT, "--controllers", "pid", "--window", "1:", "--sensor-noise",
-                  "1e-4,1e-5,1e-3,1e-4", "--seed", 7)
+    doc = ok_json(
+        *SHORT, "--controllers", "pid", "--window", "1:", "--sensor-noise", "1e-4,1e-5,1e-3,1e-4", "--seed", 7
+    )
     assert doc["settings"]["window_s"] == [1.0, 2.0]
-    assert doc["settings"]["sensor_noise"] == {"displacement": 1e-4, "angle": 1e-5, "velocity": 1e-3,
-                                               "angular_rate": 1e-4, "seed": 7}
+    assert doc["settings"]["sensor_noise"] == {
+        "displacement": 1e-4,
+        "angle": 1e-5,
+        "velocity": 1e-3,
+        "angular_rate": 1e-4,
+        "seed": 7,
+    }
     assert rms(doc, "pid") != rms(short_doc, "pid")
 
 
@@ -140,10 +146,27 @@ def test_table_output(tmp_path):
     result = run(*SHORT, "--gains", write(tmp_path / "g.toml", GainSet.default().to_toml()))
     assert result.exit_code == 0, result.output
     out = result.stdout
-    for text in ("Ride comparison", "Peak-to-peak", "asks of its dampers", "acceleration (m/s^2)",
-                 "displacement (m)", "pitch (deg)", "roll (deg)", "red. %", "railride", "paper",
-                 "0.3195", "1.2001", "35.4", "RMS force", "time at v_max", "Passive",
-                 "SAS (attitude+ride)", "ranking", "g.toml"):
+    for text in (
+        "Ride comparison",
+        "Peak-to-peak",
+        "asks of its dampers",
+        "acceleration (m/s^2)",
+        "displacement (m)",
+        "pitch (deg)",
+        "roll (deg)",
+        "red. %",
+        "railride",
+        "paper",
+        "0.3195",
+        "1.2001",
+        "35.4",
+        "RMS force",
+        "time at v_max",
+        "Passive",
+        "SAS (attitude+ride)",
+        "ranking",
+        "g.toml",
+    ):
         assert text in out, text
     assert "…" not in out  # nothing truncated at the default width of a pipe
     assert result.stderr == ""
@@ -165,8 +188,14 @@ def test_out_writes_all_files(tmp_path):
         assert ds["damper_command_voltage"].sel(controller="passive").isnull().all()
         assert ds["damper_command_voltage"].sel(controller="pid").notnull().all()
     frame = pd.read_csv(out / "compare.csv")
-    assert list(frame.columns[:6]) == ["controller", "time", "carbody_acceleration", "carbody_bounce",
-                                       "carbody_pitch", "carbody_roll"]
+    assert list(frame.columns[:6]) == [
+        "controller",
+        "time",
+        "carbody_acceleration",
+        "carbody_bounce",
+        "carbody_pitch",
+        "carbody_roll",
+    ]
     for corner in ("1R", "1L", "2R", "2L"):
         assert f"secondary_damper_force_{corner}" in frame and f"damper_command_voltage_{corner}" in frame
     assert list(frame["controller"].unique()) == list(CONTROLLERS)
@@ -186,43 +215,49 @@ def test_out_passive_only(tmp_path):
 
 
 # -- bad input --------------------------------------------------------------------------------------
-@pytest.mark.parametrize("args, fragments", [
-    (("--controllers", "pid,lqr"), ("--controllers", "'lqr'", "allowed")),
-    (("--controllers", "pid,,sas-attitude"), ("--controllers", "empty item")),
-    (("--controllers", ""), ("--controllers",)),
-    (("--seed", 3), ("--seed", "--sensor-noise")),
-    (("--sensor-noise", "1,2,3"), ("--sensor-noise", "'1,2,3'", "four numbers")),
-    (("--sensor-noise", "1,2,3,4,5"), ("--sensor-noise", "four numbers")),
-    (("--sensor-noise", "0,0,-1,0"), ("--sensor-noise", "VEL", ">= 0")),
-    (("--sensor-noise", "0,x,0,0"), ("--sensor-noise", "ANGLE", "'x'")),
-    (("--sensor-noise", "0,0,0,inf"), ("--sensor-noise", "RATE")),
-    (("--sensor-noise", "0,0,0,0", "--seed", -1), ("--seed", "-1")),
-    (("--damper", "mr9"), ("--damper", "'mr9'")),
-    (("--control-rate", 0), ("--control-rate",)),
-    (("--control-rate", 300), ("--control-rate", "300", "whole number")),
-    (("--speed", -3), ("speed", "-3")),
-    (("--window", "5:20"), ("window", "5:20")),
-    (("--window", "abc"), ("window",)),
-    (("--scenario", "nope"), ("scenario", "'nope'")),
-    (("--rail-phase", 10, "--scenario", "bump"), ("rail",)),
-    (("--dt", 0.05, "--control-rate", 20), ("dt", "too large")),
-    (("--preset", "nope"), ("nope",)),
-])
+@pytest.mark.parametrize(
+    "args, fragments",
+    [
+        (("--controllers", "pid,lqr"), ("--controllers", "'lqr'", "allowed")),
+        (("--controllers", "pid,,sas-attitude"), ("--controllers", "empty item")),
+        (("--controllers", ""), ("--controllers",)),
+        (("--seed", 3), ("--seed", "--sensor-noise")),
+        (("--sensor-noise", "1,2,3"), ("--sensor-noise", "'1,2,3'", "four numbers")),
+        (("--sensor-noise", "1,2,3,4,5"), ("--sensor-noise", "four numbers")),
+        (("--sensor-noise", "0,0,-1,0"), ("--sensor-noise", "VEL", ">= 0")),
+        (("--sensor-noise", "0,x,0,0"), ("--sensor-noise", "ANGLE", "'x'")),
+        (("--sensor-noise", "0,0,0,inf"), ("--sensor-noise", "RATE")),
+        (("--sensor-noise", "0,0,0,0", "--seed", -1), ("--seed", "-1")),
+        (("--damper", "mr9"), ("--damper", "'mr9'")),
+        (("--control-rate", 0), ("--control-rate",)),
+        (("--control-rate", 300), ("--control-rate", "300", "whole number")),
+        (("--speed", -3), ("speed", "-3")),
+        (("--window", "5:20"), ("window", "5:20")),
+        (("--window", "abc"), ("window",)),
+        (("--scenario", "nope"), ("scenario", "'nope'")),
+        (("--rail-phase", 10, "--scenario", "bump"), ("rail",)),
+        (("--dt", 0.05, "--control-rate", 20), ("dt", "too large")),
+        (("--preset", "nope"), ("nope",)),
+    ],
+)
 def test_bad_input(tmp_path, args, fragments):
     out = tmp_path / "out"
     assert_input_error(run(*SHORT, *args, "--out", out), *fragments)
     assert not out.exists() and list(tmp_path.iterdir()) == []
 
 
-@pytest.mark.parametrize("change, fragments", [
-    (None, ("--gains", "cannot read gains file", "absent.toml")),
-    (("KD_LINE", "# kd left out"), ("--gains", "missing entry 'kd' in [pid]")),
-    (("KD_LINE", "KD_LINE\nkx = 1.0"), ("--gains", "unknown entry 'kx' in [pid]")),
-    (("KD_LINE", 'kd = "lots"'), ("--gains", "'kd' in [pid]", "not a number")),
-    (("KD_LINE", "kd = -5.0"), ("--gains", "[pid]", "'kd' = -5.0", ">= 0")),
-    (("[pid]", "[pdi]"), ("--gains", "pdi")),
-    (("KD_LINE", "kd = ["), ("--gains", "not valid TOML")),
-])
+@pytest.mark.parametrize(
+    "change, fragments",
+    [
+        (None, ("--gains", "cannot read gains file", "absent.toml")),
+        (("KD_LINE", "# kd left out"), ("--gains", "missing entry 'kd' in [pid]")),
+        (("KD_LINE", "KD_LINE\nkx = 1.0"), ("--gains", "unknown entry 'kx' in [pid]")),
+        (("KD_LINE", 'kd = "lots"'), ("--gains", "'kd' in [pid]", "not a number")),
+        (("KD_LINE", "kd = -5.0"), ("--gains", "[pid]", "'kd' = -5.0", ">= 0")),
+        (("[pid]", "[pdi]"), ("--gains", "pdi")),
+        (("KD_LINE", "kd = ["), ("--gains", "not valid TOML")),
+    ],
+)
 def test_bad_gains_file(tmp_path, gains_text, change, fragments):
     if change is None:
         path = tmp_path / "absent.toml"
@@ -262,8 +297,7 @@ def test_failing_plot_leaves_out_absent(tmp_path, monkeypatch):
 
     monkeypatch.setattr(files, "plot_comparison_voltages", failing_png)
     out = tmp_path / "absent"
-    assert_input_error(run(*SHORT, "--controllers", "pid", "--out", out),
-                       "cannot write the output folder", "simulated")
+    assert_input_error(run(*SHORT, "--controllers", "pid", "--out", out), "cannot write the output folder", "simulated")
     assert not out.exists() and list(tmp_path.iterdir()) == []
 
 
@@ -296,7 +330,8 @@ def test_trade_offs_name_every_response_a_controller_loses(short_doc):
         assert sorted(t["better_on"]) == sorted(k for k in RESPONSES if rms[a][k] < rms[b][k])
     controlled = [n for n in rows if n != "passive"]
     assert seen == {(n, "passive") for n in controlled} | {
-        (a, b) for i, a in enumerate(controlled) for b in controlled[i + 1:]}
+        (a, b) for i, a in enumerate(controlled) for b in controlled[i + 1 :]
+    }
 
 
 def test_bounds_are_the_same_gains_on_the_ideal_devices(short_doc):
@@ -312,8 +347,7 @@ def test_bounds_are_the_same_gains_on_the_ideal_devices(short_doc):
         got = short_doc["bounds"][device]["sas-attitude"]
         for k in RESPONSES:
             assert got["rms"][k] == pytest.approx(float(m.sel(statistic="rms", response=k)), rel=1e-12)
-            red = float((passive.sel(response=k) - m.sel(statistic="rms", response=k))
-                        / passive.sel(response=k) * 100)
+            red = float((passive.sel(response=k) - m.sel(statistic="rms", response=k)) / passive.sel(response=k) * 100)
             assert got["reduction_percent"][k] == pytest.approx(red, rel=1e-9)
 
 

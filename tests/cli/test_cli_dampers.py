@@ -54,24 +54,33 @@ def test_damper_table():
     assert result.stderr == ""
 
 
-@pytest.mark.parametrize("args, fragments", [
-    (("--model", "nope", "--voltage", "1"), ("--model", "nope", "railway")),
-    (("--voltage", "3"), ("--voltage", "3", "2.25")),
-    (("--voltage", "-0.5"), ("--voltage", "-0.5")),
-    (("--voltage", "0,abc"), ("--voltage", "abc")),
-    (("--voltage", "0,,1"), ("--voltage",)),
-    (("--voltage", "1,1"), ("--voltage", "twice")),
-    (("--voltage", "nan"), ("--voltage", "nan")),
-    (("--voltage", "1", "--cycles", "1"), ("--cycles", "1")),
-])
+@pytest.mark.parametrize(
+    "args, fragments",
+    [
+        (("--model", "nope", "--voltage", "1"), ("--model", "nope", "railway")),
+        (("--voltage", "3"), ("--voltage", "3", "2.25")),
+        (("--voltage", "-0.5"), ("--voltage", "-0.5")),
+        (("--voltage", "0,abc"), ("--voltage", "abc")),
+        (("--voltage", "0,,1"), ("--voltage",)),
+        (("--voltage", "1,1"), ("--voltage", "twice")),
+        (("--voltage", "nan"), ("--voltage", "nan")),
+        (("--voltage", "1", "--cycles", "1"), ("--cycles", "1")),
+    ],
+)
 def test_damper_bad_input(args, fragments):
     assert_input_error(run(*DAMPER, *args), *fragments)
 
 
-@pytest.mark.parametrize("option, value", [
-    ("--amplitude", "-0.01"), ("--amplitude", "0"), ("--frequency", "0"), ("--frequency", "-1"),
-    ("--frequency", "inf"),
-])
+@pytest.mark.parametrize(
+    "option, value",
+    [
+        ("--amplitude", "-0.01"),
+        ("--amplitude", "0"),
+        ("--frequency", "0"),
+        ("--frequency", "-1"),
+        ("--frequency", "inf"),
+    ],
+)
 def test_damper_bad_motion(option, value):
     args = {"--amplitude": "0.01", "--frequency": "1", option: value}
     result = run("damper", "--voltage", "1", *[x for kv in args.items() for x in kv])
@@ -109,8 +118,9 @@ def test_damper_out_writes_three_files(tmp_path):
     assert [p.name for p in tmp_path.iterdir()] == ["loops"]  # no staging folder left
 
 
-@pytest.mark.parametrize("bad", [("--voltage", "9"), ("--voltage", "1", "--cycles", "0"),
-                                 ("--voltage", "1", "--model", "x")])
+@pytest.mark.parametrize(
+    "bad", [("--voltage", "9"), ("--voltage", "1", "--cycles", "0"), ("--voltage", "1", "--model", "x")]
+)
 def test_damper_failure_leaves_out_absent(tmp_path, bad):
     out = tmp_path / "absent"
     assert_input_error(run(*DAMPER, *bad, "--out", out))
@@ -120,8 +130,18 @@ def test_damper_failure_leaves_out_absent(tmp_path, bad):
 # -- tracking -------------------------------------------------------------------------------------
 def test_tracking_json_sine():
     doc = ok_json("tracking", "--cycles", 2)
-    assert list(doc) == ["schema", "railride_version", "damper", "desired", "amplitude_n",
-                         "frequency_hz", "stroke_m", "B", "G_v_per_n", "metrics"]
+    assert list(doc) == [
+        "schema",
+        "railride_version",
+        "damper",
+        "desired",
+        "amplitude_n",
+        "frequency_hz",
+        "stroke_m",
+        "B",
+        "G_v_per_n",
+        "metrics",
+    ]
     assert doc["schema"] == "railride.tracking/1"
     assert doc["desired"] == "sine" and doc["amplitude_n"] == 10e3 and doc["frequency_hz"] == 1.0
     assert doc["stroke_m"] == 0.02 and doc["B"] == 1.0
@@ -135,8 +155,23 @@ def test_tracking_json_sine():
 
 
 def test_tracking_gains_and_sawtooth():
-    doc = ok_json("tracking", "--desired", "sawtooth", "--cycles", 2, "--B", 0.5, "--G", 0.002,
-                  "--frequency", 2, "--amplitude", 5000, "--model", "dyke1996")
+    doc = ok_json(
+        "tracking",
+        "--desired",
+        "sawtooth",
+        "--cycles",
+        2,
+        "--B",
+        0.5,
+        "--G",
+        0.002,
+        "--frequency",
+        2,
+        "--amplitude",
+        5000,
+        "--model",
+        "dyke1996",
+    )
     assert doc["desired"] == "sawtooth" and doc["B"] == 0.5 and doc["G_v_per_n"] == 0.002
     assert doc["metrics"]["window_s"] == [0.5, 1.0]
     assert math.isfinite(doc["metrics"]["normalised_rms_error"])
@@ -149,17 +184,20 @@ def test_tracking_table():
         assert text in result.stdout
 
 
-@pytest.mark.parametrize("args, fragments", [
-    (("--desired", "square"), ("--desired", "square", "sawtooth")),
-    (("--amplitude", "0"), ("--amplitude",)),
-    (("--amplitude", "-5"), ("--amplitude", "-5")),
-    (("--frequency", "0"), ("--frequency",)),
-    (("--cycles", "1"), ("--cycles", "1")),
-    (("--model", "magic"), ("--model", "magic")),
-    (("--B", "-1"), ("--B", "-1")),
-    (("--G", "nan"), ("--G", "nan")),
-    (("--stroke", "0"), ("--stroke",)),
-])
+@pytest.mark.parametrize(
+    "args, fragments",
+    [
+        (("--desired", "square"), ("--desired", "square", "sawtooth")),
+        (("--amplitude", "0"), ("--amplitude",)),
+        (("--amplitude", "-5"), ("--amplitude", "-5")),
+        (("--frequency", "0"), ("--frequency",)),
+        (("--cycles", "1"), ("--cycles", "1")),
+        (("--model", "magic"), ("--model", "magic")),
+        (("--B", "-1"), ("--B", "-1")),
+        (("--G", "nan"), ("--G", "nan")),
+        (("--stroke", "0"), ("--stroke",)),
+    ],
+)
 def test_tracking_bad_input(args, fragments):
     assert_input_error(run("tracking", *args), *fragments)
 
@@ -211,14 +249,17 @@ def test_simulate_table_mentions_suspension():
     assert "suspension passive" in run("simulate", "--duration", 1).stdout
 
 
-@pytest.mark.parametrize("args, fragments", [
-    (("--voltage", "1"), ("--voltage", "--suspension mr")),
-    (("--damper", "railway"), ("--damper", "--suspension mr")),
-    (("--suspension", "semi"), ("--suspension", "semi")),
-    (("--suspension", "mr", "--damper", "nope"), ("--damper", "nope")),
-    (("--suspension", "mr", "--voltage", "2.5"), ("--voltage", "2.5")),
-    (("--suspension", "mr", "--voltage", "high"), ("--voltage", "high")),
-])
+@pytest.mark.parametrize(
+    "args, fragments",
+    [
+        (("--voltage", "1"), ("--voltage", "--suspension mr")),
+        (("--damper", "railway"), ("--damper", "--suspension mr")),
+        (("--suspension", "semi"), ("--suspension", "semi")),
+        (("--suspension", "mr", "--damper", "nope"), ("--damper", "nope")),
+        (("--suspension", "mr", "--voltage", "2.5"), ("--voltage", "2.5")),
+        (("--suspension", "mr", "--voltage", "high"), ("--voltage", "high")),
+    ],
+)
 def test_simulate_suspension_bad_input(tmp_path, args, fragments):
     out = tmp_path / "absent"
     assert_input_error(run("simulate", "--duration", 1, *args, "--out", out), *fragments)

@@ -15,8 +15,7 @@ PARETO = ("pareto", "--suspension", "pid", "--samples", 4, "--duration", 1)
 def test_pareto_folder_json_and_resume(tmp_path):
     out = tmp_path / "p"
     doc = json.loads(ok(*PARETO, "--seed", 2, "--out", out, "--format", "json").stdout)
-    assert sorted(p.name for p in out.iterdir()) == ["pareto.csv", "pareto.json", "pareto.png",
-                                                     "runs.csv"]
+    assert sorted(p.name for p in out.iterdir()) == ["pareto.csv", "pareto.json", "pareto.png", "runs.csv"]
     assert json.loads((out / "pareto.json").read_text()) == doc
     assert doc["schema"] == "railride.pareto/1" and doc["suspension"] == "pid"
     assert doc["settings"]["n_samples"] == 4 and doc["settings"]["seed"] == 2
@@ -24,8 +23,7 @@ def test_pareto_folder_json_and_resume(tmp_path):
     frame = pd.read_csv(out / "pareto.csv")
     assert list(frame.columns) == doc["columns"] and len(frame) == 5
     assert frame["non_dominated"].sum() == doc["counts"]["non_dominated"] >= 1
-    again = json.loads(ok(*PARETO, "--seed", 2, "--out", out, "--resume", "--format",
-                          "json").stdout)
+    again = json.loads(ok(*PARETO, "--seed", 2, "--out", out, "--resume", "--format", "json").stdout)
     assert again["samples"] == doc["samples"]
     assert len(pd.read_csv(out / "runs.csv")) == 6  # nothing ran twice
     assert_input_error(run(*PARETO, "--out", out), "runs.csv exists", "--resume")
@@ -35,21 +33,23 @@ def test_pareto_table_lists_the_non_dominated_samples_by_acceleration():
     doc = json.loads(ok(*PARETO, "--format", "json").stdout)
     table = ok(*PARETO).stdout
     assert "non-dominated" in table and "Non-dominated samples by acceleration ratio" in table
-    front = sorted((r for r in doc["samples"] if r["non_dominated"]),
-                   key=lambda r: r["acceleration_m_s2_ratio"])
+    front = sorted((r for r in doc["samples"] if r["non_dominated"]), key=lambda r: r["acceleration_m_s2_ratio"])
     lines = [line for line in table.splitlines() if line.startswith("│")]
     listed = [line.split("│")[1].split()[0] for line in lines[1:]]  # after the counts row
     assert listed == [str(r["sample"]) for r in front]
 
 
-@pytest.mark.parametrize("args, fragments", [
-    (("--samples", "100"), ("--samples = 100", "power of two")),
-    (("--samples", "0"), ("--samples = 0",)),
-    (("--seed", "-1"), ("--seed = -1",)),
-    (("--suspension", "passive"), ("--suspension", "'passive'", "sas-attitude-ride")),
-    (("--damper", "mr9"), ("--damper", "mr9")),
-    (("--resume",), ("--resume needs --out",)),
-    (("--track-seed", "2"), ("--track-seed", "random-track")),
-])
+@pytest.mark.parametrize(
+    "args, fragments",
+    [
+        (("--samples", "100"), ("--samples = 100", "power of two")),
+        (("--samples", "0"), ("--samples = 0",)),
+        (("--seed", "-1"), ("--seed = -1",)),
+        (("--suspension", "passive"), ("--suspension", "'passive'", "sas-attitude-ride")),
+        (("--damper", "mr9"), ("--damper", "mr9")),
+        (("--resume",), ("--resume needs --out",)),
+        (("--track-seed", "2"), ("--track-seed", "random-track")),
+    ],
+)
 def test_pareto_bad_input(args, fragments):
     assert_input_error(run(*PARETO, *args), *fragments)

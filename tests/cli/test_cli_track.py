@@ -35,56 +35,82 @@ def test_simulate_random_track_is_reproducible():
 
 
 def test_simulate_random_track_band_and_default_seed():
-    doc = json.loads(ok("simulate", "--scenario", "german-high", "--duration", 1,
-                        "--min-wavelength", 2, "--max-wavelength", 50, "--format", "json").stdout)
+    doc = json.loads(
+        ok(
+            "simulate",
+            "--scenario",
+            "german-high",
+            "--duration",
+            1,
+            "--min-wavelength",
+            2,
+            "--max-wavelength",
+            50,
+            "--format",
+            "json",
+        ).stdout
+    )
     sc = doc["scenario"]
     assert sc["seed"] == 0 and sc["min_wavelength_m"] == 2.0 and sc["max_wavelength_m"] == 50.0
     table = ok("simulate", "--scenario", "fra2", "--track-seed", 5, "--duration", 1).stdout
     assert "random track: seed 5, wavelengths 1-100 m" in table
 
 
-@pytest.mark.parametrize("args, fragments", [
-    (("--scenario", "fra7"), ("--scenario", "unknown scenario 'fra7'")),
-    (("--scenario", "fra4", "--track-seed", -1), ("--track-seed = -1", ">= 0")),
-    (("--track-seed", 3), ("--track-seed = 3", "random-track", "paper-sine")),
-    (("--scenario", "bump", "--min-wavelength", 2), ("--min-wavelength = 2 m", "bump")),
-    (("--scenario", "fra4", "--min-wavelength", -2), ("--min-wavelength = -2", "> 0")),
-    (("--scenario", "fra4", "--max-wavelength", 0), ("--max-wavelength = 0", "> 0")),
-    (("--scenario", "fra4", "--min-wavelength", 50, "--max-wavelength", 10),
-     ("--min-wavelength = 50 m", "--max-wavelength = 10 m", "band")),
-    (("--scenario", "fra4", "--min-wavelength", 150), ("--min-wavelength = 150 m", "[150, 100]")),
-    (("--scenario", "fra4", "--min-wavelength", 0.1),
-     ("--min-wavelength = 0.1 m", "--output-rate", "resolve")),
-    (("--scenario", "fra4", "--output-rate", 100), ("--min-wavelength = 1 m (the default)",
-                                                    "--output-rate 100 Hz")),
-    (("--scenario", "fra4", "--amplitude", 0.01), ("--amplitude", "random track")),
-])
+@pytest.mark.parametrize(
+    "args, fragments",
+    [
+        (("--scenario", "fra7"), ("--scenario", "unknown scenario 'fra7'")),
+        (("--scenario", "fra4", "--track-seed", -1), ("--track-seed = -1", ">= 0")),
+        (("--track-seed", 3), ("--track-seed = 3", "random-track", "paper-sine")),
+        (("--scenario", "bump", "--min-wavelength", 2), ("--min-wavelength = 2 m", "bump")),
+        (("--scenario", "fra4", "--min-wavelength", -2), ("--min-wavelength = -2", "> 0")),
+        (("--scenario", "fra4", "--max-wavelength", 0), ("--max-wavelength = 0", "> 0")),
+        (
+            ("--scenario", "fra4", "--min-wavelength", 50, "--max-wavelength", 10),
+            ("--min-wavelength = 50 m", "--max-wavelength = 10 m", "band"),
+        ),
+        (("--scenario", "fra4", "--min-wavelength", 150), ("--min-wavelength = 150 m", "[150, 100]")),
+        (("--scenario", "fra4", "--min-wavelength", 0.1), ("--min-wavelength = 0.1 m", "--output-rate", "resolve")),
+        (
+            ("--scenario", "fra4", "--output-rate", 100),
+            ("--min-wavelength = 1 m (the default)", "--output-rate 100 Hz"),
+        ),
+        (("--scenario", "fra4", "--amplitude", 0.01), ("--amplitude", "random track")),
+    ],
+)
 def test_simulate_bad_random_track_input(args, fragments):
     assert_input_error(run("simulate", "--duration", 1, *args), *fragments)
 
 
-@pytest.mark.parametrize("command", [
-    ("compare", "--duration", 1),
-    ("sweep", "--duration", 1),
-    ("tune", "--phase", "pid", "--duration", 1),
-])
+@pytest.mark.parametrize(
+    "command",
+    [
+        ("compare", "--duration", 1),
+        ("sweep", "--duration", 1),
+        ("tune", "--phase", "pid", "--duration", 1),
+    ],
+)
 def test_other_commands_refuse_bad_random_track_input(command, tmp_path):
     out = tmp_path / "out"
     assert_input_error(run(*command, "--scenario", "fra7", "--out", out), "unknown scenario")
-    assert_input_error(run(*command, "--scenario", "fra4", "--min-wavelength", 30,
-                           "--max-wavelength", 20, "--out", out), "--min-wavelength = 30 m")
-    assert_input_error(run(*command, "--scenario", "fra4", "--min-wavelength", 0.05, "--out", out),
-                       "--min-wavelength = 0.05 m", "resolve")
-    assert_input_error(run(*command, "--scenario", "paper-sine", "--track-seed", 1, "--out", out),
-                       "--track-seed", "random-track")
-    assert_input_error(run(*command, "--scenario", "fra4", "--track-seed", -2, "--out", out),
-                       "--track-seed", "-2")
+    assert_input_error(
+        run(*command, "--scenario", "fra4", "--min-wavelength", 30, "--max-wavelength", 20, "--out", out),
+        "--min-wavelength = 30 m",
+    )
+    assert_input_error(
+        run(*command, "--scenario", "fra4", "--min-wavelength", 0.05, "--out", out),
+        "--min-wavelength = 0.05 m",
+        "resolve",
+    )
+    assert_input_error(
+        run(*command, "--scenario", "paper-sine", "--track-seed", 1, "--out", out), "--track-seed", "random-track"
+    )
+    assert_input_error(run(*command, "--scenario", "fra4", "--track-seed", -2, "--out", out), "--track-seed", "-2")
     assert not out.exists()  # nothing written
 
 
 def test_compare_random_track_json():
-    doc = ok_json("compare", "--controllers", "pid", "--scenario", "fra5", "--track-seed", 2,
-                  "--duration", 1)
+    doc = ok_json("compare", "--controllers", "pid", "--scenario", "fra5", "--track-seed", 2, "--duration", 1)
     sc = doc["settings"]["scenario"]
     assert sc["profile"] == "random" and sc["spectrum"] == "fra5" and sc["seed"] == 2
     assert [r["name"] for r in doc["controllers"]] == ["passive", "pid"]
@@ -92,33 +118,102 @@ def test_compare_random_track_json():
 
 def test_sweep_track_seed_axis_is_not_the_noise_seed(tmp_path):
     out = tmp_path / "sweep"
-    rows = json.loads(ok("sweep", "--scenario", "fra4", "--track-seed", "0:1:2", "--suspension",
-                         "passive,pid", "--noise", "1e-4,0,0,0", "--seed", "7", "--duration", 1,
-                         "--min-wavelength", 2, "--out", out, "--format", "json").stdout)
+    rows = json.loads(
+        ok(
+            "sweep",
+            "--scenario",
+            "fra4",
+            "--track-seed",
+            "0:1:2",
+            "--suspension",
+            "passive,pid",
+            "--noise",
+            "1e-4,0,0,0",
+            "--seed",
+            "7",
+            "--duration",
+            1,
+            "--min-wavelength",
+            2,
+            "--out",
+            out,
+            "--format",
+            "json",
+        ).stdout
+    )
     doc = json.loads((out / "sweep.json").read_text())
     assert doc["settings"]["grid"]["track_seed"] == [0, 1]
     assert doc["settings"]["grid"]["seed"] == [7]
     assert "seed" not in doc["settings"]["scenario"]  # swept: in the grid
     assert doc["settings"]["scenario"]["min_wavelength_m"] == 2.0
     assert [(r["suspension"], r["track_seed"], r["seed"]) for r in rows] == [
-        ("passive", 0, None), ("passive", 1, None), ("pid", 0, 7), ("pid", 1, 7)]
+        ("passive", 0, None),
+        ("passive", 1, None),
+        ("pid", 0, 7),
+        ("pid", 1, 7),
+    ]
     passive = [r["acceleration_m_s2_rms"] for r in rows if r["suspension"] == "passive"]
     assert passive[0] != passive[1]  # two different tracks
     # the same track as simulate: seed 1, band 2-100 m
-    single = json.loads(ok("simulate", "--scenario", "fra4", "--track-seed", 1, "--duration", 1,
-                           "--min-wavelength", 2, "--format", "json").stdout)
+    single = json.loads(
+        ok(
+            "simulate",
+            "--scenario",
+            "fra4",
+            "--track-seed",
+            1,
+            "--duration",
+            1,
+            "--min-wavelength",
+            2,
+            "--format",
+            "json",
+        ).stdout
+    )
     assert single["metrics"]["acceleration_m_s2"]["rms"] == pytest.approx(passive[1], rel=1e-9)
     # resumed: every run comes from the table (stable keys)
-    result = ok("sweep", "--scenario", "fra4", "--track-seed", "0:1:2", "--suspension",
-                "passive,pid", "--noise", "1e-4,0,0,0", "--seed", "7", "--duration", 1,
-                "--min-wavelength", 2, "--out", out, "--resume", "--format", "json")
+    result = ok(
+        "sweep",
+        "--scenario",
+        "fra4",
+        "--track-seed",
+        "0:1:2",
+        "--suspension",
+        "passive,pid",
+        "--noise",
+        "1e-4,0,0,0",
+        "--seed",
+        "7",
+        "--duration",
+        1,
+        "--min-wavelength",
+        2,
+        "--out",
+        out,
+        "--resume",
+        "--format",
+        "json",
+    )
     assert json.loads(result.stdout) == rows
     assert json.loads((out / "sweep.json").read_text())["runs_evaluated"] == 0
 
 
 def test_tune_on_a_random_track(tmp_path):
-    doc = ok_json("tune", "--phase", "pid", "--values", 3, "--passes", 1, "--duration", 0.5,
-                  "--scenario", "german-low", "--track-seed", 1)
+    doc = ok_json(
+        "tune",
+        "--phase",
+        "pid",
+        "--values",
+        3,
+        "--passes",
+        1,
+        "--duration",
+        0.5,
+        "--scenario",
+        "german-low",
+        "--track-seed",
+        1,
+    )
     assert doc["scenario"]["spectrum"] == "german-low" and doc["scenario"]["seed"] == 1
     assert all(np.isfinite(v) for v in doc["passive_rms"].values())
 
@@ -146,8 +241,7 @@ def test_frf_json():
     assert np.allclose(deg, inphase["pitch_deg_per_m"])
     acc = np.array(inphase["acceleration_m_s2_per_m"])
     assert np.allclose(acc, (2 * np.pi * f) ** 2 * np.array(inphase["bounce_m_per_m"]))
-    assert [m["label"] for m in doc["modes"]][:3] == ["carbody roll", "carbody bounce",
-                                                      "carbody pitch"]
+    assert [m["label"] for m in doc["modes"]][:3] == ["carbody roll", "carbody bounce", "carbody pitch"]
 
 
 def test_frf_one_pattern_and_table():
@@ -169,19 +263,21 @@ def test_frf_out_and_csv(tmp_path):
     assert frame.filter(like="phase_deg").abs().max().max() <= 180
     assert result.stdout == (out / "frf.csv").read_text()
     modes = pd.read_csv(out / "modes.csv")
-    assert list(modes.columns) == ["mode", "label", "frequency_hz", "damped_frequency_hz",
-                                   "damping_ratio"]
+    assert list(modes.columns) == ["mode", "label", "frequency_hz", "damped_frequency_hz", "damping_ratio"]
     assert list(modes["mode"]) == list(range(1, 10))
     assert json.loads((out / "frf.json").read_text())["settings"]["points"] == 40
 
 
-@pytest.mark.parametrize("args, fragment", [
-    (("--rails", "diagonal"), "--rails"),
-    (("--fmin", 0), "--fmin"),
-    (("--fmin", 5, "--fmax", 2), "--fmax = 2 Hz"),
-    (("--points", 1), "--points"),
-    (("--speed", -1), "--speed"),
-])
+@pytest.mark.parametrize(
+    "args, fragment",
+    [
+        (("--rails", "diagonal"), "--rails"),
+        (("--fmin", 0), "--fmin"),
+        (("--fmin", 5, "--fmax", 2), "--fmax = 2 Hz"),
+        (("--points", 1), "--points"),
+        (("--speed", -1), "--speed"),
+    ],
+)
 def test_frf_bad_input(args, fragment, tmp_path):
     assert_input_error(run("frf", *args, "--out", tmp_path / "x"), fragment)
     assert not (tmp_path / "x").exists()

@@ -66,8 +66,7 @@ def test_tune_gains_file_loads_and_compare_accepts_it(tuned):
     gains = GainSet.load(out / "gains.toml")
     assert gains.pid.to_dict() == doc["gains"]["pid"]
     assert gains.attitude.to_dict() == doc["gains"]["attitude"]
-    result = ok("compare", "--controllers", "pid", "--duration", 1, "--gains", out / "gains.toml",
-                "--format", "json")
+    result = ok("compare", "--controllers", "pid", "--duration", 1, "--gains", out / "gains.toml", "--format", "json")
     compared = json.loads(result.stdout)
     assert compared["gains"]["source"] == str(out / "gains.toml")
     assert compared["gains"]["pid"] == doc["gains"]["pid"]
@@ -92,8 +91,15 @@ def test_tune_existing_run_table_needs_resume(tuned):
 
 def test_tune_table_output():
     result = ok(*TUNE)
-    for fragment in ("objective after each pass", "Tuned gains", "pid.kd", "start", "tuned",
-                     "red. %", "acceleration (m/s^2)"):
+    for fragment in (
+        "objective after each pass",
+        "Tuned gains",
+        "pid.kd",
+        "start",
+        "tuned",
+        "red. %",
+        "acceleration (m/s^2)",
+    ):
         assert fragment in result.stdout, fragment
 
 
@@ -140,8 +146,7 @@ def test_tune_interrupted(tmp_path, monkeypatch):
     assert result.exit_code == 130, (result.stdout, result.stderr)
     n = table_rows(out / "runs.csv")
     assert n == 2  # the passive run and the start gains
-    assert (f"interrupted: {n} runs saved in {out / 'runs.csv'}; run again with --resume to "
-            "continue") in result.stderr
+    assert (f"interrupted: {n} runs saved in {out / 'runs.csv'}; run again with --resume to continue") in result.stderr
     assert "Traceback" not in result.output and result.stdout == ""
     assert not (out / "tune.json").exists()
     monkeypatch.setattr(sweep, "evaluate", real)
@@ -149,34 +154,37 @@ def test_tune_interrupted(tmp_path, monkeypatch):
     assert resumed["runs"] == resumed["runs_evaluated"] + n
 
 
-@pytest.mark.parametrize("args, fragments", [
-    (("--phase", "lqr"), ("--phase", "lqr", "allowed")),
-    (("--phase", "pid,,ride"), ("--phase", "empty item")),
-    (("--objective", "weighted", "--weights", "1,1,1"), ("--weights", "four numbers")),
-    (("--objective", "weighted", "--weights", "1,1,x,1"), ("--weights", "'x'")),
-    (("--objective", "weighted", "--weights", "1,-1,1,1"), ("--weights", "-1", ">= 0")),
-    (("--objective", "weighted", "--weights", "0,0,0,0"), ("--weights", "> 0")),
-    (("--objective", "weighted"), ("--objective weighted", "--weights")),
-    (("--objective", "sum", "--weights", "1,1,2,1"), ("--weights", "weighted only", "sum")),
-    (("--objective", "best"), ("--objective", "'best'", "sum, weighted, minimax, constrained")),
-    (("--objective", "constrained"), ("--objective constrained", "--bound")),
-    (("--objective", "constrained", "--bound", "0"), ("--bound", "'0'", "> 0")),
-    (("--objective", "constrained", "--bound", "-1.2"), ("--bound", "> 0")),
-    (("--objective", "constrained", "--bound", "x"), ("--bound", "'x'", "not a number")),
-    (("--objective", "constrained", "--bound", "inf"), ("--bound", "finite")),
-    (("--objective", "minimax", "--bound", "1.2"), ("--bound", "constrained only", "minimax")),
-    (("--penalty", "-1"), ("--penalty",)),
-    (("--penalty", "ten"), ("--penalty", "'ten'", "not a number")),
-    (("--phase", "inner,pid", "--damper", "ideal"), ("--damper", "ideal", "inner")),
-    (("--phase", "inner,pid", "--damper", "ideal-damper"), ("--damper", "ideal-damper", "inner")),
-    (("--values", "2"), ("--values = 2",)),
-    (("--span", "1"), ("--span",)),
-    (("--passes", "0"), ("--passes = 0",)),
-    (("--damper", "mr9"), ("--damper", "mr9")),
-    (("--resume",), ("--resume needs --out",)),
-    (("--workers", "0"), ("--workers = 0",)),
-    (("--scheduler", "tcp://h:1", "--scheduler-file", "f"), ("--scheduler",)),
-])
+@pytest.mark.parametrize(
+    "args, fragments",
+    [
+        (("--phase", "lqr"), ("--phase", "lqr", "allowed")),
+        (("--phase", "pid,,ride"), ("--phase", "empty item")),
+        (("--objective", "weighted", "--weights", "1,1,1"), ("--weights", "four numbers")),
+        (("--objective", "weighted", "--weights", "1,1,x,1"), ("--weights", "'x'")),
+        (("--objective", "weighted", "--weights", "1,-1,1,1"), ("--weights", "-1", ">= 0")),
+        (("--objective", "weighted", "--weights", "0,0,0,0"), ("--weights", "> 0")),
+        (("--objective", "weighted"), ("--objective weighted", "--weights")),
+        (("--objective", "sum", "--weights", "1,1,2,1"), ("--weights", "weighted only", "sum")),
+        (("--objective", "best"), ("--objective", "'best'", "sum, weighted, minimax, constrained")),
+        (("--objective", "constrained"), ("--objective constrained", "--bound")),
+        (("--objective", "constrained", "--bound", "0"), ("--bound", "'0'", "> 0")),
+        (("--objective", "constrained", "--bound", "-1.2"), ("--bound", "> 0")),
+        (("--objective", "constrained", "--bound", "x"), ("--bound", "'x'", "not a number")),
+        (("--objective", "constrained", "--bound", "inf"), ("--bound", "finite")),
+        (("--objective", "minimax", "--bound", "1.2"), ("--bound", "constrained only", "minimax")),
+        (("--penalty", "-1"), ("--penalty",)),
+        (("--penalty", "ten"), ("--penalty", "'ten'", "not a number")),
+        (("--phase", "inner,pid", "--damper", "ideal"), ("--damper", "ideal", "inner")),
+        (("--phase", "inner,pid", "--damper", "ideal-damper"), ("--damper", "ideal-damper", "inner")),
+        (("--values", "2"), ("--values = 2",)),
+        (("--span", "1"), ("--span",)),
+        (("--passes", "0"), ("--passes = 0",)),
+        (("--damper", "mr9"), ("--damper", "mr9")),
+        (("--resume",), ("--resume needs --out",)),
+        (("--workers", "0"), ("--workers = 0",)),
+        (("--scheduler", "tcp://h:1", "--scheduler-file", "f"), ("--scheduler",)),
+    ],
+)
 def test_tune_bad_input(args, fragments):
     assert_input_error(run(*TUNE, *args), *fragments)
 
@@ -184,25 +192,27 @@ def test_tune_bad_input(args, fragments):
 # -- sweep --------------------------------------------------------------------------------------
 def test_sweep_speed_range_times_suspensions(tmp_path):
     out = tmp_path / "sweep"
-    result = ok(*SWEEP, "--speed", "20:40:3", "--suspension", "passive,pid", "--out", out,
-                "--format", "json")
+    result = ok(*SWEEP, "--speed", "20:40:3", "--suspension", "passive,pid", "--out", out, "--format", "json")
     rows = json.loads(result.stdout)
     assert [(r["suspension"], r["speed_m_s"]) for r in rows] == [
-        (s, v) for s in ("passive", "pid") for v in (20.0, 30.0, 40.0)]
+        (s, v) for s in ("passive", "pid") for v in (20.0, 30.0, 40.0)
+    ]
     for r in rows:
         assert all(r[f"{k}_rms"] > 0 for k in RESPONSES)
     doc = json.loads((out / "sweep.json").read_text())
     assert doc["schema"] == "railride.sweep/1"
     assert doc["rows"] == rows
-    assert doc["settings"]["grid"] == {"suspension": ["passive", "pid"],
-                                       "speed_m_s": [20.0, 30.0, 40.0]}
+    assert doc["settings"]["grid"] == {"suspension": ["passive", "pid"], "speed_m_s": [20.0, 30.0, 40.0]}
     assert doc["columns"] == list(rows[0])
     assert table_rows(out / "runs.csv") == doc["runs"] == doc["runs_evaluated"] == 6
 
     # resume: nothing to run again; more speeds: only the new ones run
     assert_input_error(run(*SWEEP, "--speed", "20:40:3", "--out", out), "--resume")
-    again = json.loads(ok(*SWEEP, "--speed", "20:40:3", "--suspension", "passive,pid",
-                          "--out", out, "--resume", "--format", "json").stdout)
+    again = json.loads(
+        ok(
+            *SWEEP, "--speed", "20:40:3", "--suspension", "passive,pid", "--out", out, "--resume", "--format", "json"
+        ).stdout
+    )
     assert again == rows
     assert table_rows(out / "runs.csv") == 6
     ok(*SWEEP, "--speed", "20:50:4", "--suspension", "passive,pid", "--out", out, "--resume")
@@ -216,12 +226,31 @@ def test_sweep_prints_the_library_result(tmp_path):
     from railride.sweep import grid, run_sweep
 
     out = tmp_path / "sweep"
-    args = (*SWEEP, "--suspension", "passive,mr,pid", "--speed", "30,40", "--voltage", "0,passive-on",
-            "--gain", "pid.kd=1e5,4.5e5", "--damper-scale", "1,2")
+    args = (
+        *SWEEP,
+        "--suspension",
+        "passive,mr,pid",
+        "--speed",
+        "30,40",
+        "--voltage",
+        "0,passive-on",
+        "--gain",
+        "pid.kd=1e5,4.5e5",
+        "--damper-scale",
+        "1,2",
+    )
     rows = json.loads(ok(*args, "--out", out, "--format", "json").stdout)
     doc = json.loads((out / "sweep.json").read_text())
-    result = run_sweep(grid(["passive", "mr", "pid"], speed=[30, 40], voltage=[0, "passive-on"],
-                            gains={"pid.kd": [1e5, 4.5e5]}, damper_scale=[1, 2], duration=1))
+    result = run_sweep(
+        grid(
+            ["passive", "mr", "pid"],
+            speed=[30, 40],
+            voltage=[0, "passive-on"],
+            gains={"pid.kd": [1e5, 4.5e5]},
+            damper_scale=[1, 2],
+            duration=1,
+        )
+    )
     mine = result.to_dict()
     assert mine["rows"] == rows
     facts = ["runs_evaluated", "runs_per_second", "wall_time_s", "executor"]
@@ -231,8 +260,17 @@ def test_sweep_prints_the_library_result(tmp_path):
 
 
 def test_sweep_csv_and_table():
-    args = (*SWEEP, "--suspension", "passive,mr,pid", "--voltage", "0,2.25",
-            "--gain", "pid.kd=1e5,4.5e5", "--speed", "30,40")
+    args = (
+        *SWEEP,
+        "--suspension",
+        "passive,mr,pid",
+        "--voltage",
+        "0,2.25",
+        "--gain",
+        "pid.kd=1e5,4.5e5",
+        "--speed",
+        "30,40",
+    )
     frame = pd.read_csv(io.StringIO(ok(*args, "--format", "csv").stdout))
     # passive once per speed, mr per voltage, pid per kd value: no cross terms
     assert len(frame) == 2 + 2 * 2 + 2 * 2
@@ -245,48 +283,74 @@ def test_sweep_csv_and_table():
 
 
 def test_sweep_noise_seeds():
-    rows = json.loads(ok(*SWEEP, "--suspension", "passive,pid", "--noise", "1e-4,1e-5,1e-3,1e-4",
-                         "--seed", "0:1:2", "--format", "json").stdout)
+    rows = json.loads(
+        ok(
+            *SWEEP,
+            "--suspension",
+            "passive,pid",
+            "--noise",
+            "1e-4,1e-5,1e-3,1e-4",
+            "--seed",
+            "0:1:2",
+            "--format",
+            "json",
+        ).stdout
+    )
     assert [(r["suspension"], r["seed"]) for r in rows] == [("passive", None), ("pid", 0), ("pid", 1)]
     assert rows[1]["acceleration_m_s2_rms"] != rows[2]["acceleration_m_s2_rms"]
 
 
-@pytest.mark.parametrize("args, fragments", [
-    (("--speed", "20:40"), ("--speed", "START:STOP:COUNT")),
-    (("--speed", "20:40:0"), ("--speed", "COUNT = 0")),
-    (("--speed", "20:40:x"), ("--speed", "COUNT")),
-    (("--speed", "20,,40"), ("--speed", "empty item")),
-    (("--speed", "20,fast"), ("--speed", "'fast'")),
-    (("--wavelength", "60,60"), ("--wavelength", "twice")),
-    (("--suspension", "passive,lqr"), ("--suspension", "lqr")),
-    (("--voltage", "1"), ("--voltage", "mr only")),
-    (("--suspension", "mr", "--voltage", "9"), ("--voltage",)),
-    (("--gain", "pid.kd=1e4"), ("--gain", "controllers")),
-    (("--suspension", "pid", "--gain", "pid.kx=1"), ("--gain", "pid.kx")),
-    (("--suspension", "pid", "--gain", "lqr.q=1"), ("--gain", "lqr.q")),
-    (("--suspension", "pid", "--gain", "pid.kd"), ("--gain", "TABLE.ENTRY=VALUES")),
-    (("--suspension", "pid", "--gain", "ride.kp_1R=1"), ("--gain", "sas-attitude-ride")),
-    (("--suspension", "pid", "--gain", "pid.kd=1:2:0"), ("--gain", "COUNT = 0")),
-    (("--noise", "0,0,0,0"), ("--noise", "controllers")),
-    (("--suspension", "pid", "--seed", "1"), ("--seed", "--noise")),
-    (("--suspension", "pid", "--noise", "0,0,0,0", "--seed", "0.5"), ("--seed", "0.5")),
-    (("--resume",), ("--resume needs --out",)),
-    (("--workers", "0"), ("--workers = 0",)),
-])
+@pytest.mark.parametrize(
+    "args, fragments",
+    [
+        (("--speed", "20:40"), ("--speed", "START:STOP:COUNT")),
+        (("--speed", "20:40:0"), ("--speed", "COUNT = 0")),
+        (("--speed", "20:40:x"), ("--speed", "COUNT")),
+        (("--speed", "20,,40"), ("--speed", "empty item")),
+        (("--speed", "20,fast"), ("--speed", "'fast'")),
+        (("--wavelength", "60,60"), ("--wavelength", "twice")),
+        (("--suspension", "passive,lqr"), ("--suspension", "lqr")),
+        (("--voltage", "1"), ("--voltage", "mr only")),
+        (("--suspension", "mr", "--voltage", "9"), ("--voltage",)),
+        (("--gain", "pid.kd=1e4"), ("--gain", "controllers")),
+        (("--suspension", "pid", "--gain", "pid.kx=1"), ("--gain", "pid.kx")),
+        (("--suspension", "pid", "--gain", "lqr.q=1"), ("--gain", "lqr.q")),
+        (("--suspension", "pid", "--gain", "pid.kd"), ("--gain", "TABLE.ENTRY=VALUES")),
+        (("--suspension", "pid", "--gain", "ride.kp_1R=1"), ("--gain", "sas-attitude-ride")),
+        (("--suspension", "pid", "--gain", "pid.kd=1:2:0"), ("--gain", "COUNT = 0")),
+        (("--noise", "0,0,0,0"), ("--noise", "controllers")),
+        (("--suspension", "pid", "--seed", "1"), ("--seed", "--noise")),
+        (("--suspension", "pid", "--noise", "0,0,0,0", "--seed", "0.5"), ("--seed", "0.5")),
+        (("--resume",), ("--resume needs --out",)),
+        (("--workers", "0"), ("--workers = 0",)),
+    ],
+)
 def test_sweep_bad_input(args, fragments):
     assert_input_error(run(*SWEEP, *args), *fragments)
 
 
 def test_sweep_goes_on_past_a_diverged_run(tmp_path):
     # pid.kp = 1e12 on the ideal actuator diverges within the first steps; the other runs stand
-    result = ok("sweep", "--suspension", "pid", "--damper", "ideal", "--gain", "pid.kp=1e5,1e12",
-                "--duration", 1, "--out", tmp_path / "sw", "--format", "json")
+    result = ok(
+        "sweep",
+        "--suspension",
+        "pid",
+        "--damper",
+        "ideal",
+        "--gain",
+        "pid.kp=1e5,1e12",
+        "--duration",
+        1,
+        "--out",
+        tmp_path / "sw",
+        "--format",
+        "json",
+    )
     rows = json.loads(result.stdout)
     good, bad = rows
     assert good["diverged_at_s"] is None and good["acceleration_m_s2_rms"] > 0
     assert 0 < bad["diverged_at_s"] < 1 and bad["acceleration_m_s2_rms"] is None
     doc = json.loads((tmp_path / "sw" / "sweep.json").read_text())
     assert "diverged_at_s" in doc["columns"]
-    table = run("sweep", "--suspension", "pid", "--damper", "ideal", "--gain", "pid.kp=1e5,1e12",
-                "--duration", 1)
+    table = run("sweep", "--suspension", "pid", "--damper", "ideal", "--gain", "pid.kp=1e5,1e12", "--duration", 1)
     assert table.exit_code == 0 and "1 run diverged" in table.stdout

@@ -15,14 +15,18 @@ ROOT = Path(__file__).resolve().parents[2]
 
 def run_example(name: str, out: Path, *args: str) -> str:
     """Run examples/<name>.py from the repository root; return its standard output."""
-    proc = subprocess.run([sys.executable, f"examples/{name}.py", "--out", str(out), *args],
-                          cwd=ROOT, capture_output=True, text=True, timeout=300)
+    proc = subprocess.run(
+        [sys.executable, f"examples/{name}.py", "--out", str(out), *args],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     assert proc.returncode == 0, f"{name} failed:\n{proc.stdout}\n{proc.stderr}"
     return proc.stdout
 
 
-@pytest.mark.parametrize("name", ["paper_comparison", "speed_sweep_random_track",
-                                  "custom_vehicle", "damper_size"])
+@pytest.mark.parametrize("name", ["paper_comparison", "speed_sweep_random_track", "custom_vehicle", "damper_size"])
 def test_example_has_a_docstring_and_uses_no_private_names(name):
     text = (ROOT / "examples" / f"{name}.py").read_text()
     assert text.startswith('"""')
@@ -58,8 +62,9 @@ def test_custom_vehicle(tmp_path):
 def test_damper_size(tmp_path):
     out = run_example("damper_size", tmp_path / "size")
     for name in ("railway x 0.5", "railway x 1", "railway x 2", "railway x 4", "ideal-damper", "ideal"):
-        assert re.search(rf"^{re.escape(name)}\s+(\d\.\d{{3}}\s+){{4}}\d\.\d{{3}}$|^{re.escape(name)}\s+diverged",
-                         out, re.M), name
+        assert re.search(
+            rf"^{re.escape(name)}\s+(\d\.\d{{3}}\s+){{4}}\d\.\d{{3}}$|^{re.escape(name)}\s+diverged", out, re.M
+        ), name
     assert "Best MR size here" in out
     assert (tmp_path / "size" / "damper_size.csv").is_file()
 

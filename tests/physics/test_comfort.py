@@ -10,21 +10,74 @@ import pytest
 import xarray as xr
 
 from railride import comfort
-from railride.comfort import (ShortRunWarning, comfort_class, comfort_intervals, floor_acceleration,
-                              mean_comfort_vertical, ride_comfort, sperling_wz, to_dict, vdv, weight,
-                              weighted_rms, weighting)
+from railride.comfort import (
+    ShortRunWarning,
+    comfort_class,
+    comfort_intervals,
+    floor_acceleration,
+    mean_comfort_vertical,
+    ride_comfort,
+    sperling_wz,
+    to_dict,
+    vdv,
+    weight,
+    weighted_rms,
+    weighting,
+)
 
 RATE = 1000.0  # railride's default output rate
 
 # ISO 2631-1:1997 Table 3, weighting factors x 1000 at the nominal one-third-octave centres. The
 # table is computed at the nominal centres (at the exact centres 10^(n/10) the filter is up to
 # 1.4 % away) and rounded to three significant figures: tolerance 1 % of the table value.
-TABLE3_WK = {0.5: 418, 0.63: 459, 0.8: 477, 1: 482, 1.25: 484, 1.6: 494, 2: 531, 2.5: 631,
-             3.15: 804, 4: 967, 5: 1039, 6.3: 1054, 8: 1036, 10: 988, 12.5: 902, 16: 768,
-             20: 636, 25: 513, 31.5: 405, 40: 314, 50: 246, 63: 186, 80: 132}
-TABLE3_WD = {0.5: 853, 0.63: 944, 0.8: 992, 1: 1011, 1.25: 1008, 1.6: 968, 2: 890, 2.5: 776,
-             3.15: 642, 4: 512, 5: 409, 6.3: 323, 8: 253, 10: 212, 12.5: 161, 16: 125, 20: 100,
-             25: 80, 31.5: 63.2, 40: 49.4, 50: 38.8}
+TABLE3_WK = {
+    0.5: 418,
+    0.63: 459,
+    0.8: 477,
+    1: 482,
+    1.25: 484,
+    1.6: 494,
+    2: 531,
+    2.5: 631,
+    3.15: 804,
+    4: 967,
+    5: 1039,
+    6.3: 1054,
+    8: 1036,
+    10: 988,
+    12.5: 902,
+    16: 768,
+    20: 636,
+    25: 513,
+    31.5: 405,
+    40: 314,
+    50: 246,
+    63: 186,
+    80: 132,
+}
+TABLE3_WD = {
+    0.5: 853,
+    0.63: 944,
+    0.8: 992,
+    1: 1011,
+    1.25: 1008,
+    1.6: 968,
+    2: 890,
+    2.5: 776,
+    3.15: 642,
+    4: 512,
+    5: 409,
+    6.3: 323,
+    8: 253,
+    10: 212,
+    12.5: 161,
+    16: 125,
+    20: 100,
+    25: 80,
+    31.5: 63.2,
+    40: 49.4,
+    50: 38.8,
+}
 # ISO 2631-1 Table 4 (Wc, We) as transcribed in a public repository, not checked against the
 # printed standard; a selection across the band.
 TABLE4_WC = {0.5: 843, 1: 991, 2: 1012, 4: 1024, 6.3: 974, 10: 776, 16: 512, 31.5: 256, 80: 84.4}
@@ -34,16 +87,16 @@ TABLE_RTOL = 0.01
 # The one table value that disagrees with the exact filter: Wd at 10 Hz prints 212, the filter
 # gives 201.7 (-4.9 %). Its neighbours agree to 0.3 %, the curve falls as ~1/f there
 # (253 * 8/10 = 202), and We at 5 Hz, the same curve an octave down, reads 202.
-DISAGREES = {("Wd", 10): "Table 3 prints 212, the exact Wd filter gives 201.7 (-4.9 %); "
-                         "likely a misprint for 202 (see docs/comfort.md)"}
+DISAGREES = {
+    ("Wd", 10): "Table 3 prints 212, the exact Wd filter gives 201.7 (-4.9 %); "
+    "likely a misprint for 202 (see docs/comfort.md)"
+}
 
 
 def _table_cases():
-    for name, table in (("Wk", TABLE3_WK), ("Wd", TABLE3_WD), ("Wc", TABLE4_WC),
-                        ("We", TABLE4_WE)):
+    for name, table in (("Wk", TABLE3_WK), ("Wd", TABLE3_WD), ("Wc", TABLE4_WC), ("We", TABLE4_WE)):
         for f, value in table.items():
-            marks = ([pytest.mark.xfail(strict=True, reason=DISAGREES[(name, f)])]
-                     if (name, f) in DISAGREES else [])
+            marks = [pytest.mark.xfail(strict=True, reason=DISAGREES[(name, f)])] if (name, f) in DISAGREES else []
             yield pytest.param(name, f, value, marks=marks, id=f"{name}-{f}Hz")
 
 
@@ -81,7 +134,7 @@ def _steady_amplitude(name, freqs, rate=RATE, settle=20.0, span=10.0):
     over a whole number of periods."""
     t = np.arange(int((settle + span) * rate)) / rate
     x = np.sin(2 * np.pi * np.asarray(freqs)[:, None] * t)
-    y = weight(name, x, rate)[:, int(settle * rate):]
+    y = weight(name, x, rate)[:, int(settle * rate) :]
     return np.sqrt(2 * np.mean(y * y, axis=-1))
 
 
@@ -164,8 +217,7 @@ def _wz_by_hand(a_m_s2, f):
 
 def test_sperling_of_one_sine():
     A, f = 0.5, 2.0  # 50 cm/s^2 at 2 Hz: F = 0.325 * 4 = 1.3
-    assert sperling_wz(_sine(A, f, 10.0), RATE) == pytest.approx(0.896 * (50**3 * 1.3 / 2) ** 0.1,
-                                                                  rel=1e-9)
+    assert sperling_wz(_sine(A, f, 10.0), RATE) == pytest.approx(0.896 * (50**3 * 1.3 / 2) ** 0.1, rel=1e-9)
 
 
 def test_sperling_of_two_sines_is_the_tenth_power_sum():
@@ -185,6 +237,7 @@ def test_signal_functions_take_a_batch():
 
 
 # -- bad input ------------------------------------------------------------------------------------
+
 
 def test_unknown_weighting_is_refused():
     with pytest.raises(ValueError, match="unknown frequency weighting 'Wx'.*Wk"):
@@ -227,11 +280,14 @@ def _run(duration=12.0, acc=(0.3, 1.5), pitch=(0.01, 0.9), rate=RATE):
     """A Dataset shaped like simulate's: carbody CG acceleration A sin(2 pi f t) and pitch
     velocity B sin(2 pi g t), so the pitch acceleration is 2 pi g B cos(2 pi g t)."""
     t = np.arange(int(duration * rate) + 1) / rate
-    return xr.Dataset({
-        "carbody_acceleration": ("time", acc[0] * np.sin(2 * np.pi * acc[1] * t)),
-        "carbody_pitch_velocity": ("time", pitch[0] * np.sin(2 * np.pi * pitch[1] * t)),
-        "vehicle_params": ((), json.dumps({"l": L, "m_c": 3.4e4})),
-    }, coords={"time": t})
+    return xr.Dataset(
+        {
+            "carbody_acceleration": ("time", acc[0] * np.sin(2 * np.pi * acc[1] * t)),
+            "carbody_pitch_velocity": ("time", pitch[0] * np.sin(2 * np.pi * pitch[1] * t)),
+            "vehicle_params": ((), json.dumps({"l": L, "m_c": 3.4e4})),
+        },
+        coords={"time": t},
+    )
 
 
 def _pitch_acc(ds, pitch=(0.01, 0.9)):
@@ -267,8 +323,7 @@ def test_ride_comfort_of_a_run():
     assert float(centre.sel(index="N_MV_z")) == pytest.approx(mean_comfort_vertical(a, RATE))
     assert out.attrs["n_intervals"] == 2
     front = a - L * _pitch_acc(ds)
-    assert float(out.sel(position="front", index="vdv_Wb")) == pytest.approx(
-        vdv(front, RATE, weighting="Wb"), rel=1e-4)
+    assert float(out.sel(position="front", index="vdv_Wb")) == pytest.approx(vdv(front, RATE, weighting="Wb"), rel=1e-4)
     d = to_dict(out)
     assert set(d) == {"centre", "front", "rear"} and set(d["rear"]) == set(out["index"].values)
     assert json.loads(json.dumps(out.to_dict()))["name"] == "ride_comfort"
@@ -281,21 +336,20 @@ def test_ride_comfort_prefers_a_pitch_acceleration_channel():
     out = ride_comfort(exact)
     assert out.attrs["pitch_acceleration"] == "carbody_pitch_acceleration channel"
     front = ds.carbody_acceleration.values - L * _pitch_acc(ds)
-    assert float(out.sel(position="front", index="aw_Wk")) == pytest.approx(
-        weighted_rms(front, RATE), rel=1e-12)
+    assert float(out.sel(position="front", index="aw_Wk")) == pytest.approx(weighted_rms(front, RATE), rel=1e-12)
     assert ride_comfort(ds).attrs["pitch_acceleration"].startswith("central difference")
 
 
 def test_ride_comfort_positions_window_and_short_runs():
     ds = _run()
-    out = ride_comfort(ds, positions={"seat_row_3": 4.5, "end": "rear"}, window=(2.0, 12.0),
-                       weightings=("Wk",))
+    out = ride_comfort(ds, positions={"seat_row_3": 4.5, "end": "rear"}, window=(2.0, 12.0), weightings=("Wk",))
     assert list(out.position.values) == ["seat_row_3", "end"]
     assert list(out.x_m.values) == [4.5, -L]
     assert list(out["index"].values) == ["aw_Wk", "vdv_Wk", "N_MV_z", "Wz"]
     a = ds.carbody_acceleration.values - 4.5 * _pitch_acc(ds)
     assert float(out.sel(position="seat_row_3", index="aw_Wk")) == pytest.approx(
-        weighted_rms(a, RATE, window=(2.0, math.inf)), rel=1e-4)
+        weighted_rms(a, RATE, window=(2.0, math.inf)), rel=1e-4
+    )
     assert out.attrs["n_intervals"] == 2
     short = ride_comfort(_run(duration=3.0))
     assert short.attrs["n_intervals"] == 1 and "5 s" in short.attrs["notes"]

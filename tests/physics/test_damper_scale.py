@@ -34,11 +34,11 @@ def test_scaled_damper_gives_factor_times_the_force_on_the_rig(name, factor):
     F = a["F"].values
     assert np.abs(F).max() > 100.0
     np.testing.assert_allclose(b["F"].values, factor * F, rtol=0, atol=1e-9 * np.abs(F).max())
-    np.testing.assert_allclose(b["E"].values, factor * a["E"].values, rtol=0,
-                               atol=1e-9 * np.abs(a["E"].values).max())
+    np.testing.assert_allclose(b["E"].values, factor * a["E"].values, rtol=0, atol=1e-9 * np.abs(a["E"].values).max())
     for state in ("z", "y", "u"):
-        np.testing.assert_allclose(b[state].values, a[state].values, rtol=0,
-                                   atol=1e-9 * max(np.abs(a[state].values).max(), 1e-30))
+        np.testing.assert_allclose(
+            b[state].values, a[state].values, rtol=0, atol=1e-9 * max(np.abs(a[state].values).max(), 1e-30)
+        )
 
 
 def test_scaled_damper_tracks_a_scaled_demand_with_the_inverse_gain():
@@ -46,8 +46,7 @@ def test_scaled_damper_tracks_a_scaled_demand_with_the_inverse_gain():
     factor times larger and G is divided by factor: the tracked force scales exactly."""
     base, factor = dampers.preset("railway"), 3.0
     a = rig.track(base, "sine", amplitude=8e3, frequency=1.0, G=1e-3)
-    b = rig.track(base.scaled(factor), "sine", amplitude=factor * 8e3, frequency=1.0,
-                  G=1e-3 / factor)
+    b = rig.track(base.scaled(factor), "sine", amplitude=factor * 8e3, frequency=1.0, G=1e-3 / factor)
     Fa, Fb = a.dataset["F"].values, b.dataset["F"].values
     np.testing.assert_allclose(Fb, factor * Fa, rtol=0, atol=1e-9 * np.abs(Fa).max())
 
@@ -96,38 +95,42 @@ def test_case_scale_is_part_of_the_key_and_the_group():
     assert passive.group == Case(scenario_options=SHORT, damper="dyke1996").group
 
 
-@pytest.mark.parametrize("kwargs, match", [
-    ({"suspension": "pid", "damper_scale": 0.0}, "damper_scale = 0.*> 0"),
-    ({"suspension": "pid", "damper_scale": -1.0}, "damper_scale = -1"),
-    ({"suspension": "mr", "damper_scale": math.nan}, "damper_scale = nan"),
-    ({"suspension": "passive", "damper_scale": 2.0}, "damper_scale = 2: the passive"),
-    ({"suspension": "pid", "damper": "ideal", "damper_scale": 2.0}, "damper_scale = 2: the ideal"),
-    ({"suspension": "mr", "damper": "ideal"}, "ideal.*mr"),
-    ({"suspension": "pid", "damper": "mr9"}, "unknown damper model 'mr9'"),
-])
+@pytest.mark.parametrize(
+    "kwargs, match",
+    [
+        ({"suspension": "pid", "damper_scale": 0.0}, "damper_scale = 0.*> 0"),
+        ({"suspension": "pid", "damper_scale": -1.0}, "damper_scale = -1"),
+        ({"suspension": "mr", "damper_scale": math.nan}, "damper_scale = nan"),
+        ({"suspension": "passive", "damper_scale": 2.0}, "damper_scale = 2: the passive"),
+        ({"suspension": "pid", "damper": "ideal", "damper_scale": 2.0}, "damper_scale = 2: the ideal"),
+        ({"suspension": "mr", "damper": "ideal"}, "ideal.*mr"),
+        ({"suspension": "pid", "damper": "mr9"}, "unknown damper model 'mr9'"),
+    ],
+)
 def test_case_refuses_a_meaningless_scale(kwargs, match):
     with pytest.raises(ValueError, match=match):
         Case(**kwargs)
 
 
 def test_run_cases_runs_the_scaled_damper():
-    cases = [Case(scenario_options=SHORT, suspension="mr", voltage=1.0, damper_scale=x)
-             for x in (1.0, 2.0)]
+    cases = [Case(scenario_options=SHORT, suspension="mr", voltage=1.0, damper_scale=x) for x in (1.0, 2.0)]
     rows = run_cases(cases)
     assert list(rows["damper_scale"]) == [1.0, 2.0]
-    direct = simulate(scenario("paper-sine", **SHORT),
-                      suspension=Suspension.semi_active(dampers.preset("railway").scaled(2.0), voltage=1.0)).metrics()
+    direct = simulate(
+        scenario("paper-sine", **SHORT),
+        suspension=Suspension.semi_active(dampers.preset("railway").scaled(2.0), voltage=1.0),
+    ).metrics()
     got = rows.iloc[1]["acceleration_m_s2_rms"]
-    assert got == pytest.approx(float(direct.sel(response="acceleration_m_s2", statistic="rms")),
-                                rel=1e-12)
+    assert got == pytest.approx(float(direct.sel(response="acceleration_m_s2", statistic="rms")), rel=1e-12)
     assert got != pytest.approx(rows.iloc[0]["acceleration_m_s2_rms"], rel=1e-3)
 
 
 # -- the command line -----------------------------------------------------------------------------
 
 
-@pytest.mark.parametrize("command", [("compare",), ("simulate", "--suspension", "mr"),
-                                     ("sweep", "--suspension", "pid")])
+@pytest.mark.parametrize(
+    "command", [("compare",), ("simulate", "--suspension", "mr"), ("sweep", "--suspension", "pid")]
+)
 @pytest.mark.parametrize("value", ["-1", "0", "nan", "inf"])
 def test_cli_damper_scale_must_be_a_positive_number(command, value):
     result = run(*command, "--damper-scale", value)
@@ -137,38 +140,62 @@ def test_cli_damper_scale_must_be_a_positive_number(command, value):
         assert_input_error(result, f"error: --damper-scale = {value}: must be a finite number > 0")
 
 
-@pytest.mark.parametrize("args, fragments", [
-    (("simulate", "--damper-scale", 2), ("--damper-scale applies to --suspension mr only",)),
-    (("sweep", "--damper-scale", "1,2"), ("--damper-scale = '1,2'", "mr and the controllers")),
-    (("sweep", "--suspension", "pid", "--damper-scale", "1,2,1"), ("1 is listed twice",)),
-    (("sweep", "--suspension", "pid", "--damper-scale", "1,x"), ("'x' is not a number",)),
-])
+@pytest.mark.parametrize(
+    "args, fragments",
+    [
+        (("simulate", "--damper-scale", 2), ("--damper-scale applies to --suspension mr only",)),
+        (("sweep", "--damper-scale", "1,2"), ("--damper-scale = '1,2'", "mr and the controllers")),
+        (("sweep", "--suspension", "pid", "--damper-scale", "1,2,1"), ("1 is listed twice",)),
+        (("sweep", "--suspension", "pid", "--damper-scale", "1,x"), ("'x' is not a number",)),
+    ],
+)
 def test_cli_damper_scale_where_it_does_not_apply(args, fragments):
     assert_input_error(run(*args), *fragments)
 
 
 def test_cli_simulate_and_compare_record_the_scale():
-    result = run("simulate", "--suspension", "mr", "--damper-scale", 2, "--voltage", 1,
-                 "--duration", 0.5, "--format", "json")
+    result = run(
+        "simulate", "--suspension", "mr", "--damper-scale", 2, "--voltage", 1, "--duration", 0.5, "--format", "json"
+    )
     assert result.exit_code == 0, result.stderr
-    assert json.loads(result.stdout)["suspension"] == {"type": "mr", "damper": "railway",
-                                                       "voltage_v": 1.0, "damper_scale": 2.0}
+    assert json.loads(result.stdout)["suspension"] == {
+        "type": "mr",
+        "damper": "railway",
+        "voltage_v": 1.0,
+        "damper_scale": 2.0,
+    }
     table = run("simulate", "--suspension", "mr", "--damper-scale", 2, "--duration", 0.5)
     assert "force x 2" in table.stdout
-    result = run("compare", "--controllers", "pid", "--damper-scale", 0.5, "--duration", 0.5,
-                 "--format", "json")
+    result = run("compare", "--controllers", "pid", "--damper-scale", 0.5, "--duration", 0.5, "--format", "json")
     assert result.exit_code == 0, result.stderr
     assert json.loads(result.stdout)["settings"]["damper_scale"] == 0.5
 
 
 def test_cli_sweep_over_the_damper_scale(tmp_path):
     out = tmp_path / "s"
-    result = run("sweep", "--suspension", "sas-attitude,passive,mr", "--damper-scale", "0.5,2",
-                 "--duration", 0.5, "--no-comfort", "--format", "json", "--out", out)
+    result = run(
+        "sweep",
+        "--suspension",
+        "sas-attitude,passive,mr",
+        "--damper-scale",
+        "0.5,2",
+        "--duration",
+        0.5,
+        "--no-comfort",
+        "--format",
+        "json",
+        "--out",
+        out,
+    )
     assert result.exit_code == 0, result.stderr
     rows = json.loads(result.stdout)
     assert [(r["suspension"], r["damper_scale"]) for r in rows] == [
-        ("sas-attitude", 0.5), ("sas-attitude", 2.0), ("passive", None), ("mr", 0.5), ("mr", 2.0)]
+        ("sas-attitude", 0.5),
+        ("sas-attitude", 2.0),
+        ("passive", None),
+        ("mr", 0.5),
+        ("mr", 2.0),
+    ]
     doc = json.loads((out / "sweep.json").read_text())
     assert doc["settings"]["grid"]["damper_scale"] == [0.5, 2.0]
     assert (out / "sweep.png").read_bytes().startswith(b"\x89PNG")
@@ -177,8 +204,6 @@ def test_cli_sweep_over_the_damper_scale(tmp_path):
     assert "damper_scale" in table[0].split(",")
 
 
-@pytest.mark.parametrize("command", [("compare",), ("tune", "--phase", "pid"),
-                                     ("simulate", "--suspension", "mr")])
+@pytest.mark.parametrize("command", [("compare",), ("tune", "--phase", "pid"), ("simulate", "--suspension", "mr")])
 def test_cli_damper_scale_that_is_not_a_number(command):
-    assert_input_error(run(*command, "--damper-scale", "abc"), "--damper-scale = 'abc'",
-                       "must be a finite number > 0")
+    assert_input_error(run(*command, "--damper-scale", "abc"), "--damper-scale = 'abc'", "must be a finite number > 0")

@@ -43,7 +43,8 @@ def test_presets_follow_the_published_values():
     assert (r.alpha_a + 2.25 * r.alpha_b) * r.z_bound == pytest.approx(19.6e3, rel=0.01)
     s = dampers.SPENCER1997  # Table 1 of Spencer et al. (1997), in N and cm
     assert (s.c0a, s.c1a, s.alpha_b, s.gamma, s.A, s.n, s.eta) == pytest.approx(
-        (21.0e2, 283e2, 695e2, 363e4, 301, 2, 190))
+        (21.0e2, 283e2, 695e2, 363e4, 301, 2, 190)
+    )
 
 
 def test_every_cycle_dissipates_energy(steady):
@@ -81,8 +82,9 @@ def test_hysteretic_variable_stays_within_its_analytic_bound(name):
 def test_coil_voltage_lags_the_command_with_time_constant_one_over_eta(name):
     d = dampers.preset(name)
     tau = 1.0 / d.eta
-    ds = rig.drive(d, rig.SineMotion(0.0, 1.0), duration=5 * tau, dt=tau / 400,
-                   command=lambda t: np.full_like(t, d.v_max))
+    ds = rig.drive(
+        d, rig.SineMotion(0.0, 1.0), duration=5 * tau, dt=tau / 400, command=lambda t: np.full_like(t, d.v_max)
+    )
     u = ds.u.values
     t = ds.time.values
     assert np.allclose(u, d.v_max * (1 - np.exp(-t / tau)), rtol=0, atol=1e-9 * d.v_max)
@@ -112,8 +114,10 @@ def test_step_halving_converges_at_the_default_step(name):
     d = dampers.preset(name)
     amp, f = MODELS[name]
     steps = (1e-4, 5e-5, 2.5e-5, 1.25e-5)
-    runs = {dt: rig.drive(d, rig.SineMotion(amp, f), duration=0.5, voltage=1.0, dt=dt,
-                          output_rate=500).F.values for dt in steps + (1.5625e-6,)}
+    runs = {
+        dt: rig.drive(d, rig.SineMotion(amp, f), duration=0.5, voltage=1.0, dt=dt, output_rate=500).F.values
+        for dt in steps + (1.5625e-6,)
+    }
     fine = runs[1.5625e-6]
     errors = [np.abs(runs[dt] - fine).max() / np.abs(fine).max() for dt in steps]
     assert all(b < a for a, b in zip(errors, errors[1:])), errors
@@ -137,8 +141,15 @@ finite = st.floats(min_value=-1.0, max_value=1.0, allow_nan=False)
 
 
 @settings(max_examples=200, deadline=None)
-@given(name=st.sampled_from(list(MODELS)), x=finite, xd=finite, z=finite, y=finite,
-       u=st.floats(0, 2.25), v=st.floats(0, 2.25))
+@given(
+    name=st.sampled_from(list(MODELS)),
+    x=finite,
+    xd=finite,
+    z=finite,
+    y=finite,
+    u=st.floats(0, 2.25),
+    v=st.floats(0, 2.25),
+)
 def test_compiled_law_equals_the_numpy_law(name, x, xd, z, y, u, v):
     d = dampers.preset(name)
     z = z * d.z_bound
@@ -169,8 +180,9 @@ def test_viscous_model_as_a_force_equals_the_passive_dashpots():
 
 
 def test_mr_vehicle_records_damper_states_and_respects_the_bound():
-    ds = simulate(scenario("paper-sine", duration=2.0),
-                  suspension=Suspension.semi_active("railway", voltage=2.25)).dataset
+    ds = simulate(
+        scenario("paper-sine", duration=2.0), suspension=Suspension.semi_active("railway", voltage=2.25)
+    ).dataset
     assert float(abs(ds.damper_hysteretic_z).max()) <= dampers.RAILWAY.z_bound * (1 + 1e-9)
     assert np.allclose(ds.damper_voltage, 2.25) and np.allclose(ds.damper_command_voltage, 2.25)
     # the damper force on the carbody opposes the deflection rate on average: it dissipates
@@ -178,24 +190,30 @@ def test_mr_vehicle_records_damper_states_and_respects_the_bound():
     assert np.all(power < 0)
 
 
-@pytest.mark.parametrize("kwargs, match", [
-    ({"damper": "magic"}, "unknown damper model"),
-    ({"damper": "railway", "voltage": 3.0}, r"voltage = 3.0 V: must lie in \[0, 2.25\]"),
-    ({"damper": "railway", "voltage": float("nan")}, "voltage"),
-    ({"voltage": 1.0}, "MR dampers only"),
-])
+@pytest.mark.parametrize(
+    "kwargs, match",
+    [
+        ({"damper": "magic"}, "unknown damper model"),
+        ({"damper": "railway", "voltage": 3.0}, r"voltage = 3.0 V: must lie in \[0, 2.25\]"),
+        ({"damper": "railway", "voltage": float("nan")}, "voltage"),
+        ({"voltage": 1.0}, "MR dampers only"),
+    ],
+)
 def test_bad_damper_input_is_refused(kwargs, match):
     with pytest.raises(ValueError, match=match):  # the suspension's checks, at construction
         Suspension(**kwargs)
 
 
-@pytest.mark.parametrize("change, match", [
-    ({"eta": -1.0}, "'eta' = -1.0"),
-    ({"n": 0.5}, "'n' = 0.5"),
-    ({"gamma": -400.0}, "gamma \\+ beta must be > 0"),
-    ({"v_max": 0.0}, "'v_max' = 0.0"),
-    ({"alpha_a": float("nan")}, "'alpha_a' = nan"),
-])
+@pytest.mark.parametrize(
+    "change, match",
+    [
+        ({"eta": -1.0}, "'eta' = -1.0"),
+        ({"n": 0.5}, "'n' = 0.5"),
+        ({"gamma": -400.0}, "gamma \\+ beta must be > 0"),
+        ({"v_max": 0.0}, "'v_max' = 0.0"),
+        ({"alpha_a": float("nan")}, "'alpha_a' = nan"),
+    ],
+)
 def test_bad_damper_parameters_name_the_field(change, match):
     with pytest.raises(ValueError, match=match):
         dampers.RAILWAY.replace(**change)

@@ -26,8 +26,7 @@ from clihelp import runner
 
 PARAMS = VehicleParams.preset("paper")
 #: bump on the left rail only: heave, pitch and roll all move
-BUMP = Scenario(CosineBump(height=0.02, length=10.0, start=5.0, rails="left"), speed=40.0,
-                duration=1.5, name="bump")
+BUMP = Scenario(CosineBump(height=0.02, length=10.0, start=5.0, rails="left"), speed=40.0, duration=1.5, name="bump")
 
 
 def _carbody(ds) -> np.ndarray:
@@ -56,8 +55,7 @@ def test_ideal_force_equals_the_held_demand_exactly(ideal_batch):
 
 def test_ideal_dataset_has_no_voltage_or_damper_state_channels(ideal_batch):
     _, ds = ideal_batch
-    for name in ("damper_voltage", "damper_command_voltage", "damper_hysteretic_z",
-                 "damper_internal_displacement"):
+    for name in ("damper_voltage", "damper_command_voltage", "damper_hysteretic_z", "damper_internal_displacement"):
         assert name not in ds
     assert json.loads(ds.attrs["damper"])["model"] == "ideal"
     assert json.loads(ds.attrs["inner_loop"]) is None  # no inner loop in use
@@ -74,13 +72,19 @@ def test_ideal_demand_is_the_previous_sample_held_for_a_period(ideal_batch):
     for i, ctrl in enumerate(ctrls):
         part = ds.isel(sample=i)
         G, H = ctrl.gains(vehicle)
-        m = np.column_stack([_carbody(part), part["carbody_bounce_velocity"],
-                             part["carbody_pitch_velocity"], part["carbody_roll_velocity"]])
+        m = np.column_stack(
+            [
+                _carbody(part),
+                part["carbody_bounce_velocity"],
+                part["carbody_pitch_velocity"],
+                part["carbody_roll_velocity"],
+            ]
+        )
         ticks = m[::per]  # the states the controller sampled
         xi = tc * np.cumsum(ticks[:, :3], axis=0)
         expected = ticks @ G.T + xi @ H.T  # computed at tick k, in effect from tick k + 1
         fd = part["damper_demand_force"].values
-        held = np.repeat(np.vstack([np.zeros((1, 4)), expected[:-1]]), per, axis=0)[:len(fd)]
+        held = np.repeat(np.vstack([np.zeros((1, 4)), expected[:-1]]), per, axis=0)[: len(fd)]
         scale = np.abs(fd).max()
         np.testing.assert_allclose(fd, held, rtol=0, atol=1e-9 * scale)
 
@@ -113,8 +117,7 @@ def test_ideal_skyhook_matches_a_linear_closed_loop_model_integrated_by_solve_iv
     vehicle = Vehicle(PARAMS)
     c = 4 * PARAMS.c_sz  # the passive secondary damping of the whole car, in heave
     l, d_s = float(vehicle.T[1, 2]), float(vehicle.T[2, 1])  # rear pitch arm, left roll arm
-    ctrl = SAS(Attitude(kp_z=0.0, kd_z=c, kp_phi=0.0, kd_phi=c * l**2, kp_theta=0.0,
-                        kd_theta=c * d_s**2))
+    ctrl = SAS(Attitude(kp_z=0.0, kd_z=c, kp_phi=0.0, kd_phi=c * l**2, kp_theta=0.0, kd_theta=c * d_s**2))
     ds = simulate(BUMP, PARAMS, Suspension.ideal(ctrl), solver=SolverSettings(dt=dt, control_rate=1.0 / dt)).dataset
     t = ds["time"].values
 
@@ -143,8 +146,17 @@ def test_ideal_skyhook_matches_a_linear_closed_loop_model_integrated_by_solve_iv
         return np.concatenate([rate, dv, da])
 
     def integrate(gain):
-        sol = solve_ivp(rhs, (0.0, t[-1]), np.zeros(36), method="DOP853", rtol=1e-10,
-                        atol=1e-14, t_eval=t, args=(gain,), max_step=0.005)
+        sol = solve_ivp(
+            rhs,
+            (0.0, t[-1]),
+            np.zeros(36),
+            method="DOP853",
+            rtol=1e-10,
+            atol=1e-14,
+            t_eval=t,
+            args=(gain,),
+            max_step=0.005,
+        )
         assert sol.success
         return sol.y[:3].T, sol.y[18:21].T
 
@@ -174,12 +186,15 @@ def test_compare_with_the_ideal_actuator_records_it_and_has_no_voltages():
 
 
 # -- (c) bad input ------------------------------------------------------------------------------
-@pytest.mark.parametrize("kwargs, match", [
-    ({"damper": "ideal"}, "ideal.*controller"),
-    ({"damper": "ideal", "voltage": 1.0}, "ideal.*controller.*voltage"),
-    ({"damper": dampers.Ideal()}, "ideal.*controller"),
-    ({"damper": "ideal", "voltage": 1.0, "controller": PID(1.0, 0.0, 1.0)}, "either voltage"),
-])
+@pytest.mark.parametrize(
+    "kwargs, match",
+    [
+        ({"damper": "ideal"}, "ideal.*controller"),
+        ({"damper": "ideal", "voltage": 1.0}, "ideal.*controller.*voltage"),
+        ({"damper": dampers.Ideal()}, "ideal.*controller"),
+        ({"damper": "ideal", "voltage": 1.0, "controller": PID(1.0, 0.0, 1.0)}, "either voltage"),
+    ],
+)
 def test_ideal_actuator_without_a_controller_is_refused(kwargs, match):
     with pytest.raises(ValueError, match=match):  # the suspension's checks, at construction
         Suspension(**kwargs)
@@ -211,24 +226,42 @@ def _input_error(args, *fragments):
         assert fragment in lines[0], lines[0]
 
 
-@pytest.mark.parametrize("args, fragments", [
-    (("simulate", "--suspension", "mr", "--damper", "ideal"), ("--damper = 'ideal'", "controller")),
-    (("damper", "--model", "ideal", "--amplitude", 0.01, "--frequency", 1, "--voltage", 0),
-     ("--model = 'ideal'", "rig", "allowed: dyke1996, railway, spencer1997")),
-    (("tracking", "--model", "ideal"), ("--model = 'ideal'", "rig")),
-    (("compare", "--damper", "ideal", "--damper-scale", 2), ("--damper-scale = 2", "ideal")),
-    (("sweep", "--suspension", "mr,pid", "--damper", "ideal"), ("--damper = 'ideal'", "mr")),
-    (("sweep", "--suspension", "pid", "--damper", "ideal", "--damper-scale", "1,2"),
-     ("--damper-scale", "ideal")),
-    (("compare", "--damper", "ideal2"), ("--damper = 'ideal2'", "unknown damper model", "ideal")),
-])
+@pytest.mark.parametrize(
+    "args, fragments",
+    [
+        (("simulate", "--suspension", "mr", "--damper", "ideal"), ("--damper = 'ideal'", "controller")),
+        (
+            ("damper", "--model", "ideal", "--amplitude", 0.01, "--frequency", 1, "--voltage", 0),
+            ("--model = 'ideal'", "rig", "allowed: dyke1996, railway, spencer1997"),
+        ),
+        (("tracking", "--model", "ideal"), ("--model = 'ideal'", "rig")),
+        (("compare", "--damper", "ideal", "--damper-scale", 2), ("--damper-scale = 2", "ideal")),
+        (("sweep", "--suspension", "mr,pid", "--damper", "ideal"), ("--damper = 'ideal'", "mr")),
+        (("sweep", "--suspension", "pid", "--damper", "ideal", "--damper-scale", "1,2"), ("--damper-scale", "ideal")),
+        (("compare", "--damper", "ideal2"), ("--damper = 'ideal2'", "unknown damper model", "ideal")),
+    ],
+)
 def test_cli_ideal_actuator_input_errors(args, fragments):
     _input_error(args, *fragments)
 
 
 def test_cli_compare_with_the_ideal_actuator(tmp_path):
-    result = runner.invoke(app, ["compare", "--damper", "ideal", "--controllers", "sas-attitude",
-                                 "--duration", "1", "--format", "json", "--out", str(tmp_path / "c")])
+    result = runner.invoke(
+        app,
+        [
+            "compare",
+            "--damper",
+            "ideal",
+            "--controllers",
+            "sas-attitude",
+            "--duration",
+            "1",
+            "--format",
+            "json",
+            "--out",
+            str(tmp_path / "c"),
+        ],
+    )
     assert result.exit_code == 0, result.stderr
     doc = json.loads(result.stdout)
     assert doc["settings"]["damper"] == "ideal"
@@ -236,10 +269,15 @@ def test_cli_compare_with_the_ideal_actuator(tmp_path):
     assert "damper_demand_force_1R" in header
     assert not any(c.startswith("damper_command_voltage") for c in header)
     row = next(r for r in doc["controllers"] if r["name"] == "sas-attitude")
-    assert set(row["damper"]) == {"force_rms_n", "force_max_n", "travel_rms_m", "travel_max_m",
-                                  "demand_rms_n", "demand_max_n"}
-    table = runner.invoke(app, ["compare", "--damper", "ideal", "--controllers", "sas-attitude",
-                                "--duration", "1"])
+    assert set(row["damper"]) == {
+        "force_rms_n",
+        "force_max_n",
+        "travel_rms_m",
+        "travel_max_m",
+        "demand_rms_n",
+        "demand_max_n",
+    }
+    table = runner.invoke(app, ["compare", "--damper", "ideal", "--controllers", "sas-attitude", "--duration", "1"])
     assert table.exit_code == 0, table.stderr
     assert "ideal actuators (force = demand)" in table.stdout
 
@@ -248,8 +286,9 @@ def test_cli_compare_with_the_ideal_actuator(tmp_path):
 def test_ideal_damper_applies_the_demand_only_where_it_dissipates():
     g = GainSet.reference()
     ctrls = [g.controller(n) for n in ("pid", "sas-attitude", "sas-attitude-ride")]
-    ds = simulate(BUMP, PARAMS, [Suspension.ideal(c, dissipative=True) for c in ctrls],
-                  solver=SolverSettings(control_rate=250.0)).dataset
+    ds = simulate(
+        BUMP, PARAMS, [Suspension.ideal(c, dissipative=True) for c in ctrls], solver=SolverSettings(control_rate=250.0)
+    ).dataset
     f = ds["secondary_damper_force"].values
     fd = ds["damper_demand_force"].values
     xd = ds["secondary_deflection_velocity"].values

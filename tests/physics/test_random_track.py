@@ -70,12 +70,15 @@ def test_seeds_are_reproducible_and_distinct():
     assert np.array_equal(r1.values, r2.values)
 
 
-@pytest.mark.parametrize("kwargs, match", [
-    ({"name": "fra7"}, "unknown track spectrum 'fra7'"),
-    ({"name": "fra4", "min_wavelength": -1.0}, "min_wavelength"),
-    ({"name": "fra4", "min_wavelength": 50.0, "max_wavelength": 10.0}, "below max_wavelength"),
-    ({"name": "fra4", "seed": -3}, "seed"),
-])
+@pytest.mark.parametrize(
+    "kwargs, match",
+    [
+        ({"name": "fra7"}, "unknown track spectrum 'fra7'"),
+        ({"name": "fra4", "min_wavelength": -1.0}, "min_wavelength"),
+        ({"name": "fra4", "min_wavelength": 50.0, "max_wavelength": 10.0}, "below max_wavelength"),
+        ({"name": "fra4", "seed": -3}, "seed"),
+    ],
+)
 def test_bad_random_track_settings(kwargs, match):
     with pytest.raises(ValueError, match=match):
         RandomTrack(**kwargs)

@@ -13,8 +13,7 @@ from railride.track import CosineBump, Scenario, SineTrack, scenario
 from railride.vehicle import DOF_NAMES, Vehicle
 
 P = VehicleParams.preset("paper")
-BUMP = Scenario(CosineBump(height=0.02, length=10.0, start=5.0, rails="left"),
-                speed=40.0, duration=1.5, name="bump")
+BUMP = Scenario(CosineBump(height=0.02, length=10.0, start=5.0, rails="left"), speed=40.0, duration=1.5, name="bump")
 
 
 def _q(ds):
@@ -42,10 +41,14 @@ def test_batch_equals_the_single_runs():
     assert batch.sizes["sample"] == 2
     for i in range(2):
         single = simulate(scen[i], pars[i], solver=SolverSettings(dt=1e-4)).dataset
-        for name in ("carbody_bounce", "carbody_roll", "carbody_acceleration",
-                     "secondary_damper_force", "rail_displacement"):
-            assert np.allclose(batch[name].isel(sample=i).values, single[name].values,
-                               rtol=1e-12, atol=0), name
+        for name in (
+            "carbody_bounce",
+            "carbody_roll",
+            "carbody_acceleration",
+            "secondary_damper_force",
+            "rail_displacement",
+        ):
+            assert np.allclose(batch[name].isel(sample=i).values, single[name].values, rtol=1e-12, atol=0), name
 
 
 def test_steady_state_sine_response_equals_the_frequency_response():
@@ -55,8 +58,7 @@ def test_steady_state_sine_response_equals_the_frequency_response():
     f = sc.speed / lam
     frf = Vehicle(P).frequency_response(f, sc.speed, rails=(1.0, np.exp(-1j * psi)))
     t = ds.time.values
-    for name in ("carbody_bounce", "carbody_pitch", "carbody_roll", "carbody_acceleration",
-                 "front_bogie_roll"):
+    for name in ("carbody_bounce", "carbody_pitch", "carbody_roll", "carbody_acceleration", "front_bogie_roll"):
         predicted = np.imag(A * frf[name].values[0] * np.exp(2j * np.pi * f * t))
         error = np.abs(ds[name].values - predicted).max()
         assert error < 0.01 * np.abs(predicted).max(), name
@@ -65,14 +67,18 @@ def test_steady_state_sine_response_equals_the_frequency_response():
 @pytest.mark.parametrize("track", [CosineBump(0.02, 10.0, 5.0, "left"), SineTrack(0.05, 60.0, 30.0)])
 def test_fourth_order_convergence_under_step_halving(track):
     sc = Scenario(track, speed=40.0, duration=1.5)
-    runs = {dt: simulate(sc, P, solver=SolverSettings(dt=dt, output_rate=250)).dataset
-            for dt in (4e-4, 2e-4, 1e-4, 2.5e-5)}
+    runs = {
+        dt: simulate(sc, P, solver=SolverSettings(dt=dt, output_rate=250)).dataset for dt in (4e-4, 2e-4, 1e-4, 2.5e-5)
+    }
     fine = runs[2.5e-5]
     errors = []
     for dt in (4e-4, 2e-4, 1e-4):
-        errors.append(max(float(np.abs(runs[dt][c] - fine[c]).max() / np.abs(fine[c]).max())
-                          for c in ("carbody_bounce", "carbody_roll", "carbody_acceleration",
-                                    "front_bogie_pitch")))
+        errors.append(
+            max(
+                float(np.abs(runs[dt][c] - fine[c]).max() / np.abs(fine[c]).max())
+                for c in ("carbody_bounce", "carbody_roll", "carbody_acceleration", "front_bogie_pitch")
+            )
+        )
     ratios = [errors[i] / errors[i + 1] for i in range(2)]
     for r in ratios:
         assert 12 < r < 20, (errors, ratios)  # 2^4 = 16 for fourth order
@@ -109,8 +115,12 @@ def test_dampers_dissipate_exactly_the_energy_the_vehicle_loses():
     state = np.zeros(18)
     state[[0, 2, 4, 8]] = [0.02, 0.01, 0.003, -0.004]
     state[9 + 1] = 0.01
-    ds = simulate(scenario("paper-sine", amplitude=0.0, duration=3.0), P,
-                  solver=SolverSettings(dt=1e-4, output_rate=10000), initial_state=state).dataset
+    ds = simulate(
+        scenario("paper-sine", amplitude=0.0, duration=3.0),
+        P,
+        solver=SolverSettings(dt=1e-4, output_rate=10000),
+        initial_state=state,
+    ).dataset
     q, v = _q(ds), np.stack([ds[f"{n}_velocity"].values for n in DOF_NAMES], axis=-1)
     energy = 0.5 * np.einsum("ti,ij,tj->t", v, veh.M, v) + 0.5 * np.einsum("ti,ij,tj->t", q, veh.K, q)
     power = np.einsum("ti,ij,tj->t", v, veh.C, v)
@@ -158,17 +168,20 @@ def test_result_channels_units_and_provenance():
     assert np.allclose(corner, expected.values, rtol=0, atol=1e-15)
 
 
-@pytest.mark.parametrize("kwargs, match", [
-    ({"dt": 0.05}, "too large"),
-    ({"dt": 0.05, "output_rate": 20.0}, "too large: fourth-order Runge-Kutta is unstable"),
-    ({"dt": -1e-4}, "dt"),
-    ({"dt": float("nan")}, "dt"),
-    ({"output_rate": 3000.0}, "whole number of steps"),
-    ({"scenario": "tgv"}, "unknown scenario"),
-    ({"initial_state": [0.0] * 5}, "initial_state"),
-    ({"scenario": [scenario(duration=1.0), scenario(duration=2.0)]}, "same duration"),
-    ({"params": "tgv"}, "unknown vehicle preset"),
-])
+@pytest.mark.parametrize(
+    "kwargs, match",
+    [
+        ({"dt": 0.05}, "too large"),
+        ({"dt": 0.05, "output_rate": 20.0}, "too large: fourth-order Runge-Kutta is unstable"),
+        ({"dt": -1e-4}, "dt"),
+        ({"dt": float("nan")}, "dt"),
+        ({"output_rate": 3000.0}, "whole number of steps"),
+        ({"scenario": "tgv"}, "unknown scenario"),
+        ({"initial_state": [0.0] * 5}, "initial_state"),
+        ({"scenario": [scenario(duration=1.0), scenario(duration=2.0)]}, "same duration"),
+        ({"params": "tgv"}, "unknown vehicle preset"),
+    ],
+)
 def test_bad_input_raises_a_clear_value_error(kwargs, match):
     kwargs.setdefault("scenario", scenario(duration=1.0))
     steps = {k: kwargs.pop(k) for k in ("dt", "output_rate") if k in kwargs}
@@ -206,9 +219,12 @@ def test_a_study_goes_on_past_a_diverged_run():
     from railride.tuning import Objective
 
     opts = {"duration": 1.0}
-    rows = run_cases([Case("paper-sine", opts, suspension="pid", damper="ideal",
-                           gains={"pid.kp": 1e12, "pid.kd": 1e11}),
-                      Case("paper-sine", opts, suspension="pid", damper="ideal")])
+    rows = run_cases(
+        [
+            Case("paper-sine", opts, suspension="pid", damper="ideal", gains={"pid.kp": 1e12, "pid.kd": 1e11}),
+            Case("paper-sine", opts, suspension="pid", damper="ideal"),
+        ]
+    )
     assert rows["diverged_at_s"].iloc[0] > 0 and np.isnan(rows["diverged_at_s"].iloc[1])
     assert np.isnan(rows["acceleration_m_s2_rms"].iloc[0])
     assert np.isfinite(rows["acceleration_m_s2_rms"].iloc[1])

@@ -2,8 +2,7 @@ import numpy as np
 import pytest
 
 from railride.simulation import simulate
-from railride.track import (CosineBump, MeasuredTrack, Scenario, SineTrack, scenario,
-                            wheelset_input_table)
+from railride.track import CosineBump, MeasuredTrack, Scenario, SineTrack, scenario, wheelset_input_table
 from railride.vehicle import Vehicle
 
 
@@ -74,16 +73,19 @@ def test_measured_profile_reproduces_the_sine_it_was_sampled_from(tmp_path):
     assert np.allclose(a.values, b.values, rtol=1e-2)
 
 
-@pytest.mark.parametrize("content, match", [
-    ("s,z_L\n0,0\n1,0\n", "no column 'z_R'"),
-    ("s,z_L,z_R\n0,0,0\n\n1,abc,0\n", "line 4.*'abc' is not a number"),
-    ("s,z_L,z_R\n0,0,0\n2,0,0\n1,0,0\n", "increase strictly"),
-    ("s,z_L,z_R\n5,0,0\n9,0,0\n", "must start at s <= 0"),
-    ("s,z_L,z_R\n0,0,0\n1,nan,0\n", "non-finite"),
-    ("s,z_L,z_R\n0,0,0\n", "at least 2 rows"),
-    ("", "empty"),
-    ("s,z_L,z_R\n0,0,0\n1,0\n", "line 3.*'<missing>'"),
-])
+@pytest.mark.parametrize(
+    "content, match",
+    [
+        ("s,z_L\n0,0\n1,0\n", "no column 'z_R'"),
+        ("s,z_L,z_R\n0,0,0\n\n1,abc,0\n", "line 4.*'abc' is not a number"),
+        ("s,z_L,z_R\n0,0,0\n2,0,0\n1,0,0\n", "increase strictly"),
+        ("s,z_L,z_R\n5,0,0\n9,0,0\n", "must start at s <= 0"),
+        ("s,z_L,z_R\n0,0,0\n1,nan,0\n", "non-finite"),
+        ("s,z_L,z_R\n0,0,0\n", "at least 2 rows"),
+        ("", "empty"),
+        ("s,z_L,z_R\n0,0,0\n1,0\n", "line 3.*'<missing>'"),
+    ],
+)
 def test_malformed_csv_gets_a_clear_error(tmp_path, content, match):
     path = tmp_path / "bad.csv"
     path.write_text(content)
@@ -100,14 +102,17 @@ def test_missing_or_short_files_are_refused(tmp_path):
     assert scenario(f"file:{path}", speed=50.0, duration=2.0).track.end() == 100.0
 
 
-@pytest.mark.parametrize("kwargs, match", [
-    ({"speed": -3.0}, "speed = -3"),
-    ({"speed": float("nan")}, "speed = nan"),
-    ({"duration": 0.0}, "duration = 0"),
-    ({"amplitude": -0.01}, "amplitude"),
-    ({"wavelength": 0.0}, "wavelength"),
-    ({"rail_phase": float("inf")}, "rail_phase"),
-])
+@pytest.mark.parametrize(
+    "kwargs, match",
+    [
+        ({"speed": -3.0}, "speed = -3"),
+        ({"speed": float("nan")}, "speed = nan"),
+        ({"duration": 0.0}, "duration = 0"),
+        ({"amplitude": -0.01}, "amplitude"),
+        ({"wavelength": 0.0}, "wavelength"),
+        ({"rail_phase": float("inf")}, "rail_phase"),
+    ],
+)
 def test_bad_scenario_settings_name_the_setting(kwargs, match):
     with pytest.raises(ValueError, match=match):
         scenario("paper-sine", **kwargs)
@@ -123,8 +128,13 @@ def test_scenario_names_and_options():
     bump = scenario("bump", amplitude=-0.01, wavelength=5.0)
     assert bump.track.height == -0.01 and bump.track.length == 5.0
     sc = scenario()
-    assert (sc.speed, sc.duration, sc.track.amplitude, sc.track.wavelength,
-            sc.track.rail_phase_deg) == (55.56, 10.0, 0.05, 60.0, 90.0)
+    assert (sc.speed, sc.duration, sc.track.amplitude, sc.track.wavelength, sc.track.rail_phase_deg) == (
+        55.56,
+        10.0,
+        0.05,
+        60.0,
+        90.0,
+    )
 
 
 def test_input_grid_falls_on_step_boundaries_and_ignores_step_halving():

@@ -51,10 +51,16 @@ def _stiff_primary_carbody(p):
     """
     return {
         "carbody bounce": (4 * p.k_sz / p.m_c, 4 * p.c_sz, p.m_c),
-        "carbody pitch": ((4 * p.k_sz * p.l**2 + 4 * p.k_sx * p.h_cs**2) / p.I_cy,
-                          4 * p.c_sz * p.l**2 + 4 * p.c_sx * p.h_cs**2, p.I_cy),
-        "carbody roll": ((4 * p.k_sz * p.d_s**2 + 4 * p.k_sy * p.h_cs**2) / p.I_cx,
-                         4 * p.c_sz * p.d_s**2 + 4 * p.c_sy * p.h_cs**2, p.I_cx),
+        "carbody pitch": (
+            (4 * p.k_sz * p.l**2 + 4 * p.k_sx * p.h_cs**2) / p.I_cy,
+            4 * p.c_sz * p.l**2 + 4 * p.c_sx * p.h_cs**2,
+            p.I_cy,
+        ),
+        "carbody roll": (
+            (4 * p.k_sz * p.d_s**2 + 4 * p.k_sy * p.h_cs**2) / p.I_cx,
+            4 * p.c_sz * p.d_s**2 + 4 * p.c_sy * p.h_cs**2,
+            p.I_cx,
+        ),
     }
 
 
@@ -69,8 +75,7 @@ def test_carbody_modes_match_hand_formulas_on_a_stiff_primary():
         mode = modes[label]
         assert mode.frequency_hz == pytest.approx(omega / (2 * np.pi), rel=1e-3), label
         assert mode.damping_ratio == pytest.approx(zeta, rel=1e-3), label
-        assert mode.damped_frequency_hz == pytest.approx(
-            omega * np.sqrt(1 - zeta**2) / (2 * np.pi), rel=2e-3), label
+        assert mode.damped_frequency_hz == pytest.approx(omega * np.sqrt(1 - zeta**2) / (2 * np.pi), rel=2e-3), label
 
 
 def test_lateral_and_longitudinal_springs_count_twice_per_bogie():
@@ -78,8 +83,7 @@ def test_lateral_and_longitudinal_springs_count_twice_per_bogie():
     # frequencies on a rigid primary are checked with the lateral and longitudinal springs made
     # ten times stiffer, where they carry most of the roll stiffness (one per bogie instead of
     # two would put the roll frequency 25 % low here), and the table holds four of each.
-    p = P.replace(k_pz=P.k_pz * 1e4, k_px=P.k_px * 1e4, k_py=P.k_py * 1e4,
-                  k_sx=P.k_sx * 10, k_sy=P.k_sy * 10)
+    p = P.replace(k_pz=P.k_pz * 1e4, k_px=P.k_px * 1e4, k_py=P.k_py * 1e4, k_sx=P.k_sx * 10, k_sy=P.k_sy * 10)
     v = Vehicle(p)
     modes = _freqs(v)
     for label in ("carbody pitch", "carbody roll"):
@@ -93,10 +97,10 @@ def test_lateral_and_longitudinal_springs_count_twice_per_bogie():
 def test_paper_carbody_modes_are_within_a_few_percent_of_the_stiff_primary_formulas():
     p = P
     modes = _freqs(Vehicle(p))
-    assert modes["carbody bounce"].frequency_hz == pytest.approx(
-        np.sqrt(4 * p.k_sz / p.m_c) / (2 * np.pi), rel=0.03)
+    assert modes["carbody bounce"].frequency_hz == pytest.approx(np.sqrt(4 * p.k_sz / p.m_c) / (2 * np.pi), rel=0.03)
     assert modes["carbody roll"].frequency_hz == pytest.approx(
-        np.sqrt((4 * p.k_sz * p.d_s**2 + 4 * p.k_sy * p.h_cs**2) / p.I_cx) / (2 * np.pi), rel=0.03)
+        np.sqrt((4 * p.k_sz * p.d_s**2 + 4 * p.k_sy * p.h_cs**2) / p.I_cx) / (2 * np.pi), rel=0.03
+    )
 
 
 def test_bogie_modes_match_hand_formulas_under_a_fixed_carbody():
@@ -106,13 +110,16 @@ def test_bogie_modes_match_hand_formulas_under_a_fixed_carbody():
     hand = {
         "bounce": (4 * p.k_pz + 2 * p.k_sz) / p.m_b,
         "pitch": (4 * p.k_pz * p.b**2 + 4 * p.k_px * p.h_tp**2 + 2 * p.k_sx * p.h_ts**2) / p.I_by,
-        "roll": (4 * p.k_pz * p.d_p**2 + 4 * p.k_py * p.h_tp**2 + 2 * p.k_sz * p.d_s**2
-                 + 2 * p.k_sy * p.h_ts**2) / p.I_bx,
+        "roll": (4 * p.k_pz * p.d_p**2 + 4 * p.k_py * p.h_tp**2 + 2 * p.k_sz * p.d_s**2 + 2 * p.k_sy * p.h_ts**2)
+        / p.I_bx,
     }
     modes = Vehicle(p).modes()
     for motion, w2 in hand.items():
-        found = [m.frequency_hz for m in modes if m.label.startswith("bogie") and motion in m.label
-                 or m.label.endswith(f"bogie {motion}")]
+        found = [
+            m.frequency_hz
+            for m in modes
+            if m.label.startswith("bogie") and motion in m.label or m.label.endswith(f"bogie {motion}")
+        ]
         assert len(found) == 2, (motion, [m.label for m in modes])
         for f in found:
             assert f == pytest.approx(np.sqrt(w2) / (2 * np.pi), rel=1e-4), motion
@@ -151,8 +158,7 @@ def _static_roll_gain(p):
         + (2 k_sy h_cs h_ts - 2 k_sz d_s^2) theta_c = (4 k_pz d_p^2 - 4 k_py h_tp h_wp) theta_w
       (2 k_sz d_s^2 + 2 k_sy h_cs^2) theta_c + (2 k_sy h_cs h_ts - 2 k_sz d_s^2) theta_b = 0
     """
-    a11 = (4 * p.k_pz * p.d_p**2 + 4 * p.k_py * p.h_tp**2 + 2 * p.k_sz * p.d_s**2
-           + 2 * p.k_sy * p.h_ts**2)
+    a11 = 4 * p.k_pz * p.d_p**2 + 4 * p.k_py * p.h_tp**2 + 2 * p.k_sz * p.d_s**2 + 2 * p.k_sy * p.h_ts**2
     a12 = 2 * p.k_sy * p.h_cs * p.h_ts - 2 * p.k_sz * p.d_s**2
     a22 = 2 * p.k_sz * p.d_s**2 + 2 * p.k_sy * p.h_cs**2
     rhs = 4 * p.k_pz * p.d_p**2 - 4 * p.k_py * p.h_tp * p.h_wp

@@ -7,8 +7,7 @@ import pytest
 from hypothesis import given, settings, strategies as st
 
 from railride import dampers
-from railride.control import (PID, SAS, Attitude, GainSet, InnerLoop, Ride, SensorNoise,
-                              carbody_map, decoupling)
+from railride.control import PID, SAS, Attitude, GainSet, InnerLoop, Ride, SensorNoise, carbody_map, decoupling
 from railride.params import VehicleParams
 from railride.simulation import simulate
 from railride.solver import SolverSettings
@@ -41,8 +40,14 @@ def test_pure_demands_spread_over_the_corners_as_expected():
 def test_attitude_loop_with_modal_gains_in_proportion_equals_corner_pd():
     # T_c T_c^T = diag(4, 4 l^2, 4 d_s^2), so T_c^+ diag(4k, 4k l^2, 4k d_s^2) = k T_c^T
     k, c = 1.3e5, 7e4
-    att = Attitude(kp_z=4 * k, kd_z=4 * c, kp_phi=4 * k * P.l**2, kd_phi=4 * c * P.l**2,
-                   kp_theta=4 * k * P.d_s**2, kd_theta=4 * c * P.d_s**2)
+    att = Attitude(
+        kp_z=4 * k,
+        kd_z=4 * c,
+        kp_phi=4 * k * P.l**2,
+        kd_phi=4 * c * P.l**2,
+        kp_theta=4 * k * P.d_s**2,
+        kd_theta=4 * c * P.d_s**2,
+    )
     G_sas, _ = SAS(att).gains(V)
     G_pid, H_pid = PID(kp=k, ki=0.0, kd=c).gains(V)
     assert np.allclose(G_sas, G_pid) and np.all(H_pid == 0)
@@ -64,8 +69,11 @@ SINE = scenario("paper-sine", duration=3.0)
 def test_voltage_stays_in_range_and_is_minimal_when_the_demand_opposes_the_damper():
     g = GainSet.default()
     noise = SensorNoise(1e-3, 1e-4, 5e-3, 5e-4, seed=7)
-    ds = simulate(SINE, suspension=[Suspension.named(n, g, sensor_noise=noise) for n in ("pid", "sas-attitude-ride")],
-                  solver=SolverSettings(output_rate=10000)).dataset
+    ds = simulate(
+        SINE,
+        suspension=[Suspension.named(n, g, sensor_noise=noise) for n in ("pid", "sas-attitude-ride")],
+        solver=SolverSettings(output_rate=10000),
+    ).dataset
     d = dampers.RAILWAY
     v = ds.damper_command_voltage.values
     assert v.min() >= d.v_min and v.max() <= d.v_max
@@ -105,9 +113,12 @@ def test_a_step_demand_appears_one_controller_period_later_and_is_held(rate):
     kp, z0 = 1e5, 0.01
     state = np.zeros(18)
     state[0] = z0  # carbody lifted at t = 0, level track
-    ds = simulate(scenario("paper-sine", amplitude=0.0, duration=0.01),
-                  suspension=Suspension.semi_active(controller=PID(kp, 0.0, 0.0)),
-                  solver=SolverSettings(control_rate=rate, output_rate=10000), initial_state=state).dataset
+    ds = simulate(
+        scenario("paper-sine", amplitude=0.0, duration=0.01),
+        suspension=Suspension.semi_active(controller=PID(kp, 0.0, 0.0)),
+        solver=SolverSettings(control_rate=rate, output_rate=10000),
+        initial_state=state,
+    ).dataset
     fd = ds.damper_demand_force.values  # (time, corner)
     t = ds.time.values
     period = 1.0 / rate
@@ -124,10 +135,12 @@ def test_a_step_demand_appears_one_controller_period_later_and_is_held(rate):
 
 def test_sensor_noise_is_seeded():
     g = GainSet.default()
+
     def run(seed):
         noise = SensorNoise(1e-3, 1e-4, 1e-3, 1e-4, seed=seed)
-        return simulate(scenario("paper-sine", duration=1.0),
-                        suspension=Suspension.named("pid", g, sensor_noise=noise)).dataset
+        return simulate(
+            scenario("paper-sine", duration=1.0), suspension=Suspension.named("pid", g, sensor_noise=noise)
+        ).dataset
 
     a, b, c = run(1), run(1), run(2)
     assert np.array_equal(a.carbody_bounce.values, b.carbody_bounce.values)
@@ -142,15 +155,20 @@ def test_gains_file_round_trip(tmp_path):
     assert (back.inner, back.pid, back.attitude, back.ride) == (g.inner, g.pid, g.attitude, g.ride)
 
 
-@pytest.mark.parametrize("edit, match", [
-    (lambda t: t.replace("kd = ", "# kd = "), r"missing entry 'kd' in \[pid\]"),
-    (lambda t: t.replace("[pid]\n", "[pid]\nkf = 1.0\n"), r"unknown entry 'kf' in \[pid\]"),
-    (lambda t: re.sub(r"kp_z = [0-9.e+]+", 'kp_z = "high"', t),
-     r"entry 'kp_z' in \[sas.attitude\] = 'high' is not a number"),
-    (lambda t: re.sub(r"kd_2L = [0-9.e+]+", "kd_2L = -5.0", t), r"\[sas.ride\] SAS ride gain 'kd_2L' = -5.0"),
-    (lambda t: t.replace("[inner]", "[inner2]"), r"unknown table"),
-    (lambda t: t + "\n[[", r"not valid TOML"),
-])
+@pytest.mark.parametrize(
+    "edit, match",
+    [
+        (lambda t: t.replace("kd = ", "# kd = "), r"missing entry 'kd' in \[pid\]"),
+        (lambda t: t.replace("[pid]\n", "[pid]\nkf = 1.0\n"), r"unknown entry 'kf' in \[pid\]"),
+        (
+            lambda t: re.sub(r"kp_z = [0-9.e+]+", 'kp_z = "high"', t),
+            r"entry 'kp_z' in \[sas.attitude\] = 'high' is not a number",
+        ),
+        (lambda t: re.sub(r"kd_2L = [0-9.e+]+", "kd_2L = -5.0", t), r"\[sas.ride\] SAS ride gain 'kd_2L' = -5.0"),
+        (lambda t: t.replace("[inner]", "[inner2]"), r"unknown table"),
+        (lambda t: t + "\n[[", r"not valid TOML"),
+    ],
+)
 def test_bad_gains_files_name_the_entry(tmp_path, edit, match):
     text = edit(GainSet.default().to_toml())
     with pytest.raises(ValueError, match=match):
@@ -163,8 +181,9 @@ def test_controller_input_errors():
     with pytest.raises(ValueError, match="either voltage"):
         Suspension.semi_active(controller=PID(1, 0, 0), voltage=1.0)
     with pytest.raises(ValueError, match="control_rate"):
-        simulate(SINE, suspension=Suspension.semi_active(controller=PID(1, 0, 0)),
-                 solver=SolverSettings(control_rate=3000.0))
+        simulate(
+            SINE, suspension=Suspension.semi_active(controller=PID(1, 0, 0)), solver=SolverSettings(control_rate=3000.0)
+        )
     with pytest.raises(ValueError, match="closed loop only"):
         Suspension(inner=InnerLoop(1.0, 1e-3))
     with pytest.raises(ValueError, match="PID gain 'kp' = -1"):

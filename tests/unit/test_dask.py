@@ -41,8 +41,11 @@ def _settings(case):
 
 
 def _cases(speeds=(30.0, 40.0, 50.0, 55.56), duration=1.0):
-    return [Case(scenario_options={"duration": duration, "speed": v}, suspension=s)
-            for s in ("passive", "pid") for v in speeds]
+    return [
+        Case(scenario_options={"duration": duration, "speed": v}, suspension=s)
+        for s in ("passive", "pid")
+        for v in speeds
+    ]
 
 
 class Cluster:
@@ -60,9 +63,14 @@ class Cluster:
     def _spawn(self, name, args):
         log = open(self.folder / f"{name}.log", "wb")
         try:
-            self.procs[name] = subprocess.Popen([sys.executable, "-m", *args], stdout=log,
-                                                stderr=subprocess.STDOUT, env=self.env,
-                                                cwd=self.folder, start_new_session=True)
+            self.procs[name] = subprocess.Popen(
+                [sys.executable, "-m", *args],
+                stdout=log,
+                stderr=subprocess.STDOUT,
+                env=self.env,
+                cwd=self.folder,
+                start_new_session=True,
+            )
         finally:
             log.close()
 
@@ -73,9 +81,22 @@ class Cluster:
     def start_scheduler(self):
         # --idle-timeout: should this test process die without its teardown, the scheduler
         # quits on its own, and the workers after it (--death-timeout)
-        self._spawn("scheduler", ["distributed.cli.dask_scheduler", "--host", "127.0.0.1",
-                                  "--port", "0", "--dashboard-address", "127.0.0.1:0",
-                                  "--scheduler-file", self.scheduler_file, "--idle-timeout", "300s"])
+        self._spawn(
+            "scheduler",
+            [
+                "distributed.cli.dask_scheduler",
+                "--host",
+                "127.0.0.1",
+                "--port",
+                "0",
+                "--dashboard-address",
+                "127.0.0.1:0",
+                "--scheduler-file",
+                self.scheduler_file,
+                "--idle-timeout",
+                "300s",
+            ],
+        )
         deadline = time.monotonic() + STARTUP
         while self.address is None:
             self._check_alive("scheduler")
@@ -87,10 +108,29 @@ class Cluster:
             time.sleep(0.1)
 
     def start_worker(self, name):
-        self._spawn(name, ["distributed.cli.dask_worker", "--scheduler-file", self.scheduler_file,
-                           "--host", "127.0.0.1", "--dashboard-address", "127.0.0.1:0",
-                           "--nworkers", "1", "--nthreads", "1", "--no-nanny", "--name", name,
-                           "--local-directory", str(self.folder / name), "--death-timeout", "60"])
+        self._spawn(
+            name,
+            [
+                "distributed.cli.dask_worker",
+                "--scheduler-file",
+                self.scheduler_file,
+                "--host",
+                "127.0.0.1",
+                "--dashboard-address",
+                "127.0.0.1:0",
+                "--nworkers",
+                "1",
+                "--nthreads",
+                "1",
+                "--no-nanny",
+                "--name",
+                name,
+                "--local-directory",
+                str(self.folder / name),
+                "--death-timeout",
+                "60",
+            ],
+        )
 
     def wait_for_workers(self, names):
         """{name: address} once every worker in ``names`` is connected."""
@@ -105,8 +145,9 @@ class Cluster:
                     return {n: found[n] for n in names}
                 if time.monotonic() > deadline:
                     logs = "\n".join(f"--- {n}\n{self.log(n)}" for n in names)
-                    raise RuntimeError(f"workers {names} not all connected after {STARTUP} s "
-                                       f"(connected: {sorted(found)}):\n{logs}")
+                    raise RuntimeError(
+                        f"workers {names} not all connected after {STARTUP} s (connected: {sorted(found)}):\n{logs}"
+                    )
                 time.sleep(0.2)
 
     def _check_alive(self, name):

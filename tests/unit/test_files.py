@@ -29,8 +29,11 @@ def batch():
 
 # -- NetCDF ---------------------------------------------------------------------------------------
 def test_netcdf_keeps_integer_coordinates_and_text(tmp_path):
-    ds = xr.Dataset({"label": ((), json.dumps({"source": "trück ψ.csv"}))},
-                    coords={"x": np.array([10, 20], dtype=np.int64)}, attrs={"ok": "ψ = 90°"})
+    ds = xr.Dataset(
+        {"label": ((), json.dumps({"source": "trück ψ.csv"}))},
+        coords={"x": np.array([10, 20], dtype=np.int64)},
+        attrs={"ok": "ψ = 90°"},
+    )
     path = tmp_path / "odd.nc"
     files.write_netcdf(ds, path)
     with xr.open_dataset(path, engine="scipy") as back:

@@ -31,10 +31,8 @@ def _failing_png(*args, **kwargs):
 
 def test_the_document_is_the_command_lines(result, tmp_path):
     assert result.to_dict() == ok_json("frf", "--points", 40)
-    doc = ok_json("frf", "--rails", "anti-phase", "--points", 5, "--speed", 30, "--fmin", 0.5,
-                  "--fmax", 12)
-    assert frequency_responses("paper", speed=30, rails="anti-phase", fmin=0.5, fmax=12,
-                               points=5).to_dict() == doc
+    doc = ok_json("frf", "--rails", "anti-phase", "--points", 5, "--speed", 30, "--fmin", 0.5, "--fmax", 12)
+    assert frequency_responses("paper", speed=30, rails="anti-phase", fmin=0.5, fmax=12, points=5).to_dict() == doc
     stiff = tmp_path / "stiff.toml"
     stiff.write_text('[vehicle]\npreset = "paper"\nk_sz = 5.8e5\n', encoding="utf-8")
     doc = ok_json("frf", "--points", 7, "--params", stiff)
@@ -102,14 +100,17 @@ def test_modes_are_the_vehicles_and_the_command_lines():
     assert found.to_pandas()["mode"].tolist() == list(range(1, 10))
 
 
-@pytest.mark.parametrize("kwargs, message", [
-    ({"rails": "diagonal"}, "rails = 'diagonal': allowed in-phase, anti-phase, both"),
-    ({"fmin": 0.0}, "fmin = 0.0: must be a finite number > 0"),
-    ({"fmin": 5, "fmax": 2}, "fmax = 2 Hz: must be above fmin = 5 Hz"),
-    ({"points": 1}, "points = 1: must be a whole number >= 2"),
-    ({"points": 2.5}, "points = 2.5"),
-    ({"speed": -1.0}, "speed = -1.0: must be a finite number > 0"),
-])
+@pytest.mark.parametrize(
+    "kwargs, message",
+    [
+        ({"rails": "diagonal"}, "rails = 'diagonal': allowed in-phase, anti-phase, both"),
+        ({"fmin": 0.0}, "fmin = 0.0: must be a finite number > 0"),
+        ({"fmin": 5, "fmax": 2}, "fmax = 2 Hz: must be above fmin = 5 Hz"),
+        ({"points": 1}, "points = 1: must be a whole number >= 2"),
+        ({"points": 2.5}, "points = 2.5"),
+        ({"speed": -1.0}, "speed = -1.0: must be a finite number > 0"),
+    ],
+)
 def test_bad_input_names_the_field(kwargs, message):
     with pytest.raises(ValueError, match=message.replace("(", r"\(")):
         frequency_responses(**kwargs)

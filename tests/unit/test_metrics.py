@@ -11,12 +11,15 @@ def _run(amplitudes, f=2.0, duration=4.0, rate=1000.0, offset=0.0):
     t = np.arange(int(duration * rate) + 1) / rate
     s = np.sin(2 * np.pi * f * t)
     acc, disp, pitch, roll = amplitudes
-    return xr.Dataset({
-        "carbody_acceleration": ("time", acc * s),
-        "carbody_bounce": ("time", disp * s + offset),
-        "carbody_pitch": ("time", pitch * s),
-        "carbody_roll": ("time", roll * s),
-    }, coords={"time": t})
+    return xr.Dataset(
+        {
+            "carbody_acceleration": ("time", acc * s),
+            "carbody_bounce": ("time", disp * s + offset),
+            "carbody_pitch": ("time", pitch * s),
+            "carbody_roll": ("time", roll * s),
+        },
+        coords={"time": t},
+    )
 
 
 def test_rms_and_peak_to_peak_of_a_sine():

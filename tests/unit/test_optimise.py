@@ -11,8 +11,14 @@ import pytest
 from matplotlib.figure import Figure
 
 from railride.files import json_text
-from railride.optimise import (OPTIMISE_FILES, SENSITIVITY_FILES, OptimiseResult, SensitivityResult, optimise,
-                               sensitivity)
+from railride.optimise import (
+    OPTIMISE_FILES,
+    SENSITIVITY_FILES,
+    OptimiseResult,
+    SensitivityResult,
+    optimise,
+    sensitivity,
+)
 
 PNG = b"\x89PNG\r\n\x1a\n"
 SHORT = {"duration": 0.5}
@@ -20,14 +26,19 @@ SHORT = {"duration": 0.5}
 
 @pytest.fixture(scope="module")
 def found():
-    return optimise(("attitude.kd_z", "attitude.kd_phi"), suspension="sas-attitude",
-                    scenario_options=SHORT, popsize=3, maxiter=2, seed=1)
+    return optimise(
+        ("attitude.kd_z", "attitude.kd_phi"),
+        suspension="sas-attitude",
+        scenario_options=SHORT,
+        popsize=3,
+        maxiter=2,
+        seed=1,
+    )
 
 
 @pytest.fixture(scope="module")
 def indices():
-    return sensitivity(("attitude.kd_z", "ride.kp_1R"), suspension="sas-attitude",
-                       scenario_options=SHORT, n=4)
+    return sensitivity(("attitude.kd_z", "ride.kp_1R"), suspension="sas-attitude", scenario_options=SHORT, n=4)
 
 
 def _failing(*args, **kwargs):
@@ -55,7 +66,7 @@ def test_the_optimise_document(found):
     assert doc["objective_value"] == found.objective and doc["runs"] == found.n_runs
     assert [p["name"] for p in doc["parameters"]] == list(found.parameters)
     for p, lg in zip(doc["parameters"], found.log10_gains):
-        assert p["value"] == 10.0 ** lg and p["low"] <= p["value"] <= p["high"]
+        assert p["value"] == 10.0**lg and p["low"] <= p["value"] <= p["high"]
     assert doc["gains"]["attitude"]["kd_z"] == found.gains.attitude.kd_z
     assert [c["best"] for c in doc["convergence"]] == found.to_pandas()["best"].tolist()
 
@@ -81,8 +92,7 @@ def test_the_optimise_plot_and_folder(found, tmp_path, monkeypatch):
 def test_an_objective_that_is_not_finite_is_null_in_the_document(found):
     import dataclasses
 
-    diverged = dataclasses.replace(found, objective=float("inf"),
-                                   convergence=np.array([[7.0, np.inf], [13.0, 1.2]]))
+    diverged = dataclasses.replace(found, objective=float("inf"), convergence=np.array([[7.0, np.inf], [13.0, 1.2]]))
     doc = json.loads(json_text(diverged.to_dict()))
     assert doc["objective_value"] is None
     assert [c["objective"] for c in doc["convergence"]] == [None, 1.2]

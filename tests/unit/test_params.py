@@ -7,12 +7,35 @@ from railride.params import VehicleParams
 
 # The paper's appendix (Harun et al.), typed from the published table, not from the code.
 APPENDIX = {
-    "m_c": 3.96e4, "m_b": 3.25e3, "I_cx": 8.85e4, "I_cy": 2.46e6, "I_cz": 2.5e6,
-    "I_bx": 3.06e3, "I_by": 3.02e3, "I_bz": 4.27e3,
-    "k_px": 4e6, "k_py": 3.25e6, "k_pz": 7e6, "c_px": 0, "c_py": 0, "c_pz": 1.5e4,
-    "k_sx": 1.5e5, "k_sy": 1.5e5, "k_sz": 2.9e5, "c_sx": 0, "c_sy": 5e4, "c_sz": 8e4,
-    "l": 9.0, "d_s": 1.0, "d_p": 1.0, "a": 1.0, "b": 1.25,
-    "h_cs": 1.207, "h_ts": 0.217, "h_tp": 0.452, "h_wp": 0.18,
+    "m_c": 3.96e4,
+    "m_b": 3.25e3,
+    "I_cx": 8.85e4,
+    "I_cy": 2.46e6,
+    "I_cz": 2.5e6,
+    "I_bx": 3.06e3,
+    "I_by": 3.02e3,
+    "I_bz": 4.27e3,
+    "k_px": 4e6,
+    "k_py": 3.25e6,
+    "k_pz": 7e6,
+    "c_px": 0,
+    "c_py": 0,
+    "c_pz": 1.5e4,
+    "k_sx": 1.5e5,
+    "k_sy": 1.5e5,
+    "k_sz": 2.9e5,
+    "c_sx": 0,
+    "c_sy": 5e4,
+    "c_sz": 8e4,
+    "l": 9.0,
+    "d_s": 1.0,
+    "d_p": 1.0,
+    "a": 1.0,
+    "b": 1.25,
+    "h_cs": 1.207,
+    "h_ts": 0.217,
+    "h_tp": 0.452,
+    "h_wp": 0.18,
 }
 
 
@@ -36,8 +59,7 @@ positive = st.floats(min_value=1e-300, max_value=1e300, allow_nan=False, allow_i
 
 
 @settings(max_examples=60, deadline=None)
-@given(m_c=positive, k_sz=positive, h_cs=positive,
-       c_sz=st.one_of(st.just(0.0), positive))
+@given(m_c=positive, k_sz=positive, h_cs=positive, c_sz=st.one_of(st.just(0.0), positive))
 def test_toml_round_trip_is_lossless_for_any_valid_value(m_c, k_sz, h_cs, c_sz):
     p = VehicleParams.preset("paper").replace(m_c=m_c, k_sz=k_sz, h_cs=h_cs, c_sz=c_sz)
     assert VehicleParams.from_toml(p.to_toml()) == p
@@ -48,14 +70,17 @@ def test_toml_may_start_from_a_preset():
     assert p.c_sz == 6e4 and p.m_c == APPENDIX["m_c"]
 
 
-@pytest.mark.parametrize("field, value, allowed", [
-    ("m_c", -1.0, "> 0"),
-    ("m_c", 0.0, "> 0"),
-    ("I_cy", math.nan, "> 0"),
-    ("k_pz", math.inf, "> 0"),
-    ("c_sz", -5.0, ">= 0"),
-    ("l", "nine", "> 0"),
-])
+@pytest.mark.parametrize(
+    "field, value, allowed",
+    [
+        ("m_c", -1.0, "> 0"),
+        ("m_c", 0.0, "> 0"),
+        ("I_cy", math.nan, "> 0"),
+        ("k_pz", math.inf, "> 0"),
+        ("c_sz", -5.0, ">= 0"),
+        ("l", "nine", "> 0"),
+    ],
+)
 def test_bad_values_name_the_field_value_and_rule(field, value, allowed):
     with pytest.raises(ValueError) as err:
         VehicleParams.preset("paper").replace(**{field: value})

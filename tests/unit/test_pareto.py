@@ -29,8 +29,12 @@ def brute_force(points) -> list[bool]:
             continue
         dominated = False
         for j, b in enumerate(rows):
-            if (j != i and not any(np.isnan(b)) and all(y <= x for x, y in zip(a, b))
-                    and any(y < x for x, y in zip(a, b))):
+            if (
+                j != i
+                and not any(np.isnan(b))
+                and all(y <= x for x, y in zip(a, b))
+                and any(y < x for x, y in zip(a, b))
+            ):
                 dominated = True
         out.append(not dominated)
     return out
@@ -42,8 +46,8 @@ def test_non_dominated_matches_the_definition(columns, seed):
     rng = np.random.default_rng(seed)
     points = rng.random((80, columns))
     points[::7] = np.round(points[::7], 1)  # ties in some columns
-    points[5] = points[3]                   # an exact duplicate
-    points[11, 0] = np.nan                  # a failed run
+    points[5] = points[3]  # an exact duplicate
+    points[11, 0] = np.nan  # a failed run
     assert non_dominated(points).tolist() == brute_force(points)
 
 
@@ -65,8 +69,14 @@ def test_a_tiny_study(tiny, tmp_path):
     frame = tiny.to_pandas()
     assert len(frame) == 5 and frame["base"].tolist() == [True] + [False] * 4
     names = list(tiny.parameters)
-    assert names == ["attitude.kp_z", "attitude.kd_z", "attitude.kp_phi", "attitude.kd_phi",
-                     "attitude.kp_theta", "attitude.kd_theta"]
+    assert names == [
+        "attitude.kp_z",
+        "attitude.kd_z",
+        "attitude.kp_phi",
+        "attitude.kd_phi",
+        "attitude.kp_theta",
+        "attitude.kd_theta",
+    ]
     base = GainSet.default().attitude.to_dict()
     assert frame.loc[0, names].tolist() == [base[n.split(".")[1]] for n in names]
     lo, hi = np.array(_bounds(names)).T
@@ -125,8 +135,7 @@ def test_a_resumed_study_runs_nothing_again(tmp_path):
     path = tmp_path / "runs.csv"
     first = pareto("pid", n_samples=2, scenario_options=SHORT, table=RunTable(path))
     assert first.runs == 4  # passive, the base gains, two samples
-    again = pareto("pid", n_samples=2, scenario_options=SHORT, table=RunTable(path, resume=True),
-                   executor=Counting())
+    again = pareto("pid", n_samples=2, scenario_options=SHORT, table=RunTable(path, resume=True), executor=Counting())
     assert Counting.cases == 0 and np.array_equal(again.rms, first.rms)
 
 
@@ -141,13 +150,16 @@ def test_the_note_when_the_base_gains_were_tuned_on_this_track():
     assert in_sample_note(GainSet.reference(), record) is None  # no provenance: nothing to say
 
 
-@pytest.mark.parametrize("kwargs, fragment", [
-    ({"n_samples": 3}, "n_samples = 3"),
-    ({"n_samples": 0}, "n_samples = 0"),
-    ({"seed": -1}, "seed = -1"),
-    ({"suspension": "passive"}, "suspension = 'passive'"),
-    ({"suspension": "sas-attitude", "parameters": ["ride.kp_1R"]}, "'ride.kp_1R'"),
-])
+@pytest.mark.parametrize(
+    "kwargs, fragment",
+    [
+        ({"n_samples": 3}, "n_samples = 3"),
+        ({"n_samples": 0}, "n_samples = 0"),
+        ({"seed": -1}, "seed = -1"),
+        ({"suspension": "passive"}, "suspension = 'passive'"),
+        ({"suspension": "sas-attitude", "parameters": ["ride.kp_1R"]}, "'ride.kp_1R'"),
+    ],
+)
 def test_pareto_refuses_bad_input(kwargs, fragment):
     with pytest.raises(ValueError) as info:
         pareto(**{"scenario_options": SHORT, **kwargs})

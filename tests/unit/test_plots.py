@@ -12,8 +12,12 @@ import railride as rr
 from railride import rig
 from railride.analysis import FRF_PATTERNS, comparison_psd, frf_frame
 from railride.pareto import ParetoResult
-from railride.plots.comparison import (plot_comparison_damper_forces, plot_comparison_psd, plot_comparison_response,
-                                       plot_comparison_voltages)
+from railride.plots.comparison import (
+    plot_comparison_damper_forces,
+    plot_comparison_psd,
+    plot_comparison_response,
+    plot_comparison_voltages,
+)
 from railride.plots.frf import plot_frf
 from railride.plots.pareto import plot_pareto
 from railride.plots.ride import plot_body_responses
@@ -47,25 +51,52 @@ def results(result):
     comparison = rr.compare(scenario("paper-sine", duration=0.5), controllers=["pid"])
     cycles = rig.cycles("railway", 0.01, 1.0, [0.0, 1.0], n_cycles=2)
     tracking = rig.track(n_cycles=2)
-    curves = [Curve("pid", 1, "pid.kp", np.array([0.0, 1e3, 1e4]), np.array([1.0, 0.8, 0.9]), 1e3),
-              Curve("pid", 1, "pid.kd", np.array([1e2, 1e3]), np.array([0.7, 0.75]), 1e2)]
+    curves = [
+        Curve("pid", 1, "pid.kp", np.array([0.0, 1e3, 1e4]), np.array([1.0, 0.8, 0.9]), 1e3),
+        Curve("pid", 1, "pid.kd", np.array([1e2, 1e3]), np.array([0.7, 0.75]), 1e2),
+    ]
     # a sweep's result without its runs: the grid's cases, and metrics made up for them
-    runs = [{"acceleration_m_s2_rms": 0.3, "displacement_m_rms": 0.03, "pitch_deg_rms": 0.9,
-             "roll_deg_rms": 2.0, "centre_N_MV_z": 1.2, "centre_aw_Wk": 0.2}]
-    runs += [{"acceleration_m_s2_rms": 0.3 + v / 10, "displacement_m_rms": 0.03, "pitch_deg_rms": 0.8,
-              "roll_deg_rms": 1.9, "centre_N_MV_z": 1.0 + v, "centre_aw_Wk": 0.2} for v in (0.0, 1.0, 2.0)]
+    runs = [
+        {
+            "acceleration_m_s2_rms": 0.3,
+            "displacement_m_rms": 0.03,
+            "pitch_deg_rms": 0.9,
+            "roll_deg_rms": 2.0,
+            "centre_N_MV_z": 1.2,
+            "centre_aw_Wk": 0.2,
+        }
+    ]
+    runs += [
+        {
+            "acceleration_m_s2_rms": 0.3 + v / 10,
+            "displacement_m_rms": 0.03,
+            "pitch_deg_rms": 0.8,
+            "roll_deg_rms": 1.9,
+            "centre_N_MV_z": 1.0 + v,
+            "centre_aw_Wk": 0.2,
+        }
+        for v in (0.0, 1.0, 2.0)
+    ]
     columns = sweep_metric_columns() + list(COMFORT_COLUMNS)
-    sweep = SweepResult(sweep_grid(["passive", "mr"], voltage=[0.0, 1.0, 2.0], duration=2.0),
-                        pd.DataFrame([{**dict.fromkeys(columns, 0.0), **r} for r in runs]), comfort=True)
+    sweep = SweepResult(
+        sweep_grid(["passive", "mr"], voltage=[0.0, 1.0, 2.0], duration=2.0),
+        pd.DataFrame([{**dict.fromkeys(columns, 0.0), **r} for r in runs]),
+        comfort=True,
+    )
     vehicle = Vehicle(rr.VehicleParams.preset("paper"))
     frequency = np.geomspace(0.2, 20.0, 40)
     frf = frf_frame({p: vehicle.frequency_response(frequency, 20.0, p) for p in FRF_PATTERNS})
     modes = modes_frame([m.to_dict() for m in vehicle.modes()])
-    pareto = ParetoResult("pid", ("pid.kp", "pid.kd"), np.array([[0.0, 1.0], [0.0, 1.0]]),
-                          np.array([[1.0, 1.0], [2.0, 3.0], [4.0, 5.0]]),
-                          np.array([[0.3, 0.03, 0.8, 1.9], [0.25, 0.03, 0.9, 1.8], [0.35, 0.02, 0.7, 2.1]]),
-                          np.array([0.32, 0.035, 0.94, 2.0]), {"name": "paper-sine", "duration_s": 1.0},
-                          {"n_samples": 2, "seed": 0, "base_gains": "shipped", "damper": "railway"})
+    pareto = ParetoResult(
+        "pid",
+        ("pid.kp", "pid.kd"),
+        np.array([[0.0, 1.0], [0.0, 1.0]]),
+        np.array([[1.0, 1.0], [2.0, 3.0], [4.0, 5.0]]),
+        np.array([[0.3, 0.03, 0.8, 1.9], [0.25, 0.03, 0.9, 1.8], [0.35, 0.02, 0.7, 2.1]]),
+        np.array([0.32, 0.035, 0.94, 2.0]),
+        {"name": "paper-sine", "duration_s": 1.0},
+        {"n_samples": 2, "seed": 0, "base_gains": "shipped", "damper": "railway"},
+    )
     return [
         (plot_body_responses, (result.dataset,), {}, 4),
         (plot_comparison_response, (comparison, "pitch"), {}, 1),

@@ -33,8 +33,15 @@ def mr():
 # -- to_dict ------------------------------------------------------------------------------------
 def test_the_document_of_a_run(mr):
     doc = mr.to_dict((0.1, 0.5))
-    assert list(doc) == ["schema", "railride_version", "scenario", "vehicle_preset", "suspension",
-                         "settings", "metrics"]
+    assert list(doc) == [
+        "schema",
+        "railride_version",
+        "scenario",
+        "vehicle_preset",
+        "suspension",
+        "settings",
+        "metrics",
+    ]
     assert doc["schema"] == SCHEMA == "railride.simulation/1"
     assert doc["scenario"] == SC.describe() and doc["vehicle_preset"] == "paper"
     assert doc["suspension"] == {"type": "mr", "damper": "dyke1996", "voltage_v": 1.0, "damper_scale": 2.0}
@@ -94,8 +101,11 @@ def test_a_suspension_keeps_the_name_and_scale_of_its_damper():
 # -- what an output rate resolves ---------------------------------------------------------------------
 def test_the_output_rate_must_resolve_a_random_track():
     fine = scenario("fra4", min_wavelength=0.1, duration=1.0)  # 556 Hz at 55.56 m/s
-    with pytest.raises(ValueError, match=r"min_wavelength = 0.1 m at speed 55.56 m/s passes at 555.6 Hz, "
-                                         r"more than output_rate 1000 Hz / 2.5 = 400 Hz"):
+    with pytest.raises(
+        ValueError,
+        match=r"min_wavelength = 0.1 m at speed 55.56 m/s passes at 555.6 Hz, "
+        r"more than output_rate 1000 Hz / 2.5 = 400 Hz",
+    ):
         check_resolution(fine, 1000.0)
     check_resolution(fine, 555.6 * RESOLUTION)
     check_resolution(scenario("paper-sine", speed=300.0), 10.0)  # no random track, nothing to resolve
@@ -104,23 +114,28 @@ def test_the_output_rate_must_resolve_a_random_track():
 
 
 # -- the studies check their settings before the first run ------------------------------------------
-@pytest.mark.parametrize("run, match", [
-    (lambda: compare(SC, controllers=["pid"], solver=SolverSettings(control_rate=300.0)),
-     "control_rate = 300 Hz with dt = 0.0001 s"),
-    (lambda: compare(scenario("fra4", min_wavelength=0.1), controllers=["pid"]), "min_wavelength = 0.1 m"),
-    (lambda: compare(SC, damper="ideal", damper_scale=2.0), "damper_scale = 2"),
-    (lambda: tune(("pid",), max_passes=0), "max_passes = 0: must be a whole number >= 1"),
-    (lambda: tune(("pid",), n_values=2), "n_values = 2: must be a whole number >= 3"),
-    (lambda: tune(("pid",), span=float("inf")), "span = inf: must be a finite number > 1"),
-    (lambda: tune(("pid",), span=1.0), "span = 1.0: must be a finite number > 1"),
-    (lambda: tune(("pid",), damper="mr9"), "unknown damper model 'mr9'"),
-    (lambda: tune(("pid",), damper="ideal", damper_scale=2.0), "damper_scale = 2"),
-    (lambda: tune(("pid",), scenario="fra4", scenario_options={"min_wavelength": 0.1}), "min_wavelength = 0.1 m"),
-    (lambda: pareto("pid", seed=-1), "seed = -1: must be a whole number >= 0"),
-    (lambda: pareto("pid", n_samples=3), "n_samples = 3: must be a power of two"),
-    (lambda: pareto("pid", damper="mr9"), "unknown damper model 'mr9'"),
-    (lambda: pareto("pid", scenario="fra4", scenario_options={"min_wavelength": 0.1}), "min_wavelength = 0.1 m"),
-])
+@pytest.mark.parametrize(
+    "run, match",
+    [
+        (
+            lambda: compare(SC, controllers=["pid"], solver=SolverSettings(control_rate=300.0)),
+            "control_rate = 300 Hz with dt = 0.0001 s",
+        ),
+        (lambda: compare(scenario("fra4", min_wavelength=0.1), controllers=["pid"]), "min_wavelength = 0.1 m"),
+        (lambda: compare(SC, damper="ideal", damper_scale=2.0), "damper_scale = 2"),
+        (lambda: tune(("pid",), max_passes=0), "max_passes = 0: must be a whole number >= 1"),
+        (lambda: tune(("pid",), n_values=2), "n_values = 2: must be a whole number >= 3"),
+        (lambda: tune(("pid",), span=float("inf")), "span = inf: must be a finite number > 1"),
+        (lambda: tune(("pid",), span=1.0), "span = 1.0: must be a finite number > 1"),
+        (lambda: tune(("pid",), damper="mr9"), "unknown damper model 'mr9'"),
+        (lambda: tune(("pid",), damper="ideal", damper_scale=2.0), "damper_scale = 2"),
+        (lambda: tune(("pid",), scenario="fra4", scenario_options={"min_wavelength": 0.1}), "min_wavelength = 0.1 m"),
+        (lambda: pareto("pid", seed=-1), "seed = -1: must be a whole number >= 0"),
+        (lambda: pareto("pid", n_samples=3), "n_samples = 3: must be a power of two"),
+        (lambda: pareto("pid", damper="mr9"), "unknown damper model 'mr9'"),
+        (lambda: pareto("pid", scenario="fra4", scenario_options={"min_wavelength": 0.1}), "min_wavelength = 0.1 m"),
+    ],
+)
 def test_the_studies_refuse_bad_settings_before_running(run, match, monkeypatch):
     from railride import simulation
 
@@ -134,8 +149,7 @@ def test_the_studies_refuse_bad_settings_before_running(run, match, monkeypatch)
 
 
 def test_the_studies_take_solver_settings_only():
-    for call in (lambda: compare(SC, dt=1e-4), lambda: tune(("pid",), dt=1e-4),
-                 lambda: pareto("pid", dt=1e-4)):
+    for call in (lambda: compare(SC, dt=1e-4), lambda: tune(("pid",), dt=1e-4), lambda: pareto("pid", dt=1e-4)):
         with pytest.raises(TypeError, match="'dt'"):
             call()
     assert np.isfinite(simulate(SC, solver=SolverSettings(dt=5e-5)).metrics().values).all()

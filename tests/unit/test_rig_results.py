@@ -35,8 +35,9 @@ def _failing_png(*args, **kwargs):
 def test_cycles_document_is_the_command_lines(cycles):
     cli = ok_json("damper", "--amplitude", 0.01, "--frequency", 2, "--voltage", "0,2.25", "--cycles", 2)
     assert cycles.to_dict() == cli
-    doc = ok_json("damper", "--amplitude", 0.005, "--frequency", 4, "--voltage", "2.25,0.5",
-                  "--model", "dyke1996", "--cycles", 3)
+    doc = ok_json(
+        "damper", "--amplitude", 0.005, "--frequency", 4, "--voltage", "2.25,0.5", "--model", "dyke1996", "--cycles", 3
+    )
     assert rig.cycles("dyke1996", 0.005, 4.0, [2.25, 0.5], n_cycles=3).to_dict() == doc
 
 
@@ -63,8 +64,7 @@ def test_cycles_plot_draws_into_the_given_axes(cycles):
         assert [line.get_label() for line in a.lines if line.get_label().endswith(" V")] == ["0 V", "2.25 V"]
     own = cycles.plot()
     assert own is not mine and len(own.get_axes()) == 2
-    assert own._suptitle.get_text() == ("railway damper (bouc-wen model), x = 10 mm sin(2 pi 2 Hz t), "
-                                        "cycle 2 of 2")
+    assert own._suptitle.get_text() == ("railway damper (bouc-wen model), x = 10 mm sin(2 pi 2 Hz t), cycle 2 of 2")
 
 
 def test_cycles_save(cycles, tmp_path, monkeypatch):
@@ -96,8 +96,25 @@ def test_cycles_refuse_bad_input_naming_the_field():
 # -- Tracking -------------------------------------------------------------------------------------
 def test_tracking_document_is_the_command_lines(tracking):
     assert tracking.to_dict() == ok_json("tracking", "--cycles", 2)
-    doc = ok_json("tracking", "--desired", "sawtooth", "--cycles", 2, "--B", 0.5, "--G", 0.002,
-                  "--frequency", 2, "--amplitude", 5000, "--model", "dyke1996", "--stroke", 0.03)
+    doc = ok_json(
+        "tracking",
+        "--desired",
+        "sawtooth",
+        "--cycles",
+        2,
+        "--B",
+        0.5,
+        "--G",
+        0.002,
+        "--frequency",
+        2,
+        "--amplitude",
+        5000,
+        "--model",
+        "dyke1996",
+        "--stroke",
+        0.03,
+    )
     result = rig.track("dyke1996", "sawtooth", 5000.0, 2.0, B=0.5, G=0.002, stroke=0.03, n_cycles=2)
     assert result.to_dict() == doc
 
@@ -108,8 +125,12 @@ def test_tracking_metrics_are_a_typed_value(tracking):
     assert m.window_s == (1.0, 2.0) and m.window_s == tracking.window
     assert m.normalised_rms_error == m.rms_error_n / m.rms_demand_n
     assert m.rms_demand_n == pytest.approx(10e3 / math.sqrt(2), rel=1e-3)
-    assert m.to_dict() == {"rms_error_n": m.rms_error_n, "rms_demand_n": m.rms_demand_n,
-                           "normalised_rms_error": m.normalised_rms_error, "window_s": [1.0, 2.0]}
+    assert m.to_dict() == {
+        "rms_error_n": m.rms_error_n,
+        "rms_demand_n": m.rms_demand_n,
+        "normalised_rms_error": m.normalised_rms_error,
+        "window_s": [1.0, 2.0],
+    }
     assert m.to_dict() == tracking.to_dict()["metrics"]
     with pytest.raises(dataclasses.FrozenInstanceError):
         m.rms_error_n = 0.0
@@ -118,8 +139,9 @@ def test_tracking_metrics_are_a_typed_value(tracking):
     assert built == rig.TrackingMetrics(1.5, 3.0, 0.5, (1.0, 2.0))
     assert all(type(v) is float for v in (built.rms_error_n, built.rms_demand_n, *built.window_s))
     # no demand: the normalised error is undefined
-    silent = dataclasses.replace(tracking, dataset=tracking.dataset.assign(
-        desired_force=tracking.dataset["desired_force"] * 0.0))
+    silent = dataclasses.replace(
+        tracking, dataset=tracking.dataset.assign(desired_force=tracking.dataset["desired_force"] * 0.0)
+    )
     assert math.isnan(silent.metrics().normalised_rms_error)
 
 
@@ -137,7 +159,8 @@ def test_tracking_plot_draws_into_the_given_axes(tracking):
     assert mine.get_axes() == list(axes) and len(axes[0].lines) == 2 and len(axes[1].lines) == 2
     own = tracking.plot()
     assert own._suptitle.get_text().startswith(
-        "sine demand 10 kN at 1 Hz, railway damper, B = 1, G = 0.00115 V/N: normalised RMS error 0.20")
+        "sine demand 10 kN at 1 Hz, railway damper, B = 1, G = 0.00115 V/N: normalised RMS error 0.20"
+    )
 
 
 def test_tracking_save(tracking, tmp_path, monkeypatch):

@@ -32,48 +32,58 @@ def _same(a, b):
         else:
             assert np.array_equal(a[name].values, b[name].values), name
     drop = {"created_utc"}
-    assert {k: v for k, v in a.attrs.items() if k not in drop} == \
-        {k: v for k, v in b.attrs.items() if k not in drop}
+    assert {k: v for k, v in a.attrs.items() if k not in drop} == {k: v for k, v in b.attrs.items() if k not in drop}
 
 
 # -- construction ---------------------------------------------------------------------------------
-@pytest.mark.parametrize("make, match", [
-    (lambda: Suspension(voltage=1.0), r"voltage = 1.0: applies to MR dampers only"),
-    (lambda: Suspension(dampers.Viscous(c=1e4), voltage=0.0), r"voltage = 0.0: applies to MR dampers only"),
-    (lambda: Suspension("railway", voltage=3.0), r"voltage = 3.0 V: must lie in \[0, 2.25\]"),
-    (lambda: Suspension.semi_active(controller=PID(1, 0, 0), voltage=1.0),
-     r"voltage = 1.0 with controller = 'pid': give either voltage"),
-    (lambda: Suspension(damper="ideal"), r"damper = 'ideal': the ideal actuator .* needs controller="),
-    (lambda: Suspension(damper="ideal-damper", voltage=1.0), r"damper = 'ideal-damper'.*got voltage = 1.0"),
-    (lambda: Suspension.ideal(None), r"controller = None"),
-    (lambda: Suspension.ideal(PID(1, 0, 0), dissipative="yes"), r"dissipative = 'yes'"),
-    (lambda: Suspension("ideal", controller=PID(1, 0, 0), inner=InnerLoop(1.0, 1e-3)),
-     r"inner = InnerLoop.*no inner loop"),
-    (lambda: Suspension(inner=InnerLoop(1.0, 1e-3)), r"inner applies to a closed loop only"),
-    (lambda: Suspension("railway", sensor_noise=NOISE), r"sensor_noise applies to a closed loop only"),
-    (lambda: Suspension(controller=PID(1, 0, 0)), r"controller = 'pid' with damper = None"),
-    (lambda: Suspension(dampers.Viscous(c=1e4), controller=PID(1, 0, 0)),
-     r"controller = 'pid': a controller needs MR dampers"),
-    (lambda: Suspension(damper="magic"), r"unknown damper model 'magic'"),
-    (lambda: Suspension(damper=42), r"damper = 42: must be None"),
-    (lambda: Suspension("railway", controller="pid"), r"controller = 'pid': must be an outer loop"),
-    (lambda: Suspension("railway", controller=PID(1, 0, 0), inner=(1.0, 1e-3)), r"inner = \(1.0"),
-    (lambda: Suspension("railway", controller=PID(1, 0, 0), sensor_noise=0.1), r"sensor_noise = 0.1"),
-    (lambda: Suspension.passive(dampers.RAILWAY), r"damper = BoucWen"),
-    (lambda: Suspension.semi_active("ideal"), r"damper = 'ideal': a semi-active suspension has MR dampers"),
-    (lambda: Suspension.semi_active(dampers.RAILWAY, damper_scale=2.0),
-     r"damper_scale = 2.0: scales a damper given by name"),
-    (lambda: Suspension.semi_active("railway", damper_scale=0.0), r"damper_scale = 0.0: must be"),
-    (lambda: Suspension.named("lqr"), r"suspension = 'lqr'; allowed: passive, mr, pid"),
-    (lambda: Suspension.named("passive", damper_scale=2.0), r"damper_scale = 2: the passive"),
-    (lambda: Suspension.named("passive", voltage=1.0), r"voltage = 1.0: applies to suspension 'mr' only"),
-    (lambda: Suspension.named("passive", sensor_noise=NOISE), r"sensor_noise applies to a closed loop only"),
-    (lambda: Suspension.named("pid", damper="ideal", damper_scale=2.0), r"damper_scale = 2: the ideal"),
-    (lambda: Suspension.named("mr", damper="ideal"), r"damper = 'ideal' with suspension 'mr'"),
-    (lambda: Suspension.named("pid", voltage=1.0), r"voltage = 1.0 with controller = 'pid'"),
-    (lambda: Suspension.named("pid", damper="mr9"), r"unknown damper model 'mr9'"),
-    (lambda: Suspension.named("pid", damper=dampers.RAILWAY), r"damper = BoucWen.*must be a name"),
-])
+@pytest.mark.parametrize(
+    "make, match",
+    [
+        (lambda: Suspension(voltage=1.0), r"voltage = 1.0: applies to MR dampers only"),
+        (lambda: Suspension(dampers.Viscous(c=1e4), voltage=0.0), r"voltage = 0.0: applies to MR dampers only"),
+        (lambda: Suspension("railway", voltage=3.0), r"voltage = 3.0 V: must lie in \[0, 2.25\]"),
+        (
+            lambda: Suspension.semi_active(controller=PID(1, 0, 0), voltage=1.0),
+            r"voltage = 1.0 with controller = 'pid': give either voltage",
+        ),
+        (lambda: Suspension(damper="ideal"), r"damper = 'ideal': the ideal actuator .* needs controller="),
+        (lambda: Suspension(damper="ideal-damper", voltage=1.0), r"damper = 'ideal-damper'.*got voltage = 1.0"),
+        (lambda: Suspension.ideal(None), r"controller = None"),
+        (lambda: Suspension.ideal(PID(1, 0, 0), dissipative="yes"), r"dissipative = 'yes'"),
+        (
+            lambda: Suspension("ideal", controller=PID(1, 0, 0), inner=InnerLoop(1.0, 1e-3)),
+            r"inner = InnerLoop.*no inner loop",
+        ),
+        (lambda: Suspension(inner=InnerLoop(1.0, 1e-3)), r"inner applies to a closed loop only"),
+        (lambda: Suspension("railway", sensor_noise=NOISE), r"sensor_noise applies to a closed loop only"),
+        (lambda: Suspension(controller=PID(1, 0, 0)), r"controller = 'pid' with damper = None"),
+        (
+            lambda: Suspension(dampers.Viscous(c=1e4), controller=PID(1, 0, 0)),
+            r"controller = 'pid': a controller needs MR dampers",
+        ),
+        (lambda: Suspension(damper="magic"), r"unknown damper model 'magic'"),
+        (lambda: Suspension(damper=42), r"damper = 42: must be None"),
+        (lambda: Suspension("railway", controller="pid"), r"controller = 'pid': must be an outer loop"),
+        (lambda: Suspension("railway", controller=PID(1, 0, 0), inner=(1.0, 1e-3)), r"inner = \(1.0"),
+        (lambda: Suspension("railway", controller=PID(1, 0, 0), sensor_noise=0.1), r"sensor_noise = 0.1"),
+        (lambda: Suspension.passive(dampers.RAILWAY), r"damper = BoucWen"),
+        (lambda: Suspension.semi_active("ideal"), r"damper = 'ideal': a semi-active suspension has MR dampers"),
+        (
+            lambda: Suspension.semi_active(dampers.RAILWAY, damper_scale=2.0),
+            r"damper_scale = 2.0: scales a damper given by name",
+        ),
+        (lambda: Suspension.semi_active("railway", damper_scale=0.0), r"damper_scale = 0.0: must be"),
+        (lambda: Suspension.named("lqr"), r"suspension = 'lqr'; allowed: passive, mr, pid"),
+        (lambda: Suspension.named("passive", damper_scale=2.0), r"damper_scale = 2: the passive"),
+        (lambda: Suspension.named("passive", voltage=1.0), r"voltage = 1.0: applies to suspension 'mr' only"),
+        (lambda: Suspension.named("passive", sensor_noise=NOISE), r"sensor_noise applies to a closed loop only"),
+        (lambda: Suspension.named("pid", damper="ideal", damper_scale=2.0), r"damper_scale = 2: the ideal"),
+        (lambda: Suspension.named("mr", damper="ideal"), r"damper = 'ideal' with suspension 'mr'"),
+        (lambda: Suspension.named("pid", voltage=1.0), r"voltage = 1.0 with controller = 'pid'"),
+        (lambda: Suspension.named("pid", damper="mr9"), r"unknown damper model 'mr9'"),
+        (lambda: Suspension.named("pid", damper=dampers.RAILWAY), r"damper = BoucWen.*must be a name"),
+    ],
+)
 def test_invalid_combinations_name_the_field(make, match):
     with pytest.raises(ValueError, match=match):
         make()
@@ -85,13 +95,20 @@ def test_the_kinds_names_and_records():
         Suspension.named("passive"): ("passive", "passive", False, "Passive"),
         Suspension.passive(dampers.Viscous(c=8e4)): ("passive", "passive", False, "Passive"),
         Suspension.semi_active(): ("semi-active", "mr", False, "railway MR dampers at 0 V"),
-        Suspension.named("mr", damper="dyke1996", voltage=1.5): ("semi-active", "mr", False,
-                                                                 "dyke1996 MR dampers at 1.5 V"),
+        Suspension.named("mr", damper="dyke1996", voltage=1.5): (
+            "semi-active",
+            "mr",
+            False,
+            "dyke1996 MR dampers at 1.5 V",
+        ),
         Suspension.named("pid"): ("semi-active", "pid", True, "PID"),
-        Suspension.named("sas-attitude-ride", damper_scale=2): ("semi-active", "sas-attitude-ride",
-                                                                True, "SAS (attitude+ride)"),
-        Suspension.named("sas-attitude", damper="ideal"): ("ideal", "sas-attitude", True,
-                                                           "SAS (attitude) (ideal)"),
+        Suspension.named("sas-attitude-ride", damper_scale=2): (
+            "semi-active",
+            "sas-attitude-ride",
+            True,
+            "SAS (attitude+ride)",
+        ),
+        Suspension.named("sas-attitude", damper="ideal"): ("ideal", "sas-attitude", True, "SAS (attitude) (ideal)"),
         Suspension.ideal(ZeroDemand(), dissipative=True): ("ideal", "none", True, "no outer loop (ideal-damper)"),
     }
     for s, (kind, name, closed, label) in cases.items():
@@ -136,10 +153,14 @@ def _plain(name, damper, scale):
 
 
 #: every name on every device it runs on (the slow Spencer model: open loop and one closed loop)
-NAMED = [(n, d, x) for n in NAMES for d, x in (("railway", 1.0), ("railway", 2.0), ("spencer1997", 1.0),
-                                             ("ideal", 1.0), ("ideal-damper", 1.0))
-         if not (n == "mr" and d in dampers.IDEAL_NAMES) and not (n == "passive" and (x != 1.0 or d != "railway"))
-         and not (d == "spencer1997" and n not in ("mr", "pid"))]
+NAMED = [
+    (n, d, x)
+    for n in NAMES
+    for d, x in (("railway", 1.0), ("railway", 2.0), ("spencer1997", 1.0), ("ideal", 1.0), ("ideal-damper", 1.0))
+    if not (n == "mr" and d in dampers.IDEAL_NAMES)
+    and not (n == "passive" and (x != 1.0 or d != "railway"))
+    and not (d == "spencer1997" and n not in ("mr", "pid"))
+]
 
 
 @pytest.mark.parametrize("name, damper, scale", NAMED)
@@ -154,9 +175,11 @@ def test_named_suspensions_run_as_the_plain_constructor(name, damper, scale):
 def test_a_closed_loop_with_noise_and_another_solver_runs_as_the_plain_constructor():
     solver = SolverSettings(dt=5e-5, output_rate=500.0, control_rate=400.0)
     new = simulate(SC, suspension=Suspension.named("sas-attitude", G, sensor_noise=NOISE), solver=solver)
-    plain = simulate(SC, suspension=Suspension("railway", controller=G.controller("sas-attitude"),
-                                               inner=G.inner, sensor_noise=NOISE),
-                     solver=SolverSettings(dt=5e-5, output_rate=500.0, control_rate=400.0))
+    plain = simulate(
+        SC,
+        suspension=Suspension("railway", controller=G.controller("sas-attitude"), inner=G.inner, sensor_noise=NOISE),
+        solver=SolverSettings(dt=5e-5, output_rate=500.0, control_rate=400.0),
+    )
     _same(new.dataset, plain.dataset)
     assert new.solver == solver and new.suspension.name == "sas-attitude"
     assert new.dataset.attrs["control_rate_hz"] == 400.0 and new.dataset.attrs["dt_s"] == 5e-5
@@ -196,10 +219,16 @@ def test_a_batch_of_suspensions_equals_the_separate_runs():
         assert ds.sizes["sample"] == len(batch)
         for i, s in enumerate(batch):
             single = simulate(SC, suspension=s).dataset
-            for name in ("carbody_bounce", "carbody_roll", "carbody_acceleration",
-                         "secondary_damper_force", "damper_command_voltage"):
-                np.testing.assert_array_equal(ds[name].isel(sample=i).values, single[name].values,
-                                              err_msg=f"{s.name} {name}")
+            for name in (
+                "carbody_bounce",
+                "carbody_roll",
+                "carbody_acceleration",
+                "secondary_damper_force",
+                "damper_command_voltage",
+            ):
+                np.testing.assert_array_equal(
+                    ds[name].isel(sample=i).values, single[name].values, err_msg=f"{s.name} {name}"
+                )
     names = simulate(SC, suspension=outer).dataset["controller"].values
     assert list(names) == ["pid", "sas-attitude", "sas-attitude-ride", "none"]
     # one item is broadcast against a list of scenarios
@@ -207,13 +236,16 @@ def test_a_batch_of_suspensions_equals_the_separate_runs():
     assert both.dataset.sizes["sample"] == 2 and both.suspension == [Suspension.named("pid")] * 2
 
 
-@pytest.mark.parametrize("batch, field", [
-    ([Suspension.semi_active(), Suspension.semi_active("dyke1996")], "damper = 'dyke1996'"),
-    ([Suspension.passive(), Suspension.semi_active()], "damper = 'railway'"),
-    ([Suspension.semi_active(voltage=1.0), Suspension.named("pid")], "closed_loop = True"),
-    ([Suspension.named("pid"), Suspension.named("pid", G.apply({"inner.G": 1e-3}))], "inner = InnerLoop"),
-    ([Suspension.named("pid"), Suspension.named("pid", sensor_noise=NOISE)], "sensor_noise = SensorNoise"),
-])
+@pytest.mark.parametrize(
+    "batch, field",
+    [
+        ([Suspension.semi_active(), Suspension.semi_active("dyke1996")], "damper = 'dyke1996'"),
+        ([Suspension.passive(), Suspension.semi_active()], "damper = 'railway'"),
+        ([Suspension.semi_active(voltage=1.0), Suspension.named("pid")], "closed_loop = True"),
+        ([Suspension.named("pid"), Suspension.named("pid", G.apply({"inner.G": 1e-3}))], "inner = InnerLoop"),
+        ([Suspension.named("pid"), Suspension.named("pid", sensor_noise=NOISE)], "sensor_noise = SensorNoise"),
+    ],
+)
 def test_a_batch_shares_its_damper_inner_loop_and_noise(batch, field):
     assert field in batch_conflict(batch)
     with pytest.raises(ValueError, match=f"a batch of suspensions shares one damper model.*suspension 1 has {field}"):
@@ -242,16 +274,19 @@ def test_solver_settings_defaults_and_steps():
         simulate(SC, suspension=Suspension.named("pid"), solver=odd)
 
 
-@pytest.mark.parametrize("kwargs, match", [
-    ({"dt": -1e-4}, r"dt = -0.0001: must be a finite number > 0"),
-    ({"dt": float("nan")}, r"dt = nan"),
-    ({"dt": "1e-4"}, r"dt = '1e-4'"),
-    ({"output_rate": 0.0}, r"output_rate = 0.0"),
-    ({"control_rate": float("inf")}, r"control_rate = inf"),
-    ({"dt": True}, r"dt = True"),
-    ({"output_rate": 3000.0}, r"output_rate = 3000 Hz with dt = 0.0001 s: .* whole number of steps"),
-    ({"dt": 0.05}, r"dt = 0.05 s is too large for output_rate = 1000 Hz"),
-])
+@pytest.mark.parametrize(
+    "kwargs, match",
+    [
+        ({"dt": -1e-4}, r"dt = -0.0001: must be a finite number > 0"),
+        ({"dt": float("nan")}, r"dt = nan"),
+        ({"dt": "1e-4"}, r"dt = '1e-4'"),
+        ({"output_rate": 0.0}, r"output_rate = 0.0"),
+        ({"control_rate": float("inf")}, r"control_rate = inf"),
+        ({"dt": True}, r"dt = True"),
+        ({"output_rate": 3000.0}, r"output_rate = 3000 Hz with dt = 0.0001 s: .* whole number of steps"),
+        ({"dt": 0.05}, r"dt = 0.05 s is too large for output_rate = 1000 Hz"),
+    ],
+)
 def test_solver_settings_are_checked_at_construction(kwargs, match):
     with pytest.raises(ValueError, match=match):
         SolverSettings(**kwargs)
@@ -266,13 +301,15 @@ def test_gain_set_knows_its_tables():
     assert GainSet.tables_read("sas-attitude-ride") == ("inner", "attitude", "ride")
     assert G.value("ride.kd_2L") == G.ride.kd_2L and G.value("inner.B") == G.inner.B
     assert len(G.entries()) == 2 + 3 + 6 + 8 and G.entries(("pid",)) == {
-        "pid.kp": G.pid.kp, "pid.ki": G.pid.ki, "pid.kd": G.pid.kd}
+        "pid.kp": G.pid.kp,
+        "pid.ki": G.pid.ki,
+        "pid.kd": G.pid.kd,
+    }
     changed = G.apply({"pid.kd": 2e5, "inner.G": 1e-3})
     assert changed.pid.kd == 2e5 and changed.inner.G == 1e-3 and changed.pid.kp == G.pid.kp
     assert changed.source == G.source and changed.provenance == {}
     assert G.apply(()) == G
-    for bad, match in (("pid", "expected table.entry"), ("lqr.k", "expected table.entry"),
-                       ("pid.kf", "unknown gain")):
+    for bad, match in (("pid", "expected table.entry"), ("lqr.k", "expected table.entry"), ("pid.kf", "unknown gain")):
         with pytest.raises(ValueError, match=match):
             G.apply({bad: 1.0})
         with pytest.raises(ValueError, match=match):
@@ -294,8 +331,9 @@ def test_a_case_gives_its_suspension_and_keeps_its_key():
     assert case.to_suspension() == Suspension.named("pid", G.apply({"pid.kd": 2e5}), sensor_noise=NOISE)
     base = G.apply({"pid.kp": 1.0})
     assert case.to_suspension(base).controller == PID(1.0, G.pid.ki, 2e5)
-    assert Case(suspension="mr", voltage=2.0, damper_scale=2).to_suspension() == \
-        Suspension.named("mr", damper_scale=2.0, voltage=2.0)
+    assert Case(suspension="mr", voltage=2.0, damper_scale=2).to_suspension() == Suspension.named(
+        "mr", damper_scale=2.0, voltage=2.0
+    )
     assert Case(noise=(1e-3, 1e-4, 1e-3, 1e-4)).to_suspension() == Suspension.passive()  # as before
     with pytest.raises(ValueError, match="voltage = 3.0 V: must lie in"):
         Case(suspension="mr", voltage=3.0)
@@ -312,8 +350,7 @@ def test_run_cases_takes_the_vehicle_and_keys_it_only_when_not_the_paper_one():
     other = run_cases(cases, solver=solver, window=(0.2, 1.0), params=soft)
     assert other["key"].iloc[0] != "ffdcb73d959713ec"
     direct = simulate(scenario("paper-sine", duration=1.0), soft, solver=solver).metrics((0.2, 1.0))
-    assert other["acceleration_m_s2_rms"].iloc[0] == float(
-        direct.sel(response="acceleration_m_s2", statistic="rms"))
+    assert other["acceleration_m_s2_rms"].iloc[0] == float(direct.sel(response="acceleration_m_s2", statistic="rms"))
     # another output rate is another run too
     faster = run_cases(cases, solver=SolverSettings(dt=5e-5, output_rate=2000.0), window=(0.2, 1.0))
     assert faster["key"].iloc[0] != "ffdcb73d959713ec"

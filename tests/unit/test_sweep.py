@@ -22,9 +22,16 @@ RMS = ["acceleration_m_s2_rms", "displacement_m_rms", "pitch_deg_rms", "roll_deg
 
 # -- the grid -------------------------------------------------------------------------------------
 def test_grid_order_and_count():
-    g = grid(["passive", "mr", "pid", "sas-attitude"], speed=[20, 40], voltage=[0, "passive-on"],
-             gains={"pid.kd": [1e4, 1e5], "attitude.kp_z": [0, 1e5, 2e5]}, noise=(1e-4, 0, 0, 0),
-             seed=[0, 1], damper_scale=[0.5, 2], duration=1)
+    g = grid(
+        ["passive", "mr", "pid", "sas-attitude"],
+        speed=[20, 40],
+        voltage=[0, "passive-on"],
+        gains={"pid.kd": [1e4, 1e5], "attitude.kp_z": [0, 1e5, 2e5]},
+        noise=(1e-4, 0, 0, 0),
+        seed=[0, 1],
+        damper_scale=[0.5, 2],
+        duration=1,
+    )
     v_max = dampers.preset("railway").v_max
     # per suspension, per speed; then mr per scale and voltage, a controller per scale, gain
     # combination and noise seed (passive once, unscaled)
@@ -38,19 +45,48 @@ def test_grid_order_and_count():
             name = "pid.kd" if s == "pid" else "attitude.kp_z"
             values = (1e4, 1e5) if s == "pid" else (0.0, 1e5, 2e5)
             expected += [(s, v, x, None, ((name, k),), sd) for x in (0.5, 2.0) for k in values for sd in (0, 1)]
-    got = [(c.suspension, dict(c.scenario_options)["speed"], None if c.suspension == "passive" else c.damper_scale,
-            c.voltage, c.gains, c.seed) for c in g.cases]
+    got = [
+        (
+            c.suspension,
+            dict(c.scenario_options)["speed"],
+            None if c.suspension == "passive" else c.damper_scale,
+            c.voltage,
+            c.gains,
+            c.seed,
+        )
+        for c in g.cases
+    ]
     assert len(g) == len(g.cases) == len(g.values) == 2 * (1 + 4 + 8 + 12) == len(expected)
     assert got == expected
     assert g.columns == ("suspension", "speed_m_s", "damper_scale", "voltage_v", "pid.kd", "attitude.kp_z", "seed")
     # the grid values each run reports: None where an axis does not act
-    assert g.values[0] == {"suspension": "passive", "speed_m_s": 20.0, "damper_scale": None, "voltage_v": None,
-                           "pid.kd": None, "attitude.kp_z": None, "seed": None}
-    assert g.values[2] == {"suspension": "mr", "speed_m_s": 20.0, "damper_scale": 0.5, "voltage_v": 0.0,
-                           "pid.kd": None, "attitude.kp_z": None, "seed": None}
-    assert g.grid_values() == {"suspension": ["passive", "mr", "pid", "sas-attitude"], "speed_m_s": [20.0, 40.0],
-                               "damper_scale": [0.5, 2.0], "voltage_v": [0.0, v_max], "pid.kd": [1e4, 1e5],
-                               "attitude.kp_z": [0.0, 1e5, 2e5], "seed": [0, 1]}
+    assert g.values[0] == {
+        "suspension": "passive",
+        "speed_m_s": 20.0,
+        "damper_scale": None,
+        "voltage_v": None,
+        "pid.kd": None,
+        "attitude.kp_z": None,
+        "seed": None,
+    }
+    assert g.values[2] == {
+        "suspension": "mr",
+        "speed_m_s": 20.0,
+        "damper_scale": 0.5,
+        "voltage_v": 0.0,
+        "pid.kd": None,
+        "attitude.kp_z": None,
+        "seed": None,
+    }
+    assert g.grid_values() == {
+        "suspension": ["passive", "mr", "pid", "sas-attitude"],
+        "speed_m_s": [20.0, 40.0],
+        "damper_scale": [0.5, 2.0],
+        "voltage_v": [0.0, v_max],
+        "pid.kd": [1e4, 1e5],
+        "attitude.kp_z": [0.0, 1e5, 2e5],
+        "seed": [0, 1],
+    }
     assert all(c.noise == (1e-4, 0.0, 0.0, 0.0) for c in g.cases if c.closed_loop)
 
 
@@ -73,36 +109,47 @@ def test_grid_random_track_seeds():
     assert g.scenario_record()["min_wavelength_m"] == 2.0 and "seed" not in g.scenario_record()
 
 
-@pytest.mark.parametrize("kwargs, fragments", [
-    (dict(suspensions=["passive", "lqr"]), ("suspensions = ['passive', 'lqr']", "unknown suspension 'lqr'")),
-    (dict(suspensions=["pid", "pid"]), ("pid is listed twice",)),
-    (dict(voltage=[1.0]), ("voltage = [1.0]: applies to suspensions mr only (suspensions is passive)",)),
-    (dict(suspensions="mr", voltage=[9.0]), ("voltage = 9.0 V", "[0, 2.25]")),
-    (dict(gains={"pid.kd": [1e4]}), ("gains = {'pid.kd': [10000.0]}: applies to the controllers",)),
-    (dict(suspensions="pid", gains={"pid.kx": [1.0]}), ("gains['pid.kx'] = [1.0]: unknown gain 'pid.kx'",
-                                                        "allowed: pid.kp, pid.ki, pid.kd")),
-    (dict(suspensions="pid", gains={"pid.kd": [-1.0]}), ("gains['pid.kd'] = [-1.0]: -1 is negative",)),
-    (dict(suspensions="pid", gains={"ride.kp_1R": [1.0]}), ("ride.kp_1R acts in sas-attitude-ride only",)),
-    (dict(suspensions="pid", seed=[1]), ("seed = [1]: applies with noise only",)),
-    (dict(suspensions="pid", noise=(0, 0, 0, 0), seed=[-1]), ("seed = [-1]: -1 is negative",)),
-    (dict(suspensions="pid", noise=(0, 0, 0, 0), seed=[0.5]), ("0.5 is not a whole number",)),
-    (dict(damper="dyke1996"), ("damper = 'dyke1996': applies to mr and the controllers only",)),
-    (dict(suspensions="pid", damper="x"), ("damper = 'x': unknown damper model",)),
-    (dict(suspensions=["mr", "pid"], damper="ideal"), ("damper = 'ideal': applies to the controllers only",)),
-    (dict(suspensions="pid", damper="ideal", damper_scale=[2.0]), ("damper_scale = [2.0]: the ideal device",)),
-    (dict(suspensions="pid", damper_scale=[1.0, -1.0]), ("damper_scale = -1: must be a finite number > 0",)),
-    (dict(scenario="fra7"), ("scenario: unknown scenario 'fra7'",)),
-    (dict(track_seed=[1]), ("track_seed = [1]: applies to the random-track scenarios", "not to scenario paper-sine")),
-    (dict(min_wavelength=2.0), ("min_wavelength = 2 m: applies to the random-track scenarios",)),
-    (dict(scenario="fra4", amplitude=[0.01]), ("amplitude = 0.01 m: does not apply to a random track",)),
-    (dict(scenario="fra4", min_wavelength=30, max_wavelength=20), ("min_wavelength = 30 m, max_wavelength = 20 m",)),
-    (dict(scenario="fra4", min_wavelength=0.05), ("min_wavelength = 0.05 m at speed 55.56 m/s", "resolve")),
-    (dict(scenario="fra4", speed=[20, 120], min_wavelength=0.2), ("min_wavelength = 0.2 m at speed 120 m/s",)),
-    (dict(speed=[20, 0]), ("speed 0: speed = 0.0: must be a finite number > 0",)),
-    (dict(speed=[]), ("speed = []: give one or more values",)),
-    (dict(duration=2, window=(1, 3)), ("window = 1:3 s",)),
-    (dict(solver="fine"), ("solver = 'fine'",)),
-])
+@pytest.mark.parametrize(
+    "kwargs, fragments",
+    [
+        (dict(suspensions=["passive", "lqr"]), ("suspensions = ['passive', 'lqr']", "unknown suspension 'lqr'")),
+        (dict(suspensions=["pid", "pid"]), ("pid is listed twice",)),
+        (dict(voltage=[1.0]), ("voltage = [1.0]: applies to suspensions mr only (suspensions is passive)",)),
+        (dict(suspensions="mr", voltage=[9.0]), ("voltage = 9.0 V", "[0, 2.25]")),
+        (dict(gains={"pid.kd": [1e4]}), ("gains = {'pid.kd': [10000.0]}: applies to the controllers",)),
+        (
+            dict(suspensions="pid", gains={"pid.kx": [1.0]}),
+            ("gains['pid.kx'] = [1.0]: unknown gain 'pid.kx'", "allowed: pid.kp, pid.ki, pid.kd"),
+        ),
+        (dict(suspensions="pid", gains={"pid.kd": [-1.0]}), ("gains['pid.kd'] = [-1.0]: -1 is negative",)),
+        (dict(suspensions="pid", gains={"ride.kp_1R": [1.0]}), ("ride.kp_1R acts in sas-attitude-ride only",)),
+        (dict(suspensions="pid", seed=[1]), ("seed = [1]: applies with noise only",)),
+        (dict(suspensions="pid", noise=(0, 0, 0, 0), seed=[-1]), ("seed = [-1]: -1 is negative",)),
+        (dict(suspensions="pid", noise=(0, 0, 0, 0), seed=[0.5]), ("0.5 is not a whole number",)),
+        (dict(damper="dyke1996"), ("damper = 'dyke1996': applies to mr and the controllers only",)),
+        (dict(suspensions="pid", damper="x"), ("damper = 'x': unknown damper model",)),
+        (dict(suspensions=["mr", "pid"], damper="ideal"), ("damper = 'ideal': applies to the controllers only",)),
+        (dict(suspensions="pid", damper="ideal", damper_scale=[2.0]), ("damper_scale = [2.0]: the ideal device",)),
+        (dict(suspensions="pid", damper_scale=[1.0, -1.0]), ("damper_scale = -1: must be a finite number > 0",)),
+        (dict(scenario="fra7"), ("scenario: unknown scenario 'fra7'",)),
+        (
+            dict(track_seed=[1]),
+            ("track_seed = [1]: applies to the random-track scenarios", "not to scenario paper-sine"),
+        ),
+        (dict(min_wavelength=2.0), ("min_wavelength = 2 m: applies to the random-track scenarios",)),
+        (dict(scenario="fra4", amplitude=[0.01]), ("amplitude = 0.01 m: does not apply to a random track",)),
+        (
+            dict(scenario="fra4", min_wavelength=30, max_wavelength=20),
+            ("min_wavelength = 30 m, max_wavelength = 20 m",),
+        ),
+        (dict(scenario="fra4", min_wavelength=0.05), ("min_wavelength = 0.05 m at speed 55.56 m/s", "resolve")),
+        (dict(scenario="fra4", speed=[20, 120], min_wavelength=0.2), ("min_wavelength = 0.2 m at speed 120 m/s",)),
+        (dict(speed=[20, 0]), ("speed 0: speed = 0.0: must be a finite number > 0",)),
+        (dict(speed=[]), ("speed = []: give one or more values",)),
+        (dict(duration=2, window=(1, 3)), ("window = 1:3 s",)),
+        (dict(solver="fine"), ("solver = 'fine'",)),
+    ],
+)
 def test_grid_checks_name_the_field(kwargs, fragments):
     kwargs.setdefault("suspensions", "passive")
     with pytest.raises(ValueError) as err:
@@ -114,8 +161,11 @@ def test_grid_checks_name_the_field(kwargs, fragments):
 def test_grid_errors_in_a_callers_words():
     # what the command line passes: its option names and the text typed
     names = {"suspensions": "--suspension", "damper_scale": "--damper-scale", "gains": "--gain"}
-    with pytest.raises(ValueError, match=r"^--damper-scale = '1,2': applies to mr and the controllers only "
-                                         r"\(--suspension is passive\)$"):
+    with pytest.raises(
+        ValueError,
+        match=r"^--damper-scale = '1,2': applies to mr and the controllers only "
+        r"\(--suspension is passive\)$",
+    ):
         grid("passive", damper_scale=[1.0, 2.0], names=names, texts={"damper_scale": "1,2"})
     with pytest.raises(ValueError, match=r"^--gain = 'pid.kx=1': unknown gain 'pid.kx'"):
         grid("pid", gains={"pid.kx": [1.0]}, names=names, texts={"gains": {"pid.kx": "pid.kx=1"}})
@@ -133,8 +183,7 @@ def test_run_sweep_result_holds_objects(swept):
     assert isinstance(swept, SweepResult) and isinstance(swept.grid, SweepGrid)
     assert swept.comfort and swept.runs == len(swept.grid) == 6
     assert swept.vehicle == rr.VehicleParams.preset("paper")
-    assert list(swept.frame["case"]) == [json.dumps(c.to_dict(), sort_keys=True, default=str)
-                                         for c in swept.grid.cases]
+    assert list(swept.frame["case"]) == [json.dumps(c.to_dict(), sort_keys=True, default=str) for c in swept.grid.cases]
 
 
 def test_to_pandas_one_row_per_run(swept):
@@ -143,7 +192,8 @@ def test_to_pandas_one_row_per_run(swept):
     assert list(frame.columns[:2]) == ["suspension", "speed_m_s"] and frame.columns[-1] == "key"
     assert set(metric_columns()) | set(COMFORT_COLUMNS) <= set(frame.columns)
     assert list(zip(frame["suspension"], frame["speed_m_s"])) == [
-        (s, v) for s in ("passive", "pid") for v in (20.0, 30.0, 40.0)]
+        (s, v) for s in ("passive", "pid") for v in (20.0, 30.0, 40.0)
+    ]
     np.testing.assert_array_equal(frame[RMS].to_numpy(), swept.frame[RMS].to_numpy())
     assert list(frame["key"]) == [c.key for c in swept.grid.cases]
 
@@ -157,8 +207,9 @@ def test_to_dict_is_the_sweep_document(swept):
     assert doc["settings"]["damper"] == "railway" and doc["settings"]["comfort"]["columns"] == list(COMFORT_COLUMNS)
     assert "speed_m_s" not in doc["settings"]["scenario"] and doc["settings"]["scenario"]["duration_s"] == 1.0
     assert doc["columns"] == swept.columns()
-    assert doc["rows"] == [{k: (None if pd.isna(v) else v) for k, v in r.items()}
-                           for r in swept.to_pandas().to_dict("records")]
+    assert doc["rows"] == [
+        {k: (None if pd.isna(v) else v) for k, v in r.items()} for r in swept.to_pandas().to_dict("records")
+    ]
     assert json.loads(json.dumps(doc, allow_nan=False)) == doc
 
 
@@ -202,8 +253,12 @@ def test_run_sweep_resumes_from_its_run_table(swept, tmp_path):
     path = tmp_path / "runs.csv"
     first = run_sweep(swept.grid, table=RunTable(path), comfort=False)
     calls = []
-    again = run_sweep(swept.grid, table=RunTable(path, resume=True), comfort=False,
-                      progress=lambda done, total, rate: calls.append((done, total)))
+    again = run_sweep(
+        swept.grid,
+        table=RunTable(path, resume=True),
+        comfort=False,
+        progress=lambda done, total, rate: calls.append((done, total)),
+    )
     assert calls == [(0, 0)] and again.runs == first.runs == 6
     assert again.to_dict()["rows"] == first.to_dict()["rows"]
     # the metrics do not depend on whether comfort was asked for

@@ -48,8 +48,9 @@ def test_a_swept_case_equals_the_direct_run():
     g = GainSet.default()
     case = Case(scenario_options={"speed": 40.0, **SHORT}, suspension="pid", gains={"pid.kd": 2e5})
     row = run_cases([case]).iloc[0]
-    direct = simulate(scenario("paper-sine", speed=40.0, **SHORT),
-                      suspension=Suspension.named("pid", g.apply((("pid.kd", 2e5),)))).metrics()
+    direct = simulate(
+        scenario("paper-sine", speed=40.0, **SHORT), suspension=Suspension.named("pid", g.apply((("pid.kd", 2e5),)))
+    ).metrics()
     expected = float(direct.sel(response="acceleration_m_s2", statistic="rms"))
     assert row["acceleration_m_s2_rms"] == pytest.approx(expected, rel=1e-12)
     assert row["roll_deg_ptp"] == pytest.approx(float(direct.sel(response="roll_deg", statistic="ptp")), rel=1e-12)
@@ -77,9 +78,16 @@ def test_sensitivity_study_never_worsens_the_objective_and_records_curves():
     for c in res.curves:  # the chosen value is the best of its curve, or the previous value
         assert c.objective.min() >= min(history) - 1e-12
     # re-evaluating the tuned gains gives the objective the study reports
-    rows = run_cases([Case(scenario_options=tuple(sorted(SHORT.items())), suspension="pid",
-                           gains=tuple((f"pid.{k}", v) for k, v in res.gains.pid.to_dict().items()))],
-                     base_gains=start)
+    rows = run_cases(
+        [
+            Case(
+                scenario_options=tuple(sorted(SHORT.items())),
+                suspension="pid",
+                gains=tuple((f"pid.{k}", v) for k, v in res.gains.pid.to_dict().items()),
+            )
+        ],
+        base_gains=start,
+    )
     rms = rows[[f"{r}_rms" for r in ("acceleration_m_s2", "displacement_m", "pitch_deg", "roll_deg")]].to_numpy()
     passive = np.array(list(res.passive.values()))
     assert res.objective is DEFAULT_OBJECTIVE  # no objective given: the one default
@@ -93,15 +101,19 @@ def test_inner_loop_objective_prefers_feedback():
 
 def test_objective_kinds_against_hand_computed_values():
     passive = np.array([2.0, 1.0, 0.5, 4.0])
-    rms = np.array([[1.0, 0.5, 0.75, 2.0],    # ratios 0.5, 0.5, 1.5, 0.5
-                    [2.0, 1.0, 0.5, 4.0]])    # passive itself: ratios 1, 1, 1, 1
+    rms = np.array(
+        [
+            [1.0, 0.5, 0.75, 2.0],  # ratios 0.5, 0.5, 1.5, 0.5
+            [2.0, 1.0, 0.5, 4.0],
+        ]
+    )  # passive itself: ratios 1, 1, 1, 1
     cases = [
         (Objective(), [3.0, 4.0]),
         (Objective("weighted", (1, 0, 2, 1)), [0.5 + 0 + 3.0 + 0.5, 4.0]),
         (Objective("minimax"), [1.5, 1.0]),
         (Objective("sum", penalty=10.0), [3.0 + 10 * 0.5, 4.0]),
         (Objective("minimax", penalty=2.0), [1.5 + 2 * 0.5, 1.0]),
-        (Objective("constrained", bound=2.0), [3.0, 4.0]),             # both within the bound
+        (Objective("constrained", bound=2.0), [3.0, 4.0]),  # both within the bound
         (Objective("constrained", bound=1.2), [1000 + 1000 * 0.3, 4.0]),  # 1.5 is 0.3 over
     ]
     for objective, expected in cases:
@@ -118,13 +130,15 @@ def test_minimax_sees_only_the_worst_ratio():
 
 
 def test_constrained_ranks_infeasible_candidates_after_feasible_ones_by_excess():
-    ratios = np.array([
-        [1.2, 1.2, 1.2, 1.2],      # feasible, at the bound: the worst feasible sum
-        [0.1, 0.1, 0.1, 1.21],     # infeasible by 0.01, with the smallest sum
-        [1.22, 1.22, 0.0, 0.0],    # infeasible by 0.04
-        [1.3, 0.1, 0.1, 0.1],      # infeasible by 0.1
-        [1.0, 1.0, 1.0, 1.0],      # feasible
-    ])
+    ratios = np.array(
+        [
+            [1.2, 1.2, 1.2, 1.2],  # feasible, at the bound: the worst feasible sum
+            [0.1, 0.1, 0.1, 1.21],  # infeasible by 0.01, with the smallest sum
+            [1.22, 1.22, 0.0, 0.0],  # infeasible by 0.04
+            [1.3, 0.1, 0.1, 0.1],  # infeasible by 0.1
+            [1.0, 1.0, 1.0, 1.0],  # feasible
+        ]
+    )
     for penalty in (0.0, 10.0):
         objective = Objective("constrained", bound=1.2, penalty=penalty)
         j = objective.score(ratios)
@@ -141,8 +155,11 @@ def test_constrained_ranks_infeasible_candidates_after_feasible_ones_by_excess()
 
 def test_every_setting_of_an_objective_is_in_its_statement():
     text = Objective("weighted", (1, 0.5, 2, 1), penalty=3.0).describe()
-    for fragment in ("weighted", "acceleration 1, displacement 0.5, pitch 2, roll 1",
-                     "penalty 3 x sum_k max(0, r_k - 1)"):
+    for fragment in (
+        "weighted",
+        "acceleration 1, displacement 0.5, pitch 2, roll 1",
+        "penalty 3 x sum_k max(0, r_k - 1)",
+    ):
         assert fragment in text
     text = Objective("constrained", bound=1.2).describe()
     assert "r_k <= 1.2" in text and "J = 1000 + 1000 x E" in text and "max(0, r_k - 1.2)" in text
@@ -152,22 +169,25 @@ def test_every_setting_of_an_objective_is_in_its_statement():
     assert d["infeasible"]["offset"] == 1000.0 and d["statement"].startswith("constrained: J")
 
 
-@pytest.mark.parametrize("kwargs, fragments", [
-    ({"kind": "best"}, ("kind", "'best'", "sum, weighted, minimax, constrained")),
-    ({"kind": "weighted"}, ("weights = None", "four numbers")),
-    ({"kind": "weighted", "weights": (1, 2)}, ("weights", "four numbers")),
-    ({"kind": "weighted", "weights": (1, -1, 0, 0)}, ("weights", ">= 0")),
-    ({"kind": "weighted", "weights": (0, 0, 0, 0)}, ("weights", "not all 0")),
-    ({"kind": "weighted", "weights": ("a", 1, 1, 1)}, ("weights", "'a'")),
-    ({"kind": "sum", "weights": (1, 1, 2, 1)}, ("weights", "'weighted' only")),
-    ({"kind": "constrained"}, ("bound = None", "> 0")),
-    ({"kind": "constrained", "bound": 0.0}, ("bound = 0.0", "> 0")),
-    ({"kind": "constrained", "bound": float("nan")}, ("bound", "finite")),
-    ({"kind": "constrained", "bound": "1.2"}, ("bound = '1.2'",)),
-    ({"kind": "minimax", "bound": 1.2}, ("bound = 1.2", "'constrained' only")),
-    ({"penalty": -1.0}, ("penalty = -1.0", ">= 0")),
-    ({"penalty": float("inf")}, ("penalty", "finite")),
-])
+@pytest.mark.parametrize(
+    "kwargs, fragments",
+    [
+        ({"kind": "best"}, ("kind", "'best'", "sum, weighted, minimax, constrained")),
+        ({"kind": "weighted"}, ("weights = None", "four numbers")),
+        ({"kind": "weighted", "weights": (1, 2)}, ("weights", "four numbers")),
+        ({"kind": "weighted", "weights": (1, -1, 0, 0)}, ("weights", ">= 0")),
+        ({"kind": "weighted", "weights": (0, 0, 0, 0)}, ("weights", "not all 0")),
+        ({"kind": "weighted", "weights": ("a", 1, 1, 1)}, ("weights", "'a'")),
+        ({"kind": "sum", "weights": (1, 1, 2, 1)}, ("weights", "'weighted' only")),
+        ({"kind": "constrained"}, ("bound = None", "> 0")),
+        ({"kind": "constrained", "bound": 0.0}, ("bound = 0.0", "> 0")),
+        ({"kind": "constrained", "bound": float("nan")}, ("bound", "finite")),
+        ({"kind": "constrained", "bound": "1.2"}, ("bound = '1.2'",)),
+        ({"kind": "minimax", "bound": 1.2}, ("bound = 1.2", "'constrained' only")),
+        ({"penalty": -1.0}, ("penalty = -1.0", ">= 0")),
+        ({"penalty": float("inf")}, ("penalty", "finite")),
+    ],
+)
 def test_objective_refuses_bad_settings(kwargs, fragments):
     with pytest.raises(ValueError) as info:
         Objective(**kwargs)
@@ -177,10 +197,10 @@ def test_objective_refuses_bad_settings(kwargs, fragments):
 
 def test_the_ride_phase_starts_from_zero_ride_gains():
     start = GainSet.reference()
-    start = GainSet(start.inner, start.pid, start.attitude,
-                    start.ride.replace(**dict.fromkeys(start.ride.to_dict(), 7e4)), "test")
-    res = tune(("ride",), scenario_options={"duration": 0.5}, gains=start, n_values=3,
-               max_passes=1)
+    start = GainSet(
+        start.inner, start.pid, start.attitude, start.ride.replace(**dict.fromkeys(start.ride.to_dict(), 7e4)), "test"
+    )
+    res = tune(("ride",), scenario_options={"duration": 0.5}, gains=start, n_values=3, max_passes=1)
     first = res.curves[0]
     # swept around REFERENCE (the centre for a gain at 0), not around the start's 7e4
     assert first.values.max() == pytest.approx(REFERENCE[first.parameter] * 30, rel=1e-3)
@@ -209,13 +229,32 @@ def test_tune_result_to_dict_is_the_tune_document(short_tune):
     res = short_tune
     doc = res.to_dict()
     assert json.loads(json.dumps(doc, allow_nan=False)) == doc
-    assert list(doc) == ["schema", "railride_version", "date", "phases", "scenario", "settings",
-                         "objective", "passive_rms", "history", "gains", "before_after", "runs"]
+    assert list(doc) == [
+        "schema",
+        "railride_version",
+        "date",
+        "phases",
+        "scenario",
+        "settings",
+        "objective",
+        "passive_rms",
+        "history",
+        "gains",
+        "before_after",
+        "runs",
+    ]
     assert doc["schema"] == "railride.tune/2" and doc["phases"] == ["pid"]
     assert doc["scenario"]["duration_s"] == 1.0
-    assert doc["settings"] == {"damper": "railway", "damper_scale": 1.0, "dt_s": 1e-4,
-                               "values": 3, "span": 30.0, "max_passes": 1, "tolerance": 1e-3,
-                               "start_gains": "railride/data/reference_gains.toml"}
+    assert doc["settings"] == {
+        "damper": "railway",
+        "damper_scale": 1.0,
+        "dt_s": 1e-4,
+        "values": 3,
+        "span": 30.0,
+        "max_passes": 1,
+        "tolerance": 1e-3,
+        "start_gains": "railride/data/reference_gains.toml",
+    }
     assert doc["objective"] == DEFAULT_OBJECTIVE.to_dict()
     assert doc["gains"]["pid"] == res.gains.pid.to_dict()
     assert doc["runs"] == res.n_runs == len(res.runs)
@@ -225,9 +264,9 @@ def test_tune_result_to_dict_is_the_tune_document(short_tune):
     rows = run_cases([Case(scenario_options=SHORT, suspension="pid")], base_gains=res.start)
     assert row["before"]["acceleration_m_s2"] == rows["acceleration_m_s2_rms"].iloc[0]
     # the tuned gains' run scores what the study reports
-    assert res.objective(np.array(list(row["after"].values())),
-                         np.array(list(res.passive.values()))) == pytest.approx(
-        res.history[-1]["objective"], rel=1e-12)
+    assert res.objective(np.array(list(row["after"].values())), np.array(list(res.passive.values()))) == pytest.approx(
+        res.history[-1]["objective"], rel=1e-12
+    )
 
 
 def test_tune_result_table_and_figure(short_tune):
@@ -267,8 +306,7 @@ def test_tune_result_saves_its_folder(short_tune, tmp_path):
 
 
 def test_tune_without_before_after():
-    res = tune(("pid",), scenario_options={"duration": 0.5}, n_values=3, max_passes=1,
-               before_after=False)
+    res = tune(("pid",), scenario_options={"duration": 0.5}, n_values=3, max_passes=1, before_after=False)
     assert res.before_after == [] and res.to_dict()["before_after"] == []
 
 
@@ -283,19 +321,36 @@ def test_reference_gains_ship_with_the_package():
 
 
 def test_global_optimiser_reports_the_objective_of_the_gains_it_returns():
-    res = optimise(("attitude.kd_z", "attitude.kd_phi"), suspension="sas-attitude",
-                   scenario_options={"duration": 0.5}, popsize=3, maxiter=2, seed=1)
-    ev = optimise.__globals__["_Evaluator"](res.parameters, "sas-attitude", "paper-sine",
-                                            {"duration": 0.5}, None, None, "railway", None, None, None,
-                                            solver=SolverSettings(dt=1e-4))
+    res = optimise(
+        ("attitude.kd_z", "attitude.kd_phi"),
+        suspension="sas-attitude",
+        scenario_options={"duration": 0.5},
+        popsize=3,
+        maxiter=2,
+        seed=1,
+    )
+    ev = optimise.__globals__["_Evaluator"](
+        res.parameters,
+        "sas-attitude",
+        "paper-sine",
+        {"duration": 0.5},
+        None,
+        None,
+        "railway",
+        None,
+        None,
+        None,
+        solver=SolverSettings(dt=1e-4),
+    )
     assert ev(res.log10_gains[None, :])[0] == pytest.approx(res.objective, rel=1e-12)
     assert res.gains.attitude.kd_z == pytest.approx(10 ** res.log10_gains[0])
 
 
 def test_a_gain_the_controller_does_not_use_has_no_sensitivity():
     # the ride gains act only with the ride loop on: under SAS (attitude) their index is zero
-    res = sensitivity(("attitude.kd_z", "ride.kp_1R"), suspension="sas-attitude",
-                      scenario_options={"duration": 0.5}, n=16)
+    res = sensitivity(
+        ("attitude.kd_z", "ride.kp_1R"), suspension="sas-attitude", scenario_options={"duration": 0.5}, n=16
+    )
     assert abs(res.total[1]) < 1e-9 and abs(res.first_order[1]) < 1e-9
     assert res.total[0] > 0.1
 
@@ -320,8 +375,10 @@ def shipped_ratios():
 
     cmp = compare("paper-sine")
     rms = cmp.metrics.sel(statistic="rms")
-    return {n: rms.sel(controller=n).values / rms.sel(controller="passive").values
-            for n in ("pid", "sas-attitude", "sas-attitude-ride")}
+    return {
+        n: rms.sel(controller=n).values / rms.sel(controller="passive").values
+        for n in ("pid", "sas-attitude", "sas-attitude-ride")
+    }
 
 
 def test_shipped_gains_make_no_response_worse_than_passive(shipped_ratios):
@@ -348,8 +405,7 @@ def test_tune_with_a_scaled_damper_tunes_the_inner_loop_for_it():
     # a damper k times larger, tracking demands k times larger, wants G / k: the tracking error
     # is the same function of G k (the force, and so the error, scales with k)
     G = 2e-3
-    assert tracking_objective(1.0, G / 4, damper_scale=4.0) == pytest.approx(
-        tracking_objective(1.0, G), rel=1e-9)
+    assert tracking_objective(1.0, G / 4, damper_scale=4.0) == pytest.approx(tracking_objective(1.0, G), rel=1e-9)
     with pytest.raises(ValueError, match="damper_scale = -1"):
         tune(("pid",), damper_scale=-1, scenario_options=SHORT)
 

@@ -21,8 +21,9 @@ def test_non_numbers_and_non_finite_values_are_refused(value):
         validation.number("speed", value, "positive", "m/s")
 
 
-@pytest.mark.parametrize("rule, bad, good", [("positive", 0.0, 1e-300), ("nonnegative", -1e-300, 0.0),
-                                             ("finite", math.nan, -1e300)])
+@pytest.mark.parametrize(
+    "rule, bad, good", [("positive", 0.0, 1e-300), ("nonnegative", -1e-300, 0.0), ("finite", math.nan, -1e300)]
+)
 def test_each_rule_draws_its_line(rule, bad, good):
     assert validation.number("x", good, rule) == good
     with pytest.raises(ValueError, match=validation.RULES[rule][0]):
