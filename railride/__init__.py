@@ -21,29 +21,25 @@ from . import dampers
 from .comparison import Comparison, compare
 from .control import GainSet
 from .frf import FrfResult, frequency_responses
-from .metrics import reduction, ride_metrics
 from .params import VehicleParams
 from .pareto import ParetoResult, pareto
 from .simulation import RideResult, simulate
 from .solver import SolverSettings
 from .suspension import Suspension
 from .sweep import SweepResult, run_sweep
-from .track import CosineBump, MeasuredTrack, Scenario, SineTrack, scenario
+from .track import Scenario, scenario
 from .objectives import Objective
 from .tuning import tune
 from .vehicle import Vehicle
 
 __all__ = [
     "Comparison",
-    "CosineBump",
     "FrfResult",
     "GainSet",
-    "MeasuredTrack",
     "Objective",
     "ParetoResult",
     "RideResult",
     "Scenario",
-    "SineTrack",
     "SolverSettings",
     "Suspension",
     "SweepResult",
@@ -53,8 +49,6 @@ __all__ = [
     "dampers",
     "frequency_responses",
     "pareto",
-    "reduction",
-    "ride_metrics",
     "scenario",
     "run_sweep",
     "simulate",

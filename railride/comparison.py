@@ -19,7 +19,8 @@ from . import __version__, dampers
 from .control import CONTROLLERS, LABELS, GainSet
 from .defaults import DEFAULT_DAMPER
 from .metrics import STATISTICS, reduction, ride_metrics, select_window
-from .simulation import _resolve_scenario, simulate
+from .simulation import simulate
+from .track import as_scenario
 from .solver import SolverSettings, check_resolution
 from .suspension import Suspension, damper_model
 
@@ -297,7 +298,7 @@ def compare(
     model = damper_model(damper, damper_scale)
     damper_scale = float(damper_scale)
     names = check_controllers(controllers)
-    scenario = _resolve_scenario(scenario)
+    scenario = as_scenario(scenario)
     check_resolution(scenario, solver.output_rate)
     if len(names) > 1:
         solver.control_steps()  # the controlled runs sample at the control rate

@@ -44,12 +44,12 @@ OPTIMISE_FILES = ("optimise.png", "optimise.csv", "optimise.json")
 SENSITIVITY_FILES = ("sobol.png", "sobol.csv", "sobol.json")
 
 
-def _bounds(parameters):
+def log_gain_bounds(parameters):
     """(low, high) log10 of each parameter: REFERENCE / 1000 to REFERENCE x 100."""
     return [(math.log10(REFERENCE[p] / 1e3), math.log10(REFERENCE[p] * 1e2)) for p in parameters]
 
 
-class _Evaluator:
+class GainEvaluator:
     """objective(log10 gains) for a batch of points, through run_cases; `rms` gives the RMS
     of the four responses instead (the Pareto view). ``batches`` records, per call of the
     objective, the runs done so far and the lowest objective of the batch (the optimiser calls
@@ -145,7 +145,7 @@ def _parameter_rows(parameters) -> list[dict]:
 
     return [
         {"name": p, "unit": gain_unit(p), "low": float(10.0**lo), "high": float(10.0**hi)}
-        for p, (lo, hi) in zip(parameters, _bounds(parameters))
+        for p, (lo, hi) in zip(parameters, log_gain_bounds(parameters))
     ]
 
 
@@ -283,7 +283,7 @@ def optimise(
     at once. ``popsize`` times the number of parameters runs per generation; ``seed`` makes the
     search repeatable. ``params``: the vehicle (`VehicleParams` or a preset name, default
     "paper"); ``solver``: the `SolverSettings` of every run."""
-    ev = _Evaluator(
+    ev = GainEvaluator(
         parameters,
         suspension,
         scenario,
@@ -299,7 +299,7 @@ def optimise(
     )
     res = scipy.optimize.differential_evolution(
         lambda x: ev(x.T),
-        _bounds(parameters),
+        log_gain_bounds(parameters),
         vectorized=True,
         updating="deferred",
         popsize=popsize,
@@ -416,7 +416,7 @@ def sensitivity(
     as for `optimise`."""
     if n < 2 or n & (n - 1):
         raise ValueError(f"n = {n!r}: a power of two >= 2")
-    ev = _Evaluator(
+    ev = GainEvaluator(
         parameters,
         suspension,
         scenario,
@@ -432,7 +432,7 @@ def sensitivity(
     )
     import scipy.stats  # here, not at import: scipy.stats costs half a second to load
 
-    dists = [scipy.stats.uniform(lo, hi - lo) for lo, hi in _bounds(parameters)]
+    dists = [scipy.stats.uniform(lo, hi - lo) for lo, hi in log_gain_bounds(parameters)]
     res = scipy.stats.sobol_indices(func=lambda x: ev(x.T), n=n, dists=dists, rng=np.random.default_rng(seed))
     record, settings = ev.record(n=n, seed=seed)
     return SensitivityResult(

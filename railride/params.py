@@ -59,6 +59,19 @@ class VehicleParams:
 
     # -- presets --------------------------------------------------------------------------
     @classmethod
+    def of(cls, value) -> "VehicleParams":
+        """``value`` as parameters: None (the `paper` preset), a preset name, or a VehicleParams."""
+        if value is None:
+            return cls.preset("paper")
+        if isinstance(value, str):
+            return cls.preset(value)
+        if isinstance(value, VehicleParams):
+            return value
+        # a common slip: simulate(scenario, suspension) puts the suspension in params
+        hint = " (a Suspension is the third argument, suspension=)" if type(value).__name__ == "Suspension" else ""
+        raise ValueError(f"params = {value!r}: must be VehicleParams or a preset name{hint}")
+
+    @classmethod
     def preset(cls, name: str = "paper") -> "VehicleParams":
         """A named parameter set; see `PRESETS` for the names."""
         try:

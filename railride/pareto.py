@@ -26,7 +26,8 @@ from .control import CONTROLLERS, GainSet
 from .defaults import DEFAULT_DAMPER
 from .files import PARETO_FILES
 from .metrics import RESPONSES
-from .optimise import _bounds, _Evaluator
+from .params import VehicleParams
+from .optimise import GainEvaluator, log_gain_bounds
 from . import validation
 from .solver import SolverSettings, check_resolution
 from .sweep import Case, RunTable
@@ -247,13 +248,12 @@ def pareto(
     every run; recorded in ``settings`` where they differ from the defaults. Every setting is
     checked before the first run.
     """
-    from .simulation import _resolve_params
     from .suspension import damper_model
     from .sweep import other_settings
     from .track import scenario as make_scenario
 
     solver = SolverSettings.of(solver)
-    vehicle = _resolve_params(params)
+    vehicle = VehicleParams.of(params)
     names = _parameters(suspension, parameters)
     n_samples = _power_of_two("n_samples", n_samples)
     seed = validation.integer("seed", seed, 0)
@@ -263,10 +263,10 @@ def pareto(
     check_resolution(scen, solver.output_rate)
     record = scen.describe()
     table = RunTable() if table is None else table
-    ev = _Evaluator(
+    ev = GainEvaluator(
         names, suspension, scenario, scenario_options, base, None, damper, executor, table, progress, vehicle, solver
     )
-    bounds = np.array(_bounds(names))
+    bounds = np.array(log_gain_bounds(names))
     import scipy.stats.qmc  # here, not at import: scipy.stats costs half a second to load
 
     unit = scipy.stats.qmc.Sobol(len(names), scramble=True, seed=seed).random_base2(int(math.log2(n_samples)))

@@ -18,7 +18,7 @@ from .params import PRESETS, VehicleParams
 from .solver import SolverSettings, check_resolution
 from .suspension import Suspension, batch_conflict
 from .track import Scenario, wheelset_input_table
-from .track import scenario as named_scenario
+from .track import as_scenario
 from .vehicle import CORNER_NAMES, DOF_NAMES, DOF_UNITS, N_DOF, RAILS, WHEELSETS, Vehicle
 
 #: the schema of `RideResult.to_dict`, the document of ``railride simulate``
@@ -126,27 +126,6 @@ def _as_list(x):
     return list(x)
 
 
-def _resolve_scenario(s) -> Scenario:
-    if s is None:
-        return named_scenario("paper-sine")
-    if isinstance(s, str):
-        return named_scenario(s)
-    if isinstance(s, Scenario):
-        return s
-    raise ValueError(f"scenario = {s!r}: must be a Scenario or a scenario name")
-
-
-def _resolve_params(p) -> VehicleParams:
-    if p is None:
-        return VehicleParams.preset("paper")
-    if isinstance(p, str):
-        return VehicleParams.preset(p)
-    if isinstance(p, VehicleParams):
-        return p
-    hint = " (a Suspension is the third argument, suspension=)" if isinstance(p, Suspension) else ""
-    raise ValueError(f"params = {p!r}: must be VehicleParams or a preset name{hint}")
-
-
 def _has_states(damper) -> bool:
     """Damper models with internal states and a voltage (not passive, not the ideal actuator)."""
     return damper is not None and damper.law != dampers.LAW_IDEAL
@@ -231,8 +210,8 @@ def simulate(
         or not (isinstance(params, (VehicleParams, str)) or params is None)
         or isinstance(suspension, (list, tuple))
     )
-    scenarios = [_resolve_scenario(s) for s in _as_list(scenario)]
-    param_sets = [_resolve_params(p) for p in _as_list(params)]
+    scenarios = [as_scenario(s) for s in _as_list(scenario)]
+    param_sets = [VehicleParams.of(p) for p in _as_list(params)]
     suspensions = _as_suspensions(suspension)
     counts = (len(scenarios), len(param_sets), len(suspensions))
     n = max(counts)

@@ -29,6 +29,7 @@ import pandas as pd
 from .defaults import DEFAULT_CONTROL_RATE, DEFAULT_DAMPER, DEFAULT_OUTPUT_RATE
 from .executors import DaskExecutor, LocalExecutor, RunTable  # noqa: F401 (their home before)
 from .metrics import RESPONSES, STATISTICS
+from .params import VehicleParams
 from .solver import SolverSettings
 from .suspension import NAMES, Suspension, batch_conflict
 from .sweep_grid import SweepGrid, grid  # noqa: F401 (the grid of the sweep study, here too)
@@ -170,11 +171,11 @@ def evaluate(
     apply to (`VehicleParams` or a preset name, default "paper"); ``solver``: the
     `SolverSettings` of every run. Runs in any process: a Dask worker calls it too."""
     from .control import GainSet
-    from .simulation import _resolve_params, simulate
+    from .simulation import simulate
     from .track import scenario as make_scenario
 
     base_gains = GainSet.default() if base_gains is None else base_gains
-    vehicle = _resolve_params(params)
+    vehicle = VehicleParams.of(params)
     solver = SolverSettings.of(solver)
     scenarios: dict = {}
     rows: dict[int, dict] = {}
@@ -285,10 +286,8 @@ def run_cases(
     """
     import functools
 
-    from .simulation import _resolve_params
-
     solver = SolverSettings.of(solver)
-    vehicle = _resolve_params(params)
+    vehicle = VehicleParams.of(params)
     executor = LocalExecutor() if executor is None else executor
     table = RunTable() if table is None else table
     done = table.done()
@@ -497,13 +496,11 @@ def run_sweep(
     """
     from datetime import datetime, timezone
 
-    from .simulation import _resolve_params
-
     if not isinstance(grid, SweepGrid):
         raise ValueError(
             f"grid = {type(grid).__name__}: must be a railride.sweep.SweepGrid (railride.sweep.grid makes one)"
         )
-    vehicle = _resolve_params(params)
+    vehicle = VehicleParams.of(params)
     table = RunTable() if table is None else table
     frame = run_cases(
         list(grid.cases),

@@ -565,3 +565,14 @@ class RandomTrack(RailProfile):
             "length_m": self.length,
             "lead_in_m": self.lead_in,
         }
+
+
+def as_scenario(value) -> Scenario:
+    """``value`` as a scenario: None (`paper-sine`), a scenario name, or a `Scenario`."""
+    if value is None:
+        return scenario("paper-sine")
+    if isinstance(value, str):
+        return scenario(value)
+    if isinstance(value, Scenario):
+        return value
+    raise ValueError(f"scenario = {value!r}: must be a Scenario or a scenario name")

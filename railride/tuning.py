@@ -34,6 +34,7 @@ import pandas as pd
 from .control import CONTROLLERS, GainSet
 from .defaults import DEFAULT_DAMPER
 from .metrics import RESPONSES
+from .params import VehicleParams
 from .objectives import (  # noqa: F401 (re-exported: the objectives' old home)
     DEFAULT_OBJECTIVE,
     INFEASIBLE_OFFSET,
@@ -310,13 +311,12 @@ def tune(
     the tuned gains (`TuneResult.before_after`; through the run table, where most of these runs
     already are). Returns a `TuneResult` (``to_dict``, ``to_pandas``, ``plot``, ``save``).
     """
-    from .simulation import _resolve_params
     from .suspension import damper_model
     from .sweep import other_settings
     from .track import scenario as make_scenario
 
     solver = SolverSettings.of(solver)
-    vehicle = _resolve_params(params)
+    vehicle = VehicleParams.of(params)
     gains = GainSet.reference() if gains is None else gains
     objective = DEFAULT_OBJECTIVE if objective is None else objective
     opts = tuple(sorted((scenario_options or {}).items()))

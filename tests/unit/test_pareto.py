@@ -10,7 +10,7 @@ import pandas as pd
 import pytest
 
 from railride.control import GainSet
-from railride.optimise import _bounds
+from railride.optimise import log_gain_bounds
 from railride.pareto import FILES, in_sample_note, non_dominated, pareto
 from railride.sweep import RunTable
 from railride.track import scenario
@@ -79,7 +79,7 @@ def test_a_tiny_study(tiny, tmp_path):
     ]
     base = GainSet.default().attitude.to_dict()
     assert frame.loc[0, names].tolist() == [base[n.split(".")[1]] for n in names]
-    lo, hi = np.array(_bounds(names)).T
+    lo, hi = np.array(log_gain_bounds(names)).T
     logs = np.log10(frame.loc[1:, names].to_numpy())
     assert ((logs >= lo) & (logs <= hi)).all()
     # a seeded sample: the same seed, the same gains; another seed, others

@@ -329,7 +329,7 @@ def test_global_optimiser_reports_the_objective_of_the_gains_it_returns():
         maxiter=2,
         seed=1,
     )
-    ev = optimise.__globals__["_Evaluator"](
+    ev = optimise.__globals__["GainEvaluator"](
         res.parameters,
         "sas-attitude",
         "paper-sine",
