@@ -1,5 +1,5 @@
 """A speed sweep on FRA class 4 random track: passive against SAS (attitude+ride) on MR
-dampers, in one call of `railride.sweep.run_cases`.
+dampers: a grid of cases (`railride.sweep.grid`) run by `railride.run_sweep`.
 
     python examples/speed_sweep_random_track.py [--out DIR]
 
@@ -12,7 +12,8 @@ from pathlib import Path
 
 import matplotlib
 
-from railride.sweep import Case, run_cases
+import railride as rr
+from railride import sweep
 
 matplotlib.use("Agg")  # no display needed: the plot goes to a file
 import matplotlib.pyplot as plt  # after choosing the backend
@@ -32,24 +33,21 @@ def main():
     duration = 10.0  # seconds per run
     speeds = [20.0, 30.0, 40.0, 50.0, 60.0]
 
-    # One Case per (suspension, speed). scenario_options are the keyword arguments of
-    # railride.scenario("fra4", ...); run_cases groups compatible cases into compiled batches.
-    cases = [
-        Case(scenario="fra4", suspension=s, scenario_options={"seed": SEED, "speed": v, "duration": duration})
-        for s in SUSPENSIONS
-        for v in speeds
-    ]
-    table = run_cases(cases)  # a pandas DataFrame, one row per case, in the order of `cases`
+    # Every combination of the axes: suspension x speed, on one realisation of the track.
+    # run_sweep groups compatible cases into compiled batches.
+    grid = sweep.grid(list(SUSPENSIONS), scenario="fra4", speed=speeds, track_seed=[SEED], duration=duration)
+    result = rr.run_sweep(grid)
+    table = result.to_pandas()  # one row per case, in the order of the grid
     table.to_csv(out / "sweep.csv", index=False)
 
     # RMS carbody acceleration per suspension, indexed by speed.
-    acc = {s: table[table["suspension"] == s].set_index("scenario.speed")["acceleration_m_s2_rms"] for s in SUSPENSIONS}
+    acc = {s: table[table["suspension"] == s].set_index("speed_m_s")["acceleration_m_s2_rms"] for s in SUSPENSIONS}
     print(f"FRA class 4 random track (seed {SEED}), {duration:g} s per run: carbody acceleration RMS [m/s^2]")
     print(f"{'speed [m/s]':>12}{'passive':>10}{'SAS (att.+ride)':>17}{'reduction':>11}")
     for v in speeds:
         p, c = acc["passive"][v], acc["sas-attitude-ride"][v]
         print(f"{v:>12g}{p:>10.4f}{c:>17.4f}{(p - c) / p * 100:>10.1f}%")
-    if table["diverged_at_s"].notna().any():
+    if result.diverged().any():
         print("Warning: some runs diverged (NaN metrics); see diverged_at_s in sweep.csv")
 
     # The plot: RMS acceleration against speed, one line per suspension.
