@@ -47,7 +47,7 @@ def main():
     for v in speeds:
         p, c = acc["passive"][v], acc["sas-attitude-ride"][v]
         print(f"{v:>12g}{p:>10.4f}{c:>17.4f}{(p - c) / p * 100:>10.1f}%")
-    if result.diverged().any():
+    if result.diverged.any():
         print("Warning: some runs diverged (NaN metrics); see diverged_at_s in sweep.csv")
 
     # The plot: RMS acceleration against speed, one line per suspension.
