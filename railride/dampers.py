@@ -44,6 +44,13 @@ LAW_VISCOUS = 1
 LAW_BOUC_WEN = 2
 LAW_SPENCER = 3
 LAW_IDEAL = 4
+#: how the closed loop sets an MR damper's voltage from the demand f_d (on the carbody) at a
+#: corner; the index is the engine's code (docs/control.md, Voltage laws):
+#: "tracking": the paper's inner loop, v = clip(G (f_d - B f) sgn f, v_min, v_max);
+#: "on-off": v_max where f_d x' < 0 (a force the damper gives while dissipating), else v_min;
+#: "clipped": Dyke et al. (1996), v_max where (f_d - f) f > 0, else v_min
+VOLTAGE_LAWS = ("tracking", "on-off", "clipped")
+VOLTAGE_TRACKING, VOLTAGE_ON_OFF, VOLTAGE_CLIPPED = range(3)
 #: length of the packed parameter vector handed to the stepper (slot 15: the bound of |z|)
 N_PACKED = 16
 #: internal states per damper in the stepper: z, y (Spencer only), u

@@ -23,7 +23,15 @@ import numpy as np
 from numba import njit
 from numba.core.errors import NumbaPerformanceWarning
 
-from .dampers import LAW_BOUC_WEN, LAW_IDEAL, LAW_SPENCER, LAW_VISCOUS, N_DAMPER_STATES
+from .dampers import (
+    LAW_BOUC_WEN,
+    LAW_IDEAL,
+    LAW_SPENCER,
+    LAW_VISCOUS,
+    N_DAMPER_STATES,
+    VOLTAGE_CLIPPED,
+    VOLTAGE_ON_OFF,
+)
 
 N_DOF = 9
 N_CORNER = 4
@@ -350,12 +358,14 @@ def run_batch(
     states are stiff (`substeps`).
 
     Open loop, each corner's command voltage is vcmd[s]. With ``closed_loop`` the controller
-    samples the carbody states (plus noise[k] at sample k, if noise has rows) every ctrl_stride
-    steps, integrates (z, phi, theta) by the rectangle rule, and computes the desired corner
-    forces f_d = Gm[s] m + Hm[s] xi, which take effect one controller period later and are held
-    (a computation delay of one sample). The inner loop, v = clip(G (f_d - B f) sgn(f), v_min,
-    v_max) with (B, G) = inner[s] and f the damper force on the carbody, runs at every step
-    from the force at the step's start. With LAW_IDEAL there is no inner loop: the command of
+    samples the state m = (q, q') (noise[k] added to the carbody's six at sample k, if noise has
+    rows) every ctrl_stride steps, integrates the carbody's (z, phi, theta) by the rectangle rule,
+    and computes the desired corner forces f_d = Gm[s] m + Hm[s] xi (Gm 4 x 18), which take effect
+    one controller period later and are held (a computation delay of one sample). The voltage
+    law inner[s, 2] (railride.dampers.VOLTAGE_LAWS) runs at every step from the damper force f on
+    the carbody and the deflection rates x' at the step's start: tracking, v = clip(G (f_d - B f)
+    sgn(f), v_min, v_max) with (B, G) = inner[s, :2]; on-off, v_max where f_d x' < 0; clipped,
+    v_max where (f_d - f) f > 0 (else v_min). With LAW_IDEAL there is no inner loop: the command of
     each corner is the held demand itself, which the ideal actuator applies (out_vc then
     records the demand, not a voltage). The controller's integrator and demands are states
     x[s, NS_MAX:], so a run can continue across calls.
@@ -388,7 +398,7 @@ def run_batch(
         at, tt, cs, pp = A[smp], TS[smp], c_sec[smp], P[smp]
         uo, fo, nn, itv = u_off[smp], f_off[smp], n_nodes[smp], interval[smp]
         vc = vcmd[smp].copy()  # command voltages, held over each step
-        meas = np.empty(6)  # the controller's sample of the carbody states
+        meas = np.empty(2 * N_DOF)  # the controller's sample of the state (q, q')
         gm, hm = Gm[smp], Hm[smp]
         tc = ctrl_stride * dt
         n_noise = noise.shape[0]
@@ -401,17 +411,17 @@ def run_batch(
                 k = step // ctrl_stride
                 for c in range(N_CORNER):  # the demand computed one period ago takes effect
                     x[smp, FD_HELD + c] = x[smp, FD_NEXT + c]
-                for j in range(3):
+                for j in range(2 * N_DOF):
                     meas[j] = s[j]
-                    meas[3 + j] = s[N_DOF + j]
-                if k < n_noise:
-                    for j in range(6):
+                if k < n_noise:  # sensor noise on the carbody's (z, phi, theta) and their rates
+                    for j in range(3):
                         meas[j] += noise[k, j]
+                        meas[N_DOF + j] += noise[k, 3 + j]
                 for j in range(3):
                     x[smp, XI + j] += tc * meas[j]
                 for c in range(N_CORNER):
                     acc_fd = 0.0
-                    for j in range(6):
+                    for j in range(2 * N_DOF):
                         acc_fd += gm[c, j] * meas[j]
                     for j in range(3):
                         acc_fd += hm[c, j] * x[smp, XI + j]
@@ -426,11 +436,18 @@ def run_batch(
             if closed_loop and law != LAW_IDEAL:
                 # inner loop from the damper forces at the step's start (they do not depend on
                 # the command, only on the coil state); then correct stage 1's coil rate
+                mode = int(inner[smp, 2])
                 for c in range(N_CORNER):
                     f = y[2 * N_DOF + c]
-                    sgn = 1.0 if f > 0.0 else (-1.0 if f < 0.0 else 0.0)
-                    v = inner[smp, 1] * (x[smp, FD_HELD + c] - inner[smp, 0] * f) * sgn
-                    vc[c] = min(max(v, pp[10]), pp[11])
+                    fd = x[smp, FD_HELD + c]
+                    if mode == VOLTAGE_ON_OFF:  # cv: the deflection rates at the step's start
+                        vc[c] = pp[11] if fd * cv[c] < 0.0 else pp[10]
+                    elif mode == VOLTAGE_CLIPPED:
+                        vc[c] = pp[11] if (fd - f) * f > 0.0 else pp[10]
+                    else:
+                        sgn = 1.0 if f > 0.0 else (-1.0 if f < 0.0 else 0.0)
+                        v = inner[smp, 1] * (fd - inner[smp, 0] * f) * sgn
+                        vc[c] = min(max(v, pp[10]), pp[11])
                     b = 2 * N_DOF + N_DAMPER_STATES * c + 2
                     K[b] = -pp[9] * (s[b] - vc[c])
             if step % stride == 0:

@@ -126,6 +126,22 @@ def _as_list(x):
     return list(x)
 
 
+def _full_state_gains(G, controller) -> np.ndarray:
+    """The outer loop's G as a map from the whole state (q, q') (4 x 18): a law on the carbody
+    states alone gives G over (z_c, phi_c, theta_c, z_c', phi_c', theta_c') (4 x 6)."""
+    G = np.asarray(G, dtype=float)
+    if G.shape == (4, 2 * N_DOF):
+        return G
+    if G.shape != (4, 6):
+        raise ValueError(
+            f"controller {getattr(controller, 'name', controller)!r}: gains(vehicle) gave G of shape {G.shape}; "
+            f"allowed (4, 6) on the carbody states or (4, {2 * N_DOF}) on (q, q')"
+        )
+    full = np.zeros((4, 2 * N_DOF))
+    full[:, :3], full[:, N_DOF : N_DOF + 3] = G[:, :3], G[:, 3:]
+    return full
+
+
 def _has_states(damper) -> bool:
     """Damper models with internal states and a voltage (not passive, not the ideal actuator)."""
     return damper is not None and damper.law != dampers.LAW_IDEAL
@@ -287,11 +303,14 @@ def simulate(
 
     rows = n_out + 1
     law = kernels.LAW_VISCOUS_IN_C if damper is None else damper.law
-    gm = np.zeros((n, 4, 6))
+    gm = np.zeros((n, 4, 2 * N_DOF))
     hm = np.zeros((n, 4, 3))
+    modes = np.zeros(n)  # the voltage law of each sample (dampers.VOLTAGE_LAWS)
     if closed is not None:
         for i, (c, p) in enumerate(zip(closed["controllers"], param_sets)):
-            gm[i], hm[i] = c.gains(vehicles[id(p)])
+            G, hm[i] = c.gains(vehicles[id(p)])
+            gm[i] = _full_state_gains(G, c)
+            modes[i] = dampers.VOLTAGE_LAWS.index(getattr(c, "voltage_law", "tracking"))
     x = np.zeros((n, kernels.NX))
     x[:, 2 * N_DOF + 2 : kernels.NS_MAX : dampers.N_DAMPER_STATES] = vcmd  # coils settled at the command
     P = np.tile(damper.pack() if damper is not None else np.zeros(dampers.N_PACKED), (n, 1))
@@ -318,11 +337,12 @@ def simulate(
     fail_step = np.full(n, -1, dtype=np.int64)
 
     if closed is None:
-        ctrl_stride, inner_gains, noise = 1, np.zeros((n, 2)), np.zeros((0, 6))
+        ctrl_stride, inner_gains, noise = 1, np.zeros((n, 3)), np.zeros((0, 6))
     else:
         ctrl_stride, noise = closed["stride"], closed["noise"]
         inner = closed["inner"]  # none for the ideal devices: the stepper does not read it
-        inner_gains = np.zeros((n, 2)) if inner is None else np.tile([inner.B, inner.G], (n, 1))
+        inner_gains = np.zeros((n, 3)) if inner is None else np.tile([inner.B, inner.G, 0.0], (n, 1))
+        inner_gains[:, 2] = modes
     chunk = n_steps if progress is None else max(stride, (_CHUNK_WORK // n) // stride * stride)
     done = 0
     while True:
