@@ -354,3 +354,21 @@ def write_pareto_outputs(result, out_dir) -> list[Path]:
         "pareto.json": _text(text),
     }
     return write_folder(out_dir, [(name, writers[name]) for name in PARETO_FILES])
+
+
+#: the files `LeagueTable.save` writes
+LEAGUE_FILES = ("league.json", "league.csv", "league.png")
+
+
+def write_league_outputs(table, out_dir) -> list[Path]:
+    """Write a `railride.league.LeagueTable` into ``out_dir``, all or nothing: ``league.json``
+    (``to_dict()``), ``league.csv`` (one row per case and controller) and ``league.png``."""
+    from .plots.league import plot_league
+
+    text = json_text(table.to_dict())
+    writers = {
+        "league.json": _text(text),
+        "league.csv": _csv(table.to_pandas()),
+        "league.png": _png(lambda: plot_league(table)),
+    }
+    return write_folder(out_dir, [(name, writers[name]) for name in LEAGUE_FILES])

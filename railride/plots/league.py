@@ -1,0 +1,45 @@
+"""The league table as a bar chart: mean RMS reduction per controller and response, with the
+same gains on the ideal actuator drawn as an outline beside each bar (the upper bound)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ._style import given_axes, new_figure, suspension_label, suspension_style
+
+_RESPONSES = (
+    ("acceleration_m_s2", "acceleration"),
+    ("displacement_m", "displacement"),
+    ("pitch_deg", "pitch"),
+    ("roll_deg", "roll"),
+)
+
+
+def plot_league(table, ax=None):
+    """Bars of the mean RMS reduction [%] of each response (groups) per controller (bars),
+    outlines at the ideal actuator's mean reduction with the same gains. ``table``: a
+    `railride.league.LeagueTable`. Returns the figure."""
+    summary = table.summary()
+    controlled = [n for n in table.controllers if n != "passive"]
+    if ax is None:
+        fig = new_figure((7.0, 3.6))
+        ax = fig.add_subplot()
+    else:
+        ax = given_axes(ax, 1, "the reductions")[0]
+        fig = ax.figure
+    width = 0.8 / max(1, len(controlled))
+    x = np.arange(len(_RESPONSES))
+    for k, name in enumerate(controlled):
+        mr = [summary.loc[name].get(f"{r}_reduction_percent", np.nan) for r, _ in _RESPONSES]
+        ideal = [summary.loc[name].get(f"{r}_ideal_reduction_percent", np.nan) for r, _ in _RESPONSES]
+        pos = x - 0.4 + width * (k + 0.5)
+        colour = suspension_style(name).get("color", f"C{k}")
+        ax.bar(pos, mr, width * 0.9, color=colour, label=suspension_label(name))
+        ax.bar(pos, ideal, width * 0.9, fill=False, edgecolor=colour, linestyle="--")
+    ax.axhline(0.0, color="k", linewidth=0.8)
+    ax.set_xticks(x, [label for _, label in _RESPONSES])
+    ax.set_ylabel("RMS reduction against passive (%)")
+    n_cases = int(summary["cases"].max()) if len(summary) else 0
+    ax.set_title(f"Mean over {n_cases} case{'s' if n_cases != 1 else ''}; dashed outline: ideal actuator", fontsize=9)
+    ax.legend(fontsize="x-small", ncols=2)
+    return fig
