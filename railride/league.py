@@ -127,10 +127,12 @@ def league(
         raise ValueError("scenarios: give at least one scenario name")
     names = check_controllers(controllers)
     gains = GainSet.default() if gains is None else gains
-    todo = list(_cases(scenarios, speeds, track_seeds))
+    # every scenario is built (and checked) before the first run
+    todo = [
+        (n, v, s, scenario(n, speed=v, seed=s, duration=duration)) for n, v, s in _cases(scenarios, speeds, track_seeds)
+    ]
     rows = []
-    for k, (name, speed, seed) in enumerate(todo):
-        sc = scenario(name, speed=speed, seed=seed, duration=duration)
+    for k, (name, speed, seed, sc) in enumerate(todo):
         comp = compare(
             sc,
             params,

@@ -1,0 +1,79 @@
+"""The league table: its cases, its means, in-sample flags and refusals."""
+
+import math
+
+import numpy as np
+import pytest
+
+from railride.league import league
+
+
+@pytest.fixture(scope="module")
+def table():
+    return league(["paper-sine", "fra4"], [30.0, 55.56], track_seeds=[0, 1], controllers=["pid"], duration=2.0)
+
+
+def test_every_case_once_and_seeds_only_on_random_track(table):
+    cases = table.cases[table.cases.controller == "pid"]
+    # paper-sine: 2 speeds; fra4: 2 speeds x 2 seeds
+    assert len(cases) == 2 + 4
+    assert cases[cases.scenario == "paper-sine"].track_seed.isna().all()
+    assert sorted(cases[cases.scenario == "fra4"].track_seed) == [0, 0, 1, 1]
+
+
+def test_summary_is_the_mean_over_the_cases(table):
+    summary = table.summary()
+    pid = table.cases[table.cases.controller == "pid"]
+    for column in ("acceleration_m_s2_reduction_percent", "centre_aw_Wk", "force_max_n"):
+        assert summary.loc["pid", column] == pytest.approx(np.mean(pid[column].to_numpy()))
+    assert summary.loc["pid", "cases"] == 6
+
+
+def test_reduction_follows_from_the_rms_of_passive_and_controller(table):
+    c = table.cases
+    for (_, speed, seed), group in c.groupby(["scenario", "speed_m_s", c.track_seed.fillna(-1)]):
+        base = group[group.controller == "passive"].iloc[0]
+        pid = group[group.controller == "pid"].iloc[0]
+        expected = (base.pitch_deg_rms - pid.pitch_deg_rms) / base.pitch_deg_rms * 100
+        assert pid.pitch_deg_reduction_percent == pytest.approx(expected)
+
+
+def test_gains_tuned_on_the_paper_case_are_in_sample_only_there():
+    t = league(["paper-sine"], [30.0, 55.56], controllers=["pid"])
+    flags = dict(zip(t.cases.speed_m_s, t.cases.in_sample))
+    assert flags == {30.0: False, 55.56: True}
+    assert t.tuned_on["name"] == "paper-sine"
+
+
+def test_to_dict_is_json_ready(table):
+    import json
+
+    doc = table.to_dict()
+    assert doc["schema"] == "railride.league/1"
+    text = json.dumps(doc, allow_nan=False)
+    assert "ideal_reduction_percent" in text
+    pid = next(r for r in doc["controllers"] if r["name"] == "pid")
+    assert math.isfinite(pid["roll_deg_ideal_reduction_percent"])
+
+
+@pytest.mark.parametrize(
+    "kwargs, message",
+    [
+        ({"scenarios": ["paper-sine", "nowhere"]}, "unknown scenario 'nowhere'"),
+        ({"scenarios": []}, "at least one scenario"),
+        ({"speeds": [-1.0]}, "speed = -1.0"),
+        ({"track_seeds": [-1]}, "track_seed = -1"),
+        ({"controllers": ["pid", "skyhoook"]}, "unknown controller 'skyhoook'"),
+    ],
+)
+def test_bad_input_names_the_field(kwargs, message):
+    with pytest.raises(ValueError, match=message):
+        league(**{"duration": 1.0, **kwargs})
+
+
+def test_protocol(table, tmp_path):
+    fig = table.plot()
+    assert fig.axes
+    assert len(table.to_pandas()) == len(table.cases)
+    paths = table.save(tmp_path / "out")
+    assert sorted(p.name for p in paths) == ["league.csv", "league.json", "league.png"]
