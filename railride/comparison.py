@@ -1,9 +1,11 @@
 """The paper's comparison (its Table 1, Figs. 8-11): passive against PID, SAS (attitude) and
-SAS (attitude+ride) on one scenario, with what each controller asks of the dampers.
+SAS (attitude+ride) on one scenario, with what each controller asks of the dampers; on request
+also the other semi-active laws (`railride.controllers`) and the MR dampers held at v_max or
+v_min (passive-on, passive-off).
 
 `compare` runs the passive vehicle (viscous dashpots) and, in one batch, the controlled vehicles
-(MR dampers closed by the inner loop). The result keeps one Dataset per suspension and the
-metrics along a ``controller`` dimension.
+(MR dampers closed by their voltage law), the constant-voltage ones in another. The result keeps
+one Dataset per suspension and the metrics along a ``controller`` dimension.
 """
 
 from __future__ import annotations
@@ -16,7 +18,7 @@ import numpy as np
 import xarray as xr
 
 from . import __version__, dampers
-from .control import CONTROLLERS, LABELS, GainSet
+from .control import CONSTANT_VOLTAGE, CONTROLLERS, LABELS, PAPER_CONTROLLERS, GainSet
 from .defaults import DEFAULT_DAMPER
 from .metrics import STATISTICS, reduction, ride_metrics, select_window
 from .simulation import simulate
@@ -40,11 +42,14 @@ PAPER_REDUCTION = {
 
 
 def check_controllers(names) -> list[str]:
-    """The requested controllers in the paper's order; passive is always the baseline."""
+    """The requested controllers in the order of `CONTROLLERS`; passive is always the baseline;
+    "all" is every one."""
     names = [n.strip() for n in names if n.strip()]
+    if "all" in names:
+        names = list(CONTROLLERS)
     unknown = [n for n in names if n not in CONTROLLERS]
     if unknown:
-        raise ValueError(f"unknown controller {unknown[0]!r}; allowed: {', '.join(CONTROLLERS)}")
+        raise ValueError(f"unknown controller {unknown[0]!r}; allowed: {', '.join(CONTROLLERS)}, or all")
     if not names:
         raise ValueError(f"no controller given; allowed: {', '.join(CONTROLLERS)}")
     return [n for n in CONTROLLERS if n in names or n == "passive"]
@@ -149,6 +154,9 @@ class Comparison:
         out: dict[str, dict] = {}
         for device, runs in self.bounds.items():
             out[device] = {}
+            for name in (n for n in self.names if n in CONSTANT_VOLTAGE):  # no bound: said, not run
+                none = {r: None for r in responses}
+                out[device][name] = {"rms": none, "reduction_percent": none, "diverged_at_s": None, "note": NO_VOLTAGE}
             for name, run in runs.items():
                 rms = run["metrics"].sel(statistic="rms").values  # in the order of `responses`
                 ok = not np.isfinite(run["diverged_at_s"])
@@ -159,6 +167,11 @@ class Comparison:
                     "diverged_at_s": None if ok else run["diverged_at_s"],
                 }
         return out
+
+    def _gains_record(self, name: str):
+        """The gains of the outer loop ``name``; None for passive and the constant voltages."""
+        controller = self.gains.controller(name)
+        return None if controller is None else controller.to_dict()
 
     @property
     def in_sample(self) -> bool:
@@ -184,13 +197,17 @@ class Comparison:
                 row["reduction_percent"] = {
                     str(r): float(red.sel(controller=name, response=r, statistic="rms")) for r in m.response.values
                 }
-            row["paper"] = {
-                r: {
-                    "rms": PAPER_TABLE1[r][name],
-                    **({"reduction_percent": PAPER_REDUCTION[r][name]} if name != "passive" else {}),
+            row["paper"] = (  # None: a controller the paper does not have
+                {
+                    r: {
+                        "rms": PAPER_TABLE1[r][name],
+                        **({"reduction_percent": PAPER_REDUCTION[r][name]} if name != "passive" else {}),
+                    }
+                    for r in PAPER_TABLE1
                 }
-                for r in PAPER_TABLE1
-            }
+                if name in PAPER_CONTROLLERS
+                else None
+            )
             if self.comfort is not None:  # only when computed: the schema stays as it was
                 row["comfort"] = comfort_record(
                     self.comfort[name], None if name == "passive" else self.comfort["passive"]
@@ -211,7 +228,7 @@ class Comparison:
             "gains": {
                 "source": self.gains.source,
                 "inner": self.gains.inner.to_dict(),
-                **{n: self.gains.controller(n).to_dict() for n in self.names if n != "passive"},
+                **{n: self._gains_record(n) for n in self.names if n != "passive"},
             },
         }
 
@@ -250,7 +267,7 @@ class Comparison:
                 ["scenario", "vehicle_params", "controller", "controller_gains"], errors="ignore"
             )
             parts.append(ds.expand_dims(controller=[name]))
-        gains = [json.dumps(None if n == "passive" else self.gains.controller(n).to_dict()) for n in self.names]
+        gains = [json.dumps(self._gains_record(n)) for n in self.names]
         out = xr.concat(parts, dim="controller", join="outer", data_vars="all", combine_attrs="drop_conflicts")
         first = self.datasets[self.names[0]]
         out["scenario"] = first["scenario"]
@@ -267,7 +284,7 @@ def compare(
     scenario,
     params=None,
     *,
-    controllers=CONTROLLERS,
+    controllers=PAPER_CONTROLLERS,
     gains: GainSet | None = None,
     damper=DEFAULT_DAMPER,
     damper_scale: float = 1.0,
@@ -280,8 +297,10 @@ def compare(
 ) -> Comparison:
     """Run the passive vehicle and each controller on ``scenario`` and collect the metrics.
 
-    ``controllers`` names from `railride.control.CONTROLLERS` (passive is always run as the
-    baseline); ``gains`` a `GainSet` (default: the shipped gains); ``damper`` the name of the
+    ``controllers`` names from `railride.control.CONTROLLERS` or "all" (default the paper's
+    four, `PAPER_CONTROLLERS`; passive is always run as the baseline; passive-on and passive-off,
+    MR dampers at a constant voltage, are not run on the ideal devices, which have none:
+    ``settings["not_run"]`` says so); ``gains`` a `GainSet` (default: the shipped gains); ``damper`` the name of the
     controlled suspensions' dampers (`railride.dampers.NAMES`: an MR preset or "ideal", the
     ideal actuator) and ``damper_scale`` the factor on an MR damper's force capacity
     (`BoucWen.scaled`; 1 for the ideal actuator); passive stays the viscous baseline. Each
@@ -303,41 +322,50 @@ def compare(
     if len(names) > 1:
         solver.control_steps()  # the controlled runs sample at the control rate
     gains = GainSet.default() if gains is None else gains
-    controlled = [n for n in names if n != "passive"]
-    bound_devices = [d for d in BOUND_DEVICES if bounds and controlled and model.law != dampers.LAW_IDEAL]
-    # progress by sample-steps: the passive run is one sample, the controlled batches the rest
-    share = 1.0 / (1 + len(controlled) * (1 + len(bound_devices)))
+    ideal = model.law == dampers.LAW_IDEAL
+    # a constant voltage means nothing to the ideal devices: said in the settings, not run
+    not_run = {n: NO_VOLTAGE for n in names if n in CONSTANT_VOLTAGE and ideal}
+    names = [n for n in names if n not in not_run]
+    closed = [n for n in names if n != "passive" and n not in CONSTANT_VOLTAGE]
+    constant = [n for n in names if n in CONSTANT_VOLTAGE]
+    bound_devices = [d for d in BOUND_DEVICES if bounds and closed and not ideal]
+    # progress by sample-steps: the passive run is one sample, the other batches the rest
+    share = 1.0 / (1 + len(constant) + len(closed) * (1 + len(bound_devices)))
     part = (lambda lo, w: lambda done: progress(lo + w * done)) if progress is not None else None
     datasets = {
         "passive": simulate(
             scenario, params, Suspension.passive(), solver=solver, progress=part and part(0.0, share)
         ).dataset
     }
-    if controlled:
-        batch = simulate(
-            scenario,
-            params,
-            [Suspension.named(n, gains, damper, damper_scale, sensor_noise=sensor_noise) for n in controlled],
-            solver=solver,
-            progress=part and part(share, share * len(controlled)),
-        ).dataset
-        for i, n in enumerate(controlled):
-            datasets[n] = batch.isel(sample=i, drop=True)
+    done = 1
+    # closed and open loops run as separate batches (a batch is all one or the other)
+    for group, noise in ((closed, sensor_noise), (constant, None)):
+        if group:
+            batch = simulate(
+                scenario,
+                params,
+                [Suspension.named(n, gains, damper, damper_scale, sensor_noise=noise) for n in group],
+                solver=solver,
+                progress=part and part(share * done, share * len(group)),
+            ).dataset
+            for i, n in enumerate(group):
+                datasets[n] = batch.isel(sample=i, drop=True)
+            done += len(group)
     bound_values = {}
     for k, device in enumerate(bound_devices):
         # the ideal actuator may not be stable with gains tuned for a damper: marked, not fatal
         res = simulate(
             scenario,
             params,
-            [Suspension.named(n, gains, device, sensor_noise=sensor_noise) for n in controlled],
+            [Suspension.named(n, gains, device, sensor_noise=sensor_noise) for n in closed],
             solver=solver,
             on_divergence="mark",
-            progress=part and part(share * (1 + len(controlled) * (1 + k)), share * len(controlled)),
+            progress=part and part(share * (done + len(closed) * k), share * len(closed)),
         )
         m = res.metrics(window)
         bound_values[device] = {
             n: {"metrics": m.isel(sample=i, drop=True), "diverged_at_s": float(res.diverged_at[i])}
-            for i, n in enumerate(controlled)
+            for i, n in enumerate(closed)
         }
     metrics = xr.concat([ride_metrics(datasets[n], window) for n in names], dim="controller")
     metrics = metrics.assign_coords(controller=names)
@@ -350,6 +378,7 @@ def compare(
         **solver.to_dict(),
         "window_s": None if window is None else [float(w) for w in window],
         "sensor_noise": None if sensor_noise is None else sensor_noise.__dict__,
+        **({"not_run": not_run} if not_run else {}),
     }
     comfort_values = None
     if comfort:
@@ -364,6 +393,8 @@ def compare(
 #: the ideal devices `compare` runs beside the MR dampers: the best a damper could do with the
 #: same control laws and gains, and what a force actuator would do
 BOUND_DEVICES = ("ideal-damper", "ideal")
+#: why passive-on and passive-off have no run on, and no bound from, the ideal devices
+NO_VOLTAGE = "MR dampers at a constant voltage: no meaning on the ideal devices, which have no voltage"
 
 
 #: indices whose reduction against passive is given: a_w, VDV and N_MV_z scale with the

@@ -8,8 +8,13 @@ forces (on the carbody, up +, corners 1R, 1L, 2R, 2L) are
 
 `Controller.gains(vehicle)` builds G (4 x 6) and H (4 x 3) from the gains and the vehicle's
 geometry; the compiled step applies them at the controller's sample rate, and the one place
-where the semi-active nonlinearity lives is the inner loop (`InnerLoop`), which turns f_d and
-the measured damper force into a voltage clipped to the damper's range.
+where the semi-active nonlinearity lives is the engine's voltage law, for these the inner loop
+(`InnerLoop`), which turns f_d and the measured damper force into a voltage clipped to the
+damper's range.
+
+The other semi-active laws (skyhook, groundhook, hybrid, clipped-optimal: `railride.controllers`)
+are registered here beside the paper's: `CONTROLLERS` names every suspension a comparison can
+run, and a `GainSet` (a gains file) holds every law's gains.
 
 Corner displacements are z_i = (T_c^T q_c)_i, T_c the carbody rows of the secondary force map
 T (rows heave, pitch, roll). The decoupling transformation of the SAS distributes a demanded
@@ -21,6 +26,7 @@ garbled).
 from __future__ import annotations
 
 import dataclasses
+import functools
 import tomllib
 from dataclasses import dataclass, field
 from importlib import resources
@@ -29,42 +35,23 @@ from typing import Callable, ClassVar, NamedTuple
 
 import numpy as np
 
+from .controllers import (  # noqa: F401 (carbody_map, decoupling, ZeroDemand: their home before)
+    ClippedOptimal,
+    GainTable,
+    Groundhook,
+    Hybrid,
+    Skyhook,
+    SkyhookOnOff,
+    ZeroDemand,
+    carbody_map,
+    decoupling,
+)
 from .params import param, validate_fields
 from .vehicle import CORNER_NAMES, Vehicle
 
 
-def carbody_map(vehicle: Vehicle) -> np.ndarray:
-    """T_c (3 x 4): generalised force (heave, pitch, roll) on the carbody from corner forces."""
-    return vehicle.T[:3].copy()
-
-
-def decoupling(vehicle: Vehicle) -> np.ndarray:
-    """T_c^+ (4 x 3), the right inverse of T_c: corner forces for a generalised force demand."""
-    Tc = carbody_map(vehicle)
-    return Tc.T @ np.linalg.inv(Tc @ Tc.T)
-
-
-class _Gains:
-    # declared for the type checker: every subclass is a frozen dataclass with these
-    __dataclass_fields__: ClassVar[dict]
-    name: str
-    label: str
-
-    def replace(self, **changes):
-        unknown = set(changes) - {f.name for f in dataclasses.fields(self)}
-        if unknown:
-            raise ValueError(
-                f"unknown gain(s) {', '.join(sorted(unknown))} for {self.name}; allowed: "
-                f"{', '.join(f.name for f in dataclasses.fields(self))}"
-            )
-        return dataclasses.replace(self, **changes)
-
-    def to_dict(self) -> dict:
-        return dataclasses.asdict(self)
-
-
 @dataclass(frozen=True)
-class InnerLoop(_Gains):
+class InnerLoop(GainTable):
     """Force tracking, paper eq. 12-14: v = clip(G (f_d - B f) sgn(f), v_min, v_max)."""
 
     B: float = param("-", "feedback weight of the measured damper force", "nonnegative")
@@ -77,7 +64,7 @@ class InnerLoop(_Gains):
 
 
 @dataclass(frozen=True)
-class PID(_Gains):
+class PID(GainTable):
     """Four identical decentralised PID loops on the carbody's corner displacements
     (paper Fig. 4): f_d,i = -(kp z_i + ki int z_i dt + kd z_i')."""
 
@@ -96,7 +83,7 @@ class PID(_Gains):
 
 
 @dataclass(frozen=True)
-class Attitude(_Gains):
+class Attitude(GainTable):
     """SAS attitude loop (paper Fig. 3, 7): PD on carbody heave, pitch and roll giving
     Q_d = -(kp_z z + kd_z z', kp_phi phi + kd_phi phi', kp_theta theta + kd_theta theta'),
     distributed by the decoupling transformation f = T_c^+ Q_d."""
@@ -115,7 +102,7 @@ class Attitude(_Gains):
 
 
 @dataclass(frozen=True)
-class Ride(_Gains):
+class Ride(GainTable):
     """SAS ride loop: per-corner PD on the carbody corner's displacement and velocity,
     subtracted from the decoupled attitude demand: f_d,i = f_DTS,i - (kp_i z_i + kd_i z_i')."""
 
@@ -173,45 +160,71 @@ class SAS:
         return out
 
 
-@dataclass(frozen=True)
-class ZeroDemand:
-    """A closed loop without an outer loop: the demand f_d is 0 at every corner, so the inner
-    loop holds the MR dampers at their lowest force (and the ideal devices apply none)."""
-
-    name = "none"
-    label = "no outer loop"
-
-    def gains(self, vehicle: Vehicle) -> tuple[np.ndarray, np.ndarray]:
-        return np.zeros((4, 6)), np.zeros((4, 3))
-
-    def to_dict(self) -> None:
-        return None  # no gains: a result records null
-
-
 # -- gains files --------------------------------------------------------------------------------
 class _OuterLoop(NamedTuple):
     tables: tuple  # the gain tables it reads besides the inner loop's
     build: Callable  # GainSet -> the outer loop
     label: str
+    inner: bool = True  # whether its voltage law reads the inner loop's gains ("tracking")
 
 
-#: the outer loops a gains file defines, by name in the paper's order: a new controller is a class
-#: with ``gains(vehicle)``, ``name`` and ``to_dict()``, and an entry here
+#: the outer loops a gains file defines, by name: the paper's, then those of railride.controllers;
+#: a new controller is a class with ``gains(vehicle)``, ``name`` and ``to_dict()``, and an entry here
 _OUTER_LOOPS = {
     "pid": _OuterLoop(("pid",), lambda g: g.pid, "PID"),
     "sas-attitude": _OuterLoop(("attitude",), lambda g: SAS(g.attitude), "SAS (attitude)"),
     "sas-attitude-ride": _OuterLoop(("attitude", "ride"), lambda g: SAS(g.attitude, g.ride), "SAS (attitude+ride)"),
+    "skyhook": _OuterLoop(("skyhook",), lambda g: g.skyhook, Skyhook.label),
+    # the skyhook's demand and gains, switched on and off (no force tracking: no inner loop)
+    "skyhook-on-off": _OuterLoop(
+        ("skyhook",), lambda g: SkyhookOnOff(**g.skyhook.to_dict()), SkyhookOnOff.label, False
+    ),
+    "groundhook": _OuterLoop(("groundhook",), lambda g: g.groundhook, Groundhook.label),
+    "hybrid": _OuterLoop(("hybrid",), lambda g: g.hybrid, Hybrid.label),
+    "clipped-optimal": _OuterLoop(("clipped_optimal",), lambda g: g.clipped_optimal, ClippedOptimal.label, False),
 }
-CONTROLLERS = ("passive", *_OUTER_LOOPS)
-LABELS = {"passive": "Passive", **{name: loop.label for name, loop in _OUTER_LOOPS.items()}}
-_TABLES = {"inner": InnerLoop, "pid": PID, "sas.attitude": Attitude, "sas.ride": Ride}
+#: the outer loops by name
+OUTER_LOOPS = tuple(_OUTER_LOOPS)
+#: MR dampers held at a constant voltage, no outer loop: the baselines of a semi-active study
+CONSTANT_VOLTAGE = {"passive-on": "v_max", "passive-off": "v_min"}
+#: every suspension a comparison can name: passive, the outer loops, the constant-voltage baselines
+CONTROLLERS = ("passive", *OUTER_LOOPS, *CONSTANT_VOLTAGE)
+#: the paper's comparison (its Table 1): what `railride compare` runs by default
+PAPER_CONTROLLERS = ("passive", "pid", "sas-attitude", "sas-attitude-ride")
+LABELS = {
+    "passive": "Passive",
+    **{name: loop.label for name, loop in _OUTER_LOOPS.items()},
+    "passive-on": "Passive-on",
+    "passive-off": "Passive-off",
+}
+#: the gain tables by their "table.entry" name: (the table in a gains file, its class)
+_TABLES = {
+    "inner": ("inner", InnerLoop),
+    "pid": ("pid", PID),
+    "attitude": ("sas.attitude", Attitude),
+    "ride": ("sas.ride", Ride),
+    "skyhook": ("skyhook", Skyhook),
+    "groundhook": ("groundhook", Groundhook),
+    "hybrid": ("hybrid", Hybrid),
+    "clipped_optimal": ("clipped_optimal", ClippedOptimal),
+}
+#: the tables a gains file of railride 0.3.0 and before has not: they take the packaged reference
+_LATER_TABLES = ("skyhook", "groundhook", "hybrid", "clipped_optimal")
+
+
+@functools.lru_cache(maxsize=1)
+def _reference_gains() -> "GainSet":
+    return GainSet.reference()
 
 
 @dataclass(frozen=True)
 class GainSet:
     """Every controller's gains, as read from a gains file. ``provenance``: the file's
-    [provenance] table (how the gains were found), empty when it has none; it does not take part
-    in comparisons, so equal gains are equal whatever their history."""
+    [provenance] table (how the gains were found), empty when it has none. ``from_reference``:
+    the tables the file (or the constructor) did not give, which took the packaged reference
+    values (`reference`): a file of railride 0.3.0 and before has no [skyhook], [groundhook],
+    [hybrid] or [clipped_optimal]. Neither takes part in comparisons, so equal gains are equal
+    whatever their history."""
 
     inner: InnerLoop
     pid: PID
@@ -219,22 +232,44 @@ class GainSet:
     ride: Ride
     source: str = "<built>"
     provenance: dict = field(default_factory=dict, compare=False, repr=False)
+    skyhook: Skyhook | None = None
+    groundhook: Groundhook | None = None
+    hybrid: Hybrid | None = None
+    clipped_optimal: ClippedOptimal | None = None
+    from_reference: tuple = field(default=(), compare=False, repr=False)
 
     #: the gain tables, as a "table.entry" name spells them (the file's [sas.attitude] is "attitude")
-    TABLES: ClassVar[tuple] = ("inner", "pid", "attitude", "ride")
+    TABLES: ClassVar[tuple] = tuple(_TABLES)
+    #: the paper's tables: those `railride tune` tunes
+    PAPER_TABLES: ClassVar[tuple] = ("inner", "pid", "attitude", "ride")
+
+    def __post_init__(self):
+        missing = tuple(t for t in _LATER_TABLES if getattr(self, t) is None)
+        if missing:
+            reference = _reference_gains()
+            for t in missing:
+                object.__setattr__(self, t, reference.table(t))
+            object.__setattr__(self, "from_reference", tuple(dict.fromkeys(self.from_reference + missing)))
+        for t, (key, kind) in _TABLES.items():
+            if type(getattr(self, t)) is not kind:  # SkyhookOnOff is a Skyhook, but not its table
+                raise ValueError(f"{t} = {getattr(self, t)!r}: must be a railride {kind.__name__} (table [{key}])")
 
     @classmethod
     def entry_names(cls, table: str) -> tuple[str, ...]:
         """The "table.entry" names of ``table``, in the order of its fields."""
-        kind = {"inner": InnerLoop, "pid": PID, "attitude": Attitude, "ride": Ride}[cls._table_name(table)]
+        kind = _TABLES[cls._table_name(table)][1]
         return tuple(f"{table}.{f.name}" for f in dataclasses.fields(kind))
 
     @staticmethod
     def tables_read(controller: str) -> tuple[str, ...]:
-        """The tables the outer loop ``controller`` and its inner loop read."""
+        """The tables the outer loop ``controller`` and its inner loop read (none for the
+        constant-voltage baselines; the on-off and clipped voltage laws read no inner loop)."""
+        if controller in CONSTANT_VOLTAGE:
+            return ()
         if controller not in _OUTER_LOOPS:
-            raise ValueError(f"controller = {controller!r}: allowed {', '.join(_OUTER_LOOPS)}")
-        return ("inner", *_OUTER_LOOPS[controller].tables)
+            raise ValueError(f"controller = {controller!r}: allowed {', '.join(CONTROLLERS[1:])}")
+        loop = _OUTER_LOOPS[controller]
+        return ("inner",) * loop.inner + loop.tables
 
     @classmethod
     def _table_name(cls, table: str) -> str:
@@ -272,7 +307,8 @@ class GainSet:
         tables = {t: self.table(t) for t in self.TABLES}
         for table, entries in grouped.items():
             tables[table] = tables[table].replace(**entries)
-        return GainSet(tables["inner"], tables["pid"], tables["attitude"], tables["ride"], self.source)
+        kept = tuple(t for t in self.from_reference if t not in grouped)
+        return GainSet(**tables, source=self.source, from_reference=kept)
 
     def tuned_on(self, record: dict | None) -> bool:
         """Whether these gains were tuned on the track ``record`` (`Scenario.describe`), as the
@@ -280,50 +316,55 @@ class GainSet:
         return self.provenance.get("scenario_record") == record
 
     def controller(self, name: str):
-        """The outer loop called ``name`` (None for the passive suspension)."""
-        if name == "passive":
+        """The outer loop called ``name`` (None for the passive suspension and the
+        constant-voltage baselines, which have none)."""
+        if name == "passive" or name in CONSTANT_VOLTAGE:
             return None
         if name not in _OUTER_LOOPS:
             raise ValueError(f"unknown controller {name!r}; allowed: {', '.join(CONTROLLERS)}")
         return _OUTER_LOOPS[name].build(self)
 
-    def to_toml(self) -> str:
+    def to_toml(self, tables=TABLES) -> str:
+        """A gains file of ``tables`` (default all: a complete file to start from)."""
         lines = []
-        for key, obj in (
-            ("inner", self.inner),
-            ("pid", self.pid),
-            ("sas.attitude", self.attitude),
-            ("sas.ride", self.ride),
-        ):
+        for t in tables:
+            key, obj = _TABLES[self._table_name(t)][0], self.table(t)
             lines.append(f"[{key}]")
             for f in dataclasses.fields(obj):
                 lines.append(f"{f.name} = {getattr(obj, f.name)!r}  # {f.metadata['unit']}")
             lines.append("")
         return "\n".join(lines)
 
+    def key_text(self) -> str:
+        """These gains as the key of a run holds them (`railride.sweep.run_cases`): the paper's
+        tables as `to_toml` writes them, then each later table that differs from the packaged
+        reference, so that the keys of runs of railride 0.3.0 and before stay what they were."""
+        reference = _reference_gains()
+        return self.to_toml([t for t in self.TABLES if t in self.PAPER_TABLES or self.table(t) != reference.table(t)])
+
     @classmethod
-    def from_toml(cls, text: str, source: str = "<string>") -> "GainSet":
-        """Read [inner], [pid], [sas.attitude], [sas.ride]; every entry must be present, known,
-        numeric and not negative; the error names the file, the table and the entry."""
+    def from_toml(cls, text: str, source: str = "<string>", *, complete: bool = False) -> "GainSet":
+        """Read [inner], [pid], [sas.attitude], [sas.ride], [skyhook], [groundhook], [hybrid],
+        [clipped_optimal]; every entry of a table must be present, known, numeric and obey its
+        rule; the error names the file, the table and the entry. The last four may be absent
+        (files of railride 0.3.0 and before): they take the packaged reference values, listed in
+        ``from_reference``; with ``complete`` every table must be there."""
         try:
             data = tomllib.loads(text)
         except tomllib.TOMLDecodeError as exc:
             raise ValueError(f"{source}: not valid TOML: {exc}") from None
-        tables = {
-            "inner": data.get("inner"),
-            "pid": data.get("pid"),
-            "sas.attitude": (data.get("sas") or {}).get("attitude"),
-            "sas.ride": (data.get("sas") or {}).get("ride"),
-        }
-        unknown_top = sorted(set(data) - {"inner", "pid", "sas", "provenance"})
+        unknown_top = sorted(set(data) - {"inner", "pid", "sas", "provenance", *_LATER_TABLES})
         if unknown_top:
-            raise ValueError(
-                f"{source}: unknown table(s) {', '.join(unknown_top)}; allowed: "
-                "[inner], [pid], [sas.attitude], [sas.ride], [provenance]"
-            )
+            allowed = ", ".join(f"[{key}]" for key, _ in _TABLES.values())
+            raise ValueError(f"{source}: unknown table(s) {', '.join(unknown_top)}; allowed: {allowed}, [provenance]")
         built = {}
-        for key, kind in _TABLES.items():
-            table = tables[key]
+        for t, (key, kind) in _TABLES.items():
+            head, _, sub = key.partition(".")
+            table = data.get(head)
+            if sub:
+                table = table.get(sub) if isinstance(table, dict) else None
+            if table is None and t in _LATER_TABLES and not complete:
+                continue  # GainSet takes the reference values and records it
             names = [f.name for f in dataclasses.fields(kind)]
             if not isinstance(table, dict):
                 raise ValueError(f"{source}: missing table [{key}] with entries {', '.join(names)}")
@@ -338,13 +379,13 @@ class GainSet:
                 if isinstance(v, bool) or not isinstance(v, (int, float)):
                     raise ValueError(f"{source}: entry {n!r} in [{key}] = {v!r} is not a number")
             try:
-                built[key] = kind(**table)
+                built[t] = kind(**table)
             except ValueError as exc:
                 raise ValueError(f"{source}: [{key}] {exc}") from None
         provenance = data.get("provenance", {})
         if not isinstance(provenance, dict):
             raise ValueError(f"{source}: [provenance] must be a table, not {provenance!r}")
-        return cls(built["inner"], built["pid"], built["sas.attitude"], built["sas.ride"], source, provenance)
+        return cls(**built, source=source, provenance=provenance)
 
     @classmethod
     def load(cls, path: str | Path) -> "GainSet":
@@ -369,8 +410,9 @@ class GainSet:
 
     @classmethod
     def _packaged(cls, name: str) -> "GainSet":
+        # complete: the packaged files hold every table (the reference fills the others' gaps)
         text = resources.files("railride").joinpath(f"data/{name}").read_text(encoding="utf-8")
-        return cls.from_toml(text, source=f"railride/data/{name}")
+        return cls.from_toml(text, source=f"railride/data/{name}", complete=True)
 
 
 @dataclass(frozen=True)

@@ -186,15 +186,16 @@ def psd_title(ds: xr.Dataset, window, segment: float) -> str:
 
 
 def gain_unit(parameter: str) -> str | None:
-    """The unit of a "table.entry" gain (tables inner, pid, attitude, ride of
-    `railride.control`), or None for an unknown table or entry."""
+    """The unit of a "table.entry" gain (`railride.control.GainSet.TABLES`), or None for an
+    unknown table or entry."""
     import dataclasses
 
-    from . import control  # here, not above: control pulls in the vehicle model
+    from .control import GainSet  # here, not above: control pulls in the vehicle model
 
-    classes = {"inner": control.InnerLoop, "pid": control.PID, "attitude": control.Attitude, "ride": control.Ride}
     table, _, entry = parameter.partition(".")
-    for f in dataclasses.fields(classes[table]) if table in classes else ():
+    if table not in GainSet.TABLES:
+        return None
+    for f in dataclasses.fields(type(GainSet.reference().table(table))):
         if f.name == entry:
             return f.metadata.get("unit")
     return None

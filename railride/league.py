@@ -18,8 +18,8 @@ import numpy as np
 import pandas as pd
 
 from . import validation
-from .comparison import CONTROLLERS, check_controllers, compare
-from .control import GainSet, LABELS
+from .comparison import check_controllers, compare
+from .control import LABELS, PAPER_CONTROLLERS, GainSet
 from .defaults import DEFAULT_DAMPER
 from .track import SPECTRA, scenario
 
@@ -107,7 +107,7 @@ def league(
     *,
     track_seeds=(0,),
     params=None,
-    controllers=CONTROLLERS,
+    controllers=PAPER_CONTROLLERS,
     gains: GainSet | None = None,
     damper: str = DEFAULT_DAMPER,
     damper_scale: float = 1.0,

@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from .control import CONTROLLERS, GainSet
+from .control import PAPER_CONTROLLERS, GainSet
 from .defaults import DEFAULT_DAMPER
 from .files import PARETO_FILES
 from .metrics import RESPONSES
@@ -38,8 +38,8 @@ FILES = PARETO_FILES  # the files `ParetoResult.save` writes
 #: the gains each controller reads (the inner loop stays at the base gains: it is one setting
 #: per compiled batch)
 CONTROLLER_PARAMETERS = {
-    n: sum((GainSet.entry_names(t) for t in GainSet.tables_read(n) if t != "inner"), ()) for n in CONTROLLERS[1:]
-}
+    n: sum((GainSet.entry_names(t) for t in GainSet.tables_read(n) if t != "inner"), ()) for n in PAPER_CONTROLLERS[1:]
+}  # the paper's controllers: their gains span the log box below (a blend such as hybrid's alpha would not)
 #: the ratios, by their short names, in the order of RESPONSES
 RATIOS = ("acceleration", "displacement", "pitch", "roll")
 #: the planes of the plot, each with its own non-dominated flag

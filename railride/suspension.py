@@ -5,15 +5,18 @@ Three kinds (`KINDS`):
 * ``passive``: the vehicle's viscous secondary dampers c_sz (or a `dampers.Viscous` in their
   place);
 * ``semi-active``: four MR dampers (`dampers.BoucWen`, `dampers.Spencer`) at a constant
-  command voltage (open loop), or under an outer loop (`railride.control`: PID, SAS) whose
-  demand the force-tracking inner loop turns into voltages (the paper's eq. 12-14);
+  command voltage (open loop), or under an outer loop (`railride.control`: PID, SAS;
+  `railride.controllers`: skyhook, groundhook, hybrid, clipped-optimal) whose demand the
+  outer loop's voltage law turns into voltages (the paper's force-tracking inner loop, eq.
+  12-14, on-off or clipped);
 * ``ideal``: an ideal device under an outer loop (`dampers.Ideal`: the ideal actuator
   "ideal", force = demand; the ideal semi-active damper "ideal-damper"), with no inner loop
   and no voltage.
 
 Simulation, comparison, sweeps and tuning all describe a run's secondary this way;
-`Suspension.named` is the one place that turns a suspension name ("passive", "mr", "pid",
-"sas-attitude", "sas-attitude-ride") and a `GainSet` into outer and inner loops.
+`Suspension.named` is the one place that turns a suspension name (`NAMES`: "passive", "mr",
+the outer loops of `control.CONTROLLERS`, "passive-on", "passive-off") and a `GainSet` into
+outer and inner loops.
 """
 
 from __future__ import annotations
@@ -24,12 +27,13 @@ from dataclasses import dataclass
 from typing import Any
 
 from . import dampers
-from .control import CONTROLLERS, LABELS, GainSet, InnerLoop, SensorNoise
+from .control import CONSTANT_VOLTAGE, CONTROLLERS, LABELS, GainSet, InnerLoop, SensorNoise
 from .defaults import DEFAULT_DAMPER
 
 #: the kinds of suspension, see `Suspension.kind`
 KINDS = ("passive", "semi-active", "ideal")
-#: the names `Suspension.named` knows: passive, MR dampers at a constant voltage, the outer loops
+#: the names `Suspension.named` knows: passive, MR dampers at a constant voltage, the outer loops,
+#: the MR dampers at their highest and lowest voltage (passive-on, passive-off)
 NAMES = ("passive", "mr", *CONTROLLERS[1:])
 
 
@@ -113,7 +117,12 @@ class Suspension:
         c = self.controller
         if c is not None and not (hasattr(c, "gains") and hasattr(c, "name")):
             raise ValueError(
-                f"controller = {c!r}: must be an outer loop from railride.control (PID, SAS, ZeroDemand) or None"
+                f"controller = {c!r}: must be an outer loop from railride.control (PID, SAS, ZeroDemand) "
+                "or railride.controllers, or None"
+            )
+        if c is not None and getattr(c, "voltage_law", "tracking") not in dampers.VOLTAGE_LAWS:
+            raise ValueError(
+                f"controller {c.name!r} voltage_law = {c.voltage_law!r}: allowed {', '.join(dampers.VOLTAGE_LAWS)}"
             )
         if self.inner is not None and not isinstance(self.inner, InnerLoop):
             raise ValueError(f"inner = {self.inner!r}: must be a railride.control.InnerLoop")
@@ -229,11 +238,13 @@ class Suspension:
         sensor_noise=None,
     ) -> "Suspension":
         """The suspension the package calls ``name`` (`NAMES`): "passive"; "mr", the MR
-        ``damper`` (a name, scaled by ``damper_scale``) at the constant ``voltage``; or an outer
-        loop of ``gains`` (default the shipped `GainSet.default`) with its inner loop on the
-        MR dampers, or on the ideal device when ``damper`` is "ideal" or "ideal-damper".
-        ``damper`` is not used by "passive", but must be a known name; a scale other than 1
-        there is refused, as is a voltage with a controller."""
+        ``damper`` (a name, scaled by ``damper_scale``) at the constant ``voltage``;
+        "passive-on" / "passive-off", the same at its v_max / v_min; or an outer loop of
+        ``gains`` (default the shipped `GainSet.default`) with its inner loop on the MR dampers,
+        or on the ideal device when ``damper`` is "ideal" or "ideal-damper". ``damper`` is not
+        used by "passive", but must be a known name; a scale other than 1 there is refused, as
+        is a voltage with a controller or with passive-on / passive-off (their name sets it),
+        and an ideal device with mr, passive-on or passive-off (it has no voltage)."""
         if name not in NAMES:
             raise ValueError(f"suspension = {name!r}; allowed: {', '.join(NAMES)}")
         model = damper_model(damper, 1.0)  # an unknown name fails here, for passive too
@@ -249,15 +260,22 @@ class Suspension:
                     f"voltage = {voltage!r}: applies to suspension 'mr' only (the passive suspension has no command)"
                 )
             return cls(None, None, None, None, sensor_noise)
-        if name == "mr" and model.law == dampers.LAW_IDEAL:
+        if (name == "mr" or name in CONSTANT_VOLTAGE) and model.law == dampers.LAW_IDEAL:
             raise ValueError(
-                f"damper = {damper!r} with suspension 'mr': the ideal actuator applies a "
+                f"damper = {damper!r} with suspension {name!r}: the ideal actuator applies a "
                 "controller's demand and has no constant voltage; use a controller"
             )
         model = damper_model(damper, damper_scale)
         scale = float(damper_scale)
         if name == "mr":
             return cls(model, voltage, None, None, sensor_noise, scale)
+        if name in CONSTANT_VOLTAGE:
+            if voltage is not None:
+                raise ValueError(
+                    f"voltage = {voltage!r} with suspension {name!r}: its voltage is the damper's "
+                    f"{CONSTANT_VOLTAGE[name]}; give a voltage with suspension 'mr'"
+                )
+            return cls(model, getattr(model, CONSTANT_VOLTAGE[name]), None, None, sensor_noise, scale)
         gains = _shipped_gains() if gains is None else gains
         controller = gains.controller(name)
         if model.law == dampers.LAW_IDEAL:

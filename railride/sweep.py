@@ -108,7 +108,7 @@ class Case:
 
     @property
     def closed_loop(self) -> bool:
-        return self.suspension not in ("passive", "mr")
+        return self.suspension not in ("passive", "mr", "passive-on", "passive-off")
 
     def _named(self, gains) -> Suspension:
         from .control import SensorNoise
@@ -150,7 +150,7 @@ class Case:
     def group(self) -> tuple:
         """Cases that can share one compiled batch."""
         duration = dict(self.scenario_options).get("duration", 10.0)
-        kind = "passive" if self.suspension == "passive" else ("mr" if self.suspension == "mr" else "closed")
+        kind = "passive" if self.suspension == "passive" else ("closed" if self.closed_loop else "mr")
         # sensor noise is one setting per batch
         return (
             duration,
@@ -299,7 +299,7 @@ def run_cases(
     settings = {
         "dt": solver.dt,
         "window": None if window is None else [float(w) for w in window],
-        "base_gains": base.to_toml(),
+        "base_gains": base.key_text(),
         **other_settings(vehicle, solver),
     }
     if comfort:  # only then: the keys of sweeps without comfort stay as they were

@@ -19,7 +19,7 @@ from collections.abc import Mapping
 import numpy as np
 
 from . import validation
-from .control import CONTROLLERS, GainSet
+from .control import CONSTANT_VOLTAGE, OUTER_LOOPS, GainSet
 from .defaults import DEFAULT_DAMPER
 from .solver import SolverSettings
 
@@ -42,7 +42,7 @@ SCENARIO_KEYS = {
     "seed": ("seed",),
 }
 #: the controllers that read each gain table (a gain axis combines with these only)
-GAIN_CONTROLLERS = {t: tuple(c for c in CONTROLLERS[1:] if t in GainSet.tables_read(c)) for t in GainSet.TABLES}
+GAIN_CONTROLLERS = {t: tuple(c for c in OUTER_LOOPS if t in GainSet.tables_read(c)) for t in GainSet.TABLES}
 #: the voltages named by words: passive-off is the damper's lowest voltage, passive-on its highest
 VOLTAGE_WORDS = {"passive-off": "v_min", "passive-on": "v_max"}
 #: the options of the random tracks besides the seed: (keyword, unit)
@@ -90,7 +90,7 @@ class SweepGrid:
     @property
     def controllers(self) -> tuple:
         """The suspensions that run an outer-loop controller."""
-        return tuple(s for s in self.suspensions if s in GAIN_CONTROLLERS["inner"])
+        return tuple(s for s in self.suspensions if s in OUTER_LOOPS)
 
     def scenario_record(self) -> dict:
         """The scenario's fixed settings: `first_scenario` without the swept options (they are
@@ -234,8 +234,10 @@ def grid(
 
     words = _Words(names or {}, texts or {})
     listed, suspensions = _suspensions(words, suspensions)
-    controllers = [s for s in suspensions if s in GAIN_CONTROLLERS["inner"]]
+    controllers = [s for s in suspensions if s in OUTER_LOOPS]
     has_mr = "mr" in suspensions
+    # passive-on and passive-off are mr at the damper's v_max and v_min
+    constant = [s for s in suspensions if s in CONSTANT_VOLTAGE]
     voltage, damper_scale = _values(words, "voltage", voltage), _values(words, "damper_scale", damper_scale)
     seed = _values(words, "seed", seed)
     _check_applies(
@@ -243,6 +245,7 @@ def grid(
         listed,
         has_mr,
         controllers,
+        constant,
         voltage=voltage,
         gains=gains,
         noise=noise,
@@ -256,10 +259,11 @@ def grid(
         raise ValueError(
             f"{words.given('damper', damper_name)}: unknown damper model; allowed: {', '.join(dampers.NAMES)}"
         )
-    if damper_name in dampers.IDEAL_NAMES and has_mr:
+    if damper_name in dampers.IDEAL_NAMES and (has_mr or constant):
+        fixed = "mr" if has_mr else constant[0]
         raise ValueError(
-            f"{words.given('damper', damper_name)}: applies to the controllers only; mr runs at a "
-            "constant voltage, which the ideal actuator has not "
+            f"{words.given('damper', damper_name)}: applies to the controllers only; "
+            f"{fixed} runs at a constant voltage, which the ideal actuator has not "
             f"({words.name('suspensions')} is {listed})"
         )
     scales = None
@@ -350,9 +354,10 @@ def _suspensions(words: _Words, given) -> tuple[str, list[str]]:
     return ", ".join(items), items
 
 
-def _check_applies(words: _Words, listed: str, has_mr: bool, controllers: list, **given) -> None:
+def _check_applies(words: _Words, listed: str, has_mr: bool, controllers: list, constant: list, **given) -> None:
     """What applies where: voltages to mr, gains, noise and base gains to the controllers,
-    noise seeds with noise, the damper and its scales to mr and the controllers."""
+    noise seeds with noise, the damper and its scales to mr, passive-on, passive-off and the
+    controllers."""
     among = f"({words.name('suspensions')} is {listed})"
     if given["voltage"] is not None and not has_mr:
         raise ValueError(
@@ -362,7 +367,7 @@ def _check_applies(words: _Words, listed: str, has_mr: bool, controllers: list, 
         if given[key] is not None and not controllers and (key != "gains" or given[key]):
             shown = getattr(given[key], "source", given[key])  # a GainSet by its file
             raise ValueError(
-                f"{words.given(key, shown)}: applies to the controllers {', '.join(CONTROLLERS[1:])} only {among}"
+                f"{words.given(key, shown)}: applies to the controllers {', '.join(OUTER_LOOPS)} only {among}"
             )
     if given["seed"] is not None and given["noise"] is None:
         raise ValueError(
@@ -370,7 +375,8 @@ def _check_applies(words: _Words, listed: str, has_mr: bool, controllers: list, 
             "(without it the measurements are ideal)"
         )
     for key in ("damper", "damper_scale"):
-        if given[key] is not None and not (has_mr or controllers):
+        if given[key] is not None and not (has_mr or controllers or constant):
+            # passive-on and passive-off are mr runs
             raise ValueError(f"{words.given(key, given[key])}: applies to mr and the controllers only {among}")
 
 
@@ -503,6 +509,7 @@ def _check_resolvable(words: _Words, scen, min_given: bool, output_rate: float) 
 def _cases(g: SweepGrid, combos: list, common: dict) -> tuple[list, list]:
     """(the cases, the grid values of each): for each suspension and scenario combination, passive
     once, mr per scale and voltage, a controller per scale, gain combination and noise seed."""
+    from . import dampers
     from .sweep import Case
 
     scaled = g.damper_scales is not None
@@ -518,6 +525,16 @@ def _cases(g: SweepGrid, combos: list, common: dict) -> tuple[list, list]:
             if s == "passive":
                 cases.append(Case(g.scenario, options))
                 values.append(base)
+            elif s in CONSTANT_VOLTAGE:  # an mr run at the damper's v_max or v_min
+                v = float(getattr(dampers.preset(g.damper), CONSTANT_VOLTAGE[s]))
+                for x in g.damper_scales or (1.0,):
+                    cases.append(Case(g.scenario, options, suspension="mr", damper=g.damper, voltage=v, damper_scale=x))
+                    row: dict = dict(base)
+                    if g.voltages is not None:  # a voltage column: mr is swept too
+                        row["voltage_v"] = v
+                    if scaled:
+                        row["damper_scale"] = x
+                    values.append(row)
             elif s == "mr":
                 for x in g.damper_scales or (1.0,):
                     for v in g.voltages or ():

@@ -31,7 +31,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from .control import CONTROLLERS, GainSet
+from .control import PAPER_CONTROLLERS, GainSet
 from .defaults import DEFAULT_DAMPER
 from .metrics import RESPONSES
 from .params import VehicleParams
@@ -47,16 +47,18 @@ from . import validation
 from .solver import SolverSettings, check_resolution
 from .sweep import Case, RunTable, run_cases
 
-#: one phase per gain table, in the paper's order
-PHASES = GainSet.TABLES
+#: one phase per gain table of the paper's controllers, in the paper's order
+PHASES = GainSet.PAPER_TABLES
 #: the gains each phase tunes, by "table.entry"
 PARAMETERS = {phase: GainSet.entry_names(phase) for phase in PHASES}
 #: the controllers whose response a phase changes (the before/after rows of `TuneResult`)
-PHASE_CONTROLLERS = {phase: tuple(n for n in CONTROLLERS[1:] if phase in GainSet.tables_read(n)) for phase in PHASES}
+PHASE_CONTROLLERS = {
+    phase: tuple(n for n in PAPER_CONTROLLERS[1:] if phase in GainSet.tables_read(n)) for phase in PHASES
+}
 #: the suspension a vehicle phase is scored with: the first controller that reads its table
 SUSPENSION = {phase: names[0] for phase, names in PHASE_CONTROLLERS.items() if phase != "inner"}
 #: the gain tables each controller reads
-CONTROLLER_TABLES = {n: GainSet.tables_read(n) for n in CONTROLLERS[1:]}
+CONTROLLER_TABLES = {n: GainSet.tables_read(n) for n in PAPER_CONTROLLERS[1:]}
 #: the schema of `TuneResult.to_dict` (tune.json)
 SCHEMA = "railride.tune/2"
 
@@ -437,7 +439,7 @@ def _gain_changes(start: GainSet, tuned: GainSet, tables) -> tuple:
 def _before_after(result: TuneResult, run, scenario, opts, damper, damper_scale) -> list[dict]:
     """RMS of each controller the phases change, with the start and with the tuned gains, and
     the reductions against passive; ``run`` evaluates cases through the study's run table."""
-    names = [n for n in CONTROLLERS if any(n in PHASE_CONTROLLERS[p] for p in result.phases)]
+    names = [n for n in PAPER_CONTROLLERS if any(n in PHASE_CONTROLLERS[p] for p in result.phases)]
     cases = []
     for n in names:
         cases.append(Case(scenario, opts, suspension=n, damper=damper, damper_scale=damper_scale))

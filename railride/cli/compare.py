@@ -56,14 +56,15 @@ COMPARE_FIELDS = {**SOLVER_FIELDS, "damper": "--damper", "damper_scale": "--damp
 
 
 def _controller_list(text: str) -> list[str]:
-    """--controllers: comma-separated names -> the suspensions to run, passive first."""
+    """--controllers: comma-separated names, or all -> the suspensions to run, passive first."""
     from ..comparison import check_controllers
     from ..control import CONTROLLERS
 
     items = [item.strip() for item in text.split(",")]
     if any(not item for item in items):
         raise ValueError(
-            f"--controllers = {text!r}: an empty item; give names separated by commas from {', '.join(CONTROLLERS)}"
+            f"--controllers = {text!r}: an empty item; give names separated by commas from "
+            f"{', '.join(CONTROLLERS)}, or all"
         )
     try:
         return check_controllers(items)
@@ -142,6 +143,8 @@ def _compare_tables(doc: dict, vehicle: str, shipped: bool):
                 "in-sample, not a test on another track."
             )
         info += _trade_off_lines(doc)
+    for name, why in (settings.get("not_run") or {}).items():
+        info.append(f"{name}: not run ({why})")
     info.append(
         "The paper's absolute values depend on settings it does not give (sine wavelength, "
         "rail phase, damper, gains): compare the ranking and the size of the reductions, "
@@ -159,11 +162,11 @@ def _compare_tables(doc: dict, vehicle: str, shipped: bool):
         ours, paper = [label, "railride"], ["", "[dim]paper[/dim]"]
         for r in rows:
             ours.append(f"{r['metrics'][key]['rms']:#.4g}")
-            p = r["paper"][key]
-            paper.append(f"[dim]{p['rms']:g}[/dim]")
+            p = r["paper"][key] if r["paper"] else None  # None: not in the paper
+            paper.append(f"[dim]{p['rms']:g}[/dim]" if p else "[dim]-[/dim]")
             if r["name"] != "passive":
                 ours.append(reduction_text(r["reduction_percent"][key]))
-                paper.append(f"[dim]{p['reduction_percent']:.1f}[/dim]")
+                paper.append(f"[dim]{p['reduction_percent']:.1f}[/dim]" if p else "[dim]-[/dim]")
         table.add_row(*ours)
         table.add_row(*paper, end_section=True)
 
@@ -173,13 +176,16 @@ def _compare_tables(doc: dict, vehicle: str, shipped: bool):
         bt = Table(title="RMS reduction % beside the bounds: the same control laws and gains on ideal devices")
         bt.add_column("response", min_width=20, no_wrap=True)
         short = {"pid": "PID", "sas-attitude": "SAS att.", "sas-attitude-ride": "SAS att.+ride"}
-        for r in controlled:
+        # passive-on and passive-off have no bound (a constant voltage): said below the table
+        unbounded = [r for r in controlled if doc["bounds"]["ideal"][r["name"]].get("note")]
+        bounded = [r for r in controlled if r not in unbounded]
+        for r in bounded:
             for head in ("MR", "ideal\ndamper", "ideal\nactuator"):
                 name = short.get(r["name"], r["label"])
                 bt.add_column(escape(f"{name}\n{head}") if head == "MR" else f"\n{head}", justify="right", min_width=7)
         for key, label in RESPONSE_LABELS.items():
             cells = [label]
-            for r in controlled:
+            for r in bounded:
                 cells.append(reduction_text(r["reduction_percent"][key]))
                 for device in ("ideal-damper", "ideal"):
                     value = doc["bounds"][device][r["name"]]["reduction_percent"][key]
@@ -194,6 +200,7 @@ def _compare_tables(doc: dict, vehicle: str, shipped: bool):
                 "could do with these gains. ideal actuator: the demand, always (an active "
                 "suspension). The gains were tuned for the MR dampers; tuned for the ideal devices "
                 "the bounds lie further out (docs/results.md)."
+                + "".join(f" {r['label']}: no bound ({doc['bounds']['ideal'][r['name']]['note']})." for r in unbounded)
             ),
         ]
 
@@ -252,7 +259,9 @@ def compare(
             "--controllers",
             metavar="NAME[,NAME...]",
             help="Suspensions to compare, comma-separated: passive, pid, sas-attitude, "
-            "sas-attitude-ride. Passive always runs as the baseline.",
+            "sas-attitude-ride (the paper's, the default), skyhook, skyhook-on-off, groundhook, "
+            "hybrid, clipped-optimal, passive-on, passive-off (MR dampers at v_max, v_min), or all. "
+            "Passive always runs as the baseline.",
         ),
     ] = "passive,pid,sas-attitude,sas-attitude-ride",
     gains: CompareGainsOption = None,
@@ -303,7 +312,8 @@ def compare(
     """Compare passive, PID and SAS suspensions on one scenario, as in the paper's Table 1.
 
     Runs the passive vehicle (the baseline) and each controller (MR dampers closed by the
-    force-tracking inner loop) with the shipped gains, and prints the RMS of the carbody
+    force-tracking inner loop, or by the on-off and clipped voltage laws of skyhook-on-off
+    and clipped-optimal) with the shipped gains, and prints the RMS of the carbody
     responses with the reduction against passive beside the paper's values, the peak-to-peak
     values and what each suspension asks of its dampers. Without options: the paper's
     scenario paper-sine.

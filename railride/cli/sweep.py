@@ -91,7 +91,9 @@ def sweep_command(
             "--controllers",
             metavar="NAME[,NAME...]",
             help="Suspensions, comma-separated: passive, mr (constant --voltage), pid, sas-attitude, "
-            "sas-attitude-ride. --controllers is the same option.",
+            "sas-attitude-ride, skyhook, skyhook-on-off, groundhook, hybrid, clipped-optimal, "
+            "passive-on, passive-off (mr at v_max, v_min), or all (every one but mr). "
+            "--controllers is the same option.",
         ),
     ] = "passive",
     speed: Annotated[
@@ -325,11 +327,16 @@ def _parse(
 
 
 def _names(option: str, text: str) -> list[str]:
-    """NAME[,NAME...] -> the names, not empty (which names are allowed is the grid's check)."""
+    """NAME[,NAME...] -> the names, not empty (which names are allowed is the grid's check);
+    all: every suspension a comparison can name (`railride.control.CONTROLLERS`)."""
+    from ..control import CONTROLLERS
+
+    if text.strip() == "all":
+        return list(CONTROLLERS)
     items = [s.strip() for s in text.split(",")]
     if any(not s for s in items):
         raise ValueError(
-            f"{option} = {text!r}: an empty item; give names separated by commas from {', '.join(SUSPENSIONS)}"
+            f"{option} = {text!r}: an empty item; give names separated by commas from {', '.join(SUSPENSIONS)}, or all"
         )
     return items
 

@@ -11,7 +11,7 @@ import pytest
 import xarray as xr
 
 from railride.comparison import PAPER_REDUCTION, PAPER_TABLE1
-from railride.control import CONTROLLERS, LABELS, GainSet
+from railride.control import LABELS, PAPER_CONTROLLERS, GainSet
 from railride.files import COMPARE_FILES
 from clihelp import PNG, assert_input_error, ok_json, run
 
@@ -50,8 +50,8 @@ def write(path, text):
 def test_json_four_controllers_in_order(short_doc):
     doc = short_doc
     assert doc["schema"] == "railride.comparison/1"
-    assert [r["name"] for r in doc["controllers"]] == list(CONTROLLERS)
-    assert [r["label"] for r in doc["controllers"]] == [LABELS[n] for n in CONTROLLERS]
+    assert [r["name"] for r in doc["controllers"]] == list(PAPER_CONTROLLERS)
+    assert [r["label"] for r in doc["controllers"]] == [LABELS[n] for n in PAPER_CONTROLLERS]
     for row in doc["controllers"]:
         assert list(row["metrics"]) == RESPONSES
         for response in RESPONSES:
@@ -91,7 +91,7 @@ def test_default_run_is_the_paper_scenario():
     doc = json.loads(result.stdout)
     assert doc["settings"]["scenario"]["name"] == "paper-sine"
     assert doc["settings"]["scenario"]["duration_s"] == 10.0
-    assert [r["name"] for r in doc["controllers"]] == list(CONTROLLERS)
+    assert [r["name"] for r in doc["controllers"]] == list(PAPER_CONTROLLERS)
     assert result.stderr == ""  # no progress when stderr is not a terminal
 
 
@@ -182,7 +182,7 @@ def test_out_writes_all_files(tmp_path):
     assert json.loads((out / "compare.json").read_text()) == doc
     with xr.open_dataset(out / "compare.nc", engine="scipy") as ds:
         assert "controller" in ds.dims
-        assert [str(c) for c in ds["controller"].values] == list(CONTROLLERS)
+        assert [str(c) for c in ds["controller"].values] == list(PAPER_CONTROLLERS)
         assert ds.sizes["time"] == 2001
         assert ds["carbody_bounce"].dims == ("controller", "time")
         assert ds["damper_command_voltage"].sel(controller="passive").isnull().all()
@@ -198,7 +198,7 @@ def test_out_writes_all_files(tmp_path):
     ]
     for corner in ("1R", "1L", "2R", "2L"):
         assert f"secondary_damper_force_{corner}" in frame and f"damper_command_voltage_{corner}" in frame
-    assert list(frame["controller"].unique()) == list(CONTROLLERS)
+    assert list(frame["controller"].unique()) == list(PAPER_CONTROLLERS)
     assert len(frame) == 4 * 2001
     for name in COMPARE_FILES:
         if name.endswith(".png"):

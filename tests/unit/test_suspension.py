@@ -148,6 +148,8 @@ def _plain(name, damper, scale):
     model = dampers.preset(damper) if scale == 1.0 else dampers.preset(damper).scaled(scale)
     if name == "mr":
         return Suspension(model, voltage=1.0)
+    if name in ("passive-on", "passive-off"):
+        return Suspension(model, voltage=model.v_max if name == "passive-on" else model.v_min)
     ideal = damper in dampers.IDEAL_NAMES
     return Suspension(model, controller=G.controller(name), inner=None if ideal else G.inner)
 
@@ -157,7 +159,7 @@ NAMED = [
     (n, d, x)
     for n in NAMES
     for d, x in (("railway", 1.0), ("railway", 2.0), ("spencer1997", 1.0), ("ideal", 1.0), ("ideal-damper", 1.0))
-    if not (n == "mr" and d in dampers.IDEAL_NAMES)
+    if not (n in ("mr", "passive-on", "passive-off") and d in dampers.IDEAL_NAMES)
     and not (n == "passive" and (x != 1.0 or d != "railway"))
     and not (d == "spencer1997" and n not in ("mr", "pid"))
 ]
@@ -296,11 +298,12 @@ def test_solver_settings_are_checked_at_construction(kwargs, match):
 
 # -- gain tables ---------------------------------------------------------------------------------
 def test_gain_set_knows_its_tables():
-    assert GainSet.TABLES == ("inner", "pid", "attitude", "ride")
+    assert GainSet.TABLES[:4] == GainSet.PAPER_TABLES == ("inner", "pid", "attitude", "ride")
+    assert GainSet.TABLES[4:] == ("skyhook", "groundhook", "hybrid", "clipped_optimal")
     assert GainSet.entry_names("pid") == ("pid.kp", "pid.ki", "pid.kd")
     assert GainSet.tables_read("sas-attitude-ride") == ("inner", "attitude", "ride")
     assert G.value("ride.kd_2L") == G.ride.kd_2L and G.value("inner.B") == G.inner.B
-    assert len(G.entries()) == 2 + 3 + 6 + 8 and G.entries(("pid",)) == {
+    assert len(G.entries(GainSet.PAPER_TABLES)) == 2 + 3 + 6 + 8 and G.entries(("pid",)) == {
         "pid.kp": G.pid.kp,
         "pid.ki": G.pid.ki,
         "pid.kd": G.pid.kd,
