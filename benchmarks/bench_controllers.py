@@ -9,17 +9,9 @@ Wall-clock minima over the repeats; no test asserts timings.
 
 from __future__ import annotations
 
+from _timing import min_time  # benchmarks/_timing.py: run as a script, this folder is on the path
+
 import argparse
-import time
-
-
-def _min_time(fn, repeat):
-    best = float("inf")
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        fn()
-        best = min(best, time.perf_counter() - t0)
-    return best
 
 
 def main():
@@ -40,7 +32,7 @@ def main():
     for name in laws:
         susp = Suspension.named(name)
         simulate(sc, None, susp)  # compile and warm
-        times[name] = _min_time(lambda: simulate(sc, None, susp).metrics(), args.repeat)
+        times[name] = min_time(lambda: simulate(sc, None, susp).metrics(), args.repeat)
     ref = times["sas-attitude-ride"]
     print(f"numba threads: {numba.get_num_threads()}\n")
     print("| law (MR dampers, 10 s, paper-sine) | time | per step | / SAS (attitude+ride) |")
@@ -52,7 +44,7 @@ def main():
     chosen = ["pid", "sas-attitude-ride", "skyhook", "groundhook", "clipped-optimal"]
     run = lambda: league(["paper-sine", "fra4", "german-low"], [30.0, 55.56], controllers=chosen)  # noqa: E731
     run()  # warm
-    t = _min_time(run, max(1, args.repeat // 2))
+    t = min_time(run, max(1, args.repeat // 2))
     print(f"\nleague table, {len(chosen)} controllers x 3 scenarios x 2 speeds (with both bounds), warm: {t:.2f} s")
 
 

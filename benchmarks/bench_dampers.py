@@ -6,19 +6,11 @@ Prints a Markdown table for docs/performance.md (wall-clock minima; no test asse
 
 from __future__ import annotations
 
+from _timing import min_time  # benchmarks/_timing.py: run as a script, this folder is on the path
+
 import argparse
-import time
 
 import numpy as np
-
-
-def _min_time(fn, repeat):
-    best = float("inf")
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        fn()
-        best = min(best, time.perf_counter() - t0)
-    return best
 
 
 def main():
@@ -40,7 +32,7 @@ def main():
     ):
         mr = Suspension.semi_active(damper, voltage=voltage)
         simulate(sc, suspension=mr)
-        t = _min_time(lambda: simulate(sc, suspension=mr), args.repeat)
+        t = min_time(lambda: simulate(sc, suspension=mr), args.repeat)
         rows.append(
             (
                 f"vehicle, four `{damper}` MR dampers at {voltage:g} V ({note}), 10 s, dt = 1e-4 s",
@@ -52,16 +44,16 @@ def main():
     for damper in ("railway", "ideal-damper", "ideal"):
         sas = Suspension.named("sas-attitude-ride", damper=damper)
         simulate(sc, suspension=sas)
-        t = _min_time(lambda: simulate(sc, suspension=sas), args.repeat)
+        t = min_time(lambda: simulate(sc, suspension=sas), args.repeat)
         rows.append((f"vehicle, SAS (attitude+ride) closed loop, `{damper}`, 10 s", f"{t * 1e3:.1f} ms", ""))
     spencer = Suspension.semi_active("spencer1997", voltage=1.0)
     simulate(scenario("paper-sine", duration=1.0), suspension=spencer)
-    t = _min_time(lambda: simulate(scenario("paper-sine", duration=1.0), suspension=spencer), max(1, args.repeat // 2))
+    t = min_time(lambda: simulate(scenario("paper-sine", duration=1.0), suspension=spencer), max(1, args.repeat // 2))
     rows.append(("vehicle, four `spencer1997` dampers at 1 V, 1 s (stiff: sub-stepped)", f"{t:.2f} s", ""))
     sc_batch = scenario("paper-sine", duration=2.0)
     batch = [Suspension.semi_active("railway", voltage=float(v)) for v in np.linspace(0.0, 2.25, 64)]
     simulate(sc_batch, suspension=batch)
-    t = _min_time(lambda: simulate(sc_batch, suspension=batch), max(1, args.repeat // 2))
+    t = min_time(lambda: simulate(sc_batch, suspension=batch), max(1, args.repeat // 2))
     rows.append(
         (
             "batch of 64 voltages x 20 000 steps, `railway` dampers, both cores",
@@ -71,10 +63,10 @@ def main():
     )
     for name in ("railway", "spencer1997"):
         rig.cycles(name, 0.015, 2.5, [0.0])
-        t = _min_time(lambda: rig.cycles(name, 0.015, 2.5, [0.0, 0.75, 1.5, 2.25]), args.repeat)
+        t = min_time(lambda: rig.cycles(name, 0.015, 2.5, [0.0, 0.75, 1.5, 2.25]), args.repeat)
         rows.append((f"rig: `{name}`, 4 voltages x 4 cycles at 2.5 Hz, dt = 1e-4 s", f"{t * 1e3:.1f} ms", ""))
     rig.track("railway")
-    t = _min_time(lambda: rig.track("railway"), args.repeat)
+    t = min_time(lambda: rig.track("railway"), args.repeat)
     rows.append(("rig: force tracking, 3 cycles at 1 Hz", f"{t * 1e3:.1f} ms", ""))
 
     print("| benchmark | result | target |")

@@ -7,6 +7,8 @@ nothing here is asserted by the tests.
 
 from __future__ import annotations
 
+from _timing import min_time  # benchmarks/_timing.py: run as a script, this folder is on the path
+
 import argparse
 import json
 import os
@@ -21,24 +23,15 @@ from pathlib import Path
 import numpy as np
 
 
-def _min_time(fn, repeat):
-    best = float("inf")
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        fn()
-        best = min(best, time.perf_counter() - t0)
-    return best
-
-
 def bench_single(repeat):
     from railride.simulation import simulate
     from railride.track import scenario
 
     sc = scenario("paper-sine")  # 10 s at dt = 1e-4 s: 100 000 RK4 steps
     simulate(sc)  # compile or load the cache
-    run = _min_time(lambda: simulate(sc), repeat)
-    with_dataset = _min_time(lambda: simulate(sc).dataset, repeat)
-    with_metrics = _min_time(lambda: simulate(sc).metrics(), repeat)
+    run = min_time(lambda: simulate(sc), repeat)
+    with_dataset = min_time(lambda: simulate(sc).dataset, repeat)
+    with_metrics = min_time(lambda: simulate(sc).metrics(), repeat)
     return run, with_dataset, with_metrics
 
 
@@ -95,7 +88,7 @@ def bench_kernel_only(repeat):
         )
 
     run()
-    return _min_time(run, repeat)
+    return min_time(run, repeat)
 
 
 def bench_batch(n_samples, repeat):
@@ -107,7 +100,7 @@ def bench_batch(n_samples, repeat):
     params = [base.replace(c_sz=c) for c in np.linspace(2e4, 1.2e5, n_samples)]
     sc = scenario("paper-sine", duration=2.0)  # 20 000 steps per sample
     simulate(sc, params[:2])
-    t = _min_time(lambda: simulate(sc, params), repeat)
+    t = min_time(lambda: simulate(sc, params), repeat)
     return n_samples * 20_000 / t, t
 
 
@@ -127,7 +120,7 @@ def bench_cli(repeat):
     t0 = time.perf_counter()
     subprocess.run(cmd, check=True, capture_output=True)
     cold = time.perf_counter() - t0
-    warm = _min_time(lambda: subprocess.run(cmd, check=True, capture_output=True), repeat)
+    warm = min_time(lambda: subprocess.run(cmd, check=True, capture_output=True), repeat)
     t0 = time.perf_counter()
     subprocess.run([sys.executable, "-c", "import railride.simulation, railride.cli"], check=True)
     imports = time.perf_counter() - t0

@@ -224,6 +224,8 @@ class Comparison:
                 "objective": self.gains.provenance.get("objective"),
                 "command": self.gains.provenance.get("command"),
                 "in_sample": self.in_sample,
+                # only when there are some: the paper's comparison's document stays as it was
+                **({"untuned": u} if (u := self.gains.untuned(self.names)) else {}),
             },
             "gains": {
                 "source": self.gains.source,

@@ -310,6 +310,16 @@ class GainSet:
         kept = tuple(t for t in self.from_reference if t not in grouped)
         return GainSet(**tables, source=self.source, from_reference=kept)
 
+    def untuned(self, controllers) -> list[str]:
+        """The ``controllers`` whose gain tables the study that made these gains did not tune
+        (its [provenance] phases): judged beside tuned ones, they start at a disadvantage."""
+        phases = set(self.provenance.get("phases", ()))
+        return [
+            n
+            for n in controllers
+            if n in OUTER_LOOPS and any(t not in phases for t in self.tables_read(n) if t != "inner")
+        ]
+
     def tuned_on(self, record: dict | None) -> bool:
         """Whether these gains were tuned on the track ``record`` (`Scenario.describe`), as the
         file's [provenance] scenario record says: judged there, they are judged in-sample."""

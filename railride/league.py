@@ -158,6 +158,7 @@ def league(
         "window_s": None if window is None else [float(w) for w in window],
         "gains": gains.source,
         "objective": gains.provenance.get("objective"),
+        "untuned": gains.untuned(names),
     }
     return LeagueTable(pd.DataFrame(rows), names, settings, gains.provenance.get("scenario_record"))
 

@@ -32,8 +32,6 @@ from ._options import (
     ParamsOption,
     PresetOption,
     RailPhaseOption,
-    SpeedOption,
-    TrackSeedOption,
     WavelengthOption,
     WindowOption,
 )
@@ -47,6 +45,7 @@ from ._parsing import (
     parse_scale,
     solver_from_options,
     track_options,
+    value_list,
     vehicle_from_options,
 )
 from ._render import RESPONSE_LABELS, compare_comfort_table, damper_text, fmt, reduction_text
@@ -142,6 +141,8 @@ def _compare_tables(doc: dict, vehicle: str, shipped: bool):
                 "The gains were tuned on this same single track: the reductions are "
                 "in-sample, not a test on another track."
             )
+        if tuning.get("untuned"):
+            info.append(_untuned_text(tuning["untuned"]))
         info += _trade_off_lines(doc)
     for name, why in (settings.get("not_run") or {}).items():
         info.append(f"{name}: not run ({why})")
@@ -286,10 +287,26 @@ def compare(
     amplitude: AmplitudeOption = None,
     wavelength: WavelengthOption = None,
     rail_phase: RailPhaseOption = None,
-    track_seed: TrackSeedOption = None,
+    track_seed: Annotated[
+        Optional[str],
+        typer.Option(
+            "--track-seed",
+            metavar="N[,N...]",
+            help="Random tracks (fra1..fra6, german-low, german-high) only: the seed of the track's "
+            "realisation, a whole number >= 0; the same seed gives the same track (default 0). Several "
+            "seeds make a league table.",
+        ),
+    ] = None,
     min_wavelength: MinWavelengthOption = None,
     max_wavelength: MaxWavelengthOption = None,
-    speed: SpeedOption = None,
+    speed: Annotated[
+        Optional[str],
+        typer.Option(
+            "--speed",
+            metavar="M/S[,M/S...]",
+            help="Vehicle speed [m/s] (default 55.56); several (a,b or START:STOP:COUNT) make a league table.",
+        ),
+    ] = None,
     duration: DurationOption = None,
     dt: DtOption = None,
     output_rate: OutputRateOption = None,
@@ -323,6 +340,40 @@ def compare(
         from ..files import check_out_dir, write_compare_outputs
         from ..metrics import check_window, parse_window
 
+        scenarios = [item.strip() for item in scenario.split(",")]
+        speeds = value_list("--speed", speed) if speed is not None else None
+        seeds = value_list("--track-seed", track_seed, integer=True) if track_seed is not None else None
+        if len(scenarios) > 1 or len(speeds or [0]) > 1 or len(seeds or [0]) > 1:
+            given = dict(
+                amplitude=amplitude,
+                wavelength=wavelength,
+                rail_phase=rail_phase,
+                min_wavelength=min_wavelength,
+                max_wavelength=max_wavelength,
+                sensor_noise=sensor_noise,
+                seed=seed,
+            )
+            _league(
+                scenarios,
+                speeds,
+                seeds,
+                given,
+                names=_controller_list(controllers),
+                gains=gains,
+                damper=damper,
+                damper_scale=damper_scale,
+                solver=solver_from_options(dt=dt, output_rate=output_rate, control_rate=control_rate),
+                duration=duration,
+                window=window,
+                params=params,
+                preset=preset,
+                format=format,
+                out=out,
+                bounds=bounds,
+            )
+            return
+        speed_value = speeds[0] if speeds else None
+        seed_value = seeds[0] if seeds else None
         names = _controller_list(controllers)
         gain_set = load_gains(gains)
         damper_preset("--damper", damper)
@@ -331,14 +382,14 @@ def compare(
         solver = solver_from_options(dt=dt, output_rate=output_rate, control_rate=control_rate)
         vehicle_params, vehicle_record = vehicle_from_options(params, preset)
         window_value = parse_window(window) if window is not None else None
-        track = track_options(scenario, track_seed, min_wavelength, max_wavelength)
+        track = track_options(scenario, seed_value, min_wavelength, max_wavelength)
         scen = make_scenario(
             scenario,
             dict(
                 amplitude=amplitude,
                 wavelength=wavelength,
                 rail_phase=rail_phase,
-                speed=speed,
+                speed=speed_value,
                 duration=duration,
                 **track,
             ),
@@ -382,3 +433,129 @@ def compare(
     console = wide_stdout_console()
     for part in _compare_tables(doc, vehicle, shipped=gains is None):
         console.print(part)
+
+
+def _untuned_text(names) -> str:
+    return (
+        f"Not tuned: {', '.join(names)} run with the starting values of their gains tables (docs/control.md), "
+        "not tuned like the others: a fair ranking needs them tuned by the same study."
+    )
+
+
+def _league(
+    scenarios,
+    speeds,
+    seeds,
+    given,
+    *,
+    names,
+    gains,
+    damper,
+    damper_scale,
+    solver,
+    duration,
+    window,
+    params,
+    preset,
+    format,
+    out,
+    bounds,
+) -> None:
+    """Several scenarios, speeds or track seeds: the league table (railride.league.league)."""
+    from ..files import check_out_dir, write_league_outputs
+    from ..league import league
+    from ..metrics import parse_window
+
+    options = {
+        "amplitude": "--amplitude",
+        "wavelength": "--wavelength",
+        "rail_phase": "--rail-phase",
+        "min_wavelength": "--min-wavelength",
+        "max_wavelength": "--max-wavelength",
+        "sensor_noise": "--sensor-noise",
+        "seed": "--seed",
+    }
+    for key, value in given.items():
+        if value is not None:
+            raise ValueError(
+                f"{options[key]}: applies to a single scenario; a league table (several --scenario, --speed "
+                "or --track-seed values) runs each scenario with its defaults"
+            )
+    if not bounds:
+        raise ValueError("--no-bounds: a league table always shows the ideal actuator beside the MR dampers")
+    damper_preset("--damper", damper)
+    vehicle_params, vehicle_record = vehicle_from_options(params, preset)
+    if out is not None:
+        check_out_dir(out)
+    with ProgressBar(stderr_is_terminal(), lambda done: "running the league table...") as progress:
+        table = league(
+            scenarios,
+            speeds,
+            track_seeds=seeds or [0],
+            params=vehicle_params,
+            controllers=names,
+            gains=load_gains(gains),
+            damper=damper,
+            damper_scale=parse_scale("--damper-scale", damper_scale),
+            duration=duration,
+            window=parse_window(window) if window is not None else None,
+            solver=solver,
+            progress=(lambda k, n: progress(k / n)) if progress.enabled else None,
+        )
+    doc = table.to_dict()
+    text = json.dumps(doc, indent=2, allow_nan=False)
+    if out is not None:
+        write_folder(out, lambda: write_league_outputs(table, out))
+    if format is OutputFormat.json:
+        typer.echo(text)
+        return
+    wide_stdout_console().print(_league_table(table, doc))
+
+
+def _league_table(table, doc):
+    """One row per controller: mean RMS reductions (MR, ideal actuator), comfort, force, travel."""
+    from rich.table import Table
+
+    from ..labels import describe_scenario
+
+    summary = table.summary()
+    cases = table.cases[table.cases.controller == "passive"]
+    tuned = doc["tuned_on"]
+    tuned_text = describe_scenario(tuned) if tuned else "not recorded in the gains file"
+    out_of_sample = int((~cases["in_sample"]).sum())
+    settings = doc["settings"]
+    at = "" if settings["speeds_m_s"] is None else " at " + ", ".join(f"{v:g}" for v in settings["speeds_m_s"]) + " m/s"
+    seeds = ", ".join(map(str, settings["track_seeds"]))
+    caption = (
+        f"Mean over {len(cases)} cases: {', '.join(settings['scenarios'])}{at}; track seeds {seeds} (random tracks).\n"
+        f"Gains tuned on: {tuned_text}. Tested on {out_of_sample} case(s) they were not tuned on"
+        f" and {len(cases) - out_of_sample} they were.\n"
+        "Reduction = (passive - controlled) / passive RMS x 100, MR dampers (ideal actuator, same gains, in brackets)."
+        + ("\n" + _untuned_text(settings["untuned"]) if settings.get("untuned") else "")
+    )
+    t = Table(title="League table", caption=caption, caption_justify="left")
+    t.add_column("suspension")
+    for label in ("acceleration", "displacement", "pitch", "roll"):
+        t.add_column(f"{label}\n(%)", justify="right")
+    t.add_column("a_w Wk\ncentre\n(m/s^2)", justify="right")
+    t.add_column("N_MV,z\ncentre", justify="right")
+    t.add_column("damper\nforce max\n(kN)", justify="right")
+    t.add_column("travel\nmax\n(mm)", justify="right")
+    for row in doc["controllers"]:
+        n = row["name"]
+        cells = []
+        for r in ("acceleration_m_s2", "displacement_m", "pitch_deg", "roll_deg"):
+            if n == "passive":
+                cells.append("-")
+                continue
+            mr, ideal = row.get(f"{r}_reduction_percent"), row.get(f"{r}_ideal_reduction_percent")
+            cells.append(("n/a" if mr is None else f"{mr:.1f}") + (" (-)" if ideal is None else f" ({ideal:.0f})"))
+        s = summary.loc[n]
+        cells += [
+            fmt(s.get("centre_aw_Wk"), ".3f"),
+            fmt(s.get("centre_N_MV_z"), ".2f"),
+            fmt(s["force_max_n"] / 1e3, ".1f"),
+            fmt(s["travel_max_m"] * 1e3, ".1f"),
+        ]
+        t.add_row(row["label"], *cells)
+    return t
