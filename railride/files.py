@@ -29,6 +29,7 @@ from .labels import CARBODY_RESPONSES, psd_title
 from .plots import save_png
 from .plots.comparison import (
     plot_comparison_damper_forces,
+    plot_comparison_hysteresis,
     plot_comparison_psd,
     plot_comparison_response,
     plot_comparison_voltages,
@@ -57,6 +58,7 @@ COMPARE_FILES = (
     "pitch.png",
     "roll.png",
     "damper_forces.png",
+    "damper_hysteresis.png",
     "voltages.png",
     "psd.png",
     "psd.csv",
@@ -265,7 +267,8 @@ def write_compare_outputs(comparison, out_dir, doc: dict) -> list[Path]:
     JSON), ``compare.nc`` (``combined()`` as NetCDF, see `netcdf_ready`), ``compare.csv``
     (`comparison_frame`), ``acceleration.png``, ``displacement.png``, ``pitch.png``,
     ``roll.png`` (`plot_comparison_response`), ``damper_forces.png``
-    (`plot_comparison_damper_forces`), ``voltages.png`` (`plot_comparison_voltages`), and the
+    (`plot_comparison_damper_forces`), ``damper_hysteresis.png`` (`plot_comparison_hysteresis`),
+    ``voltages.png`` (`plot_comparison_voltages`), and the
     acceleration spectra over the metric window ``doc["settings"]["window_s"]`` (None: the
     whole run): ``psd.png`` (`plot_comparison_psd`) and ``psd.csv``
     (`railride.analysis.comparison_psd`). Returns the written paths."""
@@ -284,6 +287,7 @@ def write_compare_outputs(comparison, out_dir, doc: dict) -> list[Path]:
         "compare.nc": lambda path: write_netcdf(ds, path),
         "compare.csv": lambda path: comparison_frame(ds).to_csv(path, index=False),
         "damper_forces.png": _png(lambda: plot_comparison_damper_forces(comparison)),
+        "damper_hysteresis.png": _png(lambda: plot_comparison_hysteresis(comparison)),
         "voltages.png": _png(lambda: plot_comparison_voltages(comparison)),
     }
     for response in CARBODY_RESPONSES:
@@ -357,18 +361,20 @@ def write_pareto_outputs(result, out_dir) -> list[Path]:
 
 
 #: the files `LeagueTable.save` writes
-LEAGUE_FILES = ("league.json", "league.csv", "league.png")
+LEAGUE_FILES = ("league.json", "league.csv", "league.png", "league_comfort.png")
 
 
 def write_league_outputs(table, out_dir) -> list[Path]:
     """Write a `railride.league.LeagueTable` into ``out_dir``, all or nothing: ``league.json``
-    (``to_dict()``), ``league.csv`` (one row per case and controller) and ``league.png``."""
-    from .plots.league import plot_league
+    (``to_dict()``), ``league.csv`` (one row per case and controller), ``league.png``
+    (`plot_league`) and ``league_comfort.png`` (`plot_league_comfort`, N_MV against speed)."""
+    from .plots.league import plot_league, plot_league_comfort
 
     text = json_text(table.to_dict())
     writers = {
         "league.json": _text(text),
         "league.csv": _csv(table.to_pandas()),
         "league.png": _png(lambda: plot_league(table)),
+        "league_comfort.png": _png(lambda: plot_league_comfort(table)),
     }
     return write_folder(out_dir, [(name, writers[name]) for name in LEAGUE_FILES])

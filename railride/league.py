@@ -82,7 +82,8 @@ class LeagueTable:
         return plot_league(self, ax=ax)
 
     def save(self, folder):
-        """league.json, league.csv (one row per case and controller) and league.png."""
+        """league.json, league.csv (one row per case and controller), league.png and
+        league_comfort.png (N_MV against speed)."""
         from .files import write_league_outputs
 
         return write_league_outputs(self, folder)

@@ -20,6 +20,14 @@ SUSPENSION_STYLES = {
     "sas-attitude": {"linestyle": "--", "color": "tab:orange"},
     "sas-attitude-ride": {"linestyle": "-", "color": "tab:red"},
     "mr": {"linestyle": "-", "color": "tab:green"},
+    # the laws beyond the paper
+    "skyhook": {"linestyle": "-", "color": "tab:purple"},
+    "skyhook-on-off": {"linestyle": "--", "color": "tab:purple"},
+    "groundhook": {"linestyle": "-", "color": "tab:brown"},
+    "hybrid": {"linestyle": "-", "color": "tab:pink"},
+    "clipped-optimal": {"linestyle": "-", "color": "tab:cyan"},
+    "passive-on": {"linestyle": ":", "color": "0.45"},
+    "passive-off": {"linestyle": ":", "color": "0.65"},
 }
 
 

@@ -186,3 +186,42 @@ def plot_comparison_psd(psd: pd.DataFrame, ax=None, *, title: str | None = None)
     if own:
         fig.suptitle(title or "PSD of the carbody CG vertical acceleration", fontsize="medium")
     return fig
+
+
+def plot_comparison_hysteresis(comparison, ax=None, *, corner: str = "1R"):
+    """What each law asks of the device: the secondary damper force on the carbody (kN, up +)
+    against the deflection rate across it (m/s) at one ``corner`` of a `Comparison`, over its
+    metric window (the whole run without one), one panel per suspension on common axes. A
+    passive viscous damper lies on a line through the origin with negative slope; a force in
+    the first or third quadrant (f x' > 0) is one no damper can give. ``ax``: one Axes per
+    suspension, or None. Returns the figure."""
+    ds = _combined(comparison)
+    window = comparison.window
+    if window is not None:
+        ds = ds.sel(time=slice(window[0], window[1]))
+    if corner not in [str(c) for c in ds["corner"].values]:
+        raise ValueError(f"corner = {corner!r}: allowed {', '.join(str(c) for c in ds['corner'].values)}")
+    names = controller_names(ds)
+    if ax is None:
+        fig = new_figure((2.4 * len(names), 2.6))
+        axes = fig.subplots(1, len(names), sharex=True, sharey=True, squeeze=False)[0]
+    else:
+        axes = given_axes(ax, len(names), "one per suspension")
+        fig = axes[0].figure
+    for a, name in zip(axes, names):
+        part = ds.sel(controller=name, corner=corner)
+        a.plot(
+            part["secondary_deflection_velocity"].values,
+            part["secondary_damper_force"].values / 1e3,
+            linewidth=0.5,
+            color=suspension_style(name).get("color"),
+        )
+        a.axhline(0.0, color="0.6", linewidth=0.5)
+        a.axvline(0.0, color="0.6", linewidth=0.5)
+        a.set_title(suspension_label(name), fontsize="small")
+        a.set_xlabel("deflection rate (m/s)")
+        a.grid(True, linewidth=0.4, alpha=0.6)
+    axes[0].set_ylabel(f"damper force at {corner} (kN)")
+    if ax is None:
+        fig.suptitle("damper force against deflection rate: what each law asks of the damper", fontsize="medium")
+    return fig

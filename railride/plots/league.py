@@ -43,3 +43,28 @@ def plot_league(table, ax=None):
     ax.set_title(f"Mean over {n_cases} case{'s' if n_cases != 1 else ''}; dashed outline: ideal actuator", fontsize=9)
     ax.legend(fontsize="x-small", ncols=2)
     return fig
+
+
+def plot_league_comfort(table, ax=None, *, index: str = "N_MV_z"):
+    """Ride comfort at the carbody centre against speed, one line per controller: ``index``
+    N_MV_z (EN 12299, vertical part) or aw_Wk (ISO 2631-1 a_w, m/s^2), the mean over the
+    scenarios and track seeds at each speed. ``table``: a `railride.league.LeagueTable`."""
+    column = f"centre_{index}"
+    if column not in table.cases:
+        raise ValueError(f"index = {index!r}: the league table has no {column} (allowed N_MV_z, aw_Wk)")
+    if ax is None:
+        fig = new_figure((5.0, 3.4))
+        ax = fig.add_subplot()
+    else:
+        ax = given_axes(ax, 1, "the comfort index")[0]
+        fig = ax.figure
+    mean = table.cases.groupby(["controller", "speed_m_s"], sort=False)[column].mean()
+    for name in table.controllers:
+        line = mean.loc[name]
+        ax.plot(line.index, line.values, marker="o", label=suspension_label(name), **suspension_style(name))
+    ax.set_xlabel("speed (m/s)")
+    ax.set_ylabel("N$_{MV,z}$ (carbody centre)" if index == "N_MV_z" else "a$_w$ Wk (m/s$^2$, carbody centre)")
+    ax.set_title(f"Mean over {', '.join(table.settings.get('scenarios', []))}", fontsize=9)
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize="x-small")
+    return fig

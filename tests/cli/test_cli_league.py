@@ -27,7 +27,12 @@ def test_json_has_one_row_per_case_and_controller():
 
 def test_out_writes_the_league_files(tmp_path):
     ok("compare", "--scenario", "paper-sine", "--speed", "30,40", *SHORT, "--out", tmp_path / "out")
-    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["league.csv", "league.json", "league.png"]
+    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == [
+        "league.csv",
+        "league.json",
+        "league.png",
+        "league_comfort.png",
+    ]
     json.loads((tmp_path / "out" / "league.json").read_text())
 
 

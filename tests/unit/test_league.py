@@ -76,4 +76,35 @@ def test_protocol(table, tmp_path):
     assert fig.axes
     assert len(table.to_pandas()) == len(table.cases)
     paths = table.save(tmp_path / "out")
-    assert sorted(p.name for p in paths) == ["league.csv", "league.json", "league.png"]
+    assert sorted(p.name for p in paths) == ["league.csv", "league.json", "league.png", "league_comfort.png"]
+
+
+def test_comfort_chart_draws_into_the_given_axes(table):
+    from matplotlib.figure import Figure
+
+    from railride.plots.league import plot_league_comfort
+
+    fig = Figure()
+    ax = fig.add_subplot()
+    assert plot_league_comfort(table, ax=ax) is fig
+    assert len(ax.lines) == len(table.controllers)  # one line per controller, against speed
+    with pytest.raises(ValueError, match="index = 'Wz'"):
+        plot_league_comfort(table, index="Wz")
+
+
+def test_hysteresis_plot_has_one_panel_per_suspension():
+    from matplotlib.figure import Figure
+
+    import railride as rr
+    from railride.plots.comparison import plot_comparison_hysteresis
+
+    comp = rr.compare(rr.scenario("paper-sine", duration=1.0), controllers=["pid", "skyhook"], bounds=False)
+    fig = Figure()
+    axes = fig.subplots(1, 3)
+    assert plot_comparison_hysteresis(comp, ax=axes) is fig
+    # passive: the viscous damper's force is -c_sz x' exactly, a line through the origin
+    x, f = axes[0].lines[0].get_data()
+    slope = np.polyfit(x, f, 1)
+    assert slope[0] < 0 and abs(slope[1]) < 1e-9 * abs(f).max()
+    with pytest.raises(ValueError, match="corner = '3R'"):
+        plot_comparison_hysteresis(comp, corner="3R")
