@@ -23,7 +23,8 @@ from .control import GainSet
 from .frf import FrfResult, frequency_responses
 from .params import VehicleParams
 from .pareto import ParetoResult, pareto
-from .simulation import RideResult, simulate
+from .ride import RideResult
+from .simulation import simulate
 from .solver import SolverSettings
 from .suspension import Suspension
 from .sweep import SweepResult, run_sweep

@@ -217,12 +217,12 @@ def _expect(value, name: str, module: str, cls: str) -> None:
 
 # -- one writer per result ------------------------------------------------------------------------
 def write_outputs(result, out_dir, metrics_doc: dict) -> list[Path]:
-    """Write the files of a run, a `railride.simulation.RideResult`, into ``out_dir``, all or
+    """Write the files of a run, a `railride.ride.RideResult`, into ``out_dir``, all or
     nothing (`write_folder`): ``ride.nc`` (its Dataset as NetCDF, see `netcdf_ready`),
     ``ride.csv`` (`railride.tables.to_frame`), ``metrics.json`` (``metrics_doc`` as indented
     JSON; NaN or infinity is refused) and ``body_responses.png``
     (`railride.plots.ride.plot_body_responses`). Returns the written paths."""
-    _expect(result, "result", "simulation", "RideResult")
+    _expect(result, "result", "ride", "RideResult")
     ds = result.dataset
     text = json_text(metrics_doc)  # refuse NaN before any file is written
     writers = {

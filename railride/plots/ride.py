@@ -1,4 +1,4 @@
-"""The carbody responses of a ride result (`railride.simulation.RideResult`)."""
+"""The carbody responses of a ride result (`railride.ride.RideResult`)."""
 
 from __future__ import annotations
 

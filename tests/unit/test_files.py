@@ -81,7 +81,7 @@ def test_write_outputs_batch(batch, tmp_path):
 
 
 def test_write_outputs_takes_a_ride_result(result, tmp_path):
-    with pytest.raises(ValueError, match="result: expected a railride.simulation.RideResult, got Dataset"):
+    with pytest.raises(ValueError, match="result: expected a railride.ride.RideResult, got Dataset"):
         files.write_outputs(result.dataset, tmp_path / "out", DOC)
     assert list(tmp_path.iterdir()) == []
 

@@ -14,7 +14,8 @@ from railride.files import OUTPUT_FILES
 from railride.metrics import to_dict as metrics_record
 from railride.params import VehicleParams
 from railride.pareto import pareto
-from railride.simulation import SCHEMA, RideResult, simulate
+from railride.ride import SCHEMA, RideResult
+from railride.simulation import simulate
 from railride.solver import RESOLUTION, SolverSettings, check_resolution
 from railride.suspension import Suspension
 from railride.track import scenario
