@@ -144,7 +144,7 @@ class Comparison:
                 )
         return out
 
-    def _bounds_record(self) -> dict | None:
+    def bounds_record(self) -> dict | None:
         """The JSON of `bounds`: per device and controller, the RMS of each response and its
         reduction against passive (None for a run that diverged), and diverged_at_s."""
         if not self.bounds:
@@ -219,7 +219,7 @@ class Comparison:
             "settings": self.settings,
             "controllers": rows,
             "trade_offs": self.trade_offs(),
-            "bounds": self._bounds_record(),
+            "bounds": self.bounds_record(),
             "tuning": {
                 "objective": self.gains.provenance.get("objective"),
                 "command": self.gains.provenance.get("command"),

@@ -261,6 +261,14 @@ class GainSet:
         return tuple(f"{table}.{f.name}" for f in dataclasses.fields(kind))
 
     @staticmethod
+    def entry_unit(entry: str) -> str | None:
+        """The unit of the gain "table.entry", or None for an unknown table or entry."""
+        table, _, name = entry.partition(".")
+        kind = _TABLES.get(table, (None, None))[1]
+        units = {f.name: f.metadata.get("unit") for f in dataclasses.fields(kind)} if kind else {}
+        return units.get(name)
+
+    @staticmethod
     def tables_read(controller: str) -> tuple[str, ...]:
         """The tables the outer loop ``controller`` and its inner loop read (none for the
         constant-voltage baselines; the on-off and clipped voltage laws read no inner loop)."""

@@ -188,17 +188,9 @@ def psd_title(ds: xr.Dataset, window, segment: float) -> str:
 def gain_unit(parameter: str) -> str | None:
     """The unit of a "table.entry" gain (`railride.control.GainSet.TABLES`), or None for an
     unknown table or entry."""
-    import dataclasses
-
     from .control import GainSet  # here, not above: control pulls in the vehicle model
 
-    table, _, entry = parameter.partition(".")
-    if table not in GainSet.TABLES:
-        return None
-    for f in dataclasses.fields(type(GainSet.reference().table(table))):
-        if f.name == entry:
-            return f.metadata.get("unit")
-    return None
+    return GainSet.entry_unit(parameter)
 
 
 def grid_axis_label(column: str) -> str:

@@ -167,7 +167,7 @@ def league(
 def _rows(comp, name: str, speed: float, seed) -> list[dict]:
     red = comp.reductions
     demands = comp.demands()
-    bound = (comp.bounds or {}).get("ideal", {})
+    bound = (comp.bounds_record() or {}).get("ideal", {})  # reductions of the same gains on the ideal actuator
     rows = []
     for n in comp.names:
         row = {
@@ -181,11 +181,8 @@ def _rows(comp, name: str, speed: float, seed) -> list[dict]:
             row[f"{r}_rms"] = float(comp.metrics.sel(controller=n, response=r, statistic="rms"))
             if n != "passive":
                 row[f"{r}_reduction_percent"] = float(red.sel(controller=n, response=r, statistic="rms"))
-                base = float(comp.metrics.sel(controller="passive", response=r, statistic="rms"))
-                run = bound.get(n)
-                ok = run is not None and not np.isfinite(run["diverged_at_s"])
-                ideal = float(run["metrics"].sel(response=r, statistic="rms")) if ok else np.nan
-                row[f"{r}_ideal_reduction_percent"] = (base - ideal) / base * 100.0 if ok else np.nan
+                ideal = (bound.get(n) or {}).get("reduction_percent", {}).get(r)  # None: diverged or no bound
+                row[f"{r}_ideal_reduction_percent"] = np.nan if ideal is None else ideal
         if comp.comfort is not None:
             for i in COMFORT:
                 row[f"centre_{i}"] = float(comp.comfort[n].sel(position="centre", index=i))

@@ -31,6 +31,7 @@ from .executors import DaskExecutor, LocalExecutor, RunTable  # noqa: F401 (thei
 from .metrics import RESPONSES, STATISTICS
 from .params import VehicleParams
 from .solver import SolverSettings
+from .control import CONSTANT_VOLTAGE
 from .suspension import NAMES, Suspension, batch_conflict
 from .sweep_grid import SweepGrid, grid  # noqa: F401 (the grid of the sweep study, here too)
 
@@ -108,7 +109,7 @@ class Case:
 
     @property
     def closed_loop(self) -> bool:
-        return self.suspension not in ("passive", "mr", "passive-on", "passive-off")
+        return self.suspension not in ("passive", "mr", *CONSTANT_VOLTAGE)
 
     def _named(self, gains) -> Suspension:
         from .control import SensorNoise

@@ -44,7 +44,7 @@ SCENARIO_KEYS = {
 #: the controllers that read each gain table (a gain axis combines with these only)
 GAIN_CONTROLLERS = {t: tuple(c for c in OUTER_LOOPS if t in GainSet.tables_read(c)) for t in GainSet.TABLES}
 #: the voltages named by words: passive-off is the damper's lowest voltage, passive-on its highest
-VOLTAGE_WORDS = {"passive-off": "v_min", "passive-on": "v_max"}
+VOLTAGE_WORDS = CONSTANT_VOLTAGE
 #: the options of the random tracks besides the seed: (keyword, unit)
 _BAND = (("min_wavelength", "m"), ("max_wavelength", "m"))
 
