@@ -4,46 +4,36 @@ Run:  python benchmarks/bench_tuning.py
 Prints a Markdown table for docs/performance.md (single wall-clock runs; the tests assert no
 timing). The studies start from the neutral reference gains (scaled from the passive
 suspension, GainSet.reference(), railride/data/reference_gains.toml) so that they have the
-whole way to go, with the default objective (minimax): the last row is `railride tune` as
-shipped.
+whole way to go, with the default objective (minimax) and budget: the second row is
+`railride tune` as shipped.
 """
 
 from __future__ import annotations
 
 import time
 
-from railride.control import GainSet
 from railride.sweep import Case, run_cases
 from railride.tuning import tune
-
-
-def reference_gains() -> GainSet:
-    return GainSet.reference()
 
 
 def main():
     run_cases([Case(scenario_options={"duration": 1.0}, suspension="pid")])  # compile
     rows = []
     studies = (
-        ("two-phase study (attitude, then ride), from the reference gains", ("attitude", "ride"), reference_gains()),
-        ("two-phase study from the shipped gains", ("attitude", "ride"), GainSet.default()),
-        (
-            "all four phases (inner, pid, attitude, ride) from the reference gains",
-            ("inner", "pid", "attitude", "ride"),
-            reference_gains(),
-        ),
+        ("SAS (attitude+ride) alone (14 gains), budget 400, from the reference gains", ("sas-attitude-ride",)),
+        ("every law and the inner loop (= `railride tune`), budget 400 per law, from the reference gains", "all"),
     )
-    for label, phases, start in studies:
+    for label, controllers in studies:
         t0 = time.perf_counter()
-        res = tune(phases, gains=start)
+        res = tune() if controllers == "all" else tune(controllers)
         dt = time.perf_counter() - t0
         n = len(res.runs)
-        target = "<= 120 s" if label.startswith("two-phase") and "reference" in label else ""
+        laws = ", ".join(f"{s.controller} {s.objective:.3f}" for s in res.studies if s.controller != "inner")
         rows.append(
             (
                 f"`tune`: {label}, `paper-sine` 10 s runs",
-                f"{dt:.1f} s, {n} runs ({n / dt:.0f} runs/s), objective {res.history[-1]['objective']:.3f}",
-                target,
+                f"{dt:.1f} s, {n} runs ({n / dt:.0f} runs/s); objective {laws}",
+                "<= 120 s per law" if controllers != "all" else "",
             )
         )
     cases = [

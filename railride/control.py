@@ -173,11 +173,14 @@ class _OuterLoop(NamedTuple):
 _OUTER_LOOPS = {
     "pid": _OuterLoop(("pid",), lambda g: g.pid, "PID"),
     "sas-attitude": _OuterLoop(("attitude",), lambda g: SAS(g.attitude), "SAS (attitude)"),
-    "sas-attitude-ride": _OuterLoop(("attitude", "ride"), lambda g: SAS(g.attitude, g.ride), "SAS (attitude+ride)"),
+    # its own attitude loop (table ride_attitude), so that each law is tuned on its own gains
+    "sas-attitude-ride": _OuterLoop(
+        ("ride_attitude", "ride"), lambda g: SAS(g.ride_attitude, g.ride), "SAS (attitude+ride)"
+    ),
     "skyhook": _OuterLoop(("skyhook",), lambda g: g.skyhook, Skyhook.label),
-    # the skyhook's demand and gains, switched on and off (no force tracking: no inner loop)
+    # the skyhook's demand, switched on and off (no force tracking: no inner loop), on its own gains
     "skyhook-on-off": _OuterLoop(
-        ("skyhook",), lambda g: SkyhookOnOff(**g.skyhook.to_dict()), SkyhookOnOff.label, False
+        ("skyhook_on_off",), lambda g: SkyhookOnOff(**g.skyhook_on_off.to_dict()), SkyhookOnOff.label, False
     ),
     "groundhook": _OuterLoop(("groundhook",), lambda g: g.groundhook, Groundhook.label),
     "hybrid": _OuterLoop(("hybrid",), lambda g: g.hybrid, Hybrid.label),
@@ -203,13 +206,19 @@ _TABLES = {
     "pid": ("pid", PID),
     "attitude": ("sas.attitude", Attitude),
     "ride": ("sas.ride", Ride),
+    "ride_attitude": ("sas.ride_attitude", Attitude),
     "skyhook": ("skyhook", Skyhook),
+    "skyhook_on_off": ("skyhook_on_off", Skyhook),
     "groundhook": ("groundhook", Groundhook),
     "hybrid": ("hybrid", Hybrid),
     "clipped_optimal": ("clipped_optimal", ClippedOptimal),
 }
 #: the tables a gains file of railride 0.3.0 and before has not: they take the packaged reference
 _LATER_TABLES = ("skyhook", "groundhook", "hybrid", "clipped_optimal")
+#: the tables a law once shared with another (before railride 0.4.0): a file without one
+#: gives it the other's gains, as those versions did (the paper tunes its ride loop on top of
+#: the attitude loop of SAS (attitude))
+_OWN_COPIES = {"ride_attitude": "attitude", "skyhook_on_off": "skyhook"}
 
 
 @functools.lru_cache(maxsize=1)
@@ -224,7 +233,10 @@ class GainSet:
     the tables the file (or the constructor) did not give, which took the packaged reference
     values (`reference`): a file of railride 0.3.0 and before has no [skyhook], [groundhook],
     [hybrid] or [clipped_optimal]. Neither takes part in comparisons, so equal gains are equal
-    whatever their history."""
+    whatever their history. Every law reads its own tables (`tables_read`); ``ride_attitude``
+    (the attitude loop of SAS (attitude+ride)) and ``skyhook_on_off``, absent from a file
+    written before railride 0.4.0, take the gains of ``attitude`` and ``skyhook``, which those
+    laws read then."""
 
     inner: InnerLoop
     pid: PID
@@ -237,6 +249,8 @@ class GainSet:
     hybrid: Hybrid | None = None
     clipped_optimal: ClippedOptimal | None = None
     from_reference: tuple = field(default=(), compare=False, repr=False)
+    ride_attitude: Attitude | None = None
+    skyhook_on_off: Skyhook | None = None
 
     #: the gain tables, as a "table.entry" name spells them (the file's [sas.attitude] is "attitude")
     TABLES: ClassVar[tuple] = tuple(_TABLES)
@@ -250,6 +264,9 @@ class GainSet:
             for t in missing:
                 object.__setattr__(self, t, reference.table(t))
             object.__setattr__(self, "from_reference", tuple(dict.fromkeys(self.from_reference + missing)))
+        for t, source in _OWN_COPIES.items():
+            if getattr(self, t) is None:
+                object.__setattr__(self, t, getattr(self, source))
         for t, (key, kind) in _TABLES.items():
             if type(getattr(self, t)) is not kind:  # SkyhookOnOff is a Skyhook, but not its table
                 raise ValueError(f"{t} = {getattr(self, t)!r}: must be a railride {kind.__name__} (table [{key}])")
@@ -278,6 +295,19 @@ class GainSet:
             raise ValueError(f"controller = {controller!r}: allowed {', '.join(CONTROLLERS[1:])}")
         loop = _OUTER_LOOPS[controller]
         return ("inner",) * loop.inner + loop.tables
+
+    @classmethod
+    def tuned_entries(cls, controller: str) -> tuple[str, ...]:
+        """The "table.entry" gains a tuning study of ``controller`` varies: the entries of its
+        own tables, not the inner loop's (shared by every law that tracks a force, tuned on the
+        damper rig) and not those its table fixes (`GainTable.fixed`: the LQR's r, since only
+        the ratios of the weights shape its gain). Empty for the constant-voltage baselines."""
+        out: tuple[str, ...] = ()
+        for t in cls.tables_read(controller):
+            if t != "inner":
+                fixed = _TABLES[t][1].fixed
+                out += tuple(e for e in cls.entry_names(t) if e.partition(".")[2] not in fixed)
+        return out
 
     @classmethod
     def _table_name(cls, table: str) -> str:
@@ -319,13 +349,18 @@ class GainSet:
         return GainSet(**tables, source=self.source, from_reference=kept)
 
     def untuned(self, controllers) -> list[str]:
-        """The ``controllers`` whose gain tables the study that made these gains did not tune
-        (its [provenance] phases): judged beside tuned ones, they start at a disadvantage."""
+        """The ``controllers`` whose gains the study that made these gains did not tune (its
+        [provenance] ``controllers``; in files before railride 0.4.0, its ``phases``, the
+        tables it tuned): judged beside tuned ones, they start at a disadvantage."""
+        if "controllers" in self.provenance:
+            tuned = set(self.provenance["controllers"])
+            return [n for n in controllers if n in OUTER_LOOPS and n not in tuned]
         phases = set(self.provenance.get("phases", ()))
         return [
             n
             for n in controllers
-            if n in OUTER_LOOPS and any(t not in phases for t in self.tables_read(n) if t != "inner")
+            if n in OUTER_LOOPS
+            and any(_OWN_COPIES.get(t, t) not in phases for t in self.tables_read(n) if t != "inner")
         ]
 
     def tuned_on(self, record: dict | None) -> bool:
@@ -358,20 +393,29 @@ class GainSet:
         tables as `to_toml` writes them, then each later table that differs from the packaged
         reference, so that the keys of runs of railride 0.3.0 and before stay what they were."""
         reference = _reference_gains()
-        return self.to_toml([t for t in self.TABLES if t in self.PAPER_TABLES or self.table(t) != reference.table(t)])
+
+        def kept(t):
+            if t in _OWN_COPIES:  # one that holds the table it once shared adds nothing
+                return self.table(t) != self.table(_OWN_COPIES[t])
+            return t in self.PAPER_TABLES or self.table(t) != reference.table(t)
+
+        return self.to_toml([t for t in self.TABLES if kept(t)])
 
     @classmethod
     def from_toml(cls, text: str, source: str = "<string>", *, complete: bool = False) -> "GainSet":
-        """Read [inner], [pid], [sas.attitude], [sas.ride], [skyhook], [groundhook], [hybrid],
-        [clipped_optimal]; every entry of a table must be present, known, numeric and obey its
-        rule; the error names the file, the table and the entry. The last four may be absent
-        (files of railride 0.3.0 and before): they take the packaged reference values, listed in
-        ``from_reference``; with ``complete`` every table must be there."""
+        """Read [inner], [pid], [sas.attitude], [sas.ride], [sas.ride_attitude], [skyhook],
+        [skyhook_on_off], [groundhook], [hybrid], [clipped_optimal]; every entry of a table must
+        be present, known, numeric and obey its rule; the error names the file, the table and
+        the entry. [skyhook], [groundhook], [hybrid] and [clipped_optimal] may be absent (files
+        of railride 0.3.0 and before): they take the packaged reference values, listed in
+        ``from_reference``; [sas.ride_attitude] and [skyhook_on_off] may be absent (files before
+        0.4.0): they take the gains of [sas.attitude] and [skyhook]; with ``complete`` every
+        table must be there."""
         try:
             data = tomllib.loads(text)
         except tomllib.TOMLDecodeError as exc:
             raise ValueError(f"{source}: not valid TOML: {exc}") from None
-        unknown_top = sorted(set(data) - {"inner", "pid", "sas", "provenance", *_LATER_TABLES})
+        unknown_top = sorted(set(data) - {"inner", "pid", "sas", "provenance", *_LATER_TABLES, "skyhook_on_off"})
         if unknown_top:
             allowed = ", ".join(f"[{key}]" for key, _ in _TABLES.values())
             raise ValueError(f"{source}: unknown table(s) {', '.join(unknown_top)}; allowed: {allowed}, [provenance]")
@@ -381,8 +425,8 @@ class GainSet:
             table = data.get(head)
             if sub:
                 table = table.get(sub) if isinstance(table, dict) else None
-            if table is None and t in _LATER_TABLES and not complete:
-                continue  # GainSet takes the reference values and records it
+            if table is None and (t in _LATER_TABLES or t in _OWN_COPIES) and not complete:
+                continue  # GainSet takes the reference values (or the shared table's) and records it
             names = [f.name for f in dataclasses.fields(kind)]
             if not isinstance(table, dict):
                 raise ValueError(f"{source}: missing table [{key}] with entries {', '.join(names)}")

@@ -55,6 +55,8 @@ class GainTable:
     __dataclass_fields__: ClassVar[dict]
     name: str
     label: str
+    #: entries a tuning study leaves as they are (`railride.tuning`): those that only set a scale
+    fixed: ClassVar[tuple] = ()
 
     def replace(self, **changes):
         unknown = set(changes) - {f.name for f in dataclasses.fields(self)}
@@ -193,6 +195,8 @@ class ClippedOptimal(GainTable):
     name = "clipped-optimal"
     label = "Clipped-optimal"
     voltage_law = "clipped"
+    # Q and r scaled together give the same gain: only the ratios Q / r are free
+    fixed = ("r",)
 
     def __post_init__(self):
         validate_fields(self, "clipped-optimal weight")

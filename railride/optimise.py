@@ -35,7 +35,7 @@ from .objectives import DEFAULT_OBJECTIVE, Objective
 from .tuning import PARAMETERS, REFERENCE, _rms
 
 #: the paper's fourteen SAS parameters
-SAS_PARAMETERS = PARAMETERS["attitude"] + PARAMETERS["ride"]
+SAS_PARAMETERS = PARAMETERS["sas-attitude-ride"]
 #: the schemas of the documents of `OptimiseResult.to_dict` and `SensitivityResult.to_dict`
 SCHEMA_OPTIMISE = "railride.optimise/1"
 SCHEMA_SENSITIVITY = "railride.sensitivity/1"
@@ -232,10 +232,7 @@ class OptimiseResult:
             "message": self.message,
             "gains": {
                 "source": g.source,
-                "inner": g.inner.to_dict(),
-                "pid": g.pid.to_dict(),
-                "attitude": g.attitude.to_dict(),
-                "ride": g.ride.to_dict(),
+                **{t: g.table(t).to_dict() for t in GainSet.TABLES},
             },
             "convergence": [
                 {

@@ -24,7 +24,7 @@ RIG_CHANNELS = ("x", "xd", "F", "z", "y", "u", "v", "E")
 #: the per-corner channels of `comparison_frame`, after the body responses
 COMPARE_CORNER_CHANNELS = ("secondary_damper_force", "damper_demand_force", "damper_command_voltage")
 #: the columns of `curves_frame` (curves.csv)
-CURVE_COLUMNS = ("phase", "pass", "parameter", "value", "objective", "chosen")
+CURVE_COLUMNS = ("controller", "pass", "parameter", "value", "objective", "chosen")
 #: the columns of `modes_frame` (modes.csv)
 MODE_COLUMNS = ("mode", "label", "frequency_hz", "damped_frequency_hz", "damping_ratio")
 
@@ -116,9 +116,10 @@ def comparison_frame(ds: xr.Dataset) -> pd.DataFrame:
 
 def curves_frame(curves) -> pd.DataFrame:
     """The sensitivity curves of `railride.tuning.tune` (``TuneResult.curves``, a sequence of
-    `railride.tuning.Curve`) as one long table: columns ``phase``, ``pass`` (1, 2, ... within
-    the phase), ``parameter`` ("table.entry"), ``value`` (SI), ``objective`` (the tuning
-    objective of that run; the normalised force tracking error for the inner phase) and
+    `railride.tune_result.Curve`) as one long table: columns ``controller`` (the law whose
+    study it is, or "inner"), ``pass`` (1, 2, ... within the study), ``parameter``
+    ("table.entry"), ``value`` (SI), ``objective`` (the tuning objective of that run; the
+    normalised force tracking error for the inner loop) and
     ``chosen`` (True on the value kept after that parameter's sweep in that pass). One row per
     value, the curves in the order they ran."""
     rows = []
@@ -127,7 +128,7 @@ def curves_frame(curves) -> pd.DataFrame:
         objective = np.asarray(c.objective, dtype=float)
         for v, o in zip(values, objective):
             rows.append(
-                (str(c.phase), int(c.sweep_pass), str(c.parameter), float(v), float(o), bool(v == float(c.chosen)))
+                (str(c.controller), int(c.sweep_pass), str(c.parameter), float(v), float(o), bool(v == float(c.chosen)))
             )
     return pd.DataFrame(rows, columns=list(CURVE_COLUMNS))
 

@@ -1,37 +1,40 @@
-"""Controller tuning by the paper's sensitivity study (its section V).
+"""Controller tuning: every law by the same sensitivity study, objective and budget of runs.
 
-One parameter at a time is swept over a logarithmic range (and 0) while the others stay fixed;
-the best value is kept; passes repeat until a whole pass improves the objective by less than a
-tolerance. Phases follow the paper: PID's three gains; the six SAS attitude gains with the ride
-loop off, then the eight ride gains with the attitude loop fixed, starting from zero ride gains
-(the paper's phase 2); the inner loop's B and G on the force-tracking error of the damper rig.
+The study is the paper's (its section V): one gain at a time is swept over log-spaced values
+(and 0) around its current value while the others stay fixed; the best value is kept; passes
+over all the law's gains repeat. What the paper leaves open is made equal for every law, so
+that a comparison does not favour the law that got more tuning:
 
-A vehicle run is scored by a named `Objective` over the four RMS ratios to passive, r_k =
-RMS_k / RMS_k(passive) (acceleration, displacement, pitch, roll): ``sum``, ``weighted``,
-``minimax`` or ``constrained``, plus an optional penalty on ratios above 1. `DEFAULT_OBJECTIVE`
-is the one home of the default; `Objective.describe` states an objective in full, and every
-output of a study prints that statement.
+- each law (`TUNED_CONTROLLERS`) is tuned on its own gains (`GainSet.tuned_entries`) from the
+  same start gains, with the same objective on the same runs;
+- each gets the same budget of vehicle runs (distinct gain sets scored, the start included).
+  The study ends when its next sweep would not fit the budget. A pass that improves the
+  objective by less than ``tol`` narrows the span of the sweeps to its square root, so a law
+  with few gains spends its budget refining them; it ends early ("converged") when the span
+  falls below ``min_span``;
+- the ride loop of SAS (attitude+ride) starts from zero gains, as in the paper's phase 2.
 
-Every vehicle evaluation goes through `railride.sweep.run_cases`, so it can run on a Dask
-cluster and lands in the run table; the study itself is deterministic given the results, so a
-resumed study replays its path from the table and only evaluates what is missing.
+The inner loop (B, G) belongs to the damper, not to a law: it is tuned first on the damper
+rig's force tracking (the paper's Fig. 6 demands), which costs no vehicle run, and every law
+that tracks a force uses it.
 
-`tune` returns a `TuneResult`, which holds what `railride tune` writes: `to_dict` (tune.json,
-schema ``railride.tune/2``), `to_pandas` (curves.csv), `plot` (sensitivity.png), `gains_toml`
-(gains.toml with its provenance) and `save` (the four files, all or nothing).
+A vehicle run is scored by a named `Objective` over the four RMS ratios to passive (docs/
+tuning.md); every output of a study states it. Every vehicle evaluation goes through
+`railride.sweep.run_cases`, so it can run on a Dask cluster and lands in the run table; the
+study is deterministic given the results, so a resumed study replays its path from the table
+and only evaluates what is missing. `tune` returns a `railride.tune_result.TuneResult`.
 """
 
 from __future__ import annotations
 
-import json
+import dataclasses
 import math
 from typing import Any
-from dataclasses import dataclass, field
 
 import numpy as np
 import pandas as pd
 
-from .control import PAPER_CONTROLLERS, GainSet
+from .control import OUTER_LOOPS, GainSet
 from .defaults import DEFAULT_DAMPER
 from .metrics import RESPONSES
 from .params import VehicleParams
@@ -46,209 +49,25 @@ from .objectives import (  # noqa: F401 (re-exported: the objectives' old home)
 from . import validation
 from .solver import SolverSettings, check_resolution
 from .sweep import Case, RunTable, run_cases
+from .tune_result import SCHEMA, Curve, Study, TuneResult  # noqa: F401 (their home before)
 
-#: one phase per gain table of the paper's controllers, in the paper's order
-PHASES = GainSet.PAPER_TABLES
-#: the gains each phase tunes, by "table.entry"
-PARAMETERS = {phase: GainSet.entry_names(phase) for phase in PHASES}
-#: the controllers whose response a phase changes (the before/after rows of `TuneResult`)
-PHASE_CONTROLLERS = {
-    phase: tuple(n for n in PAPER_CONTROLLERS[1:] if phase in GainSet.tables_read(n)) for phase in PHASES
-}
-#: the suspension a vehicle phase is scored with: the first controller that reads its table
-SUSPENSION = {phase: names[0] for phase, names in PHASE_CONTROLLERS.items() if phase != "inner"}
-#: the gain tables each controller reads
-CONTROLLER_TABLES = {n: GainSet.tables_read(n) for n in PAPER_CONTROLLERS[1:]}
-#: the schema of `TuneResult.to_dict` (tune.json)
-SCHEMA = "railride.tune/2"
-
+#: the laws with free gains, in the order a study tunes them: every outer loop (the
+#: constant-voltage baselines have no gains)
+TUNED_CONTROLLERS = tuple(n for n in OUTER_LOOPS if GainSet.tuned_entries(n))
+#: what `tune` can tune: the inner loop (on the damper rig), then the laws
+TUNABLE = ("inner", *TUNED_CONTROLLERS)
+#: the gains each study varies, by "table.entry"
+PARAMETERS = {"inner": GainSet.entry_names("inner"), **{n: GainSet.tuned_entries(n) for n in TUNED_CONTROLLERS}}
+#: the default budget of vehicle runs per law: two full passes of the law with the most gains
+#: (SAS attitude+ride: 14 gains x 14 new values per sweep = 196 runs a pass)
+DEFAULT_BUDGET = 400
+#: the passes of the inner loop's study on the rig (it has no budget of vehicle runs)
+INNER_PASSES = 5
 
 #: the neutral gains of railride/data/reference_gains.toml (`GainSet.reference`), by
 #: "table.entry": where the sweep of a gain that is 0 is centred, and the centre of the search
 #: box of the global methods
 REFERENCE = GainSet.reference().entries()
-
-
-@dataclass
-class Curve:
-    """The sensitivity curve of one parameter in one pass: objective against value."""
-
-    phase: str
-    sweep_pass: int
-    parameter: str
-    values: np.ndarray
-    objective: np.ndarray
-    chosen: float
-
-
-@dataclass
-class TuneResult:
-    """The result of `tune`: the tuned ``gains`` (the start gains ``start`` with the changes the
-    study kept), the sensitivity ``curves`` in the order they ran, the objective after each pass
-    (``history``), the passive RMS by response (``passive``), the ``objective`` the vehicle
-    phases minimised and the run table at the end (``runs``). The settings it ran with:
-    ``phases``, ``scenario`` (the `Scenario.describe` record) and ``settings`` (damper,
-    damper_scale, dt_s, values, span, max_passes, tolerance, start_gains: the source of the
-    start gains). ``before_after``: per controller the phases change, the RMS with the start and
-    with the tuned gains and their reductions against passive. ``date``: when the study ended
-    (UTC, ISO 8601).
-
-    The result protocol: `to_dict` (the ``railride.tune/2`` document), `to_pandas` (the curves
-    as one long table), `plot` (the sensitivity figure), `save` (gains.toml, sensitivity.png,
-    curves.csv, tune.json); `gains_toml` is the gains file with its provenance.
-    """
-
-    gains: GainSet
-    curves: list[Curve] = field(default_factory=list)
-    history: list[dict] = field(default_factory=list)  # objective after each pass of each phase
-    runs: pd.DataFrame | None = None
-    passive: dict = field(default_factory=dict)  # RMS of the passive run, by response
-    objective: Objective = DEFAULT_OBJECTIVE  # what the vehicle phases minimised
-    start: GainSet | None = None  # None: the gains are the start
-    phases: tuple = ()
-    scenario: dict = field(default_factory=dict)
-    settings: dict = field(default_factory=dict)
-    before_after: list[dict] = field(default_factory=list)
-    date: str | None = None
-
-    @property
-    def n_runs(self) -> int:
-        """Rows of the run table at the end (the study's runs and the before/after runs)."""
-        return 0 if self.runs is None else len(self.runs)
-
-    def to_dict(self) -> dict:
-        """The ``railride.tune/2`` document (docs/cli.md) without the facts of a command line
-        (``runs_evaluated``, ``runs_per_second``, ``wall_time_s``, ``executor``, ``command``,
-        which `railride tune` adds after ``runs``)."""
-        from . import __version__
-
-        start = self.gains if self.start is None else self.start
-        return {
-            "schema": SCHEMA,
-            "railride_version": __version__,
-            "date": self.date,
-            "phases": list(self.phases),
-            "scenario": self.scenario,
-            "settings": self.settings,
-            "objective": self.objective.to_dict(),
-            "passive_rms": {r: float(self.passive[r]) for r in RESPONSES},
-            "history": [
-                {"phase": h["phase"], "pass": int(h["pass"]), "objective": float(h["objective"])} for h in self.history
-            ],
-            "gains": {
-                "source": start.source,
-                "inner": self.gains.inner.to_dict(),
-                "pid": self.gains.pid.to_dict(),
-                "attitude": self.gains.attitude.to_dict(),
-                "ride": self.gains.ride.to_dict(),
-            },
-            "before_after": self.before_after,
-            "runs": self.n_runs,
-        }
-
-    def gains_toml(self, command: str | None = None) -> str:
-        """The gains file of the tuned gains with its provenance: a header of comments and a
-        [provenance] table (scenario and its record, damper, step, objective, phases, runs,
-        start gains, date; ``command``, the command line that ran the study, when given), which
-        `GainSet.load` keeps as ``provenance``."""
-        from .labels import describe_dampers
-
-        s = self.settings
-        last = {}
-        for h in self.history:
-            last[h["phase"]] = h
-        finals = "; ".join(f"{p} {h['objective']:.4g} after pass {h['pass']}" for p, h in last.items())
-        doc = self.to_dict()
-        run_text = f"{self._scenario_text()}, {self.scenario.get('duration_s', 0):g} s"
-        statement = self.objective.describe()
-        tool = "railride tune" if command is not None else "railride.tuning.tune"
-        lines = [
-            f"# railride controller gains, tuned by `{tool}` (the paper's sensitivity study,",
-            "# its section V; docs/tuning.md). Read by `railride compare --gains FILE`.",
-            *([f"# command: {command}"] if command is not None else []),
-            f"# date: {doc['date']}; railride {doc['railride_version']}",
-            f"# scenario: {run_text}, dt {s['dt_s']:g} s, {describe_dampers(s, detail=True)}",
-            f"# objective: {statement}",
-            f"# phases: {', '.join(doc['phases'])}; {s['values']} values from 1/{s['span']:g} to "
-            f"{s['span']:g} x the current value (and 0) per gain, passes: at most "
-            f"{s['max_passes']}" + ("; the ride phase starts from zero ride gains" if "ride" in doc["phases"] else ""),
-            f"# start values: {s['start_gains']}",
-            f"# runs: {doc['runs']}; final objective: {finals}",
-            "# Units: SI. Forces are desired forces on the carbody (up +) at corners 1R, 1L, 2R, 2L.",
-            "",
-            "[provenance]",
-            f"method = {json.dumps(f'{tool} (one-at-a-time sensitivity study)')}",
-            f"date = {json.dumps(doc['date'])}",
-            f"railride_version = {json.dumps(doc['railride_version'])}",
-            f"scenario = {json.dumps(run_text)}",
-            f"damper = {json.dumps(s['damper'])}",
-            f"damper_scale = {s.get('damper_scale', 1.0)!r}",
-            f"dt_s = {s['dt_s']!r}",
-            *([f"command = {json.dumps(command)}"] if command is not None else []),
-            f"objective = {json.dumps(statement)}",
-            # the exact track, so a study judging these gains can tell whether it is the same one
-            f"scenario_record = {_toml_inline(doc['scenario'])}",
-            f"phases = {json.dumps(doc['phases'])}",
-            f"runs = {int(doc['runs'])}",
-            f"start_gains = {json.dumps(s['start_gains'])}",
-            "",
-            self.gains.to_toml(),
-        ]
-        return "\n".join(lines)
-
-    def to_pandas(self) -> pd.DataFrame:
-        """The sensitivity curves as one long table, one row per value tried (curves.csv):
-        ``phase``, ``pass``, ``parameter``, ``value``, ``objective``, ``chosen``
-        (`railride.tables.curves_frame`)."""
-        from .tables import curves_frame
-
-        return curves_frame(self.curves)
-
-    def plot(self, ax=None):
-        """The sensitivity figure (`railride.plots.tuning.plot_sensitivity`): one panel per parameter,
-        the objective against its value, one line per pass. ``ax``: one Axes per parameter, in
-        the order tuned, or None for a new figure (titled with the scenario and the objective).
-        Returns the figure."""
-        from .plots.tuning import plot_sensitivity
-
-        return plot_sensitivity(self.curves, title=self._title(), ax=ax)
-
-    def save(self, folder, command: str | None = None, *, extra: dict | None = None) -> list:
-        """gains.toml (`gains_toml` with ``command``), sensitivity.png (`plot`), curves.csv
-        (`to_pandas`) and tune.json (`to_dict`, then the entries of ``extra``, such as a command
-        line's facts) into ``folder``, all or nothing (each file replaced atomically; other
-        files, such as the run table runs.csv, stay). Returns the paths."""
-        from .files import write_tune_outputs
-
-        doc = {**self.to_dict(), **(extra or {})}
-        return write_tune_outputs(self.curves, folder, doc, self.gains_toml(command), title=self._title())
-
-    def _scenario_text(self) -> str:
-        from .labels import describe_scenario
-
-        return describe_scenario(self.scenario)
-
-    def _title(self) -> str:
-        """The figure's title; the objective's statement is long: wrapped to fit the narrowest
-        figure."""
-        import textwrap
-
-        return "\n".join(
-            [
-                (
-                    f"Sensitivity of the tuning objective - {self._scenario_text()}, "
-                    f"{self.scenario.get('duration_s', 0):g} s, {self.settings.get('damper')} dampers"
-                ),
-                *textwrap.wrap(f"phases {', '.join(self.phases)}; {self.objective.describe()}", 100),
-            ]
-        )
-
-
-def _toml_inline(record: dict) -> str:
-    """A flat record of strings, numbers and booleans as a TOML inline table (JSON spells those
-    values as TOML does; None has no TOML form and is left out)."""
-    items = [f"{k} = {json.dumps(v)}" for k, v in record.items() if v is not None and not isinstance(v, (dict, list))]
-    return "{" + ", ".join(items) + "}"
 
 
 def _utc_now() -> str:
@@ -261,19 +80,43 @@ def _rms(rows: pd.DataFrame) -> np.ndarray:
     return rows[[f"{r}_rms" for r in RESPONSES]].to_numpy()
 
 
-def _candidates(current: float, parameter: str, n_values: int, span: float) -> list[float]:
+def _candidates(current: float, parameter: str, n_values: int, span: float, gains: GainSet) -> list[float]:
+    """The values a sweep of ``parameter`` tries: 0, the current value and ``n_values``
+    log-spaced from current / span to current x span (around the reference value when the
+    current one is 0), to four significant digits; those its table refuses (a blend above 1,
+    B = 0, which ignores the measured force) are left out."""
     ref = current if current > 0 else REFERENCE[parameter]
     values = ref * np.logspace(-math.log10(span), math.log10(span), n_values)
     # four significant digits: gains a person can read and type, nothing lost to the study
     vals = sorted({0.0, float(current), *[float(f"{v:.4g}") for v in values]})
     if parameter == "inner.B":
-        vals = [v for v in vals if v > 0]  # B = 0 ignores the measured force
-    return vals
+        vals = [v for v in vals if v > 0]
+    table, _, entry = parameter.partition(".")
+    return [v for v in vals if _allowed(gains.table(table), entry, v)]
+
+
+def _allowed(table, entry: str, value: float) -> bool:
+    try:
+        table.replace(**{entry: value})
+    except ValueError:
+        return False
+    return True
+
+
+def _check_controllers(controllers) -> tuple:
+    if isinstance(controllers, str):
+        controllers = (controllers,)
+    for c in controllers:
+        if c not in TUNABLE:
+            fixed = " (it has no gains to tune)" if c in ("passive", "passive-on", "passive-off") else ""
+            raise ValueError(f"controller = {c!r}{fixed}: allowed {', '.join(TUNABLE)}")
+    return tuple(c for c in TUNABLE if c in controllers)  # the order they run
 
 
 def tune(
-    phases=PHASES,
+    controllers=TUNABLE,
     *,
+    budget: int = DEFAULT_BUDGET,
     scenario: str = "paper-sine",
     scenario_options=None,
     gains: GainSet | None = None,
@@ -283,8 +126,8 @@ def tune(
     table: RunTable | None = None,
     n_values: int = 13,
     span: float = 30.0,
-    max_passes: int = 5,
     tol: float = 1e-3,
+    min_span: float = 1.05,
     params=None,
     solver=None,
     window=None,
@@ -293,70 +136,68 @@ def tune(
     damper_scale: float = 1.0,
     before_after: bool = True,
 ) -> TuneResult:
-    """The sensitivity study: the phases in order (from PHASES; default all four, so PID and SAS
-    are tuned by the same procedure and budget), each to convergence, from ``gains`` (default
-    the neutral `GainSet.reference`), minimising ``objective`` (default `DEFAULT_OBJECTIVE`).
+    """Tune ``controllers`` (names from `TUNABLE`; default all: the inner loop, then every law)
+    from ``gains`` (default the neutral `GainSet.reference`), minimising ``objective`` (default
+    `DEFAULT_OBJECTIVE`) on ``scenario``, each law with at most ``budget`` vehicle runs.
 
-    ``n_values`` log-spaced values from 1/span to span times the current value (and 0) per
-    parameter; a pass ends when every parameter of the phase was swept; a phase ends when a pass
-    improves the objective by less than ``tol`` (relative) or after ``max_passes``. The ride
-    phase starts from zero ride gains, as the paper's phase 2 (the ride loop is added to a tuned
-    attitude loop), whatever ``gains`` holds for them. ``damper_scale`` scales the MR dampers'
-    force capacity (`railride.dampers.BoucWen.scaled`); the inner phase then tracks demands
-    scaled alike, so a damper k times larger is tuned on the same relative task. ``params``:
-    the vehicle (`VehicleParams` or a preset name, default "paper"); ``solver``: the
-    `SolverSettings` of every vehicle run; both are recorded in ``settings`` where they differ
-    from the defaults. Every setting is checked before the first run.
-    ``progress(done, total, runs_per_second)`` after each chunk; ``log(text)`` after each pass.
+    Per pass, each gain of the law is swept over ``n_values`` log-spaced values from 1/span to
+    span times its current value (and 0); a pass that improves the objective by less than
+    ``tol`` (relative) narrows the span to its square root; a law's study ends when the next
+    sweep would not fit its budget, or when the span falls below ``min_span``. The inner loop
+    is tuned on the damper rig (at most `INNER_PASSES` passes, stopping at ``tol``).
+    ``damper_scale`` scales the MR dampers' force capacity (`railride.dampers.BoucWen.scaled`);
+    the inner loop then tracks demands scaled alike. ``params``: the vehicle (`VehicleParams`
+    or a preset name, default "paper"); ``solver``: the `SolverSettings` of every vehicle run;
+    both are recorded in ``settings`` where they differ from the defaults. Every setting is
+    checked before the first run. ``progress(done, total, runs_per_second)`` after each chunk;
+    ``log(text)`` after each pass.
 
-    ``before_after``: at the end, run each controller the phases change with the start and with
-    the tuned gains (`TuneResult.before_after`; through the run table, where most of these runs
-    already are). Returns a `TuneResult` (``to_dict``, ``to_pandas``, ``plot``, ``save``).
+    ``before_after``: at the end, run each law tuned (and, when the inner loop was tuned, each
+    law that uses it) with the start and with the tuned gains (through the run table, where
+    most of these runs already are). Returns a `TuneResult`.
     """
+    from . import dampers
     from .suspension import damper_model
     from .sweep import other_settings
     from .track import scenario as make_scenario
 
+    controllers = _check_controllers(controllers)
     solver = SolverSettings.of(solver)
     vehicle = VehicleParams.of(params)
     gains = GainSet.reference() if gains is None else gains
     objective = DEFAULT_OBJECTIVE if objective is None else objective
     opts = tuple(sorted((scenario_options or {}).items()))
     table = RunTable() if table is None else table
-    unknown = [p for p in phases if p not in PHASES]
-    if unknown:
-        raise ValueError(f"unknown phase {unknown[0]!r}; allowed: {', '.join(PHASES)}, all")
-    from . import dampers
-
     damper_model(damper, damper_scale)  # a known name, and a scale it has
-    if "inner" in phases and damper in dampers.IDEAL_NAMES:
+    if "inner" in controllers and damper in dampers.IDEAL_NAMES:
         raise ValueError(
-            f"damper = {damper!r} with phase 'inner': the ideal actuator has no force "
-            "tracking loop to tune; leave out the inner phase"
+            f"damper = {damper!r} with 'inner': the ideal actuator has no force tracking loop to "
+            "tune; leave out the inner loop"
         )
     damper_scale = dampers.check_scale("damper_scale", damper_scale)
+    budget = validation.integer("budget", budget, 1)
     validation.integer("n_values", n_values, 3)
-    validation.integer("max_passes", max_passes, 1)
-    if not validation.number("span", span, "finite", allowed="a finite number > 1") > 1:
-        raise ValueError(f"span = {validation.shown(span)}: must be a finite number > 1")
+    for name, value in (("span", span), ("min_span", min_span)):
+        if not validation.number(name, value, "finite", allowed="a finite number > 1") > 1:
+            raise ValueError(f"{name} = {validation.shown(value)}: must be a finite number > 1")
+    validation.number("tol", tol, "nonnegative")
     scen = make_scenario(scenario, **dict(scenario_options or {}))
     check_resolution(scen, solver.output_rate)
-    record = scen.describe()
-    base = gains
     result = TuneResult(
         gains,
         objective=objective,
         start=gains,
-        phases=tuple(phases),
-        scenario=record,
+        controllers=controllers,
+        scenario=scen.describe(),
         settings={
             "damper": damper,
             "damper_scale": damper_scale,
             "dt_s": solver.dt,
+            "budget": budget,
             "values": n_values,
             "span": float(span),
-            "max_passes": max_passes,
-            "tolerance": tol,
+            "tolerance": float(tol),
+            "min_span": float(min_span),
             "start_gains": gains.source,
             **other_settings(vehicle, solver),
         },
@@ -367,7 +208,7 @@ def tune(
             cases,
             executor=executor,
             table=table,
-            base_gains=base,
+            base_gains=gains,
             params=vehicle,
             solver=solver,
             window=window,
@@ -376,83 +217,101 @@ def tune(
 
     passive = _rms(run([Case(scenario, opts)]))[0]
     result.passive = dict(zip(RESPONSES, passive))
-    changes: dict[str, float] = {}
+    inner: dict[str, float] = {}  # the inner loop's changes, which every law's runs carry
+    if "inner" in controllers:
+        result.studies.append(_tune_inner(gains, inner, n_values, span, tol, result, log, damper, damper_scale))
 
-    def current_value(p):
-        return changes.get(p, base.value(p))
+    def case(name, change):
+        gains = tuple(sorted({**inner, **change}.items()))
+        return Case(scenario, opts, suspension=name, damper=damper, damper_scale=damper_scale, gains=gains)
 
-    for phase in phases:
-        params = PARAMETERS[phase]
-        if phase == "inner":
-            _tune_inner(base, changes, params, n_values, span, max_passes, tol, result, log, damper, damper_scale)
+    tuned: dict[str, dict] = {}  # each law's gains as its study left them
+    for name in controllers:
+        if name == "inner":
             continue
-        suspension = SUSPENSION[phase]
-        if phase == "ride":  # the paper's phase 2: the ride loop joins with zero gains
-            changes.update(dict.fromkeys(params, 0.0))
 
-        def score(change_sets, suspension=suspension):
-            cases = [
-                Case(
-                    scenario,
-                    opts,
-                    suspension=suspension,
-                    damper=damper,
-                    damper_scale=damper_scale,
-                    gains=tuple(sorted({**changes, **cs}.items())),
-                )
-                for cs in change_sets
-            ]
-            return objective(_rms(run(cases)), passive)
+        def score(change_sets, name=name):
+            return objective(_rms(run([case(name, cs) for cs in change_sets])), passive)
 
-        best = float(score([{}])[0])
-        for sweep_pass in range(1, max_passes + 1):
-            start = best
-            for p in params:
-                vals = _candidates(current_value(p), p, n_values, span)
-                obj = score([{p: v} for v in vals])
-                k = int(np.argmin(obj))
-                if obj[k] < best - 1e-12:
-                    changes[p], best = vals[k], float(obj[k])
-                result.curves.append(Curve(phase, sweep_pass, p, np.array(vals), np.asarray(obj), current_value(p)))
-            result.history.append({"phase": phase, "pass": sweep_pass, "objective": best})
-            if log is not None:
-                log(f"{phase} pass {sweep_pass}: objective {best:.4f}")
-            if start - best < tol * abs(start):
-                break
-    result.gains = base.apply(tuple(changes.items()))
+        study, tuned[name] = _study(name, gains, score, budget, n_values, float(span), tol, min_span, result, log)
+        result.studies.append(study)
+    result.gains = gains.apply({**inner, **{k: v for own in tuned.values() for k, v in own.items()}})
     if before_after:
-        result.before_after = _before_after(result, run, scenario, opts, damper, damper_scale)
+        result.before_after = _before_after(result, run, case, tuned, inner, damper)
     result.runs = table.frame
     result.date = _utc_now()
     return result
 
 
-def _gain_changes(start: GainSet, tuned: GainSet, tables) -> tuple:
-    """The ("table.entry", value) pairs of ``tuned`` that differ from ``start``, in ``tables``."""
-    out = []
-    for table in tables:
-        a, b = start.table(table).to_dict(), tuned.table(table).to_dict()
-        out += [(f"{table}.{k}", float(b[k])) for k in a if b[k] != a[k]]
-    return tuple(sorted(out))
+def _study(name, start, score, budget, n_values, span, tol, min_span, result, log) -> tuple[Study, dict]:
+    """One law's study: passes over its gains until the budget or the span runs out. Returns
+    the `Study` and the law's gains at the end, by "table.entry"."""
+    entries = PARAMETERS[name]
+    own: dict[str, float] = {}
+    if name == "sas-attitude-ride":  # the paper's phase 2: the ride loop joins with zero gains
+        own.update(dict.fromkeys(GainSet.entry_names("ride"), 0.0))
+    study = Study(name, entries, budget, span=span)
+
+    def value(p):
+        return own.get(p, start.value(p))
+
+    def full(change) -> dict:
+        # every gain of the law, so that one set of gains is one case (and one run) however reached
+        return {**{e: value(e) for e in entries}, **change}
+
+    def key(change):
+        return tuple(sorted(full(change).items()))
+
+    seen = {key({})}
+    best = float(score([full({})])[0])
+    study.runs, study.objective_start = 1, best
+    stopped = ""
+    while not stopped:
+        study.passes += 1
+        before, swept = best, 0
+        for p in entries:
+            vals = _candidates(value(p), p, n_values, span, start.apply(own))
+            new = {key({p: v}) for v in vals} - seen
+            if study.runs + len(new) > budget:
+                stopped = "budget"
+                break
+            obj = score([full({p: v}) for v in vals])
+            study.runs += len(new)
+            seen |= new
+            swept += 1
+            k = int(np.argmin(obj))
+            if obj[k] < best - 1e-12:
+                own[p], best = vals[k], float(obj[k])
+            result.curves.append(Curve(name, study.passes, p, np.array(vals), np.asarray(obj), value(p)))
+        if swept:
+            result.history.append(
+                {"controller": name, "pass": study.passes, "objective": best, "span": span, "runs": study.runs}
+            )
+            if log is not None:
+                log(f"{name} pass {study.passes}: objective {best:.4f} ({study.runs} runs)")
+        else:
+            study.passes -= 1
+        if not stopped and before - best < tol * abs(before):
+            span = math.sqrt(span)
+            if span < min_span:
+                stopped = "converged"
+    study.objective, study.span, study.stopped = best, span, stopped
+    return study, full({})
 
 
-def _before_after(result: TuneResult, run, scenario, opts, damper, damper_scale) -> list[dict]:
-    """RMS of each controller the phases change, with the start and with the tuned gains, and
-    the reductions against passive; ``run`` evaluates cases through the study's run table."""
-    names = [n for n in PAPER_CONTROLLERS if any(n in PHASE_CONTROLLERS[p] for p in result.phases)]
+def _before_after(result: TuneResult, run, case, tuned: dict, inner: dict, damper: str) -> list[dict]:
+    """RMS of each law the study changed, with the start gains and with the tuned gains (the
+    case its study last kept, so no run is repeated), and the reductions against passive;
+    ``run`` evaluates cases through the study's run table, ``case(name, changes)`` makes one."""
+    names = [
+        n
+        for n in TUNED_CONTROLLERS
+        if n in tuned or (inner and "inner" in GainSet.tables_read(n) and damper not in ("ideal", "ideal-damper"))
+    ]
     cases = []
     for n in names:
-        cases.append(Case(scenario, opts, suspension=n, damper=damper, damper_scale=damper_scale))
-        cases.append(
-            Case(
-                scenario,
-                opts,
-                suspension=n,
-                damper=damper,
-                damper_scale=damper_scale,
-                gains=_gain_changes(result.start or result.gains, result.gains, CONTROLLER_TABLES[n]),
-            )
-        )
+        cases.append(dataclasses.replace(case(n, {}), gains=()))  # the start gains: the study's base
+        cases.append(case(n, tuned.get(n, {})))
     frame = run(cases)
     passive = {r: float(result.passive[r]) for r in RESPONSES}
     rows = []
@@ -494,34 +353,39 @@ def tracking_objective(B: float, G: float, damper=DEFAULT_DAMPER, damper_scale: 
     )
 
 
-def _tune_inner(base, changes, params, n_values, span, max_passes, tol, result, log, damper, damper_scale=1.0):
+def _tune_inner(start, changes, n_values, span, tol, result, log, damper, damper_scale=1.0) -> Study:
     """B and G on the rig's force-tracking error (cheap: evaluated here, not on the executor)."""
+    params = PARAMETERS["inner"]
+    study = Study("inner", params, None, span=float(span))
 
     def value(p):
-        return changes.get(p, base.value(p))
+        return changes.get(p, start.value(p))
 
-    best = tracking_objective(value("inner.B"), value("inner.G"), damper, damper_scale)
-    for sweep_pass in range(1, max_passes + 1):
-        start = best
+    def objective(**change):
+        study.runs += 1
+        kw = {"B": value("inner.B"), "G": value("inner.G"), **change}
+        return tracking_objective(kw["B"], kw["G"], damper, damper_scale)
+
+    best = study.objective_start = objective()
+    for sweep_pass in range(1, INNER_PASSES + 1):
+        before = best
+        study.passes = sweep_pass
         for p in params:
-            vals = _candidates(value(p), p, n_values, span)
-            obj = np.array(
-                [
-                    tracking_objective(
-                        **{"B": value("inner.B"), "G": value("inner.G"), p.split(".")[1]: v},
-                        damper=damper,
-                        damper_scale=damper_scale,
-                    )
-                    for v in vals
-                ]
-            )
+            vals = _candidates(value(p), p, n_values, span, start)
+            obj = np.array([objective(**{p.split(".")[1]: v}) for v in vals])
             k = int(np.argmin(obj))
             if obj[k] < best - 1e-12:
                 changes[p], best = vals[k], float(obj[k])
             result.curves.append(Curve("inner", sweep_pass, p, np.array(vals), obj, value(p)))
-        result.history.append({"phase": "inner", "pass": sweep_pass, "objective": best})
+        result.history.append(
+            {"controller": "inner", "pass": sweep_pass, "objective": best, "span": float(span), "runs": study.runs}
+        )
         if log is not None:
             log(f"inner pass {sweep_pass}: tracking error {best:.4f}")
-        if start - best < tol * abs(start):
+        if before - best < tol * abs(before):
+            study.stopped = "converged"
             break
-    return best
+    else:
+        study.stopped = "passes"
+    study.objective = best
+    return study

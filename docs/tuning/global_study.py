@@ -26,10 +26,7 @@ rows = run_cases(
         Case(),
         Case(
             suspension="sas-attitude-ride",
-            gains=tuple(
-                (p, getattr(de.gains.attitude if p.startswith("attitude") else de.gains.ride, p.split(".")[1]))
-                for p in SAS_PARAMETERS
-            ),
+            gains=tuple((p, de.gains.value(p)) for p in SAS_PARAMETERS),
         ),
         Case(suspension="sas-attitude-ride"),
     ]

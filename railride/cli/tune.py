@@ -1,5 +1,5 @@
-"""``railride tune``: the paper's sensitivity study of the controller gains (railride.tuning),
-the parsing of its objective and phases, and its tables."""
+"""``railride tune``: every law's gains by the same sensitivity study and budget
+(railride.tuning), the parsing of its objective and controllers, and its tables."""
 
 from __future__ import annotations
 
@@ -54,7 +54,6 @@ from ._parsing import (
     SOLVER_FIELDS,
     TRACK_FIELDS,
     damper_preset,
-    default_of,
     load_gains,
     not_given,
     parse_float,
@@ -71,7 +70,7 @@ TUNE_FIELDS = {
     "damper": "--damper",
     "damper_scale": "--damper-scale",
     "n_values": "--values",
-    "max_passes": "--passes",
+    "budget": "--budget",
     "span": "--span",
 }
 
@@ -145,28 +144,23 @@ def _weights(weights: str) -> tuple:
     return tuple(values)
 
 
-def _phase_list(items: Optional[list[str]]) -> list[str]:
-    """--phase (repeatable, comma lists, `all`) -> the phases in the order they run; none
-    given: the library's default (all four)."""
-    from ..tuning import PHASES, tune
+def _tunable_list(text: str) -> list[str]:
+    """--controllers: comma-separated names from inner and the laws, or all -> what to tune,
+    in the order it runs."""
+    from ..tuning import TUNABLE
 
-    if not items:
-        return list(default_of(tune, "phases"))
-    wanted: set[str] = set()
-    for text in items:
-        names = [n.strip() for n in text.split(",")]
-        if any(not n for n in names):
-            raise ValueError(
-                f"--phase = {text!r}: an empty item; give phases separated by commas from {', '.join(PHASES)}, all"
-            )
-        for n in names:
-            if n == "all":
-                wanted.update(PHASES)
-            elif n in PHASES:
-                wanted.add(n)
-            else:
-                raise ValueError(f"--phase = {text!r}: unknown phase {n!r}; allowed: {', '.join(PHASES)}, all")
-    return [p for p in PHASES if p in wanted]
+    items = [n.strip() for n in text.split(",")]
+    if any(not n for n in items):
+        raise ValueError(
+            f"--controllers = {text!r}: an empty item; give names separated by commas from {', '.join(TUNABLE)}, all"
+        )
+    if "all" in items:
+        return list(TUNABLE)
+    for n in items:
+        if n not in TUNABLE:
+            why = " has no gains to tune" if n in ("passive", "passive-on", "passive-off") else " is not known"
+            raise ValueError(f"--controllers = {text!r}: {n!r}{why}; allowed: {', '.join(TUNABLE)}, all")
+    return [n for n in TUNABLE if n in items]
 
 
 def _tune_start(path: Optional[Path]):
@@ -189,9 +183,29 @@ def _tune_tables(doc: dict, start, tuned, scenario_text: str):
     from ..tuning import PARAMETERS
 
     parts = []
+    studies = Table(title=f"Tuning: every law from the same start, at most {doc['settings']['budget']} runs each")
+    for name, justify in (("study", "left"), ("gains", "right"), ("runs", "right"), ("passes", "right")):
+        studies.add_column(name, justify=justify)  # type: ignore[arg-type]
+    studies.add_column("objective\nstart", justify="right")
+    studies.add_column("objective\ntuned", justify="right")
+    studies.add_column("stopped")
+    for st in doc["studies"]:
+        budget = st["budget"]
+        studies.add_row(
+            st["controller"],
+            str(len(st["entries"])),
+            f"{st['runs']}" + ("" if budget is None else f" / {budget}"),
+            str(st["passes"]),
+            f"{st['objective_start']:.4f}",
+            f"{st['objective']:.4f}",
+            {"budget": "budget spent", "passes": "pass limit"}.get(st["stopped"], st["stopped"]),
+        )
+    parts += [studies, ""]
     passes = Table(title="Tuning: the objective after each pass")
-    passes.add_column("phase")
+    passes.add_column("study")
     passes.add_column("pass", justify="right")
+    passes.add_column("span", justify="right")
+    passes.add_column("runs", justify="right")
     passes.add_column("objective", justify="right")
     passes.add_column("change %", justify="right")
     infeasible = doc["objective"].get("infeasible")  # constrained: J >= offset breaks the bound
@@ -199,18 +213,21 @@ def _tune_tables(doc: dict, start, tuned, scenario_text: str):
         passes.add_column("within\nbound")
     previous: dict[str, float] = {}
     for h in doc["history"]:
-        before = previous.get(h["phase"])
+        before = previous.get(h["controller"])
         change = "" if before is None else f"{(h['objective'] - before) / abs(before) * 100:+.2f}"
-        cells = [h["phase"], str(h["pass"]), f"{h['objective']:.4f}", change]
+        cells = [h["controller"], str(h["pass"]), f"{h['span']:.3g}", str(h["runs"]), f"{h['objective']:.4f}", change]
         if infeasible:
-            cells.append("" if h["phase"] == "inner" else "yes" if h["objective"] < infeasible["offset"] else "no")
+            inner = h["controller"] == "inner"
+            cells.append("" if inner else "yes" if h["objective"] < infeasible["offset"] else "no")
         passes.add_row(*cells)
-        previous[h["phase"]] = h["objective"]
+        previous[h["controller"]] = h["objective"]
     parts += [
         passes,
         Text(
-            "objective: " + _objective_text_from_doc(doc) + "; inner phase: the "
-            "normalised force-tracking error on the damper rig"
+            "objective: " + _objective_text_from_doc(doc) + "; inner: the normalised force-tracking "
+            "error on the damper rig (rig runs, not counted in the budget); runs: distinct gain "
+            "sets scored by the study so far; span: each sweep runs from 1/span to span x the "
+            "current value"
         ),
         "",
     ]
@@ -221,8 +238,8 @@ def _tune_tables(doc: dict, start, tuned, scenario_text: str):
     gains.add_column("start", justify="right")
     gains.add_column("tuned", justify="right")
     gains.add_column("", no_wrap=True)
-    for phase in doc["phases"]:
-        for name in PARAMETERS[phase]:
+    for study in doc["controllers"]:
+        for name in PARAMETERS[study]:
             table_name, _, entry = name.partition(".")
             a = getattr(getattr(start, table_name), entry)
             b = getattr(getattr(tuned, table_name), entry)
@@ -281,17 +298,17 @@ def _tune_tables(doc: dict, start, tuned, scenario_text: str):
 @app.command("tune")
 def tune_command(
     ctx: typer.Context,
-    phase: Annotated[
-        Optional[list[str]],
+    controllers: Annotated[
+        str,
         typer.Option(
-            "--phase",
-            metavar="PHASE[,PHASE...]",
-            help="Tuning phases, repeatable or comma-separated: inner (B, G on the damper rig's "
-            "force tracking), pid, attitude (the six SAS attitude gains, ride loop off), ride "
-            "(the eight ride gains from 0, attitude fixed), all (= inner,pid,attitude,ride). "
-            "They run in that order. Default: all.",
+            "--controllers",
+            metavar="NAME[,NAME...]",
+            help="What to tune, comma-separated: inner (B, G on the damper rig's force tracking), "
+            "pid, sas-attitude, sas-attitude-ride, skyhook, skyhook-on-off, groundhook, hybrid, "
+            "clipped-optimal, or all (the default). They run in that order; each law starts from "
+            "the start gains and gets the same --budget.",
         ),
-    ] = None,
+    ] = "all",
     scenario: RunsScenarioOption = "paper-sine",
     amplitude: AmplitudeOption = None,
     wavelength: WavelengthOption = None,
@@ -319,15 +336,15 @@ def tune_command(
         ),
     ] = 13,
     span: Annotated[float, typer.Option("--span", metavar="S", help="Range factor of each sweep, > 1.")] = 30.0,
-    passes: Annotated[
+    budget: Annotated[
         int,
         typer.Option(
-            "--passes",
+            "--budget",
             metavar="N",
-            help="At most N passes per phase (a phase stops early when a pass improves the "
-            "objective by less than 0.1 %); >= 1.",
+            help="Vehicle runs per law (distinct gain sets scored, the start included), the same "
+            "for every law; a law with few gains narrows its sweeps and may stop earlier. >= 1.",
         ),
-    ] = 5,
+    ] = 400,
     workers: WorkersOption = None,
     scheduler: SchedulerOption = None,
     scheduler_file: SchedulerFileOption = None,
@@ -335,13 +352,14 @@ def tune_command(
     resume: TuneResumeOption = False,
     format: FormatOption = OutputFormat.table,
 ) -> None:
-    """Tune the controller gains by the paper's sensitivity study (its section V).
+    """Tune every law's gains by the paper's sensitivity study (its section V), alike.
 
     One gain at a time is swept over log-spaced values (and 0) with the others fixed; the best
-    value is kept; passes repeat until a pass gains less than 0.1 %. Each run is scored by the
-    objective (--objective) over its RMS carbody responses relative to passive. Prints the
-    objective per pass, the tuned gains and the RMS with the start and the tuned gains. Ctrl-C
-    stops; with --out, --resume continues.
+    value is kept; passes repeat. Every law starts from the same gains and gets the same budget
+    of vehicle runs; a pass that gains less than 0.1 % narrows the sweeps. Each run is scored by
+    the objective (--objective) over its RMS carbody responses relative to passive. Prints each
+    law's study, the objective per pass, the tuned gains and the RMS with the start and the
+    tuned gains. Ctrl-C stops; with --out, --resume continues.
     """
     import time
 
@@ -351,7 +369,7 @@ def tune_command(
         from .. import tuning
         from ..labels import describe_scenario
 
-        phases = _phase_list(phase)
+        names = _tunable_list(controllers)
         damper_preset("--damper", damper)
         scale = parse_scale("--damper-scale", damper_scale)
         start = _tune_start(gains)
@@ -376,7 +394,7 @@ def tune_command(
             with RunProgress(stderr_is_terminal(), "tuning") as progress:
                 t0 = time.perf_counter()
                 result = tuning.tune(
-                    phases,
+                    names,
                     scenario=scenario,
                     scenario_options=options,
                     gains=start,
@@ -387,7 +405,7 @@ def tune_command(
                     table=table,
                     n_values=values,
                     span=span,
-                    max_passes=passes,
+                    budget=budget,
                     solver=solver,
                     progress=progress,
                     log=progress.log,

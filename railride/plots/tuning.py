@@ -84,7 +84,7 @@ def _draw_parameter(ax, mine: list, colour) -> bool:
 
 def plot_sensitivity(curves, ax=None, *, title: str | None = None):
     """The sensitivity curves of a tuning study (``TuneResult.curves``, a sequence of
-    `railride.tuning.Curve`): one panel per parameter (in the order tuned), the objective
+    `railride.tune_result.Curve`): one panel per parameter (in the order tuned), the objective
     against the parameter's value on a log axis, one line per pass (coloured by pass). The
     value 0 (the gain switched off) cannot sit on a log axis: it is plotted at the shaded left
     edge, on a tick labelled 0, as an open square joined by a dotted line. The value kept after
@@ -103,7 +103,7 @@ def plot_sensitivity(curves, ax=None, *, title: str | None = None):
         raise ValueError("no sensitivity curves to plot")
     parameters = list(dict.fromkeys(c.parameter for c in curves))
     if ax is None:
-        ncols = min(4, len(parameters))
+        ncols = min(4 if len(parameters) <= 16 else 6, len(parameters))  # every law's gains: wider
         nrows = math.ceil(len(parameters) / ncols)
         fig = new_figure((3.3 * ncols + 0.6, 2.6 * nrows + 1.0))
         axes = fig.subplots(nrows, ncols, squeeze=False).ravel()

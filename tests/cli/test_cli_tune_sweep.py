@@ -16,7 +16,7 @@ from clihelp import PNG, assert_input_error, ok, run
 
 
 RESPONSES = ["acceleration_m_s2", "displacement_m", "pitch_deg", "roll_deg"]
-TUNE = ("tune", "--phase", "pid", "--duration", 1, "--values", 4, "--passes", 1)
+TUNE = ("tune", "--controllers", "pid", "--duration", 1, "--values", 4, "--budget", 12)
 SWEEP = ("sweep", "--duration", 1)
 
 
@@ -37,8 +37,10 @@ def test_tune_folder_and_json(tuned):
     out, doc = tuned
     assert sorted(p.name for p in out.iterdir()) == sorted([*TUNE_FILES, "runs.csv"])
     assert json.loads((out / "tune.json").read_text()) == doc
-    assert doc["schema"] == "railride.tune/2"
-    assert doc["phases"] == ["pid"]
+    assert doc["schema"] == "railride.tune/3"
+    assert doc["controllers"] == ["pid"]
+    assert [(s["controller"], s["budget"], s["stopped"]) for s in doc["studies"]] == [("pid", 12, "budget")]
+    assert doc["studies"][0]["runs"] <= 12
     assert doc["scenario"]["duration_s"] == 1.0
     # no --objective: the library's default, stated in full
     assert doc["objective"]["kind"] == DEFAULT_OBJECTIVE.kind
@@ -46,14 +48,14 @@ def test_tune_folder_and_json(tuned):
     assert doc["objective"]["statement"].startswith(f"{DEFAULT_OBJECTIVE.kind}: J = ")
     assert doc["settings"]["start_gains"] == "railride/data/reference_gains.toml"
     assert list(doc["passive_rms"]) == RESPONSES
-    assert [(h["phase"], h["pass"]) for h in doc["history"]] == [("pid", 1)]
+    assert [(h["controller"], h["pass"]) for h in doc["history"]] == [("pid", 1)]
     assert doc["runs"] == table_rows(out / "runs.csv") == doc["runs_evaluated"] > 0
     assert doc["runs_per_second"] > 0 and doc["wall_time_s"] > 0
     assert [r["suspension"] for r in doc["before_after"]] == ["pid"]
     assert (out / "sensitivity.png").read_bytes().startswith(PNG)
     curves = pd.read_csv(out / "curves.csv")
-    assert list(curves.columns[:5]) == ["phase", "pass", "parameter", "value", "objective"]
-    assert set(curves["parameter"]) == {"pid.kp", "pid.ki", "pid.kd"}
+    assert list(curves.columns[:5]) == ["controller", "pass", "parameter", "value", "objective"]
+    assert set(curves["parameter"]) <= {"pid.kp", "pid.ki", "pid.kd"}
     assert (curves["value"] == 0).any()  # 0 is always tried
     chosen = curves[curves["chosen"]].set_index("parameter")["value"]
     assert chosen.to_dict() == {k: doc["gains"]["pid"][k.split(".")[1]] for k in chosen.index}
@@ -157,8 +159,9 @@ def test_tune_interrupted(tmp_path, monkeypatch):
 @pytest.mark.parametrize(
     "args, fragments",
     [
-        (("--phase", "lqr"), ("--phase", "lqr", "allowed")),
-        (("--phase", "pid,,ride"), ("--phase", "empty item")),
+        (("--controllers", "lqr"), ("--controllers", "lqr", "allowed")),
+        (("--controllers", "passive-on"), ("--controllers", "passive-on", "no gains to tune")),
+        (("--controllers", "pid,,ride"), ("--controllers", "empty item")),
         (("--objective", "weighted", "--weights", "1,1,1"), ("--weights", "four numbers")),
         (("--objective", "weighted", "--weights", "1,1,x,1"), ("--weights", "'x'")),
         (("--objective", "weighted", "--weights", "1,-1,1,1"), ("--weights", "-1", ">= 0")),
@@ -174,11 +177,11 @@ def test_tune_interrupted(tmp_path, monkeypatch):
         (("--objective", "minimax", "--bound", "1.2"), ("--bound", "constrained only", "minimax")),
         (("--penalty", "-1"), ("--penalty",)),
         (("--penalty", "ten"), ("--penalty", "'ten'", "not a number")),
-        (("--phase", "inner,pid", "--damper", "ideal"), ("--damper", "ideal", "inner")),
-        (("--phase", "inner,pid", "--damper", "ideal-damper"), ("--damper", "ideal-damper", "inner")),
+        (("--controllers", "inner,pid", "--damper", "ideal"), ("--damper", "ideal", "inner")),
+        (("--controllers", "inner,pid", "--damper", "ideal-damper"), ("--damper", "ideal-damper", "inner")),
         (("--values", "2"), ("--values = 2",)),
         (("--span", "1"), ("--span",)),
-        (("--passes", "0"), ("--passes = 0",)),
+        (("--budget", "0"), ("--budget = 0",)),
         (("--damper", "mr9"), ("--damper", "mr9")),
         (("--resume",), ("--resume needs --out",)),
         (("--workers", "0"), ("--workers = 0",)),

@@ -204,6 +204,8 @@ def test_cli_sweep_over_the_damper_scale(tmp_path):
     assert "damper_scale" in table[0].split(",")
 
 
-@pytest.mark.parametrize("command", [("compare",), ("tune", "--phase", "pid"), ("simulate", "--suspension", "mr")])
+@pytest.mark.parametrize(
+    "command", [("compare",), ("tune", "--controllers", "pid"), ("simulate", "--suspension", "mr")]
+)
 def test_cli_damper_scale_that_is_not_a_number(command):
     assert_input_error(run(*command, "--damper-scale", "abc"), "--damper-scale = 'abc'", "must be a finite number > 0")

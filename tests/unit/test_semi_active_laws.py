@@ -64,10 +64,10 @@ def test_each_name_is_its_law_with_its_voltage_law():
         c = g.controller(name)
         assert type(c) is kind and c.name == name and c.voltage_law == law and LABELS[name] == c.label
         assert Suspension.named(name, g).controller == c
-    assert g.controller("skyhook-on-off").to_dict() == g.skyhook.to_dict()  # the same table
+    assert g.controller("skyhook-on-off").to_dict() == g.skyhook_on_off.to_dict()  # a table of its own
     assert g.controller("passive-on") is None and g.controller("passive-off") is None
     assert GainSet.tables_read("skyhook") == ("inner", "skyhook")
-    assert GainSet.tables_read("skyhook-on-off") == ("skyhook",)  # no force tracking: no inner loop
+    assert GainSet.tables_read("skyhook-on-off") == ("skyhook_on_off",)  # no force tracking: no inner loop
     assert GainSet.tables_read("clipped-optimal") == ("clipped_optimal",)
     assert GainSet.tables_read("hybrid") == ("inner", "hybrid") and GainSet.tables_read("passive-on") == ()
 
@@ -117,17 +117,16 @@ def test_on_off_skyhook_has_the_skyhooks_demand():
 
 
 # -- the gain tables ---------------------------------------------------------------------------------
-def test_the_shipped_tables_follow_the_passive_secondary():
-    g, ref = GainSet.default(), GainSet.reference()
+def test_the_reference_tables_follow_the_passive_secondary():
+    g = ref = GainSet.reference()
     c, k, l2, d2 = P.c_sz, P.k_sz, P.l**2, P.d_s**2
     assert g.skyhook == Skyhook(4 * c, 4 * c * l2, 4 * c * d2) and g.groundhook == Groundhook(c)
     assert g.hybrid == Hybrid(0.5, 4 * c, 4 * c * l2, 4 * c * d2, c)
     w = g.clipped_optimal
     assert (w.q_z, w.q_phi, w.q_theta) == pytest.approx((4 * k**2, 4 * k**2 * l2, 4 * k**2 * d2), rel=1e-12)
     assert (w.qd_z, w.qd_phi, w.qd_theta, w.r) == pytest.approx((4 * c**2, 4 * c**2 * l2, 4 * c**2 * d2, 1.0))
-    for t in ("skyhook", "groundhook", "hybrid", "clipped_optimal"):  # not tuned: the reference values
-        assert g.table(t) == ref.table(t)
-    assert g.from_reference == () and ref.from_reference == ()
+    assert g.skyhook_on_off == g.skyhook and g.ride_attitude == g.attitude
+    assert GainSet.default().from_reference == () and ref.from_reference == ()
 
 
 def test_a_gains_file_of_0_3_0_still_loads_with_the_reference_for_the_new_tables(tmp_path):
@@ -170,14 +169,20 @@ def test_new_tables_round_trip_and_apply(tmp_path):
         "hybrid.c_theta",
         "hybrid.c_g",
     )
-    assert g.value("groundhook.c_g") == 1e4 and len(g.entries()) == 19 + 3 + 1 + 5 + 7
+    assert g.value("groundhook.c_g") == 1e4 and len(g.entries()) == 19 + 6 + 3 + 3 + 1 + 5 + 7
 
 
 def test_key_text_is_the_paper_tables_unless_a_new_table_differs():
     g = GainSet.default()
     assert g.key_text() == g.to_toml(GainSet.PAPER_TABLES)
-    other = g.apply({"skyhook.c_z": 1.0})
-    assert other.key_text() == other.to_toml((*GainSet.PAPER_TABLES, "skyhook"))
+    ref = GainSet.reference()
+    assert ref.key_text() == ref.to_toml(GainSet.PAPER_TABLES)
+    other = ref.apply({"skyhook.c_z": 1.0})  # skyhook-on-off keeps the reference: it differs
+    assert other.key_text() == other.to_toml((*GainSet.PAPER_TABLES, "skyhook", "skyhook_on_off"))
+    both = ref.apply({"skyhook.c_z": 1.0, "skyhook_on_off.c_z": 1.0})  # the same table again
+    assert both.key_text() == both.to_toml((*GainSet.PAPER_TABLES, "skyhook"))
+    own = ref.apply({"ride_attitude.kp_z": 1.0})
+    assert own.key_text() == own.to_toml((*GainSet.PAPER_TABLES, "ride_attitude"))
 
 
 # -- bad input -------------------------------------------------------------------------------------------

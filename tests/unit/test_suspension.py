@@ -299,9 +299,16 @@ def test_solver_settings_are_checked_at_construction(kwargs, match):
 # -- gain tables ---------------------------------------------------------------------------------
 def test_gain_set_knows_its_tables():
     assert GainSet.TABLES[:4] == GainSet.PAPER_TABLES == ("inner", "pid", "attitude", "ride")
-    assert GainSet.TABLES[4:] == ("skyhook", "groundhook", "hybrid", "clipped_optimal")
+    assert GainSet.TABLES[4:] == (
+        "ride_attitude",
+        "skyhook",
+        "skyhook_on_off",
+        "groundhook",
+        "hybrid",
+        "clipped_optimal",
+    )
     assert GainSet.entry_names("pid") == ("pid.kp", "pid.ki", "pid.kd")
-    assert GainSet.tables_read("sas-attitude-ride") == ("inner", "attitude", "ride")
+    assert GainSet.tables_read("sas-attitude-ride") == ("inner", "ride_attitude", "ride")
     assert G.value("ride.kd_2L") == G.ride.kd_2L and G.value("inner.B") == G.inner.B
     assert len(G.entries(GainSet.PAPER_TABLES)) == 2 + 3 + 6 + 8 and G.entries(("pid",)) == {
         "pid.kp": G.pid.kp,

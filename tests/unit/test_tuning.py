@@ -71,7 +71,7 @@ def test_run_table_resumes_without_redoing_runs(tmp_path):
 
 def test_sensitivity_study_never_worsens_the_objective_and_records_curves():
     start = GainSet.default()
-    res = tune(("pid",), scenario_options=SHORT, gains=start, n_values=4, max_passes=2)
+    res = tune(("pid",), scenario_options=SHORT, gains=start, n_values=4, budget=30)
     history = [h["objective"] for h in res.history]
     assert all(b <= a + 1e-12 for a, b in zip(history, history[1:]))
     assert {c.parameter for c in res.curves} == {"pid.kp", "pid.ki", "pid.kd"}
@@ -195,13 +195,11 @@ def test_objective_refuses_bad_settings(kwargs, fragments):
         assert fragment in str(info.value), str(info.value)
 
 
-def test_the_ride_phase_starts_from_zero_ride_gains():
+def test_the_ride_loop_starts_from_zero_ride_gains():
     start = GainSet.reference()
-    start = GainSet(
-        start.inner, start.pid, start.attitude, start.ride.replace(**dict.fromkeys(start.ride.to_dict(), 7e4)), "test"
-    )
-    res = tune(("ride",), scenario_options={"duration": 0.5}, gains=start, n_values=3, max_passes=1)
-    first = res.curves[0]
+    start = start.apply({f"ride.{k}": 7e4 for k in start.ride.to_dict()})
+    res = tune(("sas-attitude-ride",), scenario_options={"duration": 0.5}, gains=start, n_values=3, budget=60)
+    first = next(c for c in res.curves if c.parameter.startswith("ride."))
     # swept around REFERENCE (the centre for a gain at 0), not around the start's 7e4
     assert first.values.max() == pytest.approx(REFERENCE[first.parameter] * 30, rel=1e-3)
     assert 7e4 not in first.values
@@ -211,8 +209,10 @@ def test_the_ride_phase_starts_from_zero_ride_gains():
 
 
 def test_tune_starts_from_the_reference_gains_and_refuses_ideal_with_inner():
-    res = tune(("pid",), scenario_options={"duration": 0.5}, n_values=3, max_passes=1)
-    assert res.gains.attitude == GainSet.reference().attitude  # untuned: as they started
+    res = tune(("pid",), scenario_options={"duration": 0.5}, n_values=3, budget=10)
+    ref = GainSet.reference()
+    for t in GainSet.TABLES:  # the tables PID does not read: as they started
+        assert t == "pid" or res.gains.table(t) == ref.table(t), t
     with pytest.raises(ValueError, match="ideal.*inner"):
         tune(("inner", "pid"), damper="ideal")
 
@@ -220,7 +220,7 @@ def test_tune_starts_from_the_reference_gains_and_refuses_ideal_with_inner():
 # -- the result protocol of TuneResult -------------------------------------------------------------
 @pytest.fixture(scope="module")
 def short_tune():
-    return tune(("pid",), scenario_options={"duration": 1.0}, n_values=3, max_passes=1)
+    return tune(("pid",), scenario_options={"duration": 1.0}, n_values=3, budget=10)
 
 
 def test_tune_result_to_dict_is_the_tune_document(short_tune):
@@ -233,26 +233,30 @@ def test_tune_result_to_dict_is_the_tune_document(short_tune):
         "schema",
         "railride_version",
         "date",
-        "phases",
+        "controllers",
         "scenario",
         "settings",
         "objective",
         "passive_rms",
+        "studies",
         "history",
         "gains",
         "before_after",
         "runs",
     ]
-    assert doc["schema"] == "railride.tune/2" and doc["phases"] == ["pid"]
+    assert doc["schema"] == "railride.tune/3" and doc["controllers"] == ["pid"]
+    [study] = doc["studies"]
+    assert (study["controller"], study["budget"], study["runs"], study["passes"]) == ("pid", 10, 10, 1)
     assert doc["scenario"]["duration_s"] == 1.0
     assert doc["settings"] == {
         "damper": "railway",
         "damper_scale": 1.0,
         "dt_s": 1e-4,
+        "budget": 10,
         "values": 3,
         "span": 30.0,
-        "max_passes": 1,
         "tolerance": 1e-3,
+        "min_span": 1.05,
         "start_gains": "railride/data/reference_gains.toml",
     }
     assert doc["objective"] == DEFAULT_OBJECTIVE.to_dict()
@@ -275,7 +279,7 @@ def test_tune_result_table_and_figure(short_tune):
     res = short_tune
     frame = res.to_pandas()
     assert len(frame) == sum(len(c.values) for c in res.curves)
-    assert list(frame.columns) == ["phase", "pass", "parameter", "value", "objective", "chosen"]
+    assert list(frame.columns) == ["controller", "pass", "parameter", "value", "objective", "chosen"]
     fig = res.plot()
     assert isinstance(fig, Figure)
     mine = Figure()
@@ -293,20 +297,23 @@ def test_tune_result_saves_its_folder(short_tune, tmp_path):
     assert [p.name for p in paths] == ["gains.toml", "sensitivity.png", "curves.csv", "tune.json"]
     assert json.loads((tmp_path / "out" / "tune.json").read_text()) == res.to_dict()
     loaded = GainSet.load(tmp_path / "out" / "gains.toml")
-    for table in ("inner", "pid", "attitude", "ride"):
-        assert getattr(loaded, table) == getattr(res.gains, table), table
+    assert all(loaded.table(t) == res.gains.table(t) for t in GainSet.TABLES)
     assert loaded.provenance["objective"] == res.objective.describe()
     assert loaded.provenance["scenario_record"] == res.scenario
     assert "command" not in loaded.provenance  # none given: a library call
-    text = res.gains_toml(command="railride tune --phase pid")
-    assert "# command: railride tune --phase pid\n" in text
-    assert GainSet.from_toml(text).provenance["command"] == "railride tune --phase pid"
+    assert loaded.provenance["controllers"] == ["pid"] and loaded.provenance["budget"] == 10
+    assert loaded.provenance["studies"]["pid"] == {
+        k: v for k, v in res.studies[0].to_dict().items() if k != "controller"
+    }
+    text = res.gains_toml(command="railride tune --controllers pid")
+    assert "# command: railride tune --controllers pid\n" in text
+    assert GainSet.from_toml(text).provenance["command"] == "railride tune --controllers pid"
     extra = res.save(tmp_path / "out", extra={"command": "x"})[-1]
     assert json.loads(extra.read_text()) == {**res.to_dict(), "command": "x"}
 
 
 def test_tune_without_before_after():
-    res = tune(("pid",), scenario_options={"duration": 0.5}, n_values=3, max_passes=1, before_after=False)
+    res = tune(("pid",), scenario_options={"duration": 0.5}, n_values=3, budget=5, before_after=False)
     assert res.before_after == [] and res.to_dict()["before_after"] == []
 
 
@@ -367,38 +374,105 @@ def test_a_resumed_sweep_with_other_run_settings_runs_again(tmp_path):
     assert ex.cases == 0
 
 
-# -- the shipped gains ---------------------------------------------------------------------------
-@pytest.fixture(scope="module")
-def shipped_ratios():
-    """RMS ratios to passive of the three controllers with the shipped gains on paper-sine."""
-    from railride.comparison import compare
+# -- every law alike ------------------------------------------------------------------------------
+def test_every_law_gets_the_same_budget_on_its_own_gains():
+    from railride.tuning import TUNED_CONTROLLERS
 
-    cmp = compare("paper-sine")
-    rms = cmp.metrics.sel(statistic="rms")
-    return {
-        n: rms.sel(controller=n).values / rms.sel(controller="passive").values
-        for n in ("pid", "sas-attitude", "sas-attitude-ride")
+    B = 14
+    res = tune(("pid", "skyhook", "groundhook"), scenario_options={"duration": 0.5}, n_values=3, budget=B)
+    frame = res.runs
+    start = GainSet.reference()
+    for study in res.studies:
+        # the runs a study reports are the distinct runs of its law in the table, less the
+        # before/after run of the tuned gains when the study did not score them
+        mine = frame[frame["suspension"] == study.controller]
+        assert study.runs <= B and len(mine) in (study.runs, study.runs + 1)
+        assert study.stopped in ("budget", "converged")
+        if study.stopped == "budget":  # the next sweep would not fit: it holds at most 4 new values
+            assert study.runs > B - 4
+        changed = {e for e, v in res.gains.entries().items() if v != start.value(e)}
+        assert changed <= set(GainSet.tuned_entries(study.controller)) | {
+            e for other in res.studies if other is not study for e in other.entries
+        }
+    assert [s.controller for s in res.studies] == ["pid", "skyhook", "groundhook"]
+    # one gain, swept until its span is narrow: it converges within the budget or spends it
+    assert res.studies[2].passes >= 2
+    assert set(TUNED_CONTROLLERS) == {
+        "pid",
+        "sas-attitude",
+        "sas-attitude-ride",
+        "skyhook",
+        "skyhook-on-off",
+        "groundhook",
+        "hybrid",
+        "clipped-optimal",
     }
 
 
-def test_shipped_gains_make_no_response_worse_than_passive(shipped_ratios):
-    for name, r in shipped_ratios.items():
-        assert np.all(r < 1.0), (name, r)
+def test_a_law_is_tuned_on_its_own_tables_and_the_lqr_scale_is_fixed():
+    assert "clipped_optimal.r" not in PARAMETERS["clipped-optimal"]  # Q and r together: one gain
+    assert PARAMETERS["sas-attitude-ride"][:6] == GainSet.entry_names("ride_attitude")
+    assert PARAMETERS["skyhook-on-off"] == GainSet.entry_names("skyhook_on_off")
+    owned = [e for n, es in PARAMETERS.items() for e in es]
+    assert len(owned) == len(set(owned))  # no gain belongs to two studies
 
 
-def test_shipped_ride_loop_does_not_worsen_the_worst_response(shipped_ratios):
-    # the paper's phase 2 starts from zero ride gains, so the ride loop can only lower the worst
-    # ratio that the minimax objective sees
-    assert shipped_ratios["sas-attitude-ride"].max() <= shipped_ratios["sas-attitude"].max() + 1e-12
+def test_a_blend_is_swept_within_its_range():
+    from railride.tuning import _candidates
+
+    values = _candidates(0.5, "hybrid.alpha", 13, 30.0, GainSet.reference())
+    assert 0.0 in values and 0.5 in values and max(values) <= 1.0 and len(values) >= 6
+
+
+def test_tune_refuses_what_it_cannot_tune():
+    for name in ("passive", "passive-on", "lqr"):
+        with pytest.raises(ValueError, match=f"controller = '{name}'.*allowed inner, pid"):
+            tune((name,))
+    with pytest.raises(ValueError, match="min_span = 1: must be a finite number > 1"):
+        tune(("pid",), min_span=1)
+
+
+# -- the shipped gains ---------------------------------------------------------------------------
+@pytest.fixture(scope="module")
+def shipped_ratios():
+    """RMS ratios to passive of every law with the shipped gains on paper-sine."""
+    from railride.comparison import compare
+    from railride.tuning import TUNED_CONTROLLERS
+
+    cmp = compare("paper-sine", controllers=TUNED_CONTROLLERS)
+    rms = cmp.metrics.sel(statistic="rms")
+    return {n: rms.sel(controller=n).values / rms.sel(controller="passive").values for n in TUNED_CONTROLLERS}
+
+
+def test_shipped_gains_record_how_each_law_was_tuned(shipped_ratios):
+    from railride.tuning import DEFAULT_BUDGET, TUNED_CONTROLLERS
+
+    shipped = GainSet.default()
+    p = shipped.provenance
+    assert p["controllers"] == list(TUNED_CONTROLLERS) and p["budget"] == DEFAULT_BUDGET
+    assert shipped.untuned(TUNED_CONTROLLERS) == []
+    for name in TUNED_CONTROLLERS:
+        study = p["studies"][name]
+        assert study["runs"] <= DEFAULT_BUDGET and study["entries"] == list(PARAMETERS[name])
+        # the objective the file records is the one a fresh run of the shipped gains scores
+        assert DEFAULT_OBJECTIVE(shipped_ratios[name][None, :], np.ones(4))[0] == pytest.approx(
+            study["objective"], rel=1e-9
+        ), name
+        assert study["objective"] <= study["objective_start"]
+
+
+def test_the_paper_laws_shipped_make_no_response_worse_than_passive(shipped_ratios):
+    for name in ("pid", "sas-attitude", "sas-attitude-ride"):
+        assert np.all(shipped_ratios[name] < 1.0), (name, shipped_ratios[name])
 
 
 def test_tune_defaults_reproduce_the_shipped_gains():
     # `railride tune` with no option, from an installed package: the reference start is packaged
     shipped = GainSet.default()
     assert shipped.provenance["command"] == "railride tune"
-    tuned = tune().gains
-    for table in ("inner", "pid", "attitude", "ride"):
-        assert getattr(tuned, table) == getattr(shipped, table), table
+    tuned = tune(before_after=False).gains
+    for table in GainSet.TABLES:
+        assert tuned.table(table) == shipped.table(table), table
 
 
 def test_tune_with_a_scaled_damper_tunes_the_inner_loop_for_it():
