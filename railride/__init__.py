@@ -15,7 +15,7 @@ The public API, in the order a run needs it::
     rr.frequency_responses(params)                    # carbody FRFs, their peaks, the modes
 """
 
-__version__ = "0.3.0"
+__version__ = "0.4.0"
 
 from . import dampers
 from .comparison import Comparison, compare

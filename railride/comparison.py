@@ -226,6 +226,7 @@ class Comparison:
                 "in_sample": self.in_sample,
                 # only when there are some: the paper's comparison's document stays as it was
                 **({"untuned": u} if (u := self.gains.untuned(self.names)) else {}),
+                **({"alike": a} if (a := self.gains.tuning_budget(self.names)) else {}),
             },
             "gains": {
                 "source": self.gains.source,

@@ -363,6 +363,16 @@ class GainSet:
             and any(_OWN_COPIES.get(t, t) not in phases for t in self.tables_read(n) if t != "inner")
         ]
 
+    def tuning_budget(self, controllers) -> dict | None:
+        """How alike the ``controllers`` were tuned, from the [provenance] of these gains: the
+        budget of vehicle runs each law had and the runs each used ({"budget": B, "runs":
+        {name: n}}), or None when the gains file records no budget (files before 0.4.0)."""
+        budget = self.provenance.get("budget")
+        if budget is None:
+            return None
+        studies = self.provenance.get("studies", {})
+        return {"budget": budget, "runs": {n: studies[n]["runs"] for n in controllers if n in studies}}
+
     def tuned_on(self, record: dict | None) -> bool:
         """Whether these gains were tuned on the track ``record`` (`Scenario.describe`), as the
         file's [provenance] scenario record says: judged there, they are judged in-sample."""

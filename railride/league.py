@@ -160,6 +160,7 @@ def league(
         "gains": gains.source,
         "objective": gains.provenance.get("objective"),
         "untuned": gains.untuned(names),
+        "tuned_alike": gains.tuning_budget(names),
     }
     return LeagueTable(pd.DataFrame(rows), names, settings, gains.provenance.get("scenario_record"))
 

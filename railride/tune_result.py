@@ -157,18 +157,24 @@ class TuneResult:
             f"# date: {doc['date']}; railride {doc['railride_version']}",
             f"# scenario: {run_text}, dt {s['dt_s']:g} s, {describe_dampers(s, detail=True)}",
             f"# objective: {statement}",
-            f"# study: per law at most {s['budget']} vehicle runs from its start gains; {s['values']} values "
-            f"from 1/{s['span']:g} to {s['span']:g} x the current value (and 0) per gain and pass; a pass",
-            f"#   that improves by less than {s['tolerance'] * 100:g} % narrows the span to its square root; "
-            f"a study ends when its next sweep would not fit the budget or the span falls below {s['min_span']:g}",
+            *textwrap.wrap(
+                f"study: each law from the start values, with at most {s['budget']} vehicle runs; per gain "
+                f"and pass {s['values']} values from 1/{s['span']:g} to {s['span']:g} x the current value "
+                f"(and 0); a pass that improves by less than {s['tolerance'] * 100:g} % narrows the span to "
+                f"its square root; a study ends when its next sweep would not fit the budget "
+                f"(budget) or the span falls below {s['min_span']:g} (converged)",
+                98,
+                initial_indent="# ",
+                subsequent_indent="#   ",
+            ),
             *(
-                ["# inner loop: B and G on the damper rig's force tracking (shared by every law that tracks a force)"]
+                ["# inner loop: B and G on the damper rig's force tracking, shared by every law that tracks a force"]
                 if "inner" in self.controllers
                 else []
             ),
             *[
-                f"#   {st.controller}: {len(st.entries)} gains, {st.runs} runs, {st.passes} passes, objective "
-                f"{st.objective_start:.4g} -> {st.objective:.4g} ({st.stopped})"
+                f"#   {st.controller}: {len(st.entries)} gain{'s' * (len(st.entries) != 1)}, {st.runs} runs, "
+                f"{st.passes} pass{'es' * (st.passes != 1)}, objective {st.objective_start:.4g} -> {st.objective:.4g} ({st.stopped})"
                 for st in laws
             ],
             f"# start values: {s['start_gains']}",

@@ -61,6 +61,10 @@ PARAMETERS = {"inner": GainSet.entry_names("inner"), **{n: GainSet.tuned_entries
 #: the default budget of vehicle runs per law: two full passes of the law with the most gains
 #: (SAS attitude+ride: 14 gains x 14 new values per sweep = 196 runs a pass)
 DEFAULT_BUDGET = 400
+#: laws made of loops, tuned loop by loop as the paper does (its phases 1 and 2): SAS
+#: (attitude+ride)'s attitude loop with the ride loop off (zero gains), then its ride loop from
+#: zero on top; each stage may spend its share of what the budget has left
+STAGES = {"sas-attitude-ride": (GainSet.entry_names("ride_attitude"), GainSet.entry_names("ride"))}
 #: the passes of the inner loop's study on the rig (it has no budget of vehicle runs)
 INNER_PASSES = 5
 
@@ -243,14 +247,14 @@ def tune(
     return result
 
 
-def _study(name, start, score, budget, n_values, span, tol, min_span, result, log) -> tuple[Study, dict]:
+def _study(name, start, score, budget, n_values, start_span, tol, min_span, result, log) -> tuple[Study, dict]:
     """One law's study: passes over its gains until the budget or the span runs out. Returns
     the `Study` and the law's gains at the end, by "table.entry"."""
     entries = PARAMETERS[name]
     own: dict[str, float] = {}
     if name == "sas-attitude-ride":  # the paper's phase 2: the ride loop joins with zero gains
         own.update(dict.fromkeys(GainSet.entry_names("ride"), 0.0))
-    study = Study(name, entries, budget, span=span)
+    study = Study(name, entries, budget, span=start_span)
 
     def value(p):
         return own.get(p, start.value(p))
@@ -265,36 +269,40 @@ def _study(name, start, score, budget, n_values, span, tol, min_span, result, lo
     seen = {key({})}
     best = float(score([full({})])[0])
     study.runs, study.objective_start = 1, best
-    stopped = ""
-    while not stopped:
-        study.passes += 1
-        before, swept = best, 0
-        for p in entries:
-            vals = _candidates(value(p), p, n_values, span, start.apply(own))
-            new = {key({p: v}) for v in vals} - seen
-            if study.runs + len(new) > budget:
-                stopped = "budget"
-                break
-            obj = score([full({p: v}) for v in vals])
-            study.runs += len(new)
-            seen |= new
-            swept += 1
-            k = int(np.argmin(obj))
-            if obj[k] < best - 1e-12:
-                own[p], best = vals[k], float(obj[k])
-            result.curves.append(Curve(name, study.passes, p, np.array(vals), np.asarray(obj), value(p)))
-        if swept:
-            result.history.append(
-                {"controller": name, "pass": study.passes, "objective": best, "span": span, "runs": study.runs}
-            )
-            if log is not None:
-                log(f"{name} pass {study.passes}: objective {best:.4f} ({study.runs} runs)")
-        else:
-            study.passes -= 1
-        if not stopped and before - best < tol * abs(before):
-            span = math.sqrt(span)
-            if span < min_span:
-                stopped = "converged"
+    stages = STAGES.get(name, (entries,))
+    for k, stage in enumerate(stages):
+        # this stage's share of what is left; the last stage has the rest
+        cap = study.runs + (budget - study.runs) // (len(stages) - k)
+        span, stopped = start_span, ""
+        while not stopped:
+            study.passes += 1
+            before, swept = best, 0
+            for p in stage:
+                vals = _candidates(value(p), p, n_values, span, start.apply(own))
+                new = {key({p: v}) for v in vals} - seen
+                if study.runs + len(new) > cap:
+                    stopped = "budget"
+                    break
+                obj = score([full({p: v}) for v in vals])
+                study.runs += len(new)
+                seen |= new
+                swept += 1
+                i = int(np.argmin(obj))
+                if obj[i] < best - 1e-12:
+                    own[p], best = vals[i], float(obj[i])
+                result.curves.append(Curve(name, study.passes, p, np.array(vals), np.asarray(obj), value(p)))
+            if swept:
+                result.history.append(
+                    {"controller": name, "pass": study.passes, "objective": best, "span": span, "runs": study.runs}
+                )
+                if log is not None:
+                    log(f"{name} pass {study.passes}: objective {best:.4f} ({study.runs} runs)")
+            else:
+                study.passes -= 1
+            if not stopped and before - best < tol * abs(before):
+                span = math.sqrt(span)
+                if span < min_span:
+                    stopped = "converged"
     study.objective, study.span, study.stopped = best, span, stopped
     return study, full({})
 

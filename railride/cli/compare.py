@@ -141,6 +141,8 @@ def _compare_tables(doc: dict, vehicle: str, shipped: bool):
                 "The gains were tuned on this same single track: the reductions are "
                 "in-sample, not a test on another track."
             )
+        if tuning.get("alike"):
+            info.append(_alike_text(tuning["alike"]))
         if tuning.get("untuned"):
             info.append(_untuned_text(tuning["untuned"]))
         info += _trade_off_lines(doc)
@@ -435,6 +437,14 @@ def compare(
         console.print(part)
 
 
+def _alike_text(alike: dict) -> str:
+    runs = ", ".join(f"{n} {r}" for n, r in alike["runs"].items())
+    return (
+        f"Tuned alike: every law by the same study and objective, with at most {alike['budget']} vehicle runs "
+        f"each (runs used: {runs})."
+    )
+
+
 def _untuned_text(names) -> str:
     return (
         f"Not tuned: {', '.join(names)} run with the starting values of their gains tables (docs/control.md), "
@@ -531,6 +541,7 @@ def _league_table(table, doc):
         f"Gains tuned on: {tuned_text}. Tested on {out_of_sample} case(s) they were not tuned on"
         f" and {len(cases) - out_of_sample} they were.\n"
         "Reduction = (passive - controlled) / passive RMS x 100, MR dampers (ideal actuator, same gains, in brackets)."
+        + ("\n" + _alike_text(settings["tuned_alike"]) if settings.get("tuned_alike") else "")
         + ("\n" + _untuned_text(settings["untuned"]) if settings.get("untuned") else "")
     )
     t = Table(title="League table", caption=caption, caption_justify="left")

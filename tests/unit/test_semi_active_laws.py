@@ -3,7 +3,6 @@ their gain tables in a gains file, and the refusals of bad input."""
 
 import inspect
 import re
-from importlib import resources
 
 import numpy as np
 import pytest
@@ -130,14 +129,17 @@ def test_the_reference_tables_follow_the_passive_secondary():
 
 
 def test_a_gains_file_of_0_3_0_still_loads_with_the_reference_for_the_new_tables(tmp_path):
-    # the shipped file without the new tables: the file railride 0.3.0 shipped
-    shipped = resources.files("railride").joinpath("data/gains.toml").read_text(encoding="utf-8")
-    old = shipped[: shipped.index("# The semi-active laws")]
-    assert "[sas.ride]" in old and "[skyhook]" not in old
+    # a file of the paper's four tables only, as railride 0.3.0 wrote them, with its own attitude loop
+    own = GainSet.reference().apply({"attitude.kp_z": 123.0})
+    old = own.to_toml(GainSet.PAPER_TABLES)
+    assert "[sas.ride]" in old and "[skyhook]" not in old and "[sas.ride_attitude]" not in old
     path = tmp_path / "old.toml"
     path.write_text(old)
     g = GainSet.load(path)
     assert g.from_reference == ("skyhook", "groundhook", "hybrid", "clipped_optimal")
+    # SAS (attitude+ride) and on-off skyhook read the tables they shared then: the file's own
+    assert g.ride_attitude == g.attitude == own.attitude and g.skyhook_on_off == g.skyhook
+    assert g.controller("sas-attitude-ride").attitude.kp_z == 123.0
     ref = GainSet.reference()
     assert (g.skyhook, g.groundhook, g.hybrid, g.clipped_optimal) == (
         ref.skyhook,

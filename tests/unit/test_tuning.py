@@ -199,6 +199,12 @@ def test_the_ride_loop_starts_from_zero_ride_gains():
     start = GainSet.reference()
     start = start.apply({f"ride.{k}": 7e4 for k in start.ride.to_dict()})
     res = tune(("sas-attitude-ride",), scenario_options={"duration": 0.5}, gains=start, n_values=3, budget=60)
+    # the paper's phases: the attitude loop first (ride loop off), within half the budget
+    order = [c.parameter.split(".")[0] for c in res.curves]
+    assert order == sorted(order, key=lambda t: t == "ride") and "ride_attitude" in order and "ride" in order
+    first_ride_pass = min(c.sweep_pass for c in res.curves if c.parameter.startswith("ride."))
+    stage_1 = [h["runs"] for h in res.history if h["pass"] < first_ride_pass]
+    assert max(stage_1) <= 1 + (60 - 1) // 2 and res.studies[0].runs <= 60
     first = next(c for c in res.curves if c.parameter.startswith("ride."))
     # swept around REFERENCE (the centre for a gain at 0), not around the start's 7e4
     assert first.values.max() == pytest.approx(REFERENCE[first.parameter] * 30, rel=1e-3)
