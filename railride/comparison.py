@@ -43,7 +43,9 @@ PAPER_REDUCTION = {
 
 def check_controllers(names) -> list[str]:
     """The requested controllers in the order of `CONTROLLERS`; passive is always the baseline;
-    "all" is every one."""
+    "all" is every one. ``names``: a sequence of names, or one string of comma-separated names."""
+    if isinstance(names, str):
+        names = names.split(",")
     names = [n.strip() for n in names if n.strip()]
     if "all" in names:
         names = list(CONTROLLERS)
@@ -344,16 +346,26 @@ def compare(
     # closed and open loops run as separate batches (a batch is all one or the other)
     for group, noise in ((closed, sensor_noise), (constant, None)):
         if group:
-            batch = simulate(
+            # a law whose gains are not stable on this device is said, not fatal: the others go on
+            res = simulate(
                 scenario,
                 params,
                 [Suspension.named(n, gains, damper, damper_scale, sensor_noise=noise) for n in group],
                 solver=solver,
+                on_divergence="mark",
                 progress=part and part(share * done, share * len(group)),
-            ).dataset
+            )
             for i, n in enumerate(group):
-                datasets[n] = batch.isel(sample=i, drop=True)
+                if np.isfinite(res.diverged_at[i]):
+                    not_run[n] = (
+                        f"diverged at t = {res.diverged_at[i]:.4g} s: these gains are not stable on damper "
+                        f"{damper!r} at dt = {solver.dt:g} s (another dt, or other gains)"
+                    )
+                else:
+                    datasets[n] = res.dataset.isel(sample=i, drop=True)
             done += len(group)
+    names = [n for n in names if n not in not_run]
+    closed = [n for n in closed if n not in not_run]
     bound_values = {}
     for k, device in enumerate(bound_devices):
         # the ideal actuator may not be stable with gains tuned for a damper: marked, not fatal

@@ -254,7 +254,7 @@ class GainSet:
 
     #: the gain tables, as a "table.entry" name spells them (the file's [sas.attitude] is "attitude")
     TABLES: ClassVar[tuple] = tuple(_TABLES)
-    #: the paper's tables: those `railride tune` tunes
+    #: the paper's tables, which every gains file holds (and every run key writes out)
     PAPER_TABLES: ClassVar[tuple] = ("inner", "pid", "attitude", "ride")
 
     def __post_init__(self):
@@ -267,6 +267,8 @@ class GainSet:
         for t, source in _OWN_COPIES.items():
             if getattr(self, t) is None:
                 object.__setattr__(self, t, getattr(self, source))
+                if source in self.from_reference:  # a copy of reference values is reference values
+                    object.__setattr__(self, "from_reference", (*self.from_reference, t))
         for t, (key, kind) in _TABLES.items():
             if type(getattr(self, t)) is not kind:  # SkyhookOnOff is a Skyhook, but not its table
                 raise ValueError(f"{t} = {getattr(self, t)!r}: must be a railride {kind.__name__} (table [{key}])")
@@ -368,10 +370,9 @@ class GainSet:
         budget of vehicle runs each law had and the runs each used ({"budget": B, "runs":
         {name: n}}), or None when the gains file records no budget (files before 0.4.0)."""
         budget = self.provenance.get("budget")
-        if budget is None:
-            return None
         studies = self.provenance.get("studies", {})
-        return {"budget": budget, "runs": {n: studies[n]["runs"] for n in controllers if n in studies}}
+        runs = {n: studies[n]["runs"] for n in controllers if n in studies}
+        return {"budget": budget, "runs": runs} if budget is not None and runs else None
 
     def tuned_on(self, record: dict | None) -> bool:
         """Whether these gains were tuned on the track ``record`` (`Scenario.describe`), as the

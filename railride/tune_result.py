@@ -62,8 +62,8 @@ class Study:
             "budget": self.budget,
             "runs": self.runs,
             "passes": self.passes,
-            "objective_start": self.objective_start,
-            "objective": self.objective,
+            "objective_start": _finite(self.objective_start),
+            "objective": _finite(self.objective),
             "span": self.span,
             "stopped": self.stopped,
         }
@@ -121,7 +121,7 @@ class TuneResult:
                 {
                     "controller": h["controller"],
                     "pass": int(h["pass"]),
-                    "objective": float(h["objective"]),
+                    "objective": _finite(h["objective"]),
                     "span": float(h["span"]),
                     "runs": int(h["runs"]),
                 }
@@ -174,7 +174,8 @@ class TuneResult:
             ),
             *[
                 f"#   {st.controller}: {len(st.entries)} gain{'s' * (len(st.entries) != 1)}, {st.runs} runs, "
-                f"{st.passes} pass{'es' * (st.passes != 1)}, objective {st.objective_start:.4g} -> {st.objective:.4g} ({st.stopped})"
+                f"{st.passes} pass{'es' * (st.passes != 1)}, "
+                f"objective {st.objective_start:.4g} -> {st.objective:.4g} ({st.stopped})"
                 for st in laws
             ],
             f"# start values: {s['start_gains']}",
@@ -255,6 +256,12 @@ class TuneResult:
                 ),
             ]
         )
+
+
+def _finite(value) -> float | None:
+    """A float for the JSON document, None for inf and NaN (a run that diverged scores J = inf)."""
+    value = float(value)
+    return value if np.isfinite(value) else None
 
 
 def _toml_value(value) -> str:

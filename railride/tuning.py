@@ -175,7 +175,7 @@ def tune(
     damper_model(damper, damper_scale)  # a known name, and a scale it has
     if "inner" in controllers and damper in dampers.IDEAL_NAMES:
         raise ValueError(
-            f"damper = {damper!r} with 'inner': the ideal actuator has no force tracking loop to "
+            f"damper = {damper!r} with 'inner': the ideal devices have no force-tracking loop to "
             "tune; leave out the inner loop"
         )
     damper_scale = dampers.check_scale("damper_scale", damper_scale)

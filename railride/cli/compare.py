@@ -96,9 +96,12 @@ def _trade_off_lines(doc: dict) -> list[str]:
         if not t["worse_on"]:
             continue
         a, b = labels[t["controller"]], labels.get(t["than"], t["than"])
-        better = ", ".join(words[r] for r in t["better_on"]) or "nothing"
+        better = ", ".join(words[r] for r in t["better_on"])
         worse = ", ".join(words[r] for r in t["worse_on"])
-        lines.append(f"trade-off: {a} beats {b} on {better} but is worse on {worse}")
+        if better:
+            lines.append(f"trade-off: {a} beats {b} on {better} but is worse on {worse}")
+        else:  # not a trade: one is better wherever they differ
+            lines.append(f"no trade-off: {b} beats {a} on {worse} and is worse on nothing")
     return lines
 
 

@@ -224,10 +224,15 @@ def _tune_tables(doc: dict, start, tuned, scenario_text: str):
     parts += [
         passes,
         Text(
-            "objective: " + _objective_text_from_doc(doc) + "; inner: the normalised force-tracking "
-            "error on the damper rig (rig runs, not counted in the budget); runs: distinct gain "
-            "sets scored by the study so far; span: each sweep runs from 1/span to span x the "
-            "current value"
+            "objective: "
+            + _objective_text_from_doc(doc)
+            + (
+                "; inner: the normalised force-tracking error on the damper rig (rig runs, not counted in the budget)"
+                if "inner" in doc["controllers"]
+                else ""
+            )
+            + "; runs: distinct gain sets scored by the study so far; span: each sweep runs from "
+            "1/span to span x the current value"
         ),
         "",
     ]

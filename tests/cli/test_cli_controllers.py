@@ -22,7 +22,10 @@ def test_compare_all_runs_every_controller_in_order():
     assert all(rows[n]["paper"] is None for n in CONTROLLERS[4:])  # not in the paper's Table 1
     assert all(rows[n]["paper"] is not None for n in PAPER_CONTROLLERS)
     assert rows["passive-on"]["damper"]["voltage_at_max_fraction"] == 1.0
-    assert doc["gains"]["passive-off"] is None and doc["gains"]["skyhook-on-off"] == GainSet.default().skyhook_on_off.to_dict()
+    assert (
+        doc["gains"]["passive-off"] is None
+        and doc["gains"]["skyhook-on-off"] == GainSet.default().skyhook_on_off.to_dict()
+    )
     for name in ("passive-on", "passive-off"):  # no bound, and the results say why
         assert doc["bounds"]["ideal"][name]["reduction_percent"]["roll_deg"] is None
         assert "constant voltage" in doc["bounds"]["ideal"][name]["note"]

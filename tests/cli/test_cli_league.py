@@ -14,7 +14,20 @@ def test_several_scenarios_and_speeds_give_a_league_table():
     text = result.stdout
     assert "League table" in text and "Skyhook" in text and "(%)" in text
     assert "Mean over 4 cases" in text
+    # the shipped gains: every law tuned alike, and the output says with what budget
+    assert "Tuned alike" in " ".join(text.split()) and "Not tuned" not in text
+
+
+def test_a_law_a_gains_file_did_not_tune_is_named(tmp_path):
+    from railride.tuning import tune
+
+    res = tune(("pid",), scenario_options={"duration": 0.5}, n_values=3, budget=5, before_after=False)
+    path = tmp_path / "gains.toml"
+    path.write_text(res.gains_toml())
+    text = ok("compare", "--scenario", "paper-sine", "--speed", "30,40", *SHORT, "--gains", path).stdout
     assert "Not tuned: skyhook" in text  # the untuned law is named, not ranked silently
+    flat = " ".join(text.split())
+    assert "Tuned alike" in flat and "(runs used: pid 4)" in flat  # the runs the tuned one had
 
 
 def test_json_has_one_row_per_case_and_controller():
@@ -22,7 +35,11 @@ def test_json_has_one_row_per_case_and_controller():
     assert doc["schema"] == "railride.league/1"
     assert [c["name"] for c in doc["controllers"]] == ["passive", "pid", "skyhook"]
     assert len(doc["cases"]) == 2 * 3
-    assert doc["settings"]["untuned"] == ["skyhook"]
+    assert doc["settings"]["untuned"] == []
+    assert doc["settings"]["tuned_alike"]["budget"] == 400 and set(doc["settings"]["tuned_alike"]["runs"]) == {
+        "pid",
+        "skyhook",
+    }
 
 
 def test_out_writes_the_league_files(tmp_path):

@@ -87,7 +87,7 @@ def test_simulate_bad_random_track_input(args, fragments):
     [
         ("compare", "--duration", 1),
         ("sweep", "--duration", 1),
-        ("tune", "--phase", "pid", "--duration", 1),
+        ("tune", "--controllers", "pid", "--duration", 1),
     ],
 )
 def test_other_commands_refuse_bad_random_track_input(command, tmp_path):
@@ -201,12 +201,12 @@ def test_sweep_track_seed_axis_is_not_the_noise_seed(tmp_path):
 def test_tune_on_a_random_track(tmp_path):
     doc = ok_json(
         "tune",
-        "--phase",
+        "--controllers",
         "pid",
         "--values",
         3,
-        "--passes",
-        1,
+        "--budget",
+        5,
         "--duration",
         0.5,
         "--scenario",

@@ -184,7 +184,7 @@ def test_on_off_skyhook_gives_v_max_exactly_where_the_demand_dissipates(switched
     assert np.all(v[dissipating] == d.v_max) and np.all(v[~dissipating] == d.v_min)
     # the demand is the skyhook's (the same outer loop, another voltage law): the demand held
     # from 0.5 s was computed from the carbody states sampled at 0.499 s
-    G, _ = GainSet.default().skyhook.gains(V)
+    G, _ = GainSet.default().skyhook_on_off.gains(V)  # the on-off law's own table
     run, t = switched.isel(sample=0), switched.time.values
     body = ("carbody_bounce", "carbody_pitch", "carbody_roll")
     m = np.array([float(run[n][np.isclose(t, 0.499)][0]) for n in (*body, *(f"{n}_velocity" for n in body))])
@@ -230,7 +230,21 @@ def test_passive_on_has_no_bound_beside_a_controller_and_no_run_on_the_ideal_dev
         assert doc["bounds"][device]["passive-on"]["rms"]["roll_deg"] is None
         assert "no meaning on the ideal devices" in doc["bounds"][device]["passive-on"]["note"]
         assert doc["bounds"][device]["skyhook"]["rms"]["roll_deg"] > 0
-    ideal = compare(sc, controllers=["all"], damper="ideal")
+    ideal = compare(sc, controllers=["all"], damper="ideal", gains=GainSet.reference())
     assert ideal.names == ["passive", *OUTER_LOOPS]  # passive-on and passive-off said, not run
     assert set(ideal.settings["not_run"]) == {"passive-on", "passive-off"}
     assert "no voltage" in ideal.to_dict()["settings"]["not_run"]["passive-on"]
+
+
+def test_a_law_that_diverges_on_a_device_is_said_and_the_others_go_on():
+    # the shipped groundhook gain (tuned for the MR dampers, which saturate) is far too stiff for
+    # the ideal actuator at dt = 1e-4 s: that run stops; the comparison of the others goes on
+    sc = scenario("paper-sine", duration=1.0)
+    gains = GainSet.reference().apply({"groundhook.c_g": 1e8})
+    cmp = compare(sc, controllers=["pid", "groundhook"], damper="ideal", gains=gains)
+    assert cmp.names == ["passive", "pid"]
+    why = cmp.to_dict()["settings"]["not_run"]["groundhook"]
+    assert why.startswith("diverged at t = ") and "'ideal'" in why and "dt = 0.0001 s" in why
+    with_mr = compare(sc, controllers=["groundhook"], gains=gains)  # the MR run is fine; its bound is marked
+    assert with_mr.names == ["passive", "groundhook"]
+    assert with_mr.bounds_record()["ideal"]["groundhook"]["diverged_at_s"] > 0

@@ -136,7 +136,7 @@ def test_a_gains_file_of_0_3_0_still_loads_with_the_reference_for_the_new_tables
     path = tmp_path / "old.toml"
     path.write_text(old)
     g = GainSet.load(path)
-    assert g.from_reference == ("skyhook", "groundhook", "hybrid", "clipped_optimal")
+    assert g.from_reference == ("skyhook", "groundhook", "hybrid", "clipped_optimal", "skyhook_on_off")
     # SAS (attitude+ride) and on-off skyhook read the tables they shared then: the file's own
     assert g.ride_attitude == g.attitude == own.attitude and g.skyhook_on_off == g.skyhook
     assert g.controller("sas-attitude-ride").attitude.kp_z == 123.0
@@ -154,7 +154,12 @@ def test_a_gains_file_of_0_3_0_still_loads_with_the_reference_for_the_new_tables
     built = GainSet(g.inner, g.pid, g.attitude, g.ride)
     assert built.from_reference == g.from_reference and built == GainSet(**{t: g.table(t) for t in GainSet.TABLES})
     changed = built.apply({"skyhook.c_z": 1e5})
-    assert changed.skyhook.c_z == 1e5 and changed.from_reference == ("groundhook", "hybrid", "clipped_optimal")
+    assert changed.skyhook.c_z == 1e5 and changed.from_reference == (
+        "groundhook",
+        "hybrid",
+        "clipped_optimal",
+        "skyhook_on_off",
+    )
 
 
 def test_new_tables_round_trip_and_apply(tmp_path):
@@ -175,8 +180,6 @@ def test_new_tables_round_trip_and_apply(tmp_path):
 
 
 def test_key_text_is_the_paper_tables_unless_a_new_table_differs():
-    g = GainSet.default()
-    assert g.key_text() == g.to_toml(GainSet.PAPER_TABLES)
     ref = GainSet.reference()
     assert ref.key_text() == ref.to_toml(GainSet.PAPER_TABLES)
     other = ref.apply({"skyhook.c_z": 1.0})  # skyhook-on-off keeps the reference: it differs
@@ -234,7 +237,7 @@ def test_bad_input_names_the_field(make, match):
 )
 def test_bad_new_tables_in_a_gains_file_name_the_entry(edit, match):
     with pytest.raises(ValueError, match=match):
-        GainSet.from_toml(edit(GainSet.default().to_toml()), source="g.toml")
+        GainSet.from_toml(edit(GainSet.reference().to_toml()), source="g.toml")
 
 
 def test_sweep_runs_passive_on_and_off_as_mr_at_the_ends_of_the_range():
