@@ -307,7 +307,7 @@ class GainSet:
         out: tuple[str, ...] = ()
         for t in cls.tables_read(controller):
             if t != "inner":
-                fixed = _TABLES[t][1].fixed
+                fixed: tuple = getattr(_TABLES[t][1], "fixed", ())
                 out += tuple(e for e in cls.entry_names(t) if e.partition(".")[2] not in fixed)
         return out
 
