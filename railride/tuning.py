@@ -179,8 +179,10 @@ def tune(
             "tune; leave out the inner loop"
         )
     damper_scale = dampers.check_scale("damper_scale", damper_scale)
-    budget = validation.integer("budget", budget, 1)
     validation.integer("n_values", n_values, 3)
+    # room for the start and one whole sweep (the values and 0): a smaller budget tunes nothing
+    what = f"the start run and one sweep of {n_values} values and 0"
+    budget = validation.integer("budget", budget, n_values + 2, what=what)
     for name, value in (("span", span), ("min_span", min_span)):
         if not validation.number(name, value, "finite", allowed="a finite number > 1") > 1:
             raise ValueError(f"{name} = {validation.shown(value)}: must be a finite number > 1")

@@ -182,6 +182,7 @@ def test_tune_interrupted(tmp_path, monkeypatch):
         (("--values", "2"), ("--values = 2",)),
         (("--span", "1"), ("--span",)),
         (("--budget", "0"), ("--budget = 0",)),
+        (("--budget", "5"), ("--budget = 5", ">= 6", "one sweep of 4 values")),
         (("--damper", "mr9"), ("--damper", "mr9")),
         (("--resume",), ("--resume needs --out",)),
         (("--workers", "0"), ("--workers = 0",)),

@@ -124,7 +124,10 @@ def test_the_output_rate_must_resolve_a_random_track():
         ),
         (lambda: compare(scenario("fra4", min_wavelength=0.1), controllers=["pid"]), "min_wavelength = 0.1 m"),
         (lambda: compare(SC, damper="ideal", damper_scale=2.0), "damper_scale = 2"),
-        (lambda: tune(("pid",), budget=0), "budget = 0: must be a whole number >= 1"),
+        (
+            lambda: tune(("pid",), budget=0),
+            r"budget = 0: must be a whole number >= 15 \(the start run and one sweep of 13 values and 0\)",
+        ),
         (lambda: tune(("pid",), n_values=2), "n_values = 2: must be a whole number >= 3"),
         (lambda: tune(("pid",), span=float("inf")), "span = inf: must be a finite number > 1"),
         (lambda: tune(("pid",), span=1.0), "span = 1.0: must be a finite number > 1"),
