@@ -89,6 +89,18 @@ class VehicleParams:
             )
         return dataclasses.replace(self, **changes)
 
+    def loaded(self, load: float) -> "VehicleParams":
+        """The vehicle with a payload: the carbody's mass and moments of inertia times ``load``
+        (the load factor, a finite number > 0: 1 the carbody as these parameters give it, 1.3 a
+        crush-laden car with 30 % more mass). The payload is taken as spread like the carbody's
+        own mass, so its radii of gyration stay; the bogies, wheelsets and suspensions stay as
+        they are, and a controller keeps the gains it was given."""
+        from .validation import number
+
+        factor = number("load", load, "positive", allowed="a finite number > 0 (the factor on the carbody mass)")
+        carbody = ("m_c", "I_cx", "I_cy", "I_cz")
+        return self.replace(**{n: factor * getattr(self, n) for n in carbody})
+
     def to_dict(self) -> dict[str, float]:
         return dataclasses.asdict(self)
 

@@ -31,6 +31,15 @@ ParamsOption = Annotated[
         help="Vehicle parameters from a TOML file with a [vehicle] table (see docs/cli.md). Exclusive with --preset.",
     ),
 ]
+LoadOption = Annotated[
+    Optional[float],
+    typer.Option(
+        "--load",
+        metavar="X",
+        help="Load factor: the carbody's mass and inertias times X (1: as the parameters give "
+        "them; 1.3: crush-laden, 30 % more mass). The controllers keep their gains. Default: 1.",
+    ),
+]
 PresetOption = Annotated[
     Optional[str],
     typer.Option("--preset", metavar="NAME", help="Named vehicle parameter set (available: paper). Default: paper."),

@@ -101,15 +101,23 @@ def vehicle_source(params_file: Optional[Path], preset: Optional[str]):
     return params_file if params_file is not None else preset
 
 
-def vehicle_from_options(params_file: Optional[Path], preset: Optional[str]):
-    """(VehicleParams, the record for the JSON document)."""
+def vehicle_from_options(params_file: Optional[Path], preset: Optional[str], load: Optional[float] = None):
+    """(VehicleParams, the record for the JSON document); ``load`` (--load) scales the carbody's
+    mass and inertias (`VehicleParams.loaded`) and enters the record when given."""
     from ..params import VehicleParams
 
     vehicle_source(params_file, preset)
     if params_file is not None:
-        return VehicleParams.load(params_file), {"vehicle_params_file": str(params_file)}
-    name = "paper" if preset is None else preset
-    return VehicleParams.preset(name), {"vehicle_preset": name}
+        vehicle, record = VehicleParams.load(params_file), {"vehicle_params_file": str(params_file)}
+    else:
+        name = "paper" if preset is None else preset
+        vehicle, record = VehicleParams.preset(name), {"vehicle_preset": name}
+    if load is None:
+        return vehicle, record
+    from ._common import option_names
+
+    with option_names({"load": "--load"}):
+        return vehicle.loaded(load), {**record, "load_factor": float(load)}
 
 
 def damper_preset(option: str, name: str, *, rig: bool = False):

@@ -29,6 +29,7 @@ from ._options import (
     MinWavelengthOption,
     OutputFormat,
     OutputRateOption,
+    LoadOption,
     ParamsOption,
     PresetOption,
     RailPhaseOption,
@@ -318,6 +319,7 @@ def compare(
     window: WindowOption = None,
     params: ParamsOption = None,
     preset: PresetOption = None,
+    load: LoadOption = None,
     format: FormatOption = OutputFormat.table,
     out: CompareOutOption = None,
     bounds: Annotated[
@@ -372,6 +374,7 @@ def compare(
                 window=window,
                 params=params,
                 preset=preset,
+                load=load,
                 format=format,
                 out=out,
                 bounds=bounds,
@@ -385,7 +388,7 @@ def compare(
         scale = parse_scale("--damper-scale", damper_scale)
         noise = _sensor_noise(sensor_noise, seed)
         solver = solver_from_options(dt=dt, output_rate=output_rate, control_rate=control_rate)
-        vehicle_params, vehicle_record = vehicle_from_options(params, preset)
+        vehicle_params, vehicle_record = vehicle_from_options(params, preset, load)
         window_value = parse_window(window) if window is not None else None
         track = track_options(scenario, seed_value, min_wavelength, max_wavelength)
         scen = make_scenario(
@@ -435,6 +438,8 @@ def compare(
         typer.echo(text)
         return
     vehicle = vehicle_record.get("vehicle_preset") or vehicle_record.get("vehicle_params_file")
+    if "load_factor" in vehicle_record:
+        vehicle += f" with load factor {vehicle_record['load_factor']:g} (carbody mass and inertias)"
     console = wide_stdout_console()
     for part in _compare_tables(doc, vehicle, shipped=gains is None):
         console.print(part)
@@ -470,6 +475,7 @@ def _league(
     window,
     params,
     preset,
+    load,
     format,
     out,
     bounds,
@@ -497,7 +503,7 @@ def _league(
     if not bounds:
         raise ValueError("--no-bounds: a league table always shows the ideal actuator beside the MR dampers")
     damper_preset("--damper", damper)
-    vehicle_params, vehicle_record = vehicle_from_options(params, preset)
+    vehicle_params, vehicle_record = vehicle_from_options(params, preset, load)
     if out is not None:
         check_out_dir(out)
     with ProgressBar(stderr_is_terminal(), lambda done: "running the league table...") as progress:

@@ -21,6 +21,7 @@ from ._options import (
     MinWavelengthOption,
     OutputFormat,
     OutputRateOption,
+    LoadOption,
     ParamsOption,
     PresetOption,
     RailPhaseOption,
@@ -144,6 +145,7 @@ def simulate(
     ] = None,
     params: ParamsOption = None,
     preset: PresetOption = None,
+    load: LoadOption = None,
     format: FormatOption = OutputFormat.table,
     out: SimulateOutOption = None,
     comfort: ComfortOption = False,
@@ -170,6 +172,7 @@ def simulate(
             track=track,
             comfort=comfort,
             damper_scale=damper_scale,
+            load=load,
         )
     if format is OutputFormat.json:
         print_json(doc)
@@ -226,6 +229,7 @@ def _run(
     track=None,
     comfort=False,
     damper_scale=None,
+    load=None,
 ):
     from ..files import check_out_dir, write_outputs
     from ..metrics import check_window, parse_window
@@ -233,7 +237,7 @@ def _run(
 
     with option_names(SIMULATE_FIELDS, not_given(dt=dt, output_rate=output_rate)):
         solver = solver_from_options(dt=dt, output_rate=output_rate)
-        vehicle_params, vehicle_record = vehicle_from_options(params_file, preset)
+        vehicle_params, vehicle_record = vehicle_from_options(params_file, preset, load)
         secondary = _suspension(suspension, damper_name, voltage_text, damper_scale)
         window = parse_window(window_text) if window_text is not None else None
         scen = make_scenario(

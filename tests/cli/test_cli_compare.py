@@ -13,7 +13,7 @@ import xarray as xr
 from railride.comparison import PAPER_REDUCTION, PAPER_TABLE1
 from railride.control import LABELS, PAPER_CONTROLLERS, GainSet
 from railride.files import COMPARE_FILES
-from clihelp import PNG, assert_input_error, ok_json, run
+from clihelp import PNG, assert_input_error, ok, ok_json, run
 
 
 RESPONSES = ["acceleration_m_s2", "displacement_m", "pitch_deg", "roll_deg"]
@@ -359,3 +359,25 @@ def test_compare_table_shows_the_trade_offs_and_the_bounds(short_doc):
     assert losing  # with the shipped gains, PID beats SAS on pitch and loses the rest
     assert result.stdout.count("trade-off:") == len(losing)
     assert "beside the bounds" not in run(*SHORT, "--no-bounds").stdout
+
+
+def test_compare_with_a_payload_keeps_the_gains_and_records_the_loaded_vehicle():
+    from railride.params import VehicleParams
+
+    paper = VehicleParams.preset("paper")
+    doc = ok_json("compare", "--duration", 1, "--load", 1.3)
+    params = doc["settings"]["vehicle_params"]
+    assert params["m_c"] == pytest.approx(1.3 * paper.m_c) and params["m_b"] == paper.m_b
+    nominal = ok_json("compare", "--duration", 1)
+    assert doc["gains"] == nominal["gains"]  # the gains tuned for the nominal vehicle
+    assert doc["controllers"][0]["metrics"] != nominal["controllers"][0]["metrics"]  # a heavier car rides otherwise
+    text = ok("compare", "--duration", 1, "--load", 1.3).stdout
+    assert "load factor 1.3" in text
+    simulated = ok_json("simulate", "--duration", 1, "--load", 1.3)
+    assert simulated["load_factor"] == 1.3
+
+
+@pytest.mark.parametrize("value", ["0", "-0.5", "nan"])
+def test_a_load_factor_must_be_positive(value):
+    for command in ("compare", "simulate"):
+        assert_input_error(run(command, "--duration", 1, "--load", value), "--load = ", "must be a finite number > 0")

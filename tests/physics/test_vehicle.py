@@ -191,3 +191,18 @@ def test_frequency_response_rejects_bad_input():
         v.frequency_response([np.nan], speed=10)
     with pytest.raises(ValueError, match="rails"):
         v.frequency_response(1.0, speed=10, rails="diagonal")
+
+
+def test_a_payload_lowers_the_carbody_modes_by_the_square_root_of_the_load_factor():
+    # on a stiff primary the carbody rides on the secondary alone: every carbody mode's stiffness
+    # stays and its inertia grows by the load factor, so its frequency falls by sqrt(load)
+    p = P.replace(k_pz=P.k_pz * 1e3, k_px=P.k_px * 1e3, k_py=P.k_py * 1e3)
+    empty, laden = _freqs(Vehicle(p)), _freqs(Vehicle(p.loaded(1.3)))
+    for label in ("carbody bounce", "carbody pitch", "carbody roll"):
+        assert laden[label].frequency_hz == pytest.approx(empty[label].frequency_hz / np.sqrt(1.3), rel=1e-3), label
+    loaded = P.loaded(1.3)
+    assert (loaded.m_c, loaded.I_cx, loaded.I_cy) == pytest.approx((1.3 * P.m_c, 1.3 * P.I_cx, 1.3 * P.I_cy))
+    assert loaded.replace(m_c=P.m_c, I_cx=P.I_cx, I_cy=P.I_cy, I_cz=P.I_cz) == P  # nothing else changed
+    for bad in (0, -1.0, float("nan"), "heavy"):
+        with pytest.raises(ValueError, match="load = .*: must be a finite number > 0"):
+            P.loaded(bad)
