@@ -20,6 +20,7 @@ import xarray as xr
 from . import __version__, dampers
 from .control import CONSTANT_VOLTAGE, CONTROLLERS, LABELS, PAPER_CONTROLLERS, GainSet
 from .defaults import DEFAULT_DAMPER
+from .faults import check_faults, degradation, fault_table
 from .metrics import STATISTICS, reduction, ride_metrics, select_window
 from .simulation import simulate
 from .track import as_scenario
@@ -78,6 +79,8 @@ class Comparison:
     bounds: dict | None = None
     #: how the runs were integrated (also in ``settings``: dt_s, output_rate_hz, control_rate_hz)
     solver: SolverSettings | None = None
+    #: with damper faults: the same comparison with healthy dampers (`railride.faults.degradation`)
+    healthy: "Comparison | None" = None
 
     @property
     def reductions(self) -> xr.DataArray:
@@ -222,6 +225,8 @@ class Comparison:
             "controllers": rows,
             "trade_offs": self.trade_offs(),
             "bounds": self.bounds_record(),
+            # only with faults: the paper's comparison's document stays as it was
+            **({"faults": degradation(self, self.healthy)} if self.healthy is not None else {}),
             "tuning": {
                 "objective": self.gains.provenance.get("objective"),
                 "command": self.gains.provenance.get("command"),
@@ -299,6 +304,7 @@ def compare(
     progress=None,
     comfort: bool = False,
     bounds: bool = True,
+    faults=(),
 ) -> Comparison:
     """Run the passive vehicle and each controller on ``scenario`` and collect the metrics.
 
@@ -316,8 +322,12 @@ def compare(
     ``controllers[i].comfort`` in `Comparison.to_dict`). ``bounds`` (with MR dampers): also
     run the same control laws and gains on the two ideal devices, the ideal semi-active damper
     ("ideal-damper") and the ideal actuator ("ideal"), so that every reduction is shown beside
-    what those would reach (`Comparison.bounds`). Every setting is checked before the first run.
-    """
+    what those would reach (`Comparison.bounds`). ``faults``: dampers that fail in every
+    controlled suspension (`railride.faults.DamperFault` or their text, e.g. "1R-off@2"); passive
+    stays the healthy baseline, the comparison is also run with healthy dampers
+    (`Comparison.healthy`; ``to_dict()["faults"]`` holds the degradation), and the bounds are
+    not run (they are those of the healthy design). Every setting is checked before the first
+    run."""
     solver = SolverSettings.of(solver)
     model = damper_model(damper, damper_scale)
     damper_scale = float(damper_scale)
@@ -327,13 +337,16 @@ def compare(
     if len(names) > 1:
         solver.control_steps()  # the controlled runs sample at the control rate
     gains = GainSet.default() if gains is None else gains
+    faults = check_faults(faults, model)
+    if faults:
+        fault_table([faults], solver.dt, scenario.duration)  # the times, before any run
     ideal = model.law == dampers.LAW_IDEAL
     # a constant voltage means nothing to the ideal devices: said in the settings, not run
     not_run = {n: NO_VOLTAGE for n in names if n in CONSTANT_VOLTAGE and ideal}
     names = [n for n in names if n not in not_run]
     closed = [n for n in names if n != "passive" and n not in CONSTANT_VOLTAGE]
     constant = [n for n in names if n in CONSTANT_VOLTAGE]
-    bound_devices = [d for d in BOUND_DEVICES if bounds and closed and not ideal]
+    bound_devices = [d for d in BOUND_DEVICES if bounds and closed and not ideal and not faults]
     # progress by sample-steps: the passive run is one sample, the other batches the rest
     share = 1.0 / (1 + len(constant) + len(closed) * (1 + len(bound_devices)))
     part = (lambda lo, w: lambda done: progress(lo + w * done)) if progress is not None else None
@@ -350,7 +363,10 @@ def compare(
             res = simulate(
                 scenario,
                 params,
-                [Suspension.named(n, gains, damper, damper_scale, sensor_noise=noise) for n in group],
+                [
+                    Suspension.named(n, gains, damper, damper_scale, sensor_noise=noise).with_faults(faults)
+                    for n in group
+                ],
                 solver=solver,
                 on_divergence="mark",
                 progress=part and part(share * done, share * len(group)),
@@ -394,14 +410,40 @@ def compare(
         "window_s": None if window is None else [float(w) for w in window],
         "sensor_noise": None if sensor_noise is None else sensor_noise.__dict__,
         **({"not_run": not_run} if not_run else {}),
+        **({"faults": [f.label for f in faults]} if faults else {}),
     }
     comfort_values = None
     if comfort:
         from .comfort import ride_comfort
 
         comfort_values = {n: ride_comfort(datasets[n], window=window) for n in names}
+    healthy = None
+    if faults:
+        healthy = compare(
+            scenario,
+            params,
+            controllers=names,
+            gains=gains,
+            damper=damper,
+            damper_scale=damper_scale,
+            window=window,
+            solver=solver,
+            sensor_noise=sensor_noise,
+            comfort=comfort,
+            bounds=False,
+        )
     return Comparison(
-        names, datasets, metrics, window, gains, str(damper), settings, comfort_values, bound_values or None, solver
+        names,
+        datasets,
+        metrics,
+        window,
+        gains,
+        str(damper),
+        settings,
+        comfort_values,
+        bound_values or None,
+        solver,
+        healthy,
     )
 
 

@@ -86,6 +86,12 @@ warnings.filterwarnings(
 STATUS_OK = 0
 STATUS_DIVERGED = 1
 
+#: damper faults (railride.faults): none, held at v_min ("off"), stuck at v_max ("on"), no force
+FAULT_NONE = 0
+FAULT_OFF = 1
+FAULT_ON = 2
+FAULT_DISCONNECTED = 3
+
 
 @njit(cache=True, inline="always", fastmath=_FAST)
 def _hermite(t, n_nodes, interval):
@@ -277,13 +283,14 @@ def substeps(lam, dt):
 
 
 @njit(cache=True, inline="always", fastmath=_FAST)
-def _derivative(law, s, R, roff, AT, TT, P, vcmd, y, cx, cv, K, koff):
+def _derivative(law, s, R, roff, AT, TT, P, vcmd, conn, y, cx, cv, K, koff):
     """K[koff:koff+NS_MAX] = d/dt of the state s = (q, q', damper states), with the rail forcing
     R[roff:roff+9].
 
     y receives the stage vector (q, q', f). LAW_VISCOUS_IN_C: the dampers are in Av,
     q'' = r + [Aq Av] (q, q'). Otherwise every corner's damper law gives its force F from the
-    corner deflection and rate, f = -F enters through Bf, and the damper states (z, y, u) advance.
+    corner deflection and rate, f = -F conn[c] enters through Bf (conn[c] = 0: the damper is
+    disconnected), and the damper states (z, y, u) advance.
     """
     for i in range(N_DOF):
         y[i] = s[i]
@@ -297,7 +304,7 @@ def _derivative(law, s, R, roff, AT, TT, P, vcmd, y, cx, cv, K, koff):
     for c in range(N_CORNER):
         b = 2 * N_DOF + N_DAMPER_STATES * c
         F, dz, dyy, du = damper_law(law, P, cx[c], cv[c], s[b], s[b + 1], s[b + 2], vcmd[c])
-        y[2 * N_DOF + c] = -F
+        y[2 * N_DOF + c] = -F * conn[c]
         K[koff + b] = dz
         K[koff + b + 1] = dyy
         K[koff + b + 2] = du
@@ -332,6 +339,7 @@ def run_batch(
     Hm,
     inner,
     noise,
+    faults,
     out_q,
     out_v,
     out_a,
@@ -370,6 +378,11 @@ def run_batch(
     records the demand, not a voltage). The controller's integrator and demands are states
     x[s, NS_MAX:], so a run can continue across calls.
 
+    Damper faults: corner c of sample s fails with mode faults[s, c] (FAULT_*) from step
+    faults[s, 4 + c] on. FAULT_OFF and FAULT_ON hold its command at v_min and v_max whatever the
+    voltage law asks (the coil follows with its time constant); FAULT_DISCONNECTED removes its
+    force from the vehicle.
+
     Steps are numbered globally from step0 (t = step * dt). At every step whose number is a
     multiple of ``stride`` the state, acceleration, damper forces, rail inputs, damper states,
     demanded forces and command voltages at that time are written to row step // stride of the
@@ -398,6 +411,11 @@ def run_batch(
         at, tt, cs, pp = A[smp], TS[smp], c_sec[smp], P[smp]
         uo, fo, nn, itv = u_off[smp], f_off[smp], n_nodes[smp], interval[smp]
         vc = vcmd[smp].copy()  # command voltages, held over each step
+        fm = faults[smp]
+        conn = np.ones(N_CORNER)  # 0 where a damper is disconnected
+        faulty = False  # a healthy sample skips the fault checks
+        for c in range(N_CORNER):
+            faulty = faulty or fm[c] != FAULT_NONE
         meas = np.empty(2 * N_DOF)  # the controller's sample of the state (q, q')
         gm, hm = Gm[smp], Hm[smp]
         tc = ctrl_stride * dt
@@ -431,8 +449,12 @@ def run_batch(
                 # is the command, so it is set before the step-start rates use it
                 for c in range(N_CORNER):
                     vc[c] = x[smp, FD_HELD + c]
+            if faulty:  # a fault takes effect at its step
+                for c in range(N_CORNER):
+                    if fm[c] == FAULT_DISCONNECTED and step >= fm[N_CORNER + c]:
+                        conn[c] = 0.0
             # rates at the step's start: for the record, the sub-step choice and stage 1
-            _derivative(law, s, R, 0, at, tt, pp, vc, y, cx, cv, K, 0)
+            _derivative(law, s, R, 0, at, tt, pp, vc, conn, y, cx, cv, K, 0)
             if closed_loop and law != LAW_IDEAL:
                 # inner loop from the damper forces at the step's start (they do not depend on
                 # the command, only on the coil state); then correct stage 1's coil rate
@@ -450,6 +472,12 @@ def run_batch(
                         vc[c] = min(max(v, pp[10]), pp[11])
                     b = 2 * N_DOF + N_DAMPER_STATES * c + 2
                     K[b] = -pp[9] * (s[b] - vc[c])
+            if faulty:  # a failed coil driver: the command held whatever the law asks
+                for c in range(N_CORNER):
+                    if (fm[c] == FAULT_OFF or fm[c] == FAULT_ON) and step >= fm[N_CORNER + c]:
+                        vc[c] = pp[10] if fm[c] == FAULT_OFF else pp[11]
+                        b = 2 * N_DOF + N_DAMPER_STATES * c + 2
+                        K[b] = -pp[9] * (s[b] - vc[c])
             if step % stride == 0:
                 row = step // stride
                 bad = False
@@ -509,7 +537,7 @@ def run_batch(
                     if has_states:
                         for i in range(2 * N_DOF, NS_MAX):
                             st[i] = s[i] + ch * K[prev + i]
-                    _derivative(law, st, R, roff, at, tt, pp, vc, y, cx, cv, K, NS_MAX * stage)
+                    _derivative(law, st, R, roff, at, tt, pp, vc, conn, y, cx, cv, K, NS_MAX * stage)
                 for i in range(2 * N_DOF):
                     s[i] += h / 6.0 * (K[i] + 2.0 * K[NS_MAX + i] + 2.0 * K[2 * NS_MAX + i] + K[3 * NS_MAX + i])
                 if has_states:

@@ -27,9 +27,23 @@ def has_damper_states(damper) -> bool:
 
 
 def build_dataset(
-    out, vehicles, param_sets, scenarios, dt, output_rate, rows, batch, created, suspension, vcmd, closed=None
+    out,
+    vehicles,
+    param_sets,
+    scenarios,
+    dt,
+    output_rate,
+    rows,
+    batch,
+    created,
+    suspension,
+    vcmd,
+    closed=None,
+    faults=(),
 ) -> xr.Dataset:
-    """Named channels in SI units; a ``sample`` dimension only for a batch."""
+    """Named channels in SI units; a ``sample`` dimension only for a batch. ``faults``: each
+    sample's damper faults (`railride.faults.DamperFault`), recorded as ``damper_faults`` when
+    any sample has one."""
     import numba
     import scipy
 
@@ -145,6 +159,9 @@ def build_dataset(
         data = {k: (("time",) + d, v[0], a) for k, (d, v, a) in channels.items()}
         data["scenario"] = ((), scen[0])
         data["vehicle_params"] = ((), pars[0])
+    if any(faults):  # e.g. "1R-off@2.5,2L-disconnected"; empty for a healthy sample
+        labels = np.array([",".join(f.label for f in fs) for fs in faults])
+        data["damper_faults"] = ("sample", labels) if batch else ((), labels[0])
     if closed is not None:
         data["controller"] = ("sample", controller_names) if batch else ((), controller_names[0])
         data["controller_gains"] = ("sample", controller_gains) if batch else ((), controller_gains[0])
@@ -352,6 +369,8 @@ def _suspension_record(suspension) -> dict:
             else {"type": "passive", "damper": suspension.damper.to_dict()}
         )
     record: dict[str, Any] = {"type": suspension.name, "damper": suspension.damper_name}
+    if suspension.faults:
+        record["faults"] = [f.label for f in suspension.faults]
     if suspension.voltage is not None:
         record["voltage_v"] = float(suspension.voltage)
     if suspension.damper_scale != 1.0:

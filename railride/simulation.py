@@ -9,6 +9,7 @@ import numpy as np
 
 from . import dampers, kernels
 from .defaults import DEFAULT_DT
+from .faults import fault_table
 from .params import VehicleParams
 from .solver import SolverSettings, check_resolution
 from .suspension import Suspension, batch_conflict
@@ -324,6 +325,7 @@ def simulate(
     }
     status = np.zeros(n, dtype=np.int64)
     fail_step = np.full(n, -1, dtype=np.int64)
+    faults = fault_table([s.faults for s in suspensions], dt, duration)
 
     if closed is None:
         ctrl_stride, inner_gains, noise = 1, np.zeros((n, 3)), np.zeros((0, 6))
@@ -364,6 +366,7 @@ def simulate(
             hm,
             inner_gains,
             noise,
+            faults,
             out["q"],
             out["v"],
             out["a"],
@@ -422,6 +425,7 @@ def simulate(
             suspensions[0],
             vcmd,
             closed,
+            [s.faults for s in suspensions],
         ),
         suspension=suspensions if batch else suspensions[0],
         solver=solver,

@@ -29,6 +29,7 @@ from typing import Any
 from . import dampers
 from .control import CONSTANT_VOLTAGE, CONTROLLERS, LABELS, GainSet, InnerLoop, SensorNoise
 from .defaults import DEFAULT_DAMPER
+from .faults import check_faults
 
 #: the kinds of suspension, see `Suspension.kind`
 KINDS = ("passive", "semi-active", "ideal")
@@ -100,7 +101,8 @@ class Suspension:
     Refused with a ValueError naming the field: a voltage with a controller, or without MR
     dampers; a controller on the viscous dampers or on none; an ideal device without a controller or with
     an inner loop; an inner loop or sensor noise without a controller; a voltage outside the
-    damper's range.
+    damper's range. ``faults``: dampers that fail during the run (`railride.faults.DamperFault`,
+    or their text such as "1R-off" or "2L-on@2.5"; `with_faults`), checked against the damper.
     """
 
     damper: Any = None
@@ -109,10 +111,12 @@ class Suspension:
     inner: InnerLoop | None = None
     sensor_noise: SensorNoise | None = None
     damper_scale: float = dataclasses.field(default=1.0, compare=False, repr=False)
+    faults: tuple = ()
 
     def __post_init__(self):
         model = _model(self.damper)
         object.__setattr__(self, "damper", model)
+        object.__setattr__(self, "faults", check_faults(self.faults, model))
         object.__setattr__(self, "damper_scale", dampers.check_scale("damper_scale", self.damper_scale))
         c = self.controller
         if c is not None and not (hasattr(c, "gains") and hasattr(c, "name")):
@@ -171,6 +175,11 @@ class Suspension:
                 )
         elif self.inner is None:
             object.__setattr__(self, "inner", _shipped_gains().inner)
+
+    def with_faults(self, faults) -> "Suspension":
+        """This suspension with ``faults`` (`railride.faults.DamperFault`, their text such as
+        "1R-off", "2L-on@2.5", or a sequence of them) in place of its own."""
+        return dataclasses.replace(self, faults=faults)
 
     # -- constructors --------------------------------------------------------------------------
     @classmethod
@@ -348,6 +357,7 @@ class Suspension:
             "controller": None if c is None else {"name": c.name, "gains": c.to_dict()},
             "inner_loop": None if self.inner is None else self.inner.to_dict(),
             "sensor_noise": None if self.sensor_noise is None else dataclasses.asdict(self.sensor_noise),
+            **({"faults": [f.label for f in self.faults]} if self.faults else {}),
         }
 
 

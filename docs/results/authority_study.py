@@ -2,8 +2,9 @@
 
 For each force scale of the `railway` MR dampers (every force parameter times the scale, so the
 0 V force grows with it: `--damper-scale`), the controllers are re-tuned by `railride tune`'s
-defaults (all four phases from the neutral reference gains, minimax objective; the inner phase
-tracks demands scaled alike), then judged on `paper-sine`. A second series scales only the
+defaults (the inner loop, then each law alike from the neutral reference gains with the same
+budget of runs, minimax objective; the inner phase tracks demands scaled alike), then judged on
+`paper-sine`. A second series scales only the
 field-dependent part (alpha_b, c0b) and keeps the 0 V force: the experiment that checks whether
 the off-state force is what stops the larger dampers (these variants are registered as presets
 in this script only). The same procedure and budget tune the two bounds:
@@ -12,7 +13,7 @@ would push energy in) and the ideal actuator (`ideal`: the demand, always), with
 phase, which they do not have. A second table keeps the shipped gains (tuned at scale 1) and
 only changes the damper. Writes authority.csv and authority.png next to this file.
 
-    python docs/results/authority_study.py          # about 4 minutes on 2 cores
+    python docs/results/authority_study.py          # about 15-20 minutes on 2 cores
     python docs/results/authority_study.py --plot   # only redraw the figure from the CSV
 """
 

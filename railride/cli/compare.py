@@ -72,6 +72,24 @@ def _controller_list(text: str) -> list[str]:
         raise ValueError(f"--controllers = {text!r}: {exc}") from None
 
 
+def _fault_list(text: Optional[str], damper: str, scale: float, dt: float, duration: float) -> tuple:
+    """--fault CORNER-MODE[@S][,...] -> the checked `railride.faults.DamperFault` tuple."""
+    from ..faults import DamperFault, check_faults, fault_table
+    from ..suspension import damper_model
+
+    if text is None:
+        return ()
+    try:
+        items = [item.strip() for item in text.split(",")]
+        if any(not item for item in items):
+            raise ValueError("an empty item; give CORNER-MODE[@S] items separated by commas")
+        faults = check_faults([DamperFault.parse(item) for item in items], damper_model(damper, scale))
+        fault_table([faults], dt, duration)
+    except ValueError as exc:
+        raise ValueError(f"--fault = {text!r}: {exc}") from None
+    return faults
+
+
 def _sensor_noise(text: Optional[str], seed: Optional[int]):
     """--sensor-noise Z,ANGLE,VEL,RATE and --seed -> a control.SensorNoise, or None."""
     from ..control import SensorNoise
@@ -255,7 +273,51 @@ def _compare_tables(doc: dict, vehicle: str, shipped: bool):
     parts = [table, Text("\n".join(info)), *bounds_parts, "", ptp, "", demands, Text(demands_note)]
     if all("comfort" in r for r in rows):
         parts += ["", compare_comfort_table(rows)]
+    if "faults" in doc:
+        parts += ["", *_fault_tables(doc)]
     return parts
+
+
+def _fault_tables(doc: dict):
+    """With --fault: per controller and response, the reduction against passive with healthy
+    dampers and with the faults, and the change the faults make (railride.faults.degradation)."""
+    from rich.markup import escape
+    from rich.table import Table
+    from rich.text import Text
+
+    record = doc["faults"]
+    labels = {r["name"]: r["label"] for r in doc["controllers"]}
+    table = Table(title=f"With the faults {', '.join(record['faults'])} against healthy dampers")
+    for name, justify in (("suspension", "left"), ("response", "left")):
+        table.add_column(name, justify=justify)  # type: ignore[arg-type]
+    for name in ("red. %\nhealthy", "red. %\nfaulted", "RMS change %\nby the faults"):
+        table.add_column(name, justify="right")
+    worse = []
+    for name, row in record["controllers"].items():
+        for i, (key, label) in enumerate(RESPONSE_LABELS.items()):
+            healthy = row["healthy_reduction_percent"][key]
+            change = row["change_percent"][key]
+            table.add_row(
+                escape(labels[name]) if i == 0 else "",
+                label,
+                reduction_text(healthy),
+                reduction_text(row["reduction_percent"][key]),
+                "" if change is None else (f"[red]{change:+.1f}[/red]" if change > 0 else f"{change:+.1f}"),
+                end_section=i == len(RESPONSE_LABELS) - 1,
+            )
+        if row["worse_than_passive"]:
+            words = ", ".join(k.split("_")[0] for k in row["worse_than_passive"])
+            worse.append(f"{labels[name]} ({words})")
+    note = (
+        "red. % = (passive - controlled) / passive RMS x 100, passive healthy; RMS change = (faulted - healthy) / "
+        "healthy x 100, + is worse. "
+        + (
+            "Worse than passive with the faults: " + "; ".join(worse) + "."
+            if worse
+            else "With the faults no response is worse than passive."
+        )
+    )
+    return [table, Text(note)]
 
 
 @app.command()
@@ -288,6 +350,17 @@ def compare(
     seed: Annotated[
         Optional[int],
         typer.Option("--seed", metavar="N", help="Seed of the sensor noise, >= 0 (default 0); needs --sensor-noise."),
+    ] = None,
+    fault: Annotated[
+        Optional[str],
+        typer.Option(
+            "--fault",
+            metavar="CORNER-MODE[@S][,...]",
+            help="Dampers that fail in every controlled suspension: corner 1R, 1L, 2R or 2L, mode off "
+            "(coil at v_min), on (stuck at v_max) or disconnected (no force), from time S [s] "
+            "(default 0), e.g. 1R-off or 2L-on@2.5,1R-disconnected. Also runs the healthy dampers "
+            "and prints how the ride degrades; no bounds.",
+        ),
     ] = None,
     scenario: CompareScenarioOption = "paper-sine",
     amplitude: AmplitudeOption = None,
@@ -359,6 +432,7 @@ def compare(
                 max_wavelength=max_wavelength,
                 sensor_noise=sensor_noise,
                 seed=seed,
+                fault=fault,
             )
             _league(
                 scenarios,
@@ -407,6 +481,7 @@ def compare(
             check_out_dir(out)
         # check the window before the runs, and record it resolved
         window_value = check_window(window_value or (0.0, math.inf), scen.duration)
+        faults = _fault_list(fault, damper, scale, solver.dt, scen.duration)
 
         controlled = [n for n in names if n != "passive"]
 
@@ -429,6 +504,7 @@ def compare(
                 comfort=comfort,
                 bounds=bounds,
                 progress=progress if progress.enabled else None,
+                faults=faults,
             )
         doc = result.to_dict()
         text = json.dumps(doc, indent=2, allow_nan=False)  # refuses NaN before anything is written
@@ -493,6 +569,7 @@ def _league(
         "max_wavelength": "--max-wavelength",
         "sensor_noise": "--sensor-noise",
         "seed": "--seed",
+        "fault": "--fault",
     }
     for key, value in given.items():
         if value is not None:

@@ -381,3 +381,28 @@ def test_compare_with_a_payload_keeps_the_gains_and_records_the_loaded_vehicle()
 def test_a_load_factor_must_be_positive(value):
     for command in ("compare", "simulate"):
         assert_input_error(run(command, "--duration", 1, "--load", value), "--load = ", "must be a finite number > 0")
+
+
+def test_compare_with_a_fault_prints_the_degradation():
+    text = ok("compare", "--duration", 2, "--fault", "1R-off,2L-on@1").stdout
+    flat = " ".join(text.split())
+    assert "With the faults 1R-off, 2L-on@1 against healthy dampers" in flat and "RMS change %" in flat
+    assert "beside the bounds" in ok("compare", "--duration", 2).stdout and "beside the bounds" not in text
+    doc = ok_json("compare", "--duration", 2, "--fault", "2R-disconnected")
+    assert doc["faults"]["faults"] == ["2R-disconnected"] and doc["bounds"] is None
+    assert set(doc["faults"]["controllers"]) == {"pid", "sas-attitude", "sas-attitude-ride"}
+
+
+@pytest.mark.parametrize(
+    "args, fragments",
+    [
+        (("--fault", "3R-off"), ("--fault = '3R-off'", "allowed 1R, 1L, 2R, 2L")),
+        (("--fault", "1R-stuck"), ("--fault = '1R-stuck'", "allowed off, on, disconnected")),
+        (("--fault", "1R-off@9"), ("--fault = '1R-off@9'", "not within the run")),
+        (("--fault", "1R-off,1R-on"), ("--fault", "more than one fault")),
+        (("--fault", "1R-on", "--damper", "ideal"), ("--fault", "need MR dampers")),
+        (("--fault", "1R-off", "--speed", "30,40"), ("--fault", "applies to a single scenario")),
+    ],
+)
+def test_compare_refuses_bad_faults(args, fragments):
+    assert_input_error(run("compare", "--duration", 2, *args), *fragments)
