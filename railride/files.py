@@ -378,3 +378,23 @@ def write_league_outputs(table, out_dir) -> list[Path]:
         "league_comfort.png": _png(lambda: plot_league_comfort(table)),
     }
     return write_folder(out_dir, [(name, writers[name]) for name in LEAGUE_FILES])
+
+
+#: the files `StudyResult.save` writes, in this order
+STUDY_FILES = ("study.json", "study_summary.csv", "study_runs.csv", "study.png")
+
+
+def write_study_outputs(result, out_dir) -> list[Path]:
+    """Write a `railride.study.StudyResult` into ``out_dir``, all or nothing: ``study.json``
+    (``to_dict()``), ``study_summary.csv`` (``to_pandas()``), ``study_runs.csv`` (one row per
+    run, ``cases``) and ``study.png`` (``plot()``); other files (the run table) stay."""
+    from .plots.study import plot_study
+
+    text = json_text(result.to_dict())
+    writers = {
+        "study.json": _text(text),
+        "study_summary.csv": _csv(result.to_pandas()),
+        "study_runs.csv": _csv(result.cases),
+        "study.png": _png(lambda: plot_study(result)),
+    }
+    return write_folder(out_dir, [(name, writers[name]) for name in STUDY_FILES])

@@ -88,6 +88,7 @@ class Case:
     noise: tuple = ()
     seed: int = 0
     damper_scale: float = 1.0
+    faults: tuple = ()  # damper faults as their text, e.g. ("1R-off@2",) (`railride.faults`)
 
     def __post_init__(self):
         from . import dampers
@@ -103,6 +104,12 @@ class Case:
                 self, name, tuple((str(k), float(v) if isinstance(v, (int, float)) else v) for k, v in value)
             )
         object.__setattr__(self, "noise", tuple(float(v) for v in self.noise))
+        from .faults import DamperFault
+
+        faults = (self.faults,) if isinstance(self.faults, (str, DamperFault)) else self.faults
+        object.__setattr__(
+            self, "faults", tuple(f.label if isinstance(f, DamperFault) else DamperFault.parse(f).label for f in faults)
+        )
         if self.noise and len(self.noise) != 4:
             raise ValueError(f"noise = {self.noise!r}: four standard deviations or none")
         self._named(None)  # the suspension's checks, here rather than in a batch
@@ -119,7 +126,8 @@ class Case:
         if self.noise and self.closed_loop:
             displacement, angle, velocity, angular_rate = self.noise
             noise = SensorNoise(displacement, angle, velocity, angular_rate, seed=self.seed)
-        return Suspension.named(self.suspension, gains, self.damper, self.damper_scale, self.voltage, noise)
+        named = Suspension.named(self.suspension, gains, self.damper, self.damper_scale, self.voltage, noise)
+        return named.with_faults(self.faults) if self.faults else named
 
     def to_suspension(self, base_gains=None) -> Suspension:
         """The run's `Suspension`: `Suspension.named` with the case's gain changes applied to
@@ -145,6 +153,8 @@ class Case:
             d[name] = dict(d[name])
         if d["damper_scale"] == 1.0:  # the default is left out: a scale appears only when set
             del d["damper_scale"]
+        if not d["faults"]:  # the same: the keys of healthy runs stay what they were
+            del d["faults"]
         return d
 
     @property
@@ -245,6 +255,8 @@ def _flat(c: Case) -> dict:
     d.update({f"scenario.{k}": v for k, v in c.scenario_options})
     d.update({f"vehicle.{k}": v for k, v in c.vehicle})
     d.update({f"gain.{k}": v for k, v in c.gains})
+    if c.faults:
+        d["faults"] = ",".join(c.faults)
     d["case"] = json.dumps(c.to_dict(), sort_keys=True, default=str)
     return d
 

@@ -18,7 +18,7 @@ interrupted by Ctrl-C (the finished runs stay in DIR/runs.csv for --resume). Err
 from __future__ import annotations
 
 # the commands register on `app` when imported, and `railride --help` lists them in this order
-from . import compare, modes, frf, simulate, rig, tune, pareto, sweep  # noqa: F401
+from . import compare, modes, frf, simulate, rig, tune, pareto, sweep, study  # noqa: F401
 from ._app import app
 
 __all__ = ["app", "main"]

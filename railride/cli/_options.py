@@ -272,6 +272,7 @@ ParetoGainsOption = _gains(
     "of their own (default: the shipped gains)."
 )
 SweepGainsOption = _gains("Controllers: the base gains that --gain changes (default: the shipped gains).")
+StudyGainsOption = _gains("Controller gains, kept for every load and fault (default: the shipped gains).")
 
 ObjectiveOption = Annotated[
     Optional[str],
@@ -371,6 +372,11 @@ SweepOutOption = _out(
     "end."
 )
 
+StudyOutOption = _out(
+    "Keep the run table DIR/runs.csv (updated as runs finish) and write study.json, "
+    "study_summary.csv, study_runs.csv and study.png into DIR at the end."
+)
+
 
 def _resume(help: str):
     return Annotated[bool, typer.Option("--resume", help=help)]
@@ -380,6 +386,9 @@ TuneResumeOption = _resume(
     "Continue the study whose run table is DIR/runs.csv (needs --out): runs already there are not evaluated again."
 )
 ParetoResumeOption = _resume("Continue the study whose run table is DIR/runs.csv (needs --out).")
+StudyResumeOption = _resume(
+    "Continue the study whose run table is DIR/runs.csv (needs --out): runs already there are not evaluated again."
+)
 SweepResumeOption = _resume(
     "Continue the sweep whose run table is DIR/runs.csv (needs --out): runs already there are not evaluated again."
 )

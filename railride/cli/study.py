@@ -1,0 +1,247 @@
+"""``railride study``: statistics over many tracks, speeds, payloads and damper faults
+(railride.study), and its table."""
+
+from __future__ import annotations
+
+import json
+import time
+from typing import Annotated, Optional
+
+import typer
+
+from ..defaults import DEFAULT_DAMPER
+from ._app import app
+from ._common import (
+    RunProgress,
+    errors,
+    interruptible,
+    make_executor,
+    open_run_table,
+    option_names,
+    stderr_is_terminal,
+    wide_stdout_console,
+    write_folder,
+)
+from ._options import (
+    DtOption,
+    FormatOption,
+    OutputFormat,
+    SchedulerFileOption,
+    SchedulerOption,
+    StudyGainsOption,
+    StudyOutOption,
+    StudyResumeOption,
+    WindowOption,
+    WorkersOption,
+)
+from ._parsing import damper_preset, load_gains, solver_from_options, value_list
+from ._render import RESPONSE_LABELS, reduction_text
+
+#: the library's names of the study's options, for its errors
+STUDY_FIELDS = {
+    "track_seeds": "--track-seed",
+    "speeds": "--speed",
+    "loads": "--load",
+    "fault": "--fault",
+    "faults": "--fault",
+    "duration": "--duration",
+}
+#: the metrics of the table, and their labels
+TABLE_METRICS = {
+    **{f"{k}_rms": v for k, v in RESPONSE_LABELS.items()},
+    "centre_N_MV_z": "N_MV,z centre (-)",
+    "centre_aw_Wk": "a_w Wk centre (m/s^2)",
+}
+
+
+def _faults(text: str) -> list[str]:
+    """--fault: comma-separated conditions, each `none` or faults joined by `+`."""
+    from ..study import fault_condition
+
+    items = [item.strip() for item in text.split(",")]
+    if any(not item for item in items):
+        raise ValueError(f"--fault = {text!r}: an empty item; give none or CORNER-MODE[@S] items separated by commas")
+    for item in items:
+        try:
+            fault_condition(item)
+        except ValueError as exc:
+            raise ValueError(f"--fault = {text!r}: {exc}") from None
+    return items
+
+
+def _table(doc: dict):
+    from rich.markup import escape
+    from rich.table import Table
+    from rich.text import Text
+
+    from ..control import LABELS
+
+    s = doc["settings"]
+    lo, hi = doc["percentiles"]
+    seeds = s["track_seeds"] or []
+    over = (f"{len(seeds)} track seeds x " if seeds else "") + f"{len(s['speeds_m_s'])} speed(s)"
+    table = Table(title=f"Statistics over {over}")
+    table.add_column("suspension", no_wrap=True)
+    table.add_column("load", justify="right")
+    table.add_column("fault")
+    table.add_column("metric")
+    table.add_column("mean", justify="right")
+    table.add_column(f"p{lo:g}-p{hi:g}", justify="right")
+    table.add_column("red. %\nmean", justify="right")
+    table.add_column(f"red. %\np{lo:g}-p{hi:g}", justify="right")
+    for group in doc["results"]:
+        for i, (metric, label) in enumerate(TABLE_METRICS.items()):
+            m = group["metrics"][metric]
+            band = "" if m["p5"] is None else f"{m['p5']:#.3g}-{m['p95']:#.3g}"
+            red_band = "" if m["reduction_p5"] is None else f"{m['reduction_p5']:.1f} to {m['reduction_p95']:.1f}"
+            table.add_row(
+                escape(LABELS[group["controller"]]) if i == 0 else "",
+                f"{group['load']:g}" if i == 0 else "",
+                group["fault"] if i == 0 else "",
+                label,
+                "" if m["mean"] is None else f"{m['mean']:#.4g}",
+                band,
+                reduction_text(m["reduction_mean"]),
+                red_band,
+                end_section=i == len(TABLE_METRICS) - 1,
+            )
+    speeds = ", ".join(f"{v:g}" for v in s["speeds_m_s"])
+    lines = [
+        f"{s['scenario']} at {speeds} m/s" + (f", track seeds {', '.join(map(str, seeds))}" if seeds else "") + "; "
+        f"{s['damper']} dampers, gains {s['gains']} (kept for every load and fault).",
+        f"Mean and {lo:g}th to {hi:g}th percentile over the runs of each row (tracks and speeds). red. % = "
+        "(passive - controlled) / passive x 100 on the same track, speed and load, run by run; passive "
+        "is always healthy.",
+    ]
+    if doc["failed"]:
+        failed = "; ".join(
+            f"{f['controller']} load {f['load']:g} {f['fault']}"
+            + (f" seed {f['track_seed']}" if f["track_seed"] is not None else "")
+            + f" at {f['speed_m_s']:g} m/s "
+            f"(t = {f['diverged_at_s']:.3g} s)"
+            for f in doc["failed"]
+        )
+        lines.append(f"Diverged, left out of the statistics: {failed}.")
+    return [table, Text("\n".join(lines))]
+
+
+@app.command("study")
+def study_command(
+    controllers: Annotated[
+        str,
+        typer.Option(
+            "--controllers",
+            metavar="NAME[,NAME...]",
+            help="Suspensions, comma-separated, as for compare, or all; passive always runs as the baseline.",
+        ),
+    ] = "passive,pid,sas-attitude,sas-attitude-ride",
+    scenario: Annotated[
+        str,
+        typer.Option(
+            "--scenario", metavar="NAME", help="The track: fra1..fra6, german-low, german-high (or any scenario)."
+        ),
+    ] = "fra4",
+    track_seed: Annotated[
+        Optional[str],
+        typer.Option(
+            "--track-seed",
+            metavar="N[,N...]|A:B:COUNT",
+            help="Random-track seeds: a list or a range (default 0:9:10; random tracks only).",
+        ),
+    ] = None,
+    speed: Annotated[
+        Optional[str],
+        typer.Option("--speed", metavar="M/S[,...]|A:B:COUNT", help="Speeds [m/s] (default: the scenario's)."),
+    ] = None,
+    load: Annotated[
+        str,
+        typer.Option(
+            "--load",
+            metavar="X[,X...]",
+            help="Load factors: the carbody's mass and inertias times X (1: as the parameters give them).",
+        ),
+    ] = "1",
+    fault: Annotated[
+        str,
+        typer.Option(
+            "--fault",
+            metavar="CONDITION[,...]",
+            help="Fault conditions, comma-separated: none, or CORNER-MODE[@S] faults joined by + "
+            "(e.g. none,1R-off,2L-on+1R-disconnected@2). Faults apply to the controlled suspensions.",
+        ),
+    ] = "none",
+    duration: Annotated[
+        Optional[float], typer.Option("--duration", metavar="S", help="Run length [s] (default 10).")
+    ] = None,
+    dt: DtOption = None,
+    window: WindowOption = None,
+    damper: Annotated[
+        str, typer.Option("--damper", metavar="MODEL", help="Damper model of the controllers (as for compare).")
+    ] = DEFAULT_DAMPER,
+    gains: StudyGainsOption = None,
+    workers: WorkersOption = None,
+    scheduler: SchedulerOption = None,
+    scheduler_file: SchedulerFileOption = None,
+    out: StudyOutOption = None,
+    resume: StudyResumeOption = False,
+    format: FormatOption = OutputFormat.table,
+) -> None:
+    """Statistics over many tracks: every controller on every track seed and speed, for each
+    load factor and fault condition; mean and 5th-95th percentiles of each RMS response and
+    comfort index, and of its reduction against passive on the same track.
+    Ctrl-C stops; with --out, --resume continues."""
+    from ..comparison import check_controllers
+    from ..metrics import parse_window
+
+    with errors(), option_names(STUDY_FIELDS):
+        names = check_controllers(controllers)
+        seeds = value_list("--track-seed", track_seed, integer=True) if track_seed is not None else None
+        speeds = value_list("--speed", speed) if speed is not None else None
+        loads = value_list("--load", load)
+        faults = _faults(fault)
+        damper_preset("--damper", damper)
+        gain_set = load_gains(gains)
+        solver = solver_from_options(dt=dt)
+        window_value = parse_window(window) if window is not None else None
+        table, table_path = open_run_table(out, resume)
+        executor, executor_record = make_executor(workers, scheduler, scheduler_file)
+    try:
+        with interruptible(table, table_path), errors(), option_names(STUDY_FIELDS):
+            from ..study import study
+
+            with RunProgress(stderr_is_terminal(), "running the study") as progress:
+                t0 = time.perf_counter()
+                result = study(
+                    names,
+                    scenario=scenario,
+                    track_seeds=None if seeds is None else [int(s) for s in seeds],
+                    speeds=speeds,
+                    loads=loads,
+                    faults=faults,
+                    duration=duration,
+                    gains=gain_set,
+                    damper=damper,
+                    solver=solver,
+                    window=window_value,
+                    executor=executor,
+                    table=table,
+                    progress=progress,
+                )
+                wall = time.perf_counter() - t0
+            doc = {
+                **result.to_dict(),
+                "runs_evaluated": progress.evaluated,
+                "wall_time_s": wall,
+                "executor": executor_record,
+            }
+            text = json.dumps(doc, indent=2, allow_nan=False)
+            if out is not None:
+                write_folder(out, lambda: result.save(out))
+    finally:
+        executor.close()
+    if format is OutputFormat.json:
+        typer.echo(text)
+        return
+    console = wide_stdout_console()
+    for part in _table(doc):
+        console.print(part)

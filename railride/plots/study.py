@@ -1,0 +1,76 @@
+"""Statistics over tracks (`railride.study.StudyResult`): the mean reduction against passive of
+each controller with its 5-95 % band, one panel per metric."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ._style import given_axes, new_figure, suspension_label, suspension_style
+
+#: the metrics drawn by default, and their titles
+DEFAULT_METRICS = {
+    "acceleration_m_s2_rms": "acceleration RMS",
+    "displacement_m_rms": "displacement RMS",
+    "pitch_deg_rms": "pitch RMS",
+    "roll_deg_rms": "roll RMS",
+    "centre_N_MV_z": "N_MV,z (centre)",
+}
+
+
+def plot_study(result, ax=None, metrics=None):
+    """One panel per metric (default `DEFAULT_METRICS`): per condition (load, fault) a group,
+    per controller a marker at the mean reduction [%] against passive, with a bar from the 5th
+    to the 95th percentile over the study's tracks and speeds. ``ax``: one Axes per metric, or
+    None for a new figure. Returns the figure."""
+    summary = result.summary
+    metrics = list(DEFAULT_METRICS) if metrics is None else list(metrics)
+    unknown = [m for m in metrics if m not in set(summary["metric"])]
+    if unknown:
+        raise ValueError(f"metrics: {unknown[0]!r} is not a metric of the study; allowed {', '.join(DEFAULT_METRICS)}")
+    controlled = [n for n in dict.fromkeys(summary["controller"]) if n != "passive"]
+    part = summary[summary["controller"] != "passive"]
+    conditions = list(dict.fromkeys(zip(part["load"], part["fault"])))
+    if ax is None:
+        fig = new_figure((3.4 * len(metrics) + 0.6, 3.6))
+        axes = fig.subplots(1, len(metrics), squeeze=False).ravel()
+    else:
+        axes = given_axes(ax, len(metrics), f"one per metric: {', '.join(metrics)}")
+        fig = axes[0].figure
+    width = 0.8 / max(1, len(controlled))
+    x = np.arange(len(conditions))
+    for a, metric in zip(axes, metrics):
+        rows = part[part["metric"] == metric].set_index(["controller", "load", "fault"])
+        for k, name in enumerate(controlled):
+            mean = np.array([rows.loc[(name, *c), "reduction_mean"] for c in conditions], dtype=float)
+            lo = np.array([rows.loc[(name, *c), "reduction_p5"] for c in conditions], dtype=float)
+            hi = np.array([rows.loc[(name, *c), "reduction_p95"] for c in conditions], dtype=float)
+            pos = x - 0.4 + width * (k + 0.5)
+            colour = suspension_style(name).get("color", f"C{k}")
+            a.errorbar(
+                pos,
+                mean,
+                yerr=[mean - lo, hi - mean],
+                fmt="o",
+                color=colour,
+                capsize=3,
+                markersize=4,
+                label=suspension_label(name),
+            )
+        a.axhline(0.0, color="k", linewidth=0.8)
+        a.set_xticks(x, [_condition_label(load, fault) for load, fault in conditions], fontsize="small")
+        a.set_title(DEFAULT_METRICS.get(metric, metric), fontsize=9)
+        a.grid(True, axis="y", linewidth=0.4, alpha=0.6)
+    axes[0].set_ylabel("reduction against passive (%)\nmean, 5-95 % band")
+    axes[0].legend(fontsize="x-small")
+    if ax is None:
+        s = result.settings
+        fig.suptitle(
+            f"{s.get('scenario')}: {len(s.get('track_seeds', []))} track seeds x "
+            f"{len(s.get('speeds_m_s', []))} speeds per condition",
+            fontsize=10,
+        )
+    return fig
+
+
+def _condition_label(load: float, fault: str) -> str:
+    return f"load {load:g}" + ("" if fault == "none" else f"\n{fault}")

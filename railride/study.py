@@ -1,0 +1,321 @@
+"""Statistics over many tracks: every controller on many random-track realisations, speeds,
+payloads and damper faults, summarised as mean and 5th / 95th percentiles (docs/study.md).
+
+One run gives one number per metric; on random track that number changes from one kilometre
+to the next. `study` runs each controller on every combination of track seed and speed
+(the population a statistic is taken over) for each condition, a load factor and a set of
+damper faults, beside the healthy passive suspension on the same track, speed and load. Per
+controller and condition it gives, for every RMS response and comfort index, the mean and the
+5th and 95th percentiles of the value and of its reduction against passive (computed case by
+case, on the same track). A user can then say "SAS (attitude+ride) improves N_MV by x %
+(5-95 %: a to b) on FRA class 4 at 30-60 m/s".
+
+The runs go through `railride.sweep.run_cases`: compiled batches, a local or Dask executor,
+and a run table on disk that a study resumes from; metrics are kept, time histories are not.
+A run that diverges keeps its row with the time it diverged; the statistics leave it out and
+the result lists it (`StudyResult.failed`). `study` returns a `StudyResult` with the result
+protocol (`to_dict`, `to_pandas`, `plot`, `save`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from . import validation
+from .comparison import check_controllers
+from .control import PAPER_CONTROLLERS, GainSet
+from .defaults import DEFAULT_DAMPER
+from .faults import DamperFault, check_faults
+from .metrics import RESPONSES
+from .params import VehicleParams
+from .solver import SolverSettings
+from .sweep import COMFORT_COLUMNS, Case, RunTable, run_cases
+
+#: the schema of `StudyResult.to_dict` (study.json)
+SCHEMA = "railride.study/1"
+#: the metrics a study summarises: the four RMS responses and the comfort indices
+METRICS = (*(f"{r}_rms" for r in RESPONSES), *COMFORT_COLUMNS)
+#: the percentiles of the band
+PERCENTILES = (5.0, 95.0)
+#: a fault condition with no fault
+HEALTHY = "none"
+
+
+def fault_condition(text: str) -> tuple:
+    """One fault condition: "none", or faults joined by "+" (e.g. "1R-off" or "1R-off+2L-on@2"),
+    as their labels in corner order."""
+    text = str(text).strip()
+    if text == HEALTHY:
+        return ()
+    faults = [DamperFault.parse(item) for item in text.split("+")]
+    corners = [f.corner for f in faults]
+    if len(set(corners)) != len(corners):
+        raise ValueError(f"fault = {text!r}: one fault per corner")
+    return tuple(f.label for f in sorted(faults, key=lambda f: "1R 1L 2R 2L".split().index(f.corner)))
+
+
+@dataclass
+class StudyResult:
+    """The result of `study`. ``cases``: one row per run (the run table's metrics, with the
+    study's ``controller``, ``load``, ``fault``, ``track_seed`` and ``speed_m_s`` and, for the
+    controlled runs, each metric's reduction in % against passive on the same track, speed and
+    load, ``<metric>_reduction``). ``summary``: one row per controller, condition (load, fault)
+    and metric: ``n`` (runs that did not diverge), ``mean``, ``p5``, ``p95`` of the value and
+    ``reduction_mean``, ``reduction_p5``, ``reduction_p95``. ``failed``: the runs that diverged
+    (controller, condition, seed, speed, time). ``settings``: what was run."""
+
+    cases: pd.DataFrame
+    summary: pd.DataFrame
+    settings: dict = field(default_factory=dict)
+    failed: list = field(default_factory=list)
+
+    def to_dict(self) -> dict:
+        """The ``railride.study/1`` document: settings, per controller and condition every
+        metric's statistics, and the failed runs."""
+        from . import __version__
+
+        groups = []
+        for (name, load, fault), part in self.summary.groupby(["controller", "load", "fault"], sort=False):
+            metrics = {}
+            for _, row in part.iterrows():
+                metrics[row["metric"]] = {
+                    k: _finite(row[k])
+                    for k in ("n", "mean", "p5", "p95", "reduction_mean", "reduction_p5", "reduction_p95")
+                }
+            groups.append({"controller": name, "load": float(load), "fault": fault, "metrics": metrics})
+        return {
+            "schema": SCHEMA,
+            "railride_version": __version__,
+            "settings": self.settings,
+            "percentiles": list(PERCENTILES),
+            "results": groups,
+            "failed": self.failed,
+            "runs": int(len(self.cases)),
+        }
+
+    def to_pandas(self) -> pd.DataFrame:
+        """The summary: one row per controller, condition and metric."""
+        return self.summary.copy()
+
+    def plot(self, ax=None, metrics=None):
+        """Per metric (default the four RMS responses and N_MV at the carbody centre), the mean
+        reduction against passive of each controller with its 5-95 % band, one group per
+        condition (`railride.plots.study.plot_study`). Returns the figure."""
+        from .plots.study import plot_study
+
+        return plot_study(self, ax=ax, metrics=metrics)
+
+    def save(self, folder) -> list:
+        """study.json (`to_dict`), study_summary.csv (`to_pandas`), study_runs.csv (`cases`)
+        and study.png (`plot`) into ``folder``, all or nothing (other files, such as the run
+        table runs.csv, stay). Returns the paths."""
+        from .files import write_study_outputs
+
+        return write_study_outputs(self, folder)
+
+
+def _finite(value):
+    value = float(value)
+    return value if np.isfinite(value) else None
+
+
+def study(
+    controllers=PAPER_CONTROLLERS,
+    *,
+    scenario: str = "fra4",
+    track_seeds=None,
+    speeds=None,
+    loads=(1.0,),
+    faults=(HEALTHY,),
+    duration: float | None = None,
+    gains: GainSet | None = None,
+    damper: str = DEFAULT_DAMPER,
+    params=None,
+    solver=None,
+    window=None,
+    executor=None,
+    table: RunTable | None = None,
+    progress=None,
+) -> StudyResult:
+    """Run ``controllers`` (names of `railride.control.CONTROLLERS`; passive is always the
+    baseline) on ``scenario`` for every track seed (a random track's realisation; default 0 to
+    9, none for the other scenarios) and speed (m/s; None: the scenario's), for
+    each load factor (`VehicleParams.loaded`) and fault condition ("none", or faults such as
+    "1R-off" joined by "+"; faults apply to the controlled suspensions, passive stays healthy),
+    with ``gains`` (default the shipped gains: the controllers keep them whatever the load) and
+    the ``damper`` model. Every setting is checked before the first run. ``executor``, ``table``
+    and ``progress`` as for `railride.sweep.run_cases`. Returns a `StudyResult`."""
+    from .faults import fault_table
+    from .suspension import damper_model
+    from .sweep import other_settings
+    from .track import SPECTRA
+    from .track import scenario as make_scenario
+
+    names = check_controllers(controllers)
+    solver = SolverSettings.of(solver)
+    vehicle = VehicleParams.of(params)
+    gains = GainSet.default() if gains is None else gains
+    random = scenario in SPECTRA
+    if track_seeds is not None and not random:
+        raise ValueError(
+            f"track_seeds = {list(_items(track_seeds))}: track seeds apply to the random tracks "
+            f"({', '.join(SPECTRA)}) only, not to {scenario!r}"
+        )
+    if track_seeds is None:
+        track_seeds = range(10) if random else [None]
+    seeds = [None if s is None else validation.integer("track_seeds", s, 0) for s in _items(track_seeds)]
+    speed_list = (
+        [None] if speeds is None else [validation.number("speeds", v, "positive", "m/s") for v in _items(speeds)]
+    )
+    load_list = [
+        validation.number("loads", v, "positive", allowed="a finite number > 0 (load factor)") for v in _items(loads)
+    ]
+    conditions = []
+    for f in _items(faults):
+        try:
+            conditions.append(fault_condition(f))
+        except ValueError as exc:
+            raise ValueError(f"faults = {str(f)!r}: {exc}") from None
+    for name, values in (("track_seeds", seeds), ("speeds", speed_list), ("loads", load_list), ("faults", conditions)):
+        if not values:
+            raise ValueError(f"{name}: give at least one value")
+    model = damper_model(damper, 1.0)
+    for cond in conditions:
+        if cond:
+            check_faults(cond, model)
+    opts_of: dict[tuple, tuple] = {}
+    for seed in seeds:  # every scenario is built (and checked) before the first run
+        for v in speed_list:
+            opts: dict[str, Any] = {
+                **({"seed": seed} if seed is not None else {}),
+                **({"speed": v} if v is not None else {}),
+                **({"duration": duration} if duration else {}),
+            }
+            sc = make_scenario(scenario, **opts)
+            for cond in conditions:
+                try:
+                    fault_table([[DamperFault.parse(f) for f in cond]], solver.dt, sc.duration)
+                except ValueError as exc:
+                    raise ValueError(f"faults = {'+'.join(cond)!r}: {exc}") from None
+            opts_of[(seed, v)] = (tuple(sorted(opts.items())), sc.speed)
+    cases, meta = [], []
+    controlled = [n for n in names if n != "passive"]
+    for load in load_list:
+        changes = _load_changes(vehicle, load)
+        for (seed, v), (options, speed) in opts_of.items():
+            cases.append(Case(scenario, options, vehicle=changes))
+            meta.append(("passive", load, HEALTHY, seed, speed))
+            for cond in conditions:
+                label = "+".join(cond) if cond else HEALTHY
+                for n in controlled:
+                    cases.append(Case(scenario, options, vehicle=changes, suspension=n, damper=damper, faults=cond))
+                    meta.append((n, load, label, seed, speed))
+    rows = run_cases(
+        cases,
+        executor=executor,
+        table=table,
+        base_gains=gains,
+        params=vehicle,
+        solver=solver,
+        window=window,
+        progress=progress,
+        comfort=True,
+    )
+    frame = rows.reset_index(drop=True).copy()
+    info = pd.DataFrame(meta, columns=["controller", "load", "fault", "track_seed", "speed_m_s"])
+    frame = pd.concat([info, frame.drop(columns=[c for c in info.columns if c in frame.columns])], axis=1)
+    frame = _reductions(frame)
+    summary = _summary(frame, names, load_list, conditions)
+    failed = [
+        {
+            "controller": r.controller,
+            "load": float(r.load),
+            "fault": r.fault,
+            "track_seed": None if r.track_seed is None or r.track_seed != r.track_seed else int(r.track_seed),
+            "speed_m_s": float(r.speed_m_s),
+            "diverged_at_s": float(r.diverged_at_s),
+        }
+        for r in frame.itertuples()
+        if np.isfinite(r.diverged_at_s)
+    ]
+    settings = {
+        "scenario": scenario,
+        "controllers": names,
+        "track_seeds": seeds if random else None,
+        "speeds_m_s": sorted({s for _, s in opts_of.values()}),
+        "loads": load_list,
+        "faults": ["+".join(c) if c else HEALTHY for c in conditions],
+        "duration_s": duration,
+        "damper": damper,
+        "gains": gains.source,
+        "window_s": None if window is None else [float(w) for w in window],
+        **other_settings(vehicle, solver),
+    }
+    return StudyResult(frame, summary, settings, failed)
+
+
+def _items(values) -> list:
+    if isinstance(values, (str, int, float)):
+        return [values]
+    return list(values)
+
+
+def _load_changes(vehicle: VehicleParams, load: float) -> tuple:
+    """The vehicle changes of a load factor (none for 1: the keys of unloaded runs stay)."""
+    if load == 1.0:
+        return ()
+    loaded = vehicle.loaded(load)
+    return tuple((n, getattr(loaded, n)) for n in ("m_c", "I_cx", "I_cy", "I_cz"))
+
+
+def _reductions(frame: pd.DataFrame) -> pd.DataFrame:
+    """Each controlled run's reduction in % against passive on the same track, speed and load."""
+    key = ["load", "track_seed", "speed_m_s"]
+    keys = frame[key].astype(float).fillna(-1.0)  # no seed (not a random track): one key
+    passive = frame[list(METRICS)][frame["controller"] == "passive"].set_index(
+        pd.MultiIndex.from_frame(keys[frame["controller"] == "passive"])
+    )
+    base = passive.reindex(pd.MultiIndex.from_frame(keys)).to_numpy()
+    values = frame[list(METRICS)].to_numpy()
+    with np.errstate(divide="ignore", invalid="ignore"):
+        red = np.where(base != 0, (base - values) / base * 100.0, np.nan)
+    red[frame["controller"].to_numpy() == "passive"] = np.nan
+    out = frame.copy()
+    for j, m in enumerate(METRICS):
+        out[f"{m}_reduction"] = red[:, j]
+    return out
+
+
+def _summary(frame: pd.DataFrame, names, loads, conditions) -> pd.DataFrame:
+    rows = []
+    labels = ["+".join(c) if c else HEALTHY for c in conditions]
+    lo, hi = PERCENTILES
+    for name in names:
+        for load in loads:
+            for label in [HEALTHY] if name == "passive" else labels:
+                part = frame[(frame["controller"] == name) & (frame["load"] == load) & (frame["fault"] == label)]
+                part = part[~np.isfinite(part["diverged_at_s"])]
+                for m in METRICS:
+                    x = part[m].to_numpy(dtype=float)
+                    r = part[f"{m}_reduction"].to_numpy(dtype=float)
+                    x, r = x[np.isfinite(x)], r[np.isfinite(r)]
+                    rows.append(
+                        {
+                            "controller": name,
+                            "load": load,
+                            "fault": label,
+                            "metric": m,
+                            "n": int(x.size),
+                            "mean": float(x.mean()) if x.size else np.nan,
+                            "p5": float(np.percentile(x, lo)) if x.size else np.nan,
+                            "p95": float(np.percentile(x, hi)) if x.size else np.nan,
+                            "reduction_mean": float(r.mean()) if r.size else np.nan,
+                            "reduction_p5": float(np.percentile(r, lo)) if r.size else np.nan,
+                            "reduction_p95": float(np.percentile(r, hi)) if r.size else np.nan,
+                        }
+                    )
+    return pd.DataFrame(rows)

@@ -1,0 +1,52 @@
+"""railride study: statistics over tracks, payloads and faults from the command line."""
+
+import json
+
+import pandas as pd
+import pytest
+
+from clihelp import PNG, assert_input_error, ok, ok_json, run
+
+SHORT = ("study", "--controllers", "pid", "--track-seed", "0,1", "--speed", "40", "--duration", 1)
+
+
+def test_study_json_and_table():
+    doc = ok_json(*SHORT, "--load", "1,1.3", "--fault", "none,2L-disconnected")
+    assert doc["schema"] == "railride.study/1" and doc["runs"] == 2 * 2 * (1 + 2)
+    groups = {(g["controller"], g["load"], g["fault"]) for g in doc["results"]}
+    assert ("pid", 1.3, "2L-disconnected") in groups and ("passive", 1.0, "none") in groups
+    assert doc["settings"]["loads"] == [1.0, 1.3] and doc["failed"] == []
+    text = " ".join(ok(*SHORT).stdout.split())
+    fragments = ("Statistics over 2 track seeds x 1 speed(s)", "N_MV,z centre", "p5-p95", "passive is always healthy")
+    for fragment in fragments:
+        assert fragment in text, fragment
+
+
+def test_study_out_and_resume(tmp_path):
+    out = tmp_path / "s"
+    first = ok_json(*SHORT, "--out", out)
+    names = sorted(p.name for p in out.iterdir())
+    assert names == ["runs.csv", "study.json", "study.png", "study_runs.csv", "study_summary.csv"]
+    assert (out / "study.png").read_bytes().startswith(PNG)
+    assert len(pd.read_csv(out / "study_runs.csv")) == first["runs"]
+    again = ok_json(*SHORT, "--out", out, "--resume")
+    assert again["runs_evaluated"] == 0 and again["results"] == first["results"]
+    assert json.loads((out / "study.json").read_text())["results"] == first["results"]
+
+
+@pytest.mark.parametrize(
+    "args, fragments",
+    [
+        (("--track-seed", "-1"), ("--track-seed",)),
+        (("--load", "0"), ("--load", "must be a finite number > 0")),
+        (("--fault", "3R-off"), ("--fault = '3R-off'", "allowed 1R, 1L, 2R, 2L")),
+        (("--fault", "none,,1R-off"), ("--fault", "empty item")),
+        (("--fault", "1R-off@9"), ("--fault", "not within the run")),
+        (("--controllers", "lqr"), ("unknown controller 'lqr'",)),
+        (("--scenario", "fra9"), ("--track-seed", "random tracks")),
+        (("--scenario", "fra9", "--track-seed", "0", "--controllers", "pid"), ("--track-seed",)),
+        (("--resume",), ("--resume needs --out",)),
+    ],
+)
+def test_study_bad_input(args, fragments):
+    assert_input_error(run(*SHORT, *args), *fragments)

@@ -1,0 +1,141 @@
+"""Statistics over tracks (railride.study): the numbers recomputed from the runs, the cases a
+study runs, failed runs, bad input and the result protocol."""
+
+import json
+
+import numpy as np
+import pytest
+
+from railride.control import GainSet
+from railride.simulation import simulate
+from railride.study import METRICS, fault_condition, study
+from railride.suspension import Suspension
+from railride.sweep import RunTable
+from railride.track import scenario
+
+SHORT = dict(track_seeds=[0, 1, 2], speeds=[30.0, 50.0], duration=2.0)
+
+
+@pytest.fixture(scope="module")
+def small():
+    return study(["pid", "sas-attitude"], loads=[1.0, 1.3], faults=["none", "1R-off"], **SHORT)
+
+
+def test_the_study_runs_every_case_once_with_a_healthy_passive_baseline(small):
+    c = small.cases
+    passive = c[c.controller == "passive"]
+    assert len(passive) == 3 * 2 * 2 and set(passive.fault) == {"none"}  # seeds x speeds x loads
+    assert len(c[c.controller == "pid"]) == 3 * 2 * 2 * 2  # ... x fault conditions
+    assert set(c[c.fault == "1R-off"]["faults"]) == {"1R-off"}
+    # a load factor scales the carbody (the run table holds the vehicle it ran)
+    loaded = c[(c.load == 1.3)]["vehicle.m_c"].unique()
+    assert loaded == pytest.approx([1.3 * 3.96e4])
+
+
+def test_a_run_of_the_study_is_the_direct_simulation(small):
+    c = small.cases
+    pick = (c.controller == "pid") & (c.track_seed == 1) & (c.speed_m_s == 50.0) & (c.load == 1.0)
+    row = c[pick & (c.fault == "1R-off")]
+    direct = simulate(
+        scenario("fra4", seed=1, speed=50.0, duration=2.0),
+        suspension=Suspension.named("pid", GainSet.default()).with_faults("1R-off"),
+    )
+    rms = direct.metrics().sel(statistic="rms", response="roll_deg")
+    assert float(row["roll_deg_rms"].iloc[0]) == pytest.approx(float(rms), rel=1e-12)
+
+
+def test_the_statistics_are_those_of_the_runs(small):
+    c, s = small.cases, small.summary
+    for name, load, fault in (("pid", 1.3, "1R-off"), ("sas-attitude", 1.0, "none")):
+        mine = c[(c.controller == name) & (c.load == load) & (c.fault == fault)]
+        base = c[(c.controller == "passive") & (c.load == load)].set_index(["track_seed", "speed_m_s"])
+        for metric in ("acceleration_m_s2_rms", "centre_N_MV_z"):
+            row = s[(s.controller == name) & (s.load == load) & (s.fault == fault) & (s.metric == metric)].iloc[0]
+            x = mine[metric].to_numpy()
+            p = base.loc[list(zip(mine.track_seed, mine.speed_m_s)), metric].to_numpy()
+            red = (p - x) / p * 100
+            assert row["n"] == 6
+            assert row["mean"] == pytest.approx(x.mean()) and row["p95"] == pytest.approx(np.percentile(x, 95))
+            assert row["reduction_mean"] == pytest.approx(red.mean())
+            assert row["reduction_p5"] == pytest.approx(np.percentile(red, 5))
+    assert set(s.metric) == set(METRICS)
+
+
+def test_a_run_that_diverges_is_listed_and_the_others_go_on():
+    gains = GainSet.default().apply({"groundhook.c_g": 1e8})  # too stiff for the ideal actuator
+    res = study(["pid", "groundhook"], damper="ideal", gains=gains, track_seeds=[0], speeds=[40.0], duration=1.0)
+    assert [f["controller"] for f in res.failed] == ["groundhook"] and res.failed[0]["diverged_at_s"] > 0
+    s = res.summary
+    assert s[(s.controller == "groundhook")]["n"].max() == 0
+    assert s[(s.controller == "pid")]["n"].min() == 1
+    json.dumps(res.to_dict(), allow_nan=False)  # no NaN in the document
+
+
+@pytest.mark.parametrize(
+    "kwargs, match",
+    [
+        (dict(track_seeds=[-1]), r"track_seeds = -1: must be a whole number >= 0"),
+        (dict(loads=[0.0]), r"loads = 0.0: must be a finite number > 0"),
+        (dict(speeds=[-3.0]), r"speeds = -3.0: must be a finite number > 0"),
+        (dict(faults=["3R-off"]), r"fault corner = '3R'"),
+        (dict(faults=["1R-off+1R-on"]), r"one fault per corner"),
+        (dict(faults=["1R-off@5"], duration=2.0), r"not within the run"),
+        (dict(faults=["1R-off"], damper="ideal"), r"'off' and 'on' need MR dampers"),
+        (dict(track_seeds=[]), r"track_seeds: give at least one value"),
+        (dict(controllers=["lqr"]), r"unknown controller 'lqr'"),
+    ],
+)
+def test_bad_settings_are_refused_before_any_run(kwargs, match, monkeypatch):
+    from railride import simulation
+
+    def no_run(*args, **kw):
+        raise AssertionError("a run started before the settings were checked")
+
+    monkeypatch.setattr(simulation, "simulate", no_run)
+    args = {"track_seeds": [0], "duration": 2.0, **kwargs}
+    with pytest.raises(ValueError, match=match):
+        study(args.pop("controllers", ["pid"]), **args)
+
+
+def test_a_study_resumes_from_its_run_table(tmp_path):
+    class Counting:
+        def __init__(self):
+            self.cases = 0
+
+        def map(self, fn, chunks):
+            for i, chunk in enumerate(chunks):
+                self.cases += len(chunk)
+                yield i, fn(chunk)
+
+    path = tmp_path / "runs.csv"
+    first = study(["pid"], table=RunTable(path), track_seeds=[0, 1], duration=1.0)
+    ex = Counting()
+    again = study(["pid"], table=RunTable(path, resume=True), executor=ex, track_seeds=[0, 1], duration=1.0)
+    assert ex.cases == 0
+    assert again.summary.equals(first.summary)
+
+
+def test_the_result_protocol(small, tmp_path):
+    from matplotlib.figure import Figure
+
+    doc = small.to_dict()
+    assert doc["schema"] == "railride.study/1" and doc["percentiles"] == [5.0, 95.0]
+    assert json.loads(json.dumps(doc, allow_nan=False)) == doc
+    pid = next(g for g in doc["results"] if g["controller"] == "pid" and g["fault"] == "1R-off" and g["load"] == 1.3)
+    assert set(pid["metrics"]) == set(METRICS) and pid["metrics"]["roll_deg_rms"]["n"] == 6
+    assert list(small.to_pandas().columns[:4]) == ["controller", "load", "fault", "metric"]
+    assert isinstance(small.plot(), Figure)
+    mine = Figure()
+    assert small.plot(ax=mine.subplots(1, 2), metrics=["roll_deg_rms", "centre_N_MV_z"]) is mine
+    paths = small.save(tmp_path / "out")
+    assert [p.name for p in paths] == ["study.json", "study_summary.csv", "study_runs.csv", "study.png"]
+    assert fault_condition("2L-on@1+1R-off") == ("1R-off", "2L-on@1") and fault_condition("none") == ()
+
+
+def test_a_study_on_a_sine_runs_over_speeds_alone():
+    res = study(["pid"], scenario="paper-sine", speeds=[30.0, 40.0], duration=1.0)
+    assert res.settings["track_seeds"] is None and len(res.cases) == 2 * 2
+    row = res.summary[(res.summary.controller == "pid") & (res.summary.metric == "roll_deg_rms")].iloc[0]
+    assert row["n"] == 2 and np.isfinite(row["reduction_mean"])
+    with pytest.raises(ValueError, match=r"track_seeds = \[1\]: track seeds apply to the random tracks"):
+        study(["pid"], scenario="paper-sine", track_seeds=[1])
