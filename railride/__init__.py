@@ -10,7 +10,8 @@ The public API, in the order a run needs it::
     rr.simulate(sc, params, rr.Suspension.named("sas-attitude-ride"))  # a controlled secondary
     result.metrics()                                  # RMS, peak-to-peak (docs/model.md, Metrics)
     rr.compare(sc)                                    # the paper's comparison, with the bounds
-    rr.tune()                                         # the sensitivity study (shipped gains)
+    rr.tune()                                         # every law tuned alike (shipped gains)
+    rr.study(["pid"], scenario="fra4", loads=[1, 1.3], faults=["none", "1R-off"])  # over many tracks
     rr.run_sweep(rr.sweep.grid(["passive", "pid"], speed=[20, 40, 60]))  # every combination
     rr.frequency_responses(params)                    # carbody FRFs, their peaks, the modes
 """
@@ -24,7 +25,9 @@ from .frf import FrfResult, frequency_responses
 from .params import VehicleParams
 from .pareto import ParetoResult, pareto
 from .ride import RideResult
+from .faults import DamperFault
 from .simulation import simulate
+from .study import StudyResult, study
 from .solver import SolverSettings
 from .suspension import Suspension
 from .sweep import SweepResult, run_sweep
@@ -35,6 +38,7 @@ from .vehicle import Vehicle
 
 __all__ = [
     "Comparison",
+    "DamperFault",
     "FrfResult",
     "GainSet",
     "Objective",
@@ -42,6 +46,7 @@ __all__ = [
     "RideResult",
     "Scenario",
     "SolverSettings",
+    "StudyResult",
     "Suspension",
     "SweepResult",
     "Vehicle",
@@ -53,5 +58,6 @@ __all__ = [
     "scenario",
     "run_sweep",
     "simulate",
+    "study",
     "tune",
 ]
