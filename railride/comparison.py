@@ -305,6 +305,7 @@ def compare(
     comfort: bool = False,
     bounds: bool = True,
     faults=(),
+    delay: int = 1,
 ) -> Comparison:
     """Run the passive vehicle and each controller on ``scenario`` and collect the metrics.
 
@@ -326,8 +327,9 @@ def compare(
     controlled suspension (`railride.faults.DamperFault` or their text, e.g. "1R-off@2"); passive
     stays the healthy baseline, the comparison is also run with healthy dampers
     (`Comparison.healthy`; ``to_dict()["faults"]`` holds the degradation), and the bounds are
-    not run (they are those of the healthy design). Every setting is checked before the first
-    run."""
+    not run (they are those of the healthy design). ``delay``: every controller's computation
+    and communication delay in controller periods (`Suspension.delay`; the bounds have it too).
+    Every setting is checked before the first run."""
     solver = SolverSettings.of(solver)
     model = damper_model(damper, damper_scale)
     damper_scale = float(damper_scale)
@@ -363,10 +365,7 @@ def compare(
             res = simulate(
                 scenario,
                 params,
-                [
-                    Suspension.named(n, gains, damper, damper_scale, sensor_noise=noise).with_faults(faults)
-                    for n in group
-                ],
+                [_named(n, gains, damper, damper_scale, noise, delay).with_faults(faults) for n in group],
                 solver=solver,
                 on_divergence="mark",
                 progress=part and part(share * done, share * len(group)),
@@ -375,7 +374,12 @@ def compare(
                 if np.isfinite(res.diverged_at[i]):
                     not_run[n] = (
                         f"diverged at t = {res.diverged_at[i]:.4g} s: these gains are not stable on damper "
-                        f"{damper!r} at dt = {solver.dt:g} s (another dt, or other gains)"
+                        f"{damper!r} at dt = {solver.dt:g} s"
+                        + (
+                            f" with a delay of {delay} controller periods (a shorter delay, other gains)"
+                            if delay != 1 and n in closed
+                            else " (another dt, or other gains)"
+                        )
                     )
                 else:
                     datasets[n] = res.dataset.isel(sample=i, drop=True)
@@ -388,7 +392,7 @@ def compare(
         res = simulate(
             scenario,
             params,
-            [Suspension.named(n, gains, device, sensor_noise=sensor_noise) for n in closed],
+            [_named(n, gains, device, 1.0, sensor_noise, delay) for n in closed],
             solver=solver,
             on_divergence="mark",
             progress=part and part(share * (done + len(closed) * k), share * len(closed)),
@@ -411,6 +415,7 @@ def compare(
         "sensor_noise": None if sensor_noise is None else sensor_noise.__dict__,
         **({"not_run": not_run} if not_run else {}),
         **({"faults": [f.label for f in faults]} if faults else {}),
+        **({"delay_periods": int(delay)} if delay != 1 else {}),
     }
     comfort_values = None
     if comfort:
@@ -431,6 +436,7 @@ def compare(
             sensor_noise=sensor_noise,
             comfort=comfort,
             bounds=False,
+            delay=delay,
         )
     return Comparison(
         names,
@@ -445,6 +451,12 @@ def compare(
         solver,
         healthy,
     )
+
+
+def _named(name, gains, damper, damper_scale, sensor_noise, delay) -> Suspension:
+    """`Suspension.named`, with the controller's ``delay`` for a closed loop."""
+    s = Suspension.named(name, gains, damper, damper_scale, sensor_noise=sensor_noise)
+    return s.with_delay(delay) if s.closed_loop else s
 
 
 #: the ideal devices `compare` runs beside the MR dampers: the best a damper could do with the

@@ -51,8 +51,10 @@ N_DS = N_CORNER * N_DAMPER_STATES  # damper states of the vehicle
 NS_MAX = 2 * N_DOF + N_DS  # state (q, q', damper states)
 XI = NS_MAX  # controller: integral of the sampled (z, phi, theta) ...
 FD_HELD = XI + 3  # ... the corner force demands in effect ...
-FD_NEXT = FD_HELD + N_CORNER  # ... and those computed at the last sample
-NX = FD_NEXT + N_CORNER  # columns of the state array x
+#: the longest computation delay, in controller periods
+MAX_DELAY = 64
+FD_NEXT = FD_HELD + N_CORNER  # ... and those computed at the last MAX_DELAY samples (a ring)
+NX = FD_NEXT + MAX_DELAY * N_CORNER  # columns of the state array x
 #: sub-steps resolve the fastest damper rate: rate x SUBSTEP_DT_REF / (sub-steps) <= this
 SUBSTEP_LIMIT = 0.5
 SUBSTEP_DT_REF = 1e-4
@@ -369,7 +371,8 @@ def run_batch(
     samples the state m = (q, q') (noise[k] added to the carbody's six at sample k, if noise has
     rows) every ctrl_stride steps, integrates the carbody's (z, phi, theta) by the rectangle rule,
     and computes the desired corner forces f_d = Gm[s] m + Hm[s] xi (Gm 4 x 18), which take effect
-    one controller period later and are held (a computation delay of one sample). The voltage
+    inner[s, 3] controller periods later (the computation and communication delay, 1 to
+    MAX_DELAY; zero demand until the first arrives) and are held. The voltage
     law inner[s, 2] (railride.dampers.VOLTAGE_LAWS) runs at every step from the damper force f on
     the carbody and the deflection rates x' at the step's start: tracking, v = clip(G (f_d - B f)
     sgn(f), v_min, v_max) with (B, G) = inner[s, :2]; on-off, v_max where f_d x' < 0; clipped,
@@ -418,6 +421,7 @@ def run_batch(
             faulty = faulty or fm[c] != FAULT_NONE
         meas = np.empty(2 * N_DOF)  # the controller's sample of the state (q, q')
         gm, hm = Gm[smp], Hm[smp]
+        delay = int(inner[smp, 3])  # controller periods from a sample to its demand taking effect
         tc = ctrl_stride * dt
         n_noise = noise.shape[0]
         _forcing(step0 * dt, ftab, fo, nn, itv, R, 0)
@@ -427,8 +431,10 @@ def run_batch(
             t = step * dt
             if closed_loop and step % ctrl_stride == 0:
                 k = step // ctrl_stride
-                for c in range(N_CORNER):  # the demand computed one period ago takes effect
-                    x[smp, FD_HELD + c] = x[smp, FD_NEXT + c]
+                # the demand computed `delay` periods ago takes effect; its slot takes the new one
+                slot = FD_NEXT + N_CORNER * (k % delay)
+                for c in range(N_CORNER):
+                    x[smp, FD_HELD + c] = x[smp, slot + c]
                 for j in range(2 * N_DOF):
                     meas[j] = s[j]
                 if k < n_noise:  # sensor noise on the carbody's (z, phi, theta) and their rates
@@ -443,7 +449,7 @@ def run_batch(
                         acc_fd += gm[c, j] * meas[j]
                     for j in range(3):
                         acc_fd += hm[c, j] * x[smp, XI + j]
-                    x[smp, FD_NEXT + c] = acc_fd
+                    x[smp, slot + c] = acc_fd
             if closed_loop and law == LAW_IDEAL:
                 # the ideal actuator applies the held demand itself (no inner loop); its force
                 # is the command, so it is set before the step-start rates use it

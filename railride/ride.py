@@ -371,6 +371,8 @@ def _suspension_record(suspension) -> dict:
     record: dict[str, Any] = {"type": suspension.name, "damper": suspension.damper_name}
     if suspension.faults:
         record["faults"] = [f.label for f in suspension.faults]
+    if suspension.delay != 1:
+        record["delay_periods"] = suspension.delay
     if suspension.voltage is not None:
         record["voltage_v"] = float(suspension.voltage)
     if suspension.damper_scale != 1.0:

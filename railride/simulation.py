@@ -328,12 +328,13 @@ def simulate(
     faults = fault_table([s.faults for s in suspensions], dt, duration)
 
     if closed is None:
-        ctrl_stride, inner_gains, noise = 1, np.zeros((n, 3)), np.zeros((0, 6))
+        ctrl_stride, inner_gains, noise = 1, np.zeros((n, 4)), np.zeros((0, 6))
     else:
         ctrl_stride, noise = closed["stride"], closed["noise"]
         inner = closed["inner"]  # none for the ideal devices: the stepper does not read it
-        inner_gains = np.zeros((n, 3)) if inner is None else np.tile([inner.B, inner.G, 0.0], (n, 1))
+        inner_gains = np.zeros((n, 4)) if inner is None else np.tile([inner.B, inner.G, 0.0, 0.0], (n, 1))
         inner_gains[:, 2] = modes
+        inner_gains[:, 3] = [s.delay for s in suspensions]
     chunk = n_steps if progress is None else max(stride, (_CHUNK_WORK // n) // stride * stride)
     done = 0
     while True:

@@ -19,7 +19,7 @@ protocol (`to_dict`, `to_pandas`, `plot`, `save`).
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -61,10 +61,10 @@ def fault_condition(text: str) -> tuple:
 @dataclass
 class StudyResult:
     """The result of `study`. ``cases``: one row per run (the run table's metrics, with the
-    study's ``controller``, ``load``, ``fault``, ``track_seed`` and ``speed_m_s`` and, for the
+    study's ``controller``, ``load``, ``fault``, ``delay``, ``track_seed`` and ``speed_m_s`` and, for the
     controlled runs, each metric's reduction in % against passive on the same track, speed and
-    load, ``<metric>_reduction``). ``summary``: one row per controller, condition (load, fault)
-    and metric: ``n`` (runs that did not diverge), ``mean``, ``p5``, ``p95`` of the value and
+    load, ``<metric>_reduction``). ``summary``: one row per controller, condition (load, fault,
+    delay) and metric: ``n`` (runs that did not diverge), ``mean``, ``p5``, ``p95`` of the value and
     ``reduction_mean``, ``reduction_p5``, ``reduction_p95``. ``failed``: the runs that diverged
     (controller, condition, seed, speed, time). ``settings``: what was run."""
 
@@ -79,14 +79,18 @@ class StudyResult:
         from . import __version__
 
         groups = []
-        for (name, load, fault), part in self.summary.groupby(["controller", "load", "fault"], sort=False):
+        for (name, load, fault, delay), part in self.summary.groupby(
+            ["controller", "load", "fault", "delay"], sort=False
+        ):
             metrics = {}
             for _, row in part.iterrows():
                 metrics[row["metric"]] = {
                     k: _finite(row[k])
                     for k in ("n", "mean", "p5", "p95", "reduction_mean", "reduction_p5", "reduction_p95")
                 }
-            groups.append({"controller": name, "load": float(load), "fault": fault, "metrics": metrics})
+            groups.append(
+                {"controller": name, "load": float(load), "fault": fault, "delay": int(delay), "metrics": metrics}
+            )
         return {
             "schema": SCHEMA,
             "railride_version": __version__,
@@ -131,6 +135,7 @@ def study(
     speeds=None,
     loads=(1.0,),
     faults=(HEALTHY,),
+    delays=(1,),
     duration: float | None = None,
     gains: GainSet | None = None,
     damper: str = DEFAULT_DAMPER,
@@ -144,8 +149,10 @@ def study(
     """Run ``controllers`` (names of `railride.control.CONTROLLERS`; passive is always the
     baseline) on ``scenario`` for every track seed (a random track's realisation; default 0 to
     9, none for the other scenarios) and speed (m/s; None: the scenario's), for
-    each load factor (`VehicleParams.loaded`) and fault condition ("none", or faults such as
-    "1R-off" joined by "+"; faults apply to the controlled suspensions, passive stays healthy),
+    each load factor (`VehicleParams.loaded`), fault condition ("none", or faults such as
+    "1R-off" joined by "+"; faults apply to the controlled suspensions, passive stays healthy)
+    and controller delay (in controller periods, `Suspension.delay`; 1: a demand takes effect
+    one period after its sample),
     with ``gains`` (default the shipped gains: the controllers keep them whatever the load) and
     the ``damper`` model. Every setting is checked before the first run. ``executor``, ``table``
     and ``progress`` as for `railride.sweep.run_cases`. Returns a `StudyResult`."""
@@ -180,7 +187,17 @@ def study(
             conditions.append(fault_condition(f))
         except ValueError as exc:
             raise ValueError(f"faults = {str(f)!r}: {exc}") from None
-    for name, values in (("track_seeds", seeds), ("speeds", speed_list), ("loads", load_list), ("faults", conditions)):
+    from .kernels import MAX_DELAY
+
+    what = "controller periods from a sample to its demand taking effect"
+    delay_list = [validation.integer("delays", d, 1, MAX_DELAY, what) for d in _items(delays)]
+    for name, values in (
+        ("track_seeds", seeds),
+        ("speeds", speed_list),
+        ("loads", load_list),
+        ("faults", conditions),
+        ("delays", delay_list),
+    ):
         if not values:
             raise ValueError(f"{name}: give at least one value")
     model = damper_model(damper, 1.0)
@@ -208,12 +225,14 @@ def study(
         changes = _load_changes(vehicle, load)
         for (seed, v), (options, speed) in opts_of.items():
             cases.append(Case(scenario, options, vehicle=changes))
-            meta.append(("passive", load, HEALTHY, seed, speed))
+            meta.append(("passive", load, HEALTHY, 1, seed, speed))
             for cond in conditions:
                 label = "+".join(cond) if cond else HEALTHY
-                for n in controlled:
-                    cases.append(Case(scenario, options, vehicle=changes, suspension=n, damper=damper, faults=cond))
-                    meta.append((n, load, label, seed, speed))
+                for delay in delay_list:
+                    for n in controlled:
+                        case = Case(scenario, options, vehicle=changes, suspension=n, damper=damper, faults=cond)
+                        cases.append(replace(case, delay=delay) if _closed(n) else case)
+                        meta.append((n, load, label, delay, seed, speed))
     rows = run_cases(
         cases,
         executor=executor,
@@ -226,15 +245,16 @@ def study(
         comfort=True,
     )
     frame = rows.reset_index(drop=True).copy()
-    info = pd.DataFrame(meta, columns=["controller", "load", "fault", "track_seed", "speed_m_s"])
+    info = pd.DataFrame(meta, columns=["controller", "load", "fault", "delay", "track_seed", "speed_m_s"])
     frame = pd.concat([info, frame.drop(columns=[c for c in info.columns if c in frame.columns])], axis=1)
     frame = _reductions(frame)
-    summary = _summary(frame, names, load_list, conditions)
+    summary = _summary(frame, names, load_list, conditions, delay_list)
     failed = [
         {
             "controller": r.controller,
             "load": float(r.load),
             "fault": r.fault,
+            "delay_periods": int(r.delay),
             "track_seed": None if r.track_seed is None or r.track_seed != r.track_seed else int(r.track_seed),
             "speed_m_s": float(r.speed_m_s),
             "diverged_at_s": float(r.diverged_at_s),
@@ -249,6 +269,7 @@ def study(
         "speeds_m_s": sorted({s for _, s in opts_of.values()}),
         "loads": load_list,
         "faults": ["+".join(c) if c else HEALTHY for c in conditions],
+        "delays_periods": delay_list,
         "duration_s": duration,
         "damper": damper,
         "gains": gains.source,
@@ -256,6 +277,12 @@ def study(
         **other_settings(vehicle, solver),
     }
     return StudyResult(frame, summary, settings, failed)
+
+
+def _closed(name: str) -> bool:
+    from .control import CONSTANT_VOLTAGE
+
+    return name not in CONSTANT_VOLTAGE and name not in ("passive", "mr")
 
 
 def _items(values) -> list:
@@ -290,15 +317,15 @@ def _reductions(frame: pd.DataFrame) -> pd.DataFrame:
     return out
 
 
-def _summary(frame: pd.DataFrame, names, loads, conditions) -> pd.DataFrame:
+def _summary(frame: pd.DataFrame, names, loads, conditions, delays) -> pd.DataFrame:
     rows = []
     labels = ["+".join(c) if c else HEALTHY for c in conditions]
     lo, hi = PERCENTILES
     for name in names:
         for load in loads:
-            for label in [HEALTHY] if name == "passive" else labels:
+            for label, delay in [(HEALTHY, 1)] if name == "passive" else [(f, d) for f in labels for d in delays]:
                 part = frame[(frame["controller"] == name) & (frame["load"] == load) & (frame["fault"] == label)]
-                part = part[~np.isfinite(part["diverged_at_s"])]
+                part = part[(part["delay"] == delay) & ~np.isfinite(part["diverged_at_s"])]
                 for m in METRICS:
                     x = part[m].to_numpy(dtype=float)
                     r = part[f"{m}_reduction"].to_numpy(dtype=float)
@@ -308,6 +335,7 @@ def _summary(frame: pd.DataFrame, names, loads, conditions) -> pd.DataFrame:
                             "controller": name,
                             "load": load,
                             "fault": label,
+                            "delay": delay,
                             "metric": m,
                             "n": int(x.size),
                             "mean": float(x.mean()) if x.size else np.nan,

@@ -26,7 +26,7 @@ import functools
 from dataclasses import dataclass
 from typing import Any
 
-from . import dampers
+from . import dampers, kernels, validation
 from .control import CONSTANT_VOLTAGE, CONTROLLERS, LABELS, GainSet, InnerLoop, SensorNoise
 from .defaults import DEFAULT_DAMPER
 from .faults import check_faults
@@ -101,8 +101,11 @@ class Suspension:
     Refused with a ValueError naming the field: a voltage with a controller, or without MR
     dampers; a controller on the viscous dampers or on none; an ideal device without a controller or with
     an inner loop; an inner loop or sensor noise without a controller; a voltage outside the
-    damper's range. ``faults``: dampers that fail during the run (`railride.faults.DamperFault`,
-    or their text such as "1R-off" or "2L-on@2.5"; `with_faults`), checked against the damper.
+    damper's range. ``delay``: the controller's computation and communication delay in
+    controller periods (1, the default: a demand takes effect one period after its sample;
+    up to `railride.kernels.MAX_DELAY`; `with_delay`). ``faults``: dampers that fail during the
+    run (`railride.faults.DamperFault`, or their text such as "1R-off" or "2L-on@2.5";
+    `with_faults`), checked against the damper.
     """
 
     damper: Any = None
@@ -112,11 +115,16 @@ class Suspension:
     sensor_noise: SensorNoise | None = None
     damper_scale: float = dataclasses.field(default=1.0, compare=False, repr=False)
     faults: tuple = ()
+    delay: int = 1
 
     def __post_init__(self):
         model = _model(self.damper)
         object.__setattr__(self, "damper", model)
         object.__setattr__(self, "faults", check_faults(self.faults, model))
+        what = "controller periods from a sample of the states to its demand taking effect"
+        object.__setattr__(self, "delay", validation.integer("delay", self.delay, 1, kernels.MAX_DELAY, what))
+        if self.delay != 1 and self.controller is None:
+            raise ValueError(f"delay = {self.delay}: applies to a closed loop only (give controller= as well)")
         object.__setattr__(self, "damper_scale", dampers.check_scale("damper_scale", self.damper_scale))
         c = self.controller
         if c is not None and not (hasattr(c, "gains") and hasattr(c, "name")):
@@ -175,6 +183,11 @@ class Suspension:
                 )
         elif self.inner is None:
             object.__setattr__(self, "inner", _shipped_gains().inner)
+
+    def with_delay(self, periods: int) -> "Suspension":
+        """This closed loop with a computation and communication delay of ``periods``
+        controller periods (1: the demand takes effect one period after its sample)."""
+        return dataclasses.replace(self, delay=periods)
 
     def with_faults(self, faults) -> "Suspension":
         """This suspension with ``faults`` (`railride.faults.DamperFault`, their text such as
@@ -358,6 +371,7 @@ class Suspension:
             "inner_loop": None if self.inner is None else self.inner.to_dict(),
             "sensor_noise": None if self.sensor_noise is None else dataclasses.asdict(self.sensor_noise),
             **({"faults": [f.label for f in self.faults]} if self.faults else {}),
+            **({"delay_periods": self.delay} if self.delay != 1 else {}),
         }
 
 

@@ -89,6 +89,7 @@ class Case:
     seed: int = 0
     damper_scale: float = 1.0
     faults: tuple = ()  # damper faults as their text, e.g. ("1R-off@2",) (`railride.faults`)
+    delay: int = 1  # a controller's delay in controller periods (`Suspension.delay`)
 
     def __post_init__(self):
         from . import dampers
@@ -127,6 +128,8 @@ class Case:
             displacement, angle, velocity, angular_rate = self.noise
             noise = SensorNoise(displacement, angle, velocity, angular_rate, seed=self.seed)
         named = Suspension.named(self.suspension, gains, self.damper, self.damper_scale, self.voltage, noise)
+        if self.delay != 1:
+            named = named.with_delay(self.delay)
         return named.with_faults(self.faults) if self.faults else named
 
     def to_suspension(self, base_gains=None) -> Suspension:
@@ -155,6 +158,8 @@ class Case:
             del d["damper_scale"]
         if not d["faults"]:  # the same: the keys of healthy runs stay what they were
             del d["faults"]
+        if d["delay"] == 1:
+            del d["delay"]
         return d
 
     @property
@@ -257,6 +262,8 @@ def _flat(c: Case) -> dict:
     d.update({f"gain.{k}": v for k, v in c.gains})
     if c.faults:
         d["faults"] = ",".join(c.faults)
+    if c.delay != 1:
+        d["delay_periods"] = c.delay
     d["case"] = json.dumps(c.to_dict(), sort_keys=True, default=str)
     return d
 

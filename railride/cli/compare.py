@@ -52,7 +52,7 @@ from ._parsing import (
 from ._render import RESPONSE_LABELS, compare_comfort_table, damper_text, fmt, reduction_text
 
 #: the library's names of compare's options, for its errors
-COMPARE_FIELDS = {**SOLVER_FIELDS, "damper": "--damper", "damper_scale": "--damper-scale"}
+COMPARE_FIELDS = {**SOLVER_FIELDS, "damper": "--damper", "damper_scale": "--damper-scale", "delay": "--delay"}
 
 
 def _controller_list(text: str) -> list[str]:
@@ -150,7 +150,11 @@ def _compare_tables(doc: dict, vehicle: str, shipped: bool):
             else "sensor noise z {displacement:g} m, angle {angle:g} rad, velocity {velocity:g} m/s, "
             "rate {angular_rate:g} rad/s, seed {seed}".format(**noise)
         )
-        info.append(f"{damper_text(settings)}, controller {settings['control_rate_hz']:g} Hz, {noise_text}")
+        delay = settings.get("delay_periods", 1)
+        info.append(
+            f"{damper_text(settings)}, controller {settings['control_rate_hz']:g} Hz, "
+            f"delay {delay} period{'s' * (delay != 1)}, {noise_text}"
+        )
         info.append(f"gains file {doc['gains']['source']}" + (" (shipped)" if shipped else ""))
         tuning = doc.get("tuning") or {}
         if tuning.get("objective"):
@@ -351,6 +355,16 @@ def compare(
         Optional[int],
         typer.Option("--seed", metavar="N", help="Seed of the sensor noise, >= 0 (default 0); needs --sensor-noise."),
     ] = None,
+    delay: Annotated[
+        Optional[int],
+        typer.Option(
+            "--delay",
+            metavar="N",
+            help="The controllers' computation and communication delay in controller periods, 1..64 "
+            "(default 1: a demand takes effect one period after its sample). A controller that "
+            "goes unstable is said, not run.",
+        ),
+    ] = None,
     fault: Annotated[
         Optional[str],
         typer.Option(
@@ -433,6 +447,7 @@ def compare(
                 sensor_noise=sensor_noise,
                 seed=seed,
                 fault=fault,
+                delay=delay,
             )
             _league(
                 scenarios,
@@ -505,6 +520,7 @@ def compare(
                 bounds=bounds,
                 progress=progress if progress.enabled else None,
                 faults=faults,
+                delay=1 if delay is None else delay,
             )
         doc = result.to_dict()
         text = json.dumps(doc, indent=2, allow_nan=False)  # refuses NaN before anything is written
@@ -570,6 +586,7 @@ def _league(
         "sensor_noise": "--sensor-noise",
         "seed": "--seed",
         "fault": "--fault",
+        "delay": "--delay",
     }
     for key, value in given.items():
         if value is not None:

@@ -45,6 +45,7 @@ STUDY_FIELDS = {
     "fault": "--fault",
     "faults": "--fault",
     "duration": "--duration",
+    "delays": "--delay",
 }
 #: the metrics of the table, and their labels
 TABLE_METRICS = {
@@ -84,6 +85,7 @@ def _table(doc: dict):
     table.add_column("suspension", no_wrap=True)
     table.add_column("load", justify="right")
     table.add_column("fault")
+    table.add_column("delay", justify="right")
     table.add_column("metric")
     table.add_column("mean", justify="right")
     table.add_column(f"p{lo:g}-p{hi:g}", justify="right")
@@ -98,6 +100,7 @@ def _table(doc: dict):
                 escape(LABELS[group["controller"]]) if i == 0 else "",
                 f"{group['load']:g}" if i == 0 else "",
                 group["fault"] if i == 0 else "",
+                str(group["delay"]) if i == 0 else "",
                 label,
                 "" if m["mean"] is None else f"{m['mean']:#.4g}",
                 band,
@@ -115,13 +118,13 @@ def _table(doc: dict):
     ]
     if doc["failed"]:
         failed = "; ".join(
-            f"{f['controller']} load {f['load']:g} {f['fault']}"
+            f"{f['controller']} load {f['load']:g} {f['fault']} delay {f['delay_periods']}"
             + (f" seed {f['track_seed']}" if f["track_seed"] is not None else "")
             + f" at {f['speed_m_s']:g} m/s "
             f"(t = {f['diverged_at_s']:.3g} s)"
             for f in doc["failed"]
         )
-        lines.append(f"Diverged, left out of the statistics: {failed}.")
+        lines.append(f"Unstable (the run diverged), left out of the statistics: {failed}.")
     return [table, Text("\n".join(lines))]
 
 
@@ -170,6 +173,15 @@ def study_command(
             "(e.g. none,1R-off,2L-on+1R-disconnected@2). Faults apply to the controlled suspensions.",
         ),
     ] = "none",
+    delay: Annotated[
+        str,
+        typer.Option(
+            "--delay",
+            metavar="N[,N...]|A:B:COUNT",
+            help="The controllers' computation and communication delay in controller periods, 1..64 "
+            "(1: a demand takes effect one period after its sample). A run that diverges is listed.",
+        ),
+    ] = "1",
     duration: Annotated[
         Optional[float], typer.Option("--duration", metavar="S", help="Run length [s] (default 10).")
     ] = None,
@@ -199,6 +211,7 @@ def study_command(
         speeds = value_list("--speed", speed) if speed is not None else None
         loads = value_list("--load", load)
         faults = _faults(fault)
+        delays = value_list("--delay", delay, integer=True)
         damper_preset("--damper", damper)
         gain_set = load_gains(gains)
         solver = solver_from_options(dt=dt)
@@ -218,6 +231,7 @@ def study_command(
                     speeds=speeds,
                     loads=loads,
                     faults=faults,
+                    delays=[int(d) for d in delays],
                     duration=duration,
                     gains=gain_set,
                     damper=damper,

@@ -18,7 +18,7 @@ DEFAULT_METRICS = {
 
 
 def plot_study(result, ax=None, metrics=None):
-    """One panel per metric (default `DEFAULT_METRICS`): per condition (load, fault) a group,
+    """One panel per metric (default `DEFAULT_METRICS`): per condition (load, fault, delay) a group,
     per controller a marker at the mean reduction [%] against passive, with a bar from the 5th
     to the 95th percentile over the study's tracks and speeds. ``ax``: one Axes per metric, or
     None for a new figure. Returns the figure."""
@@ -29,7 +29,7 @@ def plot_study(result, ax=None, metrics=None):
         raise ValueError(f"metrics: {unknown[0]!r} is not a metric of the study; allowed {', '.join(DEFAULT_METRICS)}")
     controlled = [n for n in dict.fromkeys(summary["controller"]) if n != "passive"]
     part = summary[summary["controller"] != "passive"]
-    conditions = list(dict.fromkeys(zip(part["load"], part["fault"])))
+    conditions = list(dict.fromkeys(zip(part["load"], part["fault"], part["delay"])))
     if ax is None:
         fig = new_figure((3.4 * len(metrics) + 0.6, 3.6))
         axes = fig.subplots(1, len(metrics), squeeze=False).ravel()
@@ -39,7 +39,7 @@ def plot_study(result, ax=None, metrics=None):
     width = 0.8 / max(1, len(controlled))
     x = np.arange(len(conditions))
     for a, metric in zip(axes, metrics):
-        rows = part[part["metric"] == metric].set_index(["controller", "load", "fault"])
+        rows = part[part["metric"] == metric].set_index(["controller", "load", "fault", "delay"])
         for k, name in enumerate(controlled):
             mean = np.array([rows.loc[(name, *c), "reduction_mean"] for c in conditions], dtype=float)
             lo = np.array([rows.loc[(name, *c), "reduction_p5"] for c in conditions], dtype=float)
@@ -57,7 +57,7 @@ def plot_study(result, ax=None, metrics=None):
                 label=suspension_label(name),
             )
         a.axhline(0.0, color="k", linewidth=0.8)
-        a.set_xticks(x, [_condition_label(load, fault) for load, fault in conditions], fontsize="small")
+        a.set_xticks(x, [_condition_label(*c) for c in conditions], fontsize="small")
         a.set_title(DEFAULT_METRICS.get(metric, metric), fontsize=9)
         a.grid(True, axis="y", linewidth=0.4, alpha=0.6)
     axes[0].set_ylabel("reduction against passive (%)\nmean, 5-95 % band")
@@ -72,5 +72,5 @@ def plot_study(result, ax=None, metrics=None):
     return fig
 
 
-def _condition_label(load: float, fault: str) -> str:
-    return f"load {load:g}" + ("" if fault == "none" else f"\n{fault}")
+def _condition_label(load: float, fault: str, delay: int) -> str:
+    return f"load {load:g}" + ("" if fault == "none" else f"\n{fault}") + ("" if delay == 1 else f"\ndelay {delay}")

@@ -123,7 +123,7 @@ def test_the_result_protocol(small, tmp_path):
     assert json.loads(json.dumps(doc, allow_nan=False)) == doc
     pid = next(g for g in doc["results"] if g["controller"] == "pid" and g["fault"] == "1R-off" and g["load"] == 1.3)
     assert set(pid["metrics"]) == set(METRICS) and pid["metrics"]["roll_deg_rms"]["n"] == 6
-    assert list(small.to_pandas().columns[:4]) == ["controller", "load", "fault", "metric"]
+    assert list(small.to_pandas().columns[:5]) == ["controller", "load", "fault", "delay", "metric"]
     assert isinstance(small.plot(), Figure)
     mine = Figure()
     assert small.plot(ax=mine.subplots(1, 2), metrics=["roll_deg_rms", "centre_N_MV_z"]) is mine
