@@ -376,8 +376,12 @@ class GainSet:
 
     def tuned_on(self, record: dict | None) -> bool:
         """Whether these gains were tuned on the track ``record`` (`Scenario.describe`), as the
-        file's [provenance] scenario record says: judged there, they are judged in-sample."""
-        return self.provenance.get("scenario_record") == record
+        file's [provenance] scenario record (or, for a robust tuning, its tuning set) says:
+        judged there, they are judged in-sample."""
+        if self.provenance.get("scenario_record") == record:
+            return True
+        # a tuning set (robust tuning): any of its tracks, whatever the load
+        return any({k: v for k, v in r.items() if k != "load"} == record for r in self.provenance.get("tuning_set", []))
 
     def controller(self, name: str):
         """The outer loop called ``name`` (None for the passive suspension and the

@@ -101,6 +101,14 @@ class VehicleParams:
         carbody = ("m_c", "I_cx", "I_cy", "I_cz")
         return self.replace(**{n: factor * getattr(self, n) for n in carbody})
 
+    def load_changes(self, load: float) -> tuple:
+        """The (field, value) changes `loaded` makes, as a sweep's `Case.vehicle` holds them;
+        none for a load factor of 1, so that the run keys of unloaded runs stay as they were."""
+        if load == 1.0:
+            return ()
+        loaded = self.loaded(load)
+        return tuple((n, getattr(loaded, n)) for n in ("m_c", "I_cx", "I_cy", "I_cz"))
+
     def to_dict(self) -> dict[str, float]:
         return dataclasses.asdict(self)
 

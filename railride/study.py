@@ -222,7 +222,7 @@ def study(
     cases, meta = [], []
     controlled = [n for n in names if n != "passive"]
     for load in load_list:
-        changes = _load_changes(vehicle, load)
+        changes = vehicle.load_changes(load)
         for (seed, v), (options, speed) in opts_of.items():
             cases.append(Case(scenario, options, vehicle=changes))
             meta.append(("passive", load, HEALTHY, 1, seed, speed))
@@ -289,14 +289,6 @@ def _items(values) -> list:
     if isinstance(values, (str, int, float)):
         return [values]
     return list(values)
-
-
-def _load_changes(vehicle: VehicleParams, load: float) -> tuple:
-    """The vehicle changes of a load factor (none for 1: the keys of unloaded runs stay)."""
-    if load == 1.0:
-        return ()
-    loaded = vehicle.loaded(load)
-    return tuple((n, getattr(loaded, n)) for n in ("m_c", "I_cx", "I_cy", "I_cz"))
 
 
 def _reductions(frame: pd.DataFrame) -> pd.DataFrame:

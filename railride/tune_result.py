@@ -157,8 +157,18 @@ class TuneResult:
             f"# date: {doc['date']}; railride {doc['railride_version']}",
             f"# scenario: {run_text}, dt {s['dt_s']:g} s, {describe_dampers(s, detail=True)}",
             f"# objective: {statement}",
+            *(
+                [
+                    f"# tuning set: {len(s['tuning_set'])} runs per gain set ({_set_text(s['tuning_set'])}), "
+                    f"objective: the {s['aggregate']} over them"
+                ]
+                if "tuning_set" in s
+                else []
+            ),
             *textwrap.wrap(
-                f"study: each law from the start values, with at most {s['budget']} vehicle runs; per gain "
+                f"study: each law from the start values, with at most {s['budget']} "
+                + (f"gain sets ({len(s['tuning_set'])} runs each)" if "tuning_set" in s else "vehicle runs")
+                + "; per gain "
                 f"and pass {s['values']} values from 1/{s['span']:g} to {s['span']:g} x the current value "
                 f"(and 0); a pass that improves by less than {s['tolerance'] * 100:g} % narrows the span to "
                 f"its square root; a study ends when its next sweep would not fit the budget "
@@ -193,6 +203,14 @@ class TuneResult:
             f"objective = {json.dumps(statement)}",
             # the exact track, so a study judging these gains can tell whether it is the same one
             f"scenario_record = {_toml_inline(doc['scenario'])}",
+            *(
+                [
+                    "tuning_set = [" + ", ".join(_toml_inline(r) for r in s["tuning_set"]) + "]",
+                    f"aggregate = {json.dumps(s['aggregate'])}",
+                ]
+                if "tuning_set" in s
+                else []
+            ),
             # the laws whose gains these are (`GainSet.untuned` names the others)
             f"controllers = {json.dumps([c for c in self.controllers if c != 'inner'])}",
             f"inner_loop_tuned = {json.dumps('inner' in self.controllers)}",
@@ -256,6 +274,16 @@ class TuneResult:
                 ),
             ]
         )
+
+
+def _set_text(records) -> str:
+    """A tuning set in a few words: its scenarios, seeds, speeds and loads."""
+    parts = []
+    for key, label in (("name", ""), ("seed", "seeds "), ("speed_m_s", "speeds "), ("load", "loads ")):
+        values = list(dict.fromkeys(r.get(key) for r in records if r.get(key) is not None))
+        if values:
+            parts.append(label + ", ".join(f"{v:g}" if isinstance(v, float) else str(v) for v in values))
+    return "; ".join(parts)
 
 
 def _finite(value) -> float | None:

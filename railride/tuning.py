@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -107,6 +108,39 @@ def _allowed(table, entry: str, value: float) -> bool:
     return True
 
 
+@dataclass(frozen=True)
+class TuningCase:
+    """One run of a tuning set: a scenario (`railride.track.scenario` name and options) and
+    a load factor (`VehicleParams.loaded`)."""
+
+    scenario: str
+    options: tuple = ()
+    load: float = 1.0
+
+
+def tuning_set(scenario: str = "fra4", *, track_seeds=None, speeds=None, loads=(1.0,), duration=None) -> tuple:
+    """The `TuningCase` of every combination of track seed (random tracks only), speed [m/s]
+    and load factor: what `tune(over=...)` scores each gain set on."""
+    seeds = [None] if track_seeds is None else [validation.integer("track_seeds", x, 0) for x in track_seeds]
+    speeds = [None] if speeds is None else [validation.number("speeds", v, "positive", "m/s") for v in speeds]
+    loads = [validation.number("loads", x, "positive", allowed="a finite number > 0 (load factor)") for x in loads]
+    out = []
+    for load in loads:
+        for seed in seeds:
+            for v in speeds:
+                opts = {
+                    **({"seed": seed} if seed is not None else {}),
+                    **({"speed": v} if v is not None else {}),
+                    **({"duration": duration} if duration else {}),
+                }
+                out.append(TuningCase(scenario, tuple(sorted(opts.items())), load))
+    return tuple(out)
+
+
+#: how a tuning set's objectives become one: their mean, or the worst
+AGGREGATES = ("mean", "worst")
+
+
 def _check_controllers(controllers) -> tuple:
     if isinstance(controllers, str):
         controllers = (controllers,)
@@ -139,6 +173,8 @@ def tune(
     log=None,
     damper_scale: float = 1.0,
     before_after: bool = True,
+    over=None,
+    aggregate: str = "mean",
 ) -> TuneResult:
     """Tune ``controllers`` (names from `TUNABLE`; default all: the inner loop, then every law)
     from ``gains`` (default the neutral `GainSet.reference`), minimising ``objective`` (default
@@ -158,7 +194,13 @@ def tune(
 
     ``before_after``: at the end, run each law tuned (and, when the inner loop was tuned, each
     law that uses it) with the start and with the tuned gains (through the run table, where
-    most of these runs already are). Returns a `TuneResult`.
+    most of these runs already are).
+
+    ``over``: robust tuning. A set of `TuningCase` (`tuning_set`: track seeds, speeds, load
+    factors) in place of ``scenario``: each gain set is scored on every case, against the
+    passive run of the same case, and the case objectives become one by ``aggregate`` ("mean"
+    or "worst"). The budget still counts gain sets; each costs one run per case. No
+    before/after rows (they belong to one scenario). Returns a `TuneResult`.
     """
     from . import dampers
     from .suspension import damper_model
@@ -187,8 +229,19 @@ def tune(
         if not validation.number(name, value, "finite", allowed="a finite number > 1") > 1:
             raise ValueError(f"{name} = {validation.shown(value)}: must be a finite number > 1")
     validation.number("tol", tol, "nonnegative")
-    scen = make_scenario(scenario, **dict(scenario_options or {}))
-    check_resolution(scen, solver.output_rate)
+    validation.choice("aggregate", aggregate, AGGREGATES)
+    if over is not None:
+        cases_set = tuple(over)
+        if not cases_set or not all(isinstance(c, TuningCase) for c in cases_set):
+            raise ValueError("over: give a non-empty sequence of railride.tuning.TuningCase (tuning_set())")
+        if scenario_options:
+            raise ValueError("scenario_options with over: the tuning set names its own scenarios")
+    else:
+        cases_set = (TuningCase(scenario, opts, 1.0),)
+    scens = [make_scenario(c.scenario, **dict(c.options)) for c in cases_set]
+    for sc in scens:
+        check_resolution(sc, solver.output_rate)
+    scen = scens[0]
     result = TuneResult(
         gains,
         objective=objective,
@@ -206,6 +259,14 @@ def tune(
             "min_span": float(min_span),
             "start_gains": gains.source,
             **other_settings(vehicle, solver),
+            **(
+                {
+                    "tuning_set": [{**sc.describe(), "load": c.load} for c, sc in zip(cases_set, scens)],
+                    "aggregate": aggregate,
+                }
+                if over is not None
+                else {}
+            ),
         },
     )
 
@@ -221,15 +282,26 @@ def tune(
             progress=progress,
         )
 
-    passive = _rms(run([Case(scenario, opts)]))[0]
+    loads = [vehicle.load_changes(c.load) for c in cases_set]
+    passives = _rms(run([Case(c.scenario, c.options, vehicle=ld) for c, ld in zip(cases_set, loads)]))
+    passive = passives[0]
     result.passive = dict(zip(RESPONSES, passive))
     inner: dict[str, float] = {}  # the inner loop's changes, which every law's runs carry
     if "inner" in controllers:
         result.studies.append(_tune_inner(gains, inner, n_values, span, tol, result, log, damper, damper_scale))
 
-    def case(name, change):
+    def case(name, change, k=0):
         gains = tuple(sorted({**inner, **change}.items()))
-        return Case(scenario, opts, suspension=name, damper=damper, damper_scale=damper_scale, gains=gains)
+        c = cases_set[k]
+        return Case(
+            c.scenario,
+            c.options,
+            vehicle=loads[k],
+            suspension=name,
+            damper=damper,
+            damper_scale=damper_scale,
+            gains=gains,
+        )
 
     tuned: dict[str, dict] = {}  # each law's gains as its study left them
     for name in controllers:
@@ -237,12 +309,17 @@ def tune(
             continue
 
         def score(change_sets, name=name):
-            return objective(_rms(run([case(name, cs) for cs in change_sets])), passive)
+            k = len(cases_set)
+            rms = _rms(run([case(name, cs, j) for cs in change_sets for j in range(k)])).reshape(
+                len(change_sets), k, -1
+            )
+            per_case = np.stack([objective(rms[:, j], passives[j]) for j in range(k)], axis=1)
+            return per_case.mean(axis=1) if aggregate == "mean" else per_case.max(axis=1)
 
         study, tuned[name] = _study(name, gains, score, budget, n_values, float(span), tol, min_span, result, log)
         result.studies.append(study)
     result.gains = gains.apply({**inner, **{k: v for own in tuned.values() for k, v in own.items()}})
-    if before_after:
+    if before_after and over is None:
         result.before_after = _before_after(result, run, case, tuned, inner, damper)
     result.runs = table.frame
     result.date = _utc_now()

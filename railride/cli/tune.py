@@ -40,7 +40,6 @@ from ._options import (
     SchedulerFileOption,
     SchedulerOption,
     SpeedOption,
-    TrackSeedOption,
     TuneDamperOption,
     TuneDamperScaleOption,
     TuneGainsOption,
@@ -60,6 +59,7 @@ from ._parsing import (
     parse_scale,
     solver_from_options,
     study_scenario,
+    value_list,
 )
 from ._render import RESPONSE_LABELS, damper_text, reduction_text
 
@@ -72,6 +72,7 @@ TUNE_FIELDS = {
     "n_values": "--values",
     "budget": "--budget",
     "span": "--span",
+    "aggregate": "--aggregate",
 }
 
 
@@ -163,6 +164,25 @@ def _tunable_list(text: str) -> list[str]:
     return [n for n in TUNABLE if n in items]
 
 
+def _tuning_set(scenario, seeds, loads, speed, duration, *single):
+    """--track-seed with several seeds, or --load: the runs every gain set is scored on."""
+    from ..tuning import tuning_set
+
+    if any(v is not None for v in single):
+        raise ValueError(
+            "--amplitude, --wavelength, --rail-phase, --min-wavelength and --max-wavelength apply to "
+            "a single tuning scenario, not to several --track-seed values or --load"
+        )
+    with option_names({"track_seeds": "--track-seed", "loads": "--load"}):
+        return tuning_set(
+            scenario,
+            track_seeds=None if seeds is None else [int(x) for x in seeds],
+            speeds=None if speed is None else [speed],
+            loads=[1.0] if loads is None else loads,
+            duration=duration,
+        )
+
+
 def _tune_start(path: Optional[Path]):
     """--gains FILE, else the neutral reference gains (the library's default start)."""
     from ..control import GainSet
@@ -183,7 +203,13 @@ def _tune_tables(doc: dict, start, tuned, scenario_text: str):
     from ..tuning import PARAMETERS
 
     parts = []
-    studies = Table(title=f"Tuning: every law from the same start, at most {doc['settings']['budget']} runs each")
+    settings = doc["settings"]
+    per_set = (
+        f" gain sets each, {len(settings['tuning_set'])} runs per set ({settings['aggregate']} objective)"
+        if "tuning_set" in settings
+        else " runs each"
+    )
+    studies = Table(title=f"Tuning: every law from the same start, at most {settings['budget']}{per_set}")
     for name, justify in (("study", "left"), ("gains", "right"), ("runs", "right"), ("passes", "right")):
         studies.add_column(name, justify=justify)  # type: ignore[arg-type]
     studies.add_column("objective\nstart", justify="right")
@@ -318,7 +344,33 @@ def tune_command(
     amplitude: AmplitudeOption = None,
     wavelength: WavelengthOption = None,
     rail_phase: RailPhaseOption = None,
-    track_seed: TrackSeedOption = None,
+    track_seed: Annotated[
+        Optional[str],
+        typer.Option(
+            "--track-seed",
+            metavar="N[,N...]|A:B:COUNT",
+            help="Random tracks only: the seed of the track's realisation (default 0); several seeds "
+            "(a list or a range) tune on all of them at once (robust tuning, see --aggregate).",
+        ),
+    ] = None,
+    load: Annotated[
+        Optional[str],
+        typer.Option(
+            "--load",
+            metavar="X[,X...]",
+            help="Load factors (carbody mass and inertias times X) to tune on; several tune on all "
+            "of them at once (robust tuning, see --aggregate). Default 1.",
+        ),
+    ] = None,
+    aggregate: Annotated[
+        str,
+        typer.Option(
+            "--aggregate",
+            metavar="mean|worst",
+            help="With several seeds or loads: each gain set's objective is the mean, or the worst, "
+            "of its runs' objectives.",
+        ),
+    ] = "mean",
     min_wavelength: MinWavelengthOption = None,
     max_wavelength: MaxWavelengthOption = None,
     speed: SpeedOption = None,
@@ -370,6 +422,7 @@ def tune_command(
 
     command = command_line(ctx, exclude=("out", "resume", "format"))
     defaults = not_given(dt=dt, min_wavelength=min_wavelength, max_wavelength=max_wavelength, seed=track_seed)
+    seeds: Optional[list] = None
     with errors(), option_names(TUNE_FIELDS, defaults):
         from .. import tuning
         from ..labels import describe_scenario
@@ -380,6 +433,22 @@ def tune_command(
         start = _tune_start(gains)
         objective = _objective(objective_kind, weights, bound, penalty)
         solver = solver_from_options(dt=dt)
+        seeds = value_list("--track-seed", track_seed, integer=True) if track_seed is not None else None
+        loads = value_list("--load", load) if load is not None else None
+        over = None
+        if (seeds is not None and len(seeds) > 1) or loads is not None:
+            over = _tuning_set(
+                scenario,
+                seeds,
+                loads,
+                speed,
+                duration,
+                amplitude,
+                wavelength,
+                rail_phase,
+                min_wavelength,
+                max_wavelength,
+            )
         scen, options = study_scenario(
             scenario,
             amplitude=amplitude,
@@ -387,7 +456,7 @@ def tune_command(
             rail_phase=rail_phase,
             speed=speed,
             duration=duration,
-            track_seed=track_seed,
+            track_seed=None if seeds is None else int(seeds[0]),
             min_wavelength=min_wavelength,
             max_wavelength=max_wavelength,
         )
@@ -401,7 +470,9 @@ def tune_command(
                 result = tuning.tune(
                     names,
                     scenario=scenario,
-                    scenario_options=options,
+                    scenario_options=None if over is not None else options,
+                    over=over,
+                    aggregate=aggregate,
                     gains=start,
                     objective=objective,
                     damper=damper,

@@ -12,7 +12,7 @@ import pytest
 from railride.control import GainSet
 from railride.files import TUNE_FILES
 from railride.tuning import DEFAULT_OBJECTIVE
-from clihelp import PNG, assert_input_error, ok, run
+from clihelp import PNG, assert_input_error, ok, ok_json, run
 
 
 RESPONSES = ["acceleration_m_s2", "displacement_m", "pitch_deg", "roll_deg"]
@@ -358,3 +358,19 @@ def test_sweep_goes_on_past_a_diverged_run(tmp_path):
     assert "diverged_at_s" in doc["columns"]
     table = run("sweep", "--suspension", "pid", "--damper", "ideal", "--gain", "pid.kp=1e5,1e12", "--duration", 1)
     assert table.exit_code == 0 and "1 run diverged" in table.stdout
+
+
+def test_tune_on_several_tracks_and_loads():
+    args = ("tune", "--controllers", "pid", "--scenario", "fra4", "--track-seed", "0,1", "--load", "1,1.3")
+    doc = ok_json(*args, "--duration", 0.5, "--values", 3, "--budget", 6, "--aggregate", "worst")
+    s = doc["settings"]
+    assert s["aggregate"] == "worst" and [(r["seed"], r["load"]) for r in s["tuning_set"]] == [
+        (0, 1.0),
+        (1, 1.0),
+        (0, 1.3),
+        (1, 1.3),
+    ]
+    assert doc["before_after"] == []
+    assert_input_error(run(*args, "--aggregate", "best"), "--aggregate = 'best'", "mean, worst")
+    assert_input_error(run(*args, "--min-wavelength", "2"), "--min-wavelength", "single tuning scenario")
+    assert_input_error(run(*args[:-2], "--load", "0"), "--load = 0", "> 0")

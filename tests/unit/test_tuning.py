@@ -10,6 +10,7 @@ from railride.solver import SolverSettings
 from railride.suspension import Suspension
 from railride.sweep import Case, RunTable, run_cases
 from railride.track import scenario
+from railride.params import VehicleParams
 from railride.tuning import (
     DEFAULT_OBJECTIVE,
     INFEASIBLE_OFFSET,
@@ -498,3 +499,53 @@ def test_run_keys_change_with_the_model_revision(monkeypatch):
     before = c.key
     monkeypatch.setattr(sweep_module, "MODEL_REVISION", sweep_module.MODEL_REVISION + 1)
     assert c.key != before
+
+
+# -- robust tuning: a set of tracks and payloads -----------------------------------------------------
+def test_robust_tuning_scores_the_mean_or_the_worst_of_its_cases():
+    from railride.tuning import tuning_set
+
+    cases = tuning_set("fra4", track_seeds=[0, 1], loads=[1.0, 1.3], duration=0.5)
+    assert len(cases) == 4 and {c.load for c in cases} == {1.0, 1.3}
+    for aggregate, reduce in (("mean", np.mean), ("worst", np.max)):
+        res = tune(("pid",), over=cases, aggregate=aggregate, budget=12, n_values=3)
+        assert res.before_after == [] and res.settings["aggregate"] == aggregate
+        assert len(res.settings["tuning_set"]) == 4
+        # the tuned gains' objective, recomputed case by case from direct runs of the sweep engine
+        params = VehicleParams.preset("paper")
+        per_case = []
+        for c in cases:
+            vehicle = params.load_changes(c.load)
+            passive = run_cases([Case(c.scenario, c.options, vehicle=vehicle)])
+            tuned = run_cases(
+                [
+                    Case(
+                        c.scenario,
+                        c.options,
+                        vehicle=vehicle,
+                        suspension="pid",
+                        gains=tuple((f"pid.{k}", v) for k, v in res.gains.pid.to_dict().items()),
+                    )
+                ],
+                base_gains=GainSet.reference(),
+            )
+            cols = [f"{r}_rms" for r in ("acceleration_m_s2", "displacement_m", "pitch_deg", "roll_deg")]
+            per_case.append(DEFAULT_OBJECTIVE(tuned[cols].to_numpy(), passive[cols].to_numpy()[0])[0])
+        assert res.studies[0].objective == pytest.approx(reduce(per_case), rel=1e-9), aggregate
+    loaded = GainSet.from_toml(res.gains_toml())
+    assert loaded.provenance["aggregate"] == "worst" and len(loaded.provenance["tuning_set"]) == 4
+    record = scenario("fra4", seed=1, duration=0.5).describe()
+    assert loaded.tuned_on(record) and not loaded.tuned_on(scenario("fra4", seed=2, duration=0.5).describe())
+
+
+def test_robust_tuning_refuses_what_it_cannot_use():
+    from railride.tuning import tuning_set
+
+    with pytest.raises(ValueError, match="aggregate = 'median'"):
+        tune(("pid",), over=tuning_set("fra4", track_seeds=[0]), aggregate="median")
+    with pytest.raises(ValueError, match="over: give a non-empty sequence"):
+        tune(("pid",), over=[])
+    with pytest.raises(ValueError, match="scenario_options with over"):
+        tune(("pid",), over=tuning_set("fra4", track_seeds=[0]), scenario_options={"speed": 30.0})
+    with pytest.raises(ValueError, match="loads = 0"):
+        tuning_set("fra4", loads=[0])
