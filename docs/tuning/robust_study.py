@@ -25,9 +25,8 @@ for label, gains in (("tuned on paper-sine (shipped)", GainSet.default()), ("tun
         x = runs[f"{m}_reduction"].to_numpy()
         print(f"  {m:24s} {x.mean():6.1f} ({np.percentile(x, 5):6.1f} to {np.percentile(x, 95):6.1f})")
     worst = (1 - runs[[f"{m}_reduction" for m in RESPONSES]] / 100).max(axis=1).to_numpy()
-    print(
-        f"  worst RMS ratio per run  {worst.mean():.3f} ({np.percentile(worst, 5):.3f} to {np.percentile(worst, 95):.3f})"
-    )
+    lo, hi = np.percentile(worst, [5, 95])
+    print(f"  worst RMS ratio per run  {worst.mean():.3f} ({lo:.3f} to {hi:.3f}), largest {worst.max():.3f}")
     red = compare(scenario("paper-sine"), controllers=["sas-attitude"], gains=gains, bounds=False).reductions
     r = red.sel(controller="sas-attitude", statistic="rms").values
     print(f"  paper-sine: {' / '.join(f'{v:.1f}' for v in r)} %, worst ratio {(1 - r / 100).max():.3f}")
