@@ -54,7 +54,15 @@ FD_HELD = XI + 3  # ... the corner force demands in effect ...
 #: the longest computation delay, in controller periods
 MAX_DELAY = 64
 FD_NEXT = FD_HELD + N_CORNER  # ... and those computed at the last MAX_DELAY samples (a ring)
-NX = FD_NEXT + MAX_DELAY * N_CORNER  # columns of the state array x
+#: realistic sensing (railride.sensing): per corner the accelerometer's anti-alias filter output,
+#: the last sample, and the two band-limited integration stages (high-pass, leaky integral)
+SENS = FD_NEXT + MAX_DELAY * N_CORNER
+N_SENS_STATES = 7  # y_f, a_prev, h1, v, v_prev, h2, d
+NX = SENS + N_SENS_STATES * N_CORNER  # columns of the state array x
+#: the columns of a sample's sensing settings: on (1) or ideal states (0), the anti-alias filter
+#: and estimator corner rates [rad/s], the bias of each corner [m/s^2], the 3 x 4 map from corner
+#: values to the carbody's (z, phi, theta), row by row
+SENSING_COLS = 3 + N_CORNER + 3 * N_CORNER
 #: sub-steps resolve the fastest damper rate: rate x SUBSTEP_DT_REF / (sub-steps) <= this
 SUBSTEP_LIMIT = 0.5
 SUBSTEP_DT_REF = 1e-4
@@ -342,6 +350,8 @@ def run_batch(
     inner,
     noise,
     faults,
+    sensing,
+    snoise,
     out_q,
     out_v,
     out_a,
@@ -380,6 +390,15 @@ def run_batch(
     each corner is the held demand itself, which the ideal actuator applies (out_vc then
     records the demand, not a voltage). The controller's integrator and demands are states
     x[s, NS_MAX:], so a run can continue across calls.
+
+    Realistic sensing (sensing[s, 0] = 1; layout `SENSING_COLS`): the controller does not see
+    the state. A vertical accelerometer at each carbody corner measures the corner's
+    acceleration through a first-order anti-alias filter (rate sensing[s, 1], integrated at every
+    step), sampled at the controller rate with a bias (sensing[s, 3:7]) and white noise
+    (snoise[k]); at each sample two band-limited integration stages, each a high-pass then a
+    leaky integral (s / (s + w)^2, w = sensing[s, 2], backward Euler), give each corner's
+    velocity and displacement, which the map sensing[s, 7:] turns into the carbody's heave, pitch
+    and roll; the bogie states read as 0.
 
     Damper faults: corner c of sample s fails with mode faults[s, c] (FAULT_*) from step
     faults[s, 4 + c] on. FAULT_OFF and FAULT_ON hold its command at v_min and v_max whatever the
@@ -423,6 +442,10 @@ def run_batch(
         gm, hm = Gm[smp], Hm[smp]
         delay = int(inner[smp, 3])  # controller periods from a sample to its demand taking effect
         tc = ctrl_stride * dt
+        sens = closed_loop and sensing[smp, 0] > 0.0
+        w_aa, w_c = sensing[smp, 1], sensing[smp, 2]
+        hp = 1.0 / (1.0 + w_c * tc)  # backward Euler of s / (s + w) and of 1 / (s + w)
+        n_snoise = snoise.shape[0]
         n_noise = noise.shape[0]
         _forcing(step0 * dt, ftab, fo, nn, itv, R, 0)
         last = n_steps + 1 if final else n_steps
@@ -436,7 +459,23 @@ def run_batch(
                 for c in range(N_CORNER):
                     x[smp, FD_HELD + c] = x[smp, slot + c]
                 for j in range(2 * N_DOF):
-                    meas[j] = s[j]
+                    meas[j] = 0.0 if sens else s[j]
+                if sens:  # the accelerometers, sampled, and the band-limited integration
+                    for c in range(N_CORNER):
+                        b = SENS + N_SENS_STATES * c
+                        a_m = x[smp, b] + sensing[smp, 3 + c] + (snoise[k, c] if k < n_snoise else 0.0)
+                        x[smp, b + 2] = hp * (x[smp, b + 2] + a_m - x[smp, b + 1])
+                        x[smp, b + 1] = a_m
+                        v_new = hp * (x[smp, b + 3] + tc * x[smp, b + 2])
+                        x[smp, b + 5] = hp * (x[smp, b + 5] + v_new - x[smp, b + 4])
+                        x[smp, b + 4] = v_new
+                        x[smp, b + 3] = v_new
+                        x[smp, b + 6] = hp * (x[smp, b + 6] + tc * x[smp, b + 5])
+                    for j in range(3):
+                        for c in range(N_CORNER):
+                            pm = sensing[smp, 3 + N_CORNER + N_CORNER * j + c]
+                            meas[j] += pm * x[smp, SENS + N_SENS_STATES * c + 6]
+                            meas[N_DOF + j] += pm * x[smp, SENS + N_SENS_STATES * c + 3]
                 if k < n_noise:  # sensor noise on the carbody's (z, phi, theta) and their rates
                     for j in range(3):
                         meas[j] += noise[k, j]
@@ -461,6 +500,13 @@ def run_batch(
                         conn[c] = 0.0
             # rates at the step's start: for the record, the sub-step choice and stage 1
             _derivative(law, s, R, 0, at, tt, pp, vc, conn, y, cx, cv, K, 0)
+            if sens:  # each accelerometer's anti-alias filter follows its corner's acceleration
+                for c in range(N_CORNER):
+                    a_c = 0.0
+                    for j in range(3):
+                        a_c += tt[j, c] * K[N_DOF + j]
+                    b = SENS + N_SENS_STATES * c
+                    x[smp, b] += dt * w_aa * (a_c - x[smp, b])
             if closed_loop and law != LAW_IDEAL:
                 # inner loop from the damper forces at the step's start (they do not depend on
                 # the command, only on the coil state); then correct stage 1's coil rate

@@ -163,6 +163,9 @@ def _closed_loop(suspensions: list[Suspension], solver: SolverSettings, duration
     stride = solver.control_steps()
     ticks = int(round(duration / (stride * solver.dt))) + 2
     noise = first.sensor_noise
+    sensing = first.sensing
+    if sensing is not None:
+        sensing.check(solver.control_rate, solver.dt)
     return {
         "controllers": [s.controller for s in suspensions],
         "inner": first.inner,
@@ -170,6 +173,8 @@ def _closed_loop(suspensions: list[Suspension], solver: SolverSettings, duration
         "stride": stride,
         "noise": noise.samples(ticks) if noise is not None else np.zeros((0, 6)),
         "sensor_noise": noise,
+        "sensing": sensing,
+        "snoise": sensing.samples(ticks) if sensing is not None else np.zeros((0, 4)),
     }
 
 
@@ -296,11 +301,22 @@ def simulate(
     gm = np.zeros((n, 4, 2 * N_DOF))
     hm = np.zeros((n, 4, 3))
     modes = np.zeros(n)  # the voltage law of each sample (dampers.VOLTAGE_LAWS)
+    sensing = np.zeros((n, kernels.SENSING_COLS))
+    snoise = np.zeros((0, 4))
     if closed is not None:
         for i, (c, p) in enumerate(zip(closed["controllers"], param_sets)):
             G, hm[i] = c.gains(vehicles[id(p)])
             gm[i] = _full_state_gains(G, c)
             modes[i] = dampers.VOLTAGE_LAWS.index(getattr(c, "voltage_law", "tracking"))
+            if closed["sensing"] is not None:
+                bogie = np.r_[3:N_DOF, N_DOF + 3 : 2 * N_DOF]
+                if np.any(gm[i][:, bogie] != 0.0):
+                    raise ValueError(
+                        f"sensing with controller {c.name!r}: it reads the bogies' states, and the "
+                        "accelerometers are on the carbody only (railride.sensing)"
+                    )
+                sensing[i] = closed["sensing"].pack(vehicles[id(p)].T[:3])
+        snoise = closed["snoise"]
     x = np.zeros((n, kernels.NX))
     x[:, 2 * N_DOF + 2 : kernels.NS_MAX : dampers.N_DAMPER_STATES] = vcmd  # coils settled at the command
     P = np.tile(damper.pack() if damper is not None else np.zeros(dampers.N_PACKED), (n, 1))
@@ -368,6 +384,8 @@ def simulate(
             inner_gains,
             noise,
             faults,
+            sensing,
+            snoise,
             out["q"],
             out["v"],
             out["a"],

@@ -105,7 +105,8 @@ class Suspension:
     controller periods (1, the default: a demand takes effect one period after its sample;
     up to `railride.kernels.MAX_DELAY`; `with_delay`). ``faults``: dampers that fail during the
     run (`railride.faults.DamperFault`, or their text such as "1R-off" or "2L-on@2.5";
-    `with_faults`), checked against the damper.
+    `with_faults`), checked against the damper. ``sensing``: what the controller measures
+    (`railride.sensing.Accelerometers`, `with_sensing`; None, the default: the exact states).
     """
 
     damper: Any = None
@@ -116,6 +117,7 @@ class Suspension:
     damper_scale: float = dataclasses.field(default=1.0, compare=False, repr=False)
     faults: tuple = ()
     delay: int = 1
+    sensing: Any = None
 
     def __post_init__(self):
         model = _model(self.damper)
@@ -125,6 +127,17 @@ class Suspension:
         object.__setattr__(self, "delay", validation.integer("delay", self.delay, 1, kernels.MAX_DELAY, what))
         if self.delay != 1 and self.controller is None:
             raise ValueError(f"delay = {self.delay}: applies to a closed loop only (give controller= as well)")
+        if self.sensing is not None:
+            from .sensing import Accelerometers
+
+            if not isinstance(self.sensing, Accelerometers):
+                raise ValueError(f"sensing = {self.sensing!r}: must be a railride.sensing.Accelerometers, or None")
+            if self.controller is None:
+                raise ValueError("sensing applies to a closed loop only (give controller= as well)")
+            if self.sensor_noise is not None:
+                raise ValueError(
+                    "sensing with sensor_noise: the accelerometers have their own noise; give one or the other"
+                )
         object.__setattr__(self, "damper_scale", dampers.check_scale("damper_scale", self.damper_scale))
         c = self.controller
         if c is not None and not (hasattr(c, "gains") and hasattr(c, "name")):
@@ -188,6 +201,11 @@ class Suspension:
         """This closed loop with a computation and communication delay of ``periods``
         controller periods (1: the demand takes effect one period after its sample)."""
         return dataclasses.replace(self, delay=periods)
+
+    def with_sensing(self, sensing) -> "Suspension":
+        """This closed loop measuring through ``sensing`` (`railride.sensing.Accelerometers`; None:
+        the exact states) in place of the exact carbody states."""
+        return dataclasses.replace(self, sensing=sensing)
 
     def with_faults(self, faults) -> "Suspension":
         """This suspension with ``faults`` (`railride.faults.DamperFault`, their text such as
@@ -372,6 +390,7 @@ class Suspension:
             "sensor_noise": None if self.sensor_noise is None else dataclasses.asdict(self.sensor_noise),
             **({"faults": [f.label for f in self.faults]} if self.faults else {}),
             **({"delay_periods": self.delay} if self.delay != 1 else {}),
+            **({"sensing": self.sensing.to_dict()} if self.sensing is not None else {}),
         }
 
 
@@ -387,7 +406,7 @@ def batch_conflict(suspensions) -> str | None:
 
     first = suspensions[0]
     for i, s in enumerate(suspensions[1:], start=1):
-        for field in ("damper", "closed_loop", "inner", "sensor_noise"):
+        for field in ("damper", "closed_loop", "inner", "sensor_noise", "sensing"):
             a, b = getattr(first, field), getattr(s, field)
             if a != b:
                 return (
