@@ -306,6 +306,7 @@ def compare(
     bounds: bool = True,
     faults=(),
     delay: int = 1,
+    sensing=None,
 ) -> Comparison:
     """Run the passive vehicle and each controller on ``scenario`` and collect the metrics.
 
@@ -329,7 +330,9 @@ def compare(
     (`Comparison.healthy`; ``to_dict()["faults"]`` holds the degradation), and the bounds are
     not run (they are those of the healthy design). ``delay``: every controller's computation
     and communication delay in controller periods (`Suspension.delay`; the bounds have it too).
-    Every setting is checked before the first run."""
+    ``sensing``: what every controller measures (`railride.sensing.Accelerometers`; None: the
+    exact states; the bounds measure the same); a law that reads the bogies' states is not run
+    with it (``settings["not_run"]`` says why). Every setting is checked before the first run."""
     solver = SolverSettings.of(solver)
     model = damper_model(damper, damper_scale)
     damper_scale = float(damper_scale)
@@ -345,6 +348,16 @@ def compare(
     ideal = model.law == dampers.LAW_IDEAL
     # a constant voltage means nothing to the ideal devices: said in the settings, not run
     not_run = {n: NO_VOLTAGE for n in names if n in CONSTANT_VOLTAGE and ideal}
+    if sensing is not None:
+        from .params import VehicleParams
+        from .sensing import reads_bogies
+        from .vehicle import Vehicle
+
+        car = Vehicle(VehicleParams.of(params))
+        for n in names:
+            c = gains.controller(n)
+            if c is not None and reads_bogies(c.gains(car)[0]):
+                not_run[n] = "reads the bogies' states; the accelerometers are on the carbody only"
     names = [n for n in names if n not in not_run]
     closed = [n for n in names if n != "passive" and n not in CONSTANT_VOLTAGE]
     constant = [n for n in names if n in CONSTANT_VOLTAGE]
@@ -365,7 +378,7 @@ def compare(
             res = simulate(
                 scenario,
                 params,
-                [_named(n, gains, damper, damper_scale, noise, delay).with_faults(faults) for n in group],
+                [_named(n, gains, damper, damper_scale, noise, delay, sensing).with_faults(faults) for n in group],
                 solver=solver,
                 on_divergence="mark",
                 progress=part and part(share * done, share * len(group)),
@@ -392,7 +405,7 @@ def compare(
         res = simulate(
             scenario,
             params,
-            [_named(n, gains, device, 1.0, sensor_noise, delay) for n in closed],
+            [_named(n, gains, device, 1.0, sensor_noise, delay, sensing) for n in closed],
             solver=solver,
             on_divergence="mark",
             progress=part and part(share * (done + len(closed) * k), share * len(closed)),
@@ -416,6 +429,7 @@ def compare(
         **({"not_run": not_run} if not_run else {}),
         **({"faults": [f.label for f in faults]} if faults else {}),
         **({"delay_periods": int(delay)} if delay != 1 else {}),
+        **({"sensing": sensing.to_dict()} if sensing is not None else {}),
     }
     comfort_values = None
     if comfort:
@@ -437,6 +451,7 @@ def compare(
             comfort=comfort,
             bounds=False,
             delay=delay,
+            sensing=sensing,
         )
     return Comparison(
         names,
@@ -453,10 +468,10 @@ def compare(
     )
 
 
-def _named(name, gains, damper, damper_scale, sensor_noise, delay) -> Suspension:
-    """`Suspension.named`, with the controller's ``delay`` for a closed loop."""
+def _named(name, gains, damper, damper_scale, sensor_noise, delay, sensing=None) -> Suspension:
+    """`Suspension.named`, with the controller's ``delay`` and ``sensing`` for a closed loop."""
     s = Suspension.named(name, gains, damper, damper_scale, sensor_noise=sensor_noise)
-    return s.with_delay(delay) if s.closed_loop else s
+    return s.with_delay(delay).with_sensing(sensing) if s.closed_loop else s
 
 
 #: the ideal devices `compare` runs beside the MR dampers: the best a damper could do with the

@@ -89,4 +89,15 @@ class Accelerometers:
         return np.random.default_rng(self.seed).standard_normal((n, 4)) * self.noise
 
 
+#: what a controller can measure: the exact states, or the carbody accelerometers
 SENSING = ("ideal", "accelerometers")
+
+
+def reads_bogies(G) -> bool:
+    """Whether an outer loop's gain G (4 x 6 on the carbody states, or 4 x 18 on (q, q'))
+    reads a bogie state, which the carbody accelerometers cannot give."""
+    G = np.asarray(G, dtype=float)
+    if G.shape != (4, 2 * kernels.N_DOF):
+        return False
+    n = kernels.N_DOF
+    return bool(np.any(G[:, 3:n] != 0.0) or np.any(G[:, n + 3 :] != 0.0))

@@ -10,6 +10,7 @@ import numpy as np
 from . import dampers, kernels
 from .defaults import DEFAULT_DT
 from .faults import fault_table
+from .sensing import reads_bogies
 from .params import VehicleParams
 from .solver import SolverSettings, check_resolution
 from .suspension import Suspension, batch_conflict
@@ -309,8 +310,7 @@ def simulate(
             gm[i] = _full_state_gains(G, c)
             modes[i] = dampers.VOLTAGE_LAWS.index(getattr(c, "voltage_law", "tracking"))
             if closed["sensing"] is not None:
-                bogie = np.r_[3:N_DOF, N_DOF + 3 : 2 * N_DOF]
-                if np.any(gm[i][:, bogie] != 0.0):
+                if reads_bogies(gm[i]):
                     raise ValueError(
                         f"sensing with controller {c.name!r}: it reads the bogies' states, and the "
                         "accelerometers are on the carbody only (railride.sensing)"
