@@ -33,7 +33,9 @@ from .faults import DamperFault, check_faults
 from .metrics import RESPONSES
 from .params import VehicleParams
 from .solver import SolverSettings
+from .sensing import SENSING, reads_bogies
 from .sweep import COMFORT_COLUMNS, Case, RunTable, run_cases
+from .vehicle import Vehicle
 
 #: the schema of `StudyResult.to_dict` (study.json)
 SCHEMA = "railride.study/1"
@@ -136,6 +138,7 @@ def study(
     loads=(1.0,),
     faults=(HEALTHY,),
     delays=(1,),
+    sensing: str = "ideal",
     duration: float | None = None,
     gains: GainSet | None = None,
     damper: str = DEFAULT_DAMPER,
@@ -152,7 +155,9 @@ def study(
     each load factor (`VehicleParams.loaded`), fault condition ("none", or faults such as
     "1R-off" joined by "+"; faults apply to the controlled suspensions, passive stays healthy)
     and controller delay (in controller periods, `Suspension.delay`; 1: a demand takes effect
-    one period after its sample),
+    one period after its sample), with every controller measuring through ``sensing``
+    ("ideal": the exact states; "accelerometers": `railride.sensing.Accelerometers` with the
+    default settings, their noise seeded per track seed),
     with ``gains`` (default the shipped gains: the controllers keep them whatever the load) and
     the ``damper`` model. Every setting is checked before the first run. ``executor``, ``table``
     and ``progress`` as for `railride.sweep.run_cases`. Returns a `StudyResult`."""
@@ -200,6 +205,16 @@ def study(
     ):
         if not values:
             raise ValueError(f"{name}: give at least one value")
+    validation.choice("sensing", sensing, SENSING)
+    if sensing != "ideal":
+        car = Vehicle(vehicle)
+        blind = [n for n in names if (c := gains.controller(n)) is not None and reads_bogies(c.gains(car)[0])]
+        if blind:
+            raise ValueError(
+                f"sensing = {sensing!r}: {', '.join(blind)} {'reads' if len(blind) == 1 else 'read'} the "
+                "bogies' states, and the accelerometers "
+                "are on the carbody only; leave them out"
+            )
     model = damper_model(damper, 1.0)
     for cond in conditions:
         if cond:
@@ -230,7 +245,17 @@ def study(
                 label = "+".join(cond) if cond else HEALTHY
                 for delay in delay_list:
                     for n in controlled:
-                        case = Case(scenario, options, vehicle=changes, suspension=n, damper=damper, faults=cond)
+                        case = Case(
+                            scenario,
+                            options,
+                            vehicle=changes,
+                            suspension=n,
+                            damper=damper,
+                            faults=cond,
+                            sensing=sensing if _closed(n) else "ideal",
+                            # the accelerometers' noise differs from track to track
+                            seed=seed if seed is not None and sensing != "ideal" and _closed(n) else 0,
+                        )
                         cases.append(replace(case, delay=delay) if _closed(n) else case)
                         meta.append((n, load, label, delay, seed, speed))
     rows = run_cases(
@@ -270,6 +295,7 @@ def study(
         "loads": load_list,
         "faults": ["+".join(c) if c else HEALTHY for c in conditions],
         "delays_periods": delay_list,
+        "sensing": sensing,
         "duration_s": duration,
         "damper": damper,
         "gains": gains.source,

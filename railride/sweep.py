@@ -90,6 +90,7 @@ class Case:
     damper_scale: float = 1.0
     faults: tuple = ()  # damper faults as their text, e.g. ("1R-off@2",) (`railride.faults`)
     delay: int = 1  # a controller's delay in controller periods (`Suspension.delay`)
+    sensing: str = "ideal"  # what a controller measures: "ideal" or "accelerometers" (`railride.sensing`)
 
     def __post_init__(self):
         from . import dampers
@@ -105,6 +106,10 @@ class Case:
                 self, name, tuple((str(k), float(v) if isinstance(v, (int, float)) else v) for k, v in value)
             )
         object.__setattr__(self, "noise", tuple(float(v) for v in self.noise))
+        from .sensing import SENSING
+
+        if self.sensing not in SENSING:
+            raise ValueError(f"sensing = {self.sensing!r}: allowed {', '.join(SENSING)}")
         from .faults import DamperFault
 
         faults = (self.faults,) if isinstance(self.faults, (str, DamperFault)) else self.faults
@@ -130,6 +135,10 @@ class Case:
         named = Suspension.named(self.suspension, gains, self.damper, self.damper_scale, self.voltage, noise)
         if self.delay != 1:
             named = named.with_delay(self.delay)
+        if self.sensing != "ideal":
+            from .sensing import Accelerometers
+
+            named = named.with_sensing(Accelerometers(seed=self.seed))
         return named.with_faults(self.faults) if self.faults else named
 
     def to_suspension(self, base_gains=None) -> Suspension:
@@ -160,6 +169,8 @@ class Case:
             del d["faults"]
         if d["delay"] == 1:
             del d["delay"]
+        if d["sensing"] == "ideal":
+            del d["sensing"]
         return d
 
     @property
@@ -174,6 +185,7 @@ class Case:
             self.damper if kind != "passive" else "",
             (self.noise, self.seed) if kind == "closed" else (),
             self.damper_scale if kind != "passive" else 1.0,
+            self.sensing if kind == "closed" else "ideal",  # one sensing model per batch
         )
 
 
@@ -264,6 +276,8 @@ def _flat(c: Case) -> dict:
         d["faults"] = ",".join(c.faults)
     if c.delay != 1:
         d["delay_periods"] = c.delay
+    if c.sensing != "ideal":
+        d["sensing"] = c.sensing
     d["case"] = json.dumps(c.to_dict(), sort_keys=True, default=str)
     return d
 

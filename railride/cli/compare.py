@@ -72,6 +72,15 @@ def _controller_list(text: str) -> list[str]:
         raise ValueError(f"--controllers = {text!r}: {exc}") from None
 
 
+def _sensing(name: str):
+    """--sensing ideal|accelerometers -> None or the default `railride.sensing.Accelerometers`."""
+    from ..sensing import SENSING, Accelerometers
+
+    if name not in SENSING:
+        raise ValueError(f"--sensing = {name!r}: allowed {', '.join(SENSING)}")
+    return None if name == "ideal" else Accelerometers()
+
+
 def _fault_list(text: Optional[str], damper: str, scale: float, dt: float, duration: float) -> tuple:
     """--fault CORNER-MODE[@S][,...] -> the checked `railride.faults.DamperFault` tuple."""
     from ..faults import DamperFault, check_faults, fault_table
@@ -151,6 +160,12 @@ def _compare_tables(doc: dict, vehicle: str, shipped: bool):
             "rate {angular_rate:g} rad/s, seed {seed}".format(**noise)
         )
         delay = settings.get("delay_periods", 1)
+        sensed = settings.get("sensing")
+        if sensed:
+            noise_text = (
+                f"accelerometers at the corners (noise {sensed['noise']:g} m/s^2, bias {sensed['bias']:g} m/s^2, "
+                f"anti-alias {sensed['antialias_hz']:g} Hz, band-limited integration from {sensed['cutoff_hz']:g} Hz)"
+            )
         info.append(
             f"{damper_text(settings)}, controller {settings['control_rate_hz']:g} Hz, "
             f"delay {delay} period{'s' * (delay != 1)}, {noise_text}"
@@ -365,6 +380,16 @@ def compare(
             "goes unstable is said, not run.",
         ),
     ] = None,
+    sensing: Annotated[
+        str,
+        typer.Option(
+            "--sensing",
+            metavar="ideal|accelerometers",
+            help="What the controllers measure: ideal (the exact states) or accelerometers (four "
+            "at the carbody corners, with noise, bias and an anti-alias filter, and band-limited "
+            "integration; docs/control.md). Laws that read the bogies do not run with accelerometers.",
+        ),
+    ] = "ideal",
     fault: Annotated[
         Optional[str],
         typer.Option(
@@ -448,6 +473,7 @@ def compare(
                 seed=seed,
                 fault=fault,
                 delay=delay,
+                sensing=None if sensing == "ideal" else sensing,
             )
             _league(
                 scenarios,
@@ -521,6 +547,7 @@ def compare(
                 progress=progress if progress.enabled else None,
                 faults=faults,
                 delay=1 if delay is None else delay,
+                sensing=_sensing(sensing),
             )
         doc = result.to_dict()
         text = json.dumps(doc, indent=2, allow_nan=False)  # refuses NaN before anything is written
@@ -587,6 +614,7 @@ def _league(
         "seed": "--seed",
         "fault": "--fault",
         "delay": "--delay",
+        "sensing": "--sensing",
     }
     for key, value in given.items():
         if value is not None:

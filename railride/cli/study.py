@@ -46,6 +46,7 @@ STUDY_FIELDS = {
     "faults": "--fault",
     "duration": "--duration",
     "delays": "--delay",
+    "sensing": "--sensing",
 }
 #: the metrics of the table, and their labels
 TABLE_METRICS = {
@@ -111,7 +112,8 @@ def _table(doc: dict):
     speeds = ", ".join(f"{v:g}" for v in s["speeds_m_s"])
     lines = [
         f"{s['scenario']} at {speeds} m/s" + (f", track seeds {', '.join(map(str, seeds))}" if seeds else "") + "; "
-        f"{s['damper']} dampers, gains {s['gains']} (kept for every load and fault).",
+        f"{s['damper']} dampers, gains {s['gains']} (kept for every load and fault); "
+        + ("exact states measured." if s.get("sensing", "ideal") == "ideal" else "accelerometers measured."),
         f"Mean and {lo:g}th to {hi:g}th percentile over the runs of each row (tracks and speeds). red. % = "
         "(passive - controlled) / passive x 100 on the same track, speed and load, run by run; passive "
         "is always healthy.",
@@ -182,6 +184,15 @@ def study_command(
             "(1: a demand takes effect one period after its sample). A run that diverges is listed.",
         ),
     ] = "1",
+    sensing: Annotated[
+        str,
+        typer.Option(
+            "--sensing",
+            metavar="ideal|accelerometers",
+            help="What the controllers measure: the exact states, or accelerometers at the carbody "
+            "corners with band-limited integration (docs/control.md).",
+        ),
+    ] = "ideal",
     duration: Annotated[
         Optional[float], typer.Option("--duration", metavar="S", help="Run length [s] (default 10).")
     ] = None,
@@ -232,6 +243,7 @@ def study_command(
                     loads=loads,
                     faults=faults,
                     delays=[int(d) for d in delays],
+                    sensing=sensing,
                     duration=duration,
                     gains=gain_set,
                     damper=damper,

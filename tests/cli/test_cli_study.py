@@ -50,3 +50,19 @@ def test_study_out_and_resume(tmp_path):
 )
 def test_study_bad_input(args, fragments):
     assert_input_error(run(*SHORT, *args), *fragments)
+
+
+def test_study_and_compare_with_accelerometers():
+    doc = ok_json(*SHORT, "--sensing", "accelerometers")
+    assert doc["settings"]["sensing"] == "accelerometers"
+    ideal = ok_json(*SHORT)
+    assert doc["results"] != ideal["results"]
+    assert_input_error(run(*SHORT, "--sensing", "gyros"), "--sensing = 'gyros'", "ideal, accelerometers")
+    assert_input_error(
+        run(*SHORT[:2], "pid,hybrid", *SHORT[3:], "--sensing", "accelerometers"), "hybrid reads the bogies"
+    )
+    cmp = ok_json("compare", "--duration", 1, "--controllers", "sas-attitude,hybrid", "--sensing", "accelerometers")
+    assert cmp["settings"]["sensing"]["kind"] == "accelerometers" and "hybrid" in cmp["settings"]["not_run"]
+    text = " ".join(ok("compare", "--duration", 1, "--sensing", "accelerometers").stdout.split())
+    assert "accelerometers at the corners" in text
+    assert_input_error(run("compare", "--duration", 1, "--sensing", "gyros"), "--sensing = 'gyros'")
