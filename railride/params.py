@@ -101,13 +101,21 @@ class VehicleParams:
         carbody = ("m_c", "I_cx", "I_cy", "I_cz")
         return self.replace(**{n: factor * getattr(self, n) for n in carbody})
 
-    def load_changes(self, load: float) -> tuple:
-        """The (field, value) changes `loaded` makes, as a sweep's `Case.vehicle` holds them;
-        none for a load factor of 1, so that the run keys of unloaded runs stay as they were."""
-        if load == 1.0:
-            return ()
-        loaded = self.loaded(load)
-        return tuple((n, getattr(loaded, n)) for n in ("m_c", "I_cx", "I_cy", "I_cz"))
+    def load_changes(self, load: float, stiffness: float = 1.0) -> tuple:
+        """The (field, value) changes of a payload (`loaded`) and of a secondary stiffness
+        tolerance (k_sz times ``stiffness``, a finite number > 0: 0.9 and 1.1 for +-10 %), as a
+        sweep's `Case.vehicle` holds them; none for factors of 1, so that the run keys of the
+        nominal vehicle stay as they were."""
+        from .validation import number
+
+        changes: tuple = ()
+        if load != 1.0:
+            loaded = self.loaded(load)
+            changes += tuple((n, getattr(loaded, n)) for n in ("m_c", "I_cx", "I_cy", "I_cz"))
+        k = number("stiffness", stiffness, "positive", allowed="a finite number > 0 (the factor on k_sz)")
+        if k != 1.0:
+            changes += (("k_sz", k * self.k_sz),)
+        return changes
 
     def to_dict(self) -> dict[str, float]:
         return dataclasses.asdict(self)

@@ -63,12 +63,13 @@ def fault_condition(text: str) -> tuple:
 @dataclass
 class StudyResult:
     """The result of `study`. ``cases``: one row per run (the run table's metrics, with the
-    study's ``controller``, ``load``, ``fault``, ``delay``, ``track_seed`` and ``speed_m_s`` and, for the
-    controlled runs, each metric's reduction in % against passive on the same track, speed and
-    load, ``<metric>_reduction``). ``summary``: one row per controller, condition (load, fault,
-    delay) and metric: ``n`` (runs that did not diverge), ``mean``, ``p5``, ``p95`` of the value and
-    ``reduction_mean``, ``reduction_p5``, ``reduction_p95``. ``failed``: the runs that diverged
-    (controller, condition, seed, speed, time). ``settings``: what was run."""
+    study's ``controller``, ``load``, ``stiffness``, ``fault``, ``delay``, ``track_seed`` and
+    ``speed_m_s`` and, for the controlled runs, each metric's reduction in % against passive on
+    the same track, speed, load and stiffness, ``<metric>_reduction``). ``summary``: one row per
+    controller, condition (load, stiffness, fault, delay) and metric: ``n`` (runs that did not
+    diverge), ``mean``, ``p5``, ``p95`` of the value and ``reduction_mean``, ``reduction_p5``,
+    ``reduction_p95``. ``failed``: the runs that diverged (controller, condition, seed, speed,
+    time). ``settings``: what was run."""
 
     cases: pd.DataFrame
     summary: pd.DataFrame
@@ -81,8 +82,8 @@ class StudyResult:
         from . import __version__
 
         groups = []
-        for (name, load, fault, delay), part in self.summary.groupby(
-            ["controller", "load", "fault", "delay"], sort=False
+        for (name, load, k, fault, delay), part in self.summary.groupby(
+            ["controller", "load", "stiffness", "fault", "delay"], sort=False
         ):
             metrics = {}
             for _, row in part.iterrows():
@@ -91,7 +92,14 @@ class StudyResult:
                     for k in ("n", "mean", "p5", "p95", "reduction_mean", "reduction_p5", "reduction_p95")
                 }
             groups.append(
-                {"controller": name, "load": float(load), "fault": fault, "delay": int(delay), "metrics": metrics}
+                {
+                    "controller": name,
+                    "load": float(load),
+                    "stiffness": float(k),
+                    "fault": fault,
+                    "delay": int(delay),
+                    "metrics": metrics,
+                }
             )
         return {
             "schema": SCHEMA,
@@ -136,6 +144,7 @@ def study(
     track_seeds=None,
     speeds=None,
     loads=(1.0,),
+    stiffness=(1.0,),
     faults=(HEALTHY,),
     delays=(1,),
     sensing: str = "ideal",
@@ -152,7 +161,8 @@ def study(
     """Run ``controllers`` (names of `railride.control.CONTROLLERS`; passive is always the
     baseline) on ``scenario`` for every track seed (a random track's realisation; default 0 to
     9, none for the other scenarios) and speed (m/s; None: the scenario's), for
-    each load factor (`VehicleParams.loaded`), fault condition ("none", or faults such as
+    each load factor (`VehicleParams.loaded`), secondary stiffness factor (k_sz times it: a
+    tolerance; `VehicleParams.load_changes`), fault condition ("none", or faults such as
     "1R-off" joined by "+"; faults apply to the controlled suspensions, passive stays healthy)
     and controller delay (in controller periods, `Suspension.delay`; 1: a demand takes effect
     one period after its sample), with every controller measuring through ``sensing``
@@ -186,6 +196,10 @@ def study(
     load_list = [
         validation.number("loads", v, "positive", allowed="a finite number > 0 (load factor)") for v in _items(loads)
     ]
+    stiffness_list = [
+        validation.number("stiffness", v, "positive", allowed="a finite number > 0 (the factor on k_sz)")
+        for v in _items(stiffness)
+    ]
     conditions = []
     for f in _items(faults):
         try:
@@ -200,6 +214,7 @@ def study(
         ("track_seeds", seeds),
         ("speeds", speed_list),
         ("loads", load_list),
+        ("stiffness", stiffness_list),
         ("faults", conditions),
         ("delays", delay_list),
     ):
@@ -236,11 +251,11 @@ def study(
             opts_of[(seed, v)] = (tuple(sorted(opts.items())), sc.speed)
     cases, meta = [], []
     controlled = [n for n in names if n != "passive"]
-    for load in load_list:
-        changes = vehicle.load_changes(load)
+    for load, k in [(load, k) for load in load_list for k in stiffness_list]:
+        changes = vehicle.load_changes(load, k)
         for (seed, v), (options, speed) in opts_of.items():
             cases.append(Case(scenario, options, vehicle=changes))
-            meta.append(("passive", load, HEALTHY, 1, seed, speed))
+            meta.append(("passive", load, k, HEALTHY, 1, seed, speed))
             for cond in conditions:
                 label = "+".join(cond) if cond else HEALTHY
                 for delay in delay_list:
@@ -257,7 +272,7 @@ def study(
                             seed=seed if seed is not None and sensing != "ideal" and _closed(n) else 0,
                         )
                         cases.append(replace(case, delay=delay) if _closed(n) else case)
-                        meta.append((n, load, label, delay, seed, speed))
+                        meta.append((n, load, k, label, delay, seed, speed))
     rows = run_cases(
         cases,
         executor=executor,
@@ -270,14 +285,15 @@ def study(
         comfort=True,
     )
     frame = rows.reset_index(drop=True).copy()
-    info = pd.DataFrame(meta, columns=["controller", "load", "fault", "delay", "track_seed", "speed_m_s"])
+    info = pd.DataFrame(meta, columns=["controller", "load", "stiffness", "fault", "delay", "track_seed", "speed_m_s"])
     frame = pd.concat([info, frame.drop(columns=[c for c in info.columns if c in frame.columns])], axis=1)
     frame = _reductions(frame)
-    summary = _summary(frame, names, load_list, conditions, delay_list)
+    summary = _summary(frame, names, load_list, stiffness_list, conditions, delay_list)
     failed = [
         {
             "controller": r.controller,
             "load": float(r.load),
+            "stiffness": float(r.stiffness),
             "fault": r.fault,
             "delay_periods": int(r.delay),
             "track_seed": None if r.track_seed is None or r.track_seed != r.track_seed else int(r.track_seed),
@@ -293,6 +309,7 @@ def study(
         "track_seeds": seeds if random else None,
         "speeds_m_s": sorted({s for _, s in opts_of.values()}),
         "loads": load_list,
+        "stiffness": stiffness_list,
         "faults": ["+".join(c) if c else HEALTHY for c in conditions],
         "delays_periods": delay_list,
         "sensing": sensing,
@@ -319,7 +336,7 @@ def _items(values) -> list:
 
 def _reductions(frame: pd.DataFrame) -> pd.DataFrame:
     """Each controlled run's reduction in % against passive on the same track, speed and load."""
-    key = ["load", "track_seed", "speed_m_s"]
+    key = ["load", "stiffness", "track_seed", "speed_m_s"]
     keys = frame[key].astype(float).fillna(-1.0)  # no seed (not a random track): one key
     passive = frame[list(METRICS)][frame["controller"] == "passive"].set_index(
         pd.MultiIndex.from_frame(keys[frame["controller"] == "passive"])
@@ -335,14 +352,19 @@ def _reductions(frame: pd.DataFrame) -> pd.DataFrame:
     return out
 
 
-def _summary(frame: pd.DataFrame, names, loads, conditions, delays) -> pd.DataFrame:
+def _summary(frame: pd.DataFrame, names, loads, stiffness, conditions, delays) -> pd.DataFrame:
     rows = []
     labels = ["+".join(c) if c else HEALTHY for c in conditions]
     lo, hi = PERCENTILES
     for name in names:
-        for load in loads:
+        for load, k in [(load, k) for load in loads for k in stiffness]:
             for label, delay in [(HEALTHY, 1)] if name == "passive" else [(f, d) for f in labels for d in delays]:
-                part = frame[(frame["controller"] == name) & (frame["load"] == load) & (frame["fault"] == label)]
+                part = frame[
+                    (frame["controller"] == name)
+                    & (frame["load"] == load)
+                    & (frame["stiffness"] == k)
+                    & (frame["fault"] == label)
+                ]
                 part = part[(part["delay"] == delay) & ~np.isfinite(part["diverged_at_s"])]
                 for m in METRICS:
                     x = part[m].to_numpy(dtype=float)
@@ -352,6 +374,7 @@ def _summary(frame: pd.DataFrame, names, loads, conditions, delays) -> pd.DataFr
                         {
                             "controller": name,
                             "load": load,
+                            "stiffness": k,
                             "fault": label,
                             "delay": delay,
                             "metric": m,

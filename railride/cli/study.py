@@ -42,6 +42,7 @@ STUDY_FIELDS = {
     "track_seeds": "--track-seed",
     "speeds": "--speed",
     "loads": "--load",
+    "stiffness": "--stiffness",
     "fault": "--fault",
     "faults": "--fault",
     "duration": "--duration",
@@ -85,6 +86,7 @@ def _table(doc: dict):
     table = Table(title=f"Statistics over {over}")
     table.add_column("suspension", no_wrap=True)
     table.add_column("load", justify="right")
+    table.add_column("k_sz x", justify="right")
     table.add_column("fault")
     table.add_column("delay", justify="right")
     table.add_column("metric")
@@ -100,6 +102,7 @@ def _table(doc: dict):
             table.add_row(
                 escape(LABELS[group["controller"]]) if i == 0 else "",
                 f"{group['load']:g}" if i == 0 else "",
+                f"{group['stiffness']:g}" if i == 0 else "",
                 group["fault"] if i == 0 else "",
                 str(group["delay"]) if i == 0 else "",
                 label,
@@ -166,6 +169,14 @@ def study_command(
             help="Load factors: the carbody's mass and inertias times X (1: as the parameters give them).",
         ),
     ] = "1",
+    stiffness: Annotated[
+        str,
+        typer.Option(
+            "--stiffness",
+            metavar="X[,X...]",
+            help="Secondary stiffness tolerance: k_sz times X (e.g. 0.9,1,1.1). Default 1.",
+        ),
+    ] = "1",
     fault: Annotated[
         str,
         typer.Option(
@@ -221,6 +232,7 @@ def study_command(
         seeds = value_list("--track-seed", track_seed, integer=True) if track_seed is not None else None
         speeds = value_list("--speed", speed) if speed is not None else None
         loads = value_list("--load", load)
+        stiffness_factors = value_list("--stiffness", stiffness)
         faults = _faults(fault)
         delays = value_list("--delay", delay, integer=True)
         damper_preset("--damper", damper)
@@ -241,6 +253,7 @@ def study_command(
                     track_seeds=None if seeds is None else [int(s) for s in seeds],
                     speeds=speeds,
                     loads=loads,
+                    stiffness=stiffness_factors,
                     faults=faults,
                     delays=[int(d) for d in delays],
                     sensing=sensing,

@@ -29,7 +29,7 @@ def plot_study(result, ax=None, metrics=None):
         raise ValueError(f"metrics: {unknown[0]!r} is not a metric of the study; allowed {', '.join(DEFAULT_METRICS)}")
     controlled = [n for n in dict.fromkeys(summary["controller"]) if n != "passive"]
     part = summary[summary["controller"] != "passive"]
-    conditions = list(dict.fromkeys(zip(part["load"], part["fault"], part["delay"])))
+    conditions = list(dict.fromkeys(zip(part["load"], part["stiffness"], part["fault"], part["delay"])))
     if ax is None:
         fig = new_figure((3.4 * len(metrics) + 0.6, 3.6))
         axes = fig.subplots(1, len(metrics), squeeze=False).ravel()
@@ -39,7 +39,7 @@ def plot_study(result, ax=None, metrics=None):
     width = 0.8 / max(1, len(controlled))
     x = np.arange(len(conditions))
     for a, metric in zip(axes, metrics):
-        rows = part[part["metric"] == metric].set_index(["controller", "load", "fault", "delay"])
+        rows = part[part["metric"] == metric].set_index(["controller", "load", "stiffness", "fault", "delay"])
         for k, name in enumerate(controlled):
             mean = np.array([rows.loc[(name, *c), "reduction_mean"] for c in conditions], dtype=float)
             lo = np.array([rows.loc[(name, *c), "reduction_p5"] for c in conditions], dtype=float)
@@ -72,5 +72,10 @@ def plot_study(result, ax=None, metrics=None):
     return fig
 
 
-def _condition_label(load: float, fault: str, delay: int) -> str:
-    return f"load {load:g}" + ("" if fault == "none" else f"\n{fault}") + ("" if delay == 1 else f"\ndelay {delay}")
+def _condition_label(load: float, stiffness: float, fault: str, delay: int) -> str:
+    return (
+        f"load {load:g}"
+        + ("" if stiffness == 1.0 else f"\nk_sz x {stiffness:g}")
+        + ("" if fault == "none" else f"\n{fault}")
+        + ("" if delay == 1 else f"\ndelay {delay}")
+    )

@@ -66,3 +66,9 @@ def test_study_and_compare_with_accelerometers():
     text = " ".join(ok("compare", "--duration", 1, "--sensing", "accelerometers").stdout.split())
     assert "accelerometers at the corners" in text
     assert_input_error(run("compare", "--duration", 1, "--sensing", "gyros"), "--sensing = 'gyros'")
+
+
+def test_study_stiffness_tolerance():
+    doc = ok_json(*SHORT, "--stiffness", "0.9,1.1")
+    assert doc["settings"]["stiffness"] == [0.9, 1.1] and {g["stiffness"] for g in doc["results"]} == {0.9, 1.1}
+    assert_input_error(run(*SHORT, "--stiffness", "-1"), "--stiffness", "> 0")

@@ -123,7 +123,7 @@ def test_the_result_protocol(small, tmp_path):
     assert json.loads(json.dumps(doc, allow_nan=False)) == doc
     pid = next(g for g in doc["results"] if g["controller"] == "pid" and g["fault"] == "1R-off" and g["load"] == 1.3)
     assert set(pid["metrics"]) == set(METRICS) and pid["metrics"]["roll_deg_rms"]["n"] == 6
-    assert list(small.to_pandas().columns[:5]) == ["controller", "load", "fault", "delay", "metric"]
+    assert list(small.to_pandas().columns[:6]) == ["controller", "load", "stiffness", "fault", "delay", "metric"]
     assert isinstance(small.plot(), Figure)
     mine = Figure()
     assert small.plot(ax=mine.subplots(1, 2), metrics=["roll_deg_rms", "centre_N_MV_z"]) is mine
@@ -139,3 +139,17 @@ def test_a_study_on_a_sine_runs_over_speeds_alone():
     assert row["n"] == 2 and np.isfinite(row["reduction_mean"])
     with pytest.raises(ValueError, match=r"track_seeds = \[1\]: track seeds apply to the random tracks"):
         study(["pid"], scenario="paper-sine", track_seeds=[1])
+
+
+def test_a_secondary_stiffness_tolerance_is_a_condition_of_its_own():
+    res = study(["pid"], track_seeds=[0], speeds=[40.0], stiffness=[0.9, 1.1], duration=1.0)
+    c = res.cases
+    assert sorted(c[c.controller == "passive"]["vehicle.k_sz"]) == pytest.approx([0.9 * 2.9e5, 1.1 * 2.9e5])
+    # each controlled run against the passive run of the same stiffness
+    for k in (0.9, 1.1):
+        p = c[(c.controller == "passive") & (c.stiffness == k)]["roll_deg_rms"].iloc[0]
+        x = c[(c.controller == "pid") & (c.stiffness == k)]
+        assert x["roll_deg_rms_reduction"].iloc[0] == pytest.approx((p - x["roll_deg_rms"].iloc[0]) / p * 100)
+    assert {g["stiffness"] for g in res.to_dict()["results"]} == {0.9, 1.1}
+    with pytest.raises(ValueError, match="stiffness = 0.0: must be a finite number > 0"):
+        study(["pid"], track_seeds=[0], stiffness=[0.0])
