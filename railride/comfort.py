@@ -287,7 +287,8 @@ def vdv(acceleration, rate_hz: float, weighting: str = "Wk", window=None):
     """Vibration dose value VDV [m/s^1.75] (ISO 2631-1, 6.3.2):
     VDV = [ integral a_w(t)^4 dt ]^(1/4), the integral a rectangle sum with dt = 1/rate_hz."""
     x, rate = _weighted_part(acceleration, rate_hz, weighting, window)
-    return _scalar(np.sum(x**4, axis=-1) / rate) ** 0.25
+    x2 = x * x  # (x^2)^2: two products, far cheaper than a power
+    return _scalar(np.sum(x2 * x2, axis=-1) / rate) ** 0.25
 
 
 def _scalar(v):

@@ -34,7 +34,7 @@ from .metrics import RESPONSES
 from .params import VehicleParams
 from .solver import SolverSettings
 from .sensing import SENSING, reads_bogies
-from .sweep import COMFORT_COLUMNS, Case, RunTable, run_cases
+from .sweep import COMFORT_COLUMNS, Case, RunTable, cached_scenario, run_cases
 from .vehicle import Vehicle
 
 #: the schema of `StudyResult.to_dict` (study.json)
@@ -175,7 +175,6 @@ def study(
     from .suspension import damper_model
     from .sweep import other_settings
     from .track import SPECTRA
-    from .track import scenario as make_scenario
 
     names = check_controllers(controllers)
     solver = SolverSettings.of(solver)
@@ -242,7 +241,7 @@ def study(
                 **({"speed": v} if v is not None else {}),
                 **({"duration": duration} if duration else {}),
             }
-            sc = make_scenario(scenario, **opts)
+            sc = cached_scenario(scenario, tuple(sorted(opts.items())))
             for cond in conditions:
                 try:
                     fault_table([[DamperFault.parse(f) for f in cond]], solver.dt, sc.duration)

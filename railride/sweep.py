@@ -17,6 +17,7 @@ of every combination, checked before the first run; `run_sweep` runs them and re
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import json
 import math
@@ -189,6 +190,21 @@ class Case:
         )
 
 
+def cached_scenario(name: str, options):
+    """`railride.track.scenario` of a case's scenario and options (pairs, as `Case` holds
+    them), kept for the next chunk and the next call: a random track is synthesised once per
+    seed and options, not once per chunk (the scenarios are frozen values)."""
+    key = tuple(sorted((str(k), float(v) if isinstance(v, (int, float)) else v) for k, v in options))
+    return _scenario(name, key)
+
+
+@functools.lru_cache(maxsize=256)
+def _scenario(name: str, options: tuple):
+    from .track import scenario as make_scenario
+
+    return make_scenario(name, **dict(options))
+
+
 def evaluate(
     cases: list[Case], base_gains=None, *, params=None, solver=None, window=None, comfort: bool = False
 ) -> list[dict]:
@@ -200,12 +216,10 @@ def evaluate(
     `SolverSettings` of every run. Runs in any process: a Dask worker calls it too."""
     from .control import GainSet
     from .simulation import simulate
-    from .track import scenario as make_scenario
 
     base_gains = GainSet.default() if base_gains is None else base_gains
     vehicle = VehicleParams.of(params)
     solver = SolverSettings.of(solver)
-    scenarios: dict = {}
     rows: dict[int, dict] = {}
     by_group: dict[tuple, list[int]] = {}
     for i, c in enumerate(cases):
@@ -213,12 +227,7 @@ def evaluate(
     for group, idx in by_group.items():
         for start in range(0, len(idx), CHUNK):
             part = [cases[i] for i in idx[start : start + CHUNK]]
-            scs = []
-            for c in part:
-                skey = (c.scenario, c.scenario_options)
-                if skey not in scenarios:
-                    scenarios[skey] = make_scenario(c.scenario, **dict(c.scenario_options))
-                scs.append(scenarios[skey])
+            scs = [cached_scenario(c.scenario, c.scenario_options) for c in part]
             pars = [vehicle.replace(**dict(c.vehicle)) for c in part]
             suspensions = [c.to_suspension(base_gains) for c in part]
             if batch_conflict(suspensions) is not None:  # the inner loop is one setting per batch
