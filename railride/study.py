@@ -233,21 +233,27 @@ def study(
     for cond in conditions:
         if cond:
             check_faults(cond, model)
-    opts_of: dict[tuple, tuple] = {}
-    for seed in seeds:  # every scenario is built (and checked) before the first run
-        for v in speed_list:
-            opts: dict[str, Any] = {
-                **({"seed": seed} if seed is not None else {}),
-                **({"speed": v} if v is not None else {}),
-                **({"duration": duration} if duration else {}),
-            }
-            sc = cached_scenario(scenario, tuple(sorted(opts.items())))
-            for cond in conditions:
-                try:
-                    fault_table([[DamperFault.parse(f) for f in cond]], solver.dt, sc.duration)
-                except ValueError as exc:
-                    raise ValueError(f"faults = {'+'.join(cond)!r}: {exc}") from None
-            opts_of[(seed, v)] = (tuple(sorted(opts.items())), sc.speed)
+
+    def options_of(seed, v) -> tuple:
+        opts: dict[str, Any] = {
+            **({"seed": seed} if seed is not None else {}),
+            **({"speed": v} if v is not None else {}),
+            **({"duration": duration} if duration else {}),
+        }
+        return tuple(sorted(opts.items()))
+
+    # every setting is checked before the first run: the scenario at each speed (the seeds
+    # differ in the realisation only), and every fault time against its duration
+    speed_of = {}
+    for v in speed_list:
+        sc = cached_scenario(scenario, options_of(seeds[0], v))
+        for cond in conditions:
+            try:
+                fault_table([[DamperFault.parse(f) for f in cond]], solver.dt, sc.duration)
+            except ValueError as exc:
+                raise ValueError(f"faults = {'+'.join(cond)!r}: {exc}") from None
+        speed_of[v] = sc.speed
+    opts_of = {(seed, v): (options_of(seed, v), speed_of[v]) for seed in seeds for v in speed_list}
     cases, meta = [], []
     controlled = [n for n in names if n != "passive"]
     for load, k in [(load, k) for load in load_list for k in stiffness_list]:

@@ -192,13 +192,13 @@ class Case:
 
 def cached_scenario(name: str, options):
     """`railride.track.scenario` of a case's scenario and options (pairs, as `Case` holds
-    them), kept for the next chunk and the next call: a random track is synthesised once per
-    seed and options, not once per chunk (the scenarios are frozen values)."""
+    them), the last 32 kept for the next chunk and the next call: a random track is not
+    synthesised again for every chunk that meets it (the scenarios are frozen values)."""
     key = tuple(sorted((str(k), float(v) if isinstance(v, (int, float)) else v) for k, v in options))
     return _scenario(name, key)
 
 
-@functools.lru_cache(maxsize=256)
+@functools.lru_cache(maxsize=32)  # a random track holds a few MB: bounded, as a study's memory
 def _scenario(name: str, options: tuple):
     from .track import scenario as make_scenario
 
