@@ -179,12 +179,30 @@ class Comparison:
         return None if controller is None else controller.to_dict()
 
     @property
+    def paper_case(self) -> bool:
+        """Whether this is the case of the paper's Table 1: its scenario (`paper-sine` with its
+        settings, any duration) at its speed, with its vehicle. Only then is the paper's table
+        a reference for these numbers."""
+        from .params import VehicleParams
+        from .track import scenario as make_scenario
+
+        def track(record):
+            return {k: v for k, v in (record or {}).items() if k != "duration_s"}
+
+        paper = make_scenario("paper-sine").describe()
+        vehicle = self.settings.get("vehicle_params")
+        return track(self.settings.get("scenario")) == track(paper) and (
+            vehicle is None or vehicle == VehicleParams.preset("paper").to_dict()
+        )
+
+    @property
     def in_sample(self) -> bool:
         """Whether the gains were tuned on this very track (their provenance says so)."""
         return self.gains.tuned_on(self.settings.get("scenario"))
 
     def to_dict(self) -> dict:
         """The JSON summary (schema railride.comparison/1, docs/cli.md)."""
+        paper_case = self.paper_case
         red = self.reductions
         rows = []
         demands = self.demands()
@@ -210,7 +228,7 @@ class Comparison:
                     }
                     for r in PAPER_TABLE1
                 }
-                if name in PAPER_CONTROLLERS
+                if name in PAPER_CONTROLLERS and paper_case
                 else None
             )
             if self.comfort is not None:  # only when computed: the schema stays as it was
@@ -222,6 +240,7 @@ class Comparison:
             "schema": "railride.comparison/1",
             "railride_version": __version__,
             "settings": self.settings,
+            "paper_case": paper_case,
             "controllers": rows,
             "trade_offs": self.trade_offs(),
             "bounds": self.bounds_record(),

@@ -406,3 +406,22 @@ def test_compare_with_a_fault_prints_the_degradation():
 )
 def test_compare_refuses_bad_faults(args, fragments):
     assert_input_error(run("compare", "--duration", 2, *args), *fragments)
+
+
+@pytest.mark.parametrize(
+    "args, paper",
+    [
+        ((), True),
+        (("--speed", "40"), False),
+        (("--wavelength", "40"), False),
+        (("--load", "1.3"), False),
+        (("--scenario", "fra4"), False),
+    ],
+)
+def test_the_papers_table_stands_beside_the_papers_case_only(args, paper):
+    doc = ok_json("compare", "--duration", 1, *args)
+    assert doc["paper_case"] is paper
+    assert all((r["paper"] is not None) is paper for r in doc["controllers"])
+    text = " ".join(ok("compare", "--duration", 1, *args).stdout.split())
+    assert ("beside the paper's Table 1" in text) is paper
+    assert ("No published reference exists for this case" in text) is not paper
