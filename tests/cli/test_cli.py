@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from clihelp import assert_input_error, run
+from clihelp import assert_input_error, ok, run
 
 
 METRIC_KEYS = {"acceleration_m_s2", "displacement_m", "pitch_deg", "roll_deg"}
@@ -331,3 +331,14 @@ def test_module_entry_point_error_path():
 def test_no_args_shows_help():
     result = run()
     assert "modes" in result.output and "simulate" in result.output
+
+
+def test_version_and_python_dash_m():
+    import subprocess
+    import sys
+
+    from railride import __version__
+
+    assert ok("--version").stdout.strip() == f"railride {__version__}"
+    out = subprocess.run([sys.executable, "-m", "railride", "--version"], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == f"railride {__version__}"
