@@ -224,7 +224,13 @@ SweepDamperOption = _damper(
 )
 #: damper and tracking: the damper on the rig
 RigModelOption = Annotated[
-    str, typer.Option("--model", metavar="MODEL", help="Damper model: railway, dyke1996 or spencer1997.")
+    str,
+    typer.Option(
+        "--damper",
+        "--model",
+        metavar="MODEL",
+        help="Damper model: railway, dyke1996 or spencer1997 (--model: the older name of the option).",
+    ),
 ]
 
 

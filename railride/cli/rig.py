@@ -70,7 +70,7 @@ def damper(
         from .. import rig
         from ..files import check_out_dir
 
-        damper_model = damper_preset("--model", model, rig=True)
+        damper_model = damper_preset("--damper", model, rig=True)
         volts = parse_voltages("--voltage", voltage, damper_model)
         if out is not None:
             check_out_dir(out)
@@ -166,7 +166,7 @@ def tracking(
         from .. import rig
         from ..files import check_out_dir
 
-        damper_model = damper_preset("--model", model, rig=True)
+        damper_model = damper_preset("--damper", model, rig=True)
         if out is not None:
             check_out_dir(out)
         with status_note("tracking..."):

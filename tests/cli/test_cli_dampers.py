@@ -57,7 +57,7 @@ def test_damper_table():
 @pytest.mark.parametrize(
     "args, fragments",
     [
-        (("--model", "nope", "--voltage", "1"), ("--model", "nope", "railway")),
+        (("--model", "nope", "--voltage", "1"), ("--damper", "nope", "railway")),
         (("--voltage", "3"), ("--voltage", "3", "2.25")),
         (("--voltage", "-0.5"), ("--voltage", "-0.5")),
         (("--voltage", "0,abc"), ("--voltage", "abc")),
@@ -192,7 +192,7 @@ def test_tracking_table():
         (("--amplitude", "-5"), ("--amplitude", "-5")),
         (("--frequency", "0"), ("--frequency",)),
         (("--cycles", "1"), ("--cycles", "1")),
-        (("--model", "magic"), ("--model", "magic")),
+        (("--damper", "magic"), ("--damper", "magic")),
         (("--B", "-1"), ("--B", "-1")),
         (("--G", "nan"), ("--G", "nan")),
         (("--stroke", "0"), ("--stroke",)),

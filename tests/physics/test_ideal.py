@@ -234,7 +234,7 @@ def _input_error(args, *fragments):
             ("damper", "--model", "ideal", "--amplitude", 0.01, "--frequency", 1, "--voltage", 0),
             ("--model = 'ideal'", "rig", "allowed: dyke1996, railway, spencer1997"),
         ),
-        (("tracking", "--model", "ideal"), ("--model = 'ideal'", "rig")),
+        (("tracking", "--model", "ideal"), ("--damper = 'ideal'", "rig")),
         (("compare", "--damper", "ideal", "--damper-scale", 2), ("--damper-scale = 2", "ideal")),
         (("sweep", "--suspension", "mr,pid", "--damper", "ideal"), ("--damper = 'ideal'", "mr")),
         (("sweep", "--suspension", "pid", "--damper", "ideal", "--damper-scale", "1,2"), ("--damper-scale", "ideal")),
