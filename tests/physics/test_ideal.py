@@ -231,8 +231,8 @@ def _input_error(args, *fragments):
     [
         (("simulate", "--suspension", "mr", "--damper", "ideal"), ("--damper = 'ideal'", "controller")),
         (
-            ("damper", "--model", "ideal", "--amplitude", 0.01, "--frequency", 1, "--voltage", 0),
-            ("--model = 'ideal'", "rig", "allowed: dyke1996, railway, spencer1997"),
+            ("damper", "--damper", "ideal", "--amplitude", 0.01, "--frequency", 1, "--voltage", 0),
+            ("--damper = 'ideal'", "rig", "allowed: dyke1996, railway, spencer1997"),
         ),
         (("tracking", "--model", "ideal"), ("--damper = 'ideal'", "rig")),
         (("compare", "--damper", "ideal", "--damper-scale", 2), ("--damper-scale = 2", "ideal")),
