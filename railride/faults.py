@@ -66,10 +66,9 @@ class DamperFault:
         return f"{self.corner}-{self.mode}" + (f"@{self.time:g}" if self.time else "")
 
 
-def check_faults(faults, model) -> tuple:
-    """``faults`` (DamperFault or their text, e.g. "1R-off") as a tuple of `DamperFault` in
-    corner order, checked against the damper ``model`` of the suspension (None: the vehicle's
-    passive dampers); one fault per corner."""
+def parse_faults(faults) -> tuple:
+    """``faults`` (DamperFault or their text, e.g. "1R-off", or a sequence of them) as a tuple
+    of `DamperFault` in corner order; one fault per corner."""
     if faults is None:
         return ()
     if isinstance(faults, (str, DamperFault)):
@@ -79,6 +78,13 @@ def check_faults(faults, model) -> tuple:
     twice = sorted({c for c in corners if corners.count(c) > 1})
     if twice:
         raise ValueError(f"faults: corner {twice[0]} has more than one fault; give one per corner")
+    return tuple(sorted(out, key=lambda f: CORNER_NAMES.index(f.corner)))
+
+
+def check_faults(faults, model) -> tuple:
+    """`parse_faults`, checked against the damper ``model`` of the suspension (None: the
+    vehicle's passive dampers)."""
+    out = parse_faults(faults)
     if out and model is None:
         raise ValueError(
             "faults apply to the dampers the engine steps (MR, ideal, or a railride.dampers.Viscous); "
@@ -91,7 +97,7 @@ def check_faults(faults, model) -> tuple:
                 f"fault {f.label!r}: 'off' and 'on' need MR dampers (a coil to fail); "
                 f"damper {getattr(model, 'model', model)!r} can only be 'disconnected'"
             )
-    return tuple(sorted(out, key=lambda f: CORNER_NAMES.index(f.corner)))
+    return out
 
 
 def fault_table(faults_per_sample, dt: float, duration: float):

@@ -29,7 +29,7 @@ from . import validation
 from .comparison import check_controllers
 from .control import PAPER_CONTROLLERS, GainSet
 from .defaults import DEFAULT_DAMPER
-from .faults import DamperFault, check_faults
+from .faults import DamperFault, check_faults, parse_faults
 from .metrics import RESPONSES
 from .params import VehicleParams
 from .solver import SolverSettings
@@ -49,15 +49,9 @@ HEALTHY = "none"
 
 def fault_condition(text: str) -> tuple:
     """One fault condition: "none", or faults joined by "+" (e.g. "1R-off" or "1R-off+2L-on@2"),
-    as their labels in corner order."""
+    as their labels in corner order (`railride.faults.parse_faults`)."""
     text = str(text).strip()
-    if text == HEALTHY:
-        return ()
-    faults = [DamperFault.parse(item) for item in text.split("+")]
-    corners = [f.corner for f in faults]
-    if len(set(corners)) != len(corners):
-        raise ValueError(f"fault = {text!r}: one fault per corner")
-    return tuple(f.label for f in sorted(faults, key=lambda f: "1R 1L 2R 2L".split().index(f.corner)))
+    return () if text == HEALTHY else tuple(f.label for f in parse_faults(text.split("+")))
 
 
 @dataclass
@@ -265,18 +259,11 @@ def study(
                 label = "+".join(cond) if cond else HEALTHY
                 for delay in delay_list:
                     for n in controlled:
-                        case = Case(
-                            scenario,
-                            options,
-                            vehicle=changes,
-                            suspension=n,
-                            damper=damper,
-                            faults=cond,
-                            sensing=sensing if _closed(n) else "ideal",
-                            # the accelerometers' noise differs from track to track
-                            seed=seed if seed is not None and sensing != "ideal" and _closed(n) else 0,
-                        )
-                        cases.append(replace(case, delay=delay) if _closed(n) else case)
+                        case = Case(scenario, options, vehicle=changes, suspension=n, damper=damper, faults=cond)
+                        if case.closed_loop:  # the accelerometers' noise differs from track to track
+                            noise_seed = seed if seed is not None and sensing != "ideal" else 0
+                            case = replace(case, delay=delay, sensing=sensing, seed=noise_seed)
+                        cases.append(case)
                         meta.append((n, load, k, label, delay, seed, speed))
     rows = run_cases(
         cases,
@@ -325,12 +312,6 @@ def study(
         **other_settings(vehicle, solver),
     }
     return StudyResult(frame, summary, settings, failed)
-
-
-def _closed(name: str) -> bool:
-    from .control import CONSTANT_VOLTAGE
-
-    return name not in CONSTANT_VOLTAGE and name not in ("passive", "mr")
 
 
 def _items(values) -> list:

@@ -47,7 +47,7 @@ from .objectives import (  # noqa: F401 (re-exported: the objectives' old home)
     RATIO_NAMES,
     Objective,
 )
-from . import validation
+from . import dampers, validation
 from .solver import SolverSettings, check_resolution
 from .sweep import Case, RunTable, run_cases
 from .tune_result import SCHEMA, Curve, Study, TuneResult  # noqa: F401 (their home before)
@@ -202,7 +202,6 @@ def tune(
     or "worst"). The budget still counts gain sets; each costs one run per case. No
     before/after rows (they belong to one scenario). Returns a `TuneResult`.
     """
-    from . import dampers
     from .suspension import damper_model
     from .sweep import other_settings
     from .track import scenario as make_scenario
@@ -393,7 +392,7 @@ def _before_after(result: TuneResult, run, case, tuned: dict, inner: dict, dampe
     names = [
         n
         for n in TUNED_CONTROLLERS
-        if n in tuned or (inner and "inner" in GainSet.tables_read(n) and damper not in ("ideal", "ideal-damper"))
+        if n in tuned or (inner and "inner" in GainSet.tables_read(n) and damper not in dampers.IDEAL_NAMES)
     ]
     cases = []
     for n in names:

@@ -130,3 +130,20 @@ def modes_table(rows: list[dict]):
             f"{r['damping_ratio']:.3f}",
         )
     return table
+
+
+def alike_text(alike: dict) -> str:
+    """The line saying how alike the laws were tuned (`GainSet.tuning_budget`)."""
+    runs = ", ".join(f"{n} {r}" for n, r in alike["runs"].items())
+    return (
+        f"Tuned alike: every law by the same study and objective, with at most {alike['budget']} vehicle runs "
+        f"each (runs used: {runs})."
+    )
+
+
+def untuned_text(names) -> str:
+    """The line naming the laws the gains file's study did not tune (`GainSet.untuned`)."""
+    return (
+        f"Not tuned: {', '.join(names)} run with the starting values of their gains tables (docs/control.md), "
+        "not tuned like the others: a fair ranking needs them tuned by the same study."
+    )

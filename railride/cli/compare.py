@@ -1,5 +1,6 @@
-"""``railride compare``: passive, PID and SAS suspensions on one scenario beside the paper's
-Table 1 (railride.comparison.compare), with the tables it prints."""
+"""``railride compare``: the suspensions on one scenario, beside the paper's Table 1 when it is
+the paper's case (railride.comparison.compare), with the tables it prints; several scenarios,
+speeds or seeds go to the league table (`_league`)."""
 
 from __future__ import annotations
 
@@ -49,7 +50,8 @@ from ._parsing import (
     value_list,
     vehicle_from_options,
 )
-from ._render import RESPONSE_LABELS, compare_comfort_table, damper_text, fmt, reduction_text
+from ._league import run_league
+from ._render import RESPONSE_LABELS, alike_text, compare_comfort_table, damper_text, fmt, reduction_text, untuned_text
 
 #: the library's names of compare's options, for its errors
 COMPARE_FIELDS = {**SOLVER_FIELDS, "damper": "--damper", "damper_scale": "--damper-scale", "delay": "--delay"}
@@ -183,9 +185,9 @@ def _compare_tables(doc: dict, vehicle: str, shipped: bool):
                 "in-sample, not a test on another track."
             )
         if tuning.get("alike"):
-            info.append(_alike_text(tuning["alike"]))
+            info.append(alike_text(tuning["alike"]))
         if tuning.get("untuned"):
-            info.append(_untuned_text(tuning["untuned"]))
+            info.append(untuned_text(tuning["untuned"]))
         info += _trade_off_lines(doc)
     for name, why in (settings.get("not_run") or {}).items():
         info.append(f"{name}: not run ({why})")
@@ -483,7 +485,7 @@ def compare(
                 delay=delay,
                 sensing=None if sensing == "ideal" else sensing,
             )
-            _league(
+            run_league(
                 scenarios,
                 speeds,
                 seeds,
@@ -570,142 +572,3 @@ def compare(
     console = wide_stdout_console()
     for part in _compare_tables(doc, vehicle, shipped=gains is None):
         console.print(part)
-
-
-def _alike_text(alike: dict) -> str:
-    runs = ", ".join(f"{n} {r}" for n, r in alike["runs"].items())
-    return (
-        f"Tuned alike: every law by the same study and objective, with at most {alike['budget']} vehicle runs "
-        f"each (runs used: {runs})."
-    )
-
-
-def _untuned_text(names) -> str:
-    return (
-        f"Not tuned: {', '.join(names)} run with the starting values of their gains tables (docs/control.md), "
-        "not tuned like the others: a fair ranking needs them tuned by the same study."
-    )
-
-
-def _league(
-    scenarios,
-    speeds,
-    seeds,
-    given,
-    *,
-    names,
-    gains,
-    damper,
-    damper_scale,
-    solver,
-    duration,
-    window,
-    params,
-    preset,
-    load,
-    format,
-    out,
-    bounds,
-) -> None:
-    """Several scenarios, speeds or track seeds: the league table (railride.league.league)."""
-    from ..files import check_out_dir, write_league_outputs
-    from ..league import league
-    from ..metrics import parse_window
-
-    options = {
-        "amplitude": "--amplitude",
-        "wavelength": "--wavelength",
-        "rail_phase": "--rail-phase",
-        "min_wavelength": "--min-wavelength",
-        "max_wavelength": "--max-wavelength",
-        "sensor_noise": "--sensor-noise",
-        "seed": "--seed",
-        "fault": "--fault",
-        "delay": "--delay",
-        "sensing": "--sensing",
-    }
-    for key, value in given.items():
-        if value is not None:
-            raise ValueError(
-                f"{options[key]}: applies to a single scenario; a league table (several --scenario, --speed "
-                "or --track-seed values) runs each scenario with its defaults"
-            )
-    if not bounds:
-        raise ValueError("--no-bounds: a league table always shows the ideal actuator beside the MR dampers")
-    damper_preset("--damper", damper)
-    vehicle_params, vehicle_record = vehicle_from_options(params, preset, load)
-    if out is not None:
-        check_out_dir(out)
-    with ProgressBar(stderr_is_terminal(), lambda done: "running the league table...") as progress:
-        table = league(
-            scenarios,
-            speeds,
-            track_seeds=seeds or [0],
-            params=vehicle_params,
-            controllers=names,
-            gains=load_gains(gains),
-            damper=damper,
-            damper_scale=parse_scale("--damper-scale", damper_scale),
-            duration=duration,
-            window=parse_window(window) if window is not None else None,
-            solver=solver,
-            progress=(lambda k, n: progress(k / n)) if progress.enabled else None,
-        )
-    doc = table.to_dict()
-    text = json.dumps(doc, indent=2, allow_nan=False)
-    if out is not None:
-        write_folder(out, lambda: write_league_outputs(table, out))
-    if format is OutputFormat.json:
-        typer.echo(text)
-        return
-    wide_stdout_console().print(_league_table(table, doc))
-
-
-def _league_table(table, doc):
-    """One row per controller: mean RMS reductions (MR, ideal actuator), comfort, force, travel."""
-    from rich.table import Table
-
-    from ..labels import describe_scenario
-
-    summary = table.summary()
-    cases = table.cases[table.cases.controller == "passive"]
-    tuned = doc["tuned_on"]
-    tuned_text = describe_scenario(tuned) if tuned else "not recorded in the gains file"
-    out_of_sample = int((~cases["in_sample"]).sum())
-    settings = doc["settings"]
-    at = "" if settings["speeds_m_s"] is None else " at " + ", ".join(f"{v:g}" for v in settings["speeds_m_s"]) + " m/s"
-    seeds = ", ".join(map(str, settings["track_seeds"]))
-    caption = (
-        f"Mean over {len(cases)} cases: {', '.join(settings['scenarios'])}{at}; track seeds {seeds} (random tracks).\n"
-        f"Gains tuned on: {tuned_text}. Tested on {out_of_sample} case(s) they were not tuned on"
-        f" and {len(cases) - out_of_sample} they were.\n"
-        "Reduction = (passive - controlled) / passive RMS x 100, MR dampers (ideal actuator, same gains, in brackets)."
-        + ("\n" + _alike_text(settings["tuned_alike"]) if settings.get("tuned_alike") else "")
-        + ("\n" + _untuned_text(settings["untuned"]) if settings.get("untuned") else "")
-    )
-    t = Table(title="League table", caption=caption, caption_justify="left")
-    t.add_column("suspension")
-    for label in ("acceleration", "displacement", "pitch", "roll"):
-        t.add_column(f"{label}\n(%)", justify="right")
-    t.add_column("a_w Wk\ncentre\n(m/s^2)", justify="right")
-    t.add_column("N_MV,z\ncentre", justify="right")
-    t.add_column("damper\nforce max\n(kN)", justify="right")
-    t.add_column("travel\nmax\n(mm)", justify="right")
-    for row in doc["controllers"]:
-        n = row["name"]
-        cells = []
-        for r in ("acceleration_m_s2", "displacement_m", "pitch_deg", "roll_deg"):
-            if n == "passive":
-                cells.append("-")
-                continue
-            mr, ideal = row.get(f"{r}_reduction_percent"), row.get(f"{r}_ideal_reduction_percent")
-            cells.append(("n/a" if mr is None else f"{mr:.1f}") + (" (-)" if ideal is None else f" ({ideal:.0f})"))
-        s = summary.loc[n]
-        cells += [
-            fmt(s.get("centre_aw_Wk"), ".3f"),
-            fmt(s.get("centre_N_MV_z"), ".2f"),
-            fmt(s["force_max_n"] / 1e3, ".1f"),
-            fmt(s["travel_max_m"] * 1e3, ".1f"),
-        ]
-        t.add_row(row["label"], *cells)
-    return t

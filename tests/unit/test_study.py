@@ -78,7 +78,7 @@ def test_a_run_that_diverges_is_listed_and_the_others_go_on():
         (dict(loads=[0.0]), r"loads = 0.0: must be a finite number > 0"),
         (dict(speeds=[-3.0]), r"speeds = -3.0: must be a finite number > 0"),
         (dict(faults=["3R-off"]), r"fault corner = '3R'"),
-        (dict(faults=["1R-off+1R-on"]), r"one fault per corner"),
+        (dict(faults=["1R-off+1R-on"]), r"corner 1R has more than one fault"),
         (dict(faults=["1R-off@5"], duration=2.0), r"not within the run"),
         (dict(faults=["1R-off"], damper="ideal"), r"'off' and 'on' need MR dampers"),
         (dict(track_seeds=[]), r"track_seeds: give at least one value"),
