@@ -1,0 +1,247 @@
+"""``railride ride-spectrum``: the ride on a random track in the frequency domain
+(railride.ride_spectrum), and ``railride state-space``: the linear model's matrices
+(railride.linear)."""
+
+from __future__ import annotations
+
+from enum import Enum
+from pathlib import Path
+from typing import Annotated, Optional
+
+import typer
+
+from ._app import app
+from ._common import errors, option_names, print_json, wide_stdout_console, write_folder
+from ._options import LoadOption, ParamsOption, PresetOption
+from ._parsing import load_gains, vehicle_from_options
+
+#: the library's names of the options, for its errors
+SPECTRUM_OPTIONS = {
+    "track": "--track",
+    "speed": "--speed",
+    "min_wavelength": "--min-wavelength",
+    "max_wavelength": "--max-wavelength",
+    "points": "--points",
+    "control_rate": "--control-rate",
+    "delay": "--delay",
+    "controllers": "--controllers",
+}
+
+
+class SpectrumFormat(str, Enum):
+    table = "table"
+    json = "json"
+    csv = "csv"
+
+
+@app.command("ride-spectrum")
+def ride_spectrum(
+    track: Annotated[
+        str,
+        typer.Option("--track", metavar="SPECTRUM", help="Track spectrum: fra1..fra6, german-low or german-high."),
+    ] = "fra4",
+    speed: Annotated[
+        Optional[float], typer.Option("--speed", metavar="M/S", help="Speed [m/s] (default 55.56).")
+    ] = None,
+    controllers: Annotated[
+        str,
+        typer.Option(
+            "--controllers",
+            metavar="NAMES",
+            help="Comma-separated: passive and outer loops on the ideal actuator (pid, "
+            "sas-attitude, sas-attitude-ride, skyhook, ...), or all.",
+        ),
+    ] = "passive,pid,sas-attitude,sas-attitude-ride",
+    gains: Annotated[
+        Optional[Path],
+        typer.Option("--gains", metavar="FILE.toml", help="Controller gains (default: the shipped gains)."),
+    ] = None,
+    min_wavelength: Annotated[
+        float, typer.Option("--min-wavelength", metavar="M", help="Shortest wavelength of the track [m].")
+    ] = 1.0,
+    max_wavelength: Annotated[
+        float, typer.Option("--max-wavelength", metavar="M", help="Longest wavelength of the track [m].")
+    ] = 100.0,
+    points: Annotated[
+        int, typer.Option("--points", metavar="N", help="Frequencies, log-spaced over the band, 16..200000.")
+    ] = 2000,
+    control_rate: Annotated[
+        Optional[float],
+        typer.Option(
+            "--control-rate",
+            metavar="HZ",
+            help="Apply each loop's demand through a sample-and-hold at this rate (default: continuously).",
+        ),
+    ] = None,
+    delay: Annotated[
+        int, typer.Option("--delay", metavar="N", help="With --control-rate: the delay in controller periods, 0..64.")
+    ] = 1,
+    params: ParamsOption = None,
+    preset: PresetOption = None,
+    load: LoadOption = None,
+    format: Annotated[
+        SpectrumFormat,
+        typer.Option(
+            "--format",
+            case_sensitive=False,
+            help="Output on stdout: tables, the JSON document or the CSV of RMS values.",
+        ),
+    ] = SpectrumFormat.table,
+    out: Annotated[
+        Optional[Path],
+        typer.Option(
+            "--out",
+            metavar="DIR",
+            help="Also write ride_spectrum.json, ride_spectrum.csv, ride_spectrum_psd.csv and "
+            "ride_spectrum.png into DIR (created if missing; all or nothing).",
+        ),
+    ] = None,
+) -> None:
+    """The ride on a random track from the frequency response and the track spectrum, without a
+    time simulation: PSDs, RMS and ISO 2631-1 Wb/Wk-weighted RMS of the carbody floor
+    acceleration, for the passive vehicle and linear outer loops on the ideal actuator."""
+    with errors(), option_names(SPECTRUM_OPTIONS):
+        from ..files import check_out_dir
+        from ..ride_spectrum import ride_spectrum as run
+
+        vehicle, _ = vehicle_from_options(params, preset, load)
+        if out is not None:
+            check_out_dir(out)
+        result = run(
+            track,
+            speed=speed,
+            params=vehicle,
+            controllers=controllers,
+            gains=None if gains is None else load_gains(gains),
+            min_wavelength=min_wavelength,
+            max_wavelength=max_wavelength,
+            points=points,
+            control_rate=control_rate,
+            delay=delay,
+        )
+        if out is not None:
+            write_folder(out, lambda: result.save(out))
+    if format is SpectrumFormat.json:
+        print_json(result.to_dict())
+        return
+    if format is SpectrumFormat.csv:
+        typer.echo(result.to_pandas().to_csv(index=False), nl=False)
+        return
+    console = wide_stdout_console(80)
+    for part in _tables(result):
+        console.print(part)
+
+
+def _tables(result) -> list:
+    """The floor table (RMS, Wb, Wk and Wb against passive, per suspension and point), the
+    carbody table and the note."""
+    from rich.markup import escape
+    from rich.table import Table
+    from rich.text import Text
+
+    from ..control import LABELS
+    from ..ride_spectrum import FLOOR
+
+    doc = result.to_dict()
+    st = doc["settings"]
+    floor = Table(title=escape("Carbody floor acceleration [m/s^2], frequency domain"))
+    for head in ("suspension", "point", "RMS", "aw Wb", "aw Wk", "Wb vs\npassive"):
+        floor.add_column(escape(head), justify="left" if head in ("suspension", "point") else "right")
+    passive = doc["weighted_rms_m_s2"].get("passive")
+    for s in result.suspensions:
+        for k, point in enumerate(FLOOR):
+            wb, wk = (doc["weighted_rms_m_s2"][s][point][w] for w in ("Wb", "Wk"))
+            change = f"{100 * (wb / passive[point]['Wb'] - 1):+.1f} %" if passive and s != "passive" else ""
+            rms = doc["rms"][s][f"floor_acceleration_{point}"]
+            floor.add_row(
+                escape(LABELS.get(s, s)) if k == 0 else "", point, f"{rms:.4g}", f"{wb:.4g}", f"{wk:.4g}", change
+            )
+    body = Table(title="Carbody accelerations and secondary travel (RMS)")
+    for head in ("suspension", "bounce\n[m/s^2]", "pitch\n[rad/s^2]", "roll\n[rad/s^2]", "travel 1R\n[mm]"):
+        body.add_column(escape(head), justify="left" if head == "suspension" else "right")
+    for s in result.suspensions:
+        r = doc["rms"][s]
+        body.add_row(
+            escape(LABELS.get(s, s)),
+            f"{r['carbody_bounce_acceleration']:.4g}",
+            f"{r['carbody_pitch_acceleration']:.4g}",
+            f"{r['carbody_roll_acceleration']:.4g}",
+            f"{1000 * r['secondary_deflection_1R']:.4g}",
+        )
+    rate = "continuously" if st["control_rate_hz"] is None else f"held at {st['control_rate_hz']:g} Hz"
+    note = Text(
+        f"{st['track']} at V = {st['speed_m_s']:g} m/s, wavelengths {st['min_wavelength_m']:g}-"
+        f"{st['max_wavelength_m']:g} m ({st['fmin_hz']:.3g}-{st['fmax_hz']:.3g} Hz, {st['points']} "
+        f"frequencies). Controllers on the ideal actuator (force = demand), applied {rate}; "
+        f"gains {st['gains']} (tuned on the paper's sine track, not on this one)."
+    )
+    parts: list = [floor, body, note]
+    for name, reason in st["not_run"].items():
+        parts.append(Text(f"not run: {name}: {reason}"))
+    return parts
+
+
+class StateSpaceFormat(str, Enum):
+    table = "table"
+    json = "json"
+
+
+@app.command("state-space")
+def state_space(
+    suspension: Annotated[
+        str,
+        typer.Option(
+            "--suspension",
+            metavar="NAME",
+            help="passive (the viscous dampers, corner forces in parallel), plant (no secondary "
+            "dashpots: what an actuator acts on) or an outer loop closed on the ideal actuator "
+            "(pid, sas-attitude, ...).",
+        ),
+    ] = "passive",
+    gains: Annotated[
+        Optional[Path],
+        typer.Option("--gains", metavar="FILE.toml", help="Controller gains (default: the shipped gains)."),
+    ] = None,
+    params: ParamsOption = None,
+    preset: PresetOption = None,
+    load: LoadOption = None,
+    format: Annotated[
+        StateSpaceFormat,
+        typer.Option("--format", case_sensitive=False, help="Output on stdout: a summary or the JSON document."),
+    ] = StateSpaceFormat.table,
+    out: Annotated[
+        Optional[Path],
+        typer.Option(
+            "--out",
+            metavar="FILE",
+            help="Write the model to FILE: .mat (MATLAB: A, B, C, D and the names) or .json.",
+        ),
+    ] = None,
+) -> None:
+    """The linear vehicle as state-space matrices x' = A x + B u, y = C x + D u, with named
+    states, inputs and outputs, for MATLAB or python-control."""
+    with errors(), option_names({"suspension": "--suspension", "controllers": "--suspension"}):
+        from ..files import write_model
+        from ..linear import linear_model, linear_suspensions
+
+        vehicle, _ = vehicle_from_options(params, preset, load)
+        if out is not None and out.suffix.lower() not in (".mat", ".json"):
+            raise ValueError(f"--out = {str(out)!r}: the file name must end in .mat or .json")
+        (secondary,) = linear_suspensions([suspension], None if gains is None else load_gains(gains)).values()
+        model = linear_model(vehicle, secondary)
+        if out is not None:
+            write_folder(out.parent, lambda: [write_model(model, out)])
+    if format is StateSpaceFormat.json:
+        print_json(model.to_dict())
+        return
+    import numpy as np
+
+    poles = model.poles()
+    console = wide_stdout_console(80)
+    console.print(
+        f"State-space model, secondary {model.secondary}: {len(model.states)} states, "
+        f"{len(model.inputs)} inputs, {len(model.outputs)} outputs; the largest real part of a "
+        f"pole is {float(np.max(poles.real)):.4g} 1/s."
+    )
+    for kind in ("states", "inputs", "outputs"):
+        console.print(f"{kind}: " + ", ".join(getattr(model, kind)))
