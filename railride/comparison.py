@@ -22,6 +22,7 @@ from .control import CONSTANT_VOLTAGE, CONTROLLERS, LABELS, PAPER_CONTROLLERS, G
 from .defaults import DEFAULT_DAMPER
 from .faults import check_faults, degradation, fault_table
 from .metrics import STATISTICS, reduction, ride_metrics, select_window
+from .plots import PNG_DPI, FigureOptions
 from .simulation import simulate
 from .track import as_scenario
 from .solver import SolverSettings, check_resolution
@@ -281,12 +282,15 @@ class Comparison:
 
         return plot_comparison_response(self, response, ax=ax)
 
-    def save(self, folder):
-        """The `railride compare --out` folder (JSON, NetCDF, CSV and the figures), written all
-        or nothing. Returns the written paths."""
+    def save(self, folder, *, figure_formats=("png",), dpi: float = PNG_DPI, history_formats=("nc", "csv")):
+        """The `railride compare --out` folder (JSON, the time histories in each of
+        ``history_formats``: nc, csv, mat, and the figures, each in every one of
+        ``figure_formats``: png, pdf, svg; PNG at ``dpi``), written all or nothing. Returns the
+        written paths."""
         from .files import write_compare_outputs
 
-        return write_compare_outputs(self, folder, self.to_dict())
+        figures = FigureOptions(figure_formats, dpi)
+        return write_compare_outputs(self, folder, self.to_dict(), figures=figures, histories=history_formats)
 
     def combined(self) -> xr.Dataset:
         """All suspensions in one Dataset along ``controller`` (damper channels NaN for passive)."""

@@ -9,7 +9,9 @@
   comparison), `write_tune_outputs` (a tuning study), `write_sweep_outputs` (a sweep),
   `write_frf_outputs` (frequency responses) and `write_pareto_outputs` (the Pareto view), each
   writing the files of its ``*_FILES`` tuple: tables from `railride.tables`, analysis from
-  `railride.analysis`, figures from `railride.plots` saved as PNG.
+  `railride.analysis`, figures from `railride.plots`. A figure is written once per format of
+  its ``figures`` (`railride.plots.FigureOptions`: PNG at 120 dpi unless asked otherwise), so
+  ``pitch.png`` in a tuple stands for ``pitch.pdf`` and ``pitch.svg`` too (`figure_files`).
 """
 
 from __future__ import annotations
@@ -26,7 +28,7 @@ import xarray as xr
 
 from .analysis import PSD_SEGMENT_S, comparison_psd
 from .labels import CARBODY_RESPONSES, psd_title
-from .plots import save_png
+from .plots import FigureOptions, save_figure
 from .plots.comparison import (
     plot_comparison_damper_forces,
     plot_comparison_hysteresis,
@@ -197,9 +199,56 @@ def _text(text: str):
     return lambda path: path.write_text(text, encoding="utf-8")
 
 
-def _png(draw):
-    """A writer that saves the figure ``draw()`` returns."""
-    return lambda path: save_png(draw(), path)
+class _Figure:
+    """A figure to write: ``draw()`` makes it; `_entries` turns it into one file per format.
+    Called with a path, it writes the PNG file alone (at 120 dpi)."""
+
+    def __init__(self, draw):
+        self.draw = draw
+
+    def __call__(self, path: Path) -> None:
+        save_figure(self.draw(), path, "png")
+
+
+def _png(draw) -> _Figure:
+    """The figure ``draw()`` returns, in a writers' table under its ``.png`` name."""
+    return _Figure(draw)
+
+
+def figure_files(stem: str, draw, figures: FigureOptions | None = None) -> list:
+    """The ``(name, write)`` pairs of `write_folder` for the figure ``draw()`` returns, one per
+    format of ``figures`` (default PNG at 120 dpi): "pitch.png", "pitch.pdf". The figure is
+    drawn once, when the first file is written, and let go after the last."""
+    figures = FigureOptions() if figures is None else figures
+    made: dict = {}
+    last = figures.figure_formats[-1]
+
+    def writer(fmt: str):
+        def write(path: Path) -> None:
+            if "figure" not in made:
+                made["figure"] = draw()
+            try:
+                save_figure(made["figure"], path, fmt, figures.dpi)
+            finally:
+                if fmt == last:
+                    made.clear()
+
+        return write
+
+    return [(f"{stem}.{fmt}", writer(fmt)) for fmt in figures.figure_formats]
+
+
+def _entries(names, writers: dict, figures: FigureOptions | None) -> list:
+    """The ``(name, write)`` pairs of the files ``names`` from ``writers``, each figure
+    (`_png`, listed as ``stem.png``) once per format of ``figures``."""
+    out: list = []
+    for name in names:
+        write = writers[name]
+        if isinstance(write, _Figure):
+            out += figure_files(name.rsplit(".", 1)[0], write.draw, figures)
+        else:
+            out.append((name, write))
+    return out
 
 
 def _csv(frame: pd.DataFrame, index: bool = False):
@@ -216,25 +265,72 @@ def _expect(value, name: str, module: str, cls: str) -> None:
 
 
 # -- one writer per result ------------------------------------------------------------------------
-def write_outputs(result, out_dir, metrics_doc: dict) -> list[Path]:
+#: the file formats of time histories: NetCDF (the Dataset), CSV (one table) and MATLAB (`write_mat`)
+HISTORY_FORMATS = ("nc", "csv", "mat")
+
+
+def history_formats(value=("nc", "csv")) -> tuple:
+    """``value`` (a sequence, or one comma-separated text, of `HISTORY_FORMATS`) as a tuple in
+    the given order without repeats; ValueError naming ``history_formats`` otherwise."""
+    items = value.split(",") if isinstance(value, str) else list(value)
+    names = [i.strip().lower() if isinstance(i, str) else i for i in items]
+    bad = [n for n in names if n not in HISTORY_FORMATS]
+    if bad or not names:
+        what = f"{bad[0]!r} is not a format" if bad else "no format given"
+        raise ValueError(f"history_formats = {value!r}: {what}; allowed one or more of {', '.join(HISTORY_FORMATS)}")
+    return tuple(dict.fromkeys(names))
+
+
+def _history_names(names, stem: str, formats) -> list:
+    """``names`` with the time-history files stem.nc and stem.csv replaced by one per format."""
+    formats = history_formats(formats)
+    out = []
+    for name in names:
+        if name == f"{stem}.nc":
+            out += [f"{stem}.{fmt}" for fmt in formats]
+        elif name != f"{stem}.csv":
+            out.append(name)
+    return out
+
+
+def write_outputs(
+    result, out_dir, metrics_doc: dict, *, figures: FigureOptions | None = None, histories=("nc", "csv")
+) -> list[Path]:
     """Write the files of a run, a `railride.ride.RideResult`, into ``out_dir``, all or
     nothing (`write_folder`): ``ride.nc`` (its Dataset as NetCDF, see `netcdf_ready`),
     ``ride.csv`` (`railride.tables.to_frame`), ``metrics.json`` (``metrics_doc`` as indented
     JSON; NaN or infinity is refused) and ``body_responses.png``
-    (`railride.plots.ride.plot_body_responses`). Returns the written paths."""
+    (`railride.plots.ride.plot_body_responses`, over the metric window of
+    ``metrics_doc["settings"]["window_s"]``; in each format of ``figures``). ``histories``:
+    the time-history formats (`HISTORY_FORMATS`; ``mat`` writes ride.mat, `write_mat`) in
+    place of ride.nc and ride.csv. Returns the written paths."""
     _expect(result, "result", "ride", "RideResult")
     ds = result.dataset
     text = json_text(metrics_doc)  # refuse NaN before any file is written
+    window = _window(metrics_doc)
     writers = {
         "ride.nc": lambda path: write_netcdf(ds, path),
         "ride.csv": lambda path: to_frame(ds).to_csv(path),
+        "ride.mat": lambda path: write_mat(ds, path),
         "metrics.json": _text(text),
-        "body_responses.png": _png(lambda: plot_body_responses(ds)),
+        "body_responses.png": _png(lambda: plot_body_responses(ds, window=window)),
     }
-    return write_folder(out_dir, [(name, writers[name]) for name in OUTPUT_FILES])
+    return write_folder(out_dir, _entries(_history_names(OUTPUT_FILES, "ride", histories), writers, figures))
 
 
-def write_damper_outputs(cycles, out_dir, doc: dict, *, title: str | None = None) -> list[Path]:
+def _window(doc) -> tuple | None:
+    """The metric window ``doc["settings"]["window_s"]`` of a result document, if it holds
+    one."""
+    settings = doc.get("settings") if isinstance(doc, dict) else None
+    window = settings.get("window_s") if isinstance(settings, dict) else None
+    if isinstance(window, (list, tuple)) and len(window) == 2:
+        return (float(window[0]), float(window[1]))
+    return None
+
+
+def write_damper_outputs(
+    cycles, out_dir, doc: dict, *, title: str | None = None, figures: FigureOptions | None = None
+) -> list[Path]:
     """Write the `railride.rig.Cycles` of `railride.rig.cycles` into ``out_dir``, all or
     nothing: ``loops.png`` (`plot_hysteresis`), ``cycles.csv`` (`cycles_frame`) and
     ``damper.json`` (``doc`` as indented strict JSON). Returns the written paths."""
@@ -244,10 +340,12 @@ def write_damper_outputs(cycles, out_dir, doc: dict, *, title: str | None = None
         "cycles.csv": lambda path: cycles_frame(cycles.dataset).to_csv(path, index=False),
         "damper.json": _text(text),
     }
-    return write_folder(out_dir, [(name, writers[name]) for name in DAMPER_FILES])
+    return write_folder(out_dir, _entries(DAMPER_FILES, writers, figures))
 
 
-def write_tracking_outputs(tracking, out_dir, doc: dict, *, title: str | None = None) -> list[Path]:
+def write_tracking_outputs(
+    tracking, out_dir, doc: dict, *, title: str | None = None, figures: FigureOptions | None = None
+) -> list[Path]:
     """Write a force-tracking run of `railride.rig.track` (a `railride.rig.Tracking`) into
     ``out_dir``, all or nothing: ``tracking.png`` (`plot_tracking`), ``tracking.csv``
     (`to_frame` of its Dataset: time, the rig channels and ``desired_force``) and
@@ -258,10 +356,12 @@ def write_tracking_outputs(tracking, out_dir, doc: dict, *, title: str | None = 
         "tracking.csv": lambda path: to_frame(tracking.dataset).to_csv(path),
         "tracking.json": _text(text),
     }
-    return write_folder(out_dir, [(name, writers[name]) for name in TRACKING_FILES])
+    return write_folder(out_dir, _entries(TRACKING_FILES, writers, figures))
 
 
-def write_compare_outputs(comparison, out_dir, doc: dict) -> list[Path]:
+def write_compare_outputs(
+    comparison, out_dir, doc: dict, *, figures: FigureOptions | None = None, histories=("nc", "csv")
+) -> list[Path]:
     """Write a `railride.comparison.Comparison` into ``out_dir``, all or nothing
     (`write_folder`): ``compare.json`` (``doc``, the ``Comparison.to_dict()`` document, strict
     JSON), ``compare.nc`` (``combined()`` as NetCDF, see `netcdf_ready`), ``compare.csv``
@@ -271,7 +371,9 @@ def write_compare_outputs(comparison, out_dir, doc: dict) -> list[Path]:
     ``voltages.png`` (`plot_comparison_voltages`), and the
     acceleration spectra over the metric window ``doc["settings"]["window_s"]`` (None: the
     whole run): ``psd.png`` (`plot_comparison_psd`) and ``psd.csv``
-    (`railride.analysis.comparison_psd`). Returns the written paths."""
+    (`railride.analysis.comparison_psd`). ``histories``: the time-history formats
+    (`HISTORY_FORMATS`; ``mat`` writes compare.mat, `write_mat`) in place of compare.nc and
+    compare.csv. Returns the written paths."""
     _expect(comparison, "comparison", "comparison", "Comparison")
     text = json_text(doc)
     ds = comparison.combined()
@@ -286,16 +388,19 @@ def write_compare_outputs(comparison, out_dir, doc: dict) -> list[Path]:
         "compare.json": _text(text),
         "compare.nc": lambda path: write_netcdf(ds, path),
         "compare.csv": lambda path: comparison_frame(ds).to_csv(path, index=False),
+        "compare.mat": lambda path: write_mat(ds, path),
         "damper_forces.png": _png(lambda: plot_comparison_damper_forces(comparison)),
         "damper_hysteresis.png": _png(lambda: plot_comparison_hysteresis(comparison)),
         "voltages.png": _png(lambda: plot_comparison_voltages(comparison)),
     }
     for response in CARBODY_RESPONSES:
         writers[f"{response}.png"] = (lambda r: _png(lambda: plot_comparison_response(comparison, r)))(response)
-    return write_folder(out_dir, [(name, writers[name]) for name in COMPARE_FILES])
+    return write_folder(out_dir, _entries(_history_names(COMPARE_FILES, "compare", histories), writers, figures))
 
 
-def write_tune_outputs(curves, out_dir, doc: dict, gains_text: str, *, title: str | None = None) -> list[Path]:
+def write_tune_outputs(
+    curves, out_dir, doc: dict, gains_text: str, *, title: str | None = None, figures: FigureOptions | None = None
+) -> list[Path]:
     """Write the results of a tuning study into ``out_dir``, all or nothing (`write_folder`;
     other files there, such as the run table ``runs.csv``, stay): ``gains.toml``
     (``gains_text``, a gains file), ``sensitivity.png`` (`plot_sensitivity` of ``curves``,
@@ -310,10 +415,12 @@ def write_tune_outputs(curves, out_dir, doc: dict, gains_text: str, *, title: st
         "curves.csv": _csv(frame),
         "tune.json": _text(text),
     }
-    return write_folder(out_dir, [(name, writers[name]) for name in TUNE_FILES])
+    return write_folder(out_dir, _entries(TUNE_FILES, writers, figures))
 
 
-def write_sweep_outputs(result, out_dir, doc: dict | None = None) -> list[Path]:
+def write_sweep_outputs(
+    result, out_dir, doc: dict | None = None, *, figures: FigureOptions | None = None
+) -> list[Path]:
     """Write a `railride.sweep.SweepResult` into ``out_dir`` beside the run table ``runs.csv``
     that `railride.sweep.run_cases` keeps there, all or nothing: ``sweep.json`` (``doc``,
     default ``result.to_dict()``) and, when the grid has one numeric axis with several values
@@ -324,13 +431,15 @@ def write_sweep_outputs(result, out_dir, doc: dict | None = None) -> list[Path]:
     files = [("sweep.json", _text(text))]
     axis = sweep_plot_axis(result)
     if axis is not None:
-        files.append(("sweep.png", _png(lambda: plot_sweep(result, axis=axis))))
+        files += figure_files("sweep", lambda: plot_sweep(result, axis=axis), figures)
         if has_comfort(result):
-            files.append(("comfort.png", _png(lambda: plot_sweep_comfort(result, axis=axis))))
+            files += figure_files("comfort", lambda: plot_sweep_comfort(result, axis=axis), figures)
     return write_folder(out_dir, files)
 
 
-def write_frf_outputs(frame: pd.DataFrame, modes, out_dir, doc: dict, *, title: str | None = None) -> list[Path]:
+def write_frf_outputs(
+    frame: pd.DataFrame, modes, out_dir, doc: dict, *, title: str | None = None, figures: FigureOptions | None = None
+) -> list[Path]:
     """Write the frequency responses of `railride frf` into ``out_dir``, all or nothing:
     ``frf.csv`` (``frame``, `railride.analysis.frf_frame`), ``frf.json`` (``doc``, strict
     JSON), ``frf.png`` (`plot_frf`) and ``modes.csv`` (`modes_frame` of ``modes``, the records
@@ -343,10 +452,10 @@ def write_frf_outputs(frame: pd.DataFrame, modes, out_dir, doc: dict, *, title: 
         "frf.png": _png(lambda: plot_frf(frame, table, title=title)),
         "modes.csv": _csv(table),
     }
-    return write_folder(out_dir, [(name, writers[name]) for name in FRF_FILES])
+    return write_folder(out_dir, _entries(FRF_FILES, writers, figures))
 
 
-def write_pareto_outputs(result, out_dir) -> list[Path]:
+def write_pareto_outputs(result, out_dir, *, figures: FigureOptions | None = None) -> list[Path]:
     """Write a `railride.pareto.ParetoResult` into ``out_dir``, all or nothing (other files,
     such as a run table, stay): ``pareto.png`` (`plot_pareto`), ``pareto.csv``
     (``to_pandas()``) and ``pareto.json`` (``to_dict()``). Returns the paths."""
@@ -357,14 +466,14 @@ def write_pareto_outputs(result, out_dir) -> list[Path]:
         "pareto.csv": _csv(frame),
         "pareto.json": _text(text),
     }
-    return write_folder(out_dir, [(name, writers[name]) for name in PARETO_FILES])
+    return write_folder(out_dir, _entries(PARETO_FILES, writers, figures))
 
 
 #: the files `LeagueTable.save` writes
 LEAGUE_FILES = ("league.json", "league.csv", "league.png", "league_comfort.png")
 
 
-def write_league_outputs(table, out_dir) -> list[Path]:
+def write_league_outputs(table, out_dir, *, figures: FigureOptions | None = None) -> list[Path]:
     """Write a `railride.league.LeagueTable` into ``out_dir``, all or nothing: ``league.json``
     (``to_dict()``), ``league.csv`` (one row per case and controller), ``league.png``
     (`plot_league`) and ``league_comfort.png`` (`plot_league_comfort`, N_MV against speed)."""
@@ -377,14 +486,14 @@ def write_league_outputs(table, out_dir) -> list[Path]:
         "league.png": _png(lambda: plot_league(table)),
         "league_comfort.png": _png(lambda: plot_league_comfort(table)),
     }
-    return write_folder(out_dir, [(name, writers[name]) for name in LEAGUE_FILES])
+    return write_folder(out_dir, _entries(LEAGUE_FILES, writers, figures))
 
 
 #: the files `StudyResult.save` writes, in this order
 STUDY_FILES = ("study.json", "study_summary.csv", "study_runs.csv", "study.png")
 
 
-def write_study_outputs(result, out_dir) -> list[Path]:
+def write_study_outputs(result, out_dir, *, figures: FigureOptions | None = None) -> list[Path]:
     """Write a `railride.study.StudyResult` into ``out_dir``, all or nothing: ``study.json``
     (``to_dict()``), ``study_summary.csv`` (``to_pandas()``), ``study_runs.csv`` (one row per
     run, ``cases``) and ``study.png`` (``plot()``); other files (the run table) stay."""
@@ -397,4 +506,72 @@ def write_study_outputs(result, out_dir) -> list[Path]:
         "study_runs.csv": _csv(result.cases),
         "study.png": _png(lambda: plot_study(result)),
     }
-    return write_folder(out_dir, [(name, writers[name]) for name in STUDY_FILES])
+    return write_folder(out_dir, _entries(STUDY_FILES, writers, figures))
+
+
+#: the files `RideSpectrum.save` writes, in this order
+RIDE_SPECTRUM_FILES = ("ride_spectrum.json", "ride_spectrum.csv", "ride_spectrum_psd.csv", "ride_spectrum.png")
+
+
+def write_ride_spectrum_outputs(result, out_dir, *, figures: FigureOptions | None = None) -> list[Path]:
+    """Write a `railride.ride_spectrum.RideSpectrum` into ``out_dir``, all or nothing:
+    ``ride_spectrum.json`` (``to_dict()``), ``ride_spectrum.csv`` (``to_pandas()``: RMS and
+    weighted RMS), ``ride_spectrum_psd.csv`` (the PSDs, one row per suspension and frequency)
+    and ``ride_spectrum.png`` (``plot()``)."""
+    from .plots.ride_spectrum import plot_ride_spectrum
+
+    text = json_text(result.to_dict())
+    psd = result.psd.to_dataframe().reset_index()
+    writers = {
+        "ride_spectrum.json": _text(text),
+        "ride_spectrum.csv": _csv(result.to_pandas()),
+        "ride_spectrum_psd.csv": _csv(psd),
+        "ride_spectrum.png": _png(lambda: plot_ride_spectrum(result)),
+    }
+    return write_folder(out_dir, _entries(RIDE_SPECTRUM_FILES, writers, figures))
+
+
+def write_model(model, path) -> Path:
+    """Write a `railride.linear.LinearModel` to ``path``, atomically: a MATLAB file for a
+    ``.mat`` suffix (`LinearModel.to_mat`), else its JSON document (``to_dict()``)."""
+    from ._io import atomic_write
+
+    path = Path(path)
+    if path.suffix.lower() == ".mat":
+        model.to_mat(path)
+    else:
+        text = json_text(model.to_dict())
+        atomic_write(path, lambda tmp: tmp.write_text(text, encoding="utf-8"))
+    return path
+
+
+def write_mat(ds: xr.Dataset, path) -> Path:
+    """Write the time histories ``ds`` (a run's or a comparison's Dataset) to ``path`` as a
+    MATLAB file (scipy.io, format 5, compressed), atomically. Each variable keeps its name, with
+    time as the first dimension (a column per corner, wheelset or rail); the coordinates are
+    variables too (text ones as cell arrays), ``units`` is a struct of every variable's unit,
+    ``dims`` a struct of its dimension names, and ``attributes`` holds the Dataset's attributes
+    (versions, step, suspension, sign convention), text records (scenario, parameters) as
+    their JSON text."""
+    from scipy.io import savemat
+
+    from ._io import atomic_write
+
+    content: dict = {}
+    units: dict = {}
+    dims: dict = {}
+    for name in [*ds.coords, *ds.data_vars]:
+        var = ds[name]
+        order = [d for d in ("time", *var.dims) if d in var.dims]
+        order = list(dict.fromkeys(order))
+        values = var.transpose(*order).values
+        if values.dtype.kind in "UO":
+            values = np.array(values.tolist(), dtype=object) if values.ndim else str(values)
+        content[str(name)] = values
+        units[str(name)] = str(var.attrs.get("units", ""))
+        dims[str(name)] = np.array(order, dtype=object)
+    content["units"] = units
+    content["dims"] = dims
+    content["attributes"] = {str(k): str(v) for k, v in ds.attrs.items()}
+    atomic_write(Path(path), lambda tmp: savemat(tmp, content, do_compression=True, long_field_names=True))
+    return Path(path)

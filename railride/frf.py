@@ -26,6 +26,7 @@ from . import validation
 from .analysis import FRF_MAGNITUDES, FRF_PATTERNS, frf_frame, frf_peaks
 from .files import FRF_FILES
 from .params import PRESETS, VehicleParams
+from .plots import PNG_DPI, FigureOptions
 
 SCHEMA = "railride.frf/1"
 #: the ``rails`` of `frequency_responses`: one rail pattern, or both
@@ -171,19 +172,22 @@ class FrfResult:
         )
 
     def plot(self, ax=None):
-        """Magnitudes against frequency, one panel per response, with the modes marked
-        (`railride.plots.frf.plot_frf`); ``ax`` None for a new figure, or four Axes. Returns
-        the figure."""
+        """Magnitudes and phases against frequency, two panels per response, with the modes
+        marked (`railride.plots.frf.plot_frf`); ``ax`` None for a new figure, or eight Axes (per
+        response its magnitude, then its phase). Returns the figure."""
         from .plots.frf import plot_frf
 
         return plot_frf(self.to_pandas(), self.modes.to_pandas(), ax=ax, title=self.title())
 
-    def save(self, folder) -> list:
+    def save(self, folder, *, figure_formats=("png",), dpi: float = PNG_DPI) -> list:
         """frf.csv, frf.json, frf.png and modes.csv into ``folder``, all or nothing (other files
-        stay). Returns the paths."""
+        stay); the figure in each of ``figure_formats`` (png, pdf, svg), PNG at ``dpi``.
+        Returns the paths."""
         from .files import write_frf_outputs
 
-        return write_frf_outputs(self.to_pandas(), self.modes.to_list(), folder, self.to_dict(), title=self.title())
+        figures = FigureOptions(figure_formats, dpi)
+        frame, modes = self.to_pandas(), self.modes.to_list()
+        return write_frf_outputs(frame, modes, folder, self.to_dict(), title=self.title(), figures=figures)
 
 
 def frequency_responses(

@@ -689,3 +689,19 @@ def run_parallel(kernel, n_samples: int, *args) -> None:
         jobs = [pool.submit(kernel, int(bounds[i]), int(bounds[i + 1]), *args) for i in range(n_threads)]
         for job in jobs:
             job.result()
+
+
+@njit(cache=True, nogil=True)
+def linear_recurrence(Phi, g, x0, out):
+    """out[s, 0] = x0[s], out[s, n + 1] = Phi out[s, n] + g[s, n]: the exact discretisation's
+    steps (`railride.discrete`), one per output sample."""
+    n_s, n_out, n = g.shape
+    for s in range(n_s):
+        for i in range(n):
+            out[s, 0, i] = x0[s, i]
+        for k in range(n_out):
+            for i in range(n):
+                acc = g[s, k, i]
+                for j in range(n):
+                    acc += Phi[i, j] * out[s, k, j]
+                out[s, k + 1, i] = acc

@@ -21,6 +21,7 @@ from . import validation
 from .comparison import check_controllers, compare
 from .control import LABELS, PAPER_CONTROLLERS, GainSet
 from .defaults import DEFAULT_DAMPER
+from .plots import PNG_DPI, FigureOptions
 from .track import SPECTRA, scenario
 
 SCHEMA = "railride.league/1"
@@ -81,12 +82,13 @@ class LeagueTable:
 
         return plot_league(self, ax=ax)
 
-    def save(self, folder):
+    def save(self, folder, *, figure_formats=("png",), dpi: float = PNG_DPI):
         """league.json, league.csv (one row per case and controller), league.png and
-        league_comfort.png (N_MV against speed)."""
+        league_comfort.png (N_MV against speed), the figures in each of ``figure_formats``
+        (png, pdf, svg), PNG at ``dpi``."""
         from .files import write_league_outputs
 
-        return write_league_outputs(self, folder)
+        return write_league_outputs(self, folder, figures=FigureOptions(figure_formats, dpi))
 
 
 def _cases(scenarios, speeds, track_seeds):

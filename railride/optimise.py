@@ -32,6 +32,7 @@ from .defaults import DEFAULT_DAMPER
 from .solver import SolverSettings
 from .sweep import Case, RunTable, run_cases
 from .objectives import DEFAULT_OBJECTIVE, Objective
+from .plots import PNG_DPI, FigureOptions
 from .tuning import PARAMETERS, REFERENCE, _rms
 
 #: the paper's fourteen SAS parameters
@@ -149,19 +150,20 @@ def _parameter_rows(parameters) -> list[dict]:
     ]
 
 
-def _save(result, folder, files) -> list:
+def _save(result, folder, files, figure_formats=("png",), dpi: float = PNG_DPI) -> list:
     """The ``files`` (png, csv, json) of a result into ``folder``, all or nothing
-    (`railride.files.write_folder`): ``plot()``, ``to_pandas()`` and ``to_dict()``."""
-    from .files import json_text, write_folder
-    from .plots import save_png
+    (`railride.files.write_folder`): ``plot()`` (in each of ``figure_formats``, PNG at
+    ``dpi``), ``to_pandas()`` and ``to_dict()``."""
+    from .files import figure_files, json_text, write_folder
 
+    figures = FigureOptions(figure_formats, dpi)
     text = json_text(result.to_dict())  # refuse NaN before any file is written
     frame = result.to_pandas()
     png, csv, doc = files
     return write_folder(
         folder,
         [
-            (png, lambda path: save_png(result.plot(), path)),
+            *figure_files(png.rsplit(".", 1)[0], result.plot, figures),
             (csv, lambda path: frame.to_csv(path, index=False)),
             (doc, lambda path: path.write_text(text, encoding="utf-8")),
         ],
@@ -252,10 +254,11 @@ class OptimiseResult:
 
         return plot_convergence(self, ax=ax)
 
-    def save(self, folder) -> list:
+    def save(self, folder, *, figure_formats=("png",), dpi: float = PNG_DPI) -> list:
         """optimise.png, optimise.csv and optimise.json into ``folder``, all or nothing (other
-        files stay). Returns the paths."""
-        return _save(self, folder, OPTIMISE_FILES)
+        files stay); the figure in each of ``figure_formats`` (png, pdf, svg), PNG at ``dpi``.
+        Returns the paths."""
+        return _save(self, folder, OPTIMISE_FILES, figure_formats, dpi)
 
 
 def optimise(
@@ -380,10 +383,11 @@ class SensitivityResult:
 
         return plot_indices(self, ax=ax)
 
-    def save(self, folder) -> list:
+    def save(self, folder, *, figure_formats=("png",), dpi: float = PNG_DPI) -> list:
         """sobol.png, sobol.csv and sobol.json into ``folder``, all or nothing (other files
-        stay). Returns the paths."""
-        return _save(self, folder, SENSITIVITY_FILES)
+        stay); the figure in each of ``figure_formats`` (png, pdf, svg), PNG at ``dpi``.
+        Returns the paths."""
+        return _save(self, folder, SENSITIVITY_FILES, figure_formats, dpi)
 
 
 def _finite(value) -> float | None:

@@ -27,6 +27,7 @@ from .defaults import DEFAULT_DAMPER
 from .files import PARETO_FILES
 from .metrics import RESPONSES
 from .params import VehicleParams
+from .plots import PNG_DPI, FigureOptions
 from .optimise import GainEvaluator, log_gain_bounds
 from . import validation
 from .solver import SolverSettings, check_resolution
@@ -166,12 +167,13 @@ class ParetoResult:
 
         return plot_pareto(self, ax)
 
-    def save(self, folder) -> list:
+    def save(self, folder, *, figure_formats=("png",), dpi: float = PNG_DPI) -> list:
         """pareto.png, pareto.csv, pareto.json into ``folder``, all or nothing (each file
-        replaced atomically; other files, such as a run table, stay). Returns the paths."""
+        replaced atomically; other files, such as a run table, stay); the figure in each of
+        ``figure_formats`` (png, pdf, svg), PNG at ``dpi``. Returns the paths."""
         from .files import write_pareto_outputs
 
-        return write_pareto_outputs(self, folder)
+        return write_pareto_outputs(self, folder, figures=FigureOptions(figure_formats, dpi))
 
 
 def _plain(value):

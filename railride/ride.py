@@ -14,6 +14,7 @@ import xarray as xr
 
 from . import dampers
 from .params import PRESETS
+from .plots import PNG_DPI, FigureOptions
 from .solver import SolverSettings
 from .vehicle import CORNER_NAMES, DOF_NAMES, DOF_UNITS, RAILS, WHEELSETS
 
@@ -40,6 +41,7 @@ def build_dataset(
     vcmd,
     closed=None,
     faults=(),
+    integrator: str = "classical RK4, fixed step",
 ) -> xr.Dataset:
     """Named channels in SI units; a ``sample`` dimension only for a batch. ``faults``: each
     sample's damper faults (`railride.faults.DamperFault`), recorded as ``damper_faults`` when
@@ -182,7 +184,7 @@ def build_dataset(
         "xarray_version": xr.__version__,
         "python_version": platform.python_version(),
         "created_utc": created,
-        "integrator": "classical RK4, fixed step",
+        "integrator": integrator,
         "dt_s": dt,
         "output_rate_hz": output_rate,
         "suspension": suspension.describe(),
@@ -339,20 +341,35 @@ class RideResult:
 
         return to_frame(self.dataset)
 
-    def plot(self, ax=None):
-        """The four body responses against time (`railride.plots.ride.plot_body_responses`);
-        ``ax``: four Axes to draw in, or None for a new figure. Returns the figure."""
+    def plot(self, ax=None, window=None):
+        """The four body responses against time (`railride.plots.ride.plot_body_responses`),
+        the y-axes fitting the metric ``window`` (start, end) s (None: the whole run); ``ax``:
+        four Axes to draw in, or None for a new figure. Returns the figure."""
         from .plots.ride import plot_body_responses
 
-        return plot_body_responses(self.dataset, ax=ax)
+        return plot_body_responses(self.dataset, ax=ax, window=window)
 
-    def save(self, folder, window=None, *, comfort: bool = False, vehicle: dict | None = None) -> list:
+    def save(
+        self,
+        folder,
+        window=None,
+        *,
+        comfort: bool = False,
+        vehicle: dict | None = None,
+        figure_formats=("png",),
+        dpi: float = PNG_DPI,
+        history_formats=("nc", "csv"),
+    ) -> list:
         """Write ride.nc, ride.csv, metrics.json (`to_dict` with these arguments) and
         body_responses.png into ``folder``, all or nothing (`railride.files.write_outputs`).
-        Returns the written paths."""
+        The figure in each of ``figure_formats`` (png, pdf, svg), PNG at ``dpi``; the time
+        histories in each of ``history_formats`` (nc, csv, mat: MATLAB). Returns the written
+        paths."""
         from .files import write_outputs
 
-        return write_outputs(self, folder, self.to_dict(window, comfort=comfort, vehicle=vehicle))
+        figures = FigureOptions(figure_formats, dpi)
+        doc = self.to_dict(window, comfort=comfort, vehicle=vehicle)
+        return write_outputs(self, folder, doc, figures=figures, histories=history_formats)
 
 
 def _suspension_record(suspension) -> dict:

@@ -181,12 +181,14 @@ class RideSpectrum:
 
         return plot_ride_spectrum(self, ax=ax)
 
-    def save(self, folder) -> list:
+    def save(self, folder, *, figure_formats=("png",), dpi: float = 120.0) -> list:
         """ride_spectrum.json, ride_spectrum.csv (the RMS table), ride_spectrum_psd.csv (the
-        PSDs) and ride_spectrum.png into ``folder``, all or nothing. Returns the paths."""
+        PSDs) and the figure ride_spectrum in each of ``figure_formats`` (png, pdf, svg; PNG at
+        ``dpi``) into ``folder``, all or nothing. Returns the paths."""
         from .files import write_ride_spectrum_outputs
+        from .plots import FigureOptions
 
-        return write_ride_spectrum_outputs(self, folder)
+        return write_ride_spectrum_outputs(self, folder, figures=FigureOptions(figure_formats, dpi))
 
 
 def ride_spectrum(

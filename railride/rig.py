@@ -25,6 +25,7 @@ import xarray as xr
 
 from . import dampers, kernels, validation
 from .defaults import DEFAULT_DAMPER, DEFAULT_DT
+from .plots import PNG_DPI, FigureOptions
 
 #: motion-table nodes per cycle of the fastest motion
 _NODES_PER_CYCLE = 400
@@ -306,12 +307,14 @@ class Cycles:
 
         return plot_hysteresis(self, ax=ax)
 
-    def save(self, folder) -> list:
+    def save(self, folder, *, figure_formats=("png",), dpi: float = PNG_DPI) -> list:
         """loops.png, cycles.csv and damper.json into ``folder``, all or nothing (other files
-        stay). Returns the paths."""
+        stay); the figure in each of ``figure_formats`` (png, pdf, svg), PNG at ``dpi``.
+        Returns the paths."""
         from .files import write_damper_outputs
 
-        return write_damper_outputs(self, folder, self.to_dict())
+        figures = FigureOptions(figure_formats, dpi)
+        return write_damper_outputs(self, folder, self.to_dict(), figures=figures)
 
 
 def cycles(
@@ -447,12 +450,14 @@ class Tracking:
 
         return plot_tracking(self, ax=ax)
 
-    def save(self, folder) -> list:
+    def save(self, folder, *, figure_formats=("png",), dpi: float = PNG_DPI) -> list:
         """tracking.png, tracking.csv and tracking.json into ``folder``, all or nothing (other
-        files stay). Returns the paths."""
+        files stay); the figure in each of ``figure_formats`` (png, pdf, svg), PNG at ``dpi``.
+        Returns the paths."""
         from .files import write_tracking_outputs
 
-        return write_tracking_outputs(self, folder, self.to_dict())
+        figures = FigureOptions(figure_formats, dpi)
+        return write_tracking_outputs(self, folder, self.to_dict(), figures=figures)
 
 
 def desired_force_signal(kind: str, amplitude: float, frequency: float):

@@ -78,6 +78,23 @@ def max_stable_dt(vehicle: Vehicle, damper=None) -> float:
     return lo
 
 
+#: what a result's ``integrator`` attribute says of each method
+INTEGRATOR_RK4 = "classical RK4, fixed step"
+INTEGRATOR_EXACT = "exact discretisation (matrix exponential, one step per output sample; railride.discrete)"
+
+
+def _exact(solver, damper, closed, suspensions) -> bool:
+    """Whether the run takes the exact discretisation: method "exact", or "auto" with the
+    passive viscous dampers (linear); "exact" with anything else is refused."""
+    linear = damper is None and closed is None and not any(s.faults for s in suspensions)
+    if solver.method == "exact" and not linear:
+        raise ValueError(
+            "method = 'exact': applies to the passive viscous suspension only (a linear vehicle); "
+            "MR dampers, ideal devices and closed loops run with method 'rk4' or 'auto'"
+        )
+    return linear and solver.method != "rk4"
+
+
 def _check_dt(vehicle: Vehicle, dt: float, damper=None) -> None:
     dt_max = _max_stable_dt(vehicle.params, damper)
     if dt > dt_max:
@@ -250,11 +267,13 @@ def simulate(
     damper = suspensions[0].damper
     vcmd = np.array([[_command_voltage(s)] * 4 for s in suspensions], dtype=float)
     closed = _closed_loop(suspensions, solver, duration)
+    exact = _exact(solver, damper, closed, suspensions)
     vehicles = {}
     for p in param_sets:
         if id(p) not in vehicles:
             vehicles[id(p)] = _vehicle(p)
-            _check_dt(vehicles[id(p)], dt, damper)
+            if not exact:  # the exact steps are stable at any dt
+                _check_dt(vehicles[id(p)], dt, damper)
     stride = solver.output_steps
     n_out_f = duration * output_rate
     n_out = int(round(n_out_f))
@@ -289,13 +308,13 @@ def simulate(
         u_off[i], tab, interval[i] = u_index[ukey]
         n_nodes[i] = len(tab)
         fkey = (id(sc), id(p))
-        if fkey not in f_index:
+        if fkey not in f_index and not exact:  # the exact steps take the inputs themselves
             sysm = systems[id(p)]
             f_index[fkey] = sum(len(t) for t in ftabs)
             ftabs.append(_forcing_table(tab, sysm["Bw"], sysm["Bwd"]))
-        f_off[i] = f_index[fkey]
+        f_off[i] = f_index.get(fkey, 0)
     utab = np.ascontiguousarray(np.concatenate(utabs))
-    ftab = np.ascontiguousarray(np.concatenate(ftabs))
+    ftab = np.ascontiguousarray(np.concatenate(ftabs)) if ftabs else np.zeros((1, 36))
 
     rows = n_out + 1
     law = kernels.LAW_VISCOUS_IN_C if damper is None else damper.law
@@ -353,7 +372,25 @@ def simulate(
         inner_gains[:, 3] = [s.delay for s in suspensions]
     chunk = n_steps if progress is None else max(stride, (_CHUNK_WORK // n) // stride * stride)
     done = 0
-    while True:
+    if exact:
+        from .discrete import run_exact
+
+        samples = [
+            (
+                vehicles[id(p)].state_matrix,
+                systems[id(p)]["Bw"],
+                systems[id(p)]["Bwd"],
+                vehicles[id(p)].T,
+                p.c_sz,
+                utab[u_off[i] : u_off[i] + n_nodes[i]],
+                interval[i],
+            )
+            for i, p in enumerate(param_sets)
+        ]
+        status, fail_step = run_exact(out, samples, x[:, : 2 * N_DOF], dt, stride, n_out, output_rate)
+        if progress is not None:
+            progress(1.0)
+    while not exact:
         todo = min(chunk, n_steps - done)
         final = done + todo == n_steps
         kernels.run_parallel(
@@ -445,6 +482,7 @@ def simulate(
             vcmd,
             closed,
             [s.faults for s in suspensions],
+            INTEGRATOR_EXACT if exact else INTEGRATOR_RK4,
         ),
         suspension=suspensions if batch else suspensions[0],
         solver=solver,

@@ -12,6 +12,10 @@ from dataclasses import dataclass
 from . import validation
 from .defaults import DEFAULT_CONTROL_RATE, DEFAULT_DT, DEFAULT_OUTPUT_RATE
 
+#: how `railride.simulate` integrates: "auto" (exact discretisation where the suspension is
+#: linear, the passive viscous dampers; RK4 otherwise), "rk4" (always the fixed-step RK4) or
+#: "exact" (refused where the suspension is not linear)
+METHODS = ("auto", "rk4", "exact")
 #: a random track's shortest wavelength must pass at speed / min_wavelength <= output_rate /
 #: RESOLUTION: a component above that shows in the stored histories only as a few samples a cycle
 RESOLUTION = 2.5
@@ -26,7 +30,9 @@ def _steps(steps: float) -> int | None:
 @dataclass(frozen=True)
 class SolverSettings:
     """The fixed RK4 step ``dt`` [s], the rate of the stored time histories ``output_rate``
-    [Hz] and the sample rate of the outer-loop controllers ``control_rate`` [Hz].
+    [Hz], the sample rate of the outer-loop controllers ``control_rate`` [Hz] and the
+    integration ``method`` (`METHODS`; default "auto": exact discretisation for the passive
+    viscous suspension, one step per output sample, where dt only sets the input grid).
 
     Checked at construction: each a finite number > 0, and the output interval 1/output_rate
     a whole number of steps (at most one output sample per step). The controller period
@@ -39,10 +45,12 @@ class SolverSettings:
     dt: float = DEFAULT_DT
     output_rate: float = DEFAULT_OUTPUT_RATE
     control_rate: float = DEFAULT_CONTROL_RATE
+    method: str = "auto"
 
     def __post_init__(self):
         for name, unit in (("dt", "s"), ("output_rate", "Hz"), ("control_rate", "Hz")):
             object.__setattr__(self, name, validation.number(name, getattr(self, name), "positive", unit))
+        validation.choice("method", self.method, METHODS)
         if self.dt * self.output_rate > 1.0 + 1e-6:
             raise ValueError(
                 f"dt = {self.dt:g} s is too large for output_rate = {self.output_rate:g} Hz: "
@@ -75,8 +83,12 @@ class SolverSettings:
         return steps
 
     def to_dict(self) -> dict:
-        """The settings as a result records them (SI units in the names)."""
-        return {"dt_s": self.dt, "output_rate_hz": self.output_rate, "control_rate_hz": self.control_rate}
+        """The settings as a result records them (SI units in the names); the method only when
+        it is not "auto", so that records of runs before it existed stay as they were."""
+        out = {"dt_s": self.dt, "output_rate_hz": self.output_rate, "control_rate_hz": self.control_rate}
+        if self.method != "auto":
+            out["method"] = self.method
+        return out
 
     @classmethod
     def of(cls, solver) -> "SolverSettings":

@@ -32,6 +32,7 @@ from .defaults import DEFAULT_DAMPER
 from .faults import DamperFault, check_faults, parse_faults
 from .metrics import RESPONSES
 from .params import VehicleParams
+from .plots import PNG_DPI, FigureOptions
 from .solver import SolverSettings
 from .sensing import SENSING, reads_bogies
 from .sweep import COMFORT_COLUMNS, Case, RunTable, cached_scenario, run_cases
@@ -117,13 +118,14 @@ class StudyResult:
 
         return plot_study(self, ax=ax, metrics=metrics)
 
-    def save(self, folder) -> list:
+    def save(self, folder, *, figure_formats=("png",), dpi: float = PNG_DPI) -> list:
         """study.json (`to_dict`), study_summary.csv (`to_pandas`), study_runs.csv (`cases`)
-        and study.png (`plot`) into ``folder``, all or nothing (other files, such as the run
-        table runs.csv, stay). Returns the paths."""
+        and study.png (`plot`; in each of ``figure_formats``, png, pdf, svg, PNG at ``dpi``)
+        into ``folder``, all or nothing (other files, such as the run table runs.csv, stay).
+        Returns the paths."""
         from .files import write_study_outputs
 
-        return write_study_outputs(self, folder)
+        return write_study_outputs(self, folder, figures=FigureOptions(figure_formats, dpi))
 
 
 def _finite(value):

@@ -30,6 +30,7 @@ import pandas as pd
 from .defaults import DEFAULT_CONTROL_RATE, DEFAULT_DAMPER, DEFAULT_OUTPUT_RATE
 from .executors import DaskExecutor, LocalExecutor, RunTable  # noqa: F401 (their home before)
 from .metrics import RESPONSES, STATISTICS
+from .plots import PNG_DPI, FigureOptions
 from .params import VehicleParams
 from .solver import SolverSettings
 from .control import CONSTANT_VOLTAGE
@@ -479,14 +480,16 @@ class SweepResult:
 
         return (plot_sweep_comfort if comfort else plot_sweep)(self, ax, axis=axis)
 
-    def save(self, folder, *, extra: dict | None = None) -> list:
+    def save(self, folder, *, extra: dict | None = None, figure_formats=("png",), dpi: float = PNG_DPI) -> list:
         """sweep.json (`to_dict`, then the entries of ``extra``, such as a command line's
         facts) and, when the grid has one numeric axis with several values, sweep.png and,
-        with comfort, comfort.png into ``folder``, all or nothing (other files, such as the run
-        table runs.csv, stay). Returns the paths."""
+        with comfort, comfort.png (each in every one of ``figure_formats``: png, pdf, svg; PNG
+        at ``dpi``) into ``folder``, all or nothing (other files, such as the run table
+        runs.csv, stay). Returns the paths."""
         from .files import write_sweep_outputs
 
-        return write_sweep_outputs(self, folder, {**self.to_dict(), **(extra or {})})
+        figures = FigureOptions(figure_formats, dpi)
+        return write_sweep_outputs(self, folder, {**self.to_dict(), **(extra or {})}, figures=figures)
 
 
 def comfort_settings(duration: float, window) -> dict:

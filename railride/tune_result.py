@@ -18,6 +18,7 @@ import pandas as pd
 from .control import GainSet
 from .metrics import RESPONSES
 from .objectives import DEFAULT_OBJECTIVE, Objective
+from .plots import PNG_DPI, FigureOptions
 
 #: the schema of `TuneResult.to_dict` (tune.json)
 SCHEMA = "railride.tune/3"
@@ -244,15 +245,26 @@ class TuneResult:
 
         return plot_sensitivity(self.curves, title=self._title(), ax=ax)
 
-    def save(self, folder, command: str | None = None, *, extra: dict | None = None) -> list:
-        """gains.toml (`gains_toml` with ``command``), sensitivity.png (`plot`), curves.csv
-        (`to_pandas`) and tune.json (`to_dict`, then the entries of ``extra``, such as a command
-        line's facts) into ``folder``, all or nothing (each file replaced atomically; other
-        files, such as the run table runs.csv, stay). Returns the paths."""
+    def save(
+        self,
+        folder,
+        command: str | None = None,
+        *,
+        extra: dict | None = None,
+        figure_formats=("png",),
+        dpi: float = PNG_DPI,
+    ) -> list:
+        """gains.toml (`gains_toml` with ``command``), sensitivity.png (`plot`; in each of
+        ``figure_formats``, png, pdf, svg, PNG at ``dpi``), curves.csv (`to_pandas`) and
+        tune.json (`to_dict`, then the entries of ``extra``, such as a command line's facts)
+        into ``folder``, all or nothing (each file replaced atomically; other files, such as
+        the run table runs.csv, stay). Returns the paths."""
         from .files import write_tune_outputs
 
+        figures = FigureOptions(figure_formats, dpi)
         doc = {**self.to_dict(), **(extra or {})}
-        return write_tune_outputs(self.curves, folder, doc, self.gains_toml(command), title=self._title())
+        gains = self.gains_toml(command)
+        return write_tune_outputs(self.curves, folder, doc, gains, title=self._title(), figures=figures)
 
     def _scenario_text(self) -> str:
         from .labels import describe_scenario

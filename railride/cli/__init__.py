@@ -1,6 +1,6 @@
 """The ``railride`` command line: ``railride compare``, ``railride modes``, ``railride frf``,
 ``railride simulate``, ``railride damper``, ``railride tracking``, ``railride tune``,
-``railride study``, ``railride pareto`` and ``railride sweep``.
+``railride study``, ``railride pareto``, ``railride sweep`` and ``railride report``.
 
 A thin layer over the library: it parses options, calls the library's studies (`simulate`,
 `compare`, `frf`, `rig`, `tune`, `study`, `pareto`, `sweep`), writes their results through their
@@ -18,7 +18,7 @@ interrupted by Ctrl-C (the finished runs stay in DIR/runs.csv for --resume). Err
 from __future__ import annotations
 
 # the commands register on `app` when imported, and `railride --help` lists them in this order
-from . import compare, modes, frf, simulate, rig, tune, pareto, sweep, study  # noqa: F401
+from . import compare, report, modes, frf, simulate, rig, tune, pareto, sweep, study, ride_spectrum  # noqa: F401
 from ._app import app
 
 __all__ = ["app", "main"]

@@ -87,15 +87,14 @@ def stderr_is_terminal() -> bool:
         return False
 
 
-def stdout_console():
-    from rich.console import Console
-
-    return Console(file=sys.stdout, highlight=False)
+#: the width of tables and text printed to a pipe or a file, unless COLUMNS says otherwise
+PIPE_WIDTH = 80
 
 
-def wide_stdout_console(width: int = 120):
-    """The stdout console for wide tables: the terminal's width on a terminal, else ``width``
-    columns (rich would assume 80 for a pipe or a file) unless COLUMNS says otherwise."""
+def stdout_console(width: int = PIPE_WIDTH):
+    """The stdout console: on a terminal its width (or COLUMNS); to a pipe or a file, COLUMNS if
+    set, else ``width`` columns (rich would take the width of a terminal on stdin or stderr).
+    Tables fit it (`railride.cli._width`)."""
     import os
 
     from rich.console import Console
@@ -106,6 +105,10 @@ def wide_stdout_console(width: int = 120):
         terminal = False
     fixed = None if terminal or os.environ.get("COLUMNS") else width
     return Console(file=sys.stdout, highlight=False, width=fixed)
+
+
+#: the older name of `stdout_console`
+wide_stdout_console = stdout_console
 
 
 def stderr_console():

@@ -4,10 +4,11 @@
 from __future__ import annotations
 
 import json
+from typing import Callable
 
 import typer
 
-from ._common import ProgressBar, stderr_is_terminal, wide_stdout_console, write_folder
+from ._common import ProgressBar, stderr_is_terminal, stdout_console, write_folder
 from ._options import OutputFormat
 from ._parsing import damper_preset, load_gains, parse_scale, vehicle_from_options
 from ._render import alike_text, fmt, untuned_text
@@ -84,14 +85,18 @@ def run_league(
     if format is OutputFormat.json:
         typer.echo(text)
         return
-    wide_stdout_console().print(league_table(table, doc))
+    console = stdout_console()
+    for part in league_table(table, doc):
+        console.print(part)
 
 
-def league_table(table, doc):
-    """One row per controller: mean RMS reductions (MR, ideal actuator), comfort, force, travel."""
-    from rich.table import Table
+def league_table(table, doc) -> list:
+    """One row per controller: mean RMS reductions (MR, ideal actuator), comfort, force, travel;
+    on a narrow console the reductions, and the comfort and damper columns, in two tables."""
+    from rich.text import Text
 
     from ..labels import describe_scenario
+    from ._width import FitTable, Split
 
     summary = table.summary()
     cases = table.cases[table.cases.controller == "passive"]
@@ -109,29 +114,37 @@ def league_table(table, doc):
         + ("\n" + alike_text(settings["tuned_alike"]) if settings.get("tuned_alike") else "")
         + ("\n" + untuned_text(settings["untuned"]) if settings.get("untuned") else "")
     )
-    t = Table(title="League table", caption=caption, caption_justify="left")
-    t.add_column("suspension")
-    for label in ("acceleration", "displacement", "pitch", "roll"):
-        t.add_column(f"{label}\n(%)", justify="right")
-    t.add_column("a_w Wk\ncentre\n(m/s^2)", justify="right")
-    t.add_column("N_MV,z\ncentre", justify="right")
-    t.add_column("damper\nforce max\n(kN)", justify="right")
-    t.add_column("travel\nmax\n(mm)", justify="right")
-    for row in doc["controllers"]:
-        n = row["name"]
-        cells = []
-        for r in ("acceleration_m_s2", "displacement_m", "pitch_deg", "roll_deg"):
-            if n == "passive":
-                cells.append("-")
-                continue
-            mr, ideal = row.get(f"{r}_reduction_percent"), row.get(f"{r}_ideal_reduction_percent")
-            cells.append(("n/a" if mr is None else f"{mr:.1f}") + (" (-)" if ideal is None else f" ({ideal:.0f})"))
-        s = summary.loc[n]
-        cells += [
-            fmt(s.get("centre_aw_Wk"), ".3f"),
-            fmt(s.get("centre_N_MV_z"), ".2f"),
-            fmt(s["force_max_n"] / 1e3, ".1f"),
-            fmt(s["travel_max_m"] * 1e3, ".1f"),
-        ]
-        t.add_row(row["label"], *cells)
-    return t
+
+    def reduction(key: str) -> Callable[[dict], str]:
+        def cell(row: dict) -> str:
+            if row["name"] == "passive":
+                return "-"
+            mr, ideal = row.get(f"{key}_reduction_percent"), row.get(f"{key}_ideal_reduction_percent")
+            return ("n/a" if mr is None else f"{mr:.1f}") + (" (-)" if ideal is None else f" ({ideal:.0f})")
+
+        return cell
+
+    columns: dict[str, Callable[[dict], str]] = {  # heading -> cell of a row of doc["controllers"]
+        "acceleration\n(%)": reduction("acceleration_m_s2"),
+        "displacement\n(%)": reduction("displacement_m"),
+        "pitch\n(%)": reduction("pitch_deg"),
+        "roll\n(%)": reduction("roll_deg"),
+        "a_w Wk\ncentre\n(m/s^2)": lambda row: fmt(summary.loc[row["name"]].get("centre_aw_Wk"), ".3f"),
+        "N_MV,z\ncentre": lambda row: fmt(summary.loc[row["name"]].get("centre_N_MV_z"), ".2f"),
+        "damper\nforce max\n(kN)": lambda row: fmt(summary.loc[row["name"]]["force_max_n"] / 1e3, ".1f"),
+        "travel\nmax\n(mm)": lambda row: fmt(summary.loc[row["name"]]["travel_max_m"] * 1e3, ".1f"),
+    }
+    headings = list(columns)
+
+    def build(groups: list[list[str]]):
+        t = FitTable(title="League table")
+        t.add_column("suspension")
+        for heading in (h for g in groups for h in g):
+            # "MR (ideal)" stays on one line
+            t.add_column(heading, justify="right", no_wrap=heading.endswith("(%)"))
+        for row in doc["controllers"]:
+            t.add_row(row["label"], *[columns[h](row) for g in groups for h in g])
+        return t
+
+    groups = [headings[:4], headings[4:6], headings[6:]]  # reductions, comfort, damper
+    return [Split(build, groups), Text(caption)]

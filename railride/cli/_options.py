@@ -343,6 +343,7 @@ SchedulerFileOption = Annotated[
 
 # -- output folders -----------------------------------------------------------------------------
 def _out(help: str):
+    help += " Figures as PNG at 120 dpi unless --figure-format or --dpi say otherwise."
     return Annotated[Optional[Path], typer.Option("--out", metavar="DIR", help=help)]
 
 
@@ -383,6 +384,53 @@ StudyOutOption = _out(
     "study_summary.csv, study_runs.csv and study.png into DIR at the end."
 )
 
+# -- figures: every command that writes an output folder -------------------------------------------
+FigureFormatOption = Annotated[
+    Optional[str],
+    typer.Option(
+        "--figure-format",
+        metavar="FORMATS",
+        help="With --out: the figures' file formats, a comma list of png, pdf and svg (default "
+        "png); each figure is written once per format (pitch.png, pitch.pdf).",
+    ),
+]
+DpiOption = Annotated[
+    Optional[str],
+    typer.Option(
+        "--dpi",
+        metavar="N",
+        help="With --out: the resolution of PNG figures [dots per inch], a number > 0 and <= 1200 "
+        "(default 120; 300 or 600 for print). PDF and SVG are vector.",
+    ),
+]
+
+
+def figure_options(figure_format: Optional[str], dpi: Optional[str], out: Optional[Path]):
+    """--figure-format and --dpi as a `railride.plots.FigureOptions` (read as text, so that a
+    word gets the one-line error too); ValueError naming the option for a bad value, or for
+    either without --out."""
+    from ..plots import PNG_DPI, FigureOptions
+
+    given = [o for o, v in (("--figure-format", figure_format), ("--dpi", dpi)) if v is not None]
+    if given and out is None:
+        raise ValueError(f"{given[0]}: applies with --out only (the figures are written into the output folder)")
+    value = PNG_DPI if dpi is None else _number(dpi)
+    try:
+        return FigureOptions("png" if figure_format is None else figure_format, value)
+    except ValueError as exc:
+        text = str(exc).replace("figure_formats = ", "--figure-format = ", 1)
+        raise ValueError(text.replace("dpi = ", "--dpi = ", 1) if text.startswith("dpi") else text) from None
+
+
+def _number(text: str):
+    """``text`` as an int or float as typed, else the text itself (FigureOptions names it)."""
+    for kind in (int, float):
+        try:
+            return kind(text)
+        except ValueError:
+            pass
+    return text
+
 
 def _resume(help: str):
     return Annotated[bool, typer.Option("--resume", help=help)]
@@ -398,3 +446,42 @@ StudyResumeOption = _resume(
 SweepResumeOption = _resume(
     "Continue the sweep whose run table is DIR/runs.csv (needs --out): runs already there are not evaluated again."
 )
+
+#: compare, sweep, tune and study: the HTML report of the result (railride.report)
+ReportOption = Annotated[
+    Optional[Path],
+    typer.Option(
+        "--report",
+        metavar="FILE.html",
+        help="Also write one self-contained HTML file of the result: settings, modal table, the "
+        "tables printed here, the result's table and its figures, time histories and spectra "
+        "interactive (docs/report.md).",
+    ),
+]
+
+
+#: simulate and compare: the formats of the time histories in --out
+HistoryFormatOption = Annotated[
+    Optional[str],
+    typer.Option(
+        "--history-format",
+        metavar="LIST",
+        help="With --out: the time histories as one or more of nc (NetCDF), csv, mat (MATLAB), "
+        "comma-separated (default nc,csv). --format stays what is printed on stdout.",
+    ),
+]
+
+
+def history_options(history_format: Optional[str], out: Optional[Path]) -> tuple:
+    """--history-format as the library's formats (`railride.files.history_formats`); ValueError
+    naming the option for a bad value, or without --out."""
+    from ..files import history_formats
+
+    if history_format is None:
+        return history_formats()
+    if out is None:
+        raise ValueError("--history-format: applies with --out only (the time histories are written into it)")
+    try:
+        return history_formats(history_format)
+    except ValueError as exc:
+        raise ValueError(str(exc).replace("history_formats = ", "--history-format = ", 1)) from None

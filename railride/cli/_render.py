@@ -58,10 +58,11 @@ def _comfort_caption(record: dict) -> str:
 def comfort_table(record: dict):
     """The comfort table of `simulate`: one row per index, one column per position."""
     from rich.markup import escape
-    from rich.table import Table
+
+    from ._width import FitTable
 
     positions = record["positions"]
-    table = Table(title="Ride comfort (carbody floor)", caption=escape(_comfort_caption(record)))
+    table = FitTable(title="Ride comfort (carbody floor)", caption=escape(_comfort_caption(record)))
     table.add_column("index")
     for name in positions:
         table.add_column(escape(POSITION_LABELS.get(name, name)), justify="right")
@@ -73,49 +74,57 @@ def comfort_table(record: dict):
 
 def compare_comfort_table(rows: list[dict]):
     """The "ride comfort" table of `compare`: the indices at each position (rows), the
-    suspensions (columns) with the reduction against passive where meaningful."""
+    suspensions (columns) with the reduction against passive where meaningful; on a narrow
+    console one table per group of suspensions, each beside passive."""
     from rich.markup import escape
-    from rich.table import Table
+
+    from ._width import FitTable, Split
 
     first = rows[0]["comfort"]
-    table = Table(
-        title="Ride comfort on the carbody floor: centre and above the bogies",
-        caption=escape(
-            _comfort_caption(first) + "\nred. % = (passive - controlled) / "
-            "passive x 100; none for Wz, which is not proportional to the "
-            "acceleration"
-        ),
+    caption = escape(
+        _comfort_caption(first) + "\nred. % = (passive - controlled) / "
+        "passive x 100; none for Wz, which is not proportional to the "
+        "acceleration"
     )
-    table.add_column("position", no_wrap=True)
-    table.add_column("index", no_wrap=True)
-    for r in rows:
-        table.add_column(escape(r["label"].replace(" (", "\n(")), justify="right", min_width=8)
-        if r["name"] != "passive":
-            table.add_column("red. %", justify="right", min_width=5)
-    for pos in first["positions"]:
-        for n, (key, label, spec) in enumerate(COMFORT_ROWS):
-            cells = [escape(SHORT_POSITION_LABELS.get(pos, pos)) if n == 0 else "", escape(label)]
-            for r in rows:
-                cells.append(format(r["comfort"]["positions"][pos][key], spec))
-                if r["name"] != "passive":
-                    red = r["comfort"].get("reduction_percent", {}).get(pos, {}).get(key)
-                    cells.append(reduction_text(red))
-            table.add_row(*cells)
-        cells = ["", "class (N_MV,z)"]
-        for r in rows:
-            cells.append(r["comfort"]["positions"][pos]["N_MV_z_class"])
+
+    def build(group: list[dict]):
+        table = FitTable(title="Ride comfort on the carbody floor: centre and above the bogies", caption=caption)
+        # the position heads its rows (not a column of its own): two suspensions fit 80 columns
+        table.add_column("position, index")
+        for r in group:
+            table.add_column(escape(r["label"].replace(" (", "\n(")), justify="right", min_width=8)
             if r["name"] != "passive":
-                cells.append("")
-        table.add_row(*cells, end_section=True)
-    return table
+                table.add_column("red. %", justify="right", no_wrap=True)
+        blank = [""] * (len(table.columns) - 1)
+        for pos in first["positions"]:
+            table.add_row(f"[bold]{escape(SHORT_POSITION_LABELS.get(pos, pos))}[/bold]", *blank)
+            for key, label, spec in COMFORT_ROWS:
+                cells = [escape(label)]
+                for r in group:
+                    cells.append(format(r["comfort"]["positions"][pos][key], spec))
+                    if r["name"] != "passive":
+                        red = r["comfort"].get("reduction_percent", {}).get(pos, {}).get(key)
+                        cells.append(reduction_text(red))
+                table.add_row(*cells)
+            cells = ["class (N_MV,z)"]
+            for r in group:
+                cells.append(r["comfort"]["positions"][pos]["N_MV_z_class"])
+                if r["name"] != "passive":
+                    cells.append("")
+            table.add_row(*cells, end_section=True)
+        return table
+
+    passive = [r for r in rows if r["name"] == "passive"]
+    return Split(build, [r for r in rows if r["name"] != "passive"], repeat=passive)
 
 
 # -- modes: modes and frf -----------------------------------------------------------------------
 def modes_table(rows: list[dict]):
     from rich.markup import escape
-    from rich.table import Table
 
-    table = Table(title="Modes of the passive vehicle")
+    from ._width import FitTable
+
+    table = FitTable(title="Modes of the passive vehicle")
     table.add_column("#", justify="right")
     table.add_column("mode", no_wrap=True)
     table.add_column("undamped (Hz)", justify="right")

@@ -13,7 +13,7 @@ import typer
 from ..dampers import IDEAL_NAMES
 from ..defaults import DEFAULT_CONTROL_RATE, DEFAULT_DAMPER
 from ._app import app
-from ._common import ProgressBar, errors, option_names, stderr_is_terminal, wide_stdout_console, write_folder
+from ._common import ProgressBar, errors, option_names, stderr_is_terminal, stdout_console, write_folder
 from ._options import (
     AmplitudeOption,
     ComfortOption,
@@ -23,8 +23,10 @@ from ._options import (
     CompareOutOption,
     CompareScenarioOption,
     ControlRateOption,
+    DpiOption,
     DtOption,
     DurationOption,
+    FigureFormatOption,
     FormatOption,
     MaxWavelengthOption,
     MinWavelengthOption,
@@ -34,8 +36,12 @@ from ._options import (
     ParamsOption,
     PresetOption,
     RailPhaseOption,
+    ReportOption,
     WavelengthOption,
     WindowOption,
+    HistoryFormatOption,
+    figure_options,
+    history_options,
 )
 from ._parsing import (
     SOLVER_FIELDS,
@@ -53,6 +59,27 @@ from ._parsing import (
 from ._league import run_league
 from ._render import RESPONSE_LABELS, alike_text, compare_comfort_table, damper_text, fmt, reduction_text, untuned_text
 
+#: --controllers and --bounds, shared with `railride report`
+ControllersOption = Annotated[
+    str,
+    typer.Option(
+        "--controllers",
+        metavar="NAME[,NAME...]",
+        help="Suspensions to compare, comma-separated: passive, pid, sas-attitude, "
+        "sas-attitude-ride (the paper's, the default), skyhook, skyhook-on-off, groundhook, "
+        "hybrid, clipped-optimal, passive-on, passive-off (MR dampers at v_max, v_min), or all. "
+        "Passive always runs as the baseline.",
+    ),
+]
+BoundsOption = Annotated[
+    bool,
+    typer.Option(
+        "--bounds/--no-bounds",
+        help="Also run the same control laws and gains on the ideal semi-active damper and the "
+        "ideal actuator, and print their reductions beside the MR dampers' (default on; "
+        "MR dampers only).",
+    ),
+]
 #: the library's names of compare's options, for its errors
 COMPARE_FIELDS = {**SOLVER_FIELDS, "damper": "--damper", "damper_scale": "--damper-scale", "delay": "--delay"}
 
@@ -138,10 +165,10 @@ def _trade_off_lines(doc: dict) -> list[str]:
 def _compare_tables(doc: dict, vehicle: str, shipped: bool):
     """The three tables of `compare`: Table 1 beside the paper, peak-to-peak, damper demands."""
     from rich.markup import escape
-    from rich.table import Table
     from rich.text import Text
 
     from ..labels import describe_scenario
+    from ._width import FitTable, Split
 
     rows = doc["controllers"]
     settings = doc["settings"]
@@ -204,47 +231,52 @@ def _compare_tables(doc: dict, vehicle: str, shipped: bool):
         + "red. % = (passive - controlled) / passive x 100 (negative: worse than passive, in red)."
     )
     title = "Ride comparison: RMS of the carbody responses" + (" beside the paper's Table 1" if paper_case else "")
-    table = Table(title=title)
-    table.add_column("response", min_width=12)
-    table.add_column("", no_wrap=True)
-    for r in rows:
-        table.add_column(escape(r["label"].replace(" (", "\n(")), justify="right", min_width=8)
-        if r["name"] != "passive":
-            table.add_column("red. %", justify="right", min_width=5)
-    for key, label in RESPONSE_LABELS.items():
-        ours, paper = [label, "railride"], ["", "[dim]paper[/dim]"]
-        for r in rows:
-            ours.append(f"{r['metrics'][key]['rms']:#.4g}")
-            p = r["paper"][key] if r["paper"] else None  # None: not in the paper
-            paper.append(f"[dim]{p['rms']:g}[/dim]" if p else "[dim]-[/dim]")
+
+    def rms_table(group: list[dict]):
+        table = FitTable(title=title)
+        table.add_column("response")
+        table.add_column("", no_wrap=True)
+        for r in group:
+            table.add_column(escape(r["label"].replace(" (", "\n(")), justify="right", min_width=8)
             if r["name"] != "passive":
-                ours.append(reduction_text(r["reduction_percent"][key]))
-                paper.append(f"[dim]{p['reduction_percent']:.1f}[/dim]" if p else "[dim]-[/dim]")
-        table.add_row(*ours, end_section=not paper_case)
-        if paper_case:
-            table.add_row(*paper, end_section=True)
+                table.add_column("red. %", justify="right", no_wrap=True)
+        for key, label in RESPONSE_LABELS.items():
+            ours, paper = [label, "railride"], ["", "[dim]paper[/dim]"]
+            for r in group:
+                ours.append(f"{r['metrics'][key]['rms']:#.4g}")
+                p = r["paper"][key] if r["paper"] else None  # None: not in the paper
+                paper.append(f"[dim]{p['rms']:g}[/dim]" if p else "[dim]-[/dim]")
+                if r["name"] != "passive":
+                    ours.append(reduction_text(r["reduction_percent"][key]))
+                    paper.append(f"[dim]{p['reduction_percent']:.1f}[/dim]" if p else "[dim]-[/dim]")
+            table.add_row(*ours, end_section=not paper_case)
+            if paper_case:
+                table.add_row(*paper, end_section=True)
+        return table
+
+    # on a narrow console, one table per group of suspensions, each beside passive
+    passive = [r for r in rows if r["name"] == "passive"]
+    table = Split(rms_table, [r for r in rows if r["name"] != "passive"], repeat=passive)
 
     # 1b. the same gains on the ideal devices: what a damper, and an actuator, could reach
     bounds_parts = []
     if doc.get("bounds"):
-        bt = Table(title="RMS reduction % beside the bounds: the same control laws and gains on ideal devices")
-        bt.add_column("response", min_width=20, no_wrap=True)
-        short = {"pid": "PID", "sas-attitude": "SAS att.", "sas-attitude-ride": "SAS att.+ride"}
+        # one row per law and response: MR dampers and both bounds side by side at any width
+        bt = FitTable(title="RMS reduction % beside the bounds: the same control laws and gains on ideal devices")
+        bt.add_column("suspension")
+        bt.add_column("response")
+        for head in ("MR\ndampers", "ideal\ndamper", "ideal\nactuator"):
+            bt.add_column(head, justify="right")
         # passive-on and passive-off have no bound (a constant voltage): said below the table
         unbounded = [r for r in controlled if doc["bounds"]["ideal"][r["name"]].get("note")]
         bounded = [r for r in controlled if r not in unbounded]
         for r in bounded:
-            for head in ("MR", "ideal\ndamper", "ideal\nactuator"):
-                name = short.get(r["name"], r["label"])
-                bt.add_column(escape(f"{name}\n{head}") if head == "MR" else f"\n{head}", justify="right", min_width=7)
-        for key, label in RESPONSE_LABELS.items():
-            cells = [label]
-            for r in bounded:
-                cells.append(reduction_text(r["reduction_percent"][key]))
+            for i, (key, label) in enumerate(RESPONSE_LABELS.items()):
+                cells = [escape(r["label"]) if i == 0 else "", label, reduction_text(r["reduction_percent"][key])]
                 for device in ("ideal-damper", "ideal"):
                     value = doc["bounds"][device][r["name"]]["reduction_percent"][key]
                     cells.append("diverged" if value is None else reduction_text(value))
-            bt.add_row(*cells)
+                bt.add_row(*cells, end_section=i == len(RESPONSE_LABELS) - 1)
         bounds_parts = [
             "",
             bt,
@@ -259,40 +291,45 @@ def _compare_tables(doc: dict, vehicle: str, shipped: bool):
         ]
 
     # 2. peak-to-peak
-    ptp = Table(title="Peak-to-peak of the carbody responses (railride)")
-    ptp.add_column("response")
-    for r in rows:
-        ptp.add_column(escape(r["label"]), justify="right", min_width=8)
-    for key, label in RESPONSE_LABELS.items():
-        ptp.add_row(label, *[f"{r['metrics'][key]['ptp']:#.4g}" for r in rows])
+    def ptp_table(group: list[dict]):
+        ptp = FitTable(title="Peak-to-peak of the carbody responses (railride)")
+        ptp.add_column("response")
+        for r in group:
+            ptp.add_column(escape(r["label"].replace(" (", "\n(")), justify="right", min_width=8)
+        for key, label in RESPONSE_LABELS.items():
+            ptp.add_row(label, *[f"{r['metrics'][key]['ptp']:#.4g}" for r in group])
+        return ptp
 
-    # 3. what each suspension asks of its dampers
-    demands = Table(title="What each suspension asks of its dampers")
-    demands.add_column("suspension", no_wrap=True)
-    for heading in (
-        "RMS demand\n(kN)",
-        "RMS force\n(kN)",
-        "max force\n(kN)",
-        "RMS travel\n(mm)",
-        "max travel\n(mm)",
-        "mean voltage\n(V)",
-        "time at v_max\n(%)",
-    ):
-        demands.add_column(heading, justify="right", min_width=6)
-    for r in rows:
-        d = r["damper"]
-        at_max = d.get("voltage_at_max_fraction")
-        demand = d.get("demand_rms_n")
-        demands.add_row(
-            escape(r["label"]),
-            "-" if demand is None else f"{demand / 1e3:.2f}",
-            f"{d['force_rms_n'] / 1e3:.2f}",
-            f"{d['force_max_n'] / 1e3:.2f}",
-            f"{d['travel_rms_m'] * 1e3:.1f}",
-            f"{d['travel_max_m'] * 1e3:.1f}",
-            fmt(d.get("voltage_mean_v"), ".2f"),
-            "-" if at_max is None else f"{at_max * 100:.1f}",
-        )
+    ptp = Split(ptp_table, [r for r in rows if r["name"] != "passive"], repeat=passive)
+
+    # 3. what each suspension asks of its dampers: forces, travel, voltage (split when narrow)
+    def demand_cells(d: dict) -> dict:
+        at_max, demand = d.get("voltage_at_max_fraction"), d.get("demand_rms_n")
+        return {
+            "RMS demand\n(kN)": "-" if demand is None else f"{demand / 1e3:.2f}",
+            "RMS force\n(kN)": f"{d['force_rms_n'] / 1e3:.2f}",
+            "max force\n(kN)": f"{d['force_max_n'] / 1e3:.2f}",
+            "RMS travel\n(mm)": f"{d['travel_rms_m'] * 1e3:.1f}",
+            "max travel\n(mm)": f"{d['travel_max_m'] * 1e3:.1f}",
+            "mean voltage\n(V)": fmt(d.get("voltage_mean_v"), ".2f"),
+            "time at v_max\n(%)": "-" if at_max is None else f"{at_max * 100:.1f}",
+        }
+
+    def demands_table(groups: list[tuple[str, ...]]):
+        demands = FitTable(title="What each suspension asks of its dampers")
+        demands.add_column("suspension")
+        for heading in (h for g in groups for h in g):
+            demands.add_column(heading, justify="right", min_width=6)
+        for r in rows:
+            cells = demand_cells(r["damper"])
+            demands.add_row(escape(r["label"]), *[cells[h] for g in groups for h in g])
+        return demands
+
+    column_groups = [  # forces; travel and voltage: each fits 80 columns unwrapped
+        ("RMS demand\n(kN)", "RMS force\n(kN)", "max force\n(kN)"),
+        ("RMS travel\n(mm)", "max travel\n(mm)", "mean voltage\n(V)", "time at v_max\n(%)"),
+    ]
+    demands = Split(demands_table, column_groups)
     demands_note = (
         "All four corners, over the metric window. demand: the force the outer loop "
         "asks for; force: the secondary damper force on the carbody; travel: the "
@@ -311,12 +348,13 @@ def _fault_tables(doc: dict):
     """With --fault: per controller and response, the reduction against passive with healthy
     dampers and with the faults, and the change the faults make (railride.faults.degradation)."""
     from rich.markup import escape
-    from rich.table import Table
     from rich.text import Text
+
+    from ._width import FitTable
 
     record = doc["faults"]
     labels = {r["name"]: r["label"] for r in doc["controllers"]}
-    table = Table(title=f"With the faults {', '.join(record['faults'])} against healthy dampers")
+    table = FitTable(title=f"With the faults {', '.join(record['faults'])} against healthy dampers")
     for name, justify in (("suspension", "left"), ("response", "left")):
         table.add_column(name, justify=justify)  # type: ignore[arg-type]
     for name in ("red. %\nhealthy", "red. %\nfaulted", "RMS change %\nby the faults"):
@@ -351,17 +389,8 @@ def _fault_tables(doc: dict):
 
 @app.command()
 def compare(
-    controllers: Annotated[
-        str,
-        typer.Option(
-            "--controllers",
-            metavar="NAME[,NAME...]",
-            help="Suspensions to compare, comma-separated: passive, pid, sas-attitude, "
-            "sas-attitude-ride (the paper's, the default), skyhook, skyhook-on-off, groundhook, "
-            "hybrid, clipped-optimal, passive-on, passive-off (MR dampers at v_max, v_min), or all. "
-            "Passive always runs as the baseline.",
-        ),
-    ] = "passive,pid,sas-attitude,sas-attitude-ride",
+    ctx: typer.Context,
+    controllers: ControllersOption = "passive,pid,sas-attitude,sas-attitude-ride",
     gains: CompareGainsOption = None,
     damper: CompareDamperOption = DEFAULT_DAMPER,
     damper_scale: CompareDamperScaleOption = None,
@@ -444,16 +473,12 @@ def compare(
     load: LoadOption = None,
     format: FormatOption = OutputFormat.table,
     out: CompareOutOption = None,
-    bounds: Annotated[
-        bool,
-        typer.Option(
-            "--bounds/--no-bounds",
-            help="Also run the same control laws and gains on the ideal semi-active damper and the "
-            "ideal actuator, and print their reductions beside the MR dampers' (default on; "
-            "MR dampers only).",
-        ),
-    ] = True,
+    bounds: BoundsOption = True,
     comfort: ComfortOption = False,
+    report: ReportOption = None,
+    figure_format: FigureFormatOption = None,
+    dpi: DpiOption = None,
+    history_format: HistoryFormatOption = None,
 ) -> None:
     """Compare passive, PID and SAS suspensions on one scenario, as in the paper's Table 1.
 
@@ -468,11 +493,28 @@ def compare(
         from ..comparison import compare as run_compare
         from ..files import check_out_dir, write_compare_outputs
         from ..metrics import check_window, parse_window
+        from .report import check_report_option, save_report  # here: report imports this module
 
+        figures = figure_options(figure_format, dpi, out)
+        histories = history_options(history_format, out)
         scenarios = [item.strip() for item in scenario.split(",")]
         speeds = value_list("--speed", speed) if speed is not None else None
         seeds = value_list("--track-seed", track_seed, integer=True) if track_seed is not None else None
         if len(scenarios) > 1 or len(speeds or [0]) > 1 or len(seeds or [0]) > 1:
+            if report is not None:
+                raise ValueError(
+                    f"--report = {str(report)!r}: the report is of one scenario, speed and track seed; "
+                    "a league table (several) has none yet"
+                )
+            if history_format is not None:
+                raise ValueError(
+                    "--history-format: a league table (several --scenario, --speed or --track-seed values) writes no time histories"
+                )
+            if figure_format is not None or dpi is not None:
+                raise ValueError(
+                    f"{'--figure-format' if figure_format is not None else '--dpi'}: not for a league table "
+                    "(several --scenario, --speed or --track-seed values) yet: its figures are PNG at 120 dpi"
+                )
             given = dict(
                 amplitude=amplitude,
                 wavelength=wavelength,
@@ -530,6 +572,7 @@ def compare(
         )
         if out is not None:
             check_out_dir(out)
+        check_report_option(report)
         # check the window before the runs, and record it resolved
         window_value = check_window(window_value or (0.0, math.inf), scen.duration)
         faults = _fault_list(fault, damper, scale, solver.dt, scen.duration)
@@ -562,13 +605,15 @@ def compare(
         doc = result.to_dict()
         text = json.dumps(doc, indent=2, allow_nan=False)  # refuses NaN before anything is written
         if out is not None:
-            write_folder(out, lambda: write_compare_outputs(result, out, doc))
-    if format is OutputFormat.json:
-        typer.echo(text)
-        return
+            write_folder(out, lambda: write_compare_outputs(result, out, doc, figures=figures, histories=histories))
     vehicle = vehicle_record.get("vehicle_preset") or vehicle_record.get("vehicle_params_file")
     if "load_factor" in vehicle_record:
         vehicle += f" with load factor {vehicle_record['load_factor']:g} (carbody mass and inertias)"
-    console = wide_stdout_console()
-    for part in _compare_tables(doc, vehicle, shipped=gains is None):
-        console.print(part)
+    if format is OutputFormat.json:
+        typer.echo(text)
+    else:
+        console = stdout_console()
+        for part in _compare_tables(doc, vehicle, shipped=gains is None):
+            console.print(part)
+    if report is not None:  # after the tables: a report that cannot be written loses no output
+        save_report(report, result, _compare_tables(doc, vehicle, shipped=gains is None), ctx)

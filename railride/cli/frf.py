@@ -9,8 +9,16 @@ from typing import Annotated
 import typer
 
 from ._app import app
-from ._common import errors, option_names, print_json, wide_stdout_console, write_folder
-from ._options import FrfOutOption, FrfSpeedOption, ParamsOption, PresetOption
+from ._common import errors, option_names, print_json, stdout_console, write_folder
+from ._options import (
+    DpiOption,
+    FigureFormatOption,
+    FrfOutOption,
+    FrfSpeedOption,
+    ParamsOption,
+    PresetOption,
+    figure_options,
+)
 from ._parsing import vehicle_source
 from ._render import modes_table
 
@@ -61,6 +69,8 @@ def frf(
         ),
     ] = FrfFormat.table,
     out: FrfOutOption = None,
+    figure_format: FigureFormatOption = None,
+    dpi: DpiOption = None,
 ) -> None:
     """Frequency responses of the passive vehicle: carbody bounce, pitch, roll and acceleration
     per metre of rail amplitude, for in-phase and anti-phase rails.
@@ -72,32 +82,33 @@ def frf(
         from ..files import check_out_dir
         from ..frf import frequency_responses
 
+        figures = figure_options(figure_format, dpi, out)
         vehicle = vehicle_source(params, preset)
         if out is not None:
             check_out_dir(out)
         result = frequency_responses(vehicle, speed=speed, rails=rails, fmin=fmin, fmax=fmax, points=points)
         doc = result.to_dict()
         if out is not None:
-            write_folder(out, lambda: result.save(out))
+            write_folder(out, lambda: result.save(out, figure_formats=figures.figure_formats, dpi=figures.dpi))
     if format is FrfFormat.json:
         print_json(doc)
         return
     if format is FrfFormat.csv:
         typer.echo(result.to_pandas().to_csv(index=False), nl=False)
         return
-    console = wide_stdout_console(100)
+    console = stdout_console()
     for part in _frf_tables(doc, result.vehicle_name):
         console.print(part)
 
 
 def _frf_tables(doc: dict, vehicle: str) -> list:
     """The peaks table, its note and the modes table."""
-    from rich.table import Table
+    from ._width import FitTable
     from rich.text import Text
 
     settings = doc["settings"]
     patterns = settings["rails"]
-    table = Table(title="Peaks of the carbody frequency responses (passive vehicle)")
+    table = FitTable(title="Peaks of the carbody frequency responses (passive vehicle)")
     table.add_column("response (per m of rail)")
     for p in patterns:
         table.add_column(f"{p}\npeak", justify="right")

@@ -10,20 +10,22 @@ import typer
 from ..defaults import DEFAULT_DAMPER
 from ._app import app
 from ._common import (
-    RunProgress,
     errors,
     interruptible,
     make_executor,
     open_run_table,
     option_names,
     print_json,
+    RunProgress,
     stderr_is_terminal,
-    wide_stdout_console,
+    stdout_console,
     write_folder,
 )
 from ._options import (
     AmplitudeOption,
+    DpiOption,
     DtOption,
+    FigureFormatOption,
     FormatOption,
     MaxWavelengthOption,
     MinWavelengthOption,
@@ -41,6 +43,7 @@ from ._options import (
     TrackSeedOption,
     WavelengthOption,
     WorkersOption,
+    figure_options,
 )
 from ._parsing import (
     SOLVER_FIELDS,
@@ -67,12 +70,12 @@ PARETO_FIELDS = {
 
 def _pareto_table(doc: dict, caption: str):
     """Counts, then the samples non-dominated over the four ratios by acceleration ratio."""
-    from rich.table import Table
+    from ._width import FitTable
 
     from ..pareto import PROJECTIONS
 
     c = doc["counts"]
-    counts = Table(title="Pareto view: samples and non-dominated samples")
+    counts = FitTable(title="Pareto view: samples and non-dominated samples")
     counts.add_column("samples (with the base gains)", justify="right")
     counts.add_column("non-dominated\nover all four ratios", justify="right")
     for x, y in PROJECTIONS:
@@ -84,7 +87,7 @@ def _pareto_table(doc: dict, caption: str):
         (r for r in doc["samples"] if r["non_dominated"]),
         key=lambda r: (r["acceleration_m_s2_ratio"] is None, r["acceleration_m_s2_ratio"] or 0.0),
     )
-    rows = Table(
+    rows = FitTable(
         title="Non-dominated samples by acceleration ratio: RMS / RMS(passive)", caption=caption, caption_justify="left"
     )
     rows.add_column("sample", justify="right")
@@ -139,6 +142,8 @@ def pareto_command(
     out: ParetoOutOption = None,
     resume: ParetoResumeOption = False,
     format: FormatOption = OutputFormat.table,
+    figure_format: FigureFormatOption = None,
+    dpi: DpiOption = None,
 ) -> None:
     """The trades a controller's gains offer: RMS ratios to passive of sampled gains.
 
@@ -154,6 +159,7 @@ def pareto_command(
         from ..labels import describe_scenario
         from ..pareto import pareto as run_pareto
 
+        figures = figure_options(figure_format, dpi, out)
         n = default_of(run_pareto, "n_samples") if samples is None else samples
         damper_preset("--damper", damper)
         base = load_gains(gains)
@@ -192,7 +198,7 @@ def pareto_command(
                 wall = time.perf_counter() - t0
             doc = result.to_dict()
             if out is not None:
-                write_folder(out, lambda: result.save(out))
+                write_folder(out, lambda: result.save(out, figure_formats=figures.figure_formats, dpi=figures.dpi))
     finally:
         executor.close()
     if format is OutputFormat.json:
@@ -209,6 +215,6 @@ def pareto_command(
     ]
     if doc["note"]:
         lines.append(doc["note"])
-    console = wide_stdout_console()
+    console = stdout_console()
     for part in _pareto_table(doc, "\n".join(lines)):
         console.print(part)

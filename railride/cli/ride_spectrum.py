@@ -12,7 +12,7 @@ import typer
 
 from ._app import app
 from ._common import errors, option_names, print_json, wide_stdout_console, write_folder
-from ._options import LoadOption, ParamsOption, PresetOption
+from ._options import DpiOption, FigureFormatOption, LoadOption, ParamsOption, PresetOption, figure_options
 from ._parsing import load_gains, vehicle_from_options
 
 #: the library's names of the options, for its errors
@@ -93,9 +93,11 @@ def ride_spectrum(
             "--out",
             metavar="DIR",
             help="Also write ride_spectrum.json, ride_spectrum.csv, ride_spectrum_psd.csv and "
-            "ride_spectrum.png into DIR (created if missing; all or nothing).",
+            "the figure ride_spectrum (--figure-format) into DIR (created if missing; all or nothing).",
         ),
     ] = None,
+    figure_format: FigureFormatOption = None,
+    dpi: DpiOption = None,
 ) -> None:
     """The ride on a random track from the frequency response and the track spectrum, without a
     time simulation: PSDs, RMS and ISO 2631-1 Wb/Wk-weighted RMS of the carbody floor
@@ -104,6 +106,7 @@ def ride_spectrum(
         from ..files import check_out_dir
         from ..ride_spectrum import ride_spectrum as run
 
+        figures = figure_options(figure_format, dpi, out)
         vehicle, _ = vehicle_from_options(params, preset, load)
         if out is not None:
             check_out_dir(out)
@@ -120,7 +123,7 @@ def ride_spectrum(
             delay=delay,
         )
         if out is not None:
-            write_folder(out, lambda: result.save(out))
+            write_folder(out, lambda: result.save(out, figure_formats=figures.figure_formats, dpi=figures.dpi))
     if format is SpectrumFormat.json:
         print_json(result.to_dict())
         return

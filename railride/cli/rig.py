@@ -10,7 +10,16 @@ import typer
 from ..defaults import DEFAULT_DAMPER
 from ._app import app
 from ._common import errors, option_names, print_json, status_note, stdout_console, write_folder
-from ._options import DamperOutOption, FormatOption, OutputFormat, RigModelOption, TrackingOutOption
+from ._options import (
+    DamperOutOption,
+    DpiOption,
+    FigureFormatOption,
+    FormatOption,
+    OutputFormat,
+    RigModelOption,
+    TrackingOutOption,
+    figure_options,
+)
 from ._parsing import damper_preset, parse_voltages
 
 #: the library's names of the options of `damper` and `tracking`, for its errors
@@ -60,6 +69,8 @@ def damper(
     ] = 4,
     format: FormatOption = OutputFormat.table,
     out: DamperOutOption = None,
+    figure_format: FigureFormatOption = None,
+    dpi: DpiOption = None,
 ) -> None:
     """Hysteresis cycles of an MR damper on a test rig.
 
@@ -70,6 +81,7 @@ def damper(
         from .. import rig
         from ..files import check_out_dir
 
+        figures = figure_options(figure_format, dpi, out)
         damper_model = damper_preset("--damper", model, rig=True)
         volts = parse_voltages("--voltage", voltage, damper_model)
         if out is not None:
@@ -78,7 +90,7 @@ def damper(
             result = rig.cycles(damper_model, amplitude, frequency, volts, n_cycles=cycles)
         doc = result.to_dict()
         if out is not None:
-            write_folder(out, lambda: result.save(out))
+            write_folder(out, lambda: result.save(out, figure_formats=figures.figure_formats, dpi=figures.dpi))
     if format is OutputFormat.json:
         print_json(doc)
         return
@@ -87,10 +99,10 @@ def damper(
 
 def _damper_table(doc: dict, name: str, result):
     from rich.markup import escape
-    from rich.table import Table
+    from ._width import FitTable
 
     n = result.n_cycles
-    table = Table(
+    table = FitTable(
         title=escape(f"Damper cycles: {name} ({result.damper.model} model)"),
         caption=escape(
             f"x = {result.motion.amplitude:g} m sin(2 pi {result.motion.frequency:g} Hz "
@@ -156,6 +168,8 @@ def tracking(
     ] = 3,
     format: FormatOption = OutputFormat.table,
     out: TrackingOutOption = None,
+    figure_format: FigureFormatOption = None,
+    dpi: DpiOption = None,
 ) -> None:
     """Force tracking of an MR damper by the inner loop.
 
@@ -166,6 +180,7 @@ def tracking(
         from .. import rig
         from ..files import check_out_dir
 
+        figures = figure_options(figure_format, dpi, out)
         damper_model = damper_preset("--damper", model, rig=True)
         if out is not None:
             check_out_dir(out)
@@ -175,7 +190,7 @@ def tracking(
             )
         doc = result.to_dict()
         if out is not None:
-            write_folder(out, lambda: result.save(out))
+            write_folder(out, lambda: result.save(out, figure_formats=figures.figure_formats, dpi=figures.dpi))
     if format is OutputFormat.json:
         print_json(doc)
         return
@@ -184,7 +199,7 @@ def tracking(
 
 def _tracking_table(doc: dict, model: str, *, default_g: bool):
     from rich.markup import escape
-    from rich.table import Table
+    from ._width import FitTable
 
     m = doc["metrics"]
     start, end = m["window_s"]
@@ -195,7 +210,7 @@ def _tracking_table(doc: dict, model: str, *, default_g: bool):
             f"metrics over {start:g}-{end:g} s (after the first cycle)",
         ]
     )
-    table = Table(
+    table = FitTable(
         title=escape(f"Force tracking: {doc['desired']} demand, {model} damper"), caption=escape(caption), min_width=56
     )
     table.add_column("quantity")

@@ -15,7 +15,9 @@ from ._options import (
     AmplitudeOption,
     ComfortOption,
     DtOption,
+    DpiOption,
     DurationOption,
+    FigureFormatOption,
     FormatOption,
     MaxWavelengthOption,
     MinWavelengthOption,
@@ -33,6 +35,9 @@ from ._options import (
     SpeedOption,
     TrackSeedOption,
     WavelengthOption,
+    HistoryFormatOption,
+    figure_options,
+    history_options,
 )
 from ._parsing import (
     SOLVER_FIELDS,
@@ -72,7 +77,7 @@ def _describe_suspension(record: dict) -> str:
 
 def _metrics_table(doc: dict):
     from rich.markup import escape
-    from rich.table import Table
+    from ._width import FitTable
 
     labels = {
         "acceleration_m_s2": "acceleration (m/s^2)",
@@ -100,7 +105,7 @@ def _metrics_table(doc: dict):
             f"suspension {_describe_suspension(doc.get('suspension') or {'type': 'passive'})}",
         ]
     )
-    table = Table(title="Ride metrics (carbody CG)", caption=escape(caption))
+    table = FitTable(title="Ride metrics (carbody CG)", caption=escape(caption))
     table.add_column("response")
     table.add_column("RMS", justify="right")
     table.add_column("peak-to-peak", justify="right")
@@ -149,9 +154,14 @@ def simulate(
     format: FormatOption = OutputFormat.table,
     out: SimulateOutOption = None,
     comfort: ComfortOption = False,
+    figure_format: FigureFormatOption = None,
+    dpi: DpiOption = None,
+    history_format: HistoryFormatOption = None,
 ) -> None:
     """Simulate the vehicle on a track and print the ride metrics."""
     with errors():
+        figures = figure_options(figure_format, dpi, out)
+        histories = history_options(history_format, out)
         track = track_options(scenario, track_seed, min_wavelength, max_wavelength)
         doc, result = _run(
             scenario,
@@ -173,6 +183,8 @@ def simulate(
             comfort=comfort,
             damper_scale=damper_scale,
             load=load,
+            figures=figures,
+            histories=histories,
         )
     if format is OutputFormat.json:
         print_json(doc)
@@ -230,6 +242,8 @@ def _run(
     comfort=False,
     damper_scale=None,
     load=None,
+    figures=None,
+    histories=("nc", "csv"),
 ):
     from ..files import check_out_dir, write_outputs
     from ..metrics import check_window, parse_window
@@ -263,5 +277,5 @@ def _run(
             )
         doc = result.to_dict(window, comfort=comfort, vehicle=vehicle_record)
     if out is not None:
-        write_folder(out, lambda: write_outputs(result, out, doc))
+        write_folder(out, lambda: write_outputs(result, out, doc, figures=figures, histories=histories))
     return doc, result

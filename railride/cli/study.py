@@ -12,30 +12,35 @@ import typer
 from ..defaults import DEFAULT_DAMPER
 from ._app import app
 from ._common import (
-    RunProgress,
     errors,
     interruptible,
     make_executor,
     open_run_table,
     option_names,
+    RunProgress,
     stderr_is_terminal,
-    wide_stdout_console,
+    stdout_console,
     write_folder,
 )
 from ._options import (
+    DpiOption,
     DtOption,
+    FigureFormatOption,
     FormatOption,
     OutputFormat,
     SchedulerFileOption,
     SchedulerOption,
     StudyGainsOption,
     StudyOutOption,
+    ReportOption,
     StudyResumeOption,
     WindowOption,
     WorkersOption,
+    figure_options,
 )
 from ._parsing import damper_preset, load_gains, solver_from_options, value_list
 from ._render import RESPONSE_LABELS, reduction_text
+from .report import check_report_option, save_report
 
 #: the library's names of the study's options, for its errors
 STUDY_FIELDS = {
@@ -68,44 +73,57 @@ def _faults(text: str) -> list[str]:
 
 def _table(doc: dict):
     from rich.markup import escape
-    from rich.table import Table
     from rich.text import Text
 
     from ..control import LABELS
+    from ._width import FitTable, Split
 
     s = doc["settings"]
     lo, hi = doc["percentiles"]
     seeds = s["track_seeds"] or []
     over = (f"{len(seeds)} track seeds x " if seeds else "") + f"{len(s['speeds_m_s'])} speed(s)"
-    table = Table(title=f"Statistics over {over}")
-    table.add_column("suspension", no_wrap=True)
-    table.add_column("load", justify="right")
-    table.add_column("k_sz x", justify="right")
-    table.add_column("fault")
-    table.add_column("delay", justify="right")
-    table.add_column("metric")
-    table.add_column("mean", justify="right")
-    table.add_column(f"p{lo:g}-p{hi:g}", justify="right")
-    table.add_column("red. %\nmean", justify="right")
-    table.add_column(f"red. %\np{lo:g}-p{hi:g}", justify="right")
-    for group in doc["results"]:
-        for i, (metric, label) in enumerate(TABLE_METRICS.items()):
-            m = group["metrics"][metric]
-            band = "" if m["p5"] is None else f"{m['p5']:#.3g}-{m['p95']:#.3g}"
-            red_band = "" if m["reduction_p5"] is None else f"{m['reduction_p5']:.1f} to {m['reduction_p95']:.1f}"
-            table.add_row(
-                escape(LABELS[group["controller"]]) if i == 0 else "",
-                f"{group['load']:g}" if i == 0 else "",
-                f"{group['stiffness']:g}" if i == 0 else "",
-                group["fault"] if i == 0 else "",
-                str(group["delay"]) if i == 0 else "",
-                label,
-                "" if m["mean"] is None else f"{m['mean']:#.4g}",
-                band,
-                reduction_text(m["reduction_mean"]),
-                red_band,
-                end_section=i == len(TABLE_METRICS) - 1,
-            )
+
+    def cells(m: dict) -> dict:
+        return {
+            "mean": "" if m["mean"] is None else f"{m['mean']:#.4g}",
+            "band": "" if m["p5"] is None else f"{m['p5']:#.3g}-{m['p95']:#.3g}",
+            "red": reduction_text(m["reduction_mean"]),
+            "red band": "" if m["reduction_p5"] is None else f"{m['reduction_p5']:.1f} to {m['reduction_p95']:.1f}",
+        }
+
+    band = f"p{lo:g}-p{hi:g}"
+    headings = {"mean": "mean", "band": band, "red": "red. %\nmean", "red band": f"red. %\n{band}"}
+
+    def build(groups: list[tuple[str, str]]):
+        table = FitTable(title=f"Statistics over {over}", labels=2)
+        # what the row group holds, one item a line down its rows: the column stays narrow
+        table.add_column("suspension, case")
+        table.add_column("metric")
+        keys = [k for g in groups for k in g]
+        for key in keys:
+            table.add_column(headings[key], justify="right", no_wrap=key == "red band")
+        for group in doc["results"]:
+            if group["controller"] == "passive" and all(k.startswith("red") for k in keys):
+                continue  # no reduction of passive against itself: no rows in a table of reductions
+            case = [
+                escape(LABELS[group["controller"]]),
+                f"load {group['load']:g}",
+                f"k_sz x {group['stiffness']:g}",
+                f"fault {group['fault']}",
+                f"delay {group['delay']}",
+            ]
+            for i, (metric, label) in enumerate(TABLE_METRICS.items()):
+                row = cells(group["metrics"][metric])
+                table.add_row(
+                    case[i] if i < len(case) else "",
+                    label,
+                    *[row[k] for k in keys],
+                    end_section=i == len(TABLE_METRICS) - 1,
+                )
+        return table
+
+    # on a narrow console the RMS and its reduction in two tables
+    table = Split(build, [("mean", "band"), ("red", "red band")])
     speeds = ", ".join(f"{v:g}" for v in s["speeds_m_s"])
     lines = [
         f"{s['scenario']} at {speeds} m/s" + (f", track seeds {', '.join(map(str, seeds))}" if seeds else "") + "; "
@@ -129,6 +147,7 @@ def _table(doc: dict):
 
 @app.command("study")
 def study_command(
+    ctx: typer.Context,
     controllers: Annotated[
         str,
         typer.Option(
@@ -213,6 +232,9 @@ def study_command(
     out: StudyOutOption = None,
     resume: StudyResumeOption = False,
     format: FormatOption = OutputFormat.table,
+    figure_format: FigureFormatOption = None,
+    dpi: DpiOption = None,
+    report: ReportOption = None,
 ) -> None:
     """Statistics over many tracks: every controller on every track seed and speed, for each
     load factor and fault condition; mean and 5th-95th percentiles of each RMS response and
@@ -222,6 +244,7 @@ def study_command(
     from ..metrics import parse_window
 
     with errors(), option_names(STUDY_FIELDS):
+        figures = figure_options(figure_format, dpi, out)
         names = check_controllers(controllers)
         seeds = value_list("--track-seed", track_seed, integer=True) if track_seed is not None else None
         speeds = value_list("--speed", speed) if speed is not None else None
@@ -233,6 +256,7 @@ def study_command(
         gain_set = load_gains(gains)
         solver = solver_from_options(dt=dt)
         window_value = parse_window(window) if window is not None else None
+        check_report_option(report)
         table, table_path = open_run_table(out, resume)
         executor, executor_record = make_executor(workers, scheduler, scheduler_file)
     try:
@@ -269,12 +293,14 @@ def study_command(
             }
             text = json.dumps(doc, indent=2, allow_nan=False)
             if out is not None:
-                write_folder(out, lambda: result.save(out))
+                write_folder(out, lambda: result.save(out, figure_formats=figures.figure_formats, dpi=figures.dpi))
     finally:
         executor.close()
     if format is OutputFormat.json:
         typer.echo(text)
-        return
-    console = wide_stdout_console()
-    for part in _table(doc):
-        console.print(part)
+    else:
+        console = stdout_console()
+        for part in _table(doc):
+            console.print(part)
+    if report is not None:  # after the output: a report that cannot be written loses none of it
+        save_report(report, result, _table(doc), ctx)

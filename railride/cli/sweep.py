@@ -17,20 +17,23 @@ from ..defaults import DEFAULT_DAMPER
 from ..suspension import NAMES as SUSPENSIONS
 from ._app import app
 from ._common import (
-    RunProgress,
     errors,
     interruptible,
     make_executor,
     open_run_table,
     option_names,
+    RunProgress,
     stderr_is_terminal,
-    wide_stdout_console,
+    stdout_console,
     write_folder,
 )
 from ._options import (
+    DpiOption,
     DtOption,
+    FigureFormatOption,
     MaxWavelengthOption,
     MinWavelengthOption,
+    ReportOption,
     RunDurationOption,
     RunsScenarioOption,
     SchedulerFileOption,
@@ -43,9 +46,11 @@ from ._options import (
     SweepResumeOption,
     WindowOption,
     WorkersOption,
+    figure_options,
 )
 from ._parsing import SOLVER_FIELDS, load_gains, parse_noise, solver_from_options, value_list
 from ._render import RESPONSE_LABELS, damper_text, fmt
+from .report import check_report_option, save_report
 
 #: how the errors of railride.sweep.grid name its keywords: by this command's options
 OPTION_NAMES = {
@@ -84,6 +89,7 @@ class SweepFormat(str, Enum):
 
 @app.command("sweep")
 def sweep_command(
+    ctx: typer.Context,
     suspension: Annotated[
         str,
         typer.Option(
@@ -192,6 +198,9 @@ def sweep_command(
         ),
     ] = SweepFormat.table,
     comfort: SweepComfortOption = True,
+    figure_format: FigureFormatOption = None,
+    dpi: DpiOption = None,
+    report: ReportOption = None,
 ) -> None:
     """Run a grid of cases: every combination of the given values (a cartesian product).
 
@@ -206,6 +215,7 @@ def sweep_command(
     with errors():
         from ..sweep import grid as make_grid, run_sweep
 
+        figures = figure_options(figure_format, dpi, out)
         values, texts = _parse(
             suspension=suspension,
             speed=speed,
@@ -232,6 +242,7 @@ def sweep_command(
             texts=texts,
             **values,
         )
+        check_report_option(report)
         table, table_path = open_run_table(out, resume)
         executor, executor_record = make_executor(workers, scheduler, scheduler_file)
     try:
@@ -250,16 +261,20 @@ def sweep_command(
             doc = {**result.to_dict(), **facts}
             text = json.dumps(doc["rows"], indent=2, allow_nan=False)  # refuses NaN before writing
             if out is not None:
-                write_folder(out, lambda: result.save(out, extra=facts))
+                write_folder(
+                    out, lambda: result.save(out, extra=facts, figure_formats=figures.figure_formats, dpi=figures.dpi)
+                )
     finally:
         executor.close()
+    printed = _sweep_table(doc["rows"], list(grid.columns), _caption(grid, doc, wall))
     if format is SweepFormat.json:
         typer.echo(text)
-        return
-    if format is SweepFormat.csv:
+    elif format is SweepFormat.csv:
         typer.echo(result.to_pandas().to_csv(index=False), nl=False)
-        return
-    wide_stdout_console().print(_sweep_table(doc["rows"], list(grid.columns), _caption(grid, doc, wall)))
+    else:
+        stdout_console().print(printed)
+    if report is not None:  # after the output: a report that cannot be written loses none of it
+        save_report(report, result, [printed], ctx)
 
 
 # -- reading the options ------------------------------------------------------------------------
@@ -402,34 +417,47 @@ def _caption(grid, doc: dict, wall: float) -> str:
 
 
 def _sweep_table(rows: list[dict], grid_columns: list[str], caption: str):
+    """One row per run: its grid values, then the RMS responses and comfort indices; on a narrow
+    console, as many of these as fit per table, each table repeating the grid values."""
     from rich.markup import escape
-    from rich.table import Table
 
-    table = Table(title="Sweep: RMS of the carbody responses, one row per run", caption=escape(caption))
-    table.add_column("#", justify="right")
-    for c in grid_columns:
-        heading = {
-            "speed_m_s": "speed\n(m/s)",
-            "wavelength_m": "wavelength\n(m)",
-            "amplitude_m": "amplitude\n(m)",
-            "rail_phase_deg": "rail phase\n(deg)",
-            "voltage_v": "voltage\n(V)",
-            "track_seed": "track\nseed",
-            "damper_scale": "damper\nscale",
-            "seed": "noise\nseed",
-        }.get(c, c)
-        table.add_column(escape(heading), justify="left" if c == "suspension" else "right", no_wrap=c == "suspension")
-    for key, label in RESPONSE_LABELS.items():
-        table.add_column(label.replace(" (", "\n("), justify="right")
-    comfort = [(c, h) for c, h in SWEEP_COMFORT_TABLE if rows and c in rows[0]]
-    for _, heading in comfort:
-        table.add_column(escape(heading), justify="right")
-    for i, row in enumerate(rows, start=1):
-        cells = [str(i)]
+    from ._width import FitTable, Split
+
+    headings = {
+        "speed_m_s": "speed\n(m/s)",
+        "wavelength_m": "wavelength\n(m)",
+        "amplitude_m": "amplitude\n(m)",
+        "rail_phase_deg": "rail phase\n(deg)",
+        "voltage_v": "voltage\n(V)",
+        "track_seed": "track\nseed",
+        "damper_scale": "damper\nscale",
+        "seed": "noise\nseed",
+    }
+    # (heading, cell of a row) of each result column
+    results = [(label.replace(" (", "\n("), f"{k}_rms", "#.4g") for k, label in RESPONSE_LABELS.items()]
+    results += [(escape(h), c, "#.3g") for c, h in SWEEP_COMFORT_TABLE if rows and c in rows[0]]
+
+    def build(columns: list[tuple[str, str, str]]):
+        table = FitTable(
+            title="Sweep: RMS of the carbody responses, one row per run",
+            caption=escape(caption),
+            caption_justify="left",
+            labels=1 + len(grid_columns),
+        )
+        table.add_column("#", justify="right")
         for c in grid_columns:
-            v = row[c]
-            cells.append("-" if v is None else (escape(v) if isinstance(v, str) else f"{v:g}"))
-        cells += [fmt(row[f"{k}_rms"], "#.4g") for k in RESPONSE_LABELS]
-        cells += [fmt(row[c], "#.3g") for c, _ in comfort]
-        table.add_row(*cells)
-    return table
+            table.add_column(
+                escape(headings.get(c, c)), justify="left" if c == "suspension" else "right", no_wrap=c == "suspension"
+            )
+        for heading, _, _ in columns:
+            table.add_column(heading, justify="right")
+        for i, row in enumerate(rows, start=1):
+            cells = [str(i)]
+            for c in grid_columns:
+                v = row[c]
+                cells.append("-" if v is None else (escape(v) if isinstance(v, str) else f"{v:g}"))
+            cells += [fmt(row[key], spec) for _, key, spec in columns]
+            table.add_row(*cells)
+        return table
+
+    return Split(build, results, breaks=[len(RESPONSE_LABELS)])  # parts: the RMS, then comfort

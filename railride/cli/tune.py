@@ -13,21 +13,23 @@ import typer
 from ..defaults import DEFAULT_DAMPER
 from ._app import app
 from ._common import (
-    RunProgress,
     command_line,
     errors,
     interruptible,
     make_executor,
     open_run_table,
     option_names,
+    RunProgress,
     stderr_is_terminal,
-    wide_stdout_console,
+    stdout_console,
     write_folder,
 )
 from ._options import (
     AmplitudeOption,
     BoundOption,
+    DpiOption,
     DtOption,
+    FigureFormatOption,
     FormatOption,
     MaxWavelengthOption,
     MinWavelengthOption,
@@ -35,6 +37,7 @@ from ._options import (
     OutputFormat,
     PenaltyOption,
     RailPhaseOption,
+    ReportOption,
     RunDurationOption,
     RunsScenarioOption,
     SchedulerFileOption,
@@ -48,6 +51,7 @@ from ._options import (
     WavelengthOption,
     WeightsOption,
     WorkersOption,
+    figure_options,
 )
 from ._parsing import (
     SOLVER_FIELDS,
@@ -62,6 +66,7 @@ from ._parsing import (
     value_list,
 )
 from ._render import RESPONSE_LABELS, damper_text, reduction_text
+from .report import check_report_option, save_report
 
 #: the library's names of tune's options, for its errors
 TUNE_FIELDS = {
@@ -196,38 +201,42 @@ def _objective_text_from_doc(doc: dict) -> str:
 
 def _tune_tables(doc: dict, start, tuned, scenario_text: str):
     from rich.markup import escape
-    from rich.table import Table
     from rich.text import Text
 
     from ..labels import gain_unit
     from ..tuning import PARAMETERS
+    from ._width import FitTable, Split
 
-    parts = []
+    parts: list = []
     settings = doc["settings"]
     per_set = (
         f" gain sets each, {len(settings['tuning_set'])} runs per set ({settings['aggregate']} objective)"
         if "tuning_set" in settings
         else " runs each"
     )
-    studies = Table(title=f"Tuning: every law from the same start, at most {settings['budget']}{per_set}")
-    for name, justify in (("study", "left"), ("gains", "right"), ("runs", "right"), ("passes", "right")):
-        studies.add_column(name, justify=justify)  # type: ignore[arg-type]
-    studies.add_column("objective\nstart", justify="right")
-    studies.add_column("objective\ntuned", justify="right")
-    studies.add_column("stopped")
-    for st in doc["studies"]:
-        budget = st["budget"]
-        studies.add_row(
-            st["controller"],
-            str(len(st["entries"])),
-            f"{st['runs']}" + ("" if budget is None else f" / {budget}"),
-            str(st["passes"]),
-            f"{st['objective_start']:.4f}",
-            f"{st['objective']:.4f}",
-            {"budget": "budget spent", "passes": "pass limit"}.get(st["stopped"], st["stopped"]),
-        )
-    parts += [studies, ""]
-    passes = Table(title="Tuning: the objective after each pass")
+    stopped = {"budget": "budget spent", "passes": "pass limit"}
+    study_cells = {  # heading -> (justify, cell of a study)
+        "gains": ("right", lambda st: str(len(st["entries"]))),
+        "runs": ("right", lambda st: f"{st['runs']}" + ("" if st["budget"] is None else f" / {st['budget']}")),
+        "passes": ("right", lambda st: str(st["passes"])),
+        "objective\nstart": ("right", lambda st: f"{st['objective_start']:.4f}"),
+        "objective\ntuned": ("right", lambda st: f"{st['objective']:.4f}"),
+        "stopped": ("left", lambda st: stopped.get(st["stopped"], st["stopped"])),
+    }
+
+    def studies_table(groups: list[list[str]]):
+        studies = FitTable(title=f"Tuning: every law from the same start, at most {settings['budget']}{per_set}")
+        studies.add_column("study")
+        for heading in (h for g in groups for h in g):
+            studies.add_column(heading, justify=study_cells[heading][0], no_wrap=heading == "runs")  # type: ignore[arg-type]
+        for st in doc["studies"]:
+            studies.add_row(st["controller"], *[study_cells[h][1](st) for g in groups for h in g])
+        return studies
+
+    # on a narrow console what each study took, then what it reached
+    headings = list(study_cells)
+    parts += [Split(studies_table, [headings[:3], headings[3:]]), ""]
+    passes = FitTable(title="Tuning: the objective after each pass")
     passes.add_column("study")
     passes.add_column("pass", justify="right")
     passes.add_column("span", justify="right")
@@ -263,7 +272,7 @@ def _tune_tables(doc: dict, start, tuned, scenario_text: str):
         "",
     ]
 
-    gains = Table(title="Tuned gains")
+    gains = FitTable(title="Tuned gains")
     gains.add_column("gain")
     gains.add_column("unit")
     gains.add_column("start", justify="right")
@@ -288,20 +297,25 @@ def _tune_tables(doc: dict, start, tuned, scenario_text: str):
     if rows:
         from ..control import LABELS
 
-        table = Table(title="RMS of the carbody responses with the start and the tuned gains")
-        table.add_column("suspension", no_wrap=True)
+        # passive first, as a block of its own (no gains: the same RMS in both columns), so
+        # that the table fits 80 columns without a passive column beside every suspension
+        table = FitTable(title="RMS of the carbody responses with the start and the tuned gains", labels=2)
+        table.add_column("suspension")
         table.add_column("response")
-        table.add_column("passive", justify="right")
         table.add_column("start\ngains", justify="right")
-        table.add_column("red. %", justify="right")
+        table.add_column("red. %", justify="right", no_wrap=True)
         table.add_column("tuned\ngains", justify="right")
-        table.add_column("red. %", justify="right")
+        table.add_column("red. %", justify="right", no_wrap=True)
+        for i, (key, label) in enumerate(RESPONSE_LABELS.items()):
+            rms = f"{doc['passive_rms'][key]:#.4g}"
+            table.add_row(
+                "Passive" if i == 0 else "", label, rms, "", rms, "", end_section=i == len(RESPONSE_LABELS) - 1
+            )
         for r in rows:
             for i, (key, label) in enumerate(RESPONSE_LABELS.items()):
                 table.add_row(
                     escape(LABELS[r["suspension"]]) if i == 0 else "",
                     label,
-                    f"{doc['passive_rms'][key]:#.4g}",
                     f"{r['before'][key]:#.4g}",
                     reduction_text(r["reduction_before_percent"][key]),
                     f"{r['after'][key]:#.4g}",
@@ -408,6 +422,9 @@ def tune_command(
     out: TuneOutOption = None,
     resume: TuneResumeOption = False,
     format: FormatOption = OutputFormat.table,
+    figure_format: FigureFormatOption = None,
+    dpi: DpiOption = None,
+    report: ReportOption = None,
 ) -> None:
     """Tune every law's gains by the paper's sensitivity study (its section V), alike.
 
@@ -420,13 +437,14 @@ def tune_command(
     """
     import time
 
-    command = command_line(ctx, exclude=("out", "resume", "format"))
+    command = command_line(ctx, exclude=("out", "resume", "format", "figure_format", "dpi"))
     defaults = not_given(dt=dt, min_wavelength=min_wavelength, max_wavelength=max_wavelength, seed=track_seed)
     seeds: Optional[list] = None
     with errors(), option_names(TUNE_FIELDS, defaults):
         from .. import tuning
         from ..labels import describe_scenario
 
+        figures = figure_options(figure_format, dpi, out)
         names = _tunable_list(controllers)
         damper_preset("--damper", damper)
         scale = parse_scale("--damper-scale", damper_scale)
@@ -461,6 +479,7 @@ def tune_command(
             max_wavelength=max_wavelength,
         )
         scenario_text = describe_scenario(scen.describe())
+        check_report_option(report)
         table, table_path = open_run_table(out, resume)
         executor, executor_record = make_executor(workers, scheduler, scheduler_file)
     try:
@@ -498,12 +517,20 @@ def tune_command(
             doc = {**result.to_dict(), **facts}
             text = json.dumps(doc, indent=2, allow_nan=False)
             if out is not None:
-                write_folder(out, lambda: result.save(out, command, extra=facts))
+                write_folder(
+                    out,
+                    lambda: result.save(
+                        out, command, extra=facts, figure_formats=figures.figure_formats, dpi=figures.dpi
+                    ),
+                )
     finally:
         executor.close()
+    parts = _tune_tables(doc, result.start, result.gains, scenario_text)
     if format is OutputFormat.json:
         typer.echo(text)
-        return
-    console = wide_stdout_console()
-    for part in _tune_tables(doc, result.start, result.gains, scenario_text):
-        console.print(part)
+    else:
+        console = stdout_console()
+        for part in parts:
+            console.print(part)
+    if report is not None:  # after the output: a report that cannot be written loses none of it
+        save_report(report, result, parts, ctx)

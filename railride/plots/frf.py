@@ -1,5 +1,6 @@
 """The carbody frequency responses of `railride.vehicle.Vehicle.frequency_response`, as
-tabulated by `railride.analysis.frf_frame`, with the modes of `Vehicle.modes()` marked."""
+tabulated by `railride.analysis.frf_frame`: magnitude and phase, with the modes of
+`Vehicle.modes()` marked."""
 
 from __future__ import annotations
 
@@ -9,7 +10,7 @@ import numpy as np
 import pandas as pd
 
 from ..analysis import FRF_PATTERNS, FRF_RESPONSES, frf_excited
-from ._style import given_axes, new_figure
+from ._style import PAGE_WIDTH, given_axes, new_figure, set_title, styled
 
 #: line style per rail pattern
 FRF_STYLES = {
@@ -72,26 +73,62 @@ def _legend_entries(axes, modes, groups) -> tuple[list, list]:
     return handles, labels
 
 
+def _phase_line(frequency, phase):
+    """The phase [deg] with a gap where it wraps from -180 to 180 (no vertical line there)."""
+    f = np.asarray(frequency, dtype=float)
+    y = np.asarray(phase, dtype=float)
+    wraps = np.flatnonzero(np.abs(np.diff(y)) > 180.0) + 1
+    return np.insert(f, wraps, np.nan), np.insert(y, wraps, np.nan)
+
+
+def _mark_modes(a, groups, labels_at) -> None:
+    """Dotted lines at the modes' frequencies; their numbers above the panel when given."""
+    for f, _ in groups:
+        a.axvline(f, color="0.45", linestyle=":", linewidth=0.9, zorder=0)
+    for f, numbers in labels_at:
+        a.annotate(
+            _mode_numbers(numbers),
+            (f, 1.0),
+            xycoords=("data", "axes fraction"),
+            xytext=(0, 2),
+            textcoords="offset points",
+            ha="center",
+            va="bottom",
+            fontsize="x-small",
+            color="0.3",
+        )
+
+
+@styled
 def plot_frf(frame: pd.DataFrame, modes: pd.DataFrame | None = None, ax=None, *, title: str | None = None):
-    """Magnitudes of the carbody frequency responses (`railride.analysis.frf_frame`) against
-    frequency on log-log axes: one panel per response (bounce m/m, pitch and roll deg/m,
-    acceleration (m/s^2)/m), one line per rail pattern. ``modes`` (`railride.tables.modes_frame`)
-    are marked as dotted vertical lines at their undamped natural frequencies, numbered at the
-    top of each panel (modes within 1 % of each other share a line) and listed below the plot.
-    A response a pattern does not excite is not drawn; the panel says so. ``ax``: four Axes to
-    draw in (the legend goes into the first, no title), or None for a new figure titled ``title``.
-    Returns the `Figure`."""
+    """The carbody frequency responses (`railride.analysis.frf_frame`) against frequency, per
+    response (bounce m/m, pitch and roll deg/m, acceleration (m/s^2)/m) a magnitude panel on
+    log-log axes and below it a phase panel [deg, against the left rail at the leading
+    wheelset, -180 to 180; a line breaks where the phase wraps], one line per rail pattern.
+    ``modes`` (`railride.tables.modes_frame`) are marked as dotted vertical lines at their
+    undamped natural frequencies, numbered at the top of each magnitude panel (modes within 1 %
+    of each other share a line) and listed below the plot. A response a pattern does not excite
+    is not drawn; the panel says so. ``ax``: eight Axes to draw in, per response its magnitude
+    then its phase (the legend goes into the first, no title), or None for a new figure titled
+    ``title``. Returns the `Figure`."""
     if ax is None:
-        fig = new_figure((11.0, 8.2))
-        axes = list(fig.subplots(2, 2, sharex=True).ravel())
+        fig = new_figure((PAGE_WIDTH, 8.4))
+        grid = fig.subplots(4, 2, sharex=True, height_ratios=(2.0, 1.0, 2.0, 1.0))
+        # per response (bounce, pitch top; roll, acceleration below): magnitude, then phase
+        axes = [grid[r + k, c] for r in (0, 2) for c in (0, 1) for k in (0, 1)]
     else:
-        axes = given_axes(ax, len(FRF_RESPONSES), "one per response: bounce, pitch, roll, acceleration")
+        axes = given_axes(
+            ax,
+            2 * len(FRF_RESPONSES),
+            "per response (bounce, pitch, roll, acceleration) its magnitude, then its phase",
+        )
         fig = axes[0].figure
     patterns = list(dict.fromkeys(frame["pattern"]))
     f_all = frame["frequency_hz"].values
     lo, hi = float(f_all.min()), float(f_all.max())
     groups, labels_at = _mode_groups(modes, lo, hi)
-    for a, (name, _, _, ylabel, column) in zip(axes, FRF_RESPONSES):
+    for k, (name, _, _, ylabel, column) in enumerate(FRF_RESPONSES):
+        a, b = axes[2 * k], axes[2 * k + 1]
         top = float(frame[column].max())
         silent = []
         for pattern in patterns:
@@ -100,32 +137,20 @@ def plot_frf(frame: pd.DataFrame, modes: pd.DataFrame | None = None, ax=None, *,
             if not frf_excited(y, top):
                 silent.append(pattern)
                 continue
-            a.loglog(
-                part["frequency_hz"].values,
-                np.where(y > 0, y, np.nan),
-                linewidth=1.3,
-                label=pattern,
-                **FRF_STYLES.get(pattern, {}),
-            )
-        a.set_xscale("log")
-        a.set_xlim(lo, hi)
+            style = FRF_STYLES.get(pattern, {})
+            f = part["frequency_hz"].values
+            a.loglog(f, np.where(y > 0, y, np.nan), linewidth=1.2, label=pattern, **style)
+            b.plot(*_phase_line(f, part[f"{name}_phase_deg"].values), linewidth=1.0, **style)
         everywhere = all(p in silent for p in patterns)
+        for p in (a, b):
+            p.set_xscale("log")
+            p.set_xlim(lo, hi)
+            p.grid(True, which="minor", linewidth=0.3, alpha=0.35)
+            _mark_modes(p, groups, labels_at if p is a else [])
         if everywhere:
             a.set_yscale("linear")
-        for f, _ in groups:
-            a.axvline(f, color="0.45", linestyle=":", linewidth=0.9, zorder=0)
-        for f, numbers in labels_at:
-            a.annotate(
-                _mode_numbers(numbers),
-                (f, 1.0),
-                xycoords=("data", "axes fraction"),
-                xytext=(0, 2),
-                textcoords="offset points",
-                ha="center",
-                va="bottom",
-                fontsize="x-small",
-                color="0.3",
-            )
+        b.set_ylim(-195.0, 195.0)
+        b.set_yticks([-180, -90, 0, 90, 180])
         if silent:
             a.text(
                 0.5 if everywhere else 0.02,
@@ -138,25 +163,17 @@ def plot_frf(frame: pd.DataFrame, modes: pd.DataFrame | None = None, ax=None, *,
             )
             if everywhere:
                 a.set_yticks([])
+                b.set_yticks([])
         a.set_ylabel(ylabel)
-        a.set_title(f"carbody {name}", fontsize="medium", pad=12)
-        a.grid(True, which="major", linewidth=0.5, alpha=0.7)
-        a.grid(True, which="minor", linewidth=0.3, alpha=0.35)
-    for a in axes[2:]:
-        a.set_xlabel("frequency (Hz)")
+        b.set_ylabel("phase (deg)")
+        a.set_title(f"carbody {name}", pad=12)
+    for b in axes[5::2] if ax is None else axes[1::2]:
+        b.set_xlabel("frequency (Hz)")
     handles, labels = _legend_entries(axes, modes, groups)
     if ax is not None:
         if handles:
             axes[0].legend(handles, labels, fontsize="x-small")
         return fig
-    fig.legend(
-        handles,
-        labels,
-        loc="outside lower center",
-        ncols=min(4, len(labels)),
-        fontsize="small",
-        frameon=False,
-        handlelength=2.2,
-    )
-    fig.suptitle(title or "Carbody frequency responses per metre of rail amplitude", fontsize="medium")
+    fig.legend(handles, labels, loc="outside lower center", ncols=2, fontsize="small", handlelength=2.2, frameon=False)
+    set_title(fig, title or "Carbody frequency responses per metre of rail amplitude")
     return fig

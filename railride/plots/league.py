@@ -5,7 +5,16 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._style import given_axes, new_figure, suspension_label, suspension_style
+from ._style import (
+    COLUMN_WIDTH,
+    PAGE_WIDTH,
+    fit_text,
+    given_axes,
+    new_figure,
+    styled,
+    suspension_label,
+    suspension_style,
+)
 
 _RESPONSES = (
     ("acceleration_m_s2", "acceleration"),
@@ -15,6 +24,7 @@ _RESPONSES = (
 )
 
 
+@styled
 def plot_league(table, ax=None):
     """Bars of the mean RMS reduction [%] of each response (groups) per controller (bars),
     outlines at the ideal actuator's mean reduction with the same gains. ``table``: a
@@ -22,7 +32,7 @@ def plot_league(table, ax=None):
     summary = table.summary()
     controlled = [n for n in table.controllers if n != "passive"]
     if ax is None:
-        fig = new_figure((7.0, 3.6))
+        fig = new_figure((PAGE_WIDTH, 3.2))
         ax = fig.add_subplot()
     else:
         ax = given_axes(ax, 1, "the reductions")[0]
@@ -40,11 +50,13 @@ def plot_league(table, ax=None):
     ax.set_xticks(x, [label for _, label in _RESPONSES])
     ax.set_ylabel("RMS reduction against passive (%)")
     n_cases = int(summary["cases"].max()) if len(summary) else 0
-    ax.set_title(f"Mean over {n_cases} case{'s' if n_cases != 1 else ''}; dashed outline: ideal actuator", fontsize=9)
-    ax.legend(fontsize="x-small", ncols=2)
+    ax.set_title(f"Mean over {n_cases} case{'s' if n_cases != 1 else ''}; dashed outline: ideal actuator")
+    ax.grid(False, axis="x")
+    ax.legend(ncols=2)
     return fig
 
 
+@styled
 def plot_league_comfort(table, ax=None, *, index: str = "N_MV_z"):
     """Ride comfort at the carbody centre against speed, one line per controller: ``index``
     N_MV_z (EN 12299, vertical part) or aw_Wk (ISO 2631-1 a_w, m/s^2), the mean over the
@@ -53,7 +65,7 @@ def plot_league_comfort(table, ax=None, *, index: str = "N_MV_z"):
     if column not in table.cases:
         raise ValueError(f"index = {index!r}: the league table has no {column} (allowed N_MV_z, aw_Wk)")
     if ax is None:
-        fig = new_figure((5.0, 3.4))
+        fig = new_figure((COLUMN_WIDTH, 3.0))
         ax = fig.add_subplot()
     else:
         ax = given_axes(ax, 1, "the comfort index")[0]
@@ -64,7 +76,6 @@ def plot_league_comfort(table, ax=None, *, index: str = "N_MV_z"):
         ax.plot(line.index, line.values, marker="o", label=suspension_label(name), **suspension_style(name))
     ax.set_xlabel("speed (m/s)")
     ax.set_ylabel("N$_{MV,z}$ (carbody centre)" if index == "N_MV_z" else "a$_w$ Wk (m/s$^2$, carbody centre)")
-    ax.set_title(f"Mean over {', '.join(table.settings.get('scenarios', []))}", fontsize=9)
-    ax.grid(True, alpha=0.3)
-    ax.legend(fontsize="x-small")
+    ax.set_title(fit_text(f"Mean over {', '.join(table.settings.get('scenarios', []))}", COLUMN_WIDTH - 0.6, 9.0))
+    ax.legend(fontsize="small")
     return fig

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._style import given_axes, new_figure
+from ._style import PAGE_WIDTH, given_axes, new_figure, set_title, styled
 
 
 def _expect(value, name: str, kind: str):
@@ -20,6 +20,7 @@ def _objective_label(definition) -> str:
     return f"objective J ({kind})" if kind else "objective J"
 
 
+@styled
 def plot_convergence(result, ax=None, *, title: str | None = None):
     """The search of `railride.optimise.optimise` (an `OptimiseResult`): per generation
     (0 the initial population) the lowest objective among its runs (dots) and the lowest so far
@@ -31,31 +32,31 @@ def plot_convergence(result, ax=None, *, title: str | None = None):
     _expect(result, "result", "OptimiseResult")
     frame = result.to_pandas()
     if ax is None:
-        fig = new_figure((8.0, 4.8))
+        fig = new_figure((PAGE_WIDTH, 3.6))
         a = fig.subplots()
     else:
         (a,) = given_axes(ax, 1, "the objective against generation")
         fig = a.figure
-    a.plot(frame["generation"], frame["objective"], "o", color="0.55", markersize=4, label="lowest in the generation")
-    a.step(frame["generation"], frame["best"], where="post", color="tab:red", linewidth=1.4, label="lowest so far")
+    a.plot(frame["generation"], frame["objective"], "o", color="0.55", label="lowest in the generation")
+    a.step(frame["generation"], frame["best"], where="post", color="tab:red", linewidth=1.3, label="lowest so far")
     a.xaxis.set_major_locator(MaxNLocator(integer=True))
     a.set_xlabel("generation (0: the initial population)")
     a.set_ylabel(_objective_label(result.objective_definition))
-    a.grid(True, linewidth=0.4, alpha=0.6)
-    a.legend(fontsize="small")
+    a.legend()
     if ax is None:
-        fig.suptitle(
+        set_title(
+            fig,
             title
             or (
                 f"Differential evolution: {result.suspension or 'controller'}, "
                 f"{len(result.parameters)} gains, {result.generations} generations, "
                 f"{result.n_runs} runs; J = {result.objective:.4g}"
             ),
-            fontsize="medium",
         )
     return fig
 
 
+@styled
 def plot_indices(result, ax=None, *, title: str | None = None):
     """The Sobol indices of `railride.optimise.sensitivity` (a `SensitivityResult`): per gain,
     a bar of its first-order index (its effect alone) and one of its total index (with every
@@ -66,7 +67,7 @@ def plot_indices(result, ax=None, *, title: str | None = None):
     names = list(result.parameters)
     y = np.arange(len(names))
     if ax is None:
-        fig = new_figure((8.0, 1.2 + 0.45 * len(names)))
+        fig = new_figure((PAGE_WIDTH, 1.2 + 0.35 * len(names)))
         a = fig.subplots()
     else:
         (a,) = given_axes(ax, 1, "the indices of every gain")
@@ -78,15 +79,15 @@ def plot_indices(result, ax=None, *, title: str | None = None):
     a.invert_yaxis()  # the first gain on top
     a.axvline(0.0, color="0.4", linewidth=0.6)
     a.set_xlabel(f"Sobol index of the {_objective_label(result.objective_definition)}")
-    a.grid(True, axis="x", linewidth=0.4, alpha=0.6)
-    a.legend(fontsize="small")
+    a.grid(False, axis="y")
+    a.legend()
     if ax is None:
-        fig.suptitle(
+        set_title(
+            fig,
             title
             or (
                 f"Sobol indices: {result.suspension or 'controller'}, gains uniform "
                 f"in log10 over the search box, {result.n_runs} runs"
             ),
-            fontsize="medium",
         )
     return fig

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..labels import describe_scenario
-from ._style import given_axes, new_figure, suspension_label
+from ._style import PAGE_WIDTH, fit_text, given_axes, new_figure, set_title, styled, suspension_label
 
 #: axis label of each ratio
 RATIO_LABELS = {
@@ -26,7 +26,7 @@ def _draw_plane(a, result, x: str, y: str) -> None:
     front = result.non_dominated
     rx, ry = ratios[:, RATIOS.index(x)], ratios[:, RATIOS.index(y)]
     plane = result.non_dominated_in(x, y)
-    a.scatter(rx, ry, s=10, color="0.65", linewidths=0, label="sample", zorder=2)
+    a.scatter(rx, ry, s=10, color="0.65", linewidths=0, label="sampled gains", zorder=2)
     a.scatter(
         rx[front], ry[front], s=16, color="tab:blue", linewidths=0, zorder=3, label="non-dominated over all four ratios"
     )
@@ -64,10 +64,9 @@ def _draw_plane(a, result, x: str, y: str) -> None:
         axis.set_minor_formatter(NullFormatter())
     a.set_xlabel(RATIO_LABELS[x], fontsize="small")
     a.set_ylabel(RATIO_LABELS[y], fontsize="small")
-    a.tick_params(labelsize="small")
-    a.grid(True, which="major", linewidth=0.4, alpha=0.6)
 
 
+@styled
 def plot_pareto(result, ax=None):
     """Two panels of `railride.pareto.ParetoResult` ``result``: the acceleration ratio (x)
     against the pitch ratio, and against the roll ratio. Every sample grey; blue the samples
@@ -78,14 +77,14 @@ def plot_pareto(result, ax=None):
     from ..pareto import PROJECTIONS
 
     if ax is None:
-        fig = new_figure((11.0, 5.0))
+        fig = new_figure((PAGE_WIDTH, 3.9))
         axes = fig.subplots(1, 2)
     else:
         axes = given_axes(ax, len(PROJECTIONS), "one per panel")
         fig = axes[0].figure
     for a, (x, y) in zip(axes, PROJECTIONS):
         _draw_plane(a, result, x, y)
-    axes[0].legend(loc="best", fontsize="x-small")
+    axes[0].legend(loc="best", fontsize="small")
     st = result.settings
     title = (
         f"{suspension_label(result.suspension)}: "
@@ -95,10 +94,11 @@ def plot_pareto(result, ax=None):
         f"{st.get('damper', '?')} dampers"
     )
     if ax is None:
-        fig.suptitle(title, fontsize="medium")
+        set_title(fig, title)
         if result.note:
-            fig.text(0.5, 0.005, result.note, ha="center", va="bottom", fontsize="small", color="tab:red")
-            fig.get_layout_engine().set(rect=(0, 0.04, 1, 0.96))
+            note = fit_text(result.note, fig.get_figwidth() - 0.2, 7.5)
+            fig.text(0.5, 0.005, note, ha="center", va="bottom", fontsize="small", color="tab:red")
+            fig.get_layout_engine().set(rect=(0, 0.03 + 0.03 * note.count("\n"), 1, 0.96))
     else:
         axes[0].set_title(title, fontsize="small", loc="left")
         if result.note:

@@ -2,10 +2,29 @@
 
 from __future__ import annotations
 
+import dataclasses
+
+import numpy as np
 import xarray as xr
 
 from ..labels import CARBODY_RESPONSES, describe_scenario, describe_suspension, json_records
-from ._style import given_axes, new_figure, save_png
+from ._style import PAGE_WIDTH, frame_window, given_axes, new_figure, save_to, set_title, styled, window_note
+
+#: how a scenario field that differs between the samples of a batch is named in the legend
+SCENARIO_WORDS = {
+    "speed_m_s": lambda v: f"V = {v:g} m/s",
+    "seed": lambda v: f"seed {v}",
+    "amplitude_m": lambda v: f"A = {v:g} m",
+    "wavelength_m": lambda v: f"wavelength {v:g} m",
+    "rail_phase_deg": lambda v: f"rail phase {v:g} deg",
+    "height_m": lambda v: f"h = {v:g} m",
+    "length_m": lambda v: f"length {v:g} m",
+    "duration_s": lambda v: f"{v:g} s",
+    "min_wavelength_m": lambda v: f"wavelengths from {v:g} m",
+    "max_wavelength_m": lambda v: f"wavelengths to {v:g} m",
+}
+#: the carbody fields a load factor scales (`VehicleParams.loaded`)
+LOAD_FIELDS = ("m_c", "I_cx", "I_cy", "I_cz")
 
 
 def ride_title(ds: xr.Dataset) -> str:
@@ -28,44 +47,124 @@ def ride_title(ds: xr.Dataset) -> str:
     return f"carbody responses - {title}" if title else "carbody responses"
 
 
-def plot_body_responses(ds: xr.Dataset, path=None, *, ax=None):
+def _differing(records: list[dict]) -> list[str]:
+    """The keys every record holds whose values are not the same in every record, in the first
+    record's order (a key some records lack belongs to another kind of track: its name tells)."""
+    keys = [k for k in dict.fromkeys(k for r in records for k in r) if all(k in r for r in records)]
+    return [k for k in keys if len({repr(r[k]) for r in records}) > 1]
+
+
+def _scenario_words(records: list[dict]) -> list[list[str]]:
+    """Per sample, the scenario fields that differ between the samples, in words."""
+    keys = _differing(records)
+    if "name" in keys:  # the name says the profile and the spectrum
+        keys = [k for k in keys if k not in ("profile", "spectrum")]
+    if any(r.get("profile") == "random" for r in records):  # its length follows speed and duration
+        keys = [k for k in keys if k not in ("length_m", "lead_in_m")]
+    words: list[list[str]] = [[] for _ in records]
+    for key in keys:
+        for w, r in zip(words, records):
+            say = SCENARIO_WORDS.get(key)
+            w.append(say(r[key]) if say else str(r[key]) if key == "name" else f"{key} {r[key]}")
+    return words
+
+
+def _vehicle_words(records: list[dict]) -> list[list[str]]:
+    """Per sample, the vehicle parameters that differ: "load x1.3" when only the carbody's mass
+    and inertias differ, by one factor, from a preset's; else "c_sz = 6e+04 N s/m"."""
+    from ..params import PRESETS, VehicleParams
+
+    keys = _differing(records)
+    if not keys:
+        return [[] for _ in records]
+    if set(keys) <= set(LOAD_FIELDS):
+        for preset in PRESETS.values():
+            base = dataclasses.asdict(preset)
+            factors = []
+            for r in records:
+                ratio = {r.get(k, np.nan) / base[k] for k in LOAD_FIELDS}
+                same = all(r.get(k) == v for k, v in base.items() if k not in LOAD_FIELDS)
+                factors.append(ratio.pop() if len(ratio) == 1 and same else None)
+            if all(f is not None for f in factors):
+                return [[f"load x{f:.4g}"] for f in factors]
+    units = {f.name: f.metadata.get("unit", "") for f in dataclasses.fields(VehicleParams)}
+    return [[f"{k} = {r[k]:.4g} {units.get(k, '')}".rstrip() for k in keys if k in r] for r in records]
+
+
+def _voltage_words(ds: xr.Dataset, samples) -> list[list[str]]:
+    """Per sample, its constant command voltage ("2.25 V") when the samples' voltages differ."""
+    if "damper_command_voltage" not in ds.variables or "sample" not in ds["damper_command_voltage"].dims:
+        return [[] for _ in samples]
+    volts = []
+    for s in samples:
+        v = np.unique(np.round(np.asarray(ds["damper_command_voltage"].sel(sample=s).values, dtype=float), 9))
+        volts.append(float(v[0]) if v.size == 1 else None)
+    if None in volts or len(set(volts)) < 2:
+        return [[] for _ in samples]
+    return [[f"{v:g} V"] for v in volts]
+
+
+def sample_labels(ds: xr.Dataset) -> list[str]:
+    """The legend text of each sample of a batch: what differs between them (the scenario's
+    speed, track seed or name, a load factor or a vehicle parameter, the command voltage), or
+    "sample k" where nothing recorded differs."""
+    samples = list(ds["sample"].values)
+    scenarios = json_records(ds, "scenario")
+    vehicles = json_records(ds, "vehicle_params")
+    parts: list[list[str]] = [[] for _ in samples]
+    if len(scenarios) == len(samples):
+        parts = [p + w for p, w in zip(parts, _scenario_words(scenarios))]
+    if len(vehicles) == len(samples):
+        parts = [p + w for p, w in zip(parts, _vehicle_words(vehicles))]
+    parts = [p + w for p, w in zip(parts, _voltage_words(ds, samples))]
+    labels = [", ".join(p) for p in parts]
+    if len(set(labels)) < len(labels) or not all(labels):
+        return [f"sample {s}" + (f": {text}" if text else "") for s, text in zip(samples, labels)]
+    return labels
+
+
+@styled
+def plot_body_responses(ds: xr.Dataset, path=None, *, ax=None, window=None):
     """Plot carbody CG vertical acceleration (m/s^2), bounce displacement (m), pitch (deg) and
     roll (deg) of a result Dataset (`RideResult.dataset`) against time in four stacked panels
     sharing the time axis.
 
-    A batch gets one line per sample. The title describes the scenario when the dataset records
-    one. ``ax``: four Axes to draw in (no title then: the caller owns the figure), or None for
-    a new figure. If ``path`` is given the figure is saved there as PNG, atomically. Returns the
-    `matplotlib.figure.Figure`.
+    A batch gets one line per sample, labelled by what differs between the samples
+    (`sample_labels`). ``window`` (start, end) s, the metric window: the whole run is drawn, the
+    part outside the window shaded, and each panel's y-axis fits the values inside it, so that
+    a start-up transient does not flatten the rest (None: the whole run). The title describes
+    the scenario when the dataset records one. ``ax``: four Axes to draw in (no title then: the
+    caller owns the figure), or None for a new figure. If ``path`` is given the figure is saved
+    there (format from its suffix, else PNG), atomically. Returns the `matplotlib.figure.Figure`.
     """
     missing = [channel for channel, _, _, _ in CARBODY_RESPONSES.values() if channel not in ds.variables]
     if missing:
         raise ValueError(f"the dataset lacks the channel(s) {', '.join(missing)}")
     if ax is None:
-        fig = new_figure((9.0, 9.0))
+        fig = new_figure((PAGE_WIDTH, 7.0))
         axes = fig.subplots(len(CARBODY_RESPONSES), 1, sharex=True)
     else:
         axes = given_axes(ax, len(CARBODY_RESPONSES), "one per response: " + ", ".join(CARBODY_RESPONSES))
         fig = axes[0].figure
     time = ds["time"].values
-    samples = list(ds["sample"].values) if "sample" in ds.dims else [None]
-    names = [r.get("name") for r in json_records(ds, "scenario")]
-    legend = {
-        s: f"sample {s}" + (f": {names[i]}" if len(names) == len(samples) and names[i] else "")
-        for i, s in enumerate(samples)
-    }
+    batch = "sample" in ds.dims
+    samples = list(ds["sample"].values) if batch else [None]
+    legend = dict(zip(samples, sample_labels(ds))) if batch else {}
+    clipped = False
     for a, (channel, factor, label, _) in zip(axes, CARBODY_RESPONSES.values()):
         da = ds[channel]
+        ys = []
         for s in samples:
             y = (da.sel(sample=s) if s is not None and "sample" in da.dims else da).values * factor
-            a.plot(time, y, linewidth=0.9, label=None if s is None else legend[s])
+            a.plot(time, y, label=legend.get(s))
+            ys.append(y)
         a.set_ylabel(label)
-        a.grid(True, linewidth=0.4, alpha=0.6)
+        clipped = frame_window([a], time, ys, window) or clipped
     axes[-1].set_xlabel("time (s)")
     axes[-1].set_xlim(time[0], time[-1])
     if 1 < len(samples) <= 12:
-        axes[0].legend(loc="upper right", fontsize="small", ncols=min(4, len(samples)))
+        axes[0].legend(loc="lower center", bbox_to_anchor=(0.5, 1.0), ncols=min(3, len(samples)), frameon=False)
     if ax is None:
-        fig.suptitle(ride_title(ds), fontsize="medium")
-    save_png(fig, path)
+        set_title(fig, ride_title(ds) + (f"\n{window_note(window)}" if clipped else ""))
+    save_to(fig, path)
     return fig

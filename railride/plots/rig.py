@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 
 from ..labels import damper_model_name
-from ._style import given_axes, new_figure, save_png
+from ._style import PAGE_WIDTH, frame_window, given_axes, new_figure, save_to, set_title, styled
 
 
 def _expect(value, name: str, kind: str):
@@ -15,6 +15,7 @@ def _expect(value, name: str, kind: str):
         raise ValueError(f"{name}: expected a railride.rig.{kind}, got {type(value).__name__}")
 
 
+@styled
 def plot_hysteresis(cycles, path=None, *, title: str | None = None, ax=None):
     """Force-displacement and force-velocity loops of the `railride.rig.Cycles` of
     `railride.rig.cycles`: the steady-state (last) cycle at each voltage, one line per voltage,
@@ -22,7 +23,8 @@ def plot_hysteresis(cycles, path=None, *, title: str | None = None, ax=None):
 
     ``ax``: two Axes to draw in (no title then), or None for a new figure titled ``title``
     (default: the damper, the motion and the cycle shown, as `railride damper --out` has it).
-    Saved as PNG at ``path`` when given (atomically). Returns the `Figure`.
+    Saved at ``path`` when given (format from its suffix, else PNG; atomically). Returns the
+    `Figure`.
     """
     from matplotlib import colormaps
 
@@ -32,7 +34,7 @@ def plot_hysteresis(cycles, path=None, *, title: str | None = None, ax=None):
     if missing or "voltage" not in ds.dims:
         raise ValueError("expected the result of railride.rig.cycles (dims voltage, time; x, xd, F)")
     if ax is None:
-        fig = new_figure((11.0, 4.8))
+        fig = new_figure((PAGE_WIDTH, 3.2))
         ax_x, ax_v = fig.subplots(1, 2, sharey=True)
     else:
         ax_x, ax_v = given_axes(ax, 2, "force against displacement, against velocity")
@@ -43,21 +45,20 @@ def plot_hysteresis(cycles, path=None, *, title: str | None = None, ax=None):
         cyc = ds.isel(voltage=i)
         colour = cmap(0.85 * i / max(1, len(volts) - 1))
         force = cyc["F"].values / 1e3
-        ax_x.plot(cyc["x"].values * 1e3, force, color=colour, linewidth=1.2, label=f"{v:g} V")
-        ax_v.plot(cyc["xd"].values, force, color=colour, linewidth=1.2, label=f"{v:g} V")
+        ax_x.plot(cyc["x"].values * 1e3, force, color=colour, label=f"{v:g} V")
+        ax_v.plot(cyc["xd"].values, force, color=colour, label=f"{v:g} V")
     ax_x.set_xlabel("extension x (mm)")
     ax_v.set_xlabel("extension rate x' (m/s)")
     ax_x.set_ylabel("damper force F (kN, tension +)")
-    ax_x.set_title("force - displacement", fontsize="medium")
-    ax_v.set_title("force - velocity", fontsize="medium")
+    ax_x.set_title("force - displacement")
+    ax_v.set_title("force - velocity")
     for a in (ax_x, ax_v):
         a.axhline(0.0, color="0.6", linewidth=0.5)
         a.axvline(0.0, color="0.6", linewidth=0.5)
-        a.grid(True, linewidth=0.4, alpha=0.6)
-    ax_v.legend(title="command voltage", fontsize="small", loc="upper left")
+    ax_v.legend(title="command voltage", loc="upper left")
     if ax is None:
-        fig.suptitle(_cycles_title(cycles) if title is None else title, fontsize="medium")
-    save_png(fig, path)
+        set_title(fig, _cycles_title(cycles) if title is None else title)
+    save_to(fig, path)
     return fig
 
 
@@ -82,14 +83,17 @@ def _cycles_title(cycles) -> str:
     return ", ".join(parts)
 
 
+@styled
 def plot_tracking(tracking, path=None, *, title: str | None = None, ax=None):
     """Force tracking of `railride.rig.track` (a `railride.rig.Tracking`): top, the desired and
     the actual damper force (kN, tension +) against time; bottom, the command voltage v and the
-    coil voltage u (V). The first cycle, left out of the metrics (start-up), is shaded.
+    coil voltage u (V). The first cycle, left out of the metrics (start-up), is shaded, and the
+    force axis fits the forces after it.
 
     ``ax``: two Axes to draw in (no title then), or None for a new figure titled ``title``
     (default: the demand, the damper, the gains and the error, as `railride tracking --out` has
-    it). Saved as PNG at ``path`` when given (atomically). Returns the `Figure`.
+    it). Saved at ``path`` when given (format from its suffix, else PNG; atomically). Returns
+    the `Figure`.
     """
     _expect(tracking, "tracking", "Tracking")
     ds = tracking.dataset
@@ -97,35 +101,33 @@ def plot_tracking(tracking, path=None, *, title: str | None = None, ax=None):
     if missing:
         raise ValueError(f"expected the result of railride.rig.track; missing {', '.join(missing)}")
     if ax is None:
-        fig = new_figure((10.0, 6.5))
+        fig = new_figure((PAGE_WIDTH, 4.6))
         ax_f, ax_v = fig.subplots(2, 1, sharex=True, height_ratios=(3, 2))
     else:
         ax_f, ax_v = given_axes(ax, 2, "forces, voltages")
         fig = ax_f.figure
     time = ds["time"].values
-    ax_f.plot(time, ds["desired_force"].values / 1e3, color="0.15", linewidth=1.1, linestyle="--", label="desired")
-    ax_f.plot(time, ds["F"].values / 1e3, color="tab:red", linewidth=1.1, label="actual")
+    desired, actual = ds["desired_force"].values / 1e3, ds["F"].values / 1e3
+    ax_f.plot(time, desired, color="0.15", linestyle="--", label="desired")
+    ax_f.plot(time, actual, color="tab:red", label="actual")
     ax_f.set_ylabel("damper force (kN, tension +)")
-    ax_f.legend(loc="upper right", fontsize="small", ncols=2)
-    ax_v.plot(time, ds["v"].values, color="tab:blue", linewidth=0.9, label="command v")
-    ax_v.plot(time, ds["u"].values, color="tab:orange", linewidth=1.2, label="coil u")
+    ax_f.legend(loc="upper right", ncols=2)
+    ax_v.plot(time, ds["v"].values, color="tab:blue", linewidth=0.8, label="command v")
+    ax_v.plot(time, ds["u"].values, color="tab:orange", label="coil u")
     ax_v.set_ylabel("voltage (V)")
     ax_v.set_xlabel("time (s)")
-    ax_v.legend(loc="upper right", fontsize="small", ncols=2)
+    ax_v.legend(loc="upper right", ncols=2)
     window = tracking.window
-    start_up = window is not None and window[0] > time[0]
-    for a in (ax_f, ax_v):
-        a.grid(True, linewidth=0.4, alpha=0.6)
-        if start_up:
-            a.axvspan(time[0], window[0], color="0.9", zorder=0)
+    start_up = frame_window([ax_f], time, [desired, actual], window)
+    frame_window([ax_v], time, [], window)  # shaded; the voltages keep the damper's range
     ax_v.set_xlim(time[0], time[-1])
     if ax is None:
         if title is None:
             title = _tracking_title(tracking)
         if start_up:
             title += "\n(shaded: start-up, left out of the metrics)"
-        fig.suptitle(title, fontsize="medium")
-    save_png(fig, path)
+        set_title(fig, title)
+    save_to(fig, path)
     return fig
 
 

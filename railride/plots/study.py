@@ -5,7 +5,16 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._style import given_axes, new_figure, suspension_label, suspension_style
+from ._style import (
+    PAGE_WIDTH,
+    given_axes,
+    grid_shape,
+    new_figure,
+    set_title,
+    styled,
+    suspension_label,
+    suspension_style,
+)
 
 #: the metrics drawn by default, and their titles
 DEFAULT_METRICS = {
@@ -17,11 +26,12 @@ DEFAULT_METRICS = {
 }
 
 
+@styled
 def plot_study(result, ax=None, metrics=None):
     """One panel per metric (default `DEFAULT_METRICS`): per condition (load, fault, delay) a group,
     per controller a marker at the mean reduction [%] against passive, with a bar from the 5th
     to the 95th percentile over the study's tracks and speeds. ``ax``: one Axes per metric, or
-    None for a new figure. Returns the figure."""
+    None for a new figure (at most three panels a row). Returns the figure."""
     summary = result.summary
     metrics = list(DEFAULT_METRICS) if metrics is None else list(metrics)
     unknown = [m for m in metrics if m not in set(summary["metric"])]
@@ -31,11 +41,16 @@ def plot_study(result, ax=None, metrics=None):
     part = summary[summary["controller"] != "passive"]
     conditions = list(dict.fromkeys(zip(part["load"], part["stiffness"], part["fault"], part["delay"])))
     if ax is None:
-        fig = new_figure((3.4 * len(metrics) + 0.6, 3.6))
-        axes = fig.subplots(1, len(metrics), squeeze=False).ravel()
+        n_rows, columns = grid_shape(len(metrics), 3)
+        fig = new_figure((PAGE_WIDTH, 0.8 + 2.6 * n_rows))
+        axes = fig.subplots(n_rows, columns, squeeze=False).ravel()
+        for a in axes[len(metrics) :]:
+            a.set_visible(False)
+        axes = axes[: len(metrics)]
     else:
         axes = given_axes(ax, len(metrics), f"one per metric: {', '.join(metrics)}")
         fig = axes[0].figure
+        columns = len(metrics)
     width = 0.8 / max(1, len(controlled))
     x = np.arange(len(conditions))
     for a, metric in zip(axes, metrics):
@@ -58,23 +73,25 @@ def plot_study(result, ax=None, metrics=None):
             )
         a.axhline(0.0, color="k", linewidth=0.8)
         a.set_xticks(x, [_condition_label(*c) for c in conditions], fontsize="small")
-        a.set_title(DEFAULT_METRICS.get(metric, metric), fontsize=9)
-        a.grid(True, axis="y", linewidth=0.4, alpha=0.6)
-    axes[0].set_ylabel("reduction against passive (%)\nmean, 5-95 % band")
-    axes[0].legend(fontsize="x-small")
+        a.set_title(DEFAULT_METRICS.get(metric, metric))
+        a.grid(False, axis="x")
+    for k, a in enumerate(axes):
+        if k % columns == 0:
+            a.set_ylabel("reduction against passive (%)\nmean, 5-95 % band")
+    axes[0].legend(fontsize="small")
     if ax is None:
         s = result.settings
-        fig.suptitle(
+        set_title(
+            fig,
             f"{s.get('scenario')}: {len(s.get('track_seeds', []))} track seeds x "
             f"{len(s.get('speeds_m_s', []))} speeds per condition",
-            fontsize=10,
         )
     return fig
 
 
 def _condition_label(load: float, stiffness: float, fault: str, delay: int) -> str:
     return (
-        f"load {load:g}"
+        f"load x{load:g}"
         + ("" if stiffness == 1.0 else f"\nk_sz x {stiffness:g}")
         + ("" if fault == "none" else f"\n{fault}")
         + ("" if delay == 1 else f"\ndelay {delay}")

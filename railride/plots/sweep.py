@@ -4,13 +4,12 @@ comfort against its one swept numeric axis."""
 from __future__ import annotations
 
 import math
-import textwrap
 
 import numpy as np
 import pandas as pd
 
 from ..labels import describe_dampers, describe_scenario, grid_axis_label
-from ._style import given_axes, new_figure, suspension_label, suspension_style
+from ._style import PAGE_WIDTH, given_axes, new_figure, set_title, styled, suspension_label, suspension_style
 
 #: (RMS column, axis label) of the four panels of `plot_sweep`
 RMS_PANELS = (
@@ -66,7 +65,7 @@ def _sweep_lines(ax, frame, axis, column, suspensions):
         off = [float(y) for x, y in zip(mine[axis], mine[column]) if pd.isna(x) and pd.notna(y)]
         if on:
             x, y = zip(*on)
-            ax.plot(x, y, marker="o", markersize=3.5, linewidth=1.3, label=label, **style)
+            ax.plot(x, y, marker="o", markersize=3.5, label=label, **style)
         elif off:
             ax.axhline(float(np.mean(off)), linewidth=1.0, alpha=0.8, label=f"{label} (not swept)", **style)
 
@@ -95,14 +94,11 @@ def _panels(result, panels, ax, figsize, shape):
 def _title(fig, axes, text: str, context: str) -> None:
     """The legend below the panels and the title ``text`` with its wrapped ``context``."""
     handles, names = axes[0].get_legend_handles_labels()
-    fig.legend(
-        handles, names, loc="outside lower center", ncols=min(5, max(1, len(names))), fontsize="small", frameon=False
-    )
-    if context:
-        text += "\n" + textwrap.fill(context, 110)
-    fig.suptitle(text, fontsize="medium")
+    fig.legend(handles, names, loc="outside lower center", ncols=min(4, max(1, len(names))), frameon=False)
+    set_title(fig, text + (f"\n{context}" if context else ""))
 
 
+@styled
 def plot_sweep(result, ax=None, *, axis: str | None = None):
     """The RMS of the four carbody responses against the swept axis of a sweep (the
     `railride.sweep.SweepResult` ``result``): four panels, one line per suspension in the paper's
@@ -111,14 +107,13 @@ def plot_sweep(result, ax=None, *, axis: str | None = None):
     Axes to draw in (legend in the first, no title), or None for a new figure. Returns the
     `Figure`."""
     axis = _swept_axis(result, axis)
-    frame, suspensions, fig, axes = _panels(result, RMS_PANELS, ax, (10.0, 7.2), (2, 2))
+    frame, suspensions, fig, axes = _panels(result, RMS_PANELS, ax, (PAGE_WIDTH, 5.4), (2, 2))
     xs = [float(x) for x in frame[axis] if pd.notna(x)]
     log_x = _log_axis(axis, xs)
     for a, (column, ylabel) in zip(axes, RMS_PANELS):
         _sweep_lines(a, frame, axis, column, suspensions)
         a.set_ylabel(ylabel)
         a.set_ylim(bottom=0)
-        a.grid(True, linewidth=0.4, alpha=0.6)
         if log_x:
             a.set_xscale("log")
     for a in axes[2:]:
@@ -143,6 +138,7 @@ def plot_sweep(result, ax=None, *, axis: str | None = None):
     return fig
 
 
+@styled
 def plot_sweep_comfort(result, ax=None, *, axis: str | None = None):
     """The ride comfort of a sweep with comfort columns (`railride.sweep.SweepResult` of
     `run_sweep` with comfort, ``railride sweep --comfort``) against
@@ -155,14 +151,13 @@ def plot_sweep_comfort(result, ax=None, *, axis: str | None = None):
     axis = _swept_axis(result, axis)
     if not has_comfort(result):
         raise ValueError("the sweep's rows hold no comfort indices (run_sweep with comfort, railride sweep --comfort)")
-    frame, suspensions, fig, axes = _panels(result, COMFORT_PANELS, ax, (10.0, 4.4), (1, 2))
+    frame, suspensions, fig, axes = _panels(result, COMFORT_PANELS, ax, (PAGE_WIDTH, 3.2), (1, 2))
     xs = [float(x) for x in frame[axis] if pd.notna(x)]
     log_x = _log_axis(axis, xs)
     for a, (column, ylabel) in zip(axes, COMFORT_PANELS):
         _sweep_lines(a, frame, axis, column, suspensions)
         a.set_ylabel(ylabel, fontsize="small")
         a.set_ylim(bottom=0)
-        a.grid(True, linewidth=0.4, alpha=0.6)
         a.set_xlabel(grid_axis_label(axis))
         if log_x:
             a.set_xscale("log")

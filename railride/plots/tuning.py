@@ -7,7 +7,7 @@ import math
 import numpy as np
 
 from ..labels import gain_unit
-from ._style import given_axes, new_figure
+from ._style import PAGE_WIDTH, given_axes, grid_shape, new_figure, set_title, styled
 
 
 def _zero_axis(ax, zero_x: float, edge: float, right: float) -> None:
@@ -50,7 +50,7 @@ def _draw_parameter(ax, mine: list, colour) -> bool:
         order = np.argsort(vals)
         vals, obj = vals[order], np.asarray(c.objective, dtype=float)[order]
         col, pos = colour(int(c.sweep_pass)), vals > 0
-        ax.plot(vals[pos], obj[pos], "-o", color=col, markersize=2.5, linewidth=1.1)
+        ax.plot(vals[pos], obj[pos], "-o", color=col, markersize=2.5)
         if (~pos).any():
             ax.plot(x(vals[~pos]), obj[~pos], "s", color=col, markerfacecolor="none", markersize=4.5)
             if pos.any():
@@ -78,10 +78,10 @@ def _draw_parameter(ax, mine: list, colour) -> bool:
     ax.set_title(f"{parameter}" + (f" ({unit})" if unit else "") + f"\nchosen {final:.3g}", fontsize="small")
     ax.set_ylabel("tracking error" if parameter.startswith("inner.") else "objective", fontsize="small")
     ax.tick_params(labelsize="small")
-    ax.grid(True, which="major", linewidth=0.4, alpha=0.6)
     return has_zero
 
 
+@styled
 def plot_sensitivity(curves, ax=None, *, title: str | None = None):
     """The sensitivity curves of a tuning study (``TuneResult.curves``, a sequence of
     `railride.tune_result.Curve`): one panel per parameter (in the order tuned), the objective
@@ -92,7 +92,7 @@ def plot_sensitivity(curves, ax=None, *, title: str | None = None):
     gives. The inner-loop panels (B, G) show the normalised force-tracking error.
 
     ``ax``: one Axes per parameter to draw in (the legend goes into the first, and ``title``
-    is left out), or None for a new figure. Returns the figure.
+    is left out), or None for a new figure, four panels a row. Returns the figure.
     """
     from matplotlib import colormaps
     from matplotlib.lines import Line2D
@@ -103,9 +103,8 @@ def plot_sensitivity(curves, ax=None, *, title: str | None = None):
         raise ValueError("no sensitivity curves to plot")
     parameters = list(dict.fromkeys(c.parameter for c in curves))
     if ax is None:
-        ncols = min(4 if len(parameters) <= 16 else 6, len(parameters))  # every law's gains: wider
-        nrows = math.ceil(len(parameters) / ncols)
-        fig = new_figure((3.3 * ncols + 0.6, 2.6 * nrows + 1.0))
+        nrows, ncols = grid_shape(len(parameters))
+        fig = new_figure((PAGE_WIDTH, 1.9 * nrows + 1.0))
         axes = fig.subplots(nrows, ncols, squeeze=False).ravel()
     else:
         axes = given_axes(ax, len(parameters), f"one per parameter: {', '.join(parameters)}")
@@ -143,6 +142,6 @@ def plot_sensitivity(curves, ax=None, *, title: str | None = None):
     if ax is not None:
         axes[0].legend(handles=handles, loc="best", fontsize="x-small")
         return fig
-    fig.legend(handles=handles, loc="outside lower center", ncols=min(len(handles), 6), fontsize="small", frameon=False)
-    fig.suptitle(title or "Sensitivity of the tuning objective, one parameter at a time", fontsize="medium")
+    fig.legend(handles=handles, loc="outside lower center", ncols=min(len(handles), 4), frameon=False)
+    set_title(fig, title or "Sensitivity of the tuning objective, one parameter at a time")
     return fig

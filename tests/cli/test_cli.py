@@ -169,7 +169,10 @@ def test_bad_speed(value):
 
 def test_dt_too_large():
     assert_input_error(run("simulate", "--duration", 2, "--dt", 0.05), "too large")
-    assert_input_error(run("simulate", "--duration", 2, "--dt", 0.05, "--output-rate", 20), "too large")
+    # RK4 (the MR dampers) is unstable at that step; the passive vehicle's exact steps are not
+    mr = ("--suspension", "mr")
+    assert_input_error(run("simulate", "--duration", 2, "--dt", 0.05, "--output-rate", 20, *mr), "too large")
+    ok("simulate", "--duration", 2, "--dt", 0.05, "--output-rate", 20)
     # a stable step that does not fit the output rate is bad input too
     assert_input_error(run("simulate", "--duration", 2, "--dt", 0.002), "--output-rate")
 

@@ -38,7 +38,7 @@ def test_compare_without_controllers_is_the_papers_four():
 
 def test_compare_table_says_what_has_no_bound_and_what_did_not_run():
     text = ok(*SHORT, "--controllers", "skyhook,passive-on").stdout
-    assert re.search(r"Passive-on: no bound \(MR dampers at a\s+constant voltage", text)
+    assert "Passive-on: no bound (MR dampers at a constant voltage" in " ".join(text.split())  # wrapped at 80
     text = ok(*SHORT, "--controllers", "all", "--damper", "ideal").stdout
     assert "passive-on: not run (MR dampers at a constant voltage" in text
     assert "Clipped-optimal" in text

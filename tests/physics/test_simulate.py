@@ -68,7 +68,9 @@ def test_steady_state_sine_response_equals_the_frequency_response():
 def test_fourth_order_convergence_under_step_halving(track):
     sc = Scenario(track, speed=40.0, duration=1.5)
     runs = {
-        dt: simulate(sc, P, solver=SolverSettings(dt=dt, output_rate=250)).dataset for dt in (4e-4, 2e-4, 1e-4, 2.5e-5)
+        # the RK4 stepper (the passive default is the exact discretisation: tests/physics/test_exact.py)
+        dt: simulate(sc, P, solver=SolverSettings(dt=dt, output_rate=250, method="rk4")).dataset
+        for dt in (4e-4, 2e-4, 1e-4, 2.5e-5)
     }
     fine = runs[2.5e-5]
     errors = []
@@ -172,7 +174,7 @@ def test_result_channels_units_and_provenance():
     "kwargs, match",
     [
         ({"dt": 0.05}, "too large"),
-        ({"dt": 0.05, "output_rate": 20.0}, "too large: fourth-order Runge-Kutta is unstable"),
+        ({"dt": 0.05, "output_rate": 20.0, "method": "rk4"}, "too large: fourth-order Runge-Kutta is unstable"),
         ({"dt": -1e-4}, "dt"),
         ({"dt": float("nan")}, "dt"),
         ({"output_rate": 3000.0}, "whole number of steps"),
@@ -184,7 +186,7 @@ def test_result_channels_units_and_provenance():
 )
 def test_bad_input_raises_a_clear_value_error(kwargs, match):
     kwargs.setdefault("scenario", scenario(duration=1.0))
-    steps = {k: kwargs.pop(k) for k in ("dt", "output_rate") if k in kwargs}
+    steps = {k: kwargs.pop(k) for k in ("dt", "output_rate", "method") if k in kwargs}
     with pytest.raises(ValueError, match=match):  # SolverSettings checks the steps, simulate the rest
         simulate(solver=SolverSettings(**steps) if steps else None, **kwargs)
 

@@ -1,0 +1,191 @@
+"""Exact discretisation of the linear vehicle: one step per output sample, no integration error
+(docs/model.md, Integration).
+
+With the passive viscous secondary the vehicle is linear, x' = A x + r(t), x = (q, q'), and its
+forcing r = Bw w + Bwd w' comes from rail inputs w that are cubic Hermite polynomials between
+the nodes of the input table (`railride.track.wheelset_input_table`; w' is their derivative,
+as the RK4 stepper takes it). Over a stretch of length L on which w is a cubic,
+
+    x(L) = e^{AL} x(0) + sum_k Gamma_k r_k,   Gamma_k = int_0^L e^{A(L-s)} s^k ds,
+
+r_k the coefficients of r in powers of the time s since the stretch began. e^{AL} and every
+Gamma_k come from one matrix exponential of an augmented matrix (Van Loan, 1978), by scipy. An
+output interval that spans nodes is split at them; the pattern of splits repeats, so each kind
+of output step gets one matrix from the nodes it touches to the state increment, and a run is
+x_{n+1} = Phi x_n + g_n with g for every step from one matrix product (`kernels.linear_recurrence`).
+"""
+
+from __future__ import annotations
+
+import math
+from functools import lru_cache
+
+import numpy as np
+import scipy.linalg
+
+from .vehicle import N_DOF
+
+#: the cubic Hermite basis as powers of tau in [0, 1]: rows tau^0..tau^3, columns the node data
+#: (y_k, I y'_k, y_k+1, I y'_k+1), I the node interval
+HERMITE = np.array(
+    [
+        [1.0, 0.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0, 0.0],
+        [-3.0, -2.0, 3.0, -1.0],
+        [2.0, 1.0, -2.0, 1.0],
+    ]
+)
+N_STATE = 2 * N_DOF
+N_INPUT = 16  # per node: the 8 rail heights, then their 8 rates
+
+
+def _exponentials(A: np.ndarray, L: float) -> tuple[np.ndarray, np.ndarray]:
+    """(e^{AL}, Gamma) with Gamma[k] = int_0^L e^{A(L-s)} E s^k ds for k = 0..3, E the lower
+    half (the accelerations): (4, 18, 9). From exp(M L), M = [[A, E, 0, 0, 0], [0, 0, I, 0, 0],
+    [0, 0, 0, I, 0], [0, 0, 0, 0, I], 0], whose top row holds int e^{A(L-s)} E s^k / k! ds."""
+    n, m = N_STATE, N_DOF
+    size = n + 4 * m
+    M = np.zeros((size, size))
+    M[:n, :n] = A
+    M[N_DOF:n, n : n + m] = np.eye(m)
+    for k in range(3):
+        M[n + k * m : n + (k + 1) * m, n + (k + 1) * m : n + (k + 2) * m] = np.eye(m)
+    E = scipy.linalg.expm(M * L)
+    gamma = np.stack([math.factorial(k) * E[:n, n + k * m : n + (k + 1) * m] for k in range(4)])
+    return E[:n, :n], gamma
+
+
+def _segment_map(gamma: np.ndarray, Bw: np.ndarray, Bwd: np.ndarray, tau0: float, interval: float) -> np.ndarray:
+    """(18, 32): the state increment over a stretch that starts at tau0 of a node interval of
+    length ``interval`` [s], from the data of its two nodes (w_k, w'_k, w_k+1, w'_k+1; 8 each).
+    ``gamma`` from `_exponentials` for the stretch's length."""
+    # w(s) = sum_j c_j s^j: re-expand the Hermite polynomial in tau = tau0 + s / interval
+    scale = np.array([1.0, interval, 1.0, interval])  # the slopes enter as I y'
+    coef = np.zeros((4, 4))  # power of s x node datum
+    for j in range(4):
+        for k in range(j + 1):
+            coef[k] += math.comb(j, k) * tau0 ** (j - k) * interval ** (-k) * HERMITE[j] * scale
+    out = np.zeros((N_STATE, 32))
+    for k in range(4):
+        # r_k = Bw c_k + (k + 1) Bwd c_(k+1): each c is a combination of the node data
+        for d in range(4):
+            block = coef[k, d] * Bw + ((k + 1) * coef[k + 1, d] * Bwd if k < 3 else 0.0)
+            out[:, 8 * d : 8 * (d + 1)] += gamma[k] @ block
+    return out
+
+
+class ExactStepper:
+    """The one-step-per-output map of the linear vehicle ``A`` (18 x 18) with rail forcing
+    ``Bw``, ``Bwd`` (9 x 8) for output steps of ``stride`` time steps ``dt`` and an input table
+    with a node every ``m`` time steps. `forcing(utab)` gives g for every output step,
+    `run(x0, g)` the states."""
+
+    def __init__(self, A, Bw, Bwd, dt: float, stride: int, m: int):
+        self.A, self.dt, self.stride, self.m = A, dt, stride, m
+        self.Phi, _ = _exponentials(A, stride * dt)
+        period = math.lcm(stride, m) // stride  # output steps before the pattern of splits repeats
+        #: nodes an output step touches, from the first node at or before its start
+        self.span = (stride + m - 1) // m + 2
+        maps = np.zeros((period, N_STATE, self.span * N_INPUT))
+        for p in range(period):
+            a, b = p * stride, (p + 1) * stride  # in time steps, from a node at 0
+            base = a // m
+            s = a
+            while s < b:
+                node = s // m
+                end = min(b, (node + 1) * m)
+                phi_rest = _cached(self, b - end)[0]
+                gamma = _cached(self, end - s)[1]
+                seg = phi_rest @ _segment_map(gamma, Bw, Bwd, (s - node * m) / m, m * dt)
+                first = (node - base) * N_INPUT
+                # node data order: w_k, w'_k, w_k+1, w'_k+1 -> the table rows k, k+1 (w then w')
+                maps[p, :, first : first + 2 * N_INPUT] += seg
+                s = end
+        self.maps = maps
+        self.period = period
+
+    def forcing(self, utab: np.ndarray, n_out: int) -> np.ndarray:
+        """g (n_out, 18): the state increment of each output step from the rail input table
+        ``utab`` (n_nodes, 16), padded with its last row where a step's span runs past it."""
+        need = (n_out * self.stride) // self.m + self.span + 1
+        if len(utab) < need:
+            utab = np.vstack([utab, np.repeat(utab[-1:], need - len(utab), axis=0)])
+        g = np.empty((n_out, N_STATE))
+        for p in range(self.period):
+            steps = np.arange(p, n_out, self.period)
+            if steps.size == 0:
+                continue
+            base = (steps * self.stride) // self.m
+            rows = base[:, None] + np.arange(self.span)[None, :]
+            window = utab[rows].reshape(steps.size, self.span * N_INPUT)
+            # einsum, not BLAS: tiny products, where a threaded BLAS waits on busy cores
+            g[steps] = np.einsum("sj,ij->si", window, self.maps[p])
+        return g
+
+
+def _cached(stepper: ExactStepper, steps: int) -> tuple[np.ndarray, np.ndarray]:
+    """(e^{AL}, Gamma) for L = steps * dt, computed once per stepper and length."""
+    cache = stepper.__dict__.setdefault("_cache", {})
+    if steps not in cache:
+        cache[steps] = _exponentials(stepper.A, steps * stepper.dt)
+    return cache[steps]
+
+
+@lru_cache(maxsize=16)
+def stepper(A_bytes: bytes, Bw_bytes: bytes, Bwd_bytes: bytes, dt: float, stride: int, m: int) -> ExactStepper:
+    """An `ExactStepper`, kept for the next run with the same vehicle and grids."""
+
+    def arr(b, shape):
+        return np.frombuffer(b).reshape(shape).copy()
+
+    return ExactStepper(
+        arr(A_bytes, (N_STATE, N_STATE)), arr(Bw_bytes, (N_DOF, 8)), arr(Bwd_bytes, (N_DOF, 8)), dt, stride, m
+    )
+
+
+def hermite_at(utab: np.ndarray, times: np.ndarray, interval: float) -> tuple[np.ndarray, np.ndarray]:
+    """Rail heights and rates (len(times), 8) at ``times`` [s] from the input table, as the
+    stepper interpolates them (cubic Hermite; the rate is the derivative of the height)."""
+    u = times / interval
+    k = np.minimum(u.astype(np.int64), len(utab) - 2)
+    tau = np.minimum(u - k, 1.0)[:, None]
+    om = 1.0 - tau
+    w0, d0, w1, d1 = utab[k, :8], utab[k, 8:], utab[k + 1, :8], utab[k + 1, 8:]
+    w = (1 + 2 * tau) * om * om * w0 + tau * om * om * interval * d0 + tau * tau * (3 - 2 * tau) * w1
+    w = w + tau * tau * (tau - 1) * interval * d1
+    wd = 6 * tau * (tau - 1) / interval * (w0 - w1) + om * (1 - 3 * tau) * d0 + tau * (3 * tau - 2) * d1
+    return w, wd
+
+
+def run_exact(out: dict, samples: list, x0: np.ndarray, dt: float, stride: int, n_out: int, output_rate: float):
+    """Fill the stepper's output arrays ``out`` (q, v, a, f, w, wd: (n, rows, .)) for the
+    passive samples: each of ``samples`` is (A, Bw, Bwd, T, c_sz, utab, interval) of one
+    sample; ``x0`` (n, 18) the states at t = 0. Returns (status, fail_step) as the stepper's."""
+    from . import kernels
+
+    n = len(samples)
+    status = np.zeros(n, dtype=np.int64)
+    fail_step = np.full(n, -1, dtype=np.int64)
+    times = np.arange(n_out + 1) / output_rate
+    states = np.empty((1, n_out + 1, N_STATE))
+    for i, (A, Bw, Bwd, T, c_sz, utab, interval) in enumerate(samples):
+        m = int(round(interval / dt))
+        st = stepper(A.tobytes(), Bw.tobytes(), Bwd.tobytes(), float(dt), int(stride), m)
+        g = st.forcing(utab, n_out)
+        kernels.linear_recurrence(st.Phi, g[None], x0[i : i + 1], states)
+        x = states[0]
+        w, wd = hermite_at(utab, times, interval)
+        out["q"][i], out["v"][i] = x[:, :N_DOF], x[:, N_DOF:]
+        out["a"][i] = (
+            np.einsum("ij,tj->ti", A[N_DOF:], x) + np.einsum("ij,tj->ti", Bw, w) + np.einsum("ij,tj->ti", Bwd, wd)
+        )
+        out["f"][i] = -c_sz * np.einsum("ic,ti->tc", T, x[:, N_DOF:])
+        out["w"][i], out["wd"][i] = w, wd
+        bad = ~(
+            np.all(np.abs(x[:, :N_DOF]) < kernels.DIVERGED, axis=1)
+            & np.all(np.abs(x[:, N_DOF:]) < 1e3 * kernels.DIVERGED, axis=1)
+        )
+        if np.any(bad):
+            status[i] = kernels.STATUS_DIVERGED
+            fail_step[i] = int(np.argmax(bad)) * stride
+    return status, fail_step
