@@ -85,7 +85,7 @@ class SolverSettings:
     def to_dict(self) -> dict:
         """The settings as a result records them (SI units in the names); the method only when
         it is not "auto", so that records of runs before it existed stay as they were."""
-        out = {"dt_s": self.dt, "output_rate_hz": self.output_rate, "control_rate_hz": self.control_rate}
+        out: dict = {"dt_s": self.dt, "output_rate_hz": self.output_rate, "control_rate_hz": self.control_rate}
         if self.method != "auto":
             out["method"] = self.method
         return out

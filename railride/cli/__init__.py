@@ -7,7 +7,7 @@ A thin layer over the library: it parses options, calls the library's studies (`
 `save()` and `railride.files`, and prints. See docs/cli.md. One module per command (`rig` holds `damper`
 and `tracking`); `_options` declares the options several commands share, `_parsing` the
 checks of their values, `_common` the errors, consoles and run machinery, `_render` the
-shared tables.
+shared tables, `_width` the tables that fit the console's width (80 columns on a pipe).
 
 Exit statuses: 0 success, 1 the simulation diverged, 2 bad input (usage errors, invalid values,
 unreadable files, an output folder that cannot be written), 130 `tune`, `study`, `pareto` or `sweep`

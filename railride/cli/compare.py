@@ -508,7 +508,8 @@ def compare(
                 )
             if history_format is not None:
                 raise ValueError(
-                    "--history-format: a league table (several --scenario, --speed or --track-seed values) writes no time histories"
+                    "--history-format: a league table (several --scenario, --speed or --track-seed "
+                    "values) writes no time histories"
                 )
             if figure_format is not None or dpi is not None:
                 raise ValueError(

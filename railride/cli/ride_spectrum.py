@@ -11,7 +11,7 @@ from typing import Annotated, Optional
 import typer
 
 from ._app import app
-from ._common import errors, option_names, print_json, wide_stdout_console, write_folder
+from ._common import errors, option_names, print_json, stdout_console, write_folder
 from ._options import DpiOption, FigureFormatOption, LoadOption, ParamsOption, PresetOption, figure_options
 from ._parsing import load_gains, vehicle_from_options
 
@@ -130,7 +130,7 @@ def ride_spectrum(
     if format is SpectrumFormat.csv:
         typer.echo(result.to_pandas().to_csv(index=False), nl=False)
         return
-    console = wide_stdout_console(80)
+    console = stdout_console()
     for part in _tables(result):
         console.print(part)
 
@@ -139,7 +139,7 @@ def _tables(result) -> list:
     """The floor table (RMS, Wb, Wk and Wb against passive, per suspension and point), the
     carbody table and the note."""
     from rich.markup import escape
-    from rich.table import Table
+    from ._width import FitTable
     from rich.text import Text
 
     from ..control import LABELS
@@ -147,7 +147,7 @@ def _tables(result) -> list:
 
     doc = result.to_dict()
     st = doc["settings"]
-    floor = Table(title=escape("Carbody floor acceleration [m/s^2], frequency domain"))
+    floor = FitTable(title=escape("Carbody floor acceleration [m/s^2], frequency domain"))
     for head in ("suspension", "point", "RMS", "aw Wb", "aw Wk", "Wb vs\npassive"):
         floor.add_column(escape(head), justify="left" if head in ("suspension", "point") else "right")
     passive = doc["weighted_rms_m_s2"].get("passive")
@@ -159,7 +159,7 @@ def _tables(result) -> list:
             floor.add_row(
                 escape(LABELS.get(s, s)) if k == 0 else "", point, f"{rms:.4g}", f"{wb:.4g}", f"{wk:.4g}", change
             )
-    body = Table(title="Carbody accelerations and secondary travel (RMS)")
+    body = FitTable(title="Carbody accelerations and secondary travel (RMS)")
     for head in ("suspension", "bounce\n[m/s^2]", "pitch\n[rad/s^2]", "roll\n[rad/s^2]", "travel 1R\n[mm]"):
         body.add_column(escape(head), justify="left" if head == "suspension" else "right")
     for s in result.suspensions:
@@ -240,7 +240,7 @@ def state_space(
     import numpy as np
 
     poles = model.poles()
-    console = wide_stdout_console(80)
+    console = stdout_console()
     console.print(
         f"State-space model, secondary {model.secondary}: {len(model.states)} states, "
         f"{len(model.inputs)} inputs, {len(model.outputs)} outputs; the largest real part of a "

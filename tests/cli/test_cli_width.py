@@ -39,6 +39,7 @@ COMMANDS = {
     "frf": ("frf", "--points", 50),
     "damper": ("damper", "--amplitude", 0.01, "--frequency", 2, "--cycles", 2, "--voltage", "0,1,2.25"),
     "tracking": ("tracking", "--desired", "sawtooth", "--amplitude", 10000, "--frequency", 1),
+    "ride-spectrum": ("ride-spectrum", "--controllers", "all", "--points", 100),
 }
 
 
