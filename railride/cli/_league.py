@@ -33,6 +33,7 @@ def run_league(
     format,
     out,
     bounds,
+    figures=None,
 ) -> None:
     """Several scenarios, speeds or track seeds: the league table (railride.league.league)."""
     from ..files import check_out_dir, write_league_outputs
@@ -81,7 +82,7 @@ def run_league(
     doc = table.to_dict()
     text = json.dumps(doc, indent=2, allow_nan=False)
     if out is not None:
-        write_folder(out, lambda: write_league_outputs(table, out))
+        write_folder(out, lambda: write_league_outputs(table, out, figures=figures))
     if format is OutputFormat.json:
         typer.echo(text)
         return

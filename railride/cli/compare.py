@@ -511,11 +511,6 @@ def compare(
                     "--history-format: a league table (several --scenario, --speed or --track-seed "
                     "values) writes no time histories"
                 )
-            if figure_format is not None or dpi is not None:
-                raise ValueError(
-                    f"{'--figure-format' if figure_format is not None else '--dpi'}: not for a league table "
-                    "(several --scenario, --speed or --track-seed values) yet: its figures are PNG at 120 dpi"
-                )
             given = dict(
                 amplitude=amplitude,
                 wavelength=wavelength,
@@ -546,6 +541,7 @@ def compare(
                 format=format,
                 out=out,
                 bounds=bounds,
+                figures=figures,
             )
             return
         speed_value = speeds[0] if speeds else None

@@ -89,6 +89,8 @@ def test_a_bad_dpi_is_refused_before_a_long_run(tmp_path):
     assert not out.exists()
 
 
-def test_a_league_table_says_its_figures_are_png_for_now(tmp_path):
-    args = ("compare", "--speed", "30,40", "--duration", 0.5, "--out", tmp_path / "lg")
-    assert_input_error(run(*args, "--dpi", 300), "--dpi: not for a league table")
+def test_a_league_table_writes_its_figures_in_the_formats_asked(tmp_path):
+    out = tmp_path / "lg"
+    ok("compare", "--speed", "30,40", "--duration", 0.5, "--controllers", "pid", "--out", out, "--figure-format", "svg")
+    names = {p.name for p in out.iterdir()}
+    assert {"league.svg", "league_comfort.svg"} <= names and "league.png" not in names
