@@ -12,7 +12,7 @@ r_k the coefficients of r in powers of the time s since the stretch began. e^{AL
 Gamma_k come from one matrix exponential of an augmented matrix (Van Loan, 1978), by scipy. An
 output interval that spans nodes is split at them; the pattern of splits repeats, so each kind
 of output step gets one matrix from the nodes it touches to the state increment, and a run is
-x_{n+1} = Phi x_n + g_n with g for every step from one matrix product (`kernels.linear_recurrence`).
+x_{n+1} = Phi x_n + maps[n % period] (the nodes of step n), compiled (`kernels.exact_run`).
 """
 
 from __future__ import annotations
@@ -77,8 +77,8 @@ def _segment_map(gamma: np.ndarray, Bw: np.ndarray, Bwd: np.ndarray, tau0: float
 class ExactStepper:
     """The one-step-per-output map of the linear vehicle ``A`` (18 x 18) with rail forcing
     ``Bw``, ``Bwd`` (9 x 8) for output steps of ``stride`` time steps ``dt`` and an input table
-    with a node every ``m`` time steps. `forcing(utab)` gives g for every output step,
-    `run(x0, g)` the states."""
+    with a node every ``m`` time steps: ``Phi`` = e^{A stride dt} and ``maps[p]``, the state
+    increment of an output step of phase p from the input-table rows it touches (`padded`)."""
 
     def __init__(self, A, Bw, Bwd, dt: float, stride: int, m: int):
         self.A, self.dt, self.stride, self.m = A, dt, stride, m
@@ -103,24 +103,16 @@ class ExactStepper:
                 s = end
         self.maps = maps
         self.period = period
+        #: per phase, how many table rows its steps touch (the map is zero beyond them)
+        blocks = np.abs(maps).reshape(period, N_STATE, self.span, N_INPUT).max(axis=(1, 3))
+        self.used = np.array([int(np.flatnonzero(b > 0).max()) + 1 if np.any(b > 0) else 0 for b in blocks])
 
-    def forcing(self, utab: np.ndarray, n_out: int) -> np.ndarray:
-        """g (n_out, 18): the state increment of each output step from the rail input table
-        ``utab`` (n_nodes, 16), padded with its last row where a step's span runs past it."""
-        need = (n_out * self.stride) // self.m + self.span + 1
-        if len(utab) < need:
-            utab = np.vstack([utab, np.repeat(utab[-1:], need - len(utab), axis=0)])
-        g = np.empty((n_out, N_STATE))
-        for p in range(self.period):
-            steps = np.arange(p, n_out, self.period)
-            if steps.size == 0:
-                continue
-            base = (steps * self.stride) // self.m
-            rows = base[:, None] + np.arange(self.span)[None, :]
-            window = utab[rows].reshape(steps.size, self.span * N_INPUT)
-            # einsum, not BLAS: tiny products, where a threaded BLAS waits on busy cores
-            g[steps] = np.einsum("sj,ij->si", window, self.maps[p])
-        return g
+    def padded(self, utab: np.ndarray, n_out: int) -> np.ndarray:
+        """``utab`` with its last row repeated where the last output step's span runs past it."""
+        need = ((n_out - 1) * self.stride) // self.m + self.span
+        if len(utab) >= need:
+            return utab
+        return np.vstack([utab, np.repeat(utab[-1:], need - len(utab), axis=0)])
 
 
 def _cached(stepper: ExactStepper, steps: int) -> tuple[np.ndarray, np.ndarray]:
@@ -157,7 +149,7 @@ def hermite_at(utab: np.ndarray, times: np.ndarray, interval: float) -> tuple[np
     return w, wd
 
 
-def run_exact(out: dict, samples: list, x0: np.ndarray, dt: float, stride: int, n_out: int, output_rate: float):
+def run_exact(out: dict, samples: list, x0: np.ndarray, dt: float, stride: int, n_out: int):
     """Fill the stepper's output arrays ``out`` (q, v, a, f, w, wd: (n, rows, .)) for the
     passive samples: each of ``samples`` is (A, Bw, Bwd, T, c_sz, utab, interval) of one
     sample; ``x0`` (n, 18) the states at t = 0. Returns (status, fail_step) as the stepper's."""
@@ -166,24 +158,33 @@ def run_exact(out: dict, samples: list, x0: np.ndarray, dt: float, stride: int, 
     n = len(samples)
     status = np.zeros(n, dtype=np.int64)
     fail_step = np.full(n, -1, dtype=np.int64)
-    times = np.arange(n_out + 1) / output_rate
-    states = np.empty((1, n_out + 1, N_STATE))
     for i, (A, Bw, Bwd, T, c_sz, utab, interval) in enumerate(samples):
         m = int(round(interval / dt))
         st = stepper(A.tobytes(), Bw.tobytes(), Bwd.tobytes(), float(dt), int(stride), m)
-        g = st.forcing(utab, n_out)
-        kernels.linear_recurrence(st.Phi, g[None], x0[i : i + 1], states)
-        x = states[0]
-        w, wd = hermite_at(utab, times, interval)
-        out["q"][i], out["v"][i] = x[:, :N_DOF], x[:, N_DOF:]
-        out["a"][i] = (
-            np.einsum("ij,tj->ti", A[N_DOF:], x) + np.einsum("ij,tj->ti", Bw, w) + np.einsum("ij,tj->ti", Bwd, wd)
+        kernels.exact_run(
+            st.Phi,
+            st.maps,
+            st.used,
+            stride,
+            m,
+            np.ascontiguousarray(st.padded(utab, n_out)),
+            float(interval),
+            np.ascontiguousarray(x0[i]),
+            A,
+            Bw,
+            Bwd,
+            np.ascontiguousarray(T),
+            np.full(4, float(c_sz)),
+            out["q"][i],
+            out["v"][i],
+            out["a"][i],
+            out["f"][i],
+            out["w"][i],
+            out["wd"][i],
         )
-        out["f"][i] = -c_sz * np.einsum("ic,ti->tc", T, x[:, N_DOF:])
-        out["w"][i], out["wd"][i] = w, wd
+        x = out["q"][i]
         bad = ~(
-            np.all(np.abs(x[:, :N_DOF]) < kernels.DIVERGED, axis=1)
-            & np.all(np.abs(x[:, N_DOF:]) < 1e3 * kernels.DIVERGED, axis=1)
+            np.all(np.abs(x) < kernels.DIVERGED, axis=1) & np.all(np.abs(out["v"][i]) < 1e3 * kernels.DIVERGED, axis=1)
         )
         if np.any(bad):
             status[i] = kernels.STATUS_DIVERGED

@@ -691,17 +691,53 @@ def run_parallel(kernel, n_samples: int, *args) -> None:
             job.result()
 
 
-@njit(cache=True, nogil=True)
-def linear_recurrence(Phi, g, x0, out):
-    """out[s, 0] = x0[s], out[s, n + 1] = Phi out[s, n] + g[s, n]: the exact discretisation's
-    steps (`railride.discrete`), one per output sample."""
-    n_s, n_out, n = g.shape
-    for s in range(n_s):
+@njit(cache=True, nogil=True, fastmath=_FAST)
+def exact_run(Phi, maps, used, stride, m, utab, interval, x0, A, Bw, Bwd, TS, c_sec, q, v, a, f, w, wd):
+    """The exact discretisation of the passive vehicle (`railride.discrete`), one sample: the
+    state (q, q') at every output row from x0 by x_(k+1) = Phi x_k + maps[k % period] (the
+    first used[k % period] input-table rows from the step's start), and the outputs the RK4 stepper records there:
+    q, q', q'' = A x + Bw w + Bwd w', the secondary forces -c T^T q' and the rail inputs w, w'
+    (cubic Hermite on the table, rates its derivative). ``utab`` holds enough rows for the last
+    step's span (padded by the caller)."""
+    period, n, width = maps.shape
+    rows = q.shape[0]
+    x = np.empty(n)
+    g = np.empty(n)
+    for i in range(n):
+        x[i] = x0[i]
+    nn = utab.shape[0]
+    for k in range(rows):
+        # the outputs at t_k
+        _rail_inputs(k * stride * (interval / m), utab, 0, nn, interval, w[k], wd[k])
+        for i in range(N_DOF):
+            q[k, i] = x[i]
+            v[k, i] = x[N_DOF + i]
+            acc = 0.0
+            for j in range(n):
+                acc += A[N_DOF + i, j] * x[j]
+            for j in range(N_RAIL):
+                acc += Bw[i, j] * w[k, j] + Bwd[i, j] * wd[k, j]
+            a[k, i] = acc
+        for c in range(N_CORNER):
+            acc = 0.0
+            for i in range(N_DOF):
+                acc += TS[i, c] * x[N_DOF + i]
+            f[k, c] = -c_sec[c] * acc
+        if k == rows - 1:
+            break
+        # one output step
+        p = k % period
+        base = (k * stride) // m
         for i in range(n):
-            out[s, 0, i] = x0[s, i]
-        for k in range(n_out):
-            for i in range(n):
-                acc = g[s, k, i]
-                for j in range(n):
-                    acc += Phi[i, j] * out[s, k, j]
-                out[s, k + 1, i] = acc
+            acc = 0.0
+            for r in range(used[p]):  # the table rows this kind of step touches
+                for j in range(16):
+                    acc += maps[p, i, 16 * r + j] * utab[base + r, j]
+            g[i] = acc
+        for i in range(n):
+            acc = g[i]
+            for j in range(n):
+                acc += Phi[i, j] * x[j]
+            g[i] = acc
+        for i in range(n):
+            x[i] = g[i]

@@ -387,7 +387,7 @@ def simulate(
             )
             for i, p in enumerate(param_sets)
         ]
-        status, fail_step = run_exact(out, samples, x[:, : 2 * N_DOF], dt, stride, n_out, output_rate)
+        status, fail_step = run_exact(out, samples, x[:, : 2 * N_DOF], dt, stride, n_out)
         if progress is not None:
             progress(1.0)
     while not exact:
