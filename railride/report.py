@@ -43,10 +43,9 @@ SUFFIXES = (".html", ".htm")
 class Contents:
     """What a result contributes to its report. ``figures``: (name, caption, figure) with a
     plotly or matplotlib figure, one per figure file its ``save()`` writes (``name``.png), in
-    that order; ``tables``:
-    (caption, DataFrame); ``settings``: nested values shown flat; ``scenario``: the scenario's
-    record (`Scenario.describe()`), if one; ``params``: the `VehicleParams` of the modal table
-    (None: the vehicles differ, no single table)."""
+    that order; ``tables``: (caption, DataFrame); ``settings``: nested values shown flat;
+    ``scenario``: the scenario's record (`Scenario.describe()`), if one; ``params``: the
+    `VehicleParams` of the modal table (None: the vehicles differ, no single table)."""
 
     title: str
     settings: dict
