@@ -232,6 +232,19 @@ def _frf(result) -> Contents:
     )
 
 
+@contents_of("railride.ride_spectrum.RideSpectrum")
+def _ride_spectrum(result) -> Contents:
+    from .plots.interactive import ride_spectrum_figure
+
+    return Contents(
+        title="Ride in the frequency domain",
+        settings=result.to_dict()["settings"],
+        params=result.params,
+        figures=[("ride_spectrum", "floor acceleration PSDs per suspension", ride_spectrum_figure(result))],
+        tables=[("RMS and weighted RMS per suspension and response", result.to_pandas())],
+    )
+
+
 # -- the page -----------------------------------------------------------------------------------
 def check_report_path(path, field: str = "path") -> Path:
     """``path`` as a Path if a report can be written there: a file name ending in .html or .htm,

@@ -12,7 +12,15 @@ import typer
 
 from ._app import app
 from ._common import errors, option_names, print_json, stdout_console, write_folder
-from ._options import DpiOption, FigureFormatOption, LoadOption, ParamsOption, PresetOption, figure_options
+from ._options import (
+    DpiOption,
+    FigureFormatOption,
+    LoadOption,
+    ParamsOption,
+    PresetOption,
+    ReportOption,
+    figure_options,
+)
 from ._parsing import load_gains, vehicle_from_options
 
 #: the library's names of the options, for its errors
@@ -36,6 +44,7 @@ class SpectrumFormat(str, Enum):
 
 @app.command("ride-spectrum")
 def ride_spectrum(
+    ctx: typer.Context,
     track: Annotated[
         str,
         typer.Option("--track", metavar="SPECTRUM", help="Track spectrum: fra1..fra6, german-low or german-high."),
@@ -98,6 +107,7 @@ def ride_spectrum(
     ] = None,
     figure_format: FigureFormatOption = None,
     dpi: DpiOption = None,
+    report: ReportOption = None,
 ) -> None:
     """The ride on a random track from the frequency response and the track spectrum, without a
     time simulation: PSDs, RMS and ISO 2631-1 Wb/Wk-weighted RMS of the carbody floor
@@ -106,7 +116,10 @@ def ride_spectrum(
         from ..files import check_out_dir
         from ..ride_spectrum import ride_spectrum as run
 
+        from .report import check_report_option, save_report  # here: report imports the commands
+
         figures = figure_options(figure_format, dpi, out)
+        check_report_option(report)
         vehicle, _ = vehicle_from_options(params, preset, load)
         if out is not None:
             check_out_dir(out)
@@ -124,15 +137,17 @@ def ride_spectrum(
         )
         if out is not None:
             write_folder(out, lambda: result.save(out, figure_formats=figures.figure_formats, dpi=figures.dpi))
+    parts = _tables(result)
     if format is SpectrumFormat.json:
         print_json(result.to_dict())
-        return
-    if format is SpectrumFormat.csv:
+    elif format is SpectrumFormat.csv:
         typer.echo(result.to_pandas().to_csv(index=False), nl=False)
-        return
-    console = stdout_console()
-    for part in _tables(result):
-        console.print(part)
+    else:
+        console = stdout_console()
+        for part in parts:
+            console.print(part)
+    if report is not None:  # after the output: a report that cannot be written loses none of it
+        save_report(report, result, parts, ctx)
 
 
 def _tables(result) -> list:

@@ -274,3 +274,38 @@ def _clusters(modes: pd.DataFrame) -> list[list]:
         else:
             groups.append([m])
     return groups
+
+
+def ride_spectrum_figure(result):
+    """The floor acceleration PSDs of a `railride.ride_spectrum.RideSpectrum`: a log-log panel per
+    floor point, a trace per suspension (legend groups toggle a suspension in every panel).
+    Returns the Figure."""
+    import plotly.graph_objects as go
+
+    from ..ride_spectrum import FLOOR
+
+    fig = _new(rows=len(FLOOR), titles=[f"floor, {p}" for p in FLOOR])
+    f = result.psd["frequency"].values
+    top = max(float(result.psd[f"floor_acceleration_{p}"].max()) for p in FLOOR)
+    for row, point in enumerate(FLOOR, start=1):
+        for name in result.suspensions:
+            y = result.psd[f"floor_acceleration_{point}"].sel(suspension=name).values
+            fig.add_trace(
+                go.Scatter(
+                    x=f.astype(np.float32),
+                    y=np.where(y > 0, y, np.nan).astype(np.float32),
+                    mode="lines",
+                    name=suspension_label(name),
+                    legendgroup=name,
+                    showlegend=row == 1,
+                    line=_line(name),
+                ),
+                row=row,
+                col=1,
+            )
+        fig.update_yaxes(type="log", title_text="(m/s²)²/Hz", exponentformat="power", row=row, col=1)
+        if top > 0:  # six decades below the peak: the wheelbase filter's notches reach zero
+            fig.update_yaxes(range=[math.log10(top) - 6, math.log10(top) + 0.5], row=row, col=1)
+    fig.update_xaxes(type="log")
+    fig.update_xaxes(title_text="frequency (Hz)", row=len(FLOOR), col=1)
+    return _finish(fig, result.title(), 820)

@@ -66,10 +66,12 @@ def reports(tmp_path_factory) -> dict:
     ok("report", "--out", folder / "compare.html")  # the paper's comparison, as a user makes it
     ok("sweep", "--duration", 1, "--speed", "20:40:3", "--report", folder / "sweep.html")
     write_report(rr.frequency_responses(), folder / "frf.html")
+    ok("ride-spectrum", "--points", 300, "--report", folder / "ride_spectrum.html")
     return {
         "compare": (folder / "compare.html", 5, 3),
         "sweep": (folder / "sweep.html", 0, 2),
         "frf": (folder / "frf.html", 1, 0),
+        "ride_spectrum": (folder / "ride_spectrum.html", 1, 0),
     }
 
 
@@ -103,7 +105,7 @@ def _open(browser, path: Path):
     return page, problems, remote
 
 
-@pytest.mark.parametrize("name", ["compare", "sweep", "frf"])
+@pytest.mark.parametrize("name", ["compare", "sweep", "frf", "ride_spectrum"])
 def test_report_renders_offline(browser, reports, name, tmp_path):
     path, n_plots, n_images = reports[name]
     page, problems, remote = _open(browser, path)
