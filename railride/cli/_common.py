@@ -139,11 +139,44 @@ def print_json(doc) -> None:
 
 
 def _first_message(verb_text: str) -> str:
-    """The bar's first text: until the stepper is compiled in this process, that it compiles."""
-    from .. import kernels
+    """The bar's first text: while the stepper is neither compiled nor in numba's cache, that it
+    compiles."""
+    from .. import compiled
 
-    compiled = bool(getattr(kernels.run_batch, "signatures", True))
-    return verb_text if compiled else "loading the stepper (the first run compiles it, up to a minute)..."
+    return "compiling the stepper (once)..." if compiled.needs_compiling() else verb_text
+
+
+def compile_message(kernel: str = "run_batch") -> str:
+    """The note printed when ``kernel`` starts compiling, with the time it takes."""
+    from .. import compiled
+
+    return f"compiling the stepper once, about {compiled.compile_seconds(kernel):.0f} s; later runs start at once"
+
+
+@contextlib.contextmanager
+def compile_note(say):
+    """Within the block, ``say`` the compile note once when numba starts compiling the stepper
+    (a fresh install's first closed-loop run), on a pipe as on a terminal: a silent pause of ten
+    seconds reads as a hang. Loading it from numba's cache says nothing."""
+    from .. import compiled
+
+    said = []
+
+    def on_start(kernel):
+        if not said:
+            said.append(kernel)
+            say(compile_message(kernel))
+
+    with compiled.watch_compiles(on_start):
+        yield
+
+
+def _say(progress, text: str) -> None:
+    """A line on stderr: above the bar when there is one (it stays when the bar goes)."""
+    if progress is not None:
+        progress.console.print(text, markup=False, highlight=False)
+    else:
+        typer.echo(text, err=True)
 
 
 class ProgressBar:
@@ -157,8 +190,10 @@ class ProgressBar:
         self._describe = describe or (lambda done: "simulating")
         self._progress = None
         self._task = None
+        self._note = compile_note(lambda text: _say(self._progress, text))
 
     def __enter__(self):
+        self._note.__enter__()
         if not self.enabled:
             return self
         from rich.progress import BarColumn, Progress, SpinnerColumn, TextColumn, TimeElapsedColumn
@@ -184,6 +219,7 @@ class ProgressBar:
     def __exit__(self, *exc):
         if self._progress is not None:
             self._progress.__exit__(*exc)
+        self._note.__exit__(*exc)
         return False
 
 
@@ -201,8 +237,10 @@ class RunProgress:
         self._base = 0
         self._progress = None
         self._task = None
+        self._note = compile_note(self.log)
 
     def __enter__(self):
+        self._note.__enter__()
         if not self.enabled:
             return self
         from rich.progress import BarColumn, MofNCompleteColumn, Progress, SpinnerColumn, TextColumn, TimeElapsedColumn
@@ -237,14 +275,12 @@ class RunProgress:
             )
 
     def log(self, text: str) -> None:
-        if self._progress is not None:
-            self._progress.console.print(text, markup=False, highlight=False)
-        else:
-            typer.echo(text, err=True)
+        _say(self._progress, text)
 
     def __exit__(self, *exc):
         if self._progress is not None:
             self._progress.__exit__(*exc)
+        self._note.__exit__(*exc)
         return False
 
 

@@ -1,0 +1,102 @@
+"""Cold and warm start of `railride compare`: a fresh process with an empty numba cache (what the
+first run after install meets), then the same cache again (every later run); wall and CPU time
+of each, the import of railride alone, and the compile time of each kernel the comparison
+builds (timed on numba's compile events, in one cold process).
+
+Run:  python benchmarks/bench_cold_start.py [--repeat N]
+Target: first `railride compare` after install <= 5 s. Prints a Markdown table for
+docs/performance.md ("Cold start"). CPU time is less disturbed than wall time by other work on
+a shared machine; each row keeps the shortest of N repeats.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import resource
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+
+#: compare in one cold process, reporting numba's compile time of each kernel it compiled
+KERNEL_TIMES = """
+import json, time
+from numba.core import event
+t0 = time.perf_counter()
+import railride
+t_import = time.perf_counter() - t0
+times, started = {}, {}
+
+class Timer(event.Listener):  # global: the stepper compiles on a worker thread
+    def on_start(self, ev):
+        started[ev.data["dispatcher"]] = time.perf_counter()
+
+    def on_end(self, ev):
+        d = ev.data["dispatcher"]
+        if d.py_func.__module__ == "railride.kernels" and d.py_func.__name__ in ("run_batch", "exact_run"):
+            times[d.py_func.__name__] = time.perf_counter() - started[d]
+
+event.register("numba:compile", Timer())
+railride.compare(railride.scenario("paper-sine"))
+print(json.dumps({"import": t_import, "compile": times}))
+"""
+
+
+def _run(cmd, cache: str) -> tuple[float, float, str]:
+    """(wall, CPU of the child [s], its stderr) of ``cmd`` with numba's cache in ``cache``."""
+    env = dict(os.environ, NUMBA_CACHE_DIR=cache)
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    t0 = time.perf_counter()
+    out = subprocess.run(cmd, env=env, check=True, capture_output=True, text=True)
+    wall = time.perf_counter() - t0
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    return wall, cpu, out.stderr + out.stdout
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--repeat", type=int, default=2, help="repeats of each measurement (the best is kept)")
+    args = parser.parse_args()
+    railride = shutil.which("railride") or sys.exit("railride is not installed (python -m pip install .)")
+    cold: list[tuple[float, float]] = []
+    warm: list[tuple[float, float]] = []
+    notes = set()
+    for _ in range(args.repeat):
+        cache = tempfile.mkdtemp(prefix="railride-numba-")
+        try:
+            wall, cpu, err = _run([railride, "compare"], cache)
+            cold.append((wall, cpu))
+            notes.update(line for line in err.splitlines() if line.startswith("compiling"))
+            wall, cpu, err = _run([railride, "compare"], cache)
+            warm.append((wall, cpu))
+            assert "compiling" not in err, err
+        finally:
+            shutil.rmtree(cache, ignore_errors=True)
+    imports = [_run([sys.executable, "-c", "import railride"], tempfile.gettempdir())[:2] for _ in range(args.repeat)]
+    cache = tempfile.mkdtemp(prefix="railride-numba-")
+    try:
+        detail = json.loads(_run([sys.executable, "-c", KERNEL_TIMES], cache)[2].strip().splitlines()[-1])
+    finally:
+        shutil.rmtree(cache, ignore_errors=True)
+
+    def row(what, pairs):
+        wall, cpu = min(p[0] for p in pairs), min(p[1] for p in pairs)
+        print(f"| {what} | {wall:.1f} s | {cpu:.1f} s |")
+
+    print("| `railride compare` (paper-sine, 10 s) | wall | CPU |")
+    print("|---|---|---|")
+    row("first run, empty numba cache", cold)
+    row("later runs", warm)
+    row("`import railride` alone", imports)
+    for name, seconds in sorted(detail["compile"].items(), key=lambda kv: -kv[1]):
+        print(f"| compile `kernels.{name}` (wall, in the first run) | {seconds:.1f} s | |")
+    print()
+    print("stderr of the first run:", "; ".join(sorted(notes)) or "(nothing)")
+
+
+if __name__ == "__main__":
+    main()
