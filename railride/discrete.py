@@ -1,5 +1,6 @@
-"""Exact discretisation of the linear vehicle: one step per output sample, no integration error
-(docs/model.md, Integration).
+"""Exact discretisation of the linear vehicle: one step per output sample (passive), or per
+stretch between rail nodes, controller samples and outputs (an outer loop on the ideal
+actuator, `ClosedStepper`); no integration error (docs/model.md, Integration).
 
 With the passive viscous secondary the vehicle is linear, x' = A x + r(t), x = (q, q'), and its
 forcing r = Bw w + Bwd w' comes from rail inputs w that are cubic Hermite polynomials between
@@ -189,4 +190,98 @@ def run_exact(out: dict, samples: list, x0: np.ndarray, dt: float, stride: int, 
         if np.any(bad):
             status[i] = kernels.STATUS_DIVERGED
             fail_step[i] = int(np.argmax(bad)) * stride
+    return status, fail_step
+
+
+class ClosedStepper:
+    """The exact steps of the plant (``A`` without the secondary dashpots) under an outer loop on
+    the ideal actuator: the force is the held demand, constant between controller samples, so
+    the run splits at every rail node (every ``m`` steps), controller sample (``ctrl``) and output
+    sample (``stride``); the pattern repeats every lcm of the three. For each stretch of the
+    pattern: ``phi`` = e^{AL}, ``rail`` (18 x 32) from the data of its node interval's two table
+    rows, and ``force`` (18 x 4) = Gamma_0 M^-1 T from the held corner forces; ``start`` its first
+    step in the pattern."""
+
+    def __init__(self, A, Bw, Bwd, Bf, dt: float, stride: int, ctrl: int, m: int):
+        self.A, self.dt = A, dt
+        period = math.lcm(stride, ctrl, m)
+        marks = sorted(set(range(0, period, stride)) | set(range(0, period, ctrl)) | set(range(0, period, m)))
+        ends = marks[1:] + [period]
+        n = len(marks)
+        self.period = period
+        self.start = np.array(marks, dtype=np.int64)
+        self.phi = np.empty((n, N_STATE, N_STATE))
+        self.rail = np.empty((n, N_STATE, 32))
+        self.force = np.empty((n, N_STATE, 4))
+        for i, (a, b) in enumerate(zip(marks, ends)):
+            phi, gamma = _cached(self, b - a)
+            self.phi[i] = phi
+            self.rail[i] = _segment_map(gamma, Bw, Bwd, (a % m) / m, m * dt)
+            self.force[i] = gamma[0] @ Bf
+
+
+@lru_cache(maxsize=16)
+def closed_stepper(A_bytes, Bw_bytes, Bwd_bytes, Bf_bytes, dt, stride, ctrl, m) -> ClosedStepper:
+    """A `ClosedStepper`, kept for the next run with the same vehicle and grids."""
+
+    def arr(b, shape):
+        return np.frombuffer(b).reshape(shape).copy()
+
+    return ClosedStepper(
+        arr(A_bytes, (N_STATE, N_STATE)),
+        arr(Bw_bytes, (N_DOF, 8)),
+        arr(Bwd_bytes, (N_DOF, 8)),
+        arr(Bf_bytes, (N_DOF, 4)),
+        dt,
+        stride,
+        ctrl,
+        m,
+    )
+
+
+def run_exact_closed(out: dict, samples: list, x0: np.ndarray, dt: float, stride: int, ctrl: int, n_out: int):
+    """Fill the stepper's output arrays (q, v, a, f, w, wd, fd, vc) for samples of an outer loop
+    on the ideal actuator: each of ``samples`` is (A of the plant, Bw, Bwd, Bf = M^-1 T, G (4 x
+    18), H (4 x 3), delay in controller periods, utab, interval). Returns (status, fail_step)."""
+    from . import kernels
+
+    n = len(samples)
+    status = np.zeros(n, dtype=np.int64)
+    fail_step = np.full(n, -1, dtype=np.int64)
+    for i, (A, Bw, Bwd, Bf, G, H, delay, utab, interval) in enumerate(samples):
+        m = int(round(interval / dt))
+        st = closed_stepper(A.tobytes(), Bw.tobytes(), Bwd.tobytes(), Bf.tobytes(), float(dt), stride, ctrl, m)
+        need = (n_out * stride) // m + 2
+        if len(utab) < need:
+            utab = np.vstack([utab, np.repeat(utab[-1:], need - len(utab), axis=0)])
+        status[i], fail_step[i] = kernels.exact_closed_run(
+            st.phi,
+            st.rail,
+            st.force,
+            st.start,
+            st.period,
+            m,
+            stride,
+            ctrl,
+            ctrl * dt,
+            np.ascontiguousarray(utab),
+            float(interval),
+            np.ascontiguousarray(x0[i]),
+            A,
+            Bw,
+            Bwd,
+            np.ascontiguousarray(Bf),
+            np.ascontiguousarray(G),
+            np.ascontiguousarray(H),
+            int(delay),
+            n_out,
+            out["q"][i],
+            out["v"][i],
+            out["a"][i],
+            out["f"][i],
+            out["w"][i],
+            out["wd"][i],
+            out["fd"][i],
+            out["vc"][i],
+        )
     return status, fail_step

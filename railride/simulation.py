@@ -84,13 +84,25 @@ INTEGRATOR_EXACT = "exact discretisation (matrix exponential, one step per outpu
 
 
 def _exact(solver, damper, closed, suspensions) -> bool:
-    """Whether the run takes the exact discretisation: method "exact", or "auto" with the
-    passive viscous dampers (linear); "exact" with anything else is refused."""
-    linear = damper is None and closed is None and not any(s.faults for s in suspensions)
+    """Whether the run takes the exact discretisation: method "exact", or "auto" where the
+    vehicle is linear: the passive viscous dampers, or an outer loop on the ideal actuator with
+    exact states (no sensing, no sensor noise); "exact" with anything else is refused."""
+    faults = any(s.faults for s in suspensions)
+    passive = damper is None and closed is None
+    actuator = (
+        closed is not None
+        and damper is not None
+        and damper.law == dampers.LAW_IDEAL
+        and not damper.dissipative
+        and closed["sensing"] is None
+        and len(closed["noise"]) == 0
+    )
+    linear = (passive or actuator) and not faults
     if solver.method == "exact" and not linear:
         raise ValueError(
-            "method = 'exact': applies to the passive viscous suspension only (a linear vehicle); "
-            "MR dampers, ideal devices and closed loops run with method 'rk4' or 'auto'"
+            "method = 'exact': applies where the vehicle is linear only: the passive viscous "
+            "suspension, or an outer loop on the ideal actuator with exact states; MR dampers, the "
+            "ideal semi-active damper, sensing, sensor noise and faults run with method 'rk4' or 'auto'"
         )
     return linear and solver.method != "rk4"
 
@@ -372,7 +384,27 @@ def simulate(
         inner_gains[:, 3] = [s.delay for s in suspensions]
     chunk = n_steps if progress is None else max(stride, (_CHUNK_WORK // n) // stride * stride)
     done = 0
-    if exact:
+    if exact and closed is not None:
+        from .discrete import run_exact_closed
+
+        closed_samples = [
+            (
+                _state_matrix(vehicles[id(p)], damper),  # the plant: C0, the force is the demand
+                systems[id(p)]["Bw"],
+                systems[id(p)]["Bwd"],
+                vehicles[id(p)].T / np.diag(vehicles[id(p)].M)[:, None],
+                gm[i],
+                hm[i],
+                suspensions[i].delay,
+                utab[u_off[i] : u_off[i] + n_nodes[i]],
+                interval[i],
+            )
+            for i, p in enumerate(param_sets)
+        ]
+        status, fail_step = run_exact_closed(out, closed_samples, x[:, : 2 * N_DOF], dt, stride, ctrl_stride, n_out)
+        if progress is not None:
+            progress(1.0)
+    elif exact:
         from .discrete import run_exact
 
         samples = [

@@ -74,7 +74,52 @@ def test_exact_reaches_the_frequency_domain_steady_state():
 
 
 def test_exact_is_refused_where_the_vehicle_is_not_linear():
-    with pytest.raises(ValueError, match="method = 'exact': applies to the passive viscous suspension only"):
+    with pytest.raises(ValueError, match="method = 'exact': applies where the vehicle is linear only"):
         rr.simulate("paper-sine", suspension=rr.Suspension.named("mr"), solver=rr.SolverSettings(method="exact"))
     with pytest.raises(ValueError, match="method = 'euler'"):
         rr.SolverSettings(method="euler")
+
+
+@pytest.mark.parametrize("name", ["pid", "sas-attitude-ride", "skyhook", "clipped-optimal"])
+def test_exact_closed_loop_on_the_ideal_actuator_agrees_with_rk4(name):
+    """An outer loop on the ideal actuator is linear too (the held demand is the force): the
+    exact steps split at rail nodes, controller samples and outputs, and agree with the RK4
+    stepper's closed loop to its error (below 1e-8 of each response)."""
+    suspension = rr.Suspension.named(name, damper="ideal")
+    scenario = rr.scenario("fra4", duration=4.0, seed=2)
+    exact, rk4 = rr.simulate(scenario, suspension=suspension), rr.simulate(scenario, suspension=suspension, solver=RK4)
+    assert exact.dataset.attrs["integrator"].startswith("exact discretisation")
+    assert _worst(exact, rk4, (*CHANNELS, "damper_demand_force", "secondary_damper_force")) < 1e-8
+
+
+@pytest.mark.parametrize("delay, rate", [(3, 1000.0), (1, 500.0), (2, 2000.0)])
+def test_exact_closed_loop_keeps_the_controller_timing(delay, rate):
+    """Delays and controller rates other than the output rate: the same sampled loop as RK4's."""
+    suspension = rr.Suspension.named("sas-attitude", damper="ideal").with_delay(delay)
+    scenario = rr.scenario("paper-sine", duration=3.0)
+    exact = rr.simulate(scenario, suspension=suspension, solver=rr.SolverSettings(control_rate=rate))
+    rk4 = rr.simulate(scenario, suspension=suspension, solver=rr.SolverSettings(control_rate=rate, method="rk4"))
+    assert _worst(exact, rk4) < 1e-10
+
+
+def test_exact_closed_loop_diverges_where_rk4_does():
+    """The shipped groundhook gain is unstable on the ideal actuator: marked at the same time."""
+    names = ("pid", "groundhook", "sas-attitude")
+    suspensions = [rr.Suspension.named(n, damper="ideal") for n in names]
+    scenario = rr.scenario("paper-sine", duration=2.0)
+    exact = rr.simulate(scenario, suspension=suspensions, on_divergence="mark")
+    rk4 = rr.simulate(scenario, suspension=suspensions, on_divergence="mark", solver=RK4)
+    assert np.isnan(exact.diverged_at[[0, 2]]).all()
+    assert exact.diverged_at[1] == pytest.approx(rk4.diverged_at[1])
+
+
+def test_nonlinear_or_noisy_loops_stay_with_rk4():
+    scenario = rr.scenario("paper-sine", duration=1.0)
+    dissipative = rr.simulate(scenario, suspension=rr.Suspension.named("pid", damper="ideal-damper"))
+    assert dissipative.dataset.attrs["integrator"].startswith("classical RK4")
+    with pytest.raises(ValueError, match="ideal semi-active damper"):
+        rr.simulate(
+            scenario,
+            suspension=rr.Suspension.named("pid", damper="ideal-damper"),
+            solver=rr.SolverSettings(method="exact"),
+        )
