@@ -116,7 +116,7 @@ class ExactStepper:
         return np.vstack([utab, np.repeat(utab[-1:], need - len(utab), axis=0)])
 
 
-def _cached(stepper: ExactStepper, steps: int) -> tuple[np.ndarray, np.ndarray]:
+def _cached(stepper: ExactStepper | ClosedStepper, steps: int) -> tuple[np.ndarray, np.ndarray]:
     """(e^{AL}, Gamma) for L = steps * dt, computed once per stepper and length."""
     cache = stepper.__dict__.setdefault("_cache", {})
     if steps not in cache:
