@@ -1,10 +1,12 @@
 """Cost of each control law in the closed loop, and of a league table.
 
-Run:  python benchmarks/bench_controllers.py [--repeat N]
+Run:  python benchmarks/bench_controllers.py [--repeat N] [--threads N] [--no-league]
 Prints a Markdown table for docs/performance.md: per law, one 10 s run on `paper-sine` with four
 `railway` MR dampers (dt = 1e-4 s, 100 000 steps), its time per step and the ratio to SAS
 (attitude+ride); then a league table of five controllers on three scenarios at two speeds, warm.
-Wall-clock minima over the repeats; no test asserts timings.
+Wall-clock minima over the repeats, and the minimum of the process's CPU time, which other jobs on
+a shared machine disturb less (with one thread it is the run's own time on its core); no test
+asserts timings. ``--threads 1`` measures one core.
 """
 
 from __future__ import annotations
@@ -12,14 +14,30 @@ from __future__ import annotations
 from _timing import min_time  # benchmarks/_timing.py: run as a script, this folder is on the path
 
 import argparse
+import time
+
+
+def min_cpu_time(fn, repeat: int) -> float:
+    """The shortest of ``repeat`` CPU times of ``fn()`` (all threads of this process) [s]."""
+    best = float("inf")
+    for _ in range(repeat):
+        t0 = time.process_time()
+        fn()
+        best = min(best, time.process_time() - t0)
+    return best
 
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--repeat", type=int, default=5)
+    ap.add_argument("--threads", type=int, default=0, help="numba threads (default: numba's)")
+    ap.add_argument("--no-league", action="store_true", help="leave out the league table")
     args = ap.parse_args()
 
     import numba
+
+    if args.threads > 0:
+        numba.set_num_threads(args.threads)
 
     from railride import Suspension, scenario, simulate
     from railride.control import CONTROLLERS
@@ -28,18 +46,21 @@ def main():
     sc = scenario("paper-sine")
     steps = round(sc.duration / 1e-4)
     laws = [n for n in CONTROLLERS if n != "passive"]
-    times = {}
+    times, cpu = {}, {}
     for name in laws:
         susp = Suspension.named(name)
         simulate(sc, None, susp)  # compile and warm
         times[name] = min_time(lambda: simulate(sc, None, susp).metrics(), args.repeat)
+        cpu[name] = min_cpu_time(lambda: simulate(sc, None, susp).metrics(), args.repeat)
     ref = times["sas-attitude-ride"]
     print(f"numba threads: {numba.get_num_threads()}\n")
-    print("| law (MR dampers, 10 s, paper-sine) | time | per step | / SAS (attitude+ride) |")
-    print("|---|---|---|---|")
+    print("| law (MR dampers, 10 s, paper-sine) | time | per step | CPU time per step | / SAS (attitude+ride) |")
+    print("|---|---|---|---|---|")
     for name in laws:
-        t = times[name]
-        print(f"| {name} | {t * 1e3:.1f} ms | {t / steps * 1e6:.3f} us | {t / ref:.2f} |")
+        t, c = times[name], cpu[name]
+        print(f"| {name} | {t * 1e3:.1f} ms | {t / steps * 1e6:.3f} us | {c / steps * 1e6:.3f} us | {t / ref:.2f} |")
+    if args.no_league:
+        return
 
     chosen = ["pid", "sas-attitude-ride", "skyhook", "groundhook", "clipped-optimal"]
     run = lambda: league(["paper-sine", "fra4", "german-low"], [30.0, 55.56], controllers=chosen)  # noqa: E731

@@ -49,7 +49,7 @@ def main():
     spencer = Suspension.semi_active("spencer1997", voltage=1.0)
     simulate(scenario("paper-sine", duration=1.0), suspension=spencer)
     t = min_time(lambda: simulate(scenario("paper-sine", duration=1.0), suspension=spencer), max(1, args.repeat // 2))
-    rows.append(("vehicle, four `spencer1997` dampers at 1 V, 1 s (stiff: sub-stepped)", f"{t:.2f} s", ""))
+    rows.append(("vehicle, four `spencer1997` dampers at 1 V, 1 s (stiff: sub-stepped)", f"{t * 1e3:.1f} ms", ""))
     sc_batch = scenario("paper-sine", duration=2.0)
     batch = [Suspension.semi_active("railway", voltage=float(v)) for v in np.linspace(0.0, 2.25, 64)]
     simulate(sc_batch, suspension=batch)

@@ -9,10 +9,12 @@ with classical fourth-order Runge-Kutta at a fixed step. The matrices are the ve
 down the columns with the nine row sums held in registers. The rail inputs w, w' and the
 forcing Bw w + Bwd w' come from tables on a time grid whose nodes fall on step boundaries,
 interpolated with cubic Hermite polynomials (see `railride.track.wheelset_input_table`).
-Sizes are module constants so that LLVM sees fixed trip counts. Nothing is allocated inside
-the time loop. Batches run in parallel on threads (`run_parallel`): the kernels release the
-GIL. numba's ``prange`` would do the same, but it doubled the compile time of the stepper
-(12 s against 6 s), which every fresh install pays once.
+Sizes are module constants so that LLVM sees fixed trip counts. The three products of every
+stage (q'', the corner deflections and rates, the rail forcing) are vector intrinsics
+(`railride._simd`); the damper laws are inlined. Nothing is allocated inside the time loop.
+Batches run in parallel on threads (`run_parallel`): the kernels release the GIL. numba's
+``prange`` would do the same, but it doubled the compile time of the stepper (12 s against
+6 s), which every fresh install pays once.
 """
 
 from __future__ import annotations
@@ -23,6 +25,7 @@ import numpy as np
 from numba import njit
 from numba.core.errors import NumbaPerformanceWarning
 
+from ._simd import corner_pairs, forcing_rows, mv9_simd
 from .dampers import (
     LAW_BOUC_WEN,
     LAW_IDEAL,
@@ -138,21 +141,11 @@ def _forcing(t, ftab, off, n_nodes, interval, out, ooff):
     Hermite interpolation is linear in the node data, so interpolating the node values
     P = Bw w_k, Q = Bw w'_k, R = Bwd w_k, S = Bwd w'_k (columns 0-8, 9-17, 18-26, 27-35)
     gives exactly Bw w(t) + Bwd w'(t) of the interpolated rail inputs, in 9 x 8 operations
-    instead of interpolating 16 inputs and multiplying by a 9 x 16 matrix.
+    instead of interpolating 16 inputs and multiplying by a 9 x 16 matrix (in vector form,
+    `railride._simd.forcing_rows`).
     """
     k, h00, h10, h01, h11, d00, d10, d11 = _hermite(t, n_nodes, interval)
-    a = off + k
-    b = a + 1
-    for i in range(N_DOF):
-        out[ooff + i] = (
-            h00 * ftab[a, i]
-            + h10 * ftab[a, 9 + i]
-            + h01 * ftab[b, i]
-            + h11 * ftab[b, 9 + i]
-            + d00 * (ftab[a, 18 + i] - ftab[b, 18 + i])
-            + d10 * ftab[a, 27 + i]
-            + d11 * ftab[b, 27 + i]
-        )
+    forcing_rows(ftab, off + k, h00, h10, h01, h11, d00, d10, d11, out, ooff)
 
 
 @njit(cache=True, inline="always", fastmath=_FAST)
@@ -167,43 +160,13 @@ def _rail_inputs(t, utab, off, n_nodes, interval, w, wd):
 
 
 @njit(cache=True, inline="always", fastmath=_FAST)
-def _mv9(AT, x, n_cols, r, roff, out, ooff):
-    """out[ooff:ooff+9] = r[roff:roff+9] + A x for the 9 rows of q'', A stored transposed
-    (n_cols, 9). Offsets instead of slices: a slice made in the loop costs reference counting.
-
-    The nine sums live in named locals on purpose: numba cannot tell LLVM that ``out`` does
-    not alias the inputs, so an array accumulator is reloaded and stored at every column and
-    the product becomes load-bound (about 3x slower, see docs/performance.md).
-    """
-    a0 = r[roff]
-    a1 = r[roff + 1]
-    a2 = r[roff + 2]
-    a3 = r[roff + 3]
-    a4 = r[roff + 4]
-    a5 = r[roff + 5]
-    a6 = r[roff + 6]
-    a7 = r[roff + 7]
-    a8 = r[roff + 8]
-    for j in range(n_cols):
-        xj = x[j]
-        a0 += AT[j, 0] * xj
-        a1 += AT[j, 1] * xj
-        a2 += AT[j, 2] * xj
-        a3 += AT[j, 3] * xj
-        a4 += AT[j, 4] * xj
-        a5 += AT[j, 5] * xj
-        a6 += AT[j, 6] * xj
-        a7 += AT[j, 7] * xj
-        a8 += AT[j, 8] * xj
-    out[ooff] = a0
-    out[ooff + 1] = a1
-    out[ooff + 2] = a2
-    out[ooff + 3] = a3
-    out[ooff + 4] = a4
-    out[ooff + 5] = a5
-    out[ooff + 6] = a6
-    out[ooff + 7] = a7
-    out[ooff + 8] = a8
+def _mv9(AT, x, xf, n_cols, r, roff, out, ooff):
+    """out[ooff:ooff+9] = r[roff:roff+9] + A y for the 9 rows of q'', A stored transposed
+    (n_cols, 9), y = (x[:18], xf[18:n_cols]): the state's (q, q') read in place, the corner
+    forces from the stage vector. Offsets instead of slices: a slice made in the loop costs
+    reference counting. The product is written in vector form (`railride._simd`): as plain
+    numba, nine named scalar sums were the fastest form and stayed scalar."""
+    mv9_simd(AT, x, xf, n_cols, r, roff, out, ooff)
 
 
 @njit(cache=True, inline="always", fastmath=_FAST)
@@ -226,7 +189,7 @@ def _corner_values(TT, s, offset, out):
     out[3] = b3
 
 
-@njit(cache=True, fastmath=_FAST)
+@njit(cache=True, inline="always", fastmath=_FAST)
 def _bouc_wen_rate(z, w, A, n, gamma, beta):
     """z' = -gamma |w| z |z|^(n-1) - beta w |z|^n + A w (see railride.dampers)."""
     az = abs(z)
@@ -239,7 +202,7 @@ def _bouc_wen_rate(z, w, A, n, gamma, beta):
     return -gamma * abs(w) * z * zn1 - beta * w * zn1 * az + A * w
 
 
-@njit(cache=True, fastmath=_FAST)
+@njit(cache=True, inline="always", fastmath=_FAST)
 def damper_law(law, P, x, xd, z, y, u, v):
     """Force F (tension +) and the rates (z', y', u') of one damper; P as `Damper.pack()`.
     LAW_IDEAL: v is the held demand on the carbody, so F = -v and the carbody gets f = v."""
@@ -292,6 +255,25 @@ def substeps(lam, dt):
     return m
 
 
+@njit(cache=True)
+def _one_step_limit(dt):
+    """The largest rate bound lam for which `substeps` gives one step (by bisection on its own
+    test, so that lam <= this is exactly substeps(lam, dt) == 1)."""
+    lo = 0.0
+    hi = 1.0
+    while substeps(hi, dt) == 1:
+        hi *= 2.0
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        if mid <= lo or mid >= hi:
+            break
+        if substeps(mid, dt) == 1:
+            lo = mid
+        else:
+            hi = mid
+    return lo
+
+
 @njit(cache=True, inline="always", fastmath=_FAST)
 def _derivative(law, s, R, roff, AT, TT, P, vcmd, conn, y, cx, cv, K, koff):
     """K[koff:koff+NS_MAX] = d/dt of the state s = (q, q', damper states), with the rail forcing
@@ -303,14 +285,11 @@ def _derivative(law, s, R, roff, AT, TT, P, vcmd, conn, y, cx, cv, K, koff):
     disconnected), and the damper states (z, y, u) advance.
     """
     for i in range(N_DOF):
-        y[i] = s[i]
-        y[N_DOF + i] = s[N_DOF + i]
         K[koff + i] = s[N_DOF + i]
     if law == LAW_VISCOUS_IN_C:
-        _mv9(AT, y, 2 * N_DOF, R, roff, K, koff + N_DOF)
+        _mv9(AT, s, y, 2 * N_DOF, R, roff, K, koff + N_DOF)
         return
-    _corner_values(TT, s, 0, cx)
-    _corner_values(TT, s, N_DOF, cv)
+    corner_pairs(TT, s, cx, cv)
     for c in range(N_CORNER):
         b = 2 * N_DOF + N_DAMPER_STATES * c
         F, dz, dyy, du = damper_law(law, P, cx[c], cv[c], s[b], s[b + 1], s[b + 2], vcmd[c])
@@ -318,7 +297,7 @@ def _derivative(law, s, R, roff, AT, TT, P, vcmd, conn, y, cx, cv, K, koff):
         K[koff + b] = dz
         K[koff + b + 1] = dyy
         K[koff + b + 2] = du
-    _mv9(AT, y, NY, R, roff, K, koff + N_DOF)
+    _mv9(AT, s, y, NY, R, roff, K, koff + N_DOF)
 
 
 @njit(cache=True, nogil=True, fastmath=_FAST, parallel=_NO_PARFORS)
@@ -447,6 +426,9 @@ def run_batch(
         hp = 1.0 / (1.0 + w_c * tc)  # backward Euler of s / (s + w) and of 1 / (s + w)
         n_snoise = snoise.shape[0]
         n_noise = noise.shape[0]
+        bw1 = law == LAW_BOUC_WEN and pp[6] == 1.0
+        gb1 = pp[6] * (abs(pp[7]) + abs(pp[8]))
+        lam1 = _one_step_limit(dt)  # the largest rate bound that needs no sub-steps
         _forcing(step0 * dt, ftab, fo, nn, itv, R, 0)
         last = n_steps + 1 if final else n_steps
         for n in range(last):
@@ -565,7 +547,17 @@ def run_batch(
             if n == n_steps:
                 break
             m = 1
-            if law != LAW_VISCOUS_IN_C:
+            if bw1:
+                # Bouc-Wen with n = 1 (the railway dampers): the bound n gb |x'| + eta of
+                # `damper_stiffness` grows with |x'| alone, so the fastest corner decides, and
+                # one comparison with the one-step limit skips `substeps` at almost every step
+                vmax = 0.0
+                for c in range(N_CORNER):
+                    vmax = max(vmax, abs(cv[c]))
+                lam = gb1 * vmax + pp[9]
+                if lam > lam1:
+                    m = substeps(lam, dt)
+            elif law != LAW_VISCOUS_IN_C:
                 lam = 0.0
                 for c in range(N_CORNER):
                     b = 2 * N_DOF + N_DAMPER_STATES * c
@@ -602,9 +594,11 @@ def run_batch(
 
 
 @njit(cache=True, nogil=True, fastmath=_FAST, parallel=_NO_PARFORS)
-def rig_batch(law, P, n_steps, stride, dt, xtab, x_interval, mode, vconst, series, B, G, out):
-    """A damper on a test rig: every sample drives one damper (parameters P[s]) through the
-    extension x(t) of the table xtab (rows (x, x') on the grid k * x_interval, cubic Hermite).
+def rig_batch(lo, hi, law, P, n_steps, stride, dt, xtab, x_interval, mode, vconst, series, B, G, out):
+    """A damper on a test rig: every sample lo <= s < hi drives one damper (parameters P[s])
+    through the extension x(t) of the table xtab (rows (x, x') on the grid k * x_interval, cubic
+    Hermite). Compiled without the GIL: `railride.rig` runs sample ranges on threads
+    (`run_parallel`).
 
     The command voltage, held over each step, is vconst[s] (``mode`` RIG_CONSTANT), the series
     series[s, step] (RIG_COMMANDED, clipped to [v_min, v_max]), or the force-tracking law of
@@ -614,9 +608,8 @@ def rig_batch(law, P, n_steps, stride, dt, xtab, x_interval, mode, vconst, serie
     receives (t, x, x', F, z, y, u, v, E) at every step that is a multiple of stride, and after
     the last step.
     """
-    n_samples = P.shape[0]
     n_rows = xtab.shape[0]
-    for smp in range(n_samples):
+    for smp in range(lo, hi):
         pp = P[smp]
         z = 0.0
         yy = 0.0

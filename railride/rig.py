@@ -180,7 +180,9 @@ def drive(
         G = _check_number("G", default_gain(damper) if G is None else G, "nonnegative", "V/N")
     rows = n_steps // stride + (1 if n_steps % stride == 0 else 2)
     out = np.zeros((n, rows, 9))
-    kernels.rig_batch(
+    kernels.run_parallel(  # the voltages of a set of cycles on threads, one range per core
+        kernels.rig_batch,
+        n,
         damper.law,
         np.tile(damper.pack(), (n, 1)),
         n_steps,
