@@ -110,10 +110,7 @@ class ExactStepper:
 
     def padded(self, utab: np.ndarray, n_out: int) -> np.ndarray:
         """``utab`` with its last row repeated where the last output step's span runs past it."""
-        need = ((n_out - 1) * self.stride) // self.m + self.span
-        if len(utab) >= need:
-            return utab
-        return np.vstack([utab, np.repeat(utab[-1:], need - len(utab), axis=0)])
+        return _padded(utab, ((n_out - 1) * self.stride) // self.m + self.span)
 
 
 def _cached(stepper: ExactStepper | ClosedStepper, steps: int) -> tuple[np.ndarray, np.ndarray]:
@@ -126,14 +123,28 @@ def _cached(stepper: ExactStepper | ClosedStepper, steps: int) -> tuple[np.ndarr
 
 @lru_cache(maxsize=16)
 def stepper(A_bytes: bytes, Bw_bytes: bytes, Bwd_bytes: bytes, dt: float, stride: int, m: int) -> ExactStepper:
-    """An `ExactStepper`, kept for the next run with the same vehicle and grids."""
-
-    def arr(b, shape):
-        return np.frombuffer(b).reshape(shape).copy()
-
+    """An `ExactStepper`, kept for the next run with the same vehicle and grids (the matrices
+    come as bytes: hashable keys of the cache)."""
     return ExactStepper(
-        arr(A_bytes, (N_STATE, N_STATE)), arr(Bw_bytes, (N_DOF, 8)), arr(Bwd_bytes, (N_DOF, 8)), dt, stride, m
+        _matrix(A_bytes, (N_STATE, N_STATE)),
+        _matrix(Bw_bytes, (N_DOF, 8)),
+        _matrix(Bwd_bytes, (N_DOF, 8)),
+        dt,
+        stride,
+        m,
     )
+
+
+def _matrix(data: bytes, shape) -> np.ndarray:
+    return np.frombuffer(data).reshape(shape).copy()
+
+
+def _padded(utab: np.ndarray, rows: int) -> np.ndarray:
+    """``utab`` with its last row repeated up to ``rows`` rows (the steps at the end of a run
+    may reach a node past the table; the rail is held there)."""
+    if len(utab) >= rows:
+        return utab
+    return np.vstack([utab, np.repeat(utab[-1:], rows - len(utab), axis=0)])
 
 
 def hermite_at(utab: np.ndarray, times: np.ndarray, interval: float) -> tuple[np.ndarray, np.ndarray]:
@@ -223,15 +234,11 @@ class ClosedStepper:
 @lru_cache(maxsize=16)
 def closed_stepper(A_bytes, Bw_bytes, Bwd_bytes, Bf_bytes, dt, stride, ctrl, m) -> ClosedStepper:
     """A `ClosedStepper`, kept for the next run with the same vehicle and grids."""
-
-    def arr(b, shape):
-        return np.frombuffer(b).reshape(shape).copy()
-
     return ClosedStepper(
-        arr(A_bytes, (N_STATE, N_STATE)),
-        arr(Bw_bytes, (N_DOF, 8)),
-        arr(Bwd_bytes, (N_DOF, 8)),
-        arr(Bf_bytes, (N_DOF, 4)),
+        _matrix(A_bytes, (N_STATE, N_STATE)),
+        _matrix(Bw_bytes, (N_DOF, 8)),
+        _matrix(Bwd_bytes, (N_DOF, 8)),
+        _matrix(Bf_bytes, (N_DOF, 4)),
         dt,
         stride,
         ctrl,
@@ -251,9 +258,7 @@ def run_exact_closed(out: dict, samples: list, x0: np.ndarray, dt: float, stride
     for i, (A, Bw, Bwd, Bf, G, H, delay, utab, interval) in enumerate(samples):
         m = int(round(interval / dt))
         st = closed_stepper(A.tobytes(), Bw.tobytes(), Bwd.tobytes(), Bf.tobytes(), float(dt), stride, ctrl, m)
-        need = (n_out * stride) // m + 2
-        if len(utab) < need:
-            utab = np.vstack([utab, np.repeat(utab[-1:], need - len(utab), axis=0)])
+        utab = _padded(utab, (n_out * stride) // m + 2)
         status[i], fail_step[i] = kernels.exact_closed_run(
             st.phi,
             st.rail,
