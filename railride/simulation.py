@@ -107,6 +107,23 @@ def _exact(solver, damper, closed, suspensions) -> bool:
     return linear and solver.method != "rk4"
 
 
+def _input_table(scenario: Scenario, lag: tuple, dt: float, duration: float):
+    """`wheelset_input_table`, the last 32 kept: the batches of a study (passive beside each
+    controller, chunk after chunk) meet the same scenario again. The tables are read, never
+    written. A scenario that cannot be a key (a measured profile's arrays) is not kept."""
+    try:
+        return _cached_input_table(scenario, lag, dt, duration)
+    except TypeError:
+        return wheelset_input_table(scenario, np.asarray(lag), dt, duration)
+
+
+@functools.lru_cache(maxsize=32)
+def _cached_input_table(scenario: Scenario, lag: tuple, dt: float, duration: float):
+    table, interval = wheelset_input_table(scenario, np.asarray(lag), dt, duration)
+    table.flags.writeable = False  # shared between runs
+    return table, interval
+
+
 def _check_dt(vehicle: Vehicle, dt: float, damper=None) -> None:
     dt_max = _max_stable_dt(vehicle.params, damper)
     if dt > dt_max:
@@ -314,7 +331,7 @@ def simulate(
         lag = vehicles[id(p)].wheelset_lag_distance
         ukey = (id(sc), tuple(lag))
         if ukey not in u_index:
-            tab, itv = wheelset_input_table(sc, lag, dt, duration)
+            tab, itv = _input_table(sc, tuple(lag), dt, duration)
             u_index[ukey] = (sum(len(t) for t in utabs), tab, itv)
             utabs.append(tab)
         u_off[i], tab, interval[i] = u_index[ukey]

@@ -20,6 +20,7 @@ by default enters through a raised-cosine taper over its first wavelength (`Sine
 from __future__ import annotations
 
 import csv
+import functools
 import math
 from abc import ABC, abstractmethod
 from dataclasses import dataclass, field
@@ -361,12 +362,12 @@ def scenario(
         V = _check("speed", common["speed"], "positive", "a finite number > 0 (m/s)")
         T = _check("duration", common["duration"], "positive", "a finite number > 0 (s)")
         # long enough that the realisation does not repeat within the run
-        track = RandomTrack(
+        track = _random_track(
             name,
-            seed=0 if seed is None else seed,
-            min_wavelength=1.0 if min_wavelength is None else min_wavelength,
-            max_wavelength=100.0 if max_wavelength is None else max_wavelength,
-            length=max(2000.0, V * T + 100.0),
+            0 if seed is None else seed,
+            1.0 if min_wavelength is None else min_wavelength,
+            100.0 if max_wavelength is None else max_wavelength,
+            max(2000.0, V * T + 100.0),
         )
     elif name.startswith("file:"):
         given = [
@@ -565,6 +566,23 @@ class RandomTrack(RailProfile):
             "length_m": self.length,
             "lead_in_m": self.lead_in,
         }
+
+
+def _random_track(name, seed, min_wavelength, max_wavelength, length) -> RandomTrack:
+    """The `RandomTrack` of these settings, the last 32 kept: a study at several speeds (or
+    passive beside a controller) meets the same realisation many times, and synthesising it
+    is most of a short run's set-up. A value that cannot be a key is checked by RandomTrack."""
+    if isinstance(seed, bool):  # True would hash as seed 1: let the constructor refuse it
+        return RandomTrack(name, seed=seed, min_wavelength=min_wavelength, max_wavelength=max_wavelength, length=length)
+    try:
+        return _cached_random_track(name, seed, min_wavelength, max_wavelength, length)
+    except TypeError:  # unhashable: let the constructor say what is wrong
+        return RandomTrack(name, seed=seed, min_wavelength=min_wavelength, max_wavelength=max_wavelength, length=length)
+
+
+@functools.lru_cache(maxsize=32)
+def _cached_random_track(name, seed, min_wavelength, max_wavelength, length) -> RandomTrack:
+    return RandomTrack(name, seed=seed, min_wavelength=min_wavelength, max_wavelength=max_wavelength, length=length)
 
 
 def as_scenario(value) -> Scenario:
