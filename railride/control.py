@@ -46,6 +46,7 @@ from .controllers import (  # noqa: F401 (carbody_map, decoupling, ZeroDemand: t
     carbody_map,
     decoupling,
 )
+from . import validation
 from .params import param, validate_fields
 from .vehicle import CORNER_NAMES, Vehicle
 
@@ -428,8 +429,8 @@ class GainSet:
         table must be there."""
         try:
             data = tomllib.loads(text)
-        except tomllib.TOMLDecodeError as exc:
-            raise ValueError(f"{source}: not valid TOML: {exc}") from None
+        except ValueError as exc:
+            raise ValueError(f"{source}: not valid TOML: {validation.toml_error(exc)}") from None
         unknown_top = sorted(set(data) - {"inner", "pid", "sas", "provenance", *_LATER_TABLES, "skyhook_on_off"})
         if unknown_top:
             allowed = ", ".join(f"[{key}]" for key, _ in _TABLES.values())
@@ -453,8 +454,8 @@ class GainSet:
                 raise ValueError(f"{source}: missing entry {missing[0]!r} in [{key}]")
             for n in names:
                 v = table[n]
-                if isinstance(v, bool) or not isinstance(v, (int, float)):
-                    raise ValueError(f"{source}: entry {n!r} in [{key}] = {v!r} is not a number")
+                if not validation.is_number(v):
+                    raise ValueError(f"{source}: entry {n!r} in [{key}] = {validation.shown(v)} is not a number")
             try:
                 built[t] = kind(**table)
             except ValueError as exc:
@@ -501,14 +502,10 @@ class SensorNoise:
     angle: float = param("rad", "pitch and roll angle noise", "nonnegative")
     velocity: float = param("m/s", "heave velocity noise", "nonnegative")
     angular_rate: float = param("rad/s", "pitch and roll rate noise", "nonnegative")
-    seed: int = param("-", "seed of the noise generator", "nonnegative")
+    seed: int = param("-", "seed of the noise generator", "seed")
 
     def __post_init__(self):
-        seed = self.seed
-        validate_fields(self, "sensor noise")
-        if isinstance(seed, bool) or not float(seed).is_integer():
-            raise ValueError(f"sensor noise 'seed' = {seed!r}: must be a whole number >= 0")
-        object.__setattr__(self, "seed", int(seed))
+        validate_fields(self, "sensor noise")  # the seed as int, never through a float
 
     def samples(self, n: int) -> np.ndarray:
         """(n, 6) noise for m = (z, phi, theta, z', phi', theta')."""

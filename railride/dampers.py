@@ -88,9 +88,10 @@ class _Damper:
         return [(f.name, f.metadata["unit"], f.metadata["doc"]) for f in dataclasses.fields(cls)]
 
     def check_voltage(self, v: float, name: str = "voltage") -> float:
-        if not (isinstance(v, (int, float)) and np.isfinite(v) and self.v_min <= v <= self.v_max):
+        if not (validation.obeys(v, "finite") and self.v_min <= v <= self.v_max):
             raise ValueError(
-                f"{name} = {v!r} V: must lie in [{self.v_min:g}, {self.v_max:g}] V for this {self.model} damper"
+                f"{name} = {validation.shown(v)} V: must lie in [{self.v_min:g}, {self.v_max:g}] V "
+                f"for this {self.model} damper"
             )
         return float(v)
 

@@ -10,9 +10,12 @@ file rewritten atomically after each chunk, so an interrupted study resumes wher
 from __future__ import annotations
 
 import json
+import os
+import socket
 import time
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 
 from ._io import atomic_write
@@ -166,24 +169,54 @@ class DaskExecutor:
 
 
 # -- the table of finished runs ----------------------------------------------------------------
+#: the lock file beside a run table: held (flock) by the process that writes the table
+LOCK_SUFFIX = ".lock"
+
+
 class RunTable:
     """Every finished run, one row each, kept in a CSV file rewritten atomically after each
     chunk: a reader never sees half a file, and an interrupted sweep loses at most the chunks
-    in flight."""
+    in flight.
+
+    A table on disk belongs to one process at a time: opening it takes an exclusive lock on the
+    file ``.runs.csv.lock`` beside it (the folder is created for it), which names the process
+    holding it; a second writer gets a ValueError naming the folder and that process, where it
+    would otherwise overwrite the first one's rows. The operating system drops the lock when
+    its process ends, however it ends, so the lock of a killed process is simply taken over.
+    `close` (or leaving a ``with`` block) releases it. Opening the table also removes what
+    killed writes left there (``.runs.csv.*.part``). Rows read back are checked: a damaged
+    file is a ValueError naming the file and the line."""
 
     def __init__(self, path: str | Path | None = None, resume: bool = False):
         self.path = None if path is None else Path(path)
         self.frame = pd.DataFrame()
-        if self.path is not None and self.path.exists():
-            if not resume:
-                raise ValueError(
-                    f"{self.path} exists: pass resume to continue that sweep, or choose another output folder"
-                )
-            try:
-                # keys are hex digests: an all-digit one must stay text to be recognised
-                self.frame = pd.read_csv(self.path, dtype={"key": str})
-            except (OSError, ValueError) as exc:
-                raise ValueError(f"cannot read the run table {self.path}: {exc}") from None
+        self._lock = None
+        if self.path is None:
+            return
+        self._lock = _FolderLock(self.path)
+        try:
+            if self.path.exists():
+                if not resume:
+                    raise ValueError(
+                        f"{self.path} exists: pass resume to continue that sweep, or choose another output folder"
+                    )
+                self.frame = read_run_table(self.path)
+        except BaseException:
+            self.close()
+            raise
+
+    def close(self) -> None:
+        """Release the table's lock (nothing for a table in memory); the table stays readable."""
+        if self._lock is not None:
+            self._lock.release()
+            self._lock = None
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+        return False
 
     def done(self) -> dict[str, dict]:
         if self.frame.empty:
@@ -196,3 +229,96 @@ class RunTable:
         self.frame = pd.concat([self.frame, pd.DataFrame(rows)], ignore_index=True)
         if self.path is not None:
             atomic_write(self.path, lambda p: self.frame.to_csv(p, index=False))
+
+
+def read_run_table(path: Path) -> pd.DataFrame:
+    """The rows of the run table ``path``, checked: every row has a key (16 hex digits) and,
+    unless it records the time its run diverged, finite numbers in its metric columns. A
+    ValueError names the file, the line and what is wrong."""
+    from .metrics import RESPONSES, STATISTICS
+
+    try:
+        # keys are hex digests: an all-digit one must stay text to be recognised
+        frame = pd.read_csv(path, dtype={"key": str})
+    except (OSError, ValueError) as exc:
+        raise ValueError(f"cannot read the run table {path}: {' '.join(str(exc).split())}") from None
+    if "key" not in frame:
+        raise ValueError(f"run table {path}: no 'key' column; not a railride run table")
+    metrics = [c for c in (f"{r}_{s}" for r in RESPONSES for s in STATISTICS) if c in frame]
+    values = frame[metrics].apply(pd.to_numeric, errors="coerce")
+    diverged = pd.to_numeric(frame["diverged_at_s"], errors="coerce") if "diverged_at_s" in frame else None
+    keys = frame["key"].astype(str).str.fullmatch("[0-9a-f]{16}") & frame["key"].notna()
+    finite = np.isfinite(values.to_numpy(dtype=float)).all(axis=1)
+    ran = ~np.isfinite(diverged.to_numpy(dtype=float)) if diverged is not None else np.ones(len(frame), bool)
+    bad = np.flatnonzero(~keys.to_numpy() | (ran & ~finite))
+    if bad.size:
+        i = int(bad[0])
+        if not keys.iloc[i]:
+            problem = f"key = {frame['key'].iloc[i]!r} is not 16 hex digits"
+        else:
+            column = next(c for c in metrics if not np.isfinite(values[c].iloc[i]))
+            problem = f"{column} = {frame[column].iloc[i]!r} is not a finite number (and the run did not diverge)"
+        raise ValueError(
+            f"run table {path}, line {i + 2} (run {i + 1}): {problem}; the file is damaged: "
+            "delete that line to run it again, or start afresh in another folder"
+        )
+    frame[metrics] = values
+    return frame
+
+
+class _FolderLock:
+    """An exclusive lock on ``.NAME.lock`` beside ``path`` (flock: held while the file is open,
+    dropped by the system when the process ends). The file names its holder for the error."""
+
+    def __init__(self, path: Path):
+        import fcntl
+
+        self.fd: int | None = None
+        self.path = path.parent / f".{path.name}{LOCK_SUFFIX}"
+        folder = path.parent
+        self.created = not folder.exists()
+        folder.mkdir(parents=True, exist_ok=True)
+        while True:
+            fd = os.open(self.path, os.O_RDWR | os.O_CREAT, 0o644)
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except BlockingIOError:
+                holder = os.read(fd, 200).decode("utf-8", "replace").strip() or "another process"
+                os.close(fd)
+                raise ValueError(
+                    f"output folder {folder} is in use by {holder} (lock {self.path}): two runs writing one "
+                    "run table would lose rows; wait for it to finish, or choose another folder"
+                ) from None
+            # the file may have been removed by its holder between our open and flock: retry on
+            # the new one, or two processes would hold locks on different files
+            try:
+                same = os.path.samestat(os.fstat(fd), os.stat(self.path))
+            except FileNotFoundError:
+                same = False
+            if same:
+                break
+            os.close(fd)
+        self.fd = fd
+        os.ftruncate(fd, 0)
+        os.write(fd, f"railride process {os.getpid()} on {socket.gethostname()}, since {_now()}\n".encode())
+        for part in folder.glob(f".{path.name}.*.part"):  # a killed atomic write's leftovers
+            part.unlink(missing_ok=True)
+
+    def release(self) -> None:
+        if self.fd is None:
+            return
+        self.path.unlink(missing_ok=True)  # while still held: no one else is between
+        os.close(self.fd)
+        self.fd = None
+        if self.created:  # a folder made only for the lock, with nothing written, goes again
+            try:
+                self.path.parent.rmdir()
+            except OSError:
+                pass
+
+    def __del__(self):
+        self.release()
+
+
+def _now() -> str:
+    return time.strftime("%Y-%m-%d %H:%M:%S")

@@ -16,6 +16,7 @@
 
 from __future__ import annotations
 
+import glob
 import json
 import os
 import secrets
@@ -107,6 +108,9 @@ def json_text(doc: dict) -> str:
 # -- the output folder ----------------------------------------------------------------------------
 def check_out_dir(out_dir) -> Path:
     """Reject an output location that cannot be a folder, before any work is done."""
+    if isinstance(out_dir, str) and not out_dir.strip():
+        # Path("") is the current folder: an empty name is a mistake, not a choice of "."
+        raise ValueError(f'output folder {out_dir!r}: an empty name; give a folder ("." for the current one)')
     out_dir = Path(out_dir)
     if out_dir.exists() and not out_dir.is_dir():
         raise ValueError(f"output folder {out_dir} exists and is not a folder")
@@ -164,6 +168,7 @@ def write_folder(out_dir, files) -> list[Path]:
     out_dir = check_out_dir(out_dir)
     parent = out_dir.absolute().parent
     parent.mkdir(parents=True, exist_ok=True)
+    remove_leftovers(out_dir)
     stage = None
     for _ in range(100):
         candidate = parent / f".{out_dir.name}.staging-{secrets.token_hex(4)}"
@@ -175,6 +180,7 @@ def write_folder(out_dir, files) -> list[Path]:
         break
     if stage is None:
         raise OSError(f"cannot create a staging folder in {parent}")
+    held = _hold(stage)  # marks the staging folder as live for `remove_leftovers`
     try:
         for name, write in files:
             write(stage / name)
@@ -192,7 +198,52 @@ def write_folder(out_dir, files) -> list[Path]:
     finally:
         if stage is not None:
             shutil.rmtree(stage, ignore_errors=True)
+        os.close(held)
     return [out_dir / name for name in names]
+
+
+#: a staging folder younger than this is never taken for a leftover (it may be one just made,
+#: whose writer is about to lock it)
+LEFTOVER_AGE_S = 2.0
+
+
+def _hold(stage: Path) -> int:
+    """A shared lock on the staging folder, held by its writer until it is renamed or removed;
+    the system drops it when the writer's process ends, however it ends."""
+    import fcntl
+
+    fd = os.open(stage, os.O_RDONLY)
+    fcntl.flock(fd, fcntl.LOCK_SH)
+    return fd
+
+
+def remove_leftovers(out_dir) -> list[Path]:
+    """Remove the staging folders ``.NAME.staging-XXXXXXXX`` beside ``out_dir`` that a killed
+    write left (`write_folder`): those no process holds (a live writer keeps a lock on its own)
+    and older than `LEFTOVER_AGE_S`. Returns the removed paths."""
+    import fcntl
+    import time
+
+    out_dir = Path(out_dir)
+    parent = out_dir.absolute().parent
+    removed = []
+    for stage in parent.glob(f".{glob.escape(out_dir.name)}.staging-*"):
+        try:
+            if not stage.is_dir() or time.time() - stage.stat().st_mtime < LEFTOVER_AGE_S:
+                continue
+            fd = os.open(stage, os.O_RDONLY)
+        except OSError:
+            continue
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            continue  # a writer is at work in it
+        else:
+            shutil.rmtree(stage, ignore_errors=True)
+            removed.append(stage)
+        finally:
+            os.close(fd)
+    return removed
 
 
 def _text(text: str):

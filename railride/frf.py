@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from . import validation
+from . import limits, validation
 from .analysis import FRF_MAGNITUDES, FRF_PATTERNS, frf_frame, frf_peaks
 from .files import FRF_FILES
 from .params import PRESETS, VehicleParams
@@ -213,8 +213,15 @@ def frequency_responses(
     if not fmax > fmin:
         raise ValueError(f"fmax = {fmax:g} Hz: must be above fmin = {fmin:g} Hz")
     points = validation.integer("points", points, 2)
-    vehicle_params, source = _vehicle(params)
     patterns = list(FRF_PATTERNS) if rails == "both" else [rails]
+    # per point and pattern: the 9 DOF responses, the carbody acceleration and 8 corner values
+    # (complex), and as much again while the Dataset and its table are built
+    limits.check(
+        8.0 * points * (1 + len(patterns) * 2 * 18 * 2),
+        f"the frequency responses on {points} points",
+        "use fewer points (400 resolve every mode of the vehicle)",
+    )
+    vehicle_params, source = _vehicle(params)
     vehicle = Vehicle(vehicle_params)
     frequency = np.geomspace(fmin, fmax, points)
     frequency[0], frequency[-1] = fmin, fmax  # exactly, without rounding

@@ -96,7 +96,7 @@ def _cases(scenarios, speeds, track_seeds):
         if not isinstance(name, str):
             raise ValueError(f"scenario = {name!r}: must be a scenario name")
     speeds = [None] if speeds is None else [validation.number("speed", v, "positive", "m/s") for v in speeds]
-    seeds = [validation.integer("track_seed", s, 0) for s in track_seeds]
+    seeds = [validation.seed("track_seed", s) for s in track_seeds]
     if not seeds:
         raise ValueError("track_seeds: give at least one seed (default 0)")
     for name, v in itertools.product(scenarios, speeds):

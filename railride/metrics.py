@@ -23,7 +23,8 @@ STATISTICS = ("rms", "ptp")
 
 
 def parse_window(text: str) -> tuple[float, float]:
-    """ "START:END" in seconds; either side may be empty (start of run, end of run)."""
+    """ "START:END" in seconds; either side may be empty (start of run, end of run), and both
+    must be finite."""
     parts = text.split(":")
     if len(parts) != 2:
         raise ValueError(f"window = {text!r}: expected START:END in seconds, e.g. 2:10")
@@ -32,6 +33,13 @@ def parse_window(text: str) -> tuple[float, float]:
         end = float(parts[1]) if parts[1].strip() else math.inf
     except ValueError:
         raise ValueError(f"window = {text!r}: START and END must be numbers of seconds") from None
+    typed = [float(p) for p in parts if p.strip()]
+    if not all(math.isfinite(v) for v in typed):
+        # an empty END is the end of the run; a typed inf or nan is a slip, not a window
+        raise ValueError(
+            f"window = {text!r}: START and END must be finite numbers of seconds "
+            "(leave END empty for the end of the run)"
+        )
     return start, end
 
 

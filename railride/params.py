@@ -13,7 +13,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ._io import atomic_write_text
-from .validation import param, rule_words, validate_fields
+from .validation import param, rule_words, toml_error, validate_fields
 
 
 @dataclass(frozen=True)
@@ -152,8 +152,8 @@ class VehicleParams:
         """
         try:
             data = tomllib.loads(text)
-        except tomllib.TOMLDecodeError as exc:
-            raise ValueError(f"{source}: not valid TOML: {exc}") from None
+        except ValueError as exc:
+            raise ValueError(f"{source}: not valid TOML: {toml_error(exc)}") from None
         table = data.get("vehicle")
         if not isinstance(table, dict):
             raise ValueError(f"{source}: needs a [vehicle] table of parameters")
@@ -166,14 +166,18 @@ class VehicleParams:
                 f"{source}: unknown vehicle parameter(s) {', '.join(unknown)}; allowed: {', '.join(names)}"
             )
         if base_name is not None:
-            return cls.preset(str(base_name)).replace(**table)
-        missing = [n for n in names if n not in table]
-        if missing:
-            raise ValueError(
-                f"{source}: missing vehicle parameter(s) {', '.join(missing)} "
-                '(list them all, or start from a base with preset = "paper")'
-            )
-        return cls(**table)
+            base = cls.preset(str(base_name))
+        else:
+            missing = [n for n in names if n not in table]
+            if missing:
+                raise ValueError(
+                    f"{source}: missing vehicle parameter(s) {', '.join(missing)} "
+                    '(list them all, or start from a base with preset = "paper")'
+                )
+        try:
+            return base.replace(**table) if base_name is not None else cls(**table)
+        except ValueError as exc:  # the field's rule: name the file and table too
+            raise ValueError(f"{source}: [vehicle] {exc}") from None
 
     @classmethod
     def load(cls, path: str | Path) -> "VehicleParams":

@@ -258,7 +258,7 @@ def pareto(
     vehicle = VehicleParams.of(params)
     names = _parameters(suspension, parameters)
     n_samples = _power_of_two("n_samples", n_samples)
-    seed = validation.integer("seed", seed, 0)
+    seed = validation.seed("seed", seed)
     damper_model(damper)  # a known name
     base = GainSet.default() if gains is None else gains
     scen = make_scenario(scenario, **dict(scenario_options or {}))

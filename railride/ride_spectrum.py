@@ -28,7 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 import xarray as xr
 
-from . import validation
+from . import limits, validation
 from .linear import LinearModel, linear_model, linear_suspensions
 from .params import VehicleParams
 from .track import SPECTRA, spectrum
@@ -224,6 +224,11 @@ def ride_spectrum(
     if control_rate is not None:
         control_rate = validation.number("control_rate", control_rate, "positive", "Hz")
     delay = validation.integer("delay", delay, 0, 64, "controller periods")
+    # the peak is the closed loop's (points, 18, 18) complex system, about three copies of it
+    n_state = 2 * N_DOF
+    runs = len(controllers) if isinstance(controllers, (list, tuple)) else 1
+    per_point = 8.0 * (3 * 2 * n_state * n_state + 2 * 2 * 16 + len(RESPONSES) * runs)
+    limits.check(points * per_point, f"the ride spectrum on {points} frequencies", "use fewer points")
     vehicle_params, _ = _vehicle(params)
     vehicle = Vehicle(vehicle_params)
     frequency = np.geomspace(speed / hi, speed / lo, points)

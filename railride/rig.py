@@ -23,8 +23,9 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from . import dampers, kernels, validation
+from . import dampers, kernels, limits, validation
 from .defaults import DEFAULT_DAMPER, DEFAULT_DT
+from .errors import DivergenceError
 from .plots import PNG_DPI, FigureOptions
 
 #: motion-table nodes per cycle of the fastest motion
@@ -109,6 +110,20 @@ def _motion_table(motion, duration: float, dt: float):
     return np.ascontiguousarray(np.column_stack([x, xd])), interval
 
 
+def _check_size(motion, duration: float, dt: float, n_steps: int, stride: int, runs: int, series: bool) -> None:
+    """`railride.limits.check` before `drive` allocates: the time grid of the steps and a
+    command on it, the motion table and the stored histories (runs x rows x 9)."""
+    limits.check_steps("dt", n_steps, "raise dt, or drive fewer or shorter cycles")
+    nodes = duration / max(dt, motion.spacing() / 2) + 3  # `_motion_table`: a node every 2**k steps
+    rows = n_steps / stride + 2
+    need = 8.0 * ((2 if series else 1) * (n_steps + 1) + 2 * nodes + runs * rows * 9)
+    limits.check(
+        need,
+        f"the damper rig's {n_steps:.4g} steps of {dt:.4g} s ({duration:.4g} s)",
+        "drive fewer cycles, raise the frequency or raise dt",
+    )
+
+
 def _resolve(damper):
     damper = dampers.preset(damper) if isinstance(damper, str) else damper
     if getattr(damper, "law", None) == dampers.LAW_IDEAL:
@@ -160,6 +175,7 @@ def drive(
     stride = int(round(1.0 / (output_rate * dt)))
     if stride < 1 or abs(stride * output_rate * dt - 1) > 1e-6:
         raise ValueError(f"output_rate = {output_rate:g} Hz: 1/(output_rate dt) must be a whole number")
+    _check_size(motion, duration, dt, n_steps, stride, np.size(voltage) if voltage is not None else 1, voltage is None)
     xtab, interval = _motion_table(motion, duration, dt)
     t_steps = np.arange(n_steps + 1) * dt
 
@@ -198,7 +214,7 @@ def drive(
         out,
     )
     if not np.all(np.isfinite(out)):
-        raise RuntimeError("the damper rig run diverged: a state stopped being finite")
+        raise DivergenceError("the damper rig run diverged: a state stopped being finite")
     names = ("x", "xd", "F", "z", "y", "u", "v", "E")
     attrs = {
         "x": ("m", "extension"),

@@ -3,24 +3,30 @@
 from __future__ import annotations
 
 import functools
+import math
+import time
 from datetime import datetime, timezone
 
 import numpy as np
 
-from . import dampers, kernels
+from . import dampers, kernels, limits
 from .defaults import DEFAULT_DT
+from .errors import DivergenceError
 from .faults import fault_table
 from .sensing import reads_bogies
 from .params import VehicleParams
 from .solver import SolverSettings, check_resolution
 from .suspension import Suspension, batch_conflict
-from .track import Scenario, wheelset_input_table
+from .track import Scenario, input_table_nodes, wheelset_input_table
 from .track import as_scenario
 from .ride import RideResult, build_dataset, has_damper_states
 from .vehicle import N_DOF, Vehicle
 
-#: sample-steps per kernel call when a progress callback is given
-_CHUNK_WORK = 2_000_000
+#: sample-steps of the first kernel call when a progress callback is given; later calls are
+#: sized to take about _CHUNK_SECONDS each, so that the callback, and Ctrl-C, which Python sees
+#: only between calls, come a few times a second whatever the damper law costs per step
+_CHUNK_WORK = 20_000
+_CHUNK_SECONDS = 0.25
 
 
 def _rk4_gain(z: np.ndarray) -> np.ndarray:
@@ -136,6 +142,27 @@ def _check_dt(vehicle: Vehicle, dt: float, damper=None) -> None:
         )
 
 
+def _check_size(scenarios, solver: SolverSettings, damper, closed, exact: bool, n_out: int, duration: float):
+    """`railride.limits.check` on what a run allocates before it allocates it: the stored
+    histories (samples x output rows x channels), the rail input and forcing tables, and the
+    exact stepper's maps (one per phase of the output steps against the table's nodes)."""
+    n, dt, stride = len(scenarios), solver.dt, solver.output_steps
+    limits.check_steps("dt", n_out * stride, "raise dt or shorten the run")
+    channels = 3 * N_DOF + 4 + 16 + (kernels.N_DS if has_damper_states(damper) else 0) + (8 if closed else 0)
+    need = 8.0 * n * (n_out + 1) * channels
+    nodes, interval = max(input_table_nodes(sc, dt, duration) for sc in scenarios)
+    need += 8.0 * n * nodes * (16 + 36)  # input and forcing tables, at most one each per sample
+    if exact:  # discrete.ExactStepper: period x 18 x (span x 8)
+        m = int(round(interval / dt))
+        period, span = math.lcm(stride, m) // stride, (stride + m - 1) // m + 2
+        need += 8.0 * period * 2 * N_DOF * span * 8
+    limits.check(
+        need,
+        f"{n} run(s) of {duration:.4g} s at dt {dt:.4g} s ({n_out + 1} output samples, {nodes} input nodes)",
+        "shorten the duration, lower output_rate, run fewer samples at once or use a dt nearer the default",
+    )
+
+
 def _system_arrays(vehicle: Vehicle, passive: bool = True) -> dict[str, np.ndarray]:
     """The stepper's matrices: the equations of motion with M^-1 folded in, transposed
     (see `railride.kernels.run_batch`).
@@ -207,8 +234,9 @@ def _closed_loop(suspensions: list[Suspension], solver: SolverSettings, duration
     first = suspensions[0]
     if not first.closed_loop:
         return None
-    stride = solver.control_steps()
+    stride = solver.control_steps(duration)
     ticks = int(round(duration / (stride * solver.dt))) + 2
+    limits.check(ticks * 10 * 8.0, f"the sensor noise of {ticks:.4g} controller samples", "lower control_rate")
     noise = first.sensor_noise
     sensing = first.sensing
     if sensing is not None:
@@ -252,9 +280,10 @@ def simulate(
     one row per sample; by default the vehicle starts at rest in equilibrium.
     ``progress(done_fraction)`` is called between chunks of a long run.
     A sample whose response leaves +-1000 (m or rad) or stops being finite has diverged: with
-    ``on_divergence="raise"`` (the default) the run stops with a RuntimeError giving the sample
-    and the time; with ``"mark"`` (what studies use) the other samples stand, the diverged
-    one's histories are NaN from that time on, and `RideResult.diverged_at` gives the time.
+    ``on_divergence="raise"`` (the default) the run stops with a `railride.errors.DivergenceError`
+    (a RuntimeError) giving the sample and the time; with ``"mark"`` (what studies use) the
+    other samples stand, the diverged one's histories are NaN from that time on, and
+    `RideResult.diverged_at` gives the time.
     """
     solver = SolverSettings.of(solver)
     dt, output_rate = solver.dt, solver.output_rate
@@ -309,8 +338,9 @@ def simulate(
     if abs(n_out - n_out_f) > 1e-6 * max(1.0, n_out_f) or n_out < 1:
         raise ValueError(f"duration = {duration:g} s must be a whole number of output intervals (1/{output_rate:g} Hz)")
     n_steps = n_out * stride
-    for sc in scenarios:  # a random track's shortest wavelength must show in the output
+    for sc in scenarios:  # the track's shortest wavelength must show in the output
         check_resolution(sc, output_rate)
+    _check_size(scenarios, solver, damper, closed, exact, n_out, duration)
 
     systems = {key: _system_arrays(v, passive=damper is None) for key, v in vehicles.items()}
     arrays = {k: np.ascontiguousarray(np.stack([systems[id(p)][k] for p in param_sets])) for k in ("A", "TS", "c_sec")}
@@ -442,6 +472,7 @@ def simulate(
     while not exact:
         todo = min(chunk, n_steps - done)
         final = done + todo == n_steps
+        started = time.perf_counter()
         kernels.run_parallel(
             kernels.run_batch,
             n,
@@ -486,6 +517,8 @@ def simulate(
         )
         done += todo
         if progress is not None:
+            took = max(time.perf_counter() - started, 1e-6)  # the first call may include compiling
+            chunk = max(stride, min(4 * todo, int(todo * _CHUNK_SECONDS / took)) // stride * stride)
             progress(done / n_steps)
         if final:
             break
@@ -498,7 +531,7 @@ def simulate(
             f"or stopped being finite; check the parameters or reduce dt"
         )
         if on_divergence != "mark":
-            raise RuntimeError(message)
+            raise DivergenceError(message)
         for i in bad.tolist():  # the stepper stopped there: what follows is not a response
             diverged_at[i] = fail_step[i] * dt
             cut = fail_step[i] // stride

@@ -71,9 +71,16 @@ class SolverSettings:
         assert steps is not None  # checked at construction
         return steps
 
-    def control_steps(self) -> int:
+    def control_steps(self, duration: float | None = None) -> int:
         """Steps per controller period; a ValueError naming control_rate and dt when the period
-        is not a whole number of steps (the check a closed loop needs)."""
+        is not a whole number of steps (the check a closed loop needs), or, given the run's
+        ``duration`` [s], when the controller would not sample again within it."""
+        if duration is not None and self.control_rate * duration < 1.0:
+            raise ValueError(
+                f"control_rate = {self.control_rate:.4g} Hz: the controller would sample once every "
+                f"{1.0 / self.control_rate:.4g} s, not once within the run's {duration:.4g} s; use "
+                f"control_rate >= {1.0 / duration:.4g} Hz"
+            )
         steps = _steps(1.0 / (self.control_rate * self.dt))
         if steps is None:
             raise ValueError(
@@ -100,17 +107,31 @@ class SolverSettings:
         return solver
 
 
+def shortest_wavelength(track) -> tuple[str, float] | None:
+    """(field, metres) of the shortest wavelength a profile holds on purpose: the sine's
+    wavelength, the bump's length, the random track's min_wavelength; None for a measured
+    profile, whose samples are what was measured."""
+    for name in ("min_wavelength", "wavelength", "length"):
+        lam = getattr(track, name, None)
+        if lam is not None:
+            return name, float(lam)
+    return None
+
+
 def check_resolution(scenario, output_rate: float) -> None:
     """ValueError when the stored time histories at ``output_rate`` [Hz] cannot resolve the
-    shortest wavelength of ``scenario``'s random track (`RESOLUTION`); other tracks pass. The
+    shortest wavelength of ``scenario``'s profile (`shortest_wavelength`, `RESOLUTION`): a sine
+    or bump shorter than that would be aliased into a slow input that is not on the track. The
     simulation checks every scenario it runs; the studies and the command line ask before their
     first run."""
-    lam = getattr(scenario.track, "min_wavelength", None)
-    if lam is None or not scenario.speed / lam > output_rate / RESOLUTION:
+    found = shortest_wavelength(scenario.track)
+    if found is None or not scenario.speed / found[1] > output_rate / RESOLUTION:
         return
+    name, lam = found
+    shortest = RESOLUTION * scenario.speed / output_rate
     raise ValueError(
-        f"min_wavelength = {lam:g} m at speed {scenario.speed:g} m/s passes at "
-        f"{scenario.speed / lam:g} Hz, more than output_rate {output_rate:g} Hz / {RESOLUTION:g} = "
-        f"{output_rate / RESOLUTION:g} Hz can resolve: raise min_wavelength, lower the speed or "
-        "raise output_rate"
+        f"{name} = {lam:.4g} m at speed {scenario.speed:.4g} m/s passes at "
+        f"{scenario.speed / lam:.4g} Hz, more than output_rate {output_rate:.4g} Hz / {RESOLUTION:g} = "
+        f"{output_rate / RESOLUTION:.4g} Hz can resolve: the shortest {name} allowed is {shortest:.4g} m; "
+        "raise it, lower the speed or raise output_rate"
     )

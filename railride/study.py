@@ -184,7 +184,7 @@ def study(
         )
     if track_seeds is None:
         track_seeds = range(10) if random else [None]
-    seeds = [None if s is None else validation.integer("track_seeds", s, 0) for s in _items(track_seeds)]
+    seeds = [None if s is None else validation.seed("track_seeds", s) for s in _items(track_seeds)]
     speed_list = (
         [None] if speeds is None else [validation.number("speeds", v, "positive", "m/s") for v in _items(speeds)]
     )
@@ -317,7 +317,7 @@ def study(
 
 
 def _items(values) -> list:
-    if isinstance(values, (str, int, float)):
+    if isinstance(values, (str, bool)) or validation.is_number(values):  # one value (a bool is refused later)
         return [values]
     return list(values)
 
@@ -325,7 +325,9 @@ def _items(values) -> list:
 def _reductions(frame: pd.DataFrame) -> pd.DataFrame:
     """Each controlled run's reduction in % against passive on the same track, speed and load."""
     key = ["load", "stiffness", "track_seed", "speed_m_s"]
-    keys = frame[key].astype(float).fillna(-1.0)  # no seed (not a random track): one key
+    # no seed (not a random track): one key; the seeds as they are, since floats would merge
+    # those past 2**53
+    keys = frame[key].astype(object).where(frame[key].notna(), -1)
     passive = frame[list(METRICS)][frame["controller"] == "passive"].set_index(
         pd.MultiIndex.from_frame(keys[frame["controller"] == "passive"])
     )

@@ -21,6 +21,7 @@ import functools
 import hashlib
 import json
 import math
+import numbers
 import time
 from dataclasses import asdict, dataclass, field
 
@@ -104,10 +105,9 @@ class Case:
             value = getattr(self, name)
             if isinstance(value, dict):
                 value = tuple(sorted(value.items()))
-            object.__setattr__(
-                self, name, tuple((str(k), float(v) if isinstance(v, (int, float)) else v) for k, v in value)
-            )
+            object.__setattr__(self, name, tuple((str(k), _plain(k, v)) for k, v in value))
         object.__setattr__(self, "noise", tuple(float(v) for v in self.noise))
+        object.__setattr__(self, "seed", _plain("seed", self.seed))
         from .sensing import SENSING
 
         if self.sensing not in SENSING:
@@ -158,7 +158,12 @@ class Case:
         """A stable identity for the run table (same settings and model, same key, in any
         session). The model revision is part of it, so a run table from an earlier model is
         not taken for this one's on resume."""
-        text = json.dumps({**self.to_dict(), "model_revision": MODEL_REVISION}, sort_keys=True, default=str)
+        d = self.to_dict()
+        if "seed" in d["scenario_options"]:
+            # as text, as when the track seed travelled as a NumPy integer: the keys of runs on
+            # random tracks stay what they were
+            d["scenario_options"]["seed"] = str(d["scenario_options"]["seed"])
+        text = json.dumps({**d, "model_revision": MODEL_REVISION}, sort_keys=True, default=str)
         return hashlib.sha1(text.encode()).hexdigest()[:16]
 
     def to_dict(self) -> dict:
@@ -195,8 +200,24 @@ def cached_scenario(name: str, options):
     """`railride.track.scenario` of a case's scenario and options (pairs, as `Case` holds
     them), the last 32 kept for the next chunk and the next call: a random track is not
     synthesised again for every chunk that meets it (the scenarios are frozen values)."""
-    key = tuple(sorted((str(k), float(v) if isinstance(v, (int, float)) else v) for k, v in options))
+    key = tuple(sorted((str(k), _plain(k, v)) for k, v in options))
     return _scenario(name, key)
+
+
+def _plain(name: str, value):
+    """A number of a case as a plain Python number: a seed a whole one as given (an int, never
+    through a float, which rounds seeds past 2**53), any other a float; NumPy scalars too, so
+    that keys and records hold plain numbers. Anything else is left for the checks that own it."""
+    from . import validation
+
+    if not validation.is_number(value):
+        return value
+    if name == "seed" and isinstance(value, numbers.Integral):
+        return int(value)
+    try:
+        return float(value)
+    except OverflowError:  # a whole number past any float: the scenario's check names it
+        return int(value)
 
 
 @functools.lru_cache(maxsize=32)  # a random track holds a few MB: bounded, as a study's memory

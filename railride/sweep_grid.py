@@ -10,13 +10,13 @@ every scenario of the grid is checked here, before the first run.
 
 from __future__ import annotations
 
+import math
+
 import dataclasses
 import itertools
-import math
 import numbers
 from collections.abc import Mapping
 
-import numpy as np
 
 from . import validation
 from .control import CONSTANT_VOLTAGE, OUTER_LOOPS, GainSet
@@ -134,12 +134,14 @@ class _Words:
 
 def _g(value) -> str:
     """A number as the grid's messages show it (20, not 20.0)."""
-    return f"{value:g}" if validation.is_number(value) else validation.shown(value)
+    if validation.is_number(value) and not isinstance(value, numbers.Integral):
+        return f"{value:g}"
+    return validation.shown(value)  # a whole number exactly (a seed), or its size past 30 digits
 
 
 def _obeys(value, rule: str) -> bool:
     """Whether ``value`` is a finite number obeying `validation.RULES` ``rule``."""
-    return validation.is_number(value) and math.isfinite(float(value)) and validation.RULES[rule][1](float(value))
+    return validation.obeys(value, rule)
 
 
 def _values(words: _Words, key: str, values) -> list | None:
@@ -165,14 +167,25 @@ def _numbers(words: _Words, key: str, values, rule: str = "finite", unit: str = 
 
 
 def _seeds(words: _Words, key: str, values, what: str) -> list[int]:
-    for v in values:
-        if isinstance(v, bool) or not isinstance(v, numbers.Integral):
+    """Every value a seed, as Python ints (never through a float); a whole float (3.0) is the
+    seed 3, as `railride.track.RandomTrack` takes it."""
+    whole = [
+        int(v) if not isinstance(v, numbers.Integral) and _obeys(v, "finite") and float(v).is_integer() else v
+        for v in values
+    ]
+    for item in whole:
+        if isinstance(item, bool) or not isinstance(item, numbers.Integral):
             raise ValueError(
-                f"{words.given(key, values)}: {_g(v)} is not a whole number; {what} are whole numbers >= 0"
+                f"{words.given(key, values)}: {_g(item)} is not a whole number; {what} are whole numbers >= 0"
             )
+        v = int(item)
         if v < 0:
             raise ValueError(f"{words.given(key, values)}: {v} is negative; {what} are whole numbers >= 0")
-    return [int(v) for v in values]
+        if v > validation.SEED_MAX:
+            raise ValueError(
+                f"{words.given(key, values)}: {validation.shown(v)} is too large; {what} are at most 2**64 - 1"
+            )
+    return [int(v) for v in whole]
 
 
 def voltage_value(value, damper) -> float:
@@ -493,14 +506,16 @@ def _key(keyword: str) -> str:
 def _check_resolvable(words: _Words, scen, min_given: bool, output_rate: float) -> None:
     """`railride.solver.check_resolution` (a random track's shortest wavelength must show at
     the runs' output rate), its error naming the grid's fields."""
-    from .solver import RESOLUTION, check_resolution
+    from .solver import RESOLUTION, check_resolution, shortest_wavelength
 
     try:
         check_resolution(scen, output_rate)
     except ValueError:
-        lam, mw, speed = scen.track.min_wavelength, words.name("min_wavelength"), words.name("speed")
+        field, lam = shortest_wavelength(scen.track) or ("min_wavelength", math.nan)
+        mw, speed = words.name("wavelength" if field == "length" else field), words.name("speed")
+        default = "" if min_given or field != "min_wavelength" else " (the default)"
         raise ValueError(
-            f"{mw} = {lam:g} m{'' if min_given else ' (the default)'} at {speed} {scen.speed:g} m/s is "
+            f"{mw} = {lam:g} m{default} at {speed} {scen.speed:g} m/s is "
             f"{scen.speed / lam:g} Hz, more than the runs' output rate {output_rate:g} Hz / {RESOLUTION:g} = "
             f"{output_rate / RESOLUTION:g} Hz can resolve: raise {mw} or lower {speed}"
         ) from None
@@ -516,10 +531,8 @@ def _cases(g: SweepGrid, combos: list, common: dict) -> tuple[list, list]:
     cases, values = [], []
     for s in g.suspensions:
         for combo in combos:
-            # a random track refuses a float seed, and Case stores Python ints as floats: the
-            # track seed travels as a NumPy integer
             given = {**common, **{kw: v for (kw, _, _), v in zip(g.axes, combo)}}
-            options = tuple(sorted((k, np.int64(v) if k == "seed" else v) for k, v in given.items()))
+            options = tuple(sorted(given.items()))  # Case keeps a seed a Python int
             base = {c: None for c in g.columns}
             base.update({"suspension": s, **{column: v for (_, column, _), v in zip(g.axes, combo)}})
             if s == "passive":

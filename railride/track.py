@@ -33,10 +33,25 @@ from . import validation
 #: nodes per shortest feature (wavelength, bump length) in the stepper's table
 NODES_PER_FEATURE = 200
 MAX_TABLE_NODES = 2_000_000
+#: plausible ranges (docs/model.md, Plausible ranges): a rail a metre out of line is no track the
+#: vehicle could run on, and 200 m/s is above the rail speed record (159.7 m/s); beyond these the
+#: run diverges or means nothing, so they are input errors rather than a "diverged" at run time
+MAX_RAIL_AMPLITUDE = 1.0  # m, sine amplitude and bump height
+MAX_SPEED = 200.0  # m/s
+MAX_RAIL_PHASE = 360.0  # deg, either way
 
 
 def _check(name: str, value, rule: str, allowed: str) -> float:
     return validation.number(name, value, rule, allowed=allowed)
+
+
+def _within(name: str, value: float, bound: float, unit: str, why: str) -> float:
+    """``value`` when |value| <= ``bound``, else a ValueError naming the field and the range."""
+    if abs(value) > bound:
+        raise ValueError(
+            f"{name} = {value:.4g} {unit}: outside the plausible range -{bound:g} to {bound:g} {unit} ({why})"
+        )
+    return value
 
 
 class RailProfile(ABC):
@@ -95,6 +110,8 @@ class SineTrack(RailProfile):
         )
         for field_name, name, rule, allowed in checks:
             object.__setattr__(self, field_name, _check(name, getattr(self, field_name), rule, allowed))
+        _within("amplitude", self.amplitude, MAX_RAIL_AMPLITUDE, "m", "a rail a metre out of line is no track")
+        _within("rail_phase", self.rail_phase_deg, MAX_RAIL_PHASE, "deg", "a phase is an angle of one turn")
 
     def _evaluate(self, s):
         k = 2 * np.pi / self.wavelength
@@ -137,6 +154,7 @@ class CosineBump(RailProfile):
         object.__setattr__(
             self, "height", _check("height", self.height, "finite", "a finite number (m; < 0 for a dip)")
         )
+        _within("height", self.height, MAX_RAIL_AMPLITUDE, "m", "a rail a metre out of line is no track")
         object.__setattr__(self, "length", _check("length", self.length, "positive", "a finite number > 0 (m)"))
         object.__setattr__(self, "start", _check("start", self.start, "nonnegative", "a finite number >= 0 (m)"))
         if self.rails not in ("both", "left", "right"):
@@ -282,6 +300,11 @@ class Scenario:
     def __post_init__(self):
         object.__setattr__(self, "speed", _check("speed", self.speed, "positive", "a finite number > 0 (m/s)"))
         object.__setattr__(self, "duration", _check("duration", self.duration, "positive", "a finite number > 0 (s)"))
+        if self.speed > MAX_SPEED:
+            raise ValueError(
+                f"speed = {self.speed:.4g} m/s: above the plausible {MAX_SPEED:g} m/s (the rail speed "
+                "record is 159.7 m/s; the model's linear suspension means nothing far beyond it)"
+            )
         if not isinstance(self.track, RailProfile):
             raise ValueError(f"track = {self.track!r}: must be a RailProfile")
         needed = self.speed * self.duration
@@ -386,6 +409,17 @@ def scenario(
     return Scenario(track=track, name=name, **common)
 
 
+def input_table_nodes(scenario: Scenario, dt: float, duration: float | None = None) -> tuple[int, float]:
+    """(rows, interval [s]) of `wheelset_input_table`'s table, without building it (the size
+    checks ask first)."""
+    duration = scenario.duration if duration is None else duration
+    # m is a power of two, so halving dt doubles m and leaves the grid (and the input) alone
+    ratio = scenario.track.table_spacing() / (scenario.speed * dt)
+    m = 1 << max(0, int(math.floor(math.log2(ratio)))) if ratio >= 1 else 1
+    interval = m * dt
+    return int(math.ceil((duration + dt) / interval)) + 2, interval
+
+
 def wheelset_input_table(
     scenario: Scenario, lag_distance: np.ndarray, dt: float, duration: float | None = None
 ) -> tuple[np.ndarray, float]:
@@ -398,11 +432,7 @@ def wheelset_input_table(
     """
     duration = scenario.duration if duration is None else duration
     V = scenario.speed
-    # m is a power of two, so halving dt doubles m and leaves the grid (and the input) alone
-    ratio = scenario.track.table_spacing() / (V * dt)
-    m = 1 << max(0, int(math.floor(math.log2(ratio)))) if ratio >= 1 else 1
-    interval = m * dt
-    n = int(math.ceil((duration + dt) / interval)) + 2
+    n, interval = input_table_nodes(scenario, dt, duration)
     if n > MAX_TABLE_NODES:
         raise ValueError(
             f"the rail input table would need {n} nodes ({duration:g} s at one node per "
@@ -494,16 +524,8 @@ class RandomTrack(RailProfile):
         from scipy.interpolate import CubicSpline
 
         spectrum(self.name, 1.0)  # an unknown name fails here
-        seed = self.seed
-        # a whole float (3.0, as sweeps store numbers) is the same seed as 3
-        if (
-            isinstance(seed, bool)
-            or not isinstance(seed, (int, float, np.integer, np.floating))
-            or not float(seed).is_integer()
-            or seed < 0
-        ):
-            raise ValueError(f"seed = {seed!r}: must be a whole number >= 0")
-        object.__setattr__(self, "seed", int(seed))
+        # a Python int, never through a float (which rounds seeds past 2**53)
+        object.__setattr__(self, "seed", validation.seed("seed", self.seed))
         lo = _check("min_wavelength", self.min_wavelength, "positive", "a finite number > 0 (m)")
         hi = _check("max_wavelength", self.max_wavelength, "positive", "a finite number > 0 (m)")
         if not lo < hi:

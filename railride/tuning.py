@@ -47,7 +47,7 @@ from .objectives import (  # noqa: F401 (re-exported: the objectives' old home)
     RATIO_NAMES,
     Objective,
 )
-from . import dampers, validation
+from . import dampers, limits, validation
 from .solver import SolverSettings, check_resolution
 from .sweep import Case, RunTable, run_cases
 from .tune_result import SCHEMA, Curve, Study, TuneResult  # noqa: F401 (their home before)
@@ -83,6 +83,11 @@ def _utc_now() -> str:
 
 def _rms(rows: pd.DataFrame) -> np.ndarray:
     return rows[[f"{r}_rms" for r in RESPONSES]].to_numpy()
+
+
+#: what a candidate value of a sweep holds while it waits to run: the value, its case (a gain
+#: set) and its row in the run table, about 2 kB; the runs themselves are checked by simulate
+CANDIDATE_BYTES = 2048
 
 
 def _candidates(current: float, parameter: str, n_values: int, span: float, gains: GainSet) -> list[float]:
@@ -121,7 +126,7 @@ class TuningCase:
 def tuning_set(scenario: str = "fra4", *, track_seeds=None, speeds=None, loads=(1.0,), duration=None) -> tuple:
     """The `TuningCase` of every combination of track seed (random tracks only), speed [m/s]
     and load factor: what `tune(over=...)` scores each gain set on."""
-    seeds = [None] if track_seeds is None else [validation.integer("track_seeds", x, 0) for x in track_seeds]
+    seeds = [None] if track_seeds is None else [validation.seed("track_seeds", x) for x in track_seeds]
     speeds = [None] if speeds is None else [validation.number("speeds", v, "positive", "m/s") for v in speeds]
     loads = [validation.number("loads", x, "positive", allowed="a finite number > 0 (load factor)") for x in loads]
     out = []
@@ -224,6 +229,11 @@ def tune(
     # room for the start and one whole sweep (the values and 0): a smaller budget tunes nothing
     what = f"the start run and one sweep of {n_values} values and 0"
     budget = validation.integer("budget", budget, n_values + 2, what=what)
+    limits.check(
+        CANDIDATE_BYTES * n_values,
+        f"a sweep of {n_values} candidate values",
+        "use fewer values (13 a gain and pass is the default)",
+    )
     for name, value in (("span", span), ("min_span", min_span)):
         if not validation.number(name, value, "finite", allowed="a finite number > 1") > 1:
             raise ValueError(f"{name} = {validation.shown(value)}: must be a finite number > 1")

@@ -14,11 +14,17 @@ import numbers
 from dataclasses import field
 from typing import Any
 
+#: the largest seed: NumPy's generators take any whole number >= 0, but a seed must also
+#: survive the run table's CSV, whose readers hold whole numbers in 64 bits
+SEED_MAX = 2**64 - 1
+
 #: rule name -> (the words of the rule, the test on a finite float)
 RULES = {
     "positive": ("a finite number > 0", lambda v: v > 0.0),
     "nonnegative": ("a finite number >= 0", lambda v: v >= 0.0),
     "finite": ("a finite number", lambda v: True),
+    # checked by `seed`, never through a float: the test here is not used
+    "seed": ("a whole number >= 0 and <= 2**64 - 1", lambda v: False),
 }
 
 
@@ -27,20 +33,53 @@ def is_number(value) -> bool:
     return isinstance(value, numbers.Real) and not isinstance(value, bool)
 
 
+def as_float(value) -> float:
+    """A number as a float; a whole number too large for one (a 400-digit TOML integer) is
+    infinite, so that the finite-number rules refuse it instead of raising OverflowError."""
+    try:
+        return float(value)
+    except OverflowError:
+        return math.inf if value > 0 else -math.inf
+
+
+def obeys(value, rule: str) -> bool:
+    """Whether ``value`` is a finite number obeying `RULES` ``rule``."""
+    if not is_number(value):
+        return False
+    v = as_float(value)
+    return math.isfinite(v) and RULES[rule][1](v)
+
+
 def shown(value) -> str:
-    """``value`` as an error message shows it: NumPy scalars as the plain number they hold."""
-    if is_number(value) and type(value) not in (int, float):
-        value = value.item()
-    return repr(value)
+    """``value`` as an error message shows it: NumPy scalars as the plain number they hold
+    (float32 at its own precision: 0.1, not 0.10000000149011612), a huge whole number by its
+    first four digits and its power of ten, a float with float noise to four significant digits."""
+    if isinstance(value, (list, tuple)):
+        inner = ", ".join(map(shown, value)) + ("," if isinstance(value, tuple) and len(value) == 1 else "")
+        return f"[{inner}]" if isinstance(value, list) else f"({inner})"
+    if not is_number(value):
+        return repr(value)
+    if isinstance(value, numbers.Integral):
+        v = int(value)
+        if abs(v) < 10**30:  # seeds (up to 20 digits) shown exactly
+            return str(v)
+        # math.log10 takes any int; str() would refuse one past 4300 digits
+        power = int(math.log10(abs(v)))
+        mantissa = abs(v) / 10**power
+        if mantissa >= 10.0:
+            power, mantissa = power + 1, mantissa / 10.0
+        return f"{'-' if v < 0 else ''}{mantissa:.4g}e+{power} (a {power + 1}-digit whole number)"
+    text = str(value) if type(value) is not float else repr(value)
+    digits = sum(c.isdigit() for c in text.split("e")[0].lstrip("-0."))
+    return f"{float(value):.4g}" if digits > 10 else text
 
 
 def number(name: str, value, rule: str = "positive", unit: str = "", *, allowed: str | None = None) -> float:
     """``value`` as a float if it is a finite real number obeying ``rule`` (see `RULES`);
     else ValueError "name = value: must be <allowed> (unit)". ``allowed`` replaces the rule's
     words where a field needs its own (e.g. "a finite angle in degrees")."""
-    words, test = RULES[rule]
-    ok = is_number(value) and math.isfinite(float(value)) and test(float(value))
-    if not ok:
+    if not obeys(value, rule):
+        words = RULES[rule][0]
         text = allowed if allowed is not None else words + (f" ({unit})" if unit else "")
         raise ValueError(f"{name} = {shown(value)}: must be {text}")
     return float(value)
@@ -55,6 +94,18 @@ def integer(name: str, value, minimum: int, maximum: int | None = None, what: st
         raise ValueError(
             f"{name} = {shown(value)}: must be a whole number >= {minimum}{upper}" + (f" ({what})" if what else "")
         )
+    return int(value)
+
+
+def seed(name: str, value) -> int:
+    """``value`` as a Python int if it is a seed: a whole number in [0, `SEED_MAX`], Python or
+    NumPy; a whole float (3.0) too, as studies once stored seeds. Never passed through a float,
+    which would round seeds past 2**53 (9007199254740993 to ...992)."""
+    whole = isinstance(value, numbers.Integral) and not isinstance(value, bool)
+    if not whole and is_number(value) and math.isfinite(as_float(value)) and float(value).is_integer():
+        value, whole = int(value), True
+    if not (whole and 0 <= value <= SEED_MAX):
+        raise ValueError(f"{name} = {shown(value)}: must be {RULES['seed'][0]}")
     return int(value)
 
 
@@ -73,15 +124,35 @@ def param(unit: str, doc: str, rule: str = "positive") -> Any:
 
 def validate_fields(obj, what: str) -> None:
     """Check every field of a frozen parameter dataclass against the rule in its metadata and
-    store it as float; the error names the field, its value, its meaning and unit, and the rule."""
+    store it as float (a seed as int); the error names the field, its value, its meaning and
+    unit, and the rule."""
     for f in dataclasses.fields(obj):
         value = getattr(obj, f.name)
-        words, test = RULES[f.metadata["rule"]]
-        if not (is_number(value) and math.isfinite(float(value)) and test(float(value))):
-            raise ValueError(
-                f"{what} {f.name!r} = {shown(value)} ({f.metadata['doc']}, {f.metadata['unit']}): must be {words}"
-            )
-        object.__setattr__(obj, f.name, float(value))
+        rule = f.metadata["rule"]
+        if rule == "seed":
+            try:
+                object.__setattr__(obj, f.name, seed(f"{what} {f.name!r}", value))
+            except ValueError:
+                pass
+            else:
+                continue
+        elif obeys(value, rule):
+            object.__setattr__(obj, f.name, float(value))
+            continue
+        raise ValueError(
+            f"{what} {f.name!r} = {shown(value)} ({f.metadata['doc']}, {f.metadata['unit']}): must be {RULES[rule][0]}"
+        )
+
+
+def toml_error(exc: ValueError) -> str:
+    """What is wrong with a TOML text, from the ValueError of ``tomllib.loads``: its syntax
+    error, or an integer longer than Python converts (4300 digits), which it raises as a plain
+    ValueError that advises a Python setting."""
+    import tomllib
+
+    if isinstance(exc, tomllib.TOMLDecodeError):
+        return str(exc)
+    return "an integer with more than 4300 digits"
 
 
 def rule_words(rule: str) -> str:

@@ -9,21 +9,71 @@ and `tracking`); `_options` declares the options several commands share, `_parsi
 checks of their values, `_common` the errors, consoles and run machinery, `_render` the
 shared tables, `_width` the tables that fit the console's width (80 columns on a pipe).
 
-Exit statuses: 0 success, 1 the simulation diverged, 2 bad input (usage errors, invalid values,
-unreadable files, an output folder that cannot be written), 130 `tune`, `study`, `pareto` or `sweep`
-interrupted by Ctrl-C (the finished runs stay in DIR/runs.csv for --resume). Errors print one line
-``error: <message>`` on stderr, never a traceback.
+Exit statuses: 0 success (also when stdout is a pipe closed early: ``railride compare | head
+-1``), 1 an internal fault (a bug: please report it), 2 anything the user can fix (usage errors,
+invalid values, unreadable files, an output folder that cannot be written or that another
+railride process is writing, a run that diverged), 130 interrupted by Ctrl-C (`tune`, `study`,
+`pareto` and `sweep` keep their finished runs in DIR/runs.csv for --resume). Errors print one
+line ``error: <message>`` on stderr, never a traceback.
 """
 
 from __future__ import annotations
 
-# the commands register on `app` when imported, and `railride --help` lists them in this order
-from . import compare, report, modes, frf, simulate, rig, tune, pareto, sweep, study, ride_spectrum  # noqa: F401
-from ._app import app
+import sys
+from typing import TYPE_CHECKING
 
 __all__ = ["app", "main"]
 
+#: the command modules, which register on `app` when imported; `railride --help` lists the
+#: commands in this order
+COMMANDS = ("compare", "report", "modes", "frf", "simulate", "rig", "tune", "pareto", "sweep", "study", "ride_spectrum")
+
+if TYPE_CHECKING:
+    from ._app import app
+
+
+def _load():
+    """`app` with every command registered (the command modules import the library)."""
+    import importlib
+
+    for name in COMMANDS:
+        importlib.import_module(f".{name}", __name__)
+    from ._app import app
+
+    return app
+
+
+def __getattr__(name: str):
+    if name == "app":
+        return _load()
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
 
 def main() -> None:
-    """Entry point of the ``railride`` console script."""
-    app(prog_name="railride")
+    """Entry point of the ``railride`` console script: the commands are loaded here, not at
+    import, so that Ctrl-C during start-up is reported like Ctrl-C during a command (status 130,
+    no traceback); a stdout closed early is not an error (`railride.cli._app.RailrideGroup`
+    handles both within a command)."""
+    status: str | int | None = 0
+    try:
+        app = _load()
+        app(prog_name="railride")
+    except SystemExit as exc:
+        status = exc.code
+    except KeyboardInterrupt:
+        print("interrupted", file=sys.stderr)
+        status = 130  # _common.INTERRUPTED, which may not be loaded yet
+    except BrokenPipeError:  # outside a command: typer's own output (--help)
+        _quiet()
+        status = 0
+    try:  # what is still buffered goes now, and a reader gone by then is no error either
+        sys.stdout.flush()
+    except BrokenPipeError:
+        _quiet()
+    sys.exit(status)
+
+
+def _quiet() -> None:
+    from ._app import quiet_closed_pipe
+
+    quiet_closed_pipe()

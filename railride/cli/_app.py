@@ -2,9 +2,65 @@
 
 from __future__ import annotations
 
+import os
+import sys
+
 import typer
+from typer.core import TyperGroup
+
+from ._common import INTERRUPTED, OK
+
+__all__ = ["INTERRUPTED", "RailrideGroup", "app", "quiet_closed_pipe"]
+
+
+def _closed(stream) -> bool:
+    """Whether ``stream`` is a pipe whose reader has gone (poll reports an error on it)."""
+    import select
+
+    try:
+        poller = select.poll()
+        poller.register(stream.fileno(), select.POLLOUT)
+        return any(events & select.POLLERR for _, events in poller.poll(0))
+    except (AttributeError, OSError, ValueError):  # no file descriptor (a test's capture)
+        return False
+
+
+def quiet_closed_pipe() -> None:
+    """Point stdout (and stderr, if its reader has gone too) at the null device, so that what
+    is still buffered is dropped at exit instead of raising again (the Python documentation's
+    way with SIGPIPE)."""
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    for stream in (sys.stdout, sys.stderr):
+        if stream is sys.stdout or _closed(stream):
+            try:
+                os.dup2(devnull, stream.fileno())
+            except (AttributeError, OSError, ValueError):
+                pass
+    os.close(devnull)
+
+
+class RailrideGroup(TyperGroup):
+    """The command group: Ctrl-C in a command prints one line and exits 130 (typer would
+    exit 130 without a word; `tune`, `study`, `pareto` and `sweep` say first what they kept);
+    a stdout whose reader has gone (``railride compare | head -1``) ends the command quietly
+    with status 0, as a closed pipe is not an error (typer would exit 1, the status of an
+    internal fault). A BrokenPipeError from anything else is a fault."""
+
+    def invoke(self, ctx):
+        try:
+            return super().invoke(ctx)
+        except KeyboardInterrupt:
+            typer.echo("interrupted", err=True)
+            raise typer.Exit(INTERRUPTED) from None
+        except BrokenPipeError:
+            if not (_closed(sys.stdout) or _closed(sys.stderr)):
+                raise
+            quiet_closed_pipe()
+            raise typer.Exit(OK) from None
+
 
 app = typer.Typer(
+    cls=RailrideGroup,
     add_completion=False,
     no_args_is_help=True,
     pretty_exceptions_show_locals=False,

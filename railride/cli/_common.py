@@ -5,6 +5,8 @@ the machinery of the many-run commands (executors, run tables, Ctrl-C)."""
 from __future__ import annotations
 
 import contextlib
+import errno
+import functools
 import json
 import math
 import sys
@@ -28,20 +30,34 @@ def _one_line(exc: BaseException) -> str:
     return text or type(exc).__name__
 
 
+#: the exit statuses: success, an internal fault (a bug), anything the user can fix, Ctrl-C
+#: (128 + SIGINT, the shells' convention)
+OK, INTERNAL, USER, INTERRUPTED = 0, 1, 2, 130
+
+
 @contextlib.contextmanager
 def errors():
-    """ValueError -> status 2, RuntimeError -> 1, OSError -> 2: one line on stderr, no traceback."""
+    """ValueError, OSError and a diverged run (`railride.errors.DivergenceError`: its inputs
+    are the user's to change) -> status 2; any other RuntimeError, an internal fault -> 1. One
+    line on stderr, no traceback. A closed stdout (BrokenPipeError) and Ctrl-C pass through:
+    the entry point (`railride.cli._app`) deals with them."""
+    from ..errors import DivergenceError
+
     try:
         yield
     except CliError as exc:
         status, message = exc.status, _one_line(exc)
     except ValueError as exc:
-        status, message = 2, _one_line(exc)
+        status, message = USER, _one_line(exc)
+    except DivergenceError as exc:
+        status, message = USER, _one_line(exc)
     except RuntimeError as exc:
-        status, message = 1, _one_line(exc)
+        status, message = INTERNAL, _one_line(exc)
+    except BrokenPipeError:
+        raise
     except OSError as exc:
         where = f" ({exc.filename})" if getattr(exc, "filename", None) else ""
-        status, message = 2, f"{exc.strerror or exc}{where}"
+        status, message = USER, f"{exc.strerror or exc}{where}"
     else:
         return
     typer.echo(f"error: {message}", err=True)
@@ -97,14 +113,26 @@ def stdout_console(width: int = PIPE_WIDTH):
     Tables fit it (`railride.cli._width`)."""
     import os
 
-    from rich.console import Console
-
     try:
         terminal = sys.stdout.isatty()
     except (AttributeError, ValueError):
         terminal = False
     fixed = None if terminal or os.environ.get("COLUMNS") else width
-    return Console(file=sys.stdout, highlight=False, width=fixed)
+    return _console_type()(file=sys.stdout, highlight=False, width=fixed)
+
+
+@functools.cache
+def _console_type():
+    """rich's Console, but a reader gone from the pipe raises BrokenPipeError, for the entry
+    point to end quietly with status 0, where rich would exit with status 1."""
+    from rich.console import Console
+
+    class PipeConsole(Console):
+        def on_broken_pipe(self) -> None:
+            self.quiet = True
+            raise BrokenPipeError(errno.EPIPE, "the reader of the pipe has gone")
+
+    return PipeConsole
 
 
 #: the older name of `stdout_console`
@@ -112,9 +140,7 @@ wide_stdout_console = stdout_console
 
 
 def stderr_console():
-    from rich.console import Console
-
-    return Console(file=sys.stderr, highlight=False)
+    return _console_type()(file=sys.stderr, highlight=False)
 
 
 def status_note(message: str):
@@ -337,6 +363,7 @@ def open_run_table(out: Optional[Path], resume: bool):
             f"--out {out}: {path} exists (the run table of an earlier run); add "
             "--resume to continue it, or choose another folder"
         )
+    # locks the folder against a second writer until `interruptible` ends (or this process)
     return sweep_lib.RunTable(path, resume=resume), path
 
 
@@ -354,7 +381,8 @@ def _saved_runs(table, path: Optional[Path]) -> int:
 
 @contextlib.contextmanager
 def interruptible(table, path: Optional[Path]):
-    """Ctrl-C: one line saying what was kept, status 130, no traceback."""
+    """Ctrl-C: one line saying what was kept, status 130, no traceback. The run table's lock
+    is released at the end of the block, however it ends."""
     try:
         yield
     except KeyboardInterrupt:
@@ -367,7 +395,9 @@ def interruptible(table, path: Optional[Path]):
                 "in DIR/runs.csv and --resume continues them)",
                 err=True,
             )
-        raise typer.Exit(130) from None
+        raise typer.Exit(INTERRUPTED) from None
+    finally:
+        table.close()
 
 
 def command_line(ctx: typer.Context, exclude=()) -> str:

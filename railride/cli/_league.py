@@ -77,7 +77,7 @@ def run_league(
             duration=duration,
             window=parse_window(window) if window is not None else None,
             solver=solver,
-            progress=(lambda k, n: progress(k / n)) if progress.enabled else None,
+            progress=lambda k, n: progress(k / n),
         )
     doc = table.to_dict()
     text = json.dumps(doc, indent=2, allow_nan=False)

@@ -342,9 +342,16 @@ SchedulerFileOption = Annotated[
 
 
 # -- output folders -----------------------------------------------------------------------------
+def out_folder(text: str) -> Path:
+    """--out's value as a path; an empty one is refused (Path("") would be the current folder)."""
+    if not text.strip():
+        raise typer.BadParameter(f"{text!r} is an empty folder name; give a folder (--out . for the current one)")
+    return Path(text)
+
+
 def _out(help: str):
     help += " Figures as PNG at 120 dpi unless --figure-format or --dpi say otherwise."
-    return Annotated[Optional[Path], typer.Option("--out", metavar="DIR", help=help)]
+    return Annotated[Optional[Path], typer.Option("--out", metavar="DIR", help=help, parser=out_folder)]
 
 
 CompareOutOption = _out(
@@ -485,3 +492,30 @@ def history_options(history_format: Optional[str], out: Optional[Path]) -> tuple
         return history_formats(history_format)
     except ValueError as exc:
         raise ValueError(str(exc).replace("history_formats = ", "--history-format = ", 1)) from None
+
+
+# -- limits ---------------------------------------------------------------------------------------
+def _set_max_memory(value: Optional[str]) -> Optional[str]:
+    """Set the library's memory limit as the command starts (None: the default share of the
+    machine, so that one command's limit never carries over to the next in one process)."""
+    from .. import limits
+    from ._common import errors
+
+    with errors():
+        try:
+            limits.set_max_memory(value)
+        except ValueError as exc:
+            raise ValueError(str(exc).replace("max_memory", "--max-memory", 1)) from None
+    return value
+
+
+MaxMemoryOption = Annotated[
+    Optional[str],
+    typer.Option(
+        "--max-memory",
+        metavar="SIZE",
+        callback=_set_max_memory,
+        help="The most memory a run may take, e.g. 4G or 512M (powers of 1024); a larger run is "
+        "refused before it starts, saying what it would need. Default: half the machine's memory.",
+    ),
+]

@@ -37,34 +37,62 @@ def value_list(option: str, text: str, *, integer: bool = False, parse=None) -> 
             raise ValueError(
                 f"{option} = {text!r}: expected a range START:STOP:COUNT (e.g. 20:80:13) or a list a,b,c of {kind}"
             )
-        start, stop = (parse_float(option, text, p) for p in parts[:2])
+        number = _whole if integer else parse_float
+        start, stop = (number(option, text, p) for p in parts[:2])
         try:
             count = int(parts[2])
         except ValueError:
             raise ValueError(f"{option} = {text!r}: COUNT = {parts[2].strip()!r} is not a whole number") from None
         if count < 1:
             raise ValueError(f"{option} = {text!r}: COUNT = {count} must be >= 1")
-        import numpy as np
+        from ..limits import VALUE_BYTES, check
 
-        values = [_tidy(v) for v in np.linspace(start, stop, count)]
+        # each value is a Python number in a list and a set, and a case of the runs: ~1 kB
+        check(VALUE_BYTES * count, f"{option} = {text!r}: {count} values", "give a smaller COUNT")
+        if integer:
+            from fractions import Fraction
+
+            # exact steps between whole numbers: seeds past 2**53 are not rounded
+            span = Fraction(stop) - Fraction(start)  # exact, for floats (1e3) too
+            values = [start + i * span / max(count - 1, 1) for i in range(count)]
+        else:
+            import numpy as np
+
+            values = [_tidy(v) for v in np.linspace(start, stop, count)]
     else:
         items = text.split(",")
         if any(not item.strip() for item in items):
             raise ValueError(
                 f"{option} = {text!r}: an empty item; give a range START:STOP:COUNT or {kind} separated by commas"
             )
-        values = [parse(item) if parse else parse_float(option, text, item) for item in items]
+        number = _whole if integer and not parse else parse_float
+        values = [parse(item) if parse else number(option, text, item) for item in items]
     if integer:
-        bad = [v for v in values if not float(v).is_integer()]
+        bad = [v for v in values if v != int(v)]
         if bad:
-            raise ValueError(f"{option} = {text!r}: {bad[0]:g} is not a whole number")
+            raise ValueError(f"{option} = {text!r}: {float(bad[0]):g} is not a whole number")
         values = [int(v) for v in values]
     seen = set()
     for v in values:
         if v in seen:
-            raise ValueError(f"{option} = {text!r}: {v:g} is listed twice")
+            raise ValueError(f"{option} = {text!r}: {_shown(v)} is listed twice")
         seen.add(v)
     return values
+
+
+def _whole(option: str, text: str, item: str):
+    """A list item of whole numbers: an int read exactly (a seed past 2**53 stays itself),
+    else the number it is (3.0, 1e3; one with a fraction is refused by `value_list`)."""
+    try:
+        return int(item.strip())
+    except ValueError:
+        return parse_float(option, text, item)
+
+
+def _shown(value) -> str:
+    from ..validation import shown
+
+    return f"{value:g}" if isinstance(value, float) else shown(value)
 
 
 def default_of(fn, name: str):
@@ -224,6 +252,15 @@ TRACK_OPTIONS = (
 )
 #: the library's names of the random-track options, for its errors (`_common.option_names`)
 TRACK_FIELDS = {keyword: option for option, keyword, _ in TRACK_OPTIONS}
+#: the profiles' field names in the library's errors -> the options that set them
+PROFILE_FIELDS = {
+    "amplitude": "--amplitude",
+    "height": "--amplitude",
+    "wavelength": "--wavelength",
+    "length": "--wavelength",
+    "rail_phase": "--rail-phase",
+    "speed": "--speed",
+}
 
 
 def random_tracks() -> tuple:
@@ -271,7 +308,11 @@ def make_scenario(name: str, options: dict, output_rate: Optional[float] = None,
                 )
     from ._common import option_names
 
-    fields = {**TRACK_FIELDS, **({"output_rate": rate_option} if rate_option.startswith("--") else {})}
+    fields = {
+        **TRACK_FIELDS,
+        **PROFILE_FIELDS,
+        **({"output_rate": rate_option} if rate_option.startswith("--") else {}),
+    }
     defaults = [k for k in TRACK_FIELDS if k not in options]
     try:
         with option_names(fields, defaults):
@@ -295,13 +336,8 @@ def _scenario_options(**given) -> dict:
 
 
 def case_options(options: dict) -> dict:
-    """Scenario options for a sweep.Case: the track seed as a NumPy integer.
-
-    Case stores Python ints as floats, and a random track refuses a float seed; a NumPy
-    integer passes through Case unchanged (a workaround until Case keeps whole numbers)."""
-    import numpy as np
-
-    return {k: (np.int64(v) if k == "seed" else v) for k, v in options.items()}
+    """Scenario options for a sweep.Case (which keeps the track seed a Python int)."""
+    return dict(options)
 
 
 def study_scenario(

@@ -15,6 +15,7 @@ from ..defaults import DEFAULT_CONTROL_RATE, DEFAULT_DAMPER
 from ._app import app
 from ._common import ProgressBar, errors, option_names, stderr_is_terminal, stdout_console, write_folder
 from ._options import (
+    MaxMemoryOption,
     AmplitudeOption,
     ComfortOption,
     CompareDamperOption,
@@ -479,6 +480,7 @@ def compare(
     figure_format: FigureFormatOption = None,
     dpi: DpiOption = None,
     history_format: HistoryFormatOption = None,
+    max_memory: MaxMemoryOption = None,
 ) -> None:
     """Compare passive, PID and SAS suspensions on one scenario, as in the paper's Table 1.
 
@@ -594,7 +596,7 @@ def compare(
                 sensor_noise=noise,
                 comfort=comfort,
                 bounds=bounds,
-                progress=progress if progress.enabled else None,
+                progress=progress,
                 faults=faults,
                 delay=1 if delay is None else delay,
                 sensing=_sensing(sensing),

@@ -11,6 +11,7 @@ import typer
 from ._app import app
 from ._common import errors, option_names, print_json, stdout_console, write_folder
 from ._options import (
+    MaxMemoryOption,
     DpiOption,
     FigureFormatOption,
     FrfOutOption,
@@ -71,6 +72,7 @@ def frf(
     out: FrfOutOption = None,
     figure_format: FigureFormatOption = None,
     dpi: DpiOption = None,
+    max_memory: MaxMemoryOption = None,
 ) -> None:
     """Frequency responses of the passive vehicle: carbody bounce, pitch, roll and acceleration
     per metre of rail amplitude, for in-phase and anti-phase rails.

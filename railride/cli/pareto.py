@@ -22,6 +22,7 @@ from ._common import (
     write_folder,
 )
 from ._options import (
+    MaxMemoryOption,
     AmplitudeOption,
     DpiOption,
     DtOption,
@@ -144,6 +145,7 @@ def pareto_command(
     format: FormatOption = OutputFormat.table,
     figure_format: FigureFormatOption = None,
     dpi: DpiOption = None,
+    max_memory: MaxMemoryOption = None,
 ) -> None:
     """The trades a controller's gains offer: RMS ratios to passive of sampled gains.
 

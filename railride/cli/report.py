@@ -13,6 +13,7 @@ from ..defaults import DEFAULT_CONTROL_RATE, DEFAULT_DAMPER
 from ._app import app
 from ._common import CliError, command_line, errors, status_note
 from ._options import (
+    MaxMemoryOption,
     AmplitudeOption,
     ComfortOption,
     CompareDamperOption,
@@ -110,6 +111,7 @@ def report_command(
             help="The report: one HTML file (.html or .htm), replaced atomically; its folder is created if missing.",
         ),
     ] = Path("report.html"),
+    max_memory: MaxMemoryOption = None,
 ) -> None:
     """Run the paper's comparison as `railride compare` does and write it as one HTML file.
 

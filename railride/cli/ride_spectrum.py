@@ -13,6 +13,7 @@ import typer
 from ._app import app
 from ._common import errors, option_names, print_json, stdout_console, write_folder
 from ._options import (
+    MaxMemoryOption,
     DpiOption,
     FigureFormatOption,
     LoadOption,
@@ -108,6 +109,7 @@ def ride_spectrum(
     figure_format: FigureFormatOption = None,
     dpi: DpiOption = None,
     report: ReportOption = None,
+    max_memory: MaxMemoryOption = None,
 ) -> None:
     """The ride on a random track from the frequency response and the track spectrum, without a
     time simulation: PSDs, RMS and ISO 2631-1 Wb/Wk-weighted RMS of the carbody floor

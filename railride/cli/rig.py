@@ -11,6 +11,7 @@ from ..defaults import DEFAULT_DAMPER
 from ._app import app
 from ._common import errors, option_names, print_json, status_note, stdout_console, write_folder
 from ._options import (
+    MaxMemoryOption,
     DamperOutOption,
     DpiOption,
     FigureFormatOption,
@@ -71,6 +72,7 @@ def damper(
     out: DamperOutOption = None,
     figure_format: FigureFormatOption = None,
     dpi: DpiOption = None,
+    max_memory: MaxMemoryOption = None,
 ) -> None:
     """Hysteresis cycles of an MR damper on a test rig.
 
@@ -170,6 +172,7 @@ def tracking(
     out: TrackingOutOption = None,
     figure_format: FigureFormatOption = None,
     dpi: DpiOption = None,
+    max_memory: MaxMemoryOption = None,
 ) -> None:
     """Force tracking of an MR damper by the inner loop.
 

@@ -12,6 +12,7 @@ from ..defaults import DEFAULT_DAMPER
 from ._app import app
 from ._common import ProgressBar, errors, option_names, print_json, stderr_is_terminal, stdout_console, write_folder
 from ._options import (
+    MaxMemoryOption,
     AmplitudeOption,
     ComfortOption,
     DtOption,
@@ -157,6 +158,7 @@ def simulate(
     figure_format: FigureFormatOption = None,
     dpi: DpiOption = None,
     history_format: HistoryFormatOption = None,
+    max_memory: MaxMemoryOption = None,
 ) -> None:
     """Simulate the vehicle on a track and print the ride metrics."""
     with errors():
@@ -272,9 +274,7 @@ def _run(
             check_window(window, scen.duration)
 
         with ProgressBar(stderr_is_terminal()) as progress:
-            result = run_simulation(
-                scen, vehicle_params, secondary, solver=solver, progress=progress if progress.enabled else None
-            )
+            result = run_simulation(scen, vehicle_params, secondary, solver=solver, progress=progress)
         doc = result.to_dict(window, comfort=comfort, vehicle=vehicle_record)
     if out is not None:
         write_folder(out, lambda: write_outputs(result, out, doc, figures=figures, histories=histories))

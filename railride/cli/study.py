@@ -23,6 +23,7 @@ from ._common import (
     write_folder,
 )
 from ._options import (
+    MaxMemoryOption,
     DpiOption,
     DtOption,
     FigureFormatOption,
@@ -235,6 +236,7 @@ def study_command(
     figure_format: FigureFormatOption = None,
     dpi: DpiOption = None,
     report: ReportOption = None,
+    max_memory: MaxMemoryOption = None,
 ) -> None:
     """Statistics over many tracks: every controller on every track seed and speed, for each
     load factor and fault condition; mean and 5th-95th percentiles of each RMS response and

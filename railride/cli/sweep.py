@@ -28,6 +28,7 @@ from ._common import (
     write_folder,
 )
 from ._options import (
+    MaxMemoryOption,
     DpiOption,
     DtOption,
     FigureFormatOption,
@@ -201,6 +202,7 @@ def sweep_command(
     figure_format: FigureFormatOption = None,
     dpi: DpiOption = None,
     report: ReportOption = None,
+    max_memory: MaxMemoryOption = None,
 ) -> None:
     """Run a grid of cases: every combination of the given values (a cartesian product).
 

@@ -25,6 +25,7 @@ from ._common import (
     write_folder,
 )
 from ._options import (
+    MaxMemoryOption,
     AmplitudeOption,
     BoundOption,
     DpiOption,
@@ -425,6 +426,7 @@ def tune_command(
     figure_format: FigureFormatOption = None,
     dpi: DpiOption = None,
     report: ReportOption = None,
+    max_memory: MaxMemoryOption = None,
 ) -> None:
     """Tune every law's gains by the paper's sensitivity study (its section V), alike.
 

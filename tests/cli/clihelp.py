@@ -13,8 +13,17 @@ runner = CliRunner()
 PNG = b"\x89PNG\r\n\x1a\n"
 
 
-def run(*args):
-    return runner.invoke(app, [str(a) for a in args])
+def run(*args, **kwargs):
+    """The command's result. An exception other than SystemExit (which every exit, clean or
+    not, raises) fails the test with its traceback: CliRunner keeps exceptions out of the
+    output, so a check for "Traceback" in it could never fail."""
+    result = runner.invoke(app, [str(a) for a in args], **kwargs)
+    if result.exception is not None and not isinstance(result.exception, SystemExit):
+        import traceback
+
+        trace = "".join(traceback.format_exception(*result.exc_info)) if result.exc_info else ""
+        raise AssertionError(f"railride {' '.join(map(str, args))} raised instead of exiting:\n{trace}")
+    return result
 
 
 def ok(*args):
@@ -34,7 +43,7 @@ def assert_input_error(result, *fragments):
     assert isinstance(result.exception, SystemExit)
     lines = result.stderr.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("error: "), result.stderr
-    assert "Traceback" not in result.output
+    assert "Traceback" not in result.output  # and no exception but SystemExit (checked above)
     assert result.stdout == ""
     for fragment in fragments:
         if fragment is not None:

@@ -247,7 +247,7 @@ def test_params_and_preset_exclusive(tmp_path):
 
 
 def test_option_not_for_scenario():
-    assert_input_error(run("simulate", "--scenario", "bump", "--rail-phase", 30), "rail_phase")
+    assert_input_error(run("simulate", "--scenario", "bump", "--rail-phase", 30), "--rail-phase")
 
 
 def test_unknown_format():
@@ -262,18 +262,20 @@ def test_not_a_number_is_usage_error():
     assert result.exit_code == 2 and "Traceback" not in result.output
 
 
-def test_diverged_run_status_1(monkeypatch):
+def test_diverged_run_status_2(monkeypatch):
     import importlib
+
+    from railride.errors import DivergenceError
 
     # the module, not the function of the same name that railride/__init__.py re-exports
     core = importlib.import_module("railride.simulation")
 
     def boom(*args, **kwargs):
-        raise RuntimeError("the simulation diverged (sample 0 at t = 1 s)")
+        raise DivergenceError("the simulation diverged (sample 0 at t = 1 s)")
 
     monkeypatch.setattr(core, "simulate", boom)
     result = run("simulate", "--duration", 1)
-    assert result.exit_code == 1
+    assert result.exit_code == 2  # its inputs diverged: the user's to change
     assert result.stderr.strip() == "error: the simulation diverged (sample 0 at t = 1 s)"
     assert "Traceback" not in result.output
 
@@ -327,7 +329,7 @@ def test_module_entry_point_error_path():
         [sys.executable, "-m", "railride.cli", "simulate", "--speed", "-3"], capture_output=True, text=True, timeout=120
     )
     assert proc.returncode == 2
-    assert proc.stderr.strip().splitlines() == ["error: speed = -3.0: must be a finite number > 0 (m/s)"]
+    assert proc.stderr.strip().splitlines() == ["error: --speed = -3.0: must be a finite number > 0 (m/s)"]
     assert proc.stdout == ""
 
 

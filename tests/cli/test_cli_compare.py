@@ -301,19 +301,21 @@ def test_failing_plot_leaves_out_absent(tmp_path, monkeypatch):
     assert not out.exists() and list(tmp_path.iterdir()) == []
 
 
-def test_diverged_run_status_1(tmp_path, monkeypatch):
+def test_diverged_run_status_2(tmp_path, monkeypatch):
     import importlib
+
+    from railride.errors import DivergenceError
 
     # the module, not the function of the same name that railride/__init__.py re-exports
     compare_module = importlib.import_module("railride.comparison")
 
     def boom(*args, **kwargs):
-        raise RuntimeError("the simulation diverged (sample 1 at t = 1 s)")
+        raise DivergenceError("the simulation diverged (sample 1 at t = 1 s)")
 
     monkeypatch.setattr(compare_module, "compare", boom)
     out = tmp_path / "absent"
     result = run(*SHORT, "--out", out)
-    assert result.exit_code == 1
+    assert result.exit_code == 2
     assert result.stderr.strip() == "error: the simulation diverged (sample 1 at t = 1 s)"
     assert not out.exists()
 

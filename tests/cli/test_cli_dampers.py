@@ -276,16 +276,17 @@ def test_simulate_mr_out(tmp_path):
 
 
 # -- failures after the run -------------------------------------------------------------------------
-def test_diverged_rig_run_status_1(tmp_path, monkeypatch):
+def test_diverged_rig_run_status_2(tmp_path, monkeypatch):
     from railride import rig
+    from railride.errors import DivergenceError
 
     def boom(*args, **kwargs):
-        raise RuntimeError("the damper rig run diverged: a state stopped being finite")
+        raise DivergenceError("the damper rig run diverged: a state stopped being finite")
 
     monkeypatch.setattr(rig, "cycles", boom)
     out = tmp_path / "absent"
     result = run(*DAMPER, "--voltage", "1", "--out", out)
-    assert result.exit_code == 1
+    assert result.exit_code == 2
     assert result.stderr.strip() == "error: the damper rig run diverged: a state stopped being finite"
     assert "Traceback" not in result.output and not out.exists()
 

@@ -219,6 +219,7 @@ def test_the_ideal_actuator_has_no_force_capacity_to_scale():
 def _input_error(args, *fragments):
     result = runner.invoke(app, [str(a) for a in args])
     assert result.exit_code == 2, (result.exit_code, result.stdout, result.stderr)
+    assert isinstance(result.exception, SystemExit), result.exception  # CliRunner hides tracebacks
     lines = result.stderr.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("error: "), result.stderr
     assert "Traceback" not in result.output and result.stdout == ""

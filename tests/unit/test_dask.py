@@ -237,6 +237,7 @@ class Counting:
 
 def test_the_cluster_listens_on_loopback_only(cluster):
     psutil = pytest.importorskip("psutil")
+    assert cluster.procs  # the loop below checks something
     for name, proc in cluster.procs.items():
         p = psutil.Process(proc.pid)
         conns = p.net_connections("inet") if hasattr(p, "net_connections") else p.connections("inet")

@@ -109,7 +109,9 @@ def test_the_output_rate_must_resolve_a_random_track():
     ):
         check_resolution(fine, 1000.0)
     check_resolution(fine, 555.6 * RESOLUTION)
-    check_resolution(scenario("paper-sine", speed=300.0), 10.0)  # no random track, nothing to resolve
+    check_resolution(scenario("paper-sine", speed=100.0), 10.0)  # 60 m at 100 m/s: 1.67 Hz <= 4 Hz
+    with pytest.raises(ValueError, match="wavelength = 60 m"):  # the sine is checked too: 2.5 Hz > 2 Hz
+        check_resolution(scenario("paper-sine", speed=150.0), 5.0)
     with pytest.raises(ValueError, match="output_rate 1000 Hz"):
         simulate(fine)
 

@@ -210,6 +210,7 @@ def test_the_ride_loop_starts_from_zero_ride_gains():
     # swept around REFERENCE (the centre for a gain at 0), not around the start's 7e4
     assert first.values.max() == pytest.approx(REFERENCE[first.parameter] * 30, rel=1e-3)
     assert 7e4 not in first.values
+    assert res.gains.ride.to_dict()  # the loop below checks something
     for name, value in res.gains.ride.to_dict().items():
         tried = {v for c in res.curves if c.parameter == f"ride.{name}" for v in c.values}
         assert value in tried and value != 7e4

@@ -1,0 +1,124 @@
+"""Sizes are estimated before anything large is allocated (railride.limits), wavelengths the
+output cannot resolve are refused for every profile, and inputs outside the plausible ranges
+are input errors."""
+
+from __future__ import annotations
+
+import math
+import time
+
+import pytest
+
+import railride as rr
+from railride import limits, rig
+from railride.frf import frequency_responses
+from railride.metrics import parse_window
+from railride.solver import SolverSettings
+from railride.track import CosineBump, Scenario, SineTrack, scenario
+
+
+def test_parse_size_reads_units_in_powers_of_1024():
+    assert limits.parse_size("4G") == 4 * 1024**3
+    assert limits.parse_size("512M") == 512 * 1024**2
+    assert limits.parse_size("1.5GiB") == 3 * 1024**3 // 2
+    assert limits.parse_size("2097152") == 2 * 1024**2
+    for bad in ("abc", "4X", "-1G", "0", "inf"):
+        with pytest.raises(ValueError, match="max_memory"):
+            limits.parse_size(bad)
+
+
+def test_the_limit_is_a_share_of_the_machine_and_restored_after_a_block():
+    total = limits.machine_memory()
+    assert total is None or limits.default_max_memory() == total // 2
+    with limits.memory_limit("64M"):
+        assert limits.max_memory() == 64 * 2**20
+    assert limits.max_memory() == limits.default_max_memory()
+
+
+def _refused_fast(fn, *fragments):
+    started = time.perf_counter()
+    with pytest.raises(ValueError) as info:
+        fn()
+    assert time.perf_counter() - started < 10.0
+    for fragment in fragments:
+        assert fragment in str(info.value), str(info.value)
+    return str(info.value)
+
+
+def test_a_billion_frf_points_are_refused_before_allocating():
+    # a billion complex responses of 9 DOF alone are 134 GiB: far above any default limit
+    message = _refused_fast(lambda: frequency_responses(points=10**9), "points", "fewer points", "--max-memory")
+    assert "TiB" in message or "GiB" in message
+
+
+def test_damper_rig_at_a_microhertz_or_a_billion_cycles_is_refused():
+    _refused_fast(lambda: rig.cycles("railway", 0.01, 1e-6, [1.0]), "4e+10 steps", "raise the frequency")
+    _refused_fast(lambda: rig.cycles("railway", 0.01, 1.0, [1.0], n_cycles=10**9), "1e+13 steps", "fewer cycles")
+
+
+def test_a_picosecond_step_is_refused_with_what_the_run_would_need():
+    solver = SolverSettings(dt=1e-12)
+    _refused_fast(lambda: rr.simulate("paper-sine", solver=solver), "memory", "dt 1e-12 s")
+
+
+def test_a_control_rate_slower_than_the_run_is_refused():
+    solver = SolverSettings(control_rate=1e-300)
+    pid = rr.Suspension.named("pid")
+    _refused_fast(
+        lambda: rr.simulate("paper-sine", suspension=pid, solver=solver), "control_rate = 1e-300 Hz", "0.1 Hz"
+    )
+
+
+def test_a_billion_tuning_candidates_are_refused():
+    _refused_fast(lambda: rr.tune(n_values=10**9, budget=10**9 + 2), "1000000000 candidate values")
+
+
+def test_the_limit_refuses_and_admits_the_same_run():
+    short = scenario("paper-sine", duration=1.0)
+    with limits.memory_limit("1M"):
+        # 1001 samples x 47 channels x 8 bytes alone are 0.36 MiB, the input tables more
+        with pytest.raises(ValueError, match="limit of 1 MiB"):
+            rr.simulate(short, solver=SolverSettings(output_rate=10000.0))
+    with limits.memory_limit("256M"):
+        assert math.isfinite(float(rr.simulate(short).metrics().sel(response="acceleration_m_s2", statistic="rms")))
+
+
+@pytest.mark.parametrize(
+    "track,field", [(SineTrack(wavelength=1e-6), "wavelength"), (CosineBump(length=0.01), "length")]
+)
+def test_wavelengths_the_output_cannot_resolve_are_refused_for_every_profile(track, field):
+    # at 55.56 m/s and 1000 Hz (2.5 samples a cycle at least) the shortest is 2.5 x 55.56 / 1000 m
+    message = _refused_fast(lambda: rr.simulate(Scenario(track=track, speed=55.56)), f"{field} = ", "0.1389 m")
+    assert "output_rate" in message
+
+
+def test_a_wavelength_just_above_the_shortest_runs():
+    result = rr.simulate(Scenario(track=SineTrack(wavelength=0.14), speed=55.56, duration=0.5))
+    assert math.isfinite(float(result.metrics().max()))
+
+
+@pytest.mark.parametrize(
+    "make,fragment",
+    [
+        (lambda: SineTrack(amplitude=100.0), "amplitude = 100 m"),
+        (lambda: SineTrack(rail_phase_deg=1e308), "rail_phase = 1e+308 deg"),
+        (lambda: CosineBump(height=-3.0), "height = -3 m"),
+        (lambda: Scenario(speed=1e5), "speed = 1e+05 m/s"),
+    ],
+)
+def test_implausible_tracks_and_speeds_are_input_errors(make, fragment):
+    with pytest.raises(ValueError, match="plausible") as info:
+        make()
+    assert fragment in str(info.value)
+
+
+def test_plausible_edges_are_accepted():
+    assert SineTrack(amplitude=1.0, rail_phase_deg=-360.0).amplitude == 1.0
+    assert Scenario(speed=200.0).speed == 200.0
+
+
+def test_the_window_is_finite():
+    assert parse_window("2:") == (2.0, math.inf)  # an empty END: the end of the run
+    for text in ("0:inf", "nan:5", "0:-inf"):
+        with pytest.raises(ValueError, match="finite"):
+            parse_window(text)
