@@ -9,7 +9,8 @@ its time; the ratio is each time over railride's exact path. Peers: railride's R
 (dt = 1e-4 s), SciPy's solve_ivp with LSODA and RK45 (rtol 1e-6, atol 1e-9, output at 1 kHz),
 a NumPy RK4 loop at dt = 1e-4 s, and python-control's forced_response (when installed; inputs
 sampled at 1 kHz and interpolated linearly, so it solves a slightly different input).
-Wall-clock minima over the repeats (the slow peers run once); no test asserts timings.
+Also: an outer loop on the ideal actuator, exact against RK4, and `ride_spectrum` beside a 60 s
+random run. Wall-clock minima over the repeats (the slow peers run once); no test asserts timings.
 """
 
 from __future__ import annotations
@@ -102,11 +103,35 @@ def main():
         response = control.forced_response(sys, t_out, U)
         record("python-control forced_response, inputs at 1 kHz", seconds, np.asarray(response.outputs).ravel())
 
+    # the other linear case: an outer loop on the ideal actuator (exact steps against RK4), and the
+    # frequency-domain ride of four laws beside a 60 s random run in the time domain
+    sas = rr.Suspension.named("sas-attitude-ride", damper="ideal")
+    rr.simulate(sc, suspension=sas)
+    closed = {
+        m: min_time(lambda m=m: rr.simulate(sc, suspension=sas, solver=rr.SolverSettings(method=m)), args.repeat)
+        for m in ("auto", "rk4")
+    }
+    from railride.ride_spectrum import ride_spectrum
+
+    ride_spectrum("fra4", points=100)
+    spectrum = min_time(lambda: ride_spectrum("fra4"), args.repeat)
+    long_run = rr.scenario("fra4", duration=60.0)
+    rr.simulate(long_run, suspension=sas)
+    random_run = min_time(lambda: rr.simulate(long_run, suspension=sas), args.repeat)
+
     print(f"scenario {args.scenario}, 10 s, passive vehicle, output at 1 kHz\n")
     print("| method | time | x railride exact | largest difference / largest bounce |")
     print("|---|---|---|---|")
     for name, seconds, error in rows:
         print(f"| {name} | {seconds * 1e3:.1f} ms | {seconds / exact:.1f} | {error:.1e} |")
+    print(
+        f"\nSAS (attitude+ride) on the ideal actuator, 10 s {args.scenario}: exact {closed['auto'] * 1e3:.1f} ms, "
+        f"RK4 {closed['rk4'] * 1e3:.1f} ms"
+    )
+    print(
+        f"ride_spectrum('fra4'), four laws, 2000 frequencies: {spectrum * 1e3:.0f} ms; "
+        f"one 60 s fra4 run of the same SAS in the time domain: {random_run * 1e3:.0f} ms"
+    )
 
 
 if __name__ == "__main__":

@@ -19,6 +19,7 @@ x_{n+1} = Phi x_n + maps[n % period] (the nodes of step n), compiled (`kernels.e
 from __future__ import annotations
 
 import math
+import functools
 from functools import lru_cache
 
 import numpy as np
@@ -82,8 +83,9 @@ class ExactStepper:
     increment of an output step of phase p from the input-table rows it touches (`padded`)."""
 
     def __init__(self, A, Bw, Bwd, dt: float, stride: int, m: int):
-        self.A, self.dt, self.stride, self.m = A, dt, stride, m
-        self.Phi, _ = _exponentials(A, stride * dt)
+        self.stride, self.m = stride, m
+        by_length = _by_length(A, dt)
+        self.Phi = by_length(stride)[0]
         period = math.lcm(stride, m) // stride  # output steps before the pattern of splits repeats
         #: nodes an output step touches, from the first node at or before its start
         self.span = (stride + m - 1) // m + 2
@@ -95,8 +97,8 @@ class ExactStepper:
             while s < b:
                 node = s // m
                 end = min(b, (node + 1) * m)
-                phi_rest = _cached(self, b - end)[0]
-                gamma = _cached(self, end - s)[1]
+                phi_rest = by_length(b - end)[0]
+                gamma = by_length(end - s)[1]
                 seg = phi_rest @ _segment_map(gamma, Bw, Bwd, (s - node * m) / m, m * dt)
                 first = (node - base) * N_INPUT
                 # node data order: w_k, w'_k, w_k+1, w'_k+1 -> the table rows k, k+1 (w then w')
@@ -113,12 +115,15 @@ class ExactStepper:
         return _padded(utab, ((n_out - 1) * self.stride) // self.m + self.span)
 
 
-def _cached(stepper: ExactStepper | ClosedStepper, steps: int) -> tuple[np.ndarray, np.ndarray]:
-    """(e^{AL}, Gamma) for L = steps * dt, computed once per stepper and length."""
-    cache = stepper.__dict__.setdefault("_cache", {})
-    if steps not in cache:
-        cache[steps] = _exponentials(stepper.A, steps * stepper.dt)
-    return cache[steps]
+def _by_length(A: np.ndarray, dt: float):
+    """steps -> (e^{AL}, Gamma) for L = steps * dt (`_exponentials`), each length computed once:
+    a pattern of stretches repeats few lengths."""
+
+    @functools.cache
+    def exponentials(steps: int) -> tuple[np.ndarray, np.ndarray]:
+        return _exponentials(A, steps * dt)
+
+    return exponentials
 
 
 @lru_cache(maxsize=16)
@@ -214,7 +219,7 @@ class ClosedStepper:
     step in the pattern."""
 
     def __init__(self, A, Bw, Bwd, Bf, dt: float, stride: int, ctrl: int, m: int):
-        self.A, self.dt = A, dt
+        by_length = _by_length(A, dt)
         period = math.lcm(stride, ctrl, m)
         marks = sorted(set(range(0, period, stride)) | set(range(0, period, ctrl)) | set(range(0, period, m)))
         ends = marks[1:] + [period]
@@ -225,7 +230,7 @@ class ClosedStepper:
         self.rail = np.empty((n, N_STATE, 32))
         self.force = np.empty((n, N_STATE, 4))
         for i, (a, b) in enumerate(zip(marks, ends)):
-            phi, gamma = _cached(self, b - a)
+            phi, gamma = by_length(b - a)
             self.phi[i] = phi
             self.rail[i] = _segment_map(gamma, Bw, Bwd, (a % m) / m, m * dt)
             self.force[i] = gamma[0] @ Bf

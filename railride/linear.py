@@ -81,6 +81,11 @@ class LinearModel:
             raise ValueError(f"{kind[:-1]} {name!r} is not in the model; allowed: {', '.join(names)}")
         return names.index(name)
 
+    def corner_forces(self) -> np.ndarray:
+        """The rows of C (4 x states) that give the secondary forces on the carbody, per corner:
+        a closed loop's demand G x + H xi."""
+        return self.C[[self.index("outputs", f"secondary_force_{c}_on_carbody") for c in CORNER_NAMES]]
+
     def frequency_response(self, frequency_hz) -> np.ndarray:
         """G(j 2 pi f) = C (j 2 pi f I - A)^-1 B + D for every frequency [Hz]: (n_f, outputs,
         inputs), complex."""

@@ -241,18 +241,12 @@ def ride_spectrum(
     for name, suspension in linear_suspensions(controllers, gains).items():
         model = linear_model(vehicle_params, suspension)
         try:
-            _check_stable(name, model, control_rate, delay)
+            _check_stable(name, model, plant, control_rate, delay)
         except ValueError as exc:  # the others go on; the result names it
             not_run[name] = str(exc)
             continue
         names.append(name)
-        if model.secondary in ("passive", "plant"):
-            base, gain = model, None
-        else:
-            base, gain = (
-                plant,
-                model.C[[model.index("outputs", f"secondary_force_{c}_on_carbody") for c in CORNER_NAMES]],
-            )
+        base, gain = (model, None) if model.secondary in ("passive", "plant") else (plant, model.corner_forces())
         y = {k: responses(base, gain, u, h, frequency) for k, u in inputs.items()}
         for r in RESPONSES:
             i = base.index("outputs", r)
@@ -303,19 +297,16 @@ def ride_spectrum(
     return RideSpectrum(ds, rms, weighted_da, settings, vehicle_params)
 
 
-def _check_stable(name: str, model: LinearModel, control_rate, delay: int) -> None:
+def _check_stable(name: str, model: LinearModel, plant: LinearModel, control_rate, delay: int) -> None:
     """Refuse a loop that is unstable: the continuous loop by the eigenvalues of A; with a
     control rate, the sampled loop as the engine runs it (the plant discretised exactly over a
     period with the demand held, the demand taking effect ``delay`` periods after its sample)
     by the eigenvalues of its transition matrix."""
-    if model.secondary in ("passive", "plant"):
-        worst = float(np.max(np.linalg.eigvals(model.A).real))
-        unstable, where = worst >= 0, f"a pole at Re = {worst:.3g} 1/s"
-    elif control_rate is None:
+    if model.secondary in ("passive", "plant") or control_rate is None:
         worst = float(np.max(np.linalg.eigvals(model.A).real))
         unstable, where = worst >= 0, f"a pole at Re = {worst:.3g} 1/s"
     else:
-        radius = float(np.max(np.abs(np.linalg.eigvals(_sampled_loop(model, 1.0 / control_rate, delay)))))
+        radius = float(np.max(np.abs(np.linalg.eigvals(_sampled_loop(model, plant, 1.0 / control_rate, delay)))))
         unstable = radius >= 1
         where = f"sampled at {control_rate:g} Hz with a delay of {delay} periods, a pole at |z| = {radius:.4g}"
     if unstable:
@@ -325,16 +316,16 @@ def _check_stable(name: str, model: LinearModel, control_rate, delay: int) -> No
         )
 
 
-def _sampled_loop(model: LinearModel, period: float, delay: int) -> np.ndarray:
+def _sampled_loop(model: LinearModel, plant: LinearModel, period: float, delay: int) -> np.ndarray:
     """The transition matrix over one controller period of the loop the engine runs: the
     state (x, the demands of the last ``delay`` samples), x_{k+1} = Phi x_k + Gamma f_k with
     f_k the demand sampled ``delay`` periods before (0 periods: the demand of this sample)."""
     import scipy.linalg
 
     n = model.A.shape[0]
-    F = model.C[[model.index("outputs", f"secondary_force_{c}_on_carbody") for c in CORNER_NAMES]]
+    F = model.corner_forces()
     Bf = np.zeros((n, 4))
-    Bf[: 2 * N_DOF] = linear_model(model.params, "plant").B[:, 16:20]
+    Bf[: 2 * N_DOF] = plant.B[:, 16:20]  # the corner forces' inputs
     A0 = model.A - Bf @ F  # the open loop (with its integrators)
     # Phi = e^{A0 T} and Gamma = int_0^T e^{A0 s} ds Bf in one exponential (Van Loan)
     E = scipy.linalg.expm(np.block([[A0, Bf], [np.zeros((4, n + 4))]]) * period)
