@@ -1,12 +1,16 @@
-"""Cold and warm start of `railride compare`: a fresh process with an empty numba cache (what the
-first run after install meets), then the same cache again (every later run); wall and CPU time
-of each, the import of railride alone, and the compile time of each kernel the comparison
-builds (timed on numba's compile events, in one cold process).
+"""Cold and warm start of `railride compare`.
 
-Run:  python benchmarks/bench_cold_start.py [--repeat N]
-Target: first `railride compare` after install <= 5 s. Prints a Markdown table for
+First the README's quick start in a fresh virtual environment: ``pip install .`` of this source
+tree (whose build compiles the engine into the package, setup.py), then the first and second
+`railride compare`; and the same with RAILRIDE_NO_PRECOMPILE=1 (the build skips the engine, so
+the first run compiles it). Then, with the installed railride: a fresh process with an empty
+numba cache, the same cache again, the import alone, and the compile time of each kernel the
+comparison builds (timed on numba's compile events, in one cold process).
+
+Run:  python benchmarks/bench_cold_start.py [--repeat N] [--no-install]
+Target: first `railride compare` after install <= 5 s. Prints Markdown tables for
 docs/performance.md ("Cold start"). CPU time is less disturbed than wall time by other work on
-a shared machine; each row keeps the shortest of N repeats.
+a shared machine; each row keeps the shortest of N repeats (the installs run once).
 """
 
 from __future__ import annotations
@@ -45,9 +49,12 @@ print(json.dumps({"import": t_import, "compile": times}))
 """
 
 
-def _run(cmd, cache: str) -> tuple[float, float, str]:
-    """(wall, CPU of the child [s], its stderr) of ``cmd`` with numba's cache in ``cache``."""
-    env = dict(os.environ, NUMBA_CACHE_DIR=cache)
+def _run(cmd, cache: str | None, env: dict | None = None) -> tuple[float, float, str]:
+    """(wall, CPU of the child [s], its stderr) of ``cmd`` with numba's cache in ``cache`` (None:
+    numba's own choice, next to the package)."""
+    env = dict(os.environ if env is None else env)
+    if cache is not None:
+        env["NUMBA_CACHE_DIR"] = cache
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
     out = subprocess.run(cmd, env=env, check=True, capture_output=True, text=True)
@@ -57,10 +64,39 @@ def _run(cmd, cache: str) -> tuple[float, float, str]:
     return wall, cpu, out.stderr + out.stdout
 
 
+def _fresh_install(precompile: bool) -> None:
+    """The README's first command in a new virtual environment, timed by step."""
+    source = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    venv = tempfile.mkdtemp(prefix="railride-venv-")
+    env = {k: v for k, v in os.environ.items() if k not in ("NUMBA_CACHE_DIR", "RAILRIDE_NO_PRECOMPILE")}
+    if not precompile:
+        env["RAILRIDE_NO_PRECOMPILE"] = "1"
+    try:
+        subprocess.run([sys.executable, "-m", "venv", venv], check=True)
+        py, rr = os.path.join(venv, "bin", "python"), os.path.join(venv, "bin", "railride")
+        label = "engine compiled by the build" if precompile else "RAILRIDE_NO_PRECOMPILE=1"
+        rows = [("`pip install .`", _run([py, "-m", "pip", "install", "-q", source], None, env)[:2])]
+        for what in ("first `railride compare`", "second `railride compare`"):
+            wall, cpu, err = _run([rr, "compare"], None, env)
+            notes = [line for line in err.splitlines() if line.startswith("compiling")]
+            rows.append((what + (f" (stderr: {notes[0]})" if notes else ""), (wall, cpu)))
+        for what, (wall, cpu) in rows:
+            print(f"| {label} | {what} | {wall:.1f} s | {cpu:.1f} s |")
+    finally:
+        shutil.rmtree(venv, ignore_errors=True)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=2, help="repeats of each measurement (the best is kept)")
+    parser.add_argument("--no-install", action="store_true", help="skip the fresh-install rows")
     args = parser.parse_args()
+    if not args.no_install:
+        print("| install | step | wall | CPU |")
+        print("|---|---|---|---|")
+        _fresh_install(precompile=True)
+        _fresh_install(precompile=False)
+        print()
     railride = shutil.which("railride") or sys.exit("railride is not installed (python -m pip install .)")
     cold: list[tuple[float, float]] = []
     warm: list[tuple[float, float]] = []

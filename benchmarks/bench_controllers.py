@@ -6,7 +6,8 @@ Prints a Markdown table for docs/performance.md: per law, one 10 s run on `paper
 (attitude+ride); then a league table of five controllers on three scenarios at two speeds, warm.
 Wall-clock minima over the repeats, and the minimum of the process's CPU time, which other jobs on
 a shared machine disturb less (with one thread it is the run's own time on its core); no test
-asserts timings. ``--threads 1`` measures one core.
+asserts timings. ``--threads 1`` measures one core, and adds the compiled stepper's own CPU
+time per step (the thread's time around the kernel call, without the input table and metrics).
 """
 
 from __future__ import annotations
@@ -43,22 +44,49 @@ def main():
     from railride.control import CONTROLLERS
     from railride.league import league
 
+    from railride import kernels
+
+    stepper: list[float] = []  # the CPU time of each kernel call in this thread
+    run_parallel = kernels.run_parallel
+
+    def timed(kernel, n_samples, *rest):
+        t0 = time.thread_time()
+        run_parallel(kernel, n_samples, *rest)
+        stepper.append(time.thread_time() - t0)
+
+    if args.threads == 1:  # one thread: the kernel runs in this thread, so its time is measurable
+        kernels.run_parallel = timed
+
+    def stepper_time(run) -> float:
+        best = float("inf")
+        for _ in range(args.repeat):
+            stepper.clear()
+            run()
+            best = min(best, sum(stepper))
+        return best
+
     sc = scenario("paper-sine")
     steps = round(sc.duration / 1e-4)
     laws = [n for n in CONTROLLERS if n != "passive"]
-    times, cpu = {}, {}
+    times, cpu, alone = {}, {}, {}
     for name in laws:
         susp = Suspension.named(name)
         simulate(sc, None, susp)  # compile and warm
         times[name] = min_time(lambda: simulate(sc, None, susp).metrics(), args.repeat)
         cpu[name] = min_cpu_time(lambda: simulate(sc, None, susp).metrics(), args.repeat)
+        if args.threads == 1:
+            alone[name] = stepper_time(lambda: simulate(sc, None, susp))
     ref = times["sas-attitude-ride"]
     print(f"numba threads: {numba.get_num_threads()}\n")
-    print("| law (MR dampers, 10 s, paper-sine) | time | per step | CPU time per step | / SAS (attitude+ride) |")
-    print("|---|---|---|---|---|")
+    extra = " stepper alone, CPU per step |" if alone else ""
+    head = "| law (MR dampers, 10 s, paper-sine) | time | per step | CPU time per step |"
+    print(f"{head}{extra} / SAS (attitude+ride) |")
+    print("|---|---|---|---|---|" + ("---|" if alone else ""))
     for name in laws:
         t, c = times[name], cpu[name]
-        print(f"| {name} | {t * 1e3:.1f} ms | {t / steps * 1e6:.3f} us | {c / steps * 1e6:.3f} us | {t / ref:.2f} |")
+        own = f" {alone[name] / steps * 1e6:.3f} us |" if alone else ""
+        row = f"| {name} | {t * 1e3:.1f} ms | {t / steps * 1e6:.3f} us | {c / steps * 1e6:.3f} us |"
+        print(f"{row}{own} {t / ref:.2f} |")
     if args.no_league:
         return
 

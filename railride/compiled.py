@@ -2,11 +2,13 @@
 
 numba compiles a kernel on its first call and caches the machine code (``cache=True``; next to
 the package in ``railride/__pycache__``, or in ``NUMBA_CACHE_DIR``). A fresh install has no
-cache, so its first closed-loop run compiles the stepper (`railride.kernels.run_batch`), some
-ten seconds; later processes load it at once. This module answers, without compiling anything,
-whether a kernel is ready (`needs_compiling`), and lets a front end hear when a compile starts
-(`watch_compiles`): the command line uses it to say so on stderr; the library itself prints
-nothing.
+cache, so its first closed-loop run would compile the stepper (`railride.kernels.run_batch`),
+some ten seconds; later processes load it at once. The package's build therefore compiles the
+kernels `railride compare` needs (`build_cache`, run by setup.py), and the wheel carries their
+machine code: after ``pip install .`` on this machine nothing is compiled. This module
+answers, without compiling anything, whether a kernel is ready (`needs_compiling`), and lets a
+front end hear when a compile starts (`watch_compiles`): the command line uses it to say so on
+stderr; the library itself prints nothing.
 """
 
 from __future__ import annotations
@@ -20,6 +22,47 @@ COMPILE_SECONDS = {"run_batch": 10.0}
 
 #: the closed-loop RK4 stepper: MR dampers, ideal devices, controllers
 STEPPER = "run_batch"
+
+
+def _signatures() -> dict[str, tuple]:
+    """The argument types with which the library calls each kernel that `railride compare`
+    needs (checked by a test against the calls themselves): what `build_cache` compiles."""
+    from numba import types
+
+    i, f, b = types.int64, types.float64, types.boolean
+
+    def a(ndim, dtype=f, layout="C"):
+        return types.Array(dtype, ndim, layout)
+
+    return {
+        # lo, hi, law, x, step0, n_steps, final, stride, dt, A, TS, c_sec, P, vcmd, utab, u_off, ftab,
+        # f_off, n_nodes, interval, closed_loop, ctrl_stride, Gm, Hm, inner, noise, faults, sensing,
+        # snoise, nine outputs, status, fail_step
+        "run_batch": (i, i, i, a(2), i, i, b, i, f, a(3), a(3), a(2), a(2), a(2), a(2), a(1, i), a(2), a(1, i))
+        + (a(1, i), a(1), b, i, a(3), a(3), a(2), a(2), a(2, i), a(2), a(2))
+        + (a(3),) * 9
+        + (a(1, i), a(1, i)),
+        # Phi (a slice), maps, used, stride, m, utab, interval, x0, A, Bw, Bwd, TS, c_sec, six outputs
+        "exact_run": (a(2, layout="A"), a(3), a(1, i), i, i, a(2), f, a(1), a(2), a(2), a(2), a(2), a(1)) + (a(2),) * 6,
+        # phi, rail, force, start, period, m, stride, ctrl, tc, utab, interval, x0, A, Bw, Bwd, Bf, G,
+        # H, delay, n_out, eight outputs
+        "exact_closed_run": (a(3), a(3), a(3), a(1, i), i, i, i, i, f, a(2), f, a(1))
+        + (a(2),) * 6
+        + (i, i)
+        + (a(2),) * 8,
+    }
+
+
+def build_cache(kernels: tuple[str, ...] | None = None) -> list[str]:
+    """Compile the kernels `railride compare` needs into numba's cache, unless it already holds
+    them; return the names compiled or loaded. The package's build runs this (setup.py), so
+    that the machine code ships inside the installed package and the first run after
+    ``pip install .`` starts at once. Compiling takes about as long as the first run would."""
+    sigs = _signatures()
+    names = list(sigs) if kernels is None else list(kernels)
+    for name in names:
+        _dispatcher(name).compile(sigs[name])
+    return names
 
 
 def _dispatcher(kernel: str):
