@@ -263,7 +263,7 @@ def evaluate(
             # runs of the study go on
             m = res.metrics(window).values  # (sample, response, statistic)
             diverged_at = res.diverged_at
-            cf = None
+            cf: np.ndarray | None = None
             if comfort:
                 from .comfort import ride_comfort
 
@@ -271,7 +271,9 @@ def evaluate(
                 if "sample" not in ds.dims:
                     ds = ds.expand_dims(sample=[0])
                 ok = np.flatnonzero(np.isnan(diverged_at))  # a diverged run has no comfort
-                cf = ride_comfort(ds.isel(sample=ok), window=window) if ok.size else None
+                if ok.size:  # the columns as one array (sample, column): xarray per value cost 4x the indices
+                    indices = ride_comfort(ds.isel(sample=ok), window=window)
+                    cf = np.stack([indices.sel(position=p, index=x).values for p, x in COMFORT_INDICES], -1)
             for j, i in enumerate(idx[start : start + CHUNK]):
                 if i in rows:
                     continue
@@ -280,9 +282,9 @@ def evaluate(
                     for s, stat in enumerate(STATISTICS):
                         row[f"{resp}_{stat}"] = float(m[j, r, s])
                 if comfort:
-                    for (pos, index), column in zip(COMFORT_INDICES, COMFORT_COLUMNS):
+                    for k, column in enumerate(COMFORT_COLUMNS):
                         row[column] = (
-                            float(cf.isel(sample=int(np.searchsorted(ok, j))).sel(position=pos, index=index))
+                            float(cf[int(np.searchsorted(ok, j)), k])
                             if np.isnan(diverged_at[j]) and cf is not None
                             else np.nan
                         )

@@ -186,6 +186,24 @@ def test_run_sweep_result_holds_objects(swept):
     assert list(swept.frame["case"]) == [json.dumps(c.to_dict(), sort_keys=True, default=str) for c in swept.grid.cases]
 
 
+def test_comfort_columns_are_each_runs_own_indices(swept):
+    # each row's comfort columns against the indices of that run simulated on its own
+    from railride.comfort import ride_comfort
+    from railride.sweep import COMFORT_INDICES
+
+    frame = swept.to_pandas()
+    for k in (0, 4):  # passive at 20 m/s, PID at 30 m/s
+        case = swept.grid.cases[k]
+        alone = rr.simulate(
+            rr.scenario(case.scenario, **dict(case.scenario_options)),
+            None,
+            case.to_suspension(rr.GainSet.default()),
+        )
+        indices = ride_comfort(alone.dataset)
+        want = [float(indices.sel(position=p, index=x)) for p, x in COMFORT_INDICES]
+        np.testing.assert_allclose(frame.loc[k, list(COMFORT_COLUMNS)].to_numpy(float), want, rtol=1e-9)
+
+
 def test_to_pandas_one_row_per_run(swept):
     frame = swept.to_pandas()
     assert len(frame) == 6 and list(frame.columns) == swept.columns()
