@@ -75,7 +75,9 @@ def _fresh_install(precompile: bool) -> None:
         subprocess.run([sys.executable, "-m", "venv", venv], check=True)
         py, rr = os.path.join(venv, "bin", "python"), os.path.join(venv, "bin", "railride")
         label = "engine compiled by the build" if precompile else "RAILRIDE_NO_PRECOMPILE=1"
-        rows = [("`pip install .`", _run([py, "-m", "pip", "install", "-q", source], None, env)[:2])]
+        wall, cpu, log = _run([py, "-m", "pip", "install", "-v", source], None, env)
+        said = [line.strip() for line in log.splitlines() if line.strip().startswith("railride:")]  # setup.py's line
+        rows = [("`pip install .`" + (f" ({said[0]})" if said else ""), (wall, cpu))]
         for what in ("first `railride compare`", "second `railride compare`"):
             wall, cpu, err = _run([rr, "compare"], None, env)
             notes = [line for line in err.splitlines() if line.startswith("compiling")]

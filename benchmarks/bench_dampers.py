@@ -1,6 +1,6 @@
 """MR damper benchmarks: the vehicle with four MR dampers, the damper rig.
 
-Run:  python benchmarks/bench_dampers.py [--repeat N]
+Run:  python benchmarks/bench_dampers.py [--repeat N] [--batches]
 Prints a Markdown table for docs/performance.md (wall-clock minima; no test asserts timings).
 """
 
@@ -9,14 +9,77 @@ from __future__ import annotations
 from _timing import min_time  # benchmarks/_timing.py: run as a script, this folder is on the path
 
 import argparse
+import time
 
 import numpy as np
+
+
+def batch_rows(repeat: int) -> list[tuple[str, str, str]]:
+    """Batch throughput, the lane stepper (`kernels.run_lanes`, the default for batches of
+    kernels.LANES samples or more) against the sample-by-sample stepper (`run_batch`), timed in
+    alternating rounds (paired: the machine is shared), 20 000 steps per sample, both cores."""
+    from railride import kernels
+    from railride.params import VehicleParams
+    from railride.simulation import simulate
+    from railride.solver import SolverSettings
+    from railride.suspension import Suspension
+    from railride.track import scenario
+
+    sc = scenario("paper-sine", duration=2.0)
+    sas = Suspension.named("sas-attitude-ride")
+    paper = VehicleParams.preset("paper")
+    batches = [
+        (
+            "batch of 64 voltages, `railway` dampers",
+            dict(suspension=[Suspension.semi_active("railway", voltage=float(v)) for v in np.linspace(0.0, 2.25, 64)]),
+        ),
+        ("batch of 64 SAS (attitude+ride) closed loops, `railway`", dict(suspension=[sas] * 64)),
+        ("batch of 512 SAS (attitude+ride) closed loops, `railway`", dict(suspension=[sas] * 512)),
+        (
+            'batch of 64 passive vehicles (c_sz swept), `method="rk4"`',
+            dict(
+                params=[paper.replace(c_sz=c) for c in np.linspace(2e4, 1.2e5, 64)],
+                solver=SolverSettings(method="rk4"),
+            ),
+        ),
+    ]
+    fit = kernels.lanes_fit
+    rows = []
+    for label, kw in batches:
+        n = len(kw.get("suspension", kw.get("params")))
+        # best wall-clock and CPU time (both threads) of each stepper
+        best = {name: [float("inf"), float("inf")] for name in ("run_batch", "run_lanes")}
+        for r in range(repeat + 1):  # round 0 compiles or loads each stepper
+            for name in best:
+                kernels.lanes_fit = fit if name == "run_lanes" else (lambda *a: False)
+                try:
+                    wall, cpu = time.perf_counter(), time.process_time()
+                    simulate(sc, **kw)
+                    wall, cpu = time.perf_counter() - wall, time.process_time() - cpu
+                finally:
+                    kernels.lanes_fit = fit
+                if r > 0:
+                    best[name] = [min(best[name][0], wall), min(best[name][1], cpu)]
+        rate = {k: [n * 20_000 / t / 1e6 for t in v] for k, v in best.items()}
+        rows.append(
+            (
+                f"{label} x 20 000 steps, both cores: `run_batch` -> `run_lanes`",
+                f"{rate['run_batch'][0]:.2f} -> **{rate['run_lanes'][0]:.2f}** M sample-steps/s "
+                f"(per CPU-second: {rate['run_batch'][1]:.2f} -> {rate['run_lanes'][1]:.2f} M)",
+                ">= 10 M/s" if "SAS" in label else "",
+            )
+        )
+    return rows
 
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--repeat", type=int, default=5)
+    ap.add_argument("--batches", action="store_true", help="only the batch rows (run_batch against run_lanes)")
     args = ap.parse_args()
+    if args.batches:
+        _print(batch_rows(args.repeat))
+        return
 
     from railride import rig
     from railride.simulation import simulate
@@ -50,17 +113,7 @@ def main():
     simulate(scenario("paper-sine", duration=1.0), suspension=spencer)
     t = min_time(lambda: simulate(scenario("paper-sine", duration=1.0), suspension=spencer), max(1, args.repeat // 2))
     rows.append(("vehicle, four `spencer1997` dampers at 1 V, 1 s (stiff: sub-stepped)", f"{t * 1e3:.1f} ms", ""))
-    sc_batch = scenario("paper-sine", duration=2.0)
-    batch = [Suspension.semi_active("railway", voltage=float(v)) for v in np.linspace(0.0, 2.25, 64)]
-    simulate(sc_batch, suspension=batch)
-    t = min_time(lambda: simulate(sc_batch, suspension=batch), max(1, args.repeat // 2))
-    rows.append(
-        (
-            "batch of 64 voltages x 20 000 steps, `railway` dampers, both cores",
-            f"{64 * 20_000 / t / 1e6:.2f} M sample-steps/s",
-            "",
-        )
-    )
+    rows += batch_rows(max(2, args.repeat // 2))
     for name in ("railway", "spencer1997"):
         rig.cycles(name, 0.015, 2.5, [0.0])
         t = min_time(lambda: rig.cycles(name, 0.015, 2.5, [0.0, 0.75, 1.5, 2.25]), args.repeat)
@@ -69,6 +122,10 @@ def main():
     t = min_time(lambda: rig.track("railway"), args.repeat)
     rows.append(("rig: force tracking, 3 cycles at 1 Hz", f"{t * 1e3:.1f} ms", ""))
 
+    _print(rows)
+
+
+def _print(rows) -> None:
     print("| benchmark | result | target |")
     print("|---|---|---|")
     for r in rows:

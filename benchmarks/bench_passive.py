@@ -91,16 +91,20 @@ def bench_kernel_only(repeat):
     return min_time(run, repeat)
 
 
-def bench_batch(n_samples, repeat):
+def bench_batch(n_samples, repeat, method="auto"):
+    """A c_sz sweep: n_samples different vehicles in one batch ("auto" runs it by RK4 on the
+    lane stepper; "exact" needs one matrix exponential per vehicle)."""
     from railride.params import VehicleParams
     from railride.simulation import simulate
+    from railride.solver import SolverSettings
     from railride.track import scenario
 
     base = VehicleParams.preset("paper")
     params = [base.replace(c_sz=c) for c in np.linspace(2e4, 1.2e5, n_samples)]
     sc = scenario("paper-sine", duration=2.0)  # 20 000 steps per sample
-    simulate(sc, params[:2])
-    t = min_time(lambda: simulate(sc, params), repeat)
+    solver = SolverSettings(method=method)
+    simulate(sc, params[: max(2, n_samples // 8)], solver=solver)
+    t = min_time(lambda: simulate(sc, params, solver=solver), repeat)
     return n_samples * 20_000 / t, t
 
 
@@ -156,6 +160,7 @@ def main():
     res["kernel_only_s"] = bench_kernel_only(args.repeat)
     for n in (64, 512):
         res[f"batch_{n}_sample_steps_per_s"], res[f"batch_{n}_s"] = bench_batch(n, max(2, args.repeat // 2))
+    res["batch_64_exact_s"] = bench_batch(64, max(2, args.repeat // 2), "exact")[1]
     res["cli_cold_s"], res["cli_warm_s"], res["import_s"] = bench_cli(max(2, args.repeat // 2))
 
     print(f"{res['date']}, {res['machine']}, Python {res['python']}, numba {res['numba']}, {res['threads']} threads\n")
@@ -173,6 +178,8 @@ def main():
             f"| batch of {n} samples x 20 000 steps | {res[f'batch_{n}_sample_steps_per_s'] / 1e6:.2f} M "
             f"sample-steps/s ({res[f'batch_{n}_s']:.2f} s) | >= 2 M/s |"
         )
+    exact = res["batch_64_exact_s"]
+    print(f'| batch of 64 x 20 000 steps, `method="exact"` (64 matrix exponentials) | {exact:.2f} s | |')
     print(f"| `railride simulate`, first call (empty numba cache, compile included) | {res['cli_cold_s']:.1f} s | |")
     print(f"| `railride simulate`, second call (numba cache) | {res['cli_warm_s']:.2f} s | |")
     print(f"| of which Python imports | {res['import_s']:.2f} s | |")

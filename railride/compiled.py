@@ -18,7 +18,8 @@ from typing import Callable, Iterator
 
 #: seconds each kernel takes to compile (docs/performance.md, "Cold start", 2 cores shared
 #: with other jobs); the kernels not named compile in about a second and go unannounced
-COMPILE_SECONDS = {"run_batch": 10.0}
+#: (run_lanes: batches of kernels.LANES samples or more, e.g. `compare --controllers all`)
+COMPILE_SECONDS = {"run_batch": 10.0, "run_lanes": 12.0}
 
 #: the closed-loop RK4 stepper: MR dampers, ideal devices, controllers
 STEPPER = "run_batch"

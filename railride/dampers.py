@@ -271,10 +271,16 @@ class Ideal(_Damper):
 
 
 def check_scale(name: str, value) -> float:
-    """A force-capacity scale: a finite number > 0, else ValueError naming ``name``."""
-    return validation.number(
+    """A force-capacity scale: a finite number > 0 within `railride.plausible.DAMPER_SCALE`,
+    else ValueError naming ``name``."""
+    from .plausible import DAMPER_SCALE as r
+
+    scale = validation.number(
         name, value, "positive", allowed="a finite number > 0 (the factor on the damper's force parameters)"
     )
+    if not r.low <= scale <= r.high:
+        raise ValueError(f"{name} = {validation.shown(value)}: must be between {r.low:g} and {r.high:g} ({r.why})")
+    return scale
 
 
 def _check_shape(d) -> None:

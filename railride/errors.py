@@ -11,3 +11,16 @@ from __future__ import annotations
 
 class DivergenceError(RuntimeError):
     """A run diverged: a response left the allowed range or stopped being finite."""
+
+
+class Interrupted(KeyboardInterrupt):
+    """Ctrl-C during a long run (`railride.simulate` with a ``progress`` callback): a
+    KeyboardInterrupt, so code that does not know this type stops as before, with what was
+    computed up to the last finished chunk in ``result`` (a `RideResult` whose Dataset says
+    ``partial`` in its attrs) and the time it reaches in ``until`` [s]; None when nothing
+    useful was computed."""
+
+    def __init__(self, result=None, until: float = 0.0):
+        super().__init__("interrupted")
+        self.result = result
+        self.until = until

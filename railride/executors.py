@@ -46,14 +46,27 @@ class DaskExecutor:
     threads: one ``dask worker --nthreads 1`` per machine gives each batch every core, a default
     ``dask worker`` (a thread per core) one core to each of its batches (docs/distributed.md).
 
-    A scheduler that does not answer within ``timeout`` seconds, a scheduler file that does not
-    appear or has no address, are ValueErrors naming the address or file. `map` yields (chunk
+    ``address`` is tcp://host:port (or host:port), ws://host:port, tls:// or wss:// with the
+    cluster's certificates (``security``, a distributed.Security, or Dask's configuration), or
+    the inproc:// address of a scheduler in this process. Every other address fails fast,
+    before a Client exists (a half-made Client hangs for 20 s as it is collected): an unknown
+    or unusable scheme, TLS without certificates, a refused port, a host that does not answer
+    within `PROBE_SECONDS`, a port that accepts but does not speak Dask within
+    `HANDSHAKE_SECONDS` (a dashboard's); a scheduler file that does not appear within
+    ``timeout`` or has no address. Each is a ValueError naming the address (or file) and what
+    is allowed. `map` yields (chunk
     index, rows) in the order chunks finish; a chunk lost with a dead worker is run again by the
     scheduler."""
 
     name = "dask"
 
-    def __init__(self, address: str | None = None, scheduler_file: str | None = None, timeout: float = 10.0):
+    def __init__(
+        self,
+        address: str | None = None,
+        scheduler_file: str | None = None,
+        timeout: float = 10.0,
+        security=None,
+    ):
         try:
             from distributed import Client
         except ImportError:
@@ -64,15 +77,16 @@ class DaskExecutor:
             address = self._address_from_file(scheduler_file, timeout)
         assert address is not None  # one of the two was given, checked above
         self.address = address
-        where = f"{address}" + ("" if scheduler_file is None else f" (from {scheduler_file})")
+        where = f"address = {address!r}" + ("" if scheduler_file is None else f" (from {scheduler_file})")
+        security = _security(address, security, where)
+        _reach(address, timeout, security, where)
         try:
-            self._handshake(address, timeout)
             # not the default client: this executor's tasks only, the caller's Dask code untouched
-            self.client = Client(address, timeout=timeout, set_as_default=False)
-        except Exception as exc:  # refused, timed out, not a Dask scheduler, unknown scheme
-            why = str(exc) or "no answer (the scheduler's port, not its dashboard's?)"
+            self.client = Client(address, timeout=timeout, set_as_default=False, security=security)
+        except Exception as exc:  # answered the handshake, then failed: not a scheduler after all
             raise ValueError(
-                f"cannot reach the Dask scheduler at {where} within {timeout:g} s: {type(exc).__name__}: {why}"
+                f"{where}: cannot reach the Dask scheduler at {address} within {timeout:g} s: "
+                f"{type(exc).__name__}: {_one_line(exc)}"
             ) from None
 
     @staticmethod
@@ -93,33 +107,6 @@ class DaskExecutor:
             if time.monotonic() >= deadline:
                 raise ValueError(f"scheduler file {str(path)!r}: {problem} after {timeout:g} s")
             time.sleep(0.1)
-
-    @staticmethod
-    def _handshake(address: str, timeout: float) -> None:
-        """Open and close one connection to a tcp ``address`` within ``timeout``: the Client
-        itself waits forever on a port that accepts but does not speak Dask (a dashboard's)."""
-        import asyncio
-        from concurrent.futures import ThreadPoolExecutor
-
-        try:
-            from distributed.comm import connect
-            from distributed.comm.addressing import parse_address
-            from distributed.comm.registry import get_backend
-        except ImportError:  # internals moved in another version: the Client alone then
-            return
-
-        scheme = parse_address(address)[0]
-        get_backend(scheme)  # an unknown scheme is a ValueError here, not a half-made Client
-        if scheme != "tcp":
-            return
-
-        async def once():
-            comm = await connect(address, timeout=timeout)
-            await comm.close()
-
-        # in a thread of its own: the caller may be inside an event loop (Jupyter)
-        with ThreadPoolExecutor(1) as pool:
-            pool.submit(lambda: asyncio.run(asyncio.wait_for(once(), timeout))).result()
 
     def map(self, fn, chunks):
         import uuid
@@ -166,6 +153,121 @@ class DaskExecutor:
 
     def close(self):
         self.client.close()
+
+
+#: seconds for a scheduler's host to accept a connection: a TCP connect on a network takes
+#: milliseconds, so a host that has not answered in this time is down or behind a firewall
+PROBE_SECONDS = 3.0
+#: seconds for a port that accepted to answer Dask's handshake (a scheduler answers at once)
+HANDSHAKE_SECONDS = 5.0
+#: the addresses a DaskExecutor can use, for the errors
+ALLOWED = (
+    "allowed: tcp://host:port (or host:port), ws://host:port, tls:// or wss:// with the cluster's "
+    "certificates, or the inproc:// address of a scheduler in this process"
+)
+
+
+def _one_line(exc: BaseException) -> str:
+    return " ".join(str(exc).split()) or type(exc).__name__
+
+
+def _security(address: str, security, where: str):
+    """The client's security for ``address``: ``security`` as given, else Dask's configuration
+    (distributed.Security()); a tls:// or wss:// address without certificates is a ValueError."""
+    from distributed.comm.addressing import parse_address
+    from distributed.security import Security
+
+    try:
+        scheme = parse_address(address)[0]
+    except ValueError as exc:
+        raise ValueError(f"{where}: {_one_line(exc)}; {ALLOWED}") from None
+    security = Security() if security is None else security
+    if scheme in ("tls", "wss") and security.get_connection_args("client").get("ssl_context") is None:
+        raise ValueError(
+            f"{where}: {scheme}:// needs the cluster's TLS certificates, and none are set: pass "
+            "security= (a distributed.Security) from Python, or set distributed.comm.tls.ca-file, "
+            ".client.cert and .client.key in Dask's configuration (DASK_DISTRIBUTED__COMM__TLS__CA_FILE "
+            "and the like), or use tcp://host:port"
+        )
+    return security
+
+
+def _reach(address: str, timeout: float, security, where: str) -> None:
+    """ValueError unless a Dask scheduler answers at ``address``: the scheme checked, then a
+    plain connection to the host's port within `PROBE_SECONDS`, then Dask's handshake within
+    `HANDSHAKE_SECONDS` (and ``timeout``)."""
+    import asyncio
+    from concurrent.futures import ThreadPoolExecutor
+
+    from distributed.comm import connect
+    from distributed.comm.addressing import parse_address, parse_host_port
+    from distributed.comm.inproc import global_manager
+    from distributed.comm.registry import backends
+
+    scheme, loc = parse_address(address)
+    if scheme not in backends or scheme == "ucx":
+        why = (
+            "the ucx protocol is no longer part of dask.distributed (it needs distributed-ucxx and a UCX network)"
+            if scheme == "ucx"
+            else f"unknown address scheme {scheme!r}"
+        )
+        raise ValueError(f"{where}: {why}; {ALLOWED}")
+    if scheme == "inproc":
+        try:
+            listener = global_manager.get_listener_for(loc)
+        except ValueError:  # not an inproc address distributed could have made
+            listener = None
+        if listener is None:
+            raise ValueError(
+                f"{where}: no scheduler of this process listens there (an inproc:// address reaches a "
+                f"scheduler started in the same Python process only); {ALLOWED}"
+            )
+        return
+    try:
+        host, port = parse_host_port(loc)
+    except ValueError as exc:
+        raise ValueError(f"{where}: {_one_line(exc)}; {ALLOWED}") from None
+    probe = min(timeout, PROBE_SECONDS)
+    try:
+        with socket.create_connection((host, port), timeout=probe) as sock:
+            context = security.get_connection_args("client").get("ssl_context")
+            if scheme in ("tls", "wss") and context is not None:  # else the server logs a failed handshake
+                context.wrap_socket(sock, server_hostname=host).close()
+    except ConnectionRefusedError:
+        raise ValueError(
+            f"{where}: cannot reach the Dask scheduler at {address}: nothing listens on port {port} of "
+            f"{host} (connection refused); is the scheduler running, and is {port} its port (8786 by default)?"
+        ) from None
+    except socket.gaierror as exc:
+        raise ValueError(
+            f"{where}: cannot reach the Dask scheduler at {address}: unknown host {host!r} ({exc.strerror})"
+        ) from None
+    except (TimeoutError, socket.timeout):
+        raise ValueError(
+            f"{where}: cannot reach the Dask scheduler at {address}: {host} did not answer on port {port} "
+            f"within {probe:g} s (a host that is down, or a firewall)"
+        ) from None
+    except OSError as exc:
+        raise ValueError(
+            f"{where}: cannot reach the Dask scheduler at {address}: {exc.strerror or _one_line(exc)}"
+        ) from None
+
+    wait = min(timeout, HANDSHAKE_SECONDS)
+
+    async def once():
+        comm = await connect(address, timeout=wait, **security.get_connection_args("client"))
+        await comm.close()
+
+    try:
+        # in a thread of its own: the caller may be inside an event loop (Jupyter)
+        with ThreadPoolExecutor(1) as pool:
+            pool.submit(lambda: asyncio.run(asyncio.wait_for(once(), wait))).result()
+    except Exception as exc:
+        raise ValueError(
+            f"{where}: cannot reach the Dask scheduler at {address}: port {port} accepts connections but "
+            f"did not answer as a Dask scheduler within {wait:g} s ({type(exc).__name__}: {_one_line(exc)}); "
+            "is it the dashboard's port (8787 by default) rather than the scheduler's (8786)?"
+        ) from None
 
 
 # -- the table of finished runs ----------------------------------------------------------------

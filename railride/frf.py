@@ -15,6 +15,7 @@ The vehicle is named as the command line names it: a preset name, a parameters f
 
 from __future__ import annotations
 
+import dataclasses
 import os
 from dataclasses import dataclass
 from pathlib import Path
@@ -82,11 +83,53 @@ class Modes:
 
 def modes(params=None) -> Modes:
     """The nine modes of the passive vehicle ``params`` (`VehicleParams`, a preset name or the
-    path of a parameters file; default "paper"), by undamped natural frequency."""
+    path of a parameters file; default "paper"), by undamped natural frequency (`checked_modes`)."""
     from .vehicle import Vehicle
 
     vehicle, _ = _vehicle(params)
-    return Modes(tuple(Vehicle(vehicle).modes()))
+    return checked_modes(Vehicle(vehicle))
+
+
+#: a damping ratio this far below 0 is the rounding of an undamped mode (a passive vehicle
+#: with dampings >= 0 has none below 0); further below, the eigenvalues are not to be trusted
+ROUNDING_ZETA = 1e-6
+
+
+def checked_modes(vehicle) -> Modes:
+    """`Vehicle.modes` as numbers a table or JSON can hold: nine modes, every frequency and
+    damping ratio finite and >= 0 (rounding below 0 shown as 0). A vehicle whose bodies and
+    springs are so far apart in size that double precision cannot separate its modes (a
+    bogie of a gram on a stiff primary, a carbody of a billion tonnes) is a ValueError naming
+    what went wrong and the parameters outside the typical ranges."""
+    from .plausible import notes
+    from .vehicle import N_DOF
+
+    problem = None
+    try:
+        with np.errstate(all="ignore"):  # the failures are reported below, not as NumPy warnings
+            found = vehicle.modes()
+    except (ValueError, np.linalg.LinAlgError) as exc:
+        found, problem = [], f"the eigenvalue solver failed ({exc})"
+    out = []
+    for i, m in enumerate(found, 1):
+        values = (m.frequency_hz, m.damped_frequency_hz, m.damping_ratio)
+        if not all(np.isfinite(values)) or min(values) < -ROUNDING_ZETA:
+            problem = problem or (
+                f"mode {i} ({m.label}) came out at {validation.shown(m.frequency_hz)} Hz with a damping "
+                f"ratio of {validation.shown(m.damping_ratio)}"
+            )
+            continue
+        out.append(dataclasses.replace(m, damping_ratio=max(m.damping_ratio, 0.0)))
+    if problem is None and len(out) != N_DOF:
+        problem = f"{len(out)} modes came out, not {N_DOF}"
+    if problem is not None:
+        outside = [n.split("'")[1] for n in notes(vehicle.params)]
+        hint = f"; outside the typical ranges: {', '.join(outside)}" if outside else ""
+        raise ValueError(
+            f"the modes of this vehicle cannot be computed in double precision: {problem}; its masses and "
+            f"stiffnesses are too far apart in size{hint}"
+        )
+    return Modes(tuple(out))
 
 
 @dataclass(frozen=True, eq=False)
@@ -135,6 +178,7 @@ class FrfResult:
         """The ``railride.frf/1`` document (docs/cli.md): the vehicle, the settings, the grid,
         the magnitudes per pattern, the peaks and the modes."""
         from . import __version__
+        from .plausible import notes
 
         frame = frf_frame(self.responses)
         vehicle: dict[str, object]
@@ -162,6 +206,8 @@ class FrfResult:
             },
             "peaks": frf_peaks(frame),
             "modes": self.modes.to_list(),
+            # the vehicle's values outside the typical ranges, as the command line warns of them
+            **({"warnings": warned} if (warned := notes(self.params)) else {}),
         }
 
     def title(self) -> str:
@@ -226,15 +272,11 @@ def frequency_responses(
     frequency = np.geomspace(fmin, fmax, points)
     frequency[0], frequency[-1] = fmin, fmax  # exactly, without rounding
     responses = {p: vehicle.frequency_response(frequency, speed, p) for p in patterns}
-    return FrfResult(
-        vehicle_params, source, speed, frequency, responses, Modes(tuple(vehicle.modes())), fmin, fmax, points
-    )
+    return FrfResult(vehicle_params, source, speed, frequency, responses, checked_modes(vehicle), fmin, fmax, points)
 
 
 def _default_speed() -> float:
     """The default speed of a `railride.track.Scenario` [m/s]."""
-    import dataclasses
-
     from .track import Scenario
 
     speed = next(f for f in dataclasses.fields(Scenario) if f.name == "speed")

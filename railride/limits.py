@@ -1,6 +1,7 @@
 """How large a run may be: the one home of the memory limit (`max_memory`, raised with
-`set_max_memory` or the command line's ``--max-memory``) and of the size checks the runs make
-before they allocate (`check`).
+`set_max_memory` or the command line's ``--max-memory``), of the size checks the runs make
+before they allocate (`check`), and of the work limit of one run (`max_work`, raised with
+`set_max_work` or ``--max-steps`` on the command line; `check_work`).
 
 Every run that allocates in proportion to an input (the time histories of `railride.simulate`,
 the rail input tables, the exact stepper's maps, the damper rig's tables, the points of a
@@ -10,6 +11,12 @@ much the run would need and how to shrink it, instead of a MemoryError (or a swa
 half way through. The default limit is half the memory of the machine (or of its container's
 cgroup, when that is smaller): a run may take a large share, and the other half is left to
 the operating system, the plots and the other processes.
+
+Memory is not time: the stepper stores every output interval's last step only, so a run at a
+tiny dt fits in memory and still takes days. The work of a run (samples x steps, its
+sample-steps; the sub-steps of stiff dampers are not known before the run, so they are not
+counted) is checked against `max_work` before it starts, and the error says how long the run
+would take at the stepper's measured rate (`STEP_RATE`).
 """
 
 from __future__ import annotations
@@ -29,8 +36,17 @@ MAX_STEPS = 2**53
 #: a set, and the case (a row of the grid) it becomes, about 1 kB
 VALUE_BYTES = 1024
 
+#: the order of the stepper's rate, sample-steps a second on one core of a recent machine: the
+#: closed loop with MR dampers runs 0.26-0.3 us a step, batches 3-4 M sample-steps a second a core
+#: (docs/performance.md); the passive vehicle is a little faster, the sub-stepped dampers slower
+STEP_RATE = 3e6
+#: the default most sample-steps of one run: about an hour at `STEP_RATE` on one core, a hundred
+#: times the paper's 10 s run at dt = 1e-4 s for a batch of a thousand samples
+DEFAULT_MAX_WORK = 10**10
+
 _UNITS = {"": 1, "B": 1, "K": 2**10, "M": 2**20, "G": 2**30, "T": 2**40}
 _limit: int | None = None  # None: the default share of the machine
+_work_limit: int | None = None  # None: DEFAULT_MAX_WORK
 
 
 def machine_memory() -> int | None:
@@ -131,3 +147,67 @@ def check_steps(name: str, steps: float, shrink: str) -> None:
     """ValueError when a run would take more than `MAX_STEPS` steps (``name``: what counts)."""
     if not steps <= MAX_STEPS:
         raise ValueError(f"{name}: {steps:.4g} steps, more than the {MAX_STEPS:.4g} a run can count exactly: {shrink}")
+
+
+# -- the work of a run ---------------------------------------------------------------------------
+def max_work() -> int:
+    """The most sample-steps (samples x steps) one run may take."""
+    return DEFAULT_MAX_WORK if _work_limit is None else _work_limit
+
+
+def parse_count(text, name: str = "max_steps") -> int:
+    """A number of sample-steps: a whole number, or a number such as 1e11; at least 1e6 (the
+    smallest run worth a limit). ValueError naming ``name`` otherwise."""
+    value = math.nan
+    if not isinstance(text, bool):
+        with contextlib.suppress(ValueError, OverflowError):  # a 400-digit number is no limit either
+            value = float(text) if isinstance(text, (int, float)) else float(str(text).strip())
+    if not math.isfinite(value) or value < 1e6:
+        raise ValueError(f"{name} = {text!r}: must be a finite number of sample-steps >= 1e6, such as 1e11")
+    return int(value)
+
+
+def set_max_work(count) -> int | None:
+    """Set the most sample-steps of one run (a number, or a text as `parse_count` reads it;
+    None: back to `DEFAULT_MAX_WORK`) for this process; returns the previous setting (None: the
+    default). The workers of a Dask cluster keep their own."""
+    global _work_limit
+    previous = _work_limit
+    _work_limit = None if count is None else parse_count(count)
+    return previous
+
+
+@contextlib.contextmanager
+def work_limit(count):
+    """`set_max_work` within a ``with`` block only."""
+    previous = set_max_work(count)
+    try:
+        yield
+    finally:
+        global _work_limit
+        _work_limit = previous
+
+
+def shown_duration(seconds: float) -> str:
+    """A duration to two or three significant digits in the largest unit that keeps it >= 1:
+    45 s, 12 min, 3.2 h, 41 days, 3.2e+03 years."""
+    for unit, size in (("years", 365.25 * 86400), ("days", 86400), ("h", 3600), ("min", 60)):
+        if seconds >= size:
+            value = seconds / size
+            return f"{value:.2g} {unit}" if value < 1e4 else f"{value:.2e} {unit}"
+    return f"{seconds:.2g} s"
+
+
+def check_work(samples: int, steps: float, what: str, shrink: str) -> None:
+    """ValueError when ``samples`` x ``steps`` exceed `max_work`: ``what`` (e.g. "1 run of 10 s
+    at dt 1e-09 s") would take so long at `STEP_RATE`; ``shrink`` says how to need less."""
+    work, limit = float(samples) * float(steps), max_work()
+    if work <= limit:
+        return
+    where = "set with --max-steps or set_max_work" if _work_limit is not None else "the default, about an hour"
+    raise ValueError(
+        f"{what}: {samples} x {steps:.4g} steps = {work:.3g} sample-steps, about "
+        f"{shown_duration(work / STEP_RATE)} at {STEP_RATE / 1e6:.0f} M sample-steps a second (the stepper's "
+        f"rate on one core), more than the limit of {limit:.3g} ({where}): {shrink}, or raise the limit "
+        "(--max-steps N, railride.limits.set_max_work)"
+    )

@@ -520,6 +520,11 @@ def track(
             f"frequency = {frequency!r} Hz: a cycle of {period:.3g} s is under 100 steps of "
             f"dt = {dt:g} s; lower the frequency or dt"
         )
+    steps_per_cycle = int(round(period / dt))
+    if abs(steps_per_cycle * dt - period) > 1e-9 * period:
+        # as `cycles`: a whole number of steps per cycle, so that any frequency (1.5 Hz: a
+        # period of 0.6667 s) gives a run of whole steps and an exact metric window
+        dt = period / steps_per_cycle
     # record at about 1 kHz, at least 200 points per cycle, on whole steps
     stride = max(1, min(int(round(1e-3 / dt)), int(period / (200 * dt))))
     ds = drive(

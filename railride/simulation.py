@@ -11,7 +11,7 @@ import numpy as np
 
 from . import dampers, kernels, limits
 from .defaults import DEFAULT_DT
-from .errors import DivergenceError
+from .errors import DivergenceError, Interrupted
 from .faults import fault_table
 from .sensing import reads_bogies
 from .params import VehicleParams
@@ -19,6 +19,7 @@ from .solver import SolverSettings, check_resolution
 from .suspension import Suspension, batch_conflict
 from .track import Scenario, input_table_nodes, wheelset_input_table
 from .track import as_scenario
+from .validation import shown
 from .ride import RideResult, build_dataset, has_damper_states
 from .vehicle import N_DOF, Vehicle
 
@@ -89,10 +90,13 @@ INTEGRATOR_RK4 = "classical RK4, fixed step"
 INTEGRATOR_EXACT = "exact discretisation (matrix exponential, one step per output sample; railride.discrete)"
 
 
-def _exact(solver, damper, closed, suspensions) -> bool:
+def _exact(solver, damper, closed, suspensions, n_vehicles: int = 1) -> bool:
     """Whether the run takes the exact discretisation: method "exact", or "auto" where the
     vehicle is linear: the passive viscous dampers, or an outer loop on the ideal actuator with
-    exact states (no sensing, no sensor noise); "exact" with anything else is refused."""
+    exact states (no sensing, no sensor noise); "exact" with anything else is refused. "auto"
+    keeps RK4 for a batch of several vehicles that fills the lane stepper: each vehicle costs a
+    matrix exponential (about 25 ms), more than its whole RK4 run there (a 64-vehicle passive
+    batch of 2 s: 2.2 s exact, 0.17 s RK4; docs/performance.md)."""
     faults = any(s.faults for s in suspensions)
     passive = damper is None and closed is None
     actuator = (
@@ -110,6 +114,8 @@ def _exact(solver, damper, closed, suspensions) -> bool:
             "suspension, or an outer loop on the ideal actuator with exact states; MR dampers, the "
             "ideal semi-active damper, sensing, sensor noise and faults run with method 'rk4' or 'auto'"
         )
+    if solver.method == "auto" and n_vehicles > 1 and len(suspensions) >= kernels.LANES:
+        return False
     return linear and solver.method != "rk4"
 
 
@@ -131,14 +137,24 @@ def _cached_input_table(scenario: Scenario, lag: tuple, dt: float, duration: flo
 
 
 def _check_dt(vehicle: Vehicle, dt: float, damper=None) -> None:
-    dt_max = _max_stable_dt(vehicle.params, damper)
+    with np.errstate(all="ignore"):  # a vehicle beyond double precision is reported below
+        dt_max = _max_stable_dt(vehicle.params, damper)
     if dt > dt_max:
-        fastest = max(vehicle.modes(), key=lambda m: m.frequency_hz)
+        from .frf import checked_modes
+
+        # the vehicle's modes, or the error that says why they cannot be computed
+        fastest = max(checked_modes(vehicle), key=lambda m: m.frequency_hz)
+        stiffer = "" if not has_damper_states(damper) else f", stiffer with the {damper.model} dampers"
+        why = f"(fastest mode {fastest.label}, {shown(fastest.frequency_hz)} Hz{stiffer})"
+        if not dt_max > 0.0:  # the bisection found no stable step: eigenvalues past what it can resolve
+            raise ValueError(
+                f"dt = {shown(dt)} s: no step keeps fourth-order Runge-Kutta stable for this vehicle {why}; "
+                "check its masses and stiffnesses"
+            )
+        default = f" (the default {DEFAULT_DT:g} s is accurate)" if DEFAULT_DT <= dt_max else ""
         raise ValueError(
-            f"dt = {dt:g} s is too large: fourth-order Runge-Kutta is unstable for this vehicle "
-            f"(fastest mode {fastest.label}, {fastest.frequency_hz:.1f} Hz"
-            + ("" if not has_damper_states(damper) else f", stiffer with the {damper.model} dampers")
-            + f"); use dt <= {dt_max:.3g} s (the default {DEFAULT_DT:g} s is accurate)"
+            f"dt = {shown(dt)} s is too large: fourth-order Runge-Kutta is unstable for this vehicle {why}; "
+            f"use dt <= {shown(dt_max)} s{default}"
         )
 
 
@@ -161,6 +177,16 @@ def _check_size(scenarios, solver: SolverSettings, damper, closed, exact: bool, 
         f"{n} run(s) of {duration:.4g} s at dt {dt:.4g} s ({n_out + 1} output samples, {nodes} input nodes)",
         "shorten the duration, lower output_rate, run fewer samples at once or use a dt nearer the default",
     )
+    # time, which memory does not bound (the histories are strided): the exact method steps
+    # once per output sample (and controller sample), RK4 once per dt
+    if exact:
+        steps = n_out * stride // (stride if closed is None else math.gcd(stride, closed["stride"]))
+        shrink = "shorten the duration, lower output_rate or run fewer samples at once"
+    else:
+        steps = n_out * stride
+        shrink = f"raise dt (the default is {DEFAULT_DT:g} s), shorten the duration or run fewer samples at once"
+    runs = "1 run" if n == 1 else f"{n} runs"
+    limits.check_work(n, steps, f"{runs} of {duration:.4g} s at dt {dt:.4g} s", shrink)
 
 
 def _system_arrays(vehicle: Vehicle, passive: bool = True) -> dict[str, np.ndarray]:
@@ -184,9 +210,29 @@ def _system_arrays(vehicle: Vehicle, passive: bool = True) -> dict[str, np.ndarr
 
 
 def _forcing_table(utab: np.ndarray, Bw: np.ndarray, Bwd: np.ndarray) -> np.ndarray:
-    """Node values (Bw w, Bw w', Bwd w, Bwd w') of the rail forcing, see kernels._forcing."""
+    """Node values (Bw w, Bw w', Bwd w, Bwd w') of the rail forcing, see kernels._forcing.
+    einsum, not ``@``: a threaded BLAS on these thin products took 90-130 ms instead of 6-10 ms
+    while other work kept the cores busy."""
     w, wd = utab[:, :8], utab[:, 8:]
-    return np.hstack([w @ Bw.T, wd @ Bw.T, w @ Bwd.T, wd @ Bwd.T])
+    return np.hstack([np.einsum("nk,jk->nj", x, B) for B in (Bw, Bwd) for x in (w, wd)])
+
+
+def _forcing(scenario: Scenario, lag: tuple, dt: float, duration: float, params: VehicleParams, table):
+    """`_forcing_table`, the last 32 kept beside the input tables (each controller's batch of a
+    study meets the same scenario and vehicle again)."""
+    try:
+        return _cached_forcing(scenario, lag, dt, duration, params)
+    except TypeError:  # a scenario that cannot be a key
+        sysm = _system_arrays(_vehicle(params))
+        return _forcing_table(table, sysm["Bw"], sysm["Bwd"])
+
+
+@functools.lru_cache(maxsize=32)
+def _cached_forcing(scenario: Scenario, lag: tuple, dt: float, duration: float, params: VehicleParams):
+    sysm = _system_arrays(_vehicle(params))
+    table = _forcing_table(_input_table(scenario, lag, dt, duration)[0], sysm["Bw"], sysm["Bwd"])
+    table.flags.writeable = False
+    return table
 
 
 def _as_list(x):
@@ -325,7 +371,7 @@ def simulate(
     damper = suspensions[0].damper
     vcmd = np.array([[_command_voltage(s)] * 4 for s in suspensions], dtype=float)
     closed = _closed_loop(suspensions, solver, duration)
-    exact = _exact(solver, damper, closed, suspensions)
+    exact = _exact(solver, damper, closed, suspensions, len(set(param_sets)))
     vehicles = {}
     for p in param_sets:
         if id(p) not in vehicles:
@@ -368,9 +414,8 @@ def simulate(
         n_nodes[i] = len(tab)
         fkey = (id(sc), id(p))
         if fkey not in f_index and not exact:  # the exact steps take the inputs themselves
-            sysm = systems[id(p)]
             f_index[fkey] = sum(len(t) for t in ftabs)
-            ftabs.append(_forcing_table(tab, sysm["Bw"], sysm["Bwd"]))
+            ftabs.append(_forcing(sc, tuple(lag), dt, duration, p, tab))
         f_off[i] = f_index.get(fkey, 0)
     utab = np.ascontiguousarray(np.concatenate(utabs))
     ftab = np.ascontiguousarray(np.concatenate(ftabs)) if ftabs else np.zeros((1, 36))
@@ -469,12 +514,18 @@ def simulate(
         status, fail_step = run_exact(out, samples, x[:, : 2 * N_DOF], dt, stride, n_out)
         if progress is not None:
             progress(1.0)
+    # a batch that fills groups of kernels.LANES samples runs them in vector form (run_lanes)
+    if kernels.lanes_fit(n, P, sensing):
+        step_batch = kernels.run_lanes_batch
+    else:
+        step_batch = functools.partial(kernels.run_parallel, kernels.run_batch)
+    stop = _StopRequest(progress is not None and not exact)
+    step_batch = stop.around(step_batch)
     while not exact:
         todo = min(chunk, n_steps - done)
         final = done + todo == n_steps
         started = time.perf_counter()
-        kernels.run_parallel(
-            kernels.run_batch,
+        step_batch(
             n,
             law,
             x,
@@ -520,8 +571,13 @@ def simulate(
             took = max(time.perf_counter() - started, 1e-6)  # the first call may include compiling
             chunk = max(stride, min(4 * todo, int(todo * _CHUNK_SECONDS / took)) // stride * stride)
             progress(done / n_steps)
-        if final:
+        if final or stop.requested:
             break
+    if stop.requested:  # Ctrl-C: keep the output rows of the finished chunks
+        rows = done // stride  # the row at `done` itself is written by the chunk after it
+        if rows < 2:
+            raise KeyboardInterrupt
+        out = {key: v[:, :rows] if v.shape[1] > 1 else v for key, v in out.items()}
     diverged_at = np.full(n, np.nan)
     if np.any(status != kernels.STATUS_OK):
         bad = np.flatnonzero(status != kernels.STATUS_OK)
@@ -547,7 +603,7 @@ def simulate(
         "batch": batch,
         "diverged_at": diverged_at,
     }
-    return RideResult(
+    result = RideResult(
         raw=raw,
         build=functools.partial(
             build_dataset,
@@ -571,3 +627,62 @@ def simulate(
         scenario=scenarios if batch else scenarios[0],
         params=param_sets if batch else param_sets[0],
     )
+    if stop.requested:
+        until = (rows - 1) / output_rate
+        result._build = _marked_partial(result._build, f"interrupted: up to t = {until:.4g} s of {duration:.4g} s")
+        raise Interrupted(result, until)
+    return result
+
+
+class _StopRequest:
+    """Ctrl-C while a chunk of the stepper runs, taken as a request to stop after it (the
+    compiled chunk cannot be left half way) instead of a KeyboardInterrupt that would lose the
+    chunks before it. Only in the main thread with Python's own handler in place, and from the
+    second chunk on: the first is short and may compile the stepper, which Ctrl-C should stop
+    at once. A second Ctrl-C raises at once; between chunks Ctrl-C is a KeyboardInterrupt."""
+
+    def __init__(self, enabled: bool):
+        import signal
+        import threading
+
+        self.requested = False
+        self.enabled = (
+            enabled
+            and threading.current_thread() is threading.main_thread()
+            and signal.getsignal(signal.SIGINT) is signal.default_int_handler
+        )
+
+    def _handler(self, signum, frame):
+        if self.requested:
+            raise KeyboardInterrupt
+        self.requested = True
+
+    def around(self, step):
+        if not self.enabled:
+            return step
+        import signal
+
+        calls = []
+
+        def guarded(*args):
+            calls.append(None)
+            if len(calls) == 1:
+                return step(*args)
+            signal.signal(signal.SIGINT, self._handler)
+            try:
+                return step(*args)
+            finally:
+                signal.signal(signal.SIGINT, signal.default_int_handler)
+
+        return guarded
+
+
+def _marked_partial(build, text: str):
+    """``build`` of a result whose Dataset gets ``partial`` = ``text`` in its attrs."""
+
+    def marked():
+        dataset = build()
+        dataset.attrs["partial"] = text
+        return dataset
+
+    return marked

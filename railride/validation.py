@@ -125,7 +125,7 @@ def param(unit: str, doc: str, rule: str = "positive") -> Any:
 def validate_fields(obj, what: str) -> None:
     """Check every field of a frozen parameter dataclass against the rule in its metadata and
     store it as float (a seed as int); the error names the field, its value, its meaning and
-    unit, and the rule."""
+    unit, and the rule. Then the plausible ranges of `railride.plausible` (errors, warnings)."""
     for f in dataclasses.fields(obj):
         value = getattr(obj, f.name)
         rule = f.metadata["rule"]
@@ -142,6 +142,9 @@ def validate_fields(obj, what: str) -> None:
         raise ValueError(
             f"{what} {f.name!r} = {shown(value)} ({f.metadata['doc']}, {f.metadata['unit']}): must be {RULES[rule][0]}"
         )
+    from .plausible import check
+
+    check(obj, what)
 
 
 def toml_error(exc: ValueError) -> str:

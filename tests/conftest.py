@@ -7,4 +7,17 @@ cli/ (the command line, the examples and the README)."""
 import sys
 from pathlib import Path
 
+import pytest
+
 sys.path.insert(0, str(Path(__file__).parent / "cli"))
+
+
+@pytest.fixture(autouse=True)
+def _default_limits():
+    """`--max-memory` and `--max-steps` set process-wide limits as a command starts; a CLI test
+    runs in this process, so put the defaults back for the tests after it."""
+    yield
+    from railride import limits
+
+    limits.set_max_memory(None)
+    limits.set_max_work(None)

@@ -2,13 +2,15 @@
 
 from __future__ import annotations
 
+import contextlib
 import os
 import sys
+import warnings
 
 import typer
 from typer.core import TyperGroup
 
-from ._common import INTERRUPTED, OK
+from ._common import INTERRUPTED, OK, USER, usage_error_line, usage_error_types
 
 __all__ = ["INTERRUPTED", "RailrideGroup", "app", "quiet_closed_pipe"]
 
@@ -44,11 +46,19 @@ class RailrideGroup(TyperGroup):
     exit 130 without a word; `tune`, `study`, `pareto` and `sweep` say first what they kept);
     a stdout whose reader has gone (``railride compare | head -1``) ends the command quietly
     with status 0, as a closed pipe is not an error (typer would exit 1, the status of an
-    internal fault). A BrokenPipeError from anything else is a fault."""
+    internal fault). A BrokenPipeError from anything else is a fault. A usage error (``--points
+    abc``) is one line ``error: ...`` and status 2 like every other error: the parser would
+    print its usage and a hint, with a blank line, before it."""
 
     def invoke(self, ctx):
+        words = [str(w) for w in ctx.args]  # the command's own words, for the value a usage error names
         try:
-            return super().invoke(ctx)
+            with _warnings_on_stderr():
+                return super().invoke(ctx)
+        except usage_error_types() as exc:
+            command = " ".join(["railride", *filter(None, [ctx.invoked_subcommand])])
+            typer.echo(f"error: {usage_error_line(exc, words, command)}", err=True)
+            raise typer.Exit(getattr(exc, "exit_code", USER)) from None
         except KeyboardInterrupt:
             typer.echo("interrupted", err=True)
             raise typer.Exit(INTERRUPTED) from None
@@ -57,6 +67,25 @@ class RailrideGroup(TyperGroup):
                 raise
             quiet_closed_pipe()
             raise typer.Exit(OK) from None
+
+
+@contextlib.contextmanager
+def _warnings_on_stderr():
+    """A `railride.plausible.PlausibilityWarning` (a vehicle outside the typical ranges) as one
+    line "warning: ..." on stderr, once per text, beside the result it qualifies."""
+    from ..plausible import PlausibilityWarning
+
+    def show(message, category, filename, lineno, file=None, line=None):
+        if issubclass(category, PlausibilityWarning):
+            typer.echo(f"warning: {message}", err=True)
+        else:
+            shown(message, category, filename, lineno, file, line)
+
+    with warnings.catch_warnings():
+        shown = warnings.showwarning
+        warnings.simplefilter("default", PlausibilityWarning)
+        warnings.showwarning = show
+        yield
 
 
 app = typer.Typer(

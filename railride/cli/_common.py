@@ -64,6 +64,41 @@ def errors():
     raise typer.Exit(status)
 
 
+def usage_error_types() -> tuple:
+    """The parser's usage errors (no number where an option takes one, an unknown option, a
+    missing value): typer's own click from typer 0.22 on, click before."""
+    import importlib
+
+    found = []
+    for module in ("typer._click.exceptions", "click.exceptions"):
+        with contextlib.suppress(ImportError, AttributeError):
+            found.append(importlib.import_module(module).UsageError)
+    return tuple(found)
+
+
+def usage_error_line(exc, args, command: str = "railride") -> str:
+    """A usage error as one line like every other error, where the parser prints its usage,
+    a hint and a blank line before it: ``--points = '1e-300': input should be a valid
+    integer ...``, the value the user typed taken from ``args`` (the command's words);
+    otherwise the parser's message and where to look (``command --help``)."""
+    message = _one_line(exc).rstrip(".")
+    param = getattr(exc, "param", None)
+    flags = [o for o in getattr(param, "opts", ()) if o.startswith("-")]
+    value = None
+    for i, word in enumerate(args):
+        if word in flags and i + 1 < len(args):
+            flag, value = word, args[i + 1]
+        elif any(word.startswith(f + "=") for f in flags):
+            flag, _, value = word.partition("=")
+    if value is not None and message:
+        return f"{flag} = {value!r}: {message[0].lower()}{message[1:]}"
+    text = " ".join(exc.format_message().split()).rstrip(".")
+    path = getattr(getattr(exc, "ctx", None), "command_path", "").split()
+    if len(path) > 1:  # the program's own name, also where a test runner names it otherwise
+        command = " ".join(["railride", *path[1:]])
+    return f"{text[:1].lower()}{text[1:]}; see {command} --help"
+
+
 @contextlib.contextmanager
 def option_names(fields: dict, defaults=()):
     """The library's errors in the command's words: in a ValueError raised inside, each field
@@ -326,7 +361,9 @@ def make_executor(workers: Optional[int], scheduler: Optional[str], scheduler_fi
             )
         if scheduler is not None and not scheduler.strip():
             raise ValueError("--scheduler = '': give the scheduler's address, e.g. tcp://host:8786")
-        with status_note("connecting to the Dask scheduler..."):
+        # the library names the address and file by its fields: the user typed these options
+        names = {"address": "--scheduler", "scheduler file": "--scheduler-file"}
+        with status_note("connecting to the Dask scheduler..."), option_names(names):
             executor = sweep_lib.DaskExecutor(
                 address=scheduler, scheduler_file=None if scheduler_file is None else str(scheduler_file)
             )

@@ -519,3 +519,29 @@ MaxMemoryOption = Annotated[
         "refused before it starts, saying what it would need. Default: half the machine's memory.",
     ),
 ]
+
+
+def _set_max_steps(value: Optional[str]) -> Optional[str]:
+    """Set the library's work limit as the command starts (None: the default, so that one
+    command's limit never carries over to the next in one process)."""
+    from .. import limits
+    from ._common import errors
+
+    with errors():
+        try:
+            limits.set_max_work(value)
+        except ValueError as exc:
+            raise ValueError(str(exc).replace("max_steps", "--max-steps", 1)) from None
+    return value
+
+
+MaxStepsOption = Annotated[
+    Optional[str],
+    typer.Option(
+        "--max-steps",
+        metavar="N",
+        callback=_set_max_steps,
+        help="The most sample-steps (samples x steps) a run may take, e.g. 1e11; a longer run is "
+        "refused before it starts, saying how long it would take. Default: 1e10, about an hour.",
+    ),
+]

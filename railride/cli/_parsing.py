@@ -70,7 +70,7 @@ def value_list(option: str, text: str, *, integer: bool = False, parse=None) -> 
     if integer:
         bad = [v for v in values if v != int(v)]
         if bad:
-            raise ValueError(f"{option} = {text!r}: {float(bad[0]):g} is not a whole number")
+            raise ValueError(f"{option} = {text!r}: {_about(bad[0])} is not a whole number")
         values = [int(v) for v in values]
     seen = set()
     for v in values:
@@ -87,6 +87,17 @@ def _whole(option: str, text: str, item: str):
         return int(item.strip())
     except ValueError:
         return parse_float(option, text, item)
+
+
+def _about(value) -> str:
+    """A number that is not whole, to four digits: a float, or a step of a range between
+    whole numbers (a Fraction), which may be too large for a float."""
+    try:
+        return f"{float(value):.4g}"
+    except OverflowError:
+        from ..validation import shown
+
+        return f"about {shown(round(value)).split(' (')[0]}"  # without "(a 400-digit whole number)"
 
 
 def _shown(value) -> str:

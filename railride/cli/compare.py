@@ -16,6 +16,7 @@ from ._app import app
 from ._common import ProgressBar, errors, option_names, stderr_is_terminal, stdout_console, write_folder
 from ._options import (
     MaxMemoryOption,
+    MaxStepsOption,
     AmplitudeOption,
     ComfortOption,
     CompareDamperOption,
@@ -481,6 +482,7 @@ def compare(
     dpi: DpiOption = None,
     history_format: HistoryFormatOption = None,
     max_memory: MaxMemoryOption = None,
+    max_steps: MaxStepsOption = None,
 ) -> None:
     """Compare passive, PID and SAS suspensions on one scenario, as in the paper's Table 1.
 

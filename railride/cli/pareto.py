@@ -23,6 +23,7 @@ from ._common import (
 )
 from ._options import (
     MaxMemoryOption,
+    MaxStepsOption,
     AmplitudeOption,
     DpiOption,
     DtOption,
@@ -146,6 +147,7 @@ def pareto_command(
     figure_format: FigureFormatOption = None,
     dpi: DpiOption = None,
     max_memory: MaxMemoryOption = None,
+    max_steps: MaxStepsOption = None,
 ) -> None:
     """The trades a controller's gains offer: RMS ratios to passive of sampled gains.
 

@@ -14,6 +14,7 @@ from ._app import app
 from ._common import CliError, command_line, errors, status_note
 from ._options import (
     MaxMemoryOption,
+    MaxStepsOption,
     AmplitudeOption,
     ComfortOption,
     CompareDamperOption,
@@ -112,6 +113,7 @@ def report_command(
         ),
     ] = Path("report.html"),
     max_memory: MaxMemoryOption = None,
+    max_steps: MaxStepsOption = None,
 ) -> None:
     """Run the paper's comparison as `railride compare` does and write it as one HTML file.
 

@@ -210,7 +210,7 @@ def _tracking_table(doc: dict, model: str, *, default_g: bool):
         [
             f"desired force amplitude {doc['amplitude_n']:g} N at {doc['frequency_hz']:g} Hz",
             f"stroke x = -{doc['stroke_m']:g} m cos(2 pi f t); force tension +",
-            f"metrics over {start:g}-{end:g} s (after the first cycle)",
+            f"metrics over {start:.4g}-{end:.4g} s (after the first cycle)",
         ]
     )
     table = FitTable(

@@ -10,9 +10,19 @@ import typer
 from .. import validation
 from ..defaults import DEFAULT_DAMPER
 from ._app import app
-from ._common import ProgressBar, errors, option_names, print_json, stderr_is_terminal, stdout_console, write_folder
+from ._common import (
+    INTERRUPTED,
+    ProgressBar,
+    errors,
+    option_names,
+    print_json,
+    stderr_is_terminal,
+    stdout_console,
+    write_folder,
+)
 from ._options import (
     MaxMemoryOption,
+    MaxStepsOption,
     AmplitudeOption,
     ComfortOption,
     DtOption,
@@ -159,6 +169,7 @@ def simulate(
     dpi: DpiOption = None,
     history_format: HistoryFormatOption = None,
     max_memory: MaxMemoryOption = None,
+    max_steps: MaxStepsOption = None,
 ) -> None:
     """Simulate the vehicle on a track and print the ride metrics."""
     with errors():
@@ -188,6 +199,14 @@ def simulate(
             figures=figures,
             histories=histories,
         )
+    if "partial" in doc:  # Ctrl-C, what was computed saved in --out
+        part = doc["partial"]
+        typer.echo(
+            f"interrupted at t = {part['until_s']:.4g} s of {part['duration_s']:.4g} s: the partial results "
+            f"(time histories up to the last finished chunk, marked partial) are saved in {out}",
+            err=True,
+        )
+        raise typer.Exit(INTERRUPTED)
     if format is OutputFormat.json:
         print_json(doc)
     else:
@@ -247,6 +266,7 @@ def _run(
     figures=None,
     histories=("nc", "csv"),
 ):
+    from ..errors import Interrupted
     from ..files import check_out_dir, write_outputs
     from ..metrics import check_window, parse_window
     from ..simulation import simulate as run_simulation
@@ -273,9 +293,20 @@ def _run(
         if window is not None:  # check the window before the run, not after it
             check_window(window, scen.duration)
 
+        interrupted = None
         with ProgressBar(stderr_is_terminal()) as progress:
-            result = run_simulation(scen, vehicle_params, secondary, solver=solver, progress=progress)
+            try:
+                result = run_simulation(scen, vehicle_params, secondary, solver=solver, progress=progress)
+            except Interrupted as exc:
+                if out is None or exc.result is None:  # nothing to keep it in: status 130 as ever
+                    raise
+                interrupted, result = exc, exc.result
+        if interrupted is not None:  # the metrics over the part of the window that was run
+            start, end = window if window is not None else (0.0, interrupted.until)
+            window = (start, min(end, interrupted.until)) if start < interrupted.until else (0.0, interrupted.until)
         doc = result.to_dict(window, comfort=comfort, vehicle=vehicle_record)
+        if interrupted is not None:
+            doc["partial"] = {"until_s": interrupted.until, "duration_s": scen.duration}
     if out is not None:
         write_folder(out, lambda: write_outputs(result, out, doc, figures=figures, histories=histories))
     return doc, result

@@ -24,6 +24,7 @@ from ._common import (
 )
 from ._options import (
     MaxMemoryOption,
+    MaxStepsOption,
     DpiOption,
     DtOption,
     FigureFormatOption,
@@ -237,6 +238,7 @@ def study_command(
     dpi: DpiOption = None,
     report: ReportOption = None,
     max_memory: MaxMemoryOption = None,
+    max_steps: MaxStepsOption = None,
 ) -> None:
     """Statistics over many tracks: every controller on every track seed and speed, for each
     load factor and fault condition; mean and 5th-95th percentiles of each RMS response and

@@ -29,6 +29,7 @@ from ._common import (
 )
 from ._options import (
     MaxMemoryOption,
+    MaxStepsOption,
     DpiOption,
     DtOption,
     FigureFormatOption,
@@ -203,6 +204,7 @@ def sweep_command(
     dpi: DpiOption = None,
     report: ReportOption = None,
     max_memory: MaxMemoryOption = None,
+    max_steps: MaxStepsOption = None,
 ) -> None:
     """Run a grid of cases: every combination of the given values (a cartesian product).
 

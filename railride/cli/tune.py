@@ -26,6 +26,7 @@ from ._common import (
 )
 from ._options import (
     MaxMemoryOption,
+    MaxStepsOption,
     AmplitudeOption,
     BoundOption,
     DpiOption,
@@ -427,6 +428,7 @@ def tune_command(
     dpi: DpiOption = None,
     report: ReportOption = None,
     max_memory: MaxMemoryOption = None,
+    max_steps: MaxStepsOption = None,
 ) -> None:
     """Tune every law's gains by the paper's sensitivity study (its section V), alike.
 

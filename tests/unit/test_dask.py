@@ -417,3 +417,51 @@ def test_an_unknown_scheme_or_both_targets_are_value_errors(tmp_path):
         DaskExecutor(address="udp://127.0.0.1:1", timeout=1)
     with pytest.raises(ValueError, match="scheduler address .* or a scheduler file"):
         DaskExecutor(address="tcp://127.0.0.1:1", scheduler_file=str(tmp_path / "s.json"))
+
+
+def _double(chunk):
+    return [2 * c for c in chunk]
+
+
+@pytest.mark.parametrize("protocol", ["inproc", "tcp://", "ws://", "tls://", "wss://"])
+def test_every_scheme_the_errors_allow_runs_chunks(protocol):
+    from distributed import LocalCluster
+    from distributed.security import Security
+
+    pytest.importorskip("cryptography")  # Security.temporary's certificates
+    security = Security.temporary() if protocol in ("tls://", "wss://") else None
+    options = dict(n_workers=1, threads_per_worker=1, processes=False, dashboard_address=None)
+    if protocol != "inproc":
+        options.update(protocol=protocol, host="127.0.0.1")
+    with LocalCluster(**options, **({"security": security} if security else {})) as cluster:
+        executor = DaskExecutor(address=cluster.scheduler_address, security=security, timeout=10)
+        try:
+            assert sorted(executor.map(_double, [[1], [2, 3]])) == [(0, [2]), (1, [4, 6])]
+        finally:
+            executor.close()
+
+
+@pytest.mark.parametrize(
+    "address,fragment",
+    [
+        ("tls://127.0.0.1:{port}", "needs the cluster's TLS certificates"),
+        ("wss://127.0.0.1:{port}", "needs the cluster's TLS certificates"),
+        ("ucx://127.0.0.1:{port}", "distributed-ucxx"),
+        ("inproc://127.0.0.1/1/1", "no scheduler of this process listens there"),
+        ("inproc://nonsense", "no scheduler of this process listens there"),
+        ("udp://127.0.0.1:{port}", "unknown address scheme"),
+        ("tcp://127.0.0.1", "missing port"),
+        ("tcp://127.0.0.1:{port}", "nothing listens on port {port} of 127.0.0.1 (connection refused)"),
+        ("127.0.0.1:{port}", "connection refused"),
+        ("tcp://nowhere.invalid:8786", "unknown host 'nowhere.invalid'"),
+    ],
+)
+def test_an_address_that_cannot_work_is_refused_at_once_naming_it(address, fragment):
+    port = _free_port()  # nothing listens there
+    address, fragment = address.format(port=port), fragment.format(port=port)
+    t0 = time.monotonic()
+    with pytest.raises(ValueError) as info:
+        DaskExecutor(address=address, timeout=30)  # the checks do not wait for the timeout
+    assert time.monotonic() - t0 < 5
+    message = str(info.value)
+    assert message.startswith(f"address = {address!r}: ") and fragment in message, message

@@ -122,3 +122,38 @@ def test_the_window_is_finite():
     for text in ("0:inf", "nan:5", "0:-inf"):
         with pytest.raises(ValueError, match="finite"):
             parse_window(text)
+
+
+def test_a_run_of_a_hundred_billion_steps_is_refused_by_its_work_with_its_time():
+    # memory does not stop it: the histories are strided to 10001 rows whatever dt is
+    mr = rr.Suspension.semi_active("railway", voltage=1.0)
+    message = _refused_fast(
+        lambda: rr.simulate("paper-sine", suspension=mr, solver=SolverSettings(dt=1e-10)),
+        "1 x 1e+11 steps",
+        "limit of 1e+10",
+        "raise dt",
+    )
+    # 1e11 sample-steps at 3e6 a second: 33 333 s, 9.3 hours
+    assert "about 9.3 h" in message
+
+
+def test_the_work_limit_counts_samples_and_is_restored_after_a_block():
+    short = scenario("paper-sine", duration=1.0)
+    mr = [rr.Suspension.semi_active("railway", voltage=v) for v in (0.0, 1.0, 2.0)]
+    assert limits.max_work() == limits.DEFAULT_MAX_WORK
+    with limits.work_limit(2e6):  # 1 s at 1e-4 s is 1e4 steps a sample
+        assert limits.max_work() == 2 * 10**6
+        rr.simulate(short, suspension=mr)  # 3e4 sample-steps
+        with pytest.raises(ValueError, match="3 runs of 1 s at dt 1e-06 s: 3 x 1e\\+06 steps = 3e\\+06"):
+            rr.simulate(short, suspension=mr, solver=SolverSettings(dt=1e-6))
+    assert limits.max_work() == limits.DEFAULT_MAX_WORK
+
+
+def test_work_limits_and_durations_read_and_show_plainly():
+    assert limits.parse_count("1e11") == 10**11 and limits.parse_count(10**7) == 10**7
+    for bad in ("many", "1e3", "inf", "nan", True, 10**400, -5):
+        with pytest.raises(ValueError, match="max_steps"):
+            limits.parse_count(bad)
+    assert limits.shown_duration(45) == "45 s"
+    assert limits.shown_duration(3600 * 9.3) == "9.3 h"
+    assert limits.shown_duration(86400 * 41) == "41 days"

@@ -1,0 +1,131 @@
+"""The command line at more edges: scheduler addresses that cannot work fail fast and name the
+option, the step-count limit, and Ctrl-C during a long run saving what was computed."""
+
+from __future__ import annotations
+
+import json
+import signal
+import socket
+import subprocess
+import sys
+import time
+
+import pytest
+
+from clihelp import assert_input_error, run
+
+#: seconds a refused scheduler may take in a subprocess, start-up (imports) included
+QUICK = 20.0
+
+
+def _railride(*args, timeout=120.0):
+    started = time.monotonic()
+    proc = subprocess.run(
+        [sys.executable, "-m", "railride.cli", *map(str, args)], capture_output=True, text=True, timeout=timeout
+    )
+    return proc, time.monotonic() - started
+
+
+def _free_port():
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+@pytest.mark.parametrize(
+    "address,fragment",
+    [
+        ("tls://127.0.0.1:{port}", "TLS certificates"),
+        ("wss://127.0.0.1:{port}", "TLS certificates"),
+        ("ucx://127.0.0.1:{port}", "allowed: tcp://host:port"),
+        ("inproc://127.0.0.1/1/1", "allowed: tcp://host:port"),
+        ("tcp://127.0.0.1:{port}", "connection refused"),
+        ("127.0.0.1:{port}", "connection refused"),
+    ],
+)
+def test_a_scheduler_that_cannot_work_fails_fast_naming_the_option(address, fragment):
+    pytest.importorskip("distributed")
+    address = address.format(port=_free_port())  # nothing listens there
+    proc, took = _railride("sweep", "--speed", "30", "--duration", "1", "--scheduler", address, timeout=60)
+    # a half-made Client once hung 20 s as it was collected, then printed a traceback
+    assert proc.returncode == 2, proc.stderr
+    assert took < QUICK, took
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1, proc.stderr
+    assert lines[0].startswith(f"error: --scheduler = '{address}': "), lines[0]
+    assert fragment in lines[0]
+
+
+def test_a_tiny_step_is_refused_by_the_step_count_with_how_long_it_would_take():
+    # MR dampers run the RK4 stepper: 10 s at 1e-10 s is 1e11 steps, its histories only 10001 rows
+    result = run("simulate", "--suspension", "mr", "--dt", "1e-10")
+    assert_input_error(result, "1e+11 sample-steps", " h at ", "raise dt", "--max-steps")
+
+
+def test_max_steps_raises_and_lowers_the_limit():
+    # 1 s at the default dt is 10 000 steps: admitted under a limit of a million, 2e6 at 5e-7 s refused
+    assert_input_error(
+        run("simulate", "--suspension", "mr", "--duration", "1", "--dt", "5e-7", "--max-steps", "1e6"),
+        "2e+06 steps",
+        "set with --max-steps",
+    )
+    assert run("simulate", "--suspension", "mr", "--duration", "1", "--max-steps", "1e6").exit_code == 0
+    assert_input_error(run("simulate", "--max-steps", "1e3"), "--max-steps = '1e3'", ">= 1e6")
+    assert_input_error(run("simulate", "--max-steps", "many"), "--max-steps = 'many'")
+
+
+def _interrupt(args, after_s, timeout=120.0, once=None):
+    """Ctrl-C after ``after_s`` seconds, or as soon as the path ``once`` exists."""
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "railride.cli", *map(str, args)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    deadline = time.monotonic() + after_s
+    while time.monotonic() < deadline and proc.poll() is None and not (once is not None and once.exists()):
+        time.sleep(0.05)
+    proc.send_signal(signal.SIGINT)
+    out, err = proc.communicate(timeout=timeout)
+    return proc.returncode, out, err
+
+
+def test_ctrl_c_in_a_long_simulate_saves_the_partial_histories(tmp_path):
+    xr = pytest.importorskip("xarray")
+    out = tmp_path / "run"
+    # 3000 s of MR dampers at 1e-4 s: minutes of stepping; interrupted after a few seconds
+    args = ["simulate", "--suspension", "mr", "--voltage", "1", "--duration", "3000", "--output-rate", "10"]
+    status, stdout, stderr = _interrupt([*args, "--out", out], after_s=15.0)
+    assert status == 130, stderr
+    assert "Traceback" not in stderr
+    if not (out / "metrics.json").exists():  # still starting (a cold compile): nothing to keep
+        assert stderr.strip().splitlines()[-1] == "interrupted", stderr
+        pytest.skip("interrupted before the first chunk finished")
+    last = stderr.strip().splitlines()[-1]
+    assert last.startswith("interrupted at t = ") and "marked partial" in last, stderr
+    doc = json.loads((out / "metrics.json").read_text())
+    until = doc["partial"]["until_s"]
+    assert 0 < until < 3000 and doc["partial"]["duration_s"] == 3000
+    assert doc["settings"]["window_s"] == [0.0, until]
+    with xr.open_dataset(out / "ride.nc") as ds:
+        assert ds.attrs["partial"].startswith("interrupted: up to t = ")
+        assert float(ds["time"][-1]) == pytest.approx(until)
+    assert not list(tmp_path.glob(".*"))  # written atomically: no staging folder left
+
+
+def test_ctrl_c_in_a_sweep_keeps_the_finished_rows_and_resume_continues(tmp_path):
+    out = tmp_path / "s"
+    speeds = "20:80:61"  # x 3 laws x 10 s: several chunks
+    args = ["sweep", "--speed", speeds, "--duration", "10", "--controllers", "passive,pid,sas-attitude", "--out", out]
+    status, _, stderr = _interrupt(args, after_s=120.0, once=out / "runs.csv")
+    assert status == 130, stderr
+    assert "Traceback" not in stderr
+    if not (out / "runs.csv").exists():
+        pytest.skip("interrupted before the first chunk finished")
+    assert "runs saved in" in stderr
+    kept = (out / "runs.csv").read_text().splitlines()[1:]
+    assert 0 < len(kept)
+    proc, _ = _railride(*args, "--resume", timeout=600)
+    assert proc.returncode == 0, proc.stderr
+    rows = (out / "runs.csv").read_text().splitlines()[1:]
+    assert rows[: len(kept)] == kept and len(rows) == 61 * 3
