@@ -31,7 +31,8 @@ class BuildWithEngine(build_py):
             if name.endswith((".nbi", ".nbc")):
                 os.remove(os.path.join(cache, name))
         env = {k: v for k, v in os.environ.items() if k != "NUMBA_CACHE_DIR"}
-        env["PYTHONPATH"] = os.path.abspath(self.build_lib)
+        # in front of pip's own entries, which make the isolated build environment's numba visible
+        env["PYTHONPATH"] = os.pathsep.join(filter(None, [os.path.abspath(self.build_lib), env.get("PYTHONPATH")]))
         started = time.perf_counter()
         done = subprocess.run(
             [sys.executable, "-c", "import railride.compiled as c; c.build_cache()"],

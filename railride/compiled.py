@@ -26,8 +26,9 @@ STEPPER = "run_batch"
 
 
 def _signatures() -> dict[str, tuple]:
-    """The argument types with which the library calls each kernel that `railride compare`
-    needs (checked by a test against the calls themselves): what `build_cache` compiles."""
+    """The argument types with which the library calls each kernel that `railride compare` and
+    the studies need (checked by a test against the calls themselves): what `build_cache`
+    compiles. The lane stepper runs every batch of eight samples or more (sweeps, tuning)."""
     from numba import types
 
     i, f, b = types.int64, types.float64, types.boolean
@@ -43,6 +44,15 @@ def _signatures() -> dict[str, tuple]:
         + (a(1, i), a(1), b, i, a(3), a(3), a(2), a(2), a(2, i), a(2), a(2))
         + (a(3),) * 9
         + (a(1, i), a(1, i)),
+        # lo, hi, lane_smp, lane_own, law, x, step0, n_steps, final, stride, dt, the q'' product's
+        # structure and values (a_ptr, a_col, a_val, a_uni) and the corner product's (t_*), c_sec, P,
+        # vcmd, utab, u_off, ftab, f_off, n_nodes, interval, closed_loop, ctrl_stride, Gm, Hm, inner,
+        # noise, faults, nine outputs, status, fail_step
+        "run_lanes": (i, i, a(2, i), a(2, b), i, a(2), i, i, b, i, f, a(1, i), a(1, i), a(3), a(1, b))
+        + (a(1, i), a(1, i), a(3), a(1, b), a(2), a(1), a(2), a(2), a(1, i), a(2), a(1, i), a(1, i), a(1))
+        + (b, i, a(3), a(3), a(2), a(2), a(2, i))
+        + (a(3),) * 9
+        + (a(1, i), a(1, i)),
         # Phi (a slice), maps, used, stride, m, utab, interval, x0, A, Bw, Bwd, TS, c_sec, six outputs
         "exact_run": (a(2, layout="A"), a(3), a(1, i), i, i, a(2), f, a(1), a(2), a(2), a(2), a(2), a(1)) + (a(2),) * 6,
         # phi, rail, force, start, period, m, stride, ctrl, tc, utab, interval, x0, A, Bw, Bwd, Bf, G,
@@ -55,7 +65,7 @@ def _signatures() -> dict[str, tuple]:
 
 
 def build_cache(kernels: tuple[str, ...] | None = None) -> list[str]:
-    """Compile the kernels `railride compare` needs into numba's cache, unless it already holds
+    """Compile the kernels `railride compare` and the studies need into numba's cache, unless it already holds
     them; return the names compiled or loaded. The package's build runs this (setup.py), so
     that the machine code ships inside the installed package and the first run after
     ``pip install .`` starts at once. Compiling takes about as long as the first run would."""

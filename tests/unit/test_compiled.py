@@ -50,12 +50,14 @@ def test_watch_hears_the_stepper_compile_only():
     assert compiled.compile_seconds("run_batch") > 1.0
 
 
-def test_the_build_compiles_what_compare_calls():
+def test_the_build_compiles_what_compare_and_studies_call():
     # setup.py compiles `build_cache`'s signatures into the wheel; if they drifted from the calls
-    # the library makes, the first run after install would compile again. Compare first, so the
-    # kernels hold the signatures of real calls; the build's must add none (a drift compiles a
-    # second one here, which the check sees).
+    # the library makes (compare, and a study's batch), the first run after install would compile
+    # again. Run those first, so the kernels hold the signatures of real calls; the build's must
+    # add none (a drift compiles a second one here, which the check sees).
     rr.compare(rr.scenario("paper-sine", duration=0.3))
+    sc = rr.scenario("paper-sine", duration=0.1)  # and a batch that fills the lane stepper, as studies do
+    rr.simulate([sc] * kernels.LANES, None, rr.Suspension.named("pid"))
     used = {name: set(getattr(kernels, name).signatures) for name in compiled._signatures()}
     assert all(used.values())  # compare went through every kernel the build compiles
     assert compiled.build_cache() == list(used)
