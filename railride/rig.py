@@ -368,8 +368,15 @@ def cycles(
         # keep a whole number of steps per cycle so the last cycle is exact
         dt = period / max(steps_per_cycle, 1)
     stride = max(1, steps_per_cycle // points_per_cycle)
-    while steps_per_cycle % stride:
-        stride -= 1
+    # the largest stride that divides the cycle, searched over at most 10**4 strides: a slow
+    # cycle (--frequency 1e-300) has more steps than any search could try. Where none divides
+    # it, the cycle gets the next whole number of strides (dt shorter by under 1/points_per_cycle)
+    divisor = next((s for s in range(stride, max(stride - 10**4, 0), -1) if steps_per_cycle % s == 0), None)
+    if divisor is None:
+        steps_per_cycle = -(-steps_per_cycle // stride) * stride
+        dt = period / steps_per_cycle
+    else:
+        stride = divisor
     ds = drive(
         damper, motion, duration=n_cycles * period, voltage=list(voltages), dt=dt, output_rate=1.0 / (stride * dt)
     )

@@ -85,6 +85,11 @@ def max_stable_dt(vehicle: Vehicle, damper=None) -> float:
     return lo
 
 
+#: the most output-step phases (distinct step maps) the exact discretisation builds: the default
+#: grids need one; a dt that splits the output interval and the input nodes unevenly needs up to
+#: the node spacing in steps (330 000 at dt = 3e-9 s: minutes of matrix exponentials)
+_MAX_EXACT_PHASES = 1000
+
 #: what a result's ``integrator`` attribute says of each method
 INTEGRATOR_RK4 = "classical RK4, fixed step"
 INTEGRATOR_EXACT = "exact discretisation (matrix exponential, one step per output sample; railride.discrete)"
@@ -172,6 +177,13 @@ def _check_size(scenarios, solver: SolverSettings, damper, closed, exact: bool, 
         m = int(round(interval / dt))
         period, span = math.lcm(stride, m) // stride, (stride + m - 1) // m + 2
         need += 8.0 * period * 2 * N_DOF * span * 8
+        if period > _MAX_EXACT_PHASES:  # each phase costs matrix exponentials, 1-2 ms each
+            raise ValueError(
+                f"dt = {shown(dt)} s: the exact discretisation would build {period} step maps (the output "
+                f"interval, {stride} steps, and the input table's node spacing, {m} steps, line up again "
+                f"only every {period} output samples); use a dt that divides both evenly, such as the "
+                f"default {DEFAULT_DT:g} s (or, from Python, SolverSettings(method='rk4'))"
+            )
     limits.check(
         need,
         f"{n} run(s) of {duration:.4g} s at dt {dt:.4g} s ({n_out + 1} output samples, {nodes} input nodes)",

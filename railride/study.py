@@ -168,6 +168,7 @@ def study(
     the ``damper`` model. Every setting is checked before the first run. ``executor``, ``table``
     and ``progress`` as for `railride.sweep.run_cases`. Returns a `StudyResult`."""
     from .faults import fault_table
+    from .metrics import check_window
     from .suspension import damper_model
     from .sweep import other_settings
     from .track import SPECTRA
@@ -249,6 +250,9 @@ def study(
             except ValueError as exc:
                 raise ValueError(f"faults = {'+'.join(cond)!r}: {exc}") from None
         speed_of[v] = sc.speed
+    # the window inside the runs, checked before the first; recorded with its open end (inf,
+    # which JSON cannot hold) resolved, while the runs' keys keep it as given (resumable)
+    window_record = None if window is None else [float(w) for w in check_window(tuple(window), sc.duration)]
     opts_of = {(seed, v): (options_of(seed, v), speed_of[v]) for seed in seeds for v in speed_list}
     cases, meta = [], []
     controlled = [n for n in names if n != "passive"]
@@ -310,7 +314,7 @@ def study(
         "duration_s": duration,
         "damper": damper,
         "gains": gains.source,
-        "window_s": None if window is None else [float(w) for w in window],
+        "window_s": window_record,
         **other_settings(vehicle, solver),
     }
     return StudyResult(frame, summary, settings, failed)

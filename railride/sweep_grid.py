@@ -316,7 +316,12 @@ def grid(
     combos, record, run_duration = _scenarios(
         words, scenario, axes, common, min_wavelength is not None, solver.output_rate
     )
-    window = None if window is None else check_window(tuple(window), run_duration)
+    if window is not None:
+        try:
+            window = check_window(tuple(window), run_duration)
+        except ValueError as exc:  # "window = ..." in the caller's words
+            name = words.name("window")
+            raise ValueError(str(exc).replace("window", name, 1) if name != "window" else str(exc)) from None
 
     columns = ["suspension"] + [column for _, column, _ in axes]
     if scales is not None:

@@ -288,6 +288,16 @@ class MeasuredTrack(RailProfile):
         return {"profile": "measured", "source": self.source, "rows": int(self.s.size), "s_end_m": float(self.s[-1])}
 
 
+def _check_speed(value) -> float:
+    speed = _check("speed", value, "positive", "a finite number > 0 (m/s)")
+    if speed > MAX_SPEED:
+        raise ValueError(
+            f"speed = {speed:.4g} m/s: above the plausible {MAX_SPEED:g} m/s (the rail speed "
+            "record is 159.7 m/s; the model's linear suspension means nothing far beyond it)"
+        )
+    return speed
+
+
 @dataclass(frozen=True)
 class Scenario:
     """A run: a rail profile passed at constant speed for a duration."""
@@ -298,13 +308,8 @@ class Scenario:
     name: str = "paper-sine"
 
     def __post_init__(self):
-        object.__setattr__(self, "speed", _check("speed", self.speed, "positive", "a finite number > 0 (m/s)"))
+        object.__setattr__(self, "speed", _check_speed(self.speed))
         object.__setattr__(self, "duration", _check("duration", self.duration, "positive", "a finite number > 0 (s)"))
-        if self.speed > MAX_SPEED:
-            raise ValueError(
-                f"speed = {self.speed:.4g} m/s: above the plausible {MAX_SPEED:g} m/s (the rail speed "
-                "record is 159.7 m/s; the model's linear suspension means nothing far beyond it)"
-            )
         if not isinstance(self.track, RailProfile):
             raise ValueError(f"track = {self.track!r}: must be a RailProfile")
         needed = self.speed * self.duration
@@ -382,7 +387,7 @@ def scenario(
                 f"{', '.join(given)} cannot be set for a random track ({name}); "
                 "use min_wavelength, max_wavelength and seed"
             )
-        V = _check("speed", common["speed"], "positive", "a finite number > 0 (m/s)")
+        V = _check_speed(common["speed"])  # before the track, whose length it sets
         T = _check("duration", common["duration"], "positive", "a finite number > 0 (s)")
         # long enough that the realisation does not repeat within the run
         track = _random_track(

@@ -384,7 +384,7 @@ def _study(name, start, score, budget, n_values, start_span, tol, min_span, resu
                     {"controller": name, "pass": study.passes, "objective": best, "span": span, "runs": study.runs}
                 )
                 if log is not None:
-                    log(f"{name} pass {study.passes}: objective {best:.4f} ({study.runs} runs)")
+                    log(f"{name} pass {study.passes}: objective {best:.4g} ({study.runs} runs)")
             else:
                 study.passes -= 1
             if not stopped and before - best < tol * abs(before):

@@ -9,6 +9,7 @@ command line turns that into exit status 2. NumPy scalars (``np.float32(0.1)``,
 from __future__ import annotations
 
 import dataclasses
+import datetime
 import math
 import numbers
 from dataclasses import field
@@ -57,6 +58,8 @@ def shown(value) -> str:
     if isinstance(value, (list, tuple)):
         inner = ", ".join(map(shown, value)) + ("," if isinstance(value, tuple) and len(value) == 1 else "")
         return f"[{inner}]" if isinstance(value, list) else f"({inner})"
+    if isinstance(value, (datetime.date, datetime.time)):  # a TOML date or time, as the file wrote it
+        return f"{value.isoformat()} (a {type(value).__name__})"
     if not is_number(value):
         return repr(value)
     if isinstance(value, numbers.Integral):

@@ -271,6 +271,7 @@ PROFILE_FIELDS = {
     "length": "--wavelength",
     "rail_phase": "--rail-phase",
     "speed": "--speed",
+    "duration": "--duration",
 }
 
 

@@ -83,7 +83,13 @@ BoundsOption = Annotated[
     ),
 ]
 #: the library's names of compare's options, for its errors
-COMPARE_FIELDS = {**SOLVER_FIELDS, "damper": "--damper", "damper_scale": "--damper-scale", "delay": "--delay"}
+COMPARE_FIELDS = {
+    **SOLVER_FIELDS,
+    "damper": "--damper",
+    "damper_scale": "--damper-scale",
+    "delay": "--delay",
+    "window": "--window",
+}
 
 
 def _controller_list(text: str) -> list[str]:
@@ -141,8 +147,13 @@ def _sensor_noise(text: Optional[str], seed: Optional[int]):
             )
         return None
     z, angle, velocity, rate = parse_noise("--sensor-noise", text)
-    with option_names({"'seed'": "--seed"}):  # as the noise's field check quotes it
-        return SensorNoise(z, angle, velocity, rate, seed=0 if seed is None else seed)
+    try:
+        with option_names({"'seed'": "--seed"}):  # as the noise's field check quotes it
+            return SensorNoise(z, angle, velocity, rate, seed=0 if seed is None else seed)
+    except ValueError as exc:
+        if "--seed" in str(exc):
+            raise
+        raise ValueError(f"--sensor-noise = {text!r}: {exc}") from None
 
 
 def _trade_off_lines(doc: dict) -> list[str]:

@@ -72,6 +72,7 @@ SIMULATE_FIELDS = {
     "damper": "--damper",
     "damper_scale": "--damper-scale",
     "voltage": "--voltage",
+    "window": "--window",
 }
 
 

@@ -55,6 +55,8 @@ STUDY_FIELDS = {
     "duration": "--duration",
     "delays": "--delay",
     "sensing": "--sensing",
+    "dt": "--dt",
+    "window": "--window",
 }
 #: the metrics of the table, and their labels
 TABLE_METRICS = {

@@ -70,6 +70,7 @@ OPTION_NAMES = {
     "base_gains": "--gains",
     "noise": "--noise",
     "seed": "--seed",
+    "window": "--window",
     "damper": "--damper",
     "damper_scale": "--damper-scale",
 }

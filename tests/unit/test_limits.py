@@ -157,3 +157,13 @@ def test_work_limits_and_durations_read_and_show_plainly():
     assert limits.shown_duration(45) == "45 s"
     assert limits.shown_duration(3600 * 9.3) == "9.3 h"
     assert limits.shown_duration(86400 * 41) == "41 days"
+
+
+def test_an_exact_run_whose_grids_never_line_up_is_refused_before_its_exponentials():
+    # dt = 3e-9 s: 333 333 steps per output sample against 2**20 per input node, so the maps
+    # would repeat only after a million output samples (minutes of matrix exponentials)
+    _refused_fast(
+        lambda: rr.simulate("paper-sine", solver=SolverSettings(dt=3e-9)),
+        "1048576 step maps",
+        "the default 0.0001 s",
+    )
