@@ -23,13 +23,13 @@ from setuptools.command.build_py import build_py
 class BuildWithEngine(build_py):
     def run(self) -> None:
         super().run()
-        if getattr(self, "editable_mode", False) or os.environ.get("RAILRIDE_NO_PRECOMPILE"):
-            return
-        # an earlier build's machine code (another source) would only bloat the wheel
+        # an earlier build's machine code in the build folder: never shipped unless made now
         cache = os.path.join(self.build_lib, "railride", "__pycache__")
         for name in os.listdir(cache) if os.path.isdir(cache) else []:
             if name.endswith((".nbi", ".nbc")):
                 os.remove(os.path.join(cache, name))
+        if getattr(self, "editable_mode", False) or os.environ.get("RAILRIDE_NO_PRECOMPILE"):
+            return
         env = {k: v for k, v in os.environ.items() if k != "NUMBA_CACHE_DIR"}
         # in front of pip's own entries, which make the isolated build environment's numba visible
         env["PYTHONPATH"] = os.pathsep.join(filter(None, [os.path.abspath(self.build_lib), env.get("PYTHONPATH")]))

@@ -177,18 +177,18 @@ def _check_size(scenarios, solver: SolverSettings, damper, closed, exact: bool, 
         m = int(round(interval / dt))
         period, span = math.lcm(stride, m) // stride, (stride + m - 1) // m + 2
         need += 8.0 * period * 2 * N_DOF * span * 8
-        if period > _MAX_EXACT_PHASES:  # each phase costs matrix exponentials, 1-2 ms each
-            raise ValueError(
-                f"dt = {shown(dt)} s: the exact discretisation would build {period} step maps (the output "
-                f"interval, {stride} steps, and the input table's node spacing, {m} steps, line up again "
-                f"only every {period} output samples); use a dt that divides both evenly, such as the "
-                f"default {DEFAULT_DT:g} s (or, from Python, SolverSettings(method='rk4'))"
-            )
     limits.check(
         need,
         f"{n} run(s) of {duration:.4g} s at dt {dt:.4g} s ({n_out + 1} output samples, {nodes} input nodes)",
         "shorten the duration, lower output_rate, run fewer samples at once or use a dt nearer the default",
     )
+    if exact and period > _MAX_EXACT_PHASES:  # each phase costs matrix exponentials, 1-2 ms each
+        raise ValueError(
+            f"dt = {shown(dt)} s: the exact discretisation would build {period} step maps (the output "
+            f"interval, {stride} steps, and the input table's node spacing, {m} steps, line up again "
+            f"only every {period} output samples); use a dt that divides both evenly, such as the "
+            f"default {DEFAULT_DT:g} s (or, from Python, SolverSettings(method='rk4'))"
+        )
     # time, which memory does not bound (the histories are strided): the exact method steps
     # once per output sample (and controller sample), RK4 once per dt
     if exact:

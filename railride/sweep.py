@@ -272,7 +272,8 @@ def evaluate(
                     ds = ds.expand_dims(sample=[0])
                 ok = np.flatnonzero(np.isnan(diverged_at))  # a diverged run has no comfort
                 if ok.size:  # the columns as one array (sample, column): xarray per value cost 4x the indices
-                    indices = ride_comfort(ds.isel(sample=ok), window=window)
+                    # every run ok (the rule): no copy of the histories
+                    indices = ride_comfort(ds if ok.size == ds.sizes["sample"] else ds.isel(sample=ok), window=window)
                     cf = np.stack([indices.sel(position=p, index=x).values for p, x in COMFORT_INDICES], -1)
             for j, i in enumerate(idx[start : start + CHUNK]):
                 if i in rows:

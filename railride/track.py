@@ -543,7 +543,8 @@ class RandomTrack(RailProfile):
         n = int(2 ** math.ceil(math.log2(length / ds)))
         if n > 2**24:
             raise ValueError(
-                f"the realisation needs {n} samples ({length:g} m at {ds:g} m): shorten it or raise min_wavelength"
+                f"the realisation needs {n:.4g} samples ({length:.4g} m at {ds:.4g} m), more than "
+                f"2**24: shorten it or raise min_wavelength"
             )
         ds = length / n
         dW = 2 * np.pi / length
