@@ -1260,45 +1260,16 @@ def _compressed(M, smp):
 
 
 def lanes_fit(n: int, P, sensing) -> bool:
-    """Whether `run_lanes_batch` can run this batch: LANES samples or more, one damper (the
+    """Whether `lanes_stepper` can run this batch: LANES samples or more, one damper (the
     packed parameters of every sample alike) and no realistic sensing."""
     return n >= LANES and bool(np.all(P == P[0])) and not bool(np.any(sensing[:, 0] > 0.0))
 
 
-def run_lanes_batch(
-    n,
-    law,
-    x,
-    step0,
-    n_steps,
-    final,
-    stride,
-    dt,
-    A,
-    TS,
-    c_sec,
-    P,
-    vcmd,
-    utab,
-    u_off,
-    ftab,
-    f_off,
-    n_nodes,
-    interval,
-    closed_loop,
-    ctrl_stride,
-    Gm,
-    Hm,
-    inner,
-    noise,
-    faults,
-    sensing,
-    snoise,
-    *outs,
-):
-    """`run_batch` over the n samples of a batch (the arguments of run_batch after lo, hi; sensing
-    must be off, see `lanes_fit`), in groups of LANES samples by `run_lanes`, the groups on
-    threads (`run_parallel`)."""
+def lanes_stepper(n, law, A, TS, P):
+    """`run_batch`'s work for the n samples of a batch (sensing off, see `lanes_fit`) in groups
+    of LANES samples by `run_lanes`, the groups on threads (`run_parallel`). The lane groups and
+    the products' compressed rows are built here, once per run; the function returned takes
+    run_batch's arguments after lo, hi, chunk after chunk (it reads A, TS and P from here)."""
     smp, own = lane_groups(n)
     n_cols = 2 * N_DOF if law == LAW_VISCOUS_IN_C else NY  # dashpots inside Av: no force columns
     a_ptr, a_col, a_val = _compressed(A[:, :n_cols, :].transpose(0, 2, 1), smp)
@@ -1306,44 +1277,15 @@ def run_lanes_batch(
     T[:, :N_CORNER, :N_DOF] = T[:, N_CORNER:, N_DOF:] = TS.transpose(0, 2, 1)
     t_ptr, t_col, t_val = _compressed(T, smp)
     a_uni, t_uni = (np.all(v == v[:, :, :1], axis=(1, 2)) for v in (a_val, t_val))  # groups of one vehicle
-    head = (
-        smp,
-        own,
-        law,
-        x,
-        step0,
-        n_steps,
-        final,
-        stride,
-        dt,
-        a_ptr,
-        a_col,
-        a_val,
-        a_uni,
-        t_ptr,
-        t_col,
-        t_val,
-        t_uni,
-        c_sec,
-    )
-    run_parallel(
-        run_lanes,
-        len(smp),
-        *head,
-        np.ascontiguousarray(P[0]),
-        vcmd,
-        utab,
-        u_off,
-        ftab,
-        f_off,
-        n_nodes,
-        interval,
-        closed_loop,
-        ctrl_stride,
-        Gm,
-        Hm,
-        inner,
-        noise,
-        faults,
-        *outs,
-    )
+    products = (a_ptr, a_col, a_val, a_uni, t_ptr, t_col, t_val, t_uni)
+    damper = np.ascontiguousarray(P[0])
+
+    def step(_n, _law, x, step0, n_steps, final, stride, dt, _A, _TS, c_sec, _P, vcmd, *rest):
+        # rest: utab ... faults (13), sensing and snoise (unused: sensing is off), the outputs
+        inputs, outs = rest[:13], rest[15:]
+        run_parallel(
+            run_lanes, len(smp), smp, own, law, x, step0, n_steps, final, stride, dt, *products, c_sec, damper,
+            vcmd, *inputs, *outs,
+        )  # fmt: skip
+
+    return step

@@ -100,8 +100,8 @@ def _exact(solver, damper, closed, suspensions, n_vehicles: int = 1) -> bool:
     vehicle is linear: the passive viscous dampers, or an outer loop on the ideal actuator with
     exact states (no sensing, no sensor noise); "exact" with anything else is refused. "auto"
     keeps RK4 for a batch of several vehicles that fills the lane stepper: each vehicle costs a
-    matrix exponential (about 25 ms), more than its whole RK4 run there (a 64-vehicle passive
-    batch of 2 s: 2.2 s exact, 0.17 s RK4; docs/performance.md)."""
+    matrix exponential, which costs more than its whole RK4 run there (a 64-vehicle passive
+    batch of 2 s: 0.26 s exact, 0.10 s RK4; benchmarks/bench_passive.py)."""
     faults = any(s.faults for s in suspensions)
     passive = damper is None and closed is None
     actuator = (
@@ -528,7 +528,7 @@ def simulate(
             progress(1.0)
     # a batch that fills groups of kernels.LANES samples runs them in vector form (run_lanes)
     if kernels.lanes_fit(n, P, sensing):
-        step_batch = kernels.run_lanes_batch
+        step_batch = kernels.lanes_stepper(n, law, arrays["A"], arrays["TS"], P)
     else:
         step_batch = functools.partial(kernels.run_parallel, kernels.run_batch)
     stop = _StopRequest(progress is not None and not exact)

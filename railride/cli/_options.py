@@ -495,18 +495,23 @@ def history_options(history_format: Optional[str], out: Optional[Path]) -> tuple
 
 
 # -- limits ---------------------------------------------------------------------------------------
-def _set_max_memory(value: Optional[str]) -> Optional[str]:
-    """Set the library's memory limit as the command starts (None: the default share of the
-    machine, so that one command's limit never carries over to the next in one process)."""
-    from .. import limits
-    from ._common import errors
+def _limit_setter(setter: str, field: str, option: str):
+    """A callback that sets one of the library's limits (`railride.limits`) as the command
+    starts; None puts the default back, so one command's limit never carries over to the next
+    in one process. Errors name the option."""
 
-    with errors():
-        try:
-            limits.set_max_memory(value)
-        except ValueError as exc:
-            raise ValueError(str(exc).replace("max_memory", "--max-memory", 1)) from None
-    return value
+    def set_limit(value: Optional[str]) -> Optional[str]:
+        from .. import limits
+        from ._common import errors
+
+        with errors():
+            try:
+                getattr(limits, setter)(value)
+            except ValueError as exc:
+                raise ValueError(str(exc).replace(field, option, 1)) from None
+        return value
+
+    return set_limit
 
 
 MaxMemoryOption = Annotated[
@@ -514,25 +519,11 @@ MaxMemoryOption = Annotated[
     typer.Option(
         "--max-memory",
         metavar="SIZE",
-        callback=_set_max_memory,
+        callback=_limit_setter("set_max_memory", "max_memory", "--max-memory"),
         help="The most memory a run may take, e.g. 4G or 512M (powers of 1024); a larger run is "
         "refused before it starts, saying what it would need. Default: half the machine's memory.",
     ),
 ]
-
-
-def _set_max_steps(value: Optional[str]) -> Optional[str]:
-    """Set the library's work limit as the command starts (None: the default, so that one
-    command's limit never carries over to the next in one process)."""
-    from .. import limits
-    from ._common import errors
-
-    with errors():
-        try:
-            limits.set_max_work(value)
-        except ValueError as exc:
-            raise ValueError(str(exc).replace("max_steps", "--max-steps", 1)) from None
-    return value
 
 
 MaxStepsOption = Annotated[
@@ -540,7 +531,7 @@ MaxStepsOption = Annotated[
     typer.Option(
         "--max-steps",
         metavar="N",
-        callback=_set_max_steps,
+        callback=_limit_setter("set_max_work", "max_steps", "--max-steps"),
         help="The most sample-steps (samples x steps) a run may take, e.g. 1e11; a longer run is "
         "refused before it starts, saying how long it would take. Default: 1e10, about an hour.",
     ),

@@ -69,15 +69,20 @@ CASES = {
 
 @pytest.fixture
 def lane_calls(monkeypatch):
-    """How many kernel calls went through the lane stepper."""
+    """How many kernel calls (chunks) went through the lane stepper."""
     calls = []
-    run = kernels.run_lanes_batch
+    make = kernels.lanes_stepper
 
-    def counted(*args):
-        calls.append(args[0])
-        return run(*args)
+    def counted_stepper(*setup):
+        step = make(*setup)
 
-    monkeypatch.setattr(kernels, "run_lanes_batch", counted)
+        def counted(*args):
+            calls.append(args[0])
+            return step(*args)
+
+        return counted
+
+    monkeypatch.setattr(kernels, "lanes_stepper", counted_stepper)
     return calls
 
 
