@@ -25,7 +25,7 @@ import numpy as np
 from numba import njit
 from numba.core.errors import NumbaPerformanceWarning
 
-from ._simd import corner_pairs, forcing_rows, mv9_simd
+from ._simd import bouc_wen1_corners, corner_pairs, forcing_rows, mv9_simd
 from ._simd_lanes import LANES, lanes_axpy, lanes_move, lanes_mr_damper, lanes_rk4, lanes_spmv
 from .dampers import (
     LAW_BOUC_WEN,
@@ -161,13 +161,14 @@ def _rail_inputs(t, utab, off, n_nodes, interval, w, wd):
 
 
 @njit(cache=True, inline="always", fastmath=_FAST)
-def _mv9(AT, x, xf, n_cols, r, roff, out, ooff):
+def _mv9(AT, x, xf, n_cols, r, roff, out, ooff, idx8, val8, n8):
     """out[ooff:ooff+9] = r[roff:roff+9] + A y for the 9 rows of q'', A stored transposed
     (n_cols, 9), y = (x[:18], xf[18:n_cols]): the state's (q, q') read in place, the corner
-    forces from the stage vector. Offsets instead of slices: a slice made in the loop costs
-    reference counting. The product is written in vector form (`railride._simd`): as plain
-    numba, nine named scalar sums were the fastest form and stayed scalar."""
-    mv9_simd(AT, x, xf, n_cols, r, roff, out, ooff)
+    forces from the stage vector; row 8 from its non-zero entries (idx8, val8, n8). Offsets
+    instead of slices: a slice made in the loop costs reference counting. The product is
+    written in vector form (`railride._simd`): as plain numba, nine named scalar sums were the
+    fastest form and stayed scalar."""
+    mv9_simd(AT, x, xf, n_cols, r, roff, out, ooff, idx8, val8, n8)
 
 
 @njit(cache=True, inline="always", fastmath=_FAST)
@@ -276,7 +277,7 @@ def _one_step_limit(dt):
 
 
 @njit(cache=True, inline="always", fastmath=_FAST)
-def _derivative(law, s, R, roff, AT, TT, P, vcmd, conn, y, cx, cv, K, koff):
+def _derivative(law, s, R, roff, AT, TT, P, vcmd, conn, y, cx, cv, K, koff, i8, v8, n8, bw1):
     """K[koff:koff+NS_MAX] = d/dt of the state s = (q, q', damper states), with the rail forcing
     R[roff:roff+9].
 
@@ -288,9 +289,13 @@ def _derivative(law, s, R, roff, AT, TT, P, vcmd, conn, y, cx, cv, K, koff):
     for i in range(N_DOF):
         K[koff + i] = s[N_DOF + i]
     if law == LAW_VISCOUS_IN_C:
-        _mv9(AT, s, y, 2 * N_DOF, R, roff, K, koff + N_DOF)
+        _mv9(AT, s, y, 2 * N_DOF, R, roff, K, koff + N_DOF, i8, v8, n8[0])
         return
     corner_pairs(TT, s, cx, cv)
+    if bw1:
+        bouc_wen1_corners(P, s, cx, cv, vcmd, conn, y, K, koff)
+        _mv9(AT, s, y, NY, R, roff, K, koff + N_DOF, i8, v8, n8[1])
+        return
     for c in range(N_CORNER):
         b = 2 * N_DOF + N_DAMPER_STATES * c
         F, dz, dyy, du = damper_law(law, P, cx[c], cv[c], s[b], s[b + 1], s[b + 2], vcmd[c])
@@ -298,7 +303,7 @@ def _derivative(law, s, R, roff, AT, TT, P, vcmd, conn, y, cx, cv, K, koff):
         K[koff + b] = dz
         K[koff + b + 1] = dyy
         K[koff + b + 2] = du
-    _mv9(AT, s, y, NY, R, roff, K, koff + N_DOF)
+    _mv9(AT, s, y, NY, R, roff, K, koff + N_DOF, i8, v8, n8[1])
 
 
 @njit(cache=True, nogil=True, fastmath=_FAST, parallel=_NO_PARFORS)
@@ -430,6 +435,17 @@ def run_batch(
         bw1 = law == LAW_BOUC_WEN and pp[6] == 1.0
         gb1 = pp[6] * (abs(pp[7]) + abs(pp[8]))
         lam1 = _one_step_limit(dt)  # the largest rate bound that needs no sub-steps
+        # the last row of q'' is sparse (a bogie's roll): its non-zero columns, in order
+        i8 = np.empty(NY, np.int64)
+        v8 = np.empty(NY)
+        n8 = np.zeros(2, np.int64)  # how many of them act on (q, q'), and on (q, q', f)
+        for j in range(NY):
+            if at[j, N_DOF - 1] != 0.0:
+                i8[n8[1]] = j
+                v8[n8[1]] = at[j, N_DOF - 1]
+                n8[1] += 1
+                if j < 2 * N_DOF:
+                    n8[0] += 1
         _forcing(step0 * dt, ftab, fo, nn, itv, R, 0)
         last = n_steps + 1 if final else n_steps
         for n in range(last):
@@ -482,7 +498,7 @@ def run_batch(
                     if fm[c] == FAULT_DISCONNECTED and step >= fm[N_CORNER + c]:
                         conn[c] = 0.0
             # rates at the step's start: for the record, the sub-step choice and stage 1
-            _derivative(law, s, R, 0, at, tt, pp, vc, conn, y, cx, cv, K, 0)
+            _derivative(law, s, R, 0, at, tt, pp, vc, conn, y, cx, cv, K, 0, i8, v8, n8, bw1)
             if sens:  # each accelerometer's anti-alias filter follows its corner's acceleration
                 for c in range(N_CORNER):
                     a_c = 0.0
@@ -582,7 +598,7 @@ def run_batch(
                     if has_states:
                         for i in range(2 * N_DOF, NS_MAX):
                             st[i] = s[i] + ch * K[prev + i]
-                    _derivative(law, st, R, roff, at, tt, pp, vc, conn, y, cx, cv, K, NS_MAX * stage)
+                    _derivative(law, st, R, roff, at, tt, pp, vc, conn, y, cx, cv, K, NS_MAX * stage, i8, v8, n8, bw1)
                 for i in range(2 * N_DOF):
                     s[i] += h / 6.0 * (K[i] + 2.0 * K[NS_MAX + i] + 2.0 * K[2 * NS_MAX + i] + K[3 * NS_MAX + i])
                 if has_states:
