@@ -37,10 +37,10 @@ MAX_STEPS = 2**53
 VALUE_BYTES = 1024
 
 #: the order of the stepper's rate, sample-steps a second on one core of a recent machine: the
-#: closed loop with MR dampers runs 0.26-0.3 us a step, batches 3-4 M sample-steps a second a core
-#: (docs/performance.md); the passive vehicle is a little faster, the sub-stepped dampers slower
-STEP_RATE = 3e6
-#: the default most sample-steps of one run: about an hour at `STEP_RATE` on one core, a hundred
+#: closed loop with MR dampers runs 0.21-0.23 us a step, batches of 8 or more about 7 M
+#: sample-steps a second a core (docs/performance.md); the sub-stepped dampers are slower
+STEP_RATE = 4e6
+#: the default most sample-steps of one run: about 40 minutes at `STEP_RATE` on one core, a hundred
 #: times the paper's 10 s run at dt = 1e-4 s for a batch of a thousand samples
 DEFAULT_MAX_WORK = 10**10
 
@@ -204,7 +204,7 @@ def check_work(samples: int, steps: float, what: str, shrink: str) -> None:
     work, limit = float(samples) * float(steps), max_work()
     if work <= limit:
         return
-    where = "set with --max-steps or set_max_work" if _work_limit is not None else "the default, about an hour"
+    where = "set with --max-steps or set_max_work" if _work_limit is not None else "the default, about 40 minutes"
     raise ValueError(
         f"{what}: {samples} x {steps:.4g} steps = {work:.3g} sample-steps, about "
         f"{shown_duration(work / STEP_RATE)} at {STEP_RATE / 1e6:.0f} M sample-steps a second (the stepper's "

@@ -533,6 +533,6 @@ MaxStepsOption = Annotated[
         metavar="N",
         callback=_limit_setter("set_max_work", "max_steps", "--max-steps"),
         help="The most sample-steps (samples x steps) a run may take, e.g. 1e11; a longer run is "
-        "refused before it starts, saying how long it would take. Default: 1e10, about an hour.",
+        "refused before it starts, saying how long it would take. Default: 1e10, about 40 minutes.",
     ),
 ]

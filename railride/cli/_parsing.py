@@ -116,6 +116,9 @@ def default_of(fn, name: str):
 # -- solver settings ------------------------------------------------------------------------------
 #: the library's names of the step and rate options, for its errors (`_common.option_names`)
 SOLVER_FIELDS = {"dt": "--dt", "output_rate": "--output-rate", "control_rate": "--control-rate"}
+#: the solver's fields in a command whose output rate is not an option (sweep, study): the rate is
+#: named in words, not as a setting the user could pass
+FIXED_RATE_FIELDS = {"dt": "--dt", "output_rate": "output rate"}
 
 
 def solver_from_options(**given):

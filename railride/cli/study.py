@@ -40,7 +40,7 @@ from ._options import (
     WorkersOption,
     figure_options,
 )
-from ._parsing import damper_preset, load_gains, solver_from_options, value_list
+from ._parsing import FIXED_RATE_FIELDS, damper_preset, load_gains, solver_from_options, value_list
 from ._render import RESPONSE_LABELS, reduction_text
 from .report import check_report_option, save_report
 
@@ -55,7 +55,7 @@ STUDY_FIELDS = {
     "duration": "--duration",
     "delays": "--delay",
     "sensing": "--sensing",
-    "dt": "--dt",
+    **FIXED_RATE_FIELDS,
     "window": "--window",
 }
 #: the metrics of the table, and their labels

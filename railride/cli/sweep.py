@@ -50,7 +50,7 @@ from ._options import (
     WorkersOption,
     figure_options,
 )
-from ._parsing import SOLVER_FIELDS, load_gains, parse_noise, solver_from_options, value_list
+from ._parsing import FIXED_RATE_FIELDS, load_gains, parse_noise, solver_from_options, value_list
 from ._render import RESPONSE_LABELS, damper_text, fmt
 from .report import check_report_option, save_report
 
@@ -305,7 +305,7 @@ def _parse(
     syntax of the options is checked here; what their values may be is the grid's to check."""
     from ..metrics import parse_window
 
-    with option_names({"dt": SOLVER_FIELDS["dt"]}):  # the runs' output rate is not an option here
+    with option_names(FIXED_RATE_FIELDS):
         solver = None if dt is None else solver_from_options(dt=dt)
     values = {
         "suspensions": _names("--suspension", suspension),

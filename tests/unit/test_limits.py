@@ -133,8 +133,8 @@ def test_a_run_of_a_hundred_billion_steps_is_refused_by_its_work_with_its_time()
         "limit of 1e+10",
         "raise dt",
     )
-    # 1e11 sample-steps at 3e6 a second: 33 333 s, 9.3 hours
-    assert "about 9.3 h" in message
+    # 1e11 sample-steps at 4e6 a second: 25 000 s, 6.9 hours
+    assert "about 6.9 h" in message
 
 
 def test_the_work_limit_counts_samples_and_is_restored_after_a_block():
