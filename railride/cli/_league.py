@@ -34,6 +34,8 @@ def run_league(
     out,
     bounds,
     figures=None,
+    report=None,
+    ctx=None,
 ) -> None:
     """Several scenarios, speeds or track seeds: the league table (railride.league.league)."""
     from ..files import check_out_dir, write_league_outputs
@@ -83,12 +85,17 @@ def run_league(
     text = json.dumps(doc, indent=2, allow_nan=False)
     if out is not None:
         write_folder(out, lambda: write_league_outputs(table, out, figures=figures))
+    parts = league_table(table, doc)
     if format is OutputFormat.json:
         typer.echo(text)
-        return
-    console = stdout_console()
-    for part in league_table(table, doc):
-        console.print(part)
+    else:
+        console = stdout_console()
+        for part in parts:
+            console.print(part)
+    if report is not None:  # after the table: a report that cannot be written loses no output
+        from .report import save_report  # here: report imports compare, which imports this module
+
+        save_report(report, table, parts, ctx)
 
 
 def league_table(table, doc) -> list:

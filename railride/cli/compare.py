@@ -516,11 +516,7 @@ def compare(
         speeds = value_list("--speed", speed) if speed is not None else None
         seeds = value_list("--track-seed", track_seed, integer=True) if track_seed is not None else None
         if len(scenarios) > 1 or len(speeds or [0]) > 1 or len(seeds or [0]) > 1:
-            if report is not None:
-                raise ValueError(
-                    f"--report = {str(report)!r}: the report is of one scenario, speed and track seed; "
-                    "a league table (several) has none yet"
-                )
+            check_report_option(report)
             if history_format is not None:
                 raise ValueError(
                     "--history-format: a league table (several --scenario, --speed or --track-seed "
@@ -557,6 +553,8 @@ def compare(
                 out=out,
                 bounds=bounds,
                 figures=figures,
+                report=report,
+                ctx=ctx,
             )
             return
         speed_value = speeds[0] if speeds else None

@@ -59,6 +59,16 @@ def test_report_option(tmp_path, args, printed):
     assert "Vehicle: modes and parameters" in page
 
 
+def test_league_table_report(tmp_path):
+    out = tmp_path / "league.html"
+    result = ok("compare", "--speed", "30,40", "--duration", 1, "--controllers", "passive,pid", "--report", out)
+    page = _page(out)
+    assert f"wrote {out}" in result.stderr
+    assert "Reduction = (passive - controlled) / passive RMS" in result.stdout  # the table, printed
+    assert '<pre class="console">' in page and "Reduction = (passive - controlled)" in page  # and in the page
+    assert "railride compare --controllers passive,pid --speed 30,40 --duration 1.0 --report" in page
+
+
 @pytest.mark.parametrize("command", [("compare", *SHORT), ("sweep", "--duration", 1), ("study", "--duration", 1)])
 def test_bad_report_paths(tmp_path, command):
     assert_input_error(run(*command, "--report", tmp_path), "--report", "a folder", "report.html")
@@ -71,6 +81,6 @@ def test_bad_report_paths(tmp_path, command):
 def test_bad_report_command_paths(tmp_path):
     assert_input_error(run("report", "--out", tmp_path), "--out", "a folder")
     assert_input_error(run("report", "--scenario", "fra4,bump", "--out", tmp_path / "r.html"), "--scenario", "one")
-    assert_input_error(run("compare", "--speed", "30,40", "--report", tmp_path / "r.html"), "--report", "league table")
+    assert_input_error(run("compare", "--speed", "30,40", "--report", tmp_path), "--report", "a folder")
     assert_input_error(run("report", "--speed", "-1", "--out", tmp_path / "r.html"), "speed = -1.0")
     assert not (tmp_path / "r.html").exists()
