@@ -14,6 +14,7 @@ The public API, in the order a run needs it::
     rr.study(["pid"], scenario="fra4", loads=[1, 1.3], faults=["none", "1R-off"])  # over many tracks
     rr.run_sweep(rr.sweep.grid(["passive", "pid"], speed=[20, 40, 60]))  # every combination
     rr.frequency_responses(params)                    # carbody FRFs, their peaks, the modes
+    rr.write_report(rr.compare(sc), "ride.html")      # any result as one HTML page
 """
 
 __version__ = "0.4.0"
@@ -50,6 +51,7 @@ _HOMES = {
     "tune": "tuning",
     "Vehicle": "vehicle",
     "dampers": "dampers",
+    "write_report": "report",
 }
 
 if TYPE_CHECKING:
@@ -61,6 +63,7 @@ if TYPE_CHECKING:
     from .objectives import Objective
     from .params import VehicleParams
     from .pareto import ParetoResult, pareto
+    from .report import write_report
     from .ride import RideResult
     from .simulation import simulate
     from .solver import SolverSettings
@@ -133,4 +136,5 @@ __all__ = [
     "simulate",
     "study",
     "tune",
+    "write_report",
 ]
