@@ -444,6 +444,7 @@ def compare(
     settings = {
         "scenario": json.loads(str(first["scenario"].values)),
         "vehicle_params": json.loads(str(first["vehicle_params"].values)),
+        **({"warnings": json.loads(w)} if (w := first.attrs.get("plausibility_warnings")) else {}),
         "damper": str(damper),
         "damper_scale": damper_scale,
         **solver.to_dict(),

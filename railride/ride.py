@@ -193,7 +193,17 @@ def build_dataset(
     }
     if closed is not None:
         attrs.update(attrs_ctrl)
+    warned = plausibility_notes(param_sets)
+    if warned:  # the vehicle outside full-size rail vehicles' ranges: kept with the result
+        attrs["plausibility_warnings"] = json.dumps(warned)
     return xr.Dataset(data, coords=coords, attrs=attrs)
+
+
+def plausibility_notes(param_sets) -> list[str]:
+    """The plausibility warnings (`railride.plausible.notes`) of the vehicles, each once."""
+    from .plausible import notes
+
+    return list(dict.fromkeys(n for p in param_sets for n in notes(p)))
 
 
 class RideResult:

@@ -2,6 +2,7 @@
 errors naming the field, the value and the range; unusual vehicles run with a warning; the
 modes of what gets through are finite numbers or a clear error."""
 
+import json
 import math
 import re
 import warnings
@@ -11,6 +12,7 @@ import numpy as np
 import pytest
 
 from railride import dampers
+from railride.comparison import compare
 from railride.control import PID, GainSet, SensorNoise
 from railride.controllers import ClippedOptimal
 from railride.frf import frequency_responses, modes
@@ -77,6 +79,15 @@ def test_a_1000_tonne_carbody_runs_with_a_warning_it_records():
     doc = frequency_responses(heavy, points=3).to_dict()
     assert len(doc["warnings"]) == 1 and "'m_c'" in doc["warnings"][0]
     assert "warnings" not in frequency_responses(P, points=3).to_dict()
+    # a ride and a comparison keep the warning with their parameters; a batch names it once
+    short = scenario("paper-sine", duration=0.5)
+    ride = simulate(short, heavy, Suspension.passive())
+    assert json.loads(ride.dataset.attrs["plausibility_warnings"]) == doc["warnings"]
+    batch = simulate(short, [heavy, heavy, P], Suspension.passive())
+    assert json.loads(batch.dataset.attrs["plausibility_warnings"]) == doc["warnings"]
+    assert "plausibility_warnings" not in simulate(short, P, Suspension.passive()).dataset.attrs
+    settings = compare(short, heavy, controllers=["passive", "pid"], bounds=False).to_dict()["settings"]
+    assert settings["warnings"] == doc["warnings"]
 
 
 @pytest.mark.parametrize(
