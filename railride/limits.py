@@ -45,8 +45,27 @@ STEP_RATE = 4e6
 DEFAULT_MAX_WORK = 10**10
 
 _UNITS = {"": 1, "B": 1, "K": 2**10, "M": 2**20, "G": 2**30, "T": 2**40}
-_limit: int | None = None  # None: the default share of the machine
-_work_limit: int | None = None  # None: DEFAULT_MAX_WORK
+#: the limits set for this process; None: the default (a share of the machine, `DEFAULT_MAX_WORK`)
+_set: dict[str, int | None] = {"memory": None, "work": None}
+
+
+def _setter(kind: str, parse):
+    """The pair (set the limit, the same within a ``with`` block) of one kind of limit."""
+
+    def set_limit(value) -> int | None:
+        previous = _set[kind]
+        _set[kind] = None if value is None else parse(value)
+        return previous
+
+    @contextlib.contextmanager
+    def limited(value):
+        previous = set_limit(value)
+        try:
+            yield
+        finally:
+            _set[kind] = previous
+
+    return set_limit, limited
 
 
 def machine_memory() -> int | None:
@@ -78,7 +97,8 @@ def default_max_memory() -> int:
 
 def max_memory() -> int:
     """The limit in force [bytes]."""
-    return default_max_memory() if _limit is None else _limit
+    limit = _set["memory"]
+    return default_max_memory() if limit is None else limit
 
 
 def parse_size(text, name: str = "max_memory") -> int:
@@ -100,25 +120,19 @@ def parse_size(text, name: str = "max_memory") -> int:
     return int(size)
 
 
+_set_memory, _memory_limit = _setter("memory", parse_size)
+
+
 def set_max_memory(size) -> int | None:
     """Set the limit (bytes, or a size text as `parse_size` reads it; None: back to the
     default) for this process; returns the previous setting (None: the default). The workers of
     a Dask cluster keep their own."""
-    global _limit
-    previous = _limit
-    _limit = None if size is None else parse_size(size)
-    return previous
+    return _set_memory(size)
 
 
-@contextlib.contextmanager
 def memory_limit(size):
     """`set_max_memory` within a ``with`` block only."""
-    previous = set_max_memory(size)
-    try:
-        yield
-    finally:
-        global _limit
-        _limit = previous
+    return _memory_limit(size)
 
 
 def shown_bytes(n: float) -> str:
@@ -135,7 +149,7 @@ def check(need: float, what: str, shrink: str) -> None:
     limit = max_memory()
     if need <= limit:
         return
-    where = "set with --max-memory or railride.limits.set_max_memory" if _limit is not None else "half this machine"
+    where = "half this machine" if _set["memory"] is None else "set with --max-memory or railride.limits.set_max_memory"
     raise ValueError(
         f"{what} would need {shown_bytes(need)} of memory, more than the limit of "
         f"{shown_bytes(limit)} ({where}): {shrink}, or raise the limit (--max-memory SIZE, "
@@ -152,7 +166,8 @@ def check_steps(name: str, steps: float, shrink: str) -> None:
 # -- the work of a run ---------------------------------------------------------------------------
 def max_work() -> int:
     """The most sample-steps (samples x steps) one run may take."""
-    return DEFAULT_MAX_WORK if _work_limit is None else _work_limit
+    limit = _set["work"]
+    return DEFAULT_MAX_WORK if limit is None else limit
 
 
 def parse_count(text, name: str = "max_steps") -> int:
@@ -167,25 +182,19 @@ def parse_count(text, name: str = "max_steps") -> int:
     return int(value)
 
 
+_set_work, _work_limit = _setter("work", parse_count)
+
+
 def set_max_work(count) -> int | None:
     """Set the most sample-steps of one run (a number, or a text as `parse_count` reads it;
     None: back to `DEFAULT_MAX_WORK`) for this process; returns the previous setting (None: the
     default). The workers of a Dask cluster keep their own."""
-    global _work_limit
-    previous = _work_limit
-    _work_limit = None if count is None else parse_count(count)
-    return previous
+    return _set_work(count)
 
 
-@contextlib.contextmanager
 def work_limit(count):
     """`set_max_work` within a ``with`` block only."""
-    previous = set_max_work(count)
-    try:
-        yield
-    finally:
-        global _work_limit
-        _work_limit = previous
+    return _work_limit(count)
 
 
 def shown_duration(seconds: float) -> str:
@@ -204,7 +213,7 @@ def check_work(samples: int, steps: float, what: str, shrink: str) -> None:
     work, limit = float(samples) * float(steps), max_work()
     if work <= limit:
         return
-    where = "set with --max-steps or set_max_work" if _work_limit is not None else "the default, about 40 minutes"
+    where = "set with --max-steps or set_max_work" if _set["work"] is not None else "the default, about 40 minutes"
     raise ValueError(
         f"{what}: {samples} x {steps:.4g} steps = {work:.3g} sample-steps, about "
         f"{shown_duration(work / STEP_RATE)} at {STEP_RATE / 1e6:.0f} M sample-steps a second (the stepper's "
