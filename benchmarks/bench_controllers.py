@@ -18,16 +18,6 @@ import argparse
 import time
 
 
-def min_cpu_time(fn, repeat: int) -> float:
-    """The shortest of ``repeat`` CPU times of ``fn()`` (all threads of this process) [s]."""
-    best = float("inf")
-    for _ in range(repeat):
-        t0 = time.process_time()
-        fn()
-        best = min(best, time.process_time() - t0)
-    return best
-
-
 def main():
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--repeat", type=int, default=5)
@@ -73,7 +63,7 @@ def main():
         susp = Suspension.named(name)
         simulate(sc, None, susp)  # compile and warm
         times[name] = min_time(lambda: simulate(sc, None, susp).metrics(), args.repeat)
-        cpu[name] = min_cpu_time(lambda: simulate(sc, None, susp).metrics(), args.repeat)
+        cpu[name] = min_time(lambda: simulate(sc, None, susp).metrics(), args.repeat, time.process_time)
         if args.threads == 1:
             alone[name] = stepper_time(lambda: simulate(sc, None, susp))
     ref = times["sas-attitude-ride"]
