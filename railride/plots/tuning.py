@@ -7,7 +7,7 @@ import math
 import numpy as np
 
 from ..labels import gain_unit
-from ._style import PAGE_WIDTH, given_axes, grid_shape, new_figure, set_title, styled
+from ._style import PAGE_WIDTH, fit_text, given_axes, grid_shape, new_figure, set_title, styled
 
 
 def _zero_axis(ax, zero_x: float, edge: float, right: float) -> None:
@@ -31,6 +31,22 @@ def _zero_axis(ax, zero_x: float, edge: float, right: float) -> None:
     ]
     ax.xaxis.set_minor_locator(FixedLocator(minor))
     ax.xaxis.set_minor_formatter(NullFormatter())
+
+
+def _panel_title(ax, name: str, unit: str, final: float) -> dict:
+    """A panel's title, the gain's name and unit over its chosen value, fitted to its column's
+    width (a long gain name with its unit ran into the next panel's): the unit goes to a line
+    of its own when both do not fit on one."""
+    from matplotlib.font_manager import FontProperties
+
+    spec = ax.get_subplotspec()
+    columns = spec.get_gridspec().ncols if spec is not None else 1
+    width = ax.figure.get_figwidth() / columns - 0.3
+    size = FontProperties(size="small").get_size_in_points()
+    head = f"{name} ({unit})" if unit else name
+    if unit and "\n" in fit_text(head, width, size):
+        head = f"{name}\n({unit})"
+    return {"label": fit_text(f"{head}\nchosen {final:.3g}", width, size), "fontsize": "small"}
 
 
 def _draw_parameter(ax, mine: list, colour) -> bool:
@@ -75,7 +91,7 @@ def _draw_parameter(ax, mine: list, colour) -> bool:
         _zero_axis(ax, zero_x, edge, hi * 1.8)
     parameter = mine[0].parameter
     unit = gain_unit(parameter)
-    ax.set_title(f"{parameter}" + (f" ({unit})" if unit else "") + f"\nchosen {final:.3g}", fontsize="small")
+    ax.set_title(**_panel_title(ax, parameter, unit, final))
     ax.set_ylabel("tracking error" if parameter.startswith("inner.") else "objective", fontsize="small")
     ax.tick_params(labelsize="small")
     return has_zero

@@ -277,6 +277,19 @@ def test_titles_fit_the_figure_width(results):
                     assert box.x0 >= -1 and box.x1 <= width + 1, (text.get_text(), box, width)
 
 
+def test_sensitivity_panel_titles_do_not_run_into_each_other():
+    # the longest gain names with their units, four panels to a row as `railride tune` draws them
+    names = ["ride_attitude.kd_theta", "clipped_optimal.qd_theta", "ride_attitude.kp_theta", "skyhook_on_off.c_phi"]
+    curves = [Curve("sas-attitude-ride", 1, n, np.array([0.0, 1e5, 1e6]), np.array([1.0, 0.8, 0.9]), 1e5) for n in names]
+    fig = plot_sensitivity(curves)
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    boxes = [ax.title.get_window_extent(renderer) for ax in fig.get_axes() if ax.title.get_text()]
+    assert len(boxes) == 4
+    for left, right in zip(boxes, boxes[1:]):
+        assert left.x1 <= right.x0, (left, right)
+
+
 # -- the metric window: the start-up transient ----------------------------------------------------
 def _with_transient(ds, height: float = 100.0, until: float = 0.2):
     """``ds`` with a start-up spike of ``height`` in the acceleration before ``until`` s."""
