@@ -280,7 +280,8 @@ def test_titles_fit_the_figure_width(results):
 def test_sensitivity_panel_titles_do_not_run_into_each_other():
     # the longest gain names with their units, four panels to a row as `railride tune` draws them
     names = ["ride_attitude.kd_theta", "clipped_optimal.qd_theta", "ride_attitude.kp_theta", "skyhook_on_off.c_phi"]
-    curves = [Curve("sas-attitude-ride", 1, n, np.array([0.0, 1e5, 1e6]), np.array([1.0, 0.8, 0.9]), 1e5) for n in names]
+    values, scores = np.array([0.0, 1e5, 1e6]), np.array([1.0, 0.8, 0.9])
+    curves = [Curve("sas-attitude-ride", 1, n, values, scores, 1e5) for n in names]
     fig = plot_sensitivity(curves)
     fig.canvas.draw()
     renderer = fig.canvas.get_renderer()
