@@ -40,12 +40,14 @@ def plot_study(result, ax=None, metrics=None):
     controlled = [n for n in dict.fromkeys(summary["controller"]) if n != "passive"]
     part = summary[summary["controller"] != "passive"]
     conditions = list(dict.fromkeys(zip(part["load"], part["stiffness"], part["fault"], part["delay"])))
+    spare = None  # a free panel of the grid, where the legend covers no data
     if ax is None:
         n_rows, columns = grid_shape(len(metrics), 3)
         fig = new_figure((PAGE_WIDTH, 0.8 + 2.6 * n_rows))
         axes = fig.subplots(n_rows, columns, squeeze=False).ravel()
         for a in axes[len(metrics) :]:
             a.set_visible(False)
+        spare = axes[len(metrics)] if len(axes) > len(metrics) else None
         axes = axes[: len(metrics)]
     else:
         axes = given_axes(ax, len(metrics), f"one per metric: {', '.join(metrics)}")
@@ -53,6 +55,7 @@ def plot_study(result, ax=None, metrics=None):
         columns = len(metrics)
     width = 0.8 / max(1, len(controlled))
     x = np.arange(len(conditions))
+    crowded = len(conditions) * columns > 9  # "load x1.3" side by side ran into each other
     for a, metric in zip(axes, metrics):
         rows = part[part["metric"] == metric].set_index(["controller", "load", "stiffness", "fault", "delay"])
         for k, name in enumerate(controlled):
@@ -72,13 +75,20 @@ def plot_study(result, ax=None, metrics=None):
                 label=suspension_label(name),
             )
         a.axhline(0.0, color="k", linewidth=0.8)
-        a.set_xticks(x, [_condition_label(*c) for c in conditions], fontsize="small")
+        a.set_xticks(x, [_condition_label(*c, crowded) for c in conditions], fontsize="small")
         a.set_title(DEFAULT_METRICS.get(metric, metric))
         a.grid(False, axis="x")
     for k, a in enumerate(axes):
         if k % columns == 0:
             a.set_ylabel("reduction against passive (%)\nmean, 5-95 % band")
-    axes[0].legend(fontsize="small")
+    if spare is not None:
+        spare.set_visible(True)
+        spare.axis("off")
+        spare.legend(*axes[0].get_legend_handles_labels(), loc="center", fontsize="small")
+    elif ax is None:
+        fig.legend(*axes[0].get_legend_handles_labels(), loc="outside lower center", ncols=3, fontsize="small")
+    else:
+        axes[0].legend(fontsize="small")
     if ax is None:
         s = result.settings
         set_title(
@@ -89,9 +99,9 @@ def plot_study(result, ax=None, metrics=None):
     return fig
 
 
-def _condition_label(load: float, stiffness: float, fault: str, delay: int) -> str:
+def _condition_label(load: float, stiffness: float, fault: str, delay: int, crowded: bool = False) -> str:
     return (
-        f"load x{load:g}"
+        f"load{chr(10) if crowded else ' '}x{load:g}"
         + ("" if stiffness == 1.0 else f"\nk_sz x {stiffness:g}")
         + ("" if fault == "none" else f"\n{fault}")
         + ("" if delay == 1 else f"\ndelay {delay}")

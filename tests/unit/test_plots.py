@@ -374,6 +374,7 @@ def test_study_conditions_name_the_load_factor():
     from railride.plots.study import _condition_label
 
     assert _condition_label(1.2, 1.0, "none", 1) == "load x1.2"
+    assert _condition_label(1.2, 1.0, "none", 1, crowded=True) == "load\nx1.2"
     assert _condition_label(1.0, 0.9, "1R-off", 4) == "load x1\nk_sz x 0.9\n1R-off\ndelay 4"
 
 

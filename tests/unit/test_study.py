@@ -124,7 +124,13 @@ def test_the_result_protocol(small, tmp_path):
     pid = next(g for g in doc["results"] if g["controller"] == "pid" and g["fault"] == "1R-off" and g["load"] == 1.3)
     assert set(pid["metrics"]) == set(METRICS) and pid["metrics"]["roll_deg_rms"]["n"] == 6
     assert list(small.to_pandas().columns[:6]) == ["controller", "load", "stiffness", "fault", "delay", "metric"]
-    assert isinstance(small.plot(), Figure)
+    fig = small.plot()
+    assert isinstance(fig, Figure)
+    # five metrics on a grid of six: the legend has the free panel to itself, clear of the data
+    (holder,) = [a for a in fig.get_axes() if a.get_legend() is not None]
+    assert not holder.lines and not holder.collections and not holder.axison
+    ticks = [t.get_text() for t in fig.get_axes()[0].get_xticklabels()]
+    assert ticks[-1] == "load\nx1.3\n1R-off"  # four conditions a panel, three panels a row: stacked
     mine = Figure()
     assert small.plot(ax=mine.subplots(1, 2), metrics=["roll_deg_rms", "centre_N_MV_z"]) is mine
     paths = small.save(tmp_path / "out")
