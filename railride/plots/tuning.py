@@ -33,7 +33,7 @@ def _zero_axis(ax, zero_x: float, edge: float, right: float) -> None:
     ax.xaxis.set_minor_formatter(NullFormatter())
 
 
-def _panel_title(ax, name: str, unit: str, final: float) -> dict:
+def _panel_title(ax, name: str, unit: str | None, final: float) -> dict:
     """A panel's title, the gain's name and unit over its chosen value, fitted to its column's
     width (a long gain name with its unit ran into the next panel's): the unit goes to a line
     of its own when both do not fit on one."""
