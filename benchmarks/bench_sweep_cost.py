@@ -3,10 +3,10 @@ profile of a fra4 sweep split into the stepper, the track tables and the metrics
 
 Run:  python benchmarks/bench_sweep_cost.py [--runs 512] [--profile-runs 128]
 Memory: sweeps of 10 s fra4 runs (passive and three controllers on MR dampers, track seeds x
-speeds, comfort indices on), first --runs / 8 runs and then --runs, each in a fresh child
+speeds, comfort indices on), --runs / 8, --runs / 4 and --runs runs, each in a fresh child
 process after a warm-up sweep that compiles; the peak resident memory of the sweep itself
 (Linux: the peak is reset after the warm-up through /proc/self/clear_refs) and above the
-warm process. If memory is bounded by the chunk (32 runs), both peaks are about the same.
+warm process. If memory is bounded by the chunk (32 runs), the peaks are about the same.
 Time: cProfile of one sweep of --profile-runs runs in this process, warm; the stepper's time is
 the main thread's wait for the compiled kernels (they run in threads that cProfile does not
 see). No test asserts either.
@@ -59,13 +59,28 @@ def child(runs: int) -> None:
     res = run_sweep(g)
     wall = time.perf_counter() - t0
     peak, after = _status("VmHWM"), _status("VmRSS")
-    # what stays after the sweep is the shared tables (LRU, at most 32 each), not histories
+    # what stays after the sweep is the shared tracks and tables (each store bounded by bytes)
     from railride import simulation, track
 
-    simulation._cached_input_table.cache_clear()
-    track._cached_random_track.cache_clear()
+    stores = (track._TRACKS, simulation._INPUT_TABLES, simulation._FORCING_TABLES)
+    held = sum(s.nbytes for s in stores) / 2**20
+    for s in stores:
+        s.clear()
     gc.collect()
-    out = {"runs": len(res.to_pandas()), "warm": warm, "peak": peak, "after": after, "cleared": _status("VmRSS")}
+    try:  # glibc keeps freed heap pages: give them back, so the column shows what is still live
+        import ctypes
+
+        ctypes.CDLL("libc.so.6").malloc_trim(0)
+    except (OSError, AttributeError):
+        pass
+    out = {
+        "runs": len(res.to_pandas()),
+        "warm": warm,
+        "peak": peak,
+        "after": after,
+        "held": held,
+        "cleared": _status("VmRSS"),
+    }
     print(json.dumps({**out, "wall": wall}))
 
 
@@ -102,10 +117,10 @@ def profile(runs: int) -> None:
         "stepper (compiled kernels; the exact steps with their exponentials)": cumulative("kernels.py", "run_parallel")
         + cumulative("discrete.py", "run_exact")
         + cumulative("discrete.py", "run_exact_closed"),
-        "track tables: random-track synthesis and wheelset input tables (shared, LRU 32)": cumulative(
+        "track tables: random-track synthesis and wheelset input tables (shared, kept by bytes)": cumulative(
             "simulation.py", "_input_table"
         ),
-        "track tables: the rail forcing tables of the RK4 stepper (one per batch and scenario)": cumulative(
+        "track tables: the rail forcing tables of the RK4 stepper (shared, kept by bytes)": cumulative(
             "simulation.py", "_forcing_table"
         ),
         "metrics (RMS, peak-to-peak)": cumulative("ride.py", "metrics"),
@@ -147,17 +162,18 @@ def main():
     if not args.skip_memory:
         print(
             "| sweep (fra4, 10 s runs, comfort on) | runs | wall | warm process | peak during the sweep "
-            "| after it | after clearing the table caches |"
+            "| after it | of it, tracks and tables kept | after clearing them |"
         )
-        print("|---|---|---|---|---|---|---|")
-        for runs in (args.runs // 8, args.runs):
+        print("|---|---|---|---|---|---|---|---|")
+        for runs in (args.runs // 8, args.runs // 4, args.runs):
             out = subprocess.run(
                 [sys.executable, __file__, "--child", str(runs)], check=True, capture_output=True, text=True
             ).stdout
             r = json.loads(out.strip().splitlines()[-1])
             print(
                 f"| {', '.join(SUSPENSIONS)} | {r['runs']} | {r['wall']:.1f} s | {r['warm']:.0f} MiB | "
-                f"{r['peak']:.0f} MiB (+{r['peak'] - r['warm']:.0f}) | {r['after']:.0f} MiB | {r['cleared']:.0f} MiB |"
+                f"{r['peak']:.0f} MiB (+{r['peak'] - r['warm']:.0f}) | {r['after']:.0f} MiB | {r['held']:.0f} MiB | "
+                f"{r['cleared']:.0f} MiB |"
             )
         print()
     if not args.skip_profile:

@@ -10,6 +10,7 @@ from datetime import datetime, timezone
 import numpy as np
 
 from . import dampers, kernels, limits
+from ._cache import MiB, BytesLRU
 from .defaults import DEFAULT_DT
 from .errors import DivergenceError, Interrupted
 from .faults import fault_table
@@ -17,7 +18,7 @@ from .sensing import reads_bogies
 from .params import VehicleParams
 from .solver import SolverSettings, check_resolution
 from .suspension import Suspension, batch_conflict
-from .track import Scenario, input_table_nodes, wheelset_input_table
+from .track import Scenario, input_table_nodes, table_key, wheelset_input_table
 from .track import as_scenario
 from .validation import shown
 from .ride import RideResult, build_dataset, has_damper_states
@@ -124,21 +125,32 @@ def _exact(solver, damper, closed, suspensions, n_vehicles: int = 1) -> bool:
     return linear and solver.method != "rk4"
 
 
-def _input_table(scenario: Scenario, lag: tuple, dt: float, duration: float):
-    """`wheelset_input_table`, the last 32 kept: the batches of a study (passive beside each
-    controller, chunk after chunk) meet the same scenario again. The tables are read, never
-    written. A scenario that cannot be a key (a measured profile's arrays) is not kept."""
-    try:
-        return _cached_input_table(scenario, lag, dt, duration)
-    except TypeError:
-        return wheelset_input_table(scenario, np.asarray(lag), dt, duration)
+#: the wheelset input tables kept for the next batches (`_input_table`): (nodes x 16) doubles,
+#: 0.8 MB for 10 s at 30 m/s on a random track, 1.6 MB at 45 m/s, 3.2 MB at 65 m/s. A passive
+#: chunk's 32 scenarios fit at the usual speeds, so the controllers' chunks on the same
+#: scenarios, which run next to it (`railride.sweep.run_cases`), find theirs
+INPUT_CACHE_BYTES = 64 * MiB
+#: the rail forcing tables kept (`_forcing`): (nodes x 36) doubles, 2.25 times the input table;
+#: shared by the closed-loop runs of a scenario and vehicle, which a study puts in one batch,
+#: and kept for the repeated rounds of tuning (a tuning set of about 16 scenarios and loads)
+FORCING_CACHE_BYTES = 64 * MiB
 
 
-@functools.lru_cache(maxsize=32)
-def _cached_input_table(scenario: Scenario, lag: tuple, dt: float, duration: float):
-    table, interval = wheelset_input_table(scenario, np.asarray(lag), dt, duration)
-    table.flags.writeable = False  # shared between runs
-    return table, interval
+_INPUT_TABLES: BytesLRU = BytesLRU("wheelset input tables", INPUT_CACHE_BYTES, lambda t: t[0].nbytes)
+_FORCING_TABLES: BytesLRU = BytesLRU("rail forcing tables", FORCING_CACHE_BYTES, lambda t: t.nbytes)
+
+
+def _input_table(scenario: Scenario, key, lag: tuple, dt: float, duration: float):
+    """`wheelset_input_table` of ``scenario`` (its `table_key` ``key``), kept within
+    `INPUT_CACHE_BYTES`: the batches of a study (passive beside each controller) meet the same
+    scenario again. The tables are read, never written. A scenario without a key is not kept."""
+
+    def build():
+        table, interval = wheelset_input_table(scenario, np.asarray(lag), dt, duration)
+        table.flags.writeable = False  # shared between runs
+        return table, interval
+
+    return _INPUT_TABLES.get(None if key is None else (key, lag, dt, duration), build)
 
 
 def _check_dt(vehicle: Vehicle, dt: float, damper=None) -> None:
@@ -229,22 +241,17 @@ def _forcing_table(utab: np.ndarray, Bw: np.ndarray, Bwd: np.ndarray) -> np.ndar
     return np.hstack([np.einsum("nk,jk->nj", x, B) for B in (Bw, Bwd) for x in (w, wd)])
 
 
-def _forcing(scenario: Scenario, lag: tuple, dt: float, duration: float, params: VehicleParams, table):
-    """`_forcing_table`, the last 32 kept beside the input tables (each controller's batch of a
-    study meets the same scenario and vehicle again)."""
-    try:
-        return _cached_forcing(scenario, lag, dt, duration, params)
-    except TypeError:  # a scenario that cannot be a key
+def _forcing(key, lag: tuple, dt: float, duration: float, params: VehicleParams, table: np.ndarray):
+    """`_forcing_table` of the input ``table`` (of the scenario with `table_key` ``key``) and
+    the vehicle ``params``, kept within `FORCING_CACHE_BYTES` beside the input tables."""
+
+    def build():
         sysm = _system_arrays(_vehicle(params))
-        return _forcing_table(table, sysm["Bw"], sysm["Bwd"])
+        forcing = _forcing_table(table, sysm["Bw"], sysm["Bwd"])
+        forcing.flags.writeable = False
+        return forcing
 
-
-@functools.lru_cache(maxsize=32)
-def _cached_forcing(scenario: Scenario, lag: tuple, dt: float, duration: float, params: VehicleParams):
-    sysm = _system_arrays(_vehicle(params))
-    table = _forcing_table(_input_table(scenario, lag, dt, duration)[0], sysm["Bw"], sysm["Bwd"])
-    table.flags.writeable = False
-    return table
+    return _FORCING_TABLES.get(None if key is None else (key, lag, dt, duration, params), build)
 
 
 def _as_list(x):
@@ -415,19 +422,25 @@ def simulate(
         np.zeros(n, dtype=np.int64),
         np.zeros(n),
     )
+    keys: dict[int, object] = {}
     for i, (sc, p) in enumerate(zip(scenarios, param_sets)):
-        lag = vehicles[id(p)].wheelset_lag_distance
-        ukey = (id(sc), tuple(lag))
+        lag = tuple(vehicles[id(p)].wheelset_lag_distance)
+        if id(sc) not in keys:
+            keys[id(sc)] = table_key(sc)
+        skey = keys[id(sc)]
+        # by value where the scenario has one: equal scenarios and vehicles given as separate
+        # objects (a study's cases) share one table in the batch, not a copy each
+        ukey = (id(sc) if skey is None else skey, lag)
         if ukey not in u_index:
-            tab, itv = _input_table(sc, tuple(lag), dt, duration)
+            tab, itv = _input_table(sc, skey, lag, dt, duration)
             u_index[ukey] = (sum(len(t) for t in utabs), tab, itv)
             utabs.append(tab)
         u_off[i], tab, interval[i] = u_index[ukey]
         n_nodes[i] = len(tab)
-        fkey = (id(sc), id(p))
+        fkey = (ukey, p)
         if fkey not in f_index and not exact:  # the exact steps take the inputs themselves
             f_index[fkey] = sum(len(t) for t in ftabs)
-            ftabs.append(_forcing(sc, tuple(lag), dt, duration, p, tab))
+            ftabs.append(_forcing(skey, lag, dt, duration, p, tab))
         f_off[i] = f_index.get(fkey, 0)
     utab = np.ascontiguousarray(np.concatenate(utabs))
     ftab = np.ascontiguousarray(np.concatenate(ftabs)) if ftabs else np.zeros((1, 36))

@@ -35,7 +35,7 @@ from .params import VehicleParams
 from .plots import PNG_DPI, FigureOptions
 from .solver import SolverSettings
 from .sensing import SENSING, reads_bogies
-from .sweep import COMFORT_COLUMNS, Case, RunTable, cached_scenario, run_cases
+from .sweep import COMFORT_COLUMNS, Case, RunTable, run_cases, scenario_of
 from .vehicle import Vehicle
 
 #: the schema of `StudyResult.to_dict` (study.json)
@@ -243,7 +243,7 @@ def study(
     # differ in the realisation only), and every fault time against its duration
     speed_of = {}
     for v in speed_list:
-        sc = cached_scenario(scenario, options_of(seeds[0], v))
+        sc = scenario_of(scenario, options_of(seeds[0], v))
         for cond in conditions:
             try:
                 fault_table([[DamperFault.parse(f) for f in cond]], solver.dt, sc.duration)

@@ -2,8 +2,9 @@
 
 A `Case` is one run described by plain settings (scenario and its options, vehicle parameter
 changes, suspension, gain changes), so it can travel to a Dask worker and has a stable key.
-`run_cases` groups compatible cases into batches for the compiled stepper, hands the chunks to
-an executor (`railride.executors`: `LocalExecutor`, this machine, the batch over both cores;
+`run_cases` groups compatible cases into batches for the compiled stepper, scenario by scenario
+so that runs sharing rail tables run in the same or neighbouring chunks (`_chunks`), hands the
+chunks to an executor (`railride.executors`: `LocalExecutor`, this machine, the batch over both cores;
 `DaskExecutor`, a dask.distributed cluster) and appends every finished chunk to a `RunTable` on
 disk, written atomically; a sweep started again with the same table skips the runs it already
 has, so an interrupted sweep resumes where it stopped. The metrics of a case do not depend on
@@ -196,12 +197,14 @@ class Case:
         )
 
 
-def cached_scenario(name: str, options):
-    """`railride.track.scenario` of a case's scenario and options (pairs, as `Case` holds
-    them), the last 32 kept for the next chunk and the next call: a random track is not
-    synthesised again for every chunk that meets it (the scenarios are frozen values)."""
-    key = tuple(sorted((str(k), _plain(k, v)) for k, v in options))
-    return _scenario(name, key)
+def scenario_of(name: str, options):
+    """`railride.track.scenario` of a case's scenario and options (pairs, as `Case` holds them).
+    Not kept here: a random track's realisation comes from `railride.track`'s store and the
+    tables from the simulation's, each bounded by bytes and keyed by settings; scenarios kept
+    here held their realisations beyond that bound (32 of them, up to 220 MB)."""
+    from .track import scenario as make_scenario
+
+    return make_scenario(name, **dict(options))
 
 
 def _plain(name: str, value):
@@ -220,13 +223,6 @@ def _plain(name: str, value):
         return int(value)
 
 
-@functools.lru_cache(maxsize=32)  # a random track holds a few MB: bounded, as a study's memory
-def _scenario(name: str, options: tuple):
-    from .track import scenario as make_scenario
-
-    return make_scenario(name, **dict(options))
-
-
 def evaluate(
     cases: list[Case], base_gains=None, *, params=None, solver=None, window=None, comfort: bool = False
 ) -> list[dict]:
@@ -243,13 +239,14 @@ def evaluate(
     vehicle = VehicleParams.of(params)
     solver = SolverSettings.of(solver)
     rows: dict[int, dict] = {}
+    made: dict[tuple, object] = {}  # one Scenario per setting in this call (a measured profile read once)
     by_group: dict[tuple, list[int]] = {}
     for i, c in enumerate(cases):
         by_group.setdefault(c.group, []).append(i)
     for group, idx in by_group.items():
         for start in range(0, len(idx), CHUNK):
             part = [cases[i] for i in idx[start : start + CHUNK]]
-            scs = [cached_scenario(c.scenario, c.scenario_options) for c in part]
+            scs = [_scenario(made, c) for c in part]
             pars = [vehicle.replace(**dict(c.vehicle)) for c in part]
             suspensions = [c.to_suspension(base_gains) for c in part]
             if batch_conflict(suspensions) is not None:  # the inner loop is one setting per batch
@@ -291,6 +288,13 @@ def evaluate(
                         )
                 rows[i] = row
     return [rows[i] for i in range(len(cases))]
+
+
+def _scenario(made: dict, c: Case):
+    key = (c.scenario, c.scenario_options)
+    if key not in made:
+        made[key] = scenario_of(*key)
+    return made[key]
 
 
 def _flat(c: Case) -> dict:
@@ -352,8 +356,6 @@ def run_cases(
 
     ``progress(done, total, runs_per_second)`` is called after each chunk.
     """
-    import functools
-
     solver = SolverSettings.of(solver)
     vehicle = VehicleParams.of(params)
     executor = LocalExecutor() if executor is None else executor
@@ -381,9 +383,7 @@ def run_cases(
         if k not in done and k not in seen:
             pending.append(c)
             seen.add(k)
-    # group compatible cases so each chunk is one compiled batch
-    pending.sort(key=lambda c: str(c.group))
-    chunks = [pending[i : i + chunk] for i in range(0, len(pending), chunk)]
+    chunks = _chunks(pending, chunk)
     fn = functools.partial(evaluate, base_gains=base, params=vehicle, solver=solver, window=window, comfort=comfort)
     t0, n_done = time.perf_counter(), 0
     if progress is not None:
@@ -398,6 +398,34 @@ def run_cases(
             elapsed = time.perf_counter() - t0
             progress(n_done, len(pending), n_done / elapsed if elapsed > 0 else math.inf)
     return pd.DataFrame([done[k] for k in keys])
+
+
+def _chunks(cases: list[Case], chunk: int) -> list[list[Case]]:
+    """``cases`` in chunks of at most ``chunk``, each of one group (one compiled batch), with
+    the runs that share tables together: by vehicle, then track (realisation or profile), then
+    scenario (speed), each in the order first met. The chunks of the groups are interleaved by
+    the first scenario they hold, so the controllers' chunks run next to the passive chunk on
+    the same scenarios and find its tables kept (bounded by bytes, `railride.simulation`): a
+    study's tables are built about once each, and its memory does not grow with its runs. The
+    vehicle comes first so that a batch mixes vehicles only where one vehicle's runs end, as
+    before: "auto" gives a passive batch of several vehicles RK4 rather than the exact steps."""
+    ranks: tuple[dict, dict, dict] = ({}, {}, {})
+
+    def rank(level: int, value) -> int:
+        return ranks[level].setdefault(value, len(ranks[level]))
+
+    def near(c: Case) -> tuple:
+        profile = tuple((k, v) for k, v in c.scenario_options if k not in ("speed", "duration"))
+        return (rank(0, c.vehicle), rank(1, (c.scenario, profile)), rank(2, (c.scenario, c.scenario_options)))
+
+    for c in cases:  # ranks in the order given
+        near(c)
+    groups: dict[str, list[Case]] = {}
+    for c in sorted(cases, key=near):
+        groups.setdefault(str(c.group), []).append(c)
+    out = [part[i : i + chunk] for _, part in sorted(groups.items()) for i in range(0, len(part), chunk)]
+    out.sort(key=lambda part: near(part[0]))  # stable: a tie keeps the groups' order
+    return out
 
 
 # -- the sweep study -------------------------------------------------------------------------------

@@ -484,7 +484,10 @@ def _scenarios(words: _Words, scenario: str, axes: list, common: dict, min_given
 
     combos = list(itertools.product(*[values for *_, values in axes]))
     record, duration = None, None
-    for combo in combos:
+    # the combinations of one profile together (speed varies last), so that each random-track
+    # realisation is synthesised once here, however few the track store keeps
+    profile = [j for j, (kw, *_) in enumerate(axes) if kw != "speed"]
+    for combo in sorted(combos, key=lambda combo: [combo[j] for j in profile]):
         options = {**common, **{kw: v for (kw, _, _), v in zip(axes, combo)}}
         try:
             scen = make_scenario(scenario, **options)
@@ -498,7 +501,8 @@ def _scenarios(words: _Words, scenario: str, axes: list, common: dict, min_given
             at = ", ".join(f"{words.name(_key(kw))} {v:g}" for (kw, _, _), v in zip(axes, combo))
             raise ValueError(f"{at}: {exc}" if at else str(exc)) from None
         _check_resolvable(words, scen, min_given, output_rate)
-        record = record or scen.describe()
+        if combo == combos[0]:
+            record = scen.describe()
         duration = scen.duration
     return combos, record, duration
 

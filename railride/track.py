@@ -20,7 +20,8 @@ by default enters through a raised-cosine taper over its first wavelength (`Sine
 from __future__ import annotations
 
 import csv
-import functools
+import dataclasses
+import hashlib
 import math
 from abc import ABC, abstractmethod
 from dataclasses import dataclass, field
@@ -29,6 +30,7 @@ from pathlib import Path
 import numpy as np
 
 from . import validation
+from ._cache import MiB, BytesLRU
 
 #: nodes per shortest feature (wavelength, bump length) in the stepper's table
 NODES_PER_FEATURE = 200
@@ -596,21 +598,57 @@ class RandomTrack(RailProfile):
         }
 
 
+#: the random-track realisations kept for the next runs (`_random_track`): 6.8 MB each for the
+#: default band over 2000 m, so four; a study takes its runs realisation by realisation
+#: (`railride.sweep.run_cases`), so it needs one or two at a time
+TRACK_CACHE_BYTES = 32 * MiB
+
+
+def _track_bytes(track: RandomTrack) -> int:
+    splines, *arrays = track._interp
+    return sum(sp.x.nbytes + sp.c.nbytes for sp in splines) + sum(a.nbytes for a in arrays)
+
+
+_TRACKS: BytesLRU[RandomTrack] = BytesLRU("random tracks", TRACK_CACHE_BYTES, _track_bytes)
+
+
 def _random_track(name, seed, min_wavelength, max_wavelength, length) -> RandomTrack:
-    """The `RandomTrack` of these settings, the last 32 kept: a study at several speeds (or
-    passive beside a controller) meets the same realisation many times, and synthesising it
-    is most of a short run's set-up. A value that cannot be a key is checked by RandomTrack."""
+    """The `RandomTrack` of these settings, kept while the realisations fit `TRACK_CACHE_BYTES`:
+    a study at several speeds (or passive beside a controller) meets the same realisation many
+    times, and synthesising it is most of a short run's set-up. A value that cannot be a key is
+    checked by RandomTrack."""
+
+    def build() -> RandomTrack:
+        return RandomTrack(name, seed=seed, min_wavelength=min_wavelength, max_wavelength=max_wavelength, length=length)
+
     if isinstance(seed, bool):  # True would hash as seed 1: let the constructor refuse it
-        return RandomTrack(name, seed=seed, min_wavelength=min_wavelength, max_wavelength=max_wavelength, length=length)
+        return build()
+    return _TRACKS.get((name, seed, min_wavelength, max_wavelength, length), build)
+
+
+def table_key(sc: Scenario):
+    """``sc`` as a plain value for the caches of its tables (`railride.simulation`): equal
+    settings give equal keys (a realisation built again, a profile read again, compared by its
+    numbers), and a key holds no track, so a kept table does not keep its track alive. None for
+    a profile that is not a dataclass of plain values."""
+    track = sc.track
+    if not dataclasses.is_dataclass(track):
+        return None
+    parts = []
+    for f in dataclasses.fields(track):
+        if f.name.startswith("_"):  # what the settings build (splines), not a setting
+            continue
+        value = getattr(track, f.name)
+        if isinstance(value, np.ndarray):
+            data = np.ascontiguousarray(value)
+            value = (data.shape, data.dtype.str, hashlib.sha1(data.tobytes()).hexdigest())
+        parts.append((f.name, value))
+    key = (type(track).__qualname__, tuple(parts), sc.name, sc.speed, sc.duration)
     try:
-        return _cached_random_track(name, seed, min_wavelength, max_wavelength, length)
-    except TypeError:  # unhashable: let the constructor say what is wrong
-        return RandomTrack(name, seed=seed, min_wavelength=min_wavelength, max_wavelength=max_wavelength, length=length)
-
-
-@functools.lru_cache(maxsize=32)
-def _cached_random_track(name, seed, min_wavelength, max_wavelength, length) -> RandomTrack:
-    return RandomTrack(name, seed=seed, min_wavelength=min_wavelength, max_wavelength=max_wavelength, length=length)
+        hash(key)
+    except TypeError:
+        return None
+    return key
 
 
 def as_scenario(value) -> Scenario:

@@ -1,0 +1,77 @@
+"""A store of shared, read-only values bounded by their bytes: the random-track realisations and
+the rail input and forcing tables that the runs of a study meet again.
+
+A bound on the number of entries does not bound memory: a table at 65 m/s is four times one at
+30 m/s, and a store per kind of value, each holding its own keys, kept every realisation a
+table's key referred to. Here each store counts the bytes of what it holds and drops the least
+recently used first once they pass its budget; keys are plain values (settings), never the
+objects built from them.
+"""
+
+from __future__ import annotations
+
+import threading
+from collections import OrderedDict
+from collections.abc import Callable, Hashable
+from typing import Generic, TypeVar
+
+V = TypeVar("V")
+
+MiB = 1 << 20
+
+
+class BytesLRU(Generic[V]):
+    """Values built on demand by ``get(key, build)`` and kept by key while their bytes
+    (``size(value)``) stay within ``budget``; past it, the least recently used go first. A value
+    larger than the budget is built and returned but not kept, and so is one whose key is None
+    or cannot be hashed (a setting that is no plain value). Safe to share between threads (a
+    Dask worker's): two threads that miss the same key at once both build it, one is kept."""
+
+    def __init__(self, name: str, budget: int, size: Callable[[V], int]):
+        self.name = name
+        self.budget = int(budget)
+        self._size = size
+        self._items: OrderedDict[Hashable, tuple[V, int]] = OrderedDict()
+        self._bytes = 0
+        self._lock = threading.Lock()
+        self.hits = 0
+        self.misses = 0
+
+    def get(self, key, build: Callable[[], V]) -> V:
+        try:
+            hash(key)
+        except TypeError:
+            key = None
+        if key is None:
+            return build()
+        with self._lock:
+            item = self._items.get(key)
+            if item is not None:
+                self._items.move_to_end(key)
+                self.hits += 1
+                return item[0]
+            self.misses += 1
+        value = build()  # outside the lock: a build takes milliseconds, other threads go on
+        nbytes = int(self._size(value))
+        if nbytes <= self.budget:
+            with self._lock:
+                if key not in self._items:
+                    self._items[key] = (value, nbytes)
+                    self._bytes += nbytes
+                while self._bytes > self.budget:
+                    _, (_, dropped) = self._items.popitem(last=False)
+                    self._bytes -= dropped
+        return value
+
+    @property
+    def nbytes(self) -> int:
+        """The bytes held now (at most `budget`)."""
+        return self._bytes
+
+    def __len__(self) -> int:
+        return len(self._items)
+
+    def clear(self) -> None:
+        with self._lock:
+            self._items.clear()
+            self._bytes = 0
