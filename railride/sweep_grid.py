@@ -498,8 +498,14 @@ def _scenarios(words: _Words, scenario: str, axes: list, common: dict, min_given
                 raise ValueError(f"{named}: {exc}") from None
             if str(exc).startswith("unknown scenario"):
                 raise ValueError(f"{words.name('scenario')}: {exc}") from None
-            at = ", ".join(f"{words.name(_key(kw))} {v:g}" for (kw, _, _), v in zip(axes, combo))
-            raise ValueError(f"{at}: {exc}" if at else str(exc)) from None
+            text, named = str(exc), []
+            for (kw, _, _), v in zip(axes, combo):
+                key = _key(kw)
+                if text.startswith(f"{key} = "):  # the message names this axis and its value itself
+                    text = words.name(key) + text[len(key) :]
+                else:
+                    named.append(f"{words.name(key)} {v:g}")
+            raise ValueError(f"{', '.join(named)}: {text}" if named else text) from None
         _check_resolvable(words, scen, min_given, output_rate)
         if combo == combos[0]:
             record = scen.describe()

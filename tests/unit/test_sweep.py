@@ -144,7 +144,9 @@ def test_grid_random_track_seeds():
         ),
         (dict(scenario="fra4", min_wavelength=0.05), ("min_wavelength = 0.05 m at speed 55.56 m/s", "resolve")),
         (dict(scenario="fra4", speed=[20, 120], min_wavelength=0.2), ("min_wavelength = 0.2 m at speed 120 m/s",)),
-        (dict(speed=[20, 0]), ("speed 0: speed = 0.0: must be a finite number > 0",)),
+        (dict(speed=[20, 0]), ("speed = 0.0: must be a finite number > 0",)),
+        # the other axes of the failing combination named, the one in the message not twice
+        (dict(scenario="fra4", track_seed=[3], speed=[250]), ("track_seed 3: speed = 250 m/s: above the plausible",)),
         (dict(speed=[]), ("speed = []: give one or more values",)),
         (dict(duration=2, window=(1, 3)), ("window = 1:3 s",)),
         (dict(solver="fine"), ("solver = 'fine'",)),
