@@ -498,14 +498,14 @@ def _scenarios(words: _Words, scenario: str, axes: list, common: dict, min_given
                 raise ValueError(f"{named}: {exc}") from None
             if str(exc).startswith("unknown scenario"):
                 raise ValueError(f"{words.name('scenario')}: {exc}") from None
-            text, named = str(exc), []
+            text, others = str(exc), []
             for (kw, _, _), v in zip(axes, combo):
                 key = _key(kw)
                 if text.startswith(f"{key} = "):  # the message names this axis and its value itself
                     text = words.name(key) + text[len(key) :]
                 else:
-                    named.append(f"{words.name(key)} {v:g}")
-            raise ValueError(f"{', '.join(named)}: {text}" if named else text) from None
+                    others.append(f"{words.name(key)} {v:g}")
+            raise ValueError(f"{', '.join(others)}: {text}" if others else text) from None
         _check_resolvable(words, scen, min_given, output_rate)
         if combo == combos[0]:
             record = scen.describe()
