@@ -45,9 +45,11 @@ def _load8(builder, ptr):
     return builder.load(builder.bitcast(ptr, _V8.as_pointer()), align=8)
 
 
-def _splat8(builder, x):
-    v = builder.insert_element(ir.Constant(_V8, ir.Undefined), x, ir.Constant(_I32, 0))
-    return builder.shuffle_vector(v, ir.Constant(_V8, ir.Undefined), ir.Constant(ir.VectorType(_I32, 8), [0] * 8))
+def _splat(builder, x, vtype=_V8):
+    """A vector of ``vtype`` (eight doubles by default) with every lane x."""
+    n = vtype.count
+    v = builder.insert_element(ir.Constant(vtype, ir.Undefined), x, ir.Constant(_I32, 0))
+    return builder.shuffle_vector(v, ir.Constant(vtype, ir.Undefined), ir.Constant(ir.VectorType(_I32, n), [0] * n))
 
 
 def _row_length(builder, arr):
@@ -98,7 +100,7 @@ def mv9_simd(typingctx, AT, x, xf, n_cols, r, roff, out, ooff, idx8, val8, n8):
                 xj = builder.load(builder.gep(src.data, [j]))
                 row = builder.gep(at.data, [builder.mul(j, width)])
                 col8 = _load8(builder, row)
-                builder.store(builder.call(fma8, [col8, _splat8(builder, xj), builder.load(acc8)]), acc8)
+                builder.store(builder.call(fma8, [col8, _splat(builder, xj), builder.load(acc8)]), acc8)
             sums.append(builder.load(acc8))
         q8, v8, f8 = sums
         # row 8 over its non-zero columns only (idx8, val8: n8 of them)
@@ -180,7 +182,7 @@ def forcing_rows(typingctx, ftab, a, h00, h10, h01, h11, d00, d10, d11, out, oof
         def scalar(p, col):
             return builder.load(builder.gep(p, [ir.Constant(_I64, col + 8)]))
 
-        for fma, load, wrap in ((fma8, vector, lambda w: _splat8(builder, w)), (fma1, scalar, lambda w: w)):
+        for fma, load, wrap in ((fma8, vector, lambda w: _splat(builder, w)), (fma1, scalar, lambda w: w)):
             w00, w10, w01, w11, e00, e10, e11 = [wrap(w) for w in weights]
             acc = builder.fmul(w00, load(pa, 0))
             acc = builder.call(fma, [w10, load(pa, 9), acc])
@@ -229,11 +231,7 @@ def bouc_wen1_corners(typingctx, P, s, cx, cv, vcmd, conn, y, K, koff):
             return builder.load(builder.bitcast(arr.data, _V4.as_pointer()), align=8)
 
         def par(i):
-            x = builder.load(builder.gep(pa.data, [ir.Constant(_I64, i)]))
-            v = builder.insert_element(ir.Constant(_V4, ir.Undefined), x, ir.Constant(_I32, 0))
-            return builder.shuffle_vector(
-                v, ir.Constant(_V4, ir.Undefined), ir.Constant(ir.VectorType(_I32, 4), [0] * 4)
-            )
+            return _splat(builder, builder.load(builder.gep(pa.data, [ir.Constant(_I64, i)])), _V4)
 
         z = _load4_strided(builder, sa.data, 18, 3)
         u = _load4_strided(builder, sa.data, 20, 3)

@@ -19,6 +19,8 @@ from numba.core import cgutils
 from numba.core.errors import TypingError
 from numba.extending import intrinsic
 
+from ._simd import _splat as splat
+
 #: samples advanced together; 8 doubles fill one AVX-512 register (two AVX2 ones). Measured
 #: against 4 and 16 in docs/performance.md. After changing it delete railride/__pycache__/kernels*.nb*
 #: (numba's cache does not track this file).
@@ -212,9 +214,7 @@ def _intrinsic_fn(builder, name, n_args):
 
 
 def _splat(builder, x):
-    v = builder.insert_element(ir.Constant(_VL, ir.Undefined), x, ir.Constant(ir.IntType(32), 0))
-    zeros = ir.Constant(ir.VectorType(ir.IntType(32), LANES), [0] * LANES)
-    return builder.shuffle_vector(v, ir.Constant(_VL, ir.Undefined), zeros)
+    return splat(builder, x, _VL)
 
 
 @intrinsic
