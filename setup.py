@@ -1,7 +1,7 @@
 """Build hook: compile the engine while the wheel is built (the rest is in pyproject.toml).
 
-`railride.compiled.build_cache` compiles the kernels that `railride compare` needs, with numba's
-cache next to the built package (``railride/__pycache__``), so the machine code ships inside the
+`railride.engine.compiled.build_cache` compiles the kernels that `railride compare` needs, with numba's
+cache next to the built package (``railride/engine/__pycache__``), so the machine code ships inside the
 wheel and the first run after ``pip install .`` loads it instead of compiling for ten seconds.
 numba keys that cache by a hash of the source, the numba version and this processor: a wheel
 carried to another machine, or run with another numba, compiles on its first run as before.
@@ -24,7 +24,7 @@ class BuildWithEngine(build_py):
     def run(self) -> None:
         super().run()
         # an earlier build's machine code in the build folder: never shipped unless made now
-        cache = os.path.join(self.build_lib, "railride", "__pycache__")
+        cache = os.path.join(self.build_lib, "railride", "engine", "__pycache__")
         for name in os.listdir(cache) if os.path.isdir(cache) else []:
             if name.endswith((".nbi", ".nbc")):
                 os.remove(os.path.join(cache, name))
@@ -35,7 +35,7 @@ class BuildWithEngine(build_py):
         env["PYTHONPATH"] = os.pathsep.join(filter(None, [os.path.abspath(self.build_lib), env.get("PYTHONPATH")]))
         started = time.perf_counter()
         done = subprocess.run(
-            [sys.executable, "-c", "import railride.compiled as c; c.build_cache()"],
+            [sys.executable, "-c", "import railride.engine.compiled as c; c.build_cache()"],
             cwd=self.build_lib,
             env=env,
             capture_output=True,

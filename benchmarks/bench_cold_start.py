@@ -40,7 +40,7 @@ class Timer(event.Listener):  # global: the stepper compiles on a worker thread
 
     def on_end(self, ev):
         d = ev.data["dispatcher"]
-        if d.py_func.__module__ == "railride.kernels" and d.py_func.__name__ in ("run_batch", "exact_run"):
+        if d.py_func.__module__ == "railride.engine.kernels" and d.py_func.__name__ in ("run_batch", "exact_run"):
             times[d.py_func.__name__] = time.perf_counter() - started[d]
 
 event.register("numba:compile", Timer())

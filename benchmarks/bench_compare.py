@@ -18,7 +18,7 @@ from pathlib import Path
 def _clear_cache() -> None:
     import railride
 
-    cache = Path(railride.__file__).parent / "__pycache__"
+    cache = Path(railride.__file__).parent / "engine" / "__pycache__"
     for f in list(cache.glob("*.nbi")) + list(cache.glob("*.nbc")):
         f.unlink()
 

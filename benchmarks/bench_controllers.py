@@ -31,10 +31,10 @@ def main():
         numba.set_num_threads(args.threads)
 
     from railride import Suspension, scenario, simulate
-    from railride.control import CONTROLLERS
-    from railride.league import league
+    from railride.secondary.control import CONTROLLERS
+    from railride.studies.league import league
 
-    from railride import kernels
+    from railride.engine import kernels
 
     stepper: list[float] = []  # the CPU time of each kernel call in this thread
     run_parallel = kernels.run_parallel

@@ -15,15 +15,15 @@ import numpy as np
 
 
 def batch_rows(repeat: int) -> list[tuple[str, str, str]]:
-    """Batch throughput, the lane stepper (`kernels.run_lanes`, the default for batches of
-    kernels.LANES samples or more) against the sample-by-sample stepper (`run_batch`), timed in
+    """Batch throughput, the lane stepper (`lanes.run_lanes`, the default for batches of
+    lanes.LANES samples or more) against the sample-by-sample stepper (`run_batch`), timed in
     alternating rounds (paired: the machine is shared), 20 000 steps per sample, both cores."""
-    from railride import kernels
-    from railride.params import VehicleParams
-    from railride.simulation import simulate
-    from railride.solver import SolverSettings
-    from railride.suspension import Suspension
-    from railride.track import scenario
+    from railride.engine import lanes
+    from railride.model.params import VehicleParams
+    from railride.run.simulation import simulate
+    from railride.run.solver import SolverSettings
+    from railride.secondary.suspension import Suspension
+    from railride.model.track import scenario
 
     sc = scenario("paper-sine", duration=2.0)
     sas = Suspension.named("sas-attitude-ride")
@@ -43,7 +43,7 @@ def batch_rows(repeat: int) -> list[tuple[str, str, str]]:
             ),
         ),
     ]
-    fit = kernels.lanes_fit
+    fit = lanes.lanes_fit
     rows = []
     for label, kw in batches:
         n = len(kw.get("suspension", kw.get("params")))
@@ -51,13 +51,13 @@ def batch_rows(repeat: int) -> list[tuple[str, str, str]]:
         best = {name: [float("inf"), float("inf")] for name in ("run_batch", "run_lanes")}
         for r in range(repeat + 1):  # round 0 compiles or loads each stepper
             for name in best:
-                kernels.lanes_fit = fit if name == "run_lanes" else (lambda *a: False)
+                lanes.lanes_fit = fit if name == "run_lanes" else (lambda *a: False)
                 try:
                     wall, cpu = time.perf_counter(), time.process_time()
                     simulate(sc, **kw)
                     wall, cpu = time.perf_counter() - wall, time.process_time() - cpu
                 finally:
-                    kernels.lanes_fit = fit
+                    lanes.lanes_fit = fit
                 if r > 0:
                     best[name] = [min(best[name][0], wall), min(best[name][1], cpu)]
         rate = {k: [n * 20_000 / t / 1e6 for t in v] for k, v in best.items()}
@@ -81,10 +81,10 @@ def main():
         _print(batch_rows(args.repeat))
         return
 
-    from railride import rig
-    from railride.simulation import simulate
-    from railride.suspension import Suspension
-    from railride.track import scenario
+    from railride.run import rig
+    from railride.run.simulation import simulate
+    from railride.secondary.suspension import Suspension
+    from railride.model.track import scenario
 
     sc = scenario("paper-sine")  # 10 s at dt = 1e-4 s
     rows = []

@@ -24,8 +24,8 @@ import numpy as np
 
 
 def bench_single(repeat):
-    from railride.simulation import simulate
-    from railride.track import scenario
+    from railride.run.simulation import simulate
+    from railride.model.track import scenario
 
     sc = scenario("paper-sine")  # 10 s at dt = 1e-4 s: 100 000 RK4 steps
     simulate(sc)  # compile or load the cache
@@ -42,10 +42,10 @@ def bench_kernel_only(repeat):
 
     import numba
 
-    from railride import kernels
-    from railride.simulation import simulate
-    from railride.solver import SolverSettings
-    from railride.track import scenario
+    from railride.engine import kernels
+    from railride.run.simulation import simulate
+    from railride.run.solver import SolverSettings
+    from railride.model.track import scenario
 
     sc, solver = scenario("paper-sine"), SolverSettings(method="rk4")
     took: list[float] = []
@@ -75,10 +75,10 @@ def bench_kernel_only(repeat):
 def bench_batch(n_samples, repeat, method="auto"):
     """A c_sz sweep: n_samples different vehicles in one batch ("auto" runs it by RK4 on the
     lane stepper; "exact" needs one matrix exponential per vehicle)."""
-    from railride.params import VehicleParams
-    from railride.simulation import simulate
-    from railride.solver import SolverSettings
-    from railride.track import scenario
+    from railride.model.params import VehicleParams
+    from railride.run.simulation import simulate
+    from railride.run.solver import SolverSettings
+    from railride.model.track import scenario
 
     base = VehicleParams.preset("paper")
     params = [base.replace(c_sz=c) for c in np.linspace(2e4, 1.2e5, n_samples)]
@@ -99,7 +99,7 @@ def bench_cli(repeat):
         if exe
         else [sys.executable, "-m", "railride.cli", "simulate", "--format", "json"]
     )
-    pkg = Path(railride.__file__).parent
+    pkg = Path(railride.__file__).parent / "engine"
     for f in list((pkg / "__pycache__").glob("*.nbi")) + list((pkg / "__pycache__").glob("*.nbc")):
         f.unlink()
     t0 = time.perf_counter()
@@ -107,7 +107,7 @@ def bench_cli(repeat):
     cold = time.perf_counter() - t0
     warm = min_time(lambda: subprocess.run(cmd, check=True, capture_output=True), repeat)
     t0 = time.perf_counter()
-    subprocess.run([sys.executable, "-c", "import railride.simulation, railride.cli"], check=True)
+    subprocess.run([sys.executable, "-c", "import railride.run.simulation, railride.cli"], check=True)
     imports = time.perf_counter() - t0
     return cold, warm, imports
 

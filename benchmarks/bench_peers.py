@@ -2,8 +2,8 @@
 
 Run:  python benchmarks/bench_peers.py [--rounds N] [--repeat N] [--scenario paper-sine|fra4]
 Every peer integrates the same equations, x' = A x + Bw w(t) + Bwd w'(t) of the passive
-vehicle (railride.vehicle), with the same rail inputs (the cubic Hermite interpolation of
-railride's input table, `railride.discrete.hermite_at`), for 10 s, output at 1 kHz, and reports
+vehicle (railride.model.vehicle), with the same rail inputs (the cubic Hermite interpolation of
+railride's input table, `railride.engine.discrete.hermite_at`), for 10 s, output at 1 kHz, and reports
 its largest difference from railride's exact discretisation (relative to the largest carbody
 bounce) and whether that is below 1e-4 (it reproduces the trajectory). Peers: railride's RK4
 stepper (dt = 1e-4 s), SciPy's solve_ivp with LSODA and RK45 (rtol 1e-6, atol 1e-9), a NumPy
@@ -49,9 +49,9 @@ def main():
     from scipy.integrate import solve_ivp
 
     import railride as rr
-    from railride.discrete import hermite_at
-    from railride.simulation import _system_arrays
-    from railride.track import wheelset_input_table
+    from railride.engine.discrete import hermite_at
+    from railride.run.simulation import _system_arrays
+    from railride.model.track import wheelset_input_table
 
     sc = rr.scenario(args.scenario, duration=10.0)
     vehicle = rr.Vehicle()
@@ -178,7 +178,7 @@ def main():
         m: min_time(lambda m=m: rr.simulate(sc, suspension=sas, solver=rr.SolverSettings(method=m)), args.repeat)
         for m in ("auto", "rk4")
     }
-    from railride.ride_spectrum import ride_spectrum
+    from railride.frequency.ride_spectrum import ride_spectrum
 
     ride_spectrum("fra4", points=100)
     spectrum = min_time(lambda: ride_spectrum("fra4"), args.repeat)

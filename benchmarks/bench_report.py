@@ -67,7 +67,7 @@ def main():
     compare = [_timed(base + ["compare"]) for _ in range(args.repeat)]
 
     import railride as rr
-    from railride import report as rep
+    from railride.output import report as rep
 
     result = rr.compare(rr.scenario("paper-sine"))
     rep.report_html(result)  # imports and first calls

@@ -1,4 +1,4 @@
-"""Cost of a study over many tracks (railride.study): wall time and peak memory.
+"""Cost of a study over many tracks (railride.studies.study): wall time and peak memory.
 
 Run:  python benchmarks/bench_study.py [--seeds N] [--dask]
 Prints a Markdown row for docs/performance.md: one study of 1000 closed-loop and passive runs
@@ -23,13 +23,13 @@ def main():
     ap.add_argument("--dask", action="store_true")
     args = ap.parse_args()
 
-    from railride.study import study
+    from railride.studies.study import study
 
     executor, cluster, where = None, None, "local, one process"
     if args.dask:
         from distributed import LocalCluster
 
-        from railride.executors import DaskExecutor
+        from railride.studies.executors import DaskExecutor
 
         cluster = LocalCluster(n_workers=1, threads_per_worker=1, processes=True, dashboard_address=None)
         executor = DaskExecutor(address=cluster.scheduler_address)

@@ -26,7 +26,7 @@ SUSPENSIONS = ["passive", "pid", "sas-attitude", "sas-attitude-ride"]
 
 
 def _grid(runs: int):
-    from railride.sweep import grid
+    from railride.studies.sweep import grid
 
     n_speeds = 8
     seeds = list(range(max(1, runs // (len(SUSPENSIONS) * n_speeds))))
@@ -47,7 +47,7 @@ def child(runs: int) -> None:
     """One sweep in this process, its peak memory as JSON on stdout."""
     import gc
 
-    from railride.sweep import run_sweep
+    from railride.studies.sweep import run_sweep
 
     run_sweep(_grid(32))  # compile and warm: the same kernels, one chunk
     gc.collect()
@@ -60,7 +60,8 @@ def child(runs: int) -> None:
     wall = time.perf_counter() - t0
     peak, after = _status("VmHWM"), _status("VmRSS")
     # what stays after the sweep is the shared tracks and tables (each store bounded by bytes)
-    from railride import simulation, track
+    from railride.run import simulation
+    from railride.model import track
 
     stores = (track._TRACKS, simulation._INPUT_TABLES, simulation._FORCING_TABLES)
     held = sum(s.nbytes for s in stores) / 2**20
@@ -85,7 +86,7 @@ def child(runs: int) -> None:
 
 
 def profile(runs: int) -> None:
-    from railride.sweep import run_sweep
+    from railride.studies.sweep import run_sweep
 
     run_sweep(_grid(32))
     g = _grid(runs)

@@ -12,8 +12,8 @@ from __future__ import annotations
 
 import time
 
-from railride.sweep import Case, run_cases
-from railride.tuning import tune
+from railride.studies.sweep import Case, run_cases
+from railride.studies.tuning import tune
 
 
 def main():

@@ -15,7 +15,7 @@ import tempfile
 from pathlib import Path
 
 import railride as rr
-from railride.control import GainSet
+from railride.secondary.control import GainSet
 
 RESPONSES = ("acceleration_m_s2", "displacement_m", "pitch_deg", "roll_deg")
 SCALES = (0.5, 1.0, 2.0, 4.0)

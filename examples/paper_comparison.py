@@ -12,7 +12,7 @@ import tempfile
 from pathlib import Path
 
 import railride as rr
-from railride.control import LABELS
+from railride.secondary.control import LABELS
 
 RESPONSES = ("acceleration_m_s2", "displacement_m", "pitch_deg", "roll_deg")
 SHORT = {

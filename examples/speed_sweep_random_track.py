@@ -1,5 +1,5 @@
 """A speed sweep on FRA class 4 random track: passive against SAS (attitude+ride) on MR
-dampers: a grid of cases (`railride.sweep.grid`) run by `railride.run_sweep`.
+dampers: a grid of cases (`railride.studies.sweep.grid`) run by `railride.run_sweep`.
 
     python examples/speed_sweep_random_track.py [--out DIR]
 
@@ -13,7 +13,7 @@ from pathlib import Path
 import matplotlib
 
 import railride as rr
-from railride import sweep
+from railride.studies import sweep
 
 matplotlib.use("Agg")  # no display needed: the plot goes to a file
 import matplotlib.pyplot as plt  # after choosing the backend

@@ -17,66 +17,105 @@ The public API, in the order a run needs it::
     rr.write_report(rr.compare(sc), "ride.html")      # any result as one HTML page
 """
 
-__version__ = "0.4.0"
-
-import sys
-import types
 from typing import TYPE_CHECKING
+
+from railride._version import __version__ as __version__
 
 #: the module that holds each public name. They are imported on first use (PEP 562), so that
 #: ``import railride`` and the command line start in a fraction of a second (the engine, xarray
 #: and pandas come with the first name that needs them) and Ctrl-C during the command line's
 #: start-up is its own to report (status 130), not a traceback in this import.
 _HOMES = {
-    "Comparison": "comparison",
-    "compare": "comparison",
-    "GainSet": "control",
-    "FrfResult": "frf",
-    "frequency_responses": "frf",
-    "VehicleParams": "params",
-    "ParetoResult": "pareto",
-    "pareto": "pareto",
-    "RideResult": "ride",
-    "DamperFault": "faults",
-    "simulate": "simulation",
-    "StudyResult": "study",
-    "study": "study",
-    "SolverSettings": "solver",
-    "Suspension": "suspension",
-    "SweepResult": "sweep",
-    "run_sweep": "sweep",
-    "Scenario": "track",
-    "scenario": "track",
-    "Objective": "objectives",
-    "tune": "tuning",
-    "Vehicle": "vehicle",
-    "dampers": "dampers",
-    "write_report": "report",
+    "Comparison": "studies.comparison",
+    "compare": "studies.comparison",
+    "GainSet": "secondary.control",
+    "FrfResult": "frequency.frf",
+    "frequency_responses": "frequency.frf",
+    "VehicleParams": "model.params",
+    "ParetoResult": "studies.pareto",
+    "pareto": "studies.pareto",
+    "RideResult": "run.ride",
+    "DamperFault": "secondary.faults",
+    "simulate": "run.simulation",
+    "StudyResult": "studies.study",
+    "study": "studies.study",
+    "SolverSettings": "run.solver",
+    "Suspension": "secondary.suspension",
+    "SweepResult": "studies.sweep",
+    "run_sweep": "studies.sweep",
+    "Scenario": "model.track",
+    "scenario": "model.track",
+    "Objective": "studies.objectives",
+    "tune": "studies.tuning",
+    "Vehicle": "model.vehicle",
+    "dampers": "secondary.dampers",
+    "write_report": "output.report",
+}
+
+
+#: where the modules of the flat layout (0.4.0) live now: ``railride.sweep.grid`` still works as an
+#: attribute of the package (``import railride.sweep`` does not; the new path does)
+_MOVED = {
+    "comfort": "analysis.comfort",
+    "comparison": "studies.comparison",
+    "compiled": "engine.compiled",
+    "control": "secondary.control",
+    "controllers": "secondary.controllers",
+    "discrete": "engine.discrete",
+    "executors": "studies.executors",
+    "faults": "secondary.faults",
+    "files": "output.files",
+    "frf": "frequency.frf",
+    "kernels": "engine.kernels",
+    "labels": "analysis.labels",
+    "league": "studies.league",
+    "linear": "frequency.linear",
+    "metrics": "analysis.metrics",
+    "objectives": "studies.objectives",
+    "optimise": "studies.optimise",
+    "params": "model.params",
+    "plausible": "model.plausible",
+    "report": "output.report",
+    "ride": "run.ride",
+    "ride_spectrum": "frequency.ride_spectrum",
+    "rig": "run.rig",
+    "sensing": "secondary.sensing",
+    "simulation": "run.simulation",
+    "solver": "run.solver",
+    "suspension": "secondary.suspension",
+    "sweep": "studies.sweep",
+    "sweep_grid": "studies.grid",
+    "tables": "output.tables",
+    "track": "model.track",
+    "tune_result": "studies.tune_result",
+    "tuning": "studies.tuning",
+    "vehicle": "model.vehicle",
 }
 
 if TYPE_CHECKING:
-    from . import dampers
-    from .comparison import Comparison, compare
-    from .control import GainSet
-    from .faults import DamperFault
-    from .frf import FrfResult, frequency_responses
-    from .objectives import Objective
-    from .params import VehicleParams
-    from .pareto import ParetoResult, pareto
-    from .report import write_report
-    from .ride import RideResult
-    from .simulation import simulate
-    from .solver import SolverSettings
-    from .study import StudyResult, study
-    from .suspension import Suspension
-    from .sweep import SweepResult, run_sweep
-    from .track import Scenario, scenario
-    from .tuning import tune
-    from .vehicle import Vehicle
+    from railride.secondary import dampers
+    from railride.studies.comparison import Comparison, compare
+    from railride.secondary.control import GainSet
+    from railride.secondary.faults import DamperFault
+    from railride.frequency.frf import FrfResult, frequency_responses
+    from railride.studies.objectives import Objective
+    from railride.model.params import VehicleParams
+    from railride.studies.pareto import ParetoResult, pareto
+    from railride.output.report import write_report
+    from railride.run.ride import RideResult
+    from railride.run.simulation import simulate
+    from railride.run.solver import SolverSettings
+    from railride.studies.study import StudyResult, study
+    from railride.secondary.suspension import Suspension
+    from railride.studies.sweep import SweepResult, run_sweep
+    from railride.model.track import Scenario, scenario
+    from railride.studies.tuning import tune
+    from railride.model.vehicle import Vehicle
 
 
 def __getattr__(name: str):
-    """A public name (`_HOMES`), imported on first use, or a submodule (``railride.sweep``)."""
+    """A public name (`_HOMES`), imported on first use, or a submodule (``railride.model``, or a
+    module by its 0.4.0 name, `_MOVED`)."""
     import importlib
 
     if name.startswith("_"):
@@ -84,11 +123,14 @@ def __getattr__(name: str):
     home = _HOMES.get(name)
     if home is None:
         try:
-            return importlib.import_module(f".{name}", __name__)
+            value = importlib.import_module(f".{_MOVED.get(name, name)}", __name__)
         except ModuleNotFoundError as exc:
-            if exc.name != f"{__name__}.{name}":
+            if exc.name != f"{__name__}.{_MOVED.get(name, name)}":
                 raise
             raise AttributeError(f"module 'railride' has no attribute {name!r}") from None
+        if name in _MOVED:
+            globals()[name] = value
+        return value
     module = importlib.import_module(f".{home}", __name__)
     value = module if name == "dampers" else getattr(module, name)
     globals()[name] = value
@@ -98,19 +140,6 @@ def __getattr__(name: str):
 def __dir__() -> list[str]:
     return sorted({*globals(), *_HOMES})
 
-
-class _Package(types.ModuleType):
-    """The package's module type: importing the submodules ``railride.study`` and
-    ``railride.pareto`` must not hide the functions ``study`` and ``pareto`` of the same names
-    (the import system sets a submodule as an attribute of its package)."""
-
-    def __setattr__(self, name: str, value) -> None:
-        if isinstance(value, types.ModuleType) and name in _HOMES and name != "dampers":
-            return
-        super().__setattr__(name, value)
-
-
-sys.modules[__name__].__class__ = _Package
 
 __all__ = [
     "Comparison",

@@ -1,6 +1,6 @@
 """``python -m railride``: the ``railride`` command line."""
 
-from .cli import main
+from railride.cli import main
 
 if __name__ == "__main__":
     main()

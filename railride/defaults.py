@@ -8,3 +8,5 @@ DEFAULT_OUTPUT_RATE = 1000.0
 DEFAULT_CONTROL_RATE = 1000.0
 #: the MR damper of a vehicle run when none is named
 DEFAULT_DAMPER = "railway"
+#: the vehicle's speed [m/s] (V, the paper's value)
+DEFAULT_SPEED = 55.56

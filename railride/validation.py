@@ -13,7 +13,11 @@ import datetime
 import math
 import numbers
 from dataclasses import field
-from typing import Any
+import sys
+import warnings
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any, NamedTuple
 
 #: the largest seed: NumPy's generators take any whole number >= 0, but a seed must also
 #: survive the run table's CSV, whose readers hold whole numbers in 64 bits
@@ -125,10 +129,27 @@ def param(unit: str, doc: str, rule: str = "positive") -> Any:
     return field(metadata={"unit": unit, "doc": doc, "rule": rule})
 
 
-def validate_fields(obj, what: str) -> None:
+class PlausibilityWarning(UserWarning):
+    """A value inside its error range but outside the typical range of a full-size rail vehicle."""
+
+
+class Range(NamedTuple):
+    """The allowed range of a field (an error outside) and, for a vehicle field, its typical
+    range (a `PlausibilityWarning` outside; None: no warning). The tables are
+    `railride.model.plausible`."""
+
+    low: float  # error below
+    high: float  # error above
+    why: str
+    typical: tuple[float, float] | None = None  # a warning outside (None: no warning)
+
+
+def validate_fields(obj, what: str, ranges: Mapping[str, Range] | None = None, then=None) -> None:
     """Check every field of a frozen parameter dataclass against the rule in its metadata and
     store it as float (a seed as int); the error names the field, its value, its meaning and
-    unit, and the rule. Then the plausible ranges of `railride.plausible` (errors, warnings)."""
+    unit, and the rule. Then the fields named in ``ranges`` against their allowed range (an
+    error), ``then()`` (a check across fields, if any), and their typical range (a
+    `PlausibilityWarning` for each field outside it)."""
     for f in dataclasses.fields(obj):
         value = getattr(obj, f.name)
         rule = f.metadata["rule"]
@@ -145,9 +166,52 @@ def validate_fields(obj, what: str) -> None:
         raise ValueError(
             f"{what} {f.name!r} = {shown(value)} ({f.metadata['doc']}, {f.metadata['unit']}): must be {RULES[rule][0]}"
         )
-    from .plausible import check
+    if not ranges:
+        return
+    fields = {f.name: f for f in dataclasses.fields(obj)}
+    for name, r in ranges.items():
+        value, meta = getattr(obj, name), fields[name].metadata
+        if not r.low <= value <= r.high:
+            raise ValueError(
+                f"{what} {name!r} = {shown(value)} ({meta['doc']}, {meta['unit']}): must be between {r.low:g} and "
+                f"{r.high:g} {meta['unit']} ({r.why})"
+            )
+    if then is not None:
+        then()
+    for note in atypical(obj, ranges, what):
+        warnings.warn(note, PlausibilityWarning, stacklevel=caller_level())
 
-    check(obj, what)
+
+_PACKAGE = str(Path(__file__).resolve().parent)
+
+
+def caller_level() -> int:
+    """The ``stacklevel`` of a warning raised by the function that calls this, such that the
+    warning points at the first line outside railride (the user's call), past dataclasses'
+    generated ``__init__`` (file ``<string>``)."""
+    frame, level = sys._getframe(2), 2
+    while frame is not None and (
+        frame.f_code.co_filename.startswith(_PACKAGE) or frame.f_code.co_filename.startswith("<")
+    ):
+        frame, level = frame.f_back, level + 1
+    return level
+
+
+def atypical(obj, ranges: Mapping[str, Range], what: str) -> list[str]:
+    """One line for each field of ``obj`` outside its typical range in ``ranges``."""
+    out = []
+    fields = {f.name: f for f in dataclasses.fields(obj)}
+    for name, r in ranges.items():
+        if r.typical is None:
+            continue
+        low, high = r.typical
+        value, meta = getattr(obj, name), fields[name].metadata
+        if not low <= value <= high:
+            out.append(
+                f"{what} {name!r} = {shown(value)} {meta['unit']} ({meta['doc']}) is outside the "
+                f"{low:g} to {high:g} {meta['unit']} of full-size rail vehicles; the results are for it as given"
+            )
+    return out
 
 
 def toml_error(exc: ValueError) -> str:

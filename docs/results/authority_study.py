@@ -26,12 +26,12 @@ from pathlib import Path
 import pandas as pd
 
 from railride import dampers
-from railride.control import GainSet
-from railride.metrics import RESPONSES
-from railride.sweep import Case, run_cases
-from railride.tuning import tune
+from railride.secondary.control import GainSet
+from railride.analysis.metrics import RESPONSES
+from railride.studies.sweep import Case, run_cases
+from railride.studies.tuning import tune
 
-#: the paper's laws and the inner loop, each tuned alike (railride.tuning)
+#: the paper's laws and the inner loop, each tuned alike (railride.studies.tuning)
 PAPER_LAWS = ("inner", "pid", "sas-attitude", "sas-attitude-ride")
 
 HERE = Path(__file__).parent

@@ -7,10 +7,10 @@ import json
 import time
 from pathlib import Path
 
-from railride.control import GainSet
-from railride.optimise import SAS_PARAMETERS, optimise, sensitivity
-from railride.sweep import Case, run_cases
-from railride.tuning import DEFAULT_OBJECTIVE
+from railride.secondary.control import GainSet
+from railride.studies.optimise import SAS_PARAMETERS, optimise, sensitivity
+from railride.studies.sweep import Case, run_cases
+from railride.studies.tuning import DEFAULT_OBJECTIVE
 
 here = Path(__file__).parent
 objective = DEFAULT_OBJECTIVE  # minimax: the objective the shipped gains were tuned with (railride tune)

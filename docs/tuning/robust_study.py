@@ -8,11 +8,11 @@ of the minimax objective), both judged on ten tracks neither saw (seeds 10-19) a
 
 import numpy as np
 
-from railride.comparison import compare
-from railride.control import GainSet
-from railride.study import study
-from railride.track import scenario
-from railride.tuning import tune, tuning_set
+from railride.studies.comparison import compare
+from railride.secondary.control import GainSet
+from railride.studies.study import study
+from railride.model.track import scenario
+from railride.studies.tuning import tune, tuning_set
 
 RESPONSES = ["acceleration_m_s2_rms", "displacement_m_rms", "pitch_deg_rms", "roll_deg_rms"]
 

@@ -4,7 +4,7 @@
 
 A thin layer over the library: it parses options, calls the library's studies (`simulate`,
 `compare`, `frf`, `rig`, `tune`, `study`, `pareto`, `sweep`), writes their results through their
-`save()` and `railride.files`, and prints. See docs/cli.md. One module per command (`rig` holds `damper`
+`save()` and `railride.output.files`, and prints. See docs/cli.md. One module per command (`rig` holds `damper`
 and `tracking`); `_options` declares the options several commands share, `_parsing` the
 checks of their values, `_common` the errors, consoles and run machinery, `_render` the
 shared tables, `_width` the tables that fit the console's width (80 columns on a pipe).
@@ -29,7 +29,7 @@ __all__ = ["app", "main"]
 COMMANDS = ("compare", "report", "modes", "frf", "simulate", "rig", "tune", "pareto", "sweep", "study", "ride_spectrum")
 
 if TYPE_CHECKING:
-    from ._app import app
+    from railride.cli._app import app
 
 
 def _load():
@@ -38,7 +38,7 @@ def _load():
 
     for name in COMMANDS:
         importlib.import_module(f".{name}", __name__)
-    from ._app import app
+    from railride.cli._app import app
 
     return app
 
@@ -74,6 +74,6 @@ def main() -> None:
 
 
 def _quiet() -> None:
-    from ._app import quiet_closed_pipe
+    from railride.cli._app import quiet_closed_pipe
 
     quiet_closed_pipe()

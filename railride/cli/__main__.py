@@ -1,6 +1,6 @@
 """``python -m railride.cli``: the ``railride`` command line."""
 
-from . import main
+from railride.cli import main
 
 if __name__ == "__main__":
     main()

@@ -10,7 +10,7 @@ import warnings
 import typer
 from typer.core import TyperGroup
 
-from ._common import INTERRUPTED, OK, USER, usage_error_line, usage_error_types
+from railride.cli._common import INTERRUPTED, OK, USER, usage_error_line, usage_error_types
 
 __all__ = ["INTERRUPTED", "RailrideGroup", "app", "quiet_closed_pipe"]
 
@@ -71,9 +71,9 @@ class RailrideGroup(TyperGroup):
 
 @contextlib.contextmanager
 def _warnings_on_stderr():
-    """A `railride.plausible.PlausibilityWarning` (a vehicle outside the typical ranges) as one
+    """A `railride.model.plausible.PlausibilityWarning` (a vehicle outside the typical ranges) as one
     line "warning: ..." on stderr, once per text, beside the result it qualifies."""
-    from ..plausible import PlausibilityWarning
+    from railride.model.plausible import PlausibilityWarning
 
     def show(message, category, filename, lineno, file=None, line=None):
         if issubclass(category, PlausibilityWarning):
@@ -104,7 +104,7 @@ app = typer.Typer(
 
 def _version(value: bool) -> None:
     if value:
-        from .. import __version__
+        from railride._version import __version__
 
         typer.echo(f"railride {__version__}")
         raise typer.Exit()

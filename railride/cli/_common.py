@@ -41,7 +41,7 @@ def errors():
     are the user's to change) -> status 2; any other RuntimeError, an internal fault -> 1. One
     line on stderr, no traceback. A closed stdout (BrokenPipeError) and Ctrl-C pass through:
     the entry point (`railride.cli._app`) deals with them."""
-    from ..errors import DivergenceError
+    from railride.errors import DivergenceError
 
     try:
         yield
@@ -185,7 +185,7 @@ def status_note(message: str):
 
 
 def write_folder(out: Path, write) -> None:
-    """Run ``write()`` (a `railride.files` writer or a result's ``save``) with a status note;
+    """Run ``write()`` (a `railride.output.files` writer or a result's ``save``) with a status note;
     OSError -> status 2."""
     try:
         with status_note(f"writing outputs to {out}..."):
@@ -202,14 +202,14 @@ def print_json(doc) -> None:
 def _first_message(verb_text: str) -> str:
     """The bar's first text: while the stepper is neither compiled nor in numba's cache, that it
     compiles."""
-    from .. import compiled
+    from railride.engine import compiled
 
     return "compiling the stepper (once)..." if compiled.needs_compiling() else verb_text
 
 
 def compile_message(kernel: str = "run_batch") -> str:
     """The note printed when ``kernel`` starts compiling, with the time it takes."""
-    from .. import compiled
+    from railride.engine import compiled
 
     return f"compiling the stepper once, about {compiled.compile_seconds(kernel):.0f} s; later runs start at once"
 
@@ -219,7 +219,7 @@ def compile_note(say):
     """Within the block, ``say`` the compile note once when numba starts compiling the stepper
     (a fresh install's first closed-loop run), on a pipe as on a terminal: a silent pause of ten
     seconds reads as a hang. Loading it from numba's cache says nothing."""
-    from .. import compiled
+    from railride.engine import compiled
 
     said = []
 
@@ -348,7 +348,7 @@ class RunProgress:
 def make_executor(workers: Optional[int], scheduler: Optional[str], scheduler_file: Optional[Path]):
     """(executor, record for the JSON): Dask with --scheduler / --scheduler-file, else the local
     executor, whose batches use --workers threads (numba's thread count, 1..cores)."""
-    from .. import sweep as sweep_lib
+    from railride.studies import sweep as sweep_lib
 
     if scheduler is not None and scheduler_file is not None:
         raise ValueError("give either --scheduler ADDRESS or --scheduler-file FILE, not both")
@@ -386,8 +386,8 @@ def make_executor(workers: Optional[int], scheduler: Optional[str], scheduler_fi
 
 def open_run_table(out: Optional[Path], resume: bool):
     """(RunTable, its path or None): DIR/runs.csv with --out, kept in memory without it."""
-    from .. import sweep as sweep_lib
-    from ..files import check_out_dir
+    from railride.studies import sweep as sweep_lib
+    from railride.output.files import check_out_dir
 
     if out is None:
         if resume:

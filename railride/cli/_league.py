@@ -1,5 +1,5 @@
 """``railride compare`` with several scenarios, speeds or track seeds: the league table
-(railride.league.league), and its table."""
+(railride.studies.league.league), and its table."""
 
 from __future__ import annotations
 
@@ -8,10 +8,10 @@ from typing import Callable
 
 import typer
 
-from ._common import ProgressBar, stderr_is_terminal, stdout_console, write_folder
-from ._options import OutputFormat
-from ._parsing import damper_preset, load_gains, parse_scale, vehicle_from_options
-from ._render import alike_text, fmt, untuned_text
+from railride.cli._common import ProgressBar, stderr_is_terminal, stdout_console, write_folder
+from railride.cli._options import OutputFormat
+from railride.cli._parsing import damper_preset, load_gains, parse_scale, vehicle_from_options
+from railride.cli._render import alike_text, fmt, untuned_text
 
 
 def run_league(
@@ -37,10 +37,10 @@ def run_league(
     report=None,
     ctx=None,
 ) -> None:
-    """Several scenarios, speeds or track seeds: the league table (railride.league.league)."""
-    from ..files import check_out_dir, write_league_outputs
-    from ..league import league
-    from ..metrics import parse_window
+    """Several scenarios, speeds or track seeds: the league table (railride.studies.league.league)."""
+    from railride.output.files import check_out_dir, write_league_outputs
+    from railride.studies.league import league
+    from railride.analysis.metrics import parse_window
 
     options = {
         "amplitude": "--amplitude",
@@ -93,7 +93,7 @@ def run_league(
         for part in parts:
             console.print(part)
     if report is not None:  # after the table: a report that cannot be written loses no output
-        from .report import save_report  # here: report imports compare, which imports this module
+        from railride.cli._render import save_report
 
         save_report(report, table, parts, ctx)
 
@@ -103,8 +103,8 @@ def league_table(table, doc) -> list:
     on a narrow console the reductions, and the comfort and damper columns, in two tables."""
     from rich.text import Text
 
-    from ..labels import describe_scenario
-    from ._width import FitTable, Split
+    from railride.analysis.labels import describe_scenario
+    from railride.cli._width import FitTable, Split
 
     summary = table.summary()
     cases = table.cases[table.cases.controller == "passive"]

@@ -416,7 +416,7 @@ def figure_options(figure_format: Optional[str], dpi: Optional[str], out: Option
     """--figure-format and --dpi as a `railride.plots.FigureOptions` (read as text, so that a
     word gets the one-line error too); ValueError naming the option for a bad value, or for
     either without --out."""
-    from ..plots import PNG_DPI, FigureOptions
+    from railride.plots import PNG_DPI, FigureOptions
 
     given = [o for o, v in (("--figure-format", figure_format), ("--dpi", dpi)) if v is not None]
     if given and out is None:
@@ -454,7 +454,7 @@ SweepResumeOption = _resume(
     "Continue the sweep whose run table is DIR/runs.csv (needs --out): runs already there are not evaluated again."
 )
 
-#: compare, sweep, tune and study: the HTML report of the result (railride.report)
+#: compare, sweep, tune and study: the HTML report of the result (railride.output.report)
 ReportOption = Annotated[
     Optional[Path],
     typer.Option(
@@ -480,9 +480,9 @@ HistoryFormatOption = Annotated[
 
 
 def history_options(history_format: Optional[str], out: Optional[Path]) -> tuple:
-    """--history-format as the library's formats (`railride.files.history_formats`); ValueError
+    """--history-format as the library's formats (`railride.output.files.history_formats`); ValueError
     naming the option for a bad value, or without --out."""
-    from ..files import history_formats
+    from railride.output.files import history_formats
 
     if history_format is None:
         return history_formats()
@@ -501,8 +501,8 @@ def _limit_setter(setter: str, field: str, option: str):
     in one process. Errors name the option."""
 
     def set_limit(value: Optional[str]) -> Optional[str]:
-        from .. import limits
-        from ._common import errors
+        from railride import limits
+        from railride.cli._common import errors
 
         with errors():
             try:

@@ -45,7 +45,7 @@ def value_list(option: str, text: str, *, integer: bool = False, parse=None) -> 
             raise ValueError(f"{option} = {text!r}: COUNT = {parts[2].strip()!r} is not a whole number") from None
         if count < 1:
             raise ValueError(f"{option} = {text!r}: COUNT = {count} must be >= 1")
-        from ..limits import VALUE_BYTES, check
+        from railride.limits import VALUE_BYTES, check
 
         # each value is a Python number in a list and a set, and a case of the runs: ~1 kB
         check(VALUE_BYTES * count, f"{option} = {text!r}: {count} values", "give a smaller COUNT")
@@ -95,13 +95,13 @@ def _about(value) -> str:
     try:
         return f"{float(value):.4g}"
     except OverflowError:
-        from ..validation import shown
+        from railride.validation import shown
 
         return f"about {shown(round(value)).split(' (')[0]}"  # without "(a 400-digit whole number)"
 
 
 def _shown(value) -> str:
-    from ..validation import shown
+    from railride.validation import shown
 
     return f"{value:g}" if isinstance(value, float) else shown(value)
 
@@ -124,7 +124,7 @@ FIXED_RATE_FIELDS = {"dt": "--dt", "output_rate": "output rate"}
 def solver_from_options(**given):
     """--dt, --output-rate, --control-rate (None: not given) -> a railride.SolverSettings, the
     others at their defaults; the settings check themselves."""
-    from ..solver import SolverSettings
+    from railride.run.solver import SolverSettings
 
     return SolverSettings(**{k: v for k, v in given.items() if v is not None})
 
@@ -146,7 +146,7 @@ def vehicle_source(params_file: Optional[Path], preset: Optional[str]):
 def vehicle_from_options(params_file: Optional[Path], preset: Optional[str], load: Optional[float] = None):
     """(VehicleParams, the record for the JSON document); ``load`` (--load) scales the carbody's
     mass and inertias (`VehicleParams.loaded`) and enters the record when given."""
-    from ..params import VehicleParams
+    from railride.model.params import VehicleParams
 
     vehicle_source(params_file, preset)
     if params_file is not None:
@@ -156,17 +156,17 @@ def vehicle_from_options(params_file: Optional[Path], preset: Optional[str], loa
         vehicle, record = VehicleParams.preset(name), {"vehicle_preset": name}
     if load is None:
         return vehicle, record
-    from ._common import option_names
+    from railride.cli._common import option_names
 
     with option_names({"load": "--load"}):
         return vehicle.loaded(load), {**record, "load_factor": float(load)}
 
 
 def damper_preset(option: str, name: str, *, rig: bool = False):
-    """The damper ``name`` (railride.dampers.NAMES: the MR presets and "ideal"), else ValueError
+    """The damper ``name`` (railride.secondary.dampers.NAMES: the MR presets and "ideal"), else ValueError
     naming the option. ``rig``: the MR presets only (the ideal actuator has no force law to
     drive on the rig)."""
-    from .. import dampers
+    from railride.secondary import dampers
 
     allowed = dampers.PRESETS if rig else dampers.NAMES
     if name not in allowed:
@@ -222,7 +222,7 @@ def parse_voltages(option: str, text: str, damper) -> list[float]:
 
 def load_gains(path: Optional[Path]):
     """The shipped gains, or --gains FILE with the library's message (file, table, entry)."""
-    from ..control import GainSet
+    from railride.secondary.control import GainSet
 
     if path is None:
         return GainSet.default()
@@ -279,7 +279,7 @@ PROFILE_FIELDS = {
 
 
 def random_tracks() -> tuple:
-    from ..track import SPECTRA
+    from railride.model.track import SPECTRA
 
     return SPECTRA
 
@@ -304,10 +304,10 @@ def track_options(
 
 def make_scenario(name: str, options: dict, output_rate: Optional[float] = None, rate_option: str = "--output-rate"):
     """track.scenario(name, **options), and with ``output_rate`` [Hz] the library's check that
-    it resolves the track (`railride.solver.check_resolution`; ``rate_option`` names the option
+    it resolves the track (`railride.run.solver.check_resolution`; ``rate_option`` names the option
     that sets the rate, or says what does). The library's errors name the options."""
-    from ..solver import check_resolution
-    from ..track import scenario as library_scenario
+    from railride.run.solver import check_resolution
+    from railride.model.track import scenario as library_scenario
 
     if name in random_tracks():
         for option, keyword, unit in (
@@ -321,7 +321,7 @@ def make_scenario(name: str, options: dict, output_rate: Optional[float] = None,
                     f"random track ({name}); its options are --track-seed, "
                     "--min-wavelength and --max-wavelength"
                 )
-    from ._common import option_names
+    from railride.cli._common import option_names
 
     fields = {
         **TRACK_FIELDS,

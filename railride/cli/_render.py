@@ -1,9 +1,17 @@
 """Rich tables and text that several commands print: the response labels and number formats,
-the ride comfort tables, the damper description and the modes table."""
+the ride comfort tables, the damper description and the modes table; and the --report file
+that compare, sweep, tune, study and ride-spectrum write of their result (`save_report`)."""
 
 from __future__ import annotations
 
-#: table labels of the four ride responses (keys of railride.metrics.RESPONSES)
+from pathlib import Path
+from typing import Optional
+
+import typer
+
+from railride.cli._common import CliError, command_line, errors, status_note
+
+#: table labels of the four ride responses (keys of railride.analysis.metrics.RESPONSES)
 RESPONSE_LABELS = {
     "acceleration_m_s2": "acceleration (m/s^2)",
     "displacement_m": "displacement (m)",
@@ -24,7 +32,7 @@ def reduction_text(value, spec: str = ".1f") -> str:
 
 
 def damper_text(settings: dict) -> str:
-    from ..labels import describe_dampers
+    from railride.analysis.labels import describe_dampers
 
     return describe_dampers(settings, detail=True)
 
@@ -59,7 +67,7 @@ def comfort_table(record: dict):
     """The comfort table of `simulate`: one row per index, one column per position."""
     from rich.markup import escape
 
-    from ._width import FitTable
+    from railride.cli._width import FitTable
 
     positions = record["positions"]
     table = FitTable(title="Ride comfort (carbody floor)", caption=escape(_comfort_caption(record)))
@@ -78,7 +86,7 @@ def compare_comfort_table(rows: list[dict]):
     console one table per group of suspensions, each beside passive."""
     from rich.markup import escape
 
-    from ._width import FitTable, Split
+    from railride.cli._width import FitTable, Split
 
     first = rows[0]["comfort"]
     caption = escape(
@@ -122,7 +130,7 @@ def compare_comfort_table(rows: list[dict]):
 def modes_table(rows: list[dict]):
     from rich.markup import escape
 
-    from ._width import FitTable
+    from railride.cli._width import FitTable
 
     table = FitTable(title="Modes of the passive vehicle")
     table.add_column("#", justify="right")
@@ -156,3 +164,43 @@ def untuned_text(names) -> str:
         f"Not tuned: {', '.join(names)} run with the starting values of their gains tables (docs/control.md), "
         "not tuned like the others: a fair ranking needs them tuned by the same study."
     )
+
+
+#: columns of the console the report's tables are rendered on (an HTML page scrolls sideways)
+REPORT_WIDTH = 120
+
+
+def check_report_option(path: Optional[Path], option: str = "--report") -> None:
+    """Before any run: ValueError naming ``option`` if no report can be written at ``path``."""
+    if path is not None:
+        from railride.output.report import check_report_path
+
+        check_report_path(path, option)
+
+
+def save_report(path: Path, result, parts=(), ctx: Optional[typer.Context] = None) -> None:
+    """Write the report of ``result`` to ``path``, with ``parts`` (the rich tables and texts the
+    command prints) rendered as HTML, and the command line of ``ctx`` as given; say so on
+    stderr. A file that cannot be written: ``error: ...``, status 2."""
+    import io
+
+    from rich.console import Console
+
+    from railride.output.report import write_report
+
+    console = Console(record=True, file=io.StringIO(), width=REPORT_WIDTH, highlight=False)
+    for part in parts:
+        console.print(part)
+    fragment = console.export_html(inline_styles=True, code_format='<pre class="console">{code}</pre>')
+    with errors():
+        try:
+            with status_note(f"writing the report {path}..."):
+                write_report(
+                    result,
+                    path,
+                    console_html=[fragment] if parts else [],
+                    command=None if ctx is None else command_line(ctx),
+                )
+        except OSError as exc:
+            raise CliError(f"cannot write the report {path}: {exc.strerror or exc}", 2) from None
+    typer.echo(f"wrote {path}", err=True)

@@ -1,5 +1,5 @@
 """``railride compare``: the suspensions on one scenario, beside the paper's Table 1 when it is
-the paper's case (railride.comparison.compare), with the tables it prints; several scenarios,
+the paper's case (railride.studies.comparison.compare), with the tables it prints; several scenarios,
 speeds or seeds go to the league table (`_league`)."""
 
 from __future__ import annotations
@@ -10,11 +10,11 @@ from typing import Annotated, Optional
 
 import typer
 
-from ..dampers import IDEAL_NAMES
-from ..defaults import DEFAULT_CONTROL_RATE, DEFAULT_DAMPER
-from ._app import app
-from ._common import ProgressBar, errors, option_names, stderr_is_terminal, stdout_console, write_folder
-from ._options import (
+from railride.secondary.dampers import IDEAL_NAMES
+from railride.defaults import DEFAULT_CONTROL_RATE, DEFAULT_DAMPER
+from railride.cli._app import app
+from railride.cli._common import ProgressBar, errors, option_names, stderr_is_terminal, stdout_console, write_folder
+from railride.cli._options import (
     MaxMemoryOption,
     MaxStepsOption,
     AmplitudeOption,
@@ -45,7 +45,7 @@ from ._options import (
     figure_options,
     history_options,
 )
-from ._parsing import (
+from railride.cli._parsing import (
     SOLVER_FIELDS,
     damper_preset,
     load_gains,
@@ -58,8 +58,16 @@ from ._parsing import (
     value_list,
     vehicle_from_options,
 )
-from ._league import run_league
-from ._render import RESPONSE_LABELS, alike_text, compare_comfort_table, damper_text, fmt, reduction_text, untuned_text
+from railride.cli._league import run_league
+from railride.cli._render import (
+    RESPONSE_LABELS,
+    alike_text,
+    compare_comfort_table,
+    damper_text,
+    fmt,
+    reduction_text,
+    untuned_text,
+)
 
 #: --controllers and --bounds, shared with `railride report`
 ControllersOption = Annotated[
@@ -94,8 +102,8 @@ COMPARE_FIELDS = {
 
 def _controller_list(text: str) -> list[str]:
     """--controllers: comma-separated names, or all -> the suspensions to run, passive first."""
-    from ..comparison import check_controllers
-    from ..control import CONTROLLERS
+    from railride.studies.comparison import check_controllers
+    from railride.secondary.control import CONTROLLERS
 
     items = [item.strip() for item in text.split(",")]
     if any(not item for item in items):
@@ -110,8 +118,8 @@ def _controller_list(text: str) -> list[str]:
 
 
 def _sensing(name: str):
-    """--sensing ideal|accelerometers -> None or the default `railride.sensing.Accelerometers`."""
-    from ..sensing import SENSING, Accelerometers
+    """--sensing ideal|accelerometers -> None or the default `railride.secondary.sensing.Accelerometers`."""
+    from railride.secondary.sensing import SENSING, Accelerometers
 
     if name not in SENSING:
         raise ValueError(f"--sensing = {name!r}: allowed {', '.join(SENSING)}")
@@ -119,9 +127,9 @@ def _sensing(name: str):
 
 
 def _fault_list(text: Optional[str], damper: str, scale: float, dt: float, duration: float) -> tuple:
-    """--fault CORNER-MODE[@S][,...] -> the checked `railride.faults.DamperFault` tuple."""
-    from ..faults import DamperFault, check_faults, fault_table
-    from ..suspension import damper_model
+    """--fault CORNER-MODE[@S][,...] -> the checked `railride.secondary.faults.DamperFault` tuple."""
+    from railride.secondary.faults import DamperFault, check_faults, fault_table
+    from railride.secondary.suspension import damper_model
 
     if text is None:
         return ()
@@ -138,7 +146,7 @@ def _fault_list(text: Optional[str], damper: str, scale: float, dt: float, durat
 
 def _sensor_noise(text: Optional[str], seed: Optional[int]):
     """--sensor-noise Z,ANGLE,VEL,RATE and --seed -> a control.SensorNoise, or None."""
-    from ..control import SensorNoise
+    from railride.secondary.control import SensorNoise
 
     if text is None:
         if seed is not None:
@@ -180,8 +188,8 @@ def _compare_tables(doc: dict, vehicle: str, shipped: bool):
     from rich.markup import escape
     from rich.text import Text
 
-    from ..labels import describe_scenario
-    from ._width import FitTable, Split
+    from railride.analysis.labels import describe_scenario
+    from railride.cli._width import FitTable, Split
 
     rows = doc["controllers"]
     settings = doc["settings"]
@@ -359,11 +367,11 @@ def _compare_tables(doc: dict, vehicle: str, shipped: bool):
 
 def _fault_tables(doc: dict):
     """With --fault: per controller and response, the reduction against passive with healthy
-    dampers and with the faults, and the change the faults make (railride.faults.degradation)."""
+    dampers and with the faults, and the change the faults make (railride.secondary.faults.degradation)."""
     from rich.markup import escape
     from rich.text import Text
 
-    from ._width import FitTable
+    from railride.cli._width import FitTable
 
     record = doc["faults"]
     labels = {r["name"]: r["label"] for r in doc["controllers"]}
@@ -505,10 +513,10 @@ def compare(
     scenario paper-sine.
     """
     with errors(), option_names(COMPARE_FIELDS, not_given(dt=dt, output_rate=output_rate)):
-        from ..comparison import compare as run_compare
-        from ..files import check_out_dir, write_compare_outputs
-        from ..metrics import check_window, parse_window
-        from .report import check_report_option, save_report  # here: report imports this module
+        from railride.studies.comparison import compare as run_compare
+        from railride.output.files import check_out_dir, write_compare_outputs
+        from railride.analysis.metrics import check_window, parse_window
+        from railride.cli._render import check_report_option, save_report
 
         figures = figure_options(figure_format, dpi, out)
         histories = history_options(history_format, out)

@@ -1,4 +1,4 @@
-"""``railride frf``: frequency responses of the passive vehicle (railride.frf), the peaks
+"""``railride frf``: frequency responses of the passive vehicle (railride.frequency.frf), the peaks
 table and the modes."""
 
 from __future__ import annotations
@@ -8,9 +8,9 @@ from typing import Annotated
 
 import typer
 
-from ._app import app
-from ._common import errors, option_names, print_json, stdout_console, write_folder
-from ._options import (
+from railride.cli._app import app
+from railride.cli._common import errors, option_names, print_json, stdout_console, write_folder
+from railride.cli._options import (
     MaxMemoryOption,
     DpiOption,
     FigureFormatOption,
@@ -20,8 +20,8 @@ from ._options import (
     PresetOption,
     figure_options,
 )
-from ._parsing import vehicle_source
-from ._render import modes_table
+from railride.cli._parsing import vehicle_source
+from railride.cli._render import modes_table
 
 #: the library's names of the options of `frf`, for its errors
 FRF_OPTIONS = {"speed": "--speed", "rails": "--rails", "fmin": "--fmin", "fmax": "--fmax", "points": "--points"}
@@ -33,7 +33,7 @@ class FrfFormat(str, Enum):
     csv = "csv"
 
 
-#: table labels of the magnitudes `frf` summarises (keys of railride.analysis.FRF_MAGNITUDES)
+#: table labels of the magnitudes `frf` summarises (keys of railride.analysis.spectra.FRF_MAGNITUDES)
 FRF_LABELS = {
     "bounce_m_per_m": "bounce (m/m)",
     "pitch_deg_per_m": "pitch (deg/m)",
@@ -81,8 +81,8 @@ def frf(
     divided by the speed. Prints the peak of each response and the modes.
     """
     with errors(), option_names(FRF_OPTIONS):
-        from ..files import check_out_dir
-        from ..frf import frequency_responses
+        from railride.output.files import check_out_dir
+        from railride.frequency.frf import frequency_responses
 
         figures = figure_options(figure_format, dpi, out)
         vehicle = vehicle_source(params, preset)
@@ -105,7 +105,7 @@ def frf(
 
 def _frf_tables(doc: dict, vehicle: str) -> list:
     """The peaks table, its note and the modes table."""
-    from ._width import FitTable
+    from railride.cli._width import FitTable
     from rich.text import Text
 
     settings = doc["settings"]

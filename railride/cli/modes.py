@@ -1,12 +1,12 @@
-"""``railride modes``: natural frequencies and damping of the passive vehicle (railride.frf)."""
+"""``railride modes``: natural frequencies and damping of the passive vehicle (railride.frequency.frf)."""
 
 from __future__ import annotations
 
-from ._app import app
-from ._common import errors, print_json, stdout_console
-from ._options import FormatOption, OutputFormat, ParamsOption, PresetOption
-from ._parsing import vehicle_source
-from ._render import modes_table
+from railride.cli._app import app
+from railride.cli._common import errors, print_json, stdout_console
+from railride.cli._options import FormatOption, OutputFormat, ParamsOption, PresetOption
+from railride.cli._parsing import vehicle_source
+from railride.cli._render import modes_table
 
 
 @app.command()
@@ -17,7 +17,7 @@ def modes(
 ) -> None:
     """Natural frequencies and damping of the passive vehicle (9 modes, ascending frequency)."""
     with errors():
-        from ..frf import modes as vehicle_modes
+        from railride.frequency.frf import modes as vehicle_modes
 
         rows = vehicle_modes(vehicle_source(params, preset)).to_list()
     if format is OutputFormat.json:

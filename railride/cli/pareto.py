@@ -1,4 +1,4 @@
-"""``railride pareto``: the trades a controller's gains offer (railride.pareto), with its
+"""``railride pareto``: the trades a controller's gains offer (railride.studies.pareto), with its
 tables."""
 
 from __future__ import annotations
@@ -7,9 +7,9 @@ from typing import Annotated, Optional
 
 import typer
 
-from ..defaults import DEFAULT_DAMPER
-from ._app import app
-from ._common import (
+from railride.defaults import DEFAULT_DAMPER
+from railride.cli._app import app
+from railride.cli._common import (
     errors,
     interruptible,
     make_executor,
@@ -21,7 +21,7 @@ from ._common import (
     stdout_console,
     write_folder,
 )
-from ._options import (
+from railride.cli._options import (
     MaxMemoryOption,
     MaxStepsOption,
     AmplitudeOption,
@@ -47,7 +47,7 @@ from ._options import (
     WorkersOption,
     figure_options,
 )
-from ._parsing import (
+from railride.cli._parsing import (
     SOLVER_FIELDS,
     TRACK_FIELDS,
     damper_preset,
@@ -57,7 +57,7 @@ from ._parsing import (
     solver_from_options,
     study_scenario,
 )
-from ._render import RESPONSE_LABELS, damper_text, fmt
+from railride.cli._render import RESPONSE_LABELS, damper_text, fmt
 
 #: the library's names of pareto's options, for its errors (the track's seed is named while the
 #: scenario is built, the sample's after)
@@ -72,9 +72,9 @@ PARETO_FIELDS = {
 
 def _pareto_table(doc: dict, caption: str):
     """Counts, then the samples non-dominated over the four ratios by acceleration ratio."""
-    from ._width import FitTable
+    from railride.cli._width import FitTable
 
-    from ..pareto import PROJECTIONS
+    from railride.studies.pareto import PROJECTIONS
 
     c = doc["counts"]
     counts = FitTable(title="Pareto view: samples and non-dominated samples")
@@ -160,8 +160,8 @@ def pareto_command(
 
     defaults = not_given(dt=dt, min_wavelength=min_wavelength, max_wavelength=max_wavelength)
     with errors(), option_names(PARETO_FIELDS, defaults):
-        from ..labels import describe_scenario
-        from ..pareto import pareto as run_pareto
+        from railride.analysis.labels import describe_scenario
+        from railride.studies.pareto import pareto as run_pareto
 
         figures = figure_options(figure_format, dpi, out)
         n = default_of(run_pareto, "n_samples") if samples is None else samples

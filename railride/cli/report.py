@@ -1,18 +1,18 @@
 """``railride report``: the paper's comparison, as `railride compare` runs it, written as one
-self-contained HTML file (railride.report); and the helpers with which compare, sweep, tune and
-study write the same report of their result with --report."""
+self-contained HTML file (railride.output.report). The helpers with which compare, sweep, tune and
+study write the same report of their result with --report are in `railride.cli._render`."""
 
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated, Optional
+from typing import Annotated
 
 import typer
 
-from ..defaults import DEFAULT_CONTROL_RATE, DEFAULT_DAMPER
-from ._app import app
-from ._common import CliError, command_line, errors, status_note
-from ._options import (
+from railride.defaults import DEFAULT_CONTROL_RATE, DEFAULT_DAMPER
+from railride.cli._app import app
+from railride.cli._common import errors
+from railride.cli._options import (
     MaxMemoryOption,
     MaxStepsOption,
     AmplitudeOption,
@@ -37,46 +37,8 @@ from ._options import (
     WavelengthOption,
     WindowOption,
 )
-from .compare import BoundsOption, ControllersOption, compare
-
-#: columns of the console the report's tables are rendered on (an HTML page scrolls sideways)
-REPORT_WIDTH = 120
-
-
-def check_report_option(path: Optional[Path], option: str = "--report") -> None:
-    """Before any run: ValueError naming ``option`` if no report can be written at ``path``."""
-    if path is not None:
-        from ..report import check_report_path
-
-        check_report_path(path, option)
-
-
-def save_report(path: Path, result, parts=(), ctx: Optional[typer.Context] = None) -> None:
-    """Write the report of ``result`` to ``path``, with ``parts`` (the rich tables and texts the
-    command prints) rendered as HTML, and the command line of ``ctx`` as given; say so on
-    stderr. A file that cannot be written: ``error: ...``, status 2."""
-    import io
-
-    from rich.console import Console
-
-    from ..report import write_report
-
-    console = Console(record=True, file=io.StringIO(), width=REPORT_WIDTH, highlight=False)
-    for part in parts:
-        console.print(part)
-    fragment = console.export_html(inline_styles=True, code_format='<pre class="console">{code}</pre>')
-    with errors():
-        try:
-            with status_note(f"writing the report {path}..."):
-                write_report(
-                    result,
-                    path,
-                    console_html=[fragment] if parts else [],
-                    command=None if ctx is None else command_line(ctx),
-                )
-        except OSError as exc:
-            raise CliError(f"cannot write the report {path}: {exc.strerror or exc}", 2) from None
-    typer.echo(f"wrote {path}", err=True)
+from railride.cli._render import check_report_option
+from railride.cli.compare import BoundsOption, ControllersOption, compare
 
 
 @app.command("report")

@@ -1,6 +1,6 @@
 """``railride ride-spectrum``: the ride on a random track in the frequency domain
-(railride.ride_spectrum), and ``railride state-space``: the linear model's matrices
-(railride.linear)."""
+(railride.frequency.ride_spectrum), and ``railride state-space``: the linear model's matrices
+(railride.frequency.linear)."""
 
 from __future__ import annotations
 
@@ -10,9 +10,9 @@ from typing import Annotated, Optional
 
 import typer
 
-from ._app import app
-from ._common import errors, option_names, print_json, stdout_console, write_folder
-from ._options import (
+from railride.cli._app import app
+from railride.cli._common import errors, option_names, print_json, stdout_console, write_folder
+from railride.cli._options import (
     MaxMemoryOption,
     DpiOption,
     FigureFormatOption,
@@ -22,7 +22,7 @@ from ._options import (
     ReportOption,
     figure_options,
 )
-from ._parsing import load_gains, vehicle_from_options
+from railride.cli._parsing import load_gains, vehicle_from_options
 
 #: the library's names of the options, for its errors
 SPECTRUM_OPTIONS = {
@@ -115,10 +115,10 @@ def ride_spectrum(
     time simulation: PSDs, RMS and ISO 2631-1 Wb/Wk-weighted RMS of the carbody floor
     acceleration, for the passive vehicle and linear outer loops on the ideal actuator."""
     with errors(), option_names(SPECTRUM_OPTIONS):
-        from ..files import check_out_dir
-        from ..ride_spectrum import ride_spectrum as run
+        from railride.output.files import check_out_dir
+        from railride.frequency.ride_spectrum import ride_spectrum as run
 
-        from .report import check_report_option, save_report  # here: report imports the commands
+        from railride.cli._render import check_report_option, save_report
 
         figures = figure_options(figure_format, dpi, out)
         check_report_option(report)
@@ -156,11 +156,11 @@ def _tables(result) -> list:
     """The floor table (RMS, Wb, Wk and Wb against passive, per suspension and point), the
     carbody table and the note."""
     from rich.markup import escape
-    from ._width import FitTable
+    from railride.cli._width import FitTable
     from rich.text import Text
 
-    from ..control import LABELS
-    from ..ride_spectrum import FLOOR
+    from railride.secondary.control import LABELS
+    from railride.frequency.ride_spectrum import FLOOR
 
     doc = result.to_dict()
     st = doc["settings"]
@@ -241,8 +241,8 @@ def state_space(
     """The linear vehicle as state-space matrices x' = A x + B u, y = C x + D u, with named
     states, inputs and outputs, for MATLAB or python-control."""
     with errors(), option_names({"suspension": "--suspension", "controllers": "--suspension"}):
-        from ..files import write_model
-        from ..linear import linear_model, linear_suspensions
+        from railride.output.files import write_model
+        from railride.frequency.linear import linear_model, linear_suspensions
 
         vehicle, _ = vehicle_from_options(params, preset, load)
         if out is not None and out.suffix.lower() not in (".mat", ".json"):

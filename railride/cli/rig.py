@@ -1,4 +1,4 @@
-"""``railride damper`` and ``railride tracking``: an MR damper on the test rig (railride.rig),
+"""``railride damper`` and ``railride tracking``: an MR damper on the test rig (railride.run.rig),
 its hysteresis cycles and the inner loop's force tracking, with their tables."""
 
 from __future__ import annotations
@@ -7,10 +7,10 @@ from typing import Annotated, Optional
 
 import typer
 
-from ..defaults import DEFAULT_DAMPER
-from ._app import app
-from ._common import errors, option_names, print_json, status_note, stdout_console, write_folder
-from ._options import (
+from railride.defaults import DEFAULT_DAMPER
+from railride.cli._app import app
+from railride.cli._common import errors, option_names, print_json, status_note, stdout_console, write_folder
+from railride.cli._options import (
     MaxMemoryOption,
     DamperOutOption,
     DpiOption,
@@ -21,7 +21,7 @@ from ._options import (
     TrackingOutOption,
     figure_options,
 )
-from ._parsing import damper_preset, parse_voltages
+from railride.cli._parsing import damper_preset, parse_voltages
 
 #: the library's names of the options of `damper` and `tracking`, for its errors
 DAMPER_OPTIONS = {
@@ -80,8 +80,8 @@ def damper(
     command prints the force range and the energy dissipated in the last (steady-state) cycle.
     """
     with errors(), option_names(DAMPER_OPTIONS):
-        from .. import rig
-        from ..files import check_out_dir
+        from railride.run import rig
+        from railride.output.files import check_out_dir
 
         figures = figure_options(figure_format, dpi, out)
         damper_model = damper_preset("--damper", model, rig=True)
@@ -101,7 +101,7 @@ def damper(
 
 def _damper_table(doc: dict, name: str, result):
     from rich.markup import escape
-    from ._width import FitTable
+    from railride.cli._width import FitTable
 
     n = result.n_cycles
     table = FitTable(
@@ -180,8 +180,8 @@ def tracking(
     x = -stroke cos(2 pi f t) follows a desired force; prints the RMS tracking error.
     """
     with errors(), option_names(TRACKING_OPTIONS):
-        from .. import rig
-        from ..files import check_out_dir
+        from railride.run import rig
+        from railride.output.files import check_out_dir
 
         figures = figure_options(figure_format, dpi, out)
         damper_model = damper_preset("--damper", model, rig=True)
@@ -202,7 +202,7 @@ def tracking(
 
 def _tracking_table(doc: dict, model: str, *, default_g: bool):
     from rich.markup import escape
-    from ._width import FitTable
+    from railride.cli._width import FitTable
 
     m = doc["metrics"]
     start, end = m["window_s"]

@@ -1,4 +1,4 @@
-"""``railride simulate``: one run of the vehicle on a track (railride.simulation.simulate) and its
+"""``railride simulate``: one run of the vehicle on a track (railride.run.simulation.simulate) and its
 ride metrics, printed as a table or as the run's document (`RideResult.to_dict`)."""
 
 from __future__ import annotations
@@ -7,10 +7,10 @@ from typing import Annotated, Optional
 
 import typer
 
-from .. import validation
-from ..defaults import DEFAULT_DAMPER
-from ._app import app
-from ._common import (
+from railride import validation
+from railride.defaults import DEFAULT_DAMPER
+from railride.cli._app import app
+from railride.cli._common import (
     INTERRUPTED,
     ProgressBar,
     errors,
@@ -20,7 +20,7 @@ from ._common import (
     stdout_console,
     write_folder,
 )
-from ._options import (
+from railride.cli._options import (
     MaxMemoryOption,
     MaxStepsOption,
     AmplitudeOption,
@@ -50,7 +50,7 @@ from ._options import (
     figure_options,
     history_options,
 )
-from ._parsing import (
+from railride.cli._parsing import (
     SOLVER_FIELDS,
     damper_preset,
     make_scenario,
@@ -61,7 +61,7 @@ from ._parsing import (
     track_options,
     vehicle_from_options,
 )
-from ._render import comfort_table
+from railride.cli._render import comfort_table
 
 #: --suspension values of `simulate` (`railride.Suspension.named`: passive, or MR dampers at a voltage)
 SUSPENSIONS = ("passive", "mr")
@@ -89,7 +89,7 @@ def _describe_suspension(record: dict) -> str:
 
 def _metrics_table(doc: dict):
     from rich.markup import escape
-    from ._width import FitTable
+    from railride.cli._width import FitTable
 
     labels = {
         "acceleration_m_s2": "acceleration (m/s^2)",
@@ -219,7 +219,7 @@ def simulate(
 
 def _suspension(name: str, damper_name, voltage_text, damper_scale=None):
     """--suspension, --damper, --damper-scale, --voltage -> a railride.Suspension."""
-    from ..suspension import Suspension
+    from railride.secondary.suspension import Suspension
 
     validation.choice("--suspension", name, SUSPENSIONS)
     if name == "passive":
@@ -267,10 +267,10 @@ def _run(
     figures=None,
     histories=("nc", "csv"),
 ):
-    from ..errors import Interrupted
-    from ..files import check_out_dir, write_outputs
-    from ..metrics import check_window, parse_window
-    from ..simulation import simulate as run_simulation
+    from railride.errors import Interrupted
+    from railride.output.files import check_out_dir, write_outputs
+    from railride.analysis.metrics import check_window, parse_window
+    from railride.run.simulation import simulate as run_simulation
 
     with option_names(SIMULATE_FIELDS, not_given(dt=dt, output_rate=output_rate)):
         solver = solver_from_options(dt=dt, output_rate=output_rate)

@@ -1,5 +1,5 @@
 """``railride study``: statistics over many tracks, speeds, payloads and damper faults
-(railride.study), and its table."""
+(railride.studies.study), and its table."""
 
 from __future__ import annotations
 
@@ -9,9 +9,9 @@ from typing import Annotated, Optional
 
 import typer
 
-from ..defaults import DEFAULT_DAMPER
-from ._app import app
-from ._common import (
+from railride.defaults import DEFAULT_DAMPER
+from railride.cli._app import app
+from railride.cli._common import (
     errors,
     interruptible,
     make_executor,
@@ -22,7 +22,7 @@ from ._common import (
     stdout_console,
     write_folder,
 )
-from ._options import (
+from railride.cli._options import (
     MaxMemoryOption,
     MaxStepsOption,
     DpiOption,
@@ -40,9 +40,9 @@ from ._options import (
     WorkersOption,
     figure_options,
 )
-from ._parsing import FIXED_RATE_FIELDS, damper_preset, load_gains, solver_from_options, value_list
-from ._render import RESPONSE_LABELS, reduction_text
-from .report import check_report_option, save_report
+from railride.cli._parsing import FIXED_RATE_FIELDS, damper_preset, load_gains, solver_from_options, value_list
+from railride.cli._render import RESPONSE_LABELS, reduction_text
+from railride.cli._render import check_report_option, save_report
 
 #: the library's names of the study's options, for its errors
 STUDY_FIELDS = {
@@ -79,8 +79,8 @@ def _table(doc: dict):
     from rich.markup import escape
     from rich.text import Text
 
-    from ..control import LABELS
-    from ._width import FitTable, Split
+    from railride.secondary.control import LABELS
+    from railride.cli._width import FitTable, Split
 
     s = doc["settings"]
     lo, hi = doc["percentiles"]
@@ -246,8 +246,8 @@ def study_command(
     load factor and fault condition; mean and 5th-95th percentiles of each RMS response and
     comfort index, and of its reduction against passive on the same track.
     Ctrl-C stops; with --out, --resume continues."""
-    from ..comparison import check_controllers
-    from ..metrics import parse_window
+    from railride.studies.comparison import check_controllers
+    from railride.analysis.metrics import parse_window
 
     with errors(), option_names(STUDY_FIELDS):
         figures = figure_options(figure_format, dpi, out)
@@ -267,7 +267,7 @@ def study_command(
         executor, executor_record = make_executor(workers, scheduler, scheduler_file)
     try:
         with interruptible(table, table_path), errors(), option_names(STUDY_FIELDS):
-            from ..study import study
+            from railride.studies.study import study
 
             with RunProgress(stderr_is_terminal(), "running the study") as progress:
                 t0 = time.perf_counter()

@@ -1,5 +1,5 @@
-"""``railride sweep``: a grid of cases (railride.sweep.grid: every combination of the given
-values) run by railride.sweep.run_sweep, with its table.
+"""``railride sweep``: a grid of cases (railride.studies.sweep.grid: every combination of the given
+values) run by railride.studies.sweep.run_sweep, with its table.
 
 The command reads its options into the grid's Python values (lists of numbers and names, the
 gain axes), calls the library and renders the result: the checks of the grid, its cases and the
@@ -13,10 +13,10 @@ from typing import Annotated, Optional
 
 import typer
 
-from ..defaults import DEFAULT_DAMPER
-from ..suspension import NAMES as SUSPENSIONS
-from ._app import app
-from ._common import (
+from railride.defaults import DEFAULT_DAMPER
+from railride.secondary.suspension import NAMES as SUSPENSIONS
+from railride.cli._app import app
+from railride.cli._common import (
     errors,
     interruptible,
     make_executor,
@@ -27,7 +27,7 @@ from ._common import (
     stdout_console,
     write_folder,
 )
-from ._options import (
+from railride.cli._options import (
     MaxMemoryOption,
     MaxStepsOption,
     DpiOption,
@@ -50,11 +50,11 @@ from ._options import (
     WorkersOption,
     figure_options,
 )
-from ._parsing import FIXED_RATE_FIELDS, load_gains, parse_noise, solver_from_options, value_list
-from ._render import RESPONSE_LABELS, damper_text, fmt
-from .report import check_report_option, save_report
+from railride.cli._parsing import FIXED_RATE_FIELDS, load_gains, parse_noise, solver_from_options, value_list
+from railride.cli._render import RESPONSE_LABELS, damper_text, fmt
+from railride.cli._render import check_report_option, save_report
 
-#: how the errors of railride.sweep.grid name its keywords: by this command's options
+#: how the errors of railride.studies.sweep.grid name its keywords: by this command's options
 OPTION_NAMES = {
     "suspensions": "--suspension",
     "speed": "--speed",
@@ -218,7 +218,7 @@ def sweep_command(
     import time
 
     with errors():
-        from ..sweep import grid as make_grid, run_sweep
+        from railride.studies.sweep import grid as make_grid, run_sweep
 
         figures = figure_options(figure_format, dpi, out)
         values, texts = _parse(
@@ -301,9 +301,9 @@ def _parse(
     dt,
     window,
 ) -> tuple[dict, dict]:
-    """(the keyword arguments of railride.sweep.grid, the text each was read from): only the
+    """(the keyword arguments of railride.studies.sweep.grid, the text each was read from): only the
     syntax of the options is checked here; what their values may be is the grid's to check."""
-    from ..metrics import parse_window
+    from railride.analysis.metrics import parse_window
 
     with option_names(FIXED_RATE_FIELDS):
         solver = None if dt is None else solver_from_options(dt=dt)
@@ -348,8 +348,8 @@ def _parse(
 
 def _names(option: str, text: str) -> list[str]:
     """NAME[,NAME...] -> the names, not empty (which names are allowed is the grid's check);
-    all: every suspension a comparison can name (`railride.control.CONTROLLERS`)."""
-    from ..control import CONTROLLERS
+    all: every suspension a comparison can name (`railride.secondary.control.CONTROLLERS`)."""
+    from railride.secondary.control import CONTROLLERS
 
     if text.strip() == "all":
         return list(CONTROLLERS)
@@ -364,8 +364,8 @@ def _names(option: str, text: str) -> list[str]:
 def _voltage_item(damper: Optional[str]):
     """The reader of a --voltage item: volts, or passive-off / passive-on from the MR damper's
     range (the word itself for a damper the grid refuses with mr)."""
-    from ..dampers import PRESETS
-    from ..sweep_grid import VOLTAGE_WORDS, voltage_value
+    from railride.secondary.dampers import PRESETS
+    from railride.studies.grid import VOLTAGE_WORDS, voltage_value
 
     model = PRESETS.get(DEFAULT_DAMPER if damper is None else damper)
 
@@ -398,7 +398,7 @@ def _gain_option(text: str) -> tuple[str, list[float]]:
 # -- the table --------------------------------------------------------------------------------------
 def _caption(grid, doc: dict, wall: float) -> str:
     """The sweep table's caption: the scenario, the dampers and gains, the runs."""
-    from ..labels import describe_scenario
+    from railride.analysis.labels import describe_scenario
 
     st, rows = doc["settings"], doc["rows"]
     start, end = grid.window or (0.0, grid.duration)
@@ -426,7 +426,7 @@ def _sweep_table(rows: list[dict], grid_columns: list[str], caption: str):
     console, as many of these as fit per table, each table repeating the grid values."""
     from rich.markup import escape
 
-    from ._width import FitTable, Split
+    from railride.cli._width import FitTable, Split
 
     headings = {
         "speed_m_s": "speed\n(m/s)",

@@ -1,5 +1,5 @@
 """``railride tune``: every law's gains by the same sensitivity study and budget
-(railride.tuning), the parsing of its objective and controllers, and its tables."""
+(railride.studies.tuning), the parsing of its objective and controllers, and its tables."""
 
 from __future__ import annotations
 
@@ -10,9 +10,9 @@ from typing import Annotated, Optional
 
 import typer
 
-from ..defaults import DEFAULT_DAMPER
-from ._app import app
-from ._common import (
+from railride.defaults import DEFAULT_DAMPER
+from railride.cli._app import app
+from railride.cli._common import (
     command_line,
     errors,
     interruptible,
@@ -24,7 +24,7 @@ from ._common import (
     stdout_console,
     write_folder,
 )
-from ._options import (
+from railride.cli._options import (
     MaxMemoryOption,
     MaxStepsOption,
     AmplitudeOption,
@@ -55,7 +55,7 @@ from ._options import (
     WorkersOption,
     figure_options,
 )
-from ._parsing import (
+from railride.cli._parsing import (
     SOLVER_FIELDS,
     TRACK_FIELDS,
     damper_preset,
@@ -67,8 +67,8 @@ from ._parsing import (
     study_scenario,
     value_list,
 )
-from ._render import RESPONSE_LABELS, damper_text, reduction_text
-from .report import check_report_option, save_report
+from railride.cli._render import RESPONSE_LABELS, damper_text, reduction_text
+from railride.cli._render import check_report_option, save_report
 
 #: the library's names of tune's options, for its errors
 TUNE_FIELDS = {
@@ -87,7 +87,7 @@ def _objective(kind: Optional[str], weights: Optional[str], bound: Optional[str]
     """--objective, --weights, --bound, --penalty -> a tuning.Objective. Without --objective,
     the library's DEFAULT_OBJECTIVE; an option not given keeps that default's value when the
     kind is the default's (weights and bound belong to their kind only)."""
-    from ..objectives import DEFAULT_OBJECTIVE, OBJECTIVE_KINDS, Objective
+    from railride.studies.objectives import DEFAULT_OBJECTIVE, OBJECTIVE_KINDS, Objective
 
     name = DEFAULT_OBJECTIVE.kind if kind is None else kind.strip()
     if name not in OBJECTIVE_KINDS:
@@ -155,7 +155,7 @@ def _weights(weights: str) -> tuple:
 def _tunable_list(text: str) -> list[str]:
     """--controllers: comma-separated names from inner and the laws, or all -> what to tune,
     in the order it runs."""
-    from ..tuning import TUNABLE
+    from railride.studies.tuning import TUNABLE
 
     items = [n.strip() for n in text.split(",")]
     if any(not n for n in items):
@@ -173,7 +173,7 @@ def _tunable_list(text: str) -> list[str]:
 
 def _tuning_set(scenario, seeds, loads, speed, duration, *single):
     """--track-seed with several seeds, or --load: the runs every gain set is scored on."""
-    from ..tuning import tuning_set
+    from railride.studies.tuning import tuning_set
 
     if any(v is not None for v in single):
         raise ValueError(
@@ -192,7 +192,7 @@ def _tuning_set(scenario, seeds, loads, speed, duration, *single):
 
 def _tune_start(path: Optional[Path]):
     """--gains FILE, else the neutral reference gains (the library's default start)."""
-    from ..control import GainSet
+    from railride.secondary.control import GainSet
 
     return GainSet.reference() if path is None else load_gains(path)
 
@@ -205,9 +205,9 @@ def _tune_tables(doc: dict, start, tuned, scenario_text: str):
     from rich.markup import escape
     from rich.text import Text
 
-    from ..labels import gain_unit
-    from ..tuning import PARAMETERS
-    from ._width import FitTable, Split
+    from railride.analysis.labels import gain_unit
+    from railride.studies.tuning import PARAMETERS
+    from railride.cli._width import FitTable, Split
 
     parts: list = []
     settings = doc["settings"]
@@ -297,7 +297,7 @@ def _tune_tables(doc: dict, start, tuned, scenario_text: str):
 
     rows = doc["before_after"]
     if rows:
-        from ..control import LABELS
+        from railride.secondary.control import LABELS
 
         # passive first, as a block of its own (no gains: the same RMS in both columns), so
         # that the table fits 80 columns without a passive column beside every suspension
@@ -445,8 +445,8 @@ def tune_command(
     defaults = not_given(dt=dt, min_wavelength=min_wavelength, max_wavelength=max_wavelength, seed=track_seed)
     seeds: Optional[list] = None
     with errors(), option_names(TUNE_FIELDS, defaults):
-        from .. import tuning
-        from ..labels import describe_scenario
+        from railride.studies import tuning
+        from railride.analysis.labels import describe_scenario
 
         figures = figure_options(figure_format, dpi, out)
         names = _tunable_list(controllers)

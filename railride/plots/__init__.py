@@ -21,7 +21,7 @@ global settings stay as they were. `save_figure` writes a figure as PNG, PDF or 
 `FigureOptions` is what a result's ``save(folder, figure_formats=, dpi=)`` writes.
 """
 
-from ._style import (
+from railride.plots._style import (
     COLUMN_WIDTH,
     FIGURE_FORMATS,
     MAX_DPI,

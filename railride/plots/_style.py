@@ -18,8 +18,8 @@ from typing import Any
 
 import numpy as np
 
-from .._io import atomic_write
-from ..validation import number, shown
+from railride._io import atomic_write
+from railride.validation import number, shown
 
 #: resolution of PNG figures unless asked otherwise [dots per inch]
 PNG_DPI = 120
@@ -268,7 +268,7 @@ def save_figure(fig, path, format: str | None = None, dpi: float = PNG_DPI) -> N
 
 def _metadata(fmt: str) -> dict:
     """Who made the file; no creation date, so that the same figure gives the same file."""
-    from .. import __version__
+    from railride._version import __version__
 
     creator = f"railride {__version__}"
     if fmt == "png":
@@ -311,7 +311,7 @@ def grid_shape(count: int, max_columns: int = 4) -> tuple[int, int]:
 def suspension_label(name: str) -> str:
     """The display name of a suspension: "Passive", "PID", "SAS (attitude)", ...,
     "MR (constant voltage)"; an unknown name as it is."""
-    from ..control import LABELS  # here, not above: control pulls in the vehicle model
+    from railride.secondary.control import LABELS  # here, not above: control pulls in the vehicle model
 
     if name == "mr":
         return "MR (constant voltage)"

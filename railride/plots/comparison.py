@@ -1,6 +1,6 @@
-"""A controller comparison (`railride.comparison.Comparison`): the carbody responses, the
+"""A controller comparison (`railride.studies.comparison.Comparison`): the carbody responses, the
 damper forces and the command voltages against time, one line or row per suspension in the
-paper's style (its Figs. 8-11), and the acceleration spectra of `railride.analysis.comparison_psd`.
+paper's style (its Figs. 8-11), and the acceleration spectra of `railride.analysis.spectra.comparison_psd`.
 """
 
 from __future__ import annotations
@@ -8,8 +8,8 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from ..labels import CARBODY_RESPONSES, comparison_title, controller_names, coordinate_label
-from ._style import (
+from railride.analysis.labels import CARBODY_RESPONSES, comparison_title, controller_names, coordinate_label
+from railride.plots._style import (
     PAGE_WIDTH,
     frame_window,
     given_axes,
@@ -25,16 +25,16 @@ from ._style import (
 
 def _combined(comparison):
     """The combined Dataset of a `Comparison` (dims controller, time, ...)."""
-    from ..comparison import Comparison
-
-    if not isinstance(comparison, Comparison):
-        raise ValueError(f"comparison: expected a railride.comparison.Comparison, got {type(comparison).__name__}")
+    if not callable(getattr(comparison, "combined", None)):  # read by what it has: plots import no result
+        raise ValueError(
+            f"comparison: expected a railride.studies.comparison.Comparison, got {type(comparison).__name__}"
+        )
     return comparison.combined()
 
 
 @styled
 def plot_comparison_response(comparison, response: str, ax=None):
-    """One carbody response of a `railride.comparison.Comparison` against time, one line per
+    """One carbody response of a `railride.studies.comparison.Comparison` against time, one line per
     suspension in the paper's style (Figs. 8-11: passive dash-dot, PID dotted, SAS (attitude)
     dashed, SAS (attitude+ride) solid).
 
@@ -94,7 +94,7 @@ def _corner_grid(ds, rows: list[str], ax):
 @styled
 def plot_comparison_damper_forces(comparison, ax=None):
     """The secondary damper force on the carbody (kN, up +) at each corner of a
-    `railride.comparison.Comparison` against time: one row per suspension (passive: the viscous
+    `railride.studies.comparison.Comparison` against time: one row per suspension (passive: the viscous
     dampers), one column per corner (1R, 1L, 2R, 2L), all panels on the same scale, solid lines
     in each suspension's colour; the common y-axis fits the forces inside the metric window,
     the part of the run outside it shaded. ``ax``: the suspensions x 4 corners Axes, row by row
@@ -128,7 +128,7 @@ def plot_comparison_damper_forces(comparison, ax=None):
 
 @styled
 def plot_comparison_voltages(comparison, ax=None):
-    """The command voltage v (V) of each MR damper of a `railride.comparison.Comparison`
+    """The command voltage v (V) of each MR damper of a `railride.studies.comparison.Comparison`
     against time: one row per controlled suspension, one column per corner. A comparison
     without a controlled suspension (or with ideal devices) gets one panel saying so. ``ax``:
     those Axes, row by row (no title then), or None for a new figure. Returns the `Figure`."""
@@ -172,7 +172,7 @@ def plot_comparison_voltages(comparison, ax=None):
 
 @styled
 def plot_comparison_psd(psd: pd.DataFrame, ax=None, *, title: str | None = None):
-    """The acceleration spectra of `railride.analysis.comparison_psd` (its DataFrame) on log-log
+    """The acceleration spectra of `railride.analysis.spectra.comparison_psd` (its DataFrame) on log-log
     axes, one line per suspension in the paper's style; the 0 Hz bin is left out. Drawn into
     ``ax`` when given (no title then), else into a new figure titled ``title``; returns the
     `Figure`."""

@@ -1,5 +1,5 @@
-"""The carbody frequency responses of `railride.vehicle.Vehicle.frequency_response`, as
-tabulated by `railride.analysis.frf_frame`: magnitude and phase, with the modes of
+"""The carbody frequency responses of `railride.model.vehicle.Vehicle.frequency_response`, as
+tabulated by `railride.analysis.spectra.frf_frame`: magnitude and phase, with the modes of
 `Vehicle.modes()` marked."""
 
 from __future__ import annotations
@@ -9,8 +9,8 @@ import math
 import numpy as np
 import pandas as pd
 
-from ..analysis import FRF_PATTERNS, FRF_RESPONSES, frf_excited
-from ._style import PAGE_WIDTH, given_axes, new_figure, set_title, styled
+from railride.analysis.spectra import FRF_PATTERNS, FRF_RESPONSES, frf_excited
+from railride.plots._style import PAGE_WIDTH, given_axes, new_figure, set_title, styled
 
 #: line style per rail pattern
 FRF_STYLES = {
@@ -101,11 +101,11 @@ def _mark_modes(a, groups, labels_at) -> None:
 
 @styled
 def plot_frf(frame: pd.DataFrame, modes: pd.DataFrame | None = None, ax=None, *, title: str | None = None):
-    """The carbody frequency responses (`railride.analysis.frf_frame`) against frequency, per
+    """The carbody frequency responses (`railride.analysis.spectra.frf_frame`) against frequency, per
     response (bounce m/m, pitch and roll deg/m, acceleration (m/s^2)/m) a magnitude panel on
     log-log axes and below it a phase panel [deg, against the left rail at the leading
     wheelset, -180 to 180; a line breaks where the phase wraps], one line per rail pattern.
-    ``modes`` (`railride.tables.modes_frame`) are marked as dotted vertical lines at their
+    ``modes`` (`railride.model.modes.modes_frame`) are marked as dotted vertical lines at their
     undamped natural frequencies, numbered at the top of each magnitude panel (modes within 1 %
     of each other share a line) and listed below the plot. A response a pattern does not excite
     is not drawn; the panel says so. ``ax``: eight Axes to draw in, per response its magnitude

@@ -1,4 +1,4 @@
-"""Interactive figures for the HTML report (`railride.report`): time histories, acceleration
+"""Interactive figures for the HTML report (`railride.output.report`): time histories, acceleration
 spectra and frequency responses as plotly figures, which the reader zooms, pans and toggles
 trace by trace (a click on a legend entry) in any browser, offline.
 
@@ -18,9 +18,9 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from ..analysis import FRF_RESPONSES, frf_excited
-from ..labels import CARBODY_RESPONSES, comparison_title, controller_names
-from ._style import suspension_label, suspension_style
+from railride.analysis.spectra import FRF_RESPONSES, frf_excited
+from railride.analysis.labels import CARBODY_RESPONSES, comparison_title, controller_names
+from railride.plots._style import suspension_label, suspension_style
 
 #: the most points one time-history trace keeps (`envelope`)
 MAX_POINTS = 4000
@@ -136,7 +136,7 @@ def comparison_response_figure(ds: xr.Dataset, response: str, *, max_points: int
 
 
 def comparison_psd_figure(psd: pd.DataFrame, *, title: str | None = None):
-    """The acceleration spectra of `railride.analysis.comparison_psd` on log-log axes, one trace
+    """The acceleration spectra of `railride.analysis.spectra.comparison_psd` on log-log axes, one trace
     per suspension (the 0 Hz bin left out: a log axis cannot show it). Returns the Figure."""
     import plotly.graph_objects as go
 
@@ -204,10 +204,10 @@ def ride_figure(ds: xr.Dataset, *, labels=None, title: str = "carbody responses"
 
 
 def frf_figure(frame: pd.DataFrame, modes: pd.DataFrame | None = None, *, title: str | None = None):
-    """The magnitudes of the carbody frequency responses (`railride.analysis.frf_frame`) on
+    """The magnitudes of the carbody frequency responses (`railride.analysis.spectra.frf_frame`) on
     log-log axes, one panel per response on a shared frequency axis, one trace per rail pattern
     (toggled in every panel at once); a response a pattern does not excite is left out. The
-    undamped natural frequencies of ``modes`` (`railride.tables.modes_frame`) are dotted
+    undamped natural frequencies of ``modes`` (`railride.model.modes.modes_frame`) are dotted
     vertical lines, numbered in the top panel. Returns the Figure."""
     import plotly.graph_objects as go
 
@@ -277,12 +277,12 @@ def _clusters(modes: pd.DataFrame) -> list[list]:
 
 
 def ride_spectrum_figure(result):
-    """The floor acceleration PSDs of a `railride.ride_spectrum.RideSpectrum`: a log-log panel per
+    """The floor acceleration PSDs of a `railride.frequency.ride_spectrum.RideSpectrum`: a log-log panel per
     floor point, a trace per suspension (legend groups toggle a suspension in every panel).
     Returns the Figure."""
     import plotly.graph_objects as go
 
-    from ..ride_spectrum import FLOOR
+    from railride.analysis.comfort import FLOOR
 
     fig = _new(rows=len(FLOOR), titles=[f"floor, {p}" for p in FLOOR])
     f = result.psd["frequency"].values

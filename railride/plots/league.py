@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._style import (
+from railride.plots._style import (
     COLUMN_WIDTH,
     PAGE_WIDTH,
     fit_text,
@@ -28,7 +28,7 @@ _RESPONSES = (
 def plot_league(table, ax=None):
     """Bars of the mean RMS reduction [%] of each response (groups) per controller (bars),
     outlines at the ideal actuator's mean reduction with the same gains. ``table``: a
-    `railride.league.LeagueTable`. Returns the figure."""
+    `railride.studies.league.LeagueTable`. Returns the figure."""
     summary = table.summary()
     controlled = [n for n in table.controllers if n != "passive"]
     if ax is None:
@@ -60,7 +60,7 @@ def plot_league(table, ax=None):
 def plot_league_comfort(table, ax=None, *, index: str = "N_MV_z"):
     """Ride comfort at the carbody centre against speed, one line per controller: ``index``
     N_MV_z (EN 12299, vertical part) or aw_Wk (ISO 2631-1 a_w, m/s^2), the mean over the
-    scenarios and track seeds at each speed. ``table``: a `railride.league.LeagueTable`."""
+    scenarios and track seeds at each speed. ``table``: a `railride.studies.league.LeagueTable`."""
     column = f"centre_{index}"
     if column not in table.cases:
         raise ValueError(f"index = {index!r}: the league table has no {column} (allowed N_MV_z, aw_Wk)")

@@ -1,18 +1,17 @@
-"""The global methods of `railride.optimise`: the convergence of the differential evolution and
+"""The global methods of `railride.studies.optimise`: the convergence of the differential evolution and
 the Sobol indices of the objective."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from ._style import PAGE_WIDTH, given_axes, new_figure, set_title, styled
+from railride.plots._style import PAGE_WIDTH, given_axes, new_figure, set_title, styled
 
 
-def _expect(value, name: str, kind: str):
-    from .. import optimise
-
-    if not isinstance(value, getattr(optimise, kind)):
-        raise ValueError(f"{name}: expected a railride.optimise.{kind}, got {type(value).__name__}")
+def _expect(value, name: str, kind: str, needs: str):
+    """``value`` has the attribute ``needs`` of a ``kind`` (plots import no result module)."""
+    if not hasattr(value, needs):
+        raise ValueError(f"{name}: expected a railride.studies.optimise.{kind}, got {type(value).__name__}")
 
 
 def _objective_label(definition) -> str:
@@ -22,14 +21,14 @@ def _objective_label(definition) -> str:
 
 @styled
 def plot_convergence(result, ax=None, *, title: str | None = None):
-    """The search of `railride.optimise.optimise` (an `OptimiseResult`): per generation
+    """The search of `railride.studies.optimise.optimise` (an `OptimiseResult`): per generation
     (0 the initial population) the lowest objective among its runs (dots) and the lowest so far
     (a step line), against the generation. ``ax``: one Axes to draw in (no title then), or None
     for a new figure titled ``title`` (default: the suspension, the generations, the runs and
     the objective reached). Returns the `Figure`."""
     from matplotlib.ticker import MaxNLocator
 
-    _expect(result, "result", "OptimiseResult")
+    _expect(result, "result", "OptimiseResult", "generations")
     frame = result.to_pandas()
     if ax is None:
         fig = new_figure((PAGE_WIDTH, 3.6))
@@ -58,12 +57,12 @@ def plot_convergence(result, ax=None, *, title: str | None = None):
 
 @styled
 def plot_indices(result, ax=None, *, title: str | None = None):
-    """The Sobol indices of `railride.optimise.sensitivity` (a `SensitivityResult`): per gain,
+    """The Sobol indices of `railride.studies.optimise.sensitivity` (a `SensitivityResult`): per gain,
     a bar of its first-order index (its effect alone) and one of its total index (with every
     interaction), horizontal, the gains top to bottom in their order. ``ax``: one Axes to draw
     in (no title then), or None for a new figure titled ``title`` (default: the suspension and
     the runs). Returns the `Figure`."""
-    _expect(result, "result", "SensitivityResult")
+    _expect(result, "result", "SensitivityResult", "first_order")
     names = list(result.parameters)
     y = np.arange(len(names))
     if ax is None:

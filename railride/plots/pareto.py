@@ -1,11 +1,11 @@
-"""The Pareto view of a controller's gains (`railride.pareto.ParetoResult`)."""
+"""The Pareto view of a controller's gains (`railride.studies.pareto.ParetoResult`)."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from ..labels import describe_scenario
-from ._style import PAGE_WIDTH, fit_text, given_axes, new_figure, set_title, styled, suspension_label
+from railride.analysis.labels import describe_scenario
+from railride.plots._style import PAGE_WIDTH, fit_text, given_axes, new_figure, set_title, styled, suspension_label
 
 #: axis label of each ratio
 RATIO_LABELS = {
@@ -20,8 +20,7 @@ def _draw_plane(a, result, x: str, y: str) -> None:
     """The samples of ``result`` in the plane of ratios ``x`` and ``y``."""
     from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
 
-    from ..pareto import RATIOS
-
+    RATIOS = result.RATIOS
     ratios = result.ratios
     front = result.non_dominated
     rx, ry = ratios[:, RATIOS.index(x)], ratios[:, RATIOS.index(y)]
@@ -68,13 +67,13 @@ def _draw_plane(a, result, x: str, y: str) -> None:
 
 @styled
 def plot_pareto(result, ax=None):
-    """Two panels of `railride.pareto.ParetoResult` ``result``: the acceleration ratio (x)
+    """Two panels of `railride.studies.pareto.ParetoResult` ``result``: the acceleration ratio (x)
     against the pitch ratio, and against the roll ratio. Every sample grey; blue the samples
     non-dominated over all four ratios; an orange staircase joins the samples non-dominated in
     that plane; the passive suspension (1, 1) a black cross, the base gains a red star. ``ax``:
     two Axes to draw in (the title then goes above the first), or None for a new figure.
     Returns the figure."""
-    from ..pareto import PROJECTIONS
+    PROJECTIONS = result.PROJECTIONS
 
     if ax is None:
         fig = new_figure((PAGE_WIDTH, 3.9))

@@ -1,4 +1,4 @@
-"""The carbody responses of a ride result (`railride.ride.RideResult`)."""
+"""The carbody responses of a ride result (`railride.run.ride.RideResult`)."""
 
 from __future__ import annotations
 
@@ -7,8 +7,17 @@ import dataclasses
 import numpy as np
 import xarray as xr
 
-from ..labels import CARBODY_RESPONSES, describe_scenario, describe_suspension, json_records
-from ._style import PAGE_WIDTH, frame_window, given_axes, new_figure, save_to, set_title, styled, window_note
+from railride.analysis.labels import CARBODY_RESPONSES, describe_scenario, describe_suspension, json_records
+from railride.plots._style import (
+    PAGE_WIDTH,
+    frame_window,
+    given_axes,
+    new_figure,
+    save_to,
+    set_title,
+    styled,
+    window_note,
+)
 
 #: how a scenario field that differs between the samples of a batch is named in the legend
 SCENARIO_WORDS = {
@@ -72,7 +81,7 @@ def _scenario_words(records: list[dict]) -> list[list[str]]:
 def _vehicle_words(records: list[dict]) -> list[list[str]]:
     """Per sample, the vehicle parameters that differ: "load x1.3" when only the carbody's mass
     and inertias differ, by one factor, from a preset's; else "c_sz = 6e+04 N s/m"."""
-    from ..params import PRESETS, VehicleParams
+    from railride.model.params import PRESETS, VehicleParams
 
     keys = _differing(records)
     if not keys:

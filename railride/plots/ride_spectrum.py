@@ -1,10 +1,18 @@
-"""The frequency-domain ride of `railride.ride_spectrum.RideSpectrum`: acceleration PSDs at the
+"""The frequency-domain ride of `railride.frequency.ride_spectrum.RideSpectrum`: acceleration PSDs at the
 carbody floor points, one line per suspension, with their RMS and Wb-weighted RMS in the
 legend."""
 
 from __future__ import annotations
 
-from ._style import PAGE_WIDTH, given_axes, new_figure, set_title, styled, suspension_label, suspension_style
+from railride.plots._style import (
+    PAGE_WIDTH,
+    given_axes,
+    new_figure,
+    set_title,
+    styled,
+    suspension_label,
+    suspension_style,
+)
 
 
 @styled
@@ -12,7 +20,7 @@ def plot_ride_spectrum(result, path=None, *, ax=None):
     """One log-log panel per floor point (centre, front, rear) of the acceleration PSD
     [(m/s^2)^2/Hz] against frequency [Hz]; the legend gives each suspension's RMS and
     Wb-weighted RMS there. ``ax``: three Axes, or None for a new figure. Returns the figure."""
-    from ..ride_spectrum import FLOOR
+    from railride.analysis.comfort import FLOOR
 
     if ax is None:
         fig = new_figure((PAGE_WIDTH, 3.4))

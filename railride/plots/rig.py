@@ -1,24 +1,23 @@
-"""The damper rig (`railride.rig`): hysteresis cycles and force tracking."""
+"""The damper rig (`railride.run.rig`): hysteresis cycles and force tracking."""
 
 from __future__ import annotations
 
 import math
 
-from ..labels import damper_model_name
-from ._style import PAGE_WIDTH, frame_window, given_axes, new_figure, save_to, set_title, styled
+from railride.analysis.labels import damper_model_name
+from railride.plots._style import PAGE_WIDTH, frame_window, given_axes, new_figure, save_to, set_title, styled
 
 
-def _expect(value, name: str, kind: str):
-    from .. import rig
-
-    if not isinstance(value, getattr(rig, kind)):
-        raise ValueError(f"{name}: expected a railride.rig.{kind}, got {type(value).__name__}")
+def _expect(value, name: str, kind: str, needs: str):
+    """``value`` has the attribute ``needs`` of a rig's ``kind`` (plots import no result module)."""
+    if not hasattr(value, "dataset") or not hasattr(value, needs):
+        raise ValueError(f"{name}: expected a railride.run.rig.{kind}, got {type(value).__name__}")
 
 
 @styled
 def plot_hysteresis(cycles, path=None, *, title: str | None = None, ax=None):
-    """Force-displacement and force-velocity loops of the `railride.rig.Cycles` of
-    `railride.rig.cycles`: the steady-state (last) cycle at each voltage, one line per voltage,
+    """Force-displacement and force-velocity loops of the `railride.run.rig.Cycles` of
+    `railride.run.rig.cycles`: the steady-state (last) cycle at each voltage, one line per voltage,
     force in kN (tension +), extension in mm, extension rate in m/s.
 
     ``ax``: two Axes to draw in (no title then), or None for a new figure titled ``title``
@@ -28,11 +27,11 @@ def plot_hysteresis(cycles, path=None, *, title: str | None = None, ax=None):
     """
     from matplotlib import colormaps
 
-    _expect(cycles, "cycles", "Cycles")
+    _expect(cycles, "cycles", "Cycles", "n_cycles")
     ds = cycles.dataset
     missing = [c for c in ("x", "xd", "F") if c not in ds.variables]
     if missing or "voltage" not in ds.dims:
-        raise ValueError("expected the result of railride.rig.cycles (dims voltage, time; x, xd, F)")
+        raise ValueError("expected the result of railride.run.rig.cycles (dims voltage, time; x, xd, F)")
     if ax is None:
         fig = new_figure((PAGE_WIDTH, 3.2))
         ax_x, ax_v = fig.subplots(1, 2, sharey=True)
@@ -85,7 +84,7 @@ def _cycles_title(cycles) -> str:
 
 @styled
 def plot_tracking(tracking, path=None, *, title: str | None = None, ax=None):
-    """Force tracking of `railride.rig.track` (a `railride.rig.Tracking`): top, the desired and
+    """Force tracking of `railride.run.rig.track` (a `railride.run.rig.Tracking`): top, the desired and
     the actual damper force (kN, tension +) against time; bottom, the command voltage v and the
     coil voltage u (V). The first cycle, left out of the metrics (start-up), is shaded, and the
     force axis fits the forces after it.
@@ -95,11 +94,11 @@ def plot_tracking(tracking, path=None, *, title: str | None = None, ax=None):
     it). Saved at ``path`` when given (format from its suffix, else PNG; atomically). Returns
     the `Figure`.
     """
-    _expect(tracking, "tracking", "Tracking")
+    _expect(tracking, "tracking", "Tracking", "desired")
     ds = tracking.dataset
     missing = [c for c in ("F", "desired_force", "v", "u") if c not in ds.variables]
     if missing:
-        raise ValueError(f"expected the result of railride.rig.track; missing {', '.join(missing)}")
+        raise ValueError(f"expected the result of railride.run.rig.track; missing {', '.join(missing)}")
     if ax is None:
         fig = new_figure((PAGE_WIDTH, 4.6))
         ax_f, ax_v = fig.subplots(2, 1, sharex=True, height_ratios=(3, 2))

@@ -1,11 +1,11 @@
-"""Statistics over tracks (`railride.study.StudyResult`): the mean reduction against passive of
+"""Statistics over tracks (`railride.studies.study.StudyResult`): the mean reduction against passive of
 each controller with its 5-95 % band, one panel per metric."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from ._style import (
+from railride.plots._style import (
     PAGE_WIDTH,
     given_axes,
     grid_shape,

@@ -1,4 +1,4 @@
-"""A sweep (a `railride.sweep.SweepResult`): the RMS of the carbody responses and the ride
+"""A sweep (a `railride.studies.sweep.SweepResult`): the RMS of the carbody responses and the ride
 comfort against its one swept numeric axis."""
 
 from __future__ import annotations
@@ -8,8 +8,16 @@ import math
 import numpy as np
 import pandas as pd
 
-from ..labels import describe_dampers, describe_scenario, grid_axis_label
-from ._style import PAGE_WIDTH, given_axes, new_figure, set_title, styled, suspension_label, suspension_style
+from railride.analysis.labels import describe_dampers, describe_scenario, grid_axis_label
+from railride.plots._style import (
+    PAGE_WIDTH,
+    given_axes,
+    new_figure,
+    set_title,
+    styled,
+    suspension_label,
+    suspension_style,
+)
 
 #: (RMS column, axis label) of the four panels of `plot_sweep`
 RMS_PANELS = (
@@ -101,7 +109,7 @@ def _title(fig, axes, text: str, context: str) -> None:
 @styled
 def plot_sweep(result, ax=None, *, axis: str | None = None):
     """The RMS of the four carbody responses against the swept axis of a sweep (the
-    `railride.sweep.SweepResult` ``result``): four panels, one line per suspension in the paper's
+    `railride.studies.sweep.SweepResult` ``result``): four panels, one line per suspension in the paper's
     style. A suspension the axis does not act on (passive against --voltage, say) ran once: a
     thin horizontal line at its value. ``axis`` defaults to `sweep_plot_axis`. ``ax``: four
     Axes to draw in (legend in the first, no title), or None for a new figure. Returns the
@@ -140,13 +148,13 @@ def plot_sweep(result, ax=None, *, axis: str | None = None):
 
 @styled
 def plot_sweep_comfort(result, ax=None, *, axis: str | None = None):
-    """The ride comfort of a sweep with comfort columns (`railride.sweep.SweepResult` of
+    """The ride comfort of a sweep with comfort columns (`railride.studies.sweep.SweepResult` of
     `run_sweep` with comfort, ``railride sweep --comfort``) against
     its swept axis: N_MV,z and a_w (Wk) at the carbody centre, two panels, one line per
     suspension as in `plot_sweep`; the N_MV,z panel marks the EN 12299 class bounds. ``ax``:
     two Axes to draw in (legend in the first, no title), or None for a new figure. Returns the
     `Figure`."""
-    from ..comfort import COMFORT_SCALE
+    from railride.analysis.comfort import COMFORT_SCALE
 
     axis = _swept_axis(result, axis)
     if not has_comfort(result):

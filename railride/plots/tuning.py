@@ -1,4 +1,4 @@
-"""The sensitivity curves of a tuning study (`railride.tuning`, ``TuneResult.curves``)."""
+"""The sensitivity curves of a tuning study (`railride.studies.tuning`, ``TuneResult.curves``)."""
 
 from __future__ import annotations
 
@@ -6,8 +6,8 @@ import math
 
 import numpy as np
 
-from ..labels import gain_unit
-from ._style import PAGE_WIDTH, fit_text, given_axes, grid_shape, new_figure, set_title, styled
+from railride.analysis.labels import gain_unit
+from railride.plots._style import PAGE_WIDTH, fit_text, given_axes, grid_shape, new_figure, set_title, styled
 
 
 def _zero_axis(ax, zero_x: float, edge: float, right: float) -> None:
@@ -100,7 +100,7 @@ def _draw_parameter(ax, mine: list, colour) -> bool:
 @styled
 def plot_sensitivity(curves, ax=None, *, title: str | None = None):
     """The sensitivity curves of a tuning study (``TuneResult.curves``, a sequence of
-    `railride.tune_result.Curve`): one panel per parameter (in the order tuned), the objective
+    `railride.studies.tune_result.Curve`): one panel per parameter (in the order tuned), the objective
     against the parameter's value on a log axis, one line per pass (coloured by pass). The
     value 0 (the gain switched off) cannot sit on a log axis: it is plotted at the shaded left
     edge, on a tick labelled 0, as an open square joined by a dotted line. The value kept after

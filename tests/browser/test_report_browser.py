@@ -60,7 +60,7 @@ MEASURE = """() => {
 def reports(tmp_path_factory) -> dict:
     """The reports to open, by name: (path, plotly figures, images) expected."""
     import railride as rr
-    from railride.report import write_report
+    from railride.output.report import write_report
 
     folder = tmp_path_factory.mktemp("reports")
     ok("report", "--out", folder / "compare.html")  # the paper's comparison, as a user makes it

@@ -199,9 +199,9 @@ def test_library_errors_name_the_options():
 
 
 def test_the_document_is_the_library_one():
-    from railride.simulation import simulate
-    from railride.suspension import Suspension
-    from railride.track import scenario
+    from railride.run.simulation import simulate
+    from railride.secondary.suspension import Suspension
+    from railride.model.track import scenario
 
     doc = json.loads(
         run(
@@ -268,7 +268,7 @@ def test_diverged_run_status_2(monkeypatch):
     from railride.errors import DivergenceError
 
     # the module, not the function of the same name that railride/__init__.py re-exports
-    core = importlib.import_module("railride.simulation")
+    core = importlib.import_module("railride.run.simulation")
 
     def boom(*args, **kwargs):
         raise DivergenceError("the simulation diverged (sample 0 at t = 1 s)")

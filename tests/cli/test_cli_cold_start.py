@@ -7,8 +7,8 @@ from __future__ import annotations
 import pytest
 from numba.core import event
 
-import railride.comparison
-from railride import kernels
+import railride.studies.comparison
+from railride.engine import kernels
 from clihelp import ok
 
 RUN = ("compare", "--duration", 1, "--controllers", "pid", "--no-bounds")
@@ -18,14 +18,14 @@ NOTE = "compiling the stepper once, about 10 s; later runs start at once"
 @pytest.fixture
 def cold(monkeypatch):
     """compare as on a fresh install: numba starts compiling the stepper during the runs."""
-    real = railride.comparison.compare
+    real = railride.studies.comparison.compare
 
     def compare(*args, **kwargs):
         with event.trigger_event("numba:compile", data=dict(dispatcher=kernels.run_batch, args=(), return_type=None)):
             pass
         return real(*args, **kwargs)
 
-    monkeypatch.setattr(railride.comparison, "compare", compare)
+    monkeypatch.setattr(railride.studies.comparison, "compare", compare)
 
 
 def test_first_run_says_it_compiles(cold):

@@ -10,8 +10,8 @@ import math
 import pandas as pd
 import pytest
 
-from railride.comfort import comfort_class
-from railride.sweep import COMFORT_COLUMNS
+from railride.analysis.comfort import comfort_class
+from railride.studies.sweep import COMFORT_COLUMNS
 from clihelp import PNG, ok
 
 

@@ -10,9 +10,9 @@ import pandas as pd
 import pytest
 import xarray as xr
 
-from railride.comparison import PAPER_REDUCTION, PAPER_TABLE1
-from railride.control import LABELS, PAPER_CONTROLLERS, GainSet
-from railride.files import COMPARE_FILES
+from railride.studies.comparison import PAPER_REDUCTION, PAPER_TABLE1
+from railride.secondary.control import LABELS, PAPER_CONTROLLERS, GainSet
+from railride.output.files import COMPARE_FILES
 from clihelp import PNG, assert_input_error, ok, ok_json, run
 
 
@@ -290,7 +290,7 @@ def test_out_is_a_file(tmp_path):
 
 
 def test_failing_plot_leaves_out_absent(tmp_path, monkeypatch):
-    from railride import files
+    from railride.output import files
 
     def failing_png(*args, **kwargs):
         raise OSError("disk full (simulated)")
@@ -307,7 +307,7 @@ def test_diverged_run_status_2(tmp_path, monkeypatch):
     from railride.errors import DivergenceError
 
     # the module, not the function of the same name that railride/__init__.py re-exports
-    compare_module = importlib.import_module("railride.comparison")
+    compare_module = importlib.import_module("railride.studies.comparison")
 
     def boom(*args, **kwargs):
         raise DivergenceError("the simulation diverged (sample 1 at t = 1 s)")
@@ -337,9 +337,9 @@ def test_trade_offs_name_every_response_a_controller_loses(short_doc):
 
 
 def test_bounds_are_the_same_gains_on_the_ideal_devices(short_doc):
-    from railride.simulation import simulate
-    from railride.suspension import Suspension
-    from railride.track import scenario
+    from railride.run.simulation import simulate
+    from railride.secondary.suspension import Suspension
+    from railride.model.track import scenario
 
     gains = GainSet.default()
     sc = scenario("paper-sine", duration=2.0)
@@ -364,7 +364,7 @@ def test_compare_table_shows_the_trade_offs_and_the_bounds(short_doc):
 
 
 def test_compare_with_a_payload_keeps_the_gains_and_records_the_loaded_vehicle():
-    from railride.params import VehicleParams
+    from railride.model.params import VehicleParams
 
     paper = VehicleParams.preset("paper")
     doc = ok_json("compare", "--duration", 1, "--load", 1.3)

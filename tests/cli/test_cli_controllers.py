@@ -9,7 +9,7 @@ import re
 import pandas as pd
 import pytest
 
-from railride.control import CONTROLLERS, OUTER_LOOPS, PAPER_CONTROLLERS, GainSet
+from railride.secondary.control import CONTROLLERS, OUTER_LOOPS, PAPER_CONTROLLERS, GainSet
 from clihelp import assert_input_error, ok, ok_json, run
 
 SHORT = ("compare", "--duration", 1)

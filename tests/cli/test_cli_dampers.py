@@ -277,7 +277,7 @@ def test_simulate_mr_out(tmp_path):
 
 # -- failures after the run -------------------------------------------------------------------------
 def test_diverged_rig_run_status_2(tmp_path, monkeypatch):
-    from railride import rig
+    from railride.run import rig
     from railride.errors import DivergenceError
 
     def boom(*args, **kwargs):
@@ -292,7 +292,7 @@ def test_diverged_rig_run_status_2(tmp_path, monkeypatch):
 
 
 def test_failing_plot_leaves_out_absent(tmp_path, monkeypatch):
-    from railride import files
+    from railride.output import files
 
     def failing_png(*args, **kwargs):
         raise OSError("disk full (simulated)")

@@ -27,7 +27,7 @@ def test_a_diverged_run_is_an_input_error(monkeypatch):
 
     from railride.errors import DivergenceError
 
-    core = importlib.import_module("railride.simulation")
+    core = importlib.import_module("railride.run.simulation")
 
     def diverge(*args, **kwargs):
         raise DivergenceError("the simulation diverged (sample 0 at t = 0.5 s): reduce dt")
@@ -38,7 +38,7 @@ def test_a_diverged_run_is_an_input_error(monkeypatch):
 
 def test_the_library_raises_divergence_as_its_own_runtime_error():
     import railride as rr
-    from railride.control import PID
+    from railride.secondary.control import PID
     from railride.errors import DivergenceError
 
     unstable = rr.Suspension.ideal(PID(kp=1e12, ki=0.0, kd=1e11))  # far past any stable gain
@@ -50,7 +50,7 @@ def test_the_library_raises_divergence_as_its_own_runtime_error():
 def test_an_internal_fault_is_status_1(monkeypatch):
     import importlib
 
-    core = importlib.import_module("railride.simulation")
+    core = importlib.import_module("railride.run.simulation")
 
     def fault(*args, **kwargs):
         raise RuntimeError("an internal fault")
@@ -119,7 +119,7 @@ def test_an_empty_out_is_refused(tmp_path, monkeypatch):
 
 
 def test_the_library_refuses_an_empty_folder_name():
-    from railride.files import check_out_dir
+    from railride.output.files import check_out_dir
 
     with pytest.raises(ValueError, match="output folder '': an empty name"):
         check_out_dir("")
@@ -129,7 +129,7 @@ def _hold_lock(folder: Path) -> subprocess.Popen:
     """Another process that opens the run table of ``folder`` and keeps it."""
     code = (
         "import sys, time\n"
-        "from railride.executors import RunTable\n"
+        "from railride.studies.executors import RunTable\n"
         f"table = RunTable({str(folder / 'runs.csv')!r})\n"
         "print('held', flush=True)\n"
         "time.sleep(120)\n"
@@ -155,7 +155,7 @@ def test_a_second_writer_of_one_folder_is_refused(tmp_path):
 
 
 def test_the_lock_of_a_process_gone_is_taken_over(tmp_path):
-    from railride.executors import RunTable
+    from railride.studies.executors import RunTable
 
     out = tmp_path / "run"
     out.mkdir()
@@ -167,7 +167,7 @@ def test_the_lock_of_a_process_gone_is_taken_over(tmp_path):
 
 
 def test_the_lock_holds_within_one_process_until_closed(tmp_path):
-    from railride.executors import RunTable
+    from railride.studies.executors import RunTable
 
     path = tmp_path / "run" / "runs.csv"
     first = RunTable(path)
@@ -217,7 +217,7 @@ def test_leftovers_of_a_killed_write_are_removed_by_the_next_write(tmp_path):
 def test_a_live_staging_folder_is_left_alone(tmp_path):
     import fcntl
 
-    from railride.files import remove_leftovers
+    from railride.output.files import remove_leftovers
 
     live = tmp_path / ".run.staging-12345678"
     live.mkdir()

@@ -19,7 +19,7 @@ def test_several_scenarios_and_speeds_give_a_league_table():
 
 
 def test_a_law_a_gains_file_did_not_tune_is_named(tmp_path):
-    from railride.tuning import tune
+    from railride.studies.tuning import tune
 
     res = tune(("pid",), scenario_options={"duration": 0.5}, n_values=3, budget=5, before_after=False)
     path = tmp_path / "gains.toml"

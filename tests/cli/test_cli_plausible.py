@@ -7,7 +7,7 @@ import re
 
 import pytest
 
-from railride.control import GainSet
+from railride.secondary.control import GainSet
 
 from clihelp import assert_input_error, run
 

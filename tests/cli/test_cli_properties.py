@@ -490,13 +490,13 @@ def toml_file(draw, text: str) -> tuple[str, list[str], list[str]]:
 
 
 def _params_text() -> str:
-    from railride.params import VehicleParams
+    from railride.model.params import VehicleParams
 
     return VehicleParams.preset("paper").to_toml()
 
 
 def _gains_text() -> str:
-    from railride.control import GainSet
+    from railride.secondary.control import GainSet
 
     return GainSet.default().to_toml()
 

@@ -10,8 +10,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from railride.analysis import FRF_MAGNITUDES, FRF_PATTERNS
-from railride.files import COMPARE_FILES, FRF_FILES
+from railride.analysis.spectra import FRF_MAGNITUDES, FRF_PATTERNS
+from railride.output.files import COMPARE_FILES, FRF_FILES
 from clihelp import assert_input_error, is_png, ok, ok_json, run
 
 

@@ -9,9 +9,9 @@ import json
 import pandas as pd
 import pytest
 
-from railride.control import GainSet
-from railride.files import TUNE_FILES
-from railride.tuning import DEFAULT_OBJECTIVE
+from railride.secondary.control import GainSet
+from railride.output.files import TUNE_FILES
+from railride.studies.tuning import DEFAULT_OBJECTIVE
 from clihelp import PNG, assert_input_error, ok, ok_json, run
 
 
@@ -131,7 +131,7 @@ def test_tune_states_its_objective_in_every_output(tmp_path):
 
 def test_tune_interrupted(tmp_path, monkeypatch):
     """Ctrl-C: one line saying how many runs the table holds, status 130, no traceback."""
-    from railride import sweep
+    from railride.studies import sweep
 
     real = sweep.evaluate
     calls = []
@@ -227,7 +227,7 @@ def test_sweep_speed_range_times_suspensions(tmp_path):
 def test_sweep_prints_the_library_result(tmp_path):
     """The command's JSON, CSV and sweep.json are the library's SweepResult of the same grid;
     the command adds only its own facts (runs evaluated, timing, executor)."""
-    from railride.sweep import grid, run_sweep
+    from railride.studies.sweep import grid, run_sweep
 
     out = tmp_path / "sweep"
     args = (

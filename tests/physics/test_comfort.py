@@ -1,4 +1,4 @@
-"""Ride comfort (railride.comfort): the weightings against the published one-third-octave tables,
+"""Ride comfort (railride.analysis.comfort): the weightings against the published one-third-octave tables,
 the digital filters against the analog weightings, and each index against a closed form."""
 
 import json
@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from railride import comfort
-from railride.comfort import (
+from railride.analysis import comfort
+from railride.analysis.comfort import (
     ShortRunWarning,
     comfort_class,
     comfort_intervals,
@@ -372,8 +372,8 @@ def test_ride_comfort_of_a_batch_equals_the_single_runs():
 
 
 def test_ride_comfort_of_a_simulated_run():
-    from railride.simulation import simulate
-    from railride.track import scenario
+    from railride.run.simulation import simulate
+    from railride.model.track import scenario
 
     ds = simulate(scenario("paper-sine", duration=6.0)).dataset
     with warnings.catch_warnings():

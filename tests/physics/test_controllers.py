@@ -7,15 +7,15 @@ import pytest
 import scipy.linalg
 
 from railride import dampers
-from railride.comparison import compare
-from railride.control import OUTER_LOOPS, GainSet
-from railride.controllers import ClippedOptimal, Skyhook
-from railride.params import VehicleParams
-from railride.simulation import simulate
-from railride.solver import SolverSettings
-from railride.suspension import Suspension
-from railride.track import scenario
-from railride.vehicle import Vehicle
+from railride.studies.comparison import compare
+from railride.secondary.control import OUTER_LOOPS, GainSet
+from railride.secondary.controllers import ClippedOptimal, Skyhook
+from railride.model.params import VehicleParams
+from railride.run.simulation import simulate
+from railride.run.solver import SolverSettings
+from railride.secondary.suspension import Suspension
+from railride.model.track import scenario
+from railride.model.vehicle import Vehicle
 
 P = VehicleParams.preset("paper")
 V = Vehicle(P)

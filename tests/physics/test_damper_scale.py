@@ -9,12 +9,14 @@ import math
 import numpy as np
 import pytest
 
-from railride import dampers, rig
-from railride.comparison import compare
-from railride.simulation import simulate
-from railride.suspension import Suspension
-from railride.sweep import Case, run_cases
-from railride.track import scenario
+from railride import dampers
+
+from railride.run import rig
+from railride.studies.comparison import compare
+from railride.run.simulation import simulate
+from railride.secondary.suspension import Suspension
+from railride.studies.sweep import Case, run_cases
+from railride.model.track import scenario
 from clihelp import assert_input_error, run
 
 SHORT = {"duration": 1.0}

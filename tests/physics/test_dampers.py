@@ -6,12 +6,14 @@ import numpy as np
 import pytest
 from hypothesis import given, settings, strategies as st
 
-from railride import dampers, rig
-from railride.kernels import damper_law
-from railride.reference import rig_reference, simulate_reference
-from railride.simulation import simulate
-from railride.suspension import Suspension
-from railride.track import scenario
+from railride import dampers
+
+from railride.run import rig
+from railride.engine.kernels import damper_law
+from railride.testing.reference import rig_reference, simulate_reference
+from railride.run.simulation import simulate
+from railride.secondary.suspension import Suspension
+from railride.model.track import scenario
 
 MODELS = {  # preset, stroke [m] and frequency [Hz] of a typical test
     "railway": (0.02, 1.0),

@@ -4,11 +4,11 @@ definition: a demand takes effect `delay` controller periods after the sample it
 import numpy as np
 import pytest
 
-from railride.comparison import compare
-from railride.control import GainSet
-from railride.simulation import simulate
-from railride.suspension import Suspension
-from railride.track import scenario
+from railride.studies.comparison import compare
+from railride.secondary.control import GainSet
+from railride.run.simulation import simulate
+from railride.secondary.suspension import Suspension
+from railride.model.track import scenario
 
 SC = scenario("paper-sine", duration=1.0)
 BODY = ("carbody_bounce", "carbody_pitch", "carbody_roll")
@@ -55,7 +55,7 @@ def test_bad_delays_name_the_field(make, match):
 
 
 def test_a_study_over_delays_lists_the_unstable_runs():
-    from railride.study import study
+    from railride.studies.study import study
 
     res = study(["pid"], damper="ideal", track_seeds=[0], speeds=[40.0], delays=[1, 10], duration=1.0)
     assert [(f["controller"], f["delay_periods"]) for f in res.failed] == [("pid", 10)]

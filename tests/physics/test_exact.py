@@ -1,4 +1,4 @@
-"""The exact discretisation of the passive vehicle (railride.discrete) against the RK4 stepper,
+"""The exact discretisation of the passive vehicle (railride.engine.discrete) against the RK4 stepper,
 against itself at half the step, and against the frequency-domain steady state."""
 
 from __future__ import annotations
@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import railride as rr
-from railride.vehicle import Vehicle
+from railride.model.vehicle import Vehicle
 
 RK4 = rr.SolverSettings(method="rk4")
 CHANNELS = ("carbody_bounce", "carbody_pitch", "carbody_roll", "carbody_acceleration", "front_bogie_bounce")

@@ -1,14 +1,14 @@
-"""Damper faults (railride.faults) against runs that mean the same by construction."""
+"""Damper faults (railride.secondary.faults) against runs that mean the same by construction."""
 
 import numpy as np
 import pytest
 
 from railride import dampers
-from railride.faults import DamperFault
-from railride.params import VehicleParams
-from railride.simulation import simulate
-from railride.suspension import Suspension
-from railride.track import scenario
+from railride.secondary.faults import DamperFault
+from railride.model.params import VehicleParams
+from railride.run.simulation import simulate
+from railride.secondary.suspension import Suspension
+from railride.model.track import scenario
 
 SC = scenario("paper-sine", duration=2.0)
 ALL = ("1R", "1L", "2R", "2L")
@@ -88,7 +88,7 @@ def test_the_ideal_actuator_can_lose_a_corner():
 
 
 def test_compare_with_a_fault_reports_the_degradation_against_healthy_dampers():
-    from railride.comparison import compare
+    from railride.studies.comparison import compare
 
     cmp = compare(SC, controllers=["pid", "sas-attitude"], faults=["1R-off"])
     assert cmp.bounds is None and cmp.healthy is not None and cmp.healthy.healthy is None

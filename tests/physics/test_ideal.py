@@ -12,16 +12,18 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from railride import dampers, rig
+from railride import dampers
+
+from railride.run import rig
 from railride.cli import app
-from railride.comparison import compare
-from railride.control import PID, SAS, Attitude, GainSet, ZeroDemand
-from railride.params import VehicleParams
-from railride.simulation import simulate
-from railride.solver import SolverSettings
-from railride.suspension import Suspension
-from railride.track import CosineBump, Scenario
-from railride.vehicle import Vehicle
+from railride.studies.comparison import compare
+from railride.secondary.control import PID, SAS, Attitude, GainSet, ZeroDemand
+from railride.model.params import VehicleParams
+from railride.run.simulation import simulate
+from railride.run.solver import SolverSettings
+from railride.secondary.suspension import Suspension
+from railride.model.track import CosineBump, Scenario
+from railride.model.vehicle import Vehicle
 from clihelp import runner
 
 PARAMS = VehicleParams.preset("paper")

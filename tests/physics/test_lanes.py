@@ -1,21 +1,23 @@
-"""The lane stepper (`railride.kernels.run_lanes`): LANES samples advanced together in vector
+"""The lane stepper (`railride.engine.lanes.run_lanes`): LANES samples advanced together in vector
 form, against the sample-by-sample stepper (`run_batch`) it replaces for batches, and against
 itself in other company."""
 
 import numpy as np
 import pytest
 
-from railride import dampers, kernels
-from railride.control import SensorNoise
-from railride.errors import DivergenceError
-from railride.params import VehicleParams
-from railride.sensing import Accelerometers
-from railride.simulation import simulate
-from railride.solver import SolverSettings
-from railride.suspension import Suspension
-from railride.track import scenario
+from railride import dampers
 
-L = kernels.LANES
+from railride.engine import lanes as engine_lanes
+from railride.secondary.control import SensorNoise
+from railride.errors import DivergenceError
+from railride.model.params import VehicleParams
+from railride.secondary.sensing import Accelerometers
+from railride.run.simulation import simulate
+from railride.run.solver import SolverSettings
+from railride.secondary.suspension import Suspension
+from railride.model.track import scenario
+
+L = engine_lanes.LANES
 SHORT = scenario("paper-sine", duration=0.5)
 STIFF = scenario("paper-sine", duration=0.2)  # Spencer dampers: sub-stepped, slow
 RK4 = SolverSettings(method="rk4")  # the linear suspensions would take the exact steps
@@ -71,7 +73,7 @@ CASES = {
 def lane_calls(monkeypatch):
     """How many kernel calls (chunks) went through the lane stepper."""
     calls = []
-    make = kernels.lanes_stepper
+    make = engine_lanes.lanes_stepper
 
     def counted_stepper(*setup):
         step = make(*setup)
@@ -82,14 +84,14 @@ def lane_calls(monkeypatch):
 
         return counted
 
-    monkeypatch.setattr(kernels, "lanes_stepper", counted_stepper)
+    monkeypatch.setattr(engine_lanes, "lanes_stepper", counted_stepper)
     return calls
 
 
 def _reference(monkeypatch, **kw):
     """The same run by run_batch, sample after sample."""
     with monkeypatch.context() as m:
-        m.setattr(kernels, "lanes_fit", lambda *args: False)
+        m.setattr(engine_lanes, "lanes_fit", lambda *args: False)
         return simulate(**kw)
 
 

@@ -5,8 +5,8 @@ import pytest
 import scipy.signal
 from scipy.integrate import quad
 
-from railride.simulation import simulate
-from railride.track import FRA_AV, RandomTrack, scenario, spectrum
+from railride.run.simulation import simulate
+from railride.model.track import FRA_AV, RandomTrack, scenario, spectrum
 
 BAND = (1.0, 100.0)  # m
 

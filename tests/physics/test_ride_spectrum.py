@@ -11,11 +11,11 @@ import pytest
 from scipy.signal import lsim
 
 import railride as rr
-from railride.comfort import floor_acceleration, ride_comfort
-from railride.linear import linear_model
-from railride.ride_spectrum import FLOOR, ride_spectrum, track_psd
-from railride.track import RandomTrack, wheelset_input_table
-from railride.vehicle import Vehicle
+from railride.analysis.comfort import floor_acceleration, ride_comfort
+from railride.frequency.linear import linear_model
+from railride.frequency.ride_spectrum import FLOOR, ride_spectrum, track_psd
+from railride.model.track import RandomTrack, wheelset_input_table
+from railride.model.vehicle import Vehicle
 
 SPEED = 55.56
 #: the frequency-domain RMS against the mean square of long random runs: two 60 s runs (50 s

@@ -1,4 +1,4 @@
-"""Realistic sensing (railride.sensing): the band-limited integration against its transfer
+"""Realistic sensing (railride.secondary.sensing): the band-limited integration against its transfer
 function, a stated bound on its velocity error, bias removal, and bad input."""
 
 import math
@@ -7,12 +7,12 @@ import numpy as np
 import pytest
 
 import railride as rr
-from railride.comparison import compare
-from railride.control import GainSet
-from railride.controllers import carbody_map
-from railride.sensing import Accelerometers
-from railride.simulation import simulate
-from railride.suspension import Suspension
+from railride.studies.comparison import compare
+from railride.secondary.control import GainSet
+from railride.secondary.controllers import carbody_map
+from railride.secondary.sensing import Accelerometers
+from railride.run.simulation import simulate
+from railride.secondary.suspension import Suspension
 
 G = GainSet.reference()  # skyhook with all three modal gains (the shipped one has no roll gain)
 TC = carbody_map(rr.Vehicle(rr.VehicleParams.preset("paper")))
@@ -85,7 +85,10 @@ def test_compare_with_accelerometers_runs_the_carbody_laws_and_says_why_not_the_
         (lambda: Accelerometers(cutoff_hz=0.0), r"accelerometer 'cutoff_hz' = 0.0"),
         (lambda: Accelerometers(seed=1.5), r"accelerometer 'seed' = 1.5"),
         (lambda: Suspension.named("mr").with_sensing(Accelerometers()), r"sensing applies to a closed loop only"),
-        (lambda: Suspension.named("pid").with_sensing("accelerometers"), r"must be a railride.sensing.Accelerometers"),
+        (
+            lambda: Suspension.named("pid").with_sensing("accelerometers"),
+            r"must be a railride.secondary.sensing.Accelerometers",
+        ),
         (
             lambda: simulate(
                 rr.scenario("paper-sine", duration=1.0),

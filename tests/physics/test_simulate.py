@@ -4,13 +4,13 @@ domain, an analytic single-mass decay, energy conservation, symmetry and step ha
 import numpy as np
 import pytest
 
-from railride.params import VehicleParams
-from railride.reference import simulate_reference
-from railride.simulation import simulate
-from railride.solver import SolverSettings
-from railride.suspension import Suspension
-from railride.track import CosineBump, Scenario, SineTrack, scenario
-from railride.vehicle import DOF_NAMES, Vehicle
+from railride.model.params import VehicleParams
+from railride.testing.reference import simulate_reference
+from railride.run.simulation import simulate
+from railride.run.solver import SolverSettings
+from railride.secondary.suspension import Suspension
+from railride.model.track import CosineBump, Scenario, SineTrack, scenario
+from railride.model.vehicle import DOF_NAMES, Vehicle
 
 P = VehicleParams.preset("paper")
 BUMP = Scenario(CosineBump(height=0.02, length=10.0, start=5.0, rails="left"), speed=40.0, duration=1.5, name="bump")
@@ -200,7 +200,7 @@ def test_a_run_that_diverges_stops_and_says_so():
 
 # -- a run that diverges ------------------------------------------------------------------------
 def test_a_diverged_sample_is_marked_and_the_others_stand():
-    from railride.control import PID, GainSet
+    from railride.secondary.control import PID, GainSet
 
     g = GainSet.default()
     unstable = PID(kp=1e12, ki=0.0, kd=1e11)  # on the ideal actuator: far past any stable gain
@@ -219,8 +219,8 @@ def test_a_diverged_sample_is_marked_and_the_others_stand():
 
 
 def test_a_study_goes_on_past_a_diverged_run():
-    from railride.sweep import Case, run_cases
-    from railride.tuning import Objective
+    from railride.studies.sweep import Case, run_cases
+    from railride.studies.tuning import Objective
 
     opts = {"duration": 1.0}
     rows = run_cases(

@@ -1,9 +1,9 @@
 import numpy as np
 import pytest
 
-from railride.simulation import simulate
-from railride.track import CosineBump, MeasuredTrack, Scenario, SineTrack, scenario, wheelset_input_table
-from railride.vehicle import Vehicle
+from railride.run.simulation import simulate
+from railride.model.track import CosineBump, MeasuredTrack, Scenario, SineTrack, scenario, wheelset_input_table
+from railride.model.vehicle import Vehicle
 
 
 def test_sine_rails_follow_the_paper_formula():

@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from railride.params import VehicleParams
-from railride.vehicle import Vehicle
+from railride.model.params import VehicleParams
+from railride.model.vehicle import Vehicle
 
 P = VehicleParams.preset("paper")
 

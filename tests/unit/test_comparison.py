@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import railride as rr
-from railride.files import COMPARE_FILES
+from railride.output.files import COMPARE_FILES
 
 matplotlib.use("Agg")
 

@@ -1,4 +1,4 @@
-"""railride.compiled: whether the stepper still needs compiling, and the watch on its compiles."""
+"""railride.engine.compiled: whether the stepper still needs compiling, and the watch on its compiles."""
 
 from __future__ import annotations
 
@@ -10,7 +10,7 @@ import pytest
 from numba.core import event
 
 import railride as rr
-from railride import compiled, kernels
+from railride.engine import compiled, kernels, lanes
 
 
 def test_an_empty_cache_means_compiling(tmp_path):
@@ -57,7 +57,7 @@ def test_the_build_compiles_what_compare_and_studies_call():
     # add none (a drift compiles a second one here, which the check sees).
     rr.compare(rr.scenario("paper-sine", duration=0.3))
     sc = rr.scenario("paper-sine", duration=0.1)  # and a batch that fills the lane stepper, as studies do
-    rr.simulate([sc] * kernels.LANES, None, rr.Suspension.named("pid"))
+    rr.simulate([sc] * lanes.LANES, None, rr.Suspension.named("pid"))
     used = {name: set(getattr(kernels, name).signatures) for name in compiled._signatures()}
     assert all(used.values())  # compare went through every kernel the build compiles
     assert compiled.build_cache() == list(used)

@@ -7,13 +7,23 @@ import pytest
 from hypothesis import given, settings, strategies as st
 
 from railride import dampers
-from railride.control import PID, SAS, Attitude, GainSet, InnerLoop, Ride, SensorNoise, carbody_map, decoupling
-from railride.params import VehicleParams
-from railride.simulation import simulate
-from railride.solver import SolverSettings
-from railride.suspension import Suspension
-from railride.track import scenario
-from railride.vehicle import Vehicle
+from railride.secondary.control import (
+    PID,
+    SAS,
+    Attitude,
+    GainSet,
+    InnerLoop,
+    Ride,
+    SensorNoise,
+    carbody_map,
+    decoupling,
+)
+from railride.model.params import VehicleParams
+from railride.run.simulation import simulate
+from railride.run.solver import SolverSettings
+from railride.secondary.suspension import Suspension
+from railride.model.track import scenario
+from railride.model.vehicle import Vehicle
 
 P = VehicleParams.preset("paper")
 V = Vehicle(P)

@@ -22,10 +22,10 @@ import pytest
 pytest.importorskip("distributed")
 from distributed import Client  # noqa: E402
 
-from railride.control import GainSet  # noqa: E402
-from railride.metrics import RESPONSES, STATISTICS  # noqa: E402
-from railride.executors import DaskExecutor, LocalExecutor, RunTable  # noqa: E402
-from railride.sweep import Case, SweepResult, grid, run_cases, run_sweep  # noqa: E402
+from railride.secondary.control import GainSet  # noqa: E402
+from railride.analysis.metrics import RESPONSES, STATISTICS  # noqa: E402
+from railride.studies.executors import DaskExecutor, LocalExecutor, RunTable  # noqa: E402
+from railride.studies.sweep import Case, SweepResult, grid, run_cases, run_sweep  # noqa: E402
 
 #: seconds for the scheduler file and for the workers to come up (imports on a slow machine)
 STARTUP = 60.0

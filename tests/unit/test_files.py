@@ -1,4 +1,4 @@
-"""The result folders of railride.files: NetCDF, and the all-or-nothing output folder."""
+"""The result folders of railride.output.files: NetCDF, and the all-or-nothing output folder."""
 
 from __future__ import annotations
 
@@ -10,9 +10,9 @@ import pandas as pd
 import pytest
 import xarray as xr
 
-from railride import files
-from railride.simulation import simulate
-from railride.track import scenario
+from railride.output import files
+from railride.run.simulation import simulate
+from railride.model.track import scenario
 
 DOC = {"schema": "test", "metrics": {"a": {"rms": 1.0, "ptp": 2.0}}}
 
@@ -81,7 +81,7 @@ def test_write_outputs_batch(batch, tmp_path):
 
 
 def test_write_outputs_takes_a_ride_result(result, tmp_path):
-    with pytest.raises(ValueError, match="result: expected a railride.ride.RideResult, got Dataset"):
+    with pytest.raises(ValueError, match="result: expected a railride.run.ride.RideResult, got Dataset"):
         files.write_outputs(result.dataset, tmp_path / "out", DOC)
     assert list(tmp_path.iterdir()) == []
 

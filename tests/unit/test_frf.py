@@ -1,4 +1,4 @@
-"""The frequency-response study (railride.frf): `FrfResult` follows the result protocol and its
+"""The frequency-response study (railride.frequency.frf): `FrfResult` follows the result protocol and its
 document is that of `railride frf`; `Modes` is the modal table of `railride modes`."""
 
 from __future__ import annotations
@@ -12,12 +12,12 @@ from matplotlib.figure import Figure
 
 import railride as rr
 from clihelp import PNG, ok, ok_json
-from railride import files
-from railride.analysis import FRF_PATTERNS, frf_peaks
-from railride.files import FRF_FILES
-from railride.frf import FrfResult, Modes, frequency_responses, modes
-from railride.tables import MODE_COLUMNS
-from railride.vehicle import Mode, Vehicle
+from railride.output import files
+from railride.analysis.spectra import FRF_PATTERNS, frf_peaks
+from railride.output.files import FRF_FILES
+from railride.frequency.frf import FrfResult, Modes, frequency_responses, modes
+from railride.model.modes import MODE_COLUMNS
+from railride.model.vehicle import Mode, Vehicle
 
 
 @pytest.fixture(scope="module")

@@ -12,10 +12,10 @@ from hypothesis import strategies as st
 import railride as rr
 from railride import dampers, validation
 from railride.cli._parsing import value_list
-from railride.control import PID, GainSet, SensorNoise
-from railride.sensing import Accelerometers
-from railride.sweep import Case, grid
-from railride.track import RandomTrack
+from railride.secondary.control import PID, GainSet, SensorNoise
+from railride.secondary.sensing import Accelerometers
+from railride.studies.sweep import Case, grid
+from railride.model.track import RandomTrack
 
 NUMPY_TYPES = [np.int8, np.int16, np.int64, np.uint8, np.uint32, np.float16, np.float32, np.float64]
 

@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from railride.league import league
+from railride.studies.league import league
 
 
 @pytest.fixture(scope="module")

@@ -10,11 +10,12 @@ import time
 import pytest
 
 import railride as rr
-from railride import limits, rig
-from railride.frf import frequency_responses
-from railride.metrics import parse_window
-from railride.solver import SolverSettings
-from railride.track import CosineBump, Scenario, SineTrack, scenario
+from railride import limits
+from railride.run import rig
+from railride.frequency.frf import frequency_responses
+from railride.analysis.metrics import parse_window
+from railride.run.solver import SolverSettings
+from railride.model.track import CosineBump, Scenario, SineTrack, scenario
 
 
 def test_parse_size_reads_units_in_powers_of_1024():

@@ -8,7 +8,7 @@ import pytest
 from scipy.io import loadmat
 
 import railride as rr
-from railride.linear import linear_model
+from railride.frequency.linear import linear_model
 
 
 def _ideal(name):
@@ -72,7 +72,7 @@ def test_non_linear_secondaries_are_refused(suspension, fragment):
 
 
 def test_ride_spectrum_refuses_what_it_cannot_compute():
-    from railride.ride_spectrum import ride_spectrum
+    from railride.frequency.ride_spectrum import ride_spectrum
 
     with pytest.raises(ValueError, match="controllers = 'passive-on': not a linear suspension"):
         ride_spectrum("fra4", controllers="passive,passive-on")
@@ -87,7 +87,7 @@ def test_ride_spectrum_refuses_what_it_cannot_compute():
 def test_ride_spectrum_result_protocol(tmp_path):
     import json
 
-    from railride.ride_spectrum import ride_spectrum
+    from railride.frequency.ride_spectrum import ride_spectrum
 
     result = ride_spectrum("german-low", speed=40.0, controllers="passive,skyhook", points=64)
     doc = result.to_dict()

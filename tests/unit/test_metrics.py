@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from railride.metrics import parse_window, reduction, ride_metrics, to_dict
+from railride.analysis.metrics import parse_window, reduction, ride_metrics, to_dict
 
 
 def _run(amplitudes, f=2.0, duration=4.0, rate=1000.0, offset=0.0):

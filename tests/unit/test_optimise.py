@@ -1,4 +1,4 @@
-"""The global methods' results (railride.optimise): `OptimiseResult` and `SensitivityResult`
+"""The global methods' results (railride.studies.optimise): `OptimiseResult` and `SensitivityResult`
 follow the result protocol; the convergence is that of the search."""
 
 from __future__ import annotations
@@ -10,8 +10,8 @@ import pandas as pd
 import pytest
 from matplotlib.figure import Figure
 
-from railride.files import json_text
-from railride.optimise import (
+from railride.output.files import json_text
+from railride.studies.optimise import (
     OPTIMISE_FILES,
     SENSITIVITY_FILES,
     OptimiseResult,

@@ -3,8 +3,8 @@ import math
 import pytest
 from hypothesis import given, settings, strategies as st
 
-from railride.params import VehicleParams
-from railride.plausible import VEHICLE
+from railride.model.params import VehicleParams
+from railride.model.plausible import VEHICLE
 
 # The paper's appendix (Harun et al.), typed from the published table, not from the code.
 APPENDIX = {
@@ -64,7 +64,7 @@ def allowed(name):
 
 @settings(max_examples=60, deadline=None)
 @given(m_c=allowed("m_c"), k_sz=allowed("k_sz"), h_cs=allowed("h_cs"), c_sz=allowed("c_sz"))
-@pytest.mark.filterwarnings("ignore::railride.plausible.PlausibilityWarning")
+@pytest.mark.filterwarnings("ignore::railride.model.plausible.PlausibilityWarning")
 def test_toml_round_trip_is_lossless_for_any_valid_value(m_c, k_sz, h_cs, c_sz):
     p = VehicleParams.preset("paper").replace(m_c=m_c, k_sz=k_sz, h_cs=h_cs, c_sz=c_sz)
     assert VehicleParams.from_toml(p.to_toml()) == p

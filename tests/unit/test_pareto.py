@@ -1,4 +1,4 @@
-"""The Pareto view (railride.pareto): the non-dominated flag against its definition, a tiny
+"""The Pareto view (railride.studies.pareto): the non-dominated flag against its definition, a tiny
 study's files, resume, and bad input."""
 
 from __future__ import annotations
@@ -9,11 +9,11 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from railride.control import GainSet
-from railride.optimise import log_gain_bounds
-from railride.pareto import FILES, in_sample_note, non_dominated, pareto
-from railride.sweep import RunTable
-from railride.track import scenario
+from railride.secondary.control import GainSet
+from railride.studies.optimise import log_gain_bounds
+from railride.studies.pareto import FILES, in_sample_note, non_dominated, pareto
+from railride.studies.sweep import RunTable
+from railride.model.track import scenario
 
 SHORT = {"duration": 1.0}
 PNG = b"\x89PNG\r\n\x1a\n"

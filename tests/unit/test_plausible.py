@@ -12,16 +12,17 @@ import numpy as np
 import pytest
 
 from railride import dampers
-from railride.comparison import compare
-from railride.control import PID, GainSet, SensorNoise
-from railride.controllers import ClippedOptimal
-from railride.frf import frequency_responses, modes
-from railride.params import PRESETS, VehicleParams
-from railride.plausible import PlausibilityWarning, markdown
-from railride.sensing import Accelerometers
-from railride.simulation import simulate
-from railride.suspension import Suspension
-from railride.track import scenario
+from railride.studies.comparison import compare
+from railride.secondary.control import PID, GainSet, SensorNoise
+from railride.secondary.controllers import ClippedOptimal
+from railride.frequency.frf import frequency_responses, modes
+from railride.model.params import PRESETS, VehicleParams
+from railride.model.params import ranges_markdown as markdown
+from railride.model.plausible import PlausibilityWarning
+from railride.secondary.sensing import Accelerometers
+from railride.run.simulation import simulate
+from railride.secondary.suspension import Suspension
+from railride.model.track import scenario
 
 P = VehicleParams.preset("paper")
 DOCS = Path(__file__).resolve().parents[2] / "docs" / "cli.md"
@@ -133,14 +134,14 @@ def test_an_undamped_vehicle_has_damping_ratios_of_exactly_zero():
     assert all(math.isclose(m["frequency_hz"], m["damped_frequency_hz"], rel_tol=1e-6) for m in found)
 
 
-@pytest.mark.filterwarnings("ignore::railride.plausible.PlausibilityWarning")
+@pytest.mark.filterwarnings("ignore::railride.model.plausible.PlausibilityWarning")
 def test_modes_beyond_double_precision_are_a_clear_error():
     absurd = P.replace(I_cx=1e-6, c_pz=0.0)  # allowed, with a warning, but its modes are lost
     with pytest.raises(ValueError, match=r"cannot be computed in double precision: .*outside the typical ranges: I_cx"):
         modes(absurd)
 
 
-@pytest.mark.filterwarnings("ignore::railride.plausible.PlausibilityWarning")
+@pytest.mark.filterwarnings("ignore::railride.model.plausible.PlausibilityWarning")
 def test_the_step_size_message_is_sensible_for_a_stiff_vehicle():
     stiff = P.replace(k_pz=1e11, m_b=1.0, I_by=1e-2)
     with pytest.raises(ValueError) as err:
@@ -158,7 +159,7 @@ def test_the_docs_list_the_vehicle_ranges_of_the_code():
 
 
 def test_values_at_the_edges_of_the_typical_ranges_stay_silent():
-    from railride.plausible import VEHICLE
+    from railride.model.plausible import VEHICLE
 
     with warnings.catch_warnings():
         warnings.simplefilter("error", PlausibilityWarning)

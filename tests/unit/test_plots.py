@@ -9,9 +9,9 @@ import pytest
 from matplotlib.figure import Figure
 
 import railride as rr
-from railride import rig
-from railride.analysis import FRF_PATTERNS, comparison_psd, frf_frame
-from railride.pareto import ParetoResult
+from railride.run import rig
+from railride.analysis.spectra import FRF_PATTERNS, comparison_psd, frf_frame
+from railride.studies.pareto import ParetoResult
 from railride.plots.comparison import (
     plot_comparison_damper_forces,
     plot_comparison_psd,
@@ -23,15 +23,15 @@ from railride.plots.pareto import plot_pareto
 from railride.plots.ride import plot_body_responses
 from railride.plots.rig import plot_hysteresis, plot_tracking
 from railride.plots.sweep import plot_sweep, plot_sweep_comfort
-from railride.sweep import COMFORT_COLUMNS, SweepResult
-from railride.sweep import grid as sweep_grid
-from railride.sweep import metric_columns as sweep_metric_columns
+from railride.studies.sweep import COMFORT_COLUMNS, SweepResult
+from railride.studies.sweep import grid as sweep_grid
+from railride.studies.sweep import metric_columns as sweep_metric_columns
 from railride.plots.tuning import plot_sensitivity
-from railride.simulation import simulate
-from railride.tables import modes_frame
-from railride.track import scenario
-from railride.tuning import Curve
-from railride.vehicle import Vehicle
+from railride.run.simulation import simulate
+from railride.output.tables import modes_frame
+from railride.model.track import scenario
+from railride.studies.tuning import Curve
+from railride.model.vehicle import Vehicle
 
 
 @pytest.fixture(scope="module")
@@ -164,9 +164,9 @@ def test_a_wrong_number_of_axes_is_refused(results):
 
 
 def test_plots_take_their_documented_type(result):
-    with pytest.raises(ValueError, match="comparison: expected a railride.comparison.Comparison"):
+    with pytest.raises(ValueError, match="comparison: expected a railride.studies.comparison.Comparison"):
         plot_comparison_response(result.dataset, "pitch")
-    with pytest.raises(ValueError, match="cycles: expected a railride.rig.Cycles"):
+    with pytest.raises(ValueError, match="cycles: expected a railride.run.rig.Cycles"):
         plot_hysteresis(result.dataset)
 
 

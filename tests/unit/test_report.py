@@ -1,4 +1,4 @@
-"""The HTML report (railride.report) and its interactive figures (railride.plots.interactive):
+"""The HTML report (railride.output.report) and its interactive figures (railride.plots.interactive):
 what the page holds, read back with the standard library's HTML parser, and the envelope that
 thins long histories."""
 
@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import railride as rr
-from railride import report
+from railride.output import report
 from railride.plots.interactive import comparison_response_figure, envelope
 
 

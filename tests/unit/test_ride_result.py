@@ -9,17 +9,17 @@ import numpy as np
 import pytest
 
 from railride import dampers
-from railride.comparison import compare
-from railride.files import OUTPUT_FILES
-from railride.metrics import to_dict as metrics_record
-from railride.params import VehicleParams
-from railride.pareto import pareto
-from railride.ride import SCHEMA, RideResult
-from railride.simulation import simulate
-from railride.solver import RESOLUTION, SolverSettings, check_resolution
-from railride.suspension import Suspension
-from railride.track import scenario
-from railride.tuning import tune
+from railride.studies.comparison import compare
+from railride.output.files import OUTPUT_FILES
+from railride.analysis.metrics import to_dict as metrics_record
+from railride.model.params import VehicleParams
+from railride.studies.pareto import pareto
+from railride.run.ride import SCHEMA, RideResult
+from railride.run.simulation import simulate
+from railride.run.solver import RESOLUTION, SolverSettings, check_resolution
+from railride.secondary.suspension import Suspension
+from railride.model.track import scenario
+from railride.studies.tuning import tune
 
 matplotlib.use("Agg")
 
@@ -143,13 +143,13 @@ def test_the_output_rate_must_resolve_a_random_track():
     ],
 )
 def test_the_studies_refuse_bad_settings_before_running(run, match, monkeypatch):
-    from railride import simulation
+    from railride.run import simulation
 
     def no_run(*args, **kwargs):
         raise AssertionError("a run started before the settings were checked")
 
     monkeypatch.setattr(simulation, "simulate", no_run)
-    monkeypatch.setattr("railride.comparison.simulate", no_run)
+    monkeypatch.setattr("railride.studies.comparison.simulate", no_run)
     with pytest.raises(ValueError, match=match):
         run()
 

@@ -1,4 +1,4 @@
-"""The damper rig's results (railride.rig): `Cycles` and `Tracking` follow the result protocol,
+"""The damper rig's results (railride.run.rig): `Cycles` and `Tracking` follow the result protocol,
 their documents are those of `railride damper` / `railride tracking`, and `TrackingMetrics`."""
 
 from __future__ import annotations
@@ -13,8 +13,9 @@ import pytest
 from matplotlib.figure import Figure
 
 from clihelp import PNG, ok_json
-from railride import files, rig
-from railride.files import DAMPER_FILES, TRACKING_FILES
+from railride.output import files
+from railride.run import rig
+from railride.output.files import DAMPER_FILES, TRACKING_FILES
 
 
 @pytest.fixture(scope="module")
@@ -50,7 +51,7 @@ def test_cycles_to_pandas_is_the_csv_table(cycles):
 
 
 def rig_channels():
-    from railride.tables import RIG_CHANNELS
+    from railride.output.tables import RIG_CHANNELS
 
     return list(RIG_CHANNELS)
 

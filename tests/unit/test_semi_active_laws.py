@@ -1,4 +1,4 @@
-"""The semi-active laws beside the paper's (railride.controllers) as gain matrices, their names,
+"""The semi-active laws beside the paper's (railride.secondary.controllers) as gain matrices, their names,
 their gain tables in a gains file, and the refusals of bad input."""
 
 import inspect
@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 from railride import dampers
-from railride.comparison import check_controllers, compare
-from railride.control import (
+from railride.studies.comparison import check_controllers, compare
+from railride.secondary.control import (
     CONSTANT_VOLTAGE,
     CONTROLLERS,
     LABELS,
@@ -17,11 +17,11 @@ from railride.control import (
     PAPER_CONTROLLERS,
     GainSet,
 )
-from railride.controllers import ClippedOptimal, Groundhook, Hybrid, Skyhook, SkyhookOnOff
-from railride.params import VehicleParams
-from railride.sweep_grid import grid
-from railride.suspension import NAMES, Suspension
-from railride.vehicle import Vehicle
+from railride.secondary.controllers import ClippedOptimal, Groundhook, Hybrid, Skyhook, SkyhookOnOff
+from railride.model.params import VehicleParams
+from railride.studies.grid import grid
+from railride.secondary.suspension import NAMES, Suspension
+from railride.model.vehicle import Vehicle
 
 P = VehicleParams.preset("paper")
 V = Vehicle(P)

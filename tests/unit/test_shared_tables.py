@@ -12,10 +12,11 @@ import numpy as np
 import pytest
 
 import railride as rr
-from railride import simulation, track
+from railride.run import simulation
+from railride.model import track
 from railride._cache import BytesLRU
-from railride.ride import RideResult
-from railride.sweep import Case, _chunks, grid, run_cases
+from railride.run.ride import RideResult
+from railride.studies.sweep import Case, _chunks, grid, run_cases
 
 
 @pytest.fixture

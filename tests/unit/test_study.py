@@ -1,4 +1,4 @@
-"""Statistics over tracks (railride.study): the numbers recomputed from the runs, the cases a
+"""Statistics over tracks (railride.studies.study): the numbers recomputed from the runs, the cases a
 study runs, failed runs, bad input and the result protocol."""
 
 import json
@@ -6,12 +6,12 @@ import json
 import numpy as np
 import pytest
 
-from railride.control import GainSet
-from railride.simulation import simulate
-from railride.study import METRICS, fault_condition, study
-from railride.suspension import Suspension
-from railride.sweep import RunTable
-from railride.track import scenario
+from railride.secondary.control import GainSet
+from railride.run.simulation import simulate
+from railride.studies.study import METRICS, fault_condition, study
+from railride.secondary.suspension import Suspension
+from railride.studies.sweep import RunTable
+from railride.model.track import scenario
 
 SHORT = dict(track_seeds=[0, 1, 2], speeds=[30.0, 50.0], duration=2.0)
 
@@ -86,7 +86,7 @@ def test_a_run_that_diverges_is_listed_and_the_others_go_on():
     ],
 )
 def test_bad_settings_are_refused_before_any_run(kwargs, match, monkeypatch):
-    from railride import simulation
+    from railride.run import simulation
 
     def no_run(*args, **kw):
         raise AssertionError("a run started before the settings were checked")

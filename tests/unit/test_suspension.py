@@ -9,13 +9,13 @@ import numpy as np
 import pytest
 
 from railride import dampers
-from railride.control import PID, GainSet, InnerLoop, SensorNoise, ZeroDemand
-from railride.params import VehicleParams
-from railride.simulation import simulate
-from railride.solver import SolverSettings
-from railride.suspension import NAMES, Suspension, batch_conflict
-from railride.sweep import Case, run_cases
-from railride.track import scenario
+from railride.secondary.control import PID, GainSet, InnerLoop, SensorNoise, ZeroDemand
+from railride.model.params import VehicleParams
+from railride.run.simulation import simulate
+from railride.run.solver import SolverSettings
+from railride.secondary.suspension import NAMES, Suspension, batch_conflict
+from railride.studies.sweep import Case, run_cases
+from railride.model.track import scenario
 
 SC = scenario("paper-sine", duration=0.5)
 G = GainSet.default()

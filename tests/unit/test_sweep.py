@@ -14,8 +14,8 @@ from matplotlib.figure import Figure
 
 import railride as rr
 from railride import dampers
-from railride.executors import RunTable
-from railride.sweep import COMFORT_COLUMNS, SCHEMA, SweepGrid, SweepResult, grid, metric_columns, run_sweep
+from railride.studies.executors import RunTable
+from railride.studies.sweep import COMFORT_COLUMNS, SCHEMA, SweepGrid, SweepResult, grid, metric_columns, run_sweep
 
 RMS = ["acceleration_m_s2_rms", "displacement_m_rms", "pitch_deg_rms", "roll_deg_rms"]
 
@@ -190,8 +190,8 @@ def test_run_sweep_result_holds_objects(swept):
 
 def test_comfort_columns_are_each_runs_own_indices(swept):
     # each row's comfort columns against the indices of that run simulated on its own
-    from railride.comfort import ride_comfort
-    from railride.sweep import COMFORT_INDICES
+    from railride.analysis.comfort import ride_comfort
+    from railride.studies.sweep import COMFORT_INDICES
 
     frame = swept.to_pandas()
     for k in (0, 4):  # passive at 20 m/s, PID at 30 m/s
@@ -286,5 +286,5 @@ def test_run_sweep_resumes_from_its_run_table(swept, tmp_path):
 
 
 def test_run_sweep_takes_a_grid():
-    with pytest.raises(ValueError, match="railride.sweep.grid makes one"):
+    with pytest.raises(ValueError, match="railride.studies.sweep.grid makes one"):
         run_sweep([rr.sweep.Case()])

@@ -1,13 +1,13 @@
-"""The flat tables of railride.tables."""
+"""The flat tables of railride.output.tables."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from railride import tables
-from railride.simulation import simulate
-from railride.track import scenario
+from railride.output import tables
+from railride.run.simulation import simulate
+from railride.model.track import scenario
 
 
 @pytest.fixture(scope="module")

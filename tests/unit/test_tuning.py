@@ -3,15 +3,15 @@
 import numpy as np
 import pytest
 
-from railride.control import GainSet
-from railride.optimise import optimise, sensitivity
-from railride.simulation import simulate
-from railride.solver import SolverSettings
-from railride.suspension import Suspension
-from railride.sweep import Case, RunTable, run_cases
-from railride.track import scenario
-from railride.params import VehicleParams
-from railride.tuning import (
+from railride.secondary.control import GainSet
+from railride.studies.optimise import optimise, sensitivity
+from railride.run.simulation import simulate
+from railride.run.solver import SolverSettings
+from railride.secondary.suspension import Suspension
+from railride.studies.sweep import Case, RunTable, run_cases
+from railride.model.track import scenario
+from railride.model.params import VehicleParams
+from railride.studies.tuning import (
     DEFAULT_OBJECTIVE,
     INFEASIBLE_OFFSET,
     PARAMETERS,
@@ -384,7 +384,7 @@ def test_a_resumed_sweep_with_other_run_settings_runs_again(tmp_path):
 
 # -- every law alike ------------------------------------------------------------------------------
 def test_every_law_gets_the_same_budget_on_its_own_gains():
-    from railride.tuning import TUNED_CONTROLLERS
+    from railride.studies.tuning import TUNED_CONTROLLERS
 
     B = 14
     res = tune(("pid", "skyhook", "groundhook"), scenario_options={"duration": 0.5}, n_values=3, budget=B)
@@ -426,7 +426,7 @@ def test_a_law_is_tuned_on_its_own_tables_and_the_lqr_scale_is_fixed():
 
 
 def test_a_blend_is_swept_within_its_range():
-    from railride.tuning import _candidates
+    from railride.studies.tuning import _candidates
 
     values = _candidates(0.5, "hybrid.alpha", 13, 30.0, GainSet.reference())
     assert 0.0 in values and 0.5 in values and max(values) <= 1.0 and len(values) >= 6
@@ -444,8 +444,8 @@ def test_tune_refuses_what_it_cannot_tune():
 @pytest.fixture(scope="module")
 def shipped_ratios():
     """RMS ratios to passive of every law with the shipped gains on paper-sine."""
-    from railride.comparison import compare
-    from railride.tuning import TUNED_CONTROLLERS
+    from railride.studies.comparison import compare
+    from railride.studies.tuning import TUNED_CONTROLLERS
 
     cmp = compare("paper-sine", controllers=TUNED_CONTROLLERS)
     rms = cmp.metrics.sel(statistic="rms")
@@ -453,7 +453,7 @@ def shipped_ratios():
 
 
 def test_shipped_gains_record_how_each_law_was_tuned(shipped_ratios):
-    from railride.tuning import DEFAULT_BUDGET, TUNED_CONTROLLERS
+    from railride.studies.tuning import DEFAULT_BUDGET, TUNED_CONTROLLERS
 
     shipped = GainSet.default()
     p = shipped.provenance
@@ -494,7 +494,7 @@ def test_tune_with_a_scaled_damper_tunes_the_inner_loop_for_it():
 
 def test_run_keys_change_with_the_model_revision(monkeypatch):
     # a run table from an earlier model must not resume into this one
-    import railride.sweep as sweep_module
+    import railride.studies.sweep as sweep_module
 
     c = Case(suspension="pid", gains={"pid.kd": 1e5})
     before = c.key
@@ -504,7 +504,7 @@ def test_run_keys_change_with_the_model_revision(monkeypatch):
 
 # -- robust tuning: a set of tracks and payloads -----------------------------------------------------
 def test_robust_tuning_scores_the_mean_or_the_worst_of_its_cases():
-    from railride.tuning import tuning_set
+    from railride.studies.tuning import tuning_set
 
     cases = tuning_set("fra4", track_seeds=[0, 1], loads=[1.0, 1.3], duration=0.5)
     assert len(cases) == 4 and {c.load for c in cases} == {1.0, 1.3}
@@ -540,7 +540,7 @@ def test_robust_tuning_scores_the_mean_or_the_worst_of_its_cases():
 
 
 def test_robust_tuning_refuses_what_it_cannot_use():
-    from railride.tuning import tuning_set
+    from railride.studies.tuning import tuning_set
 
     with pytest.raises(ValueError, match="aggregate = 'median'"):
         tune(("pid",), over=tuning_set("fra4", track_seeds=[0]), aggregate="median")

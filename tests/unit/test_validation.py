@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from railride import validation
-from railride.track import SineTrack
+from railride.model.track import SineTrack
 
 
 @pytest.mark.parametrize("value", [3, 3.0, np.float32(3.0), np.float64(3.0), np.int64(3), np.int8(3)])

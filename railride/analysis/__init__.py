@@ -1,0 +1,1 @@
+"""Analysis of time histories: metrics, ride comfort, spectra and the labels of responses."""

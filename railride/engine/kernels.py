@@ -1,0 +1,848 @@
+"""All compiled code: the closed-loop fixed-step stepper (numba).
+
+The stepper integrates, for each sample of a batch,
+
+    q'' = Aq q + Av q' + Bw w + Bwd w' + Bf f,    f_i = -c_i (Ts q')_i
+
+with classical fourth-order Runge-Kutta at a fixed step. The matrices are the vehicle's
+(M^-1 folded in, see `simulation._system_arrays`), stored transposed so that a product runs
+down the columns with the nine row sums held in registers. The rail inputs w, w' and the
+forcing Bw w + Bwd w' come from tables on a time grid whose nodes fall on step boundaries,
+interpolated with cubic Hermite polynomials (see `railride.model.track.wheelset_input_table`).
+Sizes are module constants so that LLVM sees fixed trip counts. The three products of every
+stage (q'', the corner deflections and rates, the rail forcing) are vector intrinsics
+(`railride.engine._simd`); the damper laws are inlined. Nothing is allocated inside the time loop.
+Batches run in parallel on threads (`run_parallel`): the kernels release the GIL. numba's
+``prange`` would do the same, but it doubled the compile time of the stepper (12 s against
+6 s), which every fresh install pays once.
+"""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+from numba import njit
+from numba.core.errors import NumbaPerformanceWarning
+
+from railride.engine._simd import bouc_wen1_corners, corner_pairs, forcing_rows, mv9_simd
+from railride.engine.layout import (  # sizes, codes and slots: compile-time constants to numba
+    DIVERGED,
+    FAULT_DISCONNECTED,
+    FAULT_NONE,
+    FAULT_OFF,
+    FAULT_ON,
+    FD_HELD,
+    FD_NEXT,
+    LAW_BOUC_WEN,
+    LAW_IDEAL,
+    LAW_SPENCER,
+    LAW_VISCOUS,
+    LAW_VISCOUS_IN_C,
+    MAX_SUBSTEPS,
+    NS_MAX,
+    NY,
+    N_CORNER,
+    N_DAMPER_STATES,
+    N_DOF,
+    N_DS,
+    N_RAIL,
+    N_SENS_STATES,
+    P_A,
+    P_ALPHA_A,
+    P_ALPHA_B,
+    P_DISSIPATIVE,
+    P_BETA,
+    P_C0A,
+    P_C0B,
+    P_C1A,
+    P_C1B,
+    P_ETA,
+    P_GAMMA,
+    P_K0,
+    P_K1,
+    P_N,
+    P_V_MAX,
+    P_V_MIN,
+    P_Z_BOUND,
+    RIG_COMMANDED,
+    RIG_CONSTANT,
+    RIG_TRACKING,
+    SENS,
+    STATUS_DIVERGED,
+    STATUS_OK,
+    SUBSTEP_DT_REF,
+    SUBSTEP_LIMIT,
+    VOLTAGE_CLIPPED,
+    VOLTAGE_ON_OFF,
+    XI,
+)
+from railride.engine.layout import FASTMATH as _FAST, NO_PARFORS as _NO_PARFORS
+
+# numba reports the parallel pipeline without parfors as a missed opportunity: that is the intent
+# here (`layout.NO_PARFORS`)
+warnings.filterwarnings(
+    "ignore", message=r"(?s).*keyword argument 'parallel=True' was specified", category=NumbaPerformanceWarning
+)
+
+
+@njit(cache=True, inline="always", fastmath=_FAST)
+def _hermite(t, n_nodes, interval):
+    """Node index k of time t on the input grid and the cubic Hermite weights there.
+
+    Returns (k, h00, h10, h01, h11, d00, d10, d11): a quantity with node values y, slopes y'
+    is y(t) = h00 y_k + h10 y'_k + h01 y_k+1 + h11 y'_k+1 and its rate is
+    y'(t) = d00 (y_k - y_k+1) + d10 y'_k + d11 y'_k+1 (the interval is folded in).
+    """
+    u = t / interval
+    k = int(u)
+    if k > n_nodes - 2:
+        k = n_nodes - 2
+    tau = u - k
+    if tau > 1.0:
+        tau = 1.0
+    om = 1.0 - tau
+    return (
+        k,
+        (1.0 + 2.0 * tau) * om * om,
+        tau * om * om * interval,
+        tau * tau * (3.0 - 2.0 * tau),
+        tau * tau * (tau - 1.0) * interval,
+        6.0 * tau * (tau - 1.0) / interval,
+        om * (1.0 - 3.0 * tau),
+        tau * (3.0 * tau - 2.0),
+    )
+
+
+@njit(cache=True, inline="always", fastmath=_FAST)
+def _forcing(t, ftab, off, n_nodes, interval, out, ooff):
+    """Rail forcing r = Bw w + Bwd w' at time t, from the forcing table.
+
+    Hermite interpolation is linear in the node data, so interpolating the node values
+    P = Bw w_k, Q = Bw w'_k, R = Bwd w_k, S = Bwd w'_k (columns 0-8, 9-17, 18-26, 27-35)
+    gives exactly Bw w(t) + Bwd w'(t) of the interpolated rail inputs, in 9 x 8 operations
+    instead of interpolating 16 inputs and multiplying by a 9 x 16 matrix (in vector form,
+    `railride.engine._simd.forcing_rows`).
+    """
+    k, h00, h10, h01, h11, d00, d10, d11 = _hermite(t, n_nodes, interval)
+    forcing_rows(ftab, off + k, h00, h10, h01, h11, d00, d10, d11, out, ooff)
+
+
+@njit(cache=True, inline="always", fastmath=_FAST)
+def _rail_inputs(t, utab, off, n_nodes, interval, w, wd):
+    """Rail heights w and velocities w' at the wheelsets at time t, from the input table."""
+    k, h00, h10, h01, h11, d00, d10, d11 = _hermite(t, n_nodes, interval)
+    a = off + k
+    b = a + 1
+    for c in range(N_RAIL):
+        w[c] = h00 * utab[a, c] + h10 * utab[a, 8 + c] + h01 * utab[b, c] + h11 * utab[b, 8 + c]
+        wd[c] = d00 * (utab[a, c] - utab[b, c]) + d10 * utab[a, 8 + c] + d11 * utab[b, 8 + c]
+
+
+@njit(cache=True, inline="always", fastmath=_FAST)
+def _mv9(AT, x, xf, n_cols, r, roff, out, ooff, idx8, val8, n8):
+    """out[ooff:ooff+9] = r[roff:roff+9] + A y for the 9 rows of q'', A stored transposed
+    (n_cols, 9), y = (x[:18], xf[18:n_cols]): the state's (q, q') read in place, the corner
+    forces from the stage vector; row 8 from its non-zero entries (idx8, val8, n8). Offsets
+    instead of slices: a slice made in the loop costs reference counting. The product is
+    written in vector form (`railride.engine._simd`): as plain numba, nine named scalar sums were the
+    fastest form and stayed scalar."""
+    mv9_simd(AT, x, xf, n_cols, r, roff, out, ooff, idx8, val8, n8)
+
+
+@njit(cache=True, inline="always", fastmath=_FAST)
+def _corner_values(TT, s, offset, out):
+    """out[c] = sum_j TT[j, c] s[offset + j]: the secondary deflections (offset 0, from q) or
+    their rates (offset N_DOF, from q') at the four corners (TT = T, (9, 4))."""
+    b0 = 0.0
+    b1 = 0.0
+    b2 = 0.0
+    b3 = 0.0
+    for j in range(N_DOF):
+        sj = s[offset + j]
+        b0 += TT[j, 0] * sj
+        b1 += TT[j, 1] * sj
+        b2 += TT[j, 2] * sj
+        b3 += TT[j, 3] * sj
+    out[0] = b0
+    out[1] = b1
+    out[2] = b2
+    out[3] = b3
+
+
+@njit(cache=True, inline="always", fastmath=_FAST)
+def _bouc_wen_rate(z, w, A, n, gamma, beta):
+    """z' = -gamma |w| z |z|^(n-1) - beta w |z|^n + A w (see railride.secondary.dampers)."""
+    az = abs(z)
+    if n == 1.0:
+        zn1 = 1.0
+    elif n == 2.0:
+        zn1 = az
+    else:
+        zn1 = az ** (n - 1.0)
+    return -gamma * abs(w) * z * zn1 - beta * w * zn1 * az + A * w
+
+
+@njit(cache=True, inline="always", fastmath=_FAST)
+def damper_law(law, P, x, xd, z, y, u, v):
+    """Force F (tension +) and the rates (z', y', u') of one damper; P as `Damper.pack()`.
+    LAW_IDEAL: v is the held demand on the carbody, so F = -v and the carbody gets f = v."""
+    if law == LAW_VISCOUS:
+        return P[P_C0A] * xd, 0.0, 0.0, 0.0
+    if law == LAW_IDEAL:  # P[P_DISSIPATIVE] > 0: dissipative only, no force where it would push energy in
+        if P[P_DISSIPATIVE] > 0.0 and v * xd > 0.0:
+            return 0.0, 0.0, 0.0, 0.0
+        return -v, 0.0, 0.0, 0.0
+    alpha = P[P_ALPHA_A] + P[P_ALPHA_B] * u
+    c0 = P[P_C0A] + P[P_C0B] * u
+    du = -P[P_ETA] * (u - v)
+    if law == LAW_BOUC_WEN:
+        dz = _bouc_wen_rate(z, xd, P[P_A], P[P_N], P[P_GAMMA], P[P_BETA])
+        return c0 * xd + P[P_K0] * x + alpha * z, dz, 0.0, du
+    c1 = P[P_C1A] + P[P_C1B] * u
+    dy = (alpha * z + c0 * xd + P[P_K0] * (x - y)) / (c0 + c1)
+    dz = _bouc_wen_rate(z, xd - dy, P[P_A], P[P_N], P[P_GAMMA], P[P_BETA])
+    return c1 * dy + P[P_K1] * x, dz, dy, du
+
+
+@njit(cache=True, fastmath=_FAST)
+def damper_stiffness(law, P, xd, z, u):
+    """A bound on the fastest rate of the damper's internal states [1/s]
+    (same as railride.secondary.dampers.stiffness_estimate). |z| is taken at least at the bound of the
+    hysteretic variable (P[P_Z_BOUND]): starting from z = 0 the rate grows within the step."""
+    if law == LAW_VISCOUS or law == LAW_VISCOUS_IN_C or law == LAW_IDEAL:
+        return 0.0
+    gb = abs(P[P_GAMMA]) + abs(P[P_BETA])
+    n = P[P_N]
+    az = max(abs(z), P[P_Z_BOUND])
+    lam = n * gb * abs(xd) * (1.0 if n == 1.0 else az ** (n - 1.0)) + P[P_ETA]
+    if law == LAW_SPENCER:
+        cs = P[P_C0A] + P[P_C0B] * u + P[P_C1A] + P[P_C1B] * u
+        lam += ((P[P_A] + gb * az**n) * (P[P_ALPHA_A] + P[P_ALPHA_B] * u) + P[P_K0]) / cs
+    return lam
+
+
+@njit(cache=True)
+def substeps(lam, dt):
+    """Sub-steps per step (a power of two) for a fastest damper rate lam [1/s].
+
+    The count depends on lam alone, lam * SUBSTEP_DT_REF / m <= SUBSTEP_LIMIT, so a smaller dt
+    gives proportionally smaller sub-steps and step halving refines the whole scheme; a floor
+    keeps lam * dt / m <= 2 * SUBSTEP_LIMIT for stability when dt is large.
+    """
+    m = 1
+    while (lam * SUBSTEP_DT_REF > SUBSTEP_LIMIT * m or lam * dt > 2.0 * SUBSTEP_LIMIT * m) and m < MAX_SUBSTEPS:
+        m *= 2
+    return m
+
+
+@njit(cache=True)
+def _one_step_limit(dt):
+    """The largest rate bound lam for which `substeps` gives one step (by bisection on its own
+    test, so that lam <= this is exactly substeps(lam, dt) == 1)."""
+    lo = 0.0
+    hi = 1.0
+    while substeps(hi, dt) == 1:
+        hi *= 2.0
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        if mid <= lo or mid >= hi:
+            break
+        if substeps(mid, dt) == 1:
+            lo = mid
+        else:
+            hi = mid
+    return lo
+
+
+@njit(cache=True, inline="always", fastmath=_FAST)
+def _derivative(law, s, R, roff, AT, TT, P, vcmd, conn, y, cx, cv, K, koff, i8, v8, n8, bw1):
+    """K[koff:koff+NS_MAX] = d/dt of the state s = (q, q', damper states), with the rail forcing
+    R[roff:roff+9].
+
+    y receives the stage vector (q, q', f). LAW_VISCOUS_IN_C: the dampers are in Av,
+    q'' = r + [Aq Av] (q, q'). Otherwise every corner's damper law gives its force F from the
+    corner deflection and rate, f = -F conn[c] enters through Bf (conn[c] = 0: the damper is
+    disconnected), and the damper states (z, y, u) advance.
+    """
+    for i in range(N_DOF):
+        K[koff + i] = s[N_DOF + i]
+    if law == LAW_VISCOUS_IN_C:
+        _mv9(AT, s, y, 2 * N_DOF, R, roff, K, koff + N_DOF, i8, v8, n8[0])
+        return
+    corner_pairs(TT, s, cx, cv)
+    if bw1:  # Bouc-Wen with n = 1 (the railway dampers): the four corners as one vector
+        # the product repeated in this branch on purpose: one call after an if/else made the
+        # SAS closed loop 20-25 % slower (A/B, alternating processes)
+        bouc_wen1_corners(P, s, cx, cv, vcmd, conn, y, K, koff)
+        _mv9(AT, s, y, NY, R, roff, K, koff + N_DOF, i8, v8, n8[1])
+        return
+    for c in range(N_CORNER):
+        b = 2 * N_DOF + N_DAMPER_STATES * c
+        F, dz, dyy, du = damper_law(law, P, cx[c], cv[c], s[b], s[b + 1], s[b + 2], vcmd[c])
+        y[2 * N_DOF + c] = -F * conn[c]
+        K[koff + b] = dz
+        K[koff + b + 1] = dyy
+        K[koff + b + 2] = du
+    _mv9(AT, s, y, NY, R, roff, K, koff + N_DOF, i8, v8, n8[1])
+
+
+@njit(cache=True, nogil=True, fastmath=_FAST, parallel=_NO_PARFORS)
+def run_batch(
+    lo,
+    hi,
+    law,
+    x,
+    step0,
+    n_steps,
+    final,
+    stride,
+    dt,
+    A,
+    TS,
+    c_sec,
+    P,
+    vcmd,
+    utab,
+    u_off,
+    ftab,
+    f_off,
+    n_nodes,
+    interval,
+    closed_loop,
+    ctrl_stride,
+    Gm,
+    Hm,
+    inner,
+    noise,
+    faults,
+    sensing,
+    snoise,
+    out_q,
+    out_v,
+    out_a,
+    out_f,
+    out_w,
+    out_wd,
+    out_d,
+    out_fd,
+    out_vc,
+    status,
+    fail_step,
+):
+    """Advance the state x[s] = (q, q', damper states) of samples lo <= s < hi by n_steps
+    steps of dt. Compiled without the GIL: `railride.run.simulation` runs sample ranges on threads.
+
+    Per sample s: A[s] (NY, 9) maps y = (q, q', f) to q'' (Aq, Av, Bf side by side, stored
+    transposed), TS[s] (9, 4) is T (corner deflections T^T q). ``law`` is LAW_VISCOUS_IN_C
+    (passive dashpots inside Av; c_sec[s] only for recording their forces) or a damper law
+    (railride.secondary.dampers) with packed parameters P[s] and command voltages vcmd[s] (4 corners).
+    The rail inputs come as tables on the time grid k * interval[s] with n_nodes[s] rows: utab
+    rows from u_off[s] (w, w', for the record) and ftab rows from f_off[s] (see `_forcing`).
+
+    Each step is one classical RK4 step, or 2^k equal RK4 sub-steps when the dampers' internal
+    states are stiff (`substeps`).
+
+    Open loop, each corner's command voltage is vcmd[s]. With ``closed_loop`` the controller
+    samples the state m = (q, q') (noise[k] added to the carbody's six at sample k, if noise has
+    rows) every ctrl_stride steps, integrates the carbody's (z, phi, theta) by the rectangle rule,
+    and computes the desired corner forces f_d = Gm[s] m + Hm[s] xi (Gm 4 x 18), which take effect
+    inner[s, 3] controller periods later (the computation and communication delay, 1 to
+    MAX_DELAY; zero demand until the first arrives) and are held. The voltage
+    law inner[s, 2] (railride.secondary.dampers.VOLTAGE_LAWS) runs at every step from the damper force f on
+    the carbody and the deflection rates x' at the step's start: tracking, v = clip(G (f_d - B f)
+    sgn(f), v_min, v_max) with (B, G) = inner[s, :2]; on-off, v_max where f_d x' < 0; clipped,
+    v_max where (f_d - f) f > 0 (else v_min). With LAW_IDEAL there is no inner loop: the command of
+    each corner is the held demand itself, which the ideal actuator applies (out_vc then
+    records the demand, not a voltage). The controller's integrator and demands are states
+    x[s, NS_MAX:], so a run can continue across calls.
+
+    Realistic sensing (sensing[s, 0] = 1; layout `SENSING_COLS`): the controller does not see
+    the state. A vertical accelerometer at each carbody corner measures the corner's
+    acceleration through a first-order anti-alias filter (rate sensing[s, 1], integrated at every
+    step), sampled at the controller rate with a bias (sensing[s, 3:7]) and white noise
+    (snoise[k]); at each sample two band-limited integration stages, each a high-pass then a
+    leaky integral (s / (s + w)^2, w = sensing[s, 2], backward Euler), give each corner's
+    velocity and displacement, which the map sensing[s, 7:] turns into the carbody's heave, pitch
+    and roll; the bogie states read as 0.
+
+    Damper faults: corner c of sample s fails with mode faults[s, c] (FAULT_*) from step
+    faults[s, 4 + c] on. FAULT_OFF and FAULT_ON hold its command at v_min and v_max whatever the
+    voltage law asks (the coil follows with its time constant); FAULT_DISCONNECTED removes its
+    force from the vehicle.
+
+    Steps are numbered globally from step0 (t = step * dt). At every step whose number is a
+    multiple of ``stride`` the state, acceleration, damper forces, rail inputs, damper states,
+    demanded forces and command voltages at that time are written to row step // stride of the
+    outputs (out_d, out_fd, out_vc only if they have rows);
+    with ``final`` the state after the last step is written too. A sample whose state leaves
+    +-DIVERGED or stops being finite gets status STATUS_DIVERGED and the step number in
+    fail_step, and stops.
+    """
+    # damper states to integrate (the ideal actuator has none: its law ignores them)
+    has_states = law != LAW_VISCOUS_IN_C and law != LAW_IDEAL
+    ns = NS_MAX if has_states else 2 * N_DOF
+    record_d = out_d.shape[1] > 1
+    record_c = out_fd.shape[1] > 1
+    for smp in range(lo, hi):
+        if status[smp] != STATUS_OK:
+            continue
+        s = x[smp].copy()
+        st = np.zeros(NS_MAX)  # stage state (zeros: the states a law without any still reads)
+        y = np.empty(NY)  # stage vector (q, q', f)
+        cx = np.empty(N_CORNER)
+        cv = np.empty(N_CORNER)
+        K = np.zeros(4 * NS_MAX)  # the four stage rates, one after another
+        R = np.empty(3 * N_DOF)  # rail forcing at the sub-step's start, middle and end
+        w = np.empty(N_RAIL)
+        wd = np.empty(N_RAIL)
+        at, tt, cs, pp = A[smp], TS[smp], c_sec[smp], P[smp]
+        uo, fo, nn, itv = u_off[smp], f_off[smp], n_nodes[smp], interval[smp]
+        vc = vcmd[smp].copy()  # command voltages, held over each step
+        fm = faults[smp]
+        conn = np.ones(N_CORNER)  # 0 where a damper is disconnected
+        faulty = False  # a healthy sample skips the fault checks
+        for c in range(N_CORNER):
+            faulty = faulty or fm[c] != FAULT_NONE
+        meas = np.empty(2 * N_DOF)  # the controller's sample of the state (q, q')
+        gm, hm = Gm[smp], Hm[smp]
+        delay = int(inner[smp, 3])  # controller periods from a sample to its demand taking effect
+        tc = ctrl_stride * dt
+        sens = closed_loop and sensing[smp, 0] > 0.0
+        w_aa, w_c = sensing[smp, 1], sensing[smp, 2]
+        hp = 1.0 / (1.0 + w_c * tc)  # backward Euler of s / (s + w) and of 1 / (s + w)
+        n_snoise = snoise.shape[0]
+        n_noise = noise.shape[0]
+        bw1 = law == LAW_BOUC_WEN and pp[P_N] == 1.0
+        gb1 = pp[P_N] * (abs(pp[P_GAMMA]) + abs(pp[P_BETA]))
+        lam1 = _one_step_limit(dt)  # the largest rate bound that needs no sub-steps
+        # the last row of q'' is sparse (a bogie's roll): its non-zero columns, in order
+        i8 = np.empty(NY, np.int64)
+        v8 = np.empty(NY)
+        n8 = np.zeros(2, np.int64)  # how many of them act on (q, q'), and on (q, q', f)
+        for j in range(NY):
+            if at[j, N_DOF - 1] != 0.0:
+                i8[n8[1]] = j
+                v8[n8[1]] = at[j, N_DOF - 1]
+                n8[1] += 1
+                if j < 2 * N_DOF:
+                    n8[0] += 1
+        _forcing(step0 * dt, ftab, fo, nn, itv, R, 0)
+        last = n_steps + 1 if final else n_steps
+        for n in range(last):
+            step = step0 + n
+            t = step * dt
+            if closed_loop and step % ctrl_stride == 0:
+                k = step // ctrl_stride
+                # the demand computed `delay` periods ago takes effect; its slot takes the new one
+                slot = FD_NEXT + N_CORNER * (k % delay)
+                for c in range(N_CORNER):
+                    x[smp, FD_HELD + c] = x[smp, slot + c]
+                for j in range(2 * N_DOF):
+                    meas[j] = 0.0 if sens else s[j]
+                if sens:  # the accelerometers, sampled, and the band-limited integration
+                    for c in range(N_CORNER):
+                        b = SENS + N_SENS_STATES * c
+                        a_m = x[smp, b] + sensing[smp, 3 + c] + (snoise[k, c] if k < n_snoise else 0.0)
+                        x[smp, b + 2] = hp * (x[smp, b + 2] + a_m - x[smp, b + 1])
+                        x[smp, b + 1] = a_m
+                        v_new = hp * (x[smp, b + 3] + tc * x[smp, b + 2])
+                        x[smp, b + 5] = hp * (x[smp, b + 5] + v_new - x[smp, b + 4])
+                        x[smp, b + 4] = v_new
+                        x[smp, b + 3] = v_new
+                        x[smp, b + 6] = hp * (x[smp, b + 6] + tc * x[smp, b + 5])
+                    for j in range(3):
+                        for c in range(N_CORNER):
+                            pm = sensing[smp, 3 + N_CORNER + N_CORNER * j + c]
+                            meas[j] += pm * x[smp, SENS + N_SENS_STATES * c + 6]
+                            meas[N_DOF + j] += pm * x[smp, SENS + N_SENS_STATES * c + 3]
+                if k < n_noise:  # sensor noise on the carbody's (z, phi, theta) and their rates
+                    for j in range(3):
+                        meas[j] += noise[k, j]
+                        meas[N_DOF + j] += noise[k, 3 + j]
+                for j in range(3):
+                    x[smp, XI + j] += tc * meas[j]
+                for c in range(N_CORNER):
+                    acc_fd = 0.0
+                    for j in range(2 * N_DOF):
+                        acc_fd += gm[c, j] * meas[j]
+                    for j in range(3):
+                        acc_fd += hm[c, j] * x[smp, XI + j]
+                    x[smp, slot + c] = acc_fd
+            if closed_loop and law == LAW_IDEAL:
+                # the ideal actuator applies the held demand itself (no inner loop); its force
+                # is the command, so it is set before the step-start rates use it
+                for c in range(N_CORNER):
+                    vc[c] = x[smp, FD_HELD + c]
+            if faulty:  # a fault takes effect at its step
+                for c in range(N_CORNER):
+                    if fm[c] == FAULT_DISCONNECTED and step >= fm[N_CORNER + c]:
+                        conn[c] = 0.0
+            # rates at the step's start: for the record, the sub-step choice and stage 1
+            _derivative(law, s, R, 0, at, tt, pp, vc, conn, y, cx, cv, K, 0, i8, v8, n8, bw1)
+            if sens:  # each accelerometer's anti-alias filter follows its corner's acceleration
+                for c in range(N_CORNER):
+                    a_c = 0.0
+                    for j in range(3):
+                        a_c += tt[j, c] * K[N_DOF + j]
+                    b = SENS + N_SENS_STATES * c
+                    x[smp, b] += dt * w_aa * (a_c - x[smp, b])
+            if closed_loop and law != LAW_IDEAL:
+                # inner loop from the damper forces at the step's start (they do not depend on
+                # the command, only on the coil state); then correct stage 1's coil rate
+                mode = int(inner[smp, 2])
+                for c in range(N_CORNER):
+                    f = y[2 * N_DOF + c]
+                    fd = x[smp, FD_HELD + c]
+                    if mode == VOLTAGE_ON_OFF:  # cv: the deflection rates at the step's start
+                        vc[c] = pp[P_V_MAX] if fd * cv[c] < 0.0 else pp[P_V_MIN]
+                    elif mode == VOLTAGE_CLIPPED:
+                        vc[c] = pp[P_V_MAX] if (fd - f) * f > 0.0 else pp[P_V_MIN]
+                    else:
+                        sgn = 1.0 if f > 0.0 else (-1.0 if f < 0.0 else 0.0)
+                        v = inner[smp, 1] * (fd - inner[smp, 0] * f) * sgn
+                        vc[c] = min(max(v, pp[P_V_MIN]), pp[P_V_MAX])
+                    b = 2 * N_DOF + N_DAMPER_STATES * c + 2
+                    K[b] = -pp[P_ETA] * (s[b] - vc[c])
+            if faulty:  # a failed coil driver: the command held whatever the law asks
+                for c in range(N_CORNER):
+                    if (fm[c] == FAULT_OFF or fm[c] == FAULT_ON) and step >= fm[N_CORNER + c]:
+                        vc[c] = pp[P_V_MIN] if fm[c] == FAULT_OFF else pp[P_V_MAX]
+                        b = 2 * N_DOF + N_DAMPER_STATES * c + 2
+                        K[b] = -pp[P_ETA] * (s[b] - vc[c])
+            if step % stride == 0:
+                row = step // stride
+                bad = False
+                for i in range(N_DOF):
+                    out_q[smp, row, i] = s[i]
+                    out_v[smp, row, i] = s[N_DOF + i]
+                    out_a[smp, row, i] = K[N_DOF + i]
+                    if not (abs(s[i]) < DIVERGED and abs(s[N_DOF + i]) < 1e3 * DIVERGED):
+                        bad = True
+                if law == LAW_VISCOUS_IN_C:
+                    _corner_values(tt, s, N_DOF, cv)
+                    for c in range(N_CORNER):
+                        y[2 * N_DOF + c] = -cs[c] * cv[c]
+                for c in range(N_CORNER):
+                    out_f[smp, row, c] = y[2 * N_DOF + c]
+                if record_d:
+                    for i in range(N_DS):
+                        out_d[smp, row, i] = s[2 * N_DOF + i]
+                        if not abs(s[2 * N_DOF + i]) < DIVERGED:
+                            bad = True
+                _rail_inputs(t, utab, uo, nn, itv, w, wd)
+                for c in range(N_RAIL):
+                    out_w[smp, row, c] = w[c]
+                    out_wd[smp, row, c] = wd[c]
+                if record_c:
+                    for c in range(N_CORNER):
+                        out_fd[smp, row, c] = x[smp, FD_HELD + c]
+                        out_vc[smp, row, c] = vc[c]
+                if bad:
+                    status[smp] = STATUS_DIVERGED
+                    fail_step[smp] = step
+                    break
+            if n == n_steps:
+                break
+            m = 1
+            if bw1:
+                # Bouc-Wen with n = 1 (the railway dampers): the bound n gb |x'| + eta of
+                # `damper_stiffness` grows with |x'| alone, so the fastest corner decides, and
+                # one comparison with the one-step limit skips `substeps` at almost every step
+                vmax = 0.0
+                for c in range(N_CORNER):
+                    vmax = max(vmax, abs(cv[c]))
+                lam = gb1 * vmax + pp[P_ETA]
+                if lam > lam1:
+                    m = substeps(lam, dt)
+            elif law != LAW_VISCOUS_IN_C:
+                lam = 0.0
+                for c in range(N_CORNER):
+                    b = 2 * N_DOF + N_DAMPER_STATES * c
+                    lam = max(lam, damper_stiffness(law, pp, cv[c], s[b], s[b + 2]))
+                m = substeps(lam, dt)
+            h = dt / m
+            for sub in range(m):
+                ts = t + sub * h
+                _forcing(ts + 0.5 * h, ftab, fo, nn, itv, R, N_DOF)
+                _forcing(ts + h, ftab, fo, nn, itv, R, 2 * N_DOF)
+                # classical RK4: stage j at s + c_j h K_(j-1), c = (0, 1/2, 1/2, 1), with the
+                # forcing at the sub-step's start, middle, middle and end
+                for stage in range(4):
+                    if stage == 0 and sub == 0:
+                        continue  # K_0 is the step-start rate computed above
+                    ch = h * (0.0 if stage == 0 else (0.5 if stage < 3 else 1.0))
+                    roff = N_DOF * (0 if stage == 0 else (1 if stage < 3 else 2))
+                    prev = NS_MAX * (stage - 1 if stage > 0 else 0)  # stage 0 adds 0 * K_0
+                    for i in range(2 * N_DOF):  # constant trip counts: LLVM unrolls them
+                        st[i] = s[i] + ch * K[prev + i]
+                    if has_states:
+                        for i in range(2 * N_DOF, NS_MAX):
+                            st[i] = s[i] + ch * K[prev + i]
+                    _derivative(law, st, R, roff, at, tt, pp, vc, conn, y, cx, cv, K, NS_MAX * stage, i8, v8, n8, bw1)
+                for i in range(2 * N_DOF):
+                    s[i] += h / 6.0 * (K[i] + 2.0 * K[NS_MAX + i] + 2.0 * K[2 * NS_MAX + i] + K[3 * NS_MAX + i])
+                if has_states:
+                    for i in range(2 * N_DOF, NS_MAX):
+                        s[i] += h / 6.0 * (K[i] + 2.0 * K[NS_MAX + i] + 2.0 * K[2 * NS_MAX + i] + K[3 * NS_MAX + i])
+                for i in range(N_DOF):
+                    R[i] = R[2 * N_DOF + i]
+        for i in range(ns):
+            x[smp, i] = s[i]
+
+
+@njit(cache=True, nogil=True, fastmath=_FAST, parallel=_NO_PARFORS)
+def rig_batch(lo, hi, law, P, n_steps, stride, dt, xtab, x_interval, mode, vconst, series, B, G, out):
+    """A damper on a test rig: every sample lo <= s < hi drives one damper (parameters P[s])
+    through the extension x(t) of the table xtab (rows (x, x') on the grid k * x_interval, cubic
+    Hermite). Compiled without the GIL: `railride.run.rig` runs sample ranges on threads
+    (`run_parallel`).
+
+    The command voltage, held over each step, is vconst[s] (``mode`` RIG_CONSTANT), the series
+    series[s, step] (RIG_COMMANDED, clipped to [v_min, v_max]), or the force-tracking law of
+    paper eq. 12-14 (RIG_TRACKING), v = clip(G[s] (f_d - B[s] F) sgn(F), v_min, v_max), from the
+    force F at the step's start and the desired force f_d = series[s, step].
+    States: z, y, u and the dissipated energy E (E' = F x'). Row step // stride of out[s]
+    receives (t, x, x', F, z, y, u, v, E) at every step that is a multiple of stride, and after
+    the last step.
+    """
+    n_rows = xtab.shape[0]
+    for smp in range(lo, hi):
+        pp = P[smp]
+        z = 0.0
+        yy = 0.0
+        u = vconst[smp] if mode == RIG_CONSTANT else pp[P_V_MIN]
+        E = 0.0
+        kz = np.empty(4)  # stage rates of z, y, u, E
+        ky = np.empty(4)
+        ku = np.empty(4)
+        ke = np.empty(4)
+        for n in range(n_steps + 1):
+            t = n * dt
+            k, h00, h10, h01, h11, d00, d10, d11 = _hermite(t, n_rows, x_interval)
+            x = h00 * xtab[k, 0] + h10 * xtab[k, 1] + h01 * xtab[k + 1, 0] + h11 * xtab[k + 1, 1]
+            xd = d00 * (xtab[k, 0] - xtab[k + 1, 0]) + d10 * xtab[k, 1] + d11 * xtab[k + 1, 1]
+            F, dz, dy, du = damper_law(law, pp, x, xd, z, yy, u, 0.0)
+            if mode == RIG_TRACKING:
+                sgn = 1.0 if F > 0.0 else (-1.0 if F < 0.0 else 0.0)
+                v = min(max(G[smp] * (series[smp, n] - B[smp] * F) * sgn, pp[P_V_MIN]), pp[P_V_MAX])
+            elif mode == RIG_COMMANDED:
+                v = min(max(series[smp, n], pp[P_V_MIN]), pp[P_V_MAX])
+            else:
+                v = vconst[smp]
+            if n % stride == 0 or n == n_steps:
+                row = n // stride if n % stride == 0 else out.shape[1] - 1
+                out[smp, row, 0] = t
+                out[smp, row, 1] = x
+                out[smp, row, 2] = xd
+                out[smp, row, 3] = F
+                out[smp, row, 4] = z
+                out[smp, row, 5] = yy
+                out[smp, row, 6] = u
+                out[smp, row, 7] = v
+                out[smp, row, 8] = E
+            if n == n_steps:
+                break
+            m = substeps(damper_stiffness(law, pp, xd, z, u), dt)
+            h = dt / m
+            for sub in range(m):
+                tk = t + sub * h
+                # RK4 on (z, y, u, E) with the prescribed motion at the stage times
+                for stage in range(4):
+                    c = 0.0 if stage == 0 else (0.5 if stage < 3 else 1.0)
+                    zs = z if stage == 0 else z + c * h * kz[stage - 1]
+                    ys = yy if stage == 0 else yy + c * h * ky[stage - 1]
+                    us = u if stage == 0 else u + c * h * ku[stage - 1]
+                    k, h00, h10, h01, h11, d00, d10, d11 = _hermite(tk + c * h, n_rows, x_interval)
+                    xs = h00 * xtab[k, 0] + h10 * xtab[k, 1] + h01 * xtab[k + 1, 0] + h11 * xtab[k + 1, 1]
+                    xds = d00 * (xtab[k, 0] - xtab[k + 1, 0]) + d10 * xtab[k, 1] + d11 * xtab[k + 1, 1]
+                    Fs, kz[stage], ky[stage], ku[stage] = damper_law(law, pp, xs, xds, zs, ys, us, v)
+                    ke[stage] = Fs * xds
+                z += h / 6.0 * (kz[0] + 2.0 * kz[1] + 2.0 * kz[2] + kz[3])
+                yy += h / 6.0 * (ky[0] + 2.0 * ky[1] + 2.0 * ky[2] + ky[3])
+                u += h / 6.0 * (ku[0] + 2.0 * ku[1] + 2.0 * ku[2] + ku[3])
+                E += h / 6.0 * (ke[0] + 2.0 * ke[1] + 2.0 * ke[2] + ke[3])
+
+
+def run_parallel(kernel, n_samples: int, *args) -> None:
+    """Call ``kernel(lo, hi, *args)`` on sample ranges that cover 0..n_samples, one range per
+    thread (numba's thread count as set by `numba.set_num_threads`, at most one per sample)."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    import numba
+
+    n_threads = max(1, min(n_samples, numba.get_num_threads()))
+    if n_threads == 1:
+        kernel(0, n_samples, *args)
+        return
+    bounds = np.linspace(0, n_samples, n_threads + 1).round().astype(int)
+    with ThreadPoolExecutor(n_threads) as pool:
+        jobs = [pool.submit(kernel, int(bounds[i]), int(bounds[i + 1]), *args) for i in range(n_threads)]
+        for job in jobs:
+            job.result()
+
+
+@njit(cache=True, nogil=True, fastmath=_FAST)
+def exact_run(Phi, maps, used, stride, m, utab, interval, x0, A, Bw, Bwd, TS, c_sec, q, v, a, f, w, wd):
+    """The exact discretisation of the passive vehicle (`railride.engine.discrete`), one sample: the
+    state (q, q') at every output row from x0 by x_(k+1) = Phi x_k + maps[k % period] (the
+    first used[k % period] input-table rows from the step's start), and the outputs the RK4 stepper records there:
+    q, q', q'' = A x + Bw w + Bwd w', the secondary forces -c T^T q' and the rail inputs w, w'
+    (cubic Hermite on the table, rates its derivative). ``utab`` holds enough rows for the last
+    step's span (padded by the caller)."""
+    period, n, width = maps.shape
+    rows = q.shape[0]
+    x = np.empty(n)
+    g = np.empty(n)
+    for i in range(n):
+        x[i] = x0[i]
+    nn = utab.shape[0]
+    for k in range(rows):
+        # the outputs at t_k
+        _rail_inputs(k * stride * (interval / m), utab, 0, nn, interval, w[k], wd[k])
+        for i in range(N_DOF):
+            q[k, i] = x[i]
+            v[k, i] = x[N_DOF + i]
+            acc = 0.0
+            for j in range(n):
+                acc += A[N_DOF + i, j] * x[j]
+            for j in range(N_RAIL):
+                acc += Bw[i, j] * w[k, j] + Bwd[i, j] * wd[k, j]
+            a[k, i] = acc
+        for c in range(N_CORNER):
+            acc = 0.0
+            for i in range(N_DOF):
+                acc += TS[i, c] * x[N_DOF + i]
+            f[k, c] = -c_sec[c] * acc
+        if k == rows - 1:
+            break
+        # one output step
+        p = k % period
+        base = (k * stride) // m
+        for i in range(n):
+            acc = 0.0
+            for r in range(used[p]):  # the table rows this kind of step touches
+                for j in range(16):
+                    acc += maps[p, i, 16 * r + j] * utab[base + r, j]
+            g[i] = acc
+        for i in range(n):
+            acc = g[i]
+            for j in range(n):
+                acc += Phi[i, j] * x[j]
+            g[i] = acc
+        for i in range(n):
+            x[i] = g[i]
+
+
+@njit(cache=True, nogil=True, fastmath=_FAST)
+def exact_closed_run(
+    phi,
+    rail,
+    force,
+    start,
+    period,
+    m,
+    stride,
+    ctrl,
+    tc,
+    utab,
+    interval,
+    x0,
+    A,
+    Bw,
+    Bwd,
+    Bf,
+    G,
+    H,
+    delay,
+    n_out,
+    q,
+    v,
+    a,
+    f,
+    w,
+    wd,
+    out_fd,
+    out_vc,
+):
+    """The exact steps of an outer loop on the ideal actuator (`railride.engine.discrete.ClosedStepper`),
+    one sample, with the RK4 stepper's controller: at every ``ctrl``-th step the demand computed
+    ``delay`` samples before takes hold, the integrals xi gain tc times the carbody displacements,
+    and the new demand G x + H xi is stored; the held demand is the corner force until the next
+    sample. Records at every ``stride``-th step what the stepper records there. Returns (status,
+    the step it diverged at or -1)."""
+    n = phi.shape[1]
+    n_seg = start.shape[0]
+    n_steps = n_out * stride
+    x = np.empty(n)
+    y = np.empty(n)
+    xi = np.zeros(3)
+    ring = np.zeros((delay, N_CORNER))
+    held = np.zeros(N_CORNER)
+    nn = utab.shape[0]
+    for i in range(n):
+        x[i] = x0[i]
+    rep = 0
+    while True:
+        for s in range(n_seg):
+            step = rep * period + start[s]
+            if step > n_steps:
+                return STATUS_OK, -1
+            if step % ctrl == 0:
+                k = step // ctrl
+                slot = k % delay
+                for c in range(N_CORNER):
+                    held[c] = ring[slot, c]
+                for j in range(3):
+                    xi[j] += tc * x[j]
+                for c in range(N_CORNER):
+                    acc = 0.0
+                    for j in range(n):
+                        acc += G[c, j] * x[j]
+                    for j in range(3):
+                        acc += H[c, j] * xi[j]
+                    ring[slot, c] = acc
+            if step % stride == 0:
+                row = step // stride
+                _rail_inputs(step * (interval / m), utab, 0, nn, interval, w[row], wd[row])
+                bad = False
+                for i in range(N_DOF):
+                    q[row, i] = x[i]
+                    v[row, i] = x[N_DOF + i]
+                    if not (abs(x[i]) < DIVERGED and abs(x[N_DOF + i]) < 1e3 * DIVERGED):
+                        bad = True
+                    acc = 0.0
+                    for j in range(n):
+                        acc += A[N_DOF + i, j] * x[j]
+                    for j in range(N_RAIL):
+                        acc += Bw[i, j] * w[row, j] + Bwd[i, j] * wd[row, j]
+                    for c in range(N_CORNER):
+                        acc += Bf[i, c] * held[c]
+                    a[row, i] = acc
+                for c in range(N_CORNER):
+                    f[row, c] = held[c]
+                    out_fd[row, c] = held[c]
+                    out_vc[row, c] = held[c]
+                if bad:
+                    return STATUS_DIVERGED, step
+            if step == n_steps:
+                return STATUS_OK, -1
+            node = step // m
+            for i in range(n):
+                acc = 0.0
+                for j in range(n):
+                    acc += phi[s, i, j] * x[j]
+                for j in range(16):
+                    acc += rail[s, i, j] * utab[node, j] + rail[s, i, 16 + j] * utab[node + 1, j]
+                for c in range(N_CORNER):
+                    acc += force[s, i, c] * held[c]
+                y[i] = acc
+            for i in range(n):
+                x[i] = y[i]
+        rep += 1
+
+
+# ---------------------------------------------------------------------------------------------
+# The lane stepper: run_batch's arithmetic for LANES samples at once. Every per-sample array of
+# the time loop holds one row of LANES doubles per quantity (lane-innermost), so that one vector
+# instruction advances every sample of a group (docs/architecture.md, docs/performance.md).

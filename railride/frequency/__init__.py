@@ -1,0 +1,1 @@
+"""The vehicle in the frequency domain: the linear model, frequency responses, ride on a track spectrum."""

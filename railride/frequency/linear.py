@@ -1,0 +1,319 @@
+"""The vehicle as a linear state-space model x' = A x + B u, y = C x + D u (docs/linear.md).
+
+Three secondaries are linear and have one here:
+
+* ``"passive"`` (or a passive `Suspension` with viscous dampers): the vehicle with its
+  secondary dashpots. Inputs: the rails and four corner forces acting in parallel with the
+  dashpots (an actuator beside the passive damper, or zero).
+* ``"plant"``: the vehicle without the secondary vertical dashpots, the plant an actuator acts
+  on. Inputs: the rails and the four corner forces.
+* an ideal actuator under a linear outer loop (`Suspension.ideal(controller)`): the corner
+  forces are the demand f_d = G m + H xi of the loop (`railride.secondary.control`), applied
+  continuously; the three integrals xi of the carbody displacements are states. Inputs: the
+  rails only. The engine samples and holds the demand at the control rate; this model is its
+  continuous-time limit.
+
+States: q (the nine DOFs) and q', in `railride.model.vehicle.DOF_NAMES` order, then xi for a closed
+loop. Rail inputs: the heights z_1L ... z_4R [m] and their time derivatives [m/s] (the
+equations hold both: M q'' + C q' + K q = -(K_w w + C_w w') + T f). Outputs: the DOFs, the
+carbody accelerations, the floor accelerations at the front and rear bogie centres and the
+carbody centre (a = z'' - x pitch'', as `railride.analysis.comfort.floor_acceleration`), the secondary
+deflections and the secondary forces on the carbody, per corner.
+
+`LinearModel.to_control()` gives a python-control ``StateSpace`` with these names (when that
+package is installed) and `LinearModel.to_mat()` a MATLAB file.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from railride.model.params import VehicleParams
+from railride.model.vehicle import CORNER_NAMES, DOF_NAMES, DOF_UNITS, N_DOF, RAILS, WHEELSETS, Vehicle
+
+SCHEMA = "railride.linear/1"
+#: the secondaries `linear_model` takes by name
+SECONDARIES = ("passive", "plant")
+RAIL_HEIGHTS = tuple(f"rail_height_{w}{r}" for w in WHEELSETS for r in RAILS)
+RAIL_RATES = tuple(f"rail_rate_{w}{r}" for w in WHEELSETS for r in RAILS)
+CORNER_FORCES = tuple(f"secondary_force_{c}" for c in CORNER_NAMES)
+#: x [m] of the floor points, as multiples of the bogie semi-spacing l (front +)
+FLOOR_POINTS = {"centre": 0.0, "front": 1.0, "rear": -1.0}
+
+
+@dataclass(frozen=True, eq=False)
+class LinearModel:
+    """x' = A x + B u, y = C x + D u with named ``states``, ``inputs`` and ``outputs`` and
+    their ``units``; ``secondary`` says what sits in the secondary ("passive", "plant" or the
+    outer loop's name on the ideal actuator). Checked at construction: shapes agree and every
+    entry is finite."""
+
+    A: np.ndarray
+    B: np.ndarray
+    C: np.ndarray
+    D: np.ndarray
+    states: tuple[str, ...]
+    inputs: tuple[str, ...]
+    outputs: tuple[str, ...]
+    units: dict
+    secondary: str
+    params: VehicleParams
+
+    def __post_init__(self):
+        n, m, p = len(self.states), len(self.inputs), len(self.outputs)
+        for name, matrix, shape in (
+            ("A", self.A, (n, n)),
+            ("B", self.B, (n, m)),
+            ("C", self.C, (p, n)),
+            ("D", self.D, (p, m)),
+        ):
+            if np.shape(matrix) != shape:
+                raise ValueError(f"{name} has shape {np.shape(matrix)}: must be {shape} for the names given")
+            if not np.all(np.isfinite(matrix)):
+                raise ValueError(f"{name} holds a value that is not finite: check the vehicle parameters")
+
+    def index(self, kind: str, name: str) -> int:
+        """Where ``name`` is among the ``kind`` ("states", "inputs", "outputs")."""
+        names = getattr(self, kind)
+        if name not in names:
+            raise ValueError(f"{kind[:-1]} {name!r} is not in the model; allowed: {', '.join(names)}")
+        return names.index(name)
+
+    def corner_forces(self) -> np.ndarray:
+        """The rows of C (4 x states) that give the secondary forces on the carbody, per corner:
+        a closed loop's demand G x + H xi."""
+        return self.C[[self.index("outputs", f"secondary_force_{c}_on_carbody") for c in CORNER_NAMES]]
+
+    def frequency_response(self, frequency_hz) -> np.ndarray:
+        """G(j 2 pi f) = C (j 2 pi f I - A)^-1 B + D for every frequency [Hz]: (n_f, outputs,
+        inputs), complex."""
+        f = np.atleast_1d(np.asarray(frequency_hz, dtype=float))
+        if not np.all(np.isfinite(f)) or np.any(f < 0):
+            raise ValueError(f"frequency_hz must be finite numbers >= 0 Hz, got {frequency_hz!r}")
+        s = 2j * np.pi * f
+        n = self.A.shape[0]
+        X = np.linalg.solve(s[:, None, None] * np.eye(n) - self.A, np.broadcast_to(self.B, (f.size, *self.B.shape)))
+        return self.C @ X + self.D
+
+    def poles(self) -> np.ndarray:
+        """The eigenvalues of A [1/s]."""
+        return np.linalg.eigvals(self.A)
+
+    def to_dict(self) -> dict:
+        """The ``railride.linear/1`` document: names, units and the four matrices as lists."""
+        from railride._version import __version__
+
+        return {
+            "schema": SCHEMA,
+            "railride_version": __version__,
+            "secondary": self.secondary,
+            "vehicle_params": self.params.to_dict(),
+            "states": list(self.states),
+            "inputs": list(self.inputs),
+            "outputs": list(self.outputs),
+            "units": dict(self.units),
+            **{k: getattr(self, k).tolist() for k in "ABCD"},
+        }
+
+    def to_control(self):
+        """A python-control ``StateSpace`` with the names of states, inputs and outputs. Needs
+        the ``control`` package (``pip install control``)."""
+        try:
+            import control
+        except ImportError:
+            raise ImportError(
+                "to_control needs the python-control package: pip install control "
+                "(or use to_mat, or the A, B, C, D arrays)"
+            ) from None
+        return control.ss(
+            self.A,
+            self.B,
+            self.C,
+            self.D,
+            states=list(self.states),
+            inputs=list(self.inputs),
+            outputs=list(self.outputs),
+            name=f"railride_{self.secondary}".replace("-", "_"),
+        )
+
+    def to_mat(self, path) -> None:
+        """A MATLAB .mat file (scipy.io, format 5) with A, B, C, D, the names as cell arrays
+        (state_names, input_names, output_names), their units and the secondary; written
+        atomically."""
+        from pathlib import Path
+
+        from scipy.io import savemat
+
+        from railride._io import atomic_write
+
+        def cells(names):
+            return np.array(list(names), dtype=object).reshape(-1, 1)
+
+        content = {
+            **{k: getattr(self, k) for k in "ABCD"},
+            "state_names": cells(self.states),
+            "input_names": cells(self.inputs),
+            "output_names": cells(self.outputs),
+            "state_units": cells(self.units[s] for s in self.states),
+            "input_units": cells(self.units[s] for s in self.inputs),
+            "output_units": cells(self.units[s] for s in self.outputs),
+            "secondary": self.secondary,
+        }
+        atomic_write(Path(path), lambda tmp: savemat(tmp, content, do_compression=True))
+
+
+def _check_secondary(suspension, vehicle: Vehicle):
+    """(secondary name, coefficient of the secondary dashpots [N s/m], outer loop or None)."""
+    from railride.secondary.dampers import Ideal, Viscous
+    from railride.secondary.suspension import Suspension
+
+    if suspension is None or suspension == "passive":
+        return "passive", vehicle.params.c_sz, None
+    if suspension == "plant":
+        return "plant", 0.0, None
+    if not isinstance(suspension, Suspension):
+        raise ValueError(
+            f"suspension = {suspension!r}: must be 'passive', 'plant' or a Suspension "
+            "(passive viscous dampers, or the ideal actuator under an outer loop)"
+        )
+    s = suspension
+    extras = [n for n, v in (("faults", s.faults), ("sensing", s.sensing), ("sensor_noise", s.sensor_noise)) if v]
+    if s.delay != 1:
+        extras.append("delay")
+    if extras:
+        raise ValueError(
+            f"suspension with {', '.join(extras)}: the linear model has none of them; give the suspension without them"
+        )
+    if s.controller is None and (s.damper is None or isinstance(s.damper, Viscous)):
+        c = vehicle.params.c_sz if s.damper is None else s.damper.c
+        return "passive", float(c), None
+    if isinstance(s.damper, Ideal) and not s.damper.dissipative:
+        return s.controller.name, 0.0, s.controller
+    raise ValueError(
+        f"suspension {s.describe()}: not linear. The linear model covers the passive viscous "
+        "dampers and the ideal actuator (Suspension.ideal) under an outer loop; MR dampers and "
+        "the ideal semi-active damper switch and clip"
+    )
+
+
+def _outer_gains(controller, vehicle: Vehicle) -> tuple[np.ndarray, np.ndarray]:
+    """The loop's demand f_d = G_full (q, q') + H xi with G over the whole state (4 x 18)."""
+    from railride.secondary.controllers import _full_state
+
+    G, H = controller.gains(vehicle)
+    G = np.asarray(G, dtype=float)
+    return (_full_state(G) if G.shape[1] == 6 else G), np.asarray(H, dtype=float)
+
+
+def linear_model(params=None, suspension=None) -> LinearModel:
+    """The state-space model of the vehicle ``params`` (`VehicleParams`, a preset name or a
+    parameters file; default "paper") with ``suspension``: "passive" (default, or None),
+    "plant", or a `railride.Suspension` that is linear (passive viscous dampers, or the ideal
+    actuator under an outer loop). See the module's docstring for states, inputs and outputs."""
+    vehicle_params, _ = VehicleParams.resolve(params)
+    vehicle = Vehicle(vehicle_params)
+    secondary, c_dashpot, controller = _check_secondary(suspension, vehicle)
+    Cd = vehicle.C0 + c_dashpot * vehicle.T @ vehicle.T.T
+    n = 2 * N_DOF
+    Minv = 1.0 / np.diag(vehicle.M)
+    # x' = A x + B u with x = (q, q'), u = (w, w', f)
+    A = np.zeros((n, n))
+    A[:N_DOF, N_DOF:] = np.eye(N_DOF)
+    A[N_DOF:, :N_DOF] = -Minv[:, None] * vehicle.K
+    A[N_DOF:, N_DOF:] = -Minv[:, None] * Cd
+    B = np.zeros((n, 20))
+    B[N_DOF:, 0:8] = -Minv[:, None] * vehicle.K_w
+    B[N_DOF:, 8:16] = -Minv[:, None] * vehicle.C_w
+    B[N_DOF:, 16:20] = Minv[:, None] * vehicle.T
+    # the corner force on the carbody: the dashpot's -c x' (x = T^T q) plus the input f
+    force_x = np.hstack([np.zeros((4, N_DOF)), -c_dashpot * vehicle.T.T])
+    force_u = np.hstack([np.zeros((4, 16)), np.eye(4)])
+    states = [*DOF_NAMES, *(f"{d}_rate" for d in DOF_NAMES)]
+    inputs = [*RAIL_HEIGHTS, *RAIL_RATES, *CORNER_FORCES]
+    units = {d: u for d, u in zip(DOF_NAMES, DOF_UNITS)}
+    units |= {f"{d}_rate": f"{u}/s" for d, u in zip(DOF_NAMES, DOF_UNITS)}
+    units |= {k: "m" for k in RAIL_HEIGHTS} | {k: "m/s" for k in RAIL_RATES} | {k: "N" for k in CORNER_FORCES}
+    if controller is not None:  # close the loop: f = G_full x + H xi, xi' = carbody displacements
+        G, H = _outer_gains(controller, vehicle)
+        Bf = B[:, 16:20]
+        # the integrals are states only where the loop reads them (else poles at 0 that nothing sees)
+        k = 3 if np.any(H) else 0
+        A = np.block([[A + Bf @ G, Bf @ H[:, :k]], [np.eye(k, n), np.zeros((k, k))]])
+        B = np.vstack([B[:, :16], np.zeros((k, 16))])
+        force_x = np.hstack([G, H[:, :k]])
+        force_u = np.zeros((4, 16))
+        integrals = [f"{d}_integral" for d in DOF_NAMES[:k]]
+        states += integrals
+        units |= {k: f"{units[d]} s" for k, d in zip(integrals, DOF_NAMES[:3])}
+        inputs = inputs[:16]
+    nx, nu = A.shape[0], B.shape[1]
+    pad = nx - n  # the integrals' columns
+    accel_x, accel_u = A[N_DOF:n], B[N_DOF:n]  # q'' rows
+    rows_x, rows_u, outputs = [], [], []
+
+    def add(name, unit, cx, du):
+        outputs.append(name)
+        units[name] = unit
+        rows_x.append(cx)
+        rows_u.append(du)
+
+    for i, d in enumerate(DOF_NAMES):
+        add(d, DOF_UNITS[i], np.eye(nx)[i], np.zeros(nu))
+    for i, d in enumerate(DOF_NAMES[:3]):
+        add(f"{d}_acceleration", f"{DOF_UNITS[i]}/s^2", accel_x[i], accel_u[i])
+    for point, share in FLOOR_POINTS.items():
+        x = share * vehicle_params.l
+        add(f"floor_acceleration_{point}", "m/s^2", accel_x[0] - x * accel_x[1], accel_u[0] - x * accel_u[1])
+    for c, corner in enumerate(CORNER_NAMES):
+        add(
+            f"secondary_deflection_{corner}",
+            "m",
+            np.concatenate([vehicle.T[:, c], np.zeros(N_DOF + pad)]),
+            np.zeros(nu),
+        )
+    for c, corner in enumerate(CORNER_NAMES):
+        fx = np.concatenate([force_x[c], np.zeros(nx - force_x.shape[1])])
+        add(f"secondary_force_{corner}_on_carbody", "N", fx, force_u[c])
+    return LinearModel(
+        A,
+        B,
+        np.array(rows_x),
+        np.array(rows_u),
+        tuple(states),
+        tuple(inputs),
+        tuple(outputs),
+        units,
+        secondary,
+        vehicle_params,
+    )
+
+
+def linear_suspensions(controllers, gains) -> dict[str, object]:
+    """Names (or linear `Suspension` values) -> {name: "passive" or a Suspension on the ideal
+    actuator}; "all" is passive and every outer loop."""
+    from railride.secondary.control import OUTER_LOOPS
+    from railride.secondary.suspension import Suspension
+
+    if isinstance(controllers, (str, Suspension)):
+        controllers = [c.strip() for c in controllers.split(",")] if isinstance(controllers, str) else [controllers]
+    controllers = list(controllers)
+    if "all" in controllers:
+        controllers = ["passive", *OUTER_LOOPS]
+    out: dict[str, object] = {}
+    for c in controllers:
+        if isinstance(c, Suspension):
+            out[c.name] = c
+        elif c in ("passive", "plant"):
+            out[c] = c
+        elif c in OUTER_LOOPS:
+            out[c] = Suspension.named(c, gains, damper="ideal")
+        else:
+            raise ValueError(
+                f"controllers = {c!r}: not a linear suspension; allowed: passive, plant, "
+                f"{', '.join(OUTER_LOOPS)} (each on the ideal actuator), or all"
+            )
+    if not out:
+        raise ValueError("controllers: give at least one (passive, or an outer loop on the ideal actuator)")
+    return out

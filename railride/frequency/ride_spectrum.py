@@ -1,0 +1,341 @@
+"""Ride in the frequency domain: the response PSDs, RMS values and ISO 2631-1 weighted RMS of
+the carbody on a random track, from the frequency response and the track spectrum, without a
+time simulation (docs/ride_spectrum.md).
+
+For a standard spectrum (`railride.model.track.spectrum`: FRA classes, German low/high) the track
+model has two independent components, the vertical profile z_v and the cross-level z_x, with
+z_L = z_v + z_x/2 and z_R = z_v - z_x/2; every wheelset sees the same profile delayed by its
+distance behind the leading one over the speed. So for any output y of a linear vehicle
+
+    S_y(f) = |H_v(f)|^2 S_v(f) + |H_x(f)|^2 S_x(f),
+
+with H_v the response to rails moving together (c_L = c_R = 1) and H_x to rails moving
+against each other (c_L = 1/2, c_R = -1/2), and S(f) = S(Omega) 2 pi / V the one-sided
+temporal PSD [m^2/Hz] at Omega = 2 pi f / V over the wavelength band of the random tracks.
+RMS values are sqrt(integral S_y df) and weighted RMS sqrt(integral |W(f)|^2 S_y df), by the
+trapezoid rule on a log grid.
+
+Linear suspensions only: passive, or an outer loop on the ideal actuator (`railride.frequency.linear`).
+A loop's demand is applied continuously, or, with ``control_rate``, through the engine's
+sample-and-hold and delay, e^{-s T d} (1 - e^{-s T}) / (s T), T the controller period and d
+the delay in periods (the fundamental of the held signal; aliasing is not modelled).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import xarray as xr
+
+from railride import limits, validation
+from railride.defaults import DEFAULT_SPEED
+from railride.analysis.comfort import FLOOR
+from railride.frequency.linear import LinearModel, linear_model, linear_suspensions
+from railride.model.params import VehicleParams
+from railride.model.track import SPECTRA, spectrum
+from railride.model.vehicle import CORNER_NAMES, N_DOF, Vehicle
+
+SCHEMA = "railride.ride-spectrum/1"
+#: the responses whose PSDs are computed: the floor points and the carbody
+RESPONSES = (
+    "floor_acceleration_centre",
+    "floor_acceleration_front",
+    "floor_acceleration_rear",
+    "carbody_bounce_acceleration",
+    "carbody_pitch_acceleration",
+    "carbody_roll_acceleration",
+    *(f"secondary_deflection_{c}" for c in CORNER_NAMES),
+)
+#: the ISO 2631-1 weightings applied at the floor points
+WEIGHTINGS = ("Wb", "Wk")
+
+
+def rail_patterns(vehicle: Vehicle, frequency: np.ndarray, speed: float) -> dict[str, np.ndarray]:
+    """The rail inputs (n_f, 16: heights z_1L ... z_4R, then their rates) of the vertical
+    profile (both rails 1) and of the cross-level (left 1/2, right -1/2), per unit amplitude,
+    every wheelset delayed by its lag distance over the speed."""
+    s = 2j * np.pi * frequency[:, None]
+    delay = np.exp(-s * vehicle.wheelset_lag_distance / speed)  # (n_f, 4)
+    out = {}
+    for name, (cl, cr) in (("vertical", (1.0, 1.0)), ("cross-level", (0.5, -0.5))):
+        u = np.empty((frequency.size, 16), complex)
+        u[:, 0:8:2], u[:, 1:8:2] = cl * delay, cr * delay
+        u[:, 8:16] = s * u[:, 0:8]
+        out[name] = u
+    return out
+
+
+def hold(frequency: np.ndarray, control_rate: float | None, delay: int) -> np.ndarray:
+    """The sample-and-hold with a delay of ``delay`` periods at ``control_rate`` [Hz] on a
+    sinusoid's fundamental: e^{-sTd} (1 - e^{-sT}) / (sT); 1 everywhere without a rate."""
+    if control_rate is None:
+        return np.ones(frequency.size, complex)
+    T = 1.0 / control_rate
+    sT = 2j * np.pi * frequency * T
+    with np.errstate(invalid="ignore", divide="ignore"):
+        zoh = np.where(sT == 0, 1.0, (1 - np.exp(-sT)) / np.where(sT == 0, 1.0, sT))
+    return np.exp(-sT * delay) * zoh
+
+
+def responses(plant: LinearModel, gain: np.ndarray | None, u: np.ndarray, h: np.ndarray, frequency) -> np.ndarray:
+    """The outputs (n_f, outputs) of ``plant`` ("plant" or "passive" model) to rail inputs
+    ``u`` (n_f, 16), its corner forces being ``h`` times gain @ (x, xi) (gain 4 x 21 over
+    (q, q', xi), None for none)."""
+    n = plant.A.shape[0]
+    s = 2j * np.pi * frequency
+    Bw, Bf = plant.B[:, :16], plant.B[:, 16:20]
+    Z = s[:, None, None] * np.eye(n) - plant.A
+    K = np.zeros((frequency.size, 4, n), complex)
+    if gain is not None:
+        # xi = q_carbody / s: the integrals fold into the displacement columns
+        K[:] = gain[:, :n]
+        k = gain.shape[1] - n  # 3 integrals of the carbody displacements, or none
+        K[:, :, :k] += gain[None, :, n:] / s[:, None, None]
+        K *= h[:, None, None]
+        Z = Z - Bf @ K
+    x = np.linalg.solve(Z, (Bw @ u[..., None]))[..., 0]
+    f = np.einsum("fcn,fn->fc", K, x)
+    return np.einsum("on,fn->fo", plant.C, x) + u @ plant.D[:, :16].T + f @ plant.D[:, 16:20].T
+
+
+def track_psd(name: str, frequency: np.ndarray, speed: float, band: tuple[float, float]) -> dict[str, np.ndarray]:
+    """One-sided temporal PSDs [m^2/Hz] of the vertical profile and the cross-level of spectrum
+    ``name`` at ``frequency`` [Hz] and ``speed`` [m/s], zero outside the wavelength ``band``
+    (min, max) [m]."""
+    wavenumber = 2 * np.pi * frequency / speed
+    inside = (wavenumber >= 2 * np.pi / band[1] * (1 - 1e-12)) & (wavenumber <= 2 * np.pi / band[0] * (1 + 1e-12))
+    out = {}
+    for component in ("vertical", "cross-level"):
+        S = np.zeros_like(frequency)
+        S[inside] = spectrum(name, wavenumber[inside], component) * 2 * np.pi / speed
+        out[component] = S
+    return out
+
+
+@dataclass(frozen=True, eq=False)
+class RideSpectrum:
+    """The frequency-domain ride of one or more linear suspensions on a track spectrum.
+
+    ``psd``: a Dataset over (suspension, frequency) with one variable per response of
+    `RESPONSES`, one-sided PSDs in (unit)^2/Hz; ``rms`` and ``weighted``: DataArrays over
+    (suspension, response) and (suspension, position, weighting); ``settings``: what made it.
+    The result protocol: `to_dict`, `to_pandas` (one row per suspension and response: RMS and,
+    at the floor points, the weighted RMS), `plot` (PSDs at the floor points), `save`.
+    """
+
+    psd: xr.Dataset
+    rms: xr.DataArray
+    weighted: xr.DataArray
+    settings: dict
+    params: VehicleParams
+
+    @property
+    def suspensions(self) -> tuple[str, ...]:
+        return tuple(str(s) for s in self.psd["suspension"].values)
+
+    def to_pandas(self):
+        import pandas as pd
+
+        rows = []
+        for s in self.suspensions:
+            for r in RESPONSES:
+                row = {"suspension": s, "response": r, "unit": self.psd[r].attrs["rms_units"]}
+                row["rms"] = float(self.rms.sel(suspension=s, response=r))
+                point = r.removeprefix("floor_acceleration_")
+                for w in WEIGHTINGS:
+                    row[f"aw_{w}"] = (
+                        float(self.weighted.sel(suspension=s, position=point, weighting=w)) if point in FLOOR else None
+                    )
+                rows.append(row)
+        return pd.DataFrame(rows)
+
+    def to_dict(self) -> dict:
+        from railride._version import __version__
+
+        return {
+            "schema": SCHEMA,
+            "railride_version": __version__,
+            "vehicle_params": self.params.to_dict(),
+            "settings": dict(self.settings),
+            "rms": {s: {r: float(self.rms.sel(suspension=s, response=r)) for r in RESPONSES} for s in self.suspensions},
+            "weighted_rms_m_s2": {
+                s: {
+                    p: {w: float(self.weighted.sel(suspension=s, position=p, weighting=w)) for w in WEIGHTINGS}
+                    for p in FLOOR
+                }
+                for s in self.suspensions
+            },
+        }
+
+    def title(self) -> str:
+        st = self.settings
+        return (
+            f"Carbody floor acceleration PSD - {st['track']} at V = {st['speed_m_s']:g} m/s, "
+            "frequency domain, controllers on the ideal actuator"
+        )
+
+    def plot(self, ax=None):
+        """The acceleration PSDs at the floor points, one panel per point, one line per
+        suspension (`railride.plots.ride_spectrum`). Returns the figure."""
+        from railride.plots.ride_spectrum import plot_ride_spectrum
+
+        return plot_ride_spectrum(self, ax=ax)
+
+    def save(self, folder, *, figure_formats=("png",), dpi: float = 120.0) -> list:
+        """ride_spectrum.json, ride_spectrum.csv (the RMS table), ride_spectrum_psd.csv (the
+        PSDs) and the figure ride_spectrum in each of ``figure_formats`` (png, pdf, svg; PNG at
+        ``dpi``) into ``folder``, all or nothing. Returns the paths."""
+        from railride.output.files import write_ride_spectrum_outputs
+        from railride.plots import FigureOptions
+
+        return write_ride_spectrum_outputs(self, folder, figures=FigureOptions(figure_formats, dpi))
+
+
+def ride_spectrum(
+    track: str = "fra4",
+    *,
+    speed: float | None = None,
+    params=None,
+    controllers=("passive", "pid", "sas-attitude", "sas-attitude-ride"),
+    gains=None,
+    min_wavelength: float = 1.0,
+    max_wavelength: float = 100.0,
+    points: int = 2000,
+    control_rate: float | None = None,
+    delay: int = 1,
+) -> RideSpectrum:
+    """The ride on spectrum ``track`` (`railride.model.track.SPECTRA`) at ``speed`` [m/s] (default
+    the scenarios' 55.56) of the vehicle ``params`` for each of ``controllers``: "passive",
+    outer-loop names (on the ideal actuator, gains from ``gains``, default the shipped) or
+    linear `Suspension` values. The spectrum is taken over [min_wavelength, max_wavelength] m
+    (as the random tracks are synthesised) on ``points`` log-spaced frequencies. Without
+    ``control_rate`` a loop acts continuously; with it, through the sample-and-hold and
+    ``delay`` periods. A closed loop that is unstable is not run: ``settings["not_run"]``
+    gives the reason (ValueError when none is left)."""
+    validation.choice("track", track, SPECTRA)
+    speed = DEFAULT_SPEED if speed is None else validation.number("speed", speed, "positive", "m/s")
+    lo = validation.number("min_wavelength", min_wavelength, "positive", "m")
+    hi = validation.number("max_wavelength", max_wavelength, "positive", "m")
+    if not hi > lo:
+        raise ValueError(f"max_wavelength = {hi:g} m: must be above min_wavelength = {lo:g} m")
+    points = validation.integer("points", points, 16, 200_000)
+    if control_rate is not None:
+        control_rate = validation.number("control_rate", control_rate, "positive", "Hz")
+    delay = validation.integer("delay", delay, 0, 64, "controller periods")
+    # the peak is the closed loop's (points, 18, 18) complex system, about three copies of it
+    n_state = 2 * N_DOF
+    runs = len(controllers) if isinstance(controllers, (list, tuple)) else 1
+    per_point = 8.0 * (3 * 2 * n_state * n_state + 2 * 2 * 16 + len(RESPONSES) * runs)
+    limits.check(points * per_point, f"the ride spectrum on {points} frequencies", "use fewer points")
+    vehicle_params, _ = VehicleParams.resolve(params)
+    vehicle = Vehicle(vehicle_params)
+    frequency = np.geomspace(speed / hi, speed / lo, points)
+    inputs = rail_patterns(vehicle, frequency, speed)
+    S = track_psd(track, frequency, speed, (lo, hi))
+    h = hold(frequency, control_rate, delay)
+    plant = linear_model(vehicle_params, "plant")
+    psd: dict[str, list] = {r: [] for r in RESPONSES}
+    names, not_run = [], {}
+    for name, suspension in linear_suspensions(controllers, gains).items():
+        model = linear_model(vehicle_params, suspension)
+        try:
+            _check_stable(name, model, plant, control_rate, delay)
+        except ValueError as exc:  # the others go on; the result names it
+            not_run[name] = str(exc)
+            continue
+        names.append(name)
+        base, gain = (model, None) if model.secondary in ("passive", "plant") else (plant, model.corner_forces())
+        y = {k: responses(base, gain, u, h, frequency) for k, u in inputs.items()}
+        for r in RESPONSES:
+            i = base.index("outputs", r)
+            psd[r].append(
+                np.abs(y["vertical"][:, i]) ** 2 * S["vertical"]
+                + np.abs(y["cross-level"][:, i]) ** 2 * S["cross-level"]
+            )
+    if not names:
+        raise ValueError("; ".join(not_run.values()))
+    ds = xr.Dataset(coords={"suspension": names, "frequency": ("frequency", frequency, {"units": "Hz"})})
+    for r in RESPONSES:
+        unit = plant.units[r]
+        ds[r] = (("suspension", "frequency"), np.array(psd[r]), {"units": f"({unit})^2/Hz", "rms_units": unit})
+    rms = xr.DataArray(
+        np.sqrt(np.array([[np.trapezoid(ds[r].values[k], frequency) for r in RESPONSES] for k in range(len(names))])),
+        dims=("suspension", "response"),
+        coords={"suspension": names, "response": list(RESPONSES)},
+        name="rms",
+    )
+    from railride.analysis.comfort import weighting
+
+    weighted = np.empty((len(names), len(FLOOR), len(WEIGHTINGS)))
+    for j, w in enumerate(WEIGHTINGS):
+        W2 = weighting(w, frequency) ** 2
+        for p, point in enumerate(FLOOR):
+            weighted[:, p, j] = np.sqrt(np.trapezoid(W2 * ds[f"floor_acceleration_{point}"].values, frequency, axis=-1))
+    weighted_da = xr.DataArray(
+        weighted,
+        dims=("suspension", "position", "weighting"),
+        coords={"suspension": names, "position": list(FLOOR), "weighting": list(WEIGHTINGS)},
+        name="weighted_rms",
+        attrs={"units": "m/s^2"},
+    )
+    settings = {
+        "track": track,
+        "speed_m_s": speed,
+        "min_wavelength_m": lo,
+        "max_wavelength_m": hi,
+        "fmin_hz": float(frequency[0]),
+        "fmax_hz": float(frequency[-1]),
+        "points": points,
+        "control_rate_hz": control_rate,
+        "delay_periods": delay if control_rate is not None else None,
+        "actuator": "ideal (force = demand)",
+        "gains": "shipped" if gains is None else "given",
+        "not_run": not_run,
+    }
+    return RideSpectrum(ds, rms, weighted_da, settings, vehicle_params)
+
+
+def _check_stable(name: str, model: LinearModel, plant: LinearModel, control_rate, delay: int) -> None:
+    """Refuse a loop that is unstable: the continuous loop by the eigenvalues of A; with a
+    control rate, the sampled loop as the engine runs it (the plant discretised exactly over a
+    period with the demand held, the demand taking effect ``delay`` periods after its sample)
+    by the eigenvalues of its transition matrix."""
+    if model.secondary in ("passive", "plant") or control_rate is None:
+        worst = float(np.max(np.linalg.eigvals(model.A).real))
+        unstable, where = worst >= 0, f"a pole at Re = {worst:.3g} 1/s"
+    else:
+        radius = float(np.max(np.abs(np.linalg.eigvals(_sampled_loop(model, plant, 1.0 / control_rate, delay)))))
+        unstable = radius >= 1
+        where = f"sampled at {control_rate:g} Hz with a delay of {delay} periods, a pole at |z| = {radius:.4g}"
+    if unstable:
+        raise ValueError(
+            f"controller {name!r} on the ideal actuator is unstable on this vehicle ({where}): "
+            "its frequency response has no steady state"
+        )
+
+
+def _sampled_loop(model: LinearModel, plant: LinearModel, period: float, delay: int) -> np.ndarray:
+    """The transition matrix over one controller period of the loop the engine runs: the
+    state (x, the demands of the last ``delay`` samples), x_{k+1} = Phi x_k + Gamma f_k with
+    f_k the demand sampled ``delay`` periods before (0 periods: the demand of this sample)."""
+    import scipy.linalg
+
+    n = model.A.shape[0]
+    F = model.corner_forces()
+    Bf = np.zeros((n, 4))
+    Bf[: 2 * N_DOF] = plant.B[:, 16:20]  # the corner forces' inputs
+    A0 = model.A - Bf @ F  # the open loop (with its integrators)
+    # Phi = e^{A0 T} and Gamma = int_0^T e^{A0 s} ds Bf in one exponential (Van Loan)
+    E = scipy.linalg.expm(np.block([[A0, Bf], [np.zeros((4, n + 4))]]) * period)
+    Phi, Gamma = E[:n, :n], E[:n, n:]
+    if delay == 0:
+        return Phi + Gamma @ F
+    m = n + 4 * delay
+    out = np.zeros((m, m))
+    out[:n, :n] = Phi
+    out[:n, m - 4 :] = Gamma  # the oldest stored demand acts now
+    out[n : n + 4, :n] = F  # this sample's demand enters the store
+    for k in range(1, delay):  # and each stored demand moves one place older
+        out[n + 4 * k : n + 4 * (k + 1), n + 4 * (k - 1) : n + 4 * k] = np.eye(4)
+    return out

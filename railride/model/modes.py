@@ -1,0 +1,104 @@
+"""The modes of the passive vehicle as numbers a table or JSON can hold (`checked_modes`), by
+undamped natural frequency, with their table (`modes_frame`, modes.csv)."""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from railride import validation
+from railride.engine.layout import N_DOF
+from railride.model.params import VehicleParams
+from railride.model.plausible import notes
+from railride.model.vehicle import Vehicle
+
+#: the columns of the modal table
+MODE_COLUMNS = ("mode", "label", "frequency_hz", "damped_frequency_hz", "damping_ratio")
+
+
+def modes_frame(modes) -> pd.DataFrame:
+    """The modes of `Vehicle.modes()` as a table, from their records (``[m.to_dict() for m in
+    vehicle.modes()]``): ``mode`` (1, 2, ... by undamped frequency), ``label``,
+    ``frequency_hz`` (undamped), ``damped_frequency_hz``, ``damping_ratio``."""
+    rows = []
+    for i, d in enumerate(modes, start=1):
+        rows.append(
+            (i, d["label"], float(d["frequency_hz"]), float(d["damped_frequency_hz"]), float(d["damping_ratio"]))
+        )
+    return pd.DataFrame(rows, columns=list(MODE_COLUMNS))
+
+
+@dataclass(frozen=True, eq=False)
+class Modes:
+    """The modes of the passive vehicle (`railride.model.vehicle.Mode`), by undamped frequency: a
+    sequence of `Mode` with its table (`to_pandas`) and records (`to_list`)."""
+
+    modes: tuple
+
+    def __iter__(self):
+        return iter(self.modes)
+
+    def __len__(self) -> int:
+        return len(self.modes)
+
+    def __getitem__(self, index):
+        return self.modes[index]
+
+    def to_list(self) -> list[dict]:
+        """The records of the modes (``Mode.to_dict()``): the JSON array of ``railride modes
+        --format json`` and the ``modes`` of the ``railride.frf/1`` document."""
+        return [m.to_dict() for m in self.modes]
+
+    def to_pandas(self):
+        """The modal table (`modes_frame`, modes.csv): mode number, label,
+        undamped and damped frequency [Hz], damping ratio."""
+        return modes_frame(self.to_list())
+
+
+def modes(params=None) -> Modes:
+    """The nine modes of the passive vehicle ``params`` (`VehicleParams`, a preset name or the
+    path of a parameters file; default "paper"), by undamped natural frequency (`checked_modes`)."""
+    vehicle, _ = VehicleParams.resolve(params)
+    return checked_modes(Vehicle(vehicle))
+
+
+#: a damping ratio this far below 0 is the rounding of an undamped mode (a passive vehicle
+#: with dampings >= 0 has none below 0); further below, the eigenvalues are not to be trusted
+ROUNDING_ZETA = 1e-6
+
+
+def checked_modes(vehicle) -> Modes:
+    """`Vehicle.modes` as numbers a table or JSON can hold: nine modes, every frequency and
+    damping ratio finite and >= 0 (rounding below 0 shown as 0). A vehicle whose bodies and
+    springs are so far apart in size that double precision cannot separate its modes (a
+    bogie of a gram on a stiff primary, a carbody of a billion tonnes) is a ValueError naming
+    what went wrong and the parameters outside the typical ranges."""
+    problem = None
+    try:
+        with np.errstate(all="ignore"):  # the failures are reported below, not as NumPy warnings
+            found = vehicle.modes()
+    except (ValueError, np.linalg.LinAlgError) as exc:
+        found, problem = [], f"the eigenvalue solver failed ({exc})"
+    out = []
+    for i, m in enumerate(found, 1):
+        values = (m.frequency_hz, m.damped_frequency_hz, m.damping_ratio)
+        if not all(np.isfinite(values)) or min(values) < -ROUNDING_ZETA:
+            problem = problem or (
+                f"mode {i} ({m.label}) came out at {validation.shown(m.frequency_hz)} Hz with a damping "
+                f"ratio of {validation.shown(m.damping_ratio)}"
+            )
+            continue
+        out.append(dataclasses.replace(m, damping_ratio=max(m.damping_ratio, 0.0)))
+    if problem is None and len(out) != N_DOF:
+        problem = f"{len(out)} modes came out, not {N_DOF}"
+    if problem is not None:
+        outside = [n.split("'")[1] for n in notes(vehicle.params)]
+        hint = f"; outside the typical ranges: {', '.join(outside)}" if outside else ""
+        raise ValueError(
+            f"the modes of this vehicle cannot be computed in double precision: {problem}; its masses and "
+            f"stiffnesses are too far apart in size{hint}"
+        )
+    return Modes(tuple(out))

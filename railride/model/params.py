@@ -1,0 +1,263 @@
+"""Vehicle parameter sets: frozen, validated at construction, named presets, TOML round trip.
+
+Symbols follow the appendix of Harun et al. (the paper; see docs/model.md, Parameters). Every
+field carries its SI unit and the rule it must satisfy in its metadata;
+`VehicleParams.describe()` lists them.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import os
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+
+from railride._io import atomic_write_text
+from railride.model.plausible import VEHICLE
+from railride.validation import param, rule_words, shown, toml_error, validate_fields
+
+
+@dataclass(frozen=True)
+class VehicleParams:
+    """Parameters of the 9-DOF vertical vehicle model (SI units, the paper's appendix).
+
+    Suspension values are per element: one spring and one damper at each corner or axle box,
+    as in the element table of docs/model.md, Equations.
+    """
+
+    m_c: float = param("kg", "carbody mass")
+    m_b: float = param("kg", "bogie mass (each bogie)")
+    I_cx: float = param("kg m^2", "carbody roll moment of inertia")
+    I_cy: float = param("kg m^2", "carbody pitch moment of inertia")
+    I_cz: float = param("kg m^2", "carbody yaw moment of inertia (not used by the vertical model)")
+    I_bx: float = param("kg m^2", "bogie roll moment of inertia")
+    I_by: float = param("kg m^2", "bogie pitch moment of inertia")
+    I_bz: float = param("kg m^2", "bogie yaw moment of inertia (not used by the vertical model)")
+    k_px: float = param("N/m", "primary longitudinal stiffness, per axle box")
+    k_py: float = param("N/m", "primary lateral stiffness, per axle box")
+    k_pz: float = param("N/m", "primary vertical stiffness, per axle box")
+    c_px: float = param("N s/m", "primary longitudinal damping, per axle box", "nonnegative")
+    c_py: float = param("N s/m", "primary lateral damping, per axle box", "nonnegative")
+    c_pz: float = param("N s/m", "primary vertical damping, per axle box", "nonnegative")
+    k_sx: float = param("N/m", "secondary longitudinal stiffness, per side of each bogie")
+    k_sy: float = param("N/m", "secondary lateral stiffness, per side of each bogie")
+    k_sz: float = param("N/m", "secondary vertical stiffness, per corner")
+    c_sx: float = param("N s/m", "secondary longitudinal damping, per side of each bogie", "nonnegative")
+    c_sy: float = param("N s/m", "secondary lateral damping, per side of each bogie", "nonnegative")
+    c_sz: float = param("N s/m", "secondary vertical (passive) damping, per corner", "nonnegative")
+    l: float = param("m", "half bogie-centre spacing")
+    d_s: float = param("m", "half lateral spacing of the secondary suspension")
+    d_p: float = param("m", "half lateral spacing of the primary suspension")
+    a: float = param("m", "half wheel-rail contact spacing")
+    b: float = param("m", "half wheelbase")
+    h_cs: float = param("m", "carbody CG height above the secondary suspension")
+    h_ts: float = param("m", "bogie CG depth below the secondary suspension")
+    h_tp: float = param("m", "bogie CG height above the primary suspension")
+    h_wp: float = param("m", "wheelset CG depth below the primary suspension")
+
+    def __post_init__(self) -> None:
+        validate_fields(self, "vehicle parameter", VEHICLE, then=self._check_wheelbase)
+
+    def _check_wheelbase(self) -> None:
+        if not self.b < self.l:
+            raise ValueError(
+                f"vehicle parameter 'b' = {shown(self.b)} (half wheelbase, m): must be below 'l' = {shown(self.l)} "
+                "(half bogie-centre spacing, m): the two bogies' wheelsets would pass each other"
+            )
+
+    # -- presets --------------------------------------------------------------------------
+    @classmethod
+    def of(cls, value) -> "VehicleParams":
+        """``value`` as parameters: None (the `paper` preset), a preset name, or a VehicleParams."""
+        if value is None:
+            return cls.preset("paper")
+        if isinstance(value, str):
+            return cls.preset(value)
+        if isinstance(value, VehicleParams):
+            return value
+        # a common slip: simulate(scenario, suspension) puts the suspension in params
+        suspension = hasattr(value, "controller") and hasattr(value, "damper")  # a Suspension, not imported here
+        hint = " (a Suspension is the third argument, suspension=)" if suspension else ""
+        raise ValueError(f"params = {value!r}: must be VehicleParams or a preset name{hint}")
+
+    @classmethod
+    def resolve(cls, value) -> tuple["VehicleParams", str | Path | None]:
+        """(the parameters, where they came from) of ``value``: None (the `paper` preset), a
+        preset name, the path of a parameters file, or VehicleParams (its preset's name if it is
+        one, else None)."""
+        if value is None:
+            value = "paper"
+        if isinstance(value, str):
+            return cls.preset(value), value
+        if isinstance(value, os.PathLike):
+            return cls.load(Path(value)), Path(value)
+        if isinstance(value, VehicleParams):
+            return value, next((name for name, p in PRESETS.items() if p == value), None)
+        raise ValueError(
+            f"params = {value!r}: must be VehicleParams, a preset name "
+            f"({', '.join(PRESETS)}) or the path of a parameters file"
+        )
+
+    @classmethod
+    def preset(cls, name: str = "paper") -> "VehicleParams":
+        """A named parameter set; see `PRESETS` for the names."""
+        try:
+            return PRESETS[name]
+        except KeyError:
+            raise ValueError(f"unknown vehicle preset {name!r}; allowed: {', '.join(sorted(PRESETS))}") from None
+
+    def replace(self, **changes: float) -> "VehicleParams":
+        """A copy with some fields changed (validated like any new set)."""
+        unknown = set(changes) - {f.name for f in dataclasses.fields(self)}
+        if unknown:
+            raise ValueError(
+                f"unknown vehicle parameter(s) {', '.join(sorted(unknown))}; "
+                f"allowed: {', '.join(f.name for f in dataclasses.fields(self))}"
+            )
+        return dataclasses.replace(self, **changes)
+
+    def loaded(self, load: float) -> "VehicleParams":
+        """The vehicle with a payload: the carbody's mass and moments of inertia times ``load``
+        (the load factor, a finite number > 0: 1 the carbody as these parameters give it, 1.3 a
+        crush-laden car with 30 % more mass). The payload is taken as spread like the carbody's
+        own mass, so its radii of gyration stay; the bogies, wheelsets and suspensions stay as
+        they are, and a controller keeps the gains it was given."""
+        from railride.validation import number
+
+        factor = number("load", load, "positive", allowed="a finite number > 0 (the factor on the carbody mass)")
+        carbody = ("m_c", "I_cx", "I_cy", "I_cz")
+        return self.replace(**{n: factor * getattr(self, n) for n in carbody})
+
+    def load_changes(self, load: float, stiffness: float = 1.0) -> tuple:
+        """The (field, value) changes of a payload (`loaded`) and of a secondary stiffness
+        tolerance (k_sz times ``stiffness``, a finite number > 0: 0.9 and 1.1 for +-10 %), as a
+        sweep's `Case.vehicle` holds them; none for factors of 1, so that the run keys of the
+        nominal vehicle stay as they were."""
+        from railride.validation import number
+
+        changes: tuple = ()
+        if load != 1.0:
+            loaded = self.loaded(load)
+            changes += tuple((n, getattr(loaded, n)) for n in ("m_c", "I_cx", "I_cy", "I_cz"))
+        k = number("stiffness", stiffness, "positive", allowed="a finite number > 0 (the factor on k_sz)")
+        if k != 1.0:
+            changes += (("k_sz", k * self.k_sz),)
+        return changes
+
+    def to_dict(self) -> dict[str, float]:
+        return dataclasses.asdict(self)
+
+    @classmethod
+    def describe(cls) -> list[tuple[str, str, str, str]]:
+        """(name, unit, meaning, rule) for every field."""
+        return [
+            (f.name, f.metadata["unit"], f.metadata["doc"], rule_words(f.metadata["rule"]))
+            for f in dataclasses.fields(cls)
+        ]
+
+    # -- TOML -----------------------------------------------------------------------------
+    def to_toml(self) -> str:
+        """TOML text of all fields under ``[vehicle]``; `from_toml` reads it back exactly.
+
+        Floats are written with ``repr``, the shortest text that parses back to the same
+        double, so the round trip is lossless.
+        """
+        lines = ["# railride vehicle parameters (SI units)", "[vehicle]"]
+        for name, unit, doc, _ in self.describe():
+            lines.append(f"{name} = {getattr(self, name)!r}  # {unit}: {doc}")
+        return "\n".join(lines) + "\n"
+
+    def save(self, path: str | Path) -> None:
+        atomic_write_text(Path(path), self.to_toml())
+
+    @classmethod
+    def from_toml(cls, text: str, source: str = "<string>") -> "VehicleParams":
+        """Parse TOML with a ``[vehicle]`` table.
+
+        The table either lists every field, or names a base with ``preset = "paper"`` and
+        lists only the fields that differ from it.
+        """
+        try:
+            data = tomllib.loads(text)
+        except ValueError as exc:
+            raise ValueError(f"{source}: not valid TOML: {toml_error(exc)}") from None
+        table = data.get("vehicle")
+        if not isinstance(table, dict):
+            raise ValueError(f"{source}: needs a [vehicle] table of parameters")
+        table = dict(table)
+        names = [f.name for f in dataclasses.fields(cls)]
+        base_name = table.pop("preset", None)
+        unknown = sorted(set(table) - set(names))
+        if unknown:
+            raise ValueError(
+                f"{source}: unknown vehicle parameter(s) {', '.join(unknown)}; allowed: {', '.join(names)}"
+            )
+        if base_name is not None:
+            base = cls.preset(str(base_name))
+        else:
+            missing = [n for n in names if n not in table]
+            if missing:
+                raise ValueError(
+                    f"{source}: missing vehicle parameter(s) {', '.join(missing)} "
+                    '(list them all, or start from a base with preset = "paper")'
+                )
+        try:
+            return base.replace(**table) if base_name is not None else cls(**table)
+        except ValueError as exc:  # the field's rule: name the file and table too
+            raise ValueError(f"{source}: [vehicle] {exc}") from None
+
+    @classmethod
+    def load(cls, path: str | Path) -> "VehicleParams":
+        path = Path(path)
+        try:
+            text = path.read_text(encoding="utf-8")
+        except OSError as exc:
+            raise ValueError(f"cannot read vehicle parameters from {path}: {exc.strerror}") from None
+        return cls.from_toml(text, source=str(path))
+
+
+#: The paper's appendix (Harun et al.), in SI units.
+PAPER = VehicleParams(
+    m_c=3.96e4,
+    m_b=3.25e3,
+    I_cx=8.85e4,
+    I_cy=2.46e6,
+    I_cz=2.5e6,
+    I_bx=3.06e3,
+    I_by=3.02e3,
+    I_bz=4.27e3,
+    k_px=4e6,
+    k_py=3.25e6,
+    k_pz=7e6,
+    c_px=0.0,
+    c_py=0.0,
+    c_pz=1.5e4,
+    k_sx=1.5e5,
+    k_sy=1.5e5,
+    k_sz=2.9e5,
+    c_sx=0.0,
+    c_sy=5e4,
+    c_sz=8e4,
+    l=9.0,
+    d_s=1.0,
+    d_p=1.0,
+    a=1.0,
+    b=1.25,
+    h_cs=1.207,
+    h_ts=0.217,
+    h_tp=0.452,
+    h_wp=0.18,
+)
+
+PRESETS: dict[str, VehicleParams] = {"paper": PAPER}
+
+
+def ranges_markdown() -> str:
+    """The docs' table of the vehicle's ranges (docs/cli.md, Sizes and plausible ranges)."""
+    rows = ["| field | unit | typical (else a warning) | allowed (else an error) |", "|---|---|---|---|"]
+    for name, unit, _, _ in VehicleParams.describe():
+        r = VEHICLE[name]
+        typical = f"{r.typical[0]:g} to {r.typical[1]:g}" if r.typical else "-"
+        rows.append(f"| `{name}` | {unit} | {typical} | {r.low:g} to {r.high:g} |")
+    return "\n".join(rows)

@@ -1,0 +1,663 @@
+"""Rail profiles, scenarios and the wheelset delays (docs/model.md, Track input).
+
+A profile gives the left and right rail heights z_L(s), z_R(s) [m] and their slopes along the
+track. Before s = 0 every profile is 0: the vehicle starts at rest on level track. Wheelset j is at
+s_j(t) = V t - (x1 - x_j), so it sees the leading wheelset's input delayed by (x1 - x_j)/V, and its
+rail velocity is w' = V dz/ds.
+
+For the compiled stepper the inputs are sampled once per run on a time grid t_k = k Delta,
+Delta = m dt (m the largest power of two with Delta <= `RailProfile.table_spacing` / V), for
+each wheelset: heights w_k and rail velocities w'_k. Between nodes the stepper interpolates
+with cubic Hermite polynomials, which reproduce heights to O(Delta^4) and velocities to
+O(Delta^3). Because the nodes fall on step boundaries, every Runge-Kutta step sees a single
+smooth cubic and keeps its fourth order; halving dt doubles m and leaves the input unchanged.
+A profile that does not start at zero height (a measured profile, or the paper sine with its
+taper turned off) is 0 up to s = 0 and rises to its value within the first interval after a
+wheelset passes s = 0, as a smooth cubic ramp instead of an infinitely steep step. The paper sine
+by default enters through a raised-cosine taper over its first wavelength (`SineTrack`).
+"""
+
+from __future__ import annotations
+
+import csv
+import dataclasses
+import hashlib
+import math
+from abc import ABC, abstractmethod
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from railride import validation
+from railride.defaults import DEFAULT_SPEED
+from railride._cache import MiB, BytesLRU
+
+#: nodes per shortest feature (wavelength, bump length) in the stepper's table
+NODES_PER_FEATURE = 200
+MAX_TABLE_NODES = 2_000_000
+#: plausible ranges (docs/model.md, Plausible ranges): a rail a metre out of line is no track the
+#: vehicle could run on, and 200 m/s is above the rail speed record (159.7 m/s); beyond these the
+#: run diverges or means nothing, so they are input errors rather than a "diverged" at run time
+MAX_RAIL_AMPLITUDE = 1.0  # m, sine amplitude and bump height
+MAX_SPEED = 200.0  # m/s
+MAX_RAIL_PHASE = 360.0  # deg, either way
+
+
+def _check(name: str, value, rule: str, allowed: str) -> float:
+    return validation.number(name, value, rule, allowed=allowed)
+
+
+def _within(name: str, value: float, bound: float, unit: str, why: str) -> float:
+    """``value`` when |value| <= ``bound``, else a ValueError naming the field and the range."""
+    if abs(value) > bound:
+        raise ValueError(
+            f"{name} = {value:.4g} {unit}: outside the plausible range -{bound:g} to {bound:g} {unit} ({why})"
+        )
+    return value
+
+
+class RailProfile(ABC):
+    """Left and right rail heights along the track."""
+
+    @abstractmethod
+    def _evaluate(self, s: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """z_L, z_R, dz_L/ds, dz_R/ds at s >= 0."""
+
+    @abstractmethod
+    def table_spacing(self) -> float:
+        """The node spacing ds [m] that resolves this profile in the stepper's table."""
+
+    @abstractmethod
+    def describe(self) -> dict:
+        """Settings that define the profile, for the record kept with results."""
+
+    def end(self) -> float:
+        """Last s [m] at which the profile is defined (inf if everywhere)."""
+        return math.inf
+
+    def evaluate(self, s) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """z_L, z_R [m] and their slopes dz_L/ds, dz_R/ds [-] at positions s [m]; 0 for s < 0."""
+        s = np.asarray(s, dtype=float)
+        out = [np.zeros_like(s) for _ in range(4)]
+        on = s > 0  # s = 0 itself still belongs to the level track
+        if np.any(on):
+            for o, v in zip(out, self._evaluate(s[on])):
+                o[on] = v
+        return tuple(out)
+
+
+@dataclass(frozen=True)
+class SineTrack(RailProfile):
+    """The paper's sine, entering through a raised-cosine taper of its amplitude:
+    z_L = r(s) A sin(2 pi s / lambda), z_R = r(s) A sin(2 pi s / lambda - psi), with
+    r(s) = (1 - cos(pi s / L)) / 2 for s < L = taper x lambda and r = 1 beyond.
+
+    The taper is what a vehicle sees running onto a section of periodic track: with psi = 90 deg
+    the right rail would otherwise start at -A, a 5 cm step at s = 0 that dominates peak values
+    and damper forces. r and r' vanish at s = 0, so heights and slopes are continuous there.
+    ``taper`` = 0 keeps the step (ramped over one input-grid interval, see the module notes).
+    """
+
+    amplitude: float = 0.05  # m
+    wavelength: float = 60.0  # m
+    rail_phase_deg: float = 90.0  # deg, psi: right rail lags the left
+    taper: float = 1.0  # length of the entry taper, in wavelengths
+
+    def __post_init__(self):
+        checks = (
+            ("amplitude", "amplitude", "nonnegative", "a finite number >= 0 (m)"),
+            ("wavelength", "wavelength", "positive", "a finite number > 0 (m)"),
+            ("rail_phase_deg", "rail_phase", "finite", "a finite angle in degrees"),
+            ("taper", "taper", "nonnegative", "a finite number >= 0 (wavelengths)"),
+        )
+        for field_name, name, rule, allowed in checks:
+            object.__setattr__(self, field_name, _check(name, getattr(self, field_name), rule, allowed))
+        _within("amplitude", self.amplitude, MAX_RAIL_AMPLITUDE, "m", "a rail a metre out of line is no track")
+        _within("rail_phase", self.rail_phase_deg, MAX_RAIL_PHASE, "deg", "a phase is an angle of one turn")
+
+    def _evaluate(self, s):
+        k = 2 * np.pi / self.wavelength
+        psi = np.deg2rad(self.rail_phase_deg)
+        A = self.amplitude
+        zl, zr = A * np.sin(k * s), A * np.sin(k * s - psi)
+        dzl, dzr = A * k * np.cos(k * s), A * k * np.cos(k * s - psi)
+        L = self.taper * self.wavelength
+        if L > 0:
+            inside = s < L
+            r = np.where(inside, 0.5 * (1 - np.cos(np.pi * s / L)), 1.0)
+            dr = np.where(inside, 0.5 * np.pi / L * np.sin(np.pi * s / L), 0.0)
+            zl, zr, dzl, dzr = r * zl, r * zr, r * dzl + dr * zl, r * dzr + dr * zr
+        return zl, zr, dzl, dzr
+
+    def table_spacing(self):
+        return self.wavelength / NODES_PER_FEATURE
+
+    def describe(self):
+        return {
+            "profile": "sine",
+            "amplitude_m": self.amplitude,
+            "wavelength_m": self.wavelength,
+            "rail_phase_deg": self.rail_phase_deg,
+            "taper_wavelengths": self.taper,
+        }
+
+
+@dataclass(frozen=True)
+class CosineBump(RailProfile):
+    """One cosine bump (height > 0) or dip (height < 0): z = h/2 (1 - cos(2 pi (s - s0) / L))
+    for s0 <= s <= s0 + L, on both rails or on one."""
+
+    height: float = 0.02  # m
+    length: float = 10.0  # m
+    start: float = 10.0  # m, s0
+    rails: str = "both"  # "both", "left" or "right"
+
+    def __post_init__(self):
+        object.__setattr__(
+            self, "height", _check("height", self.height, "finite", "a finite number (m; < 0 for a dip)")
+        )
+        _within("height", self.height, MAX_RAIL_AMPLITUDE, "m", "a rail a metre out of line is no track")
+        object.__setattr__(self, "length", _check("length", self.length, "positive", "a finite number > 0 (m)"))
+        object.__setattr__(self, "start", _check("start", self.start, "nonnegative", "a finite number >= 0 (m)"))
+        if self.rails not in ("both", "left", "right"):
+            raise ValueError(f"rails = {self.rails!r}: allowed 'both', 'left', 'right'")
+
+    def _evaluate(self, s):
+        x = (s - self.start) / self.length
+        inside = (x >= 0) & (x <= 1)
+        z = np.where(inside, 0.5 * self.height * (1 - np.cos(2 * np.pi * x)), 0.0)
+        dz = np.where(inside, 0.5 * self.height * 2 * np.pi / self.length * np.sin(2 * np.pi * x), 0.0)
+        zero = np.zeros_like(s)
+        left = self.rails in ("both", "left")
+        right = self.rails in ("both", "right")
+        return (z if left else zero, z if right else zero, dz if left else zero, dz if right else zero)
+
+    def table_spacing(self):
+        return self.length / NODES_PER_FEATURE
+
+    def describe(self):
+        return {
+            "profile": "cosine-bump",
+            "height_m": self.height,
+            "length_m": self.length,
+            "start_m": self.start,
+            "rails": self.rails,
+        }
+
+
+@dataclass(frozen=True, eq=False)
+class MeasuredTrack(RailProfile):
+    """A sampled profile (s, z_L, z_R), interpolated by shape-preserving cubics (PCHIP).
+
+    PCHIP gives continuous heights and slopes without overshoot at steps in the data, so the
+    rail velocity V dz/ds stays bounded by the data's own slopes.
+    """
+
+    s: np.ndarray
+    z_L: np.ndarray
+    z_R: np.ndarray
+    source: str = "<array>"
+    _interp: tuple = field(default=(), repr=False)
+
+    def __post_init__(self):
+        from scipy.interpolate import PchipInterpolator
+
+        s = np.asarray(self.s, dtype=float)
+        zl = np.asarray(self.z_L, dtype=float)
+        zr = np.asarray(self.z_R, dtype=float)
+        src = self.source
+        if s.ndim != 1 or s.shape != zl.shape or s.shape != zr.shape:
+            raise ValueError(f"{src}: s, z_L and z_R must be 1-D columns of equal length")
+        if s.size < 2:
+            raise ValueError(f"{src}: a measured profile needs at least 2 rows, got {s.size}")
+        for name, col in (("s", s), ("z_L", zl), ("z_R", zr)):
+            bad = np.flatnonzero(~np.isfinite(col))
+            if bad.size:
+                raise ValueError(
+                    f"{src}: column {name} has a non-finite value {col[bad[0]]!r} at data row {bad[0] + 1}"
+                )
+        steps = np.diff(s)
+        if np.any(steps <= 0):
+            i = int(np.flatnonzero(steps <= 0)[0])
+            raise ValueError(f"{src}: s must increase strictly; data row {i + 2} has s = {s[i + 1]!r} after {s[i]!r}")
+        if s[0] > 0:
+            raise ValueError(
+                f"{src}: the profile must start at s <= 0 m (the vehicle starts at s = 0); it starts at {s[0]!r} m"
+            )
+        object.__setattr__(self, "s", s)
+        object.__setattr__(self, "z_L", zl)
+        object.__setattr__(self, "z_R", zr)
+        pl, pr = PchipInterpolator(s, zl), PchipInterpolator(s, zr)
+        object.__setattr__(self, "_interp", (pl, pr, pl.derivative(), pr.derivative()))
+
+    @classmethod
+    def from_csv(cls, path: str | Path) -> "MeasuredTrack":
+        """Read a CSV with a header naming the columns s, z_L, z_R (metres; a unit suffix such
+        as "s [m]" is allowed, other columns are ignored)."""
+        path = Path(path)
+        try:
+            with path.open(newline="", encoding="utf-8") as fh:
+                rows = list(csv.reader(fh))
+        except OSError as exc:
+            raise ValueError(f"cannot read track file {path}: {exc.strerror or exc}") from None
+        except UnicodeDecodeError:
+            raise ValueError(f"track file {path}: not a UTF-8 text CSV") from None
+        # keep file line numbers for the messages; skip blank and comment lines
+        numbered = [
+            (n, r)
+            for n, r in enumerate(rows, start=1)
+            if r and any(c.strip() for c in r) and not r[0].lstrip().startswith("#")
+        ]
+        if not numbered:
+            raise ValueError(f"track file {path}: empty; expected a header 's,z_L,z_R' and data rows")
+        head = numbered[0][1]
+        header = [c.split("[")[0].strip().lower() for c in head]
+        idx = {}
+        for want in ("s", "z_l", "z_r"):
+            if want not in header:
+                raise ValueError(
+                    f"track file {path}: no column {want.replace('_l', '_L').replace('_r', '_R')!r} in the header "
+                    f"{head!r}; expected columns s [m], z_L [m], z_R [m]"
+                )
+            idx[want] = header.index(want)
+        data: dict[str, list[float]] = {k: [] for k in idx}
+        for lineno, row in numbered[1:]:
+            for k, j in idx.items():
+                try:
+                    data[k].append(float(row[j]))
+                except (IndexError, ValueError):
+                    cell = row[j] if j < len(row) else "<missing>"
+                    raise ValueError(
+                        f"track file {path}, line {lineno}: column {head[j].strip()!r} = {cell!r} is not a number"
+                    ) from None
+        return cls(np.array(data["s"]), np.array(data["z_l"]), np.array(data["z_r"]), source=str(path))
+
+    def _evaluate(self, s):
+        if np.any(s > self.s[-1] + 1e-9):
+            raise ValueError(
+                f"{self.source}: the profile ends at s = {self.s[-1]:g} m but the run "
+                f"reaches s = {float(np.max(s)):.1f} m"
+            )
+        return tuple(f(s) for f in self._interp)
+
+    def end(self):
+        return float(self.s[-1])
+
+    def table_spacing(self):
+        return float(np.min(np.diff(self.s))) / 2
+
+    def describe(self):
+        return {"profile": "measured", "source": self.source, "rows": int(self.s.size), "s_end_m": float(self.s[-1])}
+
+
+def _check_speed(value) -> float:
+    speed = _check("speed", value, "positive", "a finite number > 0 (m/s)")
+    if speed > MAX_SPEED:
+        raise ValueError(
+            f"speed = {speed:.4g} m/s: above the plausible {MAX_SPEED:g} m/s (the rail speed "
+            "record is 159.7 m/s; the model's linear suspension means nothing far beyond it)"
+        )
+    return speed
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """A run: a rail profile passed at constant speed for a duration."""
+
+    track: RailProfile = field(default_factory=SineTrack)
+    speed: float = DEFAULT_SPEED  # m/s, V (the paper's value)
+    duration: float = 10.0  # s
+    name: str = "paper-sine"
+
+    def __post_init__(self):
+        object.__setattr__(self, "speed", _check_speed(self.speed))
+        object.__setattr__(self, "duration", _check("duration", self.duration, "positive", "a finite number > 0 (s)"))
+        if not isinstance(self.track, RailProfile):
+            raise ValueError(f"track = {self.track!r}: must be a RailProfile")
+        needed = self.speed * self.duration
+        if needed > self.track.end() + 1e-9:
+            raise ValueError(
+                f"the run covers s = 0 to {needed:.1f} m (speed {self.speed:g} m/s x {self.duration:g} s) "
+                f"but the profile ends at s = {self.track.end():g} m: shorten the duration or lower the speed"
+            )
+
+    def describe(self) -> dict:
+        return {"name": self.name, "speed_m_s": self.speed, "duration_s": self.duration, **self.track.describe()}
+
+
+SCENARIOS = ("paper-sine", "bump", "file:PATH", "fra1..fra6", "german-low", "german-high")
+
+
+def scenario(
+    name: str = "paper-sine",
+    *,
+    amplitude: float | None = None,
+    wavelength: float | None = None,
+    rail_phase: float | None = None,
+    speed: float | None = None,
+    duration: float | None = None,
+    seed: int | None = None,
+    min_wavelength: float | None = None,
+    max_wavelength: float | None = None,
+    taper: float | None = None,
+) -> Scenario:
+    """A named scenario with optional overrides.
+
+    ``paper-sine``: amplitude [m], wavelength [m], rail_phase [deg] of the sine (defaults 0.05 m,
+    60 m, 90 deg) and the length of its entry taper in wavelengths (default 1; 0 for none).
+    ``bump``: amplitude is the bump height [m] (negative for a dip, default 0.02 m)
+    and wavelength its length [m] (default 10 m), starting at s = 10 m on both rails.
+    ``file:PATH``: a measured CSV profile (s, z_L, z_R). ``fra1`` ... ``fra6``, ``german-low``,
+    ``german-high``: a random realisation of that spectrum (`RandomTrack`) with ``seed`` (default
+    0) over the wavelength band [min_wavelength, max_wavelength] (default 1 to 100 m). Speed
+    defaults to 55.56 m/s and duration to 10 s for every scenario.
+    """
+    common = {"speed": 55.56 if speed is None else speed, "duration": 10.0 if duration is None else duration}
+    random_only = [
+        k
+        for k, v in (("seed", seed), ("min_wavelength", min_wavelength), ("max_wavelength", max_wavelength))
+        if v is not None
+    ]
+    if random_only and name not in SPECTRA:
+        raise ValueError(
+            f"{', '.join(random_only)} applies to the random tracks ({', '.join(SPECTRA)}) only, not to {name}"
+        )
+    if taper is not None and name != "paper-sine":
+        raise ValueError(f"taper applies to paper-sine only, not to {name}")
+    track: RailProfile
+    if name == "paper-sine":
+        track = SineTrack(
+            amplitude=0.05 if amplitude is None else amplitude,
+            wavelength=60.0 if wavelength is None else wavelength,
+            rail_phase_deg=90.0 if rail_phase is None else rail_phase,
+            taper=1.0 if taper is None else taper,
+        )
+    elif name == "bump":
+        if rail_phase is not None:
+            raise ValueError("rail_phase applies to paper-sine only, not to the bump scenario")
+        track = CosineBump(
+            height=0.02 if amplitude is None else amplitude, length=10.0 if wavelength is None else wavelength
+        )
+    elif name in SPECTRA:
+        given = [
+            k
+            for k, v in (("amplitude", amplitude), ("wavelength", wavelength), ("rail_phase", rail_phase))
+            if v is not None
+        ]
+        if given:
+            raise ValueError(
+                f"{', '.join(given)} cannot be set for a random track ({name}); "
+                "use min_wavelength, max_wavelength and seed"
+            )
+        V = _check_speed(common["speed"])  # before the track, whose length it sets
+        T = _check("duration", common["duration"], "positive", "a finite number > 0 (s)")
+        # long enough that the realisation does not repeat within the run
+        track = _random_track(
+            name,
+            0 if seed is None else seed,
+            1.0 if min_wavelength is None else min_wavelength,
+            100.0 if max_wavelength is None else max_wavelength,
+            max(2000.0, V * T + 100.0),
+        )
+    elif name.startswith("file:"):
+        given = [
+            k
+            for k, v in (("amplitude", amplitude), ("wavelength", wavelength), ("rail_phase", rail_phase))
+            if v is not None
+        ]
+        if given:
+            raise ValueError(f"{', '.join(given)} cannot be set for a measured profile ({name})")
+        path = name[len("file:") :]
+        if not path:
+            raise ValueError("scenario 'file:' needs a path, as in file:track.csv")
+        track = MeasuredTrack.from_csv(path)
+    else:
+        raise ValueError(f"unknown scenario {name!r}; allowed: {', '.join(SCENARIOS)}")
+    return Scenario(track=track, name=name, **common)
+
+
+def input_table_nodes(scenario: Scenario, dt: float, duration: float | None = None) -> tuple[int, float]:
+    """(rows, interval [s]) of `wheelset_input_table`'s table, without building it (the size
+    checks ask first)."""
+    duration = scenario.duration if duration is None else duration
+    # m is a power of two, so halving dt doubles m and leaves the grid (and the input) alone
+    ratio = scenario.track.table_spacing() / (scenario.speed * dt)
+    m = 1 << max(0, int(math.floor(math.log2(ratio)))) if ratio >= 1 else 1
+    interval = m * dt
+    return int(math.ceil((duration + dt) / interval)) + 2, interval
+
+
+def wheelset_input_table(
+    scenario: Scenario, lag_distance: np.ndarray, dt: float, duration: float | None = None
+) -> tuple[np.ndarray, float]:
+    """Rail inputs at the wheelsets on the stepper's time grid.
+
+    Returns ``(table, interval)``: table (n, 16) holds at t_k = k * interval the heights
+    w = (z_1L, z_1R, ..., z_4R) [m] in columns 0-7 and their rates w' = V dz/ds [m/s] in
+    columns 8-15; interval is a whole number of steps dt. ``lag_distance`` is x1 - x_j [m]
+    per wheelset.
+    """
+    duration = scenario.duration if duration is None else duration
+    V = scenario.speed
+    n, interval = input_table_nodes(scenario, dt, duration)
+    if n > MAX_TABLE_NODES:
+        raise ValueError(
+            f"the rail input table would need {n} nodes ({duration:g} s at one node per "
+            f"{interval:.3g} s); at most {MAX_TABLE_NODES} are allowed: shorten the run"
+        )
+    s = V * (np.arange(n) * interval)[:, None] - np.asarray(lag_distance)[None, :]  # (n, 4)
+    zl, zr, dzl, dzr = scenario.track.evaluate(np.minimum(s, scenario.track.end()))
+    past_end = s > scenario.track.end()  # margin nodes past a measured end: held flat
+    dzl[past_end] = 0.0
+    dzr[past_end] = 0.0
+    table = np.empty((n, 16))
+    table[:, 0:8:2], table[:, 1:8:2] = zl, zr
+    table[:, 8:16:2], table[:, 9:16:2] = V * dzl, V * dzr
+    return table, interval
+
+
+# -- random irregularity from standard spectra (docs/track.md) -----------------------------------
+#: FRA track classes (Hamid and Yang 1981; the constants as in Garg and Dukkipati 1984,
+#: "Dynamics of Railway Vehicle Systems"): A_v [cm^2 rad/m] per class, k = 0.25,
+#: Omega_c = 0.8245 rad/m, Omega_s = 0.4380 rad/m.
+FRA_AV = {1: 1.2107, 2: 1.0181, 3: 0.6816, 4: 0.5376, 5: 0.2095, 6: 0.0339}
+FRA_K, FRA_OMEGA_C, FRA_OMEGA_S = 0.25, 0.8245, 0.4380
+#: German high-speed spectra (ERRI B176 form): A_v [m^2 rad/m] for low and high interference,
+#: Omega_c = 0.8246, Omega_r = 0.0206, Omega_s = 0.4380 rad/m.
+GERMAN_AV = {"low": 4.032e-7, "high": 1.080e-6}
+GERMAN_OMEGA_C, GERMAN_OMEGA_R, GERMAN_OMEGA_S = 0.8246, 0.0206, 0.4380
+SPECTRA = tuple([f"fra{c}" for c in FRA_AV] + ["german-low", "german-high"])
+
+
+def spectrum(name: str, wavenumber, component: str = "vertical") -> np.ndarray:
+    """One-sided displacement PSD [m^2/(rad/m)] of a standard track spectrum at wavenumbers
+    [rad/m] (Omega = 2 pi / wavelength).
+
+    ``component`` "vertical": the vertical profile z_v (mean of the two rails); "cross-level":
+    the height difference z_x = z_L - z_R between the rails (z_L = z_v + z_x/2,
+    z_R = z_v - z_x/2). Formulas (docs/track.md):
+
+    * FRA class c: S_v = k A_v Omega_c^2 / (Omega^2 (Omega^2 + Omega_c^2)),
+      S_x = 4 k A_v Omega_c^2 / ((Omega^2 + Omega_c^2)(Omega^2 + Omega_s^2)), in cm^2/(rad/m),
+      converted here to m^2/(rad/m).
+    * German low/high: S_v = A_v Omega_c^2 / ((Omega^2 + Omega_r^2)(Omega^2 + Omega_c^2)); the
+      published cross-level form (A_v / b^2) Omega_c^2 Omega^2 / ((Omega^2 + Omega_r^2)(Omega^2 +
+      Omega_c^2)(Omega^2 + Omega_s^2)) is the cross-level angle with b = 0.75 m half the contact
+      distance; the height difference is that angle times 2b, so S_x = 4 A_v Omega_c^2 Omega^2 /
+      (...), independent of b.
+    """
+    W = np.asarray(wavenumber, dtype=float)
+    if not np.all(np.isfinite(W)) or np.any(W <= 0):
+        raise ValueError("wavenumber must be finite and > 0 rad/m")
+    if component not in ("vertical", "cross-level"):
+        raise ValueError(f"component = {component!r}: allowed 'vertical', 'cross-level'")
+    W2 = W * W
+    if name.startswith("fra") and name[3:].isdigit() and int(name[3:]) in FRA_AV:
+        Av, k, Wc2, Ws2 = FRA_AV[int(name[3:])], FRA_K, FRA_OMEGA_C**2, FRA_OMEGA_S**2
+        cm2 = (
+            k * Av * Wc2 / (W2 * (W2 + Wc2))
+            if component == "vertical"
+            else 4 * k * Av * Wc2 / ((W2 + Wc2) * (W2 + Ws2))
+        )
+        return cm2 * 1e-4
+    if name in ("german-low", "german-high"):
+        Av = GERMAN_AV[name.split("-")[1]]
+        Wc2, Wr2, Ws2 = GERMAN_OMEGA_C**2, GERMAN_OMEGA_R**2, GERMAN_OMEGA_S**2
+        if component == "vertical":
+            return Av * Wc2 / ((W2 + Wr2) * (W2 + Wc2))
+        return 4 * Av * Wc2 * W2 / ((W2 + Wr2) * (W2 + Wc2) * (W2 + Ws2))
+    raise ValueError(f"unknown track spectrum {name!r}; allowed: {', '.join(SPECTRA)}")
+
+
+@dataclass(frozen=True, eq=False)
+class RandomTrack(RailProfile):
+    """A seeded realisation of a standard spectrum: vertical profile and cross-level,
+    independent, each a sum of harmonics on a uniform wavenumber grid over the band
+    [2 pi / max_wavelength, 2 pi / min_wavelength] with amplitudes sqrt(2 S(Omega_k) dOmega)
+    and random phases, synthesised by an inverse FFT on a uniform grid in s and interpolated by
+    cubic splines. The realisation is ``length`` long (runs beyond it are refused); it fades in
+    over the first ``lead_in`` metres (raised cosine) so the vehicle enters from level track
+    smoothly."""
+
+    name: str = "fra4"
+    seed: int = 0
+    min_wavelength: float = 1.0  # m
+    max_wavelength: float = 100.0  # m
+    length: float = 2000.0  # m, the realisation's period
+    lead_in: float = 20.0  # m
+    _interp: tuple = field(default=(), repr=False)
+
+    def __post_init__(self):
+        from scipy.interpolate import CubicSpline
+
+        spectrum(self.name, 1.0)  # an unknown name fails here
+        # a Python int, never through a float (which rounds seeds past 2**53)
+        object.__setattr__(self, "seed", validation.seed("seed", self.seed))
+        lo = _check("min_wavelength", self.min_wavelength, "positive", "a finite number > 0 (m)")
+        hi = _check("max_wavelength", self.max_wavelength, "positive", "a finite number > 0 (m)")
+        if not lo < hi:
+            raise ValueError(f"wavelength band [{lo:g}, {hi:g}] m: min_wavelength must be below max_wavelength")
+        length = _check("length", self.length, "positive", "a finite number > 0 (m)")
+        if length < hi:
+            raise ValueError(f"length = {length:g} m: must be at least max_wavelength = {hi:g} m")
+        lead = _check("lead_in", self.lead_in, "nonnegative", "a finite number >= 0 (m)")
+        ds = lo / 20.0  # 20 samples on the shortest wavelength
+        n = int(2 ** math.ceil(math.log2(length / ds)))
+        if n > 2**24:
+            raise ValueError(
+                f"the realisation needs {n:.4g} samples ({length:.4g} m at {ds:.4g} m), more than "
+                f"2**24: shorten it or raise min_wavelength"
+            )
+        ds = length / n
+        dW = 2 * np.pi / length
+        k = np.arange(n // 2 + 1)
+        W = k * dW
+        band = (W >= 2 * np.pi / hi) & (W <= 2 * np.pi / lo)
+        rng = np.random.default_rng(self.seed)
+        s = np.arange(n) * ds
+        profiles = []
+        for component in ("vertical", "cross-level"):
+            S = np.zeros_like(W)
+            S[band] = spectrum(self.name, W[band], component)
+            amp = np.sqrt(2 * S * dW)  # one-sided: variance = sum S dW
+            phase = rng.uniform(0, 2 * np.pi, W.size)
+            # z(s) = sum amp cos(W s + phase) as the real part of an inverse FFT
+            profiles.append(np.fft.irfft(amp * np.exp(1j * phase) * (n / 2), n))
+        zv, zx = profiles
+        taper = np.where(s < lead, 0.5 * (1 - np.cos(np.pi * s / max(lead, 1e-12))), 1.0)
+        zl, zr = taper * (zv + zx / 2), taper * (zv - zx / 2)
+        # not periodic: a periodic spline would join the full-amplitude end to the faded-in
+        # start and ring there; runs stay within the length (scenario() makes it long enough)
+        splines = tuple(CubicSpline(s, z) for z in (zl, zr))
+        object.__setattr__(self, "_interp", (splines, zv, zx, s))
+
+    def end(self) -> float:
+        return float(self._interp[3][-1])
+
+    def _evaluate(self, s):
+        (sl, sr), *_ = self._interp
+        return sl(s), sr(s), sl(s, 1), sr(s, 1)
+
+    def samples(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(s, z_v, z_x) of the realisation before the lead-in taper, for checks."""
+        _, zv, zx, s = self._interp
+        return s, zv, zx
+
+    def table_spacing(self):
+        return self.min_wavelength / 20.0
+
+    def describe(self):
+        return {
+            "profile": "random",
+            "spectrum": self.name,
+            "seed": int(self.seed),
+            "min_wavelength_m": self.min_wavelength,
+            "max_wavelength_m": self.max_wavelength,
+            "length_m": self.length,
+            "lead_in_m": self.lead_in,
+        }
+
+
+#: the random-track realisations kept for the next runs (`_random_track`): 6.8 MB each for the
+#: default band over 2000 m, so four; a study takes its runs realisation by realisation
+#: (`railride.studies.sweep.run_cases`), so it needs one or two at a time
+TRACK_CACHE_BYTES = 32 * MiB
+
+
+def _track_bytes(track: RandomTrack) -> int:
+    splines, *arrays = track._interp
+    return sum(sp.x.nbytes + sp.c.nbytes for sp in splines) + sum(a.nbytes for a in arrays)
+
+
+_TRACKS: BytesLRU[RandomTrack] = BytesLRU("random tracks", TRACK_CACHE_BYTES, _track_bytes)
+
+
+def _random_track(name, seed, min_wavelength, max_wavelength, length) -> RandomTrack:
+    """The `RandomTrack` of these settings, kept while the realisations fit `TRACK_CACHE_BYTES`:
+    a study at several speeds (or passive beside a controller) meets the same realisation many
+    times, and synthesising it is most of a short run's set-up. A value that cannot be a key is
+    checked by RandomTrack."""
+
+    def build() -> RandomTrack:
+        return RandomTrack(name, seed=seed, min_wavelength=min_wavelength, max_wavelength=max_wavelength, length=length)
+
+    if isinstance(seed, bool):  # True would hash as seed 1: let the constructor refuse it
+        return build()
+    return _TRACKS.get((name, seed, min_wavelength, max_wavelength, length), build)
+
+
+def table_key(sc: Scenario):
+    """``sc`` as a plain value for the caches of its tables (`railride.run.simulation`): equal
+    settings give equal keys (a realisation built again, a profile read again, compared by its
+    numbers), and a key holds no track, so a kept table does not keep its track alive. None for
+    a profile that is not a dataclass of plain values."""
+    track = sc.track
+    if not dataclasses.is_dataclass(track):
+        return None
+    parts = []
+    for f in dataclasses.fields(track):
+        if f.name.startswith("_"):  # what the settings build (splines), not a setting
+            continue
+        value = getattr(track, f.name)
+        if isinstance(value, np.ndarray):
+            data = np.ascontiguousarray(value)
+            value = (data.shape, data.dtype.str, hashlib.sha1(data.tobytes()).hexdigest())
+        parts.append((f.name, value))
+    key = (type(track).__qualname__, tuple(parts), sc.name, sc.speed, sc.duration)
+    try:
+        hash(key)
+    except TypeError:
+        return None
+    return key
+
+
+def as_scenario(value) -> Scenario:
+    """``value`` as a scenario: None (`paper-sine`), a scenario name, or a `Scenario`."""
+    if value is None:
+        return scenario("paper-sine")
+    if isinstance(value, str):
+        return scenario(value)
+    if isinstance(value, Scenario):
+        return value
+    raise ValueError(f"scenario = {value!r}: must be a Scenario or a scenario name")

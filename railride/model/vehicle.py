@@ -1,0 +1,304 @@
+"""The 9-DOF vehicle assembled from the element table of docs/model.md, Equations.
+
+Every suspension element is a spring k and a damper c on a deflection that is linear in the
+DOFs q and the rail inputs w: delta = a.q + e.w.  The equations of motion
+
+    M q'' + C q' + K q = -(K_w w + C_w w') + T f
+
+follow by assembly: K = sum k a a^T, K_w = sum k a e^T, and likewise C, C_w with c.  Nothing
+downstream retypes an equation: matrices, modes, frequency responses and the compiled stepper
+all come from `Vehicle`.
+
+Orderings used everywhere:
+
+* DOFs q: carbody bounce, pitch, roll; front bogie bounce, pitch, roll; rear bogie (same).
+* rail inputs w: z_1L, z_1R, z_2L, z_2R, z_3L, z_3R, z_4L, z_4R (wheelset 1 leads).
+* secondary corners (forces f): 1R, 1L, 2R, 2L (bogie 1 is the front one, R is y = -d_s).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import cached_property
+
+import numpy as np
+import scipy.linalg
+import scipy.optimize
+import xarray as xr
+
+from railride import validation
+from railride.engine.layout import N_DOF, N_RAIL
+from railride.model.params import VehicleParams
+
+DOF_NAMES = (
+    "carbody_bounce",
+    "carbody_pitch",
+    "carbody_roll",
+    "front_bogie_bounce",
+    "front_bogie_pitch",
+    "front_bogie_roll",
+    "rear_bogie_bounce",
+    "rear_bogie_pitch",
+    "rear_bogie_roll",
+)
+DOF_UNITS = ("m", "rad", "rad") * 3
+CORNER_NAMES = ("1R", "1L", "2R", "2L")
+WHEELSETS = (1, 2, 3, 4)
+RAILS = ("L", "R")
+N_RAIL_INPUT = N_RAIL
+
+_BODY_OFFSET = {"carbody": 0, "front_bogie": 3, "rear_bogie": 6}
+
+
+@dataclass(frozen=True)
+class Element:
+    """One suspension element: delta = a.q + e.w, with spring k [N/m] and damper c [N s/m]."""
+
+    name: str
+    group: str
+    k: float
+    c: float
+    a: np.ndarray  # (9,) coefficients on the DOFs
+    e: np.ndarray  # (8,) coefficients on the rail inputs
+
+
+def _rail_index(wheelset: int, rail: str) -> int:
+    return 2 * (wheelset - 1) + (0 if rail == "L" else 1)
+
+
+def _point(body: str, x: float, y: float) -> np.ndarray:
+    """a-vector of the vertical motion of point (x, y) of a body: z - x*phi + y*theta."""
+    a = np.zeros(N_DOF)
+    i = _BODY_OFFSET[body]
+    a[i], a[i + 1], a[i + 2] = 1.0, -x, y
+    return a
+
+
+def _wheelset_point(wheelset: int, y: float, half_gauge: float) -> np.ndarray:
+    """e-vector of z_w + y*theta_w, the wheelset following its rails."""
+    e = np.zeros(N_RAIL_INPUT)
+    e[_rail_index(wheelset, "L")] = 0.5 + y / (2.0 * half_gauge)
+    e[_rail_index(wheelset, "R")] = 0.5 - y / (2.0 * half_gauge)
+    return e
+
+
+def _wheelset_roll(wheelset: int, half_gauge: float) -> np.ndarray:
+    """e-vector of theta_w = (z_L - z_R) / (2a)."""
+    e = np.zeros(N_RAIL_INPUT)
+    e[_rail_index(wheelset, "L")] = 1.0 / (2.0 * half_gauge)
+    e[_rail_index(wheelset, "R")] = -1.0 / (2.0 * half_gauge)
+    return e
+
+
+def element_table(p: VehicleParams) -> list[Element]:
+    """The element list of docs/model.md, Equations, in code."""
+    elements: list[Element] = []
+    zero_e = np.zeros(N_RAIL_INPUT)
+    bogies = (("front_bogie", +p.l, (1, 2)), ("rear_bogie", -p.l, (3, 4)))
+    for bi, (bogie, x_b, wheelsets) in enumerate(bogies, start=1):
+        o = _BODY_OFFSET[bogie]
+        # secondary vertical, one per corner; R before L to match the force order
+        for side, y in (("R", -p.d_s), ("L", +p.d_s)):
+            a = _point("carbody", x_b, y) - _point(bogie, 0.0, y)
+            elements.append(Element(f"secondary vertical {bi}{side}", "secondary_vertical", p.k_sz, p.c_sz, a, zero_e))
+        # secondary lateral and longitudinal act through roll and pitch only; one of each on
+        # each side of the bogie (the paper's eq. 2, 3, 5, 6 carry 2 k_sy, 2 k_sx per bogie and
+        # the appendix gives the values per side)
+        for side in ("R", "L"):
+            a = np.zeros(N_DOF)
+            a[2], a[o + 2] = p.h_cs, p.h_ts
+            elements.append(Element(f"secondary lateral {bi}{side}", "secondary_lateral", p.k_sy, p.c_sy, a, zero_e))
+            a = np.zeros(N_DOF)
+            a[1], a[o + 1] = p.h_cs, p.h_ts
+            elements.append(
+                Element(f"secondary longitudinal {bi}{side}", "secondary_longitudinal", p.k_sx, p.c_sx, a, zero_e)
+            )
+        for wheelset, x_axle in zip(wheelsets, (+p.b, -p.b)):
+            for side, y in (("R", -p.d_p), ("L", +p.d_p)):
+                box = f"{wheelset}{side}"
+                a = _point(bogie, x_axle, y)
+                e = -_wheelset_point(wheelset, y, p.a)
+                elements.append(Element(f"primary vertical {box}", "primary_vertical", p.k_pz, p.c_pz, a, e))
+                a = np.zeros(N_DOF)
+                a[o + 1] = p.h_tp
+                elements.append(
+                    Element(f"primary longitudinal {box}", "primary_longitudinal", p.k_px, p.c_px, a, zero_e)
+                )
+                a = np.zeros(N_DOF)
+                a[o + 2] = p.h_tp
+                e = p.h_wp * _wheelset_roll(wheelset, p.a)
+                elements.append(Element(f"primary lateral {box}", "primary_lateral", p.k_py, p.c_py, a, e))
+    return elements
+
+
+@dataclass(frozen=True)
+class Mode:
+    label: str
+    frequency_hz: float  # undamped natural frequency, from (K, M)
+    damped_frequency_hz: float
+    damping_ratio: float
+    shape: np.ndarray  # undamped mode shape, normalised to unit kinetic energy
+
+    def to_dict(self) -> dict:
+        return {
+            "label": self.label,
+            "frequency_hz": float(self.frequency_hz),
+            "damped_frequency_hz": float(self.damped_frequency_hz),
+            "damping_ratio": float(self.damping_ratio),
+        }
+
+
+class Vehicle:
+    """Matrices, modes and frequency responses of the 9-DOF vehicle for one parameter set."""
+
+    def __init__(self, params: VehicleParams | None = None):
+        self.params = params if params is not None else VehicleParams.preset("paper")
+        p = self.params
+        self.elements = element_table(p)
+        self.M = np.diag([p.m_c, p.I_cy, p.I_cx, p.m_b, p.I_by, p.I_bx, p.m_b, p.I_by, p.I_bx])
+        A = np.array([el.a for el in self.elements])  # (n_el, 9)
+        E = np.array([el.e for el in self.elements])  # (n_el, 8)
+        k = np.array([el.k for el in self.elements])
+        c = np.array([el.c for el in self.elements])
+        self.K = A.T @ (k[:, None] * A)
+        self.C = A.T @ (c[:, None] * A)
+        self.K_w = A.T @ (k[:, None] * E)
+        self.C_w = A.T @ (c[:, None] * E)
+        sec = [i for i, el in enumerate(self.elements) if el.group == "secondary_vertical"]
+        #: secondary force map (9, 4): columns are the a-vectors of the secondary vertical elements
+        self.T = A[sec].T.copy()
+        #: damping without the secondary vertical dashpots (those become the forces f)
+        self.C0 = self.C - p.c_sz * self.T @ self.T.T
+        #: x of each wheelset relative to the carbody centre; wheelset j lags wheelset 1 by
+        #: (x1 - xj) / V
+        self.wheelset_x = np.array([p.l + p.b, p.l - p.b, -p.l + p.b, -p.l - p.b])
+
+    @property
+    def wheelset_lag_distance(self) -> np.ndarray:
+        """x1 - x_j [m]: how far behind the leading wheelset each wheelset runs."""
+        return self.wheelset_x[0] - self.wheelset_x
+
+    @cached_property
+    def state_matrix(self) -> np.ndarray:
+        """A of x' = A x for x = (q, q') with the passive secondary dampers, rails fixed."""
+        Minv = 1.0 / np.diag(self.M)
+        A = np.zeros((2 * N_DOF, 2 * N_DOF))
+        A[:N_DOF, N_DOF:] = np.eye(N_DOF)
+        A[N_DOF:, :N_DOF] = -Minv[:, None] * self.K
+        A[N_DOF:, N_DOF:] = -Minv[:, None] * self.C
+        return A
+
+    # -- modal analysis ---------------------------------------------------------------------
+    def modes(self) -> list[Mode]:
+        """Undamped and damped modes of the passive vehicle, sorted by undamped frequency.
+
+        Undamped modes solve K phi = w^2 M phi. Damped modes are the eigenvalues lambda of the
+        state matrix: damped frequency |Im lambda|, damping ratio -Re lambda / |lambda| (an
+        overdamped pair of real roots gives one mode with ratio >= 1). Damped and undamped
+        modes are paired by the modal assurance criterion of their displacement shapes.
+        Labels name the DOF group holding most of the mode's kinetic energy.
+        """
+        w2, shapes = scipy.linalg.eigh(self.K, self.M)
+        lam, vecs = np.linalg.eig(self.state_matrix)
+        damped = _damped_modes(lam, vecs[:N_DOF])
+        mac = np.array([[_mac(shapes[:, i], d[3]) for d in damped] for i in range(N_DOF)])
+        _, match = scipy.optimize.linear_sum_assignment(-mac)  # rows come back as 0..8
+        out = []
+        for i in range(N_DOF):  # eigh sorts by frequency
+            _, omega_d, zeta, _ = damped[match[i]]
+            out.append(
+                Mode(
+                    _label(shapes[:, i], np.diag(self.M)),
+                    float(np.sqrt(max(w2[i], 0.0)) / (2 * np.pi)),
+                    float(omega_d / (2 * np.pi)),
+                    float(zeta),
+                    shapes[:, i],
+                )
+            )
+        return out
+
+    # -- frequency response -----------------------------------------------------------------
+    def frequency_response(self, frequency_hz, speed: float, rails="in-phase") -> xr.Dataset:
+        """Complex response of the passive vehicle per unit rail amplitude.
+
+        ``rails`` sets the rail pattern: "in-phase" (z_L = z_R), "anti-phase" (z_L = -z_R), or
+        a pair of complex weights (c_L, c_R). Every wheelset sees the same pattern delayed by
+        its lag distance / speed. The result holds the DOF responses (per metre of rail
+        amplitude), carbody CG acceleration, corner displacements and the rail cross-level angle
+        (z_L - z_R)/(2a) of the pattern, all over the ``frequency`` coordinate in Hz.
+        """
+        f = np.atleast_1d(np.asarray(frequency_hz, dtype=float))
+        if not np.all(np.isfinite(f)) or np.any(f < 0):
+            raise ValueError(f"frequency_hz must be finite and >= 0, got {frequency_hz!r}")
+        speed = validation.number("speed", speed, "positive", "m/s")
+        if isinstance(rails, str):
+            patterns = {"in-phase": (1.0, 1.0), "anti-phase": (1.0, -1.0)}
+            if rails not in patterns:
+                raise ValueError(f"rails = {rails!r}: allowed 'in-phase', 'anti-phase' or (c_L, c_R)")
+            cL, cR = patterns[rails]
+        else:
+            cL, cR = rails
+        omega = 2 * np.pi * f
+        lag = self.wheelset_lag_distance / speed
+        H = np.empty((f.size, N_DOF), dtype=complex)
+        for n, w in enumerate(omega):
+            delay = np.exp(-1j * w * lag)  # (4,)
+            W = np.empty(N_RAIL_INPUT, dtype=complex)
+            W[0::2], W[1::2] = cL * delay, cR * delay
+            Z = -(w**2) * self.M + 1j * w * self.C + self.K
+            H[n] = np.linalg.solve(Z, -(self.K_w + 1j * w * self.C_w) @ W)
+        ds = xr.Dataset(coords={"frequency": ("frequency", f, {"units": "Hz"}), "corner": list(CORNER_NAMES)})
+        for i, name in enumerate(DOF_NAMES):
+            ds[name] = ("frequency", H[:, i], {"units": f"{DOF_UNITS[i]}/m"})
+        ds["carbody_acceleration"] = ("frequency", -(omega**2) * H[:, 0], {"units": "(m/s^2)/m"})
+        corner = H @ self.T  # T^T q: the secondary deflection at each corner
+        corner_body = H[:, :3] @ self.T[:3]  # the carbody part alone: corner displacement
+        ds["carbody_corner_displacement"] = (("frequency", "corner"), corner_body, {"units": "m/m"})
+        ds["secondary_deflection"] = (("frequency", "corner"), corner, {"units": "m/m"})
+        ds.attrs.update(
+            speed_m_s=speed,
+            rail_L=str(cL),
+            rail_R=str(cR),
+            cross_level_angle_per_m=str((cL - cR) / (2 * self.params.a)),
+        )
+        return ds
+
+
+def _mac(u: np.ndarray, v: np.ndarray) -> float:
+    return float(abs(np.vdot(u, v)) ** 2 / (np.vdot(u, u).real * np.vdot(v, v).real))
+
+
+def _damped_modes(lam: np.ndarray, shapes: np.ndarray) -> list[tuple[float, float, float, np.ndarray]]:
+    """(omega_n, omega_d, zeta, shape) per mode from the state-matrix eigenpairs."""
+    out = []
+    tol = 1e-9 * max(1.0, float(np.max(np.abs(lam))))
+    complex_idx = [i for i in range(lam.size) if lam[i].imag > tol]
+    real_idx = [i for i in range(lam.size) if abs(lam[i].imag) <= tol]
+    for i in complex_idx:
+        wn = abs(lam[i])
+        out.append((wn, lam[i].imag, -lam[i].real / wn, shapes[:, i]))
+    # overdamped: pair the real roots whose shapes agree best
+    remaining = list(real_idx)
+    while len(remaining) >= 2:
+        i = remaining.pop(0)
+        j = max(remaining, key=lambda r: _mac(shapes[:, i], shapes[:, r]))
+        remaining.remove(j)
+        l1, l2 = lam[i].real, lam[j].real
+        wn = np.sqrt(l1 * l2) if l1 * l2 > 0 else 0.0
+        zeta = -(l1 + l2) / (2 * wn) if wn > 0 else np.inf
+        out.append((wn, 0.0, zeta, shapes[:, i].real))
+    return out
+
+
+def _label(shape: np.ndarray, mass: np.ndarray) -> str:
+    """Name a mode after the DOF group with the largest share of kinetic energy."""
+    energy = mass * np.abs(shape) ** 2
+    i = int(np.argmax(energy))
+    body, motion = DOF_NAMES[i].rsplit("_", 1)
+    if body == "carbody":
+        return f"carbody {motion}"
+    other = i + 3 if i < 6 else i - 3
+    if energy[other] > energy[i] / 3:
+        phase = "in phase" if shape[i] * shape[other] > 0 else "anti-phase"
+        return f"bogie {motion} ({phase})"
+    return f"{body.replace('_', ' ')} {motion}"

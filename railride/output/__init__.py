@@ -1,0 +1,1 @@
+"""Files and tables of results, and the HTML report."""

@@ -1,0 +1,436 @@
+"""One self-contained HTML file of a result, to open in any browser and send to colleagues.
+
+`write_report(result, path)` writes, for a result this module knows (`KNOWN`: `Comparison`,
+`SweepResult`, `TuneResult`, `StudyResult`, `LeagueTable`, `RideResult`, `FrfResult`), a page
+with the run's settings and provenance (railride version, scenario, vehicle parameters, the
+command line), the vehicle's modal table, the tables the command line printed (HTML fragments
+given by the caller, ``console_html``), the result's own table (``to_pandas()``) and every
+figure its ``save()`` writes: time histories, spectra and frequency responses as interactive
+plotly figures (`railride.plots.interactive`), the others as the package's matplotlib figures
+inlined as images. Nothing is fetched when the page opens: plotly's JavaScript is inlined once
+and every image is a data URI. See docs/report.md.
+
+A new result type is one function returning its `Contents`, registered with `contents_of`.
+"""
+
+from __future__ import annotations
+
+import base64
+import datetime as _dt
+import html
+import io
+import json
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Callable
+
+import pandas as pd
+
+from railride._version import __version__
+from railride._io import atomic_write_text
+
+#: rows of a result table shown in the report; a longer table shows its first rows and says so
+MAX_TABLE_ROWS = 500
+#: a matplotlib figure is inlined as SVG (sharp at any zoom) up to this many bytes, else as PNG:
+#: a long noisy history in SVG keeps every vertex matplotlib cannot simplify away
+SVG_LIMIT = 500_000
+#: file names a report may take
+SUFFIXES = (".html", ".htm")
+
+
+@dataclass
+class Contents:
+    """What a result contributes to its report. ``figures``: (name, caption, figure) with a
+    plotly or matplotlib figure, one per figure file its ``save()`` writes (``name``.png), in
+    that order; ``tables``: (caption, DataFrame); ``settings``: nested values shown flat;
+    ``scenario``: the scenario's record (`Scenario.describe()`), if one; ``params``: the
+    `VehicleParams` of the modal table (None: the vehicles differ, no single table)."""
+
+    title: str
+    settings: dict
+    params: Any
+    scenario: dict | None = None
+    figures: list = field(default_factory=list)
+    tables: list = field(default_factory=list)
+
+
+#: result class ("module.Class") -> the function giving its `Contents`
+KNOWN: dict[str, Callable[[Any], Contents]] = {}
+
+
+def contents_of(*classes: str):
+    """Register the decorated function as the `Contents` of the result classes named
+    ("railride.studies.comparison.Comparison")."""
+
+    def register(function):
+        for name in classes:
+            KNOWN[name] = function
+        return function
+
+    return register
+
+
+def contents(result) -> Contents:
+    """The `Contents` of ``result`` (ValueError for a type the report does not know)."""
+    for cls in type(result).__mro__:
+        function = KNOWN.get(f"{cls.__module__}.{cls.__qualname__}")
+        if function is not None:
+            return function(result)
+    known = ", ".join(sorted(name.rsplit(".", 1)[1] for name in KNOWN))
+    raise ValueError(f"result: a {type(result).__name__} has no report; allowed: {known}")
+
+
+# -- the result types ---------------------------------------------------------------------------
+def _vehicle(settings: dict):
+    from railride.model.params import VehicleParams
+
+    record = settings.get("vehicle_params")
+    return VehicleParams(**record) if record else VehicleParams.preset("paper")
+
+
+@contents_of("railride.studies.comparison.Comparison")
+def _comparison(result) -> Contents:
+    from railride.analysis.spectra import PSD_SEGMENT_S, comparison_psd
+    from railride.analysis.labels import CARBODY_RESPONSES, psd_title
+    from railride.plots import comparison as plots
+    from railride.plots.interactive import comparison_psd_figure, comparison_response_figure
+
+    doc = result.to_dict()
+    settings = doc["settings"]
+    ds = result.combined()
+    window = settings.get("window_s")
+    figures = [(r, f"carbody {r} against time", comparison_response_figure(ds, r)) for r in CARBODY_RESPONSES]
+    psd = comparison_psd_figure(comparison_psd(ds, window), title=psd_title(ds, window, PSD_SEGMENT_S))
+    figures.append(("psd", "acceleration spectra", psd))
+    figures += [
+        (name, words, draw(result))
+        for name, words, draw in (
+            ("damper_forces", "damper forces", plots.plot_comparison_damper_forces),
+            ("damper_hysteresis", "damper force against deflection rate", plots.plot_comparison_hysteresis),
+            ("voltages", "command voltages", plots.plot_comparison_voltages),
+        )
+    ]
+    return Contents(
+        title="Ride comparison" + (" beside the paper's Table 1" if doc["paper_case"] else ""),
+        settings={**settings, "paper_case": doc["paper_case"], "gains": doc["gains"], "tuning": doc["tuning"]},
+        params=_vehicle(settings),
+        scenario=settings.get("scenario"),
+        figures=figures,
+        tables=[("RMS and peak-to-peak per suspension and response, reduction % against passive", result.to_pandas())],
+    )
+
+
+@contents_of("railride.studies.sweep.SweepResult")
+def _sweep(result) -> Contents:
+    from railride.plots.sweep import has_comfort, sweep_plot_axis
+
+    settings = result.settings()
+    axis = sweep_plot_axis(result)  # None: no numeric axis with several values, no figure
+    figures = [] if axis is None else [("sweep", f"RMS against {axis}", result.plot(axis=axis))]
+    if axis is not None and has_comfort(result):
+        figures.append(("comfort", f"comfort against {axis}", result.plot(comfort=True, axis=axis)))
+    return Contents(
+        title="Sweep",
+        settings={**settings, "date": result.date, "runs": int(result.runs)},
+        params=_vehicle(settings),
+        scenario=settings.get("scenario"),
+        figures=figures,
+        tables=[("one row per run", result.to_pandas())],
+    )
+
+
+@contents_of("railride.studies.tune_result.TuneResult")
+def _tune(result) -> Contents:
+    doc = result.to_dict()
+    keys = ("controllers", "scenario", "settings", "objective", "date", "runs", "gains")
+    return Contents(
+        title="Tuning: every law by the sensitivity study",
+        settings={k: doc[k] for k in keys},
+        params=_vehicle(doc["settings"]),
+        scenario=doc["scenario"],
+        figures=[("sensitivity", "sensitivity curves", result.plot())] if result.curves else [],
+        tables=[("the sensitivity curves, one row per value tried", result.to_pandas())],
+    )
+
+
+@contents_of("railride.studies.study.StudyResult")
+def _study(result) -> Contents:
+    return Contents(
+        title="Statistics over tracks, speeds, loads and faults",
+        settings={**result.settings, "runs": int(len(result.cases))},
+        params=_vehicle(result.settings),
+        figures=[("study", "reductions against passive with their 5-95 % bands", result.plot())],
+        tables=[("one row per controller, condition and metric", result.to_pandas())],
+    )
+
+
+@contents_of("railride.studies.league.LeagueTable")
+def _league(result) -> Contents:
+    from railride.plots.league import plot_league_comfort
+
+    settings = result.to_dict().get("settings") or {}
+    return Contents(
+        title="League table over scenarios, speeds and seeds",
+        settings=settings,
+        params=_vehicle(settings),
+        figures=[
+            ("league", "RMS reductions per case", result.plot()),
+            ("league_comfort", "N_MV against speed", plot_league_comfort(result)),
+        ],
+        tables=[("one row per case and controller", result.to_pandas())],
+    )
+
+
+@contents_of("railride.run.ride.RideResult")
+def _ride(result) -> Contents:
+    from railride.analysis.labels import json_records
+    from railride.plots.interactive import ride_figure
+    from railride.plots.ride import ride_title, sample_labels
+
+    ds = result.dataset
+    params = result.params
+    if isinstance(params, list):  # a batch: one modal table if they share the vehicle
+        params = params[0] if all(p == params[0] for p in params) else None
+    elif params is None and (records := json_records(ds, "vehicle_params")):
+        params = _vehicle({"vehicle_params": records[0]})
+    if result.is_batch:
+        records = json_records(ds, "scenario")
+        settings: dict = {"samples": int(ds.sizes["sample"]), "dt_s": ds.attrs.get("dt_s")}
+        scenario = records[0] if records and all(r == records[0] for r in records) else None
+        labels = sample_labels(ds)
+    else:
+        doc = result.to_dict()
+        settings = {k: v for k, v in doc.items() if k not in ("schema", "railride_version", "metrics")}
+        scenario, labels = doc["scenario"], None
+    metrics = result.metrics().to_dataframe(name="value").reset_index()
+    return Contents(
+        title="Ride of the vehicle",
+        settings=settings,
+        params=params,
+        scenario=scenario,
+        figures=[("body_responses", "carbody responses", ride_figure(ds, labels=labels, title=ride_title(ds)))],
+        tables=[("RMS and peak-to-peak of the carbody responses", metrics)],
+    )
+
+
+@contents_of("railride.frequency.frf.FrfResult")
+def _frf(result) -> Contents:
+    from railride.plots.interactive import frf_figure
+
+    doc = result.to_dict()
+    figure = frf_figure(result.to_pandas(), result.modes.to_pandas(), title=result.title())
+    return Contents(
+        title="Frequency responses of the passive vehicle",
+        settings={
+            **{k: v for k, v in doc.items() if k.startswith("vehicle_") and k != "vehicle_params"},
+            **doc["settings"],
+        },
+        params=result.params,
+        figures=[("frf", "carbody frequency responses", figure)],
+        tables=[("magnitudes and phases per rail pattern and frequency", result.to_pandas())],
+    )
+
+
+@contents_of("railride.frequency.ride_spectrum.RideSpectrum")
+def _ride_spectrum(result) -> Contents:
+    from railride.plots.interactive import ride_spectrum_figure
+
+    return Contents(
+        title="Ride in the frequency domain",
+        settings=result.to_dict()["settings"],
+        params=result.params,
+        figures=[("ride_spectrum", "floor acceleration PSDs per suspension", ride_spectrum_figure(result))],
+        tables=[("RMS and weighted RMS per suspension and response", result.to_pandas())],
+    )
+
+
+# -- the page -----------------------------------------------------------------------------------
+def check_report_path(path, field: str = "path") -> Path:
+    """``path`` as a Path if a report can be written there: a file name ending in .html or .htm,
+    not a folder, whose parent is not a file. ValueError naming ``field`` otherwise."""
+    path = Path(path)
+    if path.is_dir():
+        raise ValueError(
+            f"{field} = {str(path)!r}: a folder; give the name of the HTML file to write, e.g. report.html"
+        )
+    if path.suffix.lower() not in SUFFIXES:
+        raise ValueError(f"{field} = {str(path)!r}: must end in .html or .htm (one HTML file), e.g. report.html")
+    parent = next((p for p in path.absolute().parents if p.exists()), None)
+    if parent is not None and not parent.is_dir():
+        raise ValueError(f"{field} = {str(path)!r}: {parent} is a file, not a folder")
+    return path
+
+
+def write_report(result, path, *, console_html=(), title: str | None = None, command: str | None = None) -> Path:
+    """Write the report of ``result`` to ``path`` (`report_html`), atomically. Returns the path."""
+    path = check_report_path(path)
+    atomic_write_text(path, report_html(result, console_html=console_html, title=title, command=command))
+    return path
+
+
+def report_html(result, *, console_html=(), title: str | None = None, command: str | None = None) -> str:
+    """The report of ``result`` as one HTML document. ``console_html``: HTML fragments (or whole
+    documents, whose body is taken) of the tables a command printed, e.g. rich's
+    ``Console.export_html(inline_styles=True)``, inlined as given; ``title`` replaces the
+    result's; ``command``: the command line that made the result."""
+    import plotly.offline
+
+    from railride.model.modes import modes
+
+    part = contents(result)
+    heading = title or part.title
+    sections = [("settings", "Settings and provenance", _settings_html(part, command))]
+    if part.params is not None:
+        table = modes(part.params).to_pandas()
+        sections.append(("vehicle", "Vehicle: modes and parameters", _table_html(table) + _params_html(part.params)))
+    else:
+        sections.append(("vehicle", "Vehicle", "<p>The runs' vehicles differ: no single modal table.</p>"))
+    if console_html:
+        sections.append(("console", "What the command printed", "\n".join(_fragment(f) for f in console_html)))
+    if part.figures:
+        sections.append(("figures", "Figures", "\n".join(_figure_html(*f) for f in part.figures)))
+    if part.tables:
+        sections.append(("tables", "Tables", "\n".join(_caption_table(c, t) for c, t in part.tables)))
+    nav = " | ".join(f'<a href="#{key}">{html.escape(name)}</a>' for key, name, _ in sections)
+    body = "\n".join(
+        f'<section id="{key}"><h2>{html.escape(name)}</h2>\n{text}</section>' for key, name, text in sections
+    )
+    when = _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
+    # plotly's JavaScript, once, and only for a page with an interactive figure (it is 4.8 MB)
+    interactive = any(hasattr(figure, "to_html") for _, _, figure in part.figures)
+    script = f'<script type="text/javascript">{plotly.offline.get_plotlyjs()}</script>' if interactive else ""
+    return f"""<!DOCTYPE html>
+<html lang="en"><head><meta charset="utf-8">
+<meta name="viewport" content="width=device-width, initial-scale=1">
+<meta name="generator" content="railride {__version__}">
+<title>railride: {html.escape(heading)}</title>
+<style>{STYLE}</style>
+{script}
+</head><body>
+<header><h1>{html.escape(heading)}</h1>
+<p class="meta">railride {__version__}, written {when}</p>
+<nav>{nav}</nav></header>
+{body}
+</body></html>
+"""
+
+
+STYLE = """
+body { font-family: system-ui, sans-serif; margin: 0 auto; max-width: 1200px; padding: 0 1.5em 3em;
+  color: #222; line-height: 1.4; }
+h1 { font-size: 1.5em; margin-bottom: 0.2em; } h2 { border-bottom: 1px solid #ccc; margin-top: 2em; }
+.meta { color: #666; margin: 0; } nav { margin: 0.6em 0; } nav a { color: #1f5fa8; }
+table.data { border-collapse: collapse; font-size: 0.85em; margin: 0.5em 0 1em; }
+table.data th, table.data td { border-bottom: 1px solid #e2e2e2; padding: 2px 8px; }
+table.data th { background: #f4f4f4; } .num { text-align: right; } .text { text-align: left; }
+table.data tbody tr:hover { background: #f7fafc; }
+.scroll { overflow-x: auto; } .note { color: #555; font-size: 0.9em; }
+pre.console { font-family: "DejaVu Sans Mono", Menlo, Consolas, monospace; font-size: 0.8em; line-height: 1.25;
+  background: #fcfcfc; border: 1px solid #e6e6e6; padding: 0.6em; overflow-x: auto; }
+figure { margin: 1.2em 0; } figcaption { color: #444; font-size: 0.9em; margin-bottom: 0.3em; }
+figure img { max-width: 100%; height: auto; border: 1px solid #eee; }
+"""
+
+
+def _settings_html(part: Contents, command: str | None) -> str:
+    from railride.analysis.labels import describe_scenario
+
+    lines = []
+    if command:
+        lines.append(f"<p>Command: <code>{html.escape(command)}</code></p>")
+    if part.scenario:
+        lines.append(f"<p>Scenario: {html.escape(describe_scenario(part.scenario))}</p>")
+    rows = [("railride version", __version__)]
+    rows += _flat("", {k: v for k, v in part.settings.items() if k != "vehicle_params"})
+    frame = pd.DataFrame(rows, columns=["setting", "value"])
+    return "\n".join(lines) + _table_html(frame)
+
+
+def _flat(prefix: str, value) -> list[tuple[str, str]]:
+    """Nested settings as (dotted key, text) rows; lists of records as JSON text."""
+    if isinstance(value, dict) and value:
+        return [row for k, v in value.items() for row in _flat(f"{prefix}.{k}" if prefix else str(k), v)]
+    if isinstance(value, (list, tuple)) and not any(isinstance(v, (dict, list)) for v in value):
+        text = ", ".join("-" if v is None else str(v) for v in value)
+    elif isinstance(value, (dict, list, tuple)):
+        text = json.dumps(value) if value else "-"
+    else:
+        text = "-" if value is None else str(value)
+    return [(prefix, text)]
+
+
+def _params_html(params) -> str:
+    values = params.to_dict()
+    rows = [(name, values[name], unit, meaning) for name, unit, meaning, _ in params.describe()]
+    table = _table_html(pd.DataFrame(rows, columns=["parameter", "value", "unit", "meaning"]))
+    return f"<details><summary>Vehicle parameters ({len(rows)})</summary>{table}</details>"
+
+
+def _table_html(frame: pd.DataFrame) -> str:
+    """A DataFrame as an HTML table: numbers right-aligned with six significant digits, text
+    left-aligned, every cell escaped."""
+    numeric = [frame[c].dtype.kind in "iuf" for c in frame.columns]
+
+    def cell(value, number: bool, tag: str = "td") -> str:
+        if value is None or (number and pd.isna(value)):
+            text = ""
+        elif number and isinstance(value, float):
+            text = f"{value:.6g}"
+        else:
+            text = str(value)
+        return f'<{tag} class="{"num" if number else "text"}">{html.escape(text)}</{tag}>'
+
+    head = "".join(cell(c, n, "th") for c, n in zip(frame.columns, numeric))
+    rows = "\n".join(
+        "<tr>" + "".join(cell(v, n) for v, n in zip(row, numeric)) + "</tr>"
+        for row in frame.itertuples(index=False, name=None)
+    )
+    return (
+        f'<div class="scroll"><table class="data"><thead><tr>{head}</tr></thead><tbody>\n{rows}</tbody></table></div>'
+    )
+
+
+def _caption_table(caption: str, frame: pd.DataFrame) -> str:
+    n = len(frame)
+    note = (
+        f"{n} rows" if n <= MAX_TABLE_ROWS else f"the first {MAX_TABLE_ROWS} of {n} rows (all: to_pandas(), or --out)"
+    )
+    table = _table_html(frame.head(MAX_TABLE_ROWS))
+    summary = f'{html.escape(caption)} <span class="note">({note})</span>'
+    opened = " open" if n <= 40 else ""
+    return f"<details{opened}><summary>{summary}</summary>{table}</details>"
+
+
+def _fragment(text: str) -> str:
+    """A console fragment: the body of a whole document, else the text as it is."""
+    found = re.search(r"<body[^>]*>(.*)</body>", text, flags=re.S | re.I)
+    return found.group(1) if found else text
+
+
+def _figure_html(name: str, caption: str, figure) -> str:
+    if hasattr(figure, "to_html"):  # plotly
+        from railride.plots.interactive import CONFIG
+
+        inner = figure.to_html(full_html=False, include_plotlyjs=False, div_id=f"plot-{name}", config=CONFIG)
+        kind = "interactive"
+    else:  # matplotlib
+        inner = _image(figure, caption)
+        kind = "static"
+    caption = f"{caption} ({name}.png in the output folder)"
+    return f'<figure id="figure-{name}" class="{kind}"><figcaption>{html.escape(caption)}</figcaption>{inner}</figure>'
+
+
+def _image(figure, alt: str) -> str:
+    """A matplotlib figure as an <img> with a data URI (its SVG ids stay its own): SVG when small
+    enough, else PNG."""
+    from railride.plots._style import PNG_DPI
+
+    buffer = io.BytesIO()
+    figure.savefig(buffer, format="svg", metadata={"Date": None})
+    data, mime = buffer.getvalue(), "image/svg+xml"
+    if len(data) > SVG_LIMIT:
+        buffer = io.BytesIO()
+        figure.savefig(buffer, format="png", dpi=PNG_DPI)
+        data, mime = buffer.getvalue(), "image/png"
+    return f'<img alt="{html.escape(alt)}" src="data:{mime};base64,{base64.b64encode(data).decode("ascii")}">'

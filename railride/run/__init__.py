@@ -1,0 +1,1 @@
+"""A run of the vehicle: solver settings, the simulation, its result, and the damper rig."""

@@ -1,0 +1,89 @@
+"""The inputs of a run: the vehicle's stepper matrices, the wheelset input tables and the rail
+forcing tables, each kept for the next batches within a byte budget (`railride._cache.BytesLRU`)."""
+
+from __future__ import annotations
+
+import functools
+
+
+import numpy as np
+
+from railride._cache import MiB, BytesLRU
+from railride.model.params import VehicleParams
+from railride.model.track import Scenario, wheelset_input_table
+from railride.model.vehicle import Vehicle
+
+
+@functools.lru_cache(maxsize=256)
+def _vehicle(params: VehicleParams) -> Vehicle:
+    """Vehicles are derived from frozen parameters: build each one once."""
+    return Vehicle(params)
+
+
+#: the wheelset input tables kept for the next batches (`_input_table`): (nodes x 16) doubles,
+#: 0.8 MB for 10 s at 30 m/s on a random track, 1.6 MB at 45 m/s, 3.2 MB at 65 m/s. A passive
+#: chunk's 32 scenarios fit at the usual speeds, so the controllers' chunks on the same
+#: scenarios, which run next to it (`railride.studies.sweep.run_cases`), find theirs
+INPUT_CACHE_BYTES = 64 * MiB
+#: the rail forcing tables kept (`_forcing`): (nodes x 36) doubles, 2.25 times the input table;
+#: shared by the closed-loop runs of a scenario and vehicle, which a study puts in one batch,
+#: and kept for the repeated rounds of tuning (a tuning set of about 16 scenarios and loads)
+FORCING_CACHE_BYTES = 64 * MiB
+
+
+_INPUT_TABLES: BytesLRU = BytesLRU("wheelset input tables", INPUT_CACHE_BYTES, lambda t: t[0].nbytes)
+_FORCING_TABLES: BytesLRU = BytesLRU("rail forcing tables", FORCING_CACHE_BYTES, lambda t: t.nbytes)
+
+
+def _input_table(scenario: Scenario, key, lag: tuple, dt: float, duration: float):
+    """`wheelset_input_table` of ``scenario`` (its `table_key` ``key``), kept within
+    `INPUT_CACHE_BYTES`: the batches of a study (passive beside each controller) meet the same
+    scenario again. The tables are read, never written. A scenario without a key is not kept."""
+
+    def build():
+        table, interval = wheelset_input_table(scenario, np.asarray(lag), dt, duration)
+        table.flags.writeable = False  # shared between runs
+        return table, interval
+
+    return _INPUT_TABLES.get(None if key is None else (key, lag, dt, duration), build)
+
+
+def _system_arrays(vehicle: Vehicle, passive: bool = True) -> dict[str, np.ndarray]:
+    """The stepper's matrices: the equations of motion with M^-1 folded in, transposed
+    (see `railride.engine.kernels.run_batch`).
+
+    ``A`` = [Aq Av Bf]^T acts on (q, q', f), ``TS`` = T maps q' to the secondary deflection
+    rates. The passive viscous dampers are linear, so they stay in Av (law LAW_VISCOUS_IN_C):
+    the stepper then skips the force computation per stage; with damper models (``passive``
+    false) Av leaves them out and their forces enter through Bf. ``Bw``, ``Bwd`` map the rail
+    inputs to q'' and are applied to the input table once, before the run.
+    """
+    minv = 1.0 / np.diag(vehicle.M)[:, None]
+    return {
+        "A": np.hstack([-minv * vehicle.K, -minv * (vehicle.C if passive else vehicle.C0), minv * vehicle.T]).T,
+        "TS": vehicle.T.copy(),
+        "c_sec": np.full(4, vehicle.params.c_sz),
+        "Bw": -minv * vehicle.K_w,
+        "Bwd": -minv * vehicle.C_w,
+    }
+
+
+def _forcing_table(utab: np.ndarray, Bw: np.ndarray, Bwd: np.ndarray) -> np.ndarray:
+    """Node values (Bw w, Bw w', Bwd w, Bwd w') of the rail forcing, see kernels._forcing.
+    einsum, not ``@``: a threaded BLAS on these thin products took 90-130 ms instead of 6-10 ms
+    while other work kept the cores busy."""
+    w, wd = utab[:, :8], utab[:, 8:]
+    return np.hstack([np.einsum("nk,jk->nj", x, B) for B in (Bw, Bwd) for x in (w, wd)])
+
+
+def _forcing(key, lag: tuple, dt: float, duration: float, params: VehicleParams, table: np.ndarray):
+    """`_forcing_table` of the input ``table`` (of the scenario with `table_key` ``key``) and
+    the vehicle ``params``, kept within `FORCING_CACHE_BYTES` beside the input tables."""
+
+    def build():
+        sysm = _system_arrays(_vehicle(params))
+        forcing = _forcing_table(table, sysm["Bw"], sysm["Bwd"])
+        forcing.flags.writeable = False
+        return forcing
+
+    return _FORCING_TABLES.get(None if key is None else (key, lag, dt, duration, params), build)

@@ -1,0 +1,410 @@
+"""The result of `railride.simulate`: the time histories as an xarray Dataset, built on first
+use from the stepper's arrays (`build_dataset`), and `RideResult` with its metrics, comfort and
+the result protocol."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import platform
+from typing import Any
+
+import numpy as np
+import xarray as xr
+
+from railride.secondary import dampers
+from railride.model.params import PRESETS
+from railride.plots import PNG_DPI, FigureOptions
+from railride.run.solver import SolverSettings
+from railride.model.vehicle import CORNER_NAMES, DOF_NAMES, DOF_UNITS, RAILS, WHEELSETS
+
+#: the schema of `RideResult.to_dict`, the document of ``railride simulate``
+SCHEMA = "railride.simulation/1"
+
+
+def has_damper_states(damper) -> bool:
+    """Damper models with internal states and a voltage (not passive, not the ideal actuator)."""
+    return damper is not None and damper.law != dampers.LAW_IDEAL
+
+
+def build_dataset(
+    out,
+    vehicles,
+    param_sets,
+    scenarios,
+    dt,
+    output_rate,
+    rows,
+    batch,
+    created,
+    suspension,
+    vcmd,
+    closed=None,
+    faults=(),
+    integrator: str = "classical RK4, fixed step",
+) -> xr.Dataset:
+    """Named channels in SI units; a ``sample`` dimension only for a batch. ``faults``: each
+    sample's damper faults (`railride.secondary.faults.DamperFault`), recorded as ``damper_faults`` when
+    any sample has one."""
+    import numba
+    import scipy
+
+    from railride._version import __version__
+
+    damper = suspension.damper
+    time = np.arange(rows) / output_rate
+    T = np.stack([vehicles[id(p)].T for p in param_sets])  # (n, 9, 4)
+    ksz = np.array([p.k_sz for p in param_sets])[:, None, None]
+    deflection = out["q"] @ T  # (n, time, 9) @ (n, 9, 4): T^T q at every sample
+    shape = out["w"].shape[:2] + (4, 2)
+    # name -> (extra dims, values with leading (sample, time), attrs)
+    channels: dict[str, tuple[tuple[str, ...], Any, dict[str, str]]] = {}
+    for i, name in enumerate(DOF_NAMES):
+        channels[name] = ((), out["q"][:, :, i], {"units": DOF_UNITS[i]})
+        channels[f"{name}_velocity"] = ((), out["v"][:, :, i], {"units": f"{DOF_UNITS[i]}/s"})
+    channels["carbody_acceleration"] = (
+        (),
+        out["a"][:, :, 0],
+        {"units": "m/s^2", "long_name": "carbody CG vertical acceleration"},
+    )
+    channels["carbody_pitch_acceleration"] = (
+        (),
+        out["a"][:, :, 1],
+        {"units": "rad/s^2", "long_name": "carbody pitch acceleration"},
+    )
+    channels["carbody_roll_acceleration"] = (
+        (),
+        out["a"][:, :, 2],
+        {"units": "rad/s^2", "long_name": "carbody roll acceleration"},
+    )
+    channels["carbody_corner_displacement"] = (
+        ("corner",),
+        out["q"][:, :, :3] @ T[:, :3],
+        {"units": "m", "long_name": "carbody vertical displacement above each secondary corner"},
+    )
+    channels["secondary_deflection"] = (
+        ("corner",),
+        deflection,
+        {"units": "m", "long_name": "secondary vertical deflection, carbody minus bogie (extension +)"},
+    )
+    channels["secondary_deflection_velocity"] = (("corner",), out["v"] @ T, {"units": "m/s"})
+    channels["secondary_spring_force"] = (
+        ("corner",),
+        -ksz * deflection,
+        {"units": "N", "long_name": "secondary vertical spring force on the carbody (up +)"},
+    )
+    channels["secondary_damper_force"] = (
+        ("corner",),
+        out["f"],
+        {"units": "N", "long_name": "secondary vertical damper force on the carbody (up +)"},
+    )
+    if has_damper_states(damper):  # the ideal actuator has no states and no voltage
+        d = out["d"]
+        channels["damper_hysteretic_z"] = (
+            ("corner",),
+            d[:, :, 0::3],
+            {"units": "m", "long_name": "Bouc-Wen hysteretic variable z of each damper"},
+        )
+        if damper.law == dampers.LAW_SPENCER:
+            channels["damper_internal_displacement"] = (
+                ("corner",),
+                d[:, :, 1::3],
+                {"units": "m", "long_name": "Spencer model internal displacement y"},
+            )
+        channels["damper_voltage"] = (
+            ("corner",),
+            d[:, :, 2::3],
+            {"units": "V", "long_name": "damper coil voltage u after the coil lag"},
+        )
+        command = out["vc"] if closed is not None else np.broadcast_to(vcmd[:, None, :], d[:, :, 2::3].shape)
+        channels["damper_command_voltage"] = (
+            ("corner",),
+            command,
+            {"units": "V", "long_name": "commanded damper voltage v"},
+        )
+    if closed is not None:
+        channels["damper_demand_force"] = (
+            ("corner",),
+            out["fd"],
+            {"units": "N", "long_name": "desired damper force on the carbody (up +) from the outer loop"},
+        )
+    channels["rail_displacement"] = (
+        ("wheelset", "rail"),
+        out["w"].reshape(shape),
+        {"units": "m", "long_name": "rail height under each wheel"},
+    )
+    channels["rail_velocity"] = (
+        ("wheelset", "rail"),
+        out["wd"].reshape(shape),
+        {"units": "m/s", "long_name": "rail vertical velocity under each wheel"},
+    )
+    scen = np.array([json.dumps(s.describe()) for s in scenarios])
+    pars = np.array([json.dumps(p.to_dict()) for p in param_sets])
+    if closed is not None:
+        ctrl = closed["controllers"]
+        inner = None if closed["inner"] is None else closed["inner"].to_dict()  # the ideal devices: none
+        attrs_ctrl = {
+            "control_rate_hz": closed["rate"],
+            "inner_loop": json.dumps(inner),
+            "sensor_noise": json.dumps(
+                None if closed["sensor_noise"] is None else dataclasses.asdict(closed["sensor_noise"])
+            ),
+        }
+        controller_names = np.array([c.name for c in ctrl])
+        controller_gains = np.array([json.dumps(c.to_dict()) for c in ctrl])
+    data: dict[str, tuple]  # name -> (dims, values[, attrs]), as xr.Dataset takes them
+    if batch:
+        data = {k: (("sample", "time") + d, v, a) for k, (d, v, a) in channels.items()}
+        data["scenario"] = ("sample", scen)
+        data["vehicle_params"] = ("sample", pars)
+    else:
+        data = {k: (("time",) + d, v[0], a) for k, (d, v, a) in channels.items()}
+        data["scenario"] = ((), scen[0])
+        data["vehicle_params"] = ((), pars[0])
+    if any(faults):  # e.g. "1R-off@2.5,2L-disconnected"; empty for a healthy sample
+        labels = np.array([",".join(f.label for f in fs) for fs in faults])
+        data["damper_faults"] = ("sample", labels) if batch else ((), labels[0])
+    if closed is not None:
+        data["controller"] = ("sample", controller_names) if batch else ((), controller_names[0])
+        data["controller_gains"] = ("sample", controller_gains) if batch else ((), controller_gains[0])
+    coords = {
+        "time": ("time", time, {"units": "s"}),
+        "corner": ("corner", list(CORNER_NAMES)),
+        "wheelset": ("wheelset", list(WHEELSETS)),
+        "rail": ("rail", list(RAILS)),
+    }
+    if batch:
+        coords["sample"] = ("sample", np.arange(len(param_sets)))
+    attrs = {
+        "title": "railride ride simulation",
+        "railride_version": __version__,
+        "numpy_version": np.__version__,
+        "numba_version": numba.__version__,
+        "scipy_version": scipy.__version__,
+        "xarray_version": xr.__version__,
+        "python_version": platform.python_version(),
+        "created_utc": created,
+        "integrator": integrator,
+        "dt_s": dt,
+        "output_rate_hz": output_rate,
+        "suspension": suspension.describe(),
+        "damper": json.dumps(None if damper is None else damper.to_dict()),
+        "sign_convention": "z up; pitch + lowers the front; roll + raises the left side; forces on the carbody, up +",
+    }
+    if closed is not None:
+        attrs.update(attrs_ctrl)
+    warned = plausibility_notes(param_sets)
+    if warned:  # the vehicle outside full-size rail vehicles' ranges: kept with the result
+        attrs["plausibility_warnings"] = json.dumps(warned)
+    return xr.Dataset(data, coords=coords, attrs=attrs)
+
+
+def plausibility_notes(param_sets) -> list[str]:
+    """The plausibility warnings (`railride.model.plausible.notes`) of the vehicles, each once."""
+    from railride.model.plausible import notes
+
+    return list(dict.fromkeys(n for p in param_sets for n in notes(p)))
+
+
+class RideResult:
+    """Time histories (``.dataset``, an xarray Dataset) and the ride metrics of a run.
+
+    The Dataset is assembled on first use, so a sweep that keeps only a few numbers per run
+    does not pay for building it. A single run follows the result protocol: `to_dict` (the
+    JSON document), `to_pandas`, `plot` and `save`.
+    """
+
+    def __init__(
+        self,
+        dataset: xr.Dataset | None = None,
+        *,
+        build=None,
+        raw=None,
+        suspension=None,
+        solver=None,
+        scenario=None,
+        params=None,
+    ):
+        if (dataset is None) == (build is None):
+            raise ValueError("RideResult needs a dataset or a build function, not both")
+        self._dataset = dataset
+        self._build = build
+        self._raw = raw
+        #: the `Suspension` of the run (a list of them for a batch) and its `SolverSettings`
+        self.suspension = suspension
+        self.solver = solver
+        #: the `Scenario` and `VehicleParams` of the run (lists for a batch)
+        self.scenario = scenario
+        self.params = params
+
+    @property
+    def dataset(self) -> xr.Dataset:
+        if self._dataset is None:
+            self._dataset = self._build()
+            self._build = None
+        return self._dataset
+
+    def __getitem__(self, name):
+        return self.dataset[name]
+
+    def __repr__(self):
+        return f"RideResult(\n{self.dataset!r}\n)"
+
+    @property
+    def diverged_at(self) -> np.ndarray:
+        """Per sample, the time [s] at which the run diverged, NaN where it did not (only a run
+        with ``on_divergence="mark"`` can hold a diverged sample)."""
+        if self._raw is not None and "diverged_at" in self._raw:
+            return self._raw["diverged_at"]
+        return np.full(self.dataset.sizes.get("sample", 1), np.nan)
+
+    @property
+    def is_batch(self) -> bool:
+        if self._raw is not None:
+            return bool(self._raw["batch"])
+        return "sample" in self.dataset.dims
+
+    def metrics(self, window=None) -> xr.DataArray:
+        """RMS and peak-to-peak of the four body responses; see `railride.analysis.metrics.ride_metrics`.
+        Computed from the raw arrays when the Dataset has not been built (sweeps)."""
+        from railride.analysis.metrics import check_window, metrics_from_arrays, ride_metrics
+
+        diverged = np.isfinite(self.diverged_at)  # NaN: did not diverge
+        if self._dataset is not None or self._raw is None:
+            return ride_metrics(self.dataset, window, diverged=diverged)
+        t, q, a = self._raw["time"], self._raw["q"], self._raw["a"]
+        if window is not None:
+            start, end = check_window(window, float(t[-1]), float(t[0]))
+            keep = (t >= start - 1e-12) & (t <= end + 1e-12)
+            if keep.sum() < 2:
+                raise ValueError(f"window = {start:g}:{end:g} s holds fewer than two output samples")
+            q, a = q[:, keep], a[:, keep]
+        out = metrics_from_arrays(a[..., 0], q[..., 0], q[..., 1], q[..., 2], diverged=diverged)
+        return out if self._raw["batch"] else out.isel(sample=0, drop=True)
+
+    def comfort(self, window=None, positions=("centre", "front", "rear"), weightings=("Wk", "Wb")):
+        """Ride comfort on the carbody floor (ISO 2631-1 a_w and VDV, EN 12299 N_MV vertical
+        part, Sperling Wz); see `railride.analysis.comfort.ride_comfort` and docs/comfort.md."""
+        from railride.analysis.comfort import ride_comfort
+
+        return ride_comfort(self.dataset, positions=positions, window=window, weightings=weightings)
+
+    def to_dict(self, window=None, *, comfort: bool = False, vehicle: dict | None = None) -> dict:
+        """The JSON document of a single run (`SCHEMA`, docs/cli.md): the scenario, the vehicle,
+        the suspension, the step and output rate with the metrics window, and the ride metrics
+        over ``window`` (start, end) s (default: the whole run); with ``comfort`` also the ride
+        comfort indices over it. ``vehicle`` names the vehicle as the caller chose it (e.g.
+        ``{"vehicle_params_file": "car.toml"}``); by default ``{"vehicle_preset": name}`` for a
+        preset's parameters, else ``{"vehicle_params": {...}}``. A batch has no such document:
+        select a sample first."""
+        from railride._version import __version__
+        from railride.analysis.metrics import check_window, to_dict
+
+        if self.is_batch:
+            raise ValueError(
+                f"to_dict describes a single run; this result is a batch of {self.dataset.sizes['sample']} samples"
+            )
+        record = self._record("scenario", self.scenario)
+        duration = float(record["duration_s"]) if "duration_s" in record else float(self.dataset["time"][-1])
+        start, end = (0.0, duration) if window is None else check_window(window, duration)
+        solver = (
+            self.solver
+            if self.solver is not None
+            else SolverSettings(self.dataset.attrs["dt_s"], self.dataset.attrs["output_rate_hz"])
+        )
+        doc = {
+            "schema": SCHEMA,
+            "railride_version": __version__,
+            "scenario": record,
+            **(self._vehicle_record() if vehicle is None else vehicle),
+            "suspension": _suspension_record(self.suspension),
+            "settings": {
+                "dt_s": float(solver.dt),
+                "output_rate_hz": float(solver.output_rate),
+                "window_s": [float(start), float(end)],
+            },
+            "metrics": to_dict(self.metrics(window)),
+        }
+        if comfort:
+            from railride.analysis.comfort import comfort_record
+
+            doc["comfort"] = comfort_record(self.comfort(window))
+        return doc
+
+    def _record(self, name: str, value) -> dict:
+        """The JSON record of the run's scenario or parameters: from the value the run kept,
+        else from the Dataset."""
+        if value is not None:
+            return value.describe() if name == "scenario" else value.to_dict()
+        return json.loads(str(self.dataset[name].values))
+
+    def _vehicle_record(self) -> dict:
+        params = self.params
+        name = next((k for k, v in PRESETS.items() if v == params), None) if params is not None else None
+        if name is not None:
+            return {"vehicle_preset": name}
+        return {"vehicle_params": self._record("vehicle_params", params)}
+
+    def to_pandas(self):
+        """The time histories as a DataFrame, one column per scalar channel."""
+        from railride.output.tables import to_frame
+
+        return to_frame(self.dataset)
+
+    def plot(self, ax=None, window=None):
+        """The four body responses against time (`railride.plots.ride.plot_body_responses`),
+        the y-axes fitting the metric ``window`` (start, end) s (None: the whole run); ``ax``:
+        four Axes to draw in, or None for a new figure. Returns the figure."""
+        from railride.plots.ride import plot_body_responses
+
+        return plot_body_responses(self.dataset, ax=ax, window=window)
+
+    def save(
+        self,
+        folder,
+        window=None,
+        *,
+        comfort: bool = False,
+        vehicle: dict | None = None,
+        figure_formats=("png",),
+        dpi: float = PNG_DPI,
+        history_formats=("nc", "csv"),
+    ) -> list:
+        """Write ride.nc, ride.csv, metrics.json (`to_dict` with these arguments) and
+        body_responses.png into ``folder``, all or nothing (`railride.output.files.write_outputs`).
+        The figure in each of ``figure_formats`` (png, pdf, svg), PNG at ``dpi``; the time
+        histories in each of ``history_formats`` (nc, csv, mat: MATLAB). Returns the written
+        paths."""
+        from railride.output.files import write_outputs
+
+        figures = FigureOptions(figure_formats, dpi)
+        doc = self.to_dict(window, comfort=comfort, vehicle=vehicle)
+        return write_outputs(self, folder, doc, figures=figures, histories=history_formats)
+
+
+def _suspension_record(suspension) -> dict:
+    """The ``suspension`` of the simulation document: ``{"type": "passive"}``, or for MR dampers
+    at a constant voltage the type "mr", the damper's name, the voltage and, when the preset was
+    scaled, its ``damper_scale``; a closed loop is typed by its outer loop's name and adds its
+    controller, inner loop and sensor noise (`Suspension.to_dict`)."""
+    if suspension is None:
+        return {"type": "passive"}
+    if suspension.kind == "passive":
+        return (
+            {"type": "passive"}
+            if suspension.damper is None
+            else {"type": "passive", "damper": suspension.damper.to_dict()}
+        )
+    record: dict[str, Any] = {"type": suspension.name, "damper": suspension.damper_name}
+    if suspension.faults:
+        record["faults"] = [f.label for f in suspension.faults]
+    if suspension.delay != 1:
+        record["delay_periods"] = suspension.delay
+    if suspension.voltage is not None:
+        record["voltage_v"] = float(suspension.voltage)
+    if suspension.damper_scale != 1.0:
+        record["damper_scale"] = suspension.damper_scale
+    if suspension.closed_loop:
+        full = suspension.to_dict()
+        record.update({k: full[k] for k in ("controller", "inner_loop", "sensor_noise")})
+    return record

@@ -1,0 +1,137 @@
+"""How a run is integrated: the `SolverSettings` value (docs/model.md, Integration), and what
+its output rate can resolve (`check_resolution`).
+
+A module of its own, not a part of `railride.run.simulation`: the studies and the command line check
+and record these settings without loading the compiled stepper.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from railride import validation
+from railride.defaults import DEFAULT_CONTROL_RATE, DEFAULT_DT, DEFAULT_OUTPUT_RATE
+
+#: how `railride.simulate` integrates: "auto" (exact discretisation where the suspension is
+#: linear, the passive viscous dampers; RK4 otherwise), "rk4" (always the fixed-step RK4) or
+#: "exact" (refused where the suspension is not linear)
+METHODS = ("auto", "rk4", "exact")
+#: a random track's shortest wavelength must pass at speed / min_wavelength <= output_rate /
+#: RESOLUTION: a component above that shows in the stored histories only as a few samples a cycle
+RESOLUTION = 2.5
+
+
+def _steps(steps: float) -> int | None:
+    """``steps`` as a whole number >= 1, or None when it is not one (to a part in a million)."""
+    whole = int(round(steps))
+    return whole if whole >= 1 and abs(whole - steps) <= 1e-6 * steps else None
+
+
+@dataclass(frozen=True)
+class SolverSettings:
+    """The fixed RK4 step ``dt`` [s], the rate of the stored time histories ``output_rate``
+    [Hz], the sample rate of the outer-loop controllers ``control_rate`` [Hz] and the
+    integration ``method`` (`METHODS`; default "auto": exact discretisation for the passive
+    viscous suspension, one step per output sample, where dt only sets the input grid).
+
+    Checked at construction: each a finite number > 0, and the output interval 1/output_rate
+    a whole number of steps (at most one output sample per step). The controller period
+    1/control_rate must be a whole number of steps too, but only a closed loop samples it:
+    `control_steps` checks it when one runs (a passive run at dt = 4e-4 s keeps the default
+    control rate, 2.5 steps per period, without an error). Whether ``dt`` is small enough for
+    the vehicle is checked by `railride.run.simulation.simulate`, which knows the vehicle.
+    """
+
+    dt: float = DEFAULT_DT
+    output_rate: float = DEFAULT_OUTPUT_RATE
+    control_rate: float = DEFAULT_CONTROL_RATE
+    method: str = "auto"
+
+    def __post_init__(self):
+        for name, unit in (("dt", "s"), ("output_rate", "Hz"), ("control_rate", "Hz")):
+            object.__setattr__(self, name, validation.number(name, getattr(self, name), "positive", unit))
+        validation.choice("method", self.method, METHODS)
+        if self.dt * self.output_rate > 1.0 + 1e-6:
+            raise ValueError(
+                f"dt = {self.dt:g} s is too large for output_rate = {self.output_rate:g} Hz: "
+                f"at most one output sample per step; use dt <= {1.0 / self.output_rate:g} s "
+                "or a lower output_rate"
+            )
+        if _steps(1.0 / (self.output_rate * self.dt)) is None:
+            raise ValueError(
+                f"output_rate = {self.output_rate:g} Hz with dt = {self.dt:g} s: the output "
+                "interval 1/output_rate must be a whole number of steps (at most one "
+                "sample per step)"
+            )
+
+    @property
+    def output_steps(self) -> int:
+        """Steps per output sample."""
+        steps = _steps(1.0 / (self.output_rate * self.dt))
+        assert steps is not None  # checked at construction
+        return steps
+
+    def control_steps(self, duration: float | None = None) -> int:
+        """Steps per controller period; a ValueError naming control_rate and dt when the period
+        is not a whole number of steps (the check a closed loop needs), or, given the run's
+        ``duration`` [s], when the controller would not sample again within it."""
+        if duration is not None and self.control_rate * duration < 1.0:
+            raise ValueError(
+                f"control_rate = {self.control_rate:.4g} Hz: the controller would sample once every "
+                f"{1.0 / self.control_rate:.4g} s, not once within the run's {duration:.4g} s; use "
+                f"control_rate >= {1.0 / duration:.4g} Hz"
+            )
+        steps = _steps(1.0 / (self.control_rate * self.dt))
+        if steps is None:
+            raise ValueError(
+                f"control_rate = {self.control_rate:g} Hz with dt = {self.dt:g} s: the "
+                "controller period must be a whole number of steps"
+            )
+        return steps
+
+    def to_dict(self) -> dict:
+        """The settings as a result records them (SI units in the names); the method only when
+        it is not "auto", so that records of runs before it existed stay as they were."""
+        out: dict = {"dt_s": self.dt, "output_rate_hz": self.output_rate, "control_rate_hz": self.control_rate}
+        if self.method != "auto":
+            out["method"] = self.method
+        return out
+
+    @classmethod
+    def of(cls, solver) -> "SolverSettings":
+        """``solver`` itself, or the defaults for None."""
+        if solver is None:
+            return cls()
+        if not isinstance(solver, cls):
+            raise ValueError(f"solver = {solver!r}: must be a railride.SolverSettings or None (the defaults)")
+        return solver
+
+
+def shortest_wavelength(track) -> tuple[str, float] | None:
+    """(field, metres) of the shortest wavelength a profile holds on purpose: the sine's
+    wavelength, the bump's length, the random track's min_wavelength; None for a measured
+    profile, whose samples are what was measured."""
+    for name in ("min_wavelength", "wavelength", "length"):
+        lam = getattr(track, name, None)
+        if lam is not None:
+            return name, float(lam)
+    return None
+
+
+def check_resolution(scenario, output_rate: float) -> None:
+    """ValueError when the stored time histories at ``output_rate`` [Hz] cannot resolve the
+    shortest wavelength of ``scenario``'s profile (`shortest_wavelength`, `RESOLUTION`): a sine
+    or bump shorter than that would be aliased into a slow input that is not on the track. The
+    simulation checks every scenario it runs; the studies and the command line ask before their
+    first run."""
+    found = shortest_wavelength(scenario.track)
+    if found is None or not scenario.speed / found[1] > output_rate / RESOLUTION:
+        return
+    name, lam = found
+    shortest = RESOLUTION * scenario.speed / output_rate
+    raise ValueError(
+        f"{name} = {lam:.4g} m at speed {scenario.speed:.4g} m/s passes at "
+        f"{scenario.speed / lam:.4g} Hz, more than output_rate {output_rate:.4g} Hz / {RESOLUTION:g} = "
+        f"{output_rate / RESOLUTION:.4g} Hz can resolve: the shortest {name} allowed is {shortest:.4g} m; "
+        "raise it, lower the speed or raise output_rate"
+    )

@@ -1,0 +1,2 @@
+"""Studies over many runs: comparison, league, cases and grids, sweeps, executors, objectives,
+tuning, Pareto and the statistical study."""

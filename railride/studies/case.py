@@ -1,0 +1,176 @@
+"""A `Case`: one run described by plain settings (scenario and its options, vehicle parameter
+changes, suspension, gain changes), so that it can travel to a Dask worker and has a stable key
+(`Case.key`, which the run tables of sweeps, tuning and studies resume by)."""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import numbers
+from dataclasses import asdict, dataclass
+
+from railride.defaults import DEFAULT_DAMPER
+from railride.secondary.control import CONSTANT_VOLTAGE
+from railride.secondary.suspension import NAMES, Suspension
+
+#: raised whenever the physics change the metrics of a run with the same settings, so that run
+#: tables from before do not resume into the new model. 2: two secondary lateral and two
+#: longitudinal springs per bogie, and the paper sine's entry taper.
+MODEL_REVISION = 2
+#: the suspensions a case can name (`Suspension.named`)
+SUSPENSIONS = NAMES
+
+
+@dataclass(frozen=True)
+class Case:
+    """One run. ``scenario_options`` are keyword arguments of `railride.model.track.scenario`,
+    ``vehicle`` changes to the study's vehicle parameters (`run_cases`' ``params``, default the
+    `paper` preset), ``gains`` changes to the base gain set as "table.entry" (e.g. "pid.kp",
+    "attitude.kd_z", "ride.kp_1R", "inner.G"). ``suspension`` is passive, mr (constant
+    ``voltage``) or a controller name; a controller may see sensor noise (``noise``: standard
+    deviations displacement [m], angle [rad], velocity [m/s], angular rate [rad/s]) drawn with
+    ``seed``. ``damper`` names the dampers of mr and the controllers (`railride.secondary.dampers.NAMES`;
+    "ideal", the ideal actuator, with a controller only) and ``damper_scale`` multiplies an MR
+    damper's force capacity (`BoucWen.scaled`); it must stay 1 for passive and the ideal
+    actuator, which have none to scale. `to_suspension` gives the run's `Suspension`
+    (`Suspension.named`, which also checks these settings when the case is made)."""
+
+    scenario: str = "paper-sine"
+    scenario_options: tuple = ()
+    vehicle: tuple = ()
+    suspension: str = "passive"
+    damper: str = DEFAULT_DAMPER
+    voltage: float | None = None
+    gains: tuple = ()
+    noise: tuple = ()
+    seed: int = 0
+    damper_scale: float = 1.0
+    faults: tuple = ()  # damper faults as their text, e.g. ("1R-off@2",) (`railride.secondary.faults`)
+    delay: int = 1  # a controller's delay in controller periods (`Suspension.delay`)
+    sensing: str = "ideal"  # what a controller measures: "ideal" or "accelerometers" (`railride.secondary.sensing`)
+
+    def __post_init__(self):
+        from railride.secondary import dampers
+
+        if self.suspension not in SUSPENSIONS:
+            raise ValueError(f"suspension = {self.suspension!r}; allowed: {', '.join(SUSPENSIONS)}")
+        object.__setattr__(self, "damper_scale", dampers.check_scale("damper_scale", self.damper_scale))
+        for name in ("scenario_options", "vehicle", "gains"):
+            value = getattr(self, name)
+            if isinstance(value, dict):
+                value = tuple(sorted(value.items()))
+            object.__setattr__(self, name, tuple((str(k), _plain(k, v)) for k, v in value))
+        object.__setattr__(self, "noise", tuple(float(v) for v in self.noise))
+        object.__setattr__(self, "seed", _plain("seed", self.seed))
+        from railride.secondary.sensing import SENSING
+
+        if self.sensing not in SENSING:
+            raise ValueError(f"sensing = {self.sensing!r}: allowed {', '.join(SENSING)}")
+        from railride.secondary.faults import DamperFault
+
+        faults = (self.faults,) if isinstance(self.faults, (str, DamperFault)) else self.faults
+        object.__setattr__(
+            self, "faults", tuple(f.label if isinstance(f, DamperFault) else DamperFault.parse(f).label for f in faults)
+        )
+        if self.noise and len(self.noise) != 4:
+            raise ValueError(f"noise = {self.noise!r}: four standard deviations or none")
+        self._named(None)  # the suspension's checks, here rather than in a batch
+
+    @property
+    def closed_loop(self) -> bool:
+        return self.suspension not in ("passive", "mr", *CONSTANT_VOLTAGE)
+
+    def _named(self, gains) -> Suspension:
+        from railride.secondary.control import SensorNoise
+
+        # noise reaches the controllers only (passive and mr runs ignore it, as they always did)
+        noise = None
+        if self.noise and self.closed_loop:
+            displacement, angle, velocity, angular_rate = self.noise
+            noise = SensorNoise(displacement, angle, velocity, angular_rate, seed=self.seed)
+        named = Suspension.named(self.suspension, gains, self.damper, self.damper_scale, self.voltage, noise)
+        if self.delay != 1:
+            named = named.with_delay(self.delay)
+        if self.sensing != "ideal":
+            from railride.secondary.sensing import Accelerometers
+
+            named = named.with_sensing(Accelerometers(seed=self.seed))
+        return named.with_faults(self.faults) if self.faults else named
+
+    def to_suspension(self, base_gains=None) -> Suspension:
+        """The run's `Suspension`: `Suspension.named` with the case's gain changes applied to
+        ``base_gains`` (default the shipped `GainSet.default`)."""
+        from railride.secondary.control import GainSet
+
+        if not self.closed_loop:
+            return self._named(None)
+        base = GainSet.default() if base_gains is None else base_gains
+        return self._named(base.apply(self.gains))
+
+    @property
+    def key(self) -> str:
+        """A stable identity for the run table (same settings and model, same key, in any
+        session). The model revision is part of it, so a run table from an earlier model is
+        not taken for this one's on resume."""
+        d = self.to_dict()
+        if "seed" in d["scenario_options"]:
+            # as text, as when the track seed travelled as a NumPy integer: the keys of runs on
+            # random tracks stay what they were
+            d["scenario_options"]["seed"] = str(d["scenario_options"]["seed"])
+        text = json.dumps({**d, "model_revision": MODEL_REVISION}, sort_keys=True, default=str)
+        return hashlib.sha1(text.encode()).hexdigest()[:16]
+
+    def to_dict(self) -> dict:
+        d = asdict(self)
+        for name in ("scenario_options", "vehicle", "gains"):
+            d[name] = dict(d[name])
+        if d["damper_scale"] == 1.0:  # the default is left out: a scale appears only when set
+            del d["damper_scale"]
+        if not d["faults"]:  # the same: the keys of healthy runs stay what they were
+            del d["faults"]
+        if d["delay"] == 1:
+            del d["delay"]
+        if d["sensing"] == "ideal":
+            del d["sensing"]
+        return d
+
+    @property
+    def group(self) -> tuple:
+        """Cases that can share one compiled batch."""
+        duration = dict(self.scenario_options).get("duration", 10.0)
+        kind = "passive" if self.suspension == "passive" else ("closed" if self.closed_loop else "mr")
+        # sensor noise is one setting per batch
+        return (
+            duration,
+            kind,
+            self.damper if kind != "passive" else "",
+            (self.noise, self.seed) if kind == "closed" else (),
+            self.damper_scale if kind != "passive" else 1.0,
+            self.sensing if kind == "closed" else "ideal",  # one sensing model per batch
+        )
+
+
+def scenario_of(name: str, options):
+    """`railride.model.track.scenario` of a case's scenario and options (pairs, as `Case` holds them).
+    Not kept here: a random track's realisation comes from `railride.model.track`'s store and the
+    tables from the simulation's, each bounded by bytes and keyed by settings; scenarios kept
+    here held their realisations beyond that bound (32 of them, up to 220 MB)."""
+    from railride.model.track import scenario as make_scenario
+
+    return make_scenario(name, **dict(options))
+
+
+def _plain(name: str, value):
+    """A number of a case as a plain Python number: a seed a whole one as given (an int, never
+    through a float, which rounds seeds past 2**53), any other a float; NumPy scalars too, so
+    that keys and records hold plain numbers. Anything else is left for the checks that own it."""
+    from railride import validation
+
+    if not validation.is_number(value):
+        return value
+    if name == "seed" and isinstance(value, numbers.Integral):
+        return int(value)
+    try:
+        return float(value)
+    except OverflowError:  # a whole number past any float: the scenario's check names it
+        return int(value)

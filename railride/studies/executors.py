@@ -1,0 +1,426 @@
+"""Where the runs of a study go and where they are kept: executors and the run table.
+
+An executor runs chunks of cases (`railride.studies.sweep.evaluate` on each) and yields their rows:
+`LocalExecutor` on this machine, one chunk after another, each batch over every core;
+`DaskExecutor` on a dask.distributed cluster. `RunTable` keeps every finished run in a CSV
+file rewritten atomically after each chunk, so an interrupted study resumes where it stopped
+(`railride.studies.sweep.run_cases`).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import socket
+import time
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from railride._io import atomic_write
+
+
+# -- executors ---------------------------------------------------------------------------------
+class LocalExecutor:
+    """Chunks run one after another in this process; each chunk's batch uses every core."""
+
+    name = "local"
+
+    def map(self, fn, chunks):
+        for i, chunk in enumerate(chunks):
+            yield i, fn(chunk)
+
+    def close(self):
+        pass
+
+
+class DaskExecutor:
+    """Chunks run as tasks on a dask.distributed cluster (``address`` tcp://host:port, or the
+    ``scheduler_file`` that ``dask scheduler --scheduler-file`` writes). Needs the optional
+    extra: pip install "railride[distributed]"; every worker imports the same railride.
+
+    One chunk is one task and one compiled batch, on its share of the worker machine's cores:
+    numba's thread count there (NUMBA_NUM_THREADS, every core by default) divided by the Dask
+    threads of all the workers on that machine, at least 1. So batches do not multiply Dask's
+    threads: one ``dask worker --nthreads 1`` per machine gives each batch every core, a default
+    ``dask worker`` (a thread per core) one core to each of its batches (docs/distributed.md).
+
+    ``address`` is tcp://host:port (or host:port), ws://host:port, tls:// or wss:// with the
+    cluster's certificates (``security``, a distributed.Security, or Dask's configuration), or
+    the inproc:// address of a scheduler in this process. Every other address fails fast,
+    before a Client exists (a half-made Client hangs for 20 s as it is collected): an unknown
+    or unusable scheme, TLS without certificates, a refused port, a host that does not answer
+    within `PROBE_SECONDS`, a port that accepts but does not speak Dask within
+    `HANDSHAKE_SECONDS` (a dashboard's); a scheduler file that does not appear within
+    ``timeout`` or has no address. Each is a ValueError naming the address (or file) and what
+    is allowed. `map` yields (chunk
+    index, rows) in the order chunks finish; a chunk lost with a dead worker is run again by the
+    scheduler."""
+
+    name = "dask"
+
+    def __init__(
+        self,
+        address: str | None = None,
+        scheduler_file: str | None = None,
+        timeout: float = 10.0,
+        security=None,
+    ):
+        try:
+            from distributed import Client
+        except ImportError:
+            raise ValueError('the Dask executor needs dask.distributed: pip install "railride[distributed]"') from None
+        if (address is None) == (scheduler_file is None):
+            raise ValueError("give a scheduler address (tcp://host:port) or a scheduler file")
+        if scheduler_file is not None:
+            address = self._address_from_file(scheduler_file, timeout)
+        assert address is not None  # one of the two was given, checked above
+        self.address = address
+        where = f"address = {address!r}" + ("" if scheduler_file is None else f" (from {scheduler_file})")
+        security = _security(address, security, where)
+        _reach(address, timeout, security, where)
+        try:
+            # not the default client: this executor's tasks only, the caller's Dask code untouched
+            self.client = Client(address, timeout=timeout, set_as_default=False, security=security)
+        except Exception as exc:  # answered the handshake, then failed: not a scheduler after all
+            raise ValueError(
+                f"{where}: cannot reach the Dask scheduler at {address} within {timeout:g} s: "
+                f"{type(exc).__name__}: {_one_line(exc)}"
+            ) from None
+
+    @staticmethod
+    def _address_from_file(path, timeout: float) -> str:
+        """The address in a scheduler file, waiting up to ``timeout`` for the scheduler to write it
+        (distributed's own Client would wait for a missing file forever)."""
+        deadline = time.monotonic() + timeout
+        while True:
+            try:
+                address = json.loads(Path(path).read_text())["address"]
+                if isinstance(address, str) and address:
+                    return address
+                problem = f"address = {address!r}"
+            except FileNotFoundError:
+                problem = "no such file"
+            except (OSError, ValueError, TypeError, KeyError) as exc:
+                problem = f"not a Dask scheduler file ({type(exc).__name__}: {exc})"
+            if time.monotonic() >= deadline:
+                raise ValueError(f"scheduler file {str(path)!r}: {problem} after {timeout:g} s")
+            time.sleep(0.1)
+
+    def map(self, fn, chunks):
+        import uuid
+
+        from distributed import as_completed
+        from distributed.comm import get_address_host
+
+        # the Dask threads on each machine (by host address), so a task knows its share
+        nthreads = self.client.nthreads()
+        per_host: dict[str, int] = {}
+        for worker, n in nthreads.items():
+            host = get_address_host(worker)
+            per_host[host] = per_host.get(host, 0) + n
+        shares = {worker: per_host[get_address_host(worker)] for worker in nthreads}
+        tag = uuid.uuid4().hex[:8]
+        futures = {
+            self.client.submit(self._run_chunk, fn, shares, chunk, key=f"railride-chunk-{tag}-{i}"): i
+            for i, chunk in enumerate(chunks)
+        }
+        try:
+            for fut in as_completed(futures, loop=self.client.loop):
+                i = futures.pop(fut)
+                yield i, fut.result()
+        finally:  # stopped early (an error, Ctrl-C): drop what has not finished
+            if futures:
+                self.client.cancel(list(futures))
+
+    @staticmethod
+    def _run_chunk(fn, shares: dict, chunk):
+        """On a worker: ``fn(chunk)`` on numba's thread count divided by the Dask threads on this
+        machine (``shares``, as the map started; this worker's own for a worker that joined
+        later). The thread count is per thread (`numba.set_num_threads`), so restored after."""
+        import numba
+        from distributed import get_worker
+
+        worker = get_worker()
+        share = shares.get(worker.address, worker.state.nthreads)
+        before = numba.get_num_threads()
+        numba.set_num_threads(max(1, numba.config.NUMBA_NUM_THREADS // max(1, share)))  # type: ignore[attr-defined]
+        try:
+            return fn(chunk)
+        finally:
+            numba.set_num_threads(before)
+
+    def close(self):
+        self.client.close()
+
+
+#: seconds for a scheduler's host to accept a connection: a TCP connect on a network takes
+#: milliseconds, so a host that has not answered in this time is down or behind a firewall
+PROBE_SECONDS = 3.0
+#: seconds for a port that accepted to answer Dask's handshake (a scheduler answers at once)
+HANDSHAKE_SECONDS = 5.0
+#: the addresses a DaskExecutor can use, for the errors
+ALLOWED = (
+    "allowed: tcp://host:port (or host:port), ws://host:port, tls:// or wss:// with the cluster's "
+    "certificates, or the inproc:// address of a scheduler in this process"
+)
+
+
+def _one_line(exc: BaseException) -> str:
+    return " ".join(str(exc).split()) or type(exc).__name__
+
+
+def _security(address: str, security, where: str):
+    """The client's security for ``address``: ``security`` as given, else Dask's configuration
+    (distributed.Security()); a tls:// or wss:// address without certificates is a ValueError."""
+    from distributed.comm.addressing import parse_address
+    from distributed.security import Security
+
+    try:
+        scheme = parse_address(address)[0]
+    except ValueError as exc:
+        raise ValueError(f"{where}: {_one_line(exc)}; {ALLOWED}") from None
+    security = Security() if security is None else security
+    if scheme in ("tls", "wss") and security.get_connection_args("client").get("ssl_context") is None:
+        raise ValueError(
+            f"{where}: {scheme}:// needs the cluster's TLS certificates, and none are set: pass "
+            "security= (a distributed.Security) from Python, or set distributed.comm.tls.ca-file, "
+            ".client.cert and .client.key in Dask's configuration (DASK_DISTRIBUTED__COMM__TLS__CA_FILE "
+            "and the like), or use tcp://host:port"
+        )
+    return security
+
+
+def _reach(address: str, timeout: float, security, where: str) -> None:
+    """ValueError unless a Dask scheduler answers at ``address``: the scheme checked, then a
+    plain connection to the host's port within `PROBE_SECONDS`, then Dask's handshake within
+    `HANDSHAKE_SECONDS` (and ``timeout``)."""
+    import asyncio
+    from concurrent.futures import ThreadPoolExecutor
+
+    from distributed.comm import connect
+    from distributed.comm.addressing import parse_address, parse_host_port
+    from distributed.comm.inproc import global_manager
+    from distributed.comm.registry import backends
+
+    scheme, loc = parse_address(address)
+    if scheme not in backends or scheme == "ucx":
+        why = (
+            "the ucx protocol is no longer part of dask.distributed (it needs distributed-ucxx and a UCX network)"
+            if scheme == "ucx"
+            else f"unknown address scheme {scheme!r}"
+        )
+        raise ValueError(f"{where}: {why}; {ALLOWED}")
+    if scheme == "inproc":
+        try:
+            listener = global_manager.get_listener_for(loc)
+        except ValueError:  # not an inproc address distributed could have made
+            listener = None
+        if listener is None:
+            raise ValueError(
+                f"{where}: no scheduler of this process listens there (an inproc:// address reaches a "
+                f"scheduler started in the same Python process only); {ALLOWED}"
+            )
+        return
+    try:
+        host, port = parse_host_port(loc)
+    except ValueError as exc:
+        raise ValueError(f"{where}: {_one_line(exc)}; {ALLOWED}") from None
+    probe = min(timeout, PROBE_SECONDS)
+    try:
+        with socket.create_connection((host, port), timeout=probe) as sock:
+            context = security.get_connection_args("client").get("ssl_context")
+            if scheme in ("tls", "wss") and context is not None:  # else the server logs a failed handshake
+                context.wrap_socket(sock, server_hostname=host).close()
+    except ConnectionRefusedError:
+        raise ValueError(
+            f"{where}: cannot reach the Dask scheduler at {address}: nothing listens on port {port} of "
+            f"{host} (connection refused); is the scheduler running, and is {port} its port (8786 by default)?"
+        ) from None
+    except socket.gaierror as exc:
+        raise ValueError(
+            f"{where}: cannot reach the Dask scheduler at {address}: unknown host {host!r} ({exc.strerror})"
+        ) from None
+    except (TimeoutError, socket.timeout):
+        raise ValueError(
+            f"{where}: cannot reach the Dask scheduler at {address}: {host} did not answer on port {port} "
+            f"within {probe:g} s (a host that is down, or a firewall)"
+        ) from None
+    except OSError as exc:
+        raise ValueError(
+            f"{where}: cannot reach the Dask scheduler at {address}: {exc.strerror or _one_line(exc)}"
+        ) from None
+
+    wait = min(timeout, HANDSHAKE_SECONDS)
+
+    async def once():
+        comm = await connect(address, timeout=wait, **security.get_connection_args("client"))
+        await comm.close()
+
+    try:
+        # in a thread of its own: the caller may be inside an event loop (Jupyter)
+        with ThreadPoolExecutor(1) as pool:
+            pool.submit(lambda: asyncio.run(asyncio.wait_for(once(), wait))).result()
+    except Exception as exc:
+        raise ValueError(
+            f"{where}: cannot reach the Dask scheduler at {address}: port {port} accepts connections but "
+            f"did not answer as a Dask scheduler within {wait:g} s ({type(exc).__name__}: {_one_line(exc)}); "
+            "is it the dashboard's port (8787 by default) rather than the scheduler's (8786)?"
+        ) from None
+
+
+# -- the table of finished runs ----------------------------------------------------------------
+#: the lock file beside a run table: held (flock) by the process that writes the table
+LOCK_SUFFIX = ".lock"
+
+
+class RunTable:
+    """Every finished run, one row each, kept in a CSV file rewritten atomically after each
+    chunk: a reader never sees half a file, and an interrupted sweep loses at most the chunks
+    in flight.
+
+    A table on disk belongs to one process at a time: opening it takes an exclusive lock on the
+    file ``.runs.csv.lock`` beside it (the folder is created for it), which names the process
+    holding it; a second writer gets a ValueError naming the folder and that process, where it
+    would otherwise overwrite the first one's rows. The operating system drops the lock when
+    its process ends, however it ends, so the lock of a killed process is simply taken over.
+    `close` (or leaving a ``with`` block) releases it. Opening the table also removes what
+    killed writes left there (``.runs.csv.*.part``). Rows read back are checked: a damaged
+    file is a ValueError naming the file and the line."""
+
+    def __init__(self, path: str | Path | None = None, resume: bool = False):
+        self.path = None if path is None else Path(path)
+        self.frame = pd.DataFrame()
+        self._lock = None
+        if self.path is None:
+            return
+        self._lock = _FolderLock(self.path)
+        try:
+            if self.path.exists():
+                if not resume:
+                    raise ValueError(
+                        f"{self.path} exists: pass resume to continue that sweep, or choose another output folder"
+                    )
+                self.frame = read_run_table(self.path)
+        except BaseException:
+            self.close()
+            raise
+
+    def close(self) -> None:
+        """Release the table's lock (nothing for a table in memory); the table stays readable."""
+        if self._lock is not None:
+            self._lock.release()
+            self._lock = None
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+        return False
+
+    def done(self) -> dict[str, dict]:
+        if self.frame.empty:
+            return {}
+        return {row["key"]: row for row in self.frame.to_dict("records")}
+
+    def add(self, rows: list[dict]) -> None:
+        if not rows:
+            return
+        self.frame = pd.concat([self.frame, pd.DataFrame(rows)], ignore_index=True)
+        if self.path is not None:
+            atomic_write(self.path, lambda p: self.frame.to_csv(p, index=False))
+
+
+def read_run_table(path: Path) -> pd.DataFrame:
+    """The rows of the run table ``path``, checked: every row has a key (16 hex digits) and,
+    unless it records the time its run diverged, finite numbers in its metric columns. A
+    ValueError names the file, the line and what is wrong."""
+    from railride.analysis.metrics import RESPONSES, STATISTICS
+
+    try:
+        # keys are hex digests: an all-digit one must stay text to be recognised
+        frame = pd.read_csv(path, dtype={"key": str})
+    except (OSError, ValueError) as exc:
+        raise ValueError(f"cannot read the run table {path}: {' '.join(str(exc).split())}") from None
+    if "key" not in frame:
+        raise ValueError(f"run table {path}: no 'key' column; not a railride run table")
+    metrics = [c for c in (f"{r}_{s}" for r in RESPONSES for s in STATISTICS) if c in frame]
+    values = frame[metrics].apply(pd.to_numeric, errors="coerce")
+    diverged = pd.to_numeric(frame["diverged_at_s"], errors="coerce") if "diverged_at_s" in frame else None
+    keys = frame["key"].astype(str).str.fullmatch("[0-9a-f]{16}") & frame["key"].notna()
+    finite = np.isfinite(values.to_numpy(dtype=float)).all(axis=1)
+    ran = ~np.isfinite(diverged.to_numpy(dtype=float)) if diverged is not None else np.ones(len(frame), bool)
+    bad = np.flatnonzero(~keys.to_numpy() | (ran & ~finite))
+    if bad.size:
+        i = int(bad[0])
+        if not keys.iloc[i]:
+            problem = f"key = {frame['key'].iloc[i]!r} is not 16 hex digits"
+        else:
+            column = next(c for c in metrics if not np.isfinite(values[c].iloc[i]))
+            problem = f"{column} = {frame[column].iloc[i]!r} is not a finite number (and the run did not diverge)"
+        raise ValueError(
+            f"run table {path}, line {i + 2} (run {i + 1}): {problem}; the file is damaged: "
+            "delete that line to run it again, or start afresh in another folder"
+        )
+    frame[metrics] = values
+    return frame
+
+
+class _FolderLock:
+    """An exclusive lock on ``.NAME.lock`` beside ``path`` (flock: held while the file is open,
+    dropped by the system when the process ends). The file names its holder for the error."""
+
+    def __init__(self, path: Path):
+        import fcntl
+
+        self.fd: int | None = None
+        self.path = path.parent / f".{path.name}{LOCK_SUFFIX}"
+        folder = path.parent
+        self.created = not folder.exists()
+        folder.mkdir(parents=True, exist_ok=True)
+        while True:
+            fd = os.open(self.path, os.O_RDWR | os.O_CREAT, 0o644)
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except BlockingIOError:
+                holder = os.read(fd, 200).decode("utf-8", "replace").strip() or "another process"
+                os.close(fd)
+                raise ValueError(
+                    f"output folder {folder} is in use by {holder} (lock {self.path}): two runs writing one "
+                    "run table would lose rows; wait for it to finish, or choose another folder"
+                ) from None
+            # the file may have been removed by its holder between our open and flock: retry on
+            # the new one, or two processes would hold locks on different files
+            try:
+                same = os.path.samestat(os.fstat(fd), os.stat(self.path))
+            except FileNotFoundError:
+                same = False
+            if same:
+                break
+            os.close(fd)
+        self.fd = fd
+        os.ftruncate(fd, 0)
+        os.write(fd, f"railride process {os.getpid()} on {socket.gethostname()}, since {_now()}\n".encode())
+        for part in folder.glob(f".{path.name}.*.part"):  # a killed atomic write's leftovers
+            part.unlink(missing_ok=True)
+
+    def release(self) -> None:
+        if self.fd is None:
+            return
+        self.path.unlink(missing_ok=True)  # while still held: no one else is between
+        os.close(self.fd)
+        self.fd = None
+        if self.created:  # a folder made only for the lock, with nothing written, goes again
+            try:
+                self.path.parent.rmdir()
+            except OSError:
+                pass
+
+    def __del__(self):
+        self.release()
+
+
+def _now() -> str:
+    return time.strftime("%Y-%m-%d %H:%M:%S")

@@ -1,0 +1,195 @@
+"""Controllers judged on several tracks and speeds at once: the league table.
+
+`league` runs `railride.compare` on every combination of scenario, speed and track seed (the
+seeds apply to the random tracks only) with the same gains, and collects per case and
+controller the RMS reduction of each response against passive, the same gains' reduction on
+the ideal actuator (the upper bound), ride comfort at the carbody centre, and what the
+controller asks of its dampers (force and travel). `LeagueTable` summarises it per controller
+as the mean over the cases, and says which cases the gains were tuned on (in-sample) and which
+they meet for the first time (out-of-sample).
+"""
+
+from __future__ import annotations
+
+import itertools
+from dataclasses import dataclass, field
+
+import numpy as np
+import pandas as pd
+
+from railride import validation
+from railride.studies.comparison import check_controllers, compare
+from railride.secondary.control import LABELS, PAPER_CONTROLLERS, GainSet
+from railride.defaults import DEFAULT_DAMPER
+from railride.plots import PNG_DPI, FigureOptions
+from railride.model.track import SPECTRA, scenario
+
+SCHEMA = "railride.league/1"
+RESPONSES = ("acceleration_m_s2", "displacement_m", "pitch_deg", "roll_deg")
+#: comfort indices in the table (carbody centre): ISO 2631-1 a_w (Wk) and EN 12299 N_MV (vertical)
+COMFORT = ("aw_Wk", "N_MV_z")
+
+
+@dataclass
+class LeagueTable:
+    """Per case (scenario, speed, seed) and controller: ``cases`` (a DataFrame, one row each);
+    ``settings``: what was run; ``tuned_on``: the scenario record the gains were tuned on
+    (None if the gains file does not say)."""
+
+    cases: pd.DataFrame
+    controllers: list[str]
+    settings: dict = field(default_factory=dict)
+    tuned_on: dict | None = None
+
+    def summary(self) -> pd.DataFrame:
+        """One row per controller (passive first): the mean over the cases of every column of
+        `cases` that is a number, and the number of cases."""
+        numeric = self.cases.select_dtypes("number").drop(columns=["speed_m_s", "track_seed"], errors="ignore")
+        table = numeric.groupby(self.cases["controller"], sort=False).mean()
+        table["cases"] = self.cases.groupby("controller", sort=False).size()
+        table["in_sample_cases"] = self.cases.groupby("controller", sort=False)["in_sample"].sum()
+        return table.reindex(self.controllers)
+
+    def to_pandas(self) -> pd.DataFrame:
+        return self.cases.copy()
+
+    def to_dict(self) -> dict:
+        def clean(v):
+            if isinstance(v, (float, np.floating)):
+                return float(v) if np.isfinite(v) else None
+            if isinstance(v, np.integer):
+                return int(v)
+            if isinstance(v, np.bool_):
+                return bool(v)
+            return v
+
+        summary = self.summary()
+        return {
+            "schema": SCHEMA,
+            "settings": self.settings,
+            "tuned_on": self.tuned_on,
+            "controllers": [
+                {"name": n, "label": LABELS[n], **{k: clean(v) for k, v in summary.loc[n].items()}}
+                for n in self.controllers
+            ],
+            "cases": [{k: clean(v) for k, v in row.items()} for row in self.cases.to_dict("records")],
+        }
+
+    def plot(self, ax=None):
+        """Bar chart of the mean RMS reductions per controller and response, with the
+        ideal-actuator bound as an outline beside each bar."""
+        from railride.plots.league import plot_league
+
+        return plot_league(self, ax=ax)
+
+    def save(self, folder, *, figure_formats=("png",), dpi: float = PNG_DPI):
+        """league.json, league.csv (one row per case and controller), league.png and
+        league_comfort.png (N_MV against speed), the figures in each of ``figure_formats``
+        (png, pdf, svg), PNG at ``dpi``."""
+        from railride.output.files import write_league_outputs
+
+        return write_league_outputs(self, folder, figures=FigureOptions(figure_formats, dpi))
+
+
+def _cases(scenarios, speeds, track_seeds):
+    for name in scenarios:
+        if not isinstance(name, str):
+            raise ValueError(f"scenario = {name!r}: must be a scenario name")
+    speeds = [None] if speeds is None else [validation.number("speed", v, "positive", "m/s") for v in speeds]
+    seeds = [validation.seed("track_seed", s) for s in track_seeds]
+    if not seeds:
+        raise ValueError("track_seeds: give at least one seed (default 0)")
+    for name, v in itertools.product(scenarios, speeds):
+        for seed in seeds if name in SPECTRA else [None]:
+            yield name, v, seed
+
+
+def league(
+    scenarios=("paper-sine",),
+    speeds=None,
+    *,
+    track_seeds=(0,),
+    params=None,
+    controllers=PAPER_CONTROLLERS,
+    gains: GainSet | None = None,
+    damper: str = DEFAULT_DAMPER,
+    damper_scale: float = 1.0,
+    duration: float | None = None,
+    window=None,
+    solver=None,
+    comfort: bool = True,
+    progress=None,
+) -> LeagueTable:
+    """Run `compare` on every (scenario, speed, track seed) with the same gains and collect the
+    league table. ``scenarios``: names (`railride.scenario`); ``speeds`` [m/s] (None: each
+    scenario's default); ``track_seeds``: the random-track realisations (ignored by the other
+    scenarios). The other arguments are `compare`'s; the bounds (ideal devices) are always run.
+    ``progress(done_cases, total_cases)`` is called after each case."""
+    scenarios = list(scenarios) if not isinstance(scenarios, str) else [scenarios]
+    if not scenarios:
+        raise ValueError("scenarios: give at least one scenario name")
+    names = check_controllers(controllers)
+    gains = GainSet.default() if gains is None else gains
+    # every scenario is built (and checked) before the first run
+    todo = [
+        (n, v, s, scenario(n, speed=v, seed=s, duration=duration)) for n, v, s in _cases(scenarios, speeds, track_seeds)
+    ]
+    rows = []
+    for k, (name, speed, seed, sc) in enumerate(todo):
+        comp = compare(
+            sc,
+            params,
+            controllers=names,
+            gains=gains,
+            damper=damper,
+            damper_scale=damper_scale,
+            window=window,
+            solver=solver,
+            comfort=comfort,
+            bounds=True,
+        )
+        rows.extend(_rows(comp, name, sc.speed, seed))
+        if progress is not None:
+            progress(k + 1, len(todo))
+    settings = {
+        "scenarios": scenarios,
+        "speeds_m_s": None if speeds is None else [float(v) for v in speeds],
+        "track_seeds": [int(s) for s in track_seeds],
+        "damper": damper,
+        "damper_scale": float(damper_scale),
+        "duration_s": duration,
+        "window_s": None if window is None else [float(w) for w in window],
+        "gains": gains.source,
+        "objective": gains.provenance.get("objective"),
+        "untuned": gains.untuned(names),
+        "tuned_alike": gains.tuning_budget(names),
+    }
+    return LeagueTable(pd.DataFrame(rows), names, settings, gains.provenance.get("scenario_record"))
+
+
+def _rows(comp, name: str, speed: float, seed) -> list[dict]:
+    red = comp.reductions
+    demands = comp.demands()
+    bound = (comp.bounds_record() or {}).get("ideal", {})  # reductions of the same gains on the ideal actuator
+    rows = []
+    for n in comp.names:
+        row = {
+            "scenario": name,
+            "speed_m_s": float(speed),
+            "track_seed": seed,
+            "controller": n,
+            "in_sample": bool(comp.in_sample),
+        }
+        for r in RESPONSES:
+            row[f"{r}_rms"] = float(comp.metrics.sel(controller=n, response=r, statistic="rms"))
+            if n != "passive":
+                row[f"{r}_reduction_percent"] = float(red.sel(controller=n, response=r, statistic="rms"))
+                ideal = (bound.get(n) or {}).get("reduction_percent", {}).get(r)  # None: diverged or no bound
+                row[f"{r}_ideal_reduction_percent"] = np.nan if ideal is None else ideal
+        if comp.comfort is not None:
+            for i in COMFORT:
+                row[f"centre_{i}"] = float(comp.comfort[n].sel(position="centre", index=i))
+        d = demands[n]
+        row.update(force_rms_n=d["force_rms_n"], force_max_n=d["force_max_n"], travel_max_m=d["travel_max_m"])
+        rows.append(row)
+    return rows

@@ -1,0 +1,193 @@
+"""Tuning objectives: one number from the four RMS ratios to passive (docs/tuning.md, Objectives).
+
+r_k = RMS_k / RMS_k(passive) for k = acceleration, displacement, pitch, roll. ``sum``,
+``weighted``, ``minimax`` or ``constrained``, plus an optional penalty on ratios above 1; a run
+that diverged scores +inf. `Objective.describe` states an objective in full, and every output
+of a study prints that statement. `DEFAULT_OBJECTIVE` is the one home of the default.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from railride.analysis.metrics import RESPONSES
+
+#: the objectives, in the order the docs list them
+OBJECTIVE_KINDS = ("sum", "weighted", "minimax", "constrained")
+#: the ratios' names in the order of the weights
+RATIO_NAMES = ("acceleration", "displacement", "pitch", "roll")
+#: constrained: an infeasible candidate scores INFEASIBLE_OFFSET + INFEASIBLE_SCALE x excess;
+#: the offset rises (by powers of ten) above the largest J a feasible candidate can have
+INFEASIBLE_OFFSET = 1000.0
+INFEASIBLE_SCALE = 1000.0
+
+
+def _number(name: str, value, rule: str, ok) -> float:
+    """``value`` as a float if it is a real number (not a bool, not text) passing ``ok``."""
+    number = not isinstance(value, (bool, str, bytes))
+    try:
+        x = float(value) if number else math.nan
+    except (TypeError, ValueError):
+        x = math.nan
+    if not (math.isfinite(x) and ok(x)):
+        raise ValueError(f"objective {name} = {value!r}: {rule}")
+    return x
+
+
+@dataclass(frozen=True)
+class Objective:
+    """A score J of a vehicle run from its RMS ratios to passive, r_k = RMS_k / RMS_k(passive),
+    k = acceleration, displacement, pitch, roll; lower is better, J(passive) = 4 for the sums.
+
+    ``kind``:
+
+    * ``sum``: J = sum_k r_k;
+    * ``weighted``: J = sum_k w_k r_k, ``weights`` four numbers >= 0, not all 0;
+    * ``minimax``: J = max_k r_k, the worst ratio (candidates with the same worst ratio tie,
+      whatever their other ratios);
+    * ``constrained``: J = sum_k r_k if every r_k <= ``bound`` (> 0); otherwise the candidate
+      is infeasible and J = offset + 1000 E, E = sum_k max(0, r_k - bound) its total excess, the
+      offset 1000 (or the next power of ten above the largest J a feasible candidate can reach):
+      every infeasible candidate ranks after every feasible one, and among themselves by E.
+
+    ``penalty`` (>= 0, default 0) adds penalty x sum_k max(0, r_k - 1) to every kind (to the
+    feasible ones of ``constrained``). ``weights`` is for ``weighted`` only and ``bound`` for
+    ``constrained`` only. `describe` is the statement printed with every result.
+    `DEFAULT_OBJECTIVE` is the tuner's default; ``Objective()`` is the plain sum.
+    """
+
+    kind: str = "sum"
+    weights: tuple | None = None  # acceleration, displacement, pitch, roll
+    bound: float | None = None
+    penalty: float = 0.0
+
+    def __post_init__(self):
+        if self.kind not in OBJECTIVE_KINDS:
+            raise ValueError(f"objective kind = {self.kind!r}: unknown; allowed: {', '.join(OBJECTIVE_KINDS)}")
+        rule = "four numbers >= 0, not all 0 (acceleration, displacement, pitch, roll), for kind 'weighted'"
+        if self.kind == "weighted":
+            if self.weights is None:
+                raise ValueError(f"objective weights = None: {rule}")
+            try:
+                w = tuple(self.weights)
+            except TypeError:
+                raise ValueError(f"objective weights = {self.weights!r}: {rule}") from None
+            if len(w) != 4:
+                raise ValueError(f"objective weights = {self.weights!r}: {rule}")
+            w = tuple(_number("weights", x, rule, lambda v: v >= 0) for x in w)
+            if sum(w) == 0:
+                raise ValueError(f"objective weights = {self.weights!r}: {rule}")
+            object.__setattr__(self, "weights", w)
+        elif self.weights is not None:
+            raise ValueError(f"objective weights = {self.weights!r}: for kind 'weighted' only (kind is {self.kind!r})")
+        if self.kind == "constrained":
+            if self.bound is None:
+                raise ValueError(
+                    "objective bound = None: kind 'constrained' needs a bound, a "
+                    "finite number > 0 (the largest RMS ratio to passive allowed)"
+                )
+            object.__setattr__(
+                self,
+                "bound",
+                _number(
+                    "bound",
+                    self.bound,
+                    "a finite number > 0 (the largest RMS ratio to passive allowed)",
+                    lambda v: v > 0,
+                ),
+            )
+        elif self.bound is not None:
+            raise ValueError(f"objective bound = {self.bound!r}: for kind 'constrained' only (kind is {self.kind!r})")
+        object.__setattr__(self, "penalty", _number("penalty", self.penalty, "a finite number >= 0", lambda v: v >= 0))
+        if self.kind == "constrained" and not math.isfinite(self.feasible_max):
+            raise ValueError(
+                f"objective bound = {self.bound!r} with penalty = {self.penalty!r}: "
+                "too large to rank infeasible candidates after feasible ones"
+            )
+
+    @property
+    def feasible_max(self) -> float:
+        """constrained: the largest J a feasible candidate can have (every r_k at the bound)."""
+        if self.kind != "constrained":
+            return math.inf
+        bound = self.bound
+        assert bound is not None  # a constrained objective has one, checked at construction
+        return 4.0 * bound + 4.0 * self.penalty * max(0.0, bound - 1.0)
+
+    @property
+    def infeasible_offset(self) -> float | None:
+        """constrained: the J of an infeasible candidate with a vanishing excess (None for the
+        other kinds): INFEASIBLE_OFFSET, or the next power of ten above `feasible_max`."""
+        if self.kind != "constrained":
+            return None
+        offset = INFEASIBLE_OFFSET
+        while offset <= self.feasible_max:
+            offset *= 10.0
+        return offset
+
+    def score(self, ratio) -> np.ndarray:
+        """J of RMS ratios to passive, ``ratio`` (..., 4). A run that diverged has NaN ratios
+        and scores +inf: after every run that did not."""
+        r = np.asarray(ratio, dtype=float)
+        if r.shape[-1:] != (4,):
+            raise ValueError(f"ratios of shape {r.shape}: the last axis must hold the four responses")
+        if self.kind == "weighted":
+            j = r @ np.array(self.weights)
+        elif self.kind == "minimax":
+            j = r.max(axis=-1)
+        else:
+            j = r.sum(axis=-1)
+        if self.penalty:
+            j = j + self.penalty * np.clip(r - 1.0, 0.0, None).sum(axis=-1)
+        if self.kind == "constrained":
+            excess = np.clip(r - self.bound, 0.0, None).sum(axis=-1)
+            j = np.where(excess > 0, self.infeasible_offset + INFEASIBLE_SCALE * excess, j)
+        return np.where(np.isnan(r).any(axis=-1), np.inf, j)
+
+    def __call__(self, rms: np.ndarray, passive: np.ndarray) -> np.ndarray:
+        """J of RMS values (..., 4) against the passive RMS (4,)."""
+        return self.score(np.asarray(rms, dtype=float) / np.asarray(passive, dtype=float))
+
+    def describe(self) -> str:
+        """The whole objective in one line: formula, weights, bound, penalty, infeasible rule."""
+        r = "r_k = RMS_k / RMS_k(passive), k = acceleration, displacement, pitch, roll"
+        if self.kind == "sum":
+            text = f"sum: J = sum_k r_k (every weight 1), {r}"
+        elif self.kind == "weighted":
+            w = ", ".join(f"{n} {v:g}" for n, v in zip(RATIO_NAMES, self.weights or ()))
+            text = f"weighted: J = sum_k w_k r_k, weights {w}, {r}"
+        elif self.kind == "minimax":
+            text = f"minimax: J = max_k r_k (the worst ratio; equal worst ratios tie), {r}"
+        else:
+            b = f"{self.bound:g}"
+            text = (
+                f"constrained: J = sum_k r_k subject to r_k <= {b} for every k, {r}; an "
+                f"infeasible candidate scores J = {self.infeasible_offset:g} + "
+                f"{INFEASIBLE_SCALE:g} x E, E = sum_k max(0, r_k - {b}), ranking it after "
+                f"every feasible one (J <= {self.feasible_max:g}) and by its excess"
+            )
+        if self.penalty:
+            text += f"; plus penalty {self.penalty:g} x sum_k max(0, r_k - 1)"
+            if self.kind == "constrained":
+                text += " on feasible candidates"
+        return text + "; a run that diverged scores J = inf"
+
+    def to_dict(self) -> dict:
+        """Every setting of the objective and its statement (for JSON documents)."""
+        return {
+            "kind": self.kind,
+            "weights": None if self.weights is None else dict(zip(RESPONSES, self.weights)),
+            "bound": self.bound,
+            "penalty": self.penalty,
+            "infeasible": None
+            if self.kind != "constrained"
+            else {"offset": self.infeasible_offset, "scale": INFEASIBLE_SCALE, "feasible_max": self.feasible_max},
+            "statement": self.describe(),
+        }
+
+
+#: the tuner's default objective (`tune`, `railride.studies.optimise`, `railride tune`)
+DEFAULT_OBJECTIVE = Objective(kind="minimax")

@@ -1,0 +1,384 @@
+"""Statistics over many tracks: every controller on many random-track realisations, speeds,
+payloads and damper faults, summarised as mean and 5th / 95th percentiles (docs/study.md).
+
+One run gives one number per metric; on random track that number changes from one kilometre
+to the next. `study` runs each controller on every combination of track seed and speed
+(the population a statistic is taken over) for each condition, a load factor and a set of
+damper faults, beside the healthy passive suspension on the same track, speed and load. Per
+controller and condition it gives, for every RMS response and comfort index, the mean and the
+5th and 95th percentiles of the value and of its reduction against passive (computed case by
+case, on the same track). A user can then say "SAS (attitude+ride) improves N_MV by x %
+(5-95 %: a to b) on FRA class 4 at 30-60 m/s".
+
+The runs go through `railride.studies.sweep.run_cases`: compiled batches, a local or Dask executor,
+and a run table on disk that a study resumes from; metrics are kept, time histories are not.
+A run that diverges keeps its row with the time it diverged; the statistics leave it out and
+the result lists it (`StudyResult.failed`). `study` returns a `StudyResult` with the result
+protocol (`to_dict`, `to_pandas`, `plot`, `save`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from railride import validation
+from railride.studies.comparison import check_controllers
+from railride.secondary.control import PAPER_CONTROLLERS, GainSet
+from railride.defaults import DEFAULT_DAMPER
+from railride.secondary.faults import DamperFault, check_faults, parse_faults
+from railride.analysis.metrics import RESPONSES
+from railride.model.params import VehicleParams
+from railride.plots import PNG_DPI, FigureOptions
+from railride.run.solver import SolverSettings
+from railride.secondary.sensing import SENSING, reads_bogies
+from railride.studies.sweep import COMFORT_COLUMNS, Case, RunTable, run_cases, scenario_of
+from railride.model.vehicle import Vehicle
+
+#: the schema of `StudyResult.to_dict` (study.json)
+SCHEMA = "railride.study/1"
+#: the metrics a study summarises: the four RMS responses and the comfort indices
+METRICS = (*(f"{r}_rms" for r in RESPONSES), *COMFORT_COLUMNS)
+#: the percentiles of the band
+PERCENTILES = (5.0, 95.0)
+#: a fault condition with no fault
+HEALTHY = "none"
+
+
+def fault_condition(text: str) -> tuple:
+    """One fault condition: "none", or faults joined by "+" (e.g. "1R-off" or "1R-off+2L-on@2"),
+    as their labels in corner order (`railride.secondary.faults.parse_faults`)."""
+    text = str(text).strip()
+    return () if text == HEALTHY else tuple(f.label for f in parse_faults(text.split("+")))
+
+
+@dataclass
+class StudyResult:
+    """The result of `study`. ``cases``: one row per run (the run table's metrics, with the
+    study's ``controller``, ``load``, ``stiffness``, ``fault``, ``delay``, ``track_seed`` and
+    ``speed_m_s`` and, for the controlled runs, each metric's reduction in % against passive on
+    the same track, speed, load and stiffness, ``<metric>_reduction``). ``summary``: one row per
+    controller, condition (load, stiffness, fault, delay) and metric: ``n`` (runs that did not
+    diverge), ``mean``, ``p5``, ``p95`` of the value and ``reduction_mean``, ``reduction_p5``,
+    ``reduction_p95``. ``failed``: the runs that diverged (controller, condition, seed, speed,
+    time). ``settings``: what was run."""
+
+    cases: pd.DataFrame
+    summary: pd.DataFrame
+    settings: dict = field(default_factory=dict)
+    failed: list = field(default_factory=list)
+
+    def to_dict(self) -> dict:
+        """The ``railride.study/1`` document: settings, per controller and condition every
+        metric's statistics, and the failed runs."""
+        from railride._version import __version__
+
+        groups = []
+        for (name, load, k, fault, delay), part in self.summary.groupby(
+            ["controller", "load", "stiffness", "fault", "delay"], sort=False
+        ):
+            metrics = {}
+            for _, row in part.iterrows():
+                metrics[row["metric"]] = {
+                    k: _finite(row[k])
+                    for k in ("n", "mean", "p5", "p95", "reduction_mean", "reduction_p5", "reduction_p95")
+                }
+            groups.append(
+                {
+                    "controller": name,
+                    "load": float(load),
+                    "stiffness": float(k),
+                    "fault": fault,
+                    "delay": int(delay),
+                    "metrics": metrics,
+                }
+            )
+        return {
+            "schema": SCHEMA,
+            "railride_version": __version__,
+            "settings": self.settings,
+            "percentiles": list(PERCENTILES),
+            "results": groups,
+            "failed": self.failed,
+            "runs": int(len(self.cases)),
+        }
+
+    def to_pandas(self) -> pd.DataFrame:
+        """The summary: one row per controller, condition and metric."""
+        return self.summary.copy()
+
+    def plot(self, ax=None, metrics=None):
+        """Per metric (default the four RMS responses and N_MV at the carbody centre), the mean
+        reduction against passive of each controller with its 5-95 % band, one group per
+        condition (`railride.plots.study.plot_study`). Returns the figure."""
+        from railride.plots.study import plot_study
+
+        return plot_study(self, ax=ax, metrics=metrics)
+
+    def save(self, folder, *, figure_formats=("png",), dpi: float = PNG_DPI) -> list:
+        """study.json (`to_dict`), study_summary.csv (`to_pandas`), study_runs.csv (`cases`)
+        and study.png (`plot`; in each of ``figure_formats``, png, pdf, svg, PNG at ``dpi``)
+        into ``folder``, all or nothing (other files, such as the run table runs.csv, stay).
+        Returns the paths."""
+        from railride.output.files import write_study_outputs
+
+        return write_study_outputs(self, folder, figures=FigureOptions(figure_formats, dpi))
+
+
+def _finite(value):
+    value = float(value)
+    return value if np.isfinite(value) else None
+
+
+def study(
+    controllers=PAPER_CONTROLLERS,
+    *,
+    scenario: str = "fra4",
+    track_seeds=None,
+    speeds=None,
+    loads=(1.0,),
+    stiffness=(1.0,),
+    faults=(HEALTHY,),
+    delays=(1,),
+    sensing: str = "ideal",
+    duration: float | None = None,
+    gains: GainSet | None = None,
+    damper: str = DEFAULT_DAMPER,
+    params=None,
+    solver=None,
+    window=None,
+    executor=None,
+    table: RunTable | None = None,
+    progress=None,
+) -> StudyResult:
+    """Run ``controllers`` (names of `railride.secondary.control.CONTROLLERS`; passive is always the
+    baseline) on ``scenario`` for every track seed (a random track's realisation; default 0 to
+    9, none for the other scenarios) and speed (m/s; None: the scenario's), for
+    each load factor (`VehicleParams.loaded`), secondary stiffness factor (k_sz times it: a
+    tolerance; `VehicleParams.load_changes`), fault condition ("none", or faults such as
+    "1R-off" joined by "+"; faults apply to the controlled suspensions, passive stays healthy)
+    and controller delay (in controller periods, `Suspension.delay`; 1: a demand takes effect
+    one period after its sample), with every controller measuring through ``sensing``
+    ("ideal": the exact states; "accelerometers": `railride.secondary.sensing.Accelerometers` with the
+    default settings, their noise seeded per track seed),
+    with ``gains`` (default the shipped gains: the controllers keep them whatever the load) and
+    the ``damper`` model. Every setting is checked before the first run. ``executor``, ``table``
+    and ``progress`` as for `railride.studies.sweep.run_cases`. Returns a `StudyResult`."""
+    from railride.secondary.faults import fault_table
+    from railride.analysis.metrics import check_window
+    from railride.secondary.suspension import damper_model
+    from railride.studies.sweep import other_settings
+    from railride.model.track import SPECTRA
+
+    names = check_controllers(controllers)
+    solver = SolverSettings.of(solver)
+    vehicle = VehicleParams.of(params)
+    gains = GainSet.default() if gains is None else gains
+    random = scenario in SPECTRA
+    if track_seeds is not None and not random:
+        raise ValueError(
+            f"track_seeds = {list(_items(track_seeds))}: track seeds apply to the random tracks "
+            f"({', '.join(SPECTRA)}) only, not to {scenario!r}"
+        )
+    if track_seeds is None:
+        track_seeds = range(10) if random else [None]
+    seeds = [None if s is None else validation.seed("track_seeds", s) for s in _items(track_seeds)]
+    speed_list = (
+        [None] if speeds is None else [validation.number("speeds", v, "positive", "m/s") for v in _items(speeds)]
+    )
+    load_list = [
+        validation.number("loads", v, "positive", allowed="a finite number > 0 (load factor)") for v in _items(loads)
+    ]
+    stiffness_list = [
+        validation.number("stiffness", v, "positive", allowed="a finite number > 0 (the factor on k_sz)")
+        for v in _items(stiffness)
+    ]
+    conditions = []
+    for f in _items(faults):
+        try:
+            conditions.append(fault_condition(f))
+        except ValueError as exc:
+            raise ValueError(f"faults = {str(f)!r}: {exc}") from None
+    from railride.engine.kernels import MAX_DELAY
+
+    what = "controller periods from a sample to its demand taking effect"
+    delay_list = [validation.integer("delays", d, 1, MAX_DELAY, what) for d in _items(delays)]
+    for name, values in (
+        ("track_seeds", seeds),
+        ("speeds", speed_list),
+        ("loads", load_list),
+        ("stiffness", stiffness_list),
+        ("faults", conditions),
+        ("delays", delay_list),
+    ):
+        if not values:
+            raise ValueError(f"{name}: give at least one value")
+    validation.choice("sensing", sensing, SENSING)
+    if sensing != "ideal":
+        car = Vehicle(vehicle)
+        blind = [n for n in names if (c := gains.controller(n)) is not None and reads_bogies(c.gains(car)[0])]
+        if blind:
+            raise ValueError(
+                f"sensing = {sensing!r}: {', '.join(blind)} {'reads' if len(blind) == 1 else 'read'} the "
+                "bogies' states, and the accelerometers "
+                "are on the carbody only; leave them out"
+            )
+    model = damper_model(damper, 1.0)
+    for cond in conditions:
+        if cond:
+            check_faults(cond, model)
+
+    def options_of(seed, v) -> tuple:
+        opts: dict[str, Any] = {
+            **({"seed": seed} if seed is not None else {}),
+            **({"speed": v} if v is not None else {}),
+            **({"duration": duration} if duration else {}),
+        }
+        return tuple(sorted(opts.items()))
+
+    # every setting is checked before the first run: the scenario at each speed (the seeds
+    # differ in the realisation only), and every fault time against its duration
+    speed_of = {}
+    for v in speed_list:
+        sc = scenario_of(scenario, options_of(seeds[0], v))
+        for cond in conditions:
+            try:
+                fault_table([[DamperFault.parse(f) for f in cond]], solver.dt, sc.duration)
+            except ValueError as exc:
+                raise ValueError(f"faults = {'+'.join(cond)!r}: {exc}") from None
+        speed_of[v] = sc.speed
+    # the window inside the runs, checked before the first; recorded with its open end (inf,
+    # which JSON cannot hold) resolved, while the runs' keys keep it as given (resumable)
+    window_record = None if window is None else [float(w) for w in check_window(tuple(window), sc.duration)]
+    opts_of = {(seed, v): (options_of(seed, v), speed_of[v]) for seed in seeds for v in speed_list}
+    cases, meta = [], []
+    controlled = [n for n in names if n != "passive"]
+    for load, k in [(load, k) for load in load_list for k in stiffness_list]:
+        changes = vehicle.load_changes(load, k)
+        for (seed, v), (options, speed) in opts_of.items():
+            cases.append(Case(scenario, options, vehicle=changes))
+            meta.append(("passive", load, k, HEALTHY, 1, seed, speed))
+            for cond in conditions:
+                label = "+".join(cond) if cond else HEALTHY
+                for delay in delay_list:
+                    for n in controlled:
+                        case = Case(scenario, options, vehicle=changes, suspension=n, damper=damper, faults=cond)
+                        if case.closed_loop:  # the accelerometers' noise differs from track to track
+                            noise_seed = seed if seed is not None and sensing != "ideal" else 0
+                            case = replace(case, delay=delay, sensing=sensing, seed=noise_seed)
+                        cases.append(case)
+                        meta.append((n, load, k, label, delay, seed, speed))
+    rows = run_cases(
+        cases,
+        executor=executor,
+        table=table,
+        base_gains=gains,
+        params=vehicle,
+        solver=solver,
+        window=window,
+        progress=progress,
+        comfort=True,
+    )
+    frame = rows.reset_index(drop=True).copy()
+    info = pd.DataFrame(meta, columns=["controller", "load", "stiffness", "fault", "delay", "track_seed", "speed_m_s"])
+    frame = pd.concat([info, frame.drop(columns=[c for c in info.columns if c in frame.columns])], axis=1)
+    frame = _reductions(frame)
+    summary = _summary(frame, names, load_list, stiffness_list, conditions, delay_list)
+    failed = [
+        {
+            "controller": r.controller,
+            "load": float(r.load),
+            "stiffness": float(r.stiffness),
+            "fault": r.fault,
+            "delay_periods": int(r.delay),
+            "track_seed": None if r.track_seed is None or r.track_seed != r.track_seed else int(r.track_seed),
+            "speed_m_s": float(r.speed_m_s),
+            "diverged_at_s": float(r.diverged_at_s),
+        }
+        for r in frame.itertuples()
+        if np.isfinite(r.diverged_at_s)
+    ]
+    settings = {
+        "scenario": scenario,
+        "controllers": names,
+        "track_seeds": seeds if random else None,
+        "speeds_m_s": sorted({s for _, s in opts_of.values()}),
+        "loads": load_list,
+        "stiffness": stiffness_list,
+        "faults": ["+".join(c) if c else HEALTHY for c in conditions],
+        "delays_periods": delay_list,
+        "sensing": sensing,
+        "duration_s": duration,
+        "damper": damper,
+        "gains": gains.source,
+        "window_s": window_record,
+        **other_settings(vehicle, solver),
+    }
+    return StudyResult(frame, summary, settings, failed)
+
+
+def _items(values) -> list:
+    if isinstance(values, (str, bool)) or validation.is_number(values):  # one value (a bool is refused later)
+        return [values]
+    return list(values)
+
+
+def _reductions(frame: pd.DataFrame) -> pd.DataFrame:
+    """Each controlled run's reduction in % against passive on the same track, speed and load."""
+    key = ["load", "stiffness", "track_seed", "speed_m_s"]
+    # no seed (not a random track): one key; the seeds as they are, since floats would merge
+    # those past 2**53
+    keys = frame[key].astype(object).where(frame[key].notna(), -1)
+    passive = frame[list(METRICS)][frame["controller"] == "passive"].set_index(
+        pd.MultiIndex.from_frame(keys[frame["controller"] == "passive"])
+    )
+    base = passive.reindex(pd.MultiIndex.from_frame(keys)).to_numpy()
+    values = frame[list(METRICS)].to_numpy()
+    with np.errstate(divide="ignore", invalid="ignore"):
+        red = np.where(base != 0, (base - values) / base * 100.0, np.nan)
+    red[frame["controller"].to_numpy() == "passive"] = np.nan
+    out = frame.copy()
+    for j, m in enumerate(METRICS):
+        out[f"{m}_reduction"] = red[:, j]
+    return out
+
+
+def _summary(frame: pd.DataFrame, names, loads, stiffness, conditions, delays) -> pd.DataFrame:
+    rows = []
+    labels = ["+".join(c) if c else HEALTHY for c in conditions]
+    lo, hi = PERCENTILES
+    for name in names:
+        for load, k in [(load, k) for load in loads for k in stiffness]:
+            for label, delay in [(HEALTHY, 1)] if name == "passive" else [(f, d) for f in labels for d in delays]:
+                part = frame[
+                    (frame["controller"] == name)
+                    & (frame["load"] == load)
+                    & (frame["stiffness"] == k)
+                    & (frame["fault"] == label)
+                ]
+                part = part[(part["delay"] == delay) & ~np.isfinite(part["diverged_at_s"])]
+                for m in METRICS:
+                    x = part[m].to_numpy(dtype=float)
+                    r = part[f"{m}_reduction"].to_numpy(dtype=float)
+                    x, r = x[np.isfinite(x)], r[np.isfinite(r)]
+                    rows.append(
+                        {
+                            "controller": name,
+                            "load": load,
+                            "stiffness": k,
+                            "fault": label,
+                            "delay": delay,
+                            "metric": m,
+                            "n": int(x.size),
+                            "mean": float(x.mean()) if x.size else np.nan,
+                            "p5": float(np.percentile(x, lo)) if x.size else np.nan,
+                            "p95": float(np.percentile(x, hi)) if x.size else np.nan,
+                            "reduction_mean": float(r.mean()) if r.size else np.nan,
+                            "reduction_p5": float(np.percentile(r, lo)) if r.size else np.nan,
+                            "reduction_p95": float(np.percentile(r, hi)) if r.size else np.nan,
+                        }
+                    )
+    return pd.DataFrame(rows)

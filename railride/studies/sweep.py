@@ -1,0 +1,454 @@
+"""Many runs at once: cases, their batches, and the sweep study over a grid of them.
+
+A `Case` is one run described by plain settings (scenario and its options, vehicle parameter
+changes, suspension, gain changes), so it can travel to a Dask worker and has a stable key.
+`run_cases` groups compatible cases into batches for the compiled stepper, scenario by scenario
+so that runs sharing rail tables run in the same or neighbouring chunks (`_chunks`), hands the
+chunks to an executor (`railride.studies.executors`: `LocalExecutor`, this machine, the batch over both cores;
+`DaskExecutor`, a dask.distributed cluster) and appends every finished chunk to a `RunTable` on
+disk, written atomically; a sweep started again with the same table skips the runs it already
+has, so an interrupted sweep resumes where it stopped. The metrics of a case do not depend on
+the executor or on the batch it ran in (a batch equals its single runs,
+tests/physics/test_simulate.py).
+
+The sweep study: `grid` (`railride.studies.grid`) turns the values of each axis into the cases
+of every combination, checked before the first run; `run_sweep` runs them and returns a
+`SweepResult` (the ``railride.sweep/1`` document, a table, the figures, a result folder).
+"""
+
+from __future__ import annotations
+
+import functools
+import hashlib
+import json
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+import pandas as pd
+
+from railride.defaults import DEFAULT_CONTROL_RATE, DEFAULT_OUTPUT_RATE
+from railride.studies.executors import DaskExecutor, LocalExecutor, RunTable  # noqa: F401 (their home before)
+from railride.analysis.metrics import RESPONSES, STATISTICS
+from railride.plots import PNG_DPI, FigureOptions
+from railride.model.params import VehicleParams
+from railride.run.solver import SolverSettings
+from railride.secondary.suspension import batch_conflict
+from railride.studies.case import MODEL_REVISION, SUSPENSIONS, Case, scenario_of  # noqa: F401 (their home before)
+from railride.studies.grid import SweepGrid, grid  # noqa: F401 (the grid of the sweep study, here too)
+
+#: samples per compiled batch: bounds the memory of the time histories (about 5 MB a sample
+#: for 10 s at 1 kHz)
+CHUNK = 32
+#: (position, index) of `railride.analysis.comfort.ride_comfort` in a row with comfort, as the column
+#: ``<position>_<index>``
+COMFORT_INDICES = (
+    ("centre", "aw_Wk"),
+    ("centre", "vdv_Wk"),
+    ("centre", "aw_Wb"),
+    ("centre", "N_MV_z"),
+    ("centre", "Wz"),
+    ("front", "aw_Wk"),
+    ("front", "N_MV_z"),
+    ("front", "Wz"),
+    ("rear", "aw_Wk"),
+    ("rear", "N_MV_z"),
+    ("rear", "Wz"),
+)
+COMFORT_COLUMNS = tuple(f"{p}_{i}" for p, i in COMFORT_INDICES)
+#: the schema of `SweepResult.to_dict` (sweep.json)
+SCHEMA = "railride.sweep/1"
+
+
+def evaluate(
+    cases: list[Case], base_gains=None, *, params=None, solver=None, window=None, comfort: bool = False
+) -> list[dict]:
+    """Run ``cases`` (in compiled batches of compatible cases) and return one row per case:
+    its key, settings and the RMS and peak-to-peak of the four body responses; with
+    ``comfort``, also the ride comfort indices of `COMFORT_COLUMNS` (`railride.analysis.comfort.
+    ride_comfort` over the same window). ``params``: the vehicle the cases' ``vehicle`` changes
+    apply to (`VehicleParams` or a preset name, default "paper"); ``solver``: the
+    `SolverSettings` of every run. Runs in any process: a Dask worker calls it too."""
+    from railride.secondary.control import GainSet
+    from railride.run.simulation import simulate
+
+    base_gains = GainSet.default() if base_gains is None else base_gains
+    vehicle = VehicleParams.of(params)
+    solver = SolverSettings.of(solver)
+    rows: dict[int, dict] = {}
+    made: dict[tuple, object] = {}  # one Scenario per setting in this call (a measured profile read once)
+    by_group: dict[tuple, list[int]] = {}
+    for i, c in enumerate(cases):
+        by_group.setdefault(c.group, []).append(i)
+    for group, idx in by_group.items():
+        for start in range(0, len(idx), CHUNK):
+            part = [cases[i] for i in idx[start : start + CHUNK]]
+            scs = [_scenario(made, c) for c in part]
+            pars = [vehicle.replace(**dict(c.vehicle)) for c in part]
+            suspensions = [c.to_suspension(base_gains) for c in part]
+            if batch_conflict(suspensions) is not None:  # the inner loop is one setting per batch
+                for i in idx[start : start + CHUNK]:  # positions, not lookups: cases may repeat
+                    rows[i] = evaluate(
+                        [cases[i]], base_gains, params=vehicle, solver=solver, window=window, comfort=comfort
+                    )[0]
+                continue
+            res = simulate(scs, pars, suspensions, solver=solver, on_divergence="mark")
+            # a diverged run keeps its row, with NaN metrics and the time it diverged: the other
+            # runs of the study go on
+            m = res.metrics(window).values  # (sample, response, statistic)
+            diverged_at = res.diverged_at
+            cf: np.ndarray | None = None
+            if comfort:
+                from railride.analysis.comfort import ride_comfort
+
+                ds = res.dataset
+                if "sample" not in ds.dims:
+                    ds = ds.expand_dims(sample=[0])
+                ok = np.flatnonzero(np.isnan(diverged_at))  # a diverged run has no comfort
+                if ok.size:  # the columns as one array (sample, column): xarray per value cost 4x the indices
+                    # every run ok (the rule): no copy of the histories
+                    indices = ride_comfort(ds if ok.size == ds.sizes["sample"] else ds.isel(sample=ok), window=window)
+                    cf = np.stack([indices.sel(position=p, index=x).values for p, x in COMFORT_INDICES], -1)
+            for j, i in enumerate(idx[start : start + CHUNK]):
+                if i in rows:
+                    continue
+                row = {"key": cases[i].key, **_flat(cases[i]), "diverged_at_s": float(diverged_at[j])}
+                for r, resp in enumerate(RESPONSES):
+                    for s, stat in enumerate(STATISTICS):
+                        row[f"{resp}_{stat}"] = float(m[j, r, s])
+                if comfort:
+                    for k, column in enumerate(COMFORT_COLUMNS):
+                        row[column] = (
+                            float(cf[int(np.searchsorted(ok, j)), k])
+                            if np.isnan(diverged_at[j]) and cf is not None
+                            else np.nan
+                        )
+                rows[i] = row
+    return [rows[i] for i in range(len(cases))]
+
+
+def _scenario(made: dict, c: Case):
+    key = (c.scenario, c.scenario_options)
+    if key not in made:
+        made[key] = scenario_of(*key)
+    return made[key]
+
+
+def _flat(c: Case) -> dict:
+    d = {
+        "scenario": c.scenario,
+        "suspension": c.suspension,
+        "damper": c.damper,
+        "damper_scale": c.damper_scale,
+        "voltage": np.nan if c.voltage is None else c.voltage,
+        "noise": json.dumps(list(c.noise)) if c.noise else "",
+        "seed": c.seed,
+    }
+    d.update({f"scenario.{k}": v for k, v in c.scenario_options})
+    d.update({f"vehicle.{k}": v for k, v in c.vehicle})
+    d.update({f"gain.{k}": v for k, v in c.gains})
+    if c.faults:
+        d["faults"] = ",".join(c.faults)
+    if c.delay != 1:
+        d["delay_periods"] = c.delay
+    if c.sensing != "ideal":
+        d["sensing"] = c.sensing
+    d["case"] = json.dumps(c.to_dict(), sort_keys=True, default=str)
+    return d
+
+
+def other_settings(vehicle, solver: SolverSettings) -> dict:
+    """The settings of a study besides its step that differ from the defaults: the solver's
+    output and control rates, the vehicle when it is not the paper's. Only those enter a run's
+    key and a study's record, so that the keys and records of default studies stay as they were."""
+    from railride.model.params import VehicleParams
+
+    out = {}
+    if solver.output_rate != DEFAULT_OUTPUT_RATE:
+        out["output_rate_hz"] = solver.output_rate
+    if solver.control_rate != DEFAULT_CONTROL_RATE:
+        out["control_rate_hz"] = solver.control_rate
+    if vehicle != VehicleParams.preset("paper"):
+        out["vehicle_params"] = vehicle.to_dict()
+    return out
+
+
+def run_cases(
+    cases: list[Case],
+    *,
+    executor=None,
+    table: RunTable | None = None,
+    base_gains=None,
+    params=None,
+    solver=None,
+    window=None,
+    chunk: int = CHUNK,
+    progress=None,
+    comfort: bool = False,
+) -> pd.DataFrame:
+    """Evaluate ``cases``, skipping those already in ``table``; returns their rows in order.
+    ``params``: the vehicle (`VehicleParams` or a preset name, default "paper") the cases'
+    ``vehicle`` changes apply to; ``solver``: the `SolverSettings` of every run. ``comfort``:
+    the rows also hold the ride comfort indices (`evaluate`).
+
+    ``progress(done, total, runs_per_second)`` is called after each chunk.
+    """
+    solver = SolverSettings.of(solver)
+    vehicle = VehicleParams.of(params)
+    executor = LocalExecutor() if executor is None else executor
+    table = RunTable() if table is None else table
+    done = table.done()
+    # a run's result depends on the case and on these settings: both go into its key, so a
+    # resumed sweep with another step, window, base gain set or vehicle does not reuse old rows
+    from railride.secondary.control import GainSet
+
+    base = GainSet.default() if base_gains is None else base_gains
+    settings = {
+        "dt": solver.dt,
+        "window": None if window is None else [float(w) for w in window],
+        "base_gains": base.key_text(),
+        **other_settings(vehicle, solver),
+    }
+    if comfort:  # only then: the keys of sweeps without comfort stay as they were
+        settings["comfort"] = True
+    settings_text = json.dumps(settings, sort_keys=True)
+    keys = [hashlib.sha1((c.key + settings_text).encode()).hexdigest()[:16] for c in cases]
+    pending, seen = [], set()
+    key_of = {}
+    for c, k in zip(cases, keys):
+        key_of[c.key] = k
+        if k not in done and k not in seen:
+            pending.append(c)
+            seen.add(k)
+    chunks = _chunks(pending, chunk)
+    fn = functools.partial(evaluate, base_gains=base, params=vehicle, solver=solver, window=window, comfort=comfort)
+    t0, n_done = time.perf_counter(), 0
+    if progress is not None:
+        progress(0, len(pending), 0.0)
+    for _, rows in executor.map(fn, chunks):
+        for row in rows:
+            row["key"] = key_of[row["key"]]  # the case's key with the run settings
+            done[row["key"]] = row
+        table.add(rows)
+        n_done += len(rows)
+        if progress is not None:
+            elapsed = time.perf_counter() - t0
+            progress(n_done, len(pending), n_done / elapsed if elapsed > 0 else math.inf)
+    return pd.DataFrame([done[k] for k in keys])
+
+
+def _chunks(cases: list[Case], chunk: int) -> list[list[Case]]:
+    """``cases`` in chunks of at most ``chunk``, each of one group (one compiled batch), with
+    the runs that share tables together: by vehicle, then track (realisation or profile), then
+    scenario (speed), each in the order first met. The chunks of the groups are interleaved by
+    the first scenario they hold, so the controllers' chunks run next to the passive chunk on
+    the same scenarios and find its tables kept (bounded by bytes, `railride.run.simulation`): a
+    study's tables are built about once each, and its memory does not grow with its runs. The
+    vehicle comes first so that a batch mixes vehicles only where one vehicle's runs end, as
+    before: "auto" gives a passive batch of several vehicles RK4 rather than the exact steps."""
+    ranks: tuple[dict, dict, dict] = ({}, {}, {})
+
+    def rank(level: int, value) -> int:
+        return ranks[level].setdefault(value, len(ranks[level]))
+
+    def near(c: Case) -> tuple:
+        profile = tuple((k, v) for k, v in c.scenario_options if k not in ("speed", "duration"))
+        return (rank(0, c.vehicle), rank(1, (c.scenario, profile)), rank(2, (c.scenario, c.scenario_options)))
+
+    for c in cases:  # ranks in the order given
+        near(c)
+    groups: dict[str, list[Case]] = {}
+    for c in sorted(cases, key=near):
+        groups.setdefault(str(c.group), []).append(c)
+    out = [part[i : i + chunk] for _, part in sorted(groups.items()) for i in range(0, len(part), chunk)]
+    out.sort(key=lambda part: near(part[0]))  # stable: a tie keeps the groups' order
+    return out
+
+
+# -- the sweep study -------------------------------------------------------------------------------
+def metric_columns() -> list[str]:
+    """The metric columns of every run: ``<response>_<statistic>``, statistic by statistic."""
+    return [f"{r}_{s}" for s in STATISTICS for r in RESPONSES]
+
+
+@dataclass(frozen=True, eq=False)
+class SweepResult:
+    """The runs of a sweep (`run_sweep`): ``grid`` (the cases, their grid values and the
+    settings), ``frame`` (the rows of `run_cases`, one per case, in the grid's order),
+    ``comfort`` (whether they hold the comfort indices, `COMFORT_COLUMNS`), ``vehicle`` (the
+    `VehicleParams` of the runs), ``runs`` (rows of the run table at the end) and ``date``
+    (when the sweep finished, UTC, ISO 8601)."""
+
+    grid: SweepGrid
+    frame: pd.DataFrame = field(repr=False)
+    comfort: bool = False
+    vehicle: object = None
+    runs: int = 0
+    date: str = ""
+
+    def metric_columns(self) -> list[str]:
+        return metric_columns() + (list(COMFORT_COLUMNS) if self.comfort else [])
+
+    @property
+    def diverged(self) -> np.ndarray:
+        """True for each case whose run diverged (no metrics, the time in ``diverged_at_s``)."""
+        if "diverged_at_s" not in self.frame:
+            return np.zeros(len(self.grid.cases), dtype=bool)
+        return self.frame["diverged_at_s"].notna().to_numpy()
+
+    def columns(self) -> list[str]:
+        """The columns of `to_pandas`: the grid's, the metrics, ``diverged_at_s`` when a run
+        diverged, and ``key`` (`Case.key`)."""
+        return (
+            list(self.grid.columns)
+            + self.metric_columns()
+            + (["diverged_at_s"] if self.diverged.any() else [])
+            + ["key"]
+        )
+
+    def rows(self) -> list[dict]:
+        """One row per run: its grid values (None where an axis does not act), its metrics
+        (None for a run that diverged) and its case's key."""
+        metrics, diverged = self.metric_columns(), self.diverged
+        rows = []
+        for case, values, (_, result), bad in zip(self.grid.cases, self.grid.values, self.frame.iterrows(), diverged):
+            row = {**values, **{m: None if bad else float(result[m]) for m in metrics}}
+            if diverged.any():  # a run that diverged has no metrics, but the time it went
+                row["diverged_at_s"] = float(result["diverged_at_s"]) if bad else None
+            rows.append({**row, "key": case.key})
+        return rows
+
+    def settings(self) -> dict:
+        """What the sweep ran: the scenario's fixed settings, each axis and its values, the
+        damper, the base gains' source, the sensor noise, the step and the metrics window;
+        with comfort, what its columns are (`comfort_settings`); a solver's rates and a vehicle
+        other than the defaults (`other_settings`)."""
+        from railride.model.params import VehicleParams
+
+        g = self.grid
+        vehicle = VehicleParams.preset("paper") if self.vehicle is None else self.vehicle
+        return {
+            "scenario": g.scenario_record(),
+            "grid": g.grid_values(),
+            "damper": g.damper if ("mr" in g.suspensions or g.controllers) else None,
+            "gains_source": g.base_gains.source if g.controllers else None,
+            "sensor_noise": None
+            if g.noise is None
+            else dict(zip(("displacement", "angle", "velocity", "angular_rate"), g.noise)),
+            "dt_s": float(g.solver.dt),
+            "window_s": None if g.window is None else list(g.window),
+            **({"comfort": comfort_settings(g.duration, g.window)} if self.comfort else {}),
+            **other_settings(vehicle, g.solver),
+        }
+
+    def to_dict(self) -> dict:
+        """The ``railride.sweep/1`` document (docs/cli.md): the settings, the columns, every
+        run as a row of `rows`, and the rows of the run table."""
+        from railride._version import __version__
+
+        return {
+            "schema": SCHEMA,
+            "railride_version": __version__,
+            "date": self.date,
+            "settings": self.settings(),
+            "columns": self.columns(),
+            "rows": self.rows(),
+            "runs": int(self.runs),
+        }
+
+    def to_pandas(self) -> pd.DataFrame:
+        """One row per run, the columns of `columns` (empty where an axis does not act)."""
+        return pd.DataFrame(self.rows(), columns=self.columns())
+
+    def plot(self, ax=None, *, comfort: bool = False, axis: str | None = None):
+        """The RMS of the four carbody responses against the swept axis (four panels,
+        `railride.plots.sweep.plot_sweep`), or with ``comfort`` N_MV,z and a_w Wk against it
+        (two panels, `plot_sweep_comfort`). ``ax``: the Axes to draw in, or None for a new
+        figure. Returns the figure."""
+        from railride.plots.sweep import plot_sweep, plot_sweep_comfort
+
+        return (plot_sweep_comfort if comfort else plot_sweep)(self, ax, axis=axis)
+
+    def save(self, folder, *, extra: dict | None = None, figure_formats=("png",), dpi: float = PNG_DPI) -> list:
+        """sweep.json (`to_dict`, then the entries of ``extra``, such as a command line's
+        facts) and, when the grid has one numeric axis with several values, sweep.png and,
+        with comfort, comfort.png (each in every one of ``figure_formats``: png, pdf, svg; PNG
+        at ``dpi``) into ``folder``, all or nothing (other files, such as the run table
+        runs.csv, stay). Returns the paths."""
+        from railride.output.files import write_sweep_outputs
+
+        figures = FigureOptions(figure_formats, dpi)
+        return write_sweep_outputs(self, folder, {**self.to_dict(), **(extra or {})}, figures=figures)
+
+
+def comfort_settings(duration: float, window) -> dict:
+    """``settings.comfort`` of a sweep with comfort: the columns and their units, where the
+    positions are and what N_MV_z is (the same for every run of a grid: they share one
+    duration)."""
+    from railride.analysis.comfort import INDEX_UNITS, INTERVAL_S
+
+    start, end = window or (0.0, duration)
+    n = max(1, int((end - start + 1e-9) // INTERVAL_S))
+    unit = {
+        i: INDEX_UNITS["aw" if i.startswith("aw_") else "vdv" if i.startswith("vdv_") else i]
+        for _, i in COMFORT_INDICES
+    }
+    return {
+        "columns": list(COMFORT_COLUMNS),
+        "units": {c: unit[i] for (_, i), c in zip(COMFORT_INDICES, COMFORT_COLUMNS)},
+        "positions": {
+            "centre": "x = 0",
+            "front": "x = +l (above the front bogie centre)",
+            "rear": "x = -l (above the rear bogie centre)",
+        },
+        "n_intervals": n,
+        "notes": [
+            "N_MV_z is the vertical term of EN 12299 only: the model has no lateral or longitudinal motion",
+            f"N_MV_z from {n} interval{'s' if n != 1 else ''} of 5 s"
+            + (" (EN 12299 evaluates 60, 5 minutes): an indication only" if n < 60 else ""),
+        ],
+    }
+
+
+def run_sweep(
+    grid: SweepGrid,  # noqa: F811 (the argument shadows the function `grid` on purpose)
+    *,
+    executor=None,
+    table: RunTable | None = None,
+    params=None,
+    progress=None,
+    comfort: bool = True,
+) -> SweepResult:
+    """Run every case of ``grid`` (`railride.studies.sweep.grid`) and return a `SweepResult`.
+
+    One call of `run_cases`: compiled batches of 32 runs, on ``executor`` (default
+    `LocalExecutor`; `DaskExecutor` for a cluster), skipping the runs already in ``table``
+    (a `RunTable`; one kept on disk makes the sweep resumable), ``progress(done, total,
+    runs_per_second)`` after each chunk. ``params``: the vehicle (`VehicleParams` or a preset
+    name, default "paper"). ``comfort``: also the ride comfort indices of every run over the
+    grid's window (`railride.analysis.comfort.ride_comfort`). The runs use the grid's base gains, solver
+    settings and metrics window.
+    """
+    from datetime import datetime, timezone
+
+    if not isinstance(grid, SweepGrid):
+        raise ValueError(
+            f"grid = {type(grid).__name__}: must be a railride.studies.grid.SweepGrid "
+            "(railride.studies.grid.grid makes one)"
+        )
+    vehicle = VehicleParams.of(params)
+    table = RunTable() if table is None else table
+    frame = run_cases(
+        list(grid.cases),
+        executor=executor,
+        table=table,
+        base_gains=grid.base_gains,
+        params=vehicle,
+        solver=grid.solver,
+        window=grid.window,
+        progress=progress,
+        comfort=bool(comfort),
+    )
+    date = datetime.now(timezone.utc).replace(microsecond=0).isoformat().replace("+00:00", "Z")
+    return SweepResult(grid, frame, bool(comfort), vehicle, len(table.frame), date)
