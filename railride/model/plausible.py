@@ -1,6 +1,6 @@
-"""Plausible ranges of the vehicle and controller inputs: the one table of them, read by the
-field checks (`railride.validation.validate_fields`) and rendered into docs/cli.md, Sizes and
-plausible ranges (`markdown`).
+"""Plausible ranges of the vehicle and controller inputs: the one table of them, each parameter
+class hands its own table to the field checks (`railride.validation.validate_fields`); the
+vehicle's is rendered into docs/cli.md, Sizes and plausible ranges (`railride.model.params.ranges_markdown`).
 
 Each input has an error range and, for the vehicle, a narrower typical range:
 
@@ -18,21 +18,7 @@ tuning study moves by factors of 30, so that a warning per candidate would say n
 
 from __future__ import annotations
 
-import dataclasses
-import warnings
-from typing import NamedTuple
-
-
-class PlausibilityWarning(UserWarning):
-    """A value inside its error range but outside the typical range of a full-size rail vehicle."""
-
-
-class Range(NamedTuple):
-    low: float  # error below
-    high: float  # error above
-    why: str
-    typical: tuple[float, float] | None = None  # a warning outside (None: no warning)
-
+from railride.validation import PlausibilityWarning as PlausibilityWarning, Range, atypical
 
 # -- the vehicle ---------------------------------------------------------------------------------
 _MASS = "a body of less than a gram or more than a billion tonnes carries no suspension"
@@ -73,101 +59,34 @@ _WEIGHT = "the square of the gains' bound: the LQR gain grows as the root of the
 _INNER = "the voltage is clipped to the damper's 0-10 V: beyond 1000 the loop is a switch already"
 SENSOR_NOISE_WHY = "noise larger than the whole range of the quantity is no measurement"
 
-CONTROLLER: dict[str, dict[str, Range]] = {
-    "InnerLoop": {k: Range(0.0, 1e3, _INNER) for k in ("B", "G")},
-    "PID": {k: _GAIN_RANGE for k in ("kp", "ki", "kd")},
-    "Attitude": {k: _GAIN_RANGE for k in ("kp_z", "kd_z", "kp_phi", "kd_phi", "kp_theta", "kd_theta")},
-    "Ride": {f"{g}_{c}": _GAIN_RANGE for g in ("kp", "kd") for c in ("1R", "1L", "2R", "2L")},
-    "Skyhook": {k: _GAIN_RANGE for k in ("c_z", "c_phi", "c_theta")},
-    "Groundhook": {"c_g": _GAIN_RANGE},
-    "Hybrid": {k: _GAIN_RANGE for k in ("c_z", "c_phi", "c_theta", "c_g")},
-    "ClippedOptimal": {
-        **{k: Range(0.0, 1e28, _WEIGHT) for k in ("q_z", "q_phi", "q_theta", "qd_z", "qd_phi", "qd_theta")},
-        "r": Range(1e-12, 1e12, "only the ratios of the weights to r matter; past 1e12 they lose their digits"),
-    },
-    "SensorNoise": {
-        "displacement": Range(0.0, 0.1, SENSOR_NOISE_WHY + ": the secondary suspension's travel is under 0.1 m"),
-        "angle": Range(0.0, 0.1, SENSOR_NOISE_WHY + ": carbody pitch and roll are milliradians"),
-        "velocity": Range(0.0, 1.0, SENSOR_NOISE_WHY + ": carbody heave velocities are cm/s"),
-        "angular_rate": Range(0.0, 1.0, SENSOR_NOISE_WHY + ": carbody pitch and roll rates are mrad/s"),
-    },
-    "Accelerometers": {
-        "noise": Range(0.0, 10.0, "1 g of noise per sample: 300 times a railway MEMS accelerometer's"),
-        "bias": Range(-10.0, 10.0, "a bias of 1 g is a sensor mounted on its side, not a bias"),
-        "antialias_hz": Range(1.0, 1e6, "below 1 Hz the filter removes the carbody modes it is there to measure"),
-        "cutoff_hz": Range(1e-3, 1e6, "below 1 mHz the integral drifts with the bias for minutes"),
-    },
+INNER_LOOP: dict[str, Range] = {k: Range(0.0, 1e3, _INNER) for k in ("B", "G")}
+PID: dict[str, Range] = {k: _GAIN_RANGE for k in ("kp", "ki", "kd")}
+ATTITUDE: dict[str, Range] = {k: _GAIN_RANGE for k in ("kp_z", "kd_z", "kp_phi", "kd_phi", "kp_theta", "kd_theta")}
+RIDE: dict[str, Range] = {f"{g}_{c}": _GAIN_RANGE for g in ("kp", "kd") for c in ("1R", "1L", "2R", "2L")}
+SKYHOOK: dict[str, Range] = {k: _GAIN_RANGE for k in ("c_z", "c_phi", "c_theta")}
+GROUNDHOOK: dict[str, Range] = {"c_g": _GAIN_RANGE}
+HYBRID: dict[str, Range] = {k: _GAIN_RANGE for k in ("c_z", "c_phi", "c_theta", "c_g")}
+CLIPPED_OPTIMAL: dict[str, Range] = {
+    **{k: Range(0.0, 1e28, _WEIGHT) for k in ("q_z", "q_phi", "q_theta", "qd_z", "qd_phi", "qd_theta")},
+    "r": Range(1e-12, 1e12, "only the ratios of the weights to r matter; past 1e12 they lose their digits"),
+}
+SENSOR_NOISE: dict[str, Range] = {
+    "displacement": Range(0.0, 0.1, SENSOR_NOISE_WHY + ": the secondary suspension's travel is under 0.1 m"),
+    "angle": Range(0.0, 0.1, SENSOR_NOISE_WHY + ": carbody pitch and roll are milliradians"),
+    "velocity": Range(0.0, 1.0, SENSOR_NOISE_WHY + ": carbody heave velocities are cm/s"),
+    "angular_rate": Range(0.0, 1.0, SENSOR_NOISE_WHY + ": carbody pitch and roll rates are mrad/s"),
+}
+ACCELEROMETERS: dict[str, Range] = {
+    "noise": Range(0.0, 10.0, "1 g of noise per sample: 300 times a railway MEMS accelerometer's"),
+    "bias": Range(-10.0, 10.0, "a bias of 1 g is a sensor mounted on its side, not a bias"),
+    "antialias_hz": Range(1.0, 1e6, "below 1 Hz the filter removes the carbody modes it is there to measure"),
+    "cutoff_hz": Range(1e-3, 1e6, "below 1 mHz the integral drifts with the bias for minutes"),
 }
 
-#: the factor on a damper's force capacity (`railride.suspension.damper_model`)
+#: the factor on a damper's force capacity (`railride.secondary.suspension.damper_model`)
 DAMPER_SCALE = Range(0.01, 100.0, "a hundredth to a hundred times the railway damper: 0.1 kN to 1 MN")
 
-#: the tables by the class whose fields they check
-TABLES: dict[str, dict[str, Range]] = {"VehicleParams": VEHICLE, **CONTROLLER}
 
-
-def table_of(obj) -> dict[str, Range]:
-    """The ranges of ``obj``'s fields (an empty table for a class without one); a subclass
-    (the on-off skyhook) takes its base's."""
-    for cls in type(obj).__mro__:
-        if cls.__name__ in TABLES:
-            return TABLES[cls.__name__]
-    return {}
-
-
-def _words(r: Range) -> str:
-    return f"between {r.low:g} and {r.high:g}"
-
-
-def check(obj, what: str) -> None:
-    """ValueError for a field of ``obj`` outside its error range (the field's own rule, finite
-    and > 0 or >= 0, is checked first); a `PlausibilityWarning` for each outside its typical
-    range. Called by `railride.validation.validate_fields`."""
-    from railride.validation import shown
-
-    fields = {f.name: f for f in dataclasses.fields(obj)}
-    for name, r in table_of(obj).items():
-        value, meta = getattr(obj, name), fields[name].metadata
-        if not r.low <= value <= r.high:
-            raise ValueError(
-                f"{what} {name!r} = {shown(value)} ({meta['doc']}, {meta['unit']}): must be {_words(r)} {meta['unit']} "
-                f"({r.why})"
-            )
-    if type(obj).__name__ == "VehicleParams" and not obj.b < obj.l:
-        raise ValueError(
-            f"{what} 'b' = {shown(obj.b)} (half wheelbase, m): must be below 'l' = {shown(obj.l)} (half bogie-centre "
-            "spacing, m): the two bogies' wheelsets would pass each other"
-        )
-    for note in notes(obj, what):
-        warnings.warn(note, PlausibilityWarning, stacklevel=2)
-
-
-def notes(obj, what: str = "vehicle parameter") -> list[str]:
-    """The warnings of ``obj``: one line per field outside its typical range."""
-    from railride.validation import shown
-
-    out = []
-    fields = {f.name: f for f in dataclasses.fields(obj)}
-    for name, r in table_of(obj).items():
-        if r.typical is None:
-            continue
-        low, high = r.typical
-        value, meta = getattr(obj, name), fields[name].metadata
-        if not low <= value <= high:
-            out.append(
-                f"{what} {name!r} = {shown(value)} {meta['unit']} ({meta['doc']}) is outside the "
-                f"{low:g} to {high:g} {meta['unit']} of full-size rail vehicles; the results are for it as given"
-            )
-    return out
-
-
-def markdown() -> str:
-    """The docs' table of the vehicle ranges (docs/cli.md, Sizes and plausible ranges)."""
-    from railride.model.params import VehicleParams
-
-    rows = ["| field | unit | typical (else a warning) | allowed (else an error) |", "|---|---|---|---|"]
-    for name, unit, _, _ in VehicleParams.describe():
-        r = VEHICLE[name]
-        typical = f"{r.typical[0]:g} to {r.typical[1]:g}" if r.typical else "-"
-        rows.append(f"| `{name}` | {unit} | {typical} | {r.low:g} to {r.high:g} |")
-    return "\n".join(rows)
+def notes(params, what: str = "vehicle parameter") -> list[str]:
+    """The warnings of vehicle parameters ``params``: one line per field outside its typical range."""
+    return atypical(params, VEHICLE, what)
