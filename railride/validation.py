@@ -17,6 +17,7 @@ import sys
 import warnings
 from collections.abc import Mapping
 from pathlib import Path
+from types import FrameType
 from typing import Any, NamedTuple
 
 #: the largest seed: NumPy's generators take any whole number >= 0, but a seed must also
@@ -188,10 +189,12 @@ _PACKAGE = str(Path(__file__).resolve().parent)
 def caller_level() -> int:
     """The ``stacklevel`` of a warning raised by the function that calls this, such that the
     warning points at the first line outside railride (the user's call), past dataclasses'
-    generated ``__init__`` (file ``<string>``)."""
-    frame, level = sys._getframe(2), 2
+    generated ``__init__`` (file ``<string>``) and
+    `dataclasses.replace`."""
+    frame: FrameType | None = sys._getframe(2)
+    level = 2
     while frame is not None and (
-        frame.f_code.co_filename.startswith(_PACKAGE) or frame.f_code.co_filename.startswith("<")
+        frame.f_code.co_filename.startswith((_PACKAGE, "<")) or frame.f_code.co_filename == dataclasses.__file__
     ):
         frame, level = frame.f_back, level + 1
     return level

@@ -306,13 +306,11 @@ def _csv(frame: pd.DataFrame, index: bool = False):
     return lambda path: frame.to_csv(path, index=index)
 
 
-def _expect(value, name: str, module: str, cls: str) -> None:
-    """ValueError unless ``value`` is a railride.<module>.<cls>; imported only here, when
-    called: the result modules pull in the compiled engine."""
-    import importlib
-
-    if not isinstance(value, getattr(importlib.import_module(f"railride.{module}"), cls)):
-        raise ValueError(f"{name}: expected a railride.{module}.{cls}, got {type(value).__name__}")
+def _expect(value, name: str, kind: str, needs: tuple[str, ...]) -> None:
+    """ValueError unless ``value`` has the attributes ``needs`` of a ``kind`` (a result class's
+    path): the writers read what they are given and import no result module (those sit above)."""
+    if not all(hasattr(value, a) for a in needs):
+        raise ValueError(f"{name}: expected a {kind}, got {type(value).__name__}")
 
 
 # -- one writer per result ------------------------------------------------------------------------
@@ -355,7 +353,7 @@ def write_outputs(
     ``metrics_doc["settings"]["window_s"]``; in each format of ``figures``). ``histories``:
     the time-history formats (`HISTORY_FORMATS`; ``mat`` writes ride.mat, `write_mat`) in
     place of ride.nc and ride.csv. Returns the written paths."""
-    _expect(result, "result", "ride", "RideResult")
+    _expect(result, "result", "railride.run.ride.RideResult", ("dataset", "metrics"))
     ds = result.dataset
     text = json_text(metrics_doc)  # refuse NaN before any file is written
     window = _window(metrics_doc)
@@ -425,7 +423,7 @@ def write_compare_outputs(
     (`railride.analysis.spectra.comparison_psd`). ``histories``: the time-history formats
     (`HISTORY_FORMATS`; ``mat`` writes compare.mat, `write_mat`) in place of compare.nc and
     compare.csv. Returns the written paths."""
-    _expect(comparison, "comparison", "comparison", "Comparison")
+    _expect(comparison, "comparison", "railride.studies.comparison.Comparison", ("combined",))
     text = json_text(doc)
     ds = comparison.combined()
     given = (doc or {}).get("settings")
@@ -477,7 +475,7 @@ def write_sweep_outputs(
     default ``result.to_dict()``) and, when the grid has one numeric axis with several values
     (`sweep_plot_axis`), ``sweep.png`` (`plot_sweep`) and, if the rows hold the comfort indices,
     ``comfort.png`` (`plot_sweep_comfort`). Returns the written paths."""
-    _expect(result, "result", "sweep", "SweepResult")
+    _expect(result, "result", "railride.studies.sweep.SweepResult", ("grid", "frame"))
     text = json_text(result.to_dict() if doc is None else doc)  # refuse NaN before any file is written
     files = [("sweep.json", _text(text))]
     axis = sweep_plot_axis(result)

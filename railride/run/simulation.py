@@ -97,7 +97,7 @@ _MAX_EXACT_PHASES = 1000
 
 #: what a result's ``integrator`` attribute says of each method
 INTEGRATOR_RK4 = "classical RK4, fixed step"
-INTEGRATOR_EXACT = "exact discretisation (matrix exponential, one step per output sample; railride.engine.discrete)"
+INTEGRATOR_EXACT = "exact discretisation (matrix exponential, one step per output sample; railride.discrete)"
 
 
 def _exact(solver, damper, closed, suspensions, n_vehicles: int = 1) -> bool:

@@ -202,7 +202,7 @@ def study(
             conditions.append(fault_condition(f))
         except ValueError as exc:
             raise ValueError(f"faults = {str(f)!r}: {exc}") from None
-    from railride.engine.kernels import MAX_DELAY
+    from railride.engine.layout import MAX_DELAY
 
     what = "controller periods from a sample to its demand taking effect"
     delay_list = [validation.integer("delays", d, 1, MAX_DELAY, what) for d in _items(delays)]

@@ -169,3 +169,12 @@ def test_values_at_the_edges_of_the_typical_ranges_stay_silent():
                     continue
                 VehicleParams(**{**P.to_dict(), name: value})
     assert np.isfinite([m.frequency_hz for m in modes(P)]).all()
+
+
+def test_a_plausibility_warning_points_at_the_callers_line():
+    import warnings as w
+
+    with w.catch_warnings(record=True) as caught:
+        w.simplefilter("always")
+        VehicleParams.preset("paper").replace(m_c=1.0e3)  # this line
+    assert caught and all(c.filename == __file__ for c in caught), [(c.filename, c.lineno) for c in caught]

@@ -286,5 +286,5 @@ def test_run_sweep_resumes_from_its_run_table(swept, tmp_path):
 
 
 def test_run_sweep_takes_a_grid():
-    with pytest.raises(ValueError, match="railride.studies.sweep.grid makes one"):
+    with pytest.raises(ValueError, match="railride.studies.grid.grid makes one"):
         run_sweep([rr.sweep.Case()])

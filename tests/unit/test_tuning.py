@@ -494,11 +494,11 @@ def test_tune_with_a_scaled_damper_tunes_the_inner_loop_for_it():
 
 def test_run_keys_change_with_the_model_revision(monkeypatch):
     # a run table from an earlier model must not resume into this one
-    import railride.studies.sweep as sweep_module
+    import railride.studies.case as case_module
 
     c = Case(suspension="pid", gains={"pid.kd": 1e5})
     before = c.key
-    monkeypatch.setattr(sweep_module, "MODEL_REVISION", sweep_module.MODEL_REVISION + 1)
+    monkeypatch.setattr(case_module, "MODEL_REVISION", case_module.MODEL_REVISION + 1)
     assert c.key != before
 
 
