@@ -1,5 +1,12 @@
 """The library's own exception types.
 
+`InputError` is a `ValueError` (what every check raised before it had a type of its own, so
+``except ValueError`` still catches it): what the user gave is wrong, an option, a field, a
+value, a file. Every check in railride raises it, naming the option or field, the value and
+what is allowed; the command line exits with status 2 for it. Any other exception that reaches
+the command line is a bug in railride: one line that says so, status 1 (``railride --debug``
+shows its traceback).
+
 `DivergenceError` is a `RuntimeError` (what a diverged run raised before it had a type of its
 own), so ``except RuntimeError`` still catches it. It is kept apart from the other runtime
 errors because its cause is the inputs (gains, step, amplitude, speed), which the user can
@@ -7,6 +14,11 @@ change; the command line exits with status 2 for it, and with 1 only for interna
 """
 
 from __future__ import annotations
+
+
+class InputError(ValueError):
+    """What the user gave is wrong: an option, a field, a value or a file (the message names it,
+    the value, and what is allowed)."""
 
 
 class DivergenceError(RuntimeError):

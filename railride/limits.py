@@ -26,6 +26,8 @@ import math
 import os
 import re
 
+from railride.errors import InputError
+
 #: the share of the machine's memory a run may take by default
 DEFAULT_SHARE = 0.5
 #: the limit assumed when the machine's memory cannot be read
@@ -110,13 +112,13 @@ def parse_size(text, name: str = "max_memory") -> int:
     else:
         match = re.fullmatch(r"\s*([0-9]*\.?[0-9]+(?:[eE][+-]?[0-9]+)?)\s*([KMGT]?)(?:i?B)?\s*", str(text), re.I)
         if match is None:
-            raise ValueError(
+            raise InputError(
                 f"{name} = {text!r}: expected a size such as 4G, 512M or 1.5T (powers of 1024), or a number of bytes"
             )
         value, unit = float(match.group(1)), match.group(2).upper()
     size = value * _UNITS[unit]
     if not math.isfinite(size) or size < 2**20:
-        raise ValueError(f"{name} = {text!r}: must be at least 1M (a megabyte) and finite")
+        raise InputError(f"{name} = {text!r}: must be at least 1M (a megabyte) and finite")
     return int(size)
 
 
@@ -150,7 +152,7 @@ def check(need: float, what: str, shrink: str) -> None:
     if need <= limit:
         return
     where = "half this machine" if _set["memory"] is None else "set with --max-memory or railride.limits.set_max_memory"
-    raise ValueError(
+    raise InputError(
         f"{what} would need {shown_bytes(need)} of memory, more than the limit of "
         f"{shown_bytes(limit)} ({where}): {shrink}, or raise the limit (--max-memory SIZE, "
         "railride.limits.set_max_memory)"
@@ -160,7 +162,7 @@ def check(need: float, what: str, shrink: str) -> None:
 def check_steps(name: str, steps: float, shrink: str) -> None:
     """ValueError when a run would take more than `MAX_STEPS` steps (``name``: what counts)."""
     if not steps <= MAX_STEPS:
-        raise ValueError(f"{name}: {steps:.4g} steps, more than the {MAX_STEPS:.4g} a run can count exactly: {shrink}")
+        raise InputError(f"{name}: {steps:.4g} steps, more than the {MAX_STEPS:.4g} a run can count exactly: {shrink}")
 
 
 # -- the work of a run ---------------------------------------------------------------------------
@@ -178,7 +180,7 @@ def parse_count(text, name: str = "max_steps") -> int:
         with contextlib.suppress(ValueError, OverflowError):  # a 400-digit number is no limit either
             value = float(text) if isinstance(text, (int, float)) else float(str(text).strip())
     if not math.isfinite(value) or value < 1e6:
-        raise ValueError(f"{name} = {text!r}: must be a finite number of sample-steps >= 1e6, such as 1e11")
+        raise InputError(f"{name} = {text!r}: must be a finite number of sample-steps >= 1e6, such as 1e11")
     return int(value)
 
 
@@ -214,7 +216,7 @@ def check_work(samples: int, steps: float, what: str, shrink: str) -> None:
     if work <= limit:
         return
     where = "set with --max-steps or set_max_work" if _set["work"] is not None else "the default, about 40 minutes"
-    raise ValueError(
+    raise InputError(
         f"{what}: {samples} x {steps:.4g} steps = {work:.3g} sample-steps, about "
         f"{shown_duration(work / STEP_RATE)} at {STEP_RATE / 1e6:.0f} M sample-steps a second (the stepper's "
         f"rate on one core), more than the limit of {limit:.3g} ({where}): {shrink}, or raise the limit "

@@ -20,6 +20,8 @@ from pathlib import Path
 from types import FrameType
 from typing import Any, NamedTuple
 
+from railride.errors import InputError
+
 #: the largest seed: NumPy's generators take any whole number >= 0, but a seed must also
 #: survive the run table's CSV, whose readers hold whole numbers in 64 bits
 SEED_MAX = 2**64 - 1
@@ -89,7 +91,7 @@ def number(name: str, value, rule: str = "positive", unit: str = "", *, allowed:
     if not obeys(value, rule):
         words = RULES[rule][0]
         text = allowed if allowed is not None else words + (f" ({unit})" if unit else "")
-        raise ValueError(f"{name} = {shown(value)}: must be {text}")
+        raise InputError(f"{name} = {shown(value)}: must be {text}")
     return float(value)
 
 
@@ -99,7 +101,7 @@ def integer(name: str, value, minimum: int, maximum: int | None = None, what: st
     ok = ok and value >= minimum and (maximum is None or value <= maximum)
     if not ok:
         upper = f" and <= {maximum}" if maximum is not None else ""
-        raise ValueError(
+        raise InputError(
             f"{name} = {shown(value)}: must be a whole number >= {minimum}{upper}" + (f" ({what})" if what else "")
         )
     return int(value)
@@ -113,14 +115,14 @@ def seed(name: str, value) -> int:
     if not whole and is_number(value) and math.isfinite(as_float(value)) and float(value).is_integer():
         value, whole = int(value), True
     if not (whole and 0 <= value <= SEED_MAX):
-        raise ValueError(f"{name} = {shown(value)}: must be {RULES['seed'][0]}")
+        raise InputError(f"{name} = {shown(value)}: must be {RULES['seed'][0]}")
     return int(value)
 
 
 def choice(name: str, value, allowed) -> str:
     """``value`` if it is one of the names ``allowed``."""
     if not isinstance(value, str) or value not in allowed:
-        raise ValueError(f"{name} = {shown(value)}: allowed {', '.join(map(str, allowed))}")
+        raise InputError(f"{name} = {shown(value)}: allowed {', '.join(map(str, allowed))}")
     return value
 
 
@@ -164,7 +166,7 @@ def validate_fields(obj, what: str, ranges: Mapping[str, Range] | None = None, t
         elif obeys(value, rule):
             object.__setattr__(obj, f.name, float(value))
             continue
-        raise ValueError(
+        raise InputError(
             f"{what} {f.name!r} = {shown(value)} ({f.metadata['doc']}, {f.metadata['unit']}): must be {RULES[rule][0]}"
         )
     if not ranges:
@@ -173,7 +175,7 @@ def validate_fields(obj, what: str, ranges: Mapping[str, Range] | None = None, t
     for name, r in ranges.items():
         value, meta = getattr(obj, name), fields[name].metadata
         if not r.low <= value <= r.high:
-            raise ValueError(
+            raise InputError(
                 f"{what} {name!r} = {shown(value)} ({meta['doc']}, {meta['unit']}): must be between {r.low:g} and "
                 f"{r.high:g} {meta['unit']} ({r.why})"
             )

@@ -24,6 +24,7 @@ import numpy as np
 import xarray as xr
 from scipy import signal as sp_signal
 
+from railride.errors import InputError
 from railride import validation
 from railride.analysis.metrics import check_window
 
@@ -140,17 +141,17 @@ def get_weighting(name: str) -> Weighting:
         for key, w in WEIGHTINGS.items():
             if key.lower() == name.strip().lower():
                 return w
-    raise ValueError(f"unknown frequency weighting {name!r}; allowed: {', '.join(WEIGHTINGS)}")
+    raise InputError(f"unknown frequency weighting {name!r}; allowed: {', '.join(WEIGHTINGS)}")
 
 
 def _check_frequency(frequency_hz) -> np.ndarray:
     try:
         f = np.asarray(frequency_hz, dtype=float)
     except (TypeError, ValueError):
-        raise ValueError(f"frequency_hz = {frequency_hz!r}: must be numbers in Hz") from None
+        raise InputError(f"frequency_hz = {frequency_hz!r}: must be numbers in Hz") from None
     bad = ~np.isfinite(f) | (f < 0)
     if np.any(bad):
-        raise ValueError(f"frequency_hz = {f[bad].ravel()[0]!r}: frequencies must be finite numbers >= 0 Hz")
+        raise InputError(f"frequency_hz = {f[bad].ravel()[0]!r}: frequencies must be finite numbers >= 0 Hz")
     return f
 
 
@@ -221,11 +222,11 @@ def _check_signal(signal, what: str = "acceleration") -> np.ndarray:
     try:
         x = np.asarray(signal, dtype=float)
     except (TypeError, ValueError):
-        raise ValueError(f"{what}: must be an array of numbers (m/s^2)") from None
+        raise InputError(f"{what}: must be an array of numbers (m/s^2)") from None
     if x.ndim == 0 or x.shape[-1] < 2:
-        raise ValueError(f"{what}: needs at least two samples along its last (time) axis")
+        raise InputError(f"{what}: needs at least two samples along its last (time) axis")
     if not np.all(np.isfinite(x)):
-        raise ValueError(f"{what}: holds NaN or infinite values")
+        raise InputError(f"{what}: holds NaN or infinite values")
     return x
 
 
@@ -240,7 +241,7 @@ def weight(name: str, signal, rate_hz: float) -> np.ndarray:
     w = get_weighting(name)
     rate = _check_rate(rate_hz)
     if rate < MIN_RATE_FACTOR * w.f2:
-        raise ValueError(
+        raise InputError(
             f"rate_hz = {rate:g} Hz is too low for weighting {w.name}: its upper band limit is "
             f"f2 = {w.f2:g} Hz, and the digital filter needs rate_hz >= {MIN_RATE_FACTOR:g} f2 = "
             f"{MIN_RATE_FACTOR * w.f2:g} Hz (docs/comfort.md, 'Digital filter')"
@@ -260,7 +261,7 @@ def _window_slice(n: int, rate: float, window) -> slice:
     i0 = int(math.ceil(start * rate - 1e-9))
     i1 = min(n, int(math.ceil(end * rate - 1e-9)))
     if i1 - i0 < 2:
-        raise ValueError(f"window = {start:g}:{end:g} s holds fewer than two samples")
+        raise InputError(f"window = {start:g}:{end:g} s holds fewer than two samples")
     return slice(i0, i1)
 
 
@@ -347,7 +348,7 @@ def comfort_class(n_mv: float) -> str:
     """The EN 12299 label of a mean comfort index N."""
     n = float(n_mv)
     if not (math.isfinite(n) and n >= 0):
-        raise ValueError(f"N = {n_mv!r}: a comfort index is a finite number >= 0")
+        raise InputError(f"N = {n_mv!r}: a comfort index is a finite number >= 0")
     return next(label for bound, label in COMFORT_SCALE if n < bound)
 
 
@@ -394,18 +395,18 @@ FLOOR = POSITION_KEYWORDS
 
 def _rate_of(time: np.ndarray) -> float:
     if time.size < 2:
-        raise ValueError("the run holds fewer than two output samples")
+        raise InputError("the run holds fewer than two output samples")
     step = np.diff(time)
     dt = float(np.median(step))
     if not (dt > 0 and np.allclose(step, dt, rtol=1e-6, atol=0)):
-        raise ValueError("the time coordinate is not uniformly sampled: comfort indices need a constant output rate")
+        raise InputError("the time coordinate is not uniformly sampled: comfort indices need a constant output rate")
     return 1.0 / dt
 
 
 def _half_lengths(ds: xr.Dataset) -> np.ndarray:
     """l [m] of every run (one per sample in a batch), from the ``vehicle_params`` record."""
     if "vehicle_params" not in ds:
-        raise ValueError(
+        raise InputError(
             "the Dataset has no vehicle_params record: give positions as {name: x in m} instead of 'front'/'rear'"
         )
     records = np.atleast_1d(ds["vehicle_params"].values)
@@ -418,13 +419,13 @@ def _positions(ds: xr.Dataset, positions, n_sample: int) -> tuple[list[str], np.
         positions = (positions,)
     items = list(positions.items()) if isinstance(positions, Mapping) else [(p, p) for p in positions]
     if not items:
-        raise ValueError("positions: give at least one position")
+        raise InputError("positions: give at least one position")
     names, xs, half = [], [], None
     for name, spec in items:
         if isinstance(spec, str):
             key = spec.strip().lower().replace("center", "centre")
             if key not in POSITION_KEYWORDS:
-                raise ValueError(
+                raise InputError(
                     f"position {spec!r}: allowed keywords are {', '.join(POSITION_KEYWORDS)}, or give {{name: x in m}}"
                 )
             if key == "centre":
@@ -435,7 +436,7 @@ def _positions(ds: xr.Dataset, positions, n_sample: int) -> tuple[list[str], np.
         else:
             ok = not isinstance(spec, bool) and isinstance(spec, (int, float, np.number)) and math.isfinite(spec)
             if not ok:
-                raise ValueError(
+                raise InputError(
                     f"position {name!r} = {spec!r}: x must be a finite number of "
                     "metres from the carbody centre (front +)"
                 )
@@ -443,7 +444,7 @@ def _positions(ds: xr.Dataset, positions, n_sample: int) -> tuple[list[str], np.
         names.append(str(name))
         xs.append(x)
     if len(set(names)) != len(names):
-        raise ValueError(f"positions: names repeat ({', '.join(names)})")
+        raise InputError(f"positions: names repeat ({', '.join(names)})")
     return names, np.stack(xs, axis=-1)
 
 
@@ -550,7 +551,7 @@ def ride_comfort(ds: xr.Dataset, positions=POSITION_KEYWORDS, window=None, weigh
 def to_dict(comfort: xr.DataArray) -> dict:
     """{position: {index: value}} of one run's `ride_comfort`."""
     if "sample" in comfort.dims:
-        raise ValueError("to_dict takes the comfort indices of one run; select a sample first")
+        raise InputError("to_dict takes the comfort indices of one run; select a sample first")
     return {
         str(p): {str(i): float(comfort.sel(position=p, index=i)) for i in comfort["index"].values}
         for p in comfort["position"].values

@@ -12,6 +12,8 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
+from railride.errors import InputError
+
 #: response name -> (channel, factor to the reported unit)
 RESPONSES = {
     "acceleration_m_s2": ("carbody_acceleration", 1.0),
@@ -27,16 +29,16 @@ def parse_window(text: str) -> tuple[float, float]:
     must be finite."""
     parts = text.split(":")
     if len(parts) != 2:
-        raise ValueError(f"window = {text!r}: expected START:END in seconds, e.g. 2:10")
+        raise InputError(f"window = {text!r}: expected START:END in seconds, e.g. 2:10")
     try:
         start = float(parts[0]) if parts[0].strip() else 0.0
         end = float(parts[1]) if parts[1].strip() else math.inf
     except ValueError:
-        raise ValueError(f"window = {text!r}: START and END must be numbers of seconds") from None
+        raise InputError(f"window = {text!r}: START and END must be numbers of seconds") from None
     typed = [float(p) for p in parts if p.strip()]
     if not all(math.isfinite(v) for v in typed):
         # an empty END is the end of the run; a typed inf or nan is a slip, not a window
-        raise ValueError(
+        raise InputError(
             f"window = {text!r}: START and END must be finite numbers of seconds "
             "(leave END empty for the end of the run)"
         )
@@ -50,7 +52,7 @@ def check_window(window, t_end: float, t_start: float = 0.0) -> tuple[float, flo
     if math.isinf(end) and end > 0:
         end = t_end
     if not (math.isfinite(start) and math.isfinite(end) and t_start <= start < end <= t_end + 1e-9):
-        raise ValueError(
+        raise InputError(
             f"window = {start:g}:{end:g} s: must satisfy {t_start:g} <= START < END <= {t_end:g} (inside the run)"
         )
     return float(start), float(end)
@@ -63,7 +65,7 @@ def select_window(ds: xr.Dataset, window) -> xr.Dataset:
     start, end = check_window(window, float(ds.time[-1]), float(ds.time[0]))
     part = ds.sel(time=slice(start - 1e-12, end + 1e-12))
     if part.sizes["time"] < 2:
-        raise ValueError(f"window = {start:g}:{end:g} s holds fewer than two output samples")
+        raise InputError(f"window = {start:g}:{end:g} s holds fewer than two output samples")
     return part
 
 
@@ -114,7 +116,7 @@ def metrics_from_arrays(acceleration, bounce, pitch, roll, sample=None, diverged
 def reduction(metrics: xr.DataArray, baseline: xr.DataArray) -> xr.DataArray:
     """Reduction in % against a baseline run: (baseline - metrics) / baseline * 100."""
     if np.any(baseline.values == 0):
-        raise ValueError("a baseline metric is zero: the reduction in % is undefined")
+        raise InputError("a baseline metric is zero: the reduction in % is undefined")
     out = (baseline - metrics) / baseline * 100.0
     out.name = "reduction_percent"
     return out
@@ -123,5 +125,5 @@ def reduction(metrics: xr.DataArray, baseline: xr.DataArray) -> xr.DataArray:
 def to_dict(metrics: xr.DataArray) -> dict:
     """{response: {rms, ptp}} for one run (the JSON schema of docs/cli.md)."""
     if "sample" in metrics.dims:
-        raise ValueError("to_dict takes the metrics of one run; select a sample first")
+        raise InputError("to_dict takes the metrics of one run; select a sample first")
     return {r: {s: float(metrics.sel(response=r, statistic=s)) for s in STATISTICS} for r in metrics.response.values}

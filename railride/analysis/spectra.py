@@ -14,6 +14,7 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
+from railride.errors import InputError
 from railride.analysis.labels import controller_names
 
 #: the Welch segment length of the acceleration spectra of a comparison [s]
@@ -66,11 +67,11 @@ def comparison_psd(ds: xr.Dataset, window=None, segment: float = PSD_SEGMENT_S) 
     from railride.analysis.metrics import select_window
 
     if "controller" not in ds.dims or "time" not in ds.dims:
-        raise ValueError(
+        raise InputError(
             "expected the combined() Dataset of a railride.studies.comparison.Comparison (dims controller, time)"
         )
     if "carbody_acceleration" not in ds.variables:
-        raise ValueError("the dataset lacks the channel carbody_acceleration")
+        raise InputError("the dataset lacks the channel carbody_acceleration")
     part = select_window(ds, None if window is None else tuple(window))
     time = part["time"].values
     # the output rate, without the float noise of the time stamps' differences

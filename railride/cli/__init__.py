@@ -10,7 +10,8 @@ checks of their values, `_common` the errors, consoles and run machinery, `_rend
 shared tables, `_width` the tables that fit the console's width (80 columns on a pipe).
 
 Exit statuses: 0 success (also when stdout is a pipe closed early: ``railride compare | head
--1``), 1 an internal fault (a bug: please report it), 2 anything the user can fix (usage errors,
+-1``), 1 a bug in railride (one line that says so; ``railride --debug COMMAND`` shows its
+traceback), 2 anything the user can fix (`railride.errors.InputError`: usage errors,
 invalid values, unreadable files, an output folder that cannot be written or that another
 railride process is writing, a run that diverged), 130 interrupted by Ctrl-C (`tune`, `study`,
 `pareto` and `sweep` keep their finished runs in DIR/runs.csv for --resume). Errors print one

@@ -10,7 +10,17 @@ import warnings
 import typer
 from typer.core import TyperGroup
 
-from railride.cli._common import INTERRUPTED, OK, USER, usage_error_line, usage_error_types
+import railride.cli._common as _common
+from railride.cli._common import (
+    INTERNAL,
+    INTERRUPTED,
+    OK,
+    USER,
+    bug_line,
+    set_debug,
+    usage_error_line,
+    usage_error_types,
+)
 
 __all__ = ["INTERRUPTED", "RailrideGroup", "app", "quiet_closed_pipe"]
 
@@ -67,6 +77,13 @@ class RailrideGroup(TyperGroup):
                 raise
             quiet_closed_pipe()
             raise typer.Exit(OK) from None
+        except (typer.Exit, typer.Abort):
+            raise
+        except Exception as exc:  # what no command's error handling took: a bug in railride
+            if _common.DEBUG:
+                raise
+            typer.echo(bug_line(exc), err=True)
+            raise typer.Exit(INTERNAL) from None
 
 
 @contextlib.contextmanager
@@ -115,5 +132,9 @@ def _main(
     version: bool = typer.Option(
         False, "--version", callback=_version, is_eager=True, help="Print the version and exit."
     ),
+    debug: bool = typer.Option(
+        False, "--debug", help="A bug in railride shows its traceback (else one line that says it is a bug)."
+    ),
 ) -> None:
     """Vertical ride of a railway vehicle with a semi-active secondary suspension."""
+    set_debug(debug)

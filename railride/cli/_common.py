@@ -15,6 +15,8 @@ from typing import Any, Optional
 
 import typer
 
+from railride.errors import InputError
+
 
 # -- errors ---------------------------------------------------------------------------------------
 class CliError(Exception):
@@ -35,29 +37,49 @@ def _one_line(exc: BaseException) -> str:
 OK, INTERNAL, USER, INTERRUPTED = 0, 1, 2, 130
 
 
+#: ``railride --debug``: a bug's traceback instead of its one line (`set_debug`)
+DEBUG = False
+
+
+def set_debug(on: bool) -> None:
+    global DEBUG
+    DEBUG = bool(on)
+
+
+def bug_line(exc: BaseException) -> str:
+    """The one line a bug in railride gets on the command line (status 1)."""
+    return (
+        f"error: a bug in railride ({type(exc).__name__}: {_one_line(exc)}); please report it. "
+        "railride --debug COMMAND ... shows its traceback"
+    )
+
+
 @contextlib.contextmanager
 def errors():
-    """ValueError, OSError and a diverged run (`railride.errors.DivergenceError`: its inputs
-    are the user's to change) -> status 2; any other RuntimeError, an internal fault -> 1. One
-    line on stderr, no traceback. A closed stdout (BrokenPipeError) and Ctrl-C pass through:
-    the entry point (`railride.cli._app`) deals with them."""
+    """What the user gave is wrong (`railride.errors.InputError`), a file it names cannot be
+    read or written (OSError), a run diverged (`railride.errors.DivergenceError`: its inputs are
+    the user's to change) -> status 2; anything else is a bug in railride -> status 1. One line
+    on stderr, no traceback (``railride --debug`` re-raises a bug). A closed stdout
+    (BrokenPipeError), Ctrl-C and typer's own exits pass through: the entry point
+    (`railride.cli._app`) deals with them."""
     from railride.errors import DivergenceError
 
     try:
         yield
+    except (typer.Exit, typer.Abort, KeyboardInterrupt, BrokenPipeError):
+        raise
     except CliError as exc:
         status, message = exc.status, _one_line(exc)
-    except ValueError as exc:
+    except (InputError, DivergenceError) as exc:
         status, message = USER, _one_line(exc)
-    except DivergenceError as exc:
-        status, message = USER, _one_line(exc)
-    except RuntimeError as exc:
-        status, message = INTERNAL, _one_line(exc)
-    except BrokenPipeError:
-        raise
     except OSError as exc:
         where = f" ({exc.filename})" if getattr(exc, "filename", None) else ""
         status, message = USER, f"{exc.strerror or exc}{where}"
+    except Exception as exc:
+        if DEBUG:
+            raise
+        typer.echo(bug_line(exc), err=True)
+        raise typer.Exit(INTERNAL) from None
     else:
         return
     typer.echo(f"error: {message}", err=True)
@@ -109,11 +131,11 @@ def option_names(fields: dict, defaults=()):
     `errors`."""
     try:
         yield
-    except ValueError as exc:
+    except InputError as exc:
         text = reworded(str(exc), fields, defaults)
         if text == str(exc):
             raise
-        raise ValueError(text) from exc
+        raise InputError(text) from exc
 
 
 def reworded(text: str, fields: dict, defaults=()) -> str:
@@ -351,16 +373,16 @@ def make_executor(workers: Optional[int], scheduler: Optional[str], scheduler_fi
     from railride.studies import sweep as sweep_lib
 
     if scheduler is not None and scheduler_file is not None:
-        raise ValueError("give either --scheduler ADDRESS or --scheduler-file FILE, not both")
+        raise InputError("give either --scheduler ADDRESS or --scheduler-file FILE, not both")
     if scheduler is not None or scheduler_file is not None:
         if workers is not None:
-            raise ValueError(
+            raise InputError(
                 f"--workers = {workers}: applies to the local executor only; the "
                 "threads of a Dask cluster are set where its workers start "
                 "(dask worker --nthreads N)"
             )
         if scheduler is not None and not scheduler.strip():
-            raise ValueError("--scheduler = '': give the scheduler's address, e.g. tcp://host:8786")
+            raise InputError("--scheduler = '': give the scheduler's address, e.g. tcp://host:8786")
         # the library names the address and file by its fields: the user typed these options
         names = {"address": "--scheduler", "scheduler file": "--scheduler-file"}
         with status_note("connecting to the Dask scheduler..."), option_names(names):
@@ -377,7 +399,7 @@ def make_executor(workers: Optional[int], scheduler: Optional[str], scheduler_fi
     cores = int(numba.config.NUMBA_NUM_THREADS)  # type: ignore[attr-defined]  # set at import
     if workers is not None:
         if not 1 <= workers <= cores:
-            raise ValueError(
+            raise InputError(
                 f"--workers = {workers}: must be a whole number from 1 to {cores} (the cores of this machine)"
             )
         numba.set_num_threads(workers)
@@ -391,12 +413,12 @@ def open_run_table(out: Optional[Path], resume: bool):
 
     if out is None:
         if resume:
-            raise ValueError("--resume needs --out DIR: the run table it continues is DIR/runs.csv")
+            raise InputError("--resume needs --out DIR: the run table it continues is DIR/runs.csv")
         return sweep_lib.RunTable(), None
     check_out_dir(out)
     path = out / "runs.csv"
     if path.exists() and not resume:
-        raise ValueError(
+        raise InputError(
             f"--out {out}: {path} exists (the run table of an earlier run); add "
             "--resume to continue it, or choose another folder"
         )

@@ -8,6 +8,7 @@ from typing import Callable
 
 import typer
 
+from railride.errors import InputError
 from railride.cli._common import ProgressBar, stderr_is_terminal, stdout_console, write_folder
 from railride.cli._options import OutputFormat
 from railride.cli._parsing import damper_preset, load_gains, parse_scale, vehicle_from_options
@@ -56,12 +57,12 @@ def run_league(
     }
     for key, value in given.items():
         if value is not None:
-            raise ValueError(
+            raise InputError(
                 f"{options[key]}: applies to a single scenario; a league table (several --scenario, --speed "
                 "or --track-seed values) runs each scenario with its defaults"
             )
     if not bounds:
-        raise ValueError("--no-bounds: a league table always shows the ideal actuator beside the MR dampers")
+        raise InputError("--no-bounds: a league table always shows the ideal actuator beside the MR dampers")
     damper_preset("--damper", damper)
     vehicle_params, vehicle_record = vehicle_from_options(params, preset, load)
     if out is not None:

@@ -12,6 +12,8 @@ from typing import Annotated, Optional
 
 import typer
 
+from railride.errors import InputError
+
 
 class OutputFormat(str, Enum):
     table = "table"
@@ -420,13 +422,13 @@ def figure_options(figure_format: Optional[str], dpi: Optional[str], out: Option
 
     given = [o for o, v in (("--figure-format", figure_format), ("--dpi", dpi)) if v is not None]
     if given and out is None:
-        raise ValueError(f"{given[0]}: applies with --out only (the figures are written into the output folder)")
+        raise InputError(f"{given[0]}: applies with --out only (the figures are written into the output folder)")
     value = PNG_DPI if dpi is None else _number(dpi)
     try:
         return FigureOptions("png" if figure_format is None else figure_format, value)
     except ValueError as exc:
         text = str(exc).replace("figure_formats = ", "--figure-format = ", 1)
-        raise ValueError(text.replace("dpi = ", "--dpi = ", 1) if text.startswith("dpi") else text) from None
+        raise InputError(text.replace("dpi = ", "--dpi = ", 1) if text.startswith("dpi") else text) from None
 
 
 def _number(text: str):
@@ -487,11 +489,11 @@ def history_options(history_format: Optional[str], out: Optional[Path]) -> tuple
     if history_format is None:
         return history_formats()
     if out is None:
-        raise ValueError("--history-format: applies with --out only (the time histories are written into it)")
+        raise InputError("--history-format: applies with --out only (the time histories are written into it)")
     try:
         return history_formats(history_format)
     except ValueError as exc:
-        raise ValueError(str(exc).replace("history_formats = ", "--history-format = ", 1)) from None
+        raise InputError(str(exc).replace("history_formats = ", "--history-format = ", 1)) from None
 
 
 # -- limits ---------------------------------------------------------------------------------------
@@ -508,7 +510,7 @@ def _limit_setter(setter: str, field: str, option: str):
             try:
                 getattr(limits, setter)(value)
             except ValueError as exc:
-                raise ValueError(str(exc).replace(field, option, 1)) from None
+                raise InputError(str(exc).replace(field, option, 1)) from None
         return value
 
     return set_limit

@@ -9,15 +9,17 @@ import math
 from pathlib import Path
 from typing import Optional
 
+from railride.errors import InputError
+
 
 # -- numbers and lists ----------------------------------------------------------------------------
 def parse_float(option: str, text: str, item: str, what: str = "") -> float:
     try:
         value = float(item)
     except ValueError:
-        raise ValueError(f"{option} = {text!r}: {item.strip()!r} is not a number{what}") from None
+        raise InputError(f"{option} = {text!r}: {item.strip()!r} is not a number{what}") from None
     if not math.isfinite(value):
-        raise ValueError(f"{option} = {text!r}: {item.strip()!r} is not a finite number")
+        raise InputError(f"{option} = {text!r}: {item.strip()!r} is not a finite number")
     return value
 
 
@@ -34,7 +36,7 @@ def value_list(option: str, text: str, *, integer: bool = False, parse=None) -> 
     if ":" in text:
         parts = text.split(":")
         if len(parts) != 3:
-            raise ValueError(
+            raise InputError(
                 f"{option} = {text!r}: expected a range START:STOP:COUNT (e.g. 20:80:13) or a list a,b,c of {kind}"
             )
         number = _whole if integer else parse_float
@@ -42,9 +44,9 @@ def value_list(option: str, text: str, *, integer: bool = False, parse=None) -> 
         try:
             count = int(parts[2])
         except ValueError:
-            raise ValueError(f"{option} = {text!r}: COUNT = {parts[2].strip()!r} is not a whole number") from None
+            raise InputError(f"{option} = {text!r}: COUNT = {parts[2].strip()!r} is not a whole number") from None
         if count < 1:
-            raise ValueError(f"{option} = {text!r}: COUNT = {count} must be >= 1")
+            raise InputError(f"{option} = {text!r}: COUNT = {count} must be >= 1")
         from railride.limits import VALUE_BYTES, check
 
         # each value is a Python number in a list and a set, and a case of the runs: ~1 kB
@@ -62,7 +64,7 @@ def value_list(option: str, text: str, *, integer: bool = False, parse=None) -> 
     else:
         items = text.split(",")
         if any(not item.strip() for item in items):
-            raise ValueError(
+            raise InputError(
                 f"{option} = {text!r}: an empty item; give a range START:STOP:COUNT or {kind} separated by commas"
             )
         number = _whole if integer and not parse else parse_float
@@ -70,12 +72,12 @@ def value_list(option: str, text: str, *, integer: bool = False, parse=None) -> 
     if integer:
         bad = [v for v in values if v != int(v)]
         if bad:
-            raise ValueError(f"{option} = {text!r}: {_about(bad[0])} is not a whole number")
+            raise InputError(f"{option} = {text!r}: {_about(bad[0])} is not a whole number")
         values = [int(v) for v in values]
     seen = set()
     for v in values:
         if v in seen:
-            raise ValueError(f"{option} = {text!r}: {_shown(v)} is listed twice")
+            raise InputError(f"{option} = {text!r}: {_shown(v)} is listed twice")
         seen.add(v)
     return values
 
@@ -139,7 +141,7 @@ def vehicle_source(params_file: Optional[Path], preset: Optional[str]):
     """--params FILE or --preset NAME as the library takes a vehicle: the file's path, the
     preset's name, or None (the default preset)."""
     if params_file is not None and preset is not None:
-        raise ValueError("give either --params FILE or --preset NAME, not both")
+        raise InputError("give either --params FILE or --preset NAME, not both")
     return params_file if params_file is not None else preset
 
 
@@ -175,7 +177,7 @@ def damper_preset(option: str, name: str, *, rig: bool = False):
             if name in dampers.IDEAL_NAMES
             else ": unknown damper model"
         )
-        raise ValueError(f"{option} = {name!r}{why}; allowed: {', '.join(allowed)}")
+        raise InputError(f"{option} = {name!r}{why}; allowed: {', '.join(allowed)}")
     return dampers.preset(name)
 
 
@@ -189,7 +191,7 @@ def parse_scale(option: str, text: Optional[str]) -> float:
             return kind(text)
         except ValueError:
             pass
-    raise ValueError(f"{option} = {text!r}: must be a finite number > 0")
+    raise InputError(f"{option} = {text!r}: must be a finite number > 0")
 
 
 def parse_voltage(option: str, text: str, damper) -> float:
@@ -202,7 +204,7 @@ def parse_voltage(option: str, text: str, damper) -> float:
     try:
         value = float(text)
     except ValueError:
-        raise ValueError(f"{option} = {text!r}: not a number of volts (nor passive-off, passive-on)") from None
+        raise InputError(f"{option} = {text!r}: not a number of volts (nor passive-off, passive-on)") from None
     return damper.check_voltage(value, option)
 
 
@@ -210,12 +212,12 @@ def parse_voltages(option: str, text: str, damper) -> list[float]:
     """A comma-separated list of distinct voltages [V], each checked against the damper's range."""
     items = text.split(",")
     if any(not item.strip() for item in items):
-        raise ValueError(f"{option} = {text!r}: an empty item; give volts separated by commas, e.g. 0,1,2.25")
+        raise InputError(f"{option} = {text!r}: an empty item; give volts separated by commas, e.g. 0,1,2.25")
     values = [parse_voltage(option, item, damper) for item in items]
     seen = set()
     for v in values:
         if v in seen:
-            raise ValueError(f"{option} = {text!r}: {v:g} V is listed twice")
+            raise InputError(f"{option} = {text!r}: {v:g} V is listed twice")
         seen.add(v)
     return values
 
@@ -229,7 +231,7 @@ def load_gains(path: Optional[Path]):
     try:
         return GainSet.load(path)
     except ValueError as exc:
-        raise ValueError(f"--gains: {exc}") from None
+        raise InputError(f"--gains: {exc}") from None
 
 
 #: --sensor-noise items: (name, unit)
@@ -242,15 +244,15 @@ def parse_noise(option: str, text: str) -> list[float]:
     units = ", ".join(u for _, u in _NOISE_ITEMS)
     items = [item.strip() for item in text.split(",")]
     if len(items) != len(_NOISE_ITEMS):
-        raise ValueError(f"{option} = {text!r}: expected four numbers {form} ({units}), got {len(items)} item(s)")
+        raise InputError(f"{option} = {text!r}: expected four numbers {form} ({units}), got {len(items)} item(s)")
     values = []
     for (name, unit), item in zip(_NOISE_ITEMS, items):
         try:
             value = float(item)
         except ValueError:
-            raise ValueError(f"{option} = {text!r}: {name} = {item!r} is not a number ({unit})") from None
+            raise InputError(f"{option} = {text!r}: {name} = {item!r} is not a number ({unit})") from None
         if not (math.isfinite(value) and value >= 0):
-            raise ValueError(
+            raise InputError(
                 f"{option} = {text!r}: {name} = {item}: must be a finite number >= 0 ({unit}, a standard deviation)"
             )
         values.append(value)
@@ -294,7 +296,7 @@ def track_options(
     if out and scenario_name not in random_tracks():
         option, keyword, unit = next(o for o in TRACK_OPTIONS if o[1] in out)
         value = f"{out[keyword]:g}" + (f" {unit}" if unit else "")
-        raise ValueError(
+        raise InputError(
             f"{option} = {value}: applies to the random-track scenarios "
             f"({', '.join(random_tracks())}) only, not to --scenario "
             f"{scenario_name}"
@@ -316,7 +318,7 @@ def make_scenario(name: str, options: dict, output_rate: Optional[float] = None,
             ("--rail-phase", "rail_phase", "deg"),
         ):
             if options.get(keyword) is not None:
-                raise ValueError(
+                raise InputError(
                     f"{option} = {options[keyword]:g} {unit}: does not apply to a "
                     f"random track ({name}); its options are --track-seed, "
                     "--min-wavelength and --max-wavelength"
@@ -338,9 +340,9 @@ def make_scenario(name: str, options: dict, output_rate: Optional[float] = None,
         band = [(o, k, u) for o, k, u in TRACK_OPTIONS if k != "seed" and k in options]
         if band and str(exc).startswith("wavelength band"):
             given = ", ".join(f"{o} = {options[k]:g} {u}" for o, k, u in band)
-            raise ValueError(f"{given}: {exc}") from None
+            raise InputError(f"{given}: {exc}") from None
         if str(exc).startswith("unknown scenario"):
-            raise ValueError(f"--scenario: {exc}") from None
+            raise InputError(f"--scenario: {exc}") from None
         raise
     return scen
 

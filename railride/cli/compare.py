@@ -10,6 +10,7 @@ from typing import Annotated, Optional
 
 import typer
 
+from railride.errors import InputError
 from railride.secondary.dampers import IDEAL_NAMES
 from railride.defaults import DEFAULT_CONTROL_RATE, DEFAULT_DAMPER
 from railride.cli._app import app
@@ -107,14 +108,14 @@ def _controller_list(text: str) -> list[str]:
 
     items = [item.strip() for item in text.split(",")]
     if any(not item for item in items):
-        raise ValueError(
+        raise InputError(
             f"--controllers = {text!r}: an empty item; give names separated by commas from "
             f"{', '.join(CONTROLLERS)}, or all"
         )
     try:
         return check_controllers(items)
     except ValueError as exc:
-        raise ValueError(f"--controllers = {text!r}: {exc}") from None
+        raise InputError(f"--controllers = {text!r}: {exc}") from None
 
 
 def _sensing(name: str):
@@ -122,7 +123,7 @@ def _sensing(name: str):
     from railride.secondary.sensing import SENSING, Accelerometers
 
     if name not in SENSING:
-        raise ValueError(f"--sensing = {name!r}: allowed {', '.join(SENSING)}")
+        raise InputError(f"--sensing = {name!r}: allowed {', '.join(SENSING)}")
     return None if name == "ideal" else Accelerometers()
 
 
@@ -136,11 +137,11 @@ def _fault_list(text: Optional[str], damper: str, scale: float, dt: float, durat
     try:
         items = [item.strip() for item in text.split(",")]
         if any(not item for item in items):
-            raise ValueError("an empty item; give CORNER-MODE[@S] items separated by commas")
+            raise InputError("an empty item; give CORNER-MODE[@S] items separated by commas")
         faults = check_faults([DamperFault.parse(item) for item in items], damper_model(damper, scale))
         fault_table([faults], dt, duration)
     except ValueError as exc:
-        raise ValueError(f"--fault = {text!r}: {exc}") from None
+        raise InputError(f"--fault = {text!r}: {exc}") from None
     return faults
 
 
@@ -150,7 +151,7 @@ def _sensor_noise(text: Optional[str], seed: Optional[int]):
 
     if text is None:
         if seed is not None:
-            raise ValueError(
+            raise InputError(
                 f"--seed = {seed}: applies with --sensor-noise only (without it the measurements are ideal)"
             )
         return None
@@ -161,7 +162,7 @@ def _sensor_noise(text: Optional[str], seed: Optional[int]):
     except ValueError as exc:
         if "--seed" in str(exc):
             raise
-        raise ValueError(f"--sensor-noise = {text!r}: {exc}") from None
+        raise InputError(f"--sensor-noise = {text!r}: {exc}") from None
 
 
 def _trade_off_lines(doc: dict) -> list[str]:
@@ -526,7 +527,7 @@ def compare(
         if len(scenarios) > 1 or len(speeds or [0]) > 1 or len(seeds or [0]) > 1:
             check_report_option(report)
             if history_format is not None:
-                raise ValueError(
+                raise InputError(
                     "--history-format: a league table (several --scenario, --speed or --track-seed "
                     "values) writes no time histories"
                 )

@@ -9,6 +9,7 @@ from typing import Annotated
 
 import typer
 
+from railride.errors import InputError
 from railride.defaults import DEFAULT_CONTROL_RATE, DEFAULT_DAMPER
 from railride.cli._app import app
 from railride.cli._common import errors
@@ -88,7 +89,7 @@ def report_command(
     with errors():
         check_report_option(out, "--out")
         if "," in scenario:
-            raise ValueError(
+            raise InputError(
                 f"--scenario = {scenario!r}: the report runs one scenario "
                 "(a league table over several: railride compare)"
             )

@@ -10,6 +10,7 @@ from typing import Annotated, Optional
 
 import typer
 
+from railride.errors import InputError
 from railride.cli._app import app
 from railride.cli._common import errors, option_names, print_json, stdout_console, write_folder
 from railride.cli._options import (
@@ -246,7 +247,7 @@ def state_space(
 
         vehicle, _ = vehicle_from_options(params, preset, load)
         if out is not None and out.suffix.lower() not in (".mat", ".json"):
-            raise ValueError(f"--out = {str(out)!r}: the file name must end in .mat or .json")
+            raise InputError(f"--out = {str(out)!r}: the file name must end in .mat or .json")
         (secondary,) = linear_suspensions([suspension], None if gains is None else load_gains(gains)).values()
         model = linear_model(vehicle, secondary)
         if out is not None:

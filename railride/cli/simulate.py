@@ -8,6 +8,7 @@ from typing import Annotated, Optional
 import typer
 
 from railride import validation
+from railride.errors import InputError
 from railride.defaults import DEFAULT_DAMPER
 from railride.cli._app import app
 from railride.cli._common import (
@@ -230,7 +231,7 @@ def _suspension(name: str, damper_name, voltage_text, damper_scale=None):
         ]
         if given:
             verb = "applies" if len(given) == 1 else "apply"
-            raise ValueError(
+            raise InputError(
                 f"{' and '.join(given)} {verb} to --suspension mr only (the passive suspension has viscous dampers)"
             )
         return Suspension.passive()

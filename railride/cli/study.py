@@ -9,6 +9,7 @@ from typing import Annotated, Optional
 
 import typer
 
+from railride.errors import InputError
 from railride.defaults import DEFAULT_DAMPER
 from railride.cli._app import app
 from railride.cli._common import (
@@ -71,7 +72,7 @@ def _faults(text: str) -> list[str]:
     checks each, naming it)."""
     items = [item.strip() for item in text.split(",")]
     if any(not item for item in items):
-        raise ValueError(f"--fault = {text!r}: an empty item; give none or CORNER-MODE[@S] items separated by commas")
+        raise InputError(f"--fault = {text!r}: an empty item; give none or CORNER-MODE[@S] items separated by commas")
     return items
 
 

@@ -13,6 +13,7 @@ from typing import Annotated, Optional
 
 import typer
 
+from railride.errors import InputError
 from railride.defaults import DEFAULT_DAMPER
 from railride.secondary.suspension import NAMES as SUSPENSIONS
 from railride.cli._app import app
@@ -330,7 +331,7 @@ def _parse(
     for text in gain or []:
         name, axis = _gain_option(text)
         if name in values["gains"]:
-            raise ValueError(f"--gain = {text!r}: {name} is given twice")
+            raise InputError(f"--gain = {text!r}: {name} is given twice")
         values["gains"][name], gain_texts[name] = axis, text
     texts = {
         "suspensions": suspension,
@@ -355,7 +356,7 @@ def _names(option: str, text: str) -> list[str]:
         return list(CONTROLLERS)
     items = [s.strip() for s in text.split(",")]
     if any(not s for s in items):
-        raise ValueError(
+        raise InputError(
             f"{option} = {text!r}: an empty item; give names separated by commas from {', '.join(SUSPENSIONS)}, or all"
         )
     return items
@@ -376,7 +377,7 @@ def _voltage_item(damper: Optional[str]):
         try:
             return float(item)
         except ValueError:
-            raise ValueError(f"--voltage = {item!r}: not a number of volts (nor passive-off, passive-on)") from None
+            raise InputError(f"--voltage = {item!r}: not a number of volts (nor passive-off, passive-on)") from None
 
     return read
 
@@ -389,7 +390,7 @@ def _gain_option(text: str) -> tuple[str, list[float]]:
     if name.startswith("sas."):
         name = name[len("sas.") :]
     if not sep or not values_text.strip():
-        raise ValueError(
+        raise InputError(
             f"--gain = {text!r}: expected TABLE.ENTRY=VALUES, e.g. pid.kd=1e4,1e5 or attitude.kp_z=0:4e5:5"
         )
     return name, value_list(f"--gain {name}", values_text)

@@ -10,6 +10,7 @@ from typing import Annotated, Optional
 
 import typer
 
+from railride.errors import InputError
 from railride.defaults import DEFAULT_DAMPER
 from railride.cli._app import app
 from railride.cli._common import (
@@ -91,31 +92,31 @@ def _objective(kind: Optional[str], weights: Optional[str], bound: Optional[str]
 
     name = DEFAULT_OBJECTIVE.kind if kind is None else kind.strip()
     if name not in OBJECTIVE_KINDS:
-        raise ValueError(f"--objective = {kind!r}: unknown objective; allowed: {', '.join(OBJECTIVE_KINDS)}")
+        raise InputError(f"--objective = {kind!r}: unknown objective; allowed: {', '.join(OBJECTIVE_KINDS)}")
     default = DEFAULT_OBJECTIVE if name == DEFAULT_OBJECTIVE.kind else Objective()
     which = f"--objective is {name}" if kind is not None else f"the default objective is {name}"
     w = default.weights if name == "weighted" else None
     if weights is not None:
         if name != "weighted":
-            raise ValueError(f"--weights = {weights!r}: applies to --objective weighted only ({which})")
+            raise InputError(f"--weights = {weights!r}: applies to --objective weighted only ({which})")
         w = _weights(weights)
     if name == "weighted" and w is None:
-        raise ValueError(
+        raise InputError(
             "--objective weighted needs --weights A,D,P,R: four numbers >= 0, not "
             "all 0 (acceleration, displacement, pitch, roll)"
         )
     b = default.bound if name == "constrained" else None
     if bound is not None:
         if name != "constrained":
-            raise ValueError(f"--bound = {bound!r}: applies to --objective constrained only ({which})")
+            raise InputError(f"--bound = {bound!r}: applies to --objective constrained only ({which})")
         b = parse_float("--bound", bound, bound, " (the largest RMS ratio to passive allowed)")
         if b <= 0:
-            raise ValueError(
+            raise InputError(
                 f"--bound = {bound!r}: must be a finite number > 0 (the largest "
                 "RMS ratio to passive allowed for every response)"
             )
     if name == "constrained" and b is None:
-        raise ValueError(
+        raise InputError(
             "--objective constrained needs --bound X: the largest RMS ratio to "
             "passive allowed for every response, a finite number > 0"
         )
@@ -123,18 +124,18 @@ def _objective(kind: Optional[str], weights: Optional[str], bound: Optional[str]
     if penalty is not None:
         p = parse_float("--penalty", penalty, penalty)
         if p < 0:
-            raise ValueError(f"--penalty = {penalty!r}: must be a finite number >= 0")
+            raise InputError(f"--penalty = {penalty!r}: must be a finite number >= 0")
     try:
         return Objective(name, w, b, p)
     except ValueError as exc:  # what the checks above cannot see, e.g. a bound too large
-        raise ValueError(f"--objective {name}: {exc}") from None
+        raise InputError(f"--objective {name}: {exc}") from None
 
 
 def _weights(weights: str) -> tuple:
     """--weights A,D,P,R -> four numbers >= 0, not all 0."""
     items = [item.strip() for item in weights.split(",")]
     if len(items) != 4:
-        raise ValueError(
+        raise InputError(
             f"--weights = {weights!r}: expected four numbers A,D,P,R (acceleration, "
             f"displacement, pitch, roll), got {len(items)} item(s)"
         )
@@ -143,12 +144,12 @@ def _weights(weights: str) -> tuple:
         try:
             value = float(item)
         except ValueError:
-            raise ValueError(f"--weights = {weights!r}: {name} = {item!r} is not a number") from None
+            raise InputError(f"--weights = {weights!r}: {name} = {item!r} is not a number") from None
         if not (math.isfinite(value) and value >= 0):
-            raise ValueError(f"--weights = {weights!r}: {name} = {item}: must be a finite number >= 0")
+            raise InputError(f"--weights = {weights!r}: {name} = {item}: must be a finite number >= 0")
         values.append(value)
     if sum(values) == 0:
-        raise ValueError(f"--weights = {weights!r}: at least one weight must be > 0")
+        raise InputError(f"--weights = {weights!r}: at least one weight must be > 0")
     return tuple(values)
 
 
@@ -159,7 +160,7 @@ def _tunable_list(text: str) -> list[str]:
 
     items = [n.strip() for n in text.split(",")]
     if any(not n for n in items):
-        raise ValueError(
+        raise InputError(
             f"--controllers = {text!r}: an empty item; give names separated by commas from {', '.join(TUNABLE)}, all"
         )
     if "all" in items:
@@ -167,7 +168,7 @@ def _tunable_list(text: str) -> list[str]:
     for n in items:
         if n not in TUNABLE:
             why = " has no gains to tune" if n in ("passive", "passive-on", "passive-off") else " is not known"
-            raise ValueError(f"--controllers = {text!r}: {n!r}{why}; allowed: {', '.join(TUNABLE)}, all")
+            raise InputError(f"--controllers = {text!r}: {n!r}{why}; allowed: {', '.join(TUNABLE)}, all")
     return [n for n in TUNABLE if n in items]
 
 
@@ -176,7 +177,7 @@ def _tuning_set(scenario, seeds, loads, speed, duration, *single):
     from railride.studies.tuning import tuning_set
 
     if any(v is not None for v in single):
-        raise ValueError(
+        raise InputError(
             "--amplitude, --wavelength, --rail-phase, --min-wavelength and --max-wavelength apply to "
             "a single tuning scenario, not to several --track-seed values or --load"
         )

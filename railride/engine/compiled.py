@@ -16,6 +16,7 @@ from __future__ import annotations
 import contextlib
 from typing import Callable, Iterator
 
+
 #: seconds each kernel takes to compile (docs/performance.md, "Cold start", 2 cores shared
 #: with other jobs); the kernels not named compile in about a second and go unannounced
 #: (run_lanes: batches of lanes.LANES samples or more, e.g. `compare --controllers all`)

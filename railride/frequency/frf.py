@@ -21,6 +21,7 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
+from railride.errors import InputError
 from railride import limits, validation
 from railride.analysis.spectra import FRF_MAGNITUDES, FRF_PATTERNS, frf_frame, frf_peaks
 from railride.output.files import FRF_FILES
@@ -161,7 +162,7 @@ def frequency_responses(
     fmin = validation.number("fmin", fmin, "positive", "Hz")
     fmax = validation.number("fmax", fmax, "positive", "Hz")
     if not fmax > fmin:
-        raise ValueError(f"fmax = {fmax:g} Hz: must be above fmin = {fmin:g} Hz")
+        raise InputError(f"fmax = {fmax:g} Hz: must be above fmin = {fmin:g} Hz")
     points = validation.integer("points", points, 2)
     patterns = list(FRF_PATTERNS) if rails == "both" else [rails]
     # per point and pattern: the 9 DOF responses, the carbody acceleration and 8 corner values

@@ -30,6 +30,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from railride.errors import InputError
 from railride.model.params import VehicleParams
 from railride.model.vehicle import CORNER_NAMES, DOF_NAMES, DOF_UNITS, N_DOF, RAILS, WHEELSETS, Vehicle
 
@@ -70,15 +71,15 @@ class LinearModel:
             ("D", self.D, (p, m)),
         ):
             if np.shape(matrix) != shape:
-                raise ValueError(f"{name} has shape {np.shape(matrix)}: must be {shape} for the names given")
+                raise InputError(f"{name} has shape {np.shape(matrix)}: must be {shape} for the names given")
             if not np.all(np.isfinite(matrix)):
-                raise ValueError(f"{name} holds a value that is not finite: check the vehicle parameters")
+                raise InputError(f"{name} holds a value that is not finite: check the vehicle parameters")
 
     def index(self, kind: str, name: str) -> int:
         """Where ``name`` is among the ``kind`` ("states", "inputs", "outputs")."""
         names = getattr(self, kind)
         if name not in names:
-            raise ValueError(f"{kind[:-1]} {name!r} is not in the model; allowed: {', '.join(names)}")
+            raise InputError(f"{kind[:-1]} {name!r} is not in the model; allowed: {', '.join(names)}")
         return names.index(name)
 
     def corner_forces(self) -> np.ndarray:
@@ -91,7 +92,7 @@ class LinearModel:
         inputs), complex."""
         f = np.atleast_1d(np.asarray(frequency_hz, dtype=float))
         if not np.all(np.isfinite(f)) or np.any(f < 0):
-            raise ValueError(f"frequency_hz must be finite numbers >= 0 Hz, got {frequency_hz!r}")
+            raise InputError(f"frequency_hz must be finite numbers >= 0 Hz, got {frequency_hz!r}")
         s = 2j * np.pi * f
         n = self.A.shape[0]
         X = np.linalg.solve(s[:, None, None] * np.eye(n) - self.A, np.broadcast_to(self.B, (f.size, *self.B.shape)))
@@ -174,7 +175,7 @@ def _check_secondary(suspension, vehicle: Vehicle):
     if suspension == "plant":
         return "plant", 0.0, None
     if not isinstance(suspension, Suspension):
-        raise ValueError(
+        raise InputError(
             f"suspension = {suspension!r}: must be 'passive', 'plant' or a Suspension "
             "(passive viscous dampers, or the ideal actuator under an outer loop)"
         )
@@ -183,7 +184,7 @@ def _check_secondary(suspension, vehicle: Vehicle):
     if s.delay != 1:
         extras.append("delay")
     if extras:
-        raise ValueError(
+        raise InputError(
             f"suspension with {', '.join(extras)}: the linear model has none of them; give the suspension without them"
         )
     if s.controller is None and (s.damper is None or isinstance(s.damper, Viscous)):
@@ -191,7 +192,7 @@ def _check_secondary(suspension, vehicle: Vehicle):
         return "passive", float(c), None
     if isinstance(s.damper, Ideal) and not s.damper.dissipative:
         return s.controller.name, 0.0, s.controller
-    raise ValueError(
+    raise InputError(
         f"suspension {s.describe()}: not linear. The linear model covers the passive viscous "
         "dampers and the ideal actuator (Suspension.ideal) under an outer loop; MR dampers and "
         "the ideal semi-active damper switch and clip"
@@ -310,10 +311,10 @@ def linear_suspensions(controllers, gains) -> dict[str, object]:
         elif c in OUTER_LOOPS:
             out[c] = Suspension.named(c, gains, damper="ideal")
         else:
-            raise ValueError(
+            raise InputError(
                 f"controllers = {c!r}: not a linear suspension; allowed: passive, plant, "
                 f"{', '.join(OUTER_LOOPS)} (each on the ideal actuator), or all"
             )
     if not out:
-        raise ValueError("controllers: give at least one (passive, or an outer loop on the ideal actuator)")
+        raise InputError("controllers: give at least one (passive, or an outer loop on the ideal actuator)")
     return out

@@ -28,6 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 import xarray as xr
 
+from railride.errors import InputError
 from railride import limits, validation
 from railride.defaults import DEFAULT_SPEED
 from railride.analysis.comfort import FLOOR
@@ -218,7 +219,7 @@ def ride_spectrum(
     lo = validation.number("min_wavelength", min_wavelength, "positive", "m")
     hi = validation.number("max_wavelength", max_wavelength, "positive", "m")
     if not hi > lo:
-        raise ValueError(f"max_wavelength = {hi:g} m: must be above min_wavelength = {lo:g} m")
+        raise InputError(f"max_wavelength = {hi:g} m: must be above min_wavelength = {lo:g} m")
     points = validation.integer("points", points, 16, 200_000)
     if control_rate is not None:
         control_rate = validation.number("control_rate", control_rate, "positive", "Hz")
@@ -254,7 +255,7 @@ def ride_spectrum(
                 + np.abs(y["cross-level"][:, i]) ** 2 * S["cross-level"]
             )
     if not names:
-        raise ValueError("; ".join(not_run.values()))
+        raise InputError("; ".join(not_run.values()))
     ds = xr.Dataset(coords={"suspension": names, "frequency": ("frequency", frequency, {"units": "Hz"})})
     for r in RESPONSES:
         unit = plant.units[r]
@@ -309,7 +310,7 @@ def _check_stable(name: str, model: LinearModel, plant: LinearModel, control_rat
         unstable = radius >= 1
         where = f"sampled at {control_rate:g} Hz with a delay of {delay} periods, a pole at |z| = {radius:.4g}"
     if unstable:
-        raise ValueError(
+        raise InputError(
             f"controller {name!r} on the ideal actuator is unstable on this vehicle ({where}): "
             "its frequency response has no steady state"
         )

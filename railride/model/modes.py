@@ -9,6 +9,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
+from railride.errors import InputError
 from railride import validation
 from railride.engine.layout import N_DOF
 from railride.model.params import VehicleParams
@@ -97,7 +98,7 @@ def checked_modes(vehicle) -> Modes:
     if problem is not None:
         outside = [n.split("'")[1] for n in notes(vehicle.params)]
         hint = f"; outside the typical ranges: {', '.join(outside)}" if outside else ""
-        raise ValueError(
+        raise InputError(
             f"the modes of this vehicle cannot be computed in double precision: {problem}; its masses and "
             f"stiffnesses are too far apart in size{hint}"
         )

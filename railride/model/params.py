@@ -13,6 +13,7 @@ import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
+from railride.errors import InputError
 from railride._io import atomic_write_text
 from railride.model.plausible import VEHICLE
 from railride.validation import param, rule_words, shown, toml_error, validate_fields
@@ -61,7 +62,7 @@ class VehicleParams:
 
     def _check_wheelbase(self) -> None:
         if not self.b < self.l:
-            raise ValueError(
+            raise InputError(
                 f"vehicle parameter 'b' = {shown(self.b)} (half wheelbase, m): must be below 'l' = {shown(self.l)} "
                 "(half bogie-centre spacing, m): the two bogies' wheelsets would pass each other"
             )
@@ -79,7 +80,7 @@ class VehicleParams:
         # a common slip: simulate(scenario, suspension) puts the suspension in params
         suspension = hasattr(value, "controller") and hasattr(value, "damper")  # a Suspension, not imported here
         hint = " (a Suspension is the third argument, suspension=)" if suspension else ""
-        raise ValueError(f"params = {value!r}: must be VehicleParams or a preset name{hint}")
+        raise InputError(f"params = {value!r}: must be VehicleParams or a preset name{hint}")
 
     @classmethod
     def resolve(cls, value) -> tuple["VehicleParams", str | Path | None]:
@@ -94,7 +95,7 @@ class VehicleParams:
             return cls.load(Path(value)), Path(value)
         if isinstance(value, VehicleParams):
             return value, next((name for name, p in PRESETS.items() if p == value), None)
-        raise ValueError(
+        raise InputError(
             f"params = {value!r}: must be VehicleParams, a preset name "
             f"({', '.join(PRESETS)}) or the path of a parameters file"
         )
@@ -105,13 +106,13 @@ class VehicleParams:
         try:
             return PRESETS[name]
         except KeyError:
-            raise ValueError(f"unknown vehicle preset {name!r}; allowed: {', '.join(sorted(PRESETS))}") from None
+            raise InputError(f"unknown vehicle preset {name!r}; allowed: {', '.join(sorted(PRESETS))}") from None
 
     def replace(self, **changes: float) -> "VehicleParams":
         """A copy with some fields changed (validated like any new set)."""
         unknown = set(changes) - {f.name for f in dataclasses.fields(self)}
         if unknown:
-            raise ValueError(
+            raise InputError(
                 f"unknown vehicle parameter(s) {', '.join(sorted(unknown))}; "
                 f"allowed: {', '.join(f.name for f in dataclasses.fields(self))}"
             )
@@ -181,16 +182,16 @@ class VehicleParams:
         try:
             data = tomllib.loads(text)
         except ValueError as exc:
-            raise ValueError(f"{source}: not valid TOML: {toml_error(exc)}") from None
+            raise InputError(f"{source}: not valid TOML: {toml_error(exc)}") from None
         table = data.get("vehicle")
         if not isinstance(table, dict):
-            raise ValueError(f"{source}: needs a [vehicle] table of parameters")
+            raise InputError(f"{source}: needs a [vehicle] table of parameters")
         table = dict(table)
         names = [f.name for f in dataclasses.fields(cls)]
         base_name = table.pop("preset", None)
         unknown = sorted(set(table) - set(names))
         if unknown:
-            raise ValueError(
+            raise InputError(
                 f"{source}: unknown vehicle parameter(s) {', '.join(unknown)}; allowed: {', '.join(names)}"
             )
         if base_name is not None:
@@ -198,14 +199,14 @@ class VehicleParams:
         else:
             missing = [n for n in names if n not in table]
             if missing:
-                raise ValueError(
+                raise InputError(
                     f"{source}: missing vehicle parameter(s) {', '.join(missing)} "
                     '(list them all, or start from a base with preset = "paper")'
                 )
         try:
             return base.replace(**table) if base_name is not None else cls(**table)
         except ValueError as exc:  # the field's rule: name the file and table too
-            raise ValueError(f"{source}: [vehicle] {exc}") from None
+            raise InputError(f"{source}: [vehicle] {exc}") from None
 
     @classmethod
     def load(cls, path: str | Path) -> "VehicleParams":
@@ -213,7 +214,7 @@ class VehicleParams:
         try:
             text = path.read_text(encoding="utf-8")
         except OSError as exc:
-            raise ValueError(f"cannot read vehicle parameters from {path}: {exc.strerror}") from None
+            raise InputError(f"cannot read vehicle parameters from {path}: {exc.strerror}") from None
         return cls.from_toml(text, source=str(path))
 
 

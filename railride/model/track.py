@@ -29,6 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
+from railride.errors import InputError
 from railride import validation
 from railride.defaults import DEFAULT_SPEED
 from railride._cache import MiB, BytesLRU
@@ -51,7 +52,7 @@ def _check(name: str, value, rule: str, allowed: str) -> float:
 def _within(name: str, value: float, bound: float, unit: str, why: str) -> float:
     """``value`` when |value| <= ``bound``, else a ValueError naming the field and the range."""
     if abs(value) > bound:
-        raise ValueError(
+        raise InputError(
             f"{name} = {value:.4g} {unit}: outside the plausible range -{bound:g} to {bound:g} {unit} ({why})"
         )
     return value
@@ -161,7 +162,7 @@ class CosineBump(RailProfile):
         object.__setattr__(self, "length", _check("length", self.length, "positive", "a finite number > 0 (m)"))
         object.__setattr__(self, "start", _check("start", self.start, "nonnegative", "a finite number >= 0 (m)"))
         if self.rails not in ("both", "left", "right"):
-            raise ValueError(f"rails = {self.rails!r}: allowed 'both', 'left', 'right'")
+            raise InputError(f"rails = {self.rails!r}: allowed 'both', 'left', 'right'")
 
     def _evaluate(self, s):
         x = (s - self.start) / self.length
@@ -208,21 +209,21 @@ class MeasuredTrack(RailProfile):
         zr = np.asarray(self.z_R, dtype=float)
         src = self.source
         if s.ndim != 1 or s.shape != zl.shape or s.shape != zr.shape:
-            raise ValueError(f"{src}: s, z_L and z_R must be 1-D columns of equal length")
+            raise InputError(f"{src}: s, z_L and z_R must be 1-D columns of equal length")
         if s.size < 2:
-            raise ValueError(f"{src}: a measured profile needs at least 2 rows, got {s.size}")
+            raise InputError(f"{src}: a measured profile needs at least 2 rows, got {s.size}")
         for name, col in (("s", s), ("z_L", zl), ("z_R", zr)):
             bad = np.flatnonzero(~np.isfinite(col))
             if bad.size:
-                raise ValueError(
+                raise InputError(
                     f"{src}: column {name} has a non-finite value {col[bad[0]]!r} at data row {bad[0] + 1}"
                 )
         steps = np.diff(s)
         if np.any(steps <= 0):
             i = int(np.flatnonzero(steps <= 0)[0])
-            raise ValueError(f"{src}: s must increase strictly; data row {i + 2} has s = {s[i + 1]!r} after {s[i]!r}")
+            raise InputError(f"{src}: s must increase strictly; data row {i + 2} has s = {s[i + 1]!r} after {s[i]!r}")
         if s[0] > 0:
-            raise ValueError(
+            raise InputError(
                 f"{src}: the profile must start at s <= 0 m (the vehicle starts at s = 0); it starts at {s[0]!r} m"
             )
         object.__setattr__(self, "s", s)
@@ -240,9 +241,9 @@ class MeasuredTrack(RailProfile):
             with path.open(newline="", encoding="utf-8") as fh:
                 rows = list(csv.reader(fh))
         except OSError as exc:
-            raise ValueError(f"cannot read track file {path}: {exc.strerror or exc}") from None
+            raise InputError(f"cannot read track file {path}: {exc.strerror or exc}") from None
         except UnicodeDecodeError:
-            raise ValueError(f"track file {path}: not a UTF-8 text CSV") from None
+            raise InputError(f"track file {path}: not a UTF-8 text CSV") from None
         # keep file line numbers for the messages; skip blank and comment lines
         numbered = [
             (n, r)
@@ -250,13 +251,13 @@ class MeasuredTrack(RailProfile):
             if r and any(c.strip() for c in r) and not r[0].lstrip().startswith("#")
         ]
         if not numbered:
-            raise ValueError(f"track file {path}: empty; expected a header 's,z_L,z_R' and data rows")
+            raise InputError(f"track file {path}: empty; expected a header 's,z_L,z_R' and data rows")
         head = numbered[0][1]
         header = [c.split("[")[0].strip().lower() for c in head]
         idx = {}
         for want in ("s", "z_l", "z_r"):
             if want not in header:
-                raise ValueError(
+                raise InputError(
                     f"track file {path}: no column {want.replace('_l', '_L').replace('_r', '_R')!r} in the header "
                     f"{head!r}; expected columns s [m], z_L [m], z_R [m]"
                 )
@@ -268,14 +269,14 @@ class MeasuredTrack(RailProfile):
                     data[k].append(float(row[j]))
                 except (IndexError, ValueError):
                     cell = row[j] if j < len(row) else "<missing>"
-                    raise ValueError(
+                    raise InputError(
                         f"track file {path}, line {lineno}: column {head[j].strip()!r} = {cell!r} is not a number"
                     ) from None
         return cls(np.array(data["s"]), np.array(data["z_l"]), np.array(data["z_r"]), source=str(path))
 
     def _evaluate(self, s):
         if np.any(s > self.s[-1] + 1e-9):
-            raise ValueError(
+            raise InputError(
                 f"{self.source}: the profile ends at s = {self.s[-1]:g} m but the run "
                 f"reaches s = {float(np.max(s)):.1f} m"
             )
@@ -294,7 +295,7 @@ class MeasuredTrack(RailProfile):
 def _check_speed(value) -> float:
     speed = _check("speed", value, "positive", "a finite number > 0 (m/s)")
     if speed > MAX_SPEED:
-        raise ValueError(
+        raise InputError(
             f"speed = {speed:.4g} m/s: above the plausible {MAX_SPEED:g} m/s (the rail speed "
             "record is 159.7 m/s; the model's linear suspension means nothing far beyond it)"
         )
@@ -314,10 +315,10 @@ class Scenario:
         object.__setattr__(self, "speed", _check_speed(self.speed))
         object.__setattr__(self, "duration", _check("duration", self.duration, "positive", "a finite number > 0 (s)"))
         if not isinstance(self.track, RailProfile):
-            raise ValueError(f"track = {self.track!r}: must be a RailProfile")
+            raise InputError(f"track = {self.track!r}: must be a RailProfile")
         needed = self.speed * self.duration
         if needed > self.track.end() + 1e-9:
-            raise ValueError(
+            raise InputError(
                 f"the run covers s = 0 to {needed:.1f} m (speed {self.speed:g} m/s x {self.duration:g} s) "
                 f"but the profile ends at s = {self.track.end():g} m: shorten the duration or lower the speed"
             )
@@ -360,11 +361,11 @@ def scenario(
         if v is not None
     ]
     if random_only and name not in SPECTRA:
-        raise ValueError(
+        raise InputError(
             f"{', '.join(random_only)} applies to the random tracks ({', '.join(SPECTRA)}) only, not to {name}"
         )
     if taper is not None and name != "paper-sine":
-        raise ValueError(f"taper applies to paper-sine only, not to {name}")
+        raise InputError(f"taper applies to paper-sine only, not to {name}")
     track: RailProfile
     if name == "paper-sine":
         track = SineTrack(
@@ -375,7 +376,7 @@ def scenario(
         )
     elif name == "bump":
         if rail_phase is not None:
-            raise ValueError("rail_phase applies to paper-sine only, not to the bump scenario")
+            raise InputError("rail_phase applies to paper-sine only, not to the bump scenario")
         track = CosineBump(
             height=0.02 if amplitude is None else amplitude, length=10.0 if wavelength is None else wavelength
         )
@@ -386,7 +387,7 @@ def scenario(
             if v is not None
         ]
         if given:
-            raise ValueError(
+            raise InputError(
                 f"{', '.join(given)} cannot be set for a random track ({name}); "
                 "use min_wavelength, max_wavelength and seed"
             )
@@ -407,13 +408,13 @@ def scenario(
             if v is not None
         ]
         if given:
-            raise ValueError(f"{', '.join(given)} cannot be set for a measured profile ({name})")
+            raise InputError(f"{', '.join(given)} cannot be set for a measured profile ({name})")
         path = name[len("file:") :]
         if not path:
-            raise ValueError("scenario 'file:' needs a path, as in file:track.csv")
+            raise InputError("scenario 'file:' needs a path, as in file:track.csv")
         track = MeasuredTrack.from_csv(path)
     else:
-        raise ValueError(f"unknown scenario {name!r}; allowed: {', '.join(SCENARIOS)}")
+        raise InputError(f"unknown scenario {name!r}; allowed: {', '.join(SCENARIOS)}")
     return Scenario(track=track, name=name, **common)
 
 
@@ -442,7 +443,7 @@ def wheelset_input_table(
     V = scenario.speed
     n, interval = input_table_nodes(scenario, dt, duration)
     if n > MAX_TABLE_NODES:
-        raise ValueError(
+        raise InputError(
             f"the rail input table would need {n} nodes ({duration:g} s at one node per "
             f"{interval:.3g} s); at most {MAX_TABLE_NODES} are allowed: shorten the run"
         )
@@ -489,9 +490,9 @@ def spectrum(name: str, wavenumber, component: str = "vertical") -> np.ndarray:
     """
     W = np.asarray(wavenumber, dtype=float)
     if not np.all(np.isfinite(W)) or np.any(W <= 0):
-        raise ValueError("wavenumber must be finite and > 0 rad/m")
+        raise InputError("wavenumber must be finite and > 0 rad/m")
     if component not in ("vertical", "cross-level"):
-        raise ValueError(f"component = {component!r}: allowed 'vertical', 'cross-level'")
+        raise InputError(f"component = {component!r}: allowed 'vertical', 'cross-level'")
     W2 = W * W
     if name.startswith("fra") and name[3:].isdigit() and int(name[3:]) in FRA_AV:
         Av, k, Wc2, Ws2 = FRA_AV[int(name[3:])], FRA_K, FRA_OMEGA_C**2, FRA_OMEGA_S**2
@@ -507,7 +508,7 @@ def spectrum(name: str, wavenumber, component: str = "vertical") -> np.ndarray:
         if component == "vertical":
             return Av * Wc2 / ((W2 + Wr2) * (W2 + Wc2))
         return 4 * Av * Wc2 * W2 / ((W2 + Wr2) * (W2 + Wc2) * (W2 + Ws2))
-    raise ValueError(f"unknown track spectrum {name!r}; allowed: {', '.join(SPECTRA)}")
+    raise InputError(f"unknown track spectrum {name!r}; allowed: {', '.join(SPECTRA)}")
 
 
 @dataclass(frozen=True, eq=False)
@@ -537,15 +538,15 @@ class RandomTrack(RailProfile):
         lo = _check("min_wavelength", self.min_wavelength, "positive", "a finite number > 0 (m)")
         hi = _check("max_wavelength", self.max_wavelength, "positive", "a finite number > 0 (m)")
         if not lo < hi:
-            raise ValueError(f"wavelength band [{lo:g}, {hi:g}] m: min_wavelength must be below max_wavelength")
+            raise InputError(f"wavelength band [{lo:g}, {hi:g}] m: min_wavelength must be below max_wavelength")
         length = _check("length", self.length, "positive", "a finite number > 0 (m)")
         if length < hi:
-            raise ValueError(f"length = {length:g} m: must be at least max_wavelength = {hi:g} m")
+            raise InputError(f"length = {length:g} m: must be at least max_wavelength = {hi:g} m")
         lead = _check("lead_in", self.lead_in, "nonnegative", "a finite number >= 0 (m)")
         ds = lo / 20.0  # 20 samples on the shortest wavelength
         n = int(2 ** math.ceil(math.log2(length / ds)))
         if n > 2**24:
-            raise ValueError(
+            raise InputError(
                 f"the realisation needs {n:.4g} samples ({length:.4g} m at {ds:.4g} m), more than "
                 f"2**24: shorten it or raise min_wavelength"
             )
@@ -660,4 +661,4 @@ def as_scenario(value) -> Scenario:
         return scenario(value)
     if isinstance(value, Scenario):
         return value
-    raise ValueError(f"scenario = {value!r}: must be a Scenario or a scenario name")
+    raise InputError(f"scenario = {value!r}: must be a Scenario or a scenario name")

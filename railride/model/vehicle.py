@@ -26,6 +26,7 @@ import scipy.linalg
 import scipy.optimize
 import xarray as xr
 
+from railride.errors import InputError
 from railride import validation
 from railride.engine.layout import N_DOF, N_RAIL
 from railride.model.params import VehicleParams
@@ -229,12 +230,12 @@ class Vehicle:
         """
         f = np.atleast_1d(np.asarray(frequency_hz, dtype=float))
         if not np.all(np.isfinite(f)) or np.any(f < 0):
-            raise ValueError(f"frequency_hz must be finite and >= 0, got {frequency_hz!r}")
+            raise InputError(f"frequency_hz must be finite and >= 0, got {frequency_hz!r}")
         speed = validation.number("speed", speed, "positive", "m/s")
         if isinstance(rails, str):
             patterns = {"in-phase": (1.0, 1.0), "anti-phase": (1.0, -1.0)}
             if rails not in patterns:
-                raise ValueError(f"rails = {rails!r}: allowed 'in-phase', 'anti-phase' or (c_L, c_R)")
+                raise InputError(f"rails = {rails!r}: allowed 'in-phase', 'anti-phase' or (c_L, c_R)")
             cL, cR = patterns[rails]
         else:
             cL, cR = rails

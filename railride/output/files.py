@@ -27,6 +27,7 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
+from railride.errors import InputError
 from railride.analysis.spectra import PSD_SEGMENT_S, comparison_psd
 from railride.analysis.labels import CARBODY_RESPONSES, psd_title
 from railride.plots import FigureOptions, save_figure
@@ -90,7 +91,7 @@ def netcdf_ready(ds: xr.Dataset) -> xr.Dataset:
     for name, var in ds.variables.items():
         if var.dtype.kind in "iu" and var.dtype != np.int32:
             if var.size and (var.values.min() < np.iinfo(np.int32).min or var.values.max() > np.iinfo(np.int32).max):
-                raise ValueError(f"{name}: integers beyond int32 cannot be stored in netCDF3")
+                raise InputError(f"{name}: integers beyond int32 cannot be stored in netCDF3")
             out[name] = var.astype(np.int32)
     return out
 
@@ -110,14 +111,14 @@ def check_out_dir(out_dir) -> Path:
     """Reject an output location that cannot be a folder, before any work is done."""
     if isinstance(out_dir, str) and not out_dir.strip():
         # Path("") is the current folder: an empty name is a mistake, not a choice of "."
-        raise ValueError(f'output folder {out_dir!r}: an empty name; give a folder ("." for the current one)')
+        raise InputError(f'output folder {out_dir!r}: an empty name; give a folder ("." for the current one)')
     out_dir = Path(out_dir)
     if out_dir.exists() and not out_dir.is_dir():
-        raise ValueError(f"output folder {out_dir} exists and is not a folder")
+        raise InputError(f"output folder {out_dir} exists and is not a folder")
     for parent in out_dir.absolute().parents:
         if parent.exists():
             if not parent.is_dir():
-                raise ValueError(f"output folder {out_dir}: {parent} is not a folder")
+                raise InputError(f"output folder {out_dir}: {parent} is not a folder")
             break
     return out_dir
 
@@ -164,7 +165,7 @@ def write_folder(out_dir, files) -> list[Path]:
     files = list(files)
     names = [name for name, _ in files]
     if len(set(names)) != len(names) or any(Path(n).name != n or n.startswith(".") for n in names):
-        raise ValueError(f"write_folder: file names must be distinct plain names, got {names}")
+        raise InputError(f"write_folder: file names must be distinct plain names, got {names}")
     out_dir = check_out_dir(out_dir)
     parent = out_dir.absolute().parent
     parent.mkdir(parents=True, exist_ok=True)
@@ -310,7 +311,7 @@ def _expect(value, name: str, kind: str, needs: tuple[str, ...]) -> None:
     """ValueError unless ``value`` has the attributes ``needs`` of a ``kind`` (a result class's
     path): the writers read what they are given and import no result module (those sit above)."""
     if not all(hasattr(value, a) for a in needs):
-        raise ValueError(f"{name}: expected a {kind}, got {type(value).__name__}")
+        raise InputError(f"{name}: expected a {kind}, got {type(value).__name__}")
 
 
 # -- one writer per result ------------------------------------------------------------------------
@@ -326,7 +327,7 @@ def history_formats(value=("nc", "csv")) -> tuple:
     bad = [n for n in names if n not in HISTORY_FORMATS]
     if bad or not names:
         what = f"{bad[0]!r} is not a format" if bad else "no format given"
-        raise ValueError(f"history_formats = {value!r}: {what}; allowed one or more of {', '.join(HISTORY_FORMATS)}")
+        raise InputError(f"history_formats = {value!r}: {what}; allowed one or more of {', '.join(HISTORY_FORMATS)}")
     return tuple(dict.fromkeys(names))
 
 

@@ -27,6 +27,7 @@ from typing import Any, Callable
 
 import pandas as pd
 
+from railride.errors import InputError
 from railride._version import __version__
 from railride._io import atomic_write_text
 
@@ -78,7 +79,7 @@ def contents(result) -> Contents:
         if function is not None:
             return function(result)
     known = ", ".join(sorted(name.rsplit(".", 1)[1] for name in KNOWN))
-    raise ValueError(f"result: a {type(result).__name__} has no report; allowed: {known}")
+    raise InputError(f"result: a {type(result).__name__} has no report; allowed: {known}")
 
 
 # -- the result types ---------------------------------------------------------------------------
@@ -251,14 +252,14 @@ def check_report_path(path, field: str = "path") -> Path:
     not a folder, whose parent is not a file. ValueError naming ``field`` otherwise."""
     path = Path(path)
     if path.is_dir():
-        raise ValueError(
+        raise InputError(
             f"{field} = {str(path)!r}: a folder; give the name of the HTML file to write, e.g. report.html"
         )
     if path.suffix.lower() not in SUFFIXES:
-        raise ValueError(f"{field} = {str(path)!r}: must end in .html or .htm (one HTML file), e.g. report.html")
+        raise InputError(f"{field} = {str(path)!r}: must end in .html or .htm (one HTML file), e.g. report.html")
     parent = next((p for p in path.absolute().parents if p.exists()), None)
     if parent is not None and not parent.is_dir():
-        raise ValueError(f"{field} = {str(path)!r}: {parent} is a file, not a folder")
+        raise InputError(f"{field} = {str(path)!r}: {parent} is a file, not a folder")
     return path
 
 

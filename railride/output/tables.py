@@ -15,6 +15,7 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
+from railride.errors import InputError
 from railride.analysis.labels import CARBODY_RESPONSES, controller_names, coordinate_label
 from railride.model.modes import MODE_COLUMNS as MODE_COLUMNS, modes_frame as modes_frame  # the modal table
 
@@ -46,9 +47,9 @@ def to_frame(ds: xr.Dataset) -> pd.DataFrame:
     variable and any variable without a ``time`` dimension are left out.
     """
     if not isinstance(ds, xr.Dataset):
-        raise ValueError(f"ds: expected an xarray Dataset (RideResult.dataset), got {type(ds).__name__}")
+        raise InputError(f"ds: expected an xarray Dataset (RideResult.dataset), got {type(ds).__name__}")
     if "time" not in ds.dims:
-        raise ValueError("the dataset has no time dimension: not a result of railride.run.simulation")
+        raise InputError("the dataset has no time dimension: not a result of railride.run.simulation")
     lead = ["sample"] if "sample" in ds.dims else []
     n_rows = ds.sizes["time"] * (ds.sizes["sample"] if lead else 1)
     columns: dict[str, np.ndarray] = {}
@@ -83,7 +84,7 @@ def cycles_frame(ds: xr.Dataset) -> pd.DataFrame:
     run]; the voltages one after another, in the order they were given."""
     missing = [c for c in RIG_CHANNELS if c not in ds.variables]
     if missing or "voltage" not in ds.dims:
-        raise ValueError(
+        raise InputError(
             f"expected the dataset of railride.run.rig.cycles (dims voltage, time; channels {', '.join(RIG_CHANNELS)})"
         )
     frame = ds[list(RIG_CHANNELS)].to_dataframe(dim_order=["voltage", "time"])
@@ -100,13 +101,13 @@ def comparison_frame(ds: xr.Dataset) -> pd.DataFrame:
     ``damper_command_voltage_<corner>`` [V]; the last two are empty (NaN) for the passive
     suspension and absent when no controlled suspension was run."""
     if "controller" not in ds.dims or "time" not in ds.dims:
-        raise ValueError(
+        raise InputError(
             "expected the combined() Dataset of a railride.studies.comparison.Comparison (dims controller, time)"
         )
     body = [channel for channel, _, _, _ in CARBODY_RESPONSES.values()]
     missing = [c for c in body if c not in ds.variables]
     if missing:
-        raise ValueError(f"the dataset lacks the channel(s) {', '.join(missing)}")
+        raise InputError(f"the dataset lacks the channel(s) {', '.join(missing)}")
     channels = body + [c for c in COMPARE_CORNER_CHANNELS if c in ds.variables]
     frames = []
     for i, name in enumerate(controller_names(ds)):

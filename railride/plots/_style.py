@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 
+from railride.errors import InputError
 from railride._io import atomic_write
 from railride.validation import number, shown
 
@@ -232,14 +233,14 @@ class FigureOptions:
         bad = [f for f in names if f not in FIGURE_FORMATS]
         if bad or not names:
             what = f"{shown(bad[0])} is not a figure format" if bad else "no format given"
-            raise ValueError(
+            raise InputError(
                 f"figure_formats = {shown(given)}: {what}; allowed one or more of {', '.join(FIGURE_FORMATS)}"
             )
         object.__setattr__(self, "figure_formats", tuple(dict.fromkeys(names)))
         allowed = f"a finite number > 0 and <= {MAX_DPI} (dots per inch)"
         dpi = number("dpi", self.dpi, "positive", allowed=allowed)
         if dpi > MAX_DPI:
-            raise ValueError(f"dpi = {shown(self.dpi)}: must be {allowed}")
+            raise InputError(f"dpi = {shown(self.dpi)}: must be {allowed}")
         object.__setattr__(self, "dpi", dpi)
 
     def names(self, stem: str) -> list[str]:
@@ -298,7 +299,7 @@ def given_axes(ax, count: int, what: str) -> list:
     naming what each panel is when the count differs."""
     axes = list(np.ravel(ax))
     if len(axes) != count:
-        raise ValueError(f"ax: {count} Axes ({what}), got {len(axes)}")
+        raise InputError(f"ax: {count} Axes ({what}), got {len(axes)}")
     return axes
 
 

@@ -8,6 +8,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from railride.errors import InputError
 from railride.analysis.labels import CARBODY_RESPONSES, comparison_title, controller_names, coordinate_label
 from railride.plots._style import (
     PAGE_WIDTH,
@@ -26,7 +27,7 @@ from railride.plots._style import (
 def _combined(comparison):
     """The combined Dataset of a `Comparison` (dims controller, time, ...)."""
     if not callable(getattr(comparison, "combined", None)):  # read by what it has: plots import no result
-        raise ValueError(
+        raise InputError(
             f"comparison: expected a railride.studies.comparison.Comparison, got {type(comparison).__name__}"
         )
     return comparison.combined()
@@ -45,11 +46,11 @@ def plot_comparison_response(comparison, response: str, ax=None):
     caller owns the figure), else into a new figure; returns the `Figure`.
     """
     if response not in CARBODY_RESPONSES:
-        raise ValueError(f"response = {response!r}: allowed {', '.join(CARBODY_RESPONSES)}")
+        raise InputError(f"response = {response!r}: allowed {', '.join(CARBODY_RESPONSES)}")
     ds = _combined(comparison)
     channel, factor, ylabel, what = CARBODY_RESPONSES[response]
     if channel not in ds.variables:
-        raise ValueError(f"the dataset lacks the channel {channel}")
+        raise InputError(f"the dataset lacks the channel {channel}")
     own = ax is None
     fig = new_figure((PAGE_WIDTH, 3.4)) if own else ax.figure
     if own:
@@ -101,7 +102,7 @@ def plot_comparison_damper_forces(comparison, ax=None):
     (no title then), or None for a new figure. Returns the `Figure`."""
     ds = _combined(comparison)
     if "secondary_damper_force" not in ds.variables:
-        raise ValueError("the dataset lacks the channel secondary_damper_force")
+        raise InputError("the dataset lacks the channel secondary_damper_force")
     names = controller_names(ds)
     fig, axes, corners = _corner_grid(ds, names, ax)
     time = ds["time"].values
@@ -215,7 +216,7 @@ def plot_comparison_hysteresis(comparison, ax=None, *, corner: str = "1R"):
     if window is not None:
         ds = ds.sel(time=slice(window[0], window[1]))
     if corner not in [str(c) for c in ds["corner"].values]:
-        raise ValueError(f"corner = {corner!r}: allowed {', '.join(str(c) for c in ds['corner'].values)}")
+        raise InputError(f"corner = {corner!r}: allowed {', '.join(str(c) for c in ds['corner'].values)}")
     names = controller_names(ds)
     if ax is None:
         rows, columns = grid_shape(len(names))

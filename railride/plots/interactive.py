@@ -18,6 +18,7 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
+from railride.errors import InputError
 from railride.analysis.spectra import FRF_RESPONSES, frf_excited
 from railride.analysis.labels import CARBODY_RESPONSES, comparison_title, controller_names
 from railride.plots._style import suspension_label, suspension_style
@@ -42,7 +43,7 @@ def envelope(x, y, max_points: int = MAX_POINTS) -> tuple[np.ndarray, np.ndarray
     x, y = np.asarray(x), np.asarray(y)
     n = y.size
     if max_points < 4:
-        raise ValueError(f"max_points = {max_points}: must be a whole number >= 4")
+        raise InputError(f"max_points = {max_points}: must be a whole number >= 4")
     if n <= max_points:
         return x, y
     buckets = (max_points - 2) // 2
@@ -112,10 +113,10 @@ def comparison_response_figure(ds: xr.Dataset, response: str, *, max_points: int
     import plotly.graph_objects as go
 
     if response not in CARBODY_RESPONSES:
-        raise ValueError(f"response = {response!r}: allowed {', '.join(CARBODY_RESPONSES)}")
+        raise InputError(f"response = {response!r}: allowed {', '.join(CARBODY_RESPONSES)}")
     channel, factor, ylabel, what = CARBODY_RESPONSES[response]
     if channel not in ds.variables:
-        raise ValueError(f"the dataset lacks the channel {channel}")
+        raise InputError(f"the dataset lacks the channel {channel}")
     fig = _new()
     time = ds["time"].values
     for i, name in enumerate(controller_names(ds)):
@@ -173,7 +174,7 @@ def ride_figure(ds: xr.Dataset, *, labels=None, title: str = "carbody responses"
 
     missing = [c for c, _, _, _ in CARBODY_RESPONSES.values() if c not in ds.variables]
     if missing:
-        raise ValueError(f"the dataset lacks the channel(s) {', '.join(missing)}")
+        raise InputError(f"the dataset lacks the channel(s) {', '.join(missing)}")
     fig = _new(len(CARBODY_RESPONSES))
     time = ds["time"].values
     samples = list(ds["sample"].values) if "sample" in ds.dims else [None]

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from railride.errors import InputError
 from railride.plots._style import (
     COLUMN_WIDTH,
     PAGE_WIDTH,
@@ -63,7 +64,7 @@ def plot_league_comfort(table, ax=None, *, index: str = "N_MV_z"):
     scenarios and track seeds at each speed. ``table``: a `railride.studies.league.LeagueTable`."""
     column = f"centre_{index}"
     if column not in table.cases:
-        raise ValueError(f"index = {index!r}: the league table has no {column} (allowed N_MV_z, aw_Wk)")
+        raise InputError(f"index = {index!r}: the league table has no {column} (allowed N_MV_z, aw_Wk)")
     if ax is None:
         fig = new_figure((COLUMN_WIDTH, 3.0))
         ax = fig.add_subplot()

@@ -5,13 +5,14 @@ from __future__ import annotations
 
 import numpy as np
 
+from railride.errors import InputError
 from railride.plots._style import PAGE_WIDTH, given_axes, new_figure, set_title, styled
 
 
 def _expect(value, name: str, kind: str, needs: str):
     """``value`` has the attribute ``needs`` of a ``kind`` (plots import no result module)."""
     if not hasattr(value, needs):
-        raise ValueError(f"{name}: expected a railride.studies.optimise.{kind}, got {type(value).__name__}")
+        raise InputError(f"{name}: expected a railride.studies.optimise.{kind}, got {type(value).__name__}")
 
 
 def _objective_label(definition) -> str:

@@ -7,6 +7,7 @@ import dataclasses
 import numpy as np
 import xarray as xr
 
+from railride.errors import InputError
 from railride.analysis.labels import CARBODY_RESPONSES, describe_scenario, describe_suspension, json_records
 from railride.plots._style import (
     PAGE_WIDTH,
@@ -148,7 +149,7 @@ def plot_body_responses(ds: xr.Dataset, path=None, *, ax=None, window=None):
     """
     missing = [channel for channel, _, _, _ in CARBODY_RESPONSES.values() if channel not in ds.variables]
     if missing:
-        raise ValueError(f"the dataset lacks the channel(s) {', '.join(missing)}")
+        raise InputError(f"the dataset lacks the channel(s) {', '.join(missing)}")
     if ax is None:
         fig = new_figure((PAGE_WIDTH, 7.0))
         axes = fig.subplots(len(CARBODY_RESPONSES), 1, sharex=True)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 
+from railride.errors import InputError
 from railride.analysis.labels import damper_model_name
 from railride.plots._style import PAGE_WIDTH, frame_window, given_axes, new_figure, save_to, set_title, styled
 
@@ -11,7 +12,7 @@ from railride.plots._style import PAGE_WIDTH, frame_window, given_axes, new_figu
 def _expect(value, name: str, kind: str, needs: str):
     """``value`` has the attribute ``needs`` of a rig's ``kind`` (plots import no result module)."""
     if not hasattr(value, "dataset") or not hasattr(value, needs):
-        raise ValueError(f"{name}: expected a railride.run.rig.{kind}, got {type(value).__name__}")
+        raise InputError(f"{name}: expected a railride.run.rig.{kind}, got {type(value).__name__}")
 
 
 @styled
@@ -31,7 +32,7 @@ def plot_hysteresis(cycles, path=None, *, title: str | None = None, ax=None):
     ds = cycles.dataset
     missing = [c for c in ("x", "xd", "F") if c not in ds.variables]
     if missing or "voltage" not in ds.dims:
-        raise ValueError("expected the result of railride.run.rig.cycles (dims voltage, time; x, xd, F)")
+        raise InputError("expected the result of railride.run.rig.cycles (dims voltage, time; x, xd, F)")
     if ax is None:
         fig = new_figure((PAGE_WIDTH, 3.2))
         ax_x, ax_v = fig.subplots(1, 2, sharey=True)
@@ -98,7 +99,7 @@ def plot_tracking(tracking, path=None, *, title: str | None = None, ax=None):
     ds = tracking.dataset
     missing = [c for c in ("F", "desired_force", "v", "u") if c not in ds.variables]
     if missing:
-        raise ValueError(f"expected the result of railride.run.rig.track; missing {', '.join(missing)}")
+        raise InputError(f"expected the result of railride.run.rig.track; missing {', '.join(missing)}")
     if ax is None:
         fig = new_figure((PAGE_WIDTH, 4.6))
         ax_f, ax_v = fig.subplots(2, 1, sharex=True, height_ratios=(3, 2))

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from railride.errors import InputError
 from railride.plots._style import (
     PAGE_WIDTH,
     given_axes,
@@ -36,7 +37,7 @@ def plot_study(result, ax=None, metrics=None):
     metrics = list(DEFAULT_METRICS) if metrics is None else list(metrics)
     unknown = [m for m in metrics if m not in set(summary["metric"])]
     if unknown:
-        raise ValueError(f"metrics: {unknown[0]!r} is not a metric of the study; allowed {', '.join(DEFAULT_METRICS)}")
+        raise InputError(f"metrics: {unknown[0]!r} is not a metric of the study; allowed {', '.join(DEFAULT_METRICS)}")
     controlled = [n for n in dict.fromkeys(summary["controller"]) if n != "passive"]
     part = summary[summary["controller"] != "passive"]
     conditions = list(dict.fromkeys(zip(part["load"], part["stiffness"], part["fault"], part["delay"])))

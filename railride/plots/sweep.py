@@ -8,6 +8,7 @@ import math
 import numpy as np
 import pandas as pd
 
+from railride.errors import InputError
 from railride.analysis.labels import describe_dampers, describe_scenario, grid_axis_label
 from railride.plots._style import (
     PAGE_WIDTH,
@@ -81,7 +82,7 @@ def _sweep_lines(ax, frame, axis, column, suspensions):
 def _swept_axis(result, axis: str | None) -> str:
     axis = axis or sweep_plot_axis(result)
     if axis is None:
-        raise ValueError("the sweep has no single numeric axis with several values to plot against")
+        raise InputError("the sweep has no single numeric axis with several values to plot against")
     return axis
 
 
@@ -158,7 +159,7 @@ def plot_sweep_comfort(result, ax=None, *, axis: str | None = None):
 
     axis = _swept_axis(result, axis)
     if not has_comfort(result):
-        raise ValueError("the sweep's rows hold no comfort indices (run_sweep with comfort, railride sweep --comfort)")
+        raise InputError("the sweep's rows hold no comfort indices (run_sweep with comfort, railride sweep --comfort)")
     frame, suspensions, fig, axes = _panels(result, COMFORT_PANELS, ax, (PAGE_WIDTH, 3.2), (1, 2))
     xs = [float(x) for x in frame[axis] if pd.notna(x)]
     log_x = _log_axis(axis, xs)

@@ -6,6 +6,7 @@ import math
 
 import numpy as np
 
+from railride.errors import InputError
 from railride.analysis.labels import gain_unit
 from railride.plots._style import PAGE_WIDTH, fit_text, given_axes, grid_shape, new_figure, set_title, styled
 
@@ -116,7 +117,7 @@ def plot_sensitivity(curves, ax=None, *, title: str | None = None):
 
     curves = list(curves)
     if not curves:
-        raise ValueError("no sensitivity curves to plot")
+        raise InputError("no sensitivity curves to plot")
     parameters = list(dict.fromkeys(c.parameter for c in curves))
     if ax is None:
         nrows, ncols = grid_shape(len(parameters))

@@ -12,6 +12,7 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
+from railride.errors import InputError
 from railride.secondary import dampers
 from railride.model.params import PRESETS
 from railride.plots import PNG_DPI, FigureOptions
@@ -226,7 +227,7 @@ class RideResult:
         params=None,
     ):
         if (dataset is None) == (build is None):
-            raise ValueError("RideResult needs a dataset or a build function, not both")
+            raise InputError("RideResult needs a dataset or a build function, not both")
         self._dataset = dataset
         self._build = build
         self._raw = raw
@@ -277,7 +278,7 @@ class RideResult:
             start, end = check_window(window, float(t[-1]), float(t[0]))
             keep = (t >= start - 1e-12) & (t <= end + 1e-12)
             if keep.sum() < 2:
-                raise ValueError(f"window = {start:g}:{end:g} s holds fewer than two output samples")
+                raise InputError(f"window = {start:g}:{end:g} s holds fewer than two output samples")
             q, a = q[:, keep], a[:, keep]
         out = metrics_from_arrays(a[..., 0], q[..., 0], q[..., 1], q[..., 2], diverged=diverged)
         return out if self._raw["batch"] else out.isel(sample=0, drop=True)
@@ -301,7 +302,7 @@ class RideResult:
         from railride.analysis.metrics import check_window, to_dict
 
         if self.is_batch:
-            raise ValueError(
+            raise InputError(
                 f"to_dict describes a single run; this result is a batch of {self.dataset.sizes['sample']} samples"
             )
         record = self._record("scenario", self.scenario)

@@ -27,7 +27,7 @@ from railride.secondary import dampers
 from railride.engine import kernels, layout
 from railride import limits, validation
 from railride.defaults import DEFAULT_DAMPER, DEFAULT_DT
-from railride.errors import DivergenceError
+from railride.errors import DivergenceError, InputError
 from railride.plots import PNG_DPI, FigureOptions
 
 #: motion-table nodes per cycle of the fastest motion
@@ -77,11 +77,11 @@ class SampledMotion:
         t = np.asarray(self.t, dtype=float)
         x = np.asarray(self.x, dtype=float)
         if t.ndim != 1 or t.shape != x.shape or t.size < 2:
-            raise ValueError("motion: t and x must be 1-D arrays of equal length >= 2")
+            raise InputError("motion: t and x must be 1-D arrays of equal length >= 2")
         if not (np.all(np.isfinite(t)) and np.all(np.isfinite(x))):
-            raise ValueError("motion: t and x must be finite")
+            raise InputError("motion: t and x must be finite")
         if np.any(np.diff(t) <= 0) or t[0] > 0:
-            raise ValueError("motion: t must increase strictly and start at or before 0 s")
+            raise InputError("motion: t must increase strictly and start at or before 0 s")
         p = PchipInterpolator(t, x)
         object.__setattr__(self, "t", t)
         object.__setattr__(self, "x", x)
@@ -130,7 +130,7 @@ def _resolve(damper):
     damper = dampers.preset(damper) if isinstance(damper, str) else damper
     if getattr(damper, "law", None) == dampers.LAW_IDEAL:
         # its force is a controller's demand, not a function of the motion: nothing to test
-        raise ValueError(
+        raise InputError(
             "damper = 'ideal': the ideal actuator has no force law of its own to "
             "drive on the rig (it applies a vehicle controller's demand); allowed: "
             f"{', '.join(dampers.PRESETS)} or a model from railride.secondary.dampers"
@@ -167,16 +167,16 @@ def drive(
         k for k, v in (("voltage", voltage), ("command", command), ("desired_force", desired_force)) if v is not None
     ]
     if len(given) != 1:
-        raise ValueError("give exactly one of voltage, command or desired_force")
+        raise InputError("give exactly one of voltage, command or desired_force")
     if hasattr(motion, "end") and motion.end() < duration - 1e-12:
-        raise ValueError(f"motion: the samples end at {motion.end():g} s, before the run's {duration:g} s")
+        raise InputError(f"motion: the samples end at {motion.end():g} s, before the run's {duration:g} s")
     n_steps = int(round(duration / dt))
     if abs(n_steps * dt - duration) > 1e-9 * duration or n_steps < 1:
-        raise ValueError(f"duration = {duration:g} s must be a whole number of steps dt = {dt:g} s")
+        raise InputError(f"duration = {duration:g} s must be a whole number of steps dt = {dt:g} s")
     output_rate = 1.0 / dt if output_rate is None else _check_number("output_rate", output_rate, "positive", "Hz")
     stride = int(round(1.0 / (output_rate * dt)))
     if stride < 1 or abs(stride * output_rate * dt - 1) > 1e-6:
-        raise ValueError(f"output_rate = {output_rate:g} Hz: 1/(output_rate dt) must be a whole number")
+        raise InputError(f"output_rate = {output_rate:g} Hz: 1/(output_rate dt) must be a whole number")
     _check_size(motion, duration, dt, n_steps, stride, np.size(voltage) if voltage is not None else 1, voltage is None)
     xtab, interval = _motion_table(motion, duration, dt)
     t_steps = np.arange(n_steps + 1) * dt
@@ -191,7 +191,7 @@ def drive(
         fn = command if command is not None else desired_force
         series = np.asarray(np.broadcast_to(fn(t_steps), t_steps.shape), dtype=float)[None, :].copy()
         if not np.all(np.isfinite(series)):
-            raise ValueError(f"{given[0]}: the function returned a non-finite value")
+            raise InputError(f"{given[0]}: the function returned a non-finite value")
         mode = layout.RIG_COMMANDED if command is not None else layout.RIG_TRACKING
     if mode == layout.RIG_TRACKING:
         B = _check_number("B", B, "nonnegative", "")
@@ -358,11 +358,11 @@ def cycles(
     if np.ndim(voltages) == 0:
         voltages = [voltages]
     if len(set(float(v) for v in voltages)) != len(voltages):
-        raise ValueError(f"voltages = {list(voltages)!r}: each voltage once")
+        raise InputError(f"voltages = {list(voltages)!r}: each voltage once")
     period = 1.0 / motion.frequency
     steps_per_cycle = int(round(period / dt))
     if steps_per_cycle < 100:
-        raise ValueError(
+        raise InputError(
             f"frequency = {frequency!r} Hz: a cycle of {period:.3g} s is under 100 steps of "
             f"dt = {dt:g} s; lower the frequency or dt"
         )
@@ -525,7 +525,7 @@ def track(
     motion = SineMotion(stroke, frequency, phase_deg=-90.0)
     period = 1.0 / frequency
     if period < 100 * dt:
-        raise ValueError(
+        raise InputError(
             f"frequency = {frequency!r} Hz: a cycle of {period:.3g} s is under 100 steps of "
             f"dt = {dt:g} s; lower the frequency or dt"
         )

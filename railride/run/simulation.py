@@ -14,7 +14,7 @@ from railride.engine import kernels, layout
 from railride.engine import lanes
 from railride import limits
 from railride.defaults import DEFAULT_DT
-from railride.errors import DivergenceError, Interrupted
+from railride.errors import DivergenceError, InputError, Interrupted
 from railride.secondary.faults import fault_table
 from railride.secondary.sensing import reads_bogies
 from railride.model.params import VehicleParams
@@ -119,7 +119,7 @@ def _exact(solver, damper, closed, suspensions, n_vehicles: int = 1) -> bool:
     )
     linear = (passive or actuator) and not faults
     if solver.method == "exact" and not linear:
-        raise ValueError(
+        raise InputError(
             "method = 'exact': applies where the vehicle is linear only: the passive viscous "
             "suspension, or an outer loop on the ideal actuator with exact states; MR dampers, the "
             "ideal semi-active damper, sensing, sensor noise and faults run with method 'rk4' or 'auto'"
@@ -140,12 +140,12 @@ def _check_dt(vehicle: Vehicle, dt: float, damper=None) -> None:
         stiffer = "" if not has_damper_states(damper) else f", stiffer with the {damper.model} dampers"
         why = f"(fastest mode {fastest.label}, {shown(fastest.frequency_hz)} Hz{stiffer})"
         if not dt_max > 0.0:  # the bisection found no stable step: eigenvalues past what it can resolve
-            raise ValueError(
+            raise InputError(
                 f"dt = {shown(dt)} s: no step keeps fourth-order Runge-Kutta stable for this vehicle {why}; "
                 "check its masses and stiffnesses"
             )
         default = f" (the default {DEFAULT_DT:g} s is accurate)" if DEFAULT_DT <= dt_max else ""
-        raise ValueError(
+        raise InputError(
             f"dt = {shown(dt)} s is too large: fourth-order Runge-Kutta is unstable for this vehicle {why}; "
             f"use dt <= {shown(dt_max)} s{default}"
         )
@@ -171,7 +171,7 @@ def _check_size(scenarios, solver: SolverSettings, damper, closed, exact: bool, 
         "shorten the duration, lower output_rate, run fewer samples at once or use a dt nearer the default",
     )
     if exact and period > _MAX_EXACT_PHASES:  # each phase costs matrix exponentials, 1-2 ms each
-        raise ValueError(
+        raise InputError(
             f"dt = {shown(dt)} s: the exact discretisation would build {period} step maps (the output "
             f"interval, {stride} steps, and the input table's node spacing, {m} steps, line up again "
             f"only every {period} output samples); use a dt that divides both evenly, such as the "
@@ -202,7 +202,7 @@ def _full_state_gains(G, controller) -> np.ndarray:
     if G.shape == (4, 2 * N_DOF):
         return G
     if G.shape != (4, 6):
-        raise ValueError(
+        raise InputError(
             f"controller {getattr(controller, 'name', controller)!r}: gains(vehicle) gave G of shape {G.shape}; "
             f"allowed (4, 6) on the carbody states or (4, {2 * N_DOF}) on (q, q')"
         )
@@ -216,7 +216,7 @@ def _as_suspensions(suspension) -> list[Suspension]:
     items = [Suspension() if s is None else s for s in items]
     for s in items:
         if not isinstance(s, Suspension):
-            raise ValueError(f"suspension = {s!r}: must be a railride.Suspension, a list of them, or None (passive)")
+            raise InputError(f"suspension = {s!r}: must be a railride.Suspension, a list of them, or None (passive)")
     return items
 
 
@@ -288,7 +288,7 @@ def simulate(
     solver = SolverSettings.of(solver)
     dt, output_rate = solver.dt, solver.output_rate
     if on_divergence not in ("raise", "mark"):
-        raise ValueError(
+        raise InputError(
             f"on_divergence = {on_divergence!r}: allowed 'raise' (stop with an error) "
             "or 'mark' (keep the other samples; see RideResult.diverged_at)"
         )
@@ -303,25 +303,25 @@ def simulate(
     counts = (len(scenarios), len(param_sets), len(suspensions))
     n = max(counts)
     if any(k not in (1, n) for k in counts):
-        raise ValueError(
+        raise InputError(
             f"a batch needs equally many scenarios, parameter sets and suspensions, "
             f"or one of each; got {counts[0]} scenarios, {counts[1]} parameter sets "
             f"and {counts[2]} suspensions"
         )
     if n == 0:
-        raise ValueError("an empty batch: give at least one scenario")
+        raise InputError("an empty batch: give at least one scenario")
     scenarios = scenarios * (n // len(scenarios))
     param_sets = param_sets * (n // len(param_sets))
     suspensions = suspensions * (n // len(suspensions))
     duration = scenarios[0].duration
     if any(abs(s.duration - duration) > 1e-12 * duration for s in scenarios):
-        raise ValueError(
+        raise InputError(
             "every sample of a batch must have the same duration; got "
             + ", ".join(sorted({f"{s.duration:g} s" for s in scenarios}))
         )
     conflict = batch_conflict(suspensions)
     if conflict is not None:
-        raise ValueError(conflict)
+        raise InputError(conflict)
     damper = suspensions[0].damper
     vcmd = np.array([[_command_voltage(s)] * 4 for s in suspensions], dtype=float)
     closed = _closed_loop(suspensions, solver, duration)
@@ -336,7 +336,7 @@ def simulate(
     n_out_f = duration * output_rate
     n_out = int(round(n_out_f))
     if abs(n_out - n_out_f) > 1e-6 * max(1.0, n_out_f) or n_out < 1:
-        raise ValueError(f"duration = {duration:g} s must be a whole number of output intervals (1/{output_rate:g} Hz)")
+        raise InputError(f"duration = {duration:g} s must be a whole number of output intervals (1/{output_rate:g} Hz)")
     n_steps = n_out * stride
     for sc in scenarios:  # the track's shortest wavelength must show in the output
         check_resolution(sc, output_rate)
@@ -394,7 +394,7 @@ def simulate(
             modes[i] = dampers.VOLTAGE_LAWS.index(getattr(c, "voltage_law", "tracking"))
             if closed["sensing"] is not None:
                 if reads_bogies(gm[i]):
-                    raise ValueError(
+                    raise InputError(
                         f"sensing with controller {c.name!r}: it reads the bogies' states, and the "
                         "accelerometers are on the carbody only (railride.secondary.sensing)"
                     )
@@ -406,7 +406,7 @@ def simulate(
     if initial_state is not None:
         x0 = np.asarray(initial_state, dtype=float)
         if x0.shape not in ((2 * N_DOF,), (n, 2 * N_DOF)) or not np.all(np.isfinite(x0)):
-            raise ValueError(
+            raise InputError(
                 f"initial_state must hold {2 * N_DOF} finite numbers (q then q') "
                 f"or one such row per sample; got shape {x0.shape}"
             )

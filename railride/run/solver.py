@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from railride.errors import InputError
 from railride import validation
 from railride.defaults import DEFAULT_CONTROL_RATE, DEFAULT_DT, DEFAULT_OUTPUT_RATE
 
@@ -52,13 +53,13 @@ class SolverSettings:
             object.__setattr__(self, name, validation.number(name, getattr(self, name), "positive", unit))
         validation.choice("method", self.method, METHODS)
         if self.dt * self.output_rate > 1.0 + 1e-6:
-            raise ValueError(
+            raise InputError(
                 f"dt = {self.dt:g} s is too large for output_rate = {self.output_rate:g} Hz: "
                 f"at most one output sample per step; use dt <= {1.0 / self.output_rate:g} s "
                 "or a lower output_rate"
             )
         if _steps(1.0 / (self.output_rate * self.dt)) is None:
-            raise ValueError(
+            raise InputError(
                 f"output_rate = {self.output_rate:g} Hz with dt = {self.dt:g} s: the output "
                 "interval 1/output_rate must be a whole number of steps (at most one "
                 "sample per step)"
@@ -76,14 +77,14 @@ class SolverSettings:
         is not a whole number of steps (the check a closed loop needs), or, given the run's
         ``duration`` [s], when the controller would not sample again within it."""
         if duration is not None and self.control_rate * duration < 1.0:
-            raise ValueError(
+            raise InputError(
                 f"control_rate = {self.control_rate:.4g} Hz: the controller would sample once every "
                 f"{1.0 / self.control_rate:.4g} s, not once within the run's {duration:.4g} s; use "
                 f"control_rate >= {1.0 / duration:.4g} Hz"
             )
         steps = _steps(1.0 / (self.control_rate * self.dt))
         if steps is None:
-            raise ValueError(
+            raise InputError(
                 f"control_rate = {self.control_rate:g} Hz with dt = {self.dt:g} s: the "
                 "controller period must be a whole number of steps"
             )
@@ -103,7 +104,7 @@ class SolverSettings:
         if solver is None:
             return cls()
         if not isinstance(solver, cls):
-            raise ValueError(f"solver = {solver!r}: must be a railride.SolverSettings or None (the defaults)")
+            raise InputError(f"solver = {solver!r}: must be a railride.SolverSettings or None (the defaults)")
         return solver
 
 
@@ -129,7 +130,7 @@ def check_resolution(scenario, output_rate: float) -> None:
         return
     name, lam = found
     shortest = RESOLUTION * scenario.speed / output_rate
-    raise ValueError(
+    raise InputError(
         f"{name} = {lam:.4g} m at speed {scenario.speed:.4g} m/s passes at "
         f"{scenario.speed / lam:.4g} Hz, more than output_rate {output_rate:.4g} Hz / {RESOLUTION:g} = "
         f"{output_rate / RESOLUTION:.4g} Hz can resolve: the shortest {name} allowed is {shortest:.4g} m; "

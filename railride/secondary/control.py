@@ -35,6 +35,7 @@ from typing import Callable, ClassVar, NamedTuple
 
 import numpy as np
 
+from railride.errors import InputError
 from railride.secondary.controllers import (  # noqa: F401 (carbody_map, decoupling, ZeroDemand: their home before)
     ClippedOptimal,
     GainTable,
@@ -273,7 +274,7 @@ class GainSet:
                     object.__setattr__(self, "from_reference", (*self.from_reference, t))
         for t, (key, kind) in _TABLES.items():
             if type(getattr(self, t)) is not kind:  # SkyhookOnOff is a Skyhook, but not its table
-                raise ValueError(f"{t} = {getattr(self, t)!r}: must be a railride {kind.__name__} (table [{key}])")
+                raise InputError(f"{t} = {getattr(self, t)!r}: must be a railride {kind.__name__} (table [{key}])")
 
     @classmethod
     def entry_names(cls, table: str) -> tuple[str, ...]:
@@ -296,7 +297,7 @@ class GainSet:
         if controller in CONSTANT_VOLTAGE:
             return ()
         if controller not in _OUTER_LOOPS:
-            raise ValueError(f"controller = {controller!r}: allowed {', '.join(CONTROLLERS[1:])}")
+            raise InputError(f"controller = {controller!r}: allowed {', '.join(CONTROLLERS[1:])}")
         loop = _OUTER_LOOPS[controller]
         return ("inner",) * loop.inner + loop.tables
 
@@ -316,7 +317,7 @@ class GainSet:
     @classmethod
     def _table_name(cls, table: str) -> str:
         if table not in cls.TABLES:
-            raise ValueError(f"gain table {table!r}: allowed {', '.join(cls.TABLES)}")
+            raise InputError(f"gain table {table!r}: allowed {', '.join(cls.TABLES)}")
         return table
 
     def table(self, name: str):
@@ -327,10 +328,10 @@ class GainSet:
         """The gain called "table.entry", e.g. "pid.kp"."""
         table, _, name = entry.partition(".")
         if table not in self.TABLES or not name:
-            raise ValueError(f"gain {entry!r}: expected table.entry with table one of {', '.join(self.TABLES)}")
+            raise InputError(f"gain {entry!r}: expected table.entry with table one of {', '.join(self.TABLES)}")
         gains = self.table(table)
         if name not in gains.to_dict():
-            raise ValueError(f"unknown gain {entry!r}; allowed: {', '.join(self.entry_names(table))}")
+            raise InputError(f"unknown gain {entry!r}; allowed: {', '.join(self.entry_names(table))}")
         return float(getattr(gains, name))
 
     def entries(self, tables=TABLES) -> dict[str, float]:
@@ -344,7 +345,7 @@ class GainSet:
         for name, value in changes.items() if isinstance(changes, dict) else changes:
             table, _, entry = name.partition(".")
             if table not in self.TABLES or not entry:
-                raise ValueError(f"gain {name!r}: expected table.entry with table one of {', '.join(self.TABLES)}")
+                raise InputError(f"gain {name!r}: expected table.entry with table one of {', '.join(self.TABLES)}")
             grouped.setdefault(table, {})[entry] = value
         tables = {t: self.table(t) for t in self.TABLES}
         for table, entries in grouped.items():
@@ -391,7 +392,7 @@ class GainSet:
         if name == "passive" or name in CONSTANT_VOLTAGE:
             return None
         if name not in _OUTER_LOOPS:
-            raise ValueError(f"unknown controller {name!r}; allowed: {', '.join(CONTROLLERS)}")
+            raise InputError(f"unknown controller {name!r}; allowed: {', '.join(CONTROLLERS)}")
         return _OUTER_LOOPS[name].build(self)
 
     def to_toml(self, tables=TABLES) -> str:
@@ -431,11 +432,11 @@ class GainSet:
         try:
             data = tomllib.loads(text)
         except ValueError as exc:
-            raise ValueError(f"{source}: not valid TOML: {validation.toml_error(exc)}") from None
+            raise InputError(f"{source}: not valid TOML: {validation.toml_error(exc)}") from None
         unknown_top = sorted(set(data) - {"inner", "pid", "sas", "provenance", *_LATER_TABLES, "skyhook_on_off"})
         if unknown_top:
             allowed = ", ".join(f"[{key}]" for key, _ in _TABLES.values())
-            raise ValueError(f"{source}: unknown table(s) {', '.join(unknown_top)}; allowed: {allowed}, [provenance]")
+            raise InputError(f"{source}: unknown table(s) {', '.join(unknown_top)}; allowed: {allowed}, [provenance]")
         built = {}
         for t, (key, kind) in _TABLES.items():
             head, _, sub = key.partition(".")
@@ -446,24 +447,24 @@ class GainSet:
                 continue  # GainSet takes the reference values (or the shared table's) and records it
             names = [f.name for f in dataclasses.fields(kind)]
             if not isinstance(table, dict):
-                raise ValueError(f"{source}: missing table [{key}] with entries {', '.join(names)}")
+                raise InputError(f"{source}: missing table [{key}] with entries {', '.join(names)}")
             unknown = sorted(set(table) - set(names))
             if unknown:
-                raise ValueError(f"{source}: unknown entry {unknown[0]!r} in [{key}]; allowed: {', '.join(names)}")
+                raise InputError(f"{source}: unknown entry {unknown[0]!r} in [{key}]; allowed: {', '.join(names)}")
             missing = [n for n in names if n not in table]
             if missing:
-                raise ValueError(f"{source}: missing entry {missing[0]!r} in [{key}]")
+                raise InputError(f"{source}: missing entry {missing[0]!r} in [{key}]")
             for n in names:
                 v = table[n]
                 if not validation.is_number(v):
-                    raise ValueError(f"{source}: entry {n!r} in [{key}] = {validation.shown(v)} is not a number")
+                    raise InputError(f"{source}: entry {n!r} in [{key}] = {validation.shown(v)} is not a number")
             try:
                 built[t] = kind(**table)
             except ValueError as exc:
-                raise ValueError(f"{source}: [{key}] {exc}") from None
+                raise InputError(f"{source}: [{key}] {exc}") from None
         provenance = data.get("provenance", {})
         if not isinstance(provenance, dict):
-            raise ValueError(f"{source}: [provenance] must be a table, not {provenance!r}")
+            raise InputError(f"{source}: [provenance] must be a table, not {provenance!r}")
         return cls(**built, source=source, provenance=provenance)
 
     @classmethod
@@ -472,7 +473,7 @@ class GainSet:
         try:
             text = path.read_text(encoding="utf-8")
         except OSError as exc:
-            raise ValueError(f"cannot read gains file {path}: {exc.strerror}") from None
+            raise InputError(f"cannot read gains file {path}: {exc.strerror}") from None
         return cls.from_toml(text, source=str(path))
 
     @classmethod

@@ -24,6 +24,7 @@ from typing import ClassVar
 import numpy as np
 import scipy.linalg
 
+from railride.errors import InputError
 from railride.model import plausible
 from railride.validation import is_number, param, shown, validate_fields
 from railride.model.vehicle import N_DOF, Vehicle
@@ -62,7 +63,7 @@ class GainTable:
     def replace(self, **changes):
         unknown = set(changes) - {f.name for f in dataclasses.fields(self)}
         if unknown:
-            raise ValueError(
+            raise InputError(
                 f"unknown gain(s) {', '.join(sorted(unknown))} for {self.name}; allowed: "
                 f"{', '.join(f.name for f in dataclasses.fields(self))}"
             )
@@ -163,7 +164,7 @@ class Hybrid(GainTable):
     def __post_init__(self):
         a = self.alpha
         if is_number(a) and math.isfinite(float(a)) and not 0.0 <= float(a) <= 1.0:
-            raise ValueError(
+            raise InputError(
                 f"hybrid gain 'alpha' = {shown(a)} (share of the skyhook demand, -): must be a number in [0, 1]"
             )
         validate_fields(self, "hybrid gain", plausible.HYBRID)

@@ -36,6 +36,7 @@ from typing import ClassVar
 
 import numpy as np
 
+from railride.errors import InputError
 from railride import validation
 from railride.engine.layout import (  # the engine's codes and slots (loads no numba)
     LAW_BOUC_WEN,
@@ -74,7 +75,7 @@ class _Damper:
     def replace(self, **changes):
         unknown = set(changes) - {f.name for f in dataclasses.fields(self)}
         if unknown:
-            raise ValueError(
+            raise InputError(
                 f"unknown damper parameter(s) {', '.join(sorted(unknown))}; allowed: "
                 f"{', '.join(f.name for f in dataclasses.fields(self))}"
             )
@@ -93,7 +94,7 @@ class _Damper:
 
     def check_voltage(self, v: float, name: str = "voltage") -> float:
         if not (validation.obeys(v, "finite") and self.v_min <= v <= self.v_max):
-            raise ValueError(
+            raise InputError(
                 f"{name} = {validation.shown(v)} V: must lie in [{self.v_min:g}, {self.v_max:g}] V "
                 f"for this {self.model} damper"
             )
@@ -269,7 +270,7 @@ class Ideal(_Damper):
         return F, 0.0 * z, 0.0 * z, 0.0 * z
 
     def scaled(self, factor: float):
-        raise ValueError(
+        raise InputError(
             f"factor = {factor!r}: the ideal actuator applies the demand exactly and has no force capacity to scale"
         )
 
@@ -283,20 +284,20 @@ def check_scale(name: str, value) -> float:
         name, value, "positive", allowed="a finite number > 0 (the factor on the damper's force parameters)"
     )
     if not r.low <= scale <= r.high:
-        raise ValueError(f"{name} = {validation.shown(value)}: must be between {r.low:g} and {r.high:g} ({r.why})")
+        raise InputError(f"{name} = {validation.shown(value)}: must be between {r.low:g} and {r.high:g} ({r.why})")
     return scale
 
 
 def _check_shape(d) -> None:
     if d.n < 1:
-        raise ValueError(f"damper parameter 'n' = {d.n!r}: must be >= 1")
+        raise InputError(f"damper parameter 'n' = {d.n!r}: must be >= 1")
     if d.gamma + d.beta <= 0:
-        raise ValueError(
+        raise InputError(
             f"damper parameters gamma = {d.gamma!r}, beta = {d.beta!r}: gamma + beta must be "
             "> 0, or the hysteretic variable grows without bound"
         )
     if d.v_max <= d.v_min:
-        raise ValueError(f"damper voltage range [{d.v_min!r}, {d.v_max!r}] V: v_max must exceed v_min")
+        raise InputError(f"damper voltage range [{d.v_min!r}, {d.v_max!r}] V: v_max must exceed v_min")
 
 
 def _bouc_wen_z_rate(z, w, A, n, gamma, beta):
@@ -372,7 +373,7 @@ def preset(name: str):
     try:
         return PRESETS[name]
     except (KeyError, TypeError):
-        raise ValueError(f"unknown damper model {name!r}; allowed: {', '.join(NAMES)}") from None
+        raise InputError(f"unknown damper model {name!r}; allowed: {', '.join(NAMES)}") from None
 
 
 def stiffness_estimate(damper, xd: float, z: float, u: float) -> float:

@@ -18,6 +18,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from railride.errors import InputError
 from railride.secondary import dampers
 from railride.engine import layout
 from railride.validation import number, shown
@@ -37,9 +38,9 @@ class DamperFault:
 
     def __post_init__(self):
         if self.corner not in CORNER_NAMES:
-            raise ValueError(f"fault corner = {self.corner!r}: allowed {', '.join(CORNER_NAMES)}")
+            raise InputError(f"fault corner = {self.corner!r}: allowed {', '.join(CORNER_NAMES)}")
         if self.mode not in FAULT_MODES:
-            raise ValueError(f"fault mode = {self.mode!r}: allowed {', '.join(FAULT_MODES)}")
+            raise InputError(f"fault mode = {self.mode!r}: allowed {', '.join(FAULT_MODES)}")
         t = number("fault time", self.time, "nonnegative", "s")
         object.__setattr__(self, "time", t)
 
@@ -49,7 +50,7 @@ class DamperFault:
         body, _, when = str(text).strip().partition("@")
         corner, _, mode = body.partition("-")
         if not corner or not mode:
-            raise ValueError(
+            raise InputError(
                 f"fault = {text!r}: expected CORNER-MODE[@TIME], e.g. 1R-off or 2L-on@2.5 "
                 f"(corners {', '.join(CORNER_NAMES)}; modes {', '.join(FAULT_MODES)})"
             )
@@ -58,7 +59,7 @@ class DamperFault:
             try:
                 time = float(when)
             except ValueError:
-                raise ValueError(f"fault = {text!r}: the time after @ must be a number of seconds") from None
+                raise InputError(f"fault = {text!r}: the time after @ must be a number of seconds") from None
         return cls(corner, mode, time)
 
     @property
@@ -78,7 +79,7 @@ def parse_faults(faults) -> tuple:
     corners = [f.corner for f in out]
     twice = sorted({c for c in corners if corners.count(c) > 1})
     if twice:
-        raise ValueError(f"faults: corner {twice[0]} has more than one fault; give one per corner")
+        raise InputError(f"faults: corner {twice[0]} has more than one fault; give one per corner")
     return tuple(sorted(out, key=lambda f: CORNER_NAMES.index(f.corner)))
 
 
@@ -87,14 +88,14 @@ def check_faults(faults, model) -> tuple:
     vehicle's passive dampers)."""
     out = parse_faults(faults)
     if out and model is None:
-        raise ValueError(
+        raise InputError(
             "faults apply to the dampers the engine steps (MR, ideal, or a railride.secondary.dampers.Viscous); "
             "the vehicle's own passive dampers sit in its damping matrix"
         )
     coil = model is not None and model.law in (dampers.LAW_BOUC_WEN, dampers.LAW_SPENCER)
     for f in out:
         if f.mode != "disconnected" and not coil:
-            raise ValueError(
+            raise InputError(
                 f"fault {f.label!r}: 'off' and 'on' need MR dampers (a coil to fail); "
                 f"damper {getattr(model, 'model', model)!r} can only be 'disconnected'"
             )
@@ -110,7 +111,7 @@ def fault_table(faults_per_sample, dt: float, duration: float):
     for i, faults in enumerate(faults_per_sample):
         for f in faults:
             if not f.time < duration:
-                raise ValueError(
+                raise InputError(
                     f"fault {f.label!r}: time = {shown(f.time)} s is not within the run (0 to {duration:g} s)"
                 )
             c = CORNER_NAMES.index(f.corner)

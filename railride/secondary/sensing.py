@@ -24,6 +24,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from railride.errors import InputError
 from railride.engine import layout
 from railride.model import plausible
 from railride.validation import validate_fields
@@ -58,12 +59,12 @@ class Accelerometers:
     def check(self, control_rate: float, dt: float) -> None:
         """The filter must be resolved by the step, and sampled below its Nyquist limit."""
         if 2 * math.pi * self.antialias_hz * dt > 0.5:
-            raise ValueError(
+            raise InputError(
                 f"accelerometer antialias_hz = {self.antialias_hz:g} Hz: too fast for dt = {dt:g} s "
                 f"(2 pi f dt must be <= 0.5; at most {0.5 / (2 * math.pi * dt):.4g} Hz)"
             )
         if not self.cutoff_hz < control_rate / 10:
-            raise ValueError(
+            raise InputError(
                 f"accelerometer cutoff_hz = {self.cutoff_hz:g} Hz: must be below a tenth of the "
                 f"controller rate ({control_rate:g} Hz)"
             )

@@ -26,6 +26,7 @@ import functools
 from dataclasses import dataclass
 from typing import Any
 
+from railride.errors import InputError
 from railride.secondary import dampers
 from railride.engine import layout
 from railride import validation
@@ -44,7 +45,7 @@ def damper_model(name: str, damper_scale: float = 1.0):
     """The damper called ``name`` (`railride.secondary.dampers.preset`) with its force capacity times
     ``damper_scale``; a scale other than 1 for an ideal device is a ValueError (it has none)."""
     if not isinstance(name, str):
-        raise ValueError(
+        raise InputError(
             f"damper = {name!r}: must be a name ({', '.join(dampers.NAMES)}); scale a preset with damper_scale"
         )
     scale = dampers.check_scale("damper_scale", damper_scale)
@@ -52,7 +53,7 @@ def damper_model(name: str, damper_scale: float = 1.0):
     if scale == 1.0:
         return model
     if model.law == dampers.LAW_IDEAL:
-        raise ValueError(
+        raise InputError(
             f"damper_scale = {scale:g}: the ideal actuator applies the demand "
             "exactly and has no force capacity to scale (leave damper_scale at 1)"
         )
@@ -78,7 +79,7 @@ def _model(damper):
         return dampers.preset(damper)
     if isinstance(damper, (dampers.Viscous, dampers.BoucWen, dampers.Ideal)):  # Spencer is a BoucWen
         return damper
-    raise ValueError(
+    raise InputError(
         f"damper = {damper!r}: must be None (passive), a name "
         f"({', '.join(dampers.NAMES)}) or a model from railride.secondary.dampers"
     )
@@ -128,49 +129,49 @@ class Suspension:
         what = "controller periods from a sample of the states to its demand taking effect"
         object.__setattr__(self, "delay", validation.integer("delay", self.delay, 1, layout.MAX_DELAY, what))
         if self.delay != 1 and self.controller is None:
-            raise ValueError(f"delay = {self.delay}: applies to a closed loop only (give controller= as well)")
+            raise InputError(f"delay = {self.delay}: applies to a closed loop only (give controller= as well)")
         if self.sensing is not None:
             from railride.secondary.sensing import Accelerometers
 
             if not isinstance(self.sensing, Accelerometers):
-                raise ValueError(
+                raise InputError(
                     f"sensing = {self.sensing!r}: must be a railride.secondary.sensing.Accelerometers, or None"
                 )
             if self.controller is None:
-                raise ValueError("sensing applies to a closed loop only (give controller= as well)")
+                raise InputError("sensing applies to a closed loop only (give controller= as well)")
             if self.sensor_noise is not None:
-                raise ValueError(
+                raise InputError(
                     "sensing with sensor_noise: the accelerometers have their own noise; give one or the other"
                 )
         object.__setattr__(self, "damper_scale", dampers.check_scale("damper_scale", self.damper_scale))
         c = self.controller
         if c is not None and not (hasattr(c, "gains") and hasattr(c, "name")):
-            raise ValueError(
+            raise InputError(
                 f"controller = {c!r}: must be an outer loop from railride.secondary.control (PID, SAS, ZeroDemand) "
                 "or railride.secondary.controllers, or None"
             )
         if c is not None and getattr(c, "voltage_law", "tracking") not in dampers.VOLTAGE_LAWS:
-            raise ValueError(
+            raise InputError(
                 f"controller {c.name!r} voltage_law = {c.voltage_law!r}: allowed {', '.join(dampers.VOLTAGE_LAWS)}"
             )
         if self.inner is not None and not isinstance(self.inner, InnerLoop):
-            raise ValueError(f"inner = {self.inner!r}: must be a railride.secondary.control.InnerLoop")
+            raise InputError(f"inner = {self.inner!r}: must be a railride.secondary.control.InnerLoop")
         if self.sensor_noise is not None and not isinstance(self.sensor_noise, SensorNoise):
-            raise ValueError(f"sensor_noise = {self.sensor_noise!r}: must be a railride.secondary.control.SensorNoise")
+            raise InputError(f"sensor_noise = {self.sensor_noise!r}: must be a railride.secondary.control.SensorNoise")
         ideal = model is not None and model.law == dampers.LAW_IDEAL
         if c is None:
             for name in ("inner", "sensor_noise"):
                 if getattr(self, name) is not None:
-                    raise ValueError(f"{name} applies to a closed loop only: give controller= as well")
+                    raise InputError(f"{name} applies to a closed loop only: give controller= as well")
             if ideal:
-                raise ValueError(
+                raise InputError(
                     f"damper = {model.model!r}: the ideal actuator applies an outer loop's "
                     "demand and needs controller= (PID or SAS); it has no voltage to set"
                     + (f" (got voltage = {self.voltage!r})" if self.voltage is not None else "")
                 )
             if model is None or model.law == dampers.LAW_VISCOUS:
                 if self.voltage is not None:
-                    raise ValueError(
+                    raise InputError(
                         f"voltage = {self.voltage!r}: applies to MR dampers only, give "
                         "damper= as well (the passive suspension has no command)"
                     )
@@ -179,23 +180,23 @@ class Suspension:
             object.__setattr__(self, "voltage", model.check_voltage(voltage))
             return
         if self.voltage is not None:
-            raise ValueError(
+            raise InputError(
                 f"voltage = {self.voltage!r} with controller = {c.name!r}: give either "
                 "voltage (open loop) or controller (closed loop), not both"
             )
         if model is None:
-            raise ValueError(
+            raise InputError(
                 f"controller = {c.name!r} with damper = None: a closed loop needs MR "
                 "dampers or an ideal device (Suspension.semi_active or Suspension.ideal)"
             )
         if model.law == dampers.LAW_VISCOUS:
-            raise ValueError(
+            raise InputError(
                 f"controller = {c.name!r}: a controller needs MR dampers or the ideal "
                 "actuator (a viscous damper has no command)"
             )
         if ideal:
             if self.inner is not None:
-                raise ValueError(
+                raise InputError(
                     f"inner = {self.inner!r}: the ideal devices apply the demand themselves and have no inner loop"
                 )
         elif self.inner is None:
@@ -222,7 +223,7 @@ class Suspension:
         """The passive viscous secondary dampers: the vehicle's c_sz, or ``damper`` (a
         `dampers.Viscous`) in their place."""
         if damper is not None and not isinstance(damper, dampers.Viscous):
-            raise ValueError(
+            raise InputError(
                 f"damper = {damper!r}: the passive suspension takes a "
                 "railride.secondary.dampers.Viscous or None (the vehicle's c_sz)"
             )
@@ -246,12 +247,12 @@ class Suspension:
             model = damper_model(damper, damper_scale)
         else:
             if dampers.check_scale("damper_scale", damper_scale) != 1.0:
-                raise ValueError(
+                raise InputError(
                     f"damper_scale = {damper_scale!r}: scales a damper given by name; scale a model with its scaled()"
                 )
             model = _model(damper)
         if model is None or model.law not in (dampers.LAW_BOUC_WEN, dampers.LAW_SPENCER):
-            raise ValueError(
+            raise InputError(
                 f"damper = {damper!r}: a semi-active suspension has MR dampers ("
                 f"{', '.join(dampers.PRESETS)} or a BoucWen / Spencer model); the "
                 "ideal devices are Suspension.ideal, the dashpots Suspension.passive"
@@ -263,12 +264,12 @@ class Suspension:
         """An ideal device under ``controller``: the ideal actuator (force = demand), or with
         ``dissipative`` the ideal semi-active damper (the demand where it dissipates, else 0)."""
         if controller is None:
-            raise ValueError(
+            raise InputError(
                 "controller = None: an ideal device applies an outer loop's demand; "
                 "give one (PID, SAS, or ZeroDemand for none)"
             )
         if not isinstance(dissipative, bool):
-            raise ValueError(f"dissipative = {dissipative!r}: must be True or False")
+            raise InputError(f"dissipative = {dissipative!r}: must be True or False")
         return cls(dampers.IDEAL_DAMPER if dissipative else dampers.IDEAL, None, controller, None, sensor_noise)
 
     @classmethod
@@ -290,22 +291,22 @@ class Suspension:
         is a voltage with a controller or with passive-on / passive-off (their name sets it),
         and an ideal device with mr, passive-on or passive-off (it has no voltage)."""
         if name not in NAMES:
-            raise ValueError(f"suspension = {name!r}; allowed: {', '.join(NAMES)}")
+            raise InputError(f"suspension = {name!r}; allowed: {', '.join(NAMES)}")
         model = damper_model(damper, 1.0)  # an unknown name fails here, for passive too
         if name == "passive":
             scale = dampers.check_scale("damper_scale", damper_scale)
             if scale != 1.0:
-                raise ValueError(
+                raise InputError(
                     f"damper_scale = {scale:g}: the passive viscous dampers have no force "
                     "capacity to scale; it applies to MR dampers only"
                 )
             if voltage is not None:
-                raise ValueError(
+                raise InputError(
                     f"voltage = {voltage!r}: applies to suspension 'mr' only (the passive suspension has no command)"
                 )
             return cls(None, None, None, None, sensor_noise)
         if (name == "mr" or name in CONSTANT_VOLTAGE) and model.law == dampers.LAW_IDEAL:
-            raise ValueError(
+            raise InputError(
                 f"damper = {damper!r} with suspension {name!r}: the ideal actuator applies a "
                 "controller's demand and has no constant voltage; use a controller"
             )
@@ -315,7 +316,7 @@ class Suspension:
             return cls(model, voltage, None, None, sensor_noise, scale)
         if name in CONSTANT_VOLTAGE:
             if voltage is not None:
-                raise ValueError(
+                raise InputError(
                     f"voltage = {voltage!r} with suspension {name!r}: its voltage is the damper's "
                     f"{CONSTANT_VOLTAGE[name]}; give a voltage with suspension 'mr'"
                 )

@@ -9,6 +9,7 @@ import json
 import numbers
 from dataclasses import asdict, dataclass
 
+from railride.errors import InputError
 from railride.defaults import DEFAULT_DAMPER
 from railride.secondary.control import CONSTANT_VOLTAGE
 from railride.secondary.suspension import NAMES, Suspension
@@ -53,7 +54,7 @@ class Case:
         from railride.secondary import dampers
 
         if self.suspension not in SUSPENSIONS:
-            raise ValueError(f"suspension = {self.suspension!r}; allowed: {', '.join(SUSPENSIONS)}")
+            raise InputError(f"suspension = {self.suspension!r}; allowed: {', '.join(SUSPENSIONS)}")
         object.__setattr__(self, "damper_scale", dampers.check_scale("damper_scale", self.damper_scale))
         for name in ("scenario_options", "vehicle", "gains"):
             value = getattr(self, name)
@@ -65,7 +66,7 @@ class Case:
         from railride.secondary.sensing import SENSING
 
         if self.sensing not in SENSING:
-            raise ValueError(f"sensing = {self.sensing!r}: allowed {', '.join(SENSING)}")
+            raise InputError(f"sensing = {self.sensing!r}: allowed {', '.join(SENSING)}")
         from railride.secondary.faults import DamperFault
 
         faults = (self.faults,) if isinstance(self.faults, (str, DamperFault)) else self.faults
@@ -73,7 +74,7 @@ class Case:
             self, "faults", tuple(f.label if isinstance(f, DamperFault) else DamperFault.parse(f).label for f in faults)
         )
         if self.noise and len(self.noise) != 4:
-            raise ValueError(f"noise = {self.noise!r}: four standard deviations or none")
+            raise InputError(f"noise = {self.noise!r}: four standard deviations or none")
         self._named(None)  # the suspension's checks, here rather than in a batch
 
     @property

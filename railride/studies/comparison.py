@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import xarray as xr
 
+from railride.errors import InputError
 from railride._version import __version__
 from railride.secondary import dampers
 from railride.secondary.control import CONSTANT_VOLTAGE, CONTROLLERS, LABELS, PAPER_CONTROLLERS, GainSet
@@ -54,9 +55,9 @@ def check_controllers(names) -> list[str]:
         names = list(CONTROLLERS)
     unknown = [n for n in names if n not in CONTROLLERS]
     if unknown:
-        raise ValueError(f"unknown controller {unknown[0]!r}; allowed: {', '.join(CONTROLLERS)}, or all")
+        raise InputError(f"unknown controller {unknown[0]!r}; allowed: {', '.join(CONTROLLERS)}, or all")
     if not names:
-        raise ValueError(f"no controller given; allowed: {', '.join(CONTROLLERS)}")
+        raise InputError(f"no controller given; allowed: {', '.join(CONTROLLERS)}")
     return [n for n in CONTROLLERS if n in names or n == "passive"]
 
 

@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from railride.errors import InputError
 from railride._io import atomic_write
 
 
@@ -70,9 +71,9 @@ class DaskExecutor:
         try:
             from distributed import Client
         except ImportError:
-            raise ValueError('the Dask executor needs dask.distributed: pip install "railride[distributed]"') from None
+            raise InputError('the Dask executor needs dask.distributed: pip install "railride[distributed]"') from None
         if (address is None) == (scheduler_file is None):
-            raise ValueError("give a scheduler address (tcp://host:port) or a scheduler file")
+            raise InputError("give a scheduler address (tcp://host:port) or a scheduler file")
         if scheduler_file is not None:
             address = self._address_from_file(scheduler_file, timeout)
         assert address is not None  # one of the two was given, checked above
@@ -84,7 +85,7 @@ class DaskExecutor:
             # not the default client: this executor's tasks only, the caller's Dask code untouched
             self.client = Client(address, timeout=timeout, set_as_default=False, security=security)
         except Exception as exc:  # answered the handshake, then failed: not a scheduler after all
-            raise ValueError(
+            raise InputError(
                 f"{where}: cannot reach the Dask scheduler at {address} within {timeout:g} s: "
                 f"{type(exc).__name__}: {_one_line(exc)}"
             ) from None
@@ -105,7 +106,7 @@ class DaskExecutor:
             except (OSError, ValueError, TypeError, KeyError) as exc:
                 problem = f"not a Dask scheduler file ({type(exc).__name__}: {exc})"
             if time.monotonic() >= deadline:
-                raise ValueError(f"scheduler file {str(path)!r}: {problem} after {timeout:g} s")
+                raise InputError(f"scheduler file {str(path)!r}: {problem} after {timeout:g} s")
             time.sleep(0.1)
 
     def map(self, fn, chunks):
@@ -180,10 +181,10 @@ def _security(address: str, security, where: str):
     try:
         scheme = parse_address(address)[0]
     except ValueError as exc:
-        raise ValueError(f"{where}: {_one_line(exc)}; {ALLOWED}") from None
+        raise InputError(f"{where}: {_one_line(exc)}; {ALLOWED}") from None
     security = Security() if security is None else security
     if scheme in ("tls", "wss") and security.get_connection_args("client").get("ssl_context") is None:
-        raise ValueError(
+        raise InputError(
             f"{where}: {scheme}:// needs the cluster's TLS certificates, and none are set: pass "
             "security= (a distributed.Security) from Python, or set distributed.comm.tls.ca-file, "
             ".client.cert and .client.key in Dask's configuration (DASK_DISTRIBUTED__COMM__TLS__CA_FILE "
@@ -211,14 +212,14 @@ def _reach(address: str, timeout: float, security, where: str) -> None:
             if scheme == "ucx"
             else f"unknown address scheme {scheme!r}"
         )
-        raise ValueError(f"{where}: {why}; {ALLOWED}")
+        raise InputError(f"{where}: {why}; {ALLOWED}")
     if scheme == "inproc":
         try:
             listener = global_manager.get_listener_for(loc)
         except ValueError:  # not an inproc address distributed could have made
             listener = None
         if listener is None:
-            raise ValueError(
+            raise InputError(
                 f"{where}: no scheduler of this process listens there (an inproc:// address reaches a "
                 f"scheduler started in the same Python process only); {ALLOWED}"
             )
@@ -226,7 +227,7 @@ def _reach(address: str, timeout: float, security, where: str) -> None:
     try:
         host, port = parse_host_port(loc)
     except ValueError as exc:
-        raise ValueError(f"{where}: {_one_line(exc)}; {ALLOWED}") from None
+        raise InputError(f"{where}: {_one_line(exc)}; {ALLOWED}") from None
     probe = min(timeout, PROBE_SECONDS)
     try:
         with socket.create_connection((host, port), timeout=probe) as sock:
@@ -234,21 +235,21 @@ def _reach(address: str, timeout: float, security, where: str) -> None:
             if scheme in ("tls", "wss") and context is not None:  # else the server logs a failed handshake
                 context.wrap_socket(sock, server_hostname=host).close()
     except ConnectionRefusedError:
-        raise ValueError(
+        raise InputError(
             f"{where}: cannot reach the Dask scheduler at {address}: nothing listens on port {port} of "
             f"{host} (connection refused); is the scheduler running, and is {port} its port (8786 by default)?"
         ) from None
     except socket.gaierror as exc:
-        raise ValueError(
+        raise InputError(
             f"{where}: cannot reach the Dask scheduler at {address}: unknown host {host!r} ({exc.strerror})"
         ) from None
     except (TimeoutError, socket.timeout):
-        raise ValueError(
+        raise InputError(
             f"{where}: cannot reach the Dask scheduler at {address}: {host} did not answer on port {port} "
             f"within {probe:g} s (a host that is down, or a firewall)"
         ) from None
     except OSError as exc:
-        raise ValueError(
+        raise InputError(
             f"{where}: cannot reach the Dask scheduler at {address}: {exc.strerror or _one_line(exc)}"
         ) from None
 
@@ -263,7 +264,7 @@ def _reach(address: str, timeout: float, security, where: str) -> None:
         with ThreadPoolExecutor(1) as pool:
             pool.submit(lambda: asyncio.run(asyncio.wait_for(once(), wait))).result()
     except Exception as exc:
-        raise ValueError(
+        raise InputError(
             f"{where}: cannot reach the Dask scheduler at {address}: port {port} accepts connections but "
             f"did not answer as a Dask scheduler within {wait:g} s ({type(exc).__name__}: {_one_line(exc)}); "
             "is it the dashboard's port (8787 by default) rather than the scheduler's (8786)?"
@@ -299,7 +300,7 @@ class RunTable:
         try:
             if self.path.exists():
                 if not resume:
-                    raise ValueError(
+                    raise InputError(
                         f"{self.path} exists: pass resume to continue that sweep, or choose another output folder"
                     )
                 self.frame = read_run_table(self.path)
@@ -343,9 +344,9 @@ def read_run_table(path: Path) -> pd.DataFrame:
         # keys are hex digests: an all-digit one must stay text to be recognised
         frame = pd.read_csv(path, dtype={"key": str})
     except (OSError, ValueError) as exc:
-        raise ValueError(f"cannot read the run table {path}: {' '.join(str(exc).split())}") from None
+        raise InputError(f"cannot read the run table {path}: {' '.join(str(exc).split())}") from None
     if "key" not in frame:
-        raise ValueError(f"run table {path}: no 'key' column; not a railride run table")
+        raise InputError(f"run table {path}: no 'key' column; not a railride run table")
     metrics = [c for c in (f"{r}_{s}" for r in RESPONSES for s in STATISTICS) if c in frame]
     values = frame[metrics].apply(pd.to_numeric, errors="coerce")
     diverged = pd.to_numeric(frame["diverged_at_s"], errors="coerce") if "diverged_at_s" in frame else None
@@ -360,7 +361,7 @@ def read_run_table(path: Path) -> pd.DataFrame:
         else:
             column = next(c for c in metrics if not np.isfinite(values[c].iloc[i]))
             problem = f"{column} = {frame[column].iloc[i]!r} is not a finite number (and the run did not diverge)"
-        raise ValueError(
+        raise InputError(
             f"run table {path}, line {i + 2} (run {i + 1}): {problem}; the file is damaged: "
             "delete that line to run it again, or start afresh in another folder"
         )
@@ -387,7 +388,7 @@ class _FolderLock:
             except BlockingIOError:
                 holder = os.read(fd, 200).decode("utf-8", "replace").strip() or "another process"
                 os.close(fd)
-                raise ValueError(
+                raise InputError(
                     f"output folder {folder} is in use by {holder} (lock {self.path}): two runs writing one "
                     "run table would lose rows; wait for it to finish, or choose another folder"
                 ) from None

@@ -18,6 +18,7 @@ import numbers
 from collections.abc import Mapping
 
 
+from railride.errors import InputError
 from railride import validation
 from railride.secondary.control import CONSTANT_VOLTAGE, OUTER_LOOPS, GainSet
 from railride.defaults import DEFAULT_DAMPER
@@ -152,7 +153,7 @@ def _values(words: _Words, key: str, values) -> list | None:
         values = [values]
     values = list(values)
     if not values:
-        raise ValueError(f"{words.given(key, values)}: give one or more values")
+        raise InputError(f"{words.given(key, values)}: give one or more values")
     return values
 
 
@@ -160,7 +161,7 @@ def _numbers(words: _Words, key: str, values, rule: str = "finite", unit: str = 
     """Every value obeying ``rule``, as floats."""
     for v in values:
         if not _obeys(v, rule):
-            raise ValueError(
+            raise InputError(
                 f"{words.name(key)} = {_g(v)}{' ' + unit if unit else ''}: must be {validation.rule_words(rule)}"
             )
     return [float(v) for v in values]
@@ -175,14 +176,14 @@ def _seeds(words: _Words, key: str, values, what: str) -> list[int]:
     ]
     for item in whole:
         if isinstance(item, bool) or not isinstance(item, numbers.Integral):
-            raise ValueError(
+            raise InputError(
                 f"{words.given(key, values)}: {_g(item)} is not a whole number; {what} are whole numbers >= 0"
             )
         v = int(item)
         if v < 0:
-            raise ValueError(f"{words.given(key, values)}: {v} is negative; {what} are whole numbers >= 0")
+            raise InputError(f"{words.given(key, values)}: {v} is negative; {what} are whole numbers >= 0")
         if v > validation.SEED_MAX:
-            raise ValueError(
+            raise InputError(
                 f"{words.given(key, values)}: {validation.shown(v)} is too large; {what} are at most 2**64 - 1"
             )
     return [int(v) for v in whole]
@@ -269,12 +270,12 @@ def grid(
     )
     damper_name = DEFAULT_DAMPER if damper is None else damper
     if damper_name not in dampers.NAMES:
-        raise ValueError(
+        raise InputError(
             f"{words.given('damper', damper_name)}: unknown damper model; allowed: {', '.join(dampers.NAMES)}"
         )
     if damper_name in dampers.IDEAL_NAMES and (has_mr or constant):
         fixed = "mr" if has_mr else constant[0]
-        raise ValueError(
+        raise InputError(
             f"{words.given('damper', damper_name)}: applies to the controllers only; "
             f"{fixed} runs at a constant voltage, which the ideal actuator has not "
             f"({words.name('suspensions')} is {listed})"
@@ -282,7 +283,7 @@ def grid(
     scales = None
     if damper_scale is not None:
         if damper_name in dampers.IDEAL_NAMES:
-            raise ValueError(
+            raise InputError(
                 f"{words.given('damper_scale', damper_scale)}: the ideal device "
                 f"({words.name('damper')} {damper_name}) applies the demand itself and has no "
                 "force capacity to scale"
@@ -321,7 +322,7 @@ def grid(
             window = check_window(tuple(window), run_duration)
         except ValueError as exc:  # "window = ..." in the caller's words
             name = words.name("window")
-            raise ValueError(str(exc).replace("window", name, 1) if name != "window" else str(exc)) from None
+            raise InputError(str(exc).replace("window", name, 1) if name != "window" else str(exc)) from None
 
     columns = ["suspension"] + [column for _, column, _ in axes]
     if scales is not None:
@@ -360,15 +361,15 @@ def _suspensions(words: _Words, given) -> tuple[str, list[str]]:
 
     items = [given] if isinstance(given, str) else list(given)
     if not items:
-        raise ValueError(f"{words.given('suspensions', items)}: give one or more of {', '.join(NAMES)}")
+        raise InputError(f"{words.given('suspensions', items)}: give one or more of {', '.join(NAMES)}")
     unknown = [s for s in items if s not in NAMES]
     if unknown:
-        raise ValueError(
+        raise InputError(
             f"{words.given('suspensions', given)}: unknown suspension {unknown[0]!r}; allowed: {', '.join(NAMES)}"
         )
     twice = [s for s in items if items.count(s) > 1]
     if twice:
-        raise ValueError(f"{words.given('suspensions', given)}: {twice[0]} is listed twice")
+        raise InputError(f"{words.given('suspensions', given)}: {twice[0]} is listed twice")
     return ", ".join(items), items
 
 
@@ -378,24 +379,24 @@ def _check_applies(words: _Words, listed: str, has_mr: bool, controllers: list, 
     controllers."""
     among = f"({words.name('suspensions')} is {listed})"
     if given["voltage"] is not None and not has_mr:
-        raise ValueError(
+        raise InputError(
             f"{words.given('voltage', given['voltage'])}: applies to {words.name('suspensions')} mr only {among}"
         )
     for key in ("gains", "noise", "base_gains"):
         if given[key] is not None and not controllers and (key != "gains" or given[key]):
             shown = getattr(given[key], "source", given[key])  # a GainSet by its file
-            raise ValueError(
+            raise InputError(
                 f"{words.given(key, shown)}: applies to the controllers {', '.join(OUTER_LOOPS)} only {among}"
             )
     if given["seed"] is not None and given["noise"] is None:
-        raise ValueError(
+        raise InputError(
             f"{words.given('seed', given['seed'])}: applies with {words.name('noise')} only "
             "(without it the measurements are ideal)"
         )
     for key in ("damper", "damper_scale"):
         if given[key] is not None and not (has_mr or controllers or constant):
             # passive-on and passive-off are mr runs
-            raise ValueError(f"{words.given(key, given[key])}: applies to mr and the controllers only {among}")
+            raise InputError(f"{words.given(key, given[key])}: applies to mr and the controllers only {among}")
 
 
 def _band(words: _Words, scenario: str, min_wavelength, max_wavelength) -> dict:
@@ -409,7 +410,7 @@ def _band(words: _Words, scenario: str, min_wavelength, max_wavelength) -> dict:
             out[key] = _numbers(words, key, [value], "positive", unit)[0]
     if out and scenario not in SPECTRA:
         key, unit = next(b for b in _BAND if b[0] in out)
-        raise ValueError(
+        raise InputError(
             f"{words.name(key)} = {out[key]:g} {unit}: applies to the random-track scenarios "
             f"({', '.join(SPECTRA)}) only, not to {words.name('scenario')} {scenario}"
         )
@@ -428,14 +429,14 @@ def _scenario_axes(words: _Words, scenario: str, **given) -> list:
         if keyword == "seed":
             values = _seeds(words, key, values, "track seeds")
             if scenario not in SPECTRA:
-                raise ValueError(
+                raise InputError(
                     f"{words.given(key, values)}: applies to the random-track scenarios "
                     f"({', '.join(SPECTRA)}) only, not to {words.name('scenario')} {scenario}"
                 )
         else:
             values = _numbers(words, key, values, unit=unit)
             if scenario in SPECTRA and key != "speed":
-                raise ValueError(
+                raise InputError(
                     f"{words.name(key)} = {values[0]:g} {unit}: does not apply to a random track "
                     f"({scenario}); its options are {words.name('track_seed')}, "
                     f"{words.name('min_wavelength')} and {words.name('max_wavelength')}"
@@ -459,16 +460,16 @@ def _gain_axes(words: _Words, gains: Mapping | None, controllers: list, listed: 
                 if table in GainSet.TABLES
                 else "inner.*, pid.*, attitude.*, ride.* (" + ", ".join(known[:5]) + ", ...)"
             )
-            raise ValueError(f"{given}: unknown gain {name!r}; allowed: {allowed}")
+            raise InputError(f"{given}: unknown gain {name!r}; allowed: {allowed}")
         bad = [v for v in values if not _obeys(v, "nonnegative")]
         if bad:
             finite = _obeys(bad[0], "finite")
-            raise ValueError(
+            raise InputError(
                 f"{given}: {_g(bad[0])} is {'negative' if finite else 'not a finite number'}; gains are >= 0"
             )
         acts_in = GAIN_CONTROLLERS[name.partition(".")[0]]
         if not any(c in acts_in for c in controllers):
-            raise ValueError(
+            raise InputError(
                 f"{given}: {name} acts in {', '.join(acts_in)} only, which "
                 f"{words.name('suspensions')} ({listed}) does not list"
             )
@@ -495,9 +496,9 @@ def _scenarios(words: _Words, scenario: str, axes: list, common: dict, min_given
             band = [(k, u) for k, u in _BAND if k in options]
             if band and "wavelength" in str(exc):
                 named = ", ".join(f"{words.name(k)} = {options[k]:g} {u}" for k, u in band)
-                raise ValueError(f"{named}: {exc}") from None
+                raise InputError(f"{named}: {exc}") from None
             if str(exc).startswith("unknown scenario"):
-                raise ValueError(f"{words.name('scenario')}: {exc}") from None
+                raise InputError(f"{words.name('scenario')}: {exc}") from None
             text, others = str(exc), []
             for (kw, _, _), v in zip(axes, combo):
                 key = _key(kw)
@@ -505,7 +506,7 @@ def _scenarios(words: _Words, scenario: str, axes: list, common: dict, min_given
                     text = words.name(key) + text[len(key) :]
                 else:
                     others.append(f"{words.name(key)} {v:g}")
-            raise ValueError(f"{', '.join(others)}: {text}" if others else text) from None
+            raise InputError(f"{', '.join(others)}: {text}" if others else text) from None
         _check_resolvable(words, scen, min_given, output_rate)
         if combo == combos[0]:
             record = scen.describe()
@@ -529,7 +530,7 @@ def _check_resolvable(words: _Words, scen, min_given: bool, output_rate: float) 
         field, lam = shortest_wavelength(scen.track) or ("min_wavelength", math.nan)
         mw, speed = words.name("wavelength" if field == "length" else field), words.name("speed")
         default = "" if min_given or field != "min_wavelength" else " (the default)"
-        raise ValueError(
+        raise InputError(
             f"{mw} = {lam:g} m{default} at {speed} {scen.speed:g} m/s is "
             f"{scen.speed / lam:g} Hz, more than the runs' output rate {output_rate:g} Hz / {RESOLUTION:g} = "
             f"{output_rate / RESOLUTION:g} Hz can resolve: raise {mw} or lower {speed}"

@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
+from railride.errors import InputError
 from railride import validation
 from railride.studies.comparison import check_controllers, compare
 from railride.secondary.control import LABELS, PAPER_CONTROLLERS, GainSet
@@ -94,11 +95,11 @@ class LeagueTable:
 def _cases(scenarios, speeds, track_seeds):
     for name in scenarios:
         if not isinstance(name, str):
-            raise ValueError(f"scenario = {name!r}: must be a scenario name")
+            raise InputError(f"scenario = {name!r}: must be a scenario name")
     speeds = [None] if speeds is None else [validation.number("speed", v, "positive", "m/s") for v in speeds]
     seeds = [validation.seed("track_seed", s) for s in track_seeds]
     if not seeds:
-        raise ValueError("track_seeds: give at least one seed (default 0)")
+        raise InputError("track_seeds: give at least one seed (default 0)")
     for name, v in itertools.product(scenarios, speeds):
         for seed in seeds if name in SPECTRA else [None]:
             yield name, v, seed
@@ -127,7 +128,7 @@ def league(
     ``progress(done_cases, total_cases)`` is called after each case."""
     scenarios = list(scenarios) if not isinstance(scenarios, str) else [scenarios]
     if not scenarios:
-        raise ValueError("scenarios: give at least one scenario name")
+        raise InputError("scenarios: give at least one scenario name")
     names = check_controllers(controllers)
     gains = GainSet.default() if gains is None else gains
     # every scenario is built (and checked) before the first run

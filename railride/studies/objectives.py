@@ -13,6 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from railride.errors import InputError
 from railride.analysis.metrics import RESPONSES
 
 #: the objectives, in the order the docs list them
@@ -33,7 +34,7 @@ def _number(name: str, value, rule: str, ok) -> float:
     except (TypeError, ValueError):
         x = math.nan
     if not (math.isfinite(x) and ok(x)):
-        raise ValueError(f"objective {name} = {value!r}: {rule}")
+        raise InputError(f"objective {name} = {value!r}: {rule}")
     return x
 
 
@@ -66,26 +67,26 @@ class Objective:
 
     def __post_init__(self):
         if self.kind not in OBJECTIVE_KINDS:
-            raise ValueError(f"objective kind = {self.kind!r}: unknown; allowed: {', '.join(OBJECTIVE_KINDS)}")
+            raise InputError(f"objective kind = {self.kind!r}: unknown; allowed: {', '.join(OBJECTIVE_KINDS)}")
         rule = "four numbers >= 0, not all 0 (acceleration, displacement, pitch, roll), for kind 'weighted'"
         if self.kind == "weighted":
             if self.weights is None:
-                raise ValueError(f"objective weights = None: {rule}")
+                raise InputError(f"objective weights = None: {rule}")
             try:
                 w = tuple(self.weights)
             except TypeError:
-                raise ValueError(f"objective weights = {self.weights!r}: {rule}") from None
+                raise InputError(f"objective weights = {self.weights!r}: {rule}") from None
             if len(w) != 4:
-                raise ValueError(f"objective weights = {self.weights!r}: {rule}")
+                raise InputError(f"objective weights = {self.weights!r}: {rule}")
             w = tuple(_number("weights", x, rule, lambda v: v >= 0) for x in w)
             if sum(w) == 0:
-                raise ValueError(f"objective weights = {self.weights!r}: {rule}")
+                raise InputError(f"objective weights = {self.weights!r}: {rule}")
             object.__setattr__(self, "weights", w)
         elif self.weights is not None:
-            raise ValueError(f"objective weights = {self.weights!r}: for kind 'weighted' only (kind is {self.kind!r})")
+            raise InputError(f"objective weights = {self.weights!r}: for kind 'weighted' only (kind is {self.kind!r})")
         if self.kind == "constrained":
             if self.bound is None:
-                raise ValueError(
+                raise InputError(
                     "objective bound = None: kind 'constrained' needs a bound, a "
                     "finite number > 0 (the largest RMS ratio to passive allowed)"
                 )
@@ -100,10 +101,10 @@ class Objective:
                 ),
             )
         elif self.bound is not None:
-            raise ValueError(f"objective bound = {self.bound!r}: for kind 'constrained' only (kind is {self.kind!r})")
+            raise InputError(f"objective bound = {self.bound!r}: for kind 'constrained' only (kind is {self.kind!r})")
         object.__setattr__(self, "penalty", _number("penalty", self.penalty, "a finite number >= 0", lambda v: v >= 0))
         if self.kind == "constrained" and not math.isfinite(self.feasible_max):
-            raise ValueError(
+            raise InputError(
                 f"objective bound = {self.bound!r} with penalty = {self.penalty!r}: "
                 "too large to rank infeasible candidates after feasible ones"
             )
@@ -133,7 +134,7 @@ class Objective:
         and scores +inf: after every run that did not."""
         r = np.asarray(ratio, dtype=float)
         if r.shape[-1:] != (4,):
-            raise ValueError(f"ratios of shape {r.shape}: the last axis must hold the four responses")
+            raise InputError(f"ratios of shape {r.shape}: the last axis must hold the four responses")
         if self.kind == "weighted":
             j = r @ np.array(self.weights)
         elif self.kind == "minimax":

@@ -27,6 +27,7 @@ import numpy as np
 import pandas as pd
 import scipy.optimize
 
+from railride.errors import InputError
 from railride.secondary.control import GainSet
 from railride.defaults import DEFAULT_DAMPER
 from railride.run.solver import SolverSettings
@@ -416,7 +417,7 @@ def sensitivity(
     bounds: n (d + 2) runs for d parameters (``n`` a power of two). ``params`` and ``solver``
     as for `optimise`."""
     if n < 2 or n & (n - 1):
-        raise ValueError(f"n = {n!r}: a power of two >= 2")
+        raise InputError(f"n = {n!r}: a power of two >= 2")
     ev = GainEvaluator(
         parameters,
         suspension,

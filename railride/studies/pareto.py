@@ -23,6 +23,7 @@ from typing import ClassVar
 import numpy as np
 import pandas as pd
 
+from railride.errors import InputError
 from railride.secondary.control import PAPER_CONTROLLERS, GainSet
 from railride.defaults import DEFAULT_DAMPER
 from railride.output.files import PARETO_FILES
@@ -58,7 +59,7 @@ def non_dominated(points) -> np.ndarray:
     not dominate each other; a row with a NaN is never non-dominated, and dominates nothing."""
     p = np.asarray(points, dtype=float)
     if p.ndim != 2:
-        raise ValueError(f"points of shape {p.shape}: expected (n, m)")
+        raise InputError(f"points of shape {p.shape}: expected (n, m)")
     valid = ~np.isnan(p).any(axis=1)
     keep = np.zeros(len(p), dtype=bool)
     front: list[int] = []
@@ -193,7 +194,7 @@ def _plain(value):
 def _power_of_two(name: str, value) -> int:
     ok = not isinstance(value, bool) and isinstance(value, (int, np.integer)) and value >= 1 and not value & (value - 1)
     if not ok:
-        raise ValueError(
+        raise InputError(
             f"{name} = {value!r}: must be a power of two (1, 2, 4, ..., 128, ...), which "
             "keeps the balance of the Sobol' sample"
         )
@@ -202,16 +203,16 @@ def _power_of_two(name: str, value) -> int:
 
 def _parameters(suspension: str, parameters) -> tuple:
     if suspension not in CONTROLLER_PARAMETERS:
-        raise ValueError(f"suspension = {suspension!r}: allowed {', '.join(CONTROLLER_PARAMETERS)}")
+        raise InputError(f"suspension = {suspension!r}: allowed {', '.join(CONTROLLER_PARAMETERS)}")
     allowed = CONTROLLER_PARAMETERS[suspension]
     if parameters is None:
         return allowed
     parameters = tuple(parameters)
     for p in parameters:
         if p not in allowed:
-            raise ValueError(f"parameter {p!r}: not a gain of {suspension}; allowed: {', '.join(allowed)}")
+            raise InputError(f"parameter {p!r}: not a gain of {suspension}; allowed: {', '.join(allowed)}")
     if not parameters or len(set(parameters)) != len(parameters):
-        raise ValueError(f"parameters = {parameters!r}: one or more distinct gains of {suspension}")
+        raise InputError(f"parameters = {parameters!r}: one or more distinct gains of {suspension}")
     return parameters
 
 

@@ -25,6 +25,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from railride.errors import InputError
 from railride import validation
 from railride.studies.comparison import check_controllers
 from railride.secondary.control import PAPER_CONTROLLERS, GainSet
@@ -179,7 +180,7 @@ def study(
     gains = GainSet.default() if gains is None else gains
     random = scenario in SPECTRA
     if track_seeds is not None and not random:
-        raise ValueError(
+        raise InputError(
             f"track_seeds = {list(_items(track_seeds))}: track seeds apply to the random tracks "
             f"({', '.join(SPECTRA)}) only, not to {scenario!r}"
         )
@@ -201,7 +202,7 @@ def study(
         try:
             conditions.append(fault_condition(f))
         except ValueError as exc:
-            raise ValueError(f"faults = {str(f)!r}: {exc}") from None
+            raise InputError(f"faults = {str(f)!r}: {exc}") from None
     from railride.engine.layout import MAX_DELAY
 
     what = "controller periods from a sample to its demand taking effect"
@@ -215,13 +216,13 @@ def study(
         ("delays", delay_list),
     ):
         if not values:
-            raise ValueError(f"{name}: give at least one value")
+            raise InputError(f"{name}: give at least one value")
     validation.choice("sensing", sensing, SENSING)
     if sensing != "ideal":
         car = Vehicle(vehicle)
         blind = [n for n in names if (c := gains.controller(n)) is not None and reads_bogies(c.gains(car)[0])]
         if blind:
-            raise ValueError(
+            raise InputError(
                 f"sensing = {sensing!r}: {', '.join(blind)} {'reads' if len(blind) == 1 else 'read'} the "
                 "bogies' states, and the accelerometers "
                 "are on the carbody only; leave them out"
@@ -248,7 +249,7 @@ def study(
             try:
                 fault_table([[DamperFault.parse(f) for f in cond]], solver.dt, sc.duration)
             except ValueError as exc:
-                raise ValueError(f"faults = {'+'.join(cond)!r}: {exc}") from None
+                raise InputError(f"faults = {'+'.join(cond)!r}: {exc}") from None
         speed_of[v] = sc.speed
     # the window inside the runs, checked before the first; recorded with its open end (inf,
     # which JSON cannot hold) resolved, while the runs' keys keep it as given (resumable)

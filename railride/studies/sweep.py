@@ -28,6 +28,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
+from railride.errors import InputError
 from railride.defaults import DEFAULT_CONTROL_RATE, DEFAULT_OUTPUT_RATE
 from railride.studies.executors import DaskExecutor, LocalExecutor, RunTable  # noqa: F401 (their home before)
 from railride.analysis.metrics import RESPONSES, STATISTICS
@@ -433,7 +434,7 @@ def run_sweep(
     from datetime import datetime, timezone
 
     if not isinstance(grid, SweepGrid):
-        raise ValueError(
+        raise InputError(
             f"grid = {type(grid).__name__}: must be a railride.studies.grid.SweepGrid "
             "(railride.studies.grid.grid makes one)"
         )

@@ -35,6 +35,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from railride.errors import InputError
 from railride.secondary.control import OUTER_LOOPS, GainSet
 from railride.defaults import DEFAULT_DAMPER
 from railride.analysis.metrics import RESPONSES
@@ -153,7 +154,7 @@ def _check_controllers(controllers) -> tuple:
     for c in controllers:
         if c not in TUNABLE:
             fixed = " (it has no gains to tune)" if c in ("passive", "passive-on", "passive-off") else ""
-            raise ValueError(f"controller = {c!r}{fixed}: allowed {', '.join(TUNABLE)}")
+            raise InputError(f"controller = {c!r}{fixed}: allowed {', '.join(TUNABLE)}")
     return tuple(c for c in TUNABLE if c in controllers)  # the order they run
 
 
@@ -221,7 +222,7 @@ def tune(
     table = RunTable() if table is None else table
     damper_model(damper, damper_scale)  # a known name, and a scale it has
     if "inner" in controllers and damper in dampers.IDEAL_NAMES:
-        raise ValueError(
+        raise InputError(
             f"damper = {damper!r} with 'inner': the ideal devices have no force-tracking loop to "
             "tune; leave out the inner loop"
         )
@@ -237,15 +238,15 @@ def tune(
     )
     for name, value in (("span", span), ("min_span", min_span)):
         if not validation.number(name, value, "finite", allowed="a finite number > 1") > 1:
-            raise ValueError(f"{name} = {validation.shown(value)}: must be a finite number > 1")
+            raise InputError(f"{name} = {validation.shown(value)}: must be a finite number > 1")
     validation.number("tol", tol, "nonnegative")
     validation.choice("aggregate", aggregate, AGGREGATES)
     if over is not None:
         cases_set = tuple(over)
         if not cases_set or not all(isinstance(c, TuningCase) for c in cases_set):
-            raise ValueError("over: give a non-empty sequence of railride.studies.tuning.TuningCase (tuning_set())")
+            raise InputError("over: give a non-empty sequence of railride.studies.tuning.TuningCase (tuning_set())")
         if scenario_options:
-            raise ValueError("scenario_options with over: the tuning set names its own scenarios")
+            raise InputError("scenario_options with over: the tuning set names its own scenarios")
     else:
         cases_set = (TuningCase(scenario, opts, 1.0),)
     scens = [make_scenario(c.scenario, **dict(c.options)) for c in cases_set]

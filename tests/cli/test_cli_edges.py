@@ -57,7 +57,41 @@ def test_an_internal_fault_is_status_1(monkeypatch):
 
     monkeypatch.setattr(core, "simulate", fault)
     result = run("simulate", "--duration", 1)
-    assert result.exit_code == 1 and result.stderr.strip() == "error: an internal fault"
+    assert result.exit_code == 1 and result.stderr.strip() == (
+        "error: a bug in railride (RuntimeError: an internal fault); please report it. "
+        "railride --debug COMMAND ... shows its traceback"
+    )
+
+
+@pytest.mark.parametrize("error", [ValueError, TypeError, KeyError])
+def test_a_bug_is_status_1_and_debug_shows_its_traceback(monkeypatch, error):
+    # a ValueError that is no InputError is railride's fault, not the user's
+    import importlib
+
+    core = importlib.import_module("railride.run.simulation")
+
+    def fault(*args, **kwargs):
+        raise error("deep inside")
+
+    monkeypatch.setattr(core, "simulate", fault)
+    result = run("simulate", "--duration", 1)
+    assert result.exit_code == 1
+    assert result.stderr.startswith(f"error: a bug in railride ({error.__name__}: ")
+    assert "Traceback" not in result.stderr and len(result.stderr.strip().splitlines()) == 1
+    from clihelp import app, runner
+
+    debug = runner.invoke(app, ["--debug", "simulate", "--duration", "1"])  # the exception itself
+    assert isinstance(debug.exception, error)
+
+
+def test_what_the_user_gave_is_status_2_and_an_input_error():
+    import railride as rr
+    from railride.errors import InputError
+
+    result = run("simulate", "--speed", -1)
+    assert result.exit_code == 2 and result.stderr.startswith("error: --speed = ")
+    with pytest.raises(InputError, match="speed"):
+        rr.scenario("paper-sine", speed=-1.0)
 
 
 def test_a_reader_leaving_the_pipe_early_is_not_an_error():
