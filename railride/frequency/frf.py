@@ -79,6 +79,12 @@ class FrfResult:
         (None where the pattern does not excite the response; `railride.analysis.spectra.frf_peaks`)."""
         return frf_peaks(self.to_pandas())
 
+    def report_contents(self):
+        """What this result shows in its HTML report (`railride.output.report.write_report`)."""
+        from railride.output.report import frf_contents
+
+        return frf_contents(self)
+
     def to_dict(self) -> dict:
         """The ``railride.frf/1`` document (docs/cli.md): the vehicle, the settings, the grid,
         the magnitudes per pattern, the peaks and the modes."""

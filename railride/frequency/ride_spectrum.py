@@ -151,6 +151,12 @@ class RideSpectrum:
                 rows.append(row)
         return pd.DataFrame(rows)
 
+    def report_contents(self):
+        """What this result shows in its HTML report (`railride.output.report.write_report`)."""
+        from railride.output.report import ride_spectrum_contents
+
+        return ride_spectrum_contents(self)
+
     def to_dict(self) -> dict:
         from railride._version import __version__
 

@@ -10,7 +10,8 @@ plotly figures (`railride.plots.interactive`), the others as the package's matpl
 inlined as images. Nothing is fetched when the page opens: plotly's JavaScript is inlined once
 and every image is a data URI. See docs/report.md.
 
-A new result type is one function returning its `Contents`, registered with `contents_of`.
+A new result type is one function returning its `Contents`, which the result's ``report_contents()``
+method calls: the report is chosen by what a result has, never by its class's name.
 """
 
 from __future__ import annotations
@@ -23,7 +24,7 @@ import json
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 import pandas as pd
 
@@ -56,30 +57,26 @@ class Contents:
     tables: list = field(default_factory=list)
 
 
-#: result class ("module.Class") -> the function giving its `Contents`
-KNOWN: dict[str, Callable[[Any], Contents]] = {}
-
-
-def contents_of(*classes: str):
-    """Register the decorated function as the `Contents` of the result classes named
-    ("railride.studies.comparison.Comparison")."""
-
-    def register(function):
-        for name in classes:
-            KNOWN[name] = function
-        return function
-
-    return register
+#: the result types with a report (each has a ``report_contents()`` method that calls one of the
+#: functions below), named in the error for a result without one
+REPORTED = (
+    "Comparison",
+    "FrfResult",
+    "LeagueTable",
+    "RideResult",
+    "RideSpectrum",
+    "StudyResult",
+    "SweepResult",
+    "TuneResult",
+)
 
 
 def contents(result) -> Contents:
-    """The `Contents` of ``result`` (ValueError for a type the report does not know)."""
-    for cls in type(result).__mro__:
-        function = KNOWN.get(f"{cls.__module__}.{cls.__qualname__}")
-        if function is not None:
-            return function(result)
-    known = ", ".join(sorted(name.rsplit(".", 1)[1] for name in KNOWN))
-    raise InputError(f"result: a {type(result).__name__} has no report; allowed: {known}")
+    """The `Contents` of ``result``: its ``report_contents()`` (InputError for a result without one)."""
+    make = getattr(result, "report_contents", None)
+    if not callable(make):
+        raise InputError(f"result: a {type(result).__name__} has no report; allowed: {', '.join(REPORTED)}")
+    return make()
 
 
 # -- the result types ---------------------------------------------------------------------------
@@ -90,8 +87,8 @@ def _vehicle(settings: dict):
     return VehicleParams(**record) if record else VehicleParams.preset("paper")
 
 
-@contents_of("railride.studies.comparison.Comparison")
-def _comparison(result) -> Contents:
+def comparison_contents(result) -> Contents:
+    """The report of a `railride.studies.comparison.Comparison`."""
     from railride.analysis.spectra import PSD_SEGMENT_S, comparison_psd
     from railride.analysis.labels import CARBODY_RESPONSES, psd_title
     from railride.plots import comparison as plots
@@ -122,8 +119,8 @@ def _comparison(result) -> Contents:
     )
 
 
-@contents_of("railride.studies.sweep.SweepResult")
-def _sweep(result) -> Contents:
+def sweep_contents(result) -> Contents:
+    """The report of a `railride.studies.sweep.SweepResult`."""
     from railride.plots.sweep import has_comfort, sweep_plot_axis
 
     settings = result.settings()
@@ -141,8 +138,8 @@ def _sweep(result) -> Contents:
     )
 
 
-@contents_of("railride.studies.tune_result.TuneResult")
-def _tune(result) -> Contents:
+def tune_contents(result) -> Contents:
+    """The report of a `railride.studies.tune_result.TuneResult`."""
     doc = result.to_dict()
     keys = ("controllers", "scenario", "settings", "objective", "date", "runs", "gains")
     return Contents(
@@ -155,8 +152,8 @@ def _tune(result) -> Contents:
     )
 
 
-@contents_of("railride.studies.study.StudyResult")
-def _study(result) -> Contents:
+def study_contents(result) -> Contents:
+    """The report of a `railride.studies.study.StudyResult`."""
     return Contents(
         title="Statistics over tracks, speeds, loads and faults",
         settings={**result.settings, "runs": int(len(result.cases))},
@@ -166,8 +163,8 @@ def _study(result) -> Contents:
     )
 
 
-@contents_of("railride.studies.league.LeagueTable")
-def _league(result) -> Contents:
+def league_contents(result) -> Contents:
+    """The report of a `railride.studies.league.LeagueTable`."""
     from railride.plots.league import plot_league_comfort
 
     settings = result.to_dict().get("settings") or {}
@@ -183,8 +180,8 @@ def _league(result) -> Contents:
     )
 
 
-@contents_of("railride.run.ride.RideResult")
-def _ride(result) -> Contents:
+def ride_contents(result) -> Contents:
+    """The report of a `railride.run.ride.RideResult`."""
     from railride.analysis.labels import json_records
     from railride.plots.interactive import ride_figure
     from railride.plots.ride import ride_title, sample_labels
@@ -215,8 +212,8 @@ def _ride(result) -> Contents:
     )
 
 
-@contents_of("railride.frequency.frf.FrfResult")
-def _frf(result) -> Contents:
+def frf_contents(result) -> Contents:
+    """The report of a `railride.frequency.frf.FrfResult`."""
     from railride.plots.interactive import frf_figure
 
     doc = result.to_dict()
@@ -233,8 +230,8 @@ def _frf(result) -> Contents:
     )
 
 
-@contents_of("railride.frequency.ride_spectrum.RideSpectrum")
-def _ride_spectrum(result) -> Contents:
+def ride_spectrum_contents(result) -> Contents:
+    """The report of a `railride.frequency.ride_spectrum.RideSpectrum`."""
     from railride.plots.interactive import ride_spectrum_figure
 
     return Contents(

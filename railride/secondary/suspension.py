@@ -41,15 +41,22 @@ KINDS = ("passive", "semi-active", "ideal")
 NAMES = ("passive", "mr", *CONTROLLERS[1:])
 
 
-def damper_model(name: str, damper_scale: float = 1.0):
-    """The damper called ``name`` (`railride.secondary.dampers.preset`) with its force capacity times
-    ``damper_scale``; a scale other than 1 for an ideal device is a ValueError (it has none)."""
-    if not isinstance(name, str):
-        raise InputError(
-            f"damper = {name!r}: must be a name ({', '.join(dampers.NAMES)}); scale a preset with damper_scale"
-        )
+def damper_model(damper, damper_scale: float = 1.0):
+    """The damper ``damper``, a name (`railride.secondary.dampers.preset`) or a model of
+    `railride.secondary.dampers` (a user's own Bouc-Wen or Spencer damper), with its force capacity
+    times ``damper_scale``; a scale other than 1 for an ideal device is an InputError (it has
+    none). The one place a damper argument is resolved: every function that takes a damper
+    name takes a model too."""
     scale = dampers.check_scale("damper_scale", damper_scale)
-    model = dampers.preset(name)
+    if isinstance(damper, str):
+        model = dampers.preset(damper)
+    elif isinstance(damper, (dampers.Viscous, dampers.BoucWen, dampers.Ideal)):  # Spencer is a BoucWen
+        model = damper
+    else:
+        raise InputError(
+            f"damper = {damper!r}: must be a name ({', '.join(dampers.NAMES)}) or a model from "
+            "railride.secondary.dampers"
+        )
     if scale == 1.0:
         return model
     if model.law == dampers.LAW_IDEAL:
@@ -57,6 +64,8 @@ def damper_model(name: str, damper_scale: float = 1.0):
             f"damper_scale = {scale:g}: the ideal actuator applies the demand "
             "exactly and has no force capacity to scale (leave damper_scale at 1)"
         )
+    if not hasattr(model, "scaled"):
+        raise InputError(f"damper_scale = {scale:g}: a {model.model} damper has no force capacity to scale")
     return model.scaled(scale)
 
 
@@ -75,10 +84,8 @@ def _model(damper):
     """A damper model from a name or a model; None stays None (the passive dashpots)."""
     if damper is None:
         return None
-    if isinstance(damper, str):
-        return dampers.preset(damper)
-    if isinstance(damper, (dampers.Viscous, dampers.BoucWen, dampers.Ideal)):  # Spencer is a BoucWen
-        return damper
+    if isinstance(damper, (str, dampers.Viscous, dampers.BoucWen, dampers.Ideal)):
+        return damper_model(damper)
     raise InputError(
         f"damper = {damper!r}: must be None (passive), a name "
         f"({', '.join(dampers.NAMES)}) or a model from railride.secondary.dampers"

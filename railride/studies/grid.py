@@ -16,6 +16,7 @@ import dataclasses
 import itertools
 import numbers
 from collections.abc import Mapping
+from typing import Any
 
 
 from railride.errors import InputError
@@ -23,6 +24,7 @@ from railride import validation
 from railride.secondary.control import CONSTANT_VOLTAGE, OUTER_LOOPS, GainSet
 from railride.defaults import DEFAULT_DAMPER
 from railride.run.solver import SolverSettings
+from railride.secondary.suspension import damper_model
 
 #: the scenario options a sweep can vary: (keyword of `grid`, keyword of
 #: `railride.model.track.scenario`, grid column, unit)
@@ -65,7 +67,7 @@ class SweepGrid:
     scenario: str
     suspensions: tuple
     axes: tuple
-    damper: str
+    damper: Any  # a name or a model of railride.secondary.dampers
     #: the damper scales; None when not an axis (every run at 1)
     damper_scales: tuple | None
     #: the voltages of mr; None without mr
@@ -269,11 +271,13 @@ def grid(
         damper_scale=damper_scale,
     )
     damper_name = DEFAULT_DAMPER if damper is None else damper
-    if damper_name not in dampers.NAMES:
+    if isinstance(damper_name, str) and damper_name not in dampers.NAMES:
         raise InputError(
             f"{words.given('damper', damper_name)}: unknown damper model; allowed: {', '.join(dampers.NAMES)}"
         )
-    if damper_name in dampers.IDEAL_NAMES and (has_mr or constant):
+    the_model = damper_model(damper_name)  # a name or a model: resolved here, once
+    ideal = the_model.law == dampers.LAW_IDEAL
+    if ideal and (has_mr or constant):
         fixed = "mr" if has_mr else constant[0]
         raise InputError(
             f"{words.given('damper', damper_name)}: applies to the controllers only; "
@@ -282,7 +286,7 @@ def grid(
         )
     scales = None
     if damper_scale is not None:
-        if damper_name in dampers.IDEAL_NAMES:
+        if ideal:
             raise InputError(
                 f"{words.given('damper_scale', damper_scale)}: the ideal device "
                 f"({words.name('damper')} {damper_name}) applies the demand itself and has no "
@@ -301,7 +305,7 @@ def grid(
     )
     volts = None
     if has_mr:
-        model = dampers.preset(damper_name)
+        model = the_model
         volts = (
             [float(model.v_min)]
             if voltage is None
@@ -540,7 +544,6 @@ def _check_resolvable(words: _Words, scen, min_given: bool, output_rate: float) 
 def _cases(g: SweepGrid, combos: list, common: dict) -> tuple[list, list]:
     """(the cases, the grid values of each): for each suspension and scenario combination, passive
     once, mr per scale and voltage, a controller per scale, gain combination and noise seed."""
-    from railride.secondary import dampers
     from railride.studies.case import Case
 
     scaled = g.damper_scales is not None
@@ -555,7 +558,7 @@ def _cases(g: SweepGrid, combos: list, common: dict) -> tuple[list, list]:
                 cases.append(Case(g.scenario, options))
                 values.append(base)
             elif s in CONSTANT_VOLTAGE:  # an mr run at the damper's v_max or v_min
-                v = float(getattr(dampers.preset(g.damper), CONSTANT_VOLTAGE[s]))
+                v = float(getattr(damper_model(g.damper), CONSTANT_VOLTAGE[s]))
                 for x in g.damper_scales or (1.0,):
                     cases.append(Case(g.scenario, options, suspension="mr", damper=g.damper, voltage=v, damper_scale=x))
                     row: dict = dict(base)

@@ -343,6 +343,12 @@ class SweepResult:
             **other_settings(vehicle, g.solver),
         }
 
+    def report_contents(self):
+        """What this result shows in its HTML report (`railride.output.report.write_report`)."""
+        from railride.output.report import sweep_contents
+
+        return sweep_contents(self)
+
     def to_dict(self) -> dict:
         """The ``railride.sweep/1`` document (docs/cli.md): the settings, the columns, every
         run as a row of `rows`, and the rows of the run table."""
