@@ -23,6 +23,8 @@ from railride.secondary.control import CONSTANT_VOLTAGE, CONTROLLERS, LABELS, PA
 from railride.defaults import DEFAULT_DAMPER
 from railride.secondary.faults import check_faults, degradation, fault_table
 from railride.analysis.comfort import comfort_record
+from railride.model.params import VehicleParams
+from railride.model.plausible import notes
 from railride.analysis.metrics import STATISTICS, reduction, ride_metrics, select_window
 from railride.plots import PNG_DPI, FigureOptions
 from railride.run.simulation import simulate
@@ -61,7 +63,7 @@ def check_controllers(names) -> list[str]:
     return [n for n in CONTROLLERS if n in names or n == "passive"]
 
 
-@dataclass
+@dataclass(frozen=True, eq=False)
 class Comparison:
     """Results of `compare`: ``datasets[name]`` per suspension, ``metrics`` (controller,
     response, statistic), RMS ``reductions`` against passive, and ``demands``: what each
@@ -186,7 +188,6 @@ class Comparison:
         """Whether this is the case of the paper's Table 1: its scenario (`paper-sine` with its
         settings, any duration) at its speed, with its vehicle. Only then is the paper's table
         a reference for these numbers."""
-        from railride.model.params import VehicleParams
         from railride.model.track import scenario as make_scenario
 
         def track(record):
@@ -202,6 +203,12 @@ class Comparison:
     def in_sample(self) -> bool:
         """Whether the gains were tuned on this very track (their provenance says so)."""
         return self.gains.tuned_on(self.settings.get("scenario"))
+
+    def report_contents(self):
+        """What this result shows in its HTML report (`railride.output.report.write_report`)."""
+        from railride.output.report import comparison_contents
+
+        return comparison_contents(self)
 
     def to_dict(self) -> dict:
         """The JSON summary (schema railride.comparison/1, docs/cli.md)."""
@@ -374,7 +381,6 @@ def compare(
     # a constant voltage means nothing to the ideal devices: said in the settings, not run
     not_run = {n: NO_VOLTAGE for n in names if n in CONSTANT_VOLTAGE and ideal}
     if sensing is not None:
-        from railride.model.params import VehicleParams
         from railride.secondary.sensing import reads_bogies
         from railride.model.vehicle import Vehicle
 
@@ -442,11 +448,11 @@ def compare(
         }
     metrics = xr.concat([ride_metrics(datasets[n], window) for n in names], dim="controller")
     metrics = metrics.assign_coords(controller=names)
-    first = datasets["passive"]
+    vehicle = VehicleParams.of(params)  # the settings from the objects, not read back from the runs
     settings = {
-        "scenario": json.loads(str(first["scenario"].values)),
-        "vehicle_params": json.loads(str(first["vehicle_params"].values)),
-        **({"warnings": json.loads(w)} if (w := first.attrs.get("plausibility_warnings")) else {}),
+        "scenario": scenario.describe(),
+        "vehicle_params": vehicle.to_dict(),
+        **({"warnings": warned} if (warned := notes(vehicle)) else {}),
         "damper": str(damper),
         "damper_scale": damper_scale,
         **solver.to_dict(),
