@@ -21,7 +21,8 @@ line ``error: <message>`` on stderr, never a traceback.
 from __future__ import annotations
 
 import sys
-from typing import TYPE_CHECKING
+
+TYPE_CHECKING = False  # typing.TYPE_CHECKING, without importing typing before main() runs
 
 __all__ = ["app", "main"]
 
