@@ -40,23 +40,26 @@ def _signatures() -> dict[str, tuple]:
     def a(ndim, dtype=f, layout="C"):
         return types.Array(dtype, ndim, layout)
 
+    # run_batch's argument groups (tuples), shared by run_lanes but for the vehicle and the damper
+    inputs = types.Tuple((a(2), a(1, i), a(2), a(1, i), a(1, i), a(1)))  # utab, u_off, ftab, f_off, n_nodes, interval
+    # closed_loop, ctrl_stride, Gm, Hm, inner, noise, faults, sensing, snoise
+    control = types.Tuple((b, i, a(3), a(3), a(2), a(2), a(2, i), a(2), a(2)))
+    outputs = types.Tuple((a(3),) * 9 + (a(1, i), a(1, i)))  # nine outputs, status, fail_step
+    run = (i, i, i, a(2), i, i, b, i, f)  # lo, hi, law, x, step0, n_steps, final, stride, dt
     return {
-        # lo, hi, law, x, step0, n_steps, final, stride, dt, A, TS, c_sec, P, vcmd, utab, u_off, ftab,
-        # f_off, n_nodes, interval, closed_loop, ctrl_stride, Gm, Hm, inner, noise, faults, sensing,
-        # snoise, nine outputs, status, fail_step
-        "run_batch": (i, i, i, a(2), i, i, b, i, f, a(3), a(3), a(2), a(2), a(2), a(2), a(1, i), a(2), a(1, i))
-        + (a(1, i), a(1), b, i, a(3), a(3), a(2), a(2), a(2, i), a(2), a(2))
-        + (a(3),) * 9
-        + (a(1, i), a(1, i)),
-        # lo, hi, lane_smp, lane_own, law, x, step0, n_steps, final, stride, dt, the q'' product's
-        # structure and values (a_ptr, a_col, a_val, a_uni) and the corner product's (t_*), c_sec, P,
-        # vcmd, utab, u_off, ftab, f_off, n_nodes, interval, closed_loop, ctrl_stride, Gm, Hm, inner,
-        # noise, faults, nine outputs, status, fail_step
-        "run_lanes": (i, i, a(2, i), a(2, b), i, a(2), i, i, b, i, f, a(1, i), a(1, i), a(3), a(1, b))
-        + (a(1, i), a(1, i), a(3), a(1, b), a(2), a(1), a(2), a(2), a(1, i), a(2), a(1, i), a(1, i), a(1))
-        + (b, i, a(3), a(3), a(2), a(2), a(2, i))
-        + (a(3),) * 9
-        + (a(1, i), a(1, i)),
+        # the run, vehicle = (A, TS, c_sec), dampers = (P, vcmd), inputs, control, outputs
+        "run_batch": run + (types.Tuple((a(3), a(3), a(2))), types.Tuple((a(2), a(2))), inputs, control, outputs),
+        # lo, hi, lane_smp, lane_own, then run_batch's arguments after hi, with vehicle = the q'' product's
+        # structure and values (a_ptr, a_col, a_val, a_uni), the corner product's (t_*), c_sec; dampers = (P, vcmd)
+        "run_lanes": (i, i, a(2, i), a(2, b))
+        + run[2:]
+        + (
+            types.Tuple((a(1, i), a(1, i), a(3), a(1, b), a(1, i), a(1, i), a(3), a(1, b), a(2))),
+            types.Tuple((a(1), a(2))),
+            inputs,
+            control,
+            outputs,
+        ),
         # Phi (a slice), maps, used, stride, m, utab, interval, x0, A, Bw, Bwd, TS, c_sec, six outputs
         "exact_run": (a(2, layout="A"), a(3), a(1, i), i, i, a(2), f, a(1), a(2), a(2), a(2), a(2), a(1)) + (a(2),) * 6,
         # phi, rail, force, start, period, m, stride, ctrl, tc, utab, interval, x0, A, Bw, Bwd, Bf, G,

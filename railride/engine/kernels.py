@@ -25,6 +25,7 @@ import numpy as np
 from numba import njit
 from numba.core.errors import NumbaPerformanceWarning
 
+from railride.engine.cache_guard import guard as _guard_cache
 from railride.engine._simd import bouc_wen1_corners, corner_pairs, forcing_rows, mv9_simd
 from railride.engine.layout import (  # sizes, codes and slots: compile-time constants to numba
     DIVERGED,
@@ -34,6 +35,12 @@ from railride.engine.layout import (  # sizes, codes and slots: compile-time con
     FAULT_ON,
     FD_HELD,
     FD_NEXT,
+    F_MODE,
+    F_STEP,
+    I_B,
+    I_DELAY,
+    I_G,
+    I_LAW,
     LAW_BOUC_WEN,
     LAW_IDEAL,
     LAW_SPENCER,
@@ -48,6 +55,8 @@ from railride.engine.layout import (  # sizes, codes and slots: compile-time con
     N_DS,
     N_RAIL,
     N_SENS_STATES,
+    NOISE_Q,
+    NOISE_V,
     P_A,
     P_ALPHA_A,
     P_ALPHA_B,
@@ -68,7 +77,19 @@ from railride.engine.layout import (  # sizes, codes and slots: compile-time con
     RIG_COMMANDED,
     RIG_CONSTANT,
     RIG_TRACKING,
+    S_BIAS,
+    S_MAP,
+    S_ON,
+    S_W_AA,
+    S_W_C,
     SENS,
+    SS_DISP,
+    SS_FILTERED,
+    SS_HP1,
+    SS_HP2,
+    SS_LAST,
+    SS_VEL,
+    SS_VEL_LAST,
     STATUS_DIVERGED,
     STATUS_OK,
     SUBSTEP_DT_REF,
@@ -78,6 +99,10 @@ from railride.engine.layout import (  # sizes, codes and slots: compile-time con
     XI,
 )
 from railride.engine.layout import FASTMATH as _FAST, NO_PARFORS as _NO_PARFORS
+
+# numba's cache keys each file's kernels by that file alone: clear it when any engine source
+# changed (an inlined function of another file), before any kernel is compiled or loaded
+_guard_cache()
 
 # numba reports the parallel pipeline without parfors as a missed opportunity: that is the intent
 # here (`layout.NO_PARFORS`)
@@ -195,7 +220,7 @@ def damper_law(law, P, x, xd, z, y, u, v):
         return -v, 0.0, 0.0, 0.0
     alpha = P[P_ALPHA_A] + P[P_ALPHA_B] * u
     c0 = P[P_C0A] + P[P_C0B] * u
-    du = -P[P_ETA] * (u - v)
+    du = coil_rate(P, u, v)
     if law == LAW_BOUC_WEN:
         dz = _bouc_wen_rate(z, xd, P[P_A], P[P_N], P[P_GAMMA], P[P_BETA])
         return c0 * xd + P[P_K0] * x + alpha * z, dz, 0.0, du
@@ -203,6 +228,46 @@ def damper_law(law, P, x, xd, z, y, u, v):
     dy = (alpha * z + c0 * xd + P[P_K0] * (x - y)) / (c0 + c1)
     dz = _bouc_wen_rate(z, xd - dy, P[P_A], P[P_N], P[P_GAMMA], P[P_BETA])
     return c1 * dy + P[P_K1] * x, dz, dy, du
+
+
+@njit(cache=True, inline="always", fastmath=_FAST)
+def coil_rate(P, u, v):
+    """u' of an MR damper's coil voltage u lagging the command v (rate P[P_ETA])."""
+    return -P[P_ETA] * (u - v)
+
+
+@njit(cache=True, inline="always", fastmath=_FAST)
+def voltage_law(mode, B, G, f, fd, xd, P):
+    """The command voltage the closed loop's inner loop gives an MR damper (voltage law ``mode``,
+    `layout.VOLTAGE_LAWS`; both steppers call this) from the damper force f on the carbody, the
+    demand fd there and the corner's deflection rate xd, within P's v_min..v_max: tracking,
+    v = clip(G (fd - B f) sgn(f), v_min, v_max); on-off, v_max where fd xd < 0; clipped, v_max
+    where (fd - f) f > 0; else v_min."""
+    if mode == VOLTAGE_ON_OFF:
+        return P[P_V_MAX] if fd * xd < 0.0 else P[P_V_MIN]
+    if mode == VOLTAGE_CLIPPED:
+        return P[P_V_MAX] if (fd - f) * f > 0.0 else P[P_V_MIN]
+    sgn = 1.0 if f > 0.0 else (-1.0 if f < 0.0 else 0.0)
+    return min(max(G * (fd - B * f) * sgn, P[P_V_MIN]), P[P_V_MAX])
+
+
+@njit(cache=True, inline="always")
+def fault_at(faults, i, c, step):
+    """The fault of sample i's corner c at ``step`` (FAULT_*): its mode from its step on, FAULT_NONE
+    before (rows of the fault table as `layout.F_MODE`, `layout.F_STEP`)."""
+    return faults[i, F_MODE + c] if step >= faults[i, F_STEP + c] else FAULT_NONE
+
+
+@njit(cache=True, inline="always", fastmath=_FAST)
+def fault_command(fault, v, P):
+    """(command, held) of a corner with ``fault`` whose voltage law asked v: a failed coil driver
+    holds v_min (FAULT_OFF) or v_max (FAULT_ON) whatever the law asks (held True); otherwise v.
+    (FAULT_DISCONNECTED leaves the command and removes the force: the steppers' ``conn``.)"""
+    if fault == FAULT_OFF:
+        return P[P_V_MIN], True
+    if fault == FAULT_ON:
+        return P[P_V_MAX], True
+    return v, False
 
 
 @njit(cache=True, fastmath=_FAST)
@@ -288,57 +353,23 @@ def _derivative(law, s, R, roff, AT, TT, P, vcmd, conn, y, cx, cv, K, koff, i8, 
 
 
 @njit(cache=True, nogil=True, fastmath=_FAST, parallel=_NO_PARFORS)
-def run_batch(
-    lo,
-    hi,
-    law,
-    x,
-    step0,
-    n_steps,
-    final,
-    stride,
-    dt,
-    A,
-    TS,
-    c_sec,
-    P,
-    vcmd,
-    utab,
-    u_off,
-    ftab,
-    f_off,
-    n_nodes,
-    interval,
-    closed_loop,
-    ctrl_stride,
-    Gm,
-    Hm,
-    inner,
-    noise,
-    faults,
-    sensing,
-    snoise,
-    out_q,
-    out_v,
-    out_a,
-    out_f,
-    out_w,
-    out_wd,
-    out_d,
-    out_fd,
-    out_vc,
-    status,
-    fail_step,
-):
+def run_batch(lo, hi, law, x, step0, n_steps, final, stride, dt, vehicle, dampers, inputs, control, outputs):
     """Advance the state x[s] = (q, q', damper states) of samples lo <= s < hi by n_steps
     steps of dt. Compiled without the GIL: `railride.run.simulation` runs sample ranges on threads.
+
+    The arrays come in five groups (tuples, unpacked once at the top; `layout` names the columns
+    of the packed ones): vehicle = (A, TS, c_sec), dampers = (P, vcmd), inputs = (utab, u_off,
+    ftab, f_off, n_nodes, interval), control = (closed_loop, ctrl_stride, Gm, Hm, inner, noise,
+    faults, sensing, snoise) and outputs = (out_q, out_v, out_a, out_f, out_w, out_wd, out_d,
+    out_fd, out_vc, status, fail_step).
 
     Per sample s: A[s] (NY, 9) maps y = (q, q', f) to q'' (Aq, Av, Bf side by side, stored
     transposed), TS[s] (9, 4) is T (corner deflections T^T q). ``law`` is LAW_VISCOUS_IN_C
     (passive dashpots inside Av; c_sec[s] only for recording their forces) or a damper law
-    (railride.secondary.dampers) with packed parameters P[s] and command voltages vcmd[s] (4 corners).
-    The rail inputs come as tables on the time grid k * interval[s] with n_nodes[s] rows: utab
-    rows from u_off[s] (w, w', for the record) and ftab rows from f_off[s] (see `_forcing`).
+    (railride.secondary.dampers) with packed parameters P[s] (slots P_*) and command voltages
+    vcmd[s] (4 corners). The rail inputs come as tables on the time grid k * interval[s] with
+    n_nodes[s] rows: utab rows from u_off[s] (w, w', for the record) and ftab rows from f_off[s]
+    (see `_forcing`).
 
     Each step is one classical RK4 step, or 2^k equal RK4 sub-steps when the dampers' internal
     states are stiff (`substeps`).
@@ -347,29 +378,28 @@ def run_batch(
     samples the state m = (q, q') (noise[k] added to the carbody's six at sample k, if noise has
     rows) every ctrl_stride steps, integrates the carbody's (z, phi, theta) by the rectangle rule,
     and computes the desired corner forces f_d = Gm[s] m + Hm[s] xi (Gm 4 x 18), which take effect
-    inner[s, 3] controller periods later (the computation and communication delay, 1 to
+    inner[s, I_DELAY] controller periods later (the computation and communication delay, 1 to
     MAX_DELAY; zero demand until the first arrives) and are held. The voltage
-    law inner[s, 2] (railride.secondary.dampers.VOLTAGE_LAWS) runs at every step from the damper force f on
-    the carbody and the deflection rates x' at the step's start: tracking, v = clip(G (f_d - B f)
-    sgn(f), v_min, v_max) with (B, G) = inner[s, :2]; on-off, v_max where f_d x' < 0; clipped,
-    v_max where (f_d - f) f > 0 (else v_min). With LAW_IDEAL there is no inner loop: the command of
+    law inner[s, I_LAW] (`voltage_law`) runs at every step from the damper force f on the carbody
+    and the deflection rates x' at the step's start, with the gains B, G = inner[s, I_B],
+    inner[s, I_G] of the tracking law. With LAW_IDEAL there is no inner loop: the command of
     each corner is the held demand itself, which the ideal actuator applies (out_vc then
     records the demand, not a voltage). The controller's integrator and demands are states
     x[s, NS_MAX:], so a run can continue across calls.
 
-    Realistic sensing (sensing[s, 0] = 1; layout `SENSING_COLS`): the controller does not see
+    Realistic sensing (sensing[s, S_ON] = 1; layout `SENSING_COLS`): the controller does not see
     the state. A vertical accelerometer at each carbody corner measures the corner's
-    acceleration through a first-order anti-alias filter (rate sensing[s, 1], integrated at every
-    step), sampled at the controller rate with a bias (sensing[s, 3:7]) and white noise
-    (snoise[k]); at each sample two band-limited integration stages, each a high-pass then a
-    leaky integral (s / (s + w)^2, w = sensing[s, 2], backward Euler), give each corner's
-    velocity and displacement, which the map sensing[s, 7:] turns into the carbody's heave, pitch
-    and roll; the bogie states read as 0.
+    acceleration through a first-order anti-alias filter (rate sensing[s, S_W_AA], integrated at
+    every step), sampled at the controller rate with a bias (sensing[s, S_BIAS + c]) and white
+    noise (snoise[k, c]); at each sample two band-limited integration stages, each a high-pass
+    then a leaky integral (s / (s + w)^2, w = sensing[s, S_W_C], backward Euler), give each
+    corner's velocity and displacement, which the map sensing[s, S_MAP:] turns into the carbody's
+    heave, pitch and roll; the bogie states read as 0.
 
-    Damper faults: corner c of sample s fails with mode faults[s, c] (FAULT_*) from step
-    faults[s, 4 + c] on. FAULT_OFF and FAULT_ON hold its command at v_min and v_max whatever the
-    voltage law asks (the coil follows with its time constant); FAULT_DISCONNECTED removes its
-    force from the vehicle.
+    Damper faults: corner c of sample s fails with mode faults[s, F_MODE + c] (FAULT_*) from step
+    faults[s, F_STEP + c] on (`fault_at`). FAULT_OFF and FAULT_ON hold its command at v_min and
+    v_max whatever the voltage law asks (`fault_command`; the coil follows with its time
+    constant); FAULT_DISCONNECTED removes its force from the vehicle.
 
     Steps are numbered globally from step0 (t = step * dt). At every step whose number is a
     multiple of ``stride`` the state, acceleration, damper forces, rail inputs, damper states,
@@ -379,6 +409,11 @@ def run_batch(
     +-DIVERGED or stops being finite gets status STATUS_DIVERGED and the step number in
     fail_step, and stops.
     """
+    A, TS, c_sec = vehicle
+    P, vcmd = dampers
+    utab, u_off, ftab, f_off, n_nodes, interval = inputs
+    closed_loop, ctrl_stride, Gm, Hm, inner, noise, faults, sensing, snoise = control
+    out_q, out_v, out_a, out_f, out_w, out_wd, out_d, out_fd, out_vc, status, fail_step = outputs
     # damper states to integrate (the ideal actuator has none: its law ignores them)
     has_states = law != LAW_VISCOUS_IN_C and law != LAW_IDEAL
     ns = NS_MAX if has_states else 2 * N_DOF
@@ -399,17 +434,17 @@ def run_batch(
         at, tt, cs, pp = A[smp], TS[smp], c_sec[smp], P[smp]
         uo, fo, nn, itv = u_off[smp], f_off[smp], n_nodes[smp], interval[smp]
         vc = vcmd[smp].copy()  # command voltages, held over each step
-        fm = faults[smp]
         conn = np.ones(N_CORNER)  # 0 where a damper is disconnected
         faulty = False  # a healthy sample skips the fault checks
         for c in range(N_CORNER):
-            faulty = faulty or fm[c] != FAULT_NONE
+            faulty = faulty or faults[smp, F_MODE + c] != FAULT_NONE
         meas = np.empty(2 * N_DOF)  # the controller's sample of the state (q, q')
         gm, hm = Gm[smp], Hm[smp]
-        delay = int(inner[smp, 3])  # controller periods from a sample to its demand taking effect
+        delay = int(inner[smp, I_DELAY])  # controller periods from a sample to its demand taking effect
+        B_in, G_in = inner[smp, I_B], inner[smp, I_G]  # the tracking law's gains
         tc = ctrl_stride * dt
-        sens = closed_loop and sensing[smp, 0] > 0.0
-        w_aa, w_c = sensing[smp, 1], sensing[smp, 2]
+        sens = closed_loop and sensing[smp, S_ON] > 0.0
+        w_aa, w_c = sensing[smp, S_W_AA], sensing[smp, S_W_C]
         hp = 1.0 / (1.0 + w_c * tc)  # backward Euler of s / (s + w) and of 1 / (s + w)
         n_snoise = snoise.shape[0]
         n_noise = noise.shape[0]
@@ -443,23 +478,24 @@ def run_batch(
                 if sens:  # the accelerometers, sampled, and the band-limited integration
                     for c in range(N_CORNER):
                         b = SENS + N_SENS_STATES * c
-                        a_m = x[smp, b] + sensing[smp, 3 + c] + (snoise[k, c] if k < n_snoise else 0.0)
-                        x[smp, b + 2] = hp * (x[smp, b + 2] + a_m - x[smp, b + 1])
-                        x[smp, b + 1] = a_m
-                        v_new = hp * (x[smp, b + 3] + tc * x[smp, b + 2])
-                        x[smp, b + 5] = hp * (x[smp, b + 5] + v_new - x[smp, b + 4])
-                        x[smp, b + 4] = v_new
-                        x[smp, b + 3] = v_new
-                        x[smp, b + 6] = hp * (x[smp, b + 6] + tc * x[smp, b + 5])
+                        a_m = x[smp, b + SS_FILTERED] + sensing[smp, S_BIAS + c]
+                        a_m += snoise[k, c] if k < n_snoise else 0.0
+                        x[smp, b + SS_HP1] = hp * (x[smp, b + SS_HP1] + a_m - x[smp, b + SS_LAST])
+                        x[smp, b + SS_LAST] = a_m
+                        v_new = hp * (x[smp, b + SS_VEL] + tc * x[smp, b + SS_HP1])
+                        x[smp, b + SS_HP2] = hp * (x[smp, b + SS_HP2] + v_new - x[smp, b + SS_VEL_LAST])
+                        x[smp, b + SS_VEL_LAST] = v_new
+                        x[smp, b + SS_VEL] = v_new
+                        x[smp, b + SS_DISP] = hp * (x[smp, b + SS_DISP] + tc * x[smp, b + SS_HP2])
                     for j in range(3):
                         for c in range(N_CORNER):
-                            pm = sensing[smp, 3 + N_CORNER + N_CORNER * j + c]
-                            meas[j] += pm * x[smp, SENS + N_SENS_STATES * c + 6]
-                            meas[N_DOF + j] += pm * x[smp, SENS + N_SENS_STATES * c + 3]
+                            pm = sensing[smp, S_MAP + N_CORNER * j + c]
+                            meas[j] += pm * x[smp, SENS + N_SENS_STATES * c + SS_DISP]
+                            meas[N_DOF + j] += pm * x[smp, SENS + N_SENS_STATES * c + SS_VEL]
                 if k < n_noise:  # sensor noise on the carbody's (z, phi, theta) and their rates
                     for j in range(3):
-                        meas[j] += noise[k, j]
-                        meas[N_DOF + j] += noise[k, 3 + j]
+                        meas[j] += noise[k, NOISE_Q + j]
+                        meas[N_DOF + j] += noise[k, NOISE_V + j]
                 for j in range(3):
                     x[smp, XI + j] += tc * meas[j]
                 for c in range(N_CORNER):
@@ -476,7 +512,7 @@ def run_batch(
                     vc[c] = x[smp, FD_HELD + c]
             if faulty:  # a fault takes effect at its step
                 for c in range(N_CORNER):
-                    if fm[c] == FAULT_DISCONNECTED and step >= fm[N_CORNER + c]:
+                    if fault_at(faults, smp, c, step) == FAULT_DISCONNECTED:
                         conn[c] = 0.0
             # rates at the step's start: for the record, the sub-step choice and stage 1
             _derivative(law, s, R, 0, at, tt, pp, vc, conn, y, cx, cv, K, 0, i8, v8, n8, bw1)
@@ -486,30 +522,22 @@ def run_batch(
                     for j in range(3):
                         a_c += tt[j, c] * K[N_DOF + j]
                     b = SENS + N_SENS_STATES * c
-                    x[smp, b] += dt * w_aa * (a_c - x[smp, b])
+                    x[smp, b + SS_FILTERED] += dt * w_aa * (a_c - x[smp, b + SS_FILTERED])
             if closed_loop and law != LAW_IDEAL:
                 # inner loop from the damper forces at the step's start (they do not depend on
                 # the command, only on the coil state); then correct stage 1's coil rate
-                mode = int(inner[smp, 2])
-                for c in range(N_CORNER):
-                    f = y[2 * N_DOF + c]
-                    fd = x[smp, FD_HELD + c]
-                    if mode == VOLTAGE_ON_OFF:  # cv: the deflection rates at the step's start
-                        vc[c] = pp[P_V_MAX] if fd * cv[c] < 0.0 else pp[P_V_MIN]
-                    elif mode == VOLTAGE_CLIPPED:
-                        vc[c] = pp[P_V_MAX] if (fd - f) * f > 0.0 else pp[P_V_MIN]
-                    else:
-                        sgn = 1.0 if f > 0.0 else (-1.0 if f < 0.0 else 0.0)
-                        v = inner[smp, 1] * (fd - inner[smp, 0] * f) * sgn
-                        vc[c] = min(max(v, pp[P_V_MIN]), pp[P_V_MAX])
+                mode = int(inner[smp, I_LAW])
+                for c in range(N_CORNER):  # cv: the deflection rates at the step's start
+                    vc[c] = voltage_law(mode, B_in, G_in, y[2 * N_DOF + c], x[smp, FD_HELD + c], cv[c], pp)
                     b = 2 * N_DOF + N_DAMPER_STATES * c + 2
-                    K[b] = -pp[P_ETA] * (s[b] - vc[c])
+                    K[b] = coil_rate(pp, s[b], vc[c])
             if faulty:  # a failed coil driver: the command held whatever the law asks
                 for c in range(N_CORNER):
-                    if (fm[c] == FAULT_OFF or fm[c] == FAULT_ON) and step >= fm[N_CORNER + c]:
-                        vc[c] = pp[P_V_MIN] if fm[c] == FAULT_OFF else pp[P_V_MAX]
+                    v, held = fault_command(fault_at(faults, smp, c, step), vc[c], pp)
+                    if held:
+                        vc[c] = v
                         b = 2 * N_DOF + N_DAMPER_STATES * c + 2
-                        K[b] = -pp[P_ETA] * (s[b] - vc[c])
+                        K[b] = coil_rate(pp, s[b], v)
             if step % stride == 0:
                 row = step // stride
                 bad = False

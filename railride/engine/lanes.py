@@ -15,19 +15,26 @@ from railride.engine.kernels import (  # the scalar laws and helpers, inlined he
     _hermite,
     _one_step_limit,
     _rail_inputs,
+    coil_rate,
     damper_law,
     damper_stiffness,
+    fault_at,
+    fault_command,
     run_parallel,
     substeps,
+    voltage_law,
 )
 from railride.engine.layout import (  # sizes, codes and slots: compile-time constants to numba
     DIVERGED,
     FAULT_DISCONNECTED,
     FAULT_NONE,
-    FAULT_OFF,
-    FAULT_ON,
     FD_HELD,
     FD_NEXT,
+    F_MODE,
+    I_B,
+    I_DELAY,
+    I_G,
+    I_LAW,
     LAW_BOUC_WEN,
     LAW_IDEAL,
     LAW_SPENCER,
@@ -39,18 +46,17 @@ from railride.engine.layout import (  # sizes, codes and slots: compile-time con
     N_DOF,
     N_DS,
     N_RAIL,
+    NOISE_Q,
+    NOISE_V,
     P_ALPHA_A,
     P_BETA,
     P_ETA,
     P_GAMMA,
     P_N,
-    P_V_MAX,
-    P_V_MIN,
+    S_ON,
     SENS,
     STATUS_DIVERGED,
     STATUS_OK,
-    VOLTAGE_CLIPPED,
-    VOLTAGE_ON_OFF,
 )
 from railride.engine.layout import FASTMATH as _FAST, NO_PARFORS as _NO_PARFORS
 
@@ -117,58 +123,15 @@ def _lane_derivative(
 
 @njit(cache=True, nogil=True, fastmath=_FAST, parallel=_NO_PARFORS)
 def run_lanes(
-    lo,
-    hi,
-    lane_smp,
-    lane_own,
-    law,
-    x,
-    step0,
-    n_steps,
-    final,
-    stride,
-    dt,
-    a_ptr,
-    a_col,
-    a_val,
-    a_uni,
-    t_ptr,
-    t_col,
-    t_val,
-    t_uni,
-    c_sec,
-    P,
-    vcmd,
-    utab,
-    u_off,
-    ftab,
-    f_off,
-    n_nodes,
-    interval,
-    closed_loop,
-    ctrl_stride,
-    Gm,
-    Hm,
-    inner,
-    noise,
-    faults,
-    out_q,
-    out_v,
-    out_a,
-    out_f,
-    out_w,
-    out_wd,
-    out_d,
-    out_fd,
-    out_vc,
-    status,
-    fail_step,
+    lo, hi, lane_smp, lane_own, law, x, step0, n_steps, final, stride, dt, vehicle, dampers, inputs, control, outputs
 ):
     """`run_batch` for the groups lo <= g < hi of LANES samples: lane l of group g is sample
     lane_smp[g, l], and writes its state, outputs and status only where lane_own[g, l] (a
     padding lane repeats a sample of its group and discards what it computes). The arguments
-    are run_batch's but for realistic sensing, which this kernel leaves out (run_batch has it);
-    P is the batch's one damper (N_PACKED,), and the products run on their non-zero structure
+    are run_batch's groups but for realistic sensing, which this kernel leaves out (run_batch has
+    it; control's sensing and snoise go unread); dampers = (P, vcmd) with P the batch's one
+    damper (N_PACKED,), and vehicle = (a_ptr, a_col, a_val, a_uni, t_ptr, t_col, t_val, t_uni,
+    c_sec): the products run on their non-zero structure
     over every lane of a group, compressed rows shared by all groups: q'' = r + A y over
     (a_ptr, a_col, a_val[g]) (rows of q'', columns of y = (q, q', f)), the corner deflections
     and rates over (t_ptr, t_col, t_val[g]) (rows cx then cv, columns of q, q'); a_val[g, k, l]
@@ -183,6 +146,11 @@ def run_lanes(
     controller, the voltage laws, the sub-step choice, the rail forcing (computed once for
     lanes that read the same table at the same time) and the records run lane by lane.
     """
+    a_ptr, a_col, a_val, a_uni, t_ptr, t_col, t_val, t_uni, c_sec = vehicle
+    P, vcmd = dampers
+    utab, u_off, ftab, f_off, n_nodes, interval = inputs
+    closed_loop, ctrl_stride, Gm, Hm, inner, noise, faults, _sensing, _snoise = control
+    out_q, out_v, out_a, out_f, out_w, out_wd, out_d, out_fd, out_vc, status, fail_step = outputs
     has_states = law != LAW_VISCOUS_IN_C and law != LAW_IDEAL
     record_d = out_d.shape[1] > 1
     record_c = out_fd.shape[1] > 1
@@ -231,7 +199,7 @@ def run_lanes(
                 XC[j, l] = x[i, NS_MAX + j]
             for c in range(N_CORNER):
                 VC[c, l] = vcmd[i, c]
-                faulty = faulty or faults[i, c] != FAULT_NONE
+                faulty = faulty or faults[i, F_MODE + c] != FAULT_NONE
             act[l] = 1.0
             ts[l] = step0 * dt
         _lane_forcing(ts, LANES, act, smp, ftab, f_off, n_nodes, interval, RR, 0)
@@ -244,15 +212,15 @@ def run_lanes(
                 for l in range(LANES):
                     i = smp[l]
                     # the demand computed `delay` periods ago takes effect; its slot the new one
-                    slot = FD_NEXT - NS_MAX + N_CORNER * (k % int(inner[i, 3]))
+                    slot = FD_NEXT - NS_MAX + N_CORNER * (k % int(inner[i, I_DELAY]))
                     for c in range(N_CORNER):
                         XC[FD_HELD - NS_MAX + c, l] = XC[slot + c, l]
                     for j in range(2 * N_DOF):
                         meas[j] = S[j, l]
                     if k < n_noise:
                         for j in range(3):
-                            meas[j] += noise[k, j]
-                            meas[N_DOF + j] += noise[k, 3 + j]
+                            meas[j] += noise[k, NOISE_Q + j]
+                            meas[N_DOF + j] += noise[k, NOISE_V + j]
                     for j in range(3):
                         XC[j, l] += tc * meas[j]
                     for c in range(N_CORNER):
@@ -270,7 +238,7 @@ def run_lanes(
                 for l in range(LANES):
                     i = smp[l]
                     for c in range(N_CORNER):
-                        if faults[i, c] == FAULT_DISCONNECTED and step >= faults[i, N_CORNER + c]:
+                        if fault_at(faults, i, c, step) == FAULT_DISCONNECTED:
                             CONN[c, l] = 0.0
             _lane_derivative(
                 law,
@@ -297,29 +265,23 @@ def run_lanes(
             if closed_loop and law != LAW_IDEAL:
                 for l in range(LANES):
                     i = smp[l]
-                    mode = int(inner[i, 2])
+                    mode = int(inner[i, I_LAW])
+                    B_in, G_in = inner[i, I_B], inner[i, I_G]
                     for c in range(N_CORNER):
                         f = S[ROW_F + c, l]
                         fd = XC[FD_HELD - NS_MAX + c, l]
-                        if mode == VOLTAGE_ON_OFF:
-                            VC[c, l] = P[P_V_MAX] if fd * CC[N_CORNER + c, l] < 0.0 else P[P_V_MIN]
-                        elif mode == VOLTAGE_CLIPPED:
-                            VC[c, l] = P[P_V_MAX] if (fd - f) * f > 0.0 else P[P_V_MIN]
-                        else:
-                            sgn = 1.0 if f > 0.0 else (-1.0 if f < 0.0 else 0.0)
-                            v = inner[i, 1] * (fd - inner[i, 0] * f) * sgn
-                            VC[c, l] = min(max(v, P[P_V_MIN]), P[P_V_MAX])
+                        VC[c, l] = voltage_law(mode, B_in, G_in, f, fd, CC[N_CORNER + c, l], P)
                         b = ROW_D + N_DAMPER_STATES * c + 2
-                        K[b, l] = -P[P_ETA] * (S[b, l] - VC[c, l])
+                        K[b, l] = coil_rate(P, S[b, l], VC[c, l])
             if faulty:
                 for l in range(LANES):
                     i = smp[l]
                     for c in range(N_CORNER):
-                        fm = faults[i, c]
-                        if (fm == FAULT_OFF or fm == FAULT_ON) and step >= faults[i, N_CORNER + c]:
-                            VC[c, l] = P[P_V_MIN] if fm == FAULT_OFF else P[P_V_MAX]
+                        v, held = fault_command(fault_at(faults, i, c, step), VC[c, l], P)
+                        if held:
+                            VC[c, l] = v
                             b = ROW_D + N_DAMPER_STATES * c + 2
-                            K[b, l] = -P[P_ETA] * (S[b, l] - VC[c, l])
+                            K[b, l] = coil_rate(P, S[b, l], v)
             if step % stride == 0:
                 row = step // stride
                 if law == LAW_VISCOUS_IN_C:  # the dashpots' forces, for the record
@@ -466,14 +428,15 @@ def _compressed(M, smp):
 def lanes_fit(n: int, P, sensing) -> bool:
     """Whether `lanes_stepper` can run this batch: LANES samples or more, one damper (the
     packed parameters of every sample alike) and no realistic sensing."""
-    return n >= LANES and bool(np.all(P == P[P_ALPHA_A])) and not bool(np.any(sensing[:, 0] > 0.0))
+    return n >= LANES and bool(np.all(P == P[P_ALPHA_A])) and not bool(np.any(sensing[:, S_ON] > 0.0))
 
 
 def lanes_stepper(n, law, A, TS, P):
     """`run_batch`'s work for the n samples of a batch (sensing off, see `lanes_fit`) in groups
     of LANES samples by `run_lanes`, the groups on threads (`run_parallel`). The lane groups and
     the products' compressed rows are built here, once per run; the function returned takes
-    run_batch's arguments after lo, hi, chunk after chunk (it reads A, TS and P from here)."""
+    run_batch's arguments after lo, hi, chunk after chunk (it reads A, TS and P from here; the
+    vehicle and damper groups it is given supply c_sec and vcmd)."""
     smp, own = lane_groups(n)
     n_cols = 2 * N_DOF if law == LAW_VISCOUS_IN_C else NY  # dashpots inside Av: no force columns
     a_ptr, a_col, a_val = _compressed(A[:, :n_cols, :].transpose(0, 2, 1), smp)
@@ -484,12 +447,11 @@ def lanes_stepper(n, law, A, TS, P):
     products = (a_ptr, a_col, a_val, a_uni, t_ptr, t_col, t_val, t_uni)
     damper = np.ascontiguousarray(P[P_ALPHA_A])
 
-    def step(_n, _law, x, step0, n_steps, final, stride, dt, _A, _TS, c_sec, _P, vcmd, *rest):
-        # rest: utab ... faults (13), sensing and snoise (unused: sensing is off), the outputs
-        inputs, outs = rest[:13], rest[15:]
+    def step(_n, _law, x, step0, n_steps, final, stride, dt, vehicle, dampers, inputs, control, outputs):
+        # run_batch's groups: the products and run_batch's c_sec, the one damper and vcmd, the rest as they are
         run_parallel(
-            run_lanes, len(smp), smp, own, law, x, step0, n_steps, final, stride, dt, *products, c_sec, damper,
-            vcmd, *inputs, *outs,
+            run_lanes, len(smp), smp, own, law, x, step0, n_steps, final, stride, dt, products + (vehicle[2],),
+            (damper, dampers[1]), inputs, control, outputs,
         )  # fmt: skip
 
     return step

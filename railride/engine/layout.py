@@ -65,6 +65,23 @@ FAULT_NONE = 0
 FAULT_OFF = 1
 FAULT_ON = 2
 FAULT_DISCONNECTED = 3
+#: the columns of a sample's row of the fault table (`railride.secondary.faults.fault_table`, int64):
+#: corner c's mode (FAULT_*) in F_MODE + c, the step it fails at in F_STEP + c
+F_MODE = 0
+F_STEP = N_CORNER
+N_FAULT_COLS = 2 * N_CORNER
+
+# -- the closed loop's settings ------------------------------------------------------------------
+#: the columns of a sample's inner-loop row: the tracking law's B and G, the voltage law
+#: (VOLTAGE_*), and the delay from a controller sample to its demand taking effect, in controller
+#: periods (1 to MAX_DELAY)
+I_B, I_G, I_LAW, I_DELAY = range(4)
+N_INNER = 4
+#: the columns of the sensor-noise table (a row per controller sample): the carbody's (z, phi,
+#: theta) from NOISE_Q, their rates from NOISE_V
+NOISE_Q = 0
+NOISE_V = 3
+NOISE_COLS = 6
 
 # -- the state array of a sample -------------------------------------------------------------------
 N_DS = N_CORNER * N_DAMPER_STATES  # damper states of the vehicle
@@ -78,12 +95,20 @@ FD_NEXT = FD_HELD + N_CORNER  # ... and those computed at the last MAX_DELAY sam
 #: filter output, the last sample, and the two band-limited integration stages (high-pass,
 #: leaky integral)
 SENS = FD_NEXT + MAX_DELAY * N_CORNER
-N_SENS_STATES = 7  # y_f, a_prev, h1, v, v_prev, h2, d
+#: a corner's sensing states, from SENS + N_SENS_STATES c: the anti-alias filter's output, the
+#: last sample, the first high-pass, the velocity estimate, its last value, the second
+#: high-pass, the displacement estimate
+SS_FILTERED, SS_LAST, SS_HP1, SS_VEL, SS_VEL_LAST, SS_HP2, SS_DISP = range(7)
+N_SENS_STATES = 7
 NX = SENS + N_SENS_STATES * N_CORNER  # columns of the state array x
-#: the columns of a sample's sensing settings: on (1) or ideal states (0), the anti-alias filter
-#: and estimator corner rates [rad/s], the bias of each corner [m/s^2], the 3 x 4 map from corner
-#: values to the carbody's (z, phi, theta), row by row
-SENSING_COLS = 3 + N_CORNER + 3 * N_CORNER
+#: the columns of a sample's sensing settings (`railride.secondary.sensing.Sensing.pack`): on (1)
+#: or ideal states (0), the anti-alias filter and estimator corner rates [rad/s], the bias of
+#: each corner [m/s^2] from S_BIAS, the 3 x 4 map from corner values to the carbody's (z, phi,
+#: theta), row by row, from S_MAP
+S_ON, S_W_AA, S_W_C = range(3)
+S_BIAS = 3
+S_MAP = S_BIAS + N_CORNER
+SENSING_COLS = S_MAP + 3 * N_CORNER
 
 # -- sub-steps, the rig, status ----------------------------------------------------------------------
 #: sub-steps resolve the fastest damper rate: rate x SUBSTEP_DT_REF / (sub-steps) <= this

@@ -427,13 +427,15 @@ def simulate(
     faults = fault_table([s.faults for s in suspensions], dt, duration)
 
     if closed is None:
-        ctrl_stride, inner_gains, noise = 1, np.zeros((n, 4)), np.zeros((0, 6))
+        ctrl_stride, inner_gains, noise = 1, np.zeros((n, layout.N_INNER)), np.zeros((0, layout.NOISE_COLS))
     else:
         ctrl_stride, noise = closed["stride"], closed["noise"]
         inner = closed["inner"]  # none for the ideal devices: the stepper does not read it
-        inner_gains = np.zeros((n, 4)) if inner is None else np.tile([inner.B, inner.G, 0.0, 0.0], (n, 1))
-        inner_gains[:, 2] = modes
-        inner_gains[:, 3] = [s.delay for s in suspensions]
+        inner_gains = np.zeros((n, layout.N_INNER))  # the inner-loop row of each sample (layout.I_*)
+        if inner is not None:
+            inner_gains[:, layout.I_B], inner_gains[:, layout.I_G] = inner.B, inner.G
+        inner_gains[:, layout.I_LAW] = modes
+        inner_gains[:, layout.I_DELAY] = [s.delay for s in suspensions]
     chunk = n_steps if progress is None else max(stride, (_CHUNK_WORK // n) // stride * stride)
     done = 0
     if exact and closed is not None:
@@ -480,52 +482,20 @@ def simulate(
     else:
         step_batch = functools.partial(kernels.run_parallel, kernels.run_batch)
     stop = _StopRequest(progress is not None and not exact)
+    # the stepper's argument groups (`kernels.run_batch`): vehicle, dampers, inputs, control, outputs
+    kernel_groups = (
+        (arrays["A"], arrays["TS"], arrays["c_sec"]),
+        (P, vcmd),
+        (utab, u_off, ftab, f_off, n_nodes, interval),
+        (closed is not None, ctrl_stride, gm, hm, inner_gains, noise, faults, sensing, snoise),
+        tuple(out[key] for key in ("q", "v", "a", "f", "w", "wd", "d", "fd", "vc")) + (status, fail_step),
+    )
     step_batch = stop.around(step_batch)
     while not exact:
         todo = min(chunk, n_steps - done)
         final = done + todo == n_steps
         started = time.perf_counter()
-        step_batch(
-            n,
-            law,
-            x,
-            done,
-            todo,
-            final,
-            stride,
-            dt,
-            arrays["A"],
-            arrays["TS"],
-            arrays["c_sec"],
-            P,
-            vcmd,
-            utab,
-            u_off,
-            ftab,
-            f_off,
-            n_nodes,
-            interval,
-            closed is not None,
-            ctrl_stride,
-            gm,
-            hm,
-            inner_gains,
-            noise,
-            faults,
-            sensing,
-            snoise,
-            out["q"],
-            out["v"],
-            out["a"],
-            out["f"],
-            out["w"],
-            out["wd"],
-            out["d"],
-            out["fd"],
-            out["vc"],
-            status,
-            fail_step,
-        )
+        step_batch(n, law, x, done, todo, final, stride, dt, *kernel_groups)
         done += todo
         if progress is not None:
             took = max(time.perf_counter() - started, 1e-6)  # the first call may include compiling

@@ -74,12 +74,12 @@ class Accelerometers:
         corner geometry is ``carbody_map`` (T_c, 3 x 4: heave, pitch, roll forces from corner
         forces; a corner's displacement is T_c^T q_c)."""
         row = np.zeros(layout.SENSING_COLS)
-        row[0] = 1.0
-        row[1] = 2 * math.pi * self.antialias_hz
-        row[2] = 2 * math.pi * self.cutoff_hz
-        row[3 : 3 + 4] = self.bias
+        row[layout.S_ON] = 1.0
+        row[layout.S_W_AA] = 2 * math.pi * self.antialias_hz
+        row[layout.S_W_C] = 2 * math.pi * self.cutoff_hz
+        row[layout.S_BIAS : layout.S_BIAS + layout.N_CORNER] = self.bias
         # q_c from the corner displacements z = T_c^T q_c: the least-squares inverse
-        row[7:] = np.linalg.solve(carbody_map @ carbody_map.T, carbody_map).ravel()
+        row[layout.S_MAP :] = np.linalg.solve(carbody_map @ carbody_map.T, carbody_map).ravel()
         return row
 
     def samples(self, n: int) -> np.ndarray:
