@@ -92,11 +92,9 @@ def plot_study(result, ax=None, metrics=None):
         axes[0].legend(fontsize="small")
     if ax is None:
         s = result.settings
-        set_title(
-            fig,
-            f"{s.get('scenario')}: {len(s.get('track_seeds', []))} track seeds x "
-            f"{len(s.get('speeds_m_s', []))} speeds per condition",
-        )
+        seeds = s.get("track_seeds") or []  # None: a scenario that is not a random track
+        over = (f"{len(seeds)} track seeds x " if seeds else "") + f"{len(s.get('speeds_m_s') or [])} speeds"
+        set_title(fig, f"{s.get('scenario')}: {over} per condition")
     return fig
 
 

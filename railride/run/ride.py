@@ -207,13 +207,25 @@ def plausibility_notes(param_sets) -> list[str]:
     return list(dict.fromkeys(n for p in param_sets for n in notes(p)))
 
 
+@dataclasses.dataclass(frozen=True, eq=False, init=False, repr=False)
 class RideResult:
     """Time histories (``.dataset``, an xarray Dataset) and the ride metrics of a run.
 
     The Dataset is assembled on first use, so a sweep that keeps only a few numbers per run
-    does not pay for building it. A single run follows the result protocol: `to_dict` (the
-    JSON document), `to_pandas`, `plot` and `save`.
+    does not pay for building it. A single run follows the result protocol (`railride.Result`):
+    `to_dict` (the JSON document), `to_pandas`, `plot` and `save`. Frozen: its fields cannot
+    be assigned (the Dataset built on first use is its only change, made once, here).
     """
+
+    _dataset: xr.Dataset | None
+    _build: Any
+    _raw: dict | None
+    #: the `Suspension` of the run (a list of them for a batch) and its `SolverSettings`
+    suspension: Any
+    solver: Any
+    #: the `Scenario` and `VehicleParams` of the run (lists for a batch)
+    scenario: Any
+    params: Any
 
     def __init__(
         self,
@@ -228,22 +240,25 @@ class RideResult:
     ):
         if (dataset is None) == (build is None):
             raise InputError("RideResult needs a dataset or a build function, not both")
-        self._dataset = dataset
-        self._build = build
-        self._raw = raw
-        #: the `Suspension` of the run (a list of them for a batch) and its `SolverSettings`
-        self.suspension = suspension
-        self.solver = solver
-        #: the `Scenario` and `VehicleParams` of the run (lists for a batch)
-        self.scenario = scenario
-        self.params = params
+        for name, value in (
+            ("_dataset", dataset),
+            ("_build", build),
+            ("_raw", raw),
+            ("suspension", suspension),
+            ("solver", solver),
+            ("scenario", scenario),
+            ("params", params),
+        ):
+            object.__setattr__(self, name, value)
 
     @property
     def dataset(self) -> xr.Dataset:
-        if self._dataset is None:
-            self._dataset = self._build()
-            self._build = None
-        return self._dataset
+        dataset = self._dataset
+        if dataset is None:  # built once, on first use (frozen: past the dataclass's guard)
+            dataset = self._build()
+            object.__setattr__(self, "_dataset", dataset)
+            object.__setattr__(self, "_build", None)
+        return dataset
 
     def __getitem__(self, name):
         return self.dataset[name]

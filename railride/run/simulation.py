@@ -559,7 +559,8 @@ def simulate(
     )
     if stop.requested:
         until = (rows - 1) / output_rate
-        result._build = _marked_partial(result._build, f"interrupted: up to t = {until:.4g} s of {duration:.4g} s")
+        marked = _marked_partial(result._build, f"interrupted: up to t = {until:.4g} s of {duration:.4g} s")
+        object.__setattr__(result, "_build", marked)  # a RideResult is frozen; its Dataset is not built yet
         raise Interrupted(result, until)
     return result
 

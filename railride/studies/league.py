@@ -31,7 +31,7 @@ RESPONSES = ("acceleration_m_s2", "displacement_m", "pitch_deg", "roll_deg")
 COMFORT = ("aw_Wk", "N_MV_z")
 
 
-@dataclass
+@dataclass(frozen=True, eq=False)
 class LeagueTable:
     """Per case (scenario, speed, seed) and controller: ``cases`` (a DataFrame, one row each);
     ``settings``: what was run; ``tuned_on``: the scenario record the gains were tuned on

@@ -80,7 +80,7 @@ def non_dominated(points) -> np.ndarray:
     return keep
 
 
-@dataclass
+@dataclass(frozen=True, eq=False)
 class ParetoResult:
     """The samples of `pareto`: ``gains`` (n, d) in SI for ``parameters``, ``rms`` (n, 4) of
     acceleration, displacement, pitch, roll, ``passive`` (4,) the passive RMS. Row 0 is the base

@@ -56,7 +56,7 @@ def fault_condition(text: str) -> tuple:
     return () if text == HEALTHY else tuple(f.label for f in parse_faults(text.split("+")))
 
 
-@dataclass
+@dataclass(frozen=True, eq=False)
 class StudyResult:
     """The result of `study`. ``cases``: one row per run (the run table's metrics, with the
     study's ``controller``, ``load``, ``stiffness``, ``fault``, ``delay``, ``track_seed`` and

@@ -70,7 +70,7 @@ class Study:
         }
 
 
-@dataclass
+@dataclass(frozen=True, eq=False)
 class TuneResult:
     """The result of `railride.studies.tuning.tune`: the tuned ``gains`` (the start gains ``start``
     with the changes the studies kept), one `Study` per law tuned (``studies``, in order), the

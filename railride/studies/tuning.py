@@ -296,7 +296,7 @@ def tune(
     loads = [vehicle.load_changes(c.load) for c in cases_set]
     passives = _rms(run([Case(c.scenario, c.options, vehicle=ld) for c, ld in zip(cases_set, loads)]))
     passive = passives[0]
-    result.passive = dict(zip(RESPONSES, passive))
+    result = dataclasses.replace(result, passive=dict(zip(RESPONSES, passive)))  # a result is frozen
     inner: dict[str, float] = {}  # the inner loop's changes, which every law's runs carry
     if "inner" in controllers:
         result.studies.append(_tune_inner(gains, inner, n_values, span, tol, result, log, damper, damper_scale))
@@ -329,12 +329,11 @@ def tune(
 
         study, tuned[name] = _study(name, gains, score, budget, n_values, float(span), tol, min_span, result, log)
         result.studies.append(study)
-    result.gains = gains.apply({**inner, **{k: v for own in tuned.values() for k, v in own.items()}})
+    tuned_gains = gains.apply({**inner, **{k: v for own in tuned.values() for k, v in own.items()}})
+    result = dataclasses.replace(result, gains=tuned_gains)
     if before_after and over is None:
-        result.before_after = _before_after(result, run, case, tuned, inner, damper)
-    result.runs = table.frame
-    result.date = _utc_now()
-    return result
+        result = dataclasses.replace(result, before_after=_before_after(result, run, case, tuned, inner, damper))
+    return dataclasses.replace(result, runs=table.frame, date=_utc_now())
 
 
 def _study(name, start, score, budget, n_values, start_span, tol, min_span, result, log) -> tuple[Study, dict]:
