@@ -77,6 +77,15 @@ from railride.engine.layout import (  # sizes, codes and slots: compile-time con
     RIG_COMMANDED,
     RIG_CONSTANT,
     RIG_TRACKING,
+    R_E,
+    R_F,
+    R_T,
+    R_U,
+    R_V,
+    R_X,
+    R_XD,
+    R_Y,
+    R_Z,
     S_BIAS,
     S_MAP,
     S_ON,
@@ -96,6 +105,7 @@ from railride.engine.layout import (  # sizes, codes and slots: compile-time con
     SUBSTEP_LIMIT,
     VOLTAGE_CLIPPED,
     VOLTAGE_ON_OFF,
+    VOLTAGE_TRACKING,
     XI,
 )
 from railride.engine.layout import FASTMATH as _FAST, NO_PARFORS as _NO_PARFORS
@@ -629,10 +639,10 @@ def rig_batch(lo, hi, law, P, n_steps, stride, dt, xtab, x_interval, mode, vcons
     The command voltage, held over each step, is vconst[s] (``mode`` RIG_CONSTANT), the series
     series[s, step] (RIG_COMMANDED, clipped to [v_min, v_max]), or the force-tracking law of
     paper eq. 12-14 (RIG_TRACKING), v = clip(G[s] (f_d - B[s] F) sgn(F), v_min, v_max), from the
-    force F at the step's start and the desired force f_d = series[s, step].
+    force F at the step's start and the desired force f_d = series[s, step] (`voltage_law`).
     States: z, y, u and the dissipated energy E (E' = F x'). Row step // stride of out[s]
-    receives (t, x, x', F, z, y, u, v, E) at every step that is a multiple of stride, and after
-    the last step.
+    receives (t, x, x', F, z, y, u, v, E) (columns `layout.RIG_COLUMNS`, slots R_*) at every
+    step that is a multiple of stride, and after the last step.
     """
     n_rows = xtab.shape[0]
     for smp in range(lo, hi):
@@ -651,24 +661,23 @@ def rig_batch(lo, hi, law, P, n_steps, stride, dt, xtab, x_interval, mode, vcons
             x = h00 * xtab[k, 0] + h10 * xtab[k, 1] + h01 * xtab[k + 1, 0] + h11 * xtab[k + 1, 1]
             xd = d00 * (xtab[k, 0] - xtab[k + 1, 0]) + d10 * xtab[k, 1] + d11 * xtab[k + 1, 1]
             F, dz, dy, du = damper_law(law, pp, x, xd, z, yy, u, 0.0)
-            if mode == RIG_TRACKING:
-                sgn = 1.0 if F > 0.0 else (-1.0 if F < 0.0 else 0.0)
-                v = min(max(G[smp] * (series[smp, n] - B[smp] * F) * sgn, pp[P_V_MIN]), pp[P_V_MAX])
+            if mode == RIG_TRACKING:  # the vehicle's tracking law on the damper's own force
+                v = voltage_law(VOLTAGE_TRACKING, B[smp], G[smp], F, series[smp, n], 0.0, pp)
             elif mode == RIG_COMMANDED:
                 v = min(max(series[smp, n], pp[P_V_MIN]), pp[P_V_MAX])
             else:
                 v = vconst[smp]
             if n % stride == 0 or n == n_steps:
                 row = n // stride if n % stride == 0 else out.shape[1] - 1
-                out[smp, row, 0] = t
-                out[smp, row, 1] = x
-                out[smp, row, 2] = xd
-                out[smp, row, 3] = F
-                out[smp, row, 4] = z
-                out[smp, row, 5] = yy
-                out[smp, row, 6] = u
-                out[smp, row, 7] = v
-                out[smp, row, 8] = E
+                out[smp, row, R_T] = t
+                out[smp, row, R_X] = x
+                out[smp, row, R_XD] = xd
+                out[smp, row, R_F] = F
+                out[smp, row, R_Z] = z
+                out[smp, row, R_Y] = yy
+                out[smp, row, R_U] = u
+                out[smp, row, R_V] = v
+                out[smp, row, R_E] = E
             if n == n_steps:
                 break
             m = substeps(damper_stiffness(law, pp, xd, z, u), dt)

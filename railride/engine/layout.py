@@ -119,6 +119,10 @@ MAX_SUBSTEPS = 1024
 RIG_CONSTANT = 0
 RIG_COMMANDED = 1
 RIG_TRACKING = 2
+#: the columns of the rig's output rows: time, extension and its rate, force, the damper states
+#: z, y, u, the command voltage and the energy dissipated
+RIG_COLUMNS = ("t", "x", "xd", "F", "z", "y", "u", "v", "E")
+R_T, R_X, R_XD, R_F, R_Z, R_Y, R_U, R_V, R_E = range(9)
 STATUS_OK = 0
 STATUS_DIVERGED = 1
 

@@ -197,7 +197,7 @@ def drive(
         B = _check_number("B", B, "nonnegative", "")
         G = _check_number("G", default_gain(damper) if G is None else G, "nonnegative", "V/N")
     rows = n_steps // stride + (1 if n_steps % stride == 0 else 2)
-    out = np.zeros((n, rows, 9))
+    out = np.zeros((n, rows, len(layout.RIG_COLUMNS)))  # the kernel's columns, layout.R_*
     kernels.run_parallel(  # the voltages of a set of cycles on threads, one range per core
         kernels.rig_batch,
         n,
