@@ -133,11 +133,14 @@ def describe_dampers(settings: dict, detail: bool = False) -> str:
         "ideal": ("ideal actuators", "force = demand"),
         "ideal-damper": ("ideal semi-active dampers", "force = demand where it dissipates, else 0"),
     }
-    if settings.get("damper") in ideal:
-        words, what = ideal[settings["damper"]]
+    damper = settings.get("damper")
+    if isinstance(damper, dict):  # a model given as such: its record
+        damper = damper.get("preset") or damper.get("model", "MR")
+    if damper in ideal:
+        words, what = ideal[damper]
         return f"{words} ({what})" if detail else words
     scale = settings.get("damper_scale") or 1.0
-    return f"{settings['damper']} MR dampers" + (f" (force x {scale:g})" if scale != 1.0 else "")
+    return f"{damper} MR dampers" + (f" (force x {scale:g})" if scale != 1.0 else "")
 
 
 def describe_suspension(ds: xr.Dataset) -> str:

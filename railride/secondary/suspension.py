@@ -69,6 +69,18 @@ def damper_model(damper, damper_scale: float = 1.0):
     return model.scaled(scale)
 
 
+def damper_record(damper):
+    """A damper argument as the records of results hold it: the name as given, or the model's
+    record (``to_dict()``) for a model."""
+    return damper if damper is None or isinstance(damper, str) else damper.to_dict()
+
+
+def damper_label(damper) -> str:
+    """A damper argument in a table's column: the name as given, else the model's preset name or
+    its model name ("bouc-wen")."""
+    return damper if isinstance(damper, str) else _damper_name(damper)
+
+
 @functools.lru_cache(maxsize=1)
 def _shipped_gains() -> GainSet:
     """The shipped gains, read once (every sweep case without a gain set asks for them)."""

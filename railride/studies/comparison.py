@@ -30,7 +30,7 @@ from railride.plots import PNG_DPI, FigureOptions
 from railride.run.simulation import simulate
 from railride.model.track import as_scenario
 from railride.run.solver import SolverSettings, check_resolution
-from railride.secondary.suspension import Suspension, damper_model
+from railride.secondary.suspension import Suspension, damper_model, damper_record
 
 #: Table 1 of Harun et al. (RMS values): for display beside railride's results.
 PAPER_TABLE1 = {
@@ -453,7 +453,7 @@ def compare(
         "scenario": scenario.describe(),
         "vehicle_params": vehicle.to_dict(),
         **({"warnings": warned} if (warned := notes(vehicle)) else {}),
-        "damper": str(damper),
+        "damper": damper_record(damper),
         "damper_scale": damper_scale,
         **solver.to_dict(),
         "window_s": None if window is None else [float(w) for w in window],

@@ -24,6 +24,7 @@ from railride.secondary.control import LABELS, PAPER_CONTROLLERS, GainSet
 from railride.defaults import DEFAULT_DAMPER
 from railride.plots import PNG_DPI, FigureOptions
 from railride.model.track import SPECTRA, scenario
+from railride.secondary.suspension import damper_record
 
 SCHEMA = "railride.league/1"
 RESPONSES = ("acceleration_m_s2", "displacement_m", "pitch_deg", "roll_deg")
@@ -53,6 +54,12 @@ class LeagueTable:
 
     def to_pandas(self) -> pd.DataFrame:
         return self.cases.copy()
+
+    def report_contents(self):
+        """What this result shows in its HTML report (`railride.output.report.write_report`)."""
+        from railride.output.report import league_contents
+
+        return league_contents(self)
 
     def to_dict(self) -> dict:
         def clean(v):
@@ -156,7 +163,7 @@ def league(
         "scenarios": scenarios,
         "speeds_m_s": None if speeds is None else [float(v) for v in speeds],
         "track_seeds": [int(s) for s in track_seeds],
-        "damper": damper,
+        "damper": damper_record(damper),
         "damper_scale": float(damper_scale),
         "duration_s": duration,
         "window_s": None if window is None else [float(w) for w in window],

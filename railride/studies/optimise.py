@@ -35,6 +35,7 @@ from railride.studies.sweep import Case, RunTable, run_cases
 from railride.studies.objectives import DEFAULT_OBJECTIVE, Objective
 from railride.plots import PNG_DPI, FigureOptions
 from railride.studies.tuning import PARAMETERS, REFERENCE, _rms
+from railride.secondary.suspension import damper_record
 
 #: the paper's fourteen SAS parameters
 SAS_PARAMETERS = PARAMETERS["sas-attitude-ride"]
@@ -134,7 +135,7 @@ class GainEvaluator:
         )
         return scenario, {
             **settings,
-            "damper": self.damper,
+            "damper": damper_record(self.damper),
             "dt_s": self.solver.dt,
             "base_gains": self.gains.source,
             **other_settings(vehicle, self.solver),

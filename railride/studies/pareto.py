@@ -34,6 +34,7 @@ from railride.studies.optimise import GainEvaluator, log_gain_bounds
 from railride import validation
 from railride.run.solver import SolverSettings, check_resolution
 from railride.studies.sweep import Case, RunTable
+from railride.secondary.suspension import damper_record
 
 SCHEMA = "railride.pareto/1"
 #: the files `ParetoResult.save` writes, in this order
@@ -285,7 +286,7 @@ def pareto(
         "n_samples": n_samples,
         "seed": seed,
         "sampling": SAMPLING,
-        "damper": damper,
+        "damper": damper_record(damper),
         "dt_s": solver.dt,
         "base_gains": base.source,
         "base_gains_tuned_on": (base.provenance or {}).get("scenario"),

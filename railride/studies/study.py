@@ -38,6 +38,7 @@ from railride.run.solver import SolverSettings
 from railride.secondary.sensing import SENSING, reads_bogies
 from railride.studies.sweep import COMFORT_COLUMNS, Case, RunTable, run_cases, scenario_of
 from railride.model.vehicle import Vehicle
+from railride.secondary.suspension import damper_record
 
 #: the schema of `StudyResult.to_dict` (study.json)
 SCHEMA = "railride.study/1"
@@ -71,6 +72,12 @@ class StudyResult:
     summary: pd.DataFrame
     settings: dict = field(default_factory=dict)
     failed: list = field(default_factory=list)
+
+    def report_contents(self):
+        """What this result shows in its HTML report (`railride.output.report.write_report`)."""
+        from railride.output.report import study_contents
+
+        return study_contents(self)
 
     def to_dict(self) -> dict:
         """The ``railride.study/1`` document: settings, per controller and condition every
@@ -313,7 +320,7 @@ def study(
         "delays_periods": delay_list,
         "sensing": sensing,
         "duration_s": duration,
-        "damper": damper,
+        "damper": damper_record(damper),
         "gains": gains.source,
         "window_s": window_record,
         **other_settings(vehicle, solver),

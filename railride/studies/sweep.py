@@ -35,7 +35,7 @@ from railride.analysis.metrics import RESPONSES, STATISTICS
 from railride.plots import PNG_DPI, FigureOptions
 from railride.model.params import VehicleParams
 from railride.run.solver import SolverSettings
-from railride.secondary.suspension import batch_conflict
+from railride.secondary.suspension import batch_conflict, damper_label, damper_record
 from railride.studies.case import MODEL_REVISION, SUSPENSIONS, Case, scenario_of  # noqa: F401 (their home before)
 from railride.studies.grid import SweepGrid, grid  # noqa: F401 (the grid of the sweep study, here too)
 
@@ -140,7 +140,7 @@ def _flat(c: Case) -> dict:
     d = {
         "scenario": c.scenario,
         "suspension": c.suspension,
-        "damper": c.damper,
+        "damper": damper_label(c.damper),
         "damper_scale": c.damper_scale,
         "voltage": np.nan if c.voltage is None else c.voltage,
         "noise": json.dumps(list(c.noise)) if c.noise else "",
@@ -332,7 +332,7 @@ class SweepResult:
         return {
             "scenario": g.scenario_record(),
             "grid": g.grid_values(),
-            "damper": g.damper if ("mr" in g.suspensions or g.controllers) else None,
+            "damper": damper_record(g.damper) if ("mr" in g.suspensions or g.controllers) else None,
             "gains_source": g.base_gains.source if g.controllers else None,
             "sensor_noise": None
             if g.noise is None

@@ -53,6 +53,7 @@ from railride import limits, validation
 from railride.run.solver import SolverSettings, check_resolution
 from railride.studies.sweep import Case, RunTable, run_cases
 from railride.studies.tune_result import SCHEMA, Curve, Study, TuneResult  # noqa: F401 (their home before)
+from railride.secondary.suspension import damper_record
 
 #: the laws with free gains, in the order a study tunes them: every outer loop (the
 #: constant-voltage baselines have no gains)
@@ -260,7 +261,7 @@ def tune(
         controllers=controllers,
         scenario=scen.describe(),
         settings={
-            "damper": damper,
+            "damper": damper_record(damper),
             "damper_scale": damper_scale,
             "dt_s": solver.dt,
             "budget": budget,
