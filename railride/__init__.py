@@ -17,9 +17,11 @@ The public API, in the order a run needs it::
     rr.write_report(rr.compare(sc), "ride.html")      # any result as one HTML page
 """
 
-from typing import TYPE_CHECKING
-
 from railride._version import __version__ as __version__
+
+#: typing.TYPE_CHECKING without importing typing: the package's face imports nothing else, so that
+#: a Ctrl-C in the command line's first milliseconds lands in its own handling (status 130)
+TYPE_CHECKING = False
 
 #: the module that holds each public name. They are imported on first use (PEP 562), so that
 #: ``import railride`` and the command line start in a fraction of a second (the engine, xarray
