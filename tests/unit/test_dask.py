@@ -361,9 +361,10 @@ def test_a_worker_killed_mid_sweep_changes_nothing(cluster):
         dask = _run(cases, executor, chunk=1)
         thread.join(SWEEP)
         # the scheduler dropped w3 and ran its chunk elsewhere
-        deadline = time.monotonic() + 30
+        deadline = time.monotonic() + SWEEP  # a guard against hanging, not a measure of speed
         while w3 in watcher.scheduler_info()["workers"]:
-            assert time.monotonic() < deadline, "the scheduler still lists the killed worker"
+            if time.monotonic() > deadline:
+                pytest.fail(f"the scheduler still lists the killed worker after {SWEEP:g} s")
             time.sleep(0.1)
     finally:
         executor.close()
@@ -380,36 +381,51 @@ def _free_port():
         return s.getsockname()[1]
 
 
-def test_an_unreachable_scheduler_is_a_quick_value_error():
+@pytest.fixture
+def clients(monkeypatch):
+    """The distributed.Client objects `DaskExecutor` tries to make, none of them made: a Client
+    waits up to its timeout for a scheduler (and a half-made one for 20 s more as it is
+    collected), so a refusal that comes before any Client is a quick one on any machine."""
+    import distributed
+
+    tried = []
+
+    def client(*args, **kwargs):
+        tried.append(args)
+        raise AssertionError("DaskExecutor made a Client before refusing the address")
+
+    monkeypatch.setattr(distributed, "Client", client)
+    return tried
+
+
+def test_an_unreachable_scheduler_is_a_quick_value_error(clients):
     address = f"tcp://127.0.0.1:{_free_port()}"  # nothing listens there
-    t0 = time.monotonic()
     with pytest.raises(ValueError, match=f"cannot reach the Dask scheduler at {address}"):
         DaskExecutor(address=address, timeout=2)
-    assert time.monotonic() - t0 < 10
+    assert clients == []  # refused by its own probe, before a Client
 
 
-def test_a_port_that_does_not_speak_dask_is_a_quick_value_error():
+def test_a_port_that_does_not_speak_dask_is_a_quick_value_error(clients):
     # accepts connections and never answers, like a web server: distributed's Client alone
     # would wait for its handshake forever
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
         s.listen()
         address = f"tcp://127.0.0.1:{s.getsockname()[1]}"
-        t0 = time.monotonic()
         with pytest.raises(ValueError, match=f"cannot reach the Dask scheduler at {address}"):
             DaskExecutor(address=address, timeout=2)
-        assert time.monotonic() - t0 < 10
+    assert clients == []  # refused by its own handshake check, before a Client
 
 
-def test_a_missing_or_broken_scheduler_file_is_a_quick_value_error(tmp_path):
-    t0 = time.monotonic()
-    with pytest.raises(ValueError, match="no such file"):
+def test_a_missing_or_broken_scheduler_file_is_a_quick_value_error(tmp_path, clients):
+    # distributed's Client would wait for a missing file forever: the executor waits its timeout
+    with pytest.raises(ValueError, match="no such file after 1 s"):
         DaskExecutor(scheduler_file=str(tmp_path / "nothing.json"), timeout=1)
     broken = tmp_path / "broken.json"
     broken.write_text("{}")
-    with pytest.raises(ValueError, match="not a Dask scheduler file"):
+    with pytest.raises(ValueError, match="not a Dask scheduler file .* after 1 s"):
         DaskExecutor(scheduler_file=str(broken), timeout=1)
-    assert time.monotonic() - t0 < 10
+    assert clients == []
 
 
 def test_an_unknown_scheme_or_both_targets_are_value_errors(tmp_path):
@@ -456,12 +472,11 @@ def test_every_scheme_the_errors_allow_runs_chunks(protocol):
         ("tcp://nowhere.invalid:8786", "unknown host 'nowhere.invalid'"),
     ],
 )
-def test_an_address_that_cannot_work_is_refused_at_once_naming_it(address, fragment):
+def test_an_address_that_cannot_work_is_refused_at_once_naming_it(address, fragment, clients):
     port = _free_port()  # nothing listens there
     address, fragment = address.format(port=port), fragment.format(port=port)
-    t0 = time.monotonic()
     with pytest.raises(ValueError) as info:
-        DaskExecutor(address=address, timeout=30)  # the checks do not wait for the timeout
-    assert time.monotonic() - t0 < 5
+        DaskExecutor(address=address, timeout=30)
+    assert clients == []  # refused by the checks, which do not wait for the timeout as a Client would
     message = str(info.value)
     assert message.startswith(f"address = {address!r}: ") and fragment in message, message

@@ -5,7 +5,6 @@ are input errors."""
 from __future__ import annotations
 
 import math
-import time
 
 import pytest
 
@@ -36,42 +35,63 @@ def test_the_limit_is_a_share_of_the_machine_and_restored_after_a_block():
     assert limits.max_memory() == limits.default_max_memory()
 
 
-def _refused_fast(fn, *fragments):
-    started = time.perf_counter()
+@pytest.fixture
+def no_work(monkeypatch):
+    """Every compiled stepper, the damper rig's kernel, the exact stepper's matrix exponentials and
+    the frequency response fail the test when entered: a refusal comes before any work (which is
+    what makes it quick on any machine)."""
+    import scipy.linalg
+
+    from railride.engine import kernels, lanes
+    from railride.model.vehicle import Vehicle
+
+    def worked(*args, **kwargs):
+        raise AssertionError("the work began before the refusal")  # not a ValueError: pytest.raises lets it by
+
+    for module, name in (
+        (kernels, "run_parallel"),
+        (kernels, "exact_run"),
+        (kernels, "exact_closed_run"),
+        (lanes, "run_parallel"),
+        (scipy.linalg, "expm"),
+    ):
+        monkeypatch.setattr(module, name, worked)
+    monkeypatch.setattr(Vehicle, "frequency_response", worked)
+
+
+def _refused(fn, *fragments):
+    """The ValueError of ``fn()``, holding every one of ``fragments`` (use with `no_work`)."""
     with pytest.raises(ValueError) as info:
         fn()
-    assert time.perf_counter() - started < 10.0
     for fragment in fragments:
         assert fragment in str(info.value), str(info.value)
     return str(info.value)
 
 
-def test_a_billion_frf_points_are_refused_before_allocating():
+def test_a_billion_frf_points_are_refused_before_allocating(no_work):
     # a billion complex responses of 9 DOF alone are 134 GiB: far above any default limit
-    message = _refused_fast(lambda: frequency_responses(points=10**9), "points", "fewer points", "--max-memory")
+    message = _refused(lambda: frequency_responses(points=10**9), "points", "fewer points", "--max-memory")
     assert "TiB" in message or "GiB" in message
 
 
-def test_damper_rig_at_a_microhertz_or_a_billion_cycles_is_refused():
-    _refused_fast(lambda: rig.cycles("railway", 0.01, 1e-6, [1.0]), "4e+10 steps", "raise the frequency")
-    _refused_fast(lambda: rig.cycles("railway", 0.01, 1.0, [1.0], n_cycles=10**9), "1e+13 steps", "fewer cycles")
+def test_damper_rig_at_a_microhertz_or_a_billion_cycles_is_refused(no_work):
+    _refused(lambda: rig.cycles("railway", 0.01, 1e-6, [1.0]), "4e+10 steps", "raise the frequency")
+    _refused(lambda: rig.cycles("railway", 0.01, 1.0, [1.0], n_cycles=10**9), "1e+13 steps", "fewer cycles")
 
 
-def test_a_picosecond_step_is_refused_with_what_the_run_would_need():
+def test_a_picosecond_step_is_refused_with_what_the_run_would_need(no_work):
     solver = SolverSettings(dt=1e-12)
-    _refused_fast(lambda: rr.simulate("paper-sine", solver=solver), "memory", "dt 1e-12 s")
+    _refused(lambda: rr.simulate("paper-sine", solver=solver), "memory", "dt 1e-12 s")
 
 
-def test_a_control_rate_slower_than_the_run_is_refused():
+def test_a_control_rate_slower_than_the_run_is_refused(no_work):
     solver = SolverSettings(control_rate=1e-300)
     pid = rr.Suspension.named("pid")
-    _refused_fast(
-        lambda: rr.simulate("paper-sine", suspension=pid, solver=solver), "control_rate = 1e-300 Hz", "0.1 Hz"
-    )
+    _refused(lambda: rr.simulate("paper-sine", suspension=pid, solver=solver), "control_rate = 1e-300 Hz", "0.1 Hz")
 
 
-def test_a_billion_tuning_candidates_are_refused():
-    _refused_fast(lambda: rr.tune(n_values=10**9, budget=10**9 + 2), "1000000000 candidate values")
+def test_a_billion_tuning_candidates_are_refused(no_work):
+    _refused(lambda: rr.tune(n_values=10**9, budget=10**9 + 2), "1000000000 candidate values")
 
 
 def test_the_limit_refuses_and_admits_the_same_run():
@@ -87,9 +107,9 @@ def test_the_limit_refuses_and_admits_the_same_run():
 @pytest.mark.parametrize(
     "track,field", [(SineTrack(wavelength=1e-6), "wavelength"), (CosineBump(length=0.01), "length")]
 )
-def test_wavelengths_the_output_cannot_resolve_are_refused_for_every_profile(track, field):
+def test_wavelengths_the_output_cannot_resolve_are_refused_for_every_profile(track, field, no_work):
     # at 55.56 m/s and 1000 Hz (2.5 samples a cycle at least) the shortest is 2.5 x 55.56 / 1000 m
-    message = _refused_fast(lambda: rr.simulate(Scenario(track=track, speed=55.56)), f"{field} = ", "0.1389 m")
+    message = _refused(lambda: rr.simulate(Scenario(track=track, speed=55.56)), f"{field} = ", "0.1389 m")
     assert "output_rate" in message
 
 
@@ -125,10 +145,10 @@ def test_the_window_is_finite():
             parse_window(text)
 
 
-def test_a_run_of_a_hundred_billion_steps_is_refused_by_its_work_with_its_time():
+def test_a_run_of_a_hundred_billion_steps_is_refused_by_its_work_with_its_time(no_work):
     # memory does not stop it: the histories are strided to 10001 rows whatever dt is
     mr = rr.Suspension.semi_active("railway", voltage=1.0)
-    message = _refused_fast(
+    message = _refused(
         lambda: rr.simulate("paper-sine", suspension=mr, solver=SolverSettings(dt=1e-10)),
         "1 x 1e+11 steps",
         "limit of 1e+10",
@@ -160,10 +180,10 @@ def test_work_limits_and_durations_read_and_show_plainly():
     assert limits.shown_duration(86400 * 41) == "41 days"
 
 
-def test_an_exact_run_whose_grids_never_line_up_is_refused_before_its_exponentials():
+def test_an_exact_run_whose_grids_never_line_up_is_refused_before_its_exponentials(no_work):
     # dt = 3e-9 s: 333 333 steps per output sample against 2**20 per input node, so the maps
     # would repeat only after a million output samples (minutes of matrix exponentials)
-    _refused_fast(
+    _refused(
         lambda: rr.simulate("paper-sine", solver=SolverSettings(dt=3e-9)),
         "1048576 step maps",
         "the default 0.0001 s",
