@@ -103,5 +103,6 @@ def test_sweep_comfort(tmp_path):
     plain_runs = pd.read_csv(plain_out / "runs.csv", dtype={"key": str})
     assert set(plain_runs["key"]).isdisjoint(set(runs["key"].astype(str)))
     # the rows' RMS values do not depend on --comfort
+    assert plain["rows"] and len(plain["rows"]) == len(doc["rows"])
     for a, b in zip(plain["rows"], doc["rows"]):
         assert a["acceleration_m_s2_rms"] == pytest.approx(b["acceleration_m_s2_rms"], rel=1e-12)

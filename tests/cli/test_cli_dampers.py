@@ -227,6 +227,7 @@ def test_simulate_mr_json():
     assert doc["schema"] == "railride.simulation/1"
     assert doc["suspension"] == {"type": "mr", "damper": "railway", "voltage_v": 2.25}
     assert list(doc).index("suspension") == list(doc).index("vehicle_preset") + 1
+    assert doc["metrics"]
     for values in doc["metrics"].values():
         assert math.isfinite(values["rms"]) and values["rms"] > 0
 

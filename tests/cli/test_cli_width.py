@@ -85,6 +85,7 @@ def test_the_compare_tables_keep_every_rms_value_and_its_unit_at_80_columns():
     doc = json.loads(printed((*args, "--format", "json"), 80))
     text = printed(args, 80)
     flat = " ".join(text.split())
+    assert doc["controllers"]
     for row in doc["controllers"]:
         assert row["label"] in flat
         for response, unit in (("acceleration_m_s2", "(m/s^2)"), ("displacement_m", "(m)"), ("pitch_deg", "(deg)")):

@@ -134,6 +134,7 @@ def test_body_responses(result, tmp_path):
 
 def test_body_responses_one_line_per_sample(batch):
     fig = plot_body_responses(batch.dataset)
+    assert fig.get_axes()
     for ax in fig.get_axes():
         assert len(ax.lines) == 2
 
@@ -388,6 +389,7 @@ def test_frf_has_a_phase_panel_per_response(results):
     assert len(phase) == 4
     for a in phase:
         assert a.get_ylim() == (-195.0, 195.0)
+        assert a.lines
         for line in a.lines:
             y = np.asarray(line.get_ydata(), dtype=float)
             y = y[np.isfinite(y)]

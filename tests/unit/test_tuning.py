@@ -474,6 +474,7 @@ def test_the_paper_laws_shipped_make_no_response_worse_than_passive(shipped_rati
         assert np.all(shipped_ratios[name] < 1.0), (name, shipped_ratios[name])
 
 
+@pytest.mark.slow  # the whole default study: about 65 s on a 2-core machine
 def test_tune_defaults_reproduce_the_shipped_gains():
     # `railride tune` with no option, from an installed package: the reference start is packaged
     shipped = GainSet.default()
