@@ -305,6 +305,12 @@ class RideResult:
 
         return ride_comfort(self.dataset, positions=positions, window=window, weightings=weightings)
 
+    def report_contents(self):
+        """What this result shows in its HTML report (`railride.output.report.write_report`)."""
+        from railride.output.report import ride_contents
+
+        return ride_contents(self)
+
     def to_dict(self, window=None, *, comfort: bool = False, vehicle: dict | None = None) -> dict:
         """The JSON document of a single run (`SCHEMA`, docs/cli.md): the scenario, the vehicle,
         the suspension, the step and output rate with the metrics window, and the ride metrics

@@ -21,15 +21,16 @@ from railride._version import __version__
 from railride.secondary import dampers
 from railride.secondary.control import CONSTANT_VOLTAGE, CONTROLLERS, LABELS, PAPER_CONTROLLERS, GainSet
 from railride.defaults import DEFAULT_DAMPER
-from railride.secondary.faults import check_faults, degradation, fault_table
+from railride.secondary.faults import check_faults, degradation
 from railride.analysis.comfort import comfort_record
 from railride.model.params import VehicleParams
 from railride.model.plausible import notes
 from railride.analysis.metrics import STATISTICS, reduction, ride_metrics, select_window
 from railride.plots import PNG_DPI, FigureOptions
+from railride.run.checks import check
 from railride.run.simulation import simulate
 from railride.model.track import as_scenario
-from railride.run.solver import SolverSettings, check_resolution
+from railride.run.solver import SolverSettings
 from railride.secondary.suspension import Suspension, damper_model, damper_record
 
 #: Table 1 of Harun et al. (RMS values): for display beside railride's results.
@@ -370,13 +371,8 @@ def compare(
     damper_scale = float(damper_scale)
     names = check_controllers(controllers)
     scenario = as_scenario(scenario)
-    check_resolution(scenario, solver.output_rate)
-    if len(names) > 1:
-        solver.control_steps()  # the controlled runs sample at the control rate
     gains = GainSet.default() if gains is None else gains
     faults = check_faults(faults, model)
-    if faults:
-        fault_table([faults], solver.dt, scenario.duration)  # the times, before any run
     ideal = model.law == dampers.LAW_IDEAL
     # a constant voltage means nothing to the ideal devices: said in the settings, not run
     not_run = {n: NO_VOLTAGE for n in names if n in CONSTANT_VOLTAGE and ideal}
@@ -396,6 +392,18 @@ def compare(
     # progress by sample-steps: the passive run is one sample, the other batches the rest
     share = 1.0 / (1 + len(constant) + len(closed) * (1 + len(bound_devices)))
     part = (lambda lo, w: lambda done: progress(lo + w * done)) if progress is not None else None
+    # the batches, each checked by the check every simulation makes (railride.run.checks.check),
+    # all of them before the first runs
+    batches = [
+        (group, [_named(n, gains, damper, damper_scale, noise, delay, sensing).with_faults(faults) for n in group])
+        for group, noise in ((closed, sensor_noise), (constant, None))
+        if group
+    ]
+    bound_batches = [
+        [_named(n, gains, device, 1.0, sensor_noise, delay, sensing) for n in closed] for device in bound_devices
+    ]
+    for suspensions in [[Suspension.passive()], *(s for _, s in batches), *bound_batches]:
+        check(scenario, params, suspensions, solver, "mark")
     datasets = {
         "passive": simulate(
             scenario, params, Suspension.passive(), solver=solver, progress=part and part(0.0, share)
@@ -403,31 +411,30 @@ def compare(
     }
     done = 1
     # closed and open loops run as separate batches (a batch is all one or the other)
-    for group, noise in ((closed, sensor_noise), (constant, None)):
-        if group:
-            # a law whose gains are not stable on this device is said, not fatal: the others go on
-            res = simulate(
-                scenario,
-                params,
-                [_named(n, gains, damper, damper_scale, noise, delay, sensing).with_faults(faults) for n in group],
-                solver=solver,
-                on_divergence="mark",
-                progress=part and part(share * done, share * len(group)),
-            )
-            for i, n in enumerate(group):
-                if np.isfinite(res.diverged_at[i]):
-                    not_run[n] = (
-                        f"diverged at t = {res.diverged_at[i]:.4g} s: these gains are not stable on damper "
-                        f"{damper!r} at dt = {solver.dt:g} s"
-                        + (
-                            f" with a delay of {delay} controller periods (a shorter delay, other gains)"
-                            if delay != 1 and n in closed
-                            else " (another dt, or other gains)"
-                        )
+    for group, suspensions in batches:
+        # a law whose gains are not stable on this device is said, not fatal: the others go on
+        res = simulate(
+            scenario,
+            params,
+            suspensions,
+            solver=solver,
+            on_divergence="mark",
+            progress=part and part(share * done, share * len(group)),
+        )
+        for i, n in enumerate(group):
+            if np.isfinite(res.diverged_at[i]):
+                not_run[n] = (
+                    f"diverged at t = {res.diverged_at[i]:.4g} s: these gains are not stable on damper "
+                    f"{damper!r} at dt = {solver.dt:g} s"
+                    + (
+                        f" with a delay of {delay} controller periods (a shorter delay, other gains)"
+                        if delay != 1 and n in closed
+                        else " (another dt, or other gains)"
                     )
-                else:
-                    datasets[n] = res.dataset.isel(sample=i, drop=True)
-            done += len(group)
+                )
+            else:
+                datasets[n] = res.dataset.isel(sample=i, drop=True)
+        done += len(group)
     names = [n for n in names if n not in not_run]
     closed = [n for n in closed if n not in not_run]
     bound_values = {}

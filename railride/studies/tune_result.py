@@ -101,6 +101,12 @@ class TuneResult:
         """Rows of the run table at the end (the studies' runs and the before/after runs)."""
         return 0 if self.runs is None else len(self.runs)
 
+    def report_contents(self):
+        """What this result shows in its HTML report (`railride.output.report.write_report`)."""
+        from railride.output.report import tune_contents
+
+        return tune_contents(self)
+
     def to_dict(self) -> dict:
         """The ``railride.tune/3`` document (docs/cli.md) without the facts of a command line
         (``runs_evaluated``, ``runs_per_second``, ``wall_time_s``, ``executor``, ``command``,

@@ -81,12 +81,17 @@ def _same(a, b):
         (lambda: Suspension.named("mr", damper="ideal"), r"damper = 'ideal' with suspension 'mr'"),
         (lambda: Suspension.named("pid", voltage=1.0), r"voltage = 1.0 with controller = 'pid'"),
         (lambda: Suspension.named("pid", damper="mr9"), r"unknown damper model 'mr9'"),
-        (lambda: Suspension.named("pid", damper=dampers.RAILWAY), r"damper = BoucWen.*must be a name"),
+        (lambda: Suspension.named("pid", damper=3), r"damper = 3: must be a name .* or a model"),
     ],
 )
 def test_invalid_combinations_name_the_field(make, match):
     with pytest.raises(ValueError, match=match):
         make()
+
+
+def test_named_takes_a_damper_model_as_its_name():
+    assert Suspension.named("pid", damper=dampers.RAILWAY) == Suspension.named("pid", damper="railway")
+    assert Suspension.named("mr", damper=dampers.RAILWAY, damper_scale=2.0).damper == dampers.RAILWAY.scaled(2.0)
 
 
 def test_the_kinds_names_and_records():
