@@ -40,3 +40,13 @@ def test_the_reference_holds_the_help_of_every_command():
 
 def test_a_page_without_the_marker_is_left_alone():
     assert _hook().on_page_markdown("# cli\n\nprose\n", None, None, None) == "# cli\n\nprose\n"
+
+
+def test_the_api_reference_holds_every_public_name():
+    import railride
+
+    page = (Path(__file__).resolve().parents[2] / "docs" / "api.md").read_text(encoding="utf-8")
+    documented = {
+        line.split("::: ", 1)[1].strip().rsplit(".", 1)[-1] for line in page.splitlines() if line.startswith("::: ")
+    }
+    assert railride.__all__ and set(railride.__all__) <= documented, set(railride.__all__) - documented
