@@ -238,7 +238,7 @@ def run_lanes(
                 for l in range(LANES):
                     i = smp[l]
                     for c in range(N_CORNER):
-                        if fault_at(faults, i, c, step) == FAULT_DISCONNECTED:
+                        if fault_at(faults[i], c, step) == FAULT_DISCONNECTED:
                             CONN[c, l] = 0.0
             _lane_derivative(
                 law,
@@ -277,7 +277,7 @@ def run_lanes(
                 for l in range(LANES):
                     i = smp[l]
                     for c in range(N_CORNER):
-                        v, held = fault_command(fault_at(faults, i, c, step), VC[c, l], P)
+                        v, held = fault_command(fault_at(faults[i], c, step), VC[c, l], P)
                         if held:
                             VC[c, l] = v
                             b = ROW_D + N_DAMPER_STATES * c + 2
