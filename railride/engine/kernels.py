@@ -416,8 +416,8 @@ def run_batch(lo, hi, law, x, step0, n_steps, final, stride, dt, vehicle, damper
     utab, u_off, ftab, f_off, n_nodes, interval = inputs
     closed_loop, ctrl_stride, Gm, Hm, inner, noise, faults, sensing, snoise = control
     out_q, out_v, out_a, out_f, out_w, out_wd, out_d, out_fd, out_vc, status, fail_step = outputs
-    # the loops in a function of their own, the arrays its arguments: run with the arrays taken
-    # from the tuples, the same loops ran 3-4 % slower (docs/performance.md, "Engine refactor")
+    # the loops in a function of their own, the arrays its arguments: with the loops on the arrays
+    # unpacked here, the stepper measured 3-4 % slower (docs/performance.md, "Engine refactor")
     _run_samples(
         lo, hi, law, x, step0, n_steps, final, stride, dt, A, TS, c_sec, P, vcmd, utab, u_off, ftab, f_off, n_nodes,
         interval, closed_loop, ctrl_stride, Gm, Hm, inner, noise, faults, sensing, snoise, out_q, out_v, out_a, out_f,
