@@ -107,7 +107,7 @@ def fault_table(faults_per_sample, dt: float, duration: float):
     then the step each fault starts at. A fault at or after the end of the run is refused."""
     import numpy as np
 
-    table = np.zeros((len(faults_per_sample), 2 * len(CORNER_NAMES)), dtype=np.int64)
+    table = np.zeros((len(faults_per_sample), layout.N_FAULT_COLS), dtype=np.int64)
     for i, faults in enumerate(faults_per_sample):
         for f in faults:
             if not f.time < duration:
@@ -115,8 +115,8 @@ def fault_table(faults_per_sample, dt: float, duration: float):
                     f"fault {f.label!r}: time = {shown(f.time)} s is not within the run (0 to {duration:g} s)"
                 )
             c = CORNER_NAMES.index(f.corner)
-            table[i, c] = FAULT_MODES[f.mode]
-            table[i, len(CORNER_NAMES) + c] = int(math.ceil(f.time / dt - 1e-9))
+            table[i, layout.F_MODE + c] = FAULT_MODES[f.mode]
+            table[i, layout.F_STEP + c] = int(math.ceil(f.time / dt - 1e-9))
     return table
 
 
