@@ -32,9 +32,10 @@ from railride.model.params import VehicleParams
 from railride.plots import PNG_DPI, FigureOptions
 from railride.studies.optimise import GainEvaluator, log_gain_bounds
 from railride import validation
-from railride.run.solver import SolverSettings, check_resolution
+from railride.run.checks import check
+from railride.run.solver import SolverSettings
 from railride.studies.sweep import Case, RunTable
-from railride.secondary.suspension import damper_record
+from railride.secondary.suspension import Suspension, damper_record
 
 SCHEMA = "railride.pareto/1"
 #: the files `ParetoResult.save` writes, in this order
@@ -268,7 +269,8 @@ def pareto(
     damper_model(damper)  # a known name
     base = GainSet.default() if gains is None else gains
     scen = make_scenario(scenario, **dict(scenario_options or {}))
-    check_resolution(scen, solver.output_rate)
+    # its runs, checked by the check every simulation makes (railride.run.checks), before the first
+    check(scen, vehicle, Suspension.named(suspension, base, damper), solver, "mark")
     record = scen.describe()
     table = RunTable() if table is None else table
     ev = GainEvaluator(

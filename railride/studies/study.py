@@ -34,11 +34,12 @@ from railride.secondary.faults import DamperFault, check_faults, parse_faults
 from railride.analysis.metrics import RESPONSES
 from railride.model.params import VehicleParams
 from railride.plots import PNG_DPI, FigureOptions
+from railride.run.checks import check
 from railride.run.solver import SolverSettings
 from railride.secondary.sensing import SENSING, reads_bogies
 from railride.studies.sweep import COMFORT_COLUMNS, Case, RunTable, run_cases, scenario_of
 from railride.model.vehicle import Vehicle
-from railride.secondary.suspension import damper_record
+from railride.secondary.suspension import Suspension, damper_record
 
 #: the schema of `StudyResult.to_dict` (study.json)
 SCHEMA = "railride.study/1"
@@ -175,7 +176,6 @@ def study(
     with ``gains`` (default the shipped gains: the controllers keep them whatever the load) and
     the ``damper`` model. Every setting is checked before the first run. ``executor``, ``table``
     and ``progress`` as for `railride.studies.sweep.run_cases`. Returns a `StudyResult`."""
-    from railride.secondary.faults import fault_table
     from railride.analysis.metrics import check_window
     from railride.secondary.suspension import damper_model
     from railride.studies.sweep import other_settings
@@ -250,13 +250,19 @@ def study(
     # every setting is checked before the first run: the scenario at each speed (the seeds
     # differ in the realisation only), and every fault time against its duration
     speed_of = {}
+    controlled = [n for n in names if n != "passive"] or ["mr"]
     for v in speed_list:
         sc = scenario_of(scenario, options_of(seeds[0], v))
+        # each condition's runs, checked by the check every simulation makes (railride.run.checks)
         for cond in conditions:
-            try:
-                fault_table([[DamperFault.parse(f) for f in cond]], solver.dt, sc.duration)
-            except ValueError as exc:
-                raise InputError(f"faults = {'+'.join(cond)!r}: {exc}") from None
+            faults = [DamperFault.parse(f) for f in cond]
+            for n in controlled:
+                try:
+                    check(sc, vehicle, Suspension.named(n, gains, damper).with_faults(faults), solver, "mark")
+                except InputError as exc:
+                    if faults and str(exc).startswith("fault "):  # a fault's time: named by the condition
+                        raise InputError(f"faults = {'+'.join(cond)!r}: {exc}") from None
+                    raise
         speed_of[v] = sc.speed
     # the window inside the runs, checked before the first; recorded with its open end (inf,
     # which JSON cannot hold) resolved, while the runs' keys keep it as given (resumable)

@@ -50,10 +50,11 @@ from railride.studies.objectives import (  # noqa: F401 (re-exported: the object
 )
 from railride.secondary import dampers
 from railride import limits, validation
-from railride.run.solver import SolverSettings, check_resolution
+from railride.run.checks import check
+from railride.run.solver import SolverSettings
 from railride.studies.sweep import Case, RunTable, run_cases
 from railride.studies.tune_result import SCHEMA, Curve, Study, TuneResult  # noqa: F401 (their home before)
-from railride.secondary.suspension import damper_record
+from railride.secondary.suspension import Suspension, damper_record
 
 #: the laws with free gains, in the order a study tunes them: every outer loop (the
 #: constant-voltage baselines have no gains)
@@ -251,8 +252,11 @@ def tune(
     else:
         cases_set = (TuningCase(scenario, opts, 1.0),)
     scens = [make_scenario(c.scenario, **dict(c.options)) for c in cases_set]
-    for sc in scens:
-        check_resolution(sc, solver.output_rate)
+    # the runs of every case, checked by the check every simulation makes (railride.run.checks),
+    # before the first: a law of the set on the case's vehicle (the laws share the dampers)
+    law = next((n for n in controllers if n != "inner"), "pid")
+    for c, sc in zip(cases_set, scens):
+        check(sc, vehicle.loaded(c.load), Suspension.named(law, gains, damper, damper_scale), solver, "mark")
     scen = scens[0]
     result = TuneResult(
         gains,
