@@ -320,6 +320,10 @@ class Comparison:
         out.attrs.update(
             title="railride controller comparison", gains_source=self.gains.source, settings=json.dumps(self.settings)
         )
+        # the runs' times differ when they straddle a second (drop_conflicts drops them): the first
+        # run's, so that the file always says when it was made
+        if "created_utc" in first.attrs:
+            out.attrs.setdefault("created_utc", first.attrs["created_utc"])
         return out
 
 
