@@ -267,6 +267,7 @@ class RunPlan:
     sensing: np.ndarray  # (n, layout.SENSING_COLS) each sample's sensing row
     x0: np.ndarray | None  # the initial (q, q'), one row or one per sample; None: at rest
     faults: np.ndarray  # the engine's fault table (`railride.secondary.faults.fault_table`)
+    on_divergence: str  # "raise" or "mark" (`railride.simulate`)
 
     @property
     def n(self) -> int:
@@ -350,7 +351,7 @@ def check(scenario=None, params=None, suspension=None, solver=None, on_divergenc
             )
     return RunPlan(
         batch, scenarios, param_sets, suspensions, solver, duration, damper, closed, exact, vehicles, n_out, vcmd,
-        gm, hm, modes, sensing, x0, faults,
+        gm, hm, modes, sensing, x0, faults, on_divergence,
     )  # fmt: skip
 
 

@@ -78,11 +78,16 @@ def simulate(
     tables), `pack` (the stepper's arrays), `step` (the compiled engine, in chunks) and
     `assemble` (the `RideResult`).
     """
-    plan = check(scenario, params, suspension, solver, on_divergence, initial_state)
+    return run(check(scenario, params, suspension, solver, on_divergence, initial_state), progress)
+
+
+def run(plan: RunPlan, progress=None) -> RideResult:
+    """The stages after `check`: a run of a checked `RunPlan` (what `compare` does with the
+    plans it checked before its first run, so that nothing is checked twice)."""
     tables = inputs(plan)
     packed = pack(plan, tables)
     stepped = step(plan, tables, packed, progress)
-    return assemble(plan, stepped, on_divergence)
+    return assemble(plan, stepped)
 
 
 # -- inputs ---------------------------------------------------------------------------------------
@@ -304,7 +309,7 @@ def step(plan: RunPlan, tables: Inputs, packed: Packed, progress=None) -> Steppe
 
 
 # -- assemble -------------------------------------------------------------------------------------
-def assemble(plan: RunPlan, stepped: Stepped, on_divergence: str = "raise") -> RideResult:
+def assemble(plan: RunPlan, stepped: Stepped) -> RideResult:
     """The assemble stage: divergence (raised, or marked with NaN from its time on), and the
     `RideResult`, whose Dataset is built when first asked for (`railride.run.ride.build_dataset`).
     A run stopped by Ctrl-C raises `railride.errors.Interrupted` holding the partial result."""
@@ -318,7 +323,7 @@ def assemble(plan: RunPlan, stepped: Stepped, on_divergence: str = "raise") -> R
             f"the simulation diverged ({which}): a response left +-{layout.DIVERGED:g} "
             f"or stopped being finite; check the parameters or reduce dt"
         )
-        if on_divergence != "mark":
+        if plan.on_divergence != "mark":
             raise DivergenceError(message)
         for i in bad.tolist():  # the stepper stopped there: what follows is not a response
             diverged_at[i] = fail_step[i] * dt

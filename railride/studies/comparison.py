@@ -28,7 +28,7 @@ from railride.model.plausible import notes
 from railride.analysis.metrics import STATISTICS, reduction, ride_metrics, select_window
 from railride.plots import PNG_DPI, FigureOptions
 from railride.run.checks import check
-from railride.run.simulation import simulate
+from railride.run.simulation import run as run_plan, simulate
 from railride.model.track import as_scenario
 from railride.run.solver import SolverSettings
 from railride.secondary.suspension import Suspension, damper_model, damper_record
@@ -406,25 +406,16 @@ def compare(
     bound_batches = [
         [_named(n, gains, device, 1.0, sensor_noise, delay, sensing) for n in closed] for device in bound_devices
     ]
-    for suspensions in [[Suspension.passive()], *(s for _, s in batches), *bound_batches]:
+    passive = check(scenario, params, Suspension.passive(), solver)
+    plans = [(group, check(scenario, params, suspensions, solver, "mark")) for group, suspensions in batches]
+    for suspensions in bound_batches:  # run below with the laws that did not diverge
         check(scenario, params, suspensions, solver, "mark")
-    datasets = {
-        "passive": simulate(
-            scenario, params, Suspension.passive(), solver=solver, progress=part and part(0.0, share)
-        ).dataset
-    }
+    datasets = {"passive": run_plan(passive, part and part(0.0, share)).dataset}
     done = 1
     # closed and open loops run as separate batches (a batch is all one or the other)
-    for group, suspensions in batches:
+    for group, plan in plans:
         # a law whose gains are not stable on this device is said, not fatal: the others go on
-        res = simulate(
-            scenario,
-            params,
-            suspensions,
-            solver=solver,
-            on_divergence="mark",
-            progress=part and part(share * done, share * len(group)),
-        )
+        res = run_plan(plan, part and part(share * done, share * len(group)))
         for i, n in enumerate(group):
             if np.isfinite(res.diverged_at[i]):
                 not_run[n] = (
