@@ -258,18 +258,11 @@ class Suspension:
         sensor_noise=None,
         damper_scale: float = 1.0,
     ) -> "Suspension":
-        """MR dampers (a name of `dampers.PRESETS` or a `BoucWen` / `Spencer` model; a name
-        scaled by ``damper_scale``, `BoucWen.scaled`) at the constant ``voltage`` [V]
+        """MR dampers (a name of `dampers.PRESETS` or a `BoucWen` / `Spencer` model, scaled by
+        ``damper_scale``, `BoucWen.scaled`) at the constant ``voltage`` [V]
         (default v_min), or closed by ``controller`` and the inner loop ``inner`` (default the
         shipped gains), the controller seeing ``sensor_noise``."""
-        if isinstance(damper, str):
-            model = damper_model(damper, damper_scale)
-        else:
-            if dampers.check_scale("damper_scale", damper_scale) != 1.0:
-                raise InputError(
-                    f"damper_scale = {damper_scale!r}: scales a damper given by name; scale a model with its scaled()"
-                )
-            model = _model(damper)
+        model = damper_model(damper, damper_scale)  # a name or a model, scaled
         if model is None or model.law not in (dampers.LAW_BOUC_WEN, dampers.LAW_SPENCER):
             raise InputError(
                 f"damper = {damper!r}: a semi-active suspension has MR dampers ("
