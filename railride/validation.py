@@ -126,10 +126,11 @@ def choice(name: str, value, allowed) -> str:
     return value
 
 
-def param(unit: str, doc: str, rule: str = "positive") -> Any:
+def param(unit: str, doc: str, rule: str = "positive", default: Any = dataclasses.MISSING) -> Any:
     """A parameter field of a frozen dataclass: SI unit, meaning and rule (see `RULES`),
-    checked by `validate_fields`."""
-    return field(metadata={"unit": unit, "doc": doc, "rule": rule})
+    checked by `validate_fields`; with a ``default`` the field is optional. A default of None
+    means "absent" (no bump stops): None is then allowed besides the rule."""
+    return field(default=default, metadata={"unit": unit, "doc": doc, "rule": rule})
 
 
 class PlausibilityWarning(UserWarning):
@@ -156,6 +157,8 @@ def validate_fields(obj, what: str, ranges: Mapping[str, Range] | None = None, t
     for f in dataclasses.fields(obj):
         value = getattr(obj, f.name)
         rule = f.metadata["rule"]
+        if value is None and f.default is None:  # an optional element left out
+            continue
         if rule == "seed":
             try:
                 object.__setattr__(obj, f.name, seed(f"{what} {f.name!r}", value))
@@ -174,6 +177,8 @@ def validate_fields(obj, what: str, ranges: Mapping[str, Range] | None = None, t
     fields = {f.name: f for f in dataclasses.fields(obj)}
     for name, r in ranges.items():
         value, meta = getattr(obj, name), fields[name].metadata
+        if value is None:
+            continue
         if not r.low <= value <= r.high:
             raise InputError(
                 f"{what} {name!r} = {shown(value)} ({meta['doc']}, {meta['unit']}): must be between {r.low:g} and "
@@ -211,7 +216,7 @@ def atypical(obj, ranges: Mapping[str, Range], what: str) -> list[str]:
             continue
         low, high = r.typical
         value, meta = getattr(obj, name), fields[name].metadata
-        if not low <= value <= high:
+        if value is not None and not low <= value <= high:
             out.append(
                 f"{what} {name!r} = {shown(value)} {meta['unit']} ({meta['doc']}) is outside the "
                 f"{low:g} to {high:g} {meta['unit']} of full-size rail vehicles; the results are for it as given"

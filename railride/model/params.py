@@ -10,7 +10,7 @@ from __future__ import annotations
 import dataclasses
 import os
 import tomllib
-from dataclasses import dataclass
+from dataclasses import MISSING, dataclass
 from pathlib import Path
 
 from railride.errors import InputError
@@ -56,11 +56,22 @@ class VehicleParams:
     h_ts: float = param("m", "bogie CG depth below the secondary suspension")
     h_tp: float = param("m", "bogie CG height above the primary suspension")
     h_wp: float = param("m", "wheelset CG depth below the primary suspension")
+    # -- beyond the paper's appendix: optional, a file without them keeps the paper's model --
+    k_ar: float = param("N m/rad", "anti-roll bar roll stiffness between the carbody and each bogie", "nonnegative", 0.0)
+    z_stop: float | None = param(
+        "m", "secondary vertical clearance to the bump stops, either way (none: no stops)", "positive", None
+    )
+    k_stop: float = param("N/m", "bump-stop stiffness beyond the clearance, per corner", "nonnegative", 0.0)
 
     def __post_init__(self) -> None:
         validate_fields(self, "vehicle parameter", VEHICLE, then=self._check_wheelbase)
 
     def _check_wheelbase(self) -> None:
+        if self.k_stop > 0.0 and self.z_stop is None:
+            raise InputError(
+                f"vehicle parameter 'k_stop' = {shown(self.k_stop)} (bump-stop stiffness, N/m): needs 'z_stop', "
+                "the clearance to the stops (m, > 0)"
+            )
         if not self.b < self.l:
             raise InputError(
                 f"vehicle parameter 'b' = {shown(self.b)} (half wheelbase, m): must be below 'l' = {shown(self.l)} "
@@ -166,7 +177,11 @@ class VehicleParams:
         """
         lines = ["# railride vehicle parameters (SI units)", "[vehicle]"]
         for name, unit, doc, _ in self.describe():
-            lines.append(f"{name} = {getattr(self, name)!r}  # {unit}: {doc}")
+            value = getattr(self, name)
+            if value is None:  # an element left out: TOML has no null
+                lines.append(f"# {name} not set  # {unit}: {doc}")
+                continue
+            lines.append(f"{name} = {value!r}  # {unit}: {doc}")
         return "\n".join(lines) + "\n"
 
     def save(self, path: str | Path) -> None:
@@ -197,7 +212,7 @@ class VehicleParams:
         if base_name is not None:
             base = cls.preset(str(base_name))
         else:
-            missing = [n for n in names if n not in table]
+            missing = [f.name for f in dataclasses.fields(cls) if f.name not in table and f.default is MISSING]
             if missing:
                 raise InputError(
                     f"{source}: missing vehicle parameter(s) {', '.join(missing)} "
@@ -249,6 +264,9 @@ PAPER = VehicleParams(
     h_ts=0.217,
     h_tp=0.452,
     h_wp=0.18,
+    # the paper gives no bump stops: assumed (docs/model.md, Presets)
+    z_stop=0.08,
+    k_stop=2.0e6,
 )
 
 PRESETS: dict[str, VehicleParams] = {"paper": PAPER}

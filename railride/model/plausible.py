@@ -47,6 +47,10 @@ VEHICLE: dict[str, Range] = {
     **{k: Range(1e-3, 10.0, _WIDE, (0.4, 1.5)) for k in ("d_s", "d_p", "a")},
     "h_cs": Range(1e-3, 10.0, _WIDE, (0.3, 3.0)),
     **{k: Range(1e-3, 10.0, _WIDE, (0.02, 1.0)) for k in ("h_ts", "h_tp", "h_wp")},
+    # an anti-roll bar: 0 (none) to about 5 MN m/rad on the stiffest tilting and high-speed cars
+    "k_ar": Range(0.0, 1e11, _STIFF, (0.0, 1e7)),
+    "z_stop": Range(1e-4, 10.0, "from 0.1 mm to 10 m: the secondary of a rail vehicle travels tens of mm", (0.01, 0.2)),
+    "k_stop": Range(0.0, 1e11, _STIFF, (0.0, 5e7)),
 }
 
 # -- controllers and sensors ---------------------------------------------------------------------
