@@ -26,7 +26,7 @@ COMPILE_SECONDS = {"run_batch": 10.0, "run_lanes": 12.0}
 STEPPER = "run_batch"
 
 #: the modules that hold the compiled kernels
-_MODULES = ("railride.engine.kernels", "railride.engine.lanes")
+_MODULES = ("railride.engine.kernels", "railride.engine.lanes", "railride.engine.exact_kernels")
 
 
 def _signatures() -> dict[str, tuple]:
@@ -84,10 +84,10 @@ def build_cache(kernels: tuple[str, ...] | None = None) -> list[str]:
 
 
 def _dispatcher(kernel: str):
-    from railride.engine import kernels, lanes
+    from railride.engine import exact_kernels, kernels, lanes
 
     found = {
-        n: v for m in (kernels, lanes) for n, v in vars(m).items() if hasattr(v, "py_func") and not n.startswith("_")
+        n: v for m in (kernels, lanes, exact_kernels) for n, v in vars(m).items() if hasattr(v, "py_func") and not n.startswith("_")
     }
     if kernel not in found:
         raise ValueError(f"kernel = {kernel!r}: not a compiled kernel; one of {', '.join(sorted(found))}")

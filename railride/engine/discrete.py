@@ -13,7 +13,7 @@ r_k the coefficients of r in powers of the time s since the stretch began. e^{AL
 Gamma_k come from one matrix exponential of an augmented matrix (Van Loan, 1978), by scipy. An
 output interval that spans nodes is split at them; the pattern of splits repeats, so each kind
 of output step gets one matrix from the nodes it touches to the state increment, and a run is
-x_{n+1} = Phi x_n + maps[n % period] (the nodes of step n), compiled (`kernels.exact_run`).
+x_{n+1} = Phi x_n + maps[n % period] (the nodes of step n), compiled (`exact_kernels.exact_run`).
 """
 
 from __future__ import annotations
@@ -170,7 +170,7 @@ def run_exact(out: dict, samples: list, x0: np.ndarray, dt: float, stride: int, 
     """Fill the stepper's output arrays ``out`` (q, v, a, f, w, wd: (n, rows, .)) for the
     passive samples: each of ``samples`` is (A, Bw, Bwd, T, c_sz, utab, interval) of one
     sample; ``x0`` (n, 18) the states at t = 0. Returns (status, fail_step) as the stepper's."""
-    from railride.engine import kernels
+    from railride.engine import exact_kernels as kernels
 
     n = len(samples)
     status = np.zeros(n, dtype=np.int64)
@@ -255,7 +255,7 @@ def run_exact_closed(out: dict, samples: list, x0: np.ndarray, dt: float, stride
     """Fill the stepper's output arrays (q, v, a, f, w, wd, fd, vc) for samples of an outer loop
     on the ideal actuator: each of ``samples`` is (A of the plant, Bw, Bwd, Bf = M^-1 T, G (4 x
     18), H (4 x 3), delay in controller periods, utab, interval). Returns (status, fail_step)."""
-    from railride.engine import kernels
+    from railride.engine import exact_kernels as kernels
 
     n = len(samples)
     status = np.zeros(n, dtype=np.int64)
