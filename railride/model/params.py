@@ -57,7 +57,9 @@ class VehicleParams:
     h_tp: float = param("m", "bogie CG height above the primary suspension")
     h_wp: float = param("m", "wheelset CG depth below the primary suspension")
     # -- beyond the paper's appendix: optional, a file without them keeps the paper's model --
-    k_ar: float = param("N m/rad", "anti-roll bar roll stiffness between the carbody and each bogie", "nonnegative", 0.0)
+    k_ar: float = param(
+        "N m/rad", "anti-roll bar roll stiffness between the carbody and each bogie", "nonnegative", 0.0
+    )
     z_stop: float | None = param(
         "m", "secondary vertical clearance to the bump stops, either way (none: no stops)", "positive", None
     )
@@ -81,34 +83,40 @@ class VehicleParams:
     # -- presets --------------------------------------------------------------------------
     @classmethod
     def of(cls, value) -> "VehicleParams":
-        """``value`` as parameters: None (the `paper` preset), a preset name, or a VehicleParams."""
-        if value is None:
-            return cls.preset("paper")
-        if isinstance(value, str):
-            return cls.preset(value)
-        if isinstance(value, VehicleParams):
-            return value
+        """``value`` as parameters: None (the `paper` preset), a preset name, the path of a
+        parameters file (`resolve`), or a VehicleParams."""
+        if value is None or isinstance(value, (str, os.PathLike, VehicleParams)):
+            return cls.resolve(value, "params")[0]
         # a common slip: simulate(scenario, suspension) puts the suspension in params
         suspension = hasattr(value, "controller") and hasattr(value, "damper")  # a Suspension, not imported here
         hint = " (a Suspension is the third argument, suspension=)" if suspension else ""
         raise InputError(f"params = {value!r}: must be VehicleParams or a preset name{hint}")
 
     @classmethod
-    def resolve(cls, value) -> tuple["VehicleParams", str | Path | None]:
+    def resolve(cls, value, field: str = "vehicle") -> tuple["VehicleParams", str | Path | None]:
         """(the parameters, where they came from) of ``value``: None (the `paper` preset), a
-        preset name, the path of a parameters file, or VehicleParams (its preset's name if it is
-        one, else None)."""
+        preset name (one of `PRESETS`), the path of a parameters file (an os.PathLike, or a
+        str that ends in ".toml" or names a file), or VehicleParams (its preset's name if it is
+        one, else None). A str that is neither a preset nor a file: an InputError naming
+        ``field`` (the argument or option), the presets and that a FILE.toml is accepted."""
         if value is None:
             value = "paper"
         if isinstance(value, str):
-            return cls.preset(value), value
+            if value in PRESETS:
+                return PRESETS[value], value
+            if value.endswith(".toml") or Path(value).is_file():
+                return cls.load(Path(value)), Path(value)
+            raise InputError(
+                f"{field} = {value!r}: unknown vehicle preset, and no such file; allowed: a preset "
+                f"({', '.join(PRESETS)}) or the path of a FILE.toml with a [vehicle] table"
+            )
         if isinstance(value, os.PathLike):
             return cls.load(Path(value)), Path(value)
         if isinstance(value, VehicleParams):
             return value, next((name for name, p in PRESETS.items() if p == value), None)
         raise InputError(
-            f"params = {value!r}: must be VehicleParams, a preset name "
-            f"({', '.join(PRESETS)}) or the path of a parameters file"
+            f"{field} = {value!r}: must be VehicleParams, a preset name "
+            f"({', '.join(PRESETS)}) or the path of a parameters file (FILE.toml)"
         )
 
     @classmethod
@@ -233,6 +241,60 @@ class VehicleParams:
         return cls.from_toml(text, source=str(path))
 
 
+# -- the vehicle of a run, as its outputs record it ----------------------------------------------
+def vehicle_argument(vehicle=None, params=None):
+    """The vehicle given to a function that takes ``vehicle=`` and its alias ``params=``: the one
+    given, None for neither; an InputError for both."""
+    if vehicle is not None and params is not None:
+        raise InputError("vehicle and params: give the vehicle once (params is an alias of vehicle)")
+    return params if vehicle is None else vehicle
+
+
+def vehicle_name(params: VehicleParams, source=None) -> str:
+    """How the outputs name a vehicle: the preset's name, the parameters file's path, or
+    "custom" for values that are no preset (``source`` as `VehicleParams.resolve` gives it)."""
+    if source is not None:
+        return str(source)
+    return next((name for name, p in PRESETS.items() if p == params), "custom")
+
+
+def vehicle_record(params: VehicleParams, source=None, load=1.0) -> dict:
+    """The record of the vehicle that every output keeps (the JSON documents, the NetCDF
+    attributes, the report, the tables' captions): ``name`` (`vehicle_name`), ``load`` (the
+    load factor on the carbody's mass and inertias, `VehicleParams.loaded`; the list of them
+    where a study runs several) and ``values`` (`to_dict` of ``params``, before the load)."""
+    from railride.validation import number
+
+    allowed = "a finite number > 0 (the factor on the carbody mass)"
+    loads = [
+        float(number("load", x, "positive", allowed=allowed))
+        for x in (load if isinstance(load, (list, tuple)) else [load])
+    ]
+    if not loads:
+        raise InputError("load: give at least one load factor")
+    return {
+        "name": vehicle_name(params, source),
+        "load": loads[0] if len(loads) == 1 else loads,
+        "values": params.to_dict(),
+    }
+
+
+def resolve_vehicle(vehicle=None, params=None, load=1.0, field: str = "vehicle") -> tuple[VehicleParams, dict]:
+    """(the vehicle to run, its `vehicle_record`) of a function's ``vehicle=`` (or its alias
+    ``params=``: a preset name, a parameters file or VehicleParams, `VehicleParams.resolve`)
+    and ``load`` factor: the edge where every study resolves its vehicle, once."""
+    base, source = VehicleParams.resolve(vehicle_argument(vehicle, params), field)
+    record = vehicle_record(base, source, load)
+    return (base if record["load"] == 1.0 else base.loaded(record["load"])), record
+
+
+def vehicle_text(record: dict) -> str:
+    """One line of a table's caption from a `vehicle_record`: "vehicle: paper, load 1"."""
+    load = record["load"]
+    loads = f"loads {', '.join(f'{x:g}' for x in load)}" if isinstance(load, list) else f"load {load:g}"
+    return f"vehicle: {record['name']}, {loads}"
+
+
 #: The paper's appendix (Harun et al.), in SI units.
 PAPER = VehicleParams(
     m_c=3.96e4,
@@ -269,7 +331,94 @@ PAPER = VehicleParams(
     k_stop=2.0e6,
 )
 
-PRESETS: dict[str, VehicleParams] = {"paper": PAPER}
+#: The Manchester Benchmark passenger vehicle (Iwnicki, ed., "The Manchester Benchmarks for Rail
+#: Vehicle Simulation", Supplement to Vehicle System Dynamics 31, 1999; Vehicle System Dynamics
+#: 30, 1998). The source's values are marked; the rest are assumed (docs/model.md, Presets).
+MANCHESTER_1 = VehicleParams(
+    m_c=3.2e4,  # source
+    m_b=2615.0,  # source (bogie frame)
+    I_cx=5.68e4,  # source
+    I_cy=1.97e6,  # source
+    I_cz=1.97e6,  # assumed: as the pitch inertia (a long, slender body)
+    I_bx=1722.0,  # source
+    I_by=1476.0,  # source
+    I_bz=3198.0,  # assumed: I_bx + I_by (a flat frame)
+    k_px=3.0e7,  # assumed: stiff longitudinal wheelset guidance
+    k_py=4.0e6,  # assumed
+    k_pz=1.22e6,  # source (some copies print 1,200 kN/m)
+    c_px=0.0,  # assumed: no longitudinal primary dampers
+    c_py=0.0,  # assumed: no lateral primary dampers
+    c_pz=4.0e3,  # source
+    k_sx=1.6e5,  # source
+    k_sy=1.6e5,  # source
+    k_sz=4.3e5,  # source, per side of each bogie
+    c_sx=0.0,  # assumed: no longitudinal dampers (yaw dampers act in yaw, not modelled)
+    c_sy=3.0e4,  # assumed: a lateral damper per side
+    c_sz=2.0e4,  # source, per side of each bogie
+    l=9.5,  # source
+    d_s=1.0,  # source
+    d_p=1.0,  # source
+    a=0.7465,  # assumed: half the 1.493 m contact spacing of standard gauge
+    b=1.28,  # source
+    h_cs=PAPER.h_cs,  # heights assumed: the paper's
+    h_ts=PAPER.h_ts,
+    h_tp=PAPER.h_tp,
+    h_wp=PAPER.h_wp,
+    k_ar=9.4e5,  # source, per bogie
+    z_stop=0.04,  # assumed
+    k_stop=2.0e6,  # assumed
+)
+
+#: A CRH380A-type high-speed car: values as given for a CRH380A-type car in the published
+#: high-speed vehicle-dynamics literature where marked "source", the others assumed
+#: (docs/model.md, Presets).
+CRH380A = VehicleParams(
+    m_c=43862.5,  # source
+    m_b=2400.0,  # source
+    I_cx=1.094e5,  # source
+    I_cy=1.654e6,  # source
+    I_cz=1.654e6,  # assumed: as the pitch inertia
+    I_bx=1944.0,  # source
+    I_by=1314.0,  # source
+    I_bz=3258.0,  # assumed: I_bx + I_by
+    k_px=1.5e7,  # assumed
+    k_py=6.0e6,  # assumed
+    k_pz=1.176e6,  # source
+    c_px=0.0,  # assumed
+    c_py=0.0,  # assumed
+    c_pz=1.0e4,  # assumed: a primary vertical damper per axle box
+    k_sx=1.5e5,  # assumed: an air spring's shear stiffness
+    k_sy=1.5e5,  # assumed
+    k_sz=1.9e5,  # source, per side of each bogie (air spring)
+    c_sx=0.0,  # assumed
+    c_sy=3.0e4,  # assumed: a lateral damper per side
+    c_sz=4.0e4,  # source, per side of each bogie
+    l=8.75,  # source
+    d_s=1.23,  # source
+    d_p=1.0,  # source
+    a=0.7465,  # assumed: standard gauge
+    b=1.25,  # source
+    h_cs=PAPER.h_cs,  # heights assumed: the paper's
+    h_ts=PAPER.h_ts,
+    h_tp=PAPER.h_tp,
+    h_wp=PAPER.h_wp,
+    k_ar=2.5e6,  # assumed: an air-spring car carries an anti-roll bar
+    z_stop=0.04,  # assumed
+    k_stop=2.0e6,  # assumed
+)
+
+PRESETS: dict[str, VehicleParams] = {"paper": PAPER, "manchester-1": MANCHESTER_1, "crh380a": CRH380A}
+
+#: Where each preset's values come from, one line each (`railride vehicles`; docs/model.md, Presets).
+PRESET_SOURCES: dict[str, str] = {
+    "paper": "Harun et al., Application of Stability Augmentation System for Semi-active Railway Vehicle "
+    "Secondary Vertical Suspension, appendix (bump stops assumed)",
+    "manchester-1": "Manchester Benchmark passenger vehicle: Iwnicki (ed.), The Manchester Benchmarks for Rail "
+    "Vehicle Simulation, Suppl. Vehicle System Dynamics 31, 1999 (yaw inertias, heights, primary "
+    "lateral and longitudinal, a, stops assumed)",
+    "crh380a": "CRH380A-type high-speed car: values as given for a CRH380A-type car in the published "
+    "high-speed vehicle-dynamics literature; source values listed in docs/model.md, others assumed",
+}
 
 
 def ranges_markdown() -> str:

@@ -53,7 +53,8 @@ _BODY_OFFSET = {"carbody": 0, "front_bogie": 3, "rear_bogie": 6}
 
 @dataclass(frozen=True)
 class Element:
-    """One suspension element: delta = a.q + e.w, with spring k [N/m] and damper c [N s/m]."""
+    """One suspension element: delta = a.q + e.w, with spring k [N/m] and damper c [N s/m]
+    (an angular deflection in rad for the anti-roll bar: k in N m/rad)."""
 
     name: str
     group: str
@@ -92,7 +93,9 @@ def _wheelset_roll(wheelset: int, half_gauge: float) -> np.ndarray:
 
 
 def element_table(p: VehicleParams) -> list[Element]:
-    """The element list of docs/model.md, Equations, in code."""
+    """The element list of docs/model.md, Equations, in code: 36 elements, and an anti-roll bar
+    per bogie (group "anti_roll_bar") where k_ar > 0. Nothing downstream counts them: the
+    matrices are sums over the list and the secondary force map picks its group by name."""
     elements: list[Element] = []
     zero_e = np.zeros(N_RAIL_INPUT)
     bogies = (("front_bogie", +p.l, (1, 2)), ("rear_bogie", -p.l, (3, 4)))
@@ -114,6 +117,14 @@ def element_table(p: VehicleParams) -> list[Element]:
             elements.append(
                 Element(f"secondary longitudinal {bi}{side}", "secondary_longitudinal", p.k_sx, p.c_sx, a, zero_e)
             )
+        # anti-roll bar, one per bogie: a torsion spring on the carbody's roll relative to the
+        # bogie's, delta = theta_c - theta_bi (rad), k_ar in N m/rad, no damping. Left out when
+        # k_ar = 0, so that a vehicle without one keeps its 36 elements and its matrices bit
+        # for bit.
+        if p.k_ar > 0.0:
+            a = np.zeros(N_DOF)
+            a[2], a[o + 2] = 1.0, -1.0
+            elements.append(Element(f"anti-roll bar {bi}", "anti_roll_bar", p.k_ar, 0.0, a, zero_e))
         for wheelset, x_axle in zip(wheelsets, (+p.b, -p.b)):
             for side, y in (("R", -p.d_p), ("L", +p.d_p)):
                 box = f"{wheelset}{side}"
