@@ -1,6 +1,6 @@
-"""The ``railride`` command line: ``railride compare``, ``railride modes``, ``railride frf``,
-``railride simulate``, ``railride damper``, ``railride tracking``, ``railride tune``,
-``railride study``, ``railride pareto``, ``railride sweep`` and ``railride report``.
+"""The ``railride`` command line: ``railride compare``, ``railride modes``, ``railride vehicles``,
+``railride frf``, ``railride simulate``, ``railride damper``, ``railride tracking``, ``railride
+tune``, ``railride study``, ``railride pareto``, ``railride sweep`` and ``railride report``.
 
 A thin layer over the library: it parses options, calls the library's studies (`simulate`,
 `compare`, `frf`, `rig`, `tune`, `study`, `pareto`, `sweep`), writes their results through their
@@ -28,7 +28,20 @@ __all__ = ["app", "main"]
 
 #: the command modules, which register on `app` when imported; `railride --help` lists the
 #: commands in this order
-COMMANDS = ("compare", "report", "modes", "frf", "simulate", "rig", "tune", "pareto", "sweep", "study", "ride_spectrum")
+COMMANDS = (
+    "compare",
+    "report",
+    "modes",
+    "vehicles",
+    "frf",
+    "simulate",
+    "rig",
+    "tune",
+    "pareto",
+    "sweep",
+    "study",
+    "ride_spectrum",
+)
 
 if TYPE_CHECKING:
     from railride.cli._app import app

@@ -29,7 +29,7 @@ import xarray as xr
 from railride.errors import InputError
 from railride import validation
 from railride.engine.layout import N_DOF, N_RAIL
-from railride.model.params import VehicleParams
+from railride.model.params import PRESET_SOURCES, PRESETS, VehicleParams
 
 DOF_NAMES = (
     "carbody_bounce",
@@ -274,6 +274,26 @@ class Vehicle:
             cross_level_angle_per_m=str((cL - cR) / (2 * self.params.a)),
         )
         return ds
+
+
+#: the schema of `presets_document` (docs/schemas/railride.vehicles-1.json)
+SCHEMA_VEHICLES = "railride.vehicles/1"
+
+
+def presets_document(names=None) -> dict:
+    """The named vehicles (`railride.model.params.PRESETS`; ``names``: some of them, in this
+    order; default all) with where their values come from (`PRESET_SOURCES`) and their nine
+    rigid-body modes (`Vehicle.modes`, by undamped frequency): ``railride vehicles --format
+    json``. An unknown name is an InputError that lists the presets."""
+    from railride._version import __version__
+
+    names = list(PRESETS) if names is None else list(names)
+    presets = []
+    for name in names:
+        params = VehicleParams.preset(name)
+        modes = [m.to_dict() for m in Vehicle(params).modes()]
+        presets.append({"name": name, "source": PRESET_SOURCES[name], "modes": modes})
+    return {"schema": SCHEMA_VEHICLES, "railride_version": __version__, "presets": presets}
 
 
 def _mac(u: np.ndarray, v: np.ndarray) -> float:
