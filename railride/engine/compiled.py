@@ -47,14 +47,15 @@ def _signatures() -> dict[str, tuple]:
     outputs = types.Tuple((a(3),) * 9 + (a(1, i), a(1, i)))  # nine outputs, status, fail_step
     run = (i, i, i, a(2), i, i, b, i, f)  # lo, hi, law, x, step0, n_steps, final, stride, dt
     return {
-        # the run, vehicle = (A, TS, c_sec), dampers = (P, vcmd), inputs, control, outputs
-        "run_batch": run + (types.Tuple((a(3), a(3), a(2))), types.Tuple((a(2), a(2))), inputs, control, outputs),
+        # the run, vehicle = (A, TS, c_sec, stops), dampers = (P, vcmd), inputs, control, outputs
+        "run_batch": run + (types.Tuple((a(3), a(3), a(2), a(2))), types.Tuple((a(2), a(2))), inputs, control, outputs),
         # lo, hi, lane_smp, lane_own, then run_batch's arguments after hi, with vehicle = the q'' product's
-        # structure and values (a_ptr, a_col, a_val, a_uni), the corner product's (t_*), c_sec; dampers = (P, vcmd)
+        # structure and values (a_ptr, a_col, a_val, a_uni), the corner product's (t_*), c_sec, stops;
+        # dampers = (P, vcmd)
         "run_lanes": (i, i, a(2, i), a(2, b))
         + run[2:]
         + (
-            types.Tuple((a(1, i), a(1, i), a(3), a(1, b), a(1, i), a(1, i), a(3), a(1, b), a(2))),
+            types.Tuple((a(1, i), a(1, i), a(3), a(1, b), a(1, i), a(1, i), a(3), a(1, b), a(2), a(2))),
             types.Tuple((a(1), a(2))),
             inputs,
             control,
@@ -87,7 +88,10 @@ def _dispatcher(kernel: str):
     from railride.engine import exact_kernels, kernels, lanes
 
     found = {
-        n: v for m in (kernels, lanes, exact_kernels) for n, v in vars(m).items() if hasattr(v, "py_func") and not n.startswith("_")
+        n: v
+        for m in (kernels, lanes, exact_kernels)
+        for n, v in vars(m).items()
+        if hasattr(v, "py_func") and not n.startswith("_")
     }
     if kernel not in found:
         raise ValueError(f"kernel = {kernel!r}: not a compiled kernel; one of {', '.join(sorted(found))}")

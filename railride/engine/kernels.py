@@ -323,7 +323,35 @@ def _one_step_limit(dt):
 
 
 @njit(cache=True, inline="always", fastmath=_FAST)
-def _derivative(law, s, R, roff, AT, TT, P, vcmd, conn, y, cx, cv, K, koff, i8, v8, n8, bw1):
+def stop_force(z_stop, k_stop, x):
+    """The force of a corner's bump stop on the carbody (up +) at the secondary deflection x
+    (extension +): none within the clearance +-z_stop, k_stop times the travel beyond it,
+    against it (`railride.model.params.VehicleParams`, z_stop and k_stop)."""
+    if x > z_stop:
+        return -k_stop * (x - z_stop)
+    if x < -z_stop:
+        return -k_stop * (x + z_stop)
+    return 0.0
+
+
+@njit(cache=True, inline="always", fastmath=_FAST)
+def add_stops(zk, cx, f, foff, fsave):
+    """Add the bump stops' forces (clearance zk[0], stiffness zk[1]) at the corner deflections
+    cx to the corner forces f[foff:foff + 4], the forces before in fsave; whether any stop is
+    touched. The damper forces go back in place after the product: what the record and the
+    inner loop read is the damper's force alone, as a load cell on the damper measures it."""
+    touched = False
+    for c in range(N_CORNER):
+        fsave[c] = f[foff + c]
+        fs = stop_force(zk[0], zk[1], cx[c])
+        if fs != 0.0:
+            touched = True
+            f[foff + c] = fsave[c] + fs
+    return touched
+
+
+@njit(cache=True, inline="always", fastmath=_FAST)
+def _derivative(law, s, R, roff, AT, TT, P, vcmd, conn, y, cx, cv, K, koff, i8, v8, n8, bw1, zk, fsave):
     """K[koff:koff+NS_MAX] = d/dt of the state s = (q, q', damper states), with the rail forcing
     R[roff:roff+9].
 
@@ -331,10 +359,21 @@ def _derivative(law, s, R, roff, AT, TT, P, vcmd, conn, y, cx, cv, K, koff, i8, 
     q'' = r + [Aq Av] (q, q'). Otherwise every corner's damper law gives its force F from the
     corner deflection and rate, f = -F conn[c] enters through Bf (conn[c] = 0: the damper is
     disconnected), and the damper states (z, y, u) advance.
+
+    Bump stops (zk = (clearance, stiffness), off where the stiffness is 0): their forces join
+    the corner forces for the product only (`add_stops`); with LAW_VISCOUS_IN_C the force
+    columns then carry the stops' forces alone.
     """
     for i in range(N_DOF):
         K[koff + i] = s[N_DOF + i]
     if law == LAW_VISCOUS_IN_C:
+        if zk[1] > 0.0:
+            corner_pairs(TT, s, cx, cv)
+            for c in range(N_CORNER):
+                y[2 * N_DOF + c] = 0.0
+            if add_stops(zk, cx, y, 2 * N_DOF, fsave):
+                _mv9(AT, s, y, NY, R, roff, K, koff + N_DOF, i8, v8, n8[1])
+                return
         _mv9(AT, s, y, 2 * N_DOF, R, roff, K, koff + N_DOF, i8, v8, n8[0])
         return
     corner_pairs(TT, s, cx, cv)
@@ -342,6 +381,11 @@ def _derivative(law, s, R, roff, AT, TT, P, vcmd, conn, y, cx, cv, K, koff, i8, 
         # the product repeated in this branch on purpose: one call after an if/else made the
         # SAS closed loop 20-25 % slower (A/B, alternating processes)
         bouc_wen1_corners(P, s, cx, cv, vcmd, conn, y, K, koff)
+        if zk[1] > 0.0 and add_stops(zk, cx, y, 2 * N_DOF, fsave):
+            _mv9(AT, s, y, NY, R, roff, K, koff + N_DOF, i8, v8, n8[1])
+            for c in range(N_CORNER):
+                y[2 * N_DOF + c] = fsave[c]
+            return
         _mv9(AT, s, y, NY, R, roff, K, koff + N_DOF, i8, v8, n8[1])
         return
     for c in range(N_CORNER):
@@ -351,6 +395,11 @@ def _derivative(law, s, R, roff, AT, TT, P, vcmd, conn, y, cx, cv, K, koff, i8, 
         K[koff + b] = dz
         K[koff + b + 1] = dyy
         K[koff + b + 2] = du
+    if zk[1] > 0.0 and add_stops(zk, cx, y, 2 * N_DOF, fsave):
+        _mv9(AT, s, y, NY, R, roff, K, koff + N_DOF, i8, v8, n8[1])
+        for c in range(N_CORNER):
+            y[2 * N_DOF + c] = fsave[c]
+        return
     _mv9(AT, s, y, NY, R, roff, K, koff + N_DOF, i8, v8, n8[1])
 
 
@@ -360,7 +409,7 @@ def run_batch(lo, hi, law, x, step0, n_steps, final, stride, dt, vehicle, damper
     steps of dt. Compiled without the GIL: `railride.run.simulation` runs sample ranges on threads.
 
     The arrays come in five groups (tuples, unpacked once at the top; `layout` names the columns
-    of the packed ones): vehicle = (A, TS, c_sec), dampers = (P, vcmd), inputs = (utab, u_off,
+    of the packed ones): vehicle = (A, TS, c_sec, stops), dampers = (P, vcmd), inputs = (utab, u_off,
     ftab, f_off, n_nodes, interval), control = (closed_loop, ctrl_stride, Gm, Hm, inner, noise,
     faults, sensing, snoise) and outputs = (out_q, out_v, out_a, out_f, out_w, out_wd, out_d,
     out_fd, out_vc, status, fail_step).
@@ -371,7 +420,8 @@ def run_batch(lo, hi, law, x, step0, n_steps, final, stride, dt, vehicle, damper
     (railride.secondary.dampers) with packed parameters P[s] (slots P_*) and command voltages
     vcmd[s] (4 corners). The rail inputs come as tables on the time grid k * interval[s] with
     n_nodes[s] rows: utab rows from u_off[s] (w, w', for the record) and ftab rows from f_off[s]
-    (see `_forcing`).
+    (see `_forcing`). stops[s] = (clearance, stiffness) of the secondary bump stops (stiffness
+    0: none; `stop_force`).
 
     Each step is one classical RK4 step, or 2^k equal RK4 sub-steps when the dampers' internal
     states are stiff (`substeps`).
@@ -411,7 +461,7 @@ def run_batch(lo, hi, law, x, step0, n_steps, final, stride, dt, vehicle, damper
     +-DIVERGED or stops being finite gets status STATUS_DIVERGED and the step number in
     fail_step, and stops.
     """
-    A, TS, c_sec = vehicle
+    A, TS, c_sec, stops = vehicle
     P, vcmd = dampers
     utab, u_off, ftab, f_off, n_nodes, interval = inputs
     closed_loop, ctrl_stride, Gm, Hm, inner, noise, faults, sensing, snoise = control
@@ -419,17 +469,17 @@ def run_batch(lo, hi, law, x, step0, n_steps, final, stride, dt, vehicle, damper
     # the loops in a function of their own, the arrays its arguments: with the loops on the arrays
     # unpacked here, the stepper measured 3-4 % slower (docs/performance.md, "Engine refactor")
     _run_samples(
-        lo, hi, law, x, step0, n_steps, final, stride, dt, A, TS, c_sec, P, vcmd, utab, u_off, ftab, f_off, n_nodes,
-        interval, closed_loop, ctrl_stride, Gm, Hm, inner, noise, faults, sensing, snoise, out_q, out_v, out_a, out_f,
-        out_w, out_wd, out_d, out_fd, out_vc, status, fail_step,
+        lo, hi, law, x, step0, n_steps, final, stride, dt, A, TS, c_sec, stops, P, vcmd, utab, u_off, ftab, f_off,
+        n_nodes, interval, closed_loop, ctrl_stride, Gm, Hm, inner, noise, faults, sensing, snoise, out_q, out_v, out_a,
+        out_f, out_w, out_wd, out_d, out_fd, out_vc, status, fail_step,
     )  # fmt: skip
 
 
 # fmt: off
 @njit(cache=True, nogil=True, fastmath=_FAST, parallel=_NO_PARFORS)
 def _run_samples(
-    lo, hi, law, x, step0, n_steps, final, stride, dt, A, TS, c_sec, P, vcmd, utab, u_off, ftab, f_off, n_nodes,
-    interval, closed_loop, ctrl_stride, Gm, Hm, inner, noise, faults, sensing, snoise, out_q, out_v, out_a, out_f,
+    lo, hi, law, x, step0, n_steps, final, stride, dt, A, TS, c_sec, stops, P, vcmd, utab, u_off, ftab, f_off,
+    n_nodes, interval, closed_loop, ctrl_stride, Gm, Hm, inner, noise, faults, sensing, snoise, out_q, out_v, out_a, out_f,
     out_w, out_wd, out_d, out_fd, out_vc, status, fail_step,
 ):
     # fmt: on
@@ -451,7 +501,8 @@ def _run_samples(
         R = np.empty(3 * N_DOF)  # rail forcing at the sub-step's start, middle and end
         w = np.empty(N_RAIL)
         wd = np.empty(N_RAIL)
-        at, tt, cs, pp = A[smp], TS[smp], c_sec[smp], P[smp]
+        at, tt, cs, pp, zk = A[smp], TS[smp], c_sec[smp], P[smp], stops[smp]
+        fsave = np.empty(N_CORNER)  # the damper forces while the bump stops' join them
         uo, fo, nn, itv = u_off[smp], f_off[smp], n_nodes[smp], interval[smp]
         vc = vcmd[smp].copy()  # command voltages, held over each step
         fm = faults[smp]
@@ -535,7 +586,7 @@ def _run_samples(
                     if fault_at(fm, c, step) == FAULT_DISCONNECTED:
                         conn[c] = 0.0
             # rates at the step's start: for the record, the sub-step choice and stage 1
-            _derivative(law, s, R, 0, at, tt, pp, vc, conn, y, cx, cv, K, 0, i8, v8, n8, bw1)
+            _derivative(law, s, R, 0, at, tt, pp, vc, conn, y, cx, cv, K, 0, i8, v8, n8, bw1, zk, fsave)
             if sens:  # each accelerometer's anti-alias filter follows its corner's acceleration
                 for c in range(N_CORNER):
                     a_c = 0.0
@@ -629,7 +680,7 @@ def _run_samples(
                     if has_states:
                         for i in range(2 * N_DOF, NS_MAX):
                             st[i] = s[i] + ch * K[prev + i]
-                    _derivative(law, st, R, roff, at, tt, pp, vc, conn, y, cx, cv, K, NS_MAX * stage, i8, v8, n8, bw1)
+                    _derivative(law, st, R, roff, at, tt, pp, vc, conn, y, cx, cv, K, NS_MAX * stage, i8, v8, n8, bw1, zk, fsave)
                 for i in range(2 * N_DOF):
                     s[i] += h / 6.0 * (K[i] + 2.0 * K[NS_MAX + i] + 2.0 * K[2 * NS_MAX + i] + K[3 * NS_MAX + i])
                 if has_states:

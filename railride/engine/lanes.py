@@ -13,6 +13,7 @@ from numba import njit
 from railride.engine._simd_lanes import LANES, lanes_axpy, lanes_move, lanes_mr_damper, lanes_rk4, lanes_spmv
 from railride.engine.kernels import (  # the scalar laws and helpers, inlined here too
     _hermite,
+    stop_force,
     _one_step_limit,
     _rail_inputs,
     coil_rate,
@@ -97,13 +98,17 @@ def _lane_forcing(ts, lanes, act, smp, ftab, f_off, n_nodes, interval, RR, roff)
 
 @njit(cache=True, inline="always", fastmath=_FAST)
 def _lane_derivative(
-    law, ST, RR, roff, a_ptr, a_col, aval, a_uni, t_ptr, t_col, tval, t_uni, P, VC, CONN, CC, ZL, ONE, K, kb
+    law, ST, RR, roff, a_ptr, a_col, aval, a_uni, t_ptr, t_col, tval, t_uni, P, VC, CONN, CC, ZL, ONE, K, kb, ZK, FS
 ):
     """K[kb:kb + NL] = d/dt of the lane states ST (rows as `NL`), with the rail forcing
     RR[roff:roff + 9]; as `_derivative`, every lane at once. ST's force rows receive f; CC the
-    corner deflections (rows 0-3) and rates (4-7)."""
+    corner deflections (rows 0-3) and rates (4-7). Bump stops where ZK (clearance, stiffness
+    per lane) has a stiffness: their forces join f for the product only (FS keeps f)."""
     lanes_move(K, kb, ST, N_DOF, N_DOF, ONE)
-    if law != LAW_VISCOUS_IN_C:
+    stops = False
+    for l in range(LANES):
+        stops = stops or ZK[1, l] > 0.0
+    if law != LAW_VISCOUS_IN_C or stops:
         lanes_spmv(t_ptr, t_col, tval, t_uni, ST, ZL, 0, CC, 0)
     if law == LAW_BOUC_WEN or law == LAW_SPENCER:
         lanes_mr_damper(law == LAW_SPENCER, P, CC, ST, ROW_F, ROW_D, VC, CONN, K, kb)
@@ -118,7 +123,20 @@ def _lane_derivative(
                 K[kb + b, l] = dz
                 K[kb + b + 1, l] = dyy
                 K[kb + b + 2, l] = du
+    if law == LAW_VISCOUS_IN_C and not stops:  # force columns there for another group's stops: none here
+        for c in range(N_CORNER):
+            for l in range(LANES):
+                ST[ROW_F + c, l] = 0.0
+    if stops:
+        for c in range(N_CORNER):
+            for l in range(LANES):
+                FS[c, l] = 0.0 if law == LAW_VISCOUS_IN_C else ST[ROW_F + c, l]
+                ST[ROW_F + c, l] = FS[c, l] + stop_force(ZK[0, l], ZK[1, l], CC[c, l])
     lanes_spmv(a_ptr, a_col, aval, a_uni, ST, RR, roff, K, kb + N_DOF)
+    if stops:
+        for c in range(N_CORNER):
+            for l in range(LANES):
+                ST[ROW_F + c, l] = FS[c, l]
 
 
 @njit(cache=True, nogil=True, fastmath=_FAST, parallel=_NO_PARFORS)
@@ -131,7 +149,7 @@ def run_lanes(
     are run_batch's groups but for realistic sensing, which this kernel leaves out (run_batch has
     it; control's sensing and snoise go unread); dampers = (P, vcmd) with P the batch's one
     damper (N_PACKED,), and vehicle = (a_ptr, a_col, a_val, a_uni, t_ptr, t_col, t_val, t_uni,
-    c_sec): the products run on their non-zero structure
+    c_sec, stops): the products run on their non-zero structure
     over every lane of a group, compressed rows shared by all groups: q'' = r + A y over
     (a_ptr, a_col, a_val[g]) (rows of q'', columns of y = (q, q', f)), the corner deflections
     and rates over (t_ptr, t_col, t_val[g]) (rows cx then cv, columns of q, q'); a_val[g, k, l]
@@ -146,7 +164,7 @@ def run_lanes(
     controller, the voltage laws, the sub-step choice, the rail forcing (computed once for
     lanes that read the same table at the same time) and the records run lane by lane.
     """
-    a_ptr, a_col, a_val, a_uni, t_ptr, t_col, t_val, t_uni, c_sec = vehicle
+    a_ptr, a_col, a_val, a_uni, t_ptr, t_col, t_val, t_uni, c_sec, stops = vehicle
     P, vcmd = dampers
     utab, u_off, ftab, f_off, n_nodes, interval = inputs
     closed_loop, ctrl_stride, Gm, Hm, inner, noise, faults, _sensing, _snoise = control
@@ -174,6 +192,8 @@ def run_lanes(
         ONE = np.ones(LANES)
         VC = np.empty((N_CORNER, LANES))
         CONN = np.ones((N_CORNER, LANES))
+        ZK = np.empty((2, LANES))  # each lane's bump stops: clearance, stiffness
+        FS = np.empty((N_CORNER, LANES))
         XC = np.empty((n_ctrl, LANES))  # controller states, lane-local: padding lanes share x rows
         ch = np.empty(LANES)
         h = np.empty(LANES)
@@ -202,6 +222,7 @@ def run_lanes(
                 faulty = faulty or faults[i, F_MODE + c] != FAULT_NONE
             act[l] = 1.0
             ts[l] = step0 * dt
+            ZK[0, l], ZK[1, l] = stops[i, 0], stops[i, 1]
         _lane_forcing(ts, LANES, act, smp, ftab, f_off, n_nodes, interval, RR, 0)
         last = n_steps + 1 if final else n_steps
         for n in range(last):
@@ -261,6 +282,8 @@ def run_lanes(
                 ONE,
                 K,
                 0,
+                ZK,
+                FS,
             )
             if closed_loop and law != LAW_IDEAL:
                 for l in range(LANES):
@@ -390,6 +413,8 @@ def run_lanes(
                         ONE,
                         K,
                         NL * stage,
+                        ZK,
+                        FS,
                     )
                 lanes_rk4(S, 0, K, NL, 2 * N_DOF, h6, act)
                 if has_states:
@@ -431,14 +456,15 @@ def lanes_fit(n: int, P, sensing) -> bool:
     return n >= LANES and bool(np.all(P == P[P_ALPHA_A])) and not bool(np.any(sensing[:, S_ON] > 0.0))
 
 
-def lanes_stepper(n, law, A, TS, P):
+def lanes_stepper(n, law, A, TS, P, stops):
     """`run_batch`'s work for the n samples of a batch (sensing off, see `lanes_fit`) in groups
     of LANES samples by `run_lanes`, the groups on threads (`run_parallel`). The lane groups and
     the products' compressed rows are built here, once per run; the function returned takes
     run_batch's arguments after lo, hi, chunk after chunk (it reads A, TS and P from here; the
     vehicle and damper groups it is given supply c_sec and vcmd)."""
     smp, own = lane_groups(n)
-    n_cols = 2 * N_DOF if law == LAW_VISCOUS_IN_C else NY  # dashpots inside Av: no force columns
+    # dashpots inside Av: no force columns, unless bump stops act through them
+    n_cols = 2 * N_DOF if law == LAW_VISCOUS_IN_C and not np.any(stops[:, 1] > 0.0) else NY
     a_ptr, a_col, a_val = _compressed(A[:, :n_cols, :].transpose(0, 2, 1), smp)
     T = np.zeros((n, 2 * N_CORNER, 2 * N_DOF))  # (cx, cv) = T^T (q, q')
     T[:, :N_CORNER, :N_DOF] = T[:, N_CORNER:, N_DOF:] = TS.transpose(0, 2, 1)
@@ -448,9 +474,9 @@ def lanes_stepper(n, law, A, TS, P):
     damper = np.ascontiguousarray(P[P_ALPHA_A])
 
     def step(_n, _law, x, step0, n_steps, final, stride, dt, vehicle, dampers, inputs, control, outputs):
-        # run_batch's groups: the products and run_batch's c_sec, the one damper and vcmd, the rest as they are
+        # run_batch's groups: the products and run_batch's c_sec and stops, the one damper and vcmd, the rest as they are
         run_parallel(
-            run_lanes, len(smp), smp, own, law, x, step0, n_steps, final, stride, dt, products + (vehicle[2],),
+            run_lanes, len(smp), smp, own, law, x, step0, n_steps, final, stride, dt, products + vehicle[2:4],
             (damper, dampers[1]), inputs, control, outputs,
         )  # fmt: skip
 

@@ -63,6 +63,8 @@ def _system_arrays(vehicle: Vehicle, passive: bool = True) -> dict[str, np.ndarr
         "A": np.hstack([-minv * vehicle.K, -minv * (vehicle.C if passive else vehicle.C0), minv * vehicle.T]).T,
         "TS": vehicle.T.copy(),
         "c_sec": np.full(4, vehicle.params.c_sz),
+        # the bump stops (clearance, stiffness; stiffness 0: none), `railride.engine.kernels.stop_force`
+        "stops": np.array([vehicle.params.z_stop or 1.0, vehicle.params.k_stop if vehicle.params.z_stop else 0.0]),
         "Bw": -minv * vehicle.K_w,
         "Bwd": -minv * vehicle.C_w,
     }

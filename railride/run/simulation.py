@@ -3,6 +3,7 @@ through named stages: `check` (`railride.run.checks`), `inputs`, `pack`, `step`,
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import time
 from dataclasses import dataclass
@@ -11,7 +12,7 @@ from datetime import datetime, timezone
 import numpy as np
 
 from railride.engine import kernels, lanes, layout
-from railride.errors import DivergenceError, Interrupted
+from railride.errors import DivergenceError, InputError, Interrupted
 from railride.model.track import table_key
 from railride.model.vehicle import N_DOF
 from railride.run.checks import (  # noqa: F401  (max_stable_dt and the integrators' names: their home before)
@@ -87,14 +88,38 @@ def run(plan: RunPlan, progress=None) -> RideResult:
     tables = inputs(plan)
     packed = pack(plan, tables)
     stepped = step(plan, tables, packed, progress)
+    if plan.exact and reaches_stops(plan, stepped.out["q"]):
+        # the exact discretisation holds while the secondary stays off its bump stops: beyond
+        # them the vehicle is not linear, and the run is stepped again by RK4
+        from railride.run.checks import _check_dt
+
+        if plan.solver.method == "exact":
+            raise InputError(
+                "method = 'exact': this run reaches the secondary bump stops (z_stop), where the "
+                "vehicle is not linear; use method 'auto' (RK4 then) or 'rk4'"
+            )
+        for vehicle in plan.vehicles.values():
+            _check_dt(vehicle, plan.solver.dt, plan.damper)
+        return run(dataclasses.replace(plan, exact=False), progress)
     return assemble(plan, stepped)
+
+
+def reaches_stops(plan: RunPlan, q: np.ndarray) -> bool:
+    """Whether any sample's secondary deflection (q, (n, rows, 9), through T) reaches its
+    vehicle's bump-stop clearance (vehicles with stops only)."""
+    for i, p in enumerate(plan.param_sets):
+        if p.z_stop is not None and p.k_stop > 0.0:
+            travel = q[i] @ plan.vehicles[id(p)].T
+            if np.nanmax(np.abs(travel), initial=0.0) >= p.z_stop:
+                return True
+    return False
 
 
 # -- inputs ---------------------------------------------------------------------------------------
 @dataclass(frozen=True, eq=False)
 class Inputs:
     """The stepper's matrices per distinct vehicle (``systems``) and stacked per sample
-    (``arrays``: A, TS, c_sec), and the rail input and forcing tables of every sample, one
+    (``arrays``: A, TS, c_sec, stops), and the rail input and forcing tables of every sample, one
     table per scenario and vehicle that the samples share, concatenated, with each sample's
     offset, node count and node interval."""
 
@@ -114,7 +139,10 @@ def inputs(plan: RunPlan) -> Inputs:
     n, dt, duration, exact = plan.n, plan.solver.dt, plan.duration, plan.exact
     vehicles, param_sets = plan.vehicles, plan.param_sets
     systems = {key: _system_arrays(v, passive=plan.damper is None) for key, v in vehicles.items()}
-    arrays = {k: np.ascontiguousarray(np.stack([systems[id(p)][k] for p in param_sets])) for k in ("A", "TS", "c_sec")}
+    arrays = {
+        k: np.ascontiguousarray(np.stack([systems[id(p)][k] for p in param_sets]))
+        for k in ("A", "TS", "c_sec", "stops")
+    }
 
     # rail inputs depend on the scenario and the wheelset spacing, the forcing also on the
     # vehicle: tables are shared between the samples that agree on those
@@ -273,13 +301,13 @@ def step(plan: RunPlan, tables: Inputs, packed: Packed, progress=None) -> Steppe
     arrays, P = tables.arrays, packed.P
     # a batch that fills groups of lanes.LANES samples runs them in vector form (run_lanes)
     if lanes.lanes_fit(n, P, packed.control[7]):
-        step_batch = lanes.lanes_stepper(n, packed.law, arrays["A"], arrays["TS"], P)
+        step_batch = lanes.lanes_stepper(n, packed.law, arrays["A"], arrays["TS"], P, arrays["stops"])
     else:
         step_batch = functools.partial(kernels.run_parallel, kernels.run_batch)
     stop = _StopRequest(progress is not None)
     # the stepper's argument groups (`kernels.run_batch`): vehicle, dampers, inputs, control, outputs
     kernel_groups = (
-        (arrays["A"], arrays["TS"], arrays["c_sec"]),
+        (arrays["A"], arrays["TS"], arrays["c_sec"], arrays["stops"]),
         (P, plan.vcmd),
         (utab, u_off, tables.ftab, tables.f_off, n_nodes, interval),
         packed.control,
