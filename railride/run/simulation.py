@@ -88,7 +88,7 @@ def run(plan: RunPlan, progress=None) -> RideResult:
     tables = inputs(plan)
     packed = pack(plan, tables)
     stepped = step(plan, tables, packed, progress)
-    if plan.exact and reaches_stops(plan, stepped.out["q"]):
+    if plan.exact and reaches_stops(plan, stepped.out["q"], stepped.status):
         # the exact discretisation holds while the secondary stays off its bump stops: beyond
         # them the vehicle is not linear, and the run is stepped again by RK4
         from railride.run.checks import _check_dt
@@ -104,11 +104,13 @@ def run(plan: RunPlan, progress=None) -> RideResult:
     return assemble(plan, stepped)
 
 
-def reaches_stops(plan: RunPlan, q: np.ndarray) -> bool:
+def reaches_stops(plan: RunPlan, q: np.ndarray, status: np.ndarray) -> bool:
     """Whether any sample's secondary deflection (q, (n, rows, 9), through T) reaches its
-    vehicle's bump-stop clearance (vehicles with stops only)."""
+    vehicle's bump-stop clearance (vehicles with stops only). A diverged sample does not count:
+    it is reported as diverged, and its batch-mates keep the exact steps (one sample reaching
+    the stops sends the whole batch to RK4, which agrees with them to its truncation error)."""
     for i, p in enumerate(plan.param_sets):
-        if p.z_stop is not None and p.k_stop > 0.0:
+        if p.z_stop is not None and p.k_stop > 0.0 and status[i] == layout.STATUS_OK:
             travel = q[i] @ plan.vehicles[id(p)].T
             if np.nanmax(np.abs(travel), initial=0.0) >= p.z_stop:
                 return True
