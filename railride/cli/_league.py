@@ -11,7 +11,7 @@ import typer
 from railride.errors import InputError
 from railride.cli._common import ProgressBar, stderr_is_terminal, stdout_console, write_folder
 from railride.cli._options import OutputFormat
-from railride.cli._parsing import damper_preset, load_gains, parse_scale, vehicle_from_options
+from railride.cli._parsing import damper_preset, load_gains, parse_scale, vehicle_arguments
 from railride.cli._render import alike_text, fmt, untuned_text
 
 
@@ -28,7 +28,7 @@ def run_league(
     solver,
     duration,
     window,
-    params,
+    vehicle,
     preset,
     load,
     format,
@@ -64,7 +64,7 @@ def run_league(
     if not bounds:
         raise InputError("--no-bounds: a league table always shows the ideal actuator beside the MR dampers")
     damper_preset("--damper", damper)
-    vehicle_params, vehicle_record = vehicle_from_options(params, preset, load)
+    vehicle_options = vehicle_arguments(vehicle, preset, load)
     if out is not None:
         check_out_dir(out)
     with ProgressBar(stderr_is_terminal(), lambda done: "running the league table...") as progress:
@@ -72,7 +72,7 @@ def run_league(
             scenarios,
             speeds,
             track_seeds=seeds or [0],
-            params=vehicle_params,
+            **vehicle_options,
             controllers=names,
             gains=load_gains(gains),
             damper=damper,
@@ -106,6 +106,7 @@ def league_table(table, doc) -> list:
 
     from railride.analysis.labels import describe_scenario
     from railride.cli._width import FitTable, Split
+    from railride.model.params import vehicle_text
 
     summary = table.summary()
     cases = table.cases[table.cases.controller == "passive"]
@@ -117,6 +118,7 @@ def league_table(table, doc) -> list:
     seeds = ", ".join(map(str, settings["track_seeds"]))
     caption = (
         f"Mean over {len(cases)} cases: {', '.join(settings['scenarios'])}{at}; track seeds {seeds} (random tracks).\n"
+        f"{vehicle_text(settings['vehicle'])}.\n"
         f"Gains tuned on: {tuned_text}. Tested on {out_of_sample} case(s) they were not tuned on"
         f" and {len(cases) - out_of_sample} they were.\n"
         "Reduction = (passive - controlled) / passive RMS x 100, MR dampers (ideal actuator, same gains, in brackets)."

@@ -24,13 +24,22 @@ FormatOption = Annotated[
     OutputFormat, typer.Option("--format", case_sensitive=False, help="Output on stdout: a table or a JSON document.")
 ]
 
+
 # -- vehicle ------------------------------------------------------------------------------------
-ParamsOption = Annotated[
-    Optional[Path],
+def _presets() -> str:
+    from railride.model.params import PRESETS
+
+    return ", ".join(PRESETS)
+
+
+VehicleOption = Annotated[
+    Optional[str],
     typer.Option(
+        "--vehicle",
         "--params",
-        metavar="FILE.toml",
-        help="Vehicle parameters from a TOML file with a [vehicle] table (see docs/cli.md). Exclusive with --preset.",
+        metavar="NAME|FILE.toml",
+        help=f"The vehicle: a preset ({_presets()}) or a TOML file with a [vehicle] table (see "
+        "docs/cli.md). --params is the same option. Exclusive with --preset. Default: paper.",
     ),
 ]
 LoadOption = Annotated[
@@ -44,7 +53,11 @@ LoadOption = Annotated[
 ]
 PresetOption = Annotated[
     Optional[str],
-    typer.Option("--preset", metavar="NAME", help="Named vehicle parameter set (available: paper). Default: paper."),
+    typer.Option(
+        "--preset",
+        metavar="NAME",
+        help=f"Named vehicle parameter set ({_presets()}), as --vehicle NAME. Default: paper.",
+    ),
 ]
 
 

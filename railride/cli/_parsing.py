@@ -137,31 +137,57 @@ def not_given(**given) -> list[str]:
 
 
 # -- vehicle, dampers, gains, sensor noise --------------------------------------------------------
-def vehicle_source(params_file: Optional[Path], preset: Optional[str]):
-    """--params FILE or --preset NAME as the library takes a vehicle: the file's path, the
-    preset's name, or None (the default preset)."""
-    if params_file is not None and preset is not None:
-        raise InputError("give either --params FILE or --preset NAME, not both")
-    return params_file if params_file is not None else preset
-
-
-def vehicle_from_options(params_file: Optional[Path], preset: Optional[str], load: Optional[float] = None):
-    """(VehicleParams, the record for the JSON document); ``load`` (--load) scales the carbody's
-    mass and inertias (`VehicleParams.loaded`) and enters the record when given."""
+def vehicle_source(vehicle: Optional[str], preset: Optional[str] = None):
+    """--vehicle NAME|FILE.toml (--params is the same option) or --preset NAME as the library
+    takes a vehicle: the preset's name, the file's Path, or None (the default preset), checked
+    before any work (the file is read): an unknown name that is no file is an InputError naming
+    --vehicle, the presets and that a FILE.toml is accepted."""
     from railride.model.params import VehicleParams
 
-    vehicle_source(params_file, preset)
-    if params_file is not None:
-        vehicle, record = VehicleParams.load(params_file), {"vehicle_params_file": str(params_file)}
-    else:
-        name = "paper" if preset is None else preset
-        vehicle, record = VehicleParams.preset(name), {"vehicle_preset": name}
-    if load is None:
-        return vehicle, record
-    from railride.cli._common import option_names
+    if vehicle is not None and preset is not None:
+        raise InputError("give either --vehicle NAME|FILE.toml (or --params) or --preset NAME, not both")
+    if preset is not None:
+        try:
+            VehicleParams.preset(preset)
+        except InputError as exc:
+            raise InputError(f"--preset: {exc}") from None
+        return preset
+    if vehicle is None:
+        return None
+    return VehicleParams.resolve(vehicle, "--vehicle")[1]
 
+
+def vehicle_from_options(vehicle: Optional[str], preset: Optional[str], load: Optional[float] = None):
+    """(the VehicleParams to run: --load scales the carbody's mass and inertias,
+    `VehicleParams.loaded`; the vehicle's entries of a run's JSON document): ``vehicle``, the
+    record of every output (`railride.model.params.vehicle_record`: name, load, values),
+    after ``vehicle_preset`` or ``vehicle_params_file`` and, when --load is given,
+    ``load_factor``, as the documents have always named the vehicle."""
+    source, params, record = _vehicle(vehicle, preset, load)
+    named: dict = (
+        {"vehicle_params_file": str(source)} if isinstance(source, Path) else {"vehicle_preset": source or "paper"}
+    )
+    if load is not None:
+        named["load_factor"] = float(load)
+    return params, {**named, "vehicle": record}
+
+
+def vehicle_arguments(vehicle: Optional[str], preset: Optional[str], load: Optional[float] = None) -> dict:
+    """--vehicle (--params), --preset and --load as the keyword arguments of a study
+    (``vehicle=``, ``load=``), checked before any work."""
+    source, _, record = _vehicle(vehicle, preset, load)
+    return {"vehicle": source, "load": record["load"]}
+
+
+def _vehicle(vehicle: Optional[str], preset: Optional[str], load: Optional[float]):
+    """(the source, the loaded parameters, the record) of the vehicle options."""
+    from railride.cli._common import option_names
+    from railride.model.params import resolve_vehicle
+
+    source = vehicle_source(vehicle, preset)
     with option_names({"load": "--load"}):
-        return vehicle.loaded(load), {**record, "load_factor": float(load)}
+        params, record = resolve_vehicle(source, load=1.0 if load is None else load, field="--vehicle")
+    return source, params, record
 
 
 def damper_preset(option: str, name: str, *, rig: bool = False):

@@ -127,12 +127,12 @@ def compare_comfort_table(rows: list[dict]):
 
 
 # -- modes: modes and frf -----------------------------------------------------------------------
-def modes_table(rows: list[dict]):
+def modes_table(rows: list[dict], caption: str | None = None):
     from rich.markup import escape
 
     from railride.cli._width import FitTable
 
-    table = FitTable(title="Modes of the passive vehicle")
+    table = FitTable(title="Modes of the passive vehicle", caption=None if caption is None else escape(caption))
     table.add_column("#", justify="right")
     table.add_column("mode", no_wrap=True)
     table.add_column("undamped (Hz)", justify="right")

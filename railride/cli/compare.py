@@ -36,7 +36,7 @@ from railride.cli._options import (
     OutputFormat,
     OutputRateOption,
     LoadOption,
-    ParamsOption,
+    VehicleOption,
     PresetOption,
     RailPhaseOption,
     ReportOption,
@@ -57,7 +57,7 @@ from railride.cli._parsing import (
     solver_from_options,
     track_options,
     value_list,
-    vehicle_from_options,
+    vehicle_arguments,
 )
 from railride.cli._league import run_league
 from railride.cli._render import (
@@ -184,13 +184,14 @@ def _trade_off_lines(doc: dict) -> list[str]:
     return lines
 
 
-def _compare_tables(doc: dict, vehicle: str, shipped: bool):
+def _compare_tables(doc: dict, shipped: bool):
     """The three tables of `compare`: Table 1 beside the paper, peak-to-peak, damper demands."""
     from rich.markup import escape
     from rich.text import Text
 
     from railride.analysis.labels import describe_scenario
     from railride.cli._width import FitTable, Split
+    from railride.model.params import vehicle_text
 
     rows = doc["controllers"]
     settings = doc["settings"]
@@ -200,7 +201,8 @@ def _compare_tables(doc: dict, vehicle: str, shipped: bool):
     start, end = settings["window_s"] or (0.0, settings["scenario"].get("duration_s", 0.0))
     info = [
         describe_scenario(settings["scenario"]),
-        f"dt {settings['dt_s']:g} s, RMS over {start:g}-{end:g} s, vehicle {vehicle}",
+        f"dt {settings['dt_s']:g} s, RMS over {start:g}-{end:g} s",
+        vehicle_text(settings["vehicle"]),
     ]
     if controlled:
         noise = settings.get("sensor_noise")
@@ -490,7 +492,7 @@ def compare(
     dt: DtOption = None,
     output_rate: OutputRateOption = None,
     window: WindowOption = None,
-    params: ParamsOption = None,
+    vehicle: VehicleOption = None,
     preset: PresetOption = None,
     load: LoadOption = None,
     format: FormatOption = OutputFormat.table,
@@ -555,7 +557,7 @@ def compare(
                 solver=solver_from_options(dt=dt, output_rate=output_rate, control_rate=control_rate),
                 duration=duration,
                 window=window,
-                params=params,
+                vehicle=vehicle,
                 preset=preset,
                 load=load,
                 format=format,
@@ -574,7 +576,7 @@ def compare(
         scale = parse_scale("--damper-scale", damper_scale)
         noise = _sensor_noise(sensor_noise, seed)
         solver = solver_from_options(dt=dt, output_rate=output_rate, control_rate=control_rate)
-        vehicle_params, vehicle_record = vehicle_from_options(params, preset, load)
+        vehicle_options = vehicle_arguments(vehicle, preset, load)
         window_value = parse_window(window) if window is not None else None
         track = track_options(scenario, seed_value, min_wavelength, max_wavelength)
         scen = make_scenario(
@@ -606,7 +608,7 @@ def compare(
         with ProgressBar(stderr_is_terminal(), describe) as progress:
             result = run_compare(
                 scen,
-                vehicle_params,
+                **vehicle_options,
                 controllers=names,
                 gains=gain_set,
                 damper=damper,
@@ -625,14 +627,11 @@ def compare(
         text = json.dumps(doc, indent=2, allow_nan=False)  # refuses NaN before anything is written
         if out is not None:
             write_folder(out, lambda: write_compare_outputs(result, out, doc, figures=figures, histories=histories))
-    vehicle = vehicle_record.get("vehicle_preset") or vehicle_record.get("vehicle_params_file")
-    if "load_factor" in vehicle_record:
-        vehicle += f" with load factor {vehicle_record['load_factor']:g} (carbody mass and inertias)"
     if format is OutputFormat.json:
         typer.echo(text)
     else:
         console = stdout_console()
-        for part in _compare_tables(doc, vehicle, shipped=gains is None):
+        for part in _compare_tables(doc, shipped=gains is None):
             console.print(part)
     if report is not None:  # after the tables: a report that cannot be written loses no output
-        save_report(report, result, _compare_tables(doc, vehicle, shipped=gains is None), ctx)
+        save_report(report, result, _compare_tables(doc, shipped=gains is None), ctx)

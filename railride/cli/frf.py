@@ -16,11 +16,12 @@ from railride.cli._options import (
     FigureFormatOption,
     FrfOutOption,
     FrfSpeedOption,
-    ParamsOption,
+    LoadOption,
     PresetOption,
+    VehicleOption,
     figure_options,
 )
-from railride.cli._parsing import vehicle_source
+from railride.cli._parsing import vehicle_arguments
 from railride.cli._render import modes_table
 
 #: the library's names of the options of `frf`, for its errors
@@ -58,8 +59,9 @@ def frf(
     points: Annotated[
         int, typer.Option("--points", metavar="N", help="Frequencies, log-spaced from --fmin to --fmax, >= 2.")
     ] = 400,
-    params: ParamsOption = None,
+    vehicle: VehicleOption = None,
     preset: PresetOption = None,
+    load: LoadOption = None,
     format: Annotated[
         FrfFormat,
         typer.Option(
@@ -85,10 +87,10 @@ def frf(
         from railride.frequency.frf import frequency_responses
 
         figures = figure_options(figure_format, dpi, out)
-        vehicle = vehicle_source(params, preset)
+        vehicle_options = vehicle_arguments(vehicle, preset, load)
         if out is not None:
             check_out_dir(out)
-        result = frequency_responses(vehicle, speed=speed, rails=rails, fmin=fmin, fmax=fmax, points=points)
+        result = frequency_responses(**vehicle_options, speed=speed, rails=rails, fmin=fmin, fmax=fmax, points=points)
         doc = result.to_dict()
         if out is not None:
             write_folder(out, lambda: result.save(out, figure_formats=figures.figure_formats, dpi=figures.dpi))
@@ -131,4 +133,6 @@ def _frf_tables(doc: dict, vehicle: str) -> list:
         "anti-phase: z_L = -z_R; every wheelset sees the pattern delayed by its distance "
         "behind the leading one / V."
     )
-    return [table, note, "", modes_table(doc["modes"])]
+    from railride.model.params import vehicle_text
+
+    return [table, note, "", modes_table(doc["modes"], vehicle_text(doc["vehicle"]))]

@@ -4,23 +4,26 @@ from __future__ import annotations
 
 from railride.cli._app import app
 from railride.cli._common import errors, print_json, stdout_console
-from railride.cli._options import FormatOption, OutputFormat, ParamsOption, PresetOption
-from railride.cli._parsing import vehicle_source
+from railride.cli._options import FormatOption, LoadOption, OutputFormat, PresetOption, VehicleOption
+from railride.cli._parsing import vehicle_from_options
 from railride.cli._render import modes_table
 
 
 @app.command()
 def modes(
     format: FormatOption = OutputFormat.table,
-    params: ParamsOption = None,
+    vehicle: VehicleOption = None,
     preset: PresetOption = None,
+    load: LoadOption = None,
 ) -> None:
     """Natural frequencies and damping of the passive vehicle (9 modes, ascending frequency)."""
     with errors():
         from railride.frequency.frf import modes as vehicle_modes
+        from railride.model.params import vehicle_text
 
-        rows = vehicle_modes(vehicle_source(params, preset)).to_list()
+        params, record = vehicle_from_options(vehicle, preset, load)
+        rows = vehicle_modes(params).to_list()
     if format is OutputFormat.json:
         print_json(rows)
         return
-    stdout_console().print(modes_table(rows))
+    stdout_console().print(modes_table(rows, vehicle_text(record["vehicle"])))

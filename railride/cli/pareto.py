@@ -29,6 +29,7 @@ from railride.cli._options import (
     DtOption,
     FigureFormatOption,
     FormatOption,
+    LoadOption,
     MaxWavelengthOption,
     MinWavelengthOption,
     OutputFormat,
@@ -36,6 +37,7 @@ from railride.cli._options import (
     ParetoGainsOption,
     ParetoOutOption,
     ParetoResumeOption,
+    PresetOption,
     RailPhaseOption,
     RunDurationOption,
     RunsScenarioOption,
@@ -43,6 +45,7 @@ from railride.cli._options import (
     SchedulerOption,
     SpeedOption,
     TrackSeedOption,
+    VehicleOption,
     WavelengthOption,
     WorkersOption,
     figure_options,
@@ -56,6 +59,7 @@ from railride.cli._parsing import (
     not_given,
     solver_from_options,
     study_scenario,
+    vehicle_arguments,
 )
 from railride.cli._render import RESPONSE_LABELS, damper_text, fmt
 
@@ -136,6 +140,9 @@ def pareto_command(
     speed: SpeedOption = None,
     duration: RunDurationOption = None,
     dt: DtOption = None,
+    vehicle: VehicleOption = None,
+    preset: PresetOption = None,
+    load: LoadOption = None,
     damper: ParetoDamperOption = DEFAULT_DAMPER,
     gains: ParetoGainsOption = None,
     workers: WorkersOption = None,
@@ -158,6 +165,8 @@ def pareto_command(
     """
     import time
 
+    from railride.model.params import vehicle_text
+
     defaults = not_given(dt=dt, min_wavelength=min_wavelength, max_wavelength=max_wavelength)
     with errors(), option_names(PARETO_FIELDS, defaults):
         from railride.analysis.labels import describe_scenario
@@ -165,6 +174,7 @@ def pareto_command(
 
         figures = figure_options(figure_format, dpi, out)
         n = default_of(run_pareto, "n_samples") if samples is None else samples
+        vehicle_options = vehicle_arguments(vehicle, preset, load)
         damper_preset("--damper", damper)
         base = load_gains(gains)
         solver = solver_from_options(dt=dt)
@@ -198,6 +208,7 @@ def pareto_command(
                     table=table,
                     solver=solver,
                     progress=progress,
+                    **vehicle_options,
                 )
                 wall = time.perf_counter() - t0
             doc = result.to_dict()
@@ -212,6 +223,7 @@ def pareto_command(
     lines = [
         (f"{scenario_text}, {scen.duration:g} s, dt {solver.dt:g} s, {damper_text(st)}; base gains {st['base_gains']}"),
         f"{st['n_samples']} samples, seed {st['seed']}: {st['sampling']}",
+        vehicle_text(st["vehicle"]),
         (
             f"{doc['runs']} runs in the run table, {progress.evaluated} evaluated now, wall "
             f"time {wall:.1f} s ({executor_record['type']})"

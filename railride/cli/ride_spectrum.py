@@ -18,12 +18,12 @@ from railride.cli._options import (
     DpiOption,
     FigureFormatOption,
     LoadOption,
-    ParamsOption,
     PresetOption,
     ReportOption,
+    VehicleOption,
     figure_options,
 )
-from railride.cli._parsing import load_gains, vehicle_from_options
+from railride.cli._parsing import load_gains, vehicle_arguments
 
 #: the library's names of the options, for its errors
 SPECTRUM_OPTIONS = {
@@ -87,7 +87,7 @@ def ride_spectrum(
     delay: Annotated[
         int, typer.Option("--delay", metavar="N", help="With --control-rate: the delay in controller periods, 0..64.")
     ] = 1,
-    params: ParamsOption = None,
+    vehicle: VehicleOption = None,
     preset: PresetOption = None,
     load: LoadOption = None,
     format: Annotated[
@@ -123,13 +123,13 @@ def ride_spectrum(
 
         figures = figure_options(figure_format, dpi, out)
         check_report_option(report)
-        vehicle, _ = vehicle_from_options(params, preset, load)
+        vehicle_options = vehicle_arguments(vehicle, preset, load)
         if out is not None:
             check_out_dir(out)
         result = run(
             track,
             speed=speed,
-            params=vehicle,
+            **vehicle_options,
             controllers=controllers,
             gains=None if gains is None else load_gains(gains),
             min_wavelength=min_wavelength,
@@ -162,6 +162,7 @@ def _tables(result) -> list:
 
     from railride.secondary.control import LABELS
     from railride.frequency.ride_spectrum import FLOOR
+    from railride.model.params import vehicle_text
 
     doc = result.to_dict()
     st = doc["settings"]
@@ -194,7 +195,7 @@ def _tables(result) -> list:
         f"{st['track']} at V = {st['speed_m_s']:g} m/s, wavelengths {st['min_wavelength_m']:g}-"
         f"{st['max_wavelength_m']:g} m ({st['fmin_hz']:.3g}-{st['fmax_hz']:.3g} Hz, {st['points']} "
         f"frequencies). Controllers on the ideal actuator (force = demand), applied {rate}; "
-        f"gains {st['gains']} (tuned on the paper's sine track, not on this one)."
+        f"gains {st['gains']} (tuned on the paper's sine track, not on this one). {vehicle_text(st['vehicle'])}."
     )
     parts: list = [floor, body, note]
     for name, reason in st["not_run"].items():
@@ -223,7 +224,7 @@ def state_space(
         Optional[Path],
         typer.Option("--gains", metavar="FILE.toml", help="Controller gains (default: the shipped gains)."),
     ] = None,
-    params: ParamsOption = None,
+    vehicle: VehicleOption = None,
     preset: PresetOption = None,
     load: LoadOption = None,
     format: Annotated[
@@ -245,11 +246,11 @@ def state_space(
         from railride.output.files import write_model
         from railride.frequency.linear import linear_model, linear_suspensions
 
-        vehicle, _ = vehicle_from_options(params, preset, load)
+        vehicle_options = vehicle_arguments(vehicle, preset, load)
         if out is not None and out.suffix.lower() not in (".mat", ".json"):
             raise InputError(f"--out = {str(out)!r}: the file name must end in .mat or .json")
         (secondary,) = linear_suspensions([suspension], None if gains is None else load_gains(gains)).values()
-        model = linear_model(vehicle, secondary)
+        model = linear_model(suspension=secondary, **vehicle_options)
         if out is not None:
             write_folder(out.parent, lambda: [write_model(model, out)])
     if format is StateSpaceFormat.json:
@@ -257,12 +258,14 @@ def state_space(
         return
     import numpy as np
 
+    from railride.model.params import vehicle_text
+
     poles = model.poles()
     console = stdout_console()
     console.print(
         f"State-space model, secondary {model.secondary}: {len(model.states)} states, "
         f"{len(model.inputs)} inputs, {len(model.outputs)} outputs; the largest real part of a "
-        f"pole is {float(np.max(poles.real)):.4g} 1/s."
+        f"pole is {float(np.max(poles.real)):.4g} 1/s; {vehicle_text(model.record())}."
     )
     for kind in ("states", "inputs", "outputs"):
         console.print(f"{kind}: " + ", ".join(getattr(model, kind)))

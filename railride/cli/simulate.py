@@ -36,7 +36,7 @@ from railride.cli._options import (
     OutputFormat,
     OutputRateOption,
     LoadOption,
-    ParamsOption,
+    VehicleOption,
     PresetOption,
     RailPhaseOption,
     ScenarioOption,
@@ -91,6 +91,7 @@ def _describe_suspension(record: dict) -> str:
 def _metrics_table(doc: dict):
     from rich.markup import escape
     from railride.cli._width import FitTable
+    from railride.model.params import vehicle_text
 
     labels = {
         "acceleration_m_s2": "acceleration (m/s^2)",
@@ -100,7 +101,6 @@ def _metrics_table(doc: dict):
     }
     sc, st = doc["scenario"], doc["settings"]
     start, end = st["window_s"]
-    vehicle = doc.get("vehicle_preset") or doc.get("vehicle_params_file")
     random = (
         [
             f"random track: seed {sc.get('seed')}, wavelengths "
@@ -114,7 +114,7 @@ def _metrics_table(doc: dict):
             f"scenario {sc.get('name')}, speed {sc.get('speed_m_s'):g} m/s",
             *random,
             f"duration {sc.get('duration_s'):g} s, dt {st['dt_s']:g} s, window {start:g}-{end:g} s",
-            f"vehicle {vehicle}",
+            vehicle_text(doc["vehicle"]),
             f"suspension {_describe_suspension(doc.get('suspension') or {'type': 'passive'})}",
         ]
     )
@@ -161,7 +161,7 @@ def simulate(
             "passive-off (v_min, the default) or passive-on (v_max).",
         ),
     ] = None,
-    params: ParamsOption = None,
+    vehicle: VehicleOption = None,
     preset: PresetOption = None,
     load: LoadOption = None,
     format: FormatOption = OutputFormat.table,
@@ -188,7 +188,7 @@ def simulate(
             dt,
             output_rate,
             window,
-            params,
+            vehicle,
             preset,
             out,
             suspension,
@@ -255,7 +255,7 @@ def _run(
     dt,
     output_rate,
     window_text,
-    params_file,
+    vehicle,
     preset,
     out,
     suspension="passive",
@@ -275,7 +275,7 @@ def _run(
 
     with option_names(SIMULATE_FIELDS, not_given(dt=dt, output_rate=output_rate)):
         solver = solver_from_options(dt=dt, output_rate=output_rate)
-        vehicle_params, vehicle_record = vehicle_from_options(params_file, preset, load)
+        vehicle_params, vehicle_record = vehicle_from_options(vehicle, preset, load)
         secondary = _suspension(suspension, damper_name, voltage_text, damper_scale)
         window = parse_window(window_text) if window_text is not None else None
         scen = make_scenario(

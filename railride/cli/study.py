@@ -31,17 +31,26 @@ from railride.cli._options import (
     FigureFormatOption,
     FormatOption,
     OutputFormat,
+    PresetOption,
     SchedulerFileOption,
     SchedulerOption,
     StudyGainsOption,
     StudyOutOption,
     ReportOption,
     StudyResumeOption,
+    VehicleOption,
     WindowOption,
     WorkersOption,
     figure_options,
 )
-from railride.cli._parsing import FIXED_RATE_FIELDS, damper_preset, load_gains, solver_from_options, value_list
+from railride.cli._parsing import (
+    FIXED_RATE_FIELDS,
+    damper_preset,
+    load_gains,
+    solver_from_options,
+    value_list,
+    vehicle_source,
+)
 from railride.cli._render import RESPONSE_LABELS, reduction_text
 from railride.cli._render import check_report_option, save_report
 
@@ -82,6 +91,7 @@ def _table(doc: dict):
 
     from railride.secondary.control import LABELS
     from railride.cli._width import FitTable, Split
+    from railride.model.params import vehicle_text
 
     s = doc["settings"]
     lo, hi = doc["percentiles"]
@@ -137,6 +147,7 @@ def _table(doc: dict):
         f"Mean and {lo:g}th to {hi:g}th percentile over the runs of each row (tracks and speeds). red. % = "
         "(passive - controlled) / passive x 100 on the same track, speed and load, run by run; passive "
         "is always healthy.",
+        vehicle_text(s["vehicle"]),
     ]
     if doc["failed"]:
         failed = "; ".join(
@@ -227,6 +238,8 @@ def study_command(
     ] = None,
     dt: DtOption = None,
     window: WindowOption = None,
+    vehicle: VehicleOption = None,
+    preset: PresetOption = None,
     damper: Annotated[
         str, typer.Option("--damper", metavar="MODEL", help="Damper model of the controllers (as for compare).")
     ] = DEFAULT_DAMPER,
@@ -253,6 +266,7 @@ def study_command(
     with errors(), option_names(STUDY_FIELDS):
         figures = figure_options(figure_format, dpi, out)
         names = check_controllers(controllers)
+        source = vehicle_source(vehicle, preset)
         seeds = value_list("--track-seed", track_seed, integer=True) if track_seed is not None else None
         speeds = value_list("--speed", speed) if speed is not None else None
         loads = value_list("--load", load)
@@ -285,6 +299,7 @@ def study_command(
                     duration=duration,
                     gains=gain_set,
                     damper=damper,
+                    vehicle=source,
                     solver=solver,
                     window=window_value,
                     executor=executor,

@@ -34,8 +34,10 @@ from railride.cli._options import (
     DpiOption,
     DtOption,
     FigureFormatOption,
+    LoadOption,
     MaxWavelengthOption,
     MinWavelengthOption,
+    PresetOption,
     ReportOption,
     RunDurationOption,
     RunsScenarioOption,
@@ -47,11 +49,19 @@ from railride.cli._options import (
     SweepGainsOption,
     SweepOutOption,
     SweepResumeOption,
+    VehicleOption,
     WindowOption,
     WorkersOption,
     figure_options,
 )
-from railride.cli._parsing import FIXED_RATE_FIELDS, load_gains, parse_noise, solver_from_options, value_list
+from railride.cli._parsing import (
+    FIXED_RATE_FIELDS,
+    load_gains,
+    parse_noise,
+    solver_from_options,
+    value_list,
+    vehicle_arguments,
+)
 from railride.cli._render import RESPONSE_LABELS, damper_text, fmt
 from railride.cli._render import check_report_option, save_report
 
@@ -190,6 +200,9 @@ def sweep_command(
     damper_scale: SweepDamperScaleOption = None,
     gains: SweepGainsOption = None,
     window: WindowOption = None,
+    vehicle: VehicleOption = None,
+    preset: PresetOption = None,
+    load: LoadOption = None,
     workers: WorkersOption = None,
     scheduler: SchedulerOption = None,
     scheduler_file: SchedulerFileOption = None,
@@ -222,6 +235,7 @@ def sweep_command(
         from railride.studies.sweep import grid as make_grid, run_sweep
 
         figures = figure_options(figure_format, dpi, out)
+        vehicle_options = vehicle_arguments(vehicle, preset, load)
         values, texts = _parse(
             suspension=suspension,
             speed=speed,
@@ -255,7 +269,9 @@ def sweep_command(
         with interruptible(table, table_path), errors():
             with RunProgress(stderr_is_terminal(), "sweeping") as progress:
                 t0 = time.perf_counter()
-                result = run_sweep(grid, executor=executor, table=table, progress=progress, comfort=comfort)
+                result = run_sweep(
+                    grid, executor=executor, table=table, progress=progress, comfort=comfort, **vehicle_options
+                )
                 wall = time.perf_counter() - t0
             # the command's own facts, after the library's document
             facts = {
@@ -400,6 +416,7 @@ def _gain_option(text: str) -> tuple[str, list[float]]:
 def _caption(grid, doc: dict, wall: float) -> str:
     """The sweep table's caption: the scenario, the dampers and gains, the runs."""
     from railride.analysis.labels import describe_scenario
+    from railride.model.params import vehicle_text
 
     st, rows = doc["settings"], doc["rows"]
     start, end = grid.window or (0.0, grid.duration)
@@ -409,6 +426,7 @@ def _caption(grid, doc: dict, wall: float) -> str:
     ]
     if st["damper"]:
         lines.append(damper_text(st) + (f"; gains {st['gains_source']}" if grid.controllers else ""))
+    lines.append(vehicle_text(st["vehicle"]))
     lines.append(
         f"{len(rows)} run{'s' if len(rows) != 1 else ''}: {doc['runs_evaluated']} evaluated now, "
         f"{len(rows) - doc['runs_evaluated']} from the run table; wall time {wall:.1f} s"

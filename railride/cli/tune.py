@@ -39,6 +39,7 @@ from railride.cli._options import (
     ObjectiveOption,
     OutputFormat,
     PenaltyOption,
+    PresetOption,
     RailPhaseOption,
     ReportOption,
     RunDurationOption,
@@ -51,6 +52,7 @@ from railride.cli._options import (
     TuneGainsOption,
     TuneOutOption,
     TuneResumeOption,
+    VehicleOption,
     WavelengthOption,
     WeightsOption,
     WorkersOption,
@@ -67,6 +69,7 @@ from railride.cli._parsing import (
     solver_from_options,
     study_scenario,
     value_list,
+    vehicle_source,
 )
 from railride.cli._render import RESPONSE_LABELS, damper_text, reduction_text
 from railride.cli._render import check_report_option, save_report
@@ -207,6 +210,7 @@ def _tune_tables(doc: dict, start, tuned, scenario_text: str):
     from rich.text import Text
 
     from railride.analysis.labels import gain_unit
+    from railride.model.params import vehicle_text
     from railride.studies.tuning import PARAMETERS
     from railride.cli._width import FitTable, Split
 
@@ -333,6 +337,7 @@ def _tune_tables(doc: dict, start, tuned, scenario_text: str):
                 [
                     f"{scenario_text}, {doc['scenario'].get('duration_s', 0):g} s, dt {s['dt_s']:g} s, "
                     f"{damper_text(s)}; start gains {s['start_gains']}",
+                    vehicle_text(s["vehicle"]),
                     "red. % = (passive - controlled) / passive x 100 (negative: worse than passive, in red)",
                     f"{doc['runs']} runs in the run table, {doc['runs_evaluated']} evaluated now "
                     f"({doc['runs_per_second']:.1f} runs/s), wall time {doc['wall_time_s']:.1f} s",
@@ -393,6 +398,8 @@ def tune_command(
     speed: SpeedOption = None,
     duration: RunDurationOption = None,
     dt: DtOption = None,
+    vehicle: VehicleOption = None,
+    preset: PresetOption = None,
     damper: TuneDamperOption = DEFAULT_DAMPER,
     damper_scale: TuneDamperScaleOption = None,
     gains: TuneGainsOption = None,
@@ -451,6 +458,7 @@ def tune_command(
 
         figures = figure_options(figure_format, dpi, out)
         names = _tunable_list(controllers)
+        source = vehicle_source(vehicle, preset)
         damper_preset("--damper", damper)
         scale = parse_scale("--damper-scale", damper_scale)
         start = _tune_start(gains)
@@ -506,6 +514,7 @@ def tune_command(
                     n_values=values,
                     span=span,
                     budget=budget,
+                    vehicle=source,
                     solver=solver,
                     progress=progress,
                     log=progress.log,

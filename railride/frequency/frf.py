@@ -27,7 +27,7 @@ from railride.analysis.spectra import FRF_MAGNITUDES, FRF_PATTERNS, frf_frame, f
 from railride.output.files import FRF_FILES
 from railride.defaults import DEFAULT_SPEED
 from railride.model.modes import Modes as Modes, checked_modes, modes as modes  # the modes as frf's, too
-from railride.model.params import VehicleParams
+from railride.model.params import VehicleParams, resolve_argument, vehicle_record
 from railride.plots import PNG_DPI, FigureOptions
 
 SCHEMA = "railride.frf/1"
@@ -42,8 +42,10 @@ class FrfResult:
     """The carbody frequency responses of `frequency_responses`: ``responses`` per rail pattern
     (the complex Datasets of `Vehicle.frequency_response` over ``frequency`` [Hz], per metre of
     rail amplitude) at ``speed`` [m/s], the log grid they were computed on (``fmin``, ``fmax``
-    [Hz], ``points``), the vehicle ``params`` and where they came from (``source``: a preset
-    name, a parameters file, or None for values not equal to a preset), and its ``modes``.
+    [Hz], ``points``), the vehicle ``params`` (with its load) and where they came from
+    (``source``: a preset name, a parameters file, or None for values not equal to a preset),
+    its ``modes`` and ``vehicle``, the record of its name, load and values
+    (`railride.model.params.vehicle_record`; None: made from ``params`` and ``source``).
 
     The result protocol: `to_dict` (the ``railride.frf/1`` document), `to_pandas` (the table of
     magnitudes and phases, frf.csv), `plot` (magnitudes against frequency with the modes
@@ -59,6 +61,7 @@ class FrfResult:
     fmin: float
     fmax: float
     points: int
+    vehicle: dict | None = None
 
     @property
     def patterns(self) -> tuple[str, ...]:
@@ -67,7 +70,13 @@ class FrfResult:
     @property
     def vehicle_name(self) -> str:
         """The preset name or the parameters file, as the figure's title gives the vehicle."""
-        return "custom parameters" if self.source is None else str(self.source)
+        name = "custom parameters" if self.source is None else str(self.source)
+        load = self.record()["load"]
+        return name if load == 1.0 else f"{name} at load {load:g}"
+
+    def record(self) -> dict:
+        """The vehicle's record: name, load and values (`railride.model.params.vehicle_record`)."""
+        return vehicle_record(self.params, self.source) if self.vehicle is None else self.vehicle
 
     def to_pandas(self):
         """One row per rail pattern and frequency: magnitudes and phases of the carbody
@@ -103,6 +112,7 @@ class FrfResult:
             "schema": SCHEMA,
             "railride_version": __version__,
             **vehicle,
+            "vehicle": self.record(),
             "settings": {
                 "speed_m_s": self.speed,
                 "rails": list(self.patterns),
@@ -148,16 +158,19 @@ class FrfResult:
 
 
 def frequency_responses(
-    params=None,
+    vehicle=None,
     *,
+    params=None,
+    load: float = 1.0,
     speed: float | None = None,
     rails: str = "both",
     fmin: float = 0.1,
     fmax: float = 30.0,
     points: int = 400,
 ) -> FrfResult:
-    """The carbody frequency responses of the passive vehicle ``params`` (`VehicleParams`, a
-    preset name or the path of a parameters file; default "paper") at ``speed`` [m/s] (default
+    """The carbody frequency responses of the passive ``vehicle`` (``params`` is an alias:
+    `VehicleParams`, a preset name or the path of a parameters file; default "paper"), with the
+    load factor ``load`` on its carbody (`VehicleParams.loaded`), at ``speed`` [m/s] (default
     the scenarios' default speed), for ``rails`` "in-phase", "anti-phase" or "both", on
     ``points`` (>= 2) frequencies log-spaced from ``fmin`` to ``fmax`` [Hz] (both exactly on the
     grid). Returns an `FrfResult` with the vehicle's modes."""
@@ -178,9 +191,12 @@ def frequency_responses(
         f"the frequency responses on {points} points",
         "use fewer points (400 resolve every mode of the vehicle)",
     )
-    vehicle_params, source = VehicleParams.resolve(params)
-    vehicle = Vehicle(vehicle_params)
+    base, source = resolve_argument(vehicle, params)
+    record = vehicle_record(base, source, load)
+    vehicle_params = base if record["load"] == 1.0 else base.loaded(record["load"])
+    car = Vehicle(vehicle_params)
     frequency = np.geomspace(fmin, fmax, points)
     frequency[0], frequency[-1] = fmin, fmax  # exactly, without rounding
-    responses = {p: vehicle.frequency_response(frequency, speed, p) for p in patterns}
-    return FrfResult(vehicle_params, source, speed, frequency, responses, checked_modes(vehicle), fmin, fmax, points)
+    responses = {p: car.frequency_response(frequency, speed, p) for p in patterns}
+    found = checked_modes(car)
+    return FrfResult(vehicle_params, source, speed, frequency, responses, found, fmin, fmax, points, record)

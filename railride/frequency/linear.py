@@ -31,7 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from railride.errors import InputError
-from railride.model.params import VehicleParams
+from railride.model.params import VehicleParams, resolve_vehicle, vehicle_record
 from railride.model.vehicle import CORNER_NAMES, DOF_NAMES, DOF_UNITS, N_DOF, RAILS, WHEELSETS, Vehicle
 
 SCHEMA = "railride.linear/1"
@@ -48,8 +48,10 @@ FLOOR_POINTS = {"centre": 0.0, "front": 1.0, "rear": -1.0}
 class LinearModel:
     """x' = A x + B u, y = C x + D u with named ``states``, ``inputs`` and ``outputs`` and
     their ``units``; ``secondary`` says what sits in the secondary ("passive", "plant" or the
-    outer loop's name on the ideal actuator). Checked at construction: shapes agree and every
-    entry is finite."""
+    outer loop's name on the ideal actuator); ``params`` the vehicle (with its load) and
+    ``vehicle`` its record: name, load and values (`railride.model.params.vehicle_record`;
+    None: made from ``params``). Checked at construction: shapes agree and every entry is
+    finite."""
 
     A: np.ndarray
     B: np.ndarray
@@ -61,6 +63,7 @@ class LinearModel:
     units: dict
     secondary: str
     params: VehicleParams
+    vehicle: dict | None = None
 
     def __post_init__(self):
         n, m, p = len(self.states), len(self.inputs), len(self.outputs)
@@ -74,6 +77,10 @@ class LinearModel:
                 raise InputError(f"{name} has shape {np.shape(matrix)}: must be {shape} for the names given")
             if not np.all(np.isfinite(matrix)):
                 raise InputError(f"{name} holds a value that is not finite: check the vehicle parameters")
+
+    def record(self) -> dict:
+        """The vehicle's record: name, load and values (`railride.model.params.vehicle_record`)."""
+        return vehicle_record(self.params) if self.vehicle is None else self.vehicle
 
     def index(self, kind: str, name: str) -> int:
         """Where ``name`` is among the ``kind`` ("states", "inputs", "outputs")."""
@@ -110,6 +117,7 @@ class LinearModel:
             "schema": SCHEMA,
             "railride_version": __version__,
             "secondary": self.secondary,
+            "vehicle": self.record(),
             "vehicle_params": self.params.to_dict(),
             "states": list(self.states),
             "inputs": list(self.inputs),
@@ -208,12 +216,13 @@ def _outer_gains(controller, vehicle: Vehicle) -> tuple[np.ndarray, np.ndarray]:
     return (_full_state(G) if G.shape[1] == 6 else G), np.asarray(H, dtype=float)
 
 
-def linear_model(params=None, suspension=None) -> LinearModel:
-    """The state-space model of the vehicle ``params`` (`VehicleParams`, a preset name or a
-    parameters file; default "paper") with ``suspension``: "passive" (default, or None),
+def linear_model(params=None, suspension=None, *, vehicle=None, load: float = 1.0) -> LinearModel:
+    """The state-space model of the vehicle ``params`` (``vehicle`` is an alias: `VehicleParams`,
+    a preset name or a parameters file; default "paper"), with the load factor ``load`` on its
+    carbody (`VehicleParams.loaded`), with ``suspension``: "passive" (default, or None),
     "plant", or a `railride.Suspension` that is linear (passive viscous dampers, or the ideal
     actuator under an outer loop). See the module's docstring for states, inputs and outputs."""
-    vehicle_params, _ = VehicleParams.resolve(params)
+    vehicle_params, record = resolve_vehicle(vehicle, params, load)
     vehicle = Vehicle(vehicle_params)
     secondary, c_dashpot, controller = _check_secondary(suspension, vehicle)
     Cd = vehicle.C0 + c_dashpot * vehicle.T @ vehicle.T.T
@@ -288,6 +297,7 @@ def linear_model(params=None, suspension=None) -> LinearModel:
         units,
         secondary,
         vehicle_params,
+        record,
     )
 
 

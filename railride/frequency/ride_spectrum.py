@@ -33,7 +33,7 @@ from railride import limits, validation
 from railride.defaults import DEFAULT_SPEED
 from railride.analysis.comfort import FLOOR
 from railride.frequency.linear import LinearModel, linear_model, linear_suspensions
-from railride.model.params import VehicleParams
+from railride.model.params import VehicleParams, resolve_vehicle
 from railride.model.track import SPECTRA, spectrum
 from railride.model.vehicle import CORNER_NAMES, N_DOF, Vehicle
 
@@ -203,7 +203,9 @@ def ride_spectrum(
     track: str = "fra4",
     *,
     speed: float | None = None,
+    vehicle=None,
     params=None,
+    load: float = 1.0,
     controllers=("passive", "pid", "sas-attitude", "sas-attitude-ride"),
     gains=None,
     min_wavelength: float = 1.0,
@@ -213,7 +215,9 @@ def ride_spectrum(
     delay: int = 1,
 ) -> RideSpectrum:
     """The ride on spectrum ``track`` (`railride.model.track.SPECTRA`) at ``speed`` [m/s] (default
-    the scenarios' 55.56) of the vehicle ``params`` for each of ``controllers``: "passive",
+    the scenarios' 55.56) of ``vehicle`` (``params`` is an alias: `VehicleParams`, a preset name
+    or a parameters file; default "paper") with the load factor ``load`` on its carbody,
+    recorded in ``settings["vehicle"]``, for each of ``controllers``: "passive",
     outer-loop names (on the ideal actuator, gains from ``gains``, default the shipped) or
     linear `Suspension` values. The spectrum is taken over [min_wavelength, max_wavelength] m
     (as the random tracks are synthesised) on ``points`` log-spaced frequencies. Without
@@ -235,7 +239,7 @@ def ride_spectrum(
     runs = len(controllers) if isinstance(controllers, (list, tuple)) else 1
     per_point = 8.0 * (3 * 2 * n_state * n_state + 2 * 2 * 16 + len(RESPONSES) * runs)
     limits.check(points * per_point, f"the ride spectrum on {points} frequencies", "use fewer points")
-    vehicle_params, _ = VehicleParams.resolve(params)
+    vehicle_params, record = resolve_vehicle(vehicle, params, load)
     vehicle = Vehicle(vehicle_params)
     frequency = np.geomspace(speed / hi, speed / lo, points)
     inputs = rail_patterns(vehicle, frequency, speed)
@@ -287,6 +291,7 @@ def ride_spectrum(
         attrs={"units": "m/s^2"},
     )
     settings = {
+        "vehicle": record,
         "track": track,
         "speed_m_s": speed,
         "min_wavelength_m": lo,

@@ -279,11 +279,17 @@ def vehicle_record(params: VehicleParams, source=None, load=1.0) -> dict:
     }
 
 
+def resolve_argument(vehicle=None, params=None, field: str = "vehicle") -> tuple[VehicleParams, str | Path | None]:
+    """`VehicleParams.resolve` of a function's ``vehicle=`` or its alias ``params=``
+    (`vehicle_argument`), its errors naming the one given (``field``: the name of ``vehicle``)."""
+    return VehicleParams.resolve(vehicle_argument(vehicle, params), field if params is None else "params")
+
+
 def resolve_vehicle(vehicle=None, params=None, load=1.0, field: str = "vehicle") -> tuple[VehicleParams, dict]:
     """(the vehicle to run, its `vehicle_record`) of a function's ``vehicle=`` (or its alias
     ``params=``: a preset name, a parameters file or VehicleParams, `VehicleParams.resolve`)
     and ``load`` factor: the edge where every study resolves its vehicle, once."""
-    base, source = VehicleParams.resolve(vehicle_argument(vehicle, params), field)
+    base, source = resolve_argument(vehicle, params, field)
     record = vehicle_record(base, source, load)
     return (base if record["load"] == 1.0 else base.loaded(record["load"])), record
 

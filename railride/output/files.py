@@ -356,6 +356,8 @@ def write_outputs(
     place of ride.nc and ride.csv. Returns the written paths."""
     _expect(result, "result", "railride.run.ride.RideResult", ("dataset", "metrics"))
     ds = result.dataset
+    if "vehicle" in metrics_doc:  # the vehicle record (name, load, values) as an attribute of ride.nc
+        ds = ds.assign_attrs(vehicle=json.dumps(metrics_doc["vehicle"]))
     text = json_text(metrics_doc)  # refuse NaN before any file is written
     window = _window(metrics_doc)
     writers = {

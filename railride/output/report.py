@@ -81,10 +81,20 @@ def contents(result) -> Contents:
 
 # -- the result types ---------------------------------------------------------------------------
 def _vehicle(settings: dict):
+    """The vehicle of a result's settings, for its modal table: ``vehicle_params`` (the vehicle
+    run), else the vehicle record's values at its load (the first of several), else paper."""
     from railride.model.params import VehicleParams
 
     record = settings.get("vehicle_params")
-    return VehicleParams(**record) if record else VehicleParams.preset("paper")
+    if record:
+        return VehicleParams(**record)
+    named = settings.get("vehicle")
+    if isinstance(named, dict) and "values" in named:
+        load = named.get("load", 1.0)
+        load = load[0] if isinstance(load, list) else load
+        base = VehicleParams(**named["values"])
+        return base if load == 1.0 else base.loaded(load)
+    return VehicleParams.preset("paper")
 
 
 def comparison_contents(result) -> Contents:
@@ -221,7 +231,7 @@ def frf_contents(result) -> Contents:
     return Contents(
         title="Frequency responses of the passive vehicle",
         settings={
-            **{k: v for k, v in doc.items() if k.startswith("vehicle_") and k != "vehicle_params"},
+            **{k: v for k, v in doc.items() if k.startswith("vehicle") and k != "vehicle_params"},
             **doc["settings"],
         },
         params=result.params,
@@ -339,8 +349,14 @@ def _settings_html(part: Contents, command: str | None) -> str:
         lines.append(f"<p>Command: <code>{html.escape(command)}</code></p>")
     if part.scenario:
         lines.append(f"<p>Scenario: {html.escape(describe_scenario(part.scenario))}</p>")
+    from railride.model.params import vehicle_text
+
     rows = [("railride version", __version__)]
-    rows += _flat("", {k: v for k, v in part.settings.items() if k != "vehicle_params"})
+    for k, v in part.settings.items():
+        if k == "vehicle" and isinstance(v, dict) and "name" in v:  # its values: the parameters' table
+            rows.append(("vehicle", vehicle_text(v).removeprefix("vehicle: ")))
+        elif k != "vehicle_params":
+            rows += _flat(k, v)
     frame = pd.DataFrame(rows, columns=["setting", "value"])
     return "\n".join(lines) + _table_html(frame)
 

@@ -23,7 +23,7 @@ from railride.secondary.control import CONSTANT_VOLTAGE, CONTROLLERS, LABELS, PA
 from railride.defaults import DEFAULT_DAMPER
 from railride.secondary.faults import check_faults, degradation
 from railride.analysis.comfort import comfort_record
-from railride.model.params import VehicleParams
+from railride.model.params import VehicleParams, resolve_vehicle, vehicle_argument
 from railride.model.plausible import notes
 from railride.analysis.metrics import STATISTICS, reduction, ride_metrics, select_window
 from railride.plots import PNG_DPI, FigureOptions
@@ -320,6 +320,8 @@ class Comparison:
         out.attrs.update(
             title="railride controller comparison", gains_source=self.gains.source, settings=json.dumps(self.settings)
         )
+        if "vehicle" in self.settings:  # the vehicle record, as ride.nc holds it too
+            out.attrs["vehicle"] = json.dumps(self.settings["vehicle"])
         # the runs' times differ when they straddle a second (drop_conflicts drops them): the first
         # run's, so that the file always says when it was made
         if "created_utc" in first.attrs:
@@ -329,8 +331,10 @@ class Comparison:
 
 def compare(
     scenario,
-    params=None,
+    vehicle=None,
     *,
+    params=None,
+    load: float = 1.0,
     controllers=PAPER_CONTROLLERS,
     gains: GainSet | None = None,
     damper=DEFAULT_DAMPER,
@@ -346,6 +350,11 @@ def compare(
     sensing=None,
 ) -> Comparison:
     """Run the passive vehicle and each controller on ``scenario`` and collect the metrics.
+
+    ``vehicle`` (``params`` is an alias): a preset name, the path of a parameters file or
+    `VehicleParams` (default "paper"; `VehicleParams.resolve`), with the load factor ``load``
+    on its carbody (`VehicleParams.loaded`); ``settings["vehicle"]`` records both
+    (`railride.model.params.vehicle_record`).
 
     ``controllers`` names from `railride.secondary.control.CONTROLLERS` or "all" (default the paper's
     four, `PAPER_CONTROLLERS`; passive is always run as the baseline; passive-on and passive-off,
@@ -370,6 +379,8 @@ def compare(
     ``sensing``: what every controller measures (`railride.secondary.sensing.Accelerometers`; None: the
     exact states; the bounds measure the same); a law that reads the bogies' states is not run
     with it (``settings["not_run"]`` says why). Every setting is checked before the first run."""
+    given = vehicle_argument(vehicle, params)
+    car, record = resolve_vehicle(given, load=load)
     solver = SolverSettings.of(solver)
     model = damper_model(damper, damper_scale)
     damper_scale = float(damper_scale)
@@ -384,10 +395,10 @@ def compare(
         from railride.secondary.sensing import reads_bogies
         from railride.model.vehicle import Vehicle
 
-        car = Vehicle(VehicleParams.of(params))
+        body = Vehicle(car)
         for n in names:
             c = gains.controller(n)
-            if c is not None and reads_bogies(c.gains(car)[0]):
+            if c is not None and reads_bogies(c.gains(body)[0]):
                 not_run[n] = "reads the bogies' states; the accelerometers are on the carbody only"
     names = [n for n in names if n not in not_run]
     closed = [n for n in names if n != "passive" and n not in CONSTANT_VOLTAGE]
@@ -406,10 +417,10 @@ def compare(
     bound_batches = [
         [_named(n, gains, device, 1.0, sensor_noise, delay, sensing) for n in closed] for device in bound_devices
     ]
-    passive = check(scenario, params, Suspension.passive(), solver)
-    plans = [(group, check(scenario, params, suspensions, solver, "mark")) for group, suspensions in batches]
+    passive = check(scenario, car, Suspension.passive(), solver)
+    plans = [(group, check(scenario, car, suspensions, solver, "mark")) for group, suspensions in batches]
     for suspensions in bound_batches:  # run below with the laws that did not diverge
-        check(scenario, params, suspensions, solver, "mark")
+        check(scenario, car, suspensions, solver, "mark")
     datasets = {"passive": run_plan(passive, part and part(0.0, share)).dataset}
     done = 1
     # closed and open loops run as separate batches (a batch is all one or the other)
@@ -437,7 +448,7 @@ def compare(
         # the ideal actuator may not be stable with gains tuned for a damper: marked, not fatal
         res = simulate(
             scenario,
-            params,
+            car,
             [_named(n, gains, device, 1.0, sensor_noise, delay, sensing) for n in closed],
             solver=solver,
             on_divergence="mark",
@@ -450,11 +461,12 @@ def compare(
         }
     metrics = xr.concat([ride_metrics(datasets[n], window) for n in names], dim="controller")
     metrics = metrics.assign_coords(controller=names)
-    vehicle = VehicleParams.of(params)  # the settings from the objects, not read back from the runs
+    # the settings from the objects, not read back from the runs
     settings = {
         "scenario": scenario.describe(),
-        "vehicle_params": vehicle.to_dict(),
-        **({"warnings": warned} if (warned := notes(vehicle)) else {}),
+        "vehicle": record,
+        "vehicle_params": car.to_dict(),
+        **({"warnings": warned} if (warned := notes(car)) else {}),
         "damper": damper_record(damper),
         "damper_scale": damper_scale,
         **solver.to_dict(),
@@ -474,7 +486,8 @@ def compare(
     if faults:
         healthy = compare(
             scenario,
-            params,
+            given,
+            load=load,
             controllers=names,
             gains=gains,
             damper=damper,

@@ -25,6 +25,7 @@ from railride.defaults import DEFAULT_DAMPER
 from railride.plots import PNG_DPI, FigureOptions
 from railride.model.track import SPECTRA, scenario
 from railride.secondary.suspension import damper_record
+from railride.model.params import resolve_vehicle
 
 SCHEMA = "railride.league/1"
 RESPONSES = ("acceleration_m_s2", "displacement_m", "pitch_deg", "roll_deg")
@@ -117,7 +118,9 @@ def league(
     speeds=None,
     *,
     track_seeds=(0,),
+    vehicle=None,
     params=None,
+    load: float = 1.0,
     controllers=PAPER_CONTROLLERS,
     gains: GainSet | None = None,
     damper: str = DEFAULT_DAMPER,
@@ -131,12 +134,16 @@ def league(
     """Run `compare` on every (scenario, speed, track seed) with the same gains and collect the
     league table. ``scenarios``: names (`railride.scenario`); ``speeds`` [m/s] (None: each
     scenario's default); ``track_seeds``: the random-track realisations (ignored by the other
-    scenarios). The other arguments are `compare`'s; the bounds (ideal devices) are always run.
+    scenarios). ``vehicle`` (``params`` is an alias) and ``load``: the vehicle as `compare`
+    takes it, resolved once and recorded in ``settings["vehicle"]`` and in the ``vehicle``
+    column of `cases`. The other arguments are `compare`'s; the bounds (ideal devices) are
+    always run.
     ``progress(done_cases, total_cases)`` is called after each case."""
     scenarios = list(scenarios) if not isinstance(scenarios, str) else [scenarios]
     if not scenarios:
         raise InputError("scenarios: give at least one scenario name")
     names = check_controllers(controllers)
+    car, record = resolve_vehicle(vehicle, params, load)
     gains = GainSet.default() if gains is None else gains
     # every scenario is built (and checked) before the first run
     todo = [
@@ -146,7 +153,7 @@ def league(
     for k, (name, speed, seed, sc) in enumerate(todo):
         comp = compare(
             sc,
-            params,
+            car,
             controllers=names,
             gains=gains,
             damper=damper,
@@ -156,11 +163,12 @@ def league(
             comfort=comfort,
             bounds=True,
         )
-        rows.extend(_rows(comp, name, sc.speed, seed))
+        rows.extend(_rows(comp, name, sc.speed, seed, record["name"]))
         if progress is not None:
             progress(k + 1, len(todo))
     settings = {
         "scenarios": scenarios,
+        "vehicle": record,
         "speeds_m_s": None if speeds is None else [float(v) for v in speeds],
         "track_seeds": [int(s) for s in track_seeds],
         "damper": damper_record(damper),
@@ -175,7 +183,7 @@ def league(
     return LeagueTable(pd.DataFrame(rows), names, settings, gains.provenance.get("scenario_record"))
 
 
-def _rows(comp, name: str, speed: float, seed) -> list[dict]:
+def _rows(comp, name: str, speed: float, seed, vehicle: str) -> list[dict]:
     red = comp.reductions
     demands = comp.demands()
     bound = (comp.bounds_record() or {}).get("ideal", {})  # reductions of the same gains on the ideal actuator
@@ -185,6 +193,7 @@ def _rows(comp, name: str, speed: float, seed) -> list[dict]:
             "scenario": name,
             "speed_m_s": float(speed),
             "track_seed": seed,
+            "vehicle": vehicle,
             "controller": n,
             "in_sample": bool(comp.in_sample),
         }

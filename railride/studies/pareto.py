@@ -28,7 +28,7 @@ from railride.secondary.control import PAPER_CONTROLLERS, GainSet
 from railride.defaults import DEFAULT_DAMPER
 from railride.output.files import PARETO_FILES
 from railride.analysis.metrics import RESPONSES
-from railride.model.params import VehicleParams
+from railride.model.params import resolve_vehicle
 from railride.plots import PNG_DPI, FigureOptions
 from railride.studies.optimise import GainEvaluator, log_gain_bounds
 from railride import validation
@@ -240,7 +240,9 @@ def pareto(
     damper: str = DEFAULT_DAMPER,
     executor=None,
     table: RunTable | None = None,
+    vehicle=None,
     params=None,
+    load: float = 1.0,
     solver=None,
     progress=None,
     parameters=None,
@@ -252,9 +254,11 @@ def pareto(
     REFERENCE / 1000 and REFERENCE x 100 (the box of `railride.studies.optimise`), the other gains at
     ``gains`` (default the shipped `GainSet.default`), which are also run as sample 0. One call
     of `run_cases`: 32-run batches, ``table`` to resume, ``executor`` for Dask;
-    ``progress(done, total, runs_per_second)`` after each chunk. ``params``: the vehicle
-    (`VehicleParams` or a preset name, default "paper"); ``solver``: the `SolverSettings` of
-    every run; recorded in ``settings`` where they differ from the defaults. Every setting is
+    ``progress(done, total, runs_per_second)`` after each chunk. ``vehicle`` (``params`` is
+    an alias): a preset name, the path of a parameters file or `VehicleParams` (default
+    "paper"), with the load factor ``load`` on its carbody, recorded in ``settings["vehicle"]``
+    (`railride.model.params.vehicle_record`); ``solver``: the `SolverSettings` of every run;
+    both recorded in ``settings`` where they differ from the defaults (the run keys). Every setting is
     checked before the first run.
     """
     from railride.secondary.suspension import damper_model
@@ -262,7 +266,7 @@ def pareto(
     from railride.model.track import scenario as make_scenario
 
     solver = SolverSettings.of(solver)
-    vehicle = VehicleParams.of(params)
+    vehicle, vehicle_rec = resolve_vehicle(vehicle, params, load)
     names = _parameters(suspension, parameters)
     n_samples = _power_of_two("n_samples", n_samples)
     seed = validation.seed("seed", seed)
@@ -292,6 +296,7 @@ def pareto(
         "dt_s": solver.dt,
         "base_gains": base.source,
         "base_gains_tuned_on": (base.provenance or {}).get("scenario"),
+        "vehicle": vehicle_rec,
         **other_settings(vehicle, solver),
     }
     return ParetoResult(

@@ -32,7 +32,7 @@ from railride.secondary.control import PAPER_CONTROLLERS, GainSet
 from railride.defaults import DEFAULT_DAMPER
 from railride.secondary.faults import DamperFault, check_faults, parse_faults
 from railride.analysis.metrics import RESPONSES
-from railride.model.params import VehicleParams
+from railride.model.params import resolve_argument, vehicle_record
 from railride.plots import PNG_DPI, FigureOptions
 from railride.run.checks import check
 from railride.run.solver import SolverSettings
@@ -156,6 +156,7 @@ def study(
     duration: float | None = None,
     gains: GainSet | None = None,
     damper: str = DEFAULT_DAMPER,
+    vehicle=None,
     params=None,
     solver=None,
     window=None,
@@ -174,7 +175,10 @@ def study(
     ("ideal": the exact states; "accelerometers": `railride.secondary.sensing.Accelerometers` with the
     default settings, their noise seeded per track seed),
     with ``gains`` (default the shipped gains: the controllers keep them whatever the load) and
-    the ``damper`` model. Every setting is checked before the first run. ``executor``, ``table``
+    the ``damper`` model, on ``vehicle`` (``params`` is an alias: a preset name, the path of a
+    parameters file or `VehicleParams`, default "paper"; the loads scale its carbody;
+    ``settings["vehicle"]`` records it, `railride.model.params.vehicle_record`, and the runs'
+    table names it in its ``vehicle`` column). Every setting is checked before the first run. ``executor``, ``table``
     and ``progress`` as for `railride.studies.sweep.run_cases`. Returns a `StudyResult`."""
     from railride.analysis.metrics import check_window
     from railride.secondary.suspension import damper_model
@@ -183,7 +187,8 @@ def study(
 
     names = check_controllers(controllers)
     solver = SolverSettings.of(solver)
-    vehicle = VehicleParams.of(params)
+    base, source = resolve_argument(vehicle, params)
+    vehicle = base
     gains = GainSet.default() if gains is None else gains
     random = scenario in SPECTRA
     if track_seeds is not None and not random:
@@ -298,6 +303,8 @@ def study(
     )
     frame = rows.reset_index(drop=True).copy()
     info = pd.DataFrame(meta, columns=["controller", "load", "stiffness", "fault", "delay", "track_seed", "speed_m_s"])
+    record = vehicle_record(base, source, load_list)
+    info.insert(1, "vehicle", record["name"])
     frame = pd.concat([info, frame.drop(columns=[c for c in info.columns if c in frame.columns])], axis=1)
     frame = _reductions(frame)
     summary = _summary(frame, names, load_list, stiffness_list, conditions, delay_list)
@@ -329,6 +336,7 @@ def study(
         "damper": damper_record(damper),
         "gains": gains.source,
         "window_s": window_record,
+        "vehicle": record,
         **other_settings(vehicle, solver),
     }
     return StudyResult(frame, summary, settings, failed)

@@ -33,7 +33,7 @@ from railride.defaults import DEFAULT_CONTROL_RATE, DEFAULT_OUTPUT_RATE
 from railride.studies.executors import DaskExecutor, LocalExecutor, RunTable  # noqa: F401 (their home before)
 from railride.analysis.metrics import RESPONSES, STATISTICS
 from railride.plots import PNG_DPI, FigureOptions
-from railride.model.params import VehicleParams
+from railride.model.params import VehicleParams, resolve_argument, resolve_vehicle
 from railride.run.solver import SolverSettings
 from railride.secondary.suspension import batch_conflict, damper_label, damper_record
 from railride.studies.case import MODEL_REVISION, SUSPENSIONS, Case, scenario_of  # noqa: F401 (their home before)
@@ -181,6 +181,7 @@ def run_cases(
     executor=None,
     table: RunTable | None = None,
     base_gains=None,
+    vehicle=None,
     params=None,
     solver=None,
     window=None,
@@ -189,14 +190,15 @@ def run_cases(
     comfort: bool = False,
 ) -> pd.DataFrame:
     """Evaluate ``cases``, skipping those already in ``table``; returns their rows in order.
-    ``params``: the vehicle (`VehicleParams` or a preset name, default "paper") the cases'
-    ``vehicle`` changes apply to; ``solver``: the `SolverSettings` of every run. ``comfort``:
-    the rows also hold the ride comfort indices (`evaluate`).
+    ``vehicle`` (``params`` is an alias): the vehicle (`VehicleParams`, a preset name or the
+    path of a parameters file, default "paper") the cases' ``vehicle`` changes apply to;
+    ``solver``: the `SolverSettings` of every run. ``comfort``: the rows also hold the ride
+    comfort indices (`evaluate`).
 
     ``progress(done, total, runs_per_second)`` is called after each chunk.
     """
     solver = SolverSettings.of(solver)
-    vehicle = VehicleParams.of(params)
+    vehicle = resolve_argument(vehicle, params)[0]
     executor = LocalExecutor() if executor is None else executor
     table = RunTable() if table is None else table
     done = table.done()
@@ -278,8 +280,9 @@ class SweepResult:
     """The runs of a sweep (`run_sweep`): ``grid`` (the cases, their grid values and the
     settings), ``frame`` (the rows of `run_cases`, one per case, in the grid's order),
     ``comfort`` (whether they hold the comfort indices, `COMFORT_COLUMNS`), ``vehicle`` (the
-    `VehicleParams` of the runs), ``runs`` (rows of the run table at the end) and ``date``
-    (when the sweep finished, UTC, ISO 8601)."""
+    `VehicleParams` of the runs), ``runs`` (rows of the run table at the end), ``date``
+    (when the sweep finished, UTC, ISO 8601) and ``vehicle_record`` (the vehicle's name, load
+    and values, `railride.model.params.vehicle_record`; None: made from ``vehicle``)."""
 
     grid: SweepGrid
     frame: pd.DataFrame = field(repr=False)
@@ -287,6 +290,7 @@ class SweepResult:
     vehicle: object = None
     runs: int = 0
     date: str = ""
+    vehicle_record: dict | None = None
 
     def metric_columns(self) -> list[str]:
         return metric_columns() + (list(COMFORT_COLUMNS) if self.comfort else [])
@@ -323,12 +327,16 @@ class SweepResult:
     def settings(self) -> dict:
         """What the sweep ran: the scenario's fixed settings, each axis and its values, the
         damper, the base gains' source, the sensor noise, the step and the metrics window;
-        with comfort, what its columns are (`comfort_settings`); a solver's rates and a vehicle
-        other than the defaults (`other_settings`)."""
-        from railride.model.params import VehicleParams
+        with comfort, what its columns are (`comfort_settings`); the vehicle's record
+        (``vehicle``: name, load, values); a solver's rates and a vehicle other than the
+        defaults (`other_settings`)."""
+        from railride.model.params import vehicle_record
 
         g = self.grid
         vehicle = VehicleParams.preset("paper") if self.vehicle is None else self.vehicle
+        record = self.vehicle_record
+        if record is None:
+            record = vehicle_record(VehicleParams.of(vehicle))
         return {
             "scenario": g.scenario_record(),
             "grid": g.grid_values(),
@@ -340,6 +348,7 @@ class SweepResult:
             "dt_s": float(g.solver.dt),
             "window_s": None if g.window is None else list(g.window),
             **({"comfort": comfort_settings(g.duration, g.window)} if self.comfort else {}),
+            "vehicle": record,
             **other_settings(vehicle, g.solver),
         }
 
@@ -423,7 +432,9 @@ def run_sweep(
     *,
     executor=None,
     table: RunTable | None = None,
+    vehicle=None,
     params=None,
+    load: float = 1.0,
     progress=None,
     comfort: bool = True,
 ) -> SweepResult:
@@ -432,9 +443,11 @@ def run_sweep(
     One call of `run_cases`: compiled batches of 32 runs, on ``executor`` (default
     `LocalExecutor`; `DaskExecutor` for a cluster), skipping the runs already in ``table``
     (a `RunTable`; one kept on disk makes the sweep resumable), ``progress(done, total,
-    runs_per_second)`` after each chunk. ``params``: the vehicle (`VehicleParams` or a preset
-    name, default "paper"). ``comfort``: also the ride comfort indices of every run over the
-    grid's window (`railride.analysis.comfort.ride_comfort`). The runs use the grid's base gains, solver
+    runs_per_second)`` after each chunk. ``vehicle`` (``params`` is an alias): a preset name,
+    the path of a parameters file or `VehicleParams` (default "paper"), with the load factor
+    ``load`` on its carbody; `SweepResult.settings` records both (``vehicle``). ``comfort``:
+    also the ride comfort indices of every run over the grid's window
+    (`railride.analysis.comfort.ride_comfort`). The runs use the grid's base gains, solver
     settings and metrics window.
     """
     from datetime import datetime, timezone
@@ -444,7 +457,7 @@ def run_sweep(
             f"grid = {type(grid).__name__}: must be a railride.studies.grid.SweepGrid "
             "(railride.studies.grid.grid makes one)"
         )
-    vehicle = VehicleParams.of(params)
+    vehicle, record = resolve_vehicle(vehicle, params, load)
     table = RunTable() if table is None else table
     frame = run_cases(
         list(grid.cases),
@@ -458,4 +471,4 @@ def run_sweep(
         comfort=bool(comfort),
     )
     date = datetime.now(timezone.utc).replace(microsecond=0).isoformat().replace("+00:00", "Z")
-    return SweepResult(grid, frame, bool(comfort), vehicle, len(table.frame), date)
+    return SweepResult(grid, frame, bool(comfort), vehicle, len(table.frame), date, record)

@@ -39,7 +39,7 @@ from railride.errors import InputError
 from railride.secondary.control import OUTER_LOOPS, GainSet
 from railride.defaults import DEFAULT_DAMPER
 from railride.analysis.metrics import RESPONSES
-from railride.model.params import VehicleParams
+from railride.model.params import resolve_argument, vehicle_record
 from railride.studies.objectives import (  # noqa: F401 (re-exported: the objectives' old home)
     DEFAULT_OBJECTIVE,
     INFEASIBLE_OFFSET,
@@ -175,6 +175,7 @@ def tune(
     span: float = 30.0,
     tol: float = 1e-3,
     min_span: float = 1.05,
+    vehicle=None,
     params=None,
     solver=None,
     window=None,
@@ -195,9 +196,11 @@ def tune(
     sweep would not fit its budget, or when the span falls below ``min_span``. The inner loop
     is tuned on the damper rig (at most `INNER_PASSES` passes, stopping at ``tol``).
     ``damper_scale`` scales the MR dampers' force capacity (`railride.secondary.dampers.BoucWen.scaled`);
-    the inner loop then tracks demands scaled alike. ``params``: the vehicle (`VehicleParams`
-    or a preset name, default "paper"); ``solver``: the `SolverSettings` of every vehicle run;
-    both are recorded in ``settings`` where they differ from the defaults. Every setting is
+    the inner loop then tracks demands scaled alike. ``vehicle`` (``params`` is an alias): a
+    preset name, the path of a parameters file or `VehicleParams` (default "paper"), recorded
+    in ``settings["vehicle"]`` with the load factors of the runs
+    (`railride.model.params.vehicle_record`); ``solver``: the `SolverSettings` of every vehicle
+    run; both are recorded in ``settings`` where they differ from the defaults (the run keys). Every setting is
     checked before the first run. ``progress(done, total, runs_per_second)`` after each chunk;
     ``log(text)`` after each pass.
 
@@ -217,7 +220,7 @@ def tune(
 
     controllers = _check_controllers(controllers)
     solver = SolverSettings.of(solver)
-    vehicle = VehicleParams.of(params)
+    vehicle, source = resolve_argument(vehicle, params)
     gains = GainSet.reference() if gains is None else gains
     objective = DEFAULT_OBJECTIVE if objective is None else objective
     opts = tuple(sorted((scenario_options or {}).items()))
@@ -274,6 +277,7 @@ def tune(
             "tolerance": float(tol),
             "min_span": float(min_span),
             "start_gains": gains.source,
+            "vehicle": vehicle_record(vehicle, source, list(dict.fromkeys(c.load for c in cases_set))),
             **other_settings(vehicle, solver),
             **(
                 {

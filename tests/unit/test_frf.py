@@ -46,9 +46,12 @@ def test_the_vehicle_is_recorded_as_it_was_given():
     custom = paper.replace(k_sz=5.8e5)
     doc = frequency_responses(custom, points=3).to_dict()
     assert "vehicle_preset" not in doc and doc["vehicle_params"] == custom.to_dict()
-    assert list(doc)[:3] == ["schema", "railride_version", "vehicle_params"]
-    with pytest.raises(ValueError, match="params = 3"):
+    assert list(doc)[:4] == ["schema", "railride_version", "vehicle_params", "vehicle"]
+    assert doc["vehicle"] == {"name": "custom", "load": 1.0, "values": custom.to_dict()}
+    with pytest.raises(ValueError, match="vehicle = 3"):
         frequency_responses(3)
+    with pytest.raises(ValueError, match="params = 3"):
+        frequency_responses(params=3)
 
 
 def test_to_pandas_peaks_and_the_modal_table(result):
