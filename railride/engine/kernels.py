@@ -337,17 +337,17 @@ def stop_force(z_stop, k_stop, x):
 @njit(cache=True, inline="always", fastmath=_FAST)
 def add_stops(zk, cx, f, foff, fsave):
     """Add the bump stops' forces (clearance zk[0], stiffness zk[1]) at the corner deflections
-    cx to the corner forces f[foff:foff + 4], the forces before in fsave; whether any stop is
-    touched. The damper forces go back in place after the product: what the record and the
-    inner loop read is the damper's force alone, as a load cell on the damper measures it."""
-    touched = False
+    cx to the corner forces f[foff:foff + 4], the forces before in fsave, where any corner is
+    beyond the clearance; whether one is. The damper forces go back in place after the
+    product: what the record and the inner loop read is the damper's force alone, as a load
+    cell on the damper measures it. Off the stops (almost every step) this is four comparisons."""
+    z = zk[0]
+    if not (abs(cx[0]) > z or abs(cx[1]) > z or abs(cx[2]) > z or abs(cx[3]) > z):
+        return False
     for c in range(N_CORNER):
         fsave[c] = f[foff + c]
-        fs = stop_force(zk[0], zk[1], cx[c])
-        if fs != 0.0:
-            touched = True
-            f[foff + c] = fsave[c] + fs
-    return touched
+        f[foff + c] = fsave[c] + stop_force(z, zk[1], cx[c])
+    return True
 
 
 @njit(cache=True, inline="always", fastmath=_FAST)

@@ -98,16 +98,36 @@ def _lane_forcing(ts, lanes, act, smp, ftab, f_off, n_nodes, interval, RR, roff)
 
 @njit(cache=True, inline="always", fastmath=_FAST)
 def _lane_derivative(
-    law, ST, RR, roff, a_ptr, a_col, aval, a_uni, t_ptr, t_col, tval, t_uni, P, VC, CONN, CC, ZL, ONE, K, kb, ZK, FS
+    law,
+    ST,
+    RR,
+    roff,
+    a_ptr,
+    a_col,
+    aval,
+    a_uni,
+    t_ptr,
+    t_col,
+    tval,
+    t_uni,
+    P,
+    VC,
+    CONN,
+    CC,
+    ZL,
+    ONE,
+    K,
+    kb,
+    ZK,
+    FS,
+    stops,
 ):
     """K[kb:kb + NL] = d/dt of the lane states ST (rows as `NL`), with the rail forcing
     RR[roff:roff + 9]; as `_derivative`, every lane at once. ST's force rows receive f; CC the
     corner deflections (rows 0-3) and rates (4-7). Bump stops where ZK (clearance, stiffness
-    per lane) has a stiffness: their forces join f for the product only (FS keeps f)."""
+    per lane) has a stiffness (``stops``: in any lane of the group): their forces join f for the
+    product only (FS keeps f), and only at a step where a lane is beyond its clearance."""
     lanes_move(K, kb, ST, N_DOF, N_DOF, ONE)
-    stops = False
-    for l in range(LANES):
-        stops = stops or ZK[1, l] > 0.0
     if law != LAW_VISCOUS_IN_C or stops:
         lanes_spmv(t_ptr, t_col, tval, t_uni, ST, ZL, 0, CC, 0)
     if law == LAW_BOUC_WEN or law == LAW_SPENCER:
@@ -123,17 +143,23 @@ def _lane_derivative(
                 K[kb + b, l] = dz
                 K[kb + b + 1, l] = dyy
                 K[kb + b + 2, l] = du
-    if law == LAW_VISCOUS_IN_C and not stops:  # force columns there for another group's stops: none here
+    if law == LAW_VISCOUS_IN_C:  # force columns only for the stops (here or in another group)
         for c in range(N_CORNER):
             for l in range(LANES):
                 ST[ROW_F + c, l] = 0.0
-    if stops:
+    n_over = 0
+    if stops:  # branch-free, so that it vectorises: a lane without stops has an infinite clearance
         for c in range(N_CORNER):
             for l in range(LANES):
-                FS[c, l] = 0.0 if law == LAW_VISCOUS_IN_C else ST[ROW_F + c, l]
+                n_over += abs(CC[c, l]) > ZK[0, l]
+    touched = n_over > 0
+    if touched:
+        for c in range(N_CORNER):
+            for l in range(LANES):
+                FS[c, l] = ST[ROW_F + c, l]
                 ST[ROW_F + c, l] = FS[c, l] + stop_force(ZK[0, l], ZK[1, l], CC[c, l])
     lanes_spmv(a_ptr, a_col, aval, a_uni, ST, RR, roff, K, kb + N_DOF)
-    if stops:
+    if touched:
         for c in range(N_CORNER):
             for l in range(LANES):
                 ST[ROW_F + c, l] = FS[c, l]
@@ -207,6 +233,7 @@ def run_lanes(
         w = np.empty(N_RAIL)
         wd = np.empty(N_RAIL)
         faulty = False
+        has_stops = False
         for l in range(LANES):
             i = smp[l]
             alive[l] = 1.0 if status[i] == STATUS_OK else 0.0
@@ -223,6 +250,7 @@ def run_lanes(
             act[l] = 1.0
             ts[l] = step0 * dt
             ZK[0, l], ZK[1, l] = stops[i, 0], stops[i, 1]
+            has_stops = has_stops or stops[i, 1] > 0.0
         _lane_forcing(ts, LANES, act, smp, ftab, f_off, n_nodes, interval, RR, 0)
         last = n_steps + 1 if final else n_steps
         for n in range(last):
@@ -284,6 +312,7 @@ def run_lanes(
                 0,
                 ZK,
                 FS,
+                has_stops,
             )
             if closed_loop and law != LAW_IDEAL:
                 for l in range(LANES):
@@ -415,6 +444,7 @@ def run_lanes(
                         NL * stage,
                         ZK,
                         FS,
+                        has_stops,
                     )
                 lanes_rk4(S, 0, K, NL, 2 * N_DOF, h6, act)
                 if has_states:

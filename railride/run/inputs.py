@@ -64,10 +64,18 @@ def _system_arrays(vehicle: Vehicle, passive: bool = True) -> dict[str, np.ndarr
         "TS": vehicle.T.copy(),
         "c_sec": np.full(4, vehicle.params.c_sz),
         # the bump stops (clearance, stiffness; stiffness 0: none), `railride.engine.kernels.stop_force`
-        "stops": np.array([vehicle.params.z_stop or 1.0, vehicle.params.k_stop if vehicle.params.z_stop else 0.0]),
+        "stops": _stops(vehicle.params),
         "Bw": -minv * vehicle.K_w,
         "Bwd": -minv * vehicle.C_w,
     }
+
+
+def _stops(params: VehicleParams) -> np.ndarray:
+    """The engine's (clearance, stiffness) of the bump stops: an infinite clearance and no
+    stiffness where there are none (a stiffness of 0, or no clearance)."""
+    if params.z_stop is None or params.k_stop == 0.0:
+        return np.array([np.inf, 0.0])
+    return np.array([params.z_stop, params.k_stop])
 
 
 def _forcing_table(utab: np.ndarray, Bw: np.ndarray, Bwd: np.ndarray) -> np.ndarray:
