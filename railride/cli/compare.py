@@ -334,7 +334,7 @@ def _compare_tables(doc: dict, shipped: bool):
             "RMS force\n(kN)": f"{d['force_rms_n'] / 1e3:.2f}",
             "max force\n(kN)": f"{d['force_max_n'] / 1e3:.2f}",
             "RMS travel\n(mm)": f"{d['travel_rms_m'] * 1e3:.1f}",
-            "max travel\n(mm)": f"{d['travel_max_m'] * 1e3:.1f}",
+            "max travel\n(mm)": f"{d['travel_max_m'] * 1e3:.1f}" + (" *" if d.get("reached_stops") else ""),
             "mean voltage\n(V)": fmt(d.get("voltage_mean_v"), ".2f"),
             "time at v_max\n(%)": "-" if at_max is None else f"{at_max * 100:.1f}",
         }
@@ -359,6 +359,7 @@ def _compare_tables(doc: dict, shipped: bool):
         "asks for; force: the secondary damper force on the carbody; travel: the "
         "secondary deflection (suspension travel); passive: the viscous dampers c_sz."
         + (" The ideal devices have no voltage." if settings.get("damper") in IDEAL_NAMES and controlled else "")
+        + _stops_note(rows)
     )
     parts = [table, Text("\n".join(info)), *bounds_parts, "", ptp, "", demands, Text(demands_note)]
     if all("comfort" in r for r in rows):
@@ -635,3 +636,17 @@ def compare(
             console.print(part)
     if report is not None:  # after the tables: a report that cannot be written loses no output
         save_report(report, result, _compare_tables(doc, shipped=gains is None), ctx)
+
+
+def _stops_note(rows: list[dict]) -> str:
+    """The bump stops under the damper table: their clearance, and which suspensions reached them."""
+    clearance = next((r["damper"].get("clearance_m") for r in rows), None)
+    if clearance is None:
+        return " The vehicle has no bump stops: the travel is unbounded."
+    hit = [r["label"] for r in rows if r["damper"].get("reached_stops")]
+    if not hit:
+        return f" No suspension reached the bump stops ({clearance * 1e3:g} mm clearance)."
+    return (
+        f" *: reached the bump stops at {clearance * 1e3:g} mm ({', '.join(hit)}): the stops bound "
+        "that travel and carry force there."
+    )

@@ -116,6 +116,7 @@ def _metrics_table(doc: dict):
             f"duration {sc.get('duration_s'):g} s, dt {st['dt_s']:g} s, window {start:g}-{end:g} s",
             vehicle_text(doc["vehicle"]),
             f"suspension {_describe_suspension(doc.get('suspension') or {'type': 'passive'})}",
+            *_travel_lines(doc.get("travel")),
         ]
     )
     table = FitTable(title="Ride metrics (carbody CG)", caption=escape(caption))
@@ -125,6 +126,17 @@ def _metrics_table(doc: dict):
     for key, values in doc["metrics"].items():
         table.add_row(labels.get(key, key), f"{values['rms']:.5g}", f"{values['ptp']:.5g}")
     return table
+
+
+def _travel_lines(travel: dict | None) -> list[str]:
+    """The largest suspension travel against the bump stops' clearance, for the caption."""
+    if travel is None:
+        return []
+    top, z = travel["max_m"] * 1e3, travel["clearance_m"]
+    if z is None:
+        return [f"max secondary travel {top:.1f} mm (no bump stops)"]
+    reached = ": REACHED the bump stops, which bound it" if travel["reached_stops"] else ""
+    return [f"max secondary travel {top:.1f} mm of {z * 1e3:g} mm clearance{reached}"]
 
 
 @app.command()

@@ -14,7 +14,7 @@ import xarray as xr
 
 from railride.errors import InputError
 from railride.secondary import dampers
-from railride.model.params import PRESETS
+from railride.model.params import PRESETS, VehicleParams
 from railride.plots import PNG_DPI, FigureOptions
 from railride.run.solver import SolverSettings
 from railride.model.vehicle import CORNER_NAMES, DOF_NAMES, DOF_UNITS, RAILS, WHEELSETS
@@ -346,12 +346,28 @@ class RideResult:
                 "window_s": [float(start), float(end)],
             },
             "metrics": to_dict(self.metrics(window)),
+            "travel": self.travel((start, end)),
         }
         if comfort:
             from railride.analysis.comfort import comfort_record
 
             doc["comfort"] = comfort_record(self.comfort(window))
         return doc
+
+    def travel(self, window=None) -> dict:
+        """The largest secondary deflection (suspension travel, any corner) over ``window``
+        (start, end) s, the bump stops' clearance (None: none) and whether the travel reached
+        it (the stops then bound the travel and carry force): ``max_m``, ``clearance_m``,
+        ``reached_stops``. A single run (select a sample of a batch first)."""
+        from railride.analysis.metrics import select_window
+
+        if self.is_batch:
+            raise InputError("travel describes a single run; select a sample of the batch first")
+        params = self.params if self.params is not None else VehicleParams(**self._record("vehicle_params", None))
+        part = select_window(self.dataset, window)
+        top = float(np.nanmax(np.abs(part["secondary_deflection"].values)))
+        z = params.z_stop  # with a stiffness of 0 the stops are only marked: reported, no force
+        return {"max_m": top, "clearance_m": z, "reached_stops": bool(z is not None and top >= z)}
 
     def _record(self, name: str, value) -> dict:
         """The JSON record of the run's scenario or parameters: from the value the run kept,
