@@ -11,7 +11,6 @@ import pandas as pd
 
 from railride.errors import InputError
 from railride import validation
-from railride.engine.layout import N_DOF
 from railride.model.params import VehicleParams
 from railride.model.plausible import notes
 from railride.model.vehicle import Vehicle
@@ -60,8 +59,9 @@ class Modes:
 
 
 def modes(params=None) -> Modes:
-    """The nine modes of the passive vehicle ``params`` (`VehicleParams`, a preset name or the
-    path of a parameters file; default "paper"), by undamped natural frequency (`checked_modes`)."""
+    """The modes of the passive vehicle ``params`` (`VehicleParams`, a preset name or the path
+    of a parameters file; default "paper"), by undamped natural frequency (`checked_modes`):
+    nine, ten where the carbody bends (`Vehicle.n_dof`)."""
     vehicle, _ = VehicleParams.resolve(params)
     return checked_modes(Vehicle(vehicle))
 
@@ -72,8 +72,9 @@ ROUNDING_ZETA = 1e-6
 
 
 def checked_modes(vehicle) -> Modes:
-    """`Vehicle.modes` as numbers a table or JSON can hold: nine modes, every frequency and
-    damping ratio finite and >= 0 (rounding below 0 shown as 0). A vehicle whose bodies and
+    """`Vehicle.modes` as numbers a table or JSON can hold: one mode per DOF (`Vehicle.n_dof`:
+    nine, ten where the carbody bends), every frequency and damping ratio finite and >= 0
+    (rounding below 0 shown as 0). A vehicle whose bodies and
     springs are so far apart in size that double precision cannot separate its modes (a
     bogie of a gram on a stiff primary, a carbody of a billion tonnes) is a ValueError naming
     what went wrong and the parameters outside the typical ranges."""
@@ -93,8 +94,8 @@ def checked_modes(vehicle) -> Modes:
             )
             continue
         out.append(dataclasses.replace(m, damping_ratio=max(m.damping_ratio, 0.0)))
-    if problem is None and len(out) != N_DOF:
-        problem = f"{len(out)} modes came out, not {N_DOF}"
+    if problem is None and len(out) != vehicle.n_dof:
+        problem = f"{len(out)} modes came out, not {vehicle.n_dof}"
     if problem is not None:
         outside = [n.split("'")[1] for n in notes(vehicle.params)]
         hint = f"; outside the typical ranges: {', '.join(outside)}" if outside else ""

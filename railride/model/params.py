@@ -15,7 +15,7 @@ from pathlib import Path
 
 from railride.errors import InputError
 from railride._io import atomic_write_text
-from railride.model.plausible import VEHICLE
+from railride.model.plausible import VEHICLE, rigid_note
 from railride.validation import param, rule_words, shown, toml_error, validate_fields
 
 
@@ -64,6 +64,19 @@ class VehicleParams:
         "m", "secondary vertical clearance to the bump stops, either way (none: no stops)", "positive", None
     )
     k_stop: float = param("N/m", "bump-stop stiffness beyond the clearance, per corner", "nonnegative", 0.0)
+    # the carbody's first vertical bending mode (docs/model.md, Flexible carbody): none of
+    # f_bend, EI_c keeps the carbody rigid (the paper's nine DOFs)
+    L_c: float | None = param("m", "carbody length (for its bending mode; none: not given)", "positive", None)
+    f_bend: float | None = param(
+        "Hz",
+        "first vertical bending frequency of the free carbody at this mass (none: a rigid carbody)",
+        "positive",
+        None,
+    )
+    EI_c: float | None = param(
+        "N m^2", "carbody vertical bending stiffness, instead of f_bend (none: not given)", "positive", None
+    )
+    zeta_bend: float = param("1", "modal damping ratio of the carbody's bending mode", "nonnegative", 0.02)
 
     def __post_init__(self) -> None:
         validate_fields(self, "vehicle parameter", VEHICLE, then=self._check_wheelbase)
@@ -79,6 +92,51 @@ class VehicleParams:
                 f"vehicle parameter 'b' = {shown(self.b)} (half wheelbase, m): must be below 'l' = {shown(self.l)} "
                 "(half bogie-centre spacing, m): the two bogies' wheelsets would pass each other"
             )
+        self._check_bending()
+
+    def _check_bending(self) -> None:
+        """The bending mode's fields together: flexible with L_c and exactly one of f_bend,
+        EI_c; L_c beyond the outer wheelsets; L_c alone runs rigid and says so."""
+        given = [n for n in ("f_bend", "EI_c") if getattr(self, n) is not None]
+        if len(given) == 2:
+            raise InputError(
+                f"vehicle parameters 'f_bend' = {shown(self.f_bend)} Hz and 'EI_c' = {shown(self.EI_c)} N m^2: give "
+                "one of them, the carbody's bending frequency or its bending stiffness, not both"
+            )
+        if given and self.L_c is None:
+            raise InputError(
+                f"vehicle parameter {given[0]!r} = {shown(getattr(self, given[0]))} needs 'L_c', the carbody "
+                "length (m), for the carbody's bending mode"
+            )
+        if self.L_c is not None and not self.L_c > 2.0 * (self.l + self.b):
+            raise InputError(
+                f"vehicle parameter 'L_c' = {shown(self.L_c)} (carbody length, m): must exceed 2 (l + b) = "
+                f"{shown(2.0 * (self.l + self.b))} m, the span of the outer wheelsets, which lie under the body"
+            )
+        if self.L_c is not None and not given:
+            import warnings
+
+            from railride.validation import PlausibilityWarning, caller_level
+
+            warnings.warn(rigid_note(self), PlausibilityWarning, stacklevel=caller_level())
+
+    @property
+    def flexible(self) -> bool:
+        """Whether the carbody bends (its first vertical bending mode, a tenth DOF): f_bend or
+        EI_c given."""
+        return self.f_bend is not None or self.EI_c is not None
+
+    @property
+    def bending_hz(self) -> float | None:
+        """The first vertical bending frequency [Hz] of the free carbody at this mass: f_bend,
+        or the free-free beam's from EI_c, m_c and L_c (`railride.model.beam`); None when rigid."""
+        if self.f_bend is not None:
+            return self.f_bend
+        if self.EI_c is not None:
+            from railride.model.beam import bending_frequency
+
+            return bending_frequency(self.EI_c, self.m_c, self.L_c)
+        return None
 
     # -- presets --------------------------------------------------------------------------
     @classmethod
@@ -142,12 +200,16 @@ class VehicleParams:
         (the load factor, a finite number > 0: 1 the carbody as these parameters give it, 1.3 a
         crush-laden car with 30 % more mass). The payload is taken as spread like the carbody's
         own mass, so its radii of gyration stay; the bogies, wheelsets and suspensions stay as
-        they are, and a controller keeps the gains it was given."""
+        they are, and a controller keeps the gains it was given. A bending carbody keeps its
+        bending stiffness: f_bend falls by 1/sqrt(load) (EI_c stays)."""
         from railride.validation import number
 
         factor = number("load", load, "positive", allowed="a finite number > 0 (the factor on the carbody mass)")
         carbody = ("m_c", "I_cx", "I_cy", "I_cz")
-        return self.replace(**{n: factor * getattr(self, n) for n in carbody})
+        changes = {n: factor * getattr(self, n) for n in carbody}
+        if self.f_bend is not None:  # the same EI: the bending frequency falls as 1/sqrt(mass)
+            changes["f_bend"] = self.f_bend / factor**0.5
+        return self.replace(**changes)
 
     def load_changes(self, load: float, stiffness: float = 1.0) -> tuple:
         """The (field, value) changes of a payload (`loaded`) and of a secondary stiffness

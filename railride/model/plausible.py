@@ -18,7 +18,7 @@ tuning study moves by factors of 30, so that a warning per candidate would say n
 
 from __future__ import annotations
 
-from railride.validation import PlausibilityWarning as PlausibilityWarning, Range, atypical
+from railride.validation import PlausibilityWarning as PlausibilityWarning, Range, atypical, shown
 
 # -- the vehicle ---------------------------------------------------------------------------------
 _MASS = "a body of less than a gram or more than a billion tonnes carries no suspension"
@@ -51,6 +51,21 @@ VEHICLE: dict[str, Range] = {
     "k_ar": Range(0.0, 1e11, _STIFF, (0.0, 1e7)),
     "z_stop": Range(1e-4, 10.0, "from 0.1 mm to 10 m: the secondary of a rail vehicle travels tens of mm", (0.01, 0.2)),
     "k_stop": Range(0.0, 1e11, _STIFF, (0.0, 5e7)),
+    # the carbody's bending mode: passenger cars are 10 to 30 m long and bend first at 7-15 Hz
+    # (Zhou et al., Proc. IMechE F 223, 2009: 8-12 Hz typical); EI of a few 1e9 N m^2
+    "L_c": Range(1e-3, 100.0, _LONG, (8.0, 35.0)),
+    "f_bend": Range(
+        1e-2, 1e3, "from 0.01 Hz, no carbody at all, to 1 kHz, a carbody as rigid as its bogies' wheelsets", (5.0, 25.0)
+    ),
+    "EI_c": Range(
+        1e-3,
+        1e14,
+        "from a plastic strip's bending stiffness to 10,000 times a carbody's (about 1e9 to 1e10 N m^2)",
+        (1e8, 1e11),
+    ),
+    "zeta_bend": Range(
+        0.0, 1.0, "1 is critical damping: a carbody's structure damps its bending by 1-5 %", (0.005, 0.1)
+    ),
 }
 
 # -- controllers and sensors ---------------------------------------------------------------------
@@ -92,5 +107,18 @@ DAMPER_SCALE = Range(0.01, 100.0, "a hundredth to a hundred times the railway da
 
 
 def notes(params, what: str = "vehicle parameter") -> list[str]:
-    """The warnings of vehicle parameters ``params``: one line per field outside its typical range."""
-    return atypical(params, VEHICLE, what)
+    """The warnings of vehicle parameters ``params``: one line per field outside its typical
+    range, and the `rigid_note` of a carbody length without a bending frequency."""
+    rigid = rigid_note(params)
+    return atypical(params, VEHICLE, what) + ([rigid] if rigid else [])
+
+
+def rigid_note(params) -> str | None:
+    """The note of vehicle parameters given a carbody length ``L_c`` but no bending frequency
+    (neither ``f_bend`` nor ``EI_c``): the carbody runs rigid; None for any other."""
+    if getattr(params, "L_c", None) is None or params.f_bend is not None or params.EI_c is not None:
+        return None
+    return (
+        f"vehicle parameter 'L_c' = {shown(params.L_c)} m (carbody length) is given without 'f_bend' or 'EI_c': "
+        "the carbody runs rigid; give one of them for its bending mode"
+    )

@@ -1,4 +1,6 @@
-"""The 9-DOF vehicle assembled from the element table of docs/model.md, Equations.
+"""The vehicle assembled from the element table of docs/model.md, Equations: nine rigid DOFs,
+and a tenth, the carbody's first vertical bending mode, where its parameters give one
+(docs/model.md, Flexible carbody).
 
 Every suspension element is a spring k and a damper c on a deflection that is linear in the
 DOFs q and the rail inputs w: delta = a.q + e.w.  The equations of motion
@@ -11,7 +13,8 @@ all come from `Vehicle`.
 
 Orderings used everywhere:
 
-* DOFs q: carbody bounce, pitch, roll; front bogie bounce, pitch, roll; rear bogie (same).
+* DOFs q: carbody bounce, pitch, roll; front bogie bounce, pitch, roll; rear bogie (same);
+  then, for a flexible carbody, its bending eta (the centre's deflection, m).
 * rail inputs w: z_1L, z_1R, z_2L, z_2R, z_3L, z_3R, z_4L, z_4R (wheelset 1 leads).
 * secondary corners (forces f): 1R, 1L, 2R, 2L (bogie 1 is the front one, R is y = -d_s).
 """
@@ -28,8 +31,13 @@ import xarray as xr
 
 from railride.errors import InputError
 from railride import validation
-from railride.engine.layout import N_DOF, N_RAIL
+from railride.engine.layout import N_RAIL, N_RIGID
+from railride.model import beam
 from railride.model.params import PRESET_SOURCES, PRESETS, VehicleParams
+
+#: the rigid vehicle's DOFs (`Vehicle.n_dof` is 10 for a bending carbody; the engine pads a rigid
+#: vehicle's matrices to its own size)
+N_DOF = N_RIGID
 
 DOF_NAMES = (
     "carbody_bounce",
@@ -43,6 +51,9 @@ DOF_NAMES = (
     "rear_bogie_roll",
 )
 DOF_UNITS = ("m", "rad", "rad") * 3
+#: the tenth DOF of a flexible carbody: its first vertical bending mode, the centre's deflection
+BENDING_NAME = "carbody_bending"
+BENDING_UNIT = "m"
 CORNER_NAMES = ("1R", "1L", "2R", "2L")
 WHEELSETS = (1, 2, 3, 4)
 RAILS = ("L", "R")
@@ -60,7 +71,7 @@ class Element:
     group: str
     k: float
     c: float
-    a: np.ndarray  # (9,) coefficients on the DOFs
+    a: np.ndarray  # (n_dof,) coefficients on the DOFs (9, or 10 with the carbody's bending)
     e: np.ndarray  # (8,) coefficients on the rail inputs
 
 
@@ -68,11 +79,22 @@ def _rail_index(wheelset: int, rail: str) -> int:
     return 2 * (wheelset - 1) + (0 if rail == "L" else 1)
 
 
-def _point(body: str, x: float, y: float) -> np.ndarray:
-    """a-vector of the vertical motion of point (x, y) of a body: z - x*phi + y*theta."""
-    a = np.zeros(N_DOF)
+def _point(body: str, x: float, y: float, n: int = N_DOF) -> np.ndarray:
+    """a-vector (of ``n`` DOFs) of the vertical motion of point (x, y) of a body as a rigid
+    body: z - x*phi + y*theta."""
+    a = np.zeros(n)
     i = _BODY_OFFSET[body]
     a[i], a[i + 1], a[i + 2] = 1.0, -x, y
+    return a
+
+
+def _carbody_point(p: VehicleParams, x: float, y: float) -> np.ndarray:
+    """a-vector of the vertical motion of the carbody's point (x, y): z_c - x phi_c + y theta_c,
+    plus phi(x) eta where the carbody bends (`railride.model.beam.mode_shape`)."""
+    if not p.flexible:
+        return _point("carbody", x, y)
+    a = _point("carbody", x, y, N_DOF + 1)
+    a[N_DOF] = beam.mode_shape(x, p.L_c)
     return a
 
 
@@ -93,9 +115,12 @@ def _wheelset_roll(wheelset: int, half_gauge: float) -> np.ndarray:
 
 
 def element_table(p: VehicleParams) -> list[Element]:
-    """The element list of docs/model.md, Equations, in code: 36 elements, and an anti-roll bar
-    per bogie (group "anti_roll_bar") where k_ar > 0. Nothing downstream counts them: the
-    matrices are sums over the list and the secondary force map picks its group by name."""
+    """The element list of docs/model.md, Equations, in code: 36 elements, an anti-roll bar
+    per bogie (group "anti_roll_bar") where k_ar > 0, and the carbody's bending (group
+    "carbody_bending", its modal stiffness and damping on the tenth DOF) where it bends. Nothing
+    downstream counts them: the matrices are sums over the list and the secondary force map
+    picks its group by name."""
+    n = N_DOF + 1 if p.flexible else N_DOF
     elements: list[Element] = []
     zero_e = np.zeros(N_RAIL_INPUT)
     bogies = (("front_bogie", +p.l, (1, 2)), ("rear_bogie", -p.l, (3, 4)))
@@ -103,16 +128,16 @@ def element_table(p: VehicleParams) -> list[Element]:
         o = _BODY_OFFSET[bogie]
         # secondary vertical, one per corner; R before L to match the force order
         for side, y in (("R", -p.d_s), ("L", +p.d_s)):
-            a = _point("carbody", x_b, y) - _point(bogie, 0.0, y)
+            a = _carbody_point(p, x_b, y) - _point(bogie, 0.0, y, n)
             elements.append(Element(f"secondary vertical {bi}{side}", "secondary_vertical", p.k_sz, p.c_sz, a, zero_e))
         # secondary lateral and longitudinal act through roll and pitch only; one of each on
         # each side of the bogie (the paper's eq. 2, 3, 5, 6 carry 2 k_sy, 2 k_sx per bogie and
         # the appendix gives the values per side)
         for side in ("R", "L"):
-            a = np.zeros(N_DOF)
+            a = np.zeros(n)
             a[2], a[o + 2] = p.h_cs, p.h_ts
             elements.append(Element(f"secondary lateral {bi}{side}", "secondary_lateral", p.k_sy, p.c_sy, a, zero_e))
-            a = np.zeros(N_DOF)
+            a = np.zeros(n)
             a[1], a[o + 1] = p.h_cs, p.h_ts
             elements.append(
                 Element(f"secondary longitudinal {bi}{side}", "secondary_longitudinal", p.k_sx, p.c_sx, a, zero_e)
@@ -122,24 +147,35 @@ def element_table(p: VehicleParams) -> list[Element]:
         # k_ar = 0, so that a vehicle without one keeps its 36 elements and its matrices bit
         # for bit.
         if p.k_ar > 0.0:
-            a = np.zeros(N_DOF)
+            a = np.zeros(n)
             a[2], a[o + 2] = 1.0, -1.0
             elements.append(Element(f"anti-roll bar {bi}", "anti_roll_bar", p.k_ar, 0.0, a, zero_e))
         for wheelset, x_axle in zip(wheelsets, (+p.b, -p.b)):
             for side, y in (("R", -p.d_p), ("L", +p.d_p)):
                 box = f"{wheelset}{side}"
-                a = _point(bogie, x_axle, y)
+                a = _point(bogie, x_axle, y, n)
                 e = -_wheelset_point(wheelset, y, p.a)
                 elements.append(Element(f"primary vertical {box}", "primary_vertical", p.k_pz, p.c_pz, a, e))
-                a = np.zeros(N_DOF)
+                a = np.zeros(n)
                 a[o + 1] = p.h_tp
                 elements.append(
                     Element(f"primary longitudinal {box}", "primary_longitudinal", p.k_px, p.c_px, a, zero_e)
                 )
-                a = np.zeros(N_DOF)
+                a = np.zeros(n)
                 a[o + 2] = p.h_tp
                 e = p.h_wp * _wheelset_roll(wheelset, p.a)
                 elements.append(Element(f"primary lateral {box}", "primary_lateral", p.k_py, p.c_py, a, e))
+    if p.flexible:
+        # the carbody's bending: the free beam's modal stiffness and damping on eta, from the
+        # bending frequency of the free carbody and the modal damping ratio
+        m_eta = beam.modal_mass_factor() * p.m_c
+        omega = 2.0 * np.pi * p.bending_hz
+        a = np.zeros(n)
+        a[N_DOF] = 1.0
+        bending = Element(
+            "carbody bending", "carbody_bending", m_eta * omega**2, 2.0 * p.zeta_bend * omega * m_eta, a, zero_e
+        )
+        elements.append(bending)
     return elements
 
 
@@ -161,14 +197,26 @@ class Mode:
 
 
 class Vehicle:
-    """Matrices, modes and frequency responses of the 9-DOF vehicle for one parameter set."""
+    """Matrices, modes and frequency responses of the vehicle for one parameter set: nine rigid
+    DOFs, and the carbody's bending as a tenth where the parameters give it (`n_dof`,
+    `dof_names`). A bending frequency at or below the carbody's rigid modes on its suspension
+    is an InputError naming the field."""
 
     def __init__(self, params: VehicleParams | None = None):
         self.params = params if params is not None else VehicleParams.preset("paper")
         p = self.params
+        #: the number of DOFs: 9 (rigid carbody) or 10 (the carbody's bending last)
+        self.n_dof = N_DOF + 1 if p.flexible else N_DOF
+        #: the DOFs' names in the order of q (`DOF_NAMES`, then `BENDING_NAME` where it bends)
+        self.dof_names = (*DOF_NAMES, BENDING_NAME) if p.flexible else DOF_NAMES
+        #: their units
+        self.dof_units = (*DOF_UNITS, BENDING_UNIT) if p.flexible else DOF_UNITS
         self.elements = element_table(p)
-        self.M = np.diag([p.m_c, p.I_cy, p.I_cx, p.m_b, p.I_by, p.I_bx, p.m_b, p.I_by, p.I_bx])
-        A = np.array([el.a for el in self.elements])  # (n_el, 9)
+        masses = [p.m_c, p.I_cy, p.I_cx, p.m_b, p.I_by, p.I_bx, p.m_b, p.I_by, p.I_bx]
+        if p.flexible:
+            masses.append(beam.modal_mass_factor() * p.m_c)  # m_eta = mu m_c
+        self.M = np.diag(masses)
+        A = np.array([el.a for el in self.elements])  # (n_el, n_dof)
         E = np.array([el.e for el in self.elements])  # (n_el, 8)
         k = np.array([el.k for el in self.elements])
         c = np.array([el.c for el in self.elements])
@@ -184,6 +232,53 @@ class Vehicle:
         #: x of each wheelset relative to the carbody centre; wheelset j lags wheelset 1 by
         #: (x1 - xj) / V
         self.wheelset_x = np.array([p.l + p.b, p.l - p.b, -p.l + p.b, -p.l - p.b])
+        if p.flexible:
+            self._check_bending()
+
+    @property
+    def carbody_dofs(self) -> tuple[int, ...]:
+        """Where the carbody's DOFs sit in q: bounce, pitch, roll, and its bending where it bends."""
+        return (0, 1, 2, N_DOF) if self.params.flexible else (0, 1, 2)
+
+    def floor_point(self, x: float, y: float = 0.0) -> np.ndarray:
+        """The a-vector (n_dof) of the vertical motion of the carbody floor's point (x, y) [m
+        from the centre; front +, left +]: z_c - x phi_c + y theta_c, plus phi(x) eta where the
+        carbody bends (x then within the carbody, |x| <= L_c / 2)."""
+        x = validation.number("x", x, "finite", "m")
+        y = validation.number("y", y, "finite", "m")
+        p = self.params
+        if p.flexible and abs(x) > 0.5 * p.L_c:
+            raise InputError(
+                f"x = {validation.shown(x)} m: the floor point must lie on the carbody, within +-L_c/2 = "
+                f"{validation.shown(0.5 * p.L_c)} m of its centre"
+            )
+        return _carbody_point(p, x, y)
+
+    def rigid_modes(self) -> list[tuple[str, float]]:
+        """(label, undamped frequency [Hz]) of the vehicle's nine rigid-body modes, the carbody
+        taken rigid (the first nine rows and columns of M and K), by frequency."""
+        n = N_DOF
+        w2, shapes = scipy.linalg.eigh(self.K[:n, :n], self.M[:n, :n])
+        mass = np.diag(self.M)[:n]
+        return [
+            (_label(shapes[:, i], mass, DOF_NAMES), float(np.sqrt(max(w2[i], 0.0)) / (2 * np.pi))) for i in range(n)
+        ]
+
+    def _check_bending(self) -> None:
+        """The bending frequency must lie above the carbody's rigid modes on its suspension:
+        below them the flexible mode would be the slowest carbody mode, no bending of a body."""
+        p = self.params
+        carbody = [(label, f) for label, f in self.rigid_modes() if label.startswith("carbody")]
+        label, highest = max(carbody, key=lambda m: m[1])
+        f = p.bending_hz
+        if not f > highest:
+            field, value, unit = ("f_bend", p.f_bend, "Hz") if p.f_bend is not None else ("EI_c", p.EI_c, "N m^2")
+            given = "" if field == "f_bend" else f" (a bending frequency of {validation.shown(f)} Hz)"
+            raise InputError(
+                f"vehicle parameter {field!r} = {validation.shown(value)} {unit}{given}: the carbody's bending "
+                f"must lie above its rigid-body modes on the suspension; the highest, {label}, is at "
+                f"{highest:.4g} Hz"
+            )
 
     @property
     def wheelset_lag_distance(self) -> np.ndarray:
@@ -192,12 +287,14 @@ class Vehicle:
 
     @cached_property
     def state_matrix(self) -> np.ndarray:
-        """A of x' = A x for x = (q, q') with the passive secondary dampers, rails fixed."""
+        """A of x' = A x for x = (q, q') with the passive secondary dampers, rails fixed
+        (2 n_dof square)."""
+        n = self.n_dof
         Minv = 1.0 / np.diag(self.M)
-        A = np.zeros((2 * N_DOF, 2 * N_DOF))
-        A[:N_DOF, N_DOF:] = np.eye(N_DOF)
-        A[N_DOF:, :N_DOF] = -Minv[:, None] * self.K
-        A[N_DOF:, N_DOF:] = -Minv[:, None] * self.C
+        A = np.zeros((2 * n, 2 * n))
+        A[:n, n:] = np.eye(n)
+        A[n:, :n] = -Minv[:, None] * self.K
+        A[n:, n:] = -Minv[:, None] * self.C
         return A
 
     # -- modal analysis ---------------------------------------------------------------------
@@ -208,19 +305,21 @@ class Vehicle:
         state matrix: damped frequency |Im lambda|, damping ratio -Re lambda / |lambda| (an
         overdamped pair of real roots gives one mode with ratio >= 1). Damped and undamped
         modes are paired by the modal assurance criterion of their displacement shapes.
-        Labels name the DOF group holding most of the mode's kinetic energy.
+        Labels name the DOF group holding most of the mode's kinetic energy ("carbody bending"
+        for the flexible carbody's bending mode).
         """
+        n = self.n_dof
         w2, shapes = scipy.linalg.eigh(self.K, self.M)
         lam, vecs = np.linalg.eig(self.state_matrix)
-        damped = _damped_modes(lam, vecs[:N_DOF])
-        mac = np.array([[_mac(shapes[:, i], d[3]) for d in damped] for i in range(N_DOF)])
-        _, match = scipy.optimize.linear_sum_assignment(-mac)  # rows come back as 0..8
+        damped = _damped_modes(lam, vecs[:n])
+        mac = np.array([[_mac(shapes[:, i], d[3]) for d in damped] for i in range(n)])
+        _, match = scipy.optimize.linear_sum_assignment(-mac)  # rows come back as 0..n-1
         out = []
-        for i in range(N_DOF):  # eigh sorts by frequency
+        for i in range(n):  # eigh sorts by frequency
             _, omega_d, zeta, _ = damped[match[i]]
             out.append(
                 Mode(
-                    _label(shapes[:, i], np.diag(self.M)),
+                    _label(shapes[:, i], np.diag(self.M), self.dof_names),
                     float(np.sqrt(max(w2[i], 0.0)) / (2 * np.pi)),
                     float(omega_d / (2 * np.pi)),
                     float(zeta),
@@ -236,8 +335,11 @@ class Vehicle:
         ``rails`` sets the rail pattern: "in-phase" (z_L = z_R), "anti-phase" (z_L = -z_R), or
         a pair of complex weights (c_L, c_R). Every wheelset sees the same pattern delayed by
         its lag distance / speed. The result holds the DOF responses (per metre of rail
-        amplitude), carbody CG acceleration, corner displacements and the rail cross-level angle
-        (z_L - z_R)/(2a) of the pattern, all over the ``frequency`` coordinate in Hz.
+        amplitude; ``carbody_bending`` too where the carbody bends), carbody CG acceleration
+        (rigid: z_c''), the floor accelerations at the centre and over the bogie centres
+        (``floor_acceleration`` over ``position``: `floor_point`, with the bending), corner
+        displacements and the rail cross-level angle (z_L - z_R)/(2a) of the pattern, all over
+        the ``frequency`` coordinate in Hz.
         """
         f = np.atleast_1d(np.asarray(frequency_hz, dtype=float))
         if not np.all(np.isfinite(f)) or np.any(f < 0):
@@ -252,19 +354,34 @@ class Vehicle:
             cL, cR = rails
         omega = 2 * np.pi * f
         lag = self.wheelset_lag_distance / speed
-        H = np.empty((f.size, N_DOF), dtype=complex)
+        H = np.empty((f.size, self.n_dof), dtype=complex)
         for n, w in enumerate(omega):
             delay = np.exp(-1j * w * lag)  # (4,)
             W = np.empty(N_RAIL_INPUT, dtype=complex)
             W[0::2], W[1::2] = cL * delay, cR * delay
             Z = -(w**2) * self.M + 1j * w * self.C + self.K
             H[n] = np.linalg.solve(Z, -(self.K_w + 1j * w * self.C_w) @ W)
-        ds = xr.Dataset(coords={"frequency": ("frequency", f, {"units": "Hz"}), "corner": list(CORNER_NAMES)})
-        for i, name in enumerate(DOF_NAMES):
-            ds[name] = ("frequency", H[:, i], {"units": f"{DOF_UNITS[i]}/m"})
+        positions = {"centre": 0.0, "front": self.params.l, "rear": -self.params.l}
+        ds = xr.Dataset(
+            coords={
+                "frequency": ("frequency", f, {"units": "Hz"}),
+                "corner": list(CORNER_NAMES),
+                "position": list(positions),
+            }
+        )
+        for i, name in enumerate(self.dof_names):
+            ds[name] = ("frequency", H[:, i], {"units": f"{self.dof_units[i]}/m"})
         ds["carbody_acceleration"] = ("frequency", -(omega**2) * H[:, 0], {"units": "(m/s^2)/m"})
+        floor = np.array([self.floor_point(x) for x in positions.values()]).T  # (n_dof, 3)
+        ds["floor_acceleration"] = (
+            ("frequency", "position"),
+            -(omega**2)[:, None] * (H @ floor),
+            {"units": "(m/s^2)/m"},
+        )
+        ds = ds.assign_coords(x_m=("position", list(positions.values()), {"units": "m"}))
         corner = H @ self.T  # T^T q: the secondary deflection at each corner
-        corner_body = H[:, :3] @ self.T[:3]  # the carbody part alone: corner displacement
+        body = list(self.carbody_dofs)
+        corner_body = H[:, body] @ self.T[body]  # the carbody part alone: corner displacement
         ds["carbody_corner_displacement"] = (("frequency", "corner"), corner_body, {"units": "m/m"})
         ds["secondary_deflection"] = (("frequency", "corner"), corner, {"units": "m/m"})
         ds.attrs.update(
@@ -282,9 +399,10 @@ SCHEMA_VEHICLES = "railride.vehicles/1"
 
 def presets_document(names=None) -> dict:
     """The named vehicles (`railride.model.params.PRESETS`; ``names``: some of them, in this
-    order; default all) with where their values come from (`PRESET_SOURCES`) and their nine
-    rigid-body modes (`Vehicle.modes`, by undamped frequency): ``railride vehicles --format
-    json``. An unknown name is an InputError that lists the presets."""
+    order; default all) with where their values come from (`PRESET_SOURCES`) and their modes
+    (`Vehicle.modes`, by undamped frequency: nine rigid-body modes, and the carbody's bending
+    where it bends): ``railride vehicles --format json``. An unknown name is an InputError that
+    lists the presets."""
     from railride._version import __version__
 
     names = list(PRESETS) if names is None else list(names)
@@ -322,11 +440,12 @@ def _damped_modes(lam: np.ndarray, shapes: np.ndarray) -> list[tuple[float, floa
     return out
 
 
-def _label(shape: np.ndarray, mass: np.ndarray) -> str:
-    """Name a mode after the DOF group with the largest share of kinetic energy."""
+def _label(shape: np.ndarray, mass: np.ndarray, names=DOF_NAMES) -> str:
+    """Name a mode after the DOF (of ``names``, in the order of q) with the largest share of
+    kinetic energy: "carbody bending" for the flexible carbody's."""
     energy = mass * np.abs(shape) ** 2
     i = int(np.argmax(energy))
-    body, motion = DOF_NAMES[i].rsplit("_", 1)
+    body, motion = names[i].rsplit("_", 1)
     if body == "carbody":
         return f"carbody {motion}"
     other = i + 3 if i < 6 else i - 3
