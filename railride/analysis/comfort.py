@@ -413,6 +413,50 @@ def _half_lengths(ds: xr.Dataset) -> np.ndarray:
     return np.array([float(json.loads(str(r))["l"]) for r in records])
 
 
+def _carbody_lengths(ds: xr.Dataset) -> np.ndarray:
+    """L_c [m] of every run (one per sample in a batch) from the ``vehicle_params`` record; NaN
+    where a run's carbody is rigid (no bending frequency) or the record is missing."""
+    if "vehicle_params" not in ds:
+        raise InputError(
+            "the Dataset has a carbody_bending_acceleration channel but no vehicle_params record: the "
+            "carbody length L_c that places the floor points on the bending mode is unknown"
+        )
+    out = []
+    for r in np.atleast_1d(ds["vehicle_params"].values):
+        record = json.loads(str(r))
+        flexible = record.get("f_bend") is not None or record.get("EI_c") is not None
+        length = record.get("L_c")
+        out.append(float(length) if flexible and length is not None else math.nan)
+    return np.array(out)
+
+
+def _bending(ds: xr.Dataset, lead: list, x: np.ndarray) -> np.ndarray | None:
+    """phi(x / L_c) eta'' (samples, positions, time) of the carbody's bending at the floor points
+    x (samples, positions) [m], from the ``carbody_bending_acceleration`` channel; None where the
+    Dataset has none or it is 0 throughout (rigid carbodies). A rigid run's share is 0; a point
+    beyond a bending carbody's ends is an InputError."""
+    if "carbody_bending_acceleration" not in ds:
+        return None
+    from railride.model.beam import mode_shape
+
+    bend = np.atleast_2d(ds["carbody_bending_acceleration"].transpose(*lead, "time").values)
+    if not np.any(bend):  # rigid carbodies (the engine holds their bending at 0)
+        return None
+    lengths = np.broadcast_to(_carbody_lengths(ds), (x.shape[0],))
+    phi = np.zeros_like(x)
+    for s, length in enumerate(lengths):
+        if math.isnan(length):
+            continue
+        beyond = np.abs(x[s]) > 0.5 * length * (1.0 + 1e-12)
+        if np.any(beyond):
+            raise InputError(
+                f"position x = {validation.shown(float(x[s][beyond][0]))} m: beyond the bending carbody's ends, "
+                f"+-L_c/2 = {validation.shown(0.5 * length)} m"
+            )
+        phi[s] = mode_shape(x[s], length)
+    return phi[:, :, None] * bend[:, None, :]
+
+
 def _positions(ds: xr.Dataset, positions, n_sample: int) -> tuple[list[str], np.ndarray]:
     """Position names and x [m] per (sample, position)."""
     if isinstance(positions, str):
@@ -449,10 +493,14 @@ def _positions(ds: xr.Dataset, positions, n_sample: int) -> tuple[list[str], np.
 
 
 def floor_acceleration(ds: xr.Dataset, positions=POSITION_KEYWORDS) -> xr.DataArray:
-    """Vertical acceleration [m/s^2] of carbody floor points at (x, 0): a = z'' - x phi'',
-    dims ([sample,] position, time). ``positions``: keywords centre (x = 0), front (x = +l),
-    rear (x = -l), or {name: x in m}. phi'' is the ``carbody_pitch_acceleration`` channel if the
-    Dataset has one, else the central difference of ``carbody_pitch_velocity``."""
+    """Vertical acceleration [m/s^2] of carbody floor points at (x, 0): a = z'' - x phi'', plus
+    phi_b(x / L_c) eta'' where the carbody bends, dims ([sample,] position, time).
+    ``positions``: keywords centre (x = 0), front (x = +l), rear (x = -l), or {name: x in m}.
+    phi'' is the ``carbody_pitch_acceleration`` channel if the Dataset has one, else the central
+    difference of ``carbody_pitch_velocity``. eta'' is the ``carbody_bending_acceleration``
+    channel where the Dataset has one, phi_b the carbody's first bending mode
+    (`railride.model.beam.mode_shape`, 1 at the centre) on the length L_c of the run's vehicle
+    record (a rigid run: no bending)."""
     out, _ = _floor(ds, positions)
     return out
 
@@ -471,6 +519,9 @@ def _floor(ds, positions):
         source = "central difference of carbody_pitch_velocity"
     names, x = _positions(ds, positions, acc.shape[0])
     floor = acc[:, None, :] - x[:, :, None] * pitch[:, None, :]
+    bending = _bending(ds, lead, x)
+    if bending is not None:
+        floor = floor + bending
     coords = {"position": names, "time": ds["time"].values}
     x_coord = (lead + ["position"], x if lead else x[0])
     if lead:
@@ -488,6 +539,8 @@ def _floor(ds, positions):
             "long_name": "carbody floor vertical acceleration at (x, 0)",
         },
     )
+    if bending is not None:
+        da.attrs["bending_acceleration"] = "carbody_bending_acceleration channel times the bending mode"
     da = da.assign_coords(x_m=x_coord)
     return da, rate
 

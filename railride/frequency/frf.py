@@ -7,7 +7,8 @@ delayed by its distance behind the leading one divided by the speed
 (`railride.model.vehicle.Vehicle.frequency_response`). It returns an `FrfResult`: the responses, their
 table and peaks (`railride.analysis.spectra.frf_frame`, `frf_peaks`) and the `Modes` of the vehicle.
 
-`modes` gives the `Modes` alone: the nine modes of `Vehicle.modes`, by undamped frequency.
+`modes` gives the `Modes` alone: the modes of `Vehicle.modes` (nine, ten where the carbody
+bends), by undamped frequency.
 
 The vehicle is named as the command line names it: a preset name, a parameters file (TOML, see
 `VehicleParams.load`) or the `VehicleParams` themselves; the documents record which.
@@ -184,17 +185,18 @@ def frequency_responses(
         raise InputError(f"fmax = {fmax:g} Hz: must be above fmin = {fmin:g} Hz")
     points = validation.integer("points", points, 2)
     patterns = list(FRF_PATTERNS) if rails == "both" else [rails]
-    # per point and pattern: the 9 DOF responses, the carbody acceleration and 8 corner values
-    # (complex), and as much again while the Dataset and its table are built
-    limits.check(
-        8.0 * points * (1 + len(patterns) * 2 * 18 * 2),
-        f"the frequency responses on {points} points",
-        "use fewer points (400 resolve every mode of the vehicle)",
-    )
     base, source = resolve_argument(vehicle, params)
     record = vehicle_record(base, source, load)
     vehicle_params = base if record["load"] == 1.0 else base.loaded(record["load"])
     car = Vehicle(vehicle_params)
+    # per point and pattern: the DOF responses (9, 10 where the carbody bends), the carbody
+    # acceleration, 3 floor points and 8 corner values (complex), and as much again while the
+    # Dataset and its table are built
+    limits.check(
+        8.0 * points * (1 + len(patterns) * 2 * (car.n_dof + 12) * 2),
+        f"the frequency responses on {points} points",
+        "use fewer points (400 resolve every mode of the vehicle)",
+    )
     frequency = np.geomspace(fmin, fmax, points)
     frequency[0], frequency[-1] = fmin, fmax  # exactly, without rounding
     responses = {p: car.frequency_response(frequency, speed, p) for p in patterns}

@@ -13,12 +13,15 @@ Three secondaries are linear and have one here:
   rails only. The engine samples and holds the demand at the control rate; this model is its
   continuous-time limit.
 
-States: q (the nine DOFs) and q', in `railride.model.vehicle.DOF_NAMES` order, then xi for a closed
-loop. Rail inputs: the heights z_1L ... z_4R [m] and their time derivatives [m/s] (the
-equations hold both: M q'' + C q' + K q = -(K_w w + C_w w') + T f). Outputs: the DOFs, the
-carbody accelerations, the floor accelerations at the front and rear bogie centres and the
-carbody centre (a = z'' - x pitch'', as `railride.analysis.comfort.floor_acceleration`), the secondary
-deflections and the secondary forces on the carbody, per corner.
+States: q (the vehicle's DOFs: nine, ten where the carbody bends) and q', in the order and
+with the names of `Vehicle.dof_names` (`railride.model.vehicle.DOF_NAMES`, then
+``carbody_bending``), then xi for a closed loop. Rail inputs: the heights z_1L ... z_4R [m]
+and their time derivatives [m/s] (the equations hold both: M q'' + C q' + K q = -(K_w w +
+C_w w') + T f). Outputs: the DOFs, the carbody accelerations (and its bending's, where it
+bends), the floor accelerations at the front and rear bogie centres and the carbody centre
+(a = z'' - x pitch'' + phi(x) eta'', `Vehicle.floor_point`, as
+`railride.analysis.comfort.floor_acceleration`), the secondary deflections and the secondary
+forces on the carbody, per corner.
 
 `LinearModel.to_control()` gives a python-control ``StateSpace`` with these names (when that
 package is installed) and `LinearModel.to_mat()` a MATLAB file.
@@ -32,7 +35,7 @@ import numpy as np
 
 from railride.errors import InputError
 from railride.model.params import VehicleParams, resolve_vehicle, vehicle_record
-from railride.model.vehicle import CORNER_NAMES, DOF_NAMES, DOF_UNITS, N_DOF, RAILS, WHEELSETS, Vehicle
+from railride.model.vehicle import CORNER_NAMES, DOF_NAMES, N_DOF, RAILS, WHEELSETS, Vehicle
 
 SCHEMA = "railride.linear/1"
 #: the secondaries `linear_model` takes by name
@@ -208,12 +211,25 @@ def _check_secondary(suspension, vehicle: Vehicle):
 
 
 def _outer_gains(controller, vehicle: Vehicle) -> tuple[np.ndarray, np.ndarray]:
-    """The loop's demand f_d = G_full (q, q') + H xi with G over the whole state (4 x 18)."""
-    from railride.secondary.controllers import _full_state
-
+    """The loop's demand f_d = G_full (q, q') + H xi with G over the vehicle's whole state (4 x
+    2 n_dof): a gain on the carbody's six rigid states (4 x 6) or on the rigid vehicle's (4 x
+    18) reads nothing of the carbody's bending."""
     G, H = controller.gains(vehicle)
     G = np.asarray(G, dtype=float)
-    return (_full_state(G) if G.shape[1] == 6 else G), np.asarray(H, dtype=float)
+    n = vehicle.n_dof
+    full = np.zeros((4, 2 * n))
+    if G.shape == (4, 6):
+        full[:, :3], full[:, n : n + 3] = G[:, :3], G[:, 3:]
+    elif G.shape == (4, 2 * N_DOF):
+        full[:, :N_DOF], full[:, n : n + N_DOF] = G[:, :N_DOF], G[:, N_DOF:]
+    elif G.shape == (4, 2 * n):
+        full = G
+    else:
+        raise InputError(
+            f"controller {controller.name!r}: its gain has shape {G.shape}; allowed (4, 6) on the carbody "
+            f"states, (4, {2 * N_DOF}) on the rigid vehicle's (q, q') or (4, {2 * n}) on this vehicle's"
+        )
+    return full, np.asarray(H, dtype=float)
 
 
 def linear_model(params=None, suspension=None, *, vehicle=None, load: float = 1.0) -> LinearModel:
@@ -226,24 +242,26 @@ def linear_model(params=None, suspension=None, *, vehicle=None, load: float = 1.
     vehicle = Vehicle(vehicle_params)
     secondary, c_dashpot, controller = _check_secondary(suspension, vehicle)
     Cd = vehicle.C0 + c_dashpot * vehicle.T @ vehicle.T.T
-    n = 2 * N_DOF
+    nd = vehicle.n_dof  # 9, or 10 where the carbody bends
+    names, dof_units = vehicle.dof_names, vehicle.dof_units
+    n = 2 * nd
     Minv = 1.0 / np.diag(vehicle.M)
     # x' = A x + B u with x = (q, q'), u = (w, w', f)
     A = np.zeros((n, n))
-    A[:N_DOF, N_DOF:] = np.eye(N_DOF)
-    A[N_DOF:, :N_DOF] = -Minv[:, None] * vehicle.K
-    A[N_DOF:, N_DOF:] = -Minv[:, None] * Cd
+    A[:nd, nd:] = np.eye(nd)
+    A[nd:, :nd] = -Minv[:, None] * vehicle.K
+    A[nd:, nd:] = -Minv[:, None] * Cd
     B = np.zeros((n, 20))
-    B[N_DOF:, 0:8] = -Minv[:, None] * vehicle.K_w
-    B[N_DOF:, 8:16] = -Minv[:, None] * vehicle.C_w
-    B[N_DOF:, 16:20] = Minv[:, None] * vehicle.T
+    B[nd:, 0:8] = -Minv[:, None] * vehicle.K_w
+    B[nd:, 8:16] = -Minv[:, None] * vehicle.C_w
+    B[nd:, 16:20] = Minv[:, None] * vehicle.T
     # the corner force on the carbody: the dashpot's -c x' (x = T^T q) plus the input f
-    force_x = np.hstack([np.zeros((4, N_DOF)), -c_dashpot * vehicle.T.T])
+    force_x = np.hstack([np.zeros((4, nd)), -c_dashpot * vehicle.T.T])
     force_u = np.hstack([np.zeros((4, 16)), np.eye(4)])
-    states = [*DOF_NAMES, *(f"{d}_rate" for d in DOF_NAMES)]
+    states = [*names, *(f"{d}_rate" for d in names)]
     inputs = [*RAIL_HEIGHTS, *RAIL_RATES, *CORNER_FORCES]
-    units = {d: u for d, u in zip(DOF_NAMES, DOF_UNITS)}
-    units |= {f"{d}_rate": f"{u}/s" for d, u in zip(DOF_NAMES, DOF_UNITS)}
+    units = {d: u for d, u in zip(names, dof_units)}
+    units |= {f"{d}_rate": f"{u}/s" for d, u in zip(names, dof_units)}
     units |= {k: "m" for k in RAIL_HEIGHTS} | {k: "m/s" for k in RAIL_RATES} | {k: "N" for k in CORNER_FORCES}
     if controller is not None:  # close the loop: f = G_full x + H xi, xi' = carbody displacements
         G, H = _outer_gains(controller, vehicle)
@@ -254,13 +272,13 @@ def linear_model(params=None, suspension=None, *, vehicle=None, load: float = 1.
         B = np.vstack([B[:, :16], np.zeros((k, 16))])
         force_x = np.hstack([G, H[:, :k]])
         force_u = np.zeros((4, 16))
-        integrals = [f"{d}_integral" for d in DOF_NAMES[:k]]
+        integrals = [f"{d}_integral" for d in names[:k]]
         states += integrals
         units |= {k: f"{units[d]} s" for k, d in zip(integrals, DOF_NAMES[:3])}
         inputs = inputs[:16]
     nx, nu = A.shape[0], B.shape[1]
     pad = nx - n  # the integrals' columns
-    accel_x, accel_u = A[N_DOF:n], B[N_DOF:n]  # q'' rows
+    accel_x, accel_u = A[nd:n], B[nd:n]  # q'' rows
     rows_x, rows_u, outputs = [], [], []
 
     def add(name, unit, cx, du):
@@ -269,18 +287,22 @@ def linear_model(params=None, suspension=None, *, vehicle=None, load: float = 1.
         rows_x.append(cx)
         rows_u.append(du)
 
-    for i, d in enumerate(DOF_NAMES):
-        add(d, DOF_UNITS[i], np.eye(nx)[i], np.zeros(nu))
-    for i, d in enumerate(DOF_NAMES[:3]):
-        add(f"{d}_acceleration", f"{DOF_UNITS[i]}/s^2", accel_x[i], accel_u[i])
+    for i, d in enumerate(names):
+        add(d, dof_units[i], np.eye(nx)[i], np.zeros(nu))
+    for i in vehicle.carbody_dofs:
+        add(f"{names[i]}_acceleration", f"{dof_units[i]}/s^2", accel_x[i], accel_u[i])
     for point, share in FLOOR_POINTS.items():
         x = share * vehicle_params.l
-        add(f"floor_acceleration_{point}", "m/s^2", accel_x[0] - x * accel_x[1], accel_u[0] - x * accel_u[1])
+        cx, du = accel_x[0] - x * accel_x[1], accel_u[0] - x * accel_u[1]
+        if vehicle.n_dof > N_DOF:  # plus phi(x) eta'' (`Vehicle.floor_point`)
+            phi = vehicle.floor_point(x)[N_DOF]
+            cx, du = cx + phi * accel_x[N_DOF], du + phi * accel_u[N_DOF]
+        add(f"floor_acceleration_{point}", "m/s^2", cx, du)
     for c, corner in enumerate(CORNER_NAMES):
         add(
             f"secondary_deflection_{corner}",
             "m",
-            np.concatenate([vehicle.T[:, c], np.zeros(N_DOF + pad)]),
+            np.concatenate([vehicle.T[:, c], np.zeros(nd + pad)]),
             np.zeros(nu),
         )
     for c, corner in enumerate(CORNER_NAMES):

@@ -35,7 +35,7 @@ from railride.analysis.comfort import FLOOR
 from railride.frequency.linear import LinearModel, linear_model, linear_suspensions
 from railride.model.params import VehicleParams, resolve_vehicle
 from railride.model.track import SPECTRA, spectrum
-from railride.model.vehicle import CORNER_NAMES, N_DOF, Vehicle
+from railride.model.vehicle import CORNER_NAMES, Vehicle
 
 SCHEMA = "railride.ride-spectrum/1"
 #: the responses whose PSDs are computed: the floor points and the carbody
@@ -234,13 +234,14 @@ def ride_spectrum(
     if control_rate is not None:
         control_rate = validation.number("control_rate", control_rate, "positive", "Hz")
     delay = validation.integer("delay", delay, 0, 64, "controller periods")
-    # the peak is the closed loop's (points, 18, 18) complex system, about three copies of it
-    n_state = 2 * N_DOF
+    vehicle_params, record = resolve_vehicle(vehicle, params, load)
+    vehicle = Vehicle(vehicle_params)
+    # the peak is the closed loop's (points, 18, 18) complex system (20 x 20 where the carbody
+    # bends), about three copies of it
+    n_state = 2 * vehicle.n_dof
     runs = len(controllers) if isinstance(controllers, (list, tuple)) else 1
     per_point = 8.0 * (3 * 2 * n_state * n_state + 2 * 2 * 16 + len(RESPONSES) * runs)
     limits.check(points * per_point, f"the ride spectrum on {points} frequencies", "use fewer points")
-    vehicle_params, record = resolve_vehicle(vehicle, params, load)
-    vehicle = Vehicle(vehicle_params)
     frequency = np.geomspace(speed / hi, speed / lo, points)
     inputs = rail_patterns(vehicle, frequency, speed)
     S = track_psd(track, frequency, speed, (lo, hi))
@@ -336,7 +337,7 @@ def _sampled_loop(model: LinearModel, plant: LinearModel, period: float, delay: 
     n = model.A.shape[0]
     F = model.corner_forces()
     Bf = np.zeros((n, 4))
-    Bf[: 2 * N_DOF] = plant.B[:, 16:20]  # the corner forces' inputs
+    Bf[: plant.A.shape[0]] = plant.B[:, 16:20]  # the corner forces' inputs
     A0 = model.A - Bf @ F  # the open loop (with its integrators)
     # Phi = e^{A0 T} and Gamma = int_0^T e^{A0 s} ds Bf in one exponential (Van Loan)
     E = scipy.linalg.expm(np.block([[A0, Bf], [np.zeros((4, n + 4))]]) * period)
