@@ -20,6 +20,12 @@ from numba.core import cgutils
 from numba.core.errors import TypingError
 from numba.extending import intrinsic
 
+from railride.engine.layout import N_DOF
+
+#: the rows of q'' beyond the vector of eight: row 8 (the rear bogie's roll) in `mv9_simd`, and
+#: from row 9 (the carbody's bending) in the kernels (`kernels._mv9`)
+_N2 = 2 * N_DOF
+
 _I32 = ir.IntType(32)
 _I64 = ir.IntType(64)
 _F64 = ir.DoubleType()
@@ -59,11 +65,12 @@ def _row_length(builder, arr):
 
 @intrinsic
 def mv9_simd(typingctx, AT, x, xf, n_cols, r, roff, out, ooff, idx8, val8, n8):
-    """out[ooff + i] = r[roff + i] + sum_j AT[j, i] v[j] for the nine rows i, v[j] = x[j] for
-    j < 18 (q, q') and xf[j] beyond (the corner forces); AT is (n_cols, 9).
+    """out[ooff + i] = r[roff + i] + sum_j AT[j, i] v[j] for rows i < 9 of q'', v[j] = x[j] for
+    j < 2 N_DOF (q, q') and xf[j] beyond (the corner forces); AT is (n_cols, N_DOF). Row 9 on
+    (the carbody's bending) is the caller's (`kernels._mv9`).
 
-    Rows 0-7 form one vector of eight. The columns are summed in three independent chains, q
-    (0-8), q' (9-17) and the forces from r (18-), added at the end: one chain of 22 multiply-adds
+    Rows 0-7 form one vector of eight. The columns are summed in three independent chains, q,
+    q' and the forces from r, added at the end: one chain of 22 multiply-adds
     made the product wait on its own latency. Row 8, a scalar, is summed over its non-zero
     entries only: n8 values val8 in the columns idx8 (a bogie's roll couples to 6 of the 22
     columns; the dense scalar row cost as many instructions as the vector of eight, and
@@ -91,9 +98,9 @@ def mv9_simd(typingctx, AT, x, xf, n_cols, r, roff, out, ooff, idx8, val8, n8):
         n8 = context.cast(builder, args[10], signature.args[10], types.int64)
         sums = []
         for src, lo, hi, init8 in (
-            (xa, ir.Constant(_I64, 0), ir.Constant(_I64, 9), zero8),
-            (xa, ir.Constant(_I64, 9), ir.Constant(_I64, 18), zero8),
-            (xfa, ir.Constant(_I64, 18), nc, _load8(builder, rp)),
+            (xa, ir.Constant(_I64, 0), ir.Constant(_I64, N_DOF), zero8),
+            (xa, ir.Constant(_I64, N_DOF), ir.Constant(_I64, _N2), zero8),
+            (xfa, ir.Constant(_I64, _N2), nc, _load8(builder, rp)),
         ):
             acc8 = cgutils.alloca_once_value(builder, init8)
             with cgutils.for_range_slice(builder, lo, hi, one, inc=True) as (j, _):
@@ -105,7 +112,7 @@ def mv9_simd(typingctx, AT, x, xf, n_cols, r, roff, out, ooff, idx8, val8, n8):
         q8, v8, f8 = sums
         # row 8 over its non-zero columns only (idx8, val8: n8 of them)
         acc1 = cgutils.alloca_once_value(builder, builder.load(builder.gep(rp, [eight])))
-        lim = ir.Constant(_I64, 18)
+        lim = ir.Constant(_I64, _N2)
         with cgutils.for_range_slice(builder, ir.Constant(_I64, 0), n8, one, inc=True) as (k, _):
             j = builder.load(builder.gep(ia.data, [k]))
             j = context.cast(builder, j, signature.args[8].dtype, types.int64)
@@ -123,7 +130,7 @@ def mv9_simd(typingctx, AT, x, xf, n_cols, r, roff, out, ooff, idx8, val8, n8):
 
 @intrinsic
 def corner_pairs(typingctx, TT, s, cx, cv):
-    """cx[c] = sum_j TT[j, c] s[j] and cv[c] = sum_j TT[j, c] s[9 + j] (c < 4, j < 9): the
+    """cx[c] = sum_j TT[j, c] s[j] and cv[c] = sum_j TT[j, c] s[N_DOF + j] (c < 4, j < N_DOF): the
     secondary deflections and their rates at the four corners, as one vector of eight."""
     _check_contiguous("corner_pairs", TT, s, cx, cv)
     sig = types.void(TT, s, cx, cv)
@@ -137,12 +144,12 @@ def corner_pairs(typingctx, TT, s, cx, cv):
         width = _row_length(builder, tt)
         acc = ir.Constant(_V8, [0.0] * 8)
         twice = ir.Constant(ir.VectorType(_I32, 8), [0, 1, 2, 3, 0, 1, 2, 3])
-        for j in range(9):
+        for j in range(N_DOF):
             row_ptr = builder.gep(tt.data, [builder.mul(ir.Constant(_I64, j), width)])
             row = builder.load(builder.bitcast(row_ptr, _V4.as_pointer()), align=8)
             both = builder.shuffle_vector(row, ir.Constant(_V4, ir.Undefined), twice)
             q = builder.load(builder.gep(sa.data, [ir.Constant(_I64, j)]))
-            qd = builder.load(builder.gep(sa.data, [ir.Constant(_I64, 9 + j)]))
+            qd = builder.load(builder.gep(sa.data, [ir.Constant(_I64, N_DOF + j)]))
             sv = ir.Constant(_V8, ir.Undefined)
             for k in range(8):
                 sv = builder.insert_element(sv, q if k < 4 else qd, ir.Constant(_I32, k))
@@ -158,9 +165,9 @@ def corner_pairs(typingctx, TT, s, cx, cv):
 
 @intrinsic
 def forcing_rows(typingctx, ftab, a, h00, h10, h01, h11, d00, d10, d11, out, ooff):
-    """out[ooff + i] (i < 9) = h00 P_a + h10 Q_a + h01 P_b + h11 Q_b + d00 (R_a - R_b)
-    + d10 S_a + d11 S_b, where rows a and b = a + 1 of ftab hold (P, Q, R, S), nine columns
-    each (`kernels._forcing`): rows 0-7 as one vector of eight, row 8 a scalar."""
+    """out[ooff + i] (i < N_DOF) = h00 P_a + h10 Q_a + h01 P_b + h11 Q_b + d00 (R_a - R_b)
+    + d10 S_a + d11 S_b, where rows a and b = a + 1 of ftab hold (P, Q, R, S), N_DOF columns
+    each (`kernels._forcing`): rows 0-7 as one vector of eight, the rows after them scalars."""
     _check_contiguous("forcing_rows", ftab, out)
     sig = types.void(ftab, a, h00, h10, h01, h11, d00, d10, d11, out, ooff)
 
@@ -179,22 +186,25 @@ def forcing_rows(typingctx, ftab, a, h00, h10, h01, h11, d00, d10, d11, out, oof
         def vector(p, col):
             return _load8(builder, builder.gep(p, [ir.Constant(_I64, col)]))
 
-        def scalar(p, col):
-            return builder.load(builder.gep(p, [ir.Constant(_I64, col + 8)]))
+        def scalar_at(row):
+            return lambda p, col: builder.load(builder.gep(p, [ir.Constant(_I64, col + row)]))
 
-        for fma, load, wrap in ((fma8, vector, lambda w: _splat(builder, w)), (fma1, scalar, lambda w: w)):
+        parts = [(fma8, vector, lambda w: _splat(builder, w), None)]
+        parts += [(fma1, scalar_at(row), lambda w: w, row) for row in range(8, N_DOF)]
+        n = N_DOF
+        for fma, load, wrap, row in parts:
             w00, w10, w01, w11, e00, e10, e11 = [wrap(w) for w in weights]
             acc = builder.fmul(w00, load(pa, 0))
-            acc = builder.call(fma, [w10, load(pa, 9), acc])
+            acc = builder.call(fma, [w10, load(pa, n), acc])
             acc = builder.call(fma, [w01, load(pb, 0), acc])
-            acc = builder.call(fma, [w11, load(pb, 9), acc])
-            acc = builder.call(fma, [e00, builder.fsub(load(pa, 18), load(pb, 18)), acc])
-            acc = builder.call(fma, [e10, load(pa, 27), acc])
-            acc = builder.call(fma, [e11, load(pb, 27), acc])
-            if fma is fma8:
+            acc = builder.call(fma, [w11, load(pb, n), acc])
+            acc = builder.call(fma, [e00, builder.fsub(load(pa, 2 * n), load(pb, 2 * n)), acc])
+            acc = builder.call(fma, [e10, load(pa, 3 * n), acc])
+            acc = builder.call(fma, [e11, load(pb, 3 * n), acc])
+            if row is None:
                 builder.store(acc, builder.bitcast(op, _V8.as_pointer()), align=8)
             else:
-                builder.store(acc, builder.gep(op, [ir.Constant(_I64, 8)]))
+                builder.store(acc, builder.gep(op, [ir.Constant(_I64, row)]))
         return context.get_dummy_value()
 
     return sig, codegen
@@ -212,9 +222,9 @@ def _load4_strided(builder, base, start, stride):
 @intrinsic
 def bouc_wen1_corners(typingctx, P, s, cx, cv, vcmd, conn, y, K, koff):
     """The four corners' Bouc-Wen dampers with n = 1 (`kernels.damper_law`, LAW_BOUC_WEN), as
-    one vector of four: with z, u the damper states s[18 + 3c], s[20 + 3c] and (x, x') = (cx[c],
-    cv[c]), F = (P0 + P1 u) z + (P2 + P3 u) x' + P4 x, and y[18 + c] = -F conn[c];
-    K[koff + 18 + 3c ...] = (z', 0, u') with z' = -P7 |x'| z - P8 x' |z| + P5 x' and
+    one vector of four: with z, u the damper states s[2N + 3c], s[2N + 2 + 3c] (N = N_DOF) and
+    (x, x') = (cx[c], cv[c]), F = (P0 + P1 u) z + (P2 + P3 u) x' + P4 x, and y[2N + c] = -F conn[c];
+    K[koff + 2N + 3c ...] = (z', 0, u') with z' = -P7 |x'| z - P8 x' |z| + P5 x' and
     u' = -P9 (u - vcmd[c])."""
     _check_contiguous("bouc_wen1_corners", P, s, cx, cv, vcmd, conn, y, K)
     sig = types.void(P, s, cx, cv, vcmd, conn, y, K, koff)
@@ -233,15 +243,15 @@ def bouc_wen1_corners(typingctx, P, s, cx, cv, vcmd, conn, y, K, koff):
         def par(i):
             return _splat(builder, builder.load(builder.gep(pa.data, [ir.Constant(_I64, i)])), _V4)
 
-        z = _load4_strided(builder, sa.data, 18, 3)
-        u = _load4_strided(builder, sa.data, 20, 3)
+        z = _load4_strided(builder, sa.data, _N2, 3)
+        u = _load4_strided(builder, sa.data, _N2 + 2, 3)
         x, xd = load4(xa), load4(va)
         alpha = builder.call(fma4, [par(1), u, par(0)])
         c0 = builder.call(fma4, [par(3), u, par(2)])
         force = builder.call(fma4, [c0, xd, builder.fmul(par(4), x)])
         force = builder.call(fma4, [alpha, z, force])
         fcar = builder.fmul(builder.fneg(force), load4(na))
-        builder.store(fcar, builder.bitcast(builder.gep(ya.data, [ir.Constant(_I64, 18)]), _V4.as_pointer()), align=8)
+        builder.store(fcar, builder.bitcast(builder.gep(ya.data, [ir.Constant(_I64, _N2)]), _V4.as_pointer()), align=8)
         dz = builder.fmul(par(5), xd)
         dz = builder.call(fma4, [builder.fneg(builder.fmul(par(7), builder.call(fabs4, [xd]))), z, dz])
         dz = builder.call(fma4, [builder.fneg(builder.fmul(par(8), xd)), builder.call(fabs4, [z]), dz])
@@ -250,9 +260,9 @@ def bouc_wen1_corners(typingctx, P, s, cx, cv, vcmd, conn, y, K, koff):
         zero = ir.Constant(_F64, 0.0)
         for c in range(4):
             idx = ir.Constant(_I32, c)
-            builder.store(builder.extract_element(dz, idx), builder.gep(base, [ir.Constant(_I64, 18 + 3 * c)]))
-            builder.store(zero, builder.gep(base, [ir.Constant(_I64, 19 + 3 * c)]))
-            builder.store(builder.extract_element(du, idx), builder.gep(base, [ir.Constant(_I64, 20 + 3 * c)]))
+            builder.store(builder.extract_element(dz, idx), builder.gep(base, [ir.Constant(_I64, _N2 + 3 * c)]))
+            builder.store(zero, builder.gep(base, [ir.Constant(_I64, _N2 + 1 + 3 * c)]))
+            builder.store(builder.extract_element(du, idx), builder.gep(base, [ir.Constant(_I64, _N2 + 2 + 3 * c)]))
         return context.get_dummy_value()
 
     return sig, codegen

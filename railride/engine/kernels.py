@@ -53,6 +53,7 @@ from railride.engine.layout import (  # sizes, codes and slots: compile-time con
     N_DAMPER_STATES,
     N_DOF,
     N_DS,
+    ROW_BENDING,
     N_RAIL,
     N_SENS_STATES,
     NOISE_Q,
@@ -146,9 +147,9 @@ def _forcing(t, ftab, off, n_nodes, interval, out, ooff):
     """Rail forcing r = Bw w + Bwd w' at time t, from the forcing table.
 
     Hermite interpolation is linear in the node data, so interpolating the node values
-    P = Bw w_k, Q = Bw w'_k, R = Bwd w_k, S = Bwd w'_k (columns 0-8, 9-17, 18-26, 27-35)
-    gives exactly Bw w(t) + Bwd w'(t) of the interpolated rail inputs, in 9 x 8 operations
-    instead of interpolating 16 inputs and multiplying by a 9 x 16 matrix (in vector form,
+    P = Bw w_k, Q = Bw w'_k, R = Bwd w_k, S = Bwd w'_k (N_DOF columns each, one after another)
+    gives exactly Bw w(t) + Bwd w'(t) of the interpolated rail inputs, in N_DOF x 8 operations
+    instead of interpolating 16 inputs and multiplying by an N_DOF x 16 matrix (in vector form,
     `railride.engine._simd.forcing_rows`).
     """
     k, h00, h10, h01, h11, d00, d10, d11 = _hermite(t, n_nodes, interval)
@@ -167,20 +168,27 @@ def _rail_inputs(t, utab, off, n_nodes, interval, w, wd):
 
 
 @njit(cache=True, inline="always", fastmath=_FAST)
-def _mv9(AT, x, xf, n_cols, r, roff, out, ooff, idx8, val8, n8):
-    """out[ooff:ooff+9] = r[roff:roff+9] + A y for the 9 rows of q'', A stored transposed
-    (n_cols, 9), y = (x[:18], xf[18:n_cols]): the state's (q, q') read in place, the corner
-    forces from the stage vector; row 8 from its non-zero entries (idx8, val8, n8). Offsets
-    instead of slices: a slice made in the loop costs reference counting. The product is
-    written in vector form (`railride.engine._simd`): as plain numba, nine named scalar sums were the
-    fastest form and stayed scalar."""
-    mv9_simd(AT, x, xf, n_cols, r, roff, out, ooff, idx8, val8, n8)
+def _mv9(AT, x, xf, n_cols, r, roff, out, ooff, idx8, val8, idx9, val9, n8, which):
+    """out[ooff:ooff+N_DOF] = r[roff:roff+N_DOF] + A y for the rows of q'', A stored transposed
+    (n_cols, N_DOF), y = (x[:2N], xf[2N:n_cols]): the state's (q, q') read in place, the corner
+    forces from the stage vector. Rows 0-8 in vector form (`railride.engine._simd`), row 8 from
+    its non-zero entries (idx8, val8, n8[0, which]); row 9, the carbody's bending, from its own
+    (idx9, val9, n8[1, which]): none for a rigid carbody, whose bending stays 0.
+    ``which``: 0 counts the entries on (q, q'), 1 those on (q, q', f). Offsets instead of
+    slices: a slice made in the loop costs reference counting. As plain numba, nine named
+    scalar sums were the fastest form and stayed scalar."""
+    mv9_simd(AT, x, xf, n_cols, r, roff, out, ooff, idx8, val8, n8[0, which])
+    acc = r[roff + ROW_BENDING]
+    for k in range(n8[1, which]):
+        j = idx9[k]
+        acc += val9[k] * (x[j] if j < 2 * N_DOF else xf[j])
+    out[ooff + ROW_BENDING] = acc
 
 
 @njit(cache=True, inline="always", fastmath=_FAST)
 def _corner_values(TT, s, offset, out):
     """out[c] = sum_j TT[j, c] s[offset + j]: the secondary deflections (offset 0, from q) or
-    their rates (offset N_DOF, from q') at the four corners (TT = T, (9, 4))."""
+    their rates (offset N_DOF, from q') at the four corners (TT = T, (N_DOF, 4))."""
     b0 = 0.0
     b1 = 0.0
     b2 = 0.0
@@ -351,9 +359,9 @@ def add_stops(zk, cx, f, foff, fsave):
 
 
 @njit(cache=True, inline="always", fastmath=_FAST)
-def _derivative(law, s, R, roff, AT, TT, P, vcmd, conn, y, cx, cv, K, koff, i8, v8, n8, bw1, zk, fsave):
+def _derivative(law, s, R, roff, AT, TT, P, vcmd, conn, y, cx, cv, K, koff, i8, v8, i9, v9, n8, bw1, zk, fsave):
     """K[koff:koff+NS_MAX] = d/dt of the state s = (q, q', damper states), with the rail forcing
-    R[roff:roff+9].
+    R[roff:roff+N_DOF].
 
     y receives the stage vector (q, q', f). LAW_VISCOUS_IN_C: the dampers are in Av,
     q'' = r + [Aq Av] (q, q'). Otherwise every corner's damper law gives its force F from the
@@ -372,9 +380,9 @@ def _derivative(law, s, R, roff, AT, TT, P, vcmd, conn, y, cx, cv, K, koff, i8, 
             for c in range(N_CORNER):
                 y[2 * N_DOF + c] = 0.0
             if add_stops(zk, cx, y, 2 * N_DOF, fsave):
-                _mv9(AT, s, y, NY, R, roff, K, koff + N_DOF, i8, v8, n8[1])
+                _mv9(AT, s, y, NY, R, roff, K, koff + N_DOF, i8, v8, i9, v9, n8, 1)
                 return
-        _mv9(AT, s, y, 2 * N_DOF, R, roff, K, koff + N_DOF, i8, v8, n8[0])
+        _mv9(AT, s, y, 2 * N_DOF, R, roff, K, koff + N_DOF, i8, v8, i9, v9, n8, 0)
         return
     corner_pairs(TT, s, cx, cv)
     if bw1:  # Bouc-Wen with n = 1 (the railway dampers): the four corners as one vector
@@ -382,11 +390,11 @@ def _derivative(law, s, R, roff, AT, TT, P, vcmd, conn, y, cx, cv, K, koff, i8, 
         # SAS closed loop 20-25 % slower (A/B, alternating processes)
         bouc_wen1_corners(P, s, cx, cv, vcmd, conn, y, K, koff)
         if zk[1] > 0.0 and add_stops(zk, cx, y, 2 * N_DOF, fsave):
-            _mv9(AT, s, y, NY, R, roff, K, koff + N_DOF, i8, v8, n8[1])
+            _mv9(AT, s, y, NY, R, roff, K, koff + N_DOF, i8, v8, i9, v9, n8, 1)
             for c in range(N_CORNER):
                 y[2 * N_DOF + c] = fsave[c]
             return
-        _mv9(AT, s, y, NY, R, roff, K, koff + N_DOF, i8, v8, n8[1])
+        _mv9(AT, s, y, NY, R, roff, K, koff + N_DOF, i8, v8, i9, v9, n8, 1)
         return
     for c in range(N_CORNER):
         b = 2 * N_DOF + N_DAMPER_STATES * c
@@ -396,11 +404,11 @@ def _derivative(law, s, R, roff, AT, TT, P, vcmd, conn, y, cx, cv, K, koff, i8, 
         K[koff + b + 1] = dyy
         K[koff + b + 2] = du
     if zk[1] > 0.0 and add_stops(zk, cx, y, 2 * N_DOF, fsave):
-        _mv9(AT, s, y, NY, R, roff, K, koff + N_DOF, i8, v8, n8[1])
+        _mv9(AT, s, y, NY, R, roff, K, koff + N_DOF, i8, v8, i9, v9, n8, 1)
         for c in range(N_CORNER):
             y[2 * N_DOF + c] = fsave[c]
         return
-    _mv9(AT, s, y, NY, R, roff, K, koff + N_DOF, i8, v8, n8[1])
+    _mv9(AT, s, y, NY, R, roff, K, koff + N_DOF, i8, v8, i9, v9, n8, 1)
 
 
 @njit(cache=True, nogil=True, fastmath=_FAST, parallel=_NO_PARFORS)
@@ -414,8 +422,8 @@ def run_batch(lo, hi, law, x, step0, n_steps, final, stride, dt, vehicle, damper
     faults, sensing, snoise) and outputs = (out_q, out_v, out_a, out_f, out_w, out_wd, out_d,
     out_fd, out_vc, status, fail_step).
 
-    Per sample s: A[s] (NY, 9) maps y = (q, q', f) to q'' (Aq, Av, Bf side by side, stored
-    transposed), TS[s] (9, 4) is T (corner deflections T^T q). ``law`` is LAW_VISCOUS_IN_C
+    Per sample s: A[s] (NY, N_DOF) maps y = (q, q', f) to q'' (Aq, Av, Bf side by side, stored
+    transposed), TS[s] (N_DOF, 4) is T (corner deflections T^T q). ``law`` is LAW_VISCOUS_IN_C
     (passive dashpots inside Av; c_sec[s] only for recording their forces) or a damper law
     (railride.secondary.dampers) with packed parameters P[s] (slots P_*) and command voltages
     vcmd[s] (4 corners). The rail inputs come as tables on the time grid k * interval[s] with
@@ -429,7 +437,7 @@ def run_batch(lo, hi, law, x, step0, n_steps, final, stride, dt, vehicle, damper
     Open loop, each corner's command voltage is vcmd[s]. With ``closed_loop`` the controller
     samples the state m = (q, q') (noise[k] added to the carbody's six at sample k, if noise has
     rows) every ctrl_stride steps, integrates the carbody's (z, phi, theta) by the rectangle rule,
-    and computes the desired corner forces f_d = Gm[s] m + Hm[s] xi (Gm 4 x 18), which take effect
+    and computes the desired corner forces f_d = Gm[s] m + Hm[s] xi (Gm 4 x 2 N_DOF), which take effect
     inner[s, I_DELAY] controller periods later (the computation and communication delay, 1 to
     MAX_DELAY; zero demand until the first arrives) and are held. The voltage
     law inner[s, I_LAW] (`voltage_law`) runs at every step from the damper force f on the carbody
@@ -522,17 +530,25 @@ def _run_samples(
         bw1 = law == LAW_BOUC_WEN and pp[P_N] == 1.0
         gb1 = pp[P_N] * (abs(pp[P_GAMMA]) + abs(pp[P_BETA]))
         lam1 = _one_step_limit(dt)  # the largest rate bound that needs no sub-steps
-        # the last row of q'' is sparse (a bogie's roll): its non-zero columns, in order
+        # rows 8 (the rear bogie's roll) and 9 (the carbody's bending) of q'' are sparse: their
+        # non-zero columns, in order
         i8 = np.empty(NY, np.int64)
         v8 = np.empty(NY)
-        n8 = np.zeros(2, np.int64)  # how many of them act on (q, q'), and on (q, q', f)
+        i9 = np.empty(NY, np.int64)
+        v9 = np.empty(NY)
+        n8 = np.zeros((2, 2), np.int64)  # per row, how many act on (q, q'), and on (q, q', f)
         for j in range(NY):
-            if at[j, N_DOF - 1] != 0.0:
-                i8[n8[1]] = j
-                v8[n8[1]] = at[j, N_DOF - 1]
-                n8[1] += 1
-                if j < 2 * N_DOF:
-                    n8[0] += 1
+            for r in range(2):
+                a_j = at[j, 8 + r]
+                if a_j != 0.0:
+                    k = n8[r, 1]
+                    if r == 0:
+                        i8[k], v8[k] = j, a_j
+                    else:
+                        i9[k], v9[k] = j, a_j
+                    n8[r, 1] += 1
+                    if j < 2 * N_DOF:
+                        n8[r, 0] += 1
         _forcing(step0 * dt, ftab, fo, nn, itv, R, 0)
         last = n_steps + 1 if final else n_steps
         for n in range(last):
@@ -586,10 +602,10 @@ def _run_samples(
                     if fault_at(fm, c, step) == FAULT_DISCONNECTED:
                         conn[c] = 0.0
             # rates at the step's start: for the record, the sub-step choice and stage 1
-            _derivative(law, s, R, 0, at, tt, pp, vc, conn, y, cx, cv, K, 0, i8, v8, n8, bw1, zk, fsave)
+            _derivative(law, s, R, 0, at, tt, pp, vc, conn, y, cx, cv, K, 0, i8, v8, i9, v9, n8, bw1, zk, fsave)
             if sens:  # each accelerometer's anti-alias filter follows its corner's acceleration
                 for c in range(N_CORNER):
-                    a_c = 0.0
+                    a_c = tt[ROW_BENDING, c] * K[N_DOF + ROW_BENDING]  # the floor, bending included
                     for j in range(3):
                         a_c += tt[j, c] * K[N_DOF + j]
                     b = SENS + N_SENS_STATES * c
@@ -680,7 +696,7 @@ def _run_samples(
                     if has_states:
                         for i in range(2 * N_DOF, NS_MAX):
                             st[i] = s[i] + ch * K[prev + i]
-                    _derivative(law, st, R, roff, at, tt, pp, vc, conn, y, cx, cv, K, NS_MAX * stage, i8, v8, n8, bw1, zk, fsave)
+                    _derivative(law, st, R, roff, at, tt, pp, vc, conn, y, cx, cv, K, NS_MAX * stage, i8, v8, i9, v9, n8, bw1, zk, fsave)
                 for i in range(2 * N_DOF):
                     s[i] += h / 6.0 * (K[i] + 2.0 * K[NS_MAX + i] + 2.0 * K[2 * NS_MAX + i] + K[3 * NS_MAX + i])
                 if has_states:

@@ -87,12 +87,12 @@ def _lane_forcing(ts, lanes, act, smp, ftab, f_off, n_nodes, interval, RR, roff)
         for i in range(N_DOF):
             RR[roff + i, l] = (
                 h00 * ftab[a, i]
-                + h10 * ftab[a, 9 + i]
+                + h10 * ftab[a, N_DOF + i]
                 + h01 * ftab[b, i]
-                + h11 * ftab[b, 9 + i]
-                + d00 * (ftab[a, 18 + i] - ftab[b, 18 + i])
-                + d10 * ftab[a, 27 + i]
-                + d11 * ftab[b, 27 + i]
+                + h11 * ftab[b, N_DOF + i]
+                + d00 * (ftab[a, 2 * N_DOF + i] - ftab[b, 2 * N_DOF + i])
+                + d10 * ftab[a, 3 * N_DOF + i]
+                + d11 * ftab[b, 3 * N_DOF + i]
             )
 
 
@@ -123,7 +123,7 @@ def _lane_derivative(
     stops,
 ):
     """K[kb:kb + NL] = d/dt of the lane states ST (rows as `NL`), with the rail forcing
-    RR[roff:roff + 9]; as `_derivative`, every lane at once. ST's force rows receive f; CC the
+    RR[roff:roff + N_DOF]; as `_derivative`, every lane at once. ST's force rows receive f; CC the
     corner deflections (rows 0-3) and rates (4-7). Bump stops where ZK (clearance, stiffness
     per lane) has a stiffness (``stops``: in any lane of the group): their forces join f for the
     product only (FS keeps f), and only at a step where a lane is beyond its clearance."""

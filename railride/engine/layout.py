@@ -8,7 +8,12 @@ slot (``P[ETA]``) compiles to the same machine code as a number (``P[9]``).
 from __future__ import annotations
 
 # -- the vehicle -----------------------------------------------------------------------------------
-N_DOF = 9  # carbody and two bogies in bounce, pitch and roll
+#: carbody and two bogies in bounce, pitch and roll, then the carbody's first vertical bending
+#: mode (`railride.model.beam`): a rigid carbody's vehicle is padded with a bending row and
+#: column of zeros, so that its bending stays 0 (`railride.run.inputs`)
+N_DOF = 10
+N_RIGID = 9
+ROW_BENDING = 9
 N_CORNER = 4  # secondary suspension corners (dampers): 1R, 1L, 2R, 2L
 N_RAIL = 8  # rail inputs: four wheelsets, two rails each
 NY = 2 * N_DOF + N_CORNER  # length of the stage vector (q, q', f)

@@ -18,8 +18,9 @@ from railride.engine import lanes, layout
 from railride.errors import InputError
 from railride.model.params import VehicleParams
 from railride.model.track import Scenario, as_scenario, input_table_nodes
-from railride.model.vehicle import N_DOF, Vehicle
-from railride.run.inputs import _vehicle
+from railride.engine.layout import N_DOF, N_RIGID
+from railride.model.vehicle import Vehicle
+from railride.run.inputs import _vehicle, engine_matrices, engine_state_matrix
 from railride.run.ride import has_damper_states
 from railride.run.solver import SolverSettings, check_resolution
 from railride.secondary import dampers
@@ -39,11 +40,11 @@ def _max_stable_dt(params: VehicleParams, damper=None) -> float:
 
 
 def _state_matrix(vehicle: Vehicle, damper=None) -> np.ndarray:
-    """The passive state matrix, or with MR dampers the vehicle linearised about their stiffest
+    """The passive state matrix (at the engine's size, `railride.run.inputs.engine_matrices`), or with MR dampers the vehicle linearised about their stiffest
     state: pre-yield stiffness k0 + k1 + alpha(v_max) A and damping c0(v_max) + c1(v_max). Their
     internal states are sub-stepped by the stepper and do not enter here."""
     if damper is None:
-        return vehicle.state_matrix
+        return engine_state_matrix(vehicle)
     if damper.law == dampers.LAW_IDEAL:
         # its force is the held demand, a forcing term to the integrator: C0 without a damper
         k_eff, c_eff = 0.0, 0.0
@@ -53,10 +54,11 @@ def _state_matrix(vehicle: Vehicle, damper=None) -> np.ndarray:
         v = damper.v_max
         k_eff = damper.k0 + getattr(damper, "k1", 0.0) + (damper.alpha_a + damper.alpha_b * v) * damper.A
         c_eff = damper.c0a + damper.c0b * v + getattr(damper, "c1a", 0.0) + getattr(damper, "c1b", 0.0) * v
-    TT = vehicle.T @ vehicle.T.T
-    K = vehicle.K + k_eff * TT
-    C = vehicle.C0 + c_eff * TT
-    minv = 1.0 / np.diag(vehicle.M)[:, None]
+    m = engine_matrices(vehicle)  # at the engine's size: the exact steps of the closed loop take it
+    TT = m["T"] @ m["T"].T
+    K = m["K"] + k_eff * TT
+    C = m["C0"] + c_eff * TT
+    minv = 1.0 / np.diag(m["M"])[:, None]
     A = np.zeros((2 * N_DOF, 2 * N_DOF))
     A[:N_DOF, N_DOF:] = np.eye(N_DOF)
     A[N_DOF:, :N_DOF] = -minv * K
@@ -226,17 +228,21 @@ def _closed_loop(suspensions: list[Suspension], solver: SolverSettings, duration
 
 
 def _full_state_gains(G, controller) -> np.ndarray:
-    """The outer loop's G as a map from the whole state (q, q') (4 x 18): a law on the carbody
-    states alone gives G over (z_c, phi_c, theta_c, z_c', phi_c', theta_c') (4 x 6)."""
+    """The outer loop's G as a map from the engine's whole state (q, q') (4 x 2 N_DOF): a law on
+    the carbody states alone gives G over (z_c, phi_c, theta_c, z_c', phi_c', theta_c') (4 x 6),
+    one on the whole state over the vehicle's (q, q') (4 x 2 n, `Vehicle.n_dof`)."""
     G = np.asarray(G, dtype=float)
-    if G.shape == (4, 2 * N_DOF):
-        return G
+    full = np.zeros((4, 2 * N_DOF))
+    if G.shape in ((4, 2 * N_RIGID), (4, 2 * N_DOF)):  # on the vehicle's (q, q'): to the engine's
+        n = G.shape[1] // 2
+        full[:, :n], full[:, N_DOF : N_DOF + n] = G[:, :n], G[:, n:]
+        return full
     if G.shape != (4, 6):
         raise InputError(
             f"controller {getattr(controller, 'name', controller)!r}: gains(vehicle) gave G of shape {G.shape}; "
-            f"allowed (4, 6) on the carbody states or (4, {2 * N_DOF}) on (q, q')"
+            f"allowed (4, 6) on the carbody states or (4, 2 n) on the vehicle's (q, q'), n = {N_RIGID} "
+            f"(a rigid carbody) or {N_DOF} (a flexible one)"
         )
-    full = np.zeros((4, 2 * N_DOF))
     full[:, :3], full[:, N_DOF : N_DOF + 3] = G[:, :3], G[:, 3:]
     return full
 
@@ -344,11 +350,16 @@ def check(scenario=None, params=None, suspension=None, solver=None, on_divergenc
     x0 = None
     if initial_state is not None:
         x0 = np.asarray(initial_state, dtype=float)
-        if x0.shape not in ((2 * N_DOF,), (n, 2 * N_DOF)) or not np.all(np.isfinite(x0)):
+        sizes = ((2 * N_RIGID,), (n, 2 * N_RIGID), (2 * N_DOF,), (n, 2 * N_DOF))
+        if x0.shape not in sizes or not np.all(np.isfinite(x0)):
             raise InputError(
-                f"initial_state must hold {2 * N_DOF} finite numbers (q then q') "
-                f"or one such row per sample; got shape {x0.shape}"
+                f"initial_state must hold {2 * N_RIGID} finite numbers (q then q'; {2 * N_DOF} with the "
+                f"carbody's bending after the nine rigid DOFs) or one such row per sample; got shape {x0.shape}"
             )
+        if x0.shape[-1] == 2 * N_RIGID:  # the bending at rest
+            padded = np.zeros(x0.shape[:-1] + (2 * N_DOF,))
+            padded[..., :N_RIGID], padded[..., N_DOF : N_DOF + N_RIGID] = x0[..., :N_RIGID], x0[..., N_RIGID:]
+            x0 = padded
     return RunPlan(
         batch, scenarios, param_sets, suspensions, solver, duration, damper, closed, exact, vehicles, n_out, vcmd,
         gm, hm, modes, sensing, x0, faults, on_divergence,
@@ -373,5 +384,5 @@ def _outer_loops(closed, param_sets, vehicles, n: int):
                         f"sensing with controller {c.name!r}: it reads the bogies' states, and the "
                         "accelerometers are on the carbody only (railride.secondary.sensing)"
                     )
-                sensing[i] = closed["sensing"].pack(vehicles[id(p)].T[:3])
+                sensing[i] = closed["sensing"].pack(vehicles[id(p)].T[:3])  # the rigid carbody's map
     return gm, hm, modes, sensing

@@ -9,6 +9,7 @@ import functools
 import numpy as np
 
 from railride._cache import MiB, BytesLRU
+from railride.engine.layout import N_DOF
 from railride.model.params import VehicleParams
 from railride.model.track import Scenario, wheelset_input_table
 from railride.model.vehicle import Vehicle
@@ -48,6 +49,40 @@ def _input_table(scenario: Scenario, key, lag: tuple, dt: float, duration: float
     return _INPUT_TABLES.get(None if key is None else (key, lag, dt, duration), build)
 
 
+def engine_matrices(vehicle: Vehicle) -> dict[str, np.ndarray]:
+    """The vehicle's M, K, C, C0, T, K_w, C_w at the engine's size (`layout.N_DOF`): a rigid
+    carbody's vehicle (`Vehicle.n_dof` 9) gets a bending row and column of zeros with a unit
+    mass, so that its bending coordinate stays exactly 0; a flexible one is the engine's size."""
+    n = vehicle.M.shape[0]
+    names = ("M", "K", "C", "C0", "T", "K_w", "C_w")
+    if n == N_DOF:
+        return {k: getattr(vehicle, k) for k in names}
+    out = {}
+    for k in names:
+        v = getattr(vehicle, k)
+        rows = np.zeros((N_DOF,) + v.shape[1:])
+        if v.shape[1:] == (n,):  # square: pad the columns too
+            rows = np.zeros((N_DOF, N_DOF))
+            rows[:n, :n] = v
+        else:
+            rows[:n] = v
+        out[k] = rows
+    out["M"][n:, n:] = np.eye(N_DOF - n)
+    return out
+
+
+def engine_state_matrix(vehicle: Vehicle, C=None) -> np.ndarray:
+    """The state matrix (q, q') at the engine's size (`engine_matrices`), with damping C (default
+    the passive vehicle's, with the secondary dashpots)."""
+    m = engine_matrices(vehicle)
+    minv = 1.0 / np.diag(m["M"])[:, None]
+    A = np.zeros((2 * N_DOF, 2 * N_DOF))
+    A[:N_DOF, N_DOF:] = np.eye(N_DOF)
+    A[N_DOF:, :N_DOF] = -minv * m["K"]
+    A[N_DOF:, N_DOF:] = -minv * (m["C"] if C is None else C)
+    return A
+
+
 def _system_arrays(vehicle: Vehicle, passive: bool = True) -> dict[str, np.ndarray]:
     """The stepper's matrices: the equations of motion with M^-1 folded in, transposed
     (see `railride.engine.kernels.run_batch`).
@@ -58,15 +93,16 @@ def _system_arrays(vehicle: Vehicle, passive: bool = True) -> dict[str, np.ndarr
     false) Av leaves them out and their forces enter through Bf. ``Bw``, ``Bwd`` map the rail
     inputs to q'' and are applied to the input table once, before the run.
     """
-    minv = 1.0 / np.diag(vehicle.M)[:, None]
+    m = engine_matrices(vehicle)
+    minv = 1.0 / np.diag(m["M"])[:, None]
     return {
-        "A": np.hstack([-minv * vehicle.K, -minv * (vehicle.C if passive else vehicle.C0), minv * vehicle.T]).T,
-        "TS": vehicle.T.copy(),
+        "A": np.hstack([-minv * m["K"], -minv * (m["C"] if passive else m["C0"]), minv * m["T"]]).T,
+        "TS": m["T"].copy(),
         "c_sec": np.full(4, vehicle.params.c_sz),
         # the bump stops (clearance, stiffness; stiffness 0: none), `railride.engine.kernels.stop_force`
         "stops": _stops(vehicle.params),
-        "Bw": -minv * vehicle.K_w,
-        "Bwd": -minv * vehicle.C_w,
+        "Bw": -minv * m["K_w"],
+        "Bwd": -minv * m["C_w"],
     }
 
 

@@ -54,15 +54,25 @@ def build_dataset(
 
     damper = suspension.damper
     time = np.arange(rows) / output_rate
-    T = np.stack([vehicles[id(p)].T for p in param_sets])  # (n, 9, 4)
+    from railride.run.inputs import engine_matrices
+
+    # T at the engine's size (a rigid carbody's bending row is 0): (n, N_DOF, 4)
+    T = np.stack([engine_matrices(vehicles[id(p)])["T"] for p in param_sets])
     ksz = np.array([p.k_sz for p in param_sets])[:, None, None]
-    deflection = out["q"] @ T  # (n, time, 9) @ (n, 9, 4): T^T q at every sample
+    deflection = out["q"] @ T  # (n, time, N_DOF) @ (n, N_DOF, 4): T^T q at every sample
+    flexible = any(vehicles[id(p)].M.shape[0] > len(DOF_NAMES) for p in param_sets)
     shape = out["w"].shape[:2] + (4, 2)
     # name -> (extra dims, values with leading (sample, time), attrs)
     channels: dict[str, tuple[tuple[str, ...], Any, dict[str, str]]] = {}
     for i, name in enumerate(DOF_NAMES):
         channels[name] = ((), out["q"][:, :, i], {"units": DOF_UNITS[i]})
         channels[f"{name}_velocity"] = ((), out["v"][:, :, i], {"units": f"{DOF_UNITS[i]}/s"})
+    if flexible:  # the carbody's first vertical bending mode (a rigid sample's is 0)
+        b = len(DOF_NAMES)
+        long = "carbody first vertical bending: the centre's deflection from the rigid body"
+        channels["carbody_bending"] = ((), out["q"][:, :, b], {"units": "m", "long_name": long})
+        channels["carbody_bending_velocity"] = ((), out["v"][:, :, b], {"units": "m/s", "long_name": long})
+        channels["carbody_bending_acceleration"] = ((), out["a"][:, :, b], {"units": "m/s^2", "long_name": long})
     channels["carbody_acceleration"] = (
         (),
         out["a"][:, :, 0],
@@ -80,7 +90,7 @@ def build_dataset(
     )
     channels["carbody_corner_displacement"] = (
         ("corner",),
-        out["q"][:, :, :3] @ T[:, :3],
+        out["q"][:, :, :3] @ T[:, :3] + out["q"][:, :, len(DOF_NAMES) :] @ T[:, len(DOF_NAMES) :],
         {"units": "m", "long_name": "carbody vertical displacement above each secondary corner"},
     )
     channels["secondary_deflection"] = (

@@ -14,7 +14,7 @@ import numpy as np
 from railride.engine import kernels, lanes, layout
 from railride.errors import DivergenceError, InputError, Interrupted
 from railride.model.track import table_key
-from railride.model.vehicle import N_DOF
+from railride.engine.layout import N_DOF
 from railride.run.checks import (  # noqa: F401  (max_stable_dt and the integrators' names: their home before)
     INTEGRATOR_EXACT,
     INTEGRATOR_RK4,
@@ -31,6 +31,8 @@ from railride.run.inputs import (  # noqa: F401  (the stores, read here by tests
     _input_table,
     _system_arrays,
     _vehicle,
+    engine_matrices,
+    engine_state_matrix,
 )
 from railride.run.ride import RideResult, build_dataset, has_damper_states
 from railride.secondary import dampers
@@ -111,7 +113,7 @@ def reaches_stops(plan: RunPlan, q: np.ndarray, status: np.ndarray) -> bool:
     the stops sends the whole batch to RK4, which agrees with them to its truncation error)."""
     for i, p in enumerate(plan.param_sets):
         if p.z_stop is not None and p.k_stop > 0.0 and status[i] == layout.STATUS_OK:
-            travel = q[i] @ plan.vehicles[id(p)].T
+            travel = q[i] @ engine_matrices(plan.vehicles[id(p)])["T"]
             if np.nanmax(np.abs(travel), initial=0.0) >= p.z_stop:
                 return True
     return False
@@ -266,7 +268,7 @@ def step(plan: RunPlan, tables: Inputs, packed: Packed, progress=None) -> Steppe
                 _state_matrix(vehicles[id(p)], plan.damper),  # the plant: C0, the force is the demand
                 systems[id(p)]["Bw"],
                 systems[id(p)]["Bwd"],
-                vehicles[id(p)].T / np.diag(vehicles[id(p)].M)[:, None],
+                engine_matrices(vehicles[id(p)])["T"] / np.diag(engine_matrices(vehicles[id(p)])["M"])[:, None],
                 plan.gm[i],
                 plan.hm[i],
                 plan.suspensions[i].delay,
@@ -286,10 +288,10 @@ def step(plan: RunPlan, tables: Inputs, packed: Packed, progress=None) -> Steppe
 
         samples = [
             (
-                vehicles[id(p)].state_matrix,
+                engine_state_matrix(vehicles[id(p)]),
                 systems[id(p)]["Bw"],
                 systems[id(p)]["Bwd"],
-                vehicles[id(p)].T,
+                engine_matrices(vehicles[id(p)])["T"],
                 p.c_sz,
                 utab[u_off[i] : u_off[i] + n_nodes[i]],
                 interval[i],

@@ -42,10 +42,12 @@ def decoupling(vehicle: Vehicle) -> np.ndarray:
 
 
 def bogie_point_velocity(vehicle: Vehicle) -> np.ndarray:
-    """(4 x 9) map from q' to the absolute vertical velocity of each corner's bogie point,
-    -(T[3:, c] . q'[3:]): the bogie rows of T with a minus sign, the carbody's left out."""
+    """(4 x n) map from q' to the absolute vertical velocity of each corner's bogie point,
+    -(T[3:9, c] . q'[3:9]): the bogie rows of T with a minus sign, the carbody's (its rigid
+    DOFs and, where it bends, its bending) left out."""
     out = -vehicle.T.T.copy()
     out[:, :3] = 0.0
+    out[:, 9:] = 0.0
     return out
 
 
@@ -73,10 +75,11 @@ class GainTable:
         return dataclasses.asdict(self)
 
 
-def _full_state(G6: np.ndarray) -> np.ndarray:
-    """A 4 x 6 gain on the carbody states as the 4 x 18 gain on (q, q') it is."""
-    G = np.zeros((4, 2 * N_DOF))
-    G[:, :3], G[:, N_DOF : N_DOF + 3] = G6[:, :3], G6[:, 3:]
+def _full_state(G6: np.ndarray, n: int = N_DOF) -> np.ndarray:
+    """A 4 x 6 gain on the carbody states as the 4 x 2n gain on the vehicle's (q, q') it is
+    (n = `Vehicle.n_dof`: 9, or 10 with the carbody's bending)."""
+    G = np.zeros((4, 2 * n))
+    G[:, :3], G[:, n : n + 3] = G6[:, :3], G6[:, 3:]
     return G
 
 
@@ -142,8 +145,9 @@ class Groundhook(GainTable):
         validate_fields(self, "groundhook gain", plausible.GROUNDHOOK)
 
     def gains(self, vehicle: Vehicle) -> tuple[np.ndarray, np.ndarray]:
-        G = np.zeros((4, 2 * N_DOF))
-        G[:, N_DOF:] = self.c_g * bogie_point_velocity(vehicle)
+        n = vehicle.M.shape[0]
+        G = np.zeros((4, 2 * n))
+        G[:, n:] = self.c_g * bogie_point_velocity(vehicle)
         return G, np.zeros((4, 3))
 
 
@@ -172,7 +176,7 @@ class Hybrid(GainTable):
     def gains(self, vehicle: Vehicle) -> tuple[np.ndarray, np.ndarray]:
         sky, _ = Skyhook(self.c_z, self.c_phi, self.c_theta).gains(vehicle)
         ground, _ = Groundhook(self.c_g).gains(vehicle)
-        return self.alpha * _full_state(sky) + (1.0 - self.alpha) * ground, np.zeros((4, 3))
+        return self.alpha * _full_state(sky, vehicle.M.shape[0]) + (1.0 - self.alpha) * ground, np.zeros((4, 3))
 
 
 @dataclass(frozen=True)
@@ -206,16 +210,17 @@ class ClippedOptimal(GainTable):
     def design_model(self, vehicle: Vehicle) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """(A, B, Q, R) of the design: x' = A x + B f on x = (q, q') without the secondary
         vertical dampers, and the weights of J."""
+        n = vehicle.M.shape[0]  # 9, or 10 with the carbody's bending
         minv = 1.0 / np.diag(vehicle.M)[:, None]
-        A = np.zeros((2 * N_DOF, 2 * N_DOF))
-        A[:N_DOF, N_DOF:] = np.eye(N_DOF)
-        A[N_DOF:, :N_DOF] = -minv * vehicle.K
-        A[N_DOF:, N_DOF:] = -minv * vehicle.C0
-        B = np.zeros((2 * N_DOF, 4))
-        B[N_DOF:] = minv * vehicle.T
-        q = np.zeros(2 * N_DOF)
+        A = np.zeros((2 * n, 2 * n))
+        A[:n, n:] = np.eye(n)
+        A[n:, :n] = -minv * vehicle.K
+        A[n:, n:] = -minv * vehicle.C0
+        B = np.zeros((2 * n, 4))
+        B[n:] = minv * vehicle.T
+        q = np.zeros(2 * n)
         q[:3] = self.q_z, self.q_phi, self.q_theta
-        q[N_DOF : N_DOF + 3] = self.qd_z, self.qd_phi, self.qd_theta
+        q[n : n + 3] = self.qd_z, self.qd_phi, self.qd_theta
         return A, B, np.diag(q), self.r * np.eye(4)
 
     def lqr(self, vehicle: Vehicle) -> tuple[np.ndarray, np.ndarray]:

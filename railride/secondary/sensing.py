@@ -92,10 +92,10 @@ SENSING = ("ideal", "accelerometers")
 
 
 def reads_bogies(G) -> bool:
-    """Whether an outer loop's gain G (4 x 6 on the carbody states, or 4 x 18 on (q, q'))
+    """Whether an outer loop's gain G (4 x 6 on the carbody states, or 4 x 2n on (q, q'))
     reads a bogie state, which the carbody accelerometers cannot give."""
     G = np.asarray(G, dtype=float)
-    if G.shape != (4, 2 * layout.N_DOF):
+    if G.shape not in ((4, 2 * layout.N_RIGID), (4, 2 * layout.N_DOF)):
         return False
-    n = layout.N_DOF
-    return bool(np.any(G[:, 3:n] != 0.0) or np.any(G[:, n + 3 :] != 0.0))
+    n = G.shape[1] // 2  # the vehicle's (q, q') or the engine's: the bogies are DOFs 3 to 8 in both
+    return bool(np.any(G[:, 3:9] != 0.0) or np.any(G[:, n + 3 : n + 9] != 0.0))
