@@ -195,6 +195,11 @@ class VehicleParams:
             )
         return dataclasses.replace(self, **changes)
 
+    def rigid(self) -> "VehicleParams":
+        """The same vehicle with a rigid carbody (its bending mode off: no L_c, f_bend, EI_c); in a
+        TOML file, ``rigid_carbody = true``."""
+        return dataclasses.replace(self, L_c=None, f_bend=None, EI_c=None)
+
     def loaded(self, load: float) -> "VehicleParams":
         """The vehicle with a payload: the carbody's mass and moments of inertia times ``load``
         (the load factor, a finite number > 0: 1 the carbody as these parameters give it, 1.3 a
@@ -274,6 +279,9 @@ class VehicleParams:
         table = dict(table)
         names = [f.name for f in dataclasses.fields(cls)]
         base_name = table.pop("preset", None)
+        rigid = table.pop("rigid_carbody", False)  # a preset's flexible carbody switched off
+        if not isinstance(rigid, bool):
+            raise InputError(f"{source}: [vehicle] rigid_carbody = {shown(rigid)}: must be true or false")
         unknown = sorted(set(table) - set(names))
         if unknown:
             raise InputError(
@@ -288,6 +296,8 @@ class VehicleParams:
                     f"{source}: missing vehicle parameter(s) {', '.join(missing)} "
                     '(list them all, or start from a base with preset = "paper")'
                 )
+        if rigid:
+            table.update(L_c=None, f_bend=None, EI_c=None)
         try:
             return base.replace(**table) if base_name is not None else cls(**table)
         except ValueError as exc:  # the field's rule: name the file and table too
@@ -435,6 +445,9 @@ MANCHESTER_1 = VehicleParams(
     k_ar=9.4e5,  # source, per bogie
     z_stop=0.04,  # assumed
     k_stop=2.0e6,  # assumed
+    L_c=23.0,  # assumed: a 23 m coach body over the 19 m bogie spacing
+    f_bend=10.0,  # assumed: the middle of the 8-12 Hz of passenger carbodies (Zhou et al. 2009)
+    zeta_bend=0.02,  # assumed: 2 % modal damping
 )
 
 #: A CRH380A-type high-speed car: values as given for a CRH380A-type car in the published
@@ -473,6 +486,9 @@ CRH380A = VehicleParams(
     k_ar=2.5e6,  # assumed: an air-spring car carries an anti-roll bar
     z_stop=0.04,  # assumed
     k_stop=2.0e6,  # assumed
+    L_c=25.0,  # assumed: the 25 m of a CRH380A-type intermediate car
+    f_bend=10.0,  # assumed: the middle of the 8-12 Hz of passenger carbodies (Zhou et al. 2009)
+    zeta_bend=0.02,  # assumed: 2 % modal damping
 )
 
 PRESETS: dict[str, VehicleParams] = {"paper": PAPER, "manchester-1": MANCHESTER_1, "crh380a": CRH380A}
