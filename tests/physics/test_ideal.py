@@ -277,6 +277,8 @@ def test_cli_compare_with_the_ideal_actuator(tmp_path):
         "force_max_n",
         "travel_rms_m",
         "travel_max_m",
+        "clearance_m",
+        "reached_stops",
         "demand_rms_n",
         "demand_max_n",
     }
