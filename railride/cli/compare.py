@@ -62,6 +62,7 @@ from railride.cli._parsing import (
 from railride.cli._league import run_league
 from railride.cli._render import (
     RESPONSE_LABELS,
+    warn_gains_mismatch,
     alike_text,
     compare_comfort_table,
     damper_text,
@@ -628,6 +629,7 @@ def compare(
         text = json.dumps(doc, indent=2, allow_nan=False)  # refuses NaN before anything is written
         if out is not None:
             write_folder(out, lambda: write_compare_outputs(result, out, doc, figures=figures, histories=histories))
+    warn_gains_mismatch(doc["settings"])
     if format is OutputFormat.json:
         typer.echo(text)
     else:

@@ -366,8 +366,10 @@ def compare(
     ``controllers`` names from `railride.secondary.control.CONTROLLERS` or "all" (default the paper's
     four, `PAPER_CONTROLLERS`; passive is always run as the baseline; passive-on and passive-off,
     MR dampers at a constant voltage, are not run on the ideal devices, which have none:
-    ``settings["not_run"]`` says so); ``gains`` a `GainSet` (default: the shipped gains); ``damper`` the name of the
-    controlled suspensions' dampers (`railride.secondary.dampers.NAMES`: an MR preset or "ideal", the
+    ``settings["not_run"]`` says so); ``gains`` a `GainSet` (default: the shipped gains; tuned
+    for another vehicle, load or track, ``settings["gains_mismatch"]`` says so in one line,
+    `GainSet.mismatch`); ``damper`` the name of the controlled suspensions' dampers
+    (`railride.secondary.dampers.NAMES`: an MR preset or "ideal", the
     ideal actuator) and ``damper_scale`` the factor on an MR damper's force capacity
     (`BoucWen.scaled`; 1 for the ideal actuator); passive stays the viscous baseline. Each
     suspension is `Suspension.named` (controller name, gains, damper, scale, ``sensor_noise``).
@@ -394,6 +396,8 @@ def compare(
     names = check_controllers(controllers)
     scenario = as_scenario(scenario)
     gains = GainSet.default() if gains is None else gains
+    # gains tuned for another vehicle, load or track: one line (the command line warns with it)
+    mismatch = gains.mismatch(record, scenario.describe(), names)
     faults = check_faults(faults, model)
     ideal = model.law == dampers.LAW_IDEAL
     # a constant voltage means nothing to the ideal devices: said in the settings, not run
@@ -483,6 +487,7 @@ def compare(
         **({"faults": [f.label for f in faults]} if faults else {}),
         **({"delay_periods": int(delay)} if delay != 1 else {}),
         **({"sensing": sensing.to_dict()} if sensing is not None else {}),
+        **({"gains_mismatch": mismatch} if mismatch else {}),
     }
     comfort_values = None
     if comfort:
