@@ -377,11 +377,19 @@ class RideResult:
         return json.loads(str(self.dataset[name].values))
 
     def _vehicle_record(self) -> dict:
+        """The vehicle's record (`railride.model.params.vehicle_record`: a preset's name, or
+        "custom"; load 1, the values as run), then the keys of railride 0.4 (``vehicle_preset``
+        or ``vehicle_params``)."""
+        from railride.model.params import vehicle_record
+
         params = self.params
-        name = next((k for k, v in PRESETS.items() if v == params), None) if params is not None else None
+        if params is None:
+            params = VehicleParams(**self._record("vehicle_params", None))
+        name = next((k for k, v in PRESETS.items() if v == params), None)
+        record = {"vehicle": vehicle_record(params, name)}
         if name is not None:
-            return {"vehicle_preset": name}
-        return {"vehicle_params": self._record("vehicle_params", params)}
+            return {**record, "vehicle_preset": name}
+        return {**record, "vehicle_params": self._record("vehicle_params", params)}
 
     def to_pandas(self):
         """The time histories as a DataFrame, one column per scalar channel."""
