@@ -641,14 +641,20 @@ def compare(
 
 
 def _stops_note(rows: list[dict]) -> str:
-    """The bump stops under the damper table: their clearance, and which suspensions reached them."""
+    """The bump stops under the damper table: their clearance, and which suspensions reached it."""
     clearance = next((r["damper"].get("clearance_m") for r in rows), None)
     if clearance is None:
         return " The vehicle has no bump stops: the travel is unbounded."
+    stiffness = next((r["damper"].get("stop_stiffness_n_per_m", 0.0) for r in rows), 0.0)
     hit = [r["label"] for r in rows if r["damper"].get("reached_stops")]
     if not hit:
         return f" No suspension reached the bump stops ({clearance * 1e3:g} mm clearance)."
+    if stiffness > 0.0:
+        return (
+            f" *: reached the bump stops at {clearance * 1e3:g} mm ({', '.join(hit)}): the stops bound "
+            "that travel and carry force there."
+        )
     return (
-        f" *: reached the bump stops at {clearance * 1e3:g} mm ({', '.join(hit)}): the stops bound "
-        "that travel and carry force there."
+        f" *: beyond the {clearance * 1e3:g} mm clearance to the bump stops ({', '.join(hit)}), which this "
+        "vehicle gives no stiffness (k_stop = 0): that travel is not bounded, and a real car would be on its stops."
     )

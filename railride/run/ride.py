@@ -356,8 +356,9 @@ class RideResult:
 
     def travel(self, window=None) -> dict:
         """The largest secondary deflection (suspension travel, any corner) over ``window``
-        (start, end) s, the bump stops' clearance (None: none) and whether the travel reached
-        it (the stops then bound the travel and carry force): ``max_m``, ``clearance_m``,
+        (start, end) s, the bump stops' clearance (None: none), their stiffness (0: the clearance
+        is only marked) and whether the travel reached the clearance (stops with a stiffness
+        then bound it and carry force): ``max_m``, ``clearance_m``, ``stop_stiffness_n_per_m``,
         ``reached_stops``. A single run (select a sample of a batch first)."""
         from railride.analysis.metrics import select_window
 
@@ -367,7 +368,12 @@ class RideResult:
         part = select_window(self.dataset, window)
         top = float(np.nanmax(np.abs(part["secondary_deflection"].values)))
         z = params.z_stop  # with a stiffness of 0 the stops are only marked: reported, no force
-        return {"max_m": top, "clearance_m": z, "reached_stops": bool(z is not None and top >= z)}
+        return {
+            "max_m": top,
+            "clearance_m": z,
+            "stop_stiffness_n_per_m": params.k_stop,
+            "reached_stops": bool(z is not None and top >= z),
+        }
 
     def _record(self, name: str, value) -> dict:
         """The JSON record of the run's scenario or parameters: from the value the run kept,

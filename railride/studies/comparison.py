@@ -97,12 +97,14 @@ class Comparison:
     def demands(self) -> dict:
         """Per suspension, over the metrics window: RMS and peak damper force on the carbody [N],
         RMS and peak secondary deflection (suspension travel) [m], the bump stops' clearance [m]
-        (None: none) and whether the travel reached it, and for the controlled ones
+        (None: none), their stiffness [N/m] (0: the clearance is only marked) and whether the
+        travel reached the clearance, and for the controlled ones
         with MR dampers the mean command voltage [V] and the fraction of time at v_max (the
         ideal actuator has no voltage: those two entries are absent, as for passive)."""
         v_max = dampers.preset(self.damper).v_max if self.damper in dampers.PRESETS else np.inf
         vehicle = self.settings.get("vehicle_params") or VehicleParams.preset("paper").to_dict()
         clearance = vehicle.get("z_stop")  # None: no bump stops
+        stiffness = vehicle.get("k_stop", 0.0)  # 0: the clearance is marked, no stop force
         out = {}
         for name, ds in self.datasets.items():
             part = select_window(ds, self.window)
@@ -116,6 +118,7 @@ class Comparison:
                 # the bump stops' clearance, and whether the travel reached it (then the stops
                 # bound the travel and carry force: the result is the vehicle on its stops)
                 "clearance_m": clearance,
+                "stop_stiffness_n_per_m": stiffness,
                 "reached_stops": bool(clearance is not None and travel.max() >= clearance),
             }
             if "damper_demand_force" in part:  # what the outer loop asked for

@@ -278,6 +278,7 @@ def test_cli_compare_with_the_ideal_actuator(tmp_path):
         "travel_rms_m",
         "travel_max_m",
         "clearance_m",
+        "stop_stiffness_n_per_m",
         "reached_stops",
         "demand_rms_n",
         "demand_max_n",
