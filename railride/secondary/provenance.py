@@ -95,8 +95,10 @@ def mismatch(gains, vehicle: dict | None = None, scenarios=None, controllers=Non
     loads = [float(x) for x in (loads if isinstance(loads, list) else [loads])]
     tuned = tuned_loads(provenance)
     differs = []
-    if not _same_vehicle(provenance, vehicle):
-        differs.append(f"vehicle {vehicle.get('name')}")
+    other = _other_values(provenance, vehicle)
+    if other is not None:  # the same name with other values: the values that differ
+        named = str(vehicle.get("name")) == tuned_vehicle(provenance)[0] and other
+        differs.append(f"vehicle {vehicle.get('name')}" + (f" (other values: {_words(other)})" if named else ""))
     other_loads = [x for x in loads if not any(math.isclose(x, t, rel_tol=1e-12) for t in tuned)]
     if other_loads:
         differs.append(f"load{'s' * (len(other_loads) > 1)} {_list(other_loads)}")
@@ -179,9 +181,10 @@ def provenance_toml(provenance: dict, name: str = "provenance") -> str:
 
 
 # -- comparisons --------------------------------------------------------------------------------
-def _same_vehicle(provenance: dict, run: dict) -> bool:
-    """Whether the run's vehicle record is the one the gains were tuned on: the same values
-    (those both records have; a preset's name stands for its values), else the same name."""
+def _other_values(provenance: dict, run: dict) -> list[str] | None:
+    """None where the run's vehicle record is the one the gains were tuned on (the same values,
+    of those both records have, a preset's name standing for its values; else the same name),
+    else the names of the values that differ (empty where names were compared)."""
     from railride.model.params import PRESETS
 
     name, values, _ = tuned_vehicle(provenance)
@@ -189,9 +192,14 @@ def _same_vehicle(provenance: dict, run: dict) -> bool:
         values = PRESETS[name].to_dict()
     run_values = run.get("values")
     if values is None or not isinstance(run_values, dict):
-        return name == str(run.get("name"))
-    common = set(values) & set(run_values)
-    return bool(common) and all(_same(values[k], run_values[k]) for k in common)
+        return None if name == str(run.get("name")) else []
+    common = [k for k in run_values if k in values]
+    other = [k for k in common if not _same(values[k], run_values[k])]
+    return other if other or not common else None
+
+
+def _words(names: list[str]) -> str:
+    return ", ".join(names[:_SHOWN]) + (f" and {len(names) - _SHOWN} more" if len(names) > _SHOWN else "")
 
 
 def _on_track(gains, record: dict) -> bool | None:

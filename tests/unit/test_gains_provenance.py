@@ -263,3 +263,11 @@ def test_provenance_toml_writes_every_toml_value():
     expected = {k: v for k, v in provenance.items() if v is not None}
     assert back == expected
     assert '"odd key" = 1' in text and "[provenance.nested.a.b]" in text and "[provenance.wide]" in text
+
+
+def test_the_same_name_with_other_values_says_which():
+    text = (
+        GainSet.default().to_toml().replace('vehicle = "paper"\n', 'vehicle = "paper"\nvehicle_values = {m_c = 1.0}\n')
+    )
+    line = GainSet.from_toml(text).mismatch(record(), track())
+    assert "this run has vehicle paper (other values: m_c); tune for it with: railride tune" in line
