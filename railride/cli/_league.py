@@ -12,7 +12,7 @@ from railride.errors import InputError
 from railride.cli._common import ProgressBar, stderr_is_terminal, stdout_console, write_folder
 from railride.cli._options import OutputFormat
 from railride.cli._parsing import damper_preset, load_gains, parse_scale, vehicle_arguments
-from railride.cli._render import alike_text, fmt, untuned_text
+from railride.cli._render import alike_text, fmt, untuned_text, warn_gains_mismatch
 
 
 def run_league(
@@ -87,6 +87,7 @@ def run_league(
     if out is not None:
         write_folder(out, lambda: write_league_outputs(table, out, figures=figures))
     parts = league_table(table, doc)
+    warn_gains_mismatch(doc["settings"])
     if format is OutputFormat.json:
         typer.echo(text)
     else:

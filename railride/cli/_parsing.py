@@ -161,7 +161,7 @@ def vehicle_from_options(vehicle: Optional[str], preset: Optional[str], load: Op
     """(the VehicleParams to run: --load scales the carbody's mass and inertias,
     `VehicleParams.loaded`; the vehicle's entries of a run's JSON document): ``vehicle``, the
     record of every output (`railride.model.params.vehicle_record`: name, load, values),
-    after ``vehicle_preset`` or ``vehicle_params_file`` and, when --load is given,
+    then ``vehicle_preset`` or ``vehicle_params_file`` and, when --load is given,
     ``load_factor``, as the documents have always named the vehicle."""
     source, params, record = _vehicle(vehicle, preset, load)
     named: dict = (
@@ -169,7 +169,7 @@ def vehicle_from_options(vehicle: Optional[str], preset: Optional[str], load: Op
     )
     if load is not None:
         named["load_factor"] = float(load)
-    return params, {**named, "vehicle": record}
+    return params, {"vehicle": record, **named}
 
 
 def vehicle_arguments(vehicle: Optional[str], preset: Optional[str], load: Optional[float] = None) -> dict:

@@ -166,6 +166,15 @@ def untuned_text(names) -> str:
     )
 
 
+def warn_gains_mismatch(settings: dict) -> None:
+    """The result's ``gains_mismatch`` (`GainSet.mismatch`: gains tuned for another vehicle,
+    load or track, and the `railride tune` command for this one) as one warning line on
+    stderr, before the results; nothing where the settings have none."""
+    line = settings.get("gains_mismatch")
+    if line:
+        typer.echo(f"warning: {line}", err=True)
+
+
 #: columns of the console the report's tables are rendered on (an HTML page scrolls sideways)
 REPORT_WIDTH = 120
 

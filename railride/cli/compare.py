@@ -62,6 +62,7 @@ from railride.cli._parsing import (
 from railride.cli._league import run_league
 from railride.cli._render import (
     RESPONSE_LABELS,
+    warn_gains_mismatch,
     alike_text,
     compare_comfort_table,
     damper_text,
@@ -628,6 +629,7 @@ def compare(
         text = json.dumps(doc, indent=2, allow_nan=False)  # refuses NaN before anything is written
         if out is not None:
             write_folder(out, lambda: write_compare_outputs(result, out, doc, figures=figures, histories=histories))
+    warn_gains_mismatch(doc["settings"])
     if format is OutputFormat.json:
         typer.echo(text)
     else:
@@ -639,14 +641,20 @@ def compare(
 
 
 def _stops_note(rows: list[dict]) -> str:
-    """The bump stops under the damper table: their clearance, and which suspensions reached them."""
+    """The bump stops under the damper table: their clearance, and which suspensions reached it."""
     clearance = next((r["damper"].get("clearance_m") for r in rows), None)
     if clearance is None:
         return " The vehicle has no bump stops: the travel is unbounded."
+    stiffness = next((r["damper"].get("stop_stiffness_n_per_m", 0.0) for r in rows), 0.0)
     hit = [r["label"] for r in rows if r["damper"].get("reached_stops")]
     if not hit:
         return f" No suspension reached the bump stops ({clearance * 1e3:g} mm clearance)."
+    if stiffness > 0.0:
+        return (
+            f" *: reached the bump stops at {clearance * 1e3:g} mm ({', '.join(hit)}): the stops bound "
+            "that travel and carry force there."
+        )
     return (
-        f" *: reached the bump stops at {clearance * 1e3:g} mm ({', '.join(hit)}): the stops bound "
-        "that travel and carry force there."
+        f" *: beyond the {clearance * 1e3:g} mm clearance to the bump stops ({', '.join(hit)}), which this "
+        "vehicle gives no stiffness (k_stop = 0): that travel is not bounded, and a real car would be on its stops."
     )

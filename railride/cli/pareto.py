@@ -61,7 +61,7 @@ from railride.cli._parsing import (
     study_scenario,
     vehicle_arguments,
 )
-from railride.cli._render import RESPONSE_LABELS, damper_text, fmt
+from railride.cli._render import RESPONSE_LABELS, damper_text, fmt, warn_gains_mismatch
 
 #: the library's names of pareto's options, for its errors (the track's seed is named while the
 #: scenario is built, the sample's after)
@@ -216,6 +216,7 @@ def pareto_command(
                 write_folder(out, lambda: result.save(out, figure_formats=figures.figure_formats, dpi=figures.dpi))
     finally:
         executor.close()
+    warn_gains_mismatch(doc["settings"])
     if format is OutputFormat.json:
         print_json(doc)
         return

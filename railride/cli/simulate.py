@@ -135,7 +135,10 @@ def _travel_lines(travel: dict | None) -> list[str]:
     top, z = travel["max_m"] * 1e3, travel["clearance_m"]
     if z is None:
         return [f"max secondary travel {top:.1f} mm (no bump stops)"]
-    reached = ": REACHED the bump stops, which bound it" if travel["reached_stops"] else ""
+    reached = ""
+    if travel["reached_stops"]:
+        bounded = travel.get("stop_stiffness_n_per_m", 0.0) > 0.0
+        reached = ": REACHED the bump stops, which bound it" if bounded else ": BEYOND it (no stop force: unbounded)"
     return [f"max secondary travel {top:.1f} mm of {z * 1e3:g} mm clearance{reached}"]
 
 

@@ -52,7 +52,7 @@ from railride.cli._parsing import (
     vehicle_source,
 )
 from railride.cli._render import RESPONSE_LABELS, reduction_text
-from railride.cli._render import check_report_option, save_report
+from railride.cli._render import check_report_option, save_report, warn_gains_mismatch
 
 #: the library's names of the study's options, for its errors
 STUDY_FIELDS = {
@@ -318,6 +318,7 @@ def study_command(
                 write_folder(out, lambda: result.save(out, figure_formats=figures.figure_formats, dpi=figures.dpi))
     finally:
         executor.close()
+    warn_gains_mismatch(doc["settings"])
     if format is OutputFormat.json:
         typer.echo(text)
     else:

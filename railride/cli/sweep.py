@@ -63,7 +63,7 @@ from railride.cli._parsing import (
     vehicle_arguments,
 )
 from railride.cli._render import RESPONSE_LABELS, damper_text, fmt
-from railride.cli._render import check_report_option, save_report
+from railride.cli._render import check_report_option, save_report, warn_gains_mismatch
 
 #: how the errors of railride.studies.sweep.grid name its keywords: by this command's options
 OPTION_NAMES = {
@@ -289,6 +289,7 @@ def sweep_command(
     finally:
         executor.close()
     printed = _sweep_table(doc["rows"], list(grid.columns), _caption(grid, doc, wall))
+    warn_gains_mismatch(doc["settings"])
     if format is SweepFormat.json:
         typer.echo(text)
     elif format is SweepFormat.csv:

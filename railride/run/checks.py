@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import functools
 import math
+import os
 from dataclasses import dataclass
 from typing import Any
 
@@ -205,7 +206,7 @@ def _check_size(scenarios, solver: SolverSettings, damper, closed, exact: bool, 
 
 
 def _as_list(x):
-    if x is None or isinstance(x, (Scenario, VehicleParams, str)) or not hasattr(x, "__iter__"):
+    if x is None or isinstance(x, (Scenario, VehicleParams, str, os.PathLike)) or not hasattr(x, "__iter__"):
         return [x]
     return list(x)
 
@@ -325,7 +326,7 @@ def check(scenario=None, params=None, suspension=None, solver=None, on_divergenc
         )
     batch = (
         not (isinstance(scenario, (Scenario, str)) or scenario is None)
-        or not (isinstance(params, (VehicleParams, str)) or params is None)
+        or not (isinstance(params, (VehicleParams, str, os.PathLike)) or params is None)
         or isinstance(suspension, (list, tuple))
     )
     scenarios = [as_scenario(s) for s in _as_list(scenario)]

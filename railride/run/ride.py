@@ -366,8 +366,9 @@ class RideResult:
 
     def travel(self, window=None) -> dict:
         """The largest secondary deflection (suspension travel, any corner) over ``window``
-        (start, end) s, the bump stops' clearance (None: none) and whether the travel reached
-        it (the stops then bound the travel and carry force): ``max_m``, ``clearance_m``,
+        (start, end) s, the bump stops' clearance (None: none), their stiffness (0: the clearance
+        is only marked) and whether the travel reached the clearance (stops with a stiffness
+        then bound it and carry force): ``max_m``, ``clearance_m``, ``stop_stiffness_n_per_m``,
         ``reached_stops``. A single run (select a sample of a batch first)."""
         from railride.analysis.metrics import select_window
 
@@ -377,7 +378,12 @@ class RideResult:
         part = select_window(self.dataset, window)
         top = float(np.nanmax(np.abs(part["secondary_deflection"].values)))
         z = params.z_stop  # with a stiffness of 0 the stops are only marked: reported, no force
-        return {"max_m": top, "clearance_m": z, "reached_stops": bool(z is not None and top >= z)}
+        return {
+            "max_m": top,
+            "clearance_m": z,
+            "stop_stiffness_n_per_m": params.k_stop,
+            "reached_stops": bool(z is not None and top >= z),
+        }
 
     def _record(self, name: str, value) -> dict:
         """The JSON record of the run's scenario or parameters: from the value the run kept,
@@ -387,11 +393,19 @@ class RideResult:
         return json.loads(str(self.dataset[name].values))
 
     def _vehicle_record(self) -> dict:
+        """The vehicle's record (`railride.model.params.vehicle_record`: a preset's name, or
+        "custom"; load 1, the values as run), then the keys of railride 0.4 (``vehicle_preset``
+        or ``vehicle_params``)."""
+        from railride.model.params import vehicle_record
+
         params = self.params
-        name = next((k for k, v in PRESETS.items() if v == params), None) if params is not None else None
+        if params is None:
+            params = VehicleParams(**self._record("vehicle_params", None))
+        name = next((k for k, v in PRESETS.items() if v == params), None)
+        record = {"vehicle": vehicle_record(params, name)}
         if name is not None:
-            return {"vehicle_preset": name}
-        return {"vehicle_params": self._record("vehicle_params", params)}
+            return {**record, "vehicle_preset": name}
+        return {**record, "vehicle_params": self._record("vehicle_params", params)}
 
     def to_pandas(self):
         """The time histories as a DataFrame, one column per scalar channel."""

@@ -49,6 +49,7 @@ def simulate(
     params=None,
     suspension=None,
     *,
+    vehicle=None,
     solver=None,
     initial_state=None,
     progress=None,
@@ -57,7 +58,8 @@ def simulate(
     """Simulate the vehicle on one or many scenarios.
 
     ``scenario`` is a `Scenario`, a scenario name (see `railride.model.track.scenario`) or a list of
-    them; ``params`` is a `VehicleParams`, a preset name or a list; ``suspension`` a
+    them; ``params`` (or ``vehicle=``, its other name) is a `VehicleParams`, a preset name, the
+    path of a parameters file or a list; ``suspension`` a
     `railride.Suspension` (None: passive, the viscous dampers c_sz) or a list. Lists run as one
     batch along a ``sample`` dimension (a single item is broadcast against a list). Every
     sample of a batch must share the duration, and the suspensions of a batch one damper model,
@@ -81,6 +83,9 @@ def simulate(
     tables), `pack` (the stepper's arrays), `step` (the compiled engine, in chunks) and
     `assemble` (the `RideResult`).
     """
+    from railride.model.params import vehicle_argument
+
+    params = vehicle_argument(vehicle, params)
     return run(check(scenario, params, suspension, solver, on_divergence, initial_state), progress)
 
 

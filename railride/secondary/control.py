@@ -386,6 +386,18 @@ class GainSet:
         # a tuning set (robust tuning): any of its tracks, whatever the load
         return any({k: v for k, v in r.items() if k != "load"} == record for r in self.provenance.get("tuning_set", []))
 
+    def mismatch(self, vehicle: dict | None = None, scenarios=None, controllers=None) -> str | None:
+        """One line when a run with these gains leaves the case they were tuned for (another
+        vehicle, load or track, as their [provenance] says), naming what differs and the
+        `railride tune` command that would tune for the run; None when it does not, or when the
+        gains record no tuning. ``vehicle``: the run's `railride.model.params.vehicle_record`;
+        ``scenarios``: its `Scenario.describe` record, or a study's list of them;
+        ``controllers``: the suspensions it runs (None: a controller among them); none that
+        reads gains, no line (`railride.secondary.provenance.mismatch`)."""
+        from railride.secondary.provenance import mismatch
+
+        return mismatch(self, vehicle, scenarios, controllers)
+
     def controller(self, name: str):
         """The outer loop called ``name`` (None for the passive suspension and the
         constant-voltage baselines, which have none)."""
@@ -395,9 +407,14 @@ class GainSet:
             raise InputError(f"unknown controller {name!r}; allowed: {', '.join(CONTROLLERS)}")
         return _OUTER_LOOPS[name].build(self)
 
-    def to_toml(self, tables=TABLES) -> str:
-        """A gains file of ``tables`` (default all: a complete file to start from)."""
-        lines = []
+    def to_toml(self, tables=TABLES, *, provenance: bool = True) -> str:
+        """A gains file of ``tables`` (default all: a complete file to start from), after the
+        [provenance] table of these gains where they have one and ``provenance`` is True
+        (`railride.secondary.provenance.provenance_toml`: `load` of the file has the same
+        provenance); `key_text` leaves it out."""
+        from railride.secondary.provenance import provenance_toml
+
+        lines = [provenance_toml(self.provenance)] if provenance and self.provenance else []
         for t in tables:
             key, obj = _TABLES[self._table_name(t)][0], self.table(t)
             lines.append(f"[{key}]")
@@ -417,7 +434,7 @@ class GainSet:
                 return self.table(t) != self.table(_OWN_COPIES[t])
             return t in self.PAPER_TABLES or self.table(t) != reference.table(t)
 
-        return self.to_toml([t for t in self.TABLES if kept(t)])
+        return self.to_toml([t for t in self.TABLES if kept(t)], provenance=False)
 
     @classmethod
     def from_toml(cls, text: str, source: str = "<string>", *, complete: bool = False) -> "GainSet":

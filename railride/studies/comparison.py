@@ -97,12 +97,14 @@ class Comparison:
     def demands(self) -> dict:
         """Per suspension, over the metrics window: RMS and peak damper force on the carbody [N],
         RMS and peak secondary deflection (suspension travel) [m], the bump stops' clearance [m]
-        (None: none) and whether the travel reached it, and for the controlled ones
+        (None: none), their stiffness [N/m] (0: the clearance is only marked) and whether the
+        travel reached the clearance, and for the controlled ones
         with MR dampers the mean command voltage [V] and the fraction of time at v_max (the
         ideal actuator has no voltage: those two entries are absent, as for passive)."""
         v_max = dampers.preset(self.damper).v_max if self.damper in dampers.PRESETS else np.inf
         vehicle = self.settings.get("vehicle_params") or VehicleParams.preset("paper").to_dict()
         clearance = vehicle.get("z_stop")  # None: no bump stops
+        stiffness = vehicle.get("k_stop", 0.0)  # 0: the clearance is marked, no stop force
         out = {}
         for name, ds in self.datasets.items():
             part = select_window(ds, self.window)
@@ -116,6 +118,7 @@ class Comparison:
                 # the bump stops' clearance, and whether the travel reached it (then the stops
                 # bound the travel and carry force: the result is the vehicle on its stops)
                 "clearance_m": clearance,
+                "stop_stiffness_n_per_m": stiffness,
                 "reached_stops": bool(clearance is not None and travel.max() >= clearance),
             }
             if "damper_demand_force" in part:  # what the outer loop asked for
@@ -366,8 +369,10 @@ def compare(
     ``controllers`` names from `railride.secondary.control.CONTROLLERS` or "all" (default the paper's
     four, `PAPER_CONTROLLERS`; passive is always run as the baseline; passive-on and passive-off,
     MR dampers at a constant voltage, are not run on the ideal devices, which have none:
-    ``settings["not_run"]`` says so); ``gains`` a `GainSet` (default: the shipped gains); ``damper`` the name of the
-    controlled suspensions' dampers (`railride.secondary.dampers.NAMES`: an MR preset or "ideal", the
+    ``settings["not_run"]`` says so); ``gains`` a `GainSet` (default: the shipped gains; tuned
+    for another vehicle, load or track, ``settings["gains_mismatch"]`` says so in one line,
+    `GainSet.mismatch`); ``damper`` the name of the controlled suspensions' dampers
+    (`railride.secondary.dampers.NAMES`: an MR preset or "ideal", the
     ideal actuator) and ``damper_scale`` the factor on an MR damper's force capacity
     (`BoucWen.scaled`; 1 for the ideal actuator); passive stays the viscous baseline. Each
     suspension is `Suspension.named` (controller name, gains, damper, scale, ``sensor_noise``).
@@ -394,6 +399,8 @@ def compare(
     names = check_controllers(controllers)
     scenario = as_scenario(scenario)
     gains = GainSet.default() if gains is None else gains
+    # gains tuned for another vehicle, load or track: one line (the command line warns with it)
+    mismatch = gains.mismatch(record, scenario.describe(), names)
     faults = check_faults(faults, model)
     ideal = model.law == dampers.LAW_IDEAL
     # a constant voltage means nothing to the ideal devices: said in the settings, not run
@@ -483,6 +490,7 @@ def compare(
         **({"faults": [f.label for f in faults]} if faults else {}),
         **({"delay_periods": int(delay)} if delay != 1 else {}),
         **({"sensing": sensing.to_dict()} if sensing is not None else {}),
+        **({"gains_mismatch": mismatch} if mismatch else {}),
     }
     comfort_values = None
     if comfort:

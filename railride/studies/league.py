@@ -137,7 +137,8 @@ def league(
     scenarios). ``vehicle`` (``params`` is an alias) and ``load``: the vehicle as `compare`
     takes it, resolved once and recorded in ``settings["vehicle"]`` and in the ``vehicle``
     column of `cases`. The other arguments are `compare`'s; the bounds (ideal devices) are
-    always run.
+    always run; ``settings["gains_mismatch"]``: the one line of `GainSet.mismatch` over every
+    case, when the gains were tuned for another vehicle, load or track.
     ``progress(done_cases, total_cases)`` is called after each case."""
     scenarios = list(scenarios) if not isinstance(scenarios, str) else [scenarios]
     if not scenarios:
@@ -180,6 +181,10 @@ def league(
         "untuned": gains.untuned(names),
         "tuned_alike": gains.tuning_budget(names),
     }
+    # gains tuned for another vehicle, load or track: one line for every case (`GainSet.mismatch`)
+    mismatch = gains.mismatch(record, [sc.describe() for *_, sc in todo], names)
+    if mismatch:
+        settings["gains_mismatch"] = mismatch
     return LeagueTable(pd.DataFrame(rows), names, settings, gains.provenance.get("scenario_record"))
 
 

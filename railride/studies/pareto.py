@@ -298,6 +298,8 @@ def pareto(
         "base_gains_tuned_on": (base.provenance or {}).get("scenario"),
         "vehicle": vehicle_rec,
         **other_settings(vehicle, solver),
+        # base gains tuned for another vehicle, load or track: one line (`GainSet.mismatch`)
+        **({"gains_mismatch": m} if (m := base.mismatch(vehicle_rec, record)) else {}),
     }
     return ParetoResult(
         suspension,

@@ -179,7 +179,9 @@ def study(
     parameters file or `VehicleParams`, default "paper"; the loads scale its carbody;
     ``settings["vehicle"]`` records it, `railride.model.params.vehicle_record`, and the runs'
     table names it in its ``vehicle`` column). Every setting is checked before the first run. ``executor``, ``table``
-    and ``progress`` as for `railride.studies.sweep.run_cases`. Returns a `StudyResult`."""
+    and ``progress`` as for `railride.studies.sweep.run_cases`. ``settings["gains_mismatch"]``:
+    one line (`GainSet.mismatch`) when the gains were tuned for another vehicle, load or track
+    than some of the runs'. Returns a `StudyResult`."""
     from railride.analysis.metrics import check_window
     from railride.secondary.suspension import damper_model
     from railride.studies.sweep import other_settings
@@ -339,6 +341,10 @@ def study(
         "vehicle": record,
         **other_settings(vehicle, solver),
     }
+    # gains tuned for another vehicle, load or track: one line for every run (`GainSet.mismatch`)
+    tracks = [scenario_of(scenario, options).describe() for options, _ in opts_of.values()]
+    if mismatch := gains.mismatch(record, tracks, names):
+        settings["gains_mismatch"] = mismatch
     return StudyResult(frame, summary, settings, failed)
 
 

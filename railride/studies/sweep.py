@@ -329,7 +329,8 @@ class SweepResult:
         damper, the base gains' source, the sensor noise, the step and the metrics window;
         with comfort, what its columns are (`comfort_settings`); the vehicle's record
         (``vehicle``: name, load, values); a solver's rates and a vehicle other than the
-        defaults (`other_settings`)."""
+        defaults (`other_settings`); ``gains_mismatch`` where the base gains were tuned for
+        another vehicle, load or track (`gains_mismatch`)."""
         from railride.model.params import vehicle_record
 
         g = self.grid
@@ -350,7 +351,20 @@ class SweepResult:
             **({"comfort": comfort_settings(g.duration, g.window)} if self.comfort else {}),
             "vehicle": record,
             **other_settings(vehicle, g.solver),
+            **({"gains_mismatch": m} if (m := self.gains_mismatch(record)) else {}),
         }
+
+    def gains_mismatch(self, record: dict | None = None) -> str | None:
+        """One line when the base gains were tuned for another vehicle, load or track than the
+        controllers' runs of the sweep (`GainSet.mismatch`, over every track they run), else
+        None. ``record``: the vehicle's record (default ``vehicle_record``)."""
+        g = self.grid
+        if record is None:
+            record = self.vehicle_record
+        controlled = {(c.scenario, c.scenario_options) for c in g.cases if c.suspension in g.controllers}
+        if not controlled:
+            return None
+        return g.base_gains.mismatch(record, [scenario_of(name, opts).describe() for name, opts in controlled])
 
     def report_contents(self):
         """What this result shows in its HTML report (`railride.output.report.write_report`)."""

@@ -144,11 +144,14 @@ class TuneResult:
 
     def gains_toml(self, command: str | None = None) -> str:
         """The gains file of the tuned gains with its provenance: a header of comments and a
-        [provenance] table (scenario and its record, damper, step, objective, the laws tuned,
-        the budget, start gains, date; ``command``, the command line that ran the study, when
-        given) with one [provenance.studies.NAME] table per law (`Study`), which `GainSet.load`
-        keeps as ``provenance``."""
+        [provenance] table (scenario and its record, damper, step, objective, the vehicle's
+        name, the load factor or factors, the scenarios and speeds, the laws tuned, the budget,
+        start gains, date; ``command``, the command line that ran the study, when given), the
+        vehicle's values ([provenance.vehicle_values]) and one [provenance.studies.NAME] table
+        per law (`Study`), which `GainSet.load` keeps as ``provenance`` (`GainSet.mismatch`
+        reads the vehicle, loads and tracks)."""
         from railride.analysis.labels import describe_dampers
+        from railride.model.params import vehicle_text
 
         s = self.settings
         doc = self.to_dict()
@@ -163,6 +166,7 @@ class TuneResult:
             *([f"# command: {command}"] if command is not None else []),
             f"# date: {doc['date']}; railride {doc['railride_version']}",
             f"# scenario: {run_text}, dt {s['dt_s']:g} s, {describe_dampers(s, detail=True)}",
+            *([f"# {vehicle_text(s['vehicle'])}"] if s.get("vehicle") else []),
             f"# objective: {statement}",
             *(
                 [
@@ -218,6 +222,8 @@ class TuneResult:
                 if "tuning_set" in s
                 else []
             ),
+            # the vehicle, loads, scenarios and speeds it ran (`GainSet.mismatch` reads them)
+            *self._case_lines(),
             # the laws whose gains these are (`GainSet.untuned` names the others)
             f"controllers = {json.dumps([c for c in self.controllers if c != 'inner'])}",
             f"inner_loop_tuned = {json.dumps('inner' in self.controllers)}",
@@ -226,6 +232,11 @@ class TuneResult:
             f"start_gains = {json.dumps(s['start_gains'])}",
             "",
         ]
+        values = (s.get("vehicle") or {}).get("values")
+        if values:
+            lines.append("[provenance.vehicle_values]")
+            lines += [f"{k} = {_toml_value(v)}" for k, v in values.items() if v is not None]
+            lines.append("")
         for st in self.studies:
             d = st.to_dict()
             lines.append(f"[provenance.studies.{st.controller}]")
@@ -271,6 +282,21 @@ class TuneResult:
         doc = {**self.to_dict(), **(extra or {})}
         gains = self.gains_toml(command)
         return write_tune_outputs(self.curves, folder, doc, gains, title=self._title(), figures=figures)
+
+    def _case_lines(self) -> list[str]:
+        """The [provenance] lines of the case it tuned for: ``vehicle`` (the name of its record),
+        ``load`` (a list for a robust tuning over several), ``scenarios`` and ``speeds_m_s``
+        (those of the scenario, or of every run of the tuning set)."""
+        vehicle = self.settings.get("vehicle") or {"name": "paper", "load": 1.0}
+        records = self.settings.get("tuning_set") or [self.scenario]
+        names = list(dict.fromkeys(r["name"] for r in records if "name" in r))
+        speeds = list(dict.fromkeys(float(r["speed_m_s"]) for r in records if "speed_m_s" in r))
+        return [
+            f"vehicle = {json.dumps(str(vehicle['name']))}",
+            f"load = {_toml_value(vehicle['load'])}",
+            f"scenarios = {json.dumps(names)}",
+            f"speeds_m_s = {json.dumps(speeds)}",
+        ]
 
     def _scenario_text(self) -> str:
         from railride.analysis.labels import describe_scenario

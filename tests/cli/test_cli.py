@@ -79,13 +79,17 @@ def test_simulate_json_document():
         "schema",
         "railride_version",
         "scenario",
+        "vehicle",
         "vehicle_preset",
         "suspension",
         "settings",
         "metrics",
+        "travel",
     ]
     assert doc["schema"] == "railride.simulation/1"
+    assert doc["travel"]["clearance_m"] == 0.08 and not doc["travel"]["reached_stops"]
     assert doc["vehicle_preset"] == "paper"
+    assert {k: v for k, v in doc["vehicle"].items() if k != "values"} == {"name": "paper", "load": 1.0}
     assert doc["scenario"]["name"] == "paper-sine" and doc["scenario"]["duration_s"] == 2.0
     assert doc["scenario"]["speed_m_s"] == 55.56  # scenario default applied
     assert doc["settings"] == {"dt_s": 1e-4, "output_rate_hz": 1000.0, "window_s": [0.0, 2.0]}
@@ -208,10 +212,16 @@ def test_the_document_is_the_library_one():
             "simulate", "--suspension", "mr", "--voltage", 1, "--damper-scale", 2, "--duration", 1, "--format", "json"
         ).stdout
     )
+    from railride.model.params import VehicleParams, vehicle_record
+
     library = simulate(
         scenario("paper-sine", duration=1.0), "paper", Suspension.named("mr", damper_scale=2.0, voltage=1.0)
     ).to_dict()
-    assert doc == library and doc["suspension"]["damper_scale"] == 2.0
+    # the command's document is the library's: the vehicle by the record every output keeps
+    record = vehicle_record(VehicleParams.preset("paper"), "paper")
+    assert doc["vehicle"] == library["vehicle"] == record
+    assert doc == library and list(doc) == list(library)
+    assert doc["suspension"]["damper_scale"] == 2.0
 
 
 def test_window_outside_run():

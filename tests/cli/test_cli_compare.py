@@ -374,7 +374,8 @@ def test_compare_with_a_payload_keeps_the_gains_and_records_the_loaded_vehicle()
     assert doc["gains"] == nominal["gains"]  # the gains tuned for the nominal vehicle
     assert doc["controllers"][0]["metrics"] != nominal["controllers"][0]["metrics"]  # a heavier car rides otherwise
     text = ok("compare", "--duration", 1, "--load", 1.3).stdout
-    assert "load factor 1.3" in text
+    assert "vehicle: paper, load 1.3" in text
+    assert doc["settings"]["vehicle"]["load"] == 1.3 and doc["settings"]["vehicle"]["values"] == paper.to_dict()
     simulated = ok_json("simulate", "--duration", 1, "--load", 1.3)
     assert simulated["load_factor"] == 1.3
 

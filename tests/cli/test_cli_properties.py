@@ -498,7 +498,7 @@ def _params_text() -> str:
 def _gains_text() -> str:
     from railride.secondary.control import GainSet
 
-    return GainSet.default().to_toml()
+    return GainSet.default().to_toml(provenance=False)  # the gains' entries, every one a number
 
 
 #: the commands that read each file, on their tiny cases

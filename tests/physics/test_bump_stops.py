@@ -14,7 +14,9 @@ from railride.model.params import VehicleParams
 from railride.model.vehicle import Vehicle
 from railride.run.solver import SolverSettings
 
-PAPER = VehicleParams.preset("paper")
+#: the paper's vehicle on bump stops at its (assumed) clearance, 80 mm, with a rubber stop's
+#: order of stiffness; the paper preset itself only marks the clearance (k_stop = 0)
+PAPER = VehicleParams.preset("paper").replace(k_stop=2.0e6)
 N = 9
 
 
@@ -62,6 +64,7 @@ def test_a_carbody_released_beyond_its_stops_moves_as_scipy_integrates_it():
 def test_a_run_that_stays_off_the_stops_is_the_run_without_them():
     sc = rr.scenario("paper-sine", duration=2.0)
     none = PAPER.replace(z_stop=None, k_stop=0.0)
+    assert VehicleParams.preset("paper").k_stop == 0.0  # the paper's preset: a marked clearance only
     for suspension in (None, rr.Suspension.named("sas-attitude-ride"), rr.Suspension.named("passive-on")):
         a = rr.simulate(sc, PAPER, suspension, solver=SolverSettings(method="rk4"))
         b = rr.simulate(sc, none, suspension, solver=SolverSettings(method="rk4"))
@@ -97,6 +100,8 @@ def test_the_lane_stepper_and_the_sample_stepper_agree_at_the_stops(monkeypatch)
     by_lanes = rr.simulate(sc, PAPER, suspension).dataset
     monkeypatch.setattr(lanes, "lanes_fit", lambda *a: False)
     by_samples = rr.simulate(sc, PAPER, suspension).dataset
+    unmarked = rr.simulate(sc, PAPER.replace(k_stop=0.0), suspension).dataset  # the stops did act
+    assert np.max(np.abs(unmarked["carbody_bounce"].values - by_samples["carbody_bounce"].values)) > 1e-4
     assert np.max(np.abs(by_lanes["secondary_deflection"].values)) > PAPER.z_stop  # some lanes touch
     for name in ("carbody_bounce", "carbody_roll", "secondary_damper_force"):  # to rounding (vector sums)
         a, b = by_lanes[name].values, by_samples[name].values

@@ -40,12 +40,12 @@ APPENDIX = {
 }
 
 
-#: beyond the appendix: no anti-roll bar, bump stops the paper does not give (assumed,
-#: docs/model.md, Presets), and a rigid carbody (no bending mode)
+#: beyond the appendix: no anti-roll bar, an assumed clearance to bump stops the paper does not
+#: give, marked only: no stop force (docs/model.md, Presets), and a rigid carbody (no bending mode)
 BEYOND = {
     "k_ar": 0.0,
     "z_stop": 0.08,
-    "k_stop": 2.0e6,
+    "k_stop": 0.0,
     "L_c": None,
     "f_bend": None,
     "EI_c": None,

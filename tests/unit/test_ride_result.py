@@ -38,10 +38,12 @@ def test_the_document_of_a_run(mr):
         "schema",
         "railride_version",
         "scenario",
+        "vehicle",
         "vehicle_preset",
         "suspension",
         "settings",
         "metrics",
+        "travel",
     ]
     assert doc["schema"] == SCHEMA == "railride.simulation/1"
     assert doc["scenario"] == SC.describe() and doc["vehicle_preset"] == "paper"

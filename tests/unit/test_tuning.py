@@ -266,6 +266,7 @@ def test_tune_result_to_dict_is_the_tune_document(short_tune):
         "tolerance": 1e-3,
         "min_span": 1.05,
         "start_gains": "railride/data/reference_gains.toml",
+        "vehicle": {"name": "paper", "load": 1.0, "values": VehicleParams.preset("paper").to_dict()},
     }
     assert doc["objective"] == DEFAULT_OBJECTIVE.to_dict()
     assert doc["gains"]["pid"] == res.gains.pid.to_dict()

@@ -1,0 +1,339 @@
+"""Where a gains file's gains were tuned, and whether a run is that case (docs/tuning.md, Provenance).
+
+`railride tune` writes a [provenance] table into the gains file it makes (`TuneResult.gains_toml`):
+besides the study's settings, the vehicle (``vehicle``: its name; ``vehicle_values``: its
+parameters), the load factor (``load``, a list for a robust tuning over several), the tracks
+(``scenario_record``, or ``tuning_set`` for a robust tuning; in short ``scenarios`` and
+``speeds_m_s``). A file whose provenance names no vehicle (one of railride 0.4.0 and before) was
+tuned on the paper's vehicle at load 1; a file with no provenance at all records no tuning, and
+nothing is said about it.
+
+`mismatch` turns that into one line when a run leaves the case the gains were tuned for (another
+vehicle, load or track), with the `railride tune` command that would tune for the run
+(`tune_command`); `provenance_toml` writes the table back as TOML (`GainSet.to_toml`)."""
+
+from __future__ import annotations
+
+import datetime
+import json
+import math
+import numbers
+import re
+import shlex
+
+#: what gains whose provenance names no vehicle were tuned on: the paper's vehicle, unloaded
+DEFAULT_VEHICLE = "paper"
+DEFAULT_LOAD = 1.0
+#: the scenario `railride tune` tunes on when --scenario is not given
+DEFAULT_SCENARIO = "paper-sine"
+#: keys of `Scenario.describe` -> (the option of `railride tune` that sets it, its word, its unit)
+_TRACK_OPTIONS = {
+    "speed_m_s": ("--speed", "speed", "m/s"),
+    "seed": ("--track-seed", "seed", ""),
+    "amplitude_m": ("--amplitude", "amplitude", "m"),
+    "height_m": ("--amplitude", "height", "m"),
+    "wavelength_m": ("--wavelength", "wavelength", "m"),
+    "length_m": ("--wavelength", "length", "m"),  # the bump's (a random track's is no option)
+    "rail_phase_deg": ("--rail-phase", "rail phase", "deg"),
+    "min_wavelength_m": ("--min-wavelength", "shortest wavelength", "m"),
+    "max_wavelength_m": ("--max-wavelength", "longest wavelength", "m"),
+    "duration_s": ("--duration", "duration", "s"),
+}
+#: how many values of a list a line shows before it says how many there are
+_SHOWN = 5
+
+
+def tuned_vehicle(provenance: dict) -> tuple[str, dict | None, bool]:
+    """(name, values or None, recorded) of the vehicle the gains were tuned on; ``recorded``
+    False: the provenance names none and the paper's vehicle is assumed."""
+    vehicle = provenance.get("vehicle")
+    if isinstance(vehicle, dict):  # the whole record as a table
+        return str(vehicle.get("name", DEFAULT_VEHICLE)), vehicle.get("values"), True
+    if vehicle is None:
+        return DEFAULT_VEHICLE, None, False
+    values = provenance.get("vehicle_values")
+    return str(vehicle), values if isinstance(values, dict) else None, True
+
+
+def tuned_loads(provenance: dict) -> list[float]:
+    """The load factors the gains were tuned at (1 where the provenance names none)."""
+    load = provenance.get("load")
+    if load is None and isinstance(provenance.get("vehicle"), dict):
+        load = provenance["vehicle"].get("load")
+    load = DEFAULT_LOAD if load is None else load
+    return [float(x) for x in (load if isinstance(load, list) else [load])]
+
+
+def tuned_tracks(provenance: dict) -> list[dict]:
+    """The scenario records the gains were tuned on: the tuning set's (without their loads), or
+    the one ``scenario_record``; empty where the provenance has neither."""
+    if isinstance(provenance.get("tuning_set"), list):
+        return [{k: v for k, v in r.items() if k != "load"} for r in provenance["tuning_set"]]
+    record = provenance.get("scenario_record")
+    return [record] if isinstance(record, dict) else []
+
+
+def mismatch(gains, vehicle: dict | None = None, scenarios=None, controllers=None) -> str | None:
+    """One line when a run with ``gains`` (a `GainSet`) leaves the case they were tuned for, else
+    None. ``vehicle``: the run's `railride.model.params.vehicle_record` (its load a list where a
+    study runs several; None: the paper's vehicle at load 1); ``scenarios``: the run's track, a
+    `Scenario.describe` record or a list of them (a study's). The vehicle differs when its
+    values do (by name where the gains' provenance has no values and names no preset); a load
+    differs when it is none of the tuned loads; a track when the gains were not tuned on it
+    (`GainSet.tuned_on`, whatever the duration). Any track or load of a robust tuning matches.
+    The line names what differs and the `railride tune` command that tunes for the run
+    (`tune_command`). Gains without provenance record no tuning: None; so do ``controllers``
+    (names, when given) of which none reads the gains (passive, constant voltages)."""
+    provenance = gains.provenance
+    if not provenance:
+        return None
+    if controllers is not None and all(gains.controller(n) is None for n in controllers):
+        return None
+    vehicle = vehicle or {"name": DEFAULT_VEHICLE, "load": DEFAULT_LOAD}
+    records = [scenarios] if isinstance(scenarios, dict) else [r for r in (scenarios or ()) if r is not None]
+    loads = vehicle.get("load", DEFAULT_LOAD)
+    loads = [float(x) for x in (loads if isinstance(loads, list) else [loads])]
+    tuned = tuned_loads(provenance)
+    differs = []
+    other = _other_values(provenance, vehicle)
+    if other is not None:  # the same name with other values: the values that differ
+        named = str(vehicle.get("name")) == tuned_vehicle(provenance)[0] and other
+        differs.append(f"vehicle {vehicle.get('name')}" + (f" (other values: {_words(other)})" if named else ""))
+    other_loads = [x for x in loads if not any(math.isclose(x, t, rel_tol=1e-12) for t in tuned)]
+    if other_loads:
+        differs.append(f"load{'s' * (len(other_loads) > 1)} {_list(other_loads)}")
+    off = [r for r in records if _on_track(gains, r) is False]
+    if off:
+        differs.append(f"track{'s' * (len(off) > 1)} {_tracks_text(off, tuned_tracks(provenance))}")
+    if not differs:
+        return None
+    # another vehicle or load wants every track tuned again; else the tracks they were not tuned on
+    retune = records if len(differs) > (1 if off else 0) else off
+    return (
+        f"the gains {gains.source} were tuned for {_tuned_text(provenance)}; this run has {', '.join(differs)}; "
+        f"tune for it with: {tune_command(vehicle, retune)}"
+    )
+
+
+def tune_command(vehicle: dict | None, scenarios=()) -> str:
+    """The `railride tune` command line that tunes for a run on ``vehicle`` (a `vehicle_record`,
+    its load a number or a list) and the tracks ``scenarios`` (`Scenario.describe` records):
+    the options that differ from the command's defaults. Several track seeds or loads are one
+    robust tuning (the command takes lists); other settings that take several values (speeds,
+    scenarios) name the first, and the line says which others want a tuning of their own."""
+    vehicle = vehicle or {}
+    parts = ["railride", "tune"]
+    name = str(vehicle.get("name", DEFAULT_VEHICLE))
+    if name != DEFAULT_VEHICLE:
+        parts += ["--vehicle", "FILE.toml" if name == "custom" else shlex.quote(name)]
+    loads = vehicle.get("load", DEFAULT_LOAD)
+    loads = list(dict.fromkeys(float(x) for x in (loads if isinstance(loads, list) else [loads])))
+    if loads != [DEFAULT_LOAD]:
+        parts += ["--load", ",".join(_number(x) for x in loads)]
+    records = [scenarios] if isinstance(scenarios, dict) else [r for r in scenarios if r is not None]
+    others = []
+    if records:
+        names = list(dict.fromkeys(str(r.get("name")) for r in records))
+        main = names[0]
+        if main != DEFAULT_SCENARIO:
+            parts += ["--scenario", shlex.quote(main)]
+        own = [r for r in records if str(r.get("name")) == main]
+        defaults = _default_record(main)
+        for key, (option, word, unit) in _TRACK_OPTIONS.items():
+            if key == "length_m" and own[0].get("profile") != "cosine-bump":
+                continue
+            values = list(dict.fromkeys(r[key] for r in own if r.get(key) is not None))
+            if not values or values == [defaults.get(key)]:
+                continue
+            if key == "seed":  # several seeds: one robust tuning
+                parts += [option, ",".join(str(v) for v in values)]
+                continue
+            parts += [option, _number(values[0])]
+            if len(values) > 1:
+                others.append(f"{word} {_list(values[1:])}{' ' + unit if unit else ''}")
+        if len(names) > 1:
+            others.append(f"scenario{'s' * (len(names) > 2)} {', '.join(names[1:])}")
+    return " ".join(parts) + (f" (and one tuning each for {'; '.join(others)})" if others else "")
+
+
+def provenance_toml(provenance: dict, name: str = "provenance") -> str:
+    """``provenance`` as the TOML table [``name``] (text ending in a blank line): numbers,
+    strings, booleans, dates, lists, flat records of up to 12 plain values as inline tables,
+    other tables as [``name``.KEY] sub-tables ([provenance.studies.pid]). None has no TOML form
+    and is left out. `tomllib` reads it back as the same dict."""
+    lines: list[str] = []
+
+    def table(head: str, values: dict) -> None:
+        subs = [(k, v) for k, v in values.items() if isinstance(v, dict) and not _inline(v)]
+        plain = [(k, v) for k, v in values.items() if not (isinstance(v, dict) and not _inline(v))]
+        if plain or not subs:  # a table of sub-tables only needs no header of its own
+            lines.append(f"[{head}]")
+            for k, v in plain:
+                text = _value(v)
+                if text is not None:
+                    lines.append(f"{_key(k)} = {text}")
+            lines.append("")
+        for k, v in subs:
+            table(f"{head}.{_key(k)}", v)
+
+    table(_key(name), provenance)
+    return "\n".join(lines) + "\n"
+
+
+# -- comparisons --------------------------------------------------------------------------------
+def _other_values(provenance: dict, run: dict) -> list[str] | None:
+    """None where the run's vehicle record is the one the gains were tuned on (the same values,
+    of those both records have, a preset's name standing for its values; else the same name),
+    else the names of the values that differ (empty where names were compared)."""
+    from railride.model.params import PRESETS
+
+    name, values, _ = tuned_vehicle(provenance)
+    if values is None and name in PRESETS:
+        values = PRESETS[name].to_dict()
+    run_values = run.get("values")
+    if values is None or not isinstance(run_values, dict):
+        return None if name == str(run.get("name")) else []
+    common = [k for k in run_values if k in values]
+    other = [k for k in common if not _same(values[k], run_values[k])]
+    return other if other or not common else None
+
+
+def _words(names: list[str]) -> str:
+    return ", ".join(names[:_SHOWN]) + (f" and {len(names) - _SHOWN} more" if len(names) > _SHOWN else "")
+
+
+def _on_track(gains, record: dict) -> bool | None:
+    """Whether the gains were tuned on the track ``record`` whatever its duration; None where
+    their provenance does not say. A hand-written provenance may give ``scenarios`` and
+    ``speeds_m_s`` alone."""
+    provenance = gains.provenance
+    tracks = tuned_tracks(provenance)
+    if tracks:
+        durations = {t.get("duration_s") for t in tracks} | {record.get("duration_s")}
+        return any(gains.tuned_on({**record, "duration_s": d} if "duration_s" in record else record) for d in durations)
+    names, speeds = provenance.get("scenarios"), provenance.get("speeds_m_s")
+    if not names and not speeds:
+        return None
+    speed = record.get("speed_m_s")
+    return (not names or record.get("name") in names) and (
+        not speeds or (speed is not None and any(_same(speed, s) for s in speeds))
+    )
+
+
+def _same(a, b) -> bool:
+    if isinstance(a, numbers.Real) and isinstance(b, numbers.Real) and not isinstance(a, bool):
+        return math.isclose(float(a), float(b), rel_tol=1e-12, abs_tol=0.0) or a == b
+    return a == b
+
+
+def _default_record(name: str) -> dict:
+    """The record of scenario ``name`` with its defaults (empty where it cannot be made: a
+    measured profile's file that is gone)."""
+    from railride.model.track import scenario
+
+    try:
+        return scenario(name).describe()
+    except (ValueError, OSError):
+        return {}
+
+
+# -- words --------------------------------------------------------------------------------------
+def _tuned_text(provenance: dict) -> str:
+    name, _, recorded = tuned_vehicle(provenance)
+    loads = tuned_loads(provenance)
+    text = f"vehicle {name}, load{'s' * (len(loads) > 1)} {_list(loads)}"
+    if not recorded:
+        text += " (assumed: the file names no vehicle)"
+    tracks = tuned_tracks(provenance)
+    names = list(dict.fromkeys(str(r.get("name")) for r in tracks)) or provenance.get("scenarios") or []
+    speeds = list(dict.fromkeys(r.get("speed_m_s") for r in tracks if r.get("speed_m_s") is not None))
+    speeds = speeds or provenance.get("speeds_m_s") or []
+    seeds = list(dict.fromkeys(r["seed"] for r in tracks if r.get("seed") is not None))
+    if names:
+        text += f", on {', '.join(map(str, names))}"
+        if seeds:
+            text += f" (seed{'s' * (len(seeds) > 1)} {_list(seeds)})"
+        if speeds:
+            text += f" at {_list(speeds)} m/s"
+    return text
+
+
+def _tracks_text(records: list[dict], tuned: list[dict]) -> str:
+    """The tracks of ``records`` in a few words: per scenario, the settings whose values are
+    none of the tuned tracks' of that scenario (its speed where it is another scenario)."""
+    out = []
+    for name in dict.fromkeys(str(r.get("name")) for r in records):
+        own = [r for r in records if str(r.get("name")) == name]
+        same = [t for t in tuned if str(t.get("name")) == name]
+        found = []
+        for k, (_, word, unit) in _TRACK_OPTIONS.items():
+            if k == "duration_s" or (k not in same[0] if same else k != "speed_m_s"):
+                continue
+            values = list(dict.fromkeys(r[k] for r in own if k in r and not any(_same(r[k], t.get(k)) for t in same)))
+            if values:
+                found.append(f"{word} {_list(values)}{' ' + unit if unit else ''}")
+        out.append(name + (f" ({'; '.join(found)})" if found else ""))
+    return ", ".join(out)
+
+
+def _list(values) -> str:
+    """Numbers as a short list: all of up to five, else the first three, "...", the last and
+    how many."""
+    shown = [_number(v) for v in values]
+    if len(shown) > _SHOWN:
+        return f"{', '.join(shown[:3])}, ..., {shown[-1]} ({len(shown)} values)"
+    return ", ".join(shown)
+
+
+def _number(value) -> str:
+    """A number as short as it reads back exactly (55.56, 1.3, 60), anything else as text."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        return str(value)
+    if isinstance(value, numbers.Integral):
+        return str(int(value))
+    short = f"{float(value):g}"
+    return short if float(short) == float(value) else repr(float(value))
+
+
+# -- TOML ---------------------------------------------------------------------------------------
+_BARE = re.compile(r"^[A-Za-z0-9_-]+$")
+
+
+def _key(key) -> str:
+    key = str(key)
+    return key if _BARE.match(key) else _string(key)
+
+
+def _inline(values: dict) -> bool:
+    """A flat record of a few plain values: written as an inline table."""
+    return len(values) <= 12 and not any(isinstance(v, (dict, list, tuple)) for v in values.values())
+
+
+def _string(text: str) -> str:
+    # JSON's escapes are TOML's; TOML also wants DEL escaped
+    return json.dumps(text, ensure_ascii=False).replace("\x7f", "\\u007f")
+
+
+def _value(value) -> str | None:
+    """A value as TOML spells it; None for None (TOML has no null)."""
+    if value is None:
+        return None
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, numbers.Integral):
+        return str(int(value))
+    if isinstance(value, numbers.Real):
+        x = float(value)
+        if math.isnan(x):
+            return "nan"
+        return repr(x) if math.isfinite(x) else ("inf" if x > 0 else "-inf")
+    if isinstance(value, str):
+        return _string(value)
+    if isinstance(value, (datetime.datetime, datetime.date, datetime.time)):
+        return value.isoformat()
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(t for t in map(_value, value) if t is not None) + "]"
+    if isinstance(value, dict):
+        items = [(_key(k), _value(v)) for k, v in value.items()]
+        return "{" + ", ".join(f"{k} = {t}" for k, t in items if t is not None) + "}"
+    return _string(str(value))
