@@ -226,7 +226,8 @@ class VehicleParams:
         changes: tuple = ()
         if load != 1.0:
             loaded = self.loaded(load)
-            changes += tuple((n, getattr(loaded, n)) for n in ("m_c", "I_cx", "I_cy", "I_cz"))
+            carbody = ("m_c", "I_cx", "I_cy", "I_cz") + (("f_bend",) if self.f_bend is not None else ())
+            changes += tuple((n, getattr(loaded, n)) for n in carbody)
         k = number("stiffness", stiffness, "positive", allowed="a finite number > 0 (the factor on k_sz)")
         if k != 1.0:
             changes += (("k_sz", k * self.k_sz),)

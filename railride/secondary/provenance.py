@@ -14,6 +14,8 @@ vehicle, load or track), with the `railride tune` command that would tune for th
 
 from __future__ import annotations
 
+import dataclasses
+
 import datetime
 import json
 import math
@@ -185,7 +187,7 @@ def _other_values(provenance: dict, run: dict) -> list[str] | None:
     """None where the run's vehicle record is the one the gains were tuned on (the same values,
     of those both records have, a preset's name standing for its values; else the same name),
     else the names of the values that differ (empty where names were compared)."""
-    from railride.model.params import PRESETS
+    from railride.model.params import PRESETS, VehicleParams
 
     name, values, _ = tuned_vehicle(provenance)
     if values is None and name in PRESETS:
@@ -193,8 +195,15 @@ def _other_values(provenance: dict, run: dict) -> list[str] | None:
     run_values = run.get("values")
     if values is None or not isinstance(run_values, dict):
         return None if name == str(run.get("name")) else []
+    # an optional field (an element the vehicle may not have: the bending, the stops) that a
+    # record leaves out holds its default (TOML keeps no None; older records lack the field);
+    # other fields are compared where both records have them
+    optional = {f.name: f.default for f in dataclasses.fields(VehicleParams) if f.default is not dataclasses.MISSING}
     common = [k for k in run_values if k in values]
-    other = [k for k in common if not _same(values[k], run_values[k])]
+    extra = [k for k in dict.fromkeys([*run_values, *values]) if k in optional and k not in common]
+    other = [
+        k for k in common + extra if not _same(values.get(k, optional.get(k)), run_values.get(k, optional.get(k)))
+    ]
     return other if other or not common else None
 
 

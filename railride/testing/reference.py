@@ -34,13 +34,15 @@ def simulate_reference(
     damper=None,
     voltage: float | None = None,
 ) -> dict[str, np.ndarray]:
-    """RK4 in NumPy. Returns time, q, q' and carbody acceleration every ``output_every`` steps.
+    """RK4 in NumPy. Returns time, q, q' (the vehicle's DOFs: nine, or ten where the carbody
+    bends) and carbody acceleration every ``output_every`` steps.
 
     Without ``damper`` the secondary dashpots are c_sz; with a model from railride.secondary.dampers its
     law (`rates`) acts at the four corners at the constant command ``voltage``.
     """
     veh = Vehicle(params)
     M, K, C0, K_w, C_w, T = veh.M, veh.K, veh.C0, veh.K_w, veh.C_w, veh.T
+    nd = veh.n_dof  # 9, or 10 where the carbody bends
     c_sz = veh.params.c_sz
     lag = veh.wheelset_lag_distance
     V = scenario.speed
@@ -56,7 +58,7 @@ def simulate_reference(
         return w, wd
 
     def rhs(t, state):
-        q, v, d = state[:9], state[9:18], state[18:].reshape(4, 3)
+        q, v, d = state[:nd], state[nd : 2 * nd], state[2 * nd :].reshape(4, 3)
         w, wd = rails(t)
         if damper is None:
             f = -c_sz * (T.T @ v)
@@ -69,24 +71,25 @@ def simulate_reference(
         return np.concatenate([v, np.linalg.solve(M, force), dd.ravel()])
 
     n_steps = int(round(scenario.duration / dt))
-    state = np.zeros(30)
-    state[20::3] = v_cmd  # coils settled at the command
+    state = np.zeros(2 * nd + 12)
+    state[2 * nd + 2 :: 3] = v_cmd  # coils settled at the command
     times, qs, vs, accs = [], [], [], []
     for n in range(n_steps + 1):
         t = n * dt
         k1 = rhs(t, state)
         if n % output_every == 0:
             times.append(t)
-            qs.append(state[:9].copy())
-            vs.append(state[9:18].copy())
-            accs.append(k1[9])
+            qs.append(state[:nd].copy())
+            vs.append(state[nd : 2 * nd].copy())
+            accs.append(k1[nd])
         if n == n_steps:
             break
         m = 1
         if damper is not None:
-            rates = T.T @ state[9:18]
+            rates = T.T @ state[nd : 2 * nd]
             lam = max(
-                dampers.stiffness_estimate(damper, rates[c], state[18 + 3 * c], state[20 + 3 * c]) for c in range(4)
+                dampers.stiffness_estimate(damper, rates[c], state[2 * nd + 3 * c], state[2 * nd + 2 + 3 * c])
+                for c in range(4)
             )
             m = _substeps(lam, dt)
         h = dt / m

@@ -26,7 +26,9 @@ def run_example(name: str, out: Path, *args: str) -> str:
     return proc.stdout
 
 
-@pytest.mark.parametrize("name", ["paper_comparison", "speed_sweep_random_track", "custom_vehicle", "damper_size"])
+@pytest.mark.parametrize(
+    "name", ["paper_comparison", "speed_sweep_random_track", "custom_vehicle", "damper_size", "flexible_carbody"]
+)
 def test_example_has_a_docstring_and_uses_no_private_names(name):
     text = (ROOT / "examples" / f"{name}.py").read_text()
     assert text.startswith('"""')
@@ -67,6 +69,12 @@ def test_damper_size(tmp_path):
         ), name
     assert "Best MR size here" in out
     assert (tmp_path / "size" / "damper_size.csv").is_file()
+
+
+def test_flexible_carbody(tmp_path):
+    out = run_example("flexible_carbody", tmp_path / "flex", "--seeds", "1", "--duration", "10")
+    assert re.search(r"^\| passive \| 0\.\d{3} \| 0\.\d{3} \(\d\.\d\dx\) \|", out, re.M)
+    assert (tmp_path / "flex" / "flexible_carbody.csv").is_file()
 
 
 def test_readme_python_block_runs():

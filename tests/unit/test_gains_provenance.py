@@ -53,7 +53,8 @@ def test_tune_records_the_vehicle_load_scenarios_and_speeds(tuned):
     res, gains = tuned
     p = gains.provenance
     assert p["vehicle"] == "crh380a" and p["load"] == 1.0
-    assert p["vehicle_values"] == VehicleParams.preset("crh380a").to_dict()
+    # TOML keeps no None: the fields the vehicle leaves out (EI_c: it bends at a given f_bend)
+    assert p["vehicle_values"] == {k: v for k, v in VehicleParams.preset("crh380a").to_dict().items() if v is not None}
     assert p["scenarios"] == ["paper-sine"] and p["speeds_m_s"] == [55.56]
     assert p["scenario_record"] == res.scenario  # the existing keys stay
     assert p["controllers"] == ["pid"] and p["budget"] == 5 and "pid" in p["studies"]
@@ -266,8 +267,15 @@ def test_provenance_toml_writes_every_toml_value():
 
 
 def test_the_same_name_with_other_values_says_which():
-    text = (
-        GainSet.default().to_toml().replace('vehicle = "paper"\n', 'vehicle = "paper"\nvehicle_values = {m_c = 1.0}\n')
-    )
+    values = {**{k: v for k, v in VehicleParams.preset("paper").to_dict().items() if v is not None}, "m_c": 1.0}
+    inline = "{" + ", ".join(f"{k} = {v!r}" for k, v in values.items()) + "}"
+    text = GainSet.default().to_toml().replace('vehicle = "paper"\n', f'vehicle = "paper"\nvehicle_values = {inline}\n')
     line = GainSet.from_toml(text).mismatch(record(), track())
     assert "this run has vehicle paper (other values: m_c); tune for it with: railride tune" in line
+
+
+def test_gains_tuned_on_the_rigid_car_say_so_on_the_car_that_bends():
+    bending = VehicleParams.preset("paper").replace(L_c=24.0, f_bend=10.0)
+    line = GainSet.default().mismatch(vehicle_record(bending, "paper"), track())
+    assert line is not None and "L_c" in line and "f_bend" in line
+    assert GainSet.default().mismatch(record(), track()) is None

@@ -80,7 +80,8 @@ def test_each_preset_is_a_plausible_full_size_vehicle(name):
         warnings.simplefilter("error")
         assert VehicleParams(**p.to_dict()) == p  # builds again without a PlausibilityWarning
     assert p.a == pytest.approx(0.7465 if name != "paper" else 1.0)
-    assert p.z_stop is not None and p.k_stop > 0
+    assert p.z_stop is not None
+    assert p.k_stop > 0 if name != "paper" else p.k_stop == 0  # the paper's clearance is only marked
 
 
 def test_an_unknown_preset_lists_the_presets():
@@ -136,7 +137,9 @@ def massless_bogies(p: VehicleParams) -> dict[str, float]:
 
 @pytest.mark.parametrize("name", list(PRESETS))
 def test_carbody_modes_against_the_carbody_on_its_secondary(name):
-    p = VehicleParams.preset(name)
+    # the hand formulas are of a rigid carbody: the presets that bend are taken rigid here (the
+    # bending, coupled at the secondary, lowers their bounce by about 1 %: checked below)
+    p = VehicleParams.preset(name).rigid()
     modes = {m.label: m.frequency_hz for m in Vehicle(p).modes()}
     held, free = held_bogies(p), massless_bogies(p)
     for label in ("carbody bounce", "carbody pitch", "carbody roll"):
@@ -154,6 +157,18 @@ def test_carbody_modes_against_the_carbody_on_its_secondary(name):
         # less than 1 %.
         assert f <= free[label] * (1 + 1e-9), label
         assert f == pytest.approx(free[label], rel=0.01), label
+
+
+@pytest.mark.parametrize("name", [n for n in PRESETS if VehicleParams.preset(n).flexible])
+def test_a_bending_carbody_keeps_its_rigid_modes_within_two_percent(name):
+    # a 10 Hz bending mode coupled at the secondary: the rigid-body modes of the carbody, at
+    # 1-2 Hz, move by the small share of the bending in them (measured 1.0 % in bounce)
+    p = VehicleParams.preset(name)
+    rigid = {m.label: m.frequency_hz for m in Vehicle(p.rigid()).modes()}
+    modes = {m.label: m.frequency_hz for m in Vehicle(p).modes()}
+    assert modes["carbody bending"] == pytest.approx(p.bending_hz, rel=0.05)
+    for label in ("carbody bounce", "carbody pitch", "carbody roll"):
+        assert modes[label] == pytest.approx(rigid[label], rel=0.02), label
 
 
 @pytest.mark.parametrize("name", list(PRESETS))
