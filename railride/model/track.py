@@ -43,6 +43,7 @@ MAX_TABLE_NODES = 2_000_000
 MAX_RAIL_AMPLITUDE = 1.0  # m, sine amplitude and bump height
 MAX_SPEED = 200.0  # m/s
 MAX_RAIL_PHASE = 360.0  # deg, either way
+MAX_WAVELENGTH = 1.0e5  # m, a sine's wavelength and a bump's length
 
 
 def _check(name: str, value, rule: str, allowed: str) -> float:
@@ -116,6 +117,7 @@ class SineTrack(RailProfile):
             object.__setattr__(self, field_name, _check(name, getattr(self, field_name), rule, allowed))
         _within("amplitude", self.amplitude, MAX_RAIL_AMPLITUDE, "m", "a rail a metre out of line is no track")
         _within("rail_phase", self.rail_phase_deg, MAX_RAIL_PHASE, "deg", "a phase is an angle of one turn")
+        _within("wavelength", self.wavelength, MAX_WAVELENGTH, "m", "a sine 100 km long is a gradient, not a ride input")
 
     def _evaluate(self, s):
         k = 2 * np.pi / self.wavelength

@@ -81,6 +81,34 @@ def test_a_robust_tuning_records_its_tracks_and_loads_and_any_of_them_matches(ro
     assert "railride tune --load 1,1.5 --scenario fra4 --track-seed 0,1,2 --duration 0.5" in line
 
 
+def check_schema(doc: dict) -> None:
+    """``doc`` validates against its schema in docs/schemas (the settings' gains_mismatch too)."""
+    import json
+    from pathlib import Path
+
+    jsonschema = pytest.importorskip("jsonschema")
+    name = doc["schema"].replace("/", "-")
+    schema = json.loads((Path(__file__).parents[2] / "docs" / "schemas" / f"{name}.json").read_text())
+    jsonschema.validate(json.loads(json.dumps(doc, default=str)), schema, cls=jsonschema.Draft202012Validator)
+    assert "gains_mismatch" in schema["properties"]["settings"]["properties"]
+
+
+def test_what_tune_writes_today_is_what_the_shipped_file_was_given_by_hand():
+    import tomllib
+
+    from railride.studies.tune_result import TuneResult
+
+    paper = TuneResult(GainSet.reference(), scenario=track(), settings={"vehicle": record()})
+    written = tomllib.loads("\n".join(paper._case_lines()))
+    shipped = GainSet.default().provenance
+    assert written == {k: shipped[k] for k in written} and set(written) == {
+        "vehicle",
+        "load",
+        "scenarios",
+        "speeds_m_s",
+    }
+
+
 # -- the shipped gains -----------------------------------------------------------------------------
 def test_the_shipped_gains_say_they_were_tuned_on_the_papers_vehicle_and_sine():
     p = GainSet.default().provenance
@@ -189,6 +217,7 @@ def test_compare_records_the_line_in_its_settings(options, command):
         assert "gains_mismatch" not in settings  # the paper's case: its document as it was
     else:
         assert settings["gains_mismatch"].endswith(command)
+        check_schema(rr.compare(scenario, controllers=["pid"], bounds=False, **options).to_dict())
     passive = rr.compare(scenario, controllers=["passive"], bounds=False, **options).settings
     assert "gains_mismatch" not in passive  # no gains run
 
@@ -207,6 +236,8 @@ def test_study_sweep_and_league_record_one_line():
     assert "gains_mismatch" not in run_sweep(grid(["pid"], duration=0.2), comfort=False).settings()
     table = league(["paper-sine"], speeds=[40.0, 55.56], controllers=["pid"], duration=0.2, comfort=False)
     assert table.to_dict()["settings"]["gains_mismatch"] == line
+    for doc in (res.to_dict(), sweep.to_dict(), table.to_dict()):
+        check_schema(doc)
 
 
 def test_the_cli_warns_with_one_line_on_stderr():
@@ -279,3 +310,21 @@ def test_gains_tuned_on_the_rigid_car_say_so_on_the_car_that_bends():
     line = GainSet.default().mismatch(vehicle_record(bending, "paper"), track())
     assert line is not None and "L_c" in line and "f_bend" in line
     assert GainSet.default().mismatch(record(), track()) is None
+
+
+@pytest.mark.parametrize(
+    "args, command",
+    [
+        (("study", "--scenario", "paper-sine", "--load", "1,1.3"), "railride tune --load 1,1.3 --duration 0.2"),
+        (("pareto", "--samples", 4, "--load", 1.3), "railride tune --load 1.3 --duration 0.2"),
+        (("sweep", "--speed", "40,55.56"), "railride tune --speed 40 --duration 0.2"),
+        (("compare", "--speed", "40,55.56"), "railride tune --speed 40 --duration 0.2"),  # the league table
+    ],
+)
+def test_the_studies_warn_with_one_line_over_all_their_runs(args, command):
+    controllers = ("--suspension", "pid") if args[0] == "sweep" else ("--controllers", "pid")
+    if args[0] == "pareto":
+        controllers = ()
+    result = ok(*args, "--duration", 0.2, *controllers)
+    lines = [line for line in result.stderr.splitlines() if line.startswith("warning: ")]
+    assert len(lines) == 1 and lines[0].endswith(f"tune for it with: {command}"), result.stderr
