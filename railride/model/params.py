@@ -299,6 +299,17 @@ class VehicleParams:
                 )
         if rigid:
             table.update(L_c=None, f_bend=None, EI_c=None)
+        elif base_name is None and not {"L_c", "f_bend", "EI_c"} & set(table):
+            import warnings
+
+            from railride.validation import PlausibilityWarning, caller_level
+
+            warnings.warn(
+                f"{source}: the file gives no bending mode of the carbody (L_c with f_bend or EI_c): "
+                "it runs rigid",
+                PlausibilityWarning,
+                stacklevel=caller_level(),
+            )
         try:
             return base.replace(**table) if base_name is not None else cls(**table)
         except ValueError as exc:  # the field's rule: name the file and table too
