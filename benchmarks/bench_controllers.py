@@ -123,7 +123,8 @@ def vehicles(args) -> None:
             many = min_time(lambda: simulate([sc] * 16, car, susp), args.repeat, time.process_time) / (16 * steps)
             base = base or (one, many)
             print(
-                f"| {law} | {name} | {one * 1e6:.3f} us | {one / base[0]:.2f} | {many * 1e6:.3f} us | {many / base[1]:.2f} |"
+                f"| {law} | {name} | {one * 1e6:.3f} us | {one / base[0]:.2f} "
+                f"| {many * 1e6:.3f} us | {many / base[1]:.2f} |"
             )
 
 

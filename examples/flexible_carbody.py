@@ -50,7 +50,12 @@ def main() -> None:
             for point in ("centre", "front"):
                 aw = comfort.sel(position=point, index="aw_Wb").values
                 rows.append(
-                    {"bending_hz": "rigid" if f is None else f, "law": law, "position": point, "aw_Wb": float(np.mean(aw))}
+                    {
+                        "bending_hz": "rigid" if f is None else f,
+                        "law": law,
+                        "position": point,
+                        "aw_Wb": float(np.mean(aw)),
+                    }
                 )
     table = pd.DataFrame(rows)
     rigid = table[table.bending_hz == "rigid"].set_index(["law", "position"])["aw_Wb"]
@@ -60,7 +65,8 @@ def main() -> None:
     heads = ["rigid"] + [f"{f:g} Hz" for f in FREQUENCIES[1:]]
     print(
         f"Centre-floor Wb-weighted RMS (m/s^2) and its ratio to the rigid car; paper vehicle, 24 m body, "
-        f"german-low at {args.speed:g} m/s, {args.seeds} seeds x {args.duration:g} s, window {window[0]:g}-{window[1]:g} s\n"
+        f"german-low at {args.speed:g} m/s, {args.seeds} seeds x {args.duration:g} s, "
+        f"window {window[0]:g}-{window[1]:g} s\n"
     )
     print("| law | " + " | ".join(heads) + " |")
     print("|---|" + "---|" * len(heads))

@@ -487,8 +487,8 @@ def run_batch(lo, hi, law, x, step0, n_steps, final, stride, dt, vehicle, damper
 @njit(cache=True, nogil=True, fastmath=_FAST, parallel=_NO_PARFORS)
 def _run_samples(
     lo, hi, law, x, step0, n_steps, final, stride, dt, A, TS, c_sec, stops, P, vcmd, utab, u_off, ftab, f_off,
-    n_nodes, interval, closed_loop, ctrl_stride, Gm, Hm, inner, noise, faults, sensing, snoise, out_q, out_v, out_a, out_f,
-    out_w, out_wd, out_d, out_fd, out_vc, status, fail_step,
+    n_nodes, interval, closed_loop, ctrl_stride, Gm, Hm, inner, noise, faults, sensing, snoise, out_q, out_v, out_a,
+    out_f, out_w, out_wd, out_d, out_fd, out_vc, status, fail_step,
 ):
     # fmt: on
     """`run_batch`'s loops, on its groups unpacked."""
@@ -696,7 +696,10 @@ def _run_samples(
                     if has_states:
                         for i in range(2 * N_DOF, NS_MAX):
                             st[i] = s[i] + ch * K[prev + i]
-                    _derivative(law, st, R, roff, at, tt, pp, vc, conn, y, cx, cv, K, NS_MAX * stage, i8, v8, i9, v9, n8, bw1, zk, fsave)
+                    kb = NS_MAX * stage
+                    _derivative(
+                        law, st, R, roff, at, tt, pp, vc, conn, y, cx, cv, K, kb, i8, v8, i9, v9, n8, bw1, zk, fsave
+                    )
                 for i in range(2 * N_DOF):
                     s[i] += h / 6.0 * (K[i] + 2.0 * K[NS_MAX + i] + 2.0 * K[2 * NS_MAX + i] + K[3 * NS_MAX + i])
                 if has_states:

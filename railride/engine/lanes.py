@@ -504,7 +504,8 @@ def lanes_stepper(n, law, A, TS, P, stops):
     damper = np.ascontiguousarray(P[P_ALPHA_A])
 
     def step(_n, _law, x, step0, n_steps, final, stride, dt, vehicle, dampers, inputs, control, outputs):
-        # run_batch's groups: the products and run_batch's c_sec and stops, the one damper and vcmd, the rest as they are
+        # run_batch's groups: the products and run_batch's c_sec and stops, the one damper and vcmd,
+        # the rest as they are
         run_parallel(
             run_lanes, len(smp), smp, own, law, x, step0, n_steps, final, stride, dt, products + vehicle[2:4],
             (damper, dampers[1]), inputs, control, outputs,

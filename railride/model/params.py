@@ -118,7 +118,9 @@ class VehicleParams:
 
             from railride.validation import PlausibilityWarning, caller_level
 
-            warnings.warn(rigid_note(self), PlausibilityWarning, stacklevel=caller_level())
+            note = rigid_note(self)
+            if note is not None:
+                warnings.warn(note, PlausibilityWarning, stacklevel=caller_level())
 
     @property
     def flexible(self) -> bool:
@@ -135,6 +137,7 @@ class VehicleParams:
         if self.EI_c is not None:
             from railride.model.beam import bending_frequency
 
+            assert self.L_c is not None  # checked at construction: EI_c needs L_c
             return bending_frequency(self.EI_c, self.m_c, self.L_c)
         return None
 
@@ -305,8 +308,7 @@ class VehicleParams:
             from railride.validation import PlausibilityWarning, caller_level
 
             warnings.warn(
-                f"{source}: the file gives no bending mode of the carbody (L_c with f_bend or EI_c): "
-                "it runs rigid",
+                f"{source}: the file gives no bending mode of the carbody (L_c with f_bend or EI_c): it runs rigid",
                 PlausibilityWarning,
                 stacklevel=caller_level(),
             )

@@ -117,7 +117,9 @@ class SineTrack(RailProfile):
             object.__setattr__(self, field_name, _check(name, getattr(self, field_name), rule, allowed))
         _within("amplitude", self.amplitude, MAX_RAIL_AMPLITUDE, "m", "a rail a metre out of line is no track")
         _within("rail_phase", self.rail_phase_deg, MAX_RAIL_PHASE, "deg", "a phase is an angle of one turn")
-        _within("wavelength", self.wavelength, MAX_WAVELENGTH, "m", "a sine 100 km long is a gradient, not a ride input")
+        _within(
+            "wavelength", self.wavelength, MAX_WAVELENGTH, "m", "a sine 100 km long is a gradient, not a ride input"
+        )
 
     def _evaluate(self, s):
         k = 2 * np.pi / self.wavelength

@@ -94,6 +94,7 @@ def _carbody_point(p: VehicleParams, x: float, y: float) -> np.ndarray:
     if not p.flexible:
         return _point("carbody", x, y)
     a = _point("carbody", x, y, N_DOF + 1)
+    assert p.L_c is not None  # a flexible carbody has its length (VehicleParams' check)
     a[N_DOF] = beam.mode_shape(x, p.L_c)
     return a
 
@@ -169,7 +170,9 @@ def element_table(p: VehicleParams) -> list[Element]:
         # the carbody's bending: the free beam's modal stiffness and damping on eta, from the
         # bending frequency of the free carbody and the modal damping ratio
         m_eta = beam.modal_mass_factor() * p.m_c
-        omega = 2.0 * np.pi * p.bending_hz
+        f_bend = p.bending_hz
+        assert f_bend is not None  # flexible: f_bend or EI_c
+        omega = 2.0 * np.pi * f_bend
         a = np.zeros(n)
         a[N_DOF] = 1.0
         bending = Element(
@@ -247,10 +250,11 @@ class Vehicle:
         x = validation.number("x", x, "finite", "m")
         y = validation.number("y", y, "finite", "m")
         p = self.params
-        if p.flexible and abs(x) > 0.5 * p.L_c:
+        half = 0.5 * p.L_c if p.flexible and p.L_c is not None else None
+        if half is not None and abs(x) > half:
             raise InputError(
                 f"x = {validation.shown(x)} m: the floor point must lie on the carbody, within +-L_c/2 = "
-                f"{validation.shown(0.5 * p.L_c)} m of its centre"
+                f"{validation.shown(half)} m of its centre"
             )
         return _carbody_point(p, x, y)
 
@@ -271,6 +275,7 @@ class Vehicle:
         carbody = [(label, f) for label, f in self.rigid_modes() if label.startswith("carbody")]
         label, highest = max(carbody, key=lambda m: m[1])
         f = p.bending_hz
+        assert f is not None  # called for a flexible carbody
         if not f > highest:
             field, value, unit = ("f_bend", p.f_bend, "Hz") if p.f_bend is not None else ("EI_c", p.EI_c, "N m^2")
             given = "" if field == "f_bend" else f" (a bending frequency of {validation.shown(f)} Hz)"

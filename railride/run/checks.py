@@ -41,7 +41,8 @@ def _max_stable_dt(params: VehicleParams, damper=None) -> float:
 
 
 def _state_matrix(vehicle: Vehicle, damper=None) -> np.ndarray:
-    """The passive state matrix (at the engine's size, `railride.run.inputs.engine_matrices`), or with MR dampers the vehicle linearised about their stiffest
+    """The passive state matrix (at the engine's size, `railride.run.inputs.engine_matrices`),
+    or with MR dampers the vehicle linearised about their stiffest
     state: pre-yield stiffness k0 + k1 + alpha(v_max) A and damping c0(v_max) + c1(v_max). Their
     internal states are sub-stepped by the stepper and do not enter here."""
     if damper is None:

@@ -201,9 +201,7 @@ def _other_values(provenance: dict, run: dict) -> list[str] | None:
     optional = {f.name: f.default for f in dataclasses.fields(VehicleParams) if f.default is not dataclasses.MISSING}
     common = [k for k in run_values if k in values]
     extra = [k for k in dict.fromkeys([*run_values, *values]) if k in optional and k not in common]
-    other = [
-        k for k in common + extra if not _same(values.get(k, optional.get(k)), run_values.get(k, optional.get(k)))
-    ]
+    other = [k for k in common + extra if not _same(values.get(k, optional.get(k)), run_values.get(k, optional.get(k)))]
     return other if other or not common else None
 
 

@@ -84,7 +84,10 @@ def test_the_state_space_model_reproduces_the_engine(name):
         u = np.hstack([u, np.zeros((u.shape[0], 4))])
     _, y, _ = lsim((model.A, model.B, model.C, model.D), u, t[keep])
     run = rr.simulate(
-        scenario, FLEX, suspension, solver=rr.SolverSettings(control_rate=1e4, method="rk4" if name == "passive" else "auto")
+        scenario,
+        FLEX,
+        suspension,
+        solver=rr.SolverSettings(control_rate=1e4, method="rk4" if name == "passive" else "auto"),
     )
     floor = floor_acceleration(run.dataset)
     late = floor["time"].values > 2.0
