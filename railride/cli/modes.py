@@ -5,7 +5,7 @@ from __future__ import annotations
 from railride.cli._app import app
 from railride.cli._common import errors, print_json, stdout_console
 from railride.cli._options import FormatOption, LoadOption, OutputFormat, PresetOption, VehicleOption
-from railride.cli._parsing import vehicle_from_options
+from railride.cli._parsing import vehicle_arguments
 from railride.cli._render import modes_table
 
 
@@ -21,9 +21,8 @@ def modes(
         from railride.frequency.frf import modes as vehicle_modes
         from railride.model.params import vehicle_text
 
-        params, record = vehicle_from_options(vehicle, preset, load)
-        rows = vehicle_modes(params).to_list()
+        doc = vehicle_modes(**vehicle_arguments(vehicle, preset, load)).to_dict()
     if format is OutputFormat.json:
-        print_json(rows)
+        print_json(doc)
         return
-    stdout_console().print(modes_table(rows, vehicle_text(record["vehicle"])))
+    stdout_console().print(modes_table(doc["modes"], vehicle_text(doc["vehicle"])))

@@ -200,5 +200,5 @@ def frequency_responses(
     frequency = np.geomspace(fmin, fmax, points)
     frequency[0], frequency[-1] = fmin, fmax  # exactly, without rounding
     responses = {p: car.frequency_response(frequency, speed, p) for p in patterns}
-    found = checked_modes(car)
+    found = checked_modes(car, record)
     return FrfResult(vehicle_params, source, speed, frequency, responses, found, fmin, fmax, points, record)

@@ -1,5 +1,6 @@
 """The modes of the passive vehicle as numbers a table or JSON can hold (`checked_modes`), by
-undamped natural frequency, with their table (`modes_frame`, modes.csv)."""
+undamped natural frequency, with their table (`modes_frame`, modes.csv) and their document
+(`Modes.to_dict`, ``railride.modes/1``: ``railride modes --format json``)."""
 
 from __future__ import annotations
 
@@ -11,10 +12,12 @@ import pandas as pd
 
 from railride.errors import InputError
 from railride import validation
-from railride.model.params import VehicleParams
+from railride.model.params import resolve_vehicle
 from railride.model.plausible import notes
 from railride.model.vehicle import Vehicle
 
+#: the schema of `Modes.to_dict` (``railride modes --format json``)
+SCHEMA = "railride.modes/1"
 #: the columns of the modal table
 MODE_COLUMNS = ("mode", "label", "frequency_hz", "damped_frequency_hz", "damping_ratio")
 
@@ -34,9 +37,12 @@ def modes_frame(modes) -> pd.DataFrame:
 @dataclass(frozen=True, eq=False)
 class Modes:
     """The modes of the passive vehicle (`railride.model.vehicle.Mode`), by undamped frequency: a
-    sequence of `Mode` with its table (`to_pandas`) and records (`to_list`)."""
+    sequence of `Mode` with its table (`to_pandas`), records (`to_list`) and document
+    (`to_dict`). ``vehicle``: the record of the vehicle they are the modes of
+    (`railride.model.params.vehicle_record`: name, load, values)."""
 
     modes: tuple
+    vehicle: dict | None = None
 
     def __iter__(self):
         return iter(self.modes)
@@ -48,9 +54,20 @@ class Modes:
         return self.modes[index]
 
     def to_list(self) -> list[dict]:
-        """The records of the modes (``Mode.to_dict()``): the JSON array of ``railride modes
-        --format json`` and the ``modes`` of the ``railride.frf/1`` document."""
+        """The records of the modes (``Mode.to_dict()``): the ``modes`` of the ``railride.modes/1``
+        document (`to_dict`), of the ``railride.frf/1`` document and of each preset of
+        ``railride.vehicles/1``."""
         return [m.to_dict() for m in self.modes]
+
+    def to_dict(self) -> dict:
+        """The ``railride.modes/1`` document (``railride modes --format json``): ``schema``,
+        ``railride_version``, ``vehicle`` (the record of the vehicle) and ``modes``
+        (`to_list`)."""
+        from railride._version import __version__
+
+        if self.vehicle is None:
+            raise ValueError("these modes carry no vehicle record (Modes.vehicle): make them with modes(vehicle)")
+        return {"schema": SCHEMA, "railride_version": __version__, "vehicle": self.vehicle, "modes": self.to_list()}
 
     def to_pandas(self):
         """The modal table (`modes_frame`, modes.csv): mode number, label,
@@ -58,12 +75,14 @@ class Modes:
         return modes_frame(self.to_list())
 
 
-def modes(params=None) -> Modes:
-    """The modes of the passive vehicle ``params`` (`VehicleParams`, a preset name or the path
-    of a parameters file; default "paper"), by undamped natural frequency (`checked_modes`):
-    nine, ten where the carbody bends (`Vehicle.n_dof`)."""
-    vehicle, _ = VehicleParams.resolve(params)
-    return checked_modes(Vehicle(vehicle))
+def modes(vehicle=None, *, params=None, load: float = 1.0) -> Modes:
+    """The modes of the passive ``vehicle`` (``params`` is an alias: `VehicleParams`, a preset
+    name or the path of a parameters file; default "paper") with the load factor ``load`` on its
+    carbody (`VehicleParams.loaded`), by undamped natural frequency (`checked_modes`): nine, ten
+    where the carbody bends (`Vehicle.n_dof`). They carry the vehicle's record (``vehicle``:
+    name, load, values), which their document (`Modes.to_dict`) holds."""
+    loaded, record = resolve_vehicle(vehicle, params, load)
+    return checked_modes(Vehicle(loaded), record)
 
 
 #: a damping ratio this far below 0 is the rounding of an undamped mode (a passive vehicle
@@ -71,10 +90,11 @@ def modes(params=None) -> Modes:
 ROUNDING_ZETA = 1e-6
 
 
-def checked_modes(vehicle) -> Modes:
+def checked_modes(vehicle, record: dict | None = None) -> Modes:
     """`Vehicle.modes` as numbers a table or JSON can hold: one mode per DOF (`Vehicle.n_dof`:
     nine, ten where the carbody bends), every frequency and damping ratio finite and >= 0
-    (rounding below 0 shown as 0). A vehicle whose bodies and
+    (rounding below 0 shown as 0), with ``record``, the vehicle's record (`vehicle_record`;
+    None: none, and no document). A vehicle whose bodies and
     springs are so far apart in size that double precision cannot separate its modes (a
     bogie of a gram on a stiff primary, a carbody of a billion tonnes) is a ValueError naming
     what went wrong and the parameters outside the typical ranges."""
@@ -103,4 +123,4 @@ def checked_modes(vehicle) -> Modes:
             f"the modes of this vehicle cannot be computed in double precision: {problem}; its masses and "
             f"stiffnesses are too far apart in size{hint}"
         )
-    return Modes(tuple(out))
+    return Modes(tuple(out), record)

@@ -32,9 +32,14 @@ def good_track(tmp_path):
 
 # -- modes ----------------------------------------------------------------------------------------
 def test_modes_json():
+    """A ``railride.modes/1`` document: the vehicle's record and its nine modes."""
     result = run("modes", "--format", "json")
     assert result.exit_code == 0, result.output
-    modes = json.loads(result.stdout)
+    doc = json.loads(result.stdout)
+    assert list(doc) == ["schema", "railride_version", "vehicle", "modes"]
+    assert doc["schema"] == "railride.modes/1"
+    assert (doc["vehicle"]["name"], doc["vehicle"]["load"]) == ("paper", 1.0)
+    modes = doc["modes"]
     assert isinstance(modes, list) and len(modes) == 9
     for m in modes:
         assert set(m) == MODE_KEYS
@@ -55,8 +60,11 @@ def test_modes_table_and_preset():
 def test_modes_params_file(tmp_path):
     stiff = tmp_path / "stiff.toml"
     stiff.write_text('[vehicle]\npreset = "paper"\nk_sz = 5.8e5\n', encoding="utf-8")
-    base = json.loads(run("modes", "--format", "json").stdout)
-    other = json.loads(run("modes", "--format", "json", "--params", stiff).stdout)
+    base = json.loads(run("modes", "--format", "json").stdout)["modes"]
+    doc = json.loads(run("modes", "--format", "json", "--params", stiff, "--load", 1.2).stdout)
+    assert (doc["vehicle"]["name"], doc["vehicle"]["load"]) == (str(stiff), 1.2)
+    assert doc["vehicle"]["values"]["k_sz"] == 5.8e5 and doc["vehicle"]["values"]["m_c"] == 3.96e4  # before the load
+    other = doc["modes"]
 
     def bounce(ms):
         return next(m["frequency_hz"] for m in ms if m["label"] == "carbody bounce")

@@ -42,7 +42,7 @@ def test_modes_refuses_an_absurd_vehicle(vehicle, fmt, field, value):
 def test_modes_of_an_unusual_vehicle_are_finite_json_with_a_warning(vehicle):
     result = run("modes", "--params", vehicle(m_c="1e6", I_cy="1e9"), "--format", "json")
     assert result.exit_code == 0, result.stderr
-    rows = strict_json(result.stdout)
+    rows = strict_json(result.stdout)["modes"]
     assert len(rows) == 9 and all(r["damping_ratio"] >= 0 for r in rows)
     warnings = result.stderr.strip().splitlines()
     assert len(warnings) == 2 and all(line.startswith("warning: vehicle parameter ") for line in warnings)

@@ -16,7 +16,8 @@ from railride.output import files
 from railride.analysis.spectra import FRF_PATTERNS, frf_peaks
 from railride.output.files import FRF_FILES
 from railride.frequency.frf import FrfResult, Modes, frequency_responses, modes
-from railride.model.modes import MODE_COLUMNS
+from railride.model.modes import MODE_COLUMNS, checked_modes
+from railride.model.params import PAPER, vehicle_record
 from railride.model.vehicle import Mode, Vehicle
 
 
@@ -98,9 +99,24 @@ def test_save_writes_the_frf_folder(result, tmp_path, monkeypatch):
 def test_modes_are_the_vehicles_and_the_command_lines():
     found = modes()
     assert isinstance(found, Modes) and len(found) == 9 and all(isinstance(m, Mode) for m in found)
-    assert found.to_list() == ok_json("modes") == [m.to_dict() for m in Vehicle().modes()]
+    assert found.to_list() == ok_json("modes")["modes"] == [m.to_dict() for m in Vehicle().modes()]
+    assert found.to_dict()["vehicle"] == ok_json("modes")["vehicle"] == vehicle_record(PAPER, "paper")
     assert found[1].label == "carbody bounce"
     assert found.to_pandas()["mode"].tolist() == list(range(1, 10))
+
+
+def test_the_modes_document_records_the_vehicle_and_its_load():
+    """`Modes.to_dict`: the ``railride.modes/1`` document of ``railride modes --format json``,
+    with the vehicle's record; the modes of the loaded carbody, the values before the load."""
+    loaded = modes("crh380a", load=1.3)
+    doc = loaded.to_dict()
+    assert list(doc) == ["schema", "railride_version", "vehicle", "modes"] and doc["schema"] == "railride.modes/1"
+    assert doc["vehicle"] == vehicle_record(rr.VehicleParams.preset("crh380a"), "crh380a", 1.3)
+    heavy = Vehicle(rr.VehicleParams.preset("crh380a").loaded(1.3)).modes()
+    assert doc["modes"] == [m.to_dict() for m in heavy] != modes("crh380a").to_list()
+    assert modes(params=PAPER).vehicle["name"] == "paper"
+    with pytest.raises(ValueError, match="no vehicle record"):
+        checked_modes(Vehicle()).to_dict()  # modes made without a record have no document
 
 
 @pytest.mark.parametrize(

@@ -90,6 +90,13 @@ def test_frf():
     check(rr.frequency_responses(points=64).to_dict(), "railride.frf/1")
 
 
+def test_modes():
+    from railride.frequency.frf import modes
+
+    check(modes().to_dict(), "railride.modes/1")
+    check(modes("crh380a", load=1.3).to_dict(), "railride.modes/1")  # ten modes: its carbody bends
+
+
 def test_damper_and_tracking():
     from railride.run import rig
 

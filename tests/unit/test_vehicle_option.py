@@ -34,7 +34,7 @@ COMMANDS = {
     "state-space": ["state-space"],
 }
 #: where each command's JSON document (--format json) keeps the vehicle record; None: no document
-#: on stdout (report writes HTML, modes prints a bare array, sweep prints its rows)
+#: on stdout (report writes HTML, sweep prints its rows)
 RECORD = {
     "simulate": lambda doc: doc["vehicle"],
     "compare": lambda doc: doc["settings"]["vehicle"],
@@ -43,7 +43,7 @@ RECORD = {
     "sweep": None,
     "pareto": lambda doc: doc["settings"]["vehicle"],
     "report": None,
-    "modes": None,
+    "modes": lambda doc: doc["vehicle"],
     "frf": lambda doc: doc["vehicle"],
     "ride-spectrum": lambda doc: doc["settings"]["vehicle"],
     "state-space": lambda doc: doc["vehicle"],
@@ -97,7 +97,7 @@ def test_vehicle_and_preset_are_exclusive_and_a_missing_file_is_named(name, tmp_
     assert_input_error(run(*_args(name, tmp_path), "--preset", "no-such-car"), "--preset", "no-such-car")
 
 
-@pytest.mark.parametrize("name", ["simulate", "compare", "pareto", "frf", "ride-spectrum", "state-space"])
+@pytest.mark.parametrize("name", ["simulate", "compare", "pareto", "modes", "frf", "ride-spectrum", "state-space"])
 def test_a_load_factor_is_recorded_with_the_vehicle(name, car, tmp_path):
     record = RECORD[name](ok_json(*_args(name, tmp_path), "--vehicle", car, "--load", 1.25))
     assert record == {"name": str(car), "load": 1.25, "values": PAPER.replace(m_c=M_C).to_dict()}
