@@ -38,6 +38,10 @@ SPECTRUM_OPTIONS = {
 }
 
 
+#: what the note says of the shipped gains
+SHIPPED = " (tuned on the paper's sine track, not on this one)"
+
+
 class SpectrumFormat(str, Enum):
     table = "table"
     json = "json"
@@ -119,7 +123,7 @@ def ride_spectrum(
         from railride.output.files import check_out_dir
         from railride.frequency.ride_spectrum import ride_spectrum as run
 
-        from railride.cli._render import check_report_option, save_report
+        from railride.cli._render import check_report_option, save_report, warn_gains_mismatch
 
         figures = figure_options(figure_format, dpi, out)
         check_report_option(report)
@@ -141,6 +145,7 @@ def ride_spectrum(
         if out is not None:
             write_folder(out, lambda: result.save(out, figure_formats=figures.figure_formats, dpi=figures.dpi))
     parts = _tables(result)
+    warn_gains_mismatch(result.settings)  # gains tuned for another vehicle, load or track: one line
     if format is SpectrumFormat.json:
         print_json(result.to_dict())
     elif format is SpectrumFormat.csv:
@@ -195,7 +200,7 @@ def _tables(result) -> list:
         f"{st['track']} at V = {st['speed_m_s']:g} m/s, wavelengths {st['min_wavelength_m']:g}-"
         f"{st['max_wavelength_m']:g} m ({st['fmin_hz']:.3g}-{st['fmax_hz']:.3g} Hz, {st['points']} "
         f"frequencies). Controllers on the ideal actuator (force = demand), applied {rate}; "
-        f"gains {st['gains']} (tuned on the paper's sine track, not on this one). {vehicle_text(st['vehicle'])}."
+        f"gains {st['gains']}{SHIPPED if st['gains'] == 'shipped' else ''}. {vehicle_text(st['vehicle'])}."
     )
     parts: list = [floor, body, note]
     for name, reason in st["not_run"].items():

@@ -223,7 +223,9 @@ def ride_spectrum(
     (as the random tracks are synthesised) on ``points`` log-spaced frequencies. Without
     ``control_rate`` a loop acts continuously; with it, through the sample-and-hold and
     ``delay`` periods. A closed loop that is unstable is not run: ``settings["not_run"]``
-    gives the reason (ValueError when none is left)."""
+    gives the reason (ValueError when none is left). ``settings["gains_mismatch"]``: one line
+    (`GainSet.mismatch`) when the gains of the outer loops run by name were tuned for another
+    vehicle, load or track (`gains_mismatch`)."""
     validation.choice("track", track, SPECTRA)
     speed = DEFAULT_SPEED if speed is None else validation.number("speed", speed, "positive", "m/s")
     lo = validation.number("min_wavelength", min_wavelength, "positive", "m")
@@ -306,7 +308,53 @@ def ride_spectrum(
         "gains": "shipped" if gains is None else "given",
         "not_run": not_run,
     }
+    mismatch = gains_mismatch(gains, _by_name(controllers, names), record, track, speed, (lo, hi))
+    if mismatch:
+        settings["gains_mismatch"] = mismatch
     return RideSpectrum(ds, rms, weighted_da, settings, vehicle_params)
+
+
+def gains_mismatch(gains, controllers, vehicle: dict, track: str, speed: float, band) -> str | None:
+    """One line (`GainSet.mismatch`) when ``gains`` (None: the shipped gains) were tuned for
+    another vehicle, load or track than the ride of ``controllers`` (names; none that reads the
+    gains, no line) on ``vehicle`` (its `vehicle_record`): the track is spectrum ``track`` at
+    ``speed`` [m/s] over the wavelength ``band`` (min, max) [m], which every realisation of the
+    random track shares; so gains tuned on one realisation (seed) of it, of any duration, were
+    tuned on it. Its scenario record is that of the realisation they were tuned on (of this
+    spectrum; else the defaults, seed 0), at this speed and band."""
+    from railride.model.track import scenario
+    from railride.secondary.control import GainSet
+    from railride.secondary.provenance import tuned_tracks
+
+    gains = GainSet.default() if gains is None else gains
+    options = {"speed": speed, "min_wavelength": band[0], "max_wavelength": band[1]}
+    records = []
+    for tuned in tuned_tracks(gains.provenance or {}):
+        if tuned.get("name") != track:
+            continue
+        realisation = {"seed": tuned.get("seed", 0), "duration": tuned.get("duration_s")}
+        try:
+            records.append(scenario(track, **options, **{k: v for k, v in realisation.items() if v is not None}))
+        except InputError:  # a realisation this ride's band or speed cannot have: not this track
+            continue
+    described = [r.describe() for r in records]
+    # the realisation they were tuned on, else the first of this spectrum: a seed is no difference
+    ride = next((r for r in described if gains.tuned_on(r)), described[0] if described else None)
+    return gains.mismatch(vehicle, ride or scenario(track, **options).describe(), list(controllers))
+
+
+def _by_name(controllers, names: list[str]) -> list[str]:
+    """The suspensions of ``names`` (those run) that ``controllers`` named, and so took their
+    gains from the gain set (a `Suspension` value brings its own)."""
+    from railride.secondary.control import OUTER_LOOPS
+    from railride.secondary.suspension import Suspension
+
+    if isinstance(controllers, str):
+        given = [c.strip() for c in controllers.split(",")]
+    else:
+        given = [] if isinstance(controllers, Suspension) else [c for c in controllers if isinstance(c, str)]
+    named = set(OUTER_LOOPS) if "all" in given else set(given)
+    return [n for n in names if n in named and n in OUTER_LOOPS]
 
 
 def _check_stable(name: str, model: LinearModel, plant: LinearModel, control_rate, delay: int) -> None:

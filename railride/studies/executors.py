@@ -337,12 +337,15 @@ class RunTable:
 def read_run_table(path: Path) -> pd.DataFrame:
     """The rows of the run table ``path``, checked: every row has a key (16 hex digits) and,
     unless it records the time its run diverged, finite numbers in its metric columns. A
-    ValueError names the file, the line and what is wrong."""
+    ValueError names the file, the line and what is wrong. The ``vehicle`` column (the name of
+    the vehicle a run ran, `railride.studies.sweep.run_cases`) is text; a table written before
+    it has none, and reads as it did."""
     from railride.analysis.metrics import RESPONSES, STATISTICS
 
     try:
-        # keys are hex digests: an all-digit one must stay text to be recognised
-        frame = pd.read_csv(path, dtype={"key": str})
+        # keys are hex digests: an all-digit one must stay text to be recognised; so must a
+        # vehicle named by a file whose name is a number
+        frame = pd.read_csv(path, dtype={"key": str, "vehicle": str})
     except (OSError, ValueError) as exc:
         raise InputError(f"cannot read the run table {path}: {' '.join(str(exc).split())}") from None
     if "key" not in frame:

@@ -72,6 +72,7 @@ class GainEvaluator:
         progress,
         params=None,
         solver=None,
+        vehicle_columns=None,
     ):
         self.parameters = tuple(parameters)
         self.suspension = suspension
@@ -85,6 +86,7 @@ class GainEvaluator:
         self.params = params
         self.solver = SolverSettings.of(solver)
         self.progress = progress
+        self.vehicle_columns = vehicle_columns  # the vehicle's name and load in the run table (run_cases)
         self.n_runs = 0
         self.batches: list[tuple[int, float]] = []
         self.passive = _rms(self._run([Case(scenario, self.opts)]))[0]
@@ -99,6 +101,7 @@ class GainEvaluator:
             params=self.params,
             solver=self.solver,
             progress=self.progress,
+            vehicle_columns=self.vehicle_columns,
         )
 
     def cases(self, points: np.ndarray) -> list[Case]:

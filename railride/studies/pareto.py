@@ -278,7 +278,19 @@ def pareto(
     record = scen.describe()
     table = RunTable() if table is None else table
     ev = GainEvaluator(
-        names, suspension, scenario, scenario_options, base, None, damper, executor, table, progress, vehicle, solver
+        names,
+        suspension,
+        scenario,
+        scenario_options,
+        base,
+        None,
+        damper,
+        executor,
+        table,
+        progress,
+        vehicle,
+        solver,
+        vehicle_columns={"vehicle": vehicle_rec["name"], "load": vehicle_rec["load"]},
     )
     bounds = np.array(log_gain_bounds(names))
     import scipy.stats.qmc  # here, not at import: scipy.stats costs half a second to load

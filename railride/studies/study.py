@@ -292,6 +292,7 @@ def study(
                             case = replace(case, delay=delay, sensing=sensing, seed=noise_seed)
                         cases.append(case)
                         meta.append((n, load, k, label, delay, seed, speed))
+    record = vehicle_record(base, source, load_list)
     rows = run_cases(
         cases,
         executor=executor,
@@ -302,10 +303,10 @@ def study(
         window=window,
         progress=progress,
         comfort=True,
+        vehicle_columns=[{"vehicle": record["name"], "load": float(m[1])} for m in meta],
     )
     frame = rows.reset_index(drop=True).copy()
     info = pd.DataFrame(meta, columns=["controller", "load", "stiffness", "fault", "delay", "track_seed", "speed_m_s"])
-    record = vehicle_record(base, source, load_list)
     info.insert(1, "vehicle", record["name"])
     frame = pd.concat([info, frame.drop(columns=[c for c in info.columns if c in frame.columns])], axis=1)
     frame = _reductions(frame)

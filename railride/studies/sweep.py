@@ -33,7 +33,7 @@ from railride.defaults import DEFAULT_CONTROL_RATE, DEFAULT_OUTPUT_RATE
 from railride.studies.executors import DaskExecutor, LocalExecutor, RunTable  # noqa: F401 (their home before)
 from railride.analysis.metrics import RESPONSES, STATISTICS
 from railride.plots import PNG_DPI, FigureOptions
-from railride.model.params import VehicleParams, resolve_argument, resolve_vehicle
+from railride.model.params import VehicleParams, resolve_argument, resolve_vehicle, vehicle_record
 from railride.run.solver import SolverSettings
 from railride.secondary.suspension import batch_conflict, damper_label, damper_record
 from railride.studies.case import MODEL_REVISION, SUSPENSIONS, Case, scenario_of  # noqa: F401 (their home before)
@@ -60,6 +60,9 @@ COMFORT_INDICES = (
 COMFORT_COLUMNS = tuple(f"{p}_{i}" for p, i in COMFORT_INDICES)
 #: the schema of `SweepResult.to_dict` (sweep.json)
 SCHEMA = "railride.sweep/1"
+#: the columns that name the vehicle of a run (its name and load factor) in the run table
+#: (runs.csv, `run_cases`) and the sweep's rows (`SweepResult.rows`), as study_runs.csv does
+VEHICLE_COLUMNS = ("vehicle", "load")
 
 
 def evaluate(
@@ -188,6 +191,7 @@ def run_cases(
     chunk: int = CHUNK,
     progress=None,
     comfort: bool = False,
+    vehicle_columns=None,
 ) -> pd.DataFrame:
     """Evaluate ``cases``, skipping those already in ``table``; returns their rows in order.
     ``vehicle`` (``params`` is an alias): the vehicle (`VehicleParams`, a preset name or the
@@ -195,10 +199,17 @@ def run_cases(
     ``solver``: the `SolverSettings` of every run. ``comfort``: the rows also hold the ride
     comfort indices (`evaluate`).
 
+    Every row names the vehicle it ran in the columns ``vehicle`` (its name) and ``load`` (the
+    load factor), after ``key``: ``vehicle_columns``, one dict of them for every case or a list
+    of one per case (a study's loads), default the name of ``vehicle`` and load 1
+    (`railride.model.params.vehicle_record`). They do not enter the keys; rows of a table
+    written without them get them in the rows returned (same key, same vehicle values).
+
     ``progress(done, total, runs_per_second)`` is called after each chunk.
     """
     solver = SolverSettings.of(solver)
-    vehicle = resolve_argument(vehicle, params)[0]
+    vehicle, source = resolve_argument(vehicle, params)
+    named = _vehicle_columns(vehicle_columns, cases, vehicle, source)
     executor = LocalExecutor() if executor is None else executor
     table = RunTable() if table is None else table
     done = table.done()
@@ -218,9 +229,10 @@ def run_cases(
     settings_text = json.dumps(settings, sort_keys=True)
     keys = [hashlib.sha1((c.key + settings_text).encode()).hexdigest()[:16] for c in cases]
     pending, seen = [], set()
-    key_of = {}
-    for c, k in zip(cases, keys):
+    key_of, columns_of = {}, {}
+    for c, k, columns in zip(cases, keys, named):
         key_of[c.key] = k
+        columns_of[k] = columns
         if k not in done and k not in seen:
             pending.append(c)
             seen.add(k)
@@ -230,15 +242,29 @@ def run_cases(
     if progress is not None:
         progress(0, len(pending), 0.0)
     for _, rows in executor.map(fn, chunks):
-        for row in rows:
-            row["key"] = key_of[row["key"]]  # the case's key with the run settings
-            done[row["key"]] = row
+        for i, row in enumerate(rows):
+            key = key_of[row.pop("key")]  # the case's key with the run settings
+            rows[i] = done[key] = {"key": key, **columns_of[key], **row}
         table.add(rows)
         n_done += len(rows)
         if progress is not None:
             elapsed = time.perf_counter() - t0
             progress(n_done, len(pending), n_done / elapsed if elapsed > 0 else math.inf)
-    return pd.DataFrame([done[k] for k in keys])
+    # a row of a table from before the vehicle columns: the same key is the same vehicle values
+    return pd.DataFrame([{**done[k], **columns_of[k]} for k in keys])
+
+
+def _vehicle_columns(given, cases: list[Case], vehicle, source) -> list[dict]:
+    """The ``vehicle`` and ``load`` columns of each case's row (`run_cases`)."""
+    if given is None:
+        record = vehicle_record(vehicle, source)
+        given = {"vehicle": record["name"], "load": record["load"]}
+    if isinstance(given, dict):
+        return [dict(given)] * len(cases)
+    given = [dict(g) for g in given]
+    if len(given) != len(cases):
+        raise InputError(f"vehicle_columns: {len(given)} for {len(cases)} cases; give one per case, or one for all")
+    return given
 
 
 def _chunks(cases: list[Case], chunk: int) -> list[list[Case]]:
@@ -302,23 +328,36 @@ class SweepResult:
             return np.zeros(len(self.grid.cases), dtype=bool)
         return self.frame["diverged_at_s"].notna().to_numpy()
 
+    def record(self) -> dict:
+        """The vehicle's record: name, load and values (``vehicle_record``, else made from
+        ``vehicle``, `railride.model.params.vehicle_record`)."""
+        from railride.model.params import vehicle_record
+
+        if self.vehicle_record is not None:
+            return self.vehicle_record
+        return vehicle_record(VehicleParams.of(VehicleParams.preset("paper") if self.vehicle is None else self.vehicle))
+
     def columns(self) -> list[str]:
-        """The columns of `to_pandas`: the grid's, the metrics, ``diverged_at_s`` when a run
+        """The columns of `to_pandas`: the grid's, ``vehicle`` and ``load`` (the vehicle's name
+        and load factor, the same in every row), the metrics, ``diverged_at_s`` when a run
         diverged, and ``key`` (`Case.key`)."""
         return (
             list(self.grid.columns)
+            + list(VEHICLE_COLUMNS)
             + self.metric_columns()
             + (["diverged_at_s"] if self.diverged.any() else [])
             + ["key"]
         )
 
     def rows(self) -> list[dict]:
-        """One row per run: its grid values (None where an axis does not act), its metrics
-        (None for a run that diverged) and its case's key."""
+        """One row per run: its grid values (None where an axis does not act), the vehicle's
+        name and load, its metrics (None for a run that diverged) and its case's key."""
         metrics, diverged = self.metric_columns(), self.diverged
+        record = self.record()
+        vehicle = {"vehicle": str(record["name"]), "load": record["load"]}
         rows = []
         for case, values, (_, result), bad in zip(self.grid.cases, self.grid.values, self.frame.iterrows(), diverged):
-            row = {**values, **{m: None if bad else float(result[m]) for m in metrics}}
+            row = {**values, **vehicle, **{m: None if bad else float(result[m]) for m in metrics}}
             if diverged.any():  # a run that diverged has no metrics, but the time it went
                 row["diverged_at_s"] = float(result["diverged_at_s"]) if bad else None
             rows.append({**row, "key": case.key})
@@ -331,13 +370,9 @@ class SweepResult:
         (``vehicle``: name, load, values); a solver's rates and a vehicle other than the
         defaults (`other_settings`); ``gains_mismatch`` where the base gains were tuned for
         another vehicle, load or track (`gains_mismatch`)."""
-        from railride.model.params import vehicle_record
-
         g = self.grid
         vehicle = VehicleParams.preset("paper") if self.vehicle is None else self.vehicle
-        record = self.vehicle_record
-        if record is None:
-            record = vehicle_record(VehicleParams.of(vehicle))
+        record = self.record()
         return {
             "scenario": g.scenario_record(),
             "grid": g.grid_values(),
@@ -483,6 +518,7 @@ def run_sweep(
         window=grid.window,
         progress=progress,
         comfort=bool(comfort),
+        vehicle_columns={"vehicle": record["name"], "load": record["load"]},
     )
     date = datetime.now(timezone.utc).replace(microsecond=0).isoformat().replace("+00:00", "Z")
     return SweepResult(grid, frame, bool(comfort), vehicle, len(table.frame), date, record)

@@ -290,6 +290,11 @@ def tune(
         },
     )
 
+    loads = [vehicle.load_changes(c.load) for c in cases_set]
+    # the load of a run by its vehicle changes, for its row in the run table
+    vehicle_name = result.settings["vehicle"]["name"]
+    load_of = {Case(vehicle=ld).vehicle: float(c.load) for c, ld in zip(cases_set, loads)}
+
     def run(cases):
         return run_cases(
             cases,
@@ -300,9 +305,9 @@ def tune(
             solver=solver,
             window=window,
             progress=progress,
+            vehicle_columns=[{"vehicle": vehicle_name, "load": load_of[c.vehicle]} for c in cases],
         )
 
-    loads = [vehicle.load_changes(c.load) for c in cases_set]
     passives = _rms(run([Case(c.scenario, c.options, vehicle=ld) for c, ld in zip(cases_set, loads)]))
     passive = passives[0]
     result = dataclasses.replace(result, passive=dict(zip(RESPONSES, passive)))  # a result is frozen

@@ -25,7 +25,9 @@ def test_pareto_folder_json_and_resume(tmp_path):
     assert frame["non_dominated"].sum() == doc["counts"]["non_dominated"] >= 1
     again = json.loads(ok(*PARETO, "--seed", 2, "--out", out, "--resume", "--format", "json").stdout)
     assert again["samples"] == doc["samples"]
-    assert len(pd.read_csv(out / "runs.csv")) == 6  # nothing ran twice
+    runs = pd.read_csv(out / "runs.csv")
+    assert len(runs) == 6  # nothing ran twice
+    assert set(runs["vehicle"]) == {"paper"} and set(runs["load"]) == {1.0}  # the vehicle of every run
     assert_input_error(run(*PARETO, "--out", out), "runs.csv exists", "--resume")
 
 

@@ -3,6 +3,8 @@ input errors."""
 
 from __future__ import annotations
 
+import json
+
 from scipy.io import loadmat
 
 from clihelp import assert_input_error, ok, ok_json, run
@@ -15,6 +17,34 @@ def test_ride_spectrum_table_and_json():
     doc = ok_json("ride-spectrum", "--track", "fra5", "--speed", "40", "--points", "200")
     assert doc["settings"]["track"] == "fra5" and doc["settings"]["speed_m_s"] == 40.0
     assert set(doc["rms"]) == {"passive", "pid", "sas-attitude", "sas-attitude-ride"}
+
+
+def test_ride_spectrum_warns_of_gains_tuned_for_another_case(tmp_path):
+    """Gains tuned for another vehicle, load or track: one ``warning:`` line on stderr before the
+    results, recorded as ``settings.gains_mismatch`` (as compare says it). Gains tuned on any
+    realisation of this spectrum, speed and band are tuned on it: nothing; nor for passive alone."""
+    from railride.model.track import scenario
+    from railride.secondary.control import GainSet
+
+    record = scenario("fra4", seed=3, duration=30.0).describe()
+    inline = ", ".join(f"{k} = {json.dumps(v)}" for k, v in record.items())
+    gains = tmp_path / "fra4.toml"
+    gains.write_text(f"[provenance]\nscenario_record = {{{inline}}}\n\n{GainSet.reference().to_toml()}")
+    args = ("ride-spectrum", "--points", 32, "--controllers", "passive,pid", "--gains", gains)
+    here = ok(*args, "--format", "json")
+    assert here.stderr == "" and "gains_mismatch" not in json.loads(here.stdout)["settings"]
+    table = " ".join(ok(*args).stdout.split())  # the note, wherever it wraps
+    assert "gains given." in table and "tuned on the paper's sine track" not in table
+    faster = ok(*args, "--speed", 40, "--load", 1.2, "--format", "json")
+    (line,) = faster.stderr.splitlines()
+    assert line.startswith(f"warning: the gains {gains} were tuned for vehicle paper, load 1")
+    assert "this run has load 1.2, track fra4 (speed 40 m/s); tune for it with: railride tune --load 1.2" in line
+    assert json.loads(faster.stdout)["settings"]["gains_mismatch"] == line.removeprefix("warning: ")
+    # the shipped gains, tuned on the paper's sine track; passive reads no gains
+    shipped = ok("ride-spectrum", "--points", 32, "--controllers", "pid").stderr
+    assert shipped.startswith("warning: the gains railride/data/gains.toml were tuned for vehicle paper, load 1, on ")
+    assert "this run has track fra4" in shipped and shipped.count("\n") == 1
+    assert ok("ride-spectrum", "--points", 32, "--controllers", "passive", "--gains", gains, "--speed", 40).stderr == ""
 
 
 def test_ride_spectrum_lists_unstable_loops_and_writes_files(tmp_path):

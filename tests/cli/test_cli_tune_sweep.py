@@ -282,6 +282,9 @@ def test_sweep_csv_and_table():
     assert frame.loc[frame.suspension == "mr", "pid.kd"].isna().all()
     assert frame.loc[frame.suspension == "pid", "voltage_v"].isna().all()
     assert sorted(frame.loc[frame.suspension == "mr", "voltage_v"].unique()) == [0.0, 2.25]
+    # the vehicle of every run, after the grid's columns
+    assert list(frame.columns[4:6]) == ["vehicle", "load"]
+    assert set(frame["vehicle"]) == {"paper"} and set(frame["load"]) == {1.0}
     table = ok(*args).stdout
     assert "suspension" in table and "pid.kd" in table and "voltage" in table
 

@@ -216,6 +216,9 @@ def test_to_pandas_one_row_per_run(swept):
     ]
     np.testing.assert_array_equal(frame[RMS].to_numpy(), swept.frame[RMS].to_numpy())
     assert list(frame["key"]) == [c.key for c in swept.grid.cases]
+    # the vehicle's name and load after the grid's columns, in every row (the CSV of the command)
+    assert list(frame.columns[2:4]) == ["vehicle", "load"]
+    assert set(frame["vehicle"]) == {"paper"} and set(frame["load"]) == {1.0}
 
 
 def test_to_dict_is_the_sweep_document(swept):
@@ -283,6 +286,47 @@ def test_run_sweep_resumes_from_its_run_table(swept, tmp_path):
     assert again.to_dict()["rows"] == first.to_dict()["rows"]
     # the metrics do not depend on whether comfort was asked for
     np.testing.assert_array_equal(first.to_pandas()[RMS].to_numpy(), swept.to_pandas()[RMS].to_numpy())
+
+
+def test_the_run_table_names_the_vehicle_and_a_table_from_before_still_resumes(tmp_path):
+    """runs.csv holds ``vehicle`` and ``load`` after ``key`` (not in the keys); a table written
+    without them (railride 0.4.0) resumes: only the new runs run, and every row returned names
+    the vehicle."""
+    from railride.studies.case import Case
+
+    car = tmp_path / "car.toml"
+    car.write_text('[vehicle]\npreset = "paper"\nm_c = 42000.0\n', encoding="utf-8")
+    path = tmp_path / "runs.csv"
+    first = run_sweep(grid("passive", speed=[20.0, 30.0], duration=0.5), table=RunTable(path), vehicle=car, load=1.1)
+    runs = pd.read_csv(path, dtype={"key": str})
+    assert list(runs.columns[:3]) == ["key", "vehicle", "load"]
+    assert set(runs["vehicle"]) == {str(car)} and set(runs["load"]) == {1.1}
+    assert set(first.to_pandas()["vehicle"]) == {str(car)} and set(first.to_pandas()["load"]) == {1.1}
+    # as a table of railride 0.4.0, without the columns
+    runs.drop(columns=["vehicle", "load"]).to_csv(path, index=False)
+    calls = []
+    again = run_sweep(
+        grid("passive", speed=[20.0, 30.0, 40.0], duration=0.5),
+        table=RunTable(path, resume=True),
+        vehicle=car,
+        load=1.1,
+        progress=lambda done, total, rate: calls.append(total),
+    )
+    assert calls[-1] == 1  # the new speed only
+    assert again.frame["key"].tolist()[:2] == runs["key"].tolist()  # the same keys as before
+    assert set(again.frame["vehicle"]) == {str(car)} and set(again.frame["load"]) == {1.1}
+    np.testing.assert_array_equal(again.frame[RMS].to_numpy()[:2], first.frame[RMS].to_numpy())
+    table = pd.read_csv(path, dtype={"key": str})
+    assert len(table) == 3 and table["vehicle"].isna().tolist() == [True, True, False]
+    assert len(RunTable(path, resume=True).frame) == 3  # and it reads back
+    # a vehicle named like a number stays text
+    pd.DataFrame([{**table.iloc[2].to_dict(), "vehicle": "1"}]).to_csv(path, index=False)
+    assert RunTable(path, resume=True).frame["vehicle"].tolist() == ["1"]
+    # the keys are those of the case and the settings, whatever the columns
+    assert (
+        Case(scenario_options={"speed": 20.0, "duration": 0.5}).key
+        == grid("passive", speed=[20.0], duration=0.5).cases[0].key
+    )
 
 
 def test_run_sweep_takes_a_grid():

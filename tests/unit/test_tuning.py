@@ -70,6 +70,36 @@ def test_run_table_resumes_without_redoing_runs(tmp_path):
     assert len(RunTable(path, resume=True).frame) == 3
 
 
+def test_every_row_of_the_run_table_names_its_vehicle_and_load(tmp_path):
+    """run_cases: ``vehicle`` and ``load`` after ``key`` in every row (default the vehicle's
+    name at load 1; one dict for all cases or one per case); a robust tuning over two loads
+    names each run's load, beside the carbody mass it ran with."""
+    import pandas as pd
+
+    from railride.studies.tuning import tuning_set
+
+    case = Case(scenario_options=SHORT)
+    row = run_cases([case]).iloc[0]
+    assert (row["vehicle"], row["load"]) == ("paper", 1.0) and list(row.index[:3]) == ["key", "vehicle", "load"]
+    heavier = VehicleParams.preset("paper").replace(m_c=4.2e4)
+    assert run_cases([case], vehicle=heavier).iloc[0]["vehicle"] == "custom"
+    assert run_cases([case], vehicle_columns=[{"vehicle": "mine", "load": 2.0}]).iloc[0]["load"] == 2.0
+    with pytest.raises(ValueError, match="one per case"):
+        run_cases([case, case], vehicle_columns=[{"vehicle": "mine", "load": 2.0}])
+    path = tmp_path / "runs.csv"
+    tune(
+        ("pid",),
+        over=tuning_set("paper-sine", loads=[1.0, 1.3], duration=0.5),
+        n_values=3,
+        budget=5,
+        table=RunTable(path),
+    )
+    runs = pd.read_csv(path)
+    assert set(runs["vehicle"]) == {"paper"} and set(runs["load"]) == {1.0, 1.3}
+    m_c = VehicleParams.preset("paper").m_c
+    assert (runs["vehicle.m_c"].fillna(m_c) == m_c * runs["load"]).all()
+
+
 def test_sensitivity_study_never_worsens_the_objective_and_records_curves():
     start = GainSet.default()
     res = tune(("pid",), scenario_options=SHORT, gains=start, n_values=4, budget=30)

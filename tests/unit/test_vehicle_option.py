@@ -4,6 +4,7 @@ option, ``--preset NAME`` exclusive with it) and ``--load X``; ``vehicle=`` (ali
 
 from __future__ import annotations
 
+import io
 import json
 from pathlib import Path
 
@@ -119,11 +120,18 @@ def test_the_study_and_sweep_files_record_the_vehicle(car, tmp_path):
     ok(*_args("study", tmp_path), "--vehicle", car, "--load", "1,1.3")
     runs = pd.read_csv(tmp_path / "out" / "study_runs.csv")
     assert set(runs["vehicle"]) == {str(car)} and set(runs["load"]) == {1.0, 1.3}
+    # the run table too, each run with its own load
+    table = pd.read_csv(tmp_path / "out" / "runs.csv")
+    assert set(table["vehicle"]) == {str(car)} and sorted(table["load"]) == [1.0, 1.3]
     doc = json.loads((tmp_path / "out" / "study.json").read_text())
     assert doc["settings"]["vehicle"]["load"] == [1.0, 1.3]
-    ok("sweep", "--duration", 1, "--vehicle", car, "--load", 1.1, "--out", tmp_path / "sweep")
+    sweep = ["sweep", "--duration", 1, "--vehicle", car, "--load", 1.1, "--out", tmp_path / "sweep"]
+    printed = pd.read_csv(io.StringIO(ok(*sweep, "--format", "csv").stdout))
+    assert printed[["vehicle", "load"]].values.tolist() == [[str(car), 1.1]]
     record = json.loads((tmp_path / "sweep" / "sweep.json").read_text())["settings"]["vehicle"]
     assert (record["name"], record["load"]) == (str(car), 1.1)
+    table = pd.read_csv(tmp_path / "sweep" / "runs.csv")
+    assert table[["vehicle", "load"]].values.tolist() == [[str(car), 1.1]]
 
 
 def test_ride_nc_and_the_report_record_the_vehicle(car, tmp_path):
