@@ -12,6 +12,7 @@ The public API, in the order a run needs it::
     rr.compare(sc)                                    # the paper's comparison, with the bounds
     rr.tune()                                         # every law tuned alike (shipped gains)
     rr.study(["pid"], scenario="fra4", loads=[1, 1.3], faults=["none", "1R-off"])  # over many tracks
+    rr.design()                                       # which law: tuned on some tracks, judged on others
     rr.run_sweep(rr.sweep.grid(["passive", "pid"], speed=[20, 40, 60]))  # every combination
     rr.frequency_responses(params)                    # carbody FRFs, their peaks, the modes
     rr.write_report(rr.compare(sc), "ride.html")      # any result as one HTML page
@@ -42,6 +43,8 @@ _HOMES = {
     "simulate": "run.simulation",
     "StudyResult": "studies.study",
     "study": "studies.study",
+    "DesignResult": "studies.design_result",
+    "design": "studies.design",
     "SolverSettings": "run.solver",
     "Suspension": "secondary.suspension",
     "SweepResult": "studies.sweep",
@@ -109,6 +112,8 @@ if TYPE_CHECKING:
     from railride.run.simulation import simulate
     from railride.run.solver import SolverSettings
     from railride.studies.study import StudyResult, study
+    from railride.studies.design import design
+    from railride.studies.design_result import DesignResult
     from railride.secondary.suspension import Suspension
     from railride.studies.sweep import SweepResult, run_sweep
     from railride.model.track import Scenario, scenario
@@ -147,6 +152,7 @@ def __dir__() -> list[str]:
 __all__ = [
     "Comparison",
     "DamperFault",
+    "DesignResult",
     "FrfResult",
     "GainSet",
     "Objective",
@@ -162,6 +168,7 @@ __all__ = [
     "VehicleParams",
     "compare",
     "dampers",
+    "design",
     "frequency_responses",
     "pareto",
     "scenario",

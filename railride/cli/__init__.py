@@ -1,6 +1,7 @@
 """The ``railride`` command line: ``railride compare``, ``railride modes``, ``railride vehicles``,
 ``railride frf``, ``railride simulate``, ``railride damper``, ``railride tracking``, ``railride
-tune``, ``railride study``, ``railride pareto``, ``railride sweep`` and ``railride report``.
+tune``, ``railride study``, ``railride design``, ``railride pareto``, ``railride sweep`` and
+``railride report``.
 
 A thin layer over the library: it parses options, calls the library's studies (`simulate`,
 `compare`, `frf`, `rig`, `tune`, `study`, `pareto`, `sweep`), writes their results through their
@@ -40,6 +41,7 @@ COMMANDS = (
     "pareto",
     "sweep",
     "study",
+    "design",
     "ride_spectrum",
 )
 

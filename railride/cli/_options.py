@@ -405,6 +405,10 @@ StudyOutOption = _out(
     "Keep the run table DIR/runs.csv (updated as runs finish) and write study.json, "
     "study_summary.csv, study_runs.csv and study.png into DIR at the end."
 )
+DesignOutOption = _out(
+    "Keep the run table DIR/runs.csv (updated as runs finish) and write design.json, design.csv, "
+    "design_runs.csv, gains.toml and design.png into DIR at the end."
+)
 
 # -- figures: every command that writes an output folder -------------------------------------------
 FigureFormatOption = Annotated[
@@ -464,6 +468,9 @@ TuneResumeOption = _resume(
 ParetoResumeOption = _resume("Continue the study whose run table is DIR/runs.csv (needs --out).")
 StudyResumeOption = _resume(
     "Continue the study whose run table is DIR/runs.csv (needs --out): runs already there are not evaluated again."
+)
+DesignResumeOption = _resume(
+    "Continue the design whose run table is DIR/runs.csv (needs --out): runs already there are not evaluated again."
 )
 SweepResumeOption = _resume(
     "Continue the sweep whose run table is DIR/runs.csv (needs --out): runs already there are not evaluated again."

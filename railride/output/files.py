@@ -561,6 +561,29 @@ def write_study_outputs(result, out_dir, *, figures: FigureOptions | None = None
     return write_folder(out_dir, _entries(STUDY_FILES, writers, figures))
 
 
+#: the files `write_design_outputs` produces, in the order they are written
+DESIGN_FILES = ("design.json", "design.csv", "design_runs.csv", "gains.toml", "design.png")
+
+
+def write_design_outputs(result, out_dir, doc: dict, gains_text: str, *, figures: FigureOptions | None = None):
+    """Write a `railride.studies.design_result.DesignResult` into ``out_dir``, all or nothing:
+    ``design.json`` (``doc``), ``design.csv`` (``to_pandas()``), ``design_runs.csv`` (the
+    held-out runs), ``gains.toml`` (``gains_text``) and ``design.png`` (`plot_design`); other
+    files (the run table) stay. Returns the written paths."""
+    from railride.plots.design import plot_design
+
+    _expect(result, "result", "railride.studies.design_result.DesignResult", ("summary", "runs", "ranking"))
+    text = json_text(doc)  # refuse NaN before any file is written
+    writers = {
+        "design.json": _text(text),
+        "design.csv": _csv(result.to_pandas()),
+        "design_runs.csv": _csv(result.runs),
+        "gains.toml": _text(gains_text),
+        "design.png": _png(lambda: plot_design(result)),
+    }
+    return write_folder(out_dir, _entries(DESIGN_FILES, writers, figures))
+
+
 #: the files `RideSpectrum.save` writes, in this order
 RIDE_SPECTRUM_FILES = ("ride_spectrum.json", "ride_spectrum.csv", "ride_spectrum_psd.csv", "ride_spectrum.png")
 

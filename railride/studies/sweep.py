@@ -66,12 +66,20 @@ VEHICLE_COLUMNS = ("vehicle", "load")
 
 
 def evaluate(
-    cases: list[Case], base_gains=None, *, params=None, solver=None, window=None, comfort: bool = False
+    cases: list[Case],
+    base_gains=None,
+    *,
+    params=None,
+    solver=None,
+    window=None,
+    comfort: bool = False,
+    costs: bool = False,
 ) -> list[dict]:
     """Run ``cases`` (in compiled batches of compatible cases) and return one row per case:
     its key, settings and the RMS and peak-to-peak of the four body responses; with
     ``comfort``, also the ride comfort indices of `COMFORT_COLUMNS` (`railride.analysis.comfort.
-    ride_comfort` over the same window). ``params``: the vehicle the cases' ``vehicle`` changes
+    ride_comfort` over the same window); with ``costs``, what the run asks of its dampers
+    (`railride.analysis.costs.COST_COLUMNS`). ``params``: the vehicle the cases' ``vehicle`` changes
     apply to (`VehicleParams` or a preset name, default "paper"); ``solver``: the
     `SolverSettings` of every run. Runs in any process: a Dask worker calls it too."""
     from railride.secondary.control import GainSet
@@ -94,7 +102,13 @@ def evaluate(
             if batch_conflict(suspensions) is not None:  # the inner loop is one setting per batch
                 for i in idx[start : start + CHUNK]:  # positions, not lookups: cases may repeat
                     rows[i] = evaluate(
-                        [cases[i]], base_gains, params=vehicle, solver=solver, window=window, comfort=comfort
+                        [cases[i]],
+                        base_gains,
+                        params=vehicle,
+                        solver=solver,
+                        window=window,
+                        comfort=comfort,
+                        costs=costs,
                     )[0]
                 continue
             res = simulate(scs, pars, suspensions, solver=solver, on_divergence="mark")
@@ -114,6 +128,7 @@ def evaluate(
                     # every run ok (the rule): no copy of the histories
                     indices = ride_comfort(ds if ok.size == ds.sizes["sample"] else ds.isel(sample=ok), window=window)
                     cf = np.stack([indices.sel(position=p, index=x).values for p, x in COMFORT_INDICES], -1)
+            paid = _costs(res, part[0], window) if costs else None
             for j, i in enumerate(idx[start : start + CHUNK]):
                 if i in rows:
                     continue
@@ -128,8 +143,23 @@ def evaluate(
                             if np.isnan(diverged_at[j]) and cf is not None
                             else np.nan
                         )
+                if paid is not None:
+                    from railride.analysis.costs import COST_COLUMNS
+
+                    for k, column in enumerate(COST_COLUMNS):
+                        row[column] = float(paid[j, k]) if np.isnan(diverged_at[j]) else np.nan
                 rows[i] = row
     return [rows[i] for i in range(len(cases))]
+
+
+def _costs(res, case: Case, window) -> np.ndarray:
+    """`railride.analysis.costs.damper_costs` of a batch's runs (one damper model per batch)."""
+    from railride.analysis.costs import damper_costs
+    from railride.analysis.metrics import select_window
+    from railride.secondary.suspension import damper_model
+
+    v_max = getattr(damper_model(case.damper, case.damper_scale), "v_max", None) if case.closed_loop else None
+    return damper_costs(select_window(res.dataset, window), v_max)
 
 
 def _scenario(made: dict, c: Case):
@@ -192,12 +222,14 @@ def run_cases(
     progress=None,
     comfort: bool = False,
     vehicle_columns=None,
+    costs: bool = False,
 ) -> pd.DataFrame:
     """Evaluate ``cases``, skipping those already in ``table``; returns their rows in order.
     ``vehicle`` (``params`` is an alias): the vehicle (`VehicleParams`, a preset name or the
     path of a parameters file, default "paper") the cases' ``vehicle`` changes apply to;
     ``solver``: the `SolverSettings` of every run. ``comfort``: the rows also hold the ride
-    comfort indices (`evaluate`).
+    comfort indices (`evaluate`); ``costs``: what each run asks of its dampers (force, travel,
+    time at v_max: `railride.analysis.costs.COST_COLUMNS`).
 
     Every row names the vehicle it ran in the columns ``vehicle`` (its name) and ``load`` (the
     load factor), after ``key``: ``vehicle_columns``, one dict of them for every case or a list
@@ -226,6 +258,8 @@ def run_cases(
     }
     if comfort:  # only then: the keys of sweeps without comfort stay as they were
         settings["comfort"] = True
+    if costs:  # the same
+        settings["costs"] = True
     settings_text = json.dumps(settings, sort_keys=True)
     keys = [hashlib.sha1((c.key + settings_text).encode()).hexdigest()[:16] for c in cases]
     pending, seen = [], set()
@@ -237,7 +271,9 @@ def run_cases(
             pending.append(c)
             seen.add(k)
     chunks = _chunks(pending, chunk)
-    fn = functools.partial(evaluate, base_gains=base, params=vehicle, solver=solver, window=window, comfort=comfort)
+    fn = functools.partial(
+        evaluate, base_gains=base, params=vehicle, solver=solver, window=window, comfort=comfort, costs=costs
+    )
     t0, n_done = time.perf_counter(), 0
     if progress is not None:
         progress(0, len(pending), 0.0)

@@ -44,6 +44,20 @@ def _study():
     return rr.study(["pid"], scenario="paper-sine", speeds=[30.0, 40.0], duration=1.0)
 
 
+def _design():
+    return rr.design(
+        ["pid"],
+        tracks=["fra4"],
+        speeds=[40.0],
+        loads=[1.0],
+        train_seeds=[0],
+        test_seeds=[1],
+        duration=1.0,
+        budget=13,
+        values=3,
+    )
+
+
 def _sweep():
     return rr.run_sweep(rr.sweep.grid(["passive", "pid"], speed=[20.0, 40.0], duration=0.5))
 
@@ -120,6 +134,7 @@ KINDS = [
     Kind("Comparison", _comparison, "compare.json", None, 1),
     Kind("LeagueTable", _league, "league.json", "league.csv", 1),
     Kind("StudyResult", _study, "study.json", "study_summary.csv", _study_panels),
+    Kind("DesignResult", _design, "design.json", "design.csv", 4),
     # sweep.json holds every row; the run table runs.csv is the sweep's, not save's
     Kind("SweepResult", _sweep, "sweep.json", None, 4),
     Kind("TuneResult", _tune, "tune.json", "curves.csv", _tune_panels),

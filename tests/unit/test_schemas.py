@@ -146,6 +146,21 @@ def test_study():
     check(result.to_dict(), "railride.study/1")
 
 
+def test_design():
+    result = rr.design(
+        ["pid"],
+        tracks=["fra4"],
+        speeds=[40.0],
+        loads=[1.0],
+        train_seeds=[0],
+        test_seeds=[1],
+        duration=0.5,
+        budget=13,
+        values=3,
+    )
+    check(result.to_dict(), "railride.design/1")
+
+
 def test_sweep_and_the_file_its_save_writes(tmp_path):
     from railride.studies.grid import grid
 

@@ -1,0 +1,375 @@
+"""``railride design``: which law for this vehicle, tuned on a training set of random tracks and
+judged on held-out seeds (railride.studies.design), and its tables."""
+
+from __future__ import annotations
+
+import json
+import time
+from typing import Annotated
+
+import typer
+
+from railride.cli._app import app
+from railride.cli._common import (
+    RunProgress,
+    command_line,
+    errors,
+    interruptible,
+    make_executor,
+    open_run_table,
+    option_names,
+    stderr_is_terminal,
+    stdout_console,
+    write_folder,
+)
+from railride.cli._options import (
+    BoundOption,
+    DpiOption,
+    DtOption,
+    FigureFormatOption,
+    FormatOption,
+    MaxMemoryOption,
+    MaxStepsOption,
+    ObjectiveOption,
+    OutputFormat,
+    PenaltyOption,
+    PresetOption,
+    SchedulerFileOption,
+    SchedulerOption,
+    VehicleOption,
+    WeightsOption,
+    WorkersOption,
+    DesignOutOption,
+    DesignResumeOption,
+    figure_options,
+)
+from railride.cli._parsing import FIXED_RATE_FIELDS, damper_preset, solver_from_options, value_list, vehicle_source
+from railride.defaults import DEFAULT_DAMPER
+
+#: the library's names of the design's options, for its errors
+DESIGN_FIELDS = {
+    "controllers": "--controllers",
+    "controller": "--controllers",
+    "loads": "--load",
+    "tracks": "--track",
+    "speeds": "--speed",
+    "train_seeds": "--train-seeds",
+    "test_seeds": "--test-seeds",
+    "duration": "--duration",
+    "budget": "--budget",
+    "values": "--values",
+    "aggregate": "--aggregate",
+    "objective": "--objective",
+    **FIXED_RATE_FIELDS,
+}
+#: the metrics of the table of ratios, and their headings
+RATIO_METRICS = {
+    "acceleration_m_s2_rms": "accel.",
+    "displacement_m_rms": "displ.",
+    "pitch_deg_rms": "pitch",
+    "roll_deg_rms": "roll",
+    "centre_N_MV_z": "N_MV,z",
+    "centre_Wz": "Wz",
+}
+#: passive's absolute values: metric -> (heading, scale, format)
+PASSIVE_METRICS = {
+    "acceleration_m_s2_rms": ("accel.\n(m/s^2)", 1.0, ".3f"),
+    "displacement_m_rms": ("displ.\n(mm)", 1e3, ".2f"),
+    "pitch_deg_rms": ("pitch\n(deg)", 1.0, ".4f"),
+    "roll_deg_rms": ("roll\n(deg)", 1.0, ".4f"),
+    "centre_N_MV_z": ("N_MV,z\n(-)", 1.0, ".2f"),
+    "centre_Wz": ("Wz\n(-)", 1.0, ".2f"),
+}
+#: the costs: metric -> (heading, scale, format)
+COST_METRICS = {
+    "force_rms_n": ("force RMS\n(kN)", 1e-3, ".2f"),
+    "force_max_n": ("force max\n(kN)", 1e-3, ".1f"),
+    "travel_max_m": ("travel max\n(mm)", 1e3, ".1f"),
+    "voltage_at_max_fraction": ("at v_max\n(%)", 100.0, ".1f"),
+}
+
+
+def _cell(m: dict, scale: float = 1.0, spec: str = ".3f", band: bool = True) -> str:
+    if m is None or m.get("mean") is None:
+        return "-"
+    text = format(m["mean"] * scale, spec)
+    if band and m.get("p5") is not None:
+        text += f"\n{m['p5'] * scale:{spec}}-{m['p95'] * scale:{spec}}"
+    return text
+
+
+def _ratio_cell(m: dict) -> str:
+    if m is None or m.get("ratio_mean") is None:
+        return "-"
+    text = f"{m['ratio_mean']:.3f}"
+    if m["ratio_mean"] > 1.0:
+        text = f"[red]{text}[/red]"
+    return text + f"\n{m['ratio_p5']:.2f}-{m['ratio_p95']:.2f}"
+
+
+def _tables(doc: dict) -> list:
+    from rich.markup import escape
+    from rich.text import Text
+
+    from railride.cli._width import FitTable, Split
+    from railride.model.params import vehicle_text
+    from railride.secondary.control import LABELS
+
+    s = doc["settings"]
+    groups = doc["results"]
+    laws = [g for g in groups if g["controller"] != "passive"]
+    passive = [g for g in groups if g["controller"] == "passive"]
+
+    def point(g: dict) -> str:
+        return f"{g['speed_m_s']:g} m/s\nload {g['load']:g}"
+
+    def ratios(keys: list):
+        table = FitTable(title="Held out: RMS ratio to passive, mean and 5-95 % band over the runs", labels=2)
+        table.add_column("law")
+        table.add_column("speed, load")
+        for key in keys:
+            table.add_column(RATIO_METRICS.get(key, "score"), justify="right")
+        last = None
+        for g in laws:
+            name = g["controller"]
+            cells = [
+                _cell(g["metrics"]["score"], spec=".3f") if k == "score" else _ratio_cell(g["metrics"][k]) for k in keys
+            ]
+            table.add_row(escape(LABELS[name]) if name != last else "", point(g), *cells)
+            last = name
+        return table
+
+    def absolute(keys: list):
+        table = FitTable(title="Held out: passive, mean and 5-95 % band over the runs", labels=1)
+        table.add_column("speed, load")
+        for key in keys:
+            table.add_column(PASSIVE_METRICS[key][0], justify="right")
+        for g in passive:
+            table.add_row(point(g), *[_cell(g["metrics"][k], *PASSIVE_METRICS[k][1:]) for k in keys])
+        return table
+
+    def costs(keys: list):
+        table = FitTable(title="What each law asks of its dampers (held out, mean and 5-95 % band)", labels=2)
+        table.add_column("law")
+        table.add_column("speed, load")
+        for key in keys:
+            table.add_column(COST_METRICS[key][0], justify="right")
+        last = None
+        for g in groups:
+            name = g["controller"]
+            table.add_row(
+                escape(LABELS[name]) if name != last else "",
+                point(g),
+                *[_cell(g["metrics"][k], *COST_METRICS[k][1:]) for k in keys],
+            )
+            last = name
+        clearance = s.get("clearance_m")
+        table.caption = (
+            "force: the secondary damper force on the carbody; travel: the secondary deflection, "
+            + (f"against a clearance of {clearance * 1e3:g} mm (z_stop)" if clearance else "no bump stops")
+            + "; at v_max: the time the command voltage sits at the damper's largest."
+        )
+        return table
+
+    ranking = FitTable(title="Ranking on held-out track", labels=2)
+    for head in ("rank", "law", "score", "worst at", "best at"):
+        ranking.add_column(head, justify="right" if head in ("rank", "score") else "left")
+    for r in doc["ranking"]:
+        worst = r["worst_at"]
+        best = ", ".join(f"{p['speed_m_s']:g} m/s load {p['load']:g}" for p in r["best_at"]) or "-"
+        ranking.add_row(
+            "-" if r["rank"] is None else str(r["rank"]),
+            escape(LABELS[r["controller"]]) + ("" if r["ranked"] else " (diverged)"),
+            "-" if r["score"] is None else f"{r['score']:.3f}",
+            f"{worst['speed_m_s']:g} m/s, load {worst['load']:g}",
+            best,
+        )
+    seeds = ", ".join(map(str, s["test_seeds"]))
+    kind = s["objective"]["kind"]
+    what = "the worst of a law's four mean RMS ratios to passive" if kind == "minimax" else f"the {kind} objective"
+    ranking.caption = (
+        f"score: {what} at a speed and load (of its mean RMS ratios to passive); a law's score is its worst "
+        "over the speeds and loads."
+    )
+    lines = [
+        f"Tracks {', '.join(s['tracks'])} at {', '.join(f'{v:g}' for v in s['speeds_m_s'])} m/s, loads "
+        f"{', '.join(f'{x:g}' for x in s['loads'])}; {s['duration_s']:g} s a run. Tuned on seeds "
+        f"{', '.join(map(str, s['train_seeds']))} ({s['training_runs_per_gain_set']} runs per gain set, the "
+        f"{s['aggregate']} objective, at most {s['budget']} gain sets per law); judged on seeds {seeds}.",
+        vehicle_text(s["vehicle"]) + f"; {s['damper'] if isinstance(s['damper'], str) else 'own'} dampers.",
+        f"{doc['runs']['training']} training and {doc['runs']['judging']} held-out runs"
+        + (
+            f", {doc['runs_evaluated']} evaluated now, wall time {doc['wall_time_s']:.1f} s."
+            if "runs_evaluated" in doc
+            else "."
+        ),
+    ]
+    ratio_keys = [*RATIO_METRICS, "score"]
+    return [
+        Split(ratios, ratio_keys),
+        Split(absolute, list(PASSIVE_METRICS)),
+        Split(costs, list(COST_METRICS)),
+        ranking,
+        Text("\n".join(lines)),
+        Text("\n" + doc["recommendation"]["text"]),
+    ]
+
+
+@app.command("design")
+def design_command(
+    ctx: typer.Context,
+    controllers: Annotated[
+        str,
+        typer.Option(
+            "--controllers",
+            metavar="NAME[,NAME...]",
+            help="The laws to consider, comma-separated (pid, sas-attitude, sas-attitude-ride, skyhook, "
+            "skyhook-on-off, groundhook, hybrid, clipped-optimal), or all. Passive is always judged.",
+        ),
+    ] = "all",
+    track: Annotated[
+        str,
+        typer.Option(
+            "--track", metavar="NAME[,NAME...]", help="Random track classes: fra1..fra6, german-low, german-high."
+        ),
+    ] = "fra4,fra5",
+    speed: Annotated[
+        str, typer.Option("--speed", metavar="M/S[,...]|A:B:COUNT", help="Speeds [m/s] to tune and judge at.")
+    ] = "30,50,70",
+    load: Annotated[
+        str,
+        typer.Option("--load", metavar="X[,X...]", help="Load factors: the carbody's mass and inertias times X."),
+    ] = "1,1.3",
+    train_seeds: Annotated[
+        str,
+        typer.Option("--train-seeds", metavar="N[,N...]|A:B:COUNT", help="Track seeds tuning runs on."),
+    ] = "0,1,2",
+    test_seeds: Annotated[
+        str,
+        typer.Option(
+            "--test-seeds",
+            metavar="N[,N...]|A:B:COUNT",
+            help="Held-out track seeds the laws are judged on; none may be a training seed.",
+        ),
+    ] = "100,101,102,103,104",
+    duration: Annotated[float, typer.Option("--duration", metavar="S", help="Track per run [s].")] = 20.0,
+    budget: Annotated[
+        int,
+        typer.Option(
+            "--budget",
+            metavar="N",
+            help="Gain sets per law (each scored on every training run); at least enough to try every gain once.",
+        ),
+    ] = 130,
+    values: Annotated[int, typer.Option("--values", metavar="N", help="Values per gain and sweep, >= 3.")] = 7,
+    aggregate: Annotated[
+        str,
+        typer.Option(
+            "--aggregate",
+            metavar="mean|worst",
+            help="A gain set's objective over the training runs: their mean, or the worst.",
+        ),
+    ] = "mean",
+    objective_kind: ObjectiveOption = None,
+    weights: WeightsOption = None,
+    bound: BoundOption = None,
+    penalty: PenaltyOption = None,
+    vehicle: VehicleOption = None,
+    preset: PresetOption = None,
+    damper: Annotated[
+        str, typer.Option("--damper", metavar="MODEL", help="Damper model of the laws.")
+    ] = DEFAULT_DAMPER,
+    dt: DtOption = None,
+    workers: WorkersOption = None,
+    scheduler: SchedulerOption = None,
+    scheduler_file: SchedulerFileOption = None,
+    out: DesignOutOption = None,
+    resume: DesignResumeOption = False,
+    format: FormatOption = OutputFormat.table,
+    figure_format: FigureFormatOption = None,
+    dpi: DpiOption = None,
+    max_memory: MaxMemoryOption = None,
+    max_steps: MaxStepsOption = None,
+) -> None:
+    """Which controller for this vehicle: every law tuned alike on a training set of random
+    tracks (seeds x speeds x loads), then judged with passive on held-out seeds never used in
+    tuning. Prints per speed and load the RMS ratios to passive with their 5-95 % bands, what
+    each law asks of its dampers, the ranking and a recommendation in words. Ctrl-C stops; with
+    --out, --resume continues."""
+    from railride.cli.tune import _objective
+    from railride.studies.objectives import OBJECTIVE_KINDS
+
+    command = command_line(ctx, exclude=("out", "resume", "format", "figure_format", "dpi"))
+    with errors(), option_names(DESIGN_FIELDS):
+        figures = figure_options(figure_format, dpi, out)
+        names = [c.strip() for c in controllers.split(",")]
+        tracks = [t.strip() for t in track.split(",")]
+        speeds = value_list("--speed", speed)
+        loads = value_list("--load", load)
+        train = [int(s) for s in value_list("--train-seeds", train_seeds, integer=True)]
+        test = [int(s) for s in value_list("--test-seeds", test_seeds, integer=True)]
+        source = vehicle_source(vehicle, preset)
+        damper_preset("--damper", damper)
+        if objective_kind is not None and objective_kind.strip() not in OBJECTIVE_KINDS:
+            objective = objective_kind  # the library names what it allows (a comfort objective: not yet)
+        else:
+            objective = _objective(objective_kind, weights, bound, penalty)
+        solver = solver_from_options(dt=dt)
+        from railride.studies.design import check_design
+
+        settings = dict(
+            vehicle=source,
+            loads=loads,
+            tracks=tracks,
+            speeds=speeds,
+            objective=objective,
+            aggregate=aggregate,
+            budget=budget,
+            values=values,
+            train_seeds=train,
+            test_seeds=test,
+            duration=duration,
+            damper=damper,
+            solver=solver,
+        )
+        check_design(None if controllers.strip() == "all" else names, **settings)  # before the folder
+        table, table_path = open_run_table(out, resume)
+        executor, executor_record = make_executor(workers, scheduler, scheduler_file)
+    try:
+        with interruptible(table, table_path), errors(), option_names(DESIGN_FIELDS):
+            from railride.studies.design import design
+
+            with RunProgress(stderr_is_terminal(), "designing") as progress:
+                t0 = time.perf_counter()
+                result = design(
+                    None if controllers.strip() == "all" else names,
+                    **settings,
+                    executor=executor,
+                    table=table,
+                    progress=progress,
+                    log=progress.log,
+                )
+                wall = time.perf_counter() - t0
+            facts = {
+                "runs_evaluated": progress.evaluated,
+                "wall_time_s": wall,
+                "executor": executor_record,
+                "command": command,
+            }
+            doc = {**result.to_dict(), **facts}
+            text = json.dumps(doc, indent=2, allow_nan=False)
+            if out is not None:
+                write_folder(
+                    out,
+                    lambda: result.save(
+                        out, command, extra=facts, figure_formats=figures.figure_formats, dpi=figures.dpi
+                    ),
+                )
+    finally:
+        executor.close()
+    if format is OutputFormat.json:
+        typer.echo(text)
+    else:
+        console = stdout_console()
+        for part in _tables(doc):
+            console.print(part)

@@ -1,0 +1,528 @@
+"""Which controller for this vehicle: a robust design study, judged on track it never saw
+(docs/design.md).
+
+`design` tunes every law alike on a training set of random tracks (track classes x training
+seeds x speeds x load factors; `railride.studies.tuning.tune` with ``over``, the inner loop
+first where a law tracks a force), then judges every law and passive on held-out seeds of the
+same track classes, at every speed and load, and returns a `DesignResult`
+(`railride.studies.design_result`): per law, speed and load the mean and the 5th / 95th
+percentiles over the held-out runs of every RMS response and comfort index (absolute and as a
+ratio to passive on the same track, run by run) and of what the law asks of its dampers, the
+ranking, and a recommendation in words built from those numbers.
+
+Every input is checked before the first run: the training and the held-out seeds must not
+share a seed, and the budget must let every law try each of its gains once. A law that
+diverges, in tuning or on held-out track, is listed with where it diverged; the others go on.
+The runs go through `railride.studies.sweep.run_cases` (a local or Dask executor, one run table
+for both stages, so a design resumes where it stopped).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from railride import validation
+from railride.analysis.costs import COST_COLUMNS
+from railride.defaults import DEFAULT_DAMPER
+from railride.errors import InputError
+from railride.studies.design_result import (
+    METRICS,
+    PERCENTILES,
+    RMS_COLUMNS,
+    DesignResult,
+    rank,
+    recommend,
+)
+from railride.studies.objectives import DEFAULT_OBJECTIVE, OBJECTIVE_KINDS, Objective
+from railride.studies.sweep import Case, RunTable, run_cases
+from railride.studies.tuning import PARAMETERS, STAGES, TUNED_CONTROLLERS, tune, tuning_set
+
+#: the defaults of `design` (docs/design.md): FRA classes 4 and 5, 30-70 m/s, load factors 1
+#: and 1.3, three training seeds and five held-out seeds, 20 s of track a run
+DEFAULT_TRACKS = ("fra4", "fra5")
+DEFAULT_SPEEDS = (30.0, 50.0, 70.0)
+DEFAULT_LOADS = (1.0, 1.3)
+DEFAULT_TRAIN_SEEDS = (0, 1, 2)
+DEFAULT_TEST_SEEDS = (100, 101, 102, 103, 104)
+DEFAULT_DURATION = 20.0
+#: values per gain and sweep: coarser than `railride tune`'s 13, so that the budget below sweeps
+#: every gain of SAS (attitude+ride) once
+DEFAULT_VALUES = 7
+#: gain sets per law (each scored on every run of the training set): just over the 128 that SAS
+#: (attitude+ride), 14 gains in two stages, needs to sweep each gain once with 7 values (`min_budget`)
+DEFAULT_BUDGET = 130
+#: how a gain set's objectives over the training runs become one (`tune`'s ``aggregate``)
+DEFAULT_AGGREGATE = "mean"
+#: comfort objectives a user may ask for, which the tuning objectives do not offer yet
+COMFORT_OBJECTIVES = ("n_mv", "nmv", "n_mv_z", "sperling", "wz", "comfort")
+
+
+@dataclass(frozen=True)
+class Plan:
+    """The checked inputs of a design."""
+
+    laws: tuple
+    vehicle: Any  # VehicleParams
+    source: Any  # what named it: a preset's name, a file's path or None
+    loads: tuple
+    tracks: tuple
+    speeds: tuple
+    train_seeds: tuple
+    test_seeds: tuple
+    duration: float
+    objective: Objective
+    aggregate: str
+    budget: int
+    values: int
+    damper: Any
+    solver: Any
+
+
+def min_budget(law: str, values: int) -> int:
+    """The fewest gain sets with which `tune` sweeps every gain of ``law`` at least once: the
+    start, then per gain one sweep of ``values`` values and 0; a law tuned in stages
+    (`railride.studies.tuning.STAGES`) gives each stage its share of what is left, and a stage
+    may spend all of its share before the next begins."""
+    stages = STAGES.get(law, (PARAMETERS[law],))
+    sweep = values + 1
+    budget = 1 + sum(len(s) for s in stages) * sweep
+    while True:
+        runs, ok = 1, True
+        for k, stage in enumerate(stages):
+            share = (budget - runs) // (len(stages) - k)
+            if share < len(stage) * sweep:
+                ok = False
+                break
+            runs += share
+        if ok:
+            return budget
+        budget += 1
+
+
+def _items(name: str, values) -> list:
+    if values is None:
+        raise InputError(f"{name} = None: give at least one value")
+    if isinstance(values, (str, bool)) or validation.is_number(values):
+        values = [values]
+    try:
+        out = list(values)
+    except TypeError:
+        raise InputError(f"{name} = {values!r}: give a list of values") from None
+    if not out:
+        raise InputError(f"{name} = []: empty; give at least one value")
+    return out
+
+
+def _laws(controllers) -> tuple:
+    allowed = f"allowed: {', '.join(TUNED_CONTROLLERS)} (passive is always judged, as the baseline)"
+    if controllers is None or controllers == "all":
+        return TUNED_CONTROLLERS
+    names = [str(c).strip() if isinstance(c, str) else c for c in _items("controllers", controllers)]
+    for n in names:
+        if n not in TUNED_CONTROLLERS and n != "passive":
+            raise InputError(f"controllers = {n!r}: not a law with gains to tune; {allowed}")
+    laws = tuple(n for n in TUNED_CONTROLLERS if n in names)
+    if not laws:
+        raise InputError(f"controllers = {names!r}: no law to design; {allowed}")
+    return laws
+
+
+def _objective(objective) -> Objective:
+    if objective is None:
+        return DEFAULT_OBJECTIVE
+    if isinstance(objective, Objective):
+        return objective
+    if isinstance(objective, str):
+        name = objective.strip()
+        if name.lower().replace("-", "_").replace(",", "_") in COMFORT_OBJECTIVES:
+            raise InputError(
+                f"objective = {objective!r}: a comfort objective is not built yet; the tuning "
+                "objectives score the four RMS ratios to passive (allowed: minimax, sum, or an Objective; "
+                "the design reports N_MV,z and Sperling's Wz for every law all the same)"
+            )
+        if name in ("minimax", "sum"):
+            return Objective(name)
+        if name in OBJECTIVE_KINDS:
+            raise InputError(
+                f"objective = {objective!r}: needs its settings; pass an Objective({name!r}, ...) "
+                "(allowed by name: minimax, sum)"
+            )
+    raise InputError(f"objective = {objective!r}: allowed minimax, sum, or a railride.Objective")
+
+
+def check_design(
+    controllers=None,
+    *,
+    vehicle=None,
+    loads=DEFAULT_LOADS,
+    tracks=DEFAULT_TRACKS,
+    speeds=DEFAULT_SPEEDS,
+    objective=None,
+    aggregate: str = DEFAULT_AGGREGATE,
+    budget: int = DEFAULT_BUDGET,
+    values: int = DEFAULT_VALUES,
+    train_seeds=DEFAULT_TRAIN_SEEDS,
+    test_seeds=DEFAULT_TEST_SEEDS,
+    duration: float = DEFAULT_DURATION,
+    damper=DEFAULT_DAMPER,
+    solver=None,
+) -> Plan:
+    """Every input of `design`, checked before any work: an `InputError` names the option, the
+    value and what is allowed. Returns the `Plan`."""
+    from railride.model.params import resolve_argument
+    from railride.model.track import SPECTRA
+    from railride.model.track import scenario as make_scenario
+    from railride.run.checks import check
+    from railride.run.solver import SolverSettings
+    from railride.secondary.control import GainSet
+    from railride.secondary.suspension import Suspension, damper_model
+    from railride.studies.tuning import AGGREGATES
+
+    laws = _laws(controllers)
+    base, source = resolve_argument(vehicle, None)
+    rule = "a finite number > 0 (load factor)"
+    load_list = tuple(
+        dict.fromkeys(validation.number("loads", x, "positive", allowed=rule) for x in _items("loads", loads))
+    )
+    track_list = []
+    for t in _items("tracks", tracks):
+        if not isinstance(t, str) or t.strip() not in SPECTRA:
+            raise InputError(f"tracks = {t!r}: not a random track; allowed {', '.join(SPECTRA)}")
+        track_list.append(t.strip())
+    speed_list = tuple(
+        sorted(dict.fromkeys(validation.number("speeds", v, "positive", "m/s") for v in _items("speeds", speeds)))
+    )
+    train = tuple(dict.fromkeys(validation.seed("train_seeds", s) for s in _items("train_seeds", train_seeds)))
+    test = tuple(dict.fromkeys(validation.seed("test_seeds", s) for s in _items("test_seeds", test_seeds)))
+    shared = [s for s in test if s in train]
+    if shared:
+        raise InputError(
+            f"test_seeds = {list(test)}: {', '.join(map(str, shared))} also in train_seeds = {list(train)}; "
+            "the held-out seeds must be seeds that tuning never sees"
+        )
+    duration = validation.number("duration", duration, "positive", "s")
+    obj = _objective(objective)
+    validation.choice("aggregate", aggregate, AGGREGATES)
+    values = validation.integer("values", values, 3, what="values per gain and sweep")
+    need = {law: min_budget(law, values) for law in laws}
+    worst = max(need, key=lambda law: need[law])
+    what = (
+        f"gain sets per law: fewer cannot try every gain once; {worst} has {len(PARAMETERS[worst])} gains, "
+        f"swept with {values} values and 0 each"
+    )
+    budget = validation.integer("budget", budget, need[worst], what=what)
+    model = damper_model(damper, 1.0)  # a known name or a model
+    solver = SolverSettings.of(solver)
+    # every held-out run, checked by the check every simulation makes before the first run of the
+    # design (the seeds differ in the realisation only; `tune` checks its own set again)
+    gains = GainSet.reference()
+    for track in track_list:
+        for v in speed_list:
+            sc = make_scenario(track, seed=test[0], speed=v, duration=duration)
+            for load in load_list:
+                for law in laws:
+                    check(sc, base.loaded(load), Suspension.named(law, gains, model), solver, "mark")
+    return Plan(
+        laws,
+        base,
+        source,
+        load_list,
+        tuple(dict.fromkeys(track_list)),
+        speed_list,
+        train,
+        test,
+        duration,
+        obj,
+        aggregate,
+        budget,
+        values,
+        damper,
+        solver,
+    )
+
+
+def design(
+    controllers=None,
+    *,
+    vehicle=None,
+    loads=DEFAULT_LOADS,
+    tracks=DEFAULT_TRACKS,
+    speeds=DEFAULT_SPEEDS,
+    objective=None,
+    aggregate: str = DEFAULT_AGGREGATE,
+    budget: int = DEFAULT_BUDGET,
+    values: int = DEFAULT_VALUES,
+    train_seeds=DEFAULT_TRAIN_SEEDS,
+    test_seeds=DEFAULT_TEST_SEEDS,
+    duration: float = DEFAULT_DURATION,
+    damper=DEFAULT_DAMPER,
+    solver=None,
+    executor=None,
+    table: RunTable | None = None,
+    progress=None,
+    log=None,
+) -> DesignResult:
+    """Which law for ``vehicle`` (a preset name, a parameters file or `VehicleParams`, default
+    "paper") on the random ``tracks`` (FRA classes, german-low, german-high) at ``speeds``
+    [m/s] and load factors ``loads``: tune each of ``controllers`` (laws with gains, default
+    all) robustly, then judge it with passive on held-out seeds, and recommend one.
+
+    Tuning: `railride.studies.tuning.tune` over every track x ``train_seeds`` x speed x load
+    (``duration`` s each), ``objective`` (an `Objective`, "minimax" or "sum"; default
+    `DEFAULT_OBJECTIVE`, the worst RMS ratio to passive) combined over those runs by
+    ``aggregate`` ("mean" or "worst"), at most ``budget`` gain sets per law with ``values``
+    values per gain and sweep, from the neutral reference gains; the inner loop first, on the
+    damper rig, when a law tracks a force and the damper is an MR damper.
+
+    Judging: every law with its tuned gains and passive on every track x ``test_seeds`` x speed
+    x load (seeds that tuning never saw). ``executor``, ``table`` (one `RunTable` for both
+    stages: resumable) and ``progress(done, total, runs_per_second)`` as for
+    `railride.studies.sweep.run_cases`; ``log(text)`` after each pass of tuning. Every input
+    is checked before the first run (`check_design`). Returns a `DesignResult`.
+    """
+    from railride.model.params import vehicle_record
+    from railride.secondary.control import GainSet
+    from railride.secondary.suspension import damper_record
+    from railride.studies.sweep import other_settings
+
+    plan = check_design(
+        controllers,
+        vehicle=vehicle,
+        loads=loads,
+        tracks=tracks,
+        speeds=speeds,
+        objective=objective,
+        aggregate=aggregate,
+        budget=budget,
+        values=values,
+        train_seeds=train_seeds,
+        test_seeds=test_seeds,
+        duration=duration,
+        damper=damper,
+        solver=solver,
+    )
+    table = RunTable() if table is None else table
+    over = tuple(
+        case
+        for track in plan.tracks
+        for case in tuning_set(
+            track, track_seeds=plan.train_seeds, speeds=plan.speeds, loads=plan.loads, duration=plan.duration
+        )
+    )
+    from railride.secondary import dampers
+
+    inner = plan.damper not in dampers.IDEAL_NAMES and any("inner" in GainSet.tables_read(n) for n in plan.laws)
+    tuned = tune(
+        (("inner",) if inner else ()) + plan.laws,
+        over=over,
+        aggregate=plan.aggregate,
+        budget=plan.budget,
+        n_values=plan.values,
+        objective=plan.objective,
+        damper=plan.damper,
+        vehicle=plan.vehicle if plan.source is None else plan.source,
+        solver=plan.solver,
+        executor=executor,
+        table=table,
+        progress=progress,
+        log=log,
+        before_after=False,
+    )
+    training = _training_frame(tuned.runs, plan)
+    runs = _judge(plan, tuned.gains, executor, table, progress)
+    summary = _summary(runs, plan)
+    diverged = _diverged(tuned, training, runs, plan)
+    ranking, points = rank(summary, plan.objective, plan.laws, {d["controller"] for d in diverged})
+    settings = {
+        "vehicle": vehicle_record(plan.vehicle, plan.source, list(plan.loads)),
+        "clearance_m": plan.vehicle.z_stop,
+        "tracks": list(plan.tracks),
+        "speeds_m_s": list(plan.speeds),
+        "loads": list(plan.loads),
+        "controllers": list(plan.laws),
+        "objective": plan.objective.to_dict(),
+        "aggregate": plan.aggregate,
+        "budget": plan.budget,
+        "values": plan.values,
+        "train_seeds": list(plan.train_seeds),
+        "test_seeds": list(plan.test_seeds),
+        "duration_s": plan.duration,
+        "damper": damper_record(plan.damper),
+        "dt_s": float(plan.solver.dt),
+        "inner_loop_tuned": inner,
+        "training_runs_per_gain_set": len(over),
+        "training_runs": int(len(training)),
+        "judging_runs": int(len(runs)),
+        "versions": _versions(),
+        **other_settings(plan.vehicle, plan.solver),
+    }
+    text = recommend(ranking, points, summary, runs, plan.objective, settings, diverged)
+    return DesignResult(
+        summary=summary,
+        runs=runs,
+        ranking=ranking,
+        points=points,
+        recommendation=text,
+        diverged=diverged,
+        tuning=tuned,
+        settings=settings,
+        date=tuned.date,
+    )
+
+
+def _versions() -> dict:
+    import platform
+    from importlib.metadata import PackageNotFoundError, version
+
+    from railride._version import __version__
+
+    out: dict[str, str | None] = {"railride": __version__, "python": platform.python_version()}
+    for name in ("numpy", "numba", "pandas", "xarray"):
+        try:
+            out[name] = version(name)
+        except PackageNotFoundError:  # pragma: no cover - every install has them
+            out[name] = None
+    return out
+
+
+def _training_frame(frame: pd.DataFrame | None, plan: Plan) -> pd.DataFrame:
+    """The rows of the run table that tuning ran: the training seeds of the design's tracks
+    (a resumed table may also hold the held-out runs of an earlier session)."""
+    if frame is None or not len(frame) or "scenario.seed" not in frame:
+        return pd.DataFrame()
+    seeds = frame["scenario.seed"].map(lambda s: s if s != s else int(s))
+    keep = frame["scenario"].isin(plan.tracks) & seeds.isin(plan.train_seeds)
+    return frame[keep].reset_index(drop=True)
+
+
+def _judge(plan: Plan, gains, executor, table, progress) -> pd.DataFrame:
+    """Every law with ``gains`` and passive on the held-out runs: one row per run, with the
+    run's law, track, seed, speed and load, its metrics and costs, and each metric's ratio to
+    passive on the same run (``<metric>_ratio``) and the objective of its RMS ratios
+    (``score``, inf where it diverged)."""
+    from railride.model.params import vehicle_record
+
+    cases, meta = [], []
+    for load in plan.loads:
+        changes = plan.vehicle.load_changes(load)
+        for track in plan.tracks:
+            for seed in plan.test_seeds:
+                for v in plan.speeds:
+                    opts = (("duration", plan.duration), ("seed", seed), ("speed", v))
+                    for name in ("passive", *plan.laws):
+                        if name == "passive":
+                            cases.append(Case(track, opts, vehicle=changes))
+                        else:
+                            cases.append(Case(track, opts, vehicle=changes, suspension=name, damper=plan.damper))
+                        meta.append((name, track, seed, v, load))
+    name = vehicle_record(plan.vehicle, plan.source)["name"]
+    rows = run_cases(
+        cases,
+        executor=executor,
+        table=table,
+        base_gains=gains,
+        params=plan.vehicle,
+        solver=plan.solver,
+        progress=progress,
+        comfort=True,
+        costs=True,
+        vehicle_columns=[{"vehicle": name, "load": float(m[4])} for m in meta],
+    )
+    info = pd.DataFrame(meta, columns=["controller", "track", "track_seed", "speed_m_s", "load"])
+    metrics = rows.reset_index(drop=True)[[*METRICS, "diverged_at_s"]].astype(float)
+    frame = pd.concat([info, metrics], axis=1)
+    key = ["track", "track_seed", "speed_m_s", "load"]
+    passive = frame[frame["controller"] == "passive"].set_index(key)[list(METRICS)]
+    base = passive.reindex(pd.MultiIndex.from_frame(frame[key])).to_numpy()
+    values = frame[list(METRICS)].to_numpy()
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = np.where(base != 0, values / base, np.nan)
+    for j, m in enumerate(METRICS):
+        frame[f"{m}_ratio"] = ratio[:, j]
+    score = plan.objective.score(frame[[f"{c}_ratio" for c in RMS_COLUMNS]].to_numpy())
+    frame["score"] = np.where(np.isfinite(frame["diverged_at_s"]), np.inf, score)
+    return frame
+
+
+def _summary(runs: pd.DataFrame, plan: Plan) -> pd.DataFrame:
+    """Per law (passive first), speed, load and metric (`METRICS`, then ``score``): the runs
+    that did not diverge (``n``), the mean and the 5th / 95th percentiles of the value and of
+    its ratio to passive."""
+    lo, hi = PERCENTILES
+    out = []
+    for name in ("passive", *plan.laws):
+        for v in plan.speeds:
+            for load in plan.loads:
+                part = runs[(runs["controller"] == name) & (runs["speed_m_s"] == v) & (runs["load"] == load)]
+                part = part[~np.isfinite(part["diverged_at_s"])]
+                for m in (*METRICS, "score"):
+                    x = part[m].to_numpy(dtype=float)
+                    r = part[f"{m}_ratio"].to_numpy(dtype=float) if m != "score" else np.array([])
+                    x, r = x[np.isfinite(x)], r[np.isfinite(r)]
+                    out.append(
+                        {
+                            "controller": name,
+                            "speed_m_s": v,
+                            "load": load,
+                            "metric": m,
+                            "n": int(len(part)),
+                            "mean": float(x.mean()) if x.size else np.nan,
+                            "p5": float(np.percentile(x, lo)) if x.size else np.nan,
+                            "p95": float(np.percentile(x, hi)) if x.size else np.nan,
+                            "ratio_mean": float(r.mean()) if r.size else np.nan,
+                            "ratio_p5": float(np.percentile(r, lo)) if r.size else np.nan,
+                            "ratio_p95": float(np.percentile(r, hi)) if r.size else np.nan,
+                        }
+                    )
+    return pd.DataFrame(out)
+
+
+#: the most places a law's divergence is listed at (the count is always given)
+MAX_PLACES = 5
+
+
+def _diverged(tuned, training: pd.DataFrame, runs: pd.DataFrame, plan: Plan) -> list[dict]:
+    """The laws that diverged: in tuning, where the tuned gains' objective over the training
+    runs is not finite (a training run with them diverged), with the training runs of that law
+    that diverged; on held-out track, every law (or passive) with a held-out run that diverged.
+    Each: controller, stage, the number of runs that diverged and up to `MAX_PLACES` of them
+    (track, seed, speed, load where known, time)."""
+    out = []
+    for st in tuned.studies:
+        if st.controller == "inner" or np.isfinite(st.objective):
+            continue
+        part = training[training["suspension"] == st.controller] if len(training) else training
+        if len(part):
+            part = part[np.isfinite(part["diverged_at_s"].astype(float))]
+        places = [
+            {
+                "track": str(r["scenario"]),
+                "track_seed": int(r["scenario.seed"]),
+                "speed_m_s": float(r["scenario.speed"]),
+                "load": None,
+                "diverged_at_s": float(r["diverged_at_s"]),
+            }
+            for _, r in part.head(MAX_PLACES).iterrows()
+        ]
+        out.append({"controller": st.controller, "stage": "tuning", "runs": int(len(part)), "where": places})
+    bad = runs[np.isfinite(runs["diverged_at_s"])]
+    for name, part in bad.groupby("controller", sort=False):
+        places = [
+            {
+                "track": str(r.track),
+                "track_seed": int(r.track_seed),
+                "speed_m_s": float(r.speed_m_s),
+                "load": float(r.load),
+                "diverged_at_s": float(r.diverged_at_s),
+            }
+            for r in part.head(MAX_PLACES).itertuples()
+        ]
+        out.append({"controller": str(name), "stage": "judging", "runs": int(len(part)), "where": places})
+    return out
+
+
+__all__ = ["COST_COLUMNS", "DesignResult", "check_design", "design", "min_budget"]

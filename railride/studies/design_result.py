@@ -1,0 +1,378 @@
+"""What a design study returns (`railride.studies.design.design`): `DesignResult`, the ranking of
+the laws on held-out track (`rank`) and the recommendation in words built from it (`recommend`).
+
+`DesignResult` follows the result protocol: `to_dict` (design.json, schema ``railride.design/1``),
+`to_pandas` (design.csv: per law, speed, load and metric the held-out statistics), `plot`
+(design.png: the RMS ratios to passive against speed with their 5-95 % bands), `save` (those
+files, the held-out runs as design_runs.csv and the tuned gains as gains.toml, all or nothing).
+"""
+
+from __future__ import annotations
+
+import json
+import textwrap
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from railride.analysis.costs import COST_COLUMNS
+from railride.analysis.metrics import RESPONSES
+from railride.plots import PNG_DPI, FigureOptions
+from railride.secondary.control import LABELS
+from railride.studies.objectives import RATIO_NAMES, Objective
+
+#: the schema of `DesignResult.to_dict` (design.json)
+SCHEMA = "railride.design/1"
+#: the RMS responses, as the run table names them
+RMS_COLUMNS = tuple(f"{r}_rms" for r in RESPONSES)
+#: the comfort indices a design reports (at the carbody's centre): EN 12299's N_MV (its
+#: vertical term), Sperling's Wz and ISO 2631's Wk-weighted RMS acceleration
+COMFORT_METRICS = ("centre_N_MV_z", "centre_Wz", "centre_aw_Wk")
+#: every metric of a held-out run that a design summarises: responses, comfort, costs
+METRICS = (*RMS_COLUMNS, *COMFORT_METRICS, *COST_COLUMNS)
+#: the band of the statistics
+PERCENTILES = (5.0, 95.0)
+#: the statistics of a metric, as `to_pandas` and the JSON name them
+STATISTICS = ("mean", "p5", "p95", "ratio_mean", "ratio_p5", "ratio_p95")
+
+
+def _finite(value) -> float | None:
+    value = float(value)
+    return value if np.isfinite(value) else None
+
+
+def _label(name: str) -> str:
+    return LABELS.get(name, name)
+
+
+def _at(speed: float, load: float) -> str:
+    return f"{speed:g} m/s, load {load:g}"
+
+
+@dataclass(frozen=True, eq=False)
+class DesignResult:
+    """The result of `railride.design`. ``summary``: per law (passive first), speed, load and
+    metric (`METRICS`, then ``score``, the objective of a run's RMS ratios) the held-out runs
+    that did not diverge (``n``), the ``mean``, ``p5`` and ``p95`` of the value and
+    ``ratio_mean``, ``ratio_p5`` and ``ratio_p95`` of its ratio to passive on the same run.
+    ``runs``: one row per held-out run (law, track, seed, speed, load, metrics, ratios,
+    ``score``, ``diverged_at_s``). ``ranking``: the laws, best first (`rank`); ``points``: per
+    speed and load, each law's score and what no law improves; ``recommendation``: the words
+    (`recommend`); ``diverged``: the laws that diverged, in tuning or judging, and where;
+    ``tuning``: the `railride.studies.tune_result.TuneResult` of the training set (its gains:
+    ``gains``); ``settings``: every input, the vehicle's record, the versions."""
+
+    summary: pd.DataFrame
+    runs: pd.DataFrame = field(repr=False)
+    ranking: list = field(default_factory=list)
+    points: list = field(default_factory=list)
+    recommendation: str = ""
+    diverged: list = field(default_factory=list)
+    tuning: Any = field(default=None, repr=False)
+    settings: dict = field(default_factory=dict)
+    date: str | None = None
+
+    @property
+    def gains(self):
+        """The tuned gains (`GainSet`): every law's, and the inner loop's where it was tuned."""
+        return self.tuning.gains
+
+    @property
+    def recommended(self) -> str | None:
+        """The law ranked first, or None when no law could be ranked (every one diverged)."""
+        first = self.ranking[0] if self.ranking else None
+        return first["controller"] if first is not None and first["ranked"] else None
+
+    def table(self, metric: str) -> pd.DataFrame:
+        """One metric's rows of `summary`, indexed by law, speed and load."""
+        part = self.summary[self.summary["metric"] == metric]
+        return part.set_index(["controller", "speed_m_s", "load"])
+
+    def to_dict(self) -> dict:
+        """The ``railride.design/1`` document (docs/schemas/railride.design-1.json)."""
+        from railride._version import __version__
+        from railride.secondary.control import GainSet
+
+        results = []
+        for (name, v, load), part in self.summary.groupby(["controller", "speed_m_s", "load"], sort=False):
+            metrics = {str(row["metric"]): {k: _finite(row[k]) for k in STATISTICS} for _, row in part.iterrows()}
+            results.append(
+                {
+                    "controller": str(name),
+                    "speed_m_s": float(v),
+                    "load": float(load),
+                    "n": int(part["n"].iloc[0]),
+                    "metrics": metrics,
+                }
+            )
+        tuning = self.tuning
+        return {
+            "schema": SCHEMA,
+            "railride_version": __version__,
+            "date": self.date,
+            "settings": self.settings,
+            "percentiles": list(PERCENTILES),
+            "results": results,
+            "points": [_plain(p) for p in self.points],
+            "ranking": [_plain(r) for r in self.ranking],
+            "recommendation": {"controller": self.recommended, "text": self.recommendation},
+            "diverged": self.diverged,
+            "tuning": {
+                "objective": tuning.objective.describe(),
+                "studies": [s.to_dict() for s in tuning.studies],
+            },
+            "gains": {t: self.gains.table(t).to_dict() for t in GainSet.TABLES},
+            "runs": {"training": int(self.settings.get("training_runs", 0)), "judging": int(len(self.runs))},
+        }
+
+    def gains_toml(self, command: str | None = None) -> str:
+        """The tuned gains as a gains file: a header that says how the design chose and judged
+        them, then the tuning's file with its [provenance] (`TuneResult.gains_toml`: the
+        training set, the vehicle, the objective, each law's study)."""
+        s = self.settings
+        tracks = ", ".join(s["tracks"])
+        lines = [
+            "# railride design: these gains were tuned on the training set in [provenance] and judged on",
+            f"# held-out seeds {', '.join(map(str, s['test_seeds']))} of {tracks} (never used in tuning).",
+            *([f"# command: {command}"] if command is not None else []),
+            *textwrap.wrap("recommendation: " + self.recommendation, 98, initial_indent="# ", subsequent_indent="#   "),
+            "",
+        ]
+        return "\n".join(lines) + self.tuning.gains_toml()
+
+    def to_pandas(self) -> pd.DataFrame:
+        """The summary: one row per law, speed, load and metric (design.csv)."""
+        return self.summary.copy()
+
+    def plot(self, ax=None):
+        """The four RMS ratios to passive against speed, per law and load, with the held-out
+        5-95 % band (`railride.plots.design.plot_design`). ``ax``: four Axes, or None for a new
+        figure. Returns the figure."""
+        from railride.plots.design import plot_design
+
+        return plot_design(self, ax=ax)
+
+    def save(
+        self,
+        folder,
+        command: str | None = None,
+        *,
+        extra: dict | None = None,
+        figure_formats=("png",),
+        dpi: float = PNG_DPI,
+    ) -> list:
+        """design.json (`to_dict`, then the entries of ``extra``), design.csv (`to_pandas`),
+        design_runs.csv (``runs``), gains.toml (`gains_toml` with ``command``) and design.png
+        (`plot`; in each of ``figure_formats``) into ``folder``, all or nothing (other files,
+        such as the run table runs.csv, stay). Returns the paths."""
+        from railride.output.files import write_design_outputs
+
+        doc = {**self.to_dict(), **(extra or {})}
+        figures = FigureOptions(figure_formats, dpi)
+        return write_design_outputs(self, folder, doc, self.gains_toml(command), figures=figures)
+
+
+def _plain(value):
+    """A record with NaN and inf as None, tuples as lists (JSON)."""
+    if isinstance(value, dict):
+        return {k: _plain(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value]
+    if isinstance(value, (float, np.floating)):
+        return _finite(value)
+    if isinstance(value, np.integer):
+        return int(value)
+    return value
+
+
+# -- the ranking -----------------------------------------------------------------------------------
+def rank(summary: pd.DataFrame, objective: Objective, laws, diverged=()) -> tuple[list, list]:
+    """The laws ranked on held-out track, and the speeds and loads.
+
+    At each speed and load (a point) a law's score is ``objective`` of its mean RMS ratios to
+    passive there (for minimax: its worst mean ratio over the four responses); a law's score
+    is its largest over the points, at ``worst_at``. The laws that did not diverge (``ranked``)
+    come first, best score first; the ``diverged`` follow. Each point lists every law's score,
+    the best ranked law (``best``) and the responses that no ranked law improves on average
+    (``no_law_beats_passive``, with the best ratio there and its law). Returns (ranking,
+    points)."""
+    ratios = summary[summary["metric"].isin(RMS_COLUMNS)]
+    mean = ratios.pivot_table(index=["controller", "speed_m_s", "load"], columns="metric", values="ratio_mean")
+    keys = list(dict.fromkeys(zip(summary["speed_m_s"], summary["load"])))
+    ranked = [n for n in laws if n not in diverged]
+    points: list[dict[str, Any]] = []
+    for v, load in keys:
+        scores: dict[str, float] = {}
+        for n in laws:
+            r = mean.loc[(n, v, load), list(RMS_COLUMNS)].to_numpy(dtype=float) if (n, v, load) in mean.index else None
+            scores[n] = float(objective.score(r)) if r is not None and np.isfinite(r).all() else np.nan
+        finite = [n for n in ranked if np.isfinite(scores[n])]
+        best = min(finite, key=lambda n: scores[n]) if finite else None
+        none = []
+        for col, word in zip(RMS_COLUMNS, RATIO_NAMES):
+            values = {
+                n: float(mean.loc[(n, v, load), col])
+                for n in ranked
+                if (n, v, load) in mean.index and np.isfinite(mean.loc[(n, v, load), col])
+            }
+            if values and min(values.values()) >= 1.0:
+                top = min(values, key=lambda n: values[n])
+                none.append({"response": word, "best_ratio": values[top], "best_controller": top})
+        points.append(
+            {"speed_m_s": float(v), "load": float(load), "scores": scores, "best": best, "no_law_beats_passive": none}
+        )
+    ranking = []
+    for n in laws:
+        per = [(p["scores"][n], p) for p in points]
+        bad = [p for s, p in per if not np.isfinite(s)]
+        worst = bad[0] if bad else max(per, key=lambda sp: sp[0])[1]
+        score = np.inf if bad else max(s for s, _ in per)
+        ranking.append(
+            {
+                "controller": n,
+                "score": score,
+                "worst_at": {"speed_m_s": worst["speed_m_s"], "load": worst["load"]},
+                "best_at": [{"speed_m_s": p["speed_m_s"], "load": p["load"]} for p in points if p["best"] == n],
+                "ranked": n not in diverged and bool(np.isfinite(score)),
+            }
+        )
+    ranking.sort(key=lambda r: (not r["ranked"], r["score"] if np.isfinite(r["score"]) else np.inf))
+    for k, r in enumerate(ranking, 1):
+        r["rank"] = k if r["ranked"] else None
+    return ranking, points
+
+
+# -- the recommendation ----------------------------------------------------------------------------
+def recommend(ranking, points, summary: pd.DataFrame, runs: pd.DataFrame, objective, settings, diverged) -> str:
+    """The recommendation in a few sentences, each one a number of the ranking or the summary:
+    the law ranked first and its score; the responses it makes worse than passive on average,
+    and where; where another law scores better; how sure (whether the held-out 5-95 % bands of
+    the per-run scores of it and the runner-up overlap, and how many runs it wins run by run);
+    where no law beats passive; the laws that diverged."""
+    ok = [r for r in ranking if r["ranked"]]
+    n = len(settings["tracks"]) * len(settings["test_seeds"])
+    seeds = ", ".join(map(str, settings["test_seeds"]))
+    held = (
+        f"{n} held-out run{'s' * (n != 1)} per law, speed and load ({', '.join(settings['tracks'])}, "
+        f"seed{'s' * (len(settings['test_seeds']) != 1)} {seeds}; never used in tuning)"
+    )
+    out = []
+    if not ok:
+        out.append("No law can be recommended: every law diverged in tuning or on held-out track.")
+    else:
+        best = ok[0]
+        name, score, w = best["controller"], best["score"], best["worst_at"]
+        if objective.kind == "minimax":
+            what = "its worst mean RMS ratio to passive over the four responses, at any speed and load, is"
+        else:
+            what = (
+                f"its largest score ({objective.kind} of the mean RMS ratios to passive) over the speeds and loads is"
+            )
+        out.append(f"Recommended: {_label(name)}. On {held}, {what} {score:.3f} (at {_at(w['speed_m_s'], w['load'])}).")
+        out.append(_worse_than_passive(name, summary))
+        out.append(_wins(name, points))
+        out.append(_sureness(best, ok[1] if len(ok) > 1 else None, points, summary, runs))
+        if objective.kind == "minimax" and score >= 1.0:
+            out.append(
+                "No law keeps every RMS response better than passive on average at every speed and load; "
+                "the recommended law is the one whose worst response is least worse."
+            )
+    out.append(_passive_unbeaten(points, bool(diverged)))
+    for d in diverged:
+        if d["controller"] == "passive":
+            out.append(f"Passive diverged on {d['runs']} held-out run(s): those runs have no ratios.")
+            continue
+        first = d["where"][0] if d["where"] else None
+        place = ""
+        if first is not None:
+            load = "" if first["load"] is None else f", load {first['load']:g}"
+            place = (
+                f", first on {first['track']} seed {first['track_seed']} at {first['speed_m_s']:g} m/s{load}, "
+                f"t = {first['diverged_at_s']:.3g} s"
+            )
+        stage = "in tuning" if d["stage"] == "tuning" else "on held-out track"
+        out.append(
+            f"{_label(d['controller'])} diverged {stage} ({d['runs']} run{'s' * (d['runs'] != 1)}{place}) "
+            "and is not ranked."
+        )
+    return " ".join(s for s in out if s)
+
+
+def _worse_than_passive(name: str, summary: pd.DataFrame) -> str:
+    part = summary[(summary["controller"] == name) & summary["metric"].isin(RMS_COLUMNS)]
+    worse: dict[str, list] = {}
+    for _, row in part.iterrows():
+        if np.isfinite(row["ratio_mean"]) and row["ratio_mean"] > 1.0:
+            word = RATIO_NAMES[RMS_COLUMNS.index(row["metric"])]
+            worse.setdefault(word, []).append(f"{_at(row['speed_m_s'], row['load'])} (x{row['ratio_mean']:.3f})")
+    if not worse:
+        return "It is better than passive on average in every RMS response at every speed and load."
+    return (
+        "On average it is worse than passive in " + "; ".join(f"{w} at {', '.join(p)}" for w, p in worse.items()) + "."
+    )
+
+
+def _wins(name: str, points) -> str:
+    lost = [p for p in points if p["best"] not in (None, name)]
+    if not lost:
+        return "It has the best score of the laws at every speed and load."
+    where = "; ".join(
+        f"{_label(p['best'])} at {_at(p['speed_m_s'], p['load'])} ({p['scores'][p['best']]:.3f} against "
+        f"{p['scores'][name]:.3f})"
+        for p in lost
+    )
+    return f"It has the best score at {len(points) - len(lost)} of {len(points)} speeds and loads; it loses to {where}."
+
+
+def _sureness(best: dict, runner: dict | None, points, summary: pd.DataFrame, runs: pd.DataFrame) -> str:
+    if runner is None:
+        return "No other law was ranked: there is no runner-up to compare with."
+    a, b = best["controller"], runner["controller"]
+    band = summary[summary["metric"] == "score"].set_index(["controller", "speed_m_s", "load"])
+    overlap = 0
+    counts = sorted({int(band.loc[(x, p["speed_m_s"], p["load"]), "n"]) for x in (a, b) for p in points})
+    n = counts[-1] if counts else 0
+    runs_text = f"{n} run{'s' * (n != 1)}" if len(counts) < 2 else f"{counts[0]} to {n} runs"
+    for p in points:
+        key_a, key_b = (a, p["speed_m_s"], p["load"]), (b, p["speed_m_s"], p["load"])
+        lo = max(band.loc[key_a, "p5"], band.loc[key_b, "p5"])
+        hi = min(band.loc[key_a, "p95"], band.loc[key_b, "p95"])
+        overlap += bool(lo <= hi)
+    text = (
+        f"Runner-up: {_label(b)} ({runner['score']:.3f}). The held-out 5-95 % bands of the two laws' per-run "
+        f"scores (over {runs_text} each) overlap at {overlap} of {len(points)} speeds and loads"
+    )
+    if overlap == len(points):
+        text += ": these runs do not separate the two"
+    elif overlap == 0:
+        text += ": they are apart at every one"
+    key = ["track", "track_seed", "speed_m_s", "load"]
+    pair = runs[runs["controller"] == a].set_index(key)["score"].to_frame("a")
+    pair = pair.join(runs[runs["controller"] == b].set_index(key)["score"].to_frame("b"))
+    pair = pair[np.isfinite(pair["a"]) & np.isfinite(pair["b"])]
+    wins = int((pair["a"] < pair["b"]).sum())
+    return text + f"; run by run (the same track, speed and load) {_label(a)} scores lower in {wins} of {len(pair)}."
+
+
+def _passive_unbeaten(points, some_diverged: bool) -> str:
+    laws = "law that did not diverge" if some_diverged else "law"
+    by_response: dict[str, list] = {}
+    for p in points:
+        for item in p["no_law_beats_passive"]:
+            by_response.setdefault(item["response"], []).append(
+                f"{_at(p['speed_m_s'], p['load'])} (best x{item['best_ratio']:.3f}, {_label(item['best_controller'])})"
+            )
+    if not by_response:
+        return f"At every speed and load, every RMS response has a {laws} better than passive on average."
+    return (
+        f"No {laws} is better than passive on average in "
+        + "; ".join(f"{w} at {', '.join(where)}" for w, where in by_response.items())
+        + "."
+    )
+
+
+def dumps(result: DesignResult) -> str:
+    """The document as strict JSON (the command line's ``--format json``)."""
+    return json.dumps(result.to_dict(), indent=2, allow_nan=False)

@@ -1,0 +1,243 @@
+"""railride.design: a law tuned on training seeds and judged on held-out seeds, the result, its
+ranking and recommendation, and the checks of its inputs (before any run)."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pandas as pd
+import pytest
+
+import railride as rr
+from railride.errors import InputError
+from railride.studies.design import min_budget
+from railride.studies.design_result import METRICS, RMS_COLUMNS, rank, recommend
+from railride.studies.objectives import Objective
+from railride.studies.sweep import RunTable
+
+#: a design of two laws that takes a few seconds: one track, speed, load, training and held-out seed
+TINY = dict(
+    tracks=["fra4"],
+    speeds=[40.0],
+    loads=[1.0],
+    train_seeds=[0],
+    test_seeds=[1],
+    duration=2.0,
+    budget=13,
+    values=3,
+)
+
+
+@pytest.fixture(scope="module")
+def tiny():
+    return rr.design(["pid", "skyhook"], **TINY)
+
+
+def test_the_result_holds_every_law_and_passive_per_speed_and_load(tiny):
+    assert isinstance(tiny, rr.DesignResult) and isinstance(tiny, rr.Result)
+    summary = tiny.to_pandas()
+    assert list(dict.fromkeys(summary["controller"])) == ["passive", "pid", "skyhook"]
+    assert set(summary["metric"]) == {*METRICS, "score"}
+    assert (summary["n"] == 1).all()
+    # one held-out run per law: track fra4, seed 1, 40 m/s, load 1
+    assert len(tiny.runs) == 3 and set(tiny.runs["track_seed"]) == {1}
+    passive = summary[summary["controller"] == "passive"].set_index("metric")
+    assert passive.loc["acceleration_m_s2_rms", "ratio_mean"] == 1.0
+    assert passive.loc["acceleration_m_s2_rms", "mean"] > 0
+    # the costs: force and travel for every law, time at v_max for the MR laws only
+    pid = summary[summary["controller"] == "pid"].set_index("metric")
+    assert pid.loc["force_rms_n", "mean"] > 0 and pid.loc["travel_max_m", "mean"] > 0
+    assert 0 <= pid.loc["voltage_at_max_fraction", "mean"] <= 1
+    assert math.isnan(passive.loc["voltage_at_max_fraction", "mean"])
+    assert tiny.settings["clearance_m"] == rr.VehicleParams.preset("paper").z_stop
+
+
+def test_held_out_seeds_are_never_in_training(tiny):
+    trained = set(tiny.tuning.runs["scenario.seed"].astype(int))
+    judged = set(tiny.runs["track_seed"].astype(int))
+    assert trained == {0} and judged == {1} and not trained & judged
+    assert tiny.settings["train_seeds"] == [0] and tiny.settings["test_seeds"] == [1]
+    assert {r["seed"] for r in tiny.tuning.settings["tuning_set"]} == {0}
+
+
+def test_the_ranking_and_the_recommendation_name_the_winner(tiny):
+    first = tiny.ranking[0]
+    assert first["rank"] == 1 and tiny.recommended == first["controller"]
+    assert [r["controller"] for r in tiny.ranking] == sorted(
+        ["pid", "skyhook"], key=lambda n: next(r["score"] for r in tiny.ranking if r["controller"] == n)
+    )
+    label = rr.secondary.control.LABELS[tiny.recommended]
+    assert tiny.recommendation.startswith(f"Recommended: {label}.")
+    assert "held-out" in tiny.recommendation and "Runner-up" in tiny.recommendation
+    # the score is the worst mean ratio (minimax) of the winner on its held-out runs
+    ratios = tiny.table("roll_deg_rms").loc[(tiny.recommended, 40.0, 1.0), "ratio_mean"]
+    assert first["score"] >= ratios
+
+
+def test_the_document_the_files_and_the_gains_file(tiny, tmp_path):
+    jsonschema = pytest.importorskip("jsonschema")
+    from pathlib import Path
+
+    doc = json.loads(json.dumps(tiny.to_dict(), allow_nan=False))
+    schema = json.loads((Path(__file__).parents[2] / "docs/schemas/railride.design-1.json").read_text())
+    jsonschema.validate(doc, schema, cls=jsonschema.Draft202012Validator)
+    assert doc["recommendation"]["controller"] == tiny.recommended
+    assert doc["runs"] == {"training": tiny.settings["training_runs"], "judging": 3}
+    paths = tiny.save(tmp_path / "d", command="railride design --budget 13")
+    assert sorted(p.name for p in paths) == ["design.csv", "design.json", "design.png", "design_runs.csv", "gains.toml"]
+    gains = rr.GainSet.load(tmp_path / "d" / "gains.toml")
+    assert gains.provenance["aggregate"] == "mean"
+    assert {r["seed"] for r in gains.provenance["tuning_set"]} == {0}
+    assert gains.table("pid") == tiny.gains.table("pid")
+    text = (tmp_path / "d" / "gains.toml").read_text()
+    assert "held-out seeds 1 of fra4" in text and "# command: railride design --budget 13" in text
+    runs = pd.read_csv(tmp_path / "d" / "design_runs.csv")
+    assert len(runs) == 3 and set(runs["controller"]) == {"passive", "pid", "skyhook"}
+
+
+def _summary(ratios: dict) -> pd.DataFrame:
+    """A summary of one speed and load: ``ratios`` law -> four mean RMS ratios; a band of
+    +-0.05 around each score."""
+    rows = []
+    for name, values in {"passive": [1.0] * 4, **ratios}.items():
+        for col, r in zip(RMS_COLUMNS, values):
+            rows.append({"controller": name, "speed_m_s": 50.0, "load": 1.0, "metric": col, "n": 5, "ratio_mean": r})
+        score = max(values)
+        rows.append(
+            {
+                "controller": name,
+                "speed_m_s": 50.0,
+                "load": 1.0,
+                "metric": "score",
+                "n": 5,
+                "mean": score,
+                "p5": score - 0.05,
+                "p95": score + 0.05,
+            }
+        )
+    return pd.DataFrame(rows)
+
+
+def _runs(scores: dict) -> pd.DataFrame:
+    return pd.DataFrame(
+        [
+            {"controller": n, "track": "fra4", "track_seed": s, "speed_m_s": 50.0, "load": 1.0, "score": v + 0.01 * s}
+            for n, v in scores.items()
+            for s in range(5)
+        ]
+    )
+
+
+SETTINGS = {"tracks": ["fra4"], "test_seeds": [100, 101, 102, 103, 104]}
+
+
+def test_the_recommendation_says_where_no_law_beats_passive():
+    summary = _summary({"pid": [0.8, 0.7, 0.9, 1.10], "skyhook": [0.6, 0.9, 0.95, 1.20]})
+    ranking, points = rank(summary, Objective("minimax"), ["pid", "skyhook"])
+    assert [r["controller"] for r in ranking] == ["pid", "skyhook"]
+    assert points[0]["no_law_beats_passive"] == [{"response": "roll", "best_ratio": 1.1, "best_controller": "pid"}]
+    text = recommend(ranking, points, summary, _runs({"pid": 1.1, "skyhook": 1.2}), Objective("minimax"), SETTINGS, [])
+    assert text.startswith("Recommended: PID.")
+    assert "worse than passive in roll at 50 m/s, load 1 (x1.100)" in text
+    assert "No law is better than passive on average in roll at 50 m/s, load 1" in text
+    assert "No law keeps every RMS response better than passive" in text
+    # the bands (1.05-1.15 and 1.15-1.25) touch: they overlap; PID wins every run
+    assert "overlap at 1 of 1" in text and "PID scores lower in 5 of 5" in text
+
+
+def test_apart_bands_and_a_law_that_diverged():
+    summary = _summary({"pid": [0.5, 0.5, 0.6, 0.7], "skyhook": [0.9, 0.9, 0.9, 0.9], "hybrid": [0.4] * 4})
+    diverged = [
+        {
+            "controller": "hybrid",
+            "stage": "judging",
+            "runs": 1,
+            "where": [{"track": "fra4", "track_seed": 102, "speed_m_s": 50.0, "load": 1.0, "diverged_at_s": 3.5}],
+        }
+    ]
+    ranking, points = rank(summary, Objective("minimax"), ["pid", "skyhook", "hybrid"], {"hybrid"})
+    assert [(r["controller"], r["rank"]) for r in ranking] == [("pid", 1), ("skyhook", 2), ("hybrid", None)]
+    assert points[0]["best"] == "pid" and points[0]["no_law_beats_passive"] == []
+    text = recommend(
+        ranking,
+        points,
+        summary,
+        _runs({"pid": 0.7, "skyhook": 0.9, "hybrid": 0.4}),
+        Objective("minimax"),
+        SETTINGS,
+        diverged,
+    )
+    assert "better than passive on average in every RMS response" in text
+    assert "apart at every one" in text
+    assert "every RMS response has a law that did not diverge better than passive" in text
+    assert "Hybrid diverged on held-out track (1 run, first on fra4 seed 102 at 50 m/s, load 1, t = 3.5 s)" in text
+
+
+def test_min_budget_lets_every_gain_be_swept_once():
+    assert min_budget("pid", 3) == 1 + 3 * 4
+    assert min_budget("groundhook", 13) == 1 + 14
+    # SAS (attitude+ride): 6 attitude gains, then 8 ride gains on what the first stage leaves
+    # (the first stage may spend its half of what the start leaves: (B - 1) // 2 >= 48, B - 1 - that >= 64)
+    need = min_budget("sas-attitude-ride", 7)
+    assert need == 128 and (need - 1) // 2 >= 6 * 8 and need - 1 - (need - 1) // 2 >= 8 * 8
+    assert (need - 2) - (need - 2) // 2 < 8 * 8  # one fewer would not do
+    assert rr.studies.design.DEFAULT_BUDGET >= max(min_budget(n, 7) for n in rr.studies.tuning.TUNED_CONTROLLERS)
+
+
+@pytest.mark.parametrize(
+    "change, fragments",
+    [
+        ({"speeds": []}, ("speeds = []", "at least one")),
+        ({"loads": []}, ("loads = []",)),
+        ({"test_seeds": [0, 5]}, ("test_seeds = [0, 5]", "0 also in train_seeds", "never sees")),
+        ({"budget": 5}, ("budget = 5", ">= 13", "try every gain once")),
+        ({"controllers": ["lqr"]}, ("controllers = 'lqr'", "allowed: pid")),
+        ({"tracks": ["paper-sine"]}, ("tracks = 'paper-sine'", "fra4")),
+        ({"objective": "sperling"}, ("objective = 'sperling'", "not built yet")),
+        ({"aggregate": "median"}, ("aggregate",)),
+        ({"values": 2}, ("values = 2",)),
+        ({"duration": -1.0}, ("duration",)),
+    ],
+)
+def test_bad_input_is_refused_before_any_run(change, fragments):
+    table = RunTable()
+    settings = {**TINY, **change}
+    controllers = settings.pop("controllers", ["pid"])
+    with pytest.raises(InputError) as caught:
+        rr.design(controllers, table=table, **settings)
+    for fragment in fragments:
+        assert fragment in str(caught.value), (fragment, str(caught.value))
+    assert len(table.frame) == 0
+
+
+def test_passive_is_always_the_baseline_and_all_means_every_law():
+    from railride.studies.design import check_design
+    from railride.studies.tuning import TUNED_CONTROLLERS
+
+    assert check_design(["passive", "pid"], **TINY).laws == ("pid",)
+    assert check_design(None, **{**TINY, "budget": 400}).laws == TUNED_CONTROLLERS
+    assert np.isfinite(check_design("all", **{**TINY, "budget": 400}).budget)
+
+
+def test_run_cases_with_costs_adds_the_damper_columns_and_its_own_keys():
+    from railride.analysis.costs import COST_COLUMNS
+    from railride.studies.sweep import Case, run_cases
+
+    opts = (("duration", 1.0), ("seed", 0), ("speed", 40.0))
+    cases = [
+        Case("fra4", opts),
+        Case("fra4", opts, suspension="pid"),
+        Case("fra4", opts, suspension="pid", damper="ideal"),
+    ]
+    table = RunTable()
+    rows = run_cases(cases, table=table, costs=True)
+    assert set(COST_COLUMNS) <= set(rows.columns)
+    passive, pid, ideal = (rows.iloc[i] for i in range(3))
+    assert passive["force_rms_n"] > 0 and passive["travel_max_m"] > 0 and math.isnan(passive["voltage_at_max_fraction"])
+    assert 0 <= pid["voltage_at_max_fraction"] <= 1 and pid["force_max_n"] >= pid["force_rms_n"]
+    assert math.isnan(ideal["voltage_at_max_fraction"])  # an ideal device has no voltage
+    plain = run_cases(cases, table=table)
+    assert not set(COST_COLUMNS) & set(plain.columns)
+    assert set(plain["key"]).isdisjoint(rows["key"])  # costs are in a run's key: a table resumes neither into the other
