@@ -286,8 +286,8 @@ def _compare_tables(doc: dict, shipped: bool):
     # 1b. the same gains on the ideal devices: what a damper, and an actuator, could reach
     bounds_parts = []
     if doc.get("bounds"):
-        # one row per law and response: MR dampers and both bounds side by side at any width
-        bt = FitTable(title="RMS reduction % beside the bounds: the same control laws and gains on ideal devices")
+        # one row per law and response: MR dampers and both references side by side at any width
+        bt = FitTable(title="RMS reduction % beside the references: the same control laws and gains on ideal devices")
         bt.add_column("suspension")
         bt.add_column("response")
         for head in ("MR\ndampers", "ideal\ndamper", "ideal\nactuator"):
@@ -307,11 +307,11 @@ def _compare_tables(doc: dict, shipped: bool):
             bt,
             Text(
                 "ideal damper: the demand where it dissipates energy, no force where it would push "
-                "energy in (no force limit, no lag, no hysteresis): the best any semi-active damper "
-                "could do with these gains. ideal actuator: the demand, always (an active "
-                "suspension). The gains were tuned for the MR dampers; tuned for the ideal devices "
-                "the bounds lie further out (docs/results.md)."
-                + "".join(f" {r['label']}: no bound ({doc['bounds']['ideal'][r['name']]['note']})." for r in unbounded)
+                "energy in (no force limit, no lag, no hysteresis). ideal actuator: the demand, "
+                "always (an active suspension). References for these gains, not bounds: the MR "
+                "dampers can beat the ideal damper with them (their lag and hysteresis change the "
+                "loop), and gains tuned for an ideal device reach further (docs/results.md)."
+                + "".join(f" {r['label']}: no reference ({doc['bounds']['ideal'][r['name']]['note']})." for r in unbounded)
             ),
         ]
 

@@ -1,5 +1,5 @@
 """The league table as a bar chart: mean RMS reduction per controller and response, with the
-same gains on the ideal actuator drawn as an outline beside each bar (the upper bound)."""
+same gains on the ideal actuator drawn as an outline beside each bar (a reference, not a bound)."""
 
 from __future__ import annotations
 

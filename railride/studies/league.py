@@ -3,7 +3,7 @@
 `league` runs `railride.compare` on every combination of scenario, speed and track seed (the
 seeds apply to the random tracks only) with the same gains, and collects per case and
 controller the RMS reduction of each response against passive, the same gains' reduction on
-the ideal actuator (the upper bound), ride comfort at the carbody centre, and what the
+the ideal actuator (a reference for the same gains, not a bound), ride comfort at the carbody centre, and what the
 controller asks of its dampers (force and travel). `LeagueTable` summarises it per controller
 as the mean over the cases, and says which cases the gains were tuned on (in-sample) and which
 they meet for the first time (out-of-sample).
@@ -86,7 +86,7 @@ class LeagueTable:
 
     def plot(self, ax=None):
         """Bar chart of the mean RMS reductions per controller and response, with the
-        ideal-actuator bound as an outline beside each bar."""
+        ideal-actuator reference as an outline beside each bar."""
         from railride.plots.league import plot_league
 
         return plot_league(self, ax=ax)
