@@ -199,7 +199,9 @@ def rank(summary: pd.DataFrame, objective: Objective, laws, diverged=()) -> tupl
     (``no_law_beats_passive``, with the best ratio there and its law). Returns (ranking,
     points)."""
     ratios = summary[summary["metric"].isin(RMS_COLUMNS)]
-    mean = ratios.pivot_table(index=["controller", "speed_m_s", "load"], columns="metric", values="ratio_mean")
+    mean = ratios.pivot_table(
+        index=["controller", "speed_m_s", "load"], columns="metric", values="ratio_mean", dropna=False
+    ).reindex(columns=list(RMS_COLUMNS))
     keys = list(dict.fromkeys(zip(summary["speed_m_s"], summary["load"])))
     ranked = [n for n in laws if n not in diverged]
     points: list[dict[str, Any]] = []
