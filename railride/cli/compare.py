@@ -311,7 +311,9 @@ def _compare_tables(doc: dict, shipped: bool):
                 "always (an active suspension). References for these gains, not bounds: the MR "
                 "dampers can beat the ideal damper with them (their lag and hysteresis change the "
                 "loop), and gains tuned for an ideal device reach further (docs/results.md)."
-                + "".join(f" {r['label']}: no reference ({doc['bounds']['ideal'][r['name']]['note']})." for r in unbounded)
+                + "".join(
+                    f" {r['label']}: no reference ({doc['bounds']['ideal'][r['name']]['note']})." for r in unbounded
+                )
             ),
         ]
 
