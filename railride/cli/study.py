@@ -96,7 +96,7 @@ def _table(doc: dict):
     s = doc["settings"]
     lo, hi = doc["percentiles"]
     seeds = s["track_seeds"] or []
-    over = (f"{len(seeds)} track seeds x " if seeds else "") + f"{len(s['speeds_m_s'])} speed(s)"
+    over = f"{len(seeds)} track seeds, per speed and condition" if seeds else "one run per speed and condition"
 
     def cells(m: dict) -> dict:
         return {
@@ -122,6 +122,7 @@ def _table(doc: dict):
                 continue  # no reduction of passive against itself: no rows in a table of reductions
             case = [
                 escape(LABELS[group["controller"]]),
+                f"{group['speed_m_s']:g} m/s",
                 f"load {group['load']:g}",
                 f"k_sz x {group['stiffness']:g}",
                 f"fault {group['fault']}",

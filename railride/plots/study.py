@@ -29,10 +29,11 @@ DEFAULT_METRICS = {
 
 @styled
 def plot_study(result, ax=None, metrics=None):
-    """One panel per metric (default `DEFAULT_METRICS`): per condition (load, fault, delay) a group,
-    per controller a marker at the mean reduction [%] against passive, with a bar from the 5th
-    to the 95th percentile over the study's tracks and speeds. ``ax``: one Axes per metric, or
-    None for a new figure (at most three panels a row). Returns the figure."""
+    """One panel per metric (default `DEFAULT_METRICS`): per speed and condition (load, fault,
+    delay) a group, per controller a marker at the mean reduction [%] against passive, with a bar
+    from the 5th to the 95th percentile over the study's tracks (speeds and loads are never
+    pooled). ``ax``: one Axes per metric, or None for a new figure (at most three panels a
+    row). Returns the figure."""
     summary = result.summary
     metrics = list(DEFAULT_METRICS) if metrics is None else list(metrics)
     unknown = [m for m in metrics if m not in set(summary["metric"])]
@@ -40,7 +41,9 @@ def plot_study(result, ax=None, metrics=None):
         raise InputError(f"metrics: {unknown[0]!r} is not a metric of the study; allowed {', '.join(DEFAULT_METRICS)}")
     controlled = [n for n in dict.fromkeys(summary["controller"]) if n != "passive"]
     part = summary[summary["controller"] != "passive"]
-    conditions = list(dict.fromkeys(zip(part["load"], part["stiffness"], part["fault"], part["delay"])))
+    conditions = list(
+        dict.fromkeys(zip(part["speed_m_s"], part["load"], part["stiffness"], part["fault"], part["delay"]))
+    )
     spare = None  # a free panel of the grid, where the legend covers no data
     if ax is None:
         n_rows, columns = grid_shape(len(metrics), 3)
@@ -58,7 +61,9 @@ def plot_study(result, ax=None, metrics=None):
     x = np.arange(len(conditions))
     crowded = len(conditions) * columns > 9  # "load x1.3" side by side ran into each other
     for a, metric in zip(axes, metrics):
-        rows = part[part["metric"] == metric].set_index(["controller", "load", "stiffness", "fault", "delay"])
+        rows = part[part["metric"] == metric].set_index(
+            ["controller", "speed_m_s", "load", "stiffness", "fault", "delay"]
+        )
         for k, name in enumerate(controlled):
             mean = np.array([rows.loc[(name, *c), "reduction_mean"] for c in conditions], dtype=float)
             lo = np.array([rows.loc[(name, *c), "reduction_p5"] for c in conditions], dtype=float)
@@ -93,13 +98,14 @@ def plot_study(result, ax=None, metrics=None):
     if ax is None:
         s = result.settings
         seeds = s.get("track_seeds") or []  # None: a scenario that is not a random track
-        over = (f"{len(seeds)} track seeds x " if seeds else "") + f"{len(s.get('speeds_m_s') or [])} speeds"
-        set_title(fig, f"{s.get('scenario')}: {over} per condition")
+        over = f"{len(seeds)} track seeds" if seeds else "one run"
+        set_title(fig, f"{s.get('scenario')}: {over} per speed and condition")
     return fig
 
 
-def _condition_label(load: float, stiffness: float, fault: str, delay: int, crowded: bool = False) -> str:
+def _condition_label(speed: float, load: float, stiffness: float, fault: str, delay: int, crowded: bool = False) -> str:
     return (
+        f"{speed:g} m/s\n"
         f"load{chr(10) if crowded else ' '}x{load:g}"
         + ("" if stiffness == 1.0 else f"\nk_sz x {stiffness:g}")
         + ("" if fault == "none" else f"\n{fault}")

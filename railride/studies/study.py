@@ -64,10 +64,11 @@ class StudyResult:
     study's ``controller``, ``load``, ``stiffness``, ``fault``, ``delay``, ``track_seed`` and
     ``speed_m_s`` and, for the controlled runs, each metric's reduction in % against passive on
     the same track, speed, load and stiffness, ``<metric>_reduction``). ``summary``: one row per
-    controller, condition (load, stiffness, fault, delay) and metric: ``n`` (runs that did not
-    diverge), ``mean``, ``p5``, ``p95`` of the value and ``reduction_mean``, ``reduction_p5``,
-    ``reduction_p95``. ``failed``: the runs that diverged (controller, condition, seed, speed,
-    time). ``settings``: what was run."""
+    controller, speed, condition (load, stiffness, fault, delay) and metric, over the track
+    seeds: ``n`` (runs that did not diverge), ``mean``, ``p5``, ``p95`` of the value and
+    ``reduction_mean``, ``reduction_p5``, ``reduction_p95``. Speeds and loads are design
+    variables: they are never pooled into one band. ``failed``: the runs that diverged
+    (controller, condition, seed, speed, time). ``settings``: what was run."""
 
     cases: pd.DataFrame
     summary: pd.DataFrame
@@ -86,8 +87,8 @@ class StudyResult:
         from railride._version import __version__
 
         groups = []
-        for (name, load, k, fault, delay), part in self.summary.groupby(
-            ["controller", "load", "stiffness", "fault", "delay"], sort=False
+        for (name, speed, load, k, fault, delay), part in self.summary.groupby(
+            ["controller", "speed_m_s", "load", "stiffness", "fault", "delay"], sort=False
         ):
             metrics = {}
             for _, row in part.iterrows():
@@ -98,6 +99,7 @@ class StudyResult:
             groups.append(
                 {
                     "controller": name,
+                    "speed_m_s": float(speed),
                     "load": float(load),
                     "stiffness": float(k),
                     "fault": fault,
@@ -310,7 +312,8 @@ def study(
     info.insert(1, "vehicle", record["name"])
     frame = pd.concat([info, frame.drop(columns=[c for c in info.columns if c in frame.columns])], axis=1)
     frame = _reductions(frame)
-    summary = _summary(frame, names, load_list, stiffness_list, conditions, delay_list)
+    speeds_run = list(dict.fromkeys(float(v) for v in frame["speed_m_s"]))
+    summary = _summary(frame, names, speeds_run, load_list, stiffness_list, conditions, delay_list)
     failed = [
         {
             "controller": r.controller,
@@ -375,15 +378,18 @@ def _reductions(frame: pd.DataFrame) -> pd.DataFrame:
     return out
 
 
-def _summary(frame: pd.DataFrame, names, loads, stiffness, conditions, delays) -> pd.DataFrame:
+def _summary(frame: pd.DataFrame, names, speeds, loads, stiffness, conditions, delays) -> pd.DataFrame:
+    """One row per controller, speed, load, stiffness, fault, delay and metric: the statistics over
+    the track seeds (the speeds and loads kept apart, never pooled)."""
     rows = []
     labels = ["+".join(c) if c else HEALTHY for c in conditions]
     lo, hi = PERCENTILES
     for name in names:
-        for load, k in [(load, k) for load in loads for k in stiffness]:
+        for speed, load, k in [(v, load, k) for v in speeds for load in loads for k in stiffness]:
             for label, delay in [(HEALTHY, 1)] if name == "passive" else [(f, d) for f in labels for d in delays]:
                 part = frame[
                     (frame["controller"] == name)
+                    & (frame["speed_m_s"] == speed)
                     & (frame["load"] == load)
                     & (frame["stiffness"] == k)
                     & (frame["fault"] == label)
@@ -396,6 +402,7 @@ def _summary(frame: pd.DataFrame, names, loads, stiffness, conditions, delays) -
                     rows.append(
                         {
                             "controller": name,
+                            "speed_m_s": speed,
                             "load": load,
                             "stiffness": k,
                             "fault": label,

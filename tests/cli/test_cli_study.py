@@ -17,7 +17,12 @@ def test_study_json_and_table():
     assert ("pid", 1.3, "2L-disconnected") in groups and ("passive", 1.0, "none") in groups
     assert doc["settings"]["loads"] == [1.0, 1.3] and doc["failed"] == []
     text = " ".join(ok(*SHORT).stdout.split())
-    fragments = ("Statistics over 2 track seeds x 1 speed(s)", "N_MV,z centre", "p5-p95", "passive is always healthy")
+    fragments = (
+        "Statistics over 2 track seeds, per speed and condition",
+        "N_MV,z centre",
+        "p5-p95",
+        "passive is always healthy",
+    )
     for fragment in fragments:
         assert fragment in text, fragment
 

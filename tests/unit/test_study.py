@@ -46,15 +46,23 @@ def test_a_run_of_the_study_is_the_direct_simulation(small):
 
 def test_the_statistics_are_those_of_the_runs(small):
     c, s = small.cases, small.summary
+    # the statistics of each speed apart, over the three track seeds: speeds are never pooled
+    speed = sorted(set(c.speed_m_s))[-1]
     for name, load, fault in (("pid", 1.3, "1R-off"), ("sas-attitude", 1.0, "none")):
-        mine = c[(c.controller == name) & (c.load == load) & (c.fault == fault)]
+        mine = c[(c.controller == name) & (c.load == load) & (c.fault == fault) & (c.speed_m_s == speed)]
         base = c[(c.controller == "passive") & (c.load == load)].set_index(["track_seed", "speed_m_s"])
         for metric in ("acceleration_m_s2_rms", "centre_N_MV_z"):
-            row = s[(s.controller == name) & (s.load == load) & (s.fault == fault) & (s.metric == metric)].iloc[0]
+            row = s[
+                (s.controller == name)
+                & (s.speed_m_s == speed)
+                & (s.load == load)
+                & (s.fault == fault)
+                & (s.metric == metric)
+            ].iloc[0]
             x = mine[metric].to_numpy()
             p = base.loc[list(zip(mine.track_seed, mine.speed_m_s)), metric].to_numpy()
             red = (p - x) / p * 100
-            assert row["n"] == 6
+            assert row["n"] == 3
             assert row["mean"] == pytest.approx(x.mean()) and row["p95"] == pytest.approx(np.percentile(x, 95))
             assert row["reduction_mean"] == pytest.approx(red.mean())
             assert row["reduction_p5"] == pytest.approx(np.percentile(red, 5))
@@ -122,15 +130,18 @@ def test_the_result_protocol(small, tmp_path):
     assert doc["schema"] == "railride.study/1" and doc["percentiles"] == [5.0, 95.0]
     assert json.loads(json.dumps(doc, allow_nan=False)) == doc
     pid = next(g for g in doc["results"] if g["controller"] == "pid" and g["fault"] == "1R-off" and g["load"] == 1.3)
-    assert set(pid["metrics"]) == set(METRICS) and pid["metrics"]["roll_deg_rms"]["n"] == 6
-    assert list(small.to_pandas().columns[:6]) == ["controller", "load", "stiffness", "fault", "delay", "metric"]
+    assert set(pid["metrics"]) == set(METRICS) and pid["metrics"]["roll_deg_rms"]["n"] == 3  # one speed's seeds
+    assert {g["speed_m_s"] for g in doc["results"]} == set(small.cases.speed_m_s)
+    columns = ["controller", "speed_m_s", "load", "stiffness", "fault", "delay", "metric"]
+    assert list(small.to_pandas().columns[:7]) == columns
     fig = small.plot()
     assert isinstance(fig, Figure)
     # five metrics on a grid of six: the legend has the free panel to itself, clear of the data
     (holder,) = [a for a in fig.get_axes() if a.get_legend() is not None]
     assert not holder.lines and not holder.collections and not holder.axison
     ticks = [t.get_text() for t in fig.get_axes()[0].get_xticklabels()]
-    assert ticks[-1] == "load\nx1.3\n1R-off"  # four conditions a panel, three panels a row: stacked
+    # two speeds x four conditions a panel, three panels a row: stacked
+    assert ticks[-1] == f"{max(small.cases.speed_m_s):g} m/s\nload\nx1.3\n1R-off"
     mine = Figure()
     assert small.plot(ax=mine.subplots(1, 2), metrics=["roll_deg_rms", "centre_N_MV_z"]) is mine
     paths = small.save(tmp_path / "out")
@@ -141,8 +152,9 @@ def test_the_result_protocol(small, tmp_path):
 def test_a_study_on_a_sine_runs_over_speeds_alone():
     res = study(["pid"], scenario="paper-sine", speeds=[30.0, 40.0], duration=1.0)
     assert res.settings["track_seeds"] is None and len(res.cases) == 2 * 2
-    row = res.summary[(res.summary.controller == "pid") & (res.summary.metric == "roll_deg_rms")].iloc[0]
-    assert row["n"] == 2 and np.isfinite(row["reduction_mean"])
+    rows = res.summary[(res.summary.controller == "pid") & (res.summary.metric == "roll_deg_rms")]
+    assert sorted(rows.speed_m_s) == [30.0, 40.0]  # one row per speed: never pooled
+    assert list(rows["n"]) == [1, 1] and np.all(np.isfinite(rows["reduction_mean"]))
     with pytest.raises(ValueError, match=r"track_seeds = \[1\]: track seeds apply to the random tracks"):
         study(["pid"], scenario="paper-sine", track_seeds=[1])
 
