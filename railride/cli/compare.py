@@ -292,7 +292,7 @@ def _compare_tables(doc: dict, shipped: bool):
         bt.add_column("response")
         for head in ("MR\ndampers", "ideal\ndamper", "ideal\nactuator"):
             bt.add_column(head, justify="right")
-        # passive-on and passive-off have no bound (a constant voltage): said below the table
+        # passive-on and passive-off have no reference (a constant voltage): said below the table
         unbounded = [r for r in controlled if doc["bounds"]["ideal"][r["name"]].get("note")]
         bounded = [r for r in controlled if r not in unbounded]
         for r in bounded:
@@ -465,7 +465,7 @@ def compare(
             help="Dampers that fail in every controlled suspension: corner 1R, 1L, 2R or 2L, mode off "
             "(coil at v_min), on (stuck at v_max) or disconnected (no force), from time S [s] "
             "(default 0), e.g. 1R-off or 2L-on@2.5,1R-disconnected. Also runs the healthy dampers "
-            "and prints how the ride degrades; no bounds.",
+            "and prints how the ride degrades; no ideal-device references.",
         ),
     ] = None,
     scenario: CompareScenarioOption = "paper-sine",

@@ -26,7 +26,7 @@ def test_compare_all_runs_every_controller_in_order():
         doc["gains"]["passive-off"] is None
         and doc["gains"]["skyhook-on-off"] == GainSet.default().skyhook_on_off.to_dict()
     )
-    for name in ("passive-on", "passive-off"):  # no bound, and the results say why
+    for name in ("passive-on", "passive-off"):  # no reference, and the results say why
         assert doc["bounds"]["ideal"][name]["reduction_percent"]["roll_deg"] is None
         assert "constant voltage" in doc["bounds"]["ideal"][name]["note"]
 
@@ -38,7 +38,7 @@ def test_compare_without_controllers_is_the_papers_four():
 
 def test_compare_table_says_what_has_no_bound_and_what_did_not_run():
     text = ok(*SHORT, "--controllers", "skyhook,passive-on").stdout
-    assert "Passive-on: no bound (MR dampers at a constant voltage" in " ".join(text.split())  # wrapped at 80
+    assert "Passive-on: no reference (MR dampers at a constant voltage" in " ".join(text.split())  # wrapped at 80
     text = ok(*SHORT, "--controllers", "all", "--damper", "ideal").stdout
     assert "passive-on: not run (MR dampers at a constant voltage" in text
     assert "Clipped-optimal" in text
