@@ -126,7 +126,7 @@ def _tables(doc: dict) -> list:
     def ratios(keys: list):
         table = FitTable(title="Held out: RMS ratio to passive, mean and 5-95 % band over the runs", labels=2)
         table.add_column("law")
-        table.add_column("speed, load")
+        table.add_column("speed\nload", no_wrap=True)
         for key in keys:
             table.add_column(RATIO_METRICS.get(key, "score"), justify="right")
         last = None
@@ -141,7 +141,7 @@ def _tables(doc: dict) -> list:
 
     def absolute(keys: list):
         table = FitTable(title="Held out: passive, mean and 5-95 % band over the runs", labels=1)
-        table.add_column("speed, load")
+        table.add_column("speed\nload", no_wrap=True)
         for key in keys:
             table.add_column(PASSIVE_METRICS[key][0], justify="right")
         for g in passive:
@@ -151,7 +151,7 @@ def _tables(doc: dict) -> list:
     def costs(keys: list):
         table = FitTable(title="What each law asks of its dampers (held out, mean and 5-95 % band)", labels=2)
         table.add_column("law")
-        table.add_column("speed, load")
+        table.add_column("speed\nload", no_wrap=True)
         for key in keys:
             table.add_column(COST_METRICS[key][0], justify="right")
         last = None
