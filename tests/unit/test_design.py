@@ -241,3 +241,70 @@ def test_run_cases_with_costs_adds_the_damper_columns_and_its_own_keys():
     plain = run_cases(cases, table=table)
     assert not set(COST_COLUMNS) & set(plain.columns)
     assert set(plain["key"]).isdisjoint(rows["key"])  # costs are in a run's key: a table resumes neither into the other
+
+
+def test_a_law_that_diverged_in_tuning_or_judging_is_listed_with_where():
+    from types import SimpleNamespace
+
+    from railride.studies.design import Plan, _diverged
+    from railride.studies.tune_result import Study
+
+    tuned = SimpleNamespace(
+        studies=[
+            Study("inner", ("inner.B",), None, objective=0.4),
+            Study("pid", ("pid.kp",), 13, objective=0.9),
+            Study("hybrid", ("hybrid.alpha",), 13, objective=math.inf),
+        ]
+    )
+    training = pd.DataFrame(
+        {
+            "suspension": ["passive", "pid", "hybrid", "hybrid"],
+            "scenario": ["fra4"] * 4,
+            "scenario.seed": [0, 0, 0, 1],
+            "scenario.speed": [40.0] * 4,
+            "diverged_at_s": [np.nan, 1.0, np.nan, 2.5],
+        }
+    )
+    runs = pd.DataFrame(
+        {
+            "controller": ["passive", "pid", "hybrid"],
+            "track": ["fra4"] * 3,
+            "track_seed": [7] * 3,
+            "speed_m_s": [40.0] * 3,
+            "load": [1.3] * 3,
+            "diverged_at_s": [np.nan, 0.75, np.nan],
+        }
+    )
+    plan = Plan(
+        ("pid", "hybrid"),
+        None,
+        None,
+        (1.3,),
+        ("fra4",),
+        (40.0,),
+        (0, 1),
+        (7,),
+        2.0,
+        None,
+        "mean",
+        13,
+        3,
+        "railway",
+        None,
+    )
+    found = _diverged(tuned, training, runs, plan)
+    # the candidate runs of pid that diverged in tuning do not count: its tuned gains are finite
+    assert found == [
+        {
+            "controller": "hybrid",
+            "stage": "tuning",
+            "runs": 1,
+            "where": [{"track": "fra4", "track_seed": 1, "speed_m_s": 40.0, "load": None, "diverged_at_s": 2.5}],
+        },
+        {
+            "controller": "pid",
+            "stage": "judging",
+            "runs": 1,
+            "where": [{"track": "fra4", "track_seed": 7, "speed_m_s": 40.0, "load": 1.3, "diverged_at_s": 0.75}],
+        },
+    ]
