@@ -159,4 +159,57 @@ def league_table(table, doc) -> list:
         return t
 
     groups = [headings[:4], headings[4:6], headings[6:]]  # reductions, comfort, damper
-    return [Split(build, groups), Text(caption)]
+    return [Split(build, groups), Text(caption), "", *_by_speed_table(doc)]
+
+
+def _by_speed_table(doc) -> list:
+    """Per scenario and speed (never pooled), over the track seeds: each response's RMS
+    reduction % (mean, 5th to 95th percentile) and its absolute RMS (mean), passive included."""
+    from rich.text import Text
+
+    from railride.cli._width import FitTable, Split
+    from railride.secondary.control import LABELS
+
+    units = {"acceleration_m_s2": "m/s^2", "displacement_m": "m", "pitch_deg": "deg", "roll_deg": "deg"}
+    words = {
+        "acceleration_m_s2": "acceleration",
+        "displacement_m": "displacement",
+        "pitch_deg": "pitch",
+        "roll_deg": "roll",
+    }
+    rows: dict[tuple, dict] = {}
+    for r in doc["by_speed"]:
+        rows.setdefault((r["scenario"], r["speed_m_s"], r["controller"]), {})[r["response"]] = r
+
+    def cell(r: dict, key: str) -> str:
+        if key == "rms":
+            return f"{r['rms_mean']:#.4g}"
+        if r["reduction_mean"] is None:
+            return "-"
+        return f"{r['reduction_mean']:.1f} ({r['reduction_p5']:.0f} to {r['reduction_p95']:.0f})"
+
+    heads = [(resp, "red", f"{words[resp]}\nred. % (p5 to p95)") for resp in units]
+    heads += [(resp, "rms", f"{words[resp]}\nRMS ({units[resp]})") for resp in units]
+
+    def build(groups: list[list[tuple]]):
+        t = FitTable(title="Per scenario and speed, over the track seeds")
+        t.add_column("case")
+        t.add_column("suspension")
+        for resp, key, heading in (h for g in groups for h in g):
+            t.add_column(heading, justify="right", no_wrap=key == "red")
+        last = None
+        for (scen, speed, name), resp_rows in rows.items():
+            case = f"{scen} {speed:g} m/s"
+            t.add_row(
+                case if case != last else "",
+                LABELS[name],
+                *[cell(resp_rows[resp], key) for resp, key, _ in (h for g in groups for h in g)],
+            )
+            last = case
+        return t
+
+    note = (
+        "Speeds are kept apart, not pooled: each row is the mean over the track seeds at that speed, "
+        "with the 5th to 95th percentile of the reduction in brackets, and the absolute RMS beside it."
+    )
+    return [Split(build, [heads[:2], heads[2:4], heads[4:6], heads[6:]]), Text(note)]

@@ -31,6 +31,8 @@ SCHEMA = "railride.league/1"
 RESPONSES = ("acceleration_m_s2", "displacement_m", "pitch_deg", "roll_deg")
 #: comfort indices in the table (carbody centre): ISO 2631-1 a_w (Wk) and EN 12299 N_MV (vertical)
 COMFORT = ("aw_Wk", "N_MV_z")
+#: the percentiles of the bands per speed (`LeagueTable.by_speed`)
+PERCENTILES = (5.0, 95.0)
 
 
 @dataclass(frozen=True, eq=False)
@@ -52,6 +54,36 @@ class LeagueTable:
         table["cases"] = self.cases.groupby("controller", sort=False).size()
         table["in_sample_cases"] = self.cases.groupby("controller", sort=False)["in_sample"].sum()
         return table.reindex(self.controllers)
+
+    def by_speed(self) -> pd.DataFrame:
+        """One row per controller, scenario, speed and response: over the track seeds (the
+        speeds never pooled), the mean and the 5th and 95th percentiles of the RMS value
+        (``rms_*``, absolute) and of its reduction against passive in % (``reduction_*``; NaN for
+        passive), and the number of cases."""
+        rows = []
+        lo, hi = PERCENTILES
+        for (name, scen, speed), part in self.cases.groupby(["controller", "scenario", "speed_m_s"], sort=False):
+            for r in RESPONSES:
+                x = part[f"{r}_rms"].to_numpy(dtype=float)
+                col = f"{r}_reduction_percent"
+                red = part[col].to_numpy(dtype=float) if col in part else np.full(x.size, np.nan)
+                red = red[np.isfinite(red)]
+                rows.append(
+                    {
+                        "controller": name,
+                        "scenario": scen,
+                        "speed_m_s": float(speed),
+                        "response": r,
+                        "cases": int(x.size),
+                        "rms_mean": float(x.mean()),
+                        "rms_p5": float(np.percentile(x, lo)),
+                        "rms_p95": float(np.percentile(x, hi)),
+                        "reduction_mean": float(red.mean()) if red.size else np.nan,
+                        "reduction_p5": float(np.percentile(red, lo)) if red.size else np.nan,
+                        "reduction_p95": float(np.percentile(red, hi)) if red.size else np.nan,
+                    }
+                )
+        return pd.DataFrame(rows)
 
     def to_pandas(self) -> pd.DataFrame:
         return self.cases.copy()
@@ -82,6 +114,7 @@ class LeagueTable:
                 for n in self.controllers
             ],
             "cases": [{k: clean(v) for k, v in row.items()} for row in self.cases.to_dict("records")],
+            "by_speed": [{k: clean(v) for k, v in row.items()} for row in self.by_speed().to_dict("records")],
         }
 
     def plot(self, ax=None):

@@ -29,6 +29,27 @@ def test_summary_is_the_mean_over_the_cases(table):
     assert summary.loc["pid", "cases"] == 6
 
 
+def test_by_speed_keeps_the_speeds_apart_over_the_seeds(table):
+    rows = table.by_speed()
+    pid = table.cases[(table.cases.controller == "pid") & (table.cases.scenario == "fra4")]
+    for speed in (30.0, 55.56):
+        seeds = pid[pid.speed_m_s == speed]
+        row = rows[
+            (rows.controller == "pid")
+            & (rows.scenario == "fra4")
+            & (rows.speed_m_s == speed)
+            & (rows.response == "roll_deg")
+        ].iloc[0]
+        x, red = seeds["roll_deg_rms"].to_numpy(), seeds["roll_deg_reduction_percent"].to_numpy()
+        assert row["cases"] == 2 and row["rms_mean"] == pytest.approx(x.mean())
+        assert row["reduction_mean"] == pytest.approx(red.mean())
+        assert row["reduction_p5"] == pytest.approx(np.percentile(red, 5))
+        assert row["rms_p95"] == pytest.approx(np.percentile(x, 95))
+    passive = rows[rows.controller == "passive"]
+    assert passive["reduction_mean"].isna().all() and (passive["rms_mean"] > 0).all()
+    assert len(table.to_dict()["by_speed"]) == len(rows) == 2 * (2 + 2) * 4  # controllers x cases x responses
+
+
 def test_reduction_follows_from_the_rms_of_passive_and_controller(table):
     c = table.cases
     for (_, speed, seed), group in c.groupby(["scenario", "speed_m_s", c.track_seed.fillna(-1)]):
