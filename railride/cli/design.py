@@ -68,6 +68,7 @@ RATIO_METRICS = {
     "displacement_m_rms": "displ.",
     "pitch_deg_rms": "pitch",
     "roll_deg_rms": "roll",
+    "acceleration_m_s2_ptp": "accel.\np-p",
     "centre_N_MV_z": "N_MV,z",
     "centre_Wz": "Wz",
 }
@@ -77,6 +78,7 @@ PASSIVE_METRICS = {
     "displacement_m_rms": ("displ.\n(mm)", 1e3, ".2f"),
     "pitch_deg_rms": ("pitch\n(deg)", 1.0, ".4f"),
     "roll_deg_rms": ("roll\n(deg)", 1.0, ".4f"),
+    "acceleration_m_s2_ptp": ("accel. p-p\n(m/s^2)", 1.0, ".2f"),
     "centre_N_MV_z": ("N_MV,z\n(-)", 1.0, ".2f"),
     "centre_Wz": ("Wz\n(-)", 1.0, ".2f"),
 }

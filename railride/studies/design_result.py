@@ -30,8 +30,10 @@ RMS_COLUMNS = tuple(f"{r}_rms" for r in RESPONSES)
 #: the comfort indices a design reports (at the carbody's centre): EN 12299's N_MV (its
 #: vertical term), Sperling's Wz and ISO 2631's Wk-weighted RMS acceleration
 COMFORT_METRICS = ("centre_N_MV_z", "centre_Wz", "centre_aw_Wk")
-#: every metric of a held-out run that a design summarises: responses, comfort, costs
-METRICS = (*RMS_COLUMNS, *COMFORT_METRICS, *COST_COLUMNS)
+#: the peaks a design reports beside the RMS: the carbody's peak-to-peak vertical acceleration
+PEAK_METRICS = ("acceleration_m_s2_ptp",)
+#: every metric of a held-out run that a design summarises: responses, peaks, comfort, costs
+METRICS = (*RMS_COLUMNS, *PEAK_METRICS, *COMFORT_METRICS, *COST_COLUMNS)
 #: the band of the statistics
 PERCENTILES = (5.0, 95.0)
 #: the statistics of a metric, as `to_pandas` and the JSON name them
