@@ -4,6 +4,7 @@ forcing tables, each kept for the next batches within a byte budget (`railride._
 from __future__ import annotations
 
 import functools
+import weakref
 
 
 import numpy as np
@@ -49,38 +50,43 @@ def _input_table(scenario: Scenario, key, lag: tuple, dt: float, duration: float
     return _INPUT_TABLES.get(None if key is None else (key, lag, dt, duration), build)
 
 
+#: each vehicle's matrices at the engine's size, made once: a batch's samples share the vehicle
+_ENGINE_MATRICES: "weakref.WeakKeyDictionary[Vehicle, dict[str, np.ndarray]]" = weakref.WeakKeyDictionary()
+
+
 def engine_matrices(vehicle: Vehicle) -> dict[str, np.ndarray]:
-    """The vehicle's M, K, C, C0, T, K_w, C_w at the engine's size (`layout.N_DOF`): a rigid
+    """The vehicle's M, K, C, C0, T, K_w, C_w at the engine's size (`layout.N_DOF`), and its
+    passive state matrix ``A`` (q, q'), made once per vehicle (read them, do not write): a rigid
     carbody's vehicle (`Vehicle.n_dof` 9) gets a bending row and column of zeros with a unit
     mass, so that its bending coordinate stays exactly 0; a flexible one is the engine's size."""
+    cached = _ENGINE_MATRICES.get(vehicle)
+    if cached is not None:
+        return cached
     n = vehicle.M.shape[0]
-    names = ("M", "K", "C", "C0", "T", "K_w", "C_w")
-    if n == N_DOF:
-        return {k: getattr(vehicle, k) for k in names}
     out = {}
-    for k in names:
+    for k in ("M", "K", "C", "C0", "T", "K_w", "C_w"):
         v = getattr(vehicle, k)
-        rows = np.zeros((N_DOF,) + v.shape[1:])
-        if v.shape[1:] == (n,):  # square: pad the columns too
-            rows = np.zeros((N_DOF, N_DOF))
-            rows[:n, :n] = v
+        square = v.shape[1:] == (n,)  # pad the columns too
+        out[k] = np.zeros((N_DOF, N_DOF) if square else (N_DOF,) + v.shape[1:])
+        if square:
+            out[k][:n, :n] = v
         else:
-            rows[:n] = v
-        out[k] = rows
+            out[k][:n] = v
     out["M"][n:, n:] = np.eye(N_DOF - n)
+    minv = 1.0 / np.diag(out["M"])[:, None]
+    A = np.zeros((2 * N_DOF, 2 * N_DOF))
+    A[:N_DOF, N_DOF:] = np.eye(N_DOF)
+    A[N_DOF:, :N_DOF] = -minv * out["K"]
+    A[N_DOF:, N_DOF:] = -minv * out["C"]
+    out["A"] = A
+    _ENGINE_MATRICES[vehicle] = out
     return out
 
 
-def engine_state_matrix(vehicle: Vehicle, C=None) -> np.ndarray:
-    """The state matrix (q, q') at the engine's size (`engine_matrices`), with damping C (default
-    the passive vehicle's, with the secondary dashpots)."""
-    m = engine_matrices(vehicle)
-    minv = 1.0 / np.diag(m["M"])[:, None]
-    A = np.zeros((2 * N_DOF, 2 * N_DOF))
-    A[:N_DOF, N_DOF:] = np.eye(N_DOF)
-    A[N_DOF:, :N_DOF] = -minv * m["K"]
-    A[N_DOF:, N_DOF:] = -minv * (m["C"] if C is None else C)
-    return A
+def engine_state_matrix(vehicle: Vehicle) -> np.ndarray:
+    """The passive state matrix (q, q') at the engine's size (`engine_matrices`), with the
+    secondary dashpots."""
+    return engine_matrices(vehicle)["A"]
 
 
 def _system_arrays(vehicle: Vehicle, passive: bool = True) -> dict[str, np.ndarray]:
