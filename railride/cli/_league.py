@@ -1,5 +1,5 @@
-"""``railride compare`` with several scenarios, speeds or track seeds: the league table
-(railride.studies.league.league), and its table."""
+"""``railride compare`` with several scenarios, speeds, track seeds or load factors: the league
+table (railride.studies.league.league), and its tables."""
 
 from __future__ import annotations
 
@@ -30,7 +30,7 @@ def run_league(
     window,
     vehicle,
     preset,
-    load,
+    loads,
     format,
     out,
     bounds,
@@ -38,7 +38,8 @@ def run_league(
     report=None,
     ctx=None,
 ) -> None:
-    """Several scenarios, speeds or track seeds: the league table (railride.studies.league.league)."""
+    """Several scenarios, speeds, track seeds or load factors (``loads``: --load's list, None:
+    load 1): the league table (railride.studies.league.league), every case at every load."""
     from railride.output.files import check_out_dir, write_league_outputs
     from railride.studies.league import league
     from railride.analysis.metrics import parse_window
@@ -58,13 +59,16 @@ def run_league(
     for key, value in given.items():
         if value is not None:
             raise InputError(
-                f"{options[key]}: applies to a single scenario; a league table (several --scenario, --speed "
-                "or --track-seed values) runs each scenario with its defaults"
+                f"{options[key]}: applies to a single scenario; a league table (several --scenario, --speed, "
+                "--track-seed or --load values) runs each scenario with its defaults"
             )
     if not bounds:
         raise InputError("--no-bounds: a league table always shows the ideal actuator beside the MR dampers")
     damper_preset("--damper", damper)
-    vehicle_options = vehicle_arguments(vehicle, preset, load)
+    loads = loads or [1.0]
+    for x in loads:  # each load checked before the first run, its errors naming --load
+        vehicle_options = vehicle_arguments(vehicle, preset, x)
+    vehicle_options["load"] = loads if len(loads) > 1 else loads[0]
     if out is not None:
         check_out_dir(out)
     with ProgressBar(stderr_is_terminal(), lambda done: "running the league table...") as progress:
@@ -117,9 +121,19 @@ def league_table(table, doc) -> list:
     settings = doc["settings"]
     at = "" if settings["speeds_m_s"] is None else " at " + ", ".join(f"{v:g}" for v in settings["speeds_m_s"]) + " m/s"
     seeds = ", ".join(map(str, settings["track_seeds"]))
+    loads = _loads(settings["vehicle"])
+    at_loads = f", each at loads {', '.join(f'{x:g}' for x in loads)}" if len(loads) > 1 else ""
+    pooled = [w for w, n in (("speeds", len(set(table.cases["speed_m_s"]))), ("loads", len(loads))) if n > 1]
     caption = (
-        f"Mean over {len(cases)} cases: {', '.join(settings['scenarios'])}{at}; track seeds {seeds} (random tracks).\n"
-        f"{vehicle_text(settings['vehicle'])}.\n"
+        f"Mean over {len(cases)} cases: {', '.join(settings['scenarios'])}{at}{at_loads}; track seeds {seeds} "
+        "(random tracks).\n"
+        + (
+            f"This mean pools the {' and '.join(pooled)}: see the table per scenario, speed and load below "
+            "for each on its own.\n"
+            if pooled
+            else ""
+        )
+        + f"{vehicle_text(settings['vehicle'])}.\n"
         f"Gains tuned on: {tuned_text}. Tested on {out_of_sample} case(s) they were not tuned on"
         f" and {len(cases) - out_of_sample} they were.\n"
         "Reduction = (passive - controlled) / passive RMS x 100, MR dampers (ideal actuator, same gains, in brackets)."
@@ -162,9 +176,16 @@ def league_table(table, doc) -> list:
     return [Split(build, groups), Text(caption), "", *_by_speed_table(doc)]
 
 
+def _loads(record: dict) -> list[float]:
+    """The load factors of a `vehicle_record`: one, or the list of a league over several."""
+    load = record["load"]
+    return [float(x) for x in load] if isinstance(load, list) else [float(load)]
+
+
 def _by_speed_table(doc) -> list:
-    """Per scenario and speed (never pooled), over the track seeds: each response's RMS
-    reduction % (mean, 5th to 95th percentile) and its absolute RMS (mean), passive included."""
+    """Per scenario, speed and load factor (never pooled), over the track seeds: each
+    response's RMS reduction % (mean, 5th to 95th percentile) and its absolute RMS (mean),
+    passive included."""
     from rich.text import Text
 
     from railride.cli._width import FitTable, Split
@@ -179,7 +200,7 @@ def _by_speed_table(doc) -> list:
     }
     rows: dict[tuple, dict] = {}
     for r in doc["by_speed"]:
-        rows.setdefault((r["scenario"], r["speed_m_s"], r["controller"]), {})[r["response"]] = r
+        rows.setdefault((r["scenario"], r["speed_m_s"], r.get("load", 1.0), r["controller"]), {})[r["response"]] = r
 
     def cell(r: dict, key: str) -> str:
         if key == "rms":
@@ -192,24 +213,27 @@ def _by_speed_table(doc) -> list:
     heads += [(resp, "rms", f"{words[resp]}\nRMS ({units[resp]})") for resp in units]
 
     def build(groups: list[list[tuple]]):
-        t = FitTable(title="Per scenario and speed, over the track seeds")
+        t = FitTable(title="Per scenario, speed and load, over the track seeds")
         t.add_column("case")
+        t.add_column("load", justify="right")
         t.add_column("suspension")
         for resp, key, heading in (h for g in groups for h in g):
             t.add_column(heading, justify="right", no_wrap=key == "red")
         last = None
-        for (scen, speed, name), resp_rows in rows.items():
+        for (scen, speed, load, name), resp_rows in rows.items():
             case = f"{scen} {speed:g} m/s"
             t.add_row(
-                case if case != last else "",
+                case if case != (last or ("",))[0] else "",
+                f"{load:g}" if (case, load) != last else "",
                 LABELS[name],
                 *[cell(resp_rows[resp], key) for resp, key, _ in (h for g in groups for h in g)],
             )
-            last = case
+            last = (case, load)
         return t
 
     note = (
-        "Speeds are kept apart, not pooled: each row is the mean over the track seeds at that speed, "
-        "with the 5th to 95th percentile of the reduction in brackets, and the absolute RMS beside it."
+        "Speeds and loads are kept apart, not pooled: each row is the mean over the track seeds at that speed "
+        "and load factor, with the 5th to 95th percentile of the reduction in brackets, and the absolute RMS "
+        "beside it."
     )
     return [Split(build, [heads[:2], heads[2:4], heads[4:6], heads[6:]]), Text(note)]

@@ -1,6 +1,6 @@
 """``railride compare``: the suspensions on one scenario, beside the paper's Table 1 when it is
 the paper's case (railride.studies.comparison.compare), with the tables it prints; several scenarios,
-speeds or seeds go to the league table (`_league`)."""
+speeds, seeds or loads go to the league table (`_league`)."""
 
 from __future__ import annotations
 
@@ -35,7 +35,6 @@ from railride.cli._options import (
     MinWavelengthOption,
     OutputFormat,
     OutputRateOption,
-    LoadOption,
     VehicleOption,
     PresetOption,
     RailPhaseOption,
@@ -92,6 +91,18 @@ BoundsOption = Annotated[
         "MR dampers only).",
     ),
 ]
+#: --load: compare's own (the shared `LoadOption` takes one factor), several make a league table
+CompareLoadOption = Annotated[
+    Optional[str],
+    typer.Option(
+        "--load",
+        metavar="X[,X...]",
+        help="Load factor: the carbody's mass and inertias times X (1: as the parameters give "
+        "them; 1.3: crush-laden, 30 % more mass). The controllers keep their gains. Default: 1. "
+        "Several (a,b or START:STOP:COUNT) make a league table, every case at every load, the "
+        "loads kept apart.",
+    ),
+]
 #: the library's names of compare's options, for its errors
 COMPARE_FIELDS = {
     **SOLVER_FIELDS,
@@ -100,6 +111,21 @@ COMPARE_FIELDS = {
     "delay": "--delay",
     "window": "--window",
 }
+
+
+def _load_list(text: str) -> list[float]:
+    """--load X[,X...] -> the load factors, each checked by the vehicle's own rule (> 0,
+    finite) where it is used, so that 0, -0.5 and nan get the same message as one load."""
+
+    def item(part: str) -> float:
+        try:
+            return float(part)
+        except ValueError:
+            raise InputError(
+                f"--load = {text!r}: {part.strip()!r} is not a number; give load factors > 0 separated by commas"
+            ) from None
+
+    return value_list("--load", text, parse=item)
 
 
 def _controller_list(text: str) -> list[str]:
@@ -498,7 +524,7 @@ def compare(
     window: WindowOption = None,
     vehicle: VehicleOption = None,
     preset: PresetOption = None,
-    load: LoadOption = None,
+    load: CompareLoadOption = None,
     format: FormatOption = OutputFormat.table,
     out: CompareOutOption = None,
     bounds: BoundsOption = True,
@@ -530,11 +556,12 @@ def compare(
         scenarios = [item.strip() for item in scenario.split(",")]
         speeds = value_list("--speed", speed) if speed is not None else None
         seeds = value_list("--track-seed", track_seed, integer=True) if track_seed is not None else None
-        if len(scenarios) > 1 or len(speeds or [0]) > 1 or len(seeds or [0]) > 1:
+        loads = _load_list(load) if load is not None else None
+        if any(len(values or [0]) > 1 for values in (scenarios, speeds, seeds, loads)):
             check_report_option(report)
             if history_format is not None:
                 raise InputError(
-                    "--history-format: a league table (several --scenario, --speed or --track-seed "
+                    "--history-format: a league table (several --scenario, --speed, --track-seed or --load "
                     "values) writes no time histories"
                 )
             given = dict(
@@ -563,7 +590,7 @@ def compare(
                 window=window,
                 vehicle=vehicle,
                 preset=preset,
-                load=load,
+                loads=loads,
                 format=format,
                 out=out,
                 bounds=bounds,
@@ -580,7 +607,7 @@ def compare(
         scale = parse_scale("--damper-scale", damper_scale)
         noise = _sensor_noise(sensor_noise, seed)
         solver = solver_from_options(dt=dt, output_rate=output_rate, control_rate=control_rate)
-        vehicle_options = vehicle_arguments(vehicle, preset, load)
+        vehicle_options = vehicle_arguments(vehicle, preset, loads[0] if loads else None)
         window_value = parse_window(window) if window is not None else None
         track = track_options(scenario, seed_value, min_wavelength, max_wavelength)
         scen = make_scenario(

@@ -119,7 +119,7 @@ def report_command(
         window=window,
         vehicle=vehicle,
         preset=preset,
-        load=load,
+        load=None if load is None else repr(load),
         format=OutputFormat.table,
         out=None,
         bounds=bounds,

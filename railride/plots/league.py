@@ -23,6 +23,8 @@ _RESPONSES = (
     ("pitch_deg", "pitch"),
     ("roll_deg", "roll"),
 )
+#: the markers of the load factors in `plot_league_comfort`
+_MARKERS = ("o", "s", "^", "D", "v", "P", "X")
 
 
 @styled
@@ -51,7 +53,9 @@ def plot_league(table, ax=None):
     ax.set_xticks(x, [label for _, label in _RESPONSES])
     ax.set_ylabel("RMS reduction against passive (%)")
     n_cases = int(summary["cases"].max()) if len(summary) else 0
-    ax.set_title(f"Mean over {n_cases} case{'s' if n_cases != 1 else ''}; dashed outline: ideal actuator")
+    loads = list(dict.fromkeys(table.cases["load"])) if "load" in table.cases else []
+    pooled = f", loads {', '.join(f'{x:g}' for x in loads)} pooled" if len(loads) > 1 else ""
+    ax.set_title(f"Mean over {n_cases} case{'s' if n_cases != 1 else ''}{pooled}; dashed outline: ideal actuator")
     ax.grid(False, axis="x")
     ax.legend(ncols=2)
     return fig
@@ -59,9 +63,10 @@ def plot_league(table, ax=None):
 
 @styled
 def plot_league_comfort(table, ax=None, *, index: str = "N_MV_z"):
-    """Ride comfort at the carbody centre against speed, one line per controller: ``index``
-    N_MV_z (EN 12299, vertical part) or aw_Wk (ISO 2631-1 a_w, m/s^2), the mean over the
-    scenarios and track seeds at each speed. ``table``: a `railride.studies.league.LeagueTable`."""
+    """Ride comfort at the carbody centre against speed, one line per controller (and per load
+    factor where the league ran several: the loads are never pooled): ``index`` N_MV_z
+    (EN 12299, vertical part) or aw_Wk (ISO 2631-1 a_w, m/s^2), the mean over the scenarios and
+    track seeds at each speed. ``table``: a `railride.studies.league.LeagueTable`."""
     column = f"centre_{index}"
     if column not in table.cases:
         raise InputError(f"index = {index!r}: the league table has no {column} (allowed N_MV_z, aw_Wk)")
@@ -71,10 +76,17 @@ def plot_league_comfort(table, ax=None, *, index: str = "N_MV_z"):
     else:
         ax = given_axes(ax, 1, "the comfort index")[0]
         fig = ax.figure
-    mean = table.cases.groupby(["controller", "speed_m_s"], sort=False)[column].mean()
+    cases = table.cases if "load" in table.cases else table.cases.assign(load=1.0)
+    loads = list(dict.fromkeys(cases["load"]))
+    mean = cases.groupby(["controller", "load", "speed_m_s"])[column].mean()  # each line in order of speed
     for name in table.controllers:
-        line = mean.loc[name]
-        ax.plot(line.index, line.values, marker="o", label=suspension_label(name), **suspension_style(name))
+        for k, load in enumerate(loads):
+            line = mean.loc[(name, load)]
+            style = suspension_style(name)
+            label = suspension_label(name)
+            if len(loads) > 1:  # one line per load, told apart by its marker
+                style, label = {**style, "marker": _MARKERS[k % len(_MARKERS)]}, f"{label}, load {load:g}"
+            ax.plot(line.index, line.values, **{"marker": "o", **style}, label=label)
     ax.set_xlabel("speed (m/s)")
     ax.set_ylabel("N$_{MV,z}$ (carbody centre)" if index == "N_MV_z" else "a$_w$ Wk (m/s$^2$, carbody centre)")
     ax.set_title(fit_text(f"Mean over {', '.join(table.settings.get('scenarios', []))}", COLUMN_WIDTH - 0.6, 9.0))

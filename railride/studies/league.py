@@ -1,17 +1,20 @@
 """Controllers judged on several tracks and speeds at once: the league table.
 
 `league` runs `railride.compare` on every combination of scenario, speed and track seed (the
-seeds apply to the random tracks only) with the same gains, and collects per case and
-controller the RMS reduction of each response against passive, the same gains' reduction on
+seeds apply to the random tracks only), at each load factor, with the same gains, and collects
+per case, load and controller the RMS reduction of each response against passive, the same gains' reduction on
 the ideal actuator (a reference for the same gains, not a bound), ride comfort at the carbody centre, and what the
 controller asks of its dampers (force and travel). `LeagueTable` summarises it per controller
-as the mean over the cases, and says which cases the gains were tuned on (in-sample) and which
-they meet for the first time (out-of-sample).
+as the mean over the cases (`LeagueTable.summary`), and per controller, scenario, speed and
+load over the track seeds (`LeagueTable.by_speed`: speed and load are design variables, never
+pooled into one band), and says which cases the gains were tuned on (in-sample) and which they
+meet for the first time (out-of-sample).
 """
 
 from __future__ import annotations
 
 import itertools
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -25,7 +28,7 @@ from railride.defaults import DEFAULT_DAMPER
 from railride.plots import PNG_DPI, FigureOptions
 from railride.model.track import SPECTRA, scenario
 from railride.secondary.suspension import damper_record
-from railride.model.params import resolve_vehicle
+from railride.model.params import resolve_argument, resolve_vehicle, vehicle_record
 
 SCHEMA = "railride.league/1"
 RESPONSES = ("acceleration_m_s2", "displacement_m", "pitch_deg", "roll_deg")
@@ -37,9 +40,10 @@ PERCENTILES = (5.0, 95.0)
 
 @dataclass(frozen=True, eq=False)
 class LeagueTable:
-    """Per case (scenario, speed, seed) and controller: ``cases`` (a DataFrame, one row each);
-    ``settings``: what was run; ``tuned_on``: the scenario record the gains were tuned on
-    (None if the gains file does not say)."""
+    """Per case (scenario, speed, seed), load factor and controller: ``cases`` (a DataFrame, one
+    row each, the load factor in its ``load`` column); ``settings``: what was run;
+    ``tuned_on``: the scenario record the gains were tuned on (None if the gains file does not
+    say)."""
 
     cases: pd.DataFrame
     controllers: list[str]
@@ -47,22 +51,26 @@ class LeagueTable:
     tuned_on: dict | None = None
 
     def summary(self) -> pd.DataFrame:
-        """One row per controller (passive first): the mean over the cases of every column of
-        `cases` that is a number, and the number of cases."""
-        numeric = self.cases.select_dtypes("number").drop(columns=["speed_m_s", "track_seed"], errors="ignore")
+        """One row per controller (passive first): the mean over all the cases of every column
+        of `cases` that is a number, and the number of cases (rows of `cases`). Where the league
+        ran several speeds or load factors this mean pools them: a headline, not a statistic of
+        one operating point; `by_speed` keeps each scenario, speed and load apart."""
+        numeric = self.cases.select_dtypes("number").drop(columns=["speed_m_s", "track_seed", "load"], errors="ignore")
         table = numeric.groupby(self.cases["controller"], sort=False).mean()
         table["cases"] = self.cases.groupby("controller", sort=False).size()
         table["in_sample_cases"] = self.cases.groupby("controller", sort=False)["in_sample"].sum()
         return table.reindex(self.controllers)
 
     def by_speed(self) -> pd.DataFrame:
-        """One row per controller, scenario, speed and response: over the track seeds (the
-        speeds never pooled), the mean and the 5th and 95th percentiles of the RMS value
-        (``rms_*``, absolute) and of its reduction against passive in % (``reduction_*``; NaN for
-        passive), and the number of cases."""
+        """One row per controller, scenario, speed, load factor (column ``load``) and response:
+        over the track seeds (the speeds and loads never pooled), the mean and the 5th and 95th
+        percentiles of the RMS value (``rms_*``, absolute) and of its reduction against passive
+        in % (``reduction_*``; NaN for passive), and the number of cases."""
         rows = []
         lo, hi = PERCENTILES
-        for (name, scen, speed), part in self.cases.groupby(["controller", "scenario", "speed_m_s"], sort=False):
+        cases = self.cases if "load" in self.cases else self.cases.assign(load=1.0)
+        keys = ["controller", "scenario", "speed_m_s", "load"]
+        for (name, scen, speed, load), part in cases.groupby(keys, sort=False):
             for r in RESPONSES:
                 x = part[f"{r}_rms"].to_numpy(dtype=float)
                 col = f"{r}_reduction_percent"
@@ -73,6 +81,7 @@ class LeagueTable:
                         "controller": name,
                         "scenario": scen,
                         "speed_m_s": float(speed),
+                        "load": float(load),
                         "response": r,
                         "cases": int(x.size),
                         "rms_mean": float(x.mean()),
@@ -153,7 +162,7 @@ def league(
     track_seeds=(0,),
     vehicle=None,
     params=None,
-    load: float = 1.0,
+    load: float | Sequence[float] = 1.0,
     controllers=PAPER_CONTROLLERS,
     gains: GainSet | None = None,
     damper: str = DEFAULT_DAMPER,
@@ -164,27 +173,36 @@ def league(
     comfort: bool = True,
     progress=None,
 ) -> LeagueTable:
-    """Run `compare` on every (scenario, speed, track seed) with the same gains and collect the
-    league table. ``scenarios``: names (`railride.scenario`); ``speeds`` [m/s] (None: each
-    scenario's default); ``track_seeds``: the random-track realisations (ignored by the other
-    scenarios). ``vehicle`` (``params`` is an alias) and ``load``: the vehicle as `compare`
-    takes it, resolved once and recorded in ``settings["vehicle"]`` and in the ``vehicle``
-    column of `cases`. The other arguments are `compare`'s; the bounds (ideal devices) are
-    always run; ``settings["gains_mismatch"]``: the one line of `GainSet.mismatch` over every
-    case, when the gains were tuned for another vehicle, load or track.
-    ``progress(done_cases, total_cases)`` is called after each case."""
+    """Run `compare` on every (scenario, speed, track seed) at every load factor with the same
+    gains and collect the league table. ``scenarios``: names (`railride.scenario`); ``speeds``
+    [m/s] (None: each scenario's default); ``track_seeds``: the random-track realisations
+    (ignored by the other scenarios). ``vehicle`` (``params`` is an alias): the vehicle as
+    `compare` takes it; ``load``: one load factor on its carbody or a list of them (e.g.
+    ``[1.0, 1.3]``), each > 0 and listed once, all checked before the first run; every case
+    runs at every load (`resolve_vehicle` per load). The vehicle is recorded in
+    ``settings["vehicle"]`` (`vehicle_record`: its ``load`` the list where there are several)
+    and in the ``vehicle`` column of `cases`, the load of each row in its ``load`` column.
+    The other arguments are `compare`'s; the bounds (ideal devices) are always run;
+    ``settings["gains_mismatch"]``: the one line of `GainSet.mismatch` over every case and
+    load, when the gains were tuned for another vehicle, load or track.
+    `LeagueTable.summary` pools the speeds and loads; `LeagueTable.by_speed` keeps them apart.
+    ``progress(done_runs, total_runs)`` is called after each case at each load."""
     scenarios = list(scenarios) if not isinstance(scenarios, str) else [scenarios]
     if not scenarios:
         raise InputError("scenarios: give at least one scenario name")
     names = check_controllers(controllers)
-    car, record = resolve_vehicle(vehicle, params, load)
+    loads = _loads(load)
+    # every load checked and its vehicle resolved before the first run
+    cars = [resolve_vehicle(vehicle, params, x)[0] for x in loads]
+    record = vehicle_record(*resolve_argument(vehicle, params), loads)
     gains = GainSet.default() if gains is None else gains
     # every scenario is built (and checked) before the first run
     todo = [
         (n, v, s, scenario(n, speed=v, seed=s, duration=duration)) for n, v, s in _cases(scenarios, speeds, track_seeds)
     ]
     rows = []
-    for k, (name, speed, seed, sc) in enumerate(todo):
+    runs = list(itertools.product(todo, zip(loads, cars)))  # every case at every load, the loads inner
+    for k, ((name, speed, seed, sc), (x, car)) in enumerate(runs):
         comp = compare(
             sc,
             car,
@@ -197,9 +215,9 @@ def league(
             comfort=comfort,
             bounds=True,
         )
-        rows.extend(_rows(comp, name, sc.speed, seed, record["name"]))
+        rows.extend(_rows(comp, name, sc.speed, seed, record["name"], x))
         if progress is not None:
-            progress(k + 1, len(todo))
+            progress(k + 1, len(runs))
     settings = {
         "scenarios": scenarios,
         "vehicle": record,
@@ -221,7 +239,22 @@ def league(
     return LeagueTable(pd.DataFrame(rows), names, settings, gains.provenance.get("scenario_record"))
 
 
-def _rows(comp, name: str, speed: float, seed, vehicle: str) -> list[dict]:
+def _loads(load) -> list[float]:
+    """``load``: one load factor or a list of them -> the checked list (each a finite number
+    > 0, none listed twice, at least one), errors naming ``load``."""
+    many = isinstance(load, (list, tuple, np.ndarray, pd.Series))
+    items = list(load) if many else [load]
+    if not items:
+        raise InputError("load = []: give at least one load factor, a finite number > 0 (e.g. 1.0 or [1.0, 1.3])")
+    allowed = "a finite number > 0 (the factor on the carbody mass), or a list of them"
+    loads = [validation.number("load", x, "positive", allowed=allowed) for x in items]
+    twice = [x for i, x in enumerate(loads) if x in loads[:i]]
+    if twice:
+        raise InputError(f"load = {loads}: {twice[0]:g} is listed twice; give each load factor once")
+    return loads
+
+
+def _rows(comp, name: str, speed: float, seed, vehicle: str, load: float) -> list[dict]:
     red = comp.reductions
     demands = comp.demands()
     bound = (comp.bounds_record() or {}).get("ideal", {})  # reductions of the same gains on the ideal actuator
@@ -232,6 +265,7 @@ def _rows(comp, name: str, speed: float, seed, vehicle: str) -> list[dict]:
             "speed_m_s": float(speed),
             "track_seed": seed,
             "vehicle": vehicle,
+            "load": float(load),
             "controller": n,
             "in_sample": bool(comp.in_sample),
         }

@@ -67,3 +67,38 @@ def test_out_writes_the_league_files(tmp_path):
 def test_bad_lists_are_input_errors(extra, words):
     args = [a for a in SHORT if a not in ("--controllers", "pid,skyhook")] if "--controllers" in extra else SHORT
     assert_input_error(run("compare", *args, *extra), *words)
+
+
+def test_several_loads_make_a_league_table_that_keeps_them_apart():
+    args = ("compare", "--speed", "40", "--load", "1,1.3", *SHORT)
+    text = ok(*args).stdout
+    flat = " ".join(text.split())
+    assert "League table" in text and "Mean over 2 cases: paper-sine at 40 m/s, each at loads 1, 1.3" in flat
+    assert "This mean pools the loads" in flat and "vehicle: paper, loads 1, 1.3" in flat
+    assert "Per scenario, speed and load" in text and "Speeds and loads are kept apart" in flat
+    doc = ok_json(*args)
+    assert doc["schema"] == "railride.league/1" and doc["settings"]["vehicle"]["load"] == [1.0, 1.3]
+    assert sorted({c["load"] for c in doc["cases"]}) == [1.0, 1.3] and len(doc["cases"]) == 2 * 3
+    assert sorted({r["load"] for r in doc["by_speed"]}) == [1.0, 1.3]
+    # the loads are runs of their own: the heavier carbody rides otherwise
+    passive = {c["load"]: c["acceleration_m_s2_rms"] for c in doc["cases"] if c["controller"] == "passive"}
+    assert passive[1.0] != passive[1.3]
+
+
+def test_one_load_is_one_comparison_as_before():
+    doc = ok_json("compare", "--duration", "1", "--controllers", "pid", "--no-bounds", "--load", "1.3")
+    assert doc["schema"] == "railride.comparison/1" and doc["settings"]["vehicle"]["load"] == 1.3
+
+
+@pytest.mark.parametrize(
+    "load, words",
+    [
+        ("1,0", ("--load = 0", "must be a finite number > 0")),
+        ("1,-1.3", ("--load = -1.3", "must be a finite number > 0")),
+        ("1,heavy", ("--load = '1,heavy'", "'heavy' is not a number")),
+        ("1,,1.3", ("--load = '1,,1.3'", "an empty item")),
+        ("1,1.3,1", ("--load = '1,1.3,1'", "listed twice")),
+    ],
+)
+def test_bad_load_lists_are_input_errors(load, words):
+    assert_input_error(run("compare", "--speed", "40", "--load", load, *SHORT), *words)
