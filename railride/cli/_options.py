@@ -276,13 +276,20 @@ SweepDamperScaleOption = _damper_scale(
 
 
 # -- gains and the tuning objective -------------------------------------------------------------
+#: what the shipped default is, in every --gains help that takes it
+_SHIPPED = (
+    "the shipped set for the track: robust (railride/data/robust_gains.toml, tuned on random track) on "
+    "random or measured track, paper (railride/data/gains.toml, tuned on the paper's sine) on the sine and bump"
+)
+
+
 def _gains(help: str):
-    return Annotated[Optional[Path], typer.Option("--gains", metavar="FILE.toml", help=help)]
+    return Annotated[Optional[Path], typer.Option("--gains", metavar="paper|robust|FILE.toml", help=help)]
 
 
 CompareGainsOption = _gains(
-    "Controller gains from a TOML file with [inner], [pid], [sas.attitude] and "
-    "[sas.ride] (default: the shipped railride/data/gains.toml)."
+    "Controller gains: a shipped set (paper, robust) or a TOML file with [inner], [pid], [sas.attitude] "
+    f"and [sas.ride] (default: {_SHIPPED})."
 )
 TuneGainsOption = _gains(
     "Start values: a gains file as for compare (default: the neutral reference gains, "
@@ -290,10 +297,10 @@ TuneGainsOption = _gains(
 )
 ParetoGainsOption = _gains(
     "Base gains: the gains not sampled (the inner loop's among them), and one sample "
-    "of their own (default: the shipped gains)."
+    f"of their own (default: {_SHIPPED})."
 )
-SweepGainsOption = _gains("Controllers: the base gains that --gain changes (default: the shipped gains).")
-StudyGainsOption = _gains("Controller gains, kept for every load and fault (default: the shipped gains).")
+SweepGainsOption = _gains(f"Controllers: the base gains that --gain changes (default: {_SHIPPED}).")
+StudyGainsOption = _gains(f"Controller gains, kept for every load and fault (default: {_SHIPPED}).")
 
 ObjectiveOption = Annotated[
     Optional[str],
@@ -302,7 +309,9 @@ ObjectiveOption = Annotated[
         metavar="KIND",
         help="What each run's RMS ratios to passive r_k (acceleration, displacement, pitch, "
         "roll) are scored by: sum (sum of r_k), weighted (sum of w_k r_k, --weights), "
-        "minimax (the largest r_k), constrained (sum of r_k with every r_k <= --bound). "
+        "minimax (the largest r_k), constrained (sum of r_k with every r_k <= --bound); or "
+        "ride comfort: n_mv (the worst ratio to passive of EN 12299's N_MV,z over the floor's "
+        "centre, front and rear), sperling (the same with Sperling's Wz). "
         "Default: the library's DEFAULT_OBJECTIVE; the statement is printed with the "
         "result.",
     ),
@@ -330,6 +339,25 @@ PenaltyOption = Annotated[
         metavar="X",
         help="Added to any objective: X times the sum of the RMS ratios above 1 (responses "
         "worse than passive); >= 0 (default 0).",
+    ),
+]
+
+MaxPeakOption = Annotated[
+    Optional[str],
+    typer.Option(
+        "--max-peak",
+        metavar="X",
+        help="A bound on any objective: every run's peak-to-peak carbody acceleration at most X times "
+        "passive's on the same track, > 0; a run above it is infeasible.",
+    ),
+]
+MaxTravelOption = Annotated[
+    Optional[str],
+    typer.Option(
+        "--max-travel",
+        metavar="M",
+        help="A bound on any objective: every run's largest secondary travel [m] at most M (e.g. the bump "
+        "stops' clearance), > 0; a run above it is infeasible.",
     ),
 ]
 

@@ -249,13 +249,15 @@ def parse_voltages(option: str, text: str, damper) -> list[float]:
 
 
 def load_gains(path: Optional[Path]):
-    """The shipped gains, or --gains FILE with the library's message (file, table, entry)."""
-    from railride.secondary.control import GainSet
+    """--gains: None where it is not given (the library takes the shipped set for the track,
+    `GainSet.for_tracks`), a shipped set by name (paper, robust), else the file, with the
+    library's message (file, table, entry)."""
+    from railride.secondary.control import SHIPPED, GainSet
 
     if path is None:
-        return GainSet.default()
+        return None
     try:
-        return GainSet.load(path)
+        return GainSet.named(str(path)) if str(path) in SHIPPED else GainSet.load(path)
     except ValueError as exc:
         raise InputError(f"--gains: {exc}") from None
 

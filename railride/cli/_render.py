@@ -152,6 +152,12 @@ def modes_table(rows: list[dict], caption: str | None = None):
 def alike_text(alike: dict) -> str:
     """The line saying how alike the laws were tuned (`GainSet.tuning_budget`)."""
     runs = ", ".join(f"{n} {r}" for n, r in alike["runs"].items())
+    per_set = alike.get("runs_per_gain_set")
+    if per_set:
+        return (
+            f"Tuned alike: every law by the same study and objective, with at most {alike['budget']} gain sets "
+            f"each, every set scored on the same {per_set} runs (gain sets used: {runs})."
+        )
     return (
         f"Tuned alike: every law by the same study and objective, with at most {alike['budget']} vehicle runs "
         f"each (runs used: {runs})."
@@ -213,3 +219,19 @@ def save_report(path: Path, result, parts=(), ctx: Optional[typer.Context] = Non
         except OSError as exc:
             raise CliError(f"cannot write the report {path}: {exc.strerror or exc}", 2) from None
     typer.echo(f"wrote {path}", err=True)
+
+
+def gains_text(source: str, shipped: bool) -> str:
+    """Which gain set a run took, in words: a shipped set by its name and what it was tuned on
+    (the library takes the robust set on random and measured track, `GainSet.for_tracks`)."""
+    if not shipped:
+        return f"gains file {source}"
+    if source.endswith("robust_gains.toml"):
+        return (
+            f"gains: the shipped robust set {source}, tuned on random track and taken on random and measured "
+            "track (--gains paper: the set tuned on the paper's sine)"
+        )
+    return (
+        f"gains: the shipped paper set {source}, tuned on the paper's sine and taken on the sine and the bump "
+        "(--gains robust: the set tuned on random track)"
+    )

@@ -64,6 +64,7 @@ from railride.cli._render import (
     warn_gains_mismatch,
     alike_text,
     compare_comfort_table,
+    gains_text,
     damper_text,
     fmt,
     reduction_text,
@@ -250,7 +251,7 @@ def _compare_tables(doc: dict, shipped: bool):
             f"{damper_text(settings)}, controller {settings['control_rate_hz']:g} Hz, "
             f"delay {delay} period{'s' * (delay != 1)}, {noise_text}"
         )
-        info.append(f"gains file {doc['gains']['source']}" + (" (shipped)" if shipped else ""))
+        info.append(gains_text(doc["gains"]["source"], shipped))
         tuning = doc.get("tuning") or {}
         if tuning.get("objective"):
             info.append(

@@ -32,7 +32,10 @@ from railride.cli._options import (
     MaxStepsOption,
     ObjectiveOption,
     OutputFormat,
+    MaxPeakOption,
+    MaxTravelOption,
     PenaltyOption,
+    ReportOption,
     PresetOption,
     SchedulerFileOption,
     SchedulerOption,
@@ -88,7 +91,16 @@ COST_METRICS = {
     "force_max_n": ("force max\n(kN)", 1e-3, ".1f"),
     "travel_max_m": ("travel max\n(mm)", 1e3, ".1f"),
     "voltage_at_max_fraction": ("at v_max\n(%)", 100.0, ".1f"),
+    "coil_power_fraction": ("coil power\n(% of v_max)", 100.0, ".1f"),
 }
+
+
+#: the columns of the references in the ranking, by device
+REFERENCE_HEADS = {"ideal": "ideal\nactuator", "ideal-damper": "ideal\ndamper"}
+
+
+def _score(value) -> str:
+    return "-" if value is None else f"{value:.3f}"
 
 
 def _cell(m: dict, scale: float = 1.0, spec: str = ".3f", band: bool = True) -> str:
@@ -169,20 +181,25 @@ def _tables(doc: dict) -> list:
         table.caption = (
             "force: the secondary damper force on the carbody; travel: the secondary deflection, "
             + (f"against a clearance of {clearance * 1e3:g} mm (z_stop)" if clearance else "no bump stops")
-            + "; at v_max: the time the command voltage sits at the damper's largest."
+            + "; at v_max: the time the command voltage sits at the damper's largest; coil power: the mean "
+            "electrical power of the coils as a % of their power at v_max (mean (u / v_max)^2, u the coil voltage)."
         )
         return table
 
     ranking = FitTable(title="Ranking on held-out track", labels=2)
-    for head in ("rank", "law", "score", "worst at", "best at"):
-        ranking.add_column(head, justify="right" if head in ("rank", "score") else "left")
+    refs = doc.get("references") or {}
+    heads = ["rank", "law", "score", *[REFERENCE_HEADS[d] for d in refs], "worst at", "best at"]
+    for head in heads:
+        ranking.add_column(head, justify="left" if head in ("law", "worst at", "best at") else "right")
     for r in doc["ranking"]:
         worst = r["worst_at"]
         best = ", ".join(f"{p['speed_m_s']:g} m/s load {p['load']:g}" for p in r["best_at"]) or "-"
+        ref_cells = [_score(refs[d].get(r["controller"], {}).get("score")) for d in refs]
         ranking.add_row(
             "-" if r["rank"] is None else str(r["rank"]),
             escape(LABELS[r["controller"]]) + ("" if r["ranked"] else " (diverged)"),
-            "-" if r["score"] is None else f"{r['score']:.3f}",
+            _score(r["score"]),
+            *ref_cells,
             f"{worst['speed_m_s']:g} m/s, load {worst['load']:g}",
             best,
         )
@@ -190,8 +207,17 @@ def _tables(doc: dict) -> list:
     kind = s["objective"]["kind"]
     what = "the worst of a law's four mean RMS ratios to passive" if kind == "minimax" else f"the {kind} objective"
     ranking.caption = (
-        f"score: {what} at a speed and load (of its mean RMS ratios to passive); a law's score is its worst "
-        "over the speeds and loads."
+        f"score: {what} at a speed and load (of its mean ratios to passive); a law's score is its worst "
+        "over the speeds and loads. Objective: "
+        + s["objective"]["statement"]
+        + "."
+        + (
+            " Ideal actuator / ideal damper: the law's score with the same gains on the ideal actuator "
+            "(force = demand) and on the ideal semi-active damper; references, not bounds (with the same "
+            "gains the MR dampers can do better)."
+            if refs
+            else ""
+        )
     )
     lines = [
         f"Tracks {', '.join(s['tracks'])} at {', '.join(f'{v:g}' for v in s['speeds_m_s'])} m/s, loads "
@@ -245,7 +271,7 @@ def design_command(
     train_seeds: Annotated[
         str,
         typer.Option("--train-seeds", metavar="N[,N...]|A:B:COUNT", help="Track seeds tuning runs on."),
-    ] = "0,1,2",
+    ] = "1,2,3",
     test_seeds: Annotated[
         str,
         typer.Option(
@@ -276,6 +302,8 @@ def design_command(
     weights: WeightsOption = None,
     bound: BoundOption = None,
     penalty: PenaltyOption = None,
+    max_peak: MaxPeakOption = None,
+    max_travel: MaxTravelOption = None,
     vehicle: VehicleOption = None,
     preset: PresetOption = None,
     damper: Annotated[
@@ -290,6 +318,7 @@ def design_command(
     format: FormatOption = OutputFormat.table,
     figure_format: FigureFormatOption = None,
     dpi: DpiOption = None,
+    report: ReportOption = None,
     max_memory: MaxMemoryOption = None,
     max_steps: MaxStepsOption = None,
 ) -> None:
@@ -301,8 +330,11 @@ def design_command(
     from railride.cli.tune import _objective
     from railride.studies.objectives import OBJECTIVE_KINDS
 
-    command = command_line(ctx, exclude=("out", "resume", "format", "figure_format", "dpi"))
+    from railride.cli._render import check_report_option, save_report
+
+    command = command_line(ctx, exclude=("out", "resume", "format", "figure_format", "dpi", "report"))
     with errors(), option_names(DESIGN_FIELDS):
+        check_report_option(report)
         figures = figure_options(figure_format, dpi, out)
         names = [c.strip() for c in controllers.split(",")]
         tracks = [t.strip() for t in track.split(",")]
@@ -313,9 +345,9 @@ def design_command(
         source = vehicle_source(vehicle, preset)
         damper_preset("--damper", damper)
         if objective_kind is not None and objective_kind.strip() not in OBJECTIVE_KINDS:
-            objective = objective_kind  # the library names what it allows (a comfort objective: not yet)
+            objective = objective_kind  # the library names what it allows, and knows other spellings
         else:
-            objective = _objective(objective_kind, weights, bound, penalty)
+            objective = _objective(objective_kind, weights, bound, penalty, max_peak, max_travel)
         solver = solver_from_options(dt=dt)
         from railride.studies.design import check_design
 
@@ -375,3 +407,5 @@ def design_command(
         console = stdout_console()
         for part in _tables(doc):
             console.print(part)
+    if report is not None:  # after the output: a report that cannot be written loses none of it
+        save_report(report, result, _tables(doc), ctx)

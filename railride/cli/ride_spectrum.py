@@ -69,7 +69,11 @@ def ride_spectrum(
     ] = "passive,pid,sas-attitude,sas-attitude-ride",
     gains: Annotated[
         Optional[Path],
-        typer.Option("--gains", metavar="FILE.toml", help="Controller gains (default: the shipped gains)."),
+        typer.Option(
+            "--gains",
+            metavar="paper|robust|FILE.toml",
+            help="Controller gains: a shipped set or a gains file (default: robust, the set tuned on random track).",
+        ),
     ] = None,
     min_wavelength: Annotated[
         float, typer.Option("--min-wavelength", metavar="M", help="Shortest wavelength of the track [m].")
@@ -227,7 +231,11 @@ def state_space(
     ] = "passive",
     gains: Annotated[
         Optional[Path],
-        typer.Option("--gains", metavar="FILE.toml", help="Controller gains (default: the shipped gains)."),
+        typer.Option(
+            "--gains",
+            metavar="paper|robust|FILE.toml",
+            help="Controller gains: a shipped set or a gains file (default: paper, the set tuned on the paper's sine).",
+        ),
     ] = None,
     vehicle: VehicleOption = None,
     preset: PresetOption = None,

@@ -38,6 +38,8 @@ from railride.cli._options import (
     MinWavelengthOption,
     ObjectiveOption,
     OutputFormat,
+    MaxPeakOption,
+    MaxTravelOption,
     PenaltyOption,
     PresetOption,
     RailPhaseOption,
@@ -87,8 +89,16 @@ TUNE_FIELDS = {
 }
 
 
-def _objective(kind: Optional[str], weights: Optional[str], bound: Optional[str], penalty: Optional[str]):
-    """--objective, --weights, --bound, --penalty -> a tuning.Objective. Without --objective,
+def _objective(
+    kind: Optional[str],
+    weights: Optional[str],
+    bound: Optional[str],
+    penalty: Optional[str],
+    max_peak: Optional[str] = None,
+    max_travel: Optional[str] = None,
+):
+    """--objective, --weights, --bound, --penalty, --max-peak, --max-travel -> a
+    tuning.Objective (the last two: its ``peak_bound`` and ``travel_bound``). Without --objective,
     the library's DEFAULT_OBJECTIVE; an option not given keeps that default's value when the
     kind is the default's (weights and bound belong to their kind only)."""
     from railride.studies.objectives import DEFAULT_OBJECTIVE, OBJECTIVE_KINDS, Objective
@@ -128,10 +138,15 @@ def _objective(kind: Optional[str], weights: Optional[str], bound: Optional[str]
         p = parse_float("--penalty", penalty, penalty)
         if p < 0:
             raise InputError(f"--penalty = {penalty!r}: must be a finite number >= 0")
+    limits = {
+        "peak_bound": None if max_peak is None else parse_float("--max-peak", max_peak, max_peak),
+        "travel_bound": None if max_travel is None else parse_float("--max-travel", max_travel, max_travel),
+    }
     try:
-        return Objective(name, w, b, p)
+        return Objective(name, w, b, p, **limits)
     except ValueError as exc:  # what the checks above cannot see, e.g. a bound too large
-        raise InputError(f"--objective {name}: {exc}") from None
+        text = str(exc).replace("objective peak_bound", "--max-peak").replace("objective travel_bound", "--max-travel")
+        raise InputError(text if text != str(exc) else f"--objective {name}: {exc}") from None
 
 
 def _weights(weights: str) -> tuple:
@@ -407,6 +422,8 @@ def tune_command(
     weights: WeightsOption = None,
     bound: BoundOption = None,
     penalty: PenaltyOption = None,
+    max_peak: MaxPeakOption = None,
+    max_travel: MaxTravelOption = None,
     values: Annotated[
         int,
         typer.Option(
@@ -462,7 +479,7 @@ def tune_command(
         damper_preset("--damper", damper)
         scale = parse_scale("--damper-scale", damper_scale)
         start = _tune_start(gains)
-        objective = _objective(objective_kind, weights, bound, penalty)
+        objective = _objective(objective_kind, weights, bound, penalty, max_peak, max_travel)
         solver = solver_from_options(dt=dt)
         seeds = value_list("--track-seed", track_seed, integer=True) if track_seed is not None else None
         loads = value_list("--load", load) if load is not None else None

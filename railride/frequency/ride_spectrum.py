@@ -251,6 +251,10 @@ def ride_spectrum(
     plant = linear_model(vehicle_params, "plant")
     psd: dict[str, list] = {r: [] for r in RESPONSES}
     names, not_run = [], {}
+    from railride.secondary.control import GainSet
+
+    given = gains is not None
+    gains = GainSet.of(gains, track)  # a random track: the robust set unless given
     for name, suspension in linear_suspensions(controllers, gains).items():
         model = linear_model(vehicle_params, suspension)
         try:
@@ -305,7 +309,8 @@ def ride_spectrum(
         "control_rate_hz": control_rate,
         "delay_periods": delay if control_rate is not None else None,
         "actuator": "ideal (force = demand)",
-        "gains": "shipped" if gains is None else "given",
+        "gains": "given" if given else "shipped",
+        "gains_source": gains.source,
         "not_run": not_run,
     }
     mismatch = gains_mismatch(gains, _by_name(controllers, names), record, track, speed, (lo, hi))
@@ -326,7 +331,7 @@ def gains_mismatch(gains, controllers, vehicle: dict, track: str, speed: float, 
     from railride.secondary.control import GainSet
     from railride.secondary.provenance import tuned_tracks
 
-    gains = GainSet.default() if gains is None else gains
+    gains = GainSet.of(gains, track)
     options = {"speed": speed, "min_wavelength": band[0], "max_wavelength": band[1]}
     records = []
     for tuned in tuned_tracks(gains.provenance or {}):

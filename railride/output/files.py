@@ -562,15 +562,16 @@ def write_study_outputs(result, out_dir, *, figures: FigureOptions | None = None
 
 
 #: the files `write_design_outputs` produces, in the order they are written
-DESIGN_FILES = ("design.json", "design.csv", "design_runs.csv", "gains.toml", "design.png")
+DESIGN_FILES = ("design.json", "design.csv", "design_runs.csv", "gains.toml", "design.png", "design_costs.png")
 
 
 def write_design_outputs(result, out_dir, doc: dict, gains_text: str, *, figures: FigureOptions | None = None):
     """Write a `railride.studies.design_result.DesignResult` into ``out_dir``, all or nothing:
     ``design.json`` (``doc``), ``design.csv`` (``to_pandas()``), ``design_runs.csv`` (the
-    held-out runs), ``gains.toml`` (``gains_text``) and ``design.png`` (`plot_design`); other
-    files (the run table) stay. Returns the written paths."""
-    from railride.plots.design import plot_design
+    held-out runs), ``gains.toml`` (``gains_text``), ``design.png`` (`plot_design`) and
+    ``design_costs.png`` (`plot_design_costs`); other files (the run table) stay. Returns the
+    written paths."""
+    from railride.plots.design import plot_design, plot_design_costs
 
     _expect(result, "result", "railride.studies.design_result.DesignResult", ("summary", "runs", "ranking"))
     text = json_text(doc)  # refuse NaN before any file is written
@@ -580,6 +581,7 @@ def write_design_outputs(result, out_dir, doc: dict, gains_text: str, *, figures
         "design_runs.csv": _csv(result.runs),
         "gains.toml": _text(gains_text),
         "design.png": _png(lambda: plot_design(result)),
+        "design_costs.png": _png(lambda: plot_design_costs(result)),
     }
     return write_folder(out_dir, _entries(DESIGN_FILES, writers, figures))
 

@@ -61,6 +61,7 @@ class Contents:
 #: functions below), named in the error for a result without one
 REPORTED = (
     "Comparison",
+    "DesignResult",
     "FrfResult",
     "LeagueTable",
     "RideResult",
@@ -170,6 +171,22 @@ def study_contents(result) -> Contents:
         params=_vehicle(result.settings),
         figures=[("study", "reductions against passive with their 5-95 % bands", result.plot())],
         tables=[("one row per controller, condition and metric", result.to_pandas())],
+    )
+
+
+def design_contents(result) -> Contents:
+    """The report of a `railride.studies.design_result.DesignResult`."""
+    from railride.plots.design import plot_design_costs
+
+    return Contents(
+        title="Which controller: a robust design judged on held-out track",
+        settings={**result.settings, "recommended": result.recommended},
+        params=_vehicle(result.settings),
+        figures=[
+            ("design", "RMS ratios to passive against speed, held out, with their 5-95 % bands", result.plot()),
+            ("design_costs", "each law's score against the RMS damper force it asks for", plot_design_costs(result)),
+        ],
+        tables=[("one row per law, speed, load and metric (held out)", result.to_pandas())],
     )
 
 

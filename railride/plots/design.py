@@ -71,3 +71,50 @@ def plot_design(result, ax=None):
     else:
         axes[0].legend(fontsize="small")
     return fig
+
+
+@styled
+def plot_design_costs(result, ax=None):
+    """What each law costs against what it gives, on held-out track: per law and speed/load
+    point, its score there (the design's objective of its mean ratios to passive; lower is
+    better) against the RMS damper force it asks for (mean over the held-out runs), passive's
+    viscous dampers beside them at passive's own score (1 for minimax). One line per law
+    through its points, in order of speed. ``ax``: one Axes, or None for a new figure. Returns
+    the figure."""
+    summary = result.summary
+    if ax is None:
+        fig = new_figure((PAGE_WIDTH * 0.6, 4.2))
+        a = fig.subplots()
+    else:
+        (a,) = given_axes(ax, 1, "the score against the damper force")
+        fig = a.figure
+    force = summary[summary["metric"] == "force_rms_n"].set_index(["controller", "speed_m_s", "load"])["mean"]
+    objective = result.tuning.objective
+    # passive's own score: every ratio to itself is 1
+    ones = {c: np.float64(1.0) for c in objective.columns}
+    travel = objective.travel_bound if objective.needs_costs else None
+    baseline = float(objective.of_ratios(ones, travel))
+    for k, point in enumerate(result.points):
+        v, load = point["speed_m_s"], point["load"]
+        if ("passive", v, load) in force.index:
+            label = "passive" if k == 0 else None
+            a.plot(force[("passive", v, load)] / 1e3, baseline, "ks", markersize=4, label=label)
+    for j, row in enumerate(result.ranking):
+        name = row["controller"]
+        colour = suspension_style(name).get("color", f"C{j}")
+        xs, ys = [], []
+        for point in result.points:
+            key = (name, point["speed_m_s"], point["load"])
+            score = point["scores"].get(name)
+            if key in force.index and score is not None and np.isfinite(score):
+                xs.append(force[key] / 1e3)
+                ys.append(score)
+        if xs:
+            a.plot(xs, ys, "-o", color=colour, markersize=3, linewidth=0.8, label=suspension_label(name))
+    a.axhline(baseline, color="k", linewidth=0.6, linestyle=":")
+    a.set_xlabel("RMS damper force, held-out mean (kN)")
+    a.set_ylabel("score at each speed and load\n(lower is better)")
+    a.legend(fontsize="small")
+    if ax is None:
+        set_title(fig, "What each law gives against what it asks of its dampers, held out")
+    return fig

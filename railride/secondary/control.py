@@ -371,11 +371,16 @@ class GainSet:
     def tuning_budget(self, controllers) -> dict | None:
         """How alike the ``controllers`` were tuned, from the [provenance] of these gains: the
         budget of vehicle runs each law had and the runs each used ({"budget": B, "runs":
-        {name: n}}), or None when the gains file records no budget (files before 0.4.0)."""
+        {name: n}}; for a robust tuning, gain sets, and ``runs_per_gain_set``), or None when the
+        gains file records no budget (files before 0.4.0)."""
         budget = self.provenance.get("budget")
         studies = self.provenance.get("studies", {})
         runs = {n: studies[n]["runs"] for n in controllers if n in studies}
-        return {"budget": budget, "runs": runs} if budget is not None and runs else None
+        if budget is None or not runs:
+            return None
+        # a robust tuning's budget counts gain sets, each scored on every run of its tuning set
+        per_set = len(self.provenance.get("tuning_set") or ()) or None
+        return {"budget": budget, "runs": runs, **({"runs_per_gain_set": per_set} if per_set else {})}
 
     def tuned_on(self, record: dict | None) -> bool:
         """Whether these gains were tuned on the track ``record`` (`Scenario.describe`), as the
@@ -499,6 +504,50 @@ class GainSet:
         return cls._packaged("gains.toml")
 
     @classmethod
+    def robust(cls) -> "GainSet":
+        """The shipped robust gains (railride/data/robust_gains.toml): every law tuned by
+        `railride design` on random track of FRA classes 4 and 5 over a range of speeds and
+        loads, and judged on track seeds it never saw; its [provenance] says on what."""
+        return cls._packaged(SHIPPED["robust"])
+
+    @classmethod
+    def named(cls, name: str) -> "GainSet":
+        """A shipped gain set by name: "paper" (`default`, tuned on the paper's sine) or
+        "robust" (`robust`)."""
+        if name not in SHIPPED:
+            raise InputError(f"gains = {name!r}: not a shipped gain set; allowed {', '.join(SHIPPED)} or a gains file")
+        return cls._packaged(SHIPPED[name])
+
+    @classmethod
+    def for_tracks(cls, scenarios=None) -> "GainSet":
+        """The shipped set a run takes when it is given none (docs/tuning.md, Shipped gains):
+        the robust gains where every track of the run is real track (random or measured,
+        `REAL_TRACK`), else the paper's sine-tuned gains. ``scenarios``: a `Scenario`, its
+        `describe` record, a scenario name, or a list of them; None: the paper's gains."""
+        items = [] if scenarios is None else scenarios
+        if isinstance(items, (str, dict)) or hasattr(items, "describe"):
+            items = [items]
+        profiles = [_profile(s) for s in items]
+        return cls.robust() if profiles and all(p in REAL_TRACK for p in profiles) else cls.default()
+
+    @classmethod
+    def of(cls, gains, scenarios=None) -> "GainSet":
+        """A gains argument as a `GainSet`: None, the shipped set for ``scenarios``
+        (`for_tracks`); a `GainSet`; a shipped set's name ("paper", "robust"); or a gains
+        file's path."""
+        if gains is None:
+            return cls.for_tracks(scenarios)
+        if isinstance(gains, GainSet):
+            return gains
+        if isinstance(gains, str) and gains in SHIPPED:
+            return cls.named(gains)
+        if isinstance(gains, (str, Path)):
+            return cls.load(gains)
+        raise InputError(
+            f"gains = {gains!r}: allowed a GainSet, a gains file's path or a shipped set ({', '.join(SHIPPED)})"
+        )
+
+    @classmethod
     def reference(cls) -> "GainSet":
         """The neutral start of the tuning study (railride/data/reference_gains.toml): every gain
         scaled from the passive suspension, the default start of `railride.studies.tuning.tune` and
@@ -510,6 +559,28 @@ class GainSet:
         # complete: the packaged files hold every table (the reference fills the others' gaps)
         text = resources.files("railride").joinpath(f"data/{name}").read_text(encoding="utf-8")
         return cls.from_toml(text, source=f"railride/data/{name}", complete=True)
+
+
+#: the shipped gain sets by name (`GainSet.named`; --gains NAME on the command line)
+SHIPPED = {"paper": "gains.toml", "robust": "robust_gains.toml"}
+#: the track profiles the robust gains serve by default: real track, random or measured; the
+#: paper's deterministic inputs (sine, bump) take the gains tuned on the paper's sine
+REAL_TRACK = ("random", "measured")
+
+
+def _profile(scenario) -> str | None:
+    """A scenario's profile ("sine", "cosine-bump", "random", "measured"), from a `Scenario`,
+    its record or its name."""
+    if isinstance(scenario, dict):
+        return scenario.get("profile")
+    if hasattr(scenario, "describe"):
+        return scenario.describe().get("profile")
+    if isinstance(scenario, str):
+        from railride.model.track import SPECTRA
+
+        name = scenario.strip()
+        return "random" if name in SPECTRA else "measured" if name.startswith("file:") else "deterministic"
+    return None
 
 
 @dataclass(frozen=True)

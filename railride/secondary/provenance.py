@@ -82,7 +82,9 @@ def mismatch(gains, vehicle: dict | None = None, scenarios=None, controllers=Non
     `Scenario.describe` record or a list of them (a study's). The vehicle differs when its
     values do (by name where the gains' provenance has no values and names no preset); a load
     differs when it is none of the tuned loads; a track when the gains were not tuned on it
-    (`GainSet.tuned_on`, whatever the duration). Any track or load of a robust tuning matches.
+    (`GainSet.tuned_on`, whatever the duration). Any track or load of a robust tuning matches,
+    and so does what it spans: a load between its least and largest, and a random track of a
+    spectrum it was tuned on with several seeds, at any seed and a speed within its speeds.
     The line names what differs and the `railride tune` command that tunes for the run
     (`tune_command`). Gains without provenance record no tuning: None; so do ``controllers``
     (names, when given) of which none reads the gains (passive, constant voltages)."""
@@ -101,7 +103,7 @@ def mismatch(gains, vehicle: dict | None = None, scenarios=None, controllers=Non
     if other is not None:  # the same name with other values: the values that differ
         named = str(vehicle.get("name")) == tuned_vehicle(provenance)[0] and other
         differs.append(f"vehicle {vehicle.get('name')}" + (f" (other values: {_words(other)})" if named else ""))
-    other_loads = [x for x in loads if not any(math.isclose(x, t, rel_tol=1e-12) for t in tuned)]
+    other_loads = [x for x in loads if not _load_covered(x, tuned)]
     if other_loads:
         differs.append(f"load{'s' * (len(other_loads) > 1)} {_list(other_loads)}")
     off = [r for r in records if _on_track(gains, r) is False]
@@ -205,6 +207,31 @@ def _other_values(provenance: dict, run: dict) -> list[str] | None:
     return other if other or not common else None
 
 
+def _load_covered(load: float, tuned: list[float]) -> bool:
+    """A load is covered by one it was tuned at, or by a robust tuning's range of loads (two or
+    more, the load between the least and the largest)."""
+    if any(math.isclose(load, t, rel_tol=1e-12) for t in tuned):
+        return True
+    return len(set(tuned)) > 1 and min(tuned) <= load <= max(tuned)
+
+
+def _range_covered(tracks: list[dict], record: dict) -> bool:
+    """Whether a robust tuning on random track covers ``record``: the tuning set holds two or
+    more seeds of the same spectrum over the same wavelength band, and the record's speed lies
+    within the tuned speeds' range; its seed and duration do not matter (every realisation of
+    a spectrum is the same track in the statistical sense)."""
+    if record.get("profile") != "random":
+        return False
+    keys = ("name", "min_wavelength_m", "max_wavelength_m")
+    same = [t for t in tracks if t.get("profile") == "random" and all(_same(t.get(k), record.get(k)) for k in keys)]
+    seeds = {t.get("seed") for t in same}
+    speeds = [float(t["speed_m_s"]) for t in same if t.get("speed_m_s") is not None]
+    speed = record.get("speed_m_s")
+    if len(seeds) < 2 or not speeds or speed is None:
+        return False
+    return min(speeds) * (1 - 1e-12) <= float(speed) <= max(speeds) * (1 + 1e-12)
+
+
 def _words(names: list[str]) -> str:
     return ", ".join(names[:_SHOWN]) + (f" and {len(names) - _SHOWN} more" if len(names) > _SHOWN else "")
 
@@ -216,6 +243,8 @@ def _on_track(gains, record: dict) -> bool | None:
     provenance = gains.provenance
     tracks = tuned_tracks(provenance)
     if tracks:
+        if _range_covered(tracks, record):
+            return True
         durations = {t.get("duration_s") for t in tracks} | {record.get("duration_s")}
         return any(gains.tuned_on({**record, "duration_s": d} if "duration_s" in record else record) for d in durations)
     names, speeds = provenance.get("scenarios"), provenance.get("speeds_m_s")

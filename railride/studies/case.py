@@ -100,12 +100,12 @@ class Case:
 
     def to_suspension(self, base_gains=None) -> Suspension:
         """The run's `Suspension`: `Suspension.named` with the case's gain changes applied to
-        ``base_gains`` (default the shipped `GainSet.default`)."""
+        ``base_gains`` (default the shipped set for the case's track, `GainSet.for_tracks`)."""
         from railride.secondary.control import GainSet
 
         if not self.closed_loop:
             return self._named(None)
-        base = GainSet.default() if base_gains is None else base_gains
+        base = GainSet.of(base_gains, self.scenario)
         return self._named(base.apply(self.gains))
 
     @property

@@ -398,7 +398,7 @@ def compare(
     damper_scale = float(damper_scale)
     names = check_controllers(controllers)
     scenario = as_scenario(scenario)
-    gains = GainSet.default() if gains is None else gains
+    gains = GainSet.of(gains, scenario)
     # gains tuned for another vehicle, load or track: one line (the command line warns with it)
     mismatch = gains.mismatch(record, scenario.describe(), names)
     faults = check_faults(faults, model)

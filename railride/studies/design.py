@@ -32,12 +32,11 @@ from railride.errors import InputError
 from railride.studies.design_result import (
     METRICS,
     PERCENTILES,
-    RMS_COLUMNS,
     DesignResult,
     rank,
     recommend,
 )
-from railride.studies.objectives import DEFAULT_OBJECTIVE, OBJECTIVE_KINDS, Objective
+from railride.studies.objectives import DEFAULT_OBJECTIVE, OBJECTIVE_KINDS, TRAVEL_COLUMN, Objective
 from railride.studies.sweep import Case, RunTable, run_cases
 from railride.studies.tuning import PARAMETERS, STAGES, TUNED_CONTROLLERS, tune, tuning_set
 
@@ -46,7 +45,7 @@ from railride.studies.tuning import PARAMETERS, STAGES, TUNED_CONTROLLERS, tune,
 DEFAULT_TRACKS = ("fra4", "fra5")
 DEFAULT_SPEEDS = (30.0, 50.0, 70.0)
 DEFAULT_LOADS = (1.0, 1.3)
-DEFAULT_TRAIN_SEEDS = (0, 1, 2)
+DEFAULT_TRAIN_SEEDS = (1, 2, 3)
 DEFAULT_TEST_SEEDS = (100, 101, 102, 103, 104)
 DEFAULT_DURATION = 20.0
 #: values per gain and sweep: coarser than `railride tune`'s 13, so that the budget below sweeps
@@ -57,8 +56,8 @@ DEFAULT_VALUES = 7
 DEFAULT_BUDGET = 130
 #: how a gain set's objectives over the training runs become one (`tune`'s ``aggregate``)
 DEFAULT_AGGREGATE = "mean"
-#: comfort objectives a user may ask for, which the tuning objectives do not offer yet
-COMFORT_OBJECTIVES = ("n_mv", "nmv", "n_mv_z", "sperling", "wz", "comfort")
+#: other spellings of the comfort objectives' names
+COMFORT_ALIASES = {"nmv": "n_mv", "n_mv_z": "n_mv", "n-mv": "n_mv", "wz": "sperling"}
 
 
 @dataclass(frozen=True)
@@ -136,22 +135,17 @@ def _objective(objective) -> Objective:
         return DEFAULT_OBJECTIVE
     if isinstance(objective, Objective):
         return objective
+    allowed = "allowed by name: minimax, sum, n_mv, sperling; or a railride.Objective"
     if isinstance(objective, str):
-        name = objective.strip()
-        if name.lower().replace("-", "_").replace(",", "_") in COMFORT_OBJECTIVES:
-            raise InputError(
-                f"objective = {objective!r}: a comfort objective is not built yet; the tuning "
-                "objectives score the four RMS ratios to passive (allowed: minimax, sum, or an Objective; "
-                "the design reports N_MV,z and Sperling's Wz for every law all the same)"
-            )
-        if name in ("minimax", "sum"):
+        name = objective.strip().lower()
+        name = COMFORT_ALIASES.get(name, name)
+        if name in ("minimax", "sum", "n_mv", "sperling"):
             return Objective(name)
         if name in OBJECTIVE_KINDS:
             raise InputError(
-                f"objective = {objective!r}: needs its settings; pass an Objective({name!r}, ...) "
-                "(allowed by name: minimax, sum)"
+                f"objective = {objective!r}: needs its settings; pass an Objective({name!r}, ...) ({allowed})"
             )
-    raise InputError(f"objective = {objective!r}: allowed minimax, sum, or a railride.Objective")
+    raise InputError(f"objective = {objective!r}: {allowed}")
 
 
 def check_design(
@@ -337,6 +331,13 @@ def design(
     summary = _summary(runs, plan)
     diverged = _diverged(tuned, training, runs, plan)
     ranking, points = rank(summary, plan.objective, plan.laws, {d["controller"] for d in diverged})
+    from railride.studies.design_probes import fault_check, references
+
+    refs = references(plan, tuned.gains, lambda **kw: _scores(plan, tuned.gains, executor, table, progress, **kw))
+    leaders = [r["controller"] for r in ranking if r["ranked"]][:2]
+    faulted = fault_check(
+        plan, leaders, points, lambda **kw: _scores(plan, tuned.gains, executor, table, progress, **kw)
+    )
     settings = {
         "vehicle": vehicle_record(plan.vehicle, plan.source, list(plan.loads)),
         "clearance_m": plan.vehicle.z_stop,
@@ -361,7 +362,10 @@ def design(
         **other_settings(plan.vehicle, plan.solver),
     }
     text = recommend(ranking, points, summary, runs, plan.objective, settings, diverged)
+    text = " ".join(t for t in (text, faulted.get("text") if faulted else None) if t)
     return DesignResult(
+        references=refs,
+        fault=faulted,
         summary=summary,
         runs=runs,
         ranking=ranking,
@@ -399,13 +403,16 @@ def _training_frame(frame: pd.DataFrame | None, plan: Plan) -> pd.DataFrame:
     return frame[keep].reset_index(drop=True)
 
 
-def _judge(plan: Plan, gains, executor, table, progress) -> pd.DataFrame:
-    """Every law with ``gains`` and passive on the held-out runs: one row per run, with the
-    run's law, track, seed, speed and load, its metrics and costs, and each metric's ratio to
-    passive on the same run (``<metric>_ratio``) and the objective of its RMS ratios
-    (``score``, inf where it diverged)."""
+def _judge(plan: Plan, gains, executor, table, progress, laws=None, damper=None, faults=()) -> pd.DataFrame:
+    """Every law of ``laws`` (default the plan's) with ``gains`` and passive on the held-out
+    runs: one row per run, with the run's law, track, seed, speed and load, its metrics and
+    costs, and each metric's ratio to passive on the same run (``<metric>_ratio``) and the
+    objective of its ratios (``score``, inf where it diverged). ``damper`` (default the plan's)
+    and ``faults`` apply to the laws, not to passive (`railride.studies.design_probes`)."""
     from railride.model.params import vehicle_record
 
+    laws = plan.laws if laws is None else laws
+    damper = plan.damper if damper is None else damper
     cases, meta = [], []
     for load in plan.loads:
         changes = plan.vehicle.load_changes(load)
@@ -413,11 +420,12 @@ def _judge(plan: Plan, gains, executor, table, progress) -> pd.DataFrame:
             for seed in plan.test_seeds:
                 for v in plan.speeds:
                     opts = (("duration", plan.duration), ("seed", seed), ("speed", v))
-                    for name in ("passive", *plan.laws):
+                    for name in ("passive", *laws):
                         if name == "passive":
                             cases.append(Case(track, opts, vehicle=changes))
                         else:
-                            cases.append(Case(track, opts, vehicle=changes, suspension=name, damper=plan.damper))
+                            law = Case(track, opts, vehicle=changes, suspension=name, damper=damper, faults=faults)
+                            cases.append(law)
                         meta.append((name, track, seed, v, load))
     name = vehicle_record(plan.vehicle, plan.source)["name"]
     rows = run_cases(
@@ -443,18 +451,31 @@ def _judge(plan: Plan, gains, executor, table, progress) -> pd.DataFrame:
         ratio = np.where(base != 0, values / base, np.nan)
     for j, m in enumerate(METRICS):
         frame[f"{m}_ratio"] = ratio[:, j]
-    score = plan.objective.score(frame[[f"{c}_ratio" for c in RMS_COLUMNS]].to_numpy())
+    # the objective of each run against passive on the same run, from every column it reads (a
+    # comfort objective's floor points, the travel of a travel bound)
+    cols = [*plan.objective.columns, *([TRAVEL_COLUMN] if plan.objective.needs_costs else [])]
+    read = pd.concat([info, rows.reset_index(drop=True)[cols].astype(float)], axis=1)
+    alone = read[read["controller"] == "passive"].set_index(key)[cols]
+    score = plan.objective.of_runs(read, alone.reindex(pd.MultiIndex.from_frame(read[key])))
     frame["score"] = np.where(np.isfinite(frame["diverged_at_s"]), np.inf, score)
     return frame
 
 
-def _summary(runs: pd.DataFrame, plan: Plan) -> pd.DataFrame:
+def _scores(plan: Plan, gains, executor, table, progress, laws=None, damper=None, faults=()) -> list:
+    """The points (`rank`) of ``laws`` judged with ``damper`` and ``faults``: per speed and load,
+    each law's score there."""
+    laws = plan.laws if laws is None else tuple(laws)
+    runs = _judge(plan, gains, executor, table, progress, laws=laws, damper=damper, faults=faults)
+    return rank(_summary(runs, plan, laws), plan.objective, laws)[1]
+
+
+def _summary(runs: pd.DataFrame, plan: Plan, laws=None) -> pd.DataFrame:
     """Per law (passive first), speed, load and metric (`METRICS`, then ``score``): the runs
     that did not diverge (``n``), the mean and the 5th / 95th percentiles of the value and of
     its ratio to passive."""
     lo, hi = PERCENTILES
     out = []
-    for name in ("passive", *plan.laws):
+    for name in ("passive", *(plan.laws if laws is None else laws)):
         for v in plan.speeds:
             for load in plan.loads:
                 part = runs[(runs["controller"] == name) & (runs["speed_m_s"] == v) & (runs["load"] == load)]

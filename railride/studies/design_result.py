@@ -4,7 +4,9 @@ the laws on held-out track (`rank`) and the recommendation in words built from i
 `DesignResult` follows the result protocol: `to_dict` (design.json, schema ``railride.design/1``),
 `to_pandas` (design.csv: per law, speed, load and metric the held-out statistics), `plot`
 (design.png: the RMS ratios to passive against speed with their 5-95 % bands), `save` (those
-files, the held-out runs as design_runs.csv and the tuned gains as gains.toml, all or nothing).
+files, design_costs.png (each law's score against its damper force), the held-out runs as
+design_runs.csv and the tuned gains as gains.toml, all or nothing); `report_contents` (the HTML
+report).
 """
 
 from __future__ import annotations
@@ -21,15 +23,24 @@ from railride.analysis.costs import COST_COLUMNS
 from railride.analysis.metrics import RESPONSES
 from railride.plots import PNG_DPI, FigureOptions
 from railride.secondary.control import LABELS
-from railride.studies.objectives import RATIO_NAMES, Objective
+from railride.studies.objectives import PEAK_COLUMN, RATIO_NAMES, TRAVEL_COLUMN, Objective
 
 #: the schema of `DesignResult.to_dict` (design.json)
 SCHEMA = "railride.design/1"
 #: the RMS responses, as the run table names them
 RMS_COLUMNS = tuple(f"{r}_rms" for r in RESPONSES)
-#: the comfort indices a design reports (at the carbody's centre): EN 12299's N_MV (its
-#: vertical term), Sperling's Wz and ISO 2631's Wk-weighted RMS acceleration
-COMFORT_METRICS = ("centre_N_MV_z", "centre_Wz", "centre_aw_Wk")
+#: the comfort indices a design reports: EN 12299's N_MV (its vertical term) and Sperling's Wz
+#: at the carbody's centre, front and rear floor points, and ISO 2631's Wk-weighted RMS
+#: acceleration at the centre
+COMFORT_METRICS = (
+    "centre_N_MV_z",
+    "centre_Wz",
+    "centre_aw_Wk",
+    "front_N_MV_z",
+    "front_Wz",
+    "rear_N_MV_z",
+    "rear_Wz",
+)
 #: the peaks a design reports beside the RMS: the carbody's peak-to-peak vertical acceleration
 PEAK_METRICS = ("acceleration_m_s2_ptp",)
 #: every metric of a held-out run that a design summarises: responses, peaks, comfort, costs
@@ -64,7 +75,9 @@ class DesignResult:
     speed and load, each law's score and what no law improves; ``recommendation``: the words
     (`recommend`); ``diverged``: the laws that diverged, in tuning or judging, and where;
     ``tuning``: the `railride.studies.tune_result.TuneResult` of the training set (its gains:
-    ``gains``); ``settings``: every input, the vehicle's record, the versions."""
+    ``gains``); ``settings``: every input, the vehicle's record, the versions. ``references``:
+    each law's score with the same gains on the ideal devices; ``fault``: the two leading laws
+    with a failed damper (`railride.studies.design_probes`)."""
 
     summary: pd.DataFrame
     runs: pd.DataFrame = field(repr=False)
@@ -75,6 +88,8 @@ class DesignResult:
     tuning: Any = field(default=None, repr=False)
     settings: dict = field(default_factory=dict)
     date: str | None = None
+    references: dict = field(default_factory=dict)
+    fault: dict | None = None
 
     @property
     def gains(self):
@@ -91,6 +106,12 @@ class DesignResult:
         """One metric's rows of `summary`, indexed by law, speed and load."""
         part = self.summary[self.summary["metric"] == metric]
         return part.set_index(["controller", "speed_m_s", "load"])
+
+    def report_contents(self):
+        """What this result shows in its HTML report (`railride.output.report.write_report`)."""
+        from railride.output.report import design_contents
+
+        return design_contents(self)
 
     def to_dict(self) -> dict:
         """The ``railride.design/1`` document (docs/schemas/railride.design-1.json)."""
@@ -121,6 +142,8 @@ class DesignResult:
             "ranking": [_plain(r) for r in self.ranking],
             "recommendation": {"controller": self.recommended, "text": self.recommendation},
             "diverged": self.diverged,
+            "references": _plain(self.references),
+            "fault": _plain(self.fault),
             "tuning": {
                 "objective": tuning.objective.describe(),
                 "studies": [s.to_dict() for s in tuning.studies],
@@ -142,7 +165,21 @@ class DesignResult:
             *textwrap.wrap("recommendation: " + self.recommendation, 98, initial_indent="# ", subsequent_indent="#   "),
             "",
         ]
-        return "\n".join(lines) + self.tuning.gains_toml()
+        ranked = [r for r in self.ranking if r["ranked"]]
+        design = [
+            "",
+            "# how the design judged them: the held-out seeds, the laws in their order, each one's score",
+            "[provenance.design]",
+            f"test_seeds = {json.dumps(list(s['test_seeds']))}",
+            f"tracks = {json.dumps(list(s['tracks']))}",
+            f"speeds_m_s = {json.dumps(list(s['speeds_m_s']))}",
+            f"loads = {json.dumps(list(s['loads']))}",
+            f"recommended = {json.dumps(self.recommended or '')}",
+            f"ranking = {json.dumps([r['controller'] for r in ranked])}",
+            "scores = {" + ", ".join(f"{json.dumps(r['controller'])} = {float(r['score'])!r}" for r in ranked) + "}",
+            "",
+        ]
+        return "\n".join(lines) + self.tuning.gains_toml().rstrip("\n") + "\n" + "\n".join(design)
 
     def to_pandas(self) -> pd.DataFrame:
         """The summary: one row per law, speed, load and metric (design.csv)."""
@@ -190,11 +227,29 @@ def _plain(value):
 
 
 # -- the ranking -----------------------------------------------------------------------------------
+def _point_score(by: pd.DataFrame, objective: Objective, law: str, speed: float, load: float) -> float:
+    """A law's score at a speed and load: ``objective`` of its mean ratios to passive over the
+    held-out runs there, its bounds (peak, travel) checked on the 95th percentiles (a bound
+    holds where 95 % of the held-out runs keep it); NaN where a value is missing."""
+    try:
+        ratios = {c: by.loc[(law, speed, load, c), "ratio_mean"] for c in objective.columns if c != PEAK_COLUMN}
+        if objective.peak_bound is not None:
+            ratios[PEAK_COLUMN] = by.loc[(law, speed, load, PEAK_COLUMN), "ratio_p95"]
+        travel = by.loc[(law, speed, load, TRAVEL_COLUMN), "p95"] if objective.needs_costs else None
+    except KeyError:
+        return np.nan
+    values = [*ratios.values(), *([] if travel is None else [travel])]
+    if not np.isfinite(np.asarray(values, dtype=float)).all():
+        return np.nan
+    return float(objective.of_ratios({k: np.float64(x) for k, x in ratios.items()}, travel))
+
+
 def rank(summary: pd.DataFrame, objective: Objective, laws, diverged=()) -> tuple[list, list]:
     """The laws ranked on held-out track, and the speeds and loads.
 
-    At each speed and load (a point) a law's score is ``objective`` of its mean RMS ratios to
-    passive there (for minimax: its worst mean ratio over the four responses); a law's score
+    At each speed and load (a point) a law's score is ``objective`` of its mean ratios to
+    passive there (for minimax: its worst mean RMS ratio over the four responses; its bounds on
+    the 95th percentiles, `_point_score`); a law's score
     is its largest over the points, at ``worst_at``. The laws that did not diverge (``ranked``)
     come first, best score first; the ``diverged`` follow. Each point lists every law's score,
     the best ranked law (``best``) and the responses that no ranked law improves on average
@@ -206,12 +261,10 @@ def rank(summary: pd.DataFrame, objective: Objective, laws, diverged=()) -> tupl
     ).reindex(columns=list(RMS_COLUMNS))
     keys = list(dict.fromkeys(zip(summary["speed_m_s"], summary["load"])))
     ranked = [n for n in laws if n not in diverged]
+    by = summary.set_index(["controller", "speed_m_s", "load", "metric"])
     points: list[dict[str, Any]] = []
     for v, load in keys:
-        scores: dict[str, float] = {}
-        for n in laws:
-            r = mean.loc[(n, v, load), list(RMS_COLUMNS)].to_numpy(dtype=float) if (n, v, load) in mean.index else None
-            scores[n] = float(objective.score(r)) if r is not None and np.isfinite(r).all() else np.nan
+        scores = {n: _point_score(by, objective, n, v, load) for n in laws}
         finite = [n for n in ranked if np.isfinite(scores[n])]
         best = min(finite, key=lambda n: scores[n]) if finite else None
         none = []
@@ -270,6 +323,9 @@ def recommend(ranking, points, summary: pd.DataFrame, runs: pd.DataFrame, object
         name, score, w = best["controller"], best["score"], best["worst_at"]
         if objective.kind == "minimax":
             what = "its worst mean RMS ratio to passive over the four responses, at any speed and load, is"
+        elif objective.needs_comfort:
+            index = "N_MV,z" if objective.kind == "n_mv" else "Wz"
+            what = f"its worst mean {index} ratio to passive over the floor points, at any speed and load, is"
         else:
             what = (
                 f"its largest score ({objective.kind} of the mean RMS ratios to passive) over the speeds and loads is"
@@ -278,6 +334,11 @@ def recommend(ranking, points, summary: pd.DataFrame, runs: pd.DataFrame, object
         out.append(_worse_than_passive(name, summary))
         out.append(_wins(name, points))
         out.append(_sureness(best, ok[1] if len(ok) > 1 else None, points, summary, runs))
+        if objective.peak_bound is not None or objective.travel_bound is not None:
+            out.append(
+                "Bounds, on the 95th percentile of the held-out runs at each speed and load: "
+                + _bounds_text(ok, objective)
+            )
         if objective.kind == "minimax" and score >= 1.0:
             out.append(
                 "No law keeps every RMS response better than passive on average at every speed and load; "
@@ -302,6 +363,22 @@ def recommend(ranking, points, summary: pd.DataFrame, runs: pd.DataFrame, object
             "and is not ranked."
         )
     return " ".join(s for s in out if s)
+
+
+def _bounds_text(ok: list, objective) -> str:
+    """Which ranked laws keep the bounds of ``objective`` (a score below the infeasible offset)."""
+    from railride.studies.objectives import INFEASIBLE_OFFSET
+
+    offset = objective.infeasible_offset or INFEASIBLE_OFFSET
+    limits = []
+    if objective.peak_bound is not None:
+        limits.append(f"peak-to-peak acceleration <= {objective.peak_bound:g} x passive's")
+    if objective.travel_bound is not None:
+        limits.append(f"travel <= {objective.travel_bound * 1e3:g} mm")
+    broke = [_label(r["controller"]) for r in ok if r["score"] >= offset]
+    kept = len(ok) - len(broke)
+    text = f"{' and '.join(limits)}; {kept} of {len(ok)} ranked laws keep them everywhere"
+    return text + (f" ({', '.join(broke)} do not)." if broke else ".")
 
 
 def _worse_than_passive(name: str, summary: pd.DataFrame) -> str:

@@ -314,7 +314,7 @@ def grid(
     gain_axes = _gain_axes(words, gains, controllers, listed)
     noise = None if noise is None else tuple(float(v) for v in noise)
     seeds = [0] if seed is None else _seeds(words, "seed", seed, "seeds")
-    base_gains = GainSet.default() if base_gains is None else base_gains
+    base_gains = GainSet.of(base_gains, scenario)
     solver = SolverSettings.of(solver)
     common = {} if duration is None else {"duration": float(duration)}
     common.update(band)

@@ -195,7 +195,7 @@ def league(
     # every load checked and its vehicle resolved before the first run
     cars = [resolve_vehicle(vehicle, params, x)[0] for x in loads]
     record = vehicle_record(*resolve_argument(vehicle, params), loads)
-    gains = GainSet.default() if gains is None else gains
+    gains = GainSet.of(gains, scenarios)
     # every scenario is built (and checked) before the first run
     todo = [
         (n, v, s, scenario(n, speed=v, seed=s, duration=duration)) for n, v, s in _cases(scenarios, speeds, track_seeds)

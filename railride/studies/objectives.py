@@ -17,7 +17,16 @@ from railride.errors import InputError
 from railride.analysis.metrics import RESPONSES
 
 #: the objectives, in the order the docs list them
-OBJECTIVE_KINDS = ("sum", "weighted", "minimax", "constrained")
+OBJECTIVE_KINDS = ("sum", "weighted", "minimax", "constrained", "n_mv", "sperling")
+#: the comfort objectives: kind -> the comfort index whose worst ratio to passive over the floor
+#: points is J (EN 12299's N_MV vertical term; Sperling's ride index Wz, EN 12299 annex)
+COMFORT_KINDS = {"n_mv": "N_MV_z", "sperling": "Wz"}
+#: the floor points a comfort objective looks at (`railride.analysis.comfort.FLOOR`)
+FLOOR_POINTS = ("centre", "front", "rear")
+#: the run-table columns: the four RMS responses, in the order of the ratios, and the peak
+RMS_COLUMNS = tuple(f"{r}_rms" for r in RESPONSES)
+PEAK_COLUMN = "acceleration_m_s2_ptp"
+TRAVEL_COLUMN = "travel_max_m"
 #: the ratios' names in the order of the weights
 RATIO_NAMES = ("acceleration", "displacement", "pitch", "roll")
 #: constrained: an infeasible candidate scores INFEASIBLE_OFFSET + INFEASIBLE_SCALE x excess;
@@ -54,16 +63,29 @@ class Objective:
       offset 1000 (or the next power of ten above the largest J a feasible candidate can reach):
       every infeasible candidate ranks after every feasible one, and among themselves by E.
 
+    * ``n_mv``: J = max_p N_MV,z(p) / N_MV,z(p, passive), the worst ratio of the vertical term
+      of EN 12299's comfort index over the floor points p (centre, front, rear);
+    * ``sperling``: the same with Sperling's ride index Wz.
+
     ``penalty`` (>= 0, default 0) adds penalty x sum_k max(0, r_k - 1) to every kind (to the
     feasible ones of ``constrained``). ``weights`` is for ``weighted`` only and ``bound`` for
-    ``constrained`` only. `describe` is the statement printed with every result.
-    `DEFAULT_OBJECTIVE` is the tuner's default; ``Objective()`` is the plain sum.
+    ``constrained`` only.
+
+    Two constraints apply to any kind: ``peak_bound`` (> 0), the largest peak-to-peak carbody
+    acceleration as a ratio to passive's, and ``travel_bound`` (> 0) [m], the largest secondary
+    travel (for example the bump stops' clearance). A run that breaks one is infeasible and
+    scores J = offset + 1000 E, E the sum of its excesses (the peak ratio above its bound; the
+    travel above its bound, as a fraction of it), after every feasible run (`of_ratios`).
+    `describe` is the statement printed with every result. `DEFAULT_OBJECTIVE` is the tuner's
+    default; ``Objective()`` is the plain sum.
     """
 
     kind: str = "sum"
     weights: tuple | None = None  # acceleration, displacement, pitch, roll
     bound: float | None = None
     penalty: float = 0.0
+    peak_bound: float | None = None
+    travel_bound: float | None = None
 
     def __post_init__(self):
         if self.kind not in OBJECTIVE_KINDS:
@@ -103,11 +125,69 @@ class Objective:
         elif self.bound is not None:
             raise InputError(f"objective bound = {self.bound!r}: for kind 'constrained' only (kind is {self.kind!r})")
         object.__setattr__(self, "penalty", _number("penalty", self.penalty, "a finite number >= 0", lambda v: v >= 0))
+        for name, rule in (
+            ("peak_bound", "a finite number > 0 (the largest peak-to-peak acceleration as a ratio to passive's)"),
+            ("travel_bound", "a finite number > 0 [m] (the largest secondary travel)"),
+        ):
+            if getattr(self, name) is not None:
+                object.__setattr__(self, name, _number(name, getattr(self, name), rule, lambda v: v > 0))
         if self.kind == "constrained" and not math.isfinite(self.feasible_max):
             raise InputError(
                 f"objective bound = {self.bound!r} with penalty = {self.penalty!r}: "
                 "too large to rank infeasible candidates after feasible ones"
             )
+
+    @property
+    def needs_comfort(self) -> bool:
+        """Whether J needs the runs' comfort indices (a comfort kind)."""
+        return self.kind in COMFORT_KINDS
+
+    @property
+    def needs_costs(self) -> bool:
+        """Whether J needs what the runs ask of their dampers (the travel constraint)."""
+        return self.travel_bound is not None
+
+    @property
+    def columns(self) -> tuple:
+        """The run-table columns whose ratios to passive J reads (the travel is read as it is)."""
+        comfort = tuple(f"{p}_{COMFORT_KINDS[self.kind]}" for p in FLOOR_POINTS) if self.needs_comfort else ()
+        return (*RMS_COLUMNS, *comfort, *((PEAK_COLUMN,) if self.peak_bound is not None else ()))
+
+    def of_runs(self, runs, passive) -> np.ndarray:
+        """J of each run of ``runs`` (a table with the run-table columns, `columns` and for
+        the travel constraint `TRAVEL_COLUMN`) against ``passive`` (one row, or a table of as
+        many rows: passive on the same tracks)."""
+        cols = list(self.columns)
+        base = np.asarray(passive[cols], dtype=float)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ratio = np.asarray(runs[cols], dtype=float) / base
+        ratios = dict(zip(cols, np.moveaxis(ratio, -1, 0)))
+        travel = np.asarray(runs[TRAVEL_COLUMN], dtype=float) if self.needs_costs else None
+        return self.of_ratios(ratios, travel)
+
+    def of_ratios(self, ratios, travel=None) -> np.ndarray:
+        """J from ratios to passive by run-table column (a mapping of arrays: `columns`) and,
+        for the travel constraint, the largest travel [m]: the kind's J, then the constraints
+        (an infeasible run scores `infeasible_offset` + 1000 x its excess)."""
+        r = np.stack([np.asarray(ratios[c], dtype=float) for c in RMS_COLUMNS], axis=-1)
+        if self.needs_comfort:
+            comfort = np.stack([np.asarray(ratios[f"{p}_{COMFORT_KINDS[self.kind]}"], float) for p in FLOOR_POINTS], -1)
+            j = comfort.max(axis=-1)
+            if self.penalty:
+                j = j + self.penalty * np.clip(r - 1.0, 0.0, None).sum(axis=-1)
+            j = np.where(np.isnan(r).any(axis=-1) | np.isnan(comfort).any(axis=-1), np.inf, j)
+        else:
+            j = self.score(r)
+        excess = np.zeros(np.shape(j))
+        if self.peak_bound is not None:
+            excess = excess + np.clip(np.asarray(ratios[PEAK_COLUMN], dtype=float) - self.peak_bound, 0.0, None)
+        if self.travel_bound is not None:
+            travel = np.asarray(travel, dtype=float)
+            excess = excess + np.clip(travel / self.travel_bound - 1.0, 0.0, None)
+        if self.peak_bound is not None or self.travel_bound is not None:
+            offset = self.infeasible_offset or INFEASIBLE_OFFSET
+            j = np.where(np.isfinite(j) & (excess > 0), offset + INFEASIBLE_SCALE * excess, j)
+        return j
 
     @property
     def feasible_max(self) -> float:
@@ -132,6 +212,8 @@ class Objective:
     def score(self, ratio) -> np.ndarray:
         """J of RMS ratios to passive, ``ratio`` (..., 4). A run that diverged has NaN ratios
         and scores +inf: after every run that did not."""
+        if self.needs_comfort:
+            raise InputError(f"objective {self.kind!r} scores comfort indices, not the RMS ratios: use of_runs")
         r = np.asarray(ratio, dtype=float)
         if r.shape[-1:] != (4,):
             raise InputError(f"ratios of shape {r.shape}: the last axis must hold the four responses")
@@ -162,6 +244,14 @@ class Objective:
             text = f"weighted: J = sum_k w_k r_k, weights {w}, {r}"
         elif self.kind == "minimax":
             text = f"minimax: J = max_k r_k (the worst ratio; equal worst ratios tie), {r}"
+        elif self.kind in COMFORT_KINDS:
+            index = "N_MV,z (EN 12299, vertical term)" if self.kind == "n_mv" else "Sperling's Wz"
+            text = (
+                f"{self.kind}: J = max_p {COMFORT_KINDS[self.kind]}(p) / {COMFORT_KINDS[self.kind]}(p, passive), "
+                f"the worst ratio of {index} over the floor points p = centre, front, rear"
+            )
+            if self.penalty:
+                text += f", {r}"
         else:
             b = f"{self.bound:g}"
             text = (
@@ -174,6 +264,18 @@ class Objective:
             text += f"; plus penalty {self.penalty:g} x sum_k max(0, r_k - 1)"
             if self.kind == "constrained":
                 text += " on feasible candidates"
+        limits = []
+        if self.peak_bound is not None:
+            limits.append(f"peak-to-peak carbody acceleration <= {self.peak_bound:g} x passive's")
+        if self.travel_bound is not None:
+            limits.append(f"secondary travel <= {self.travel_bound:g} m")
+        if limits:
+            offset = self.infeasible_offset or INFEASIBLE_OFFSET
+            text += (
+                f"; subject to {' and '.join(limits)} in every run: a run that breaks them scores "
+                f"J = {offset:g} + {INFEASIBLE_SCALE:g} x its excess (peak ratio above its bound, travel "
+                "above its bound as a fraction of it)"
+            )
         return text + "; a run that diverged scores J = inf"
 
     def to_dict(self) -> dict:
@@ -183,9 +285,15 @@ class Objective:
             "weights": None if self.weights is None else dict(zip(RESPONSES, self.weights)),
             "bound": self.bound,
             "penalty": self.penalty,
+            **({"peak_bound": self.peak_bound} if self.peak_bound is not None else {}),
+            **({"travel_bound_m": self.travel_bound} if self.travel_bound is not None else {}),
             "infeasible": None
-            if self.kind != "constrained"
-            else {"offset": self.infeasible_offset, "scale": INFEASIBLE_SCALE, "feasible_max": self.feasible_max},
+            if self.kind != "constrained" and self.peak_bound is None and self.travel_bound is None
+            else {
+                "offset": self.infeasible_offset or INFEASIBLE_OFFSET,
+                "scale": INFEASIBLE_SCALE,
+                "feasible_max": self.feasible_max if math.isfinite(self.feasible_max) else None,
+            },
             "statement": self.describe(),
         }
 

@@ -32,7 +32,7 @@ from railride.secondary.control import GainSet
 from railride.defaults import DEFAULT_DAMPER
 from railride.run.solver import SolverSettings
 from railride.studies.sweep import Case, RunTable, run_cases
-from railride.studies.objectives import DEFAULT_OBJECTIVE, Objective
+from railride.studies.objectives import DEFAULT_OBJECTIVE, RMS_COLUMNS, Objective
 from railride.plots import PNG_DPI, FigureOptions
 from railride.studies.tuning import PARAMETERS, REFERENCE, _rms
 from railride.secondary.suspension import damper_record
@@ -78,8 +78,13 @@ class GainEvaluator:
         self.suspension = suspension
         self.scenario = scenario
         self.opts = tuple(sorted((scenario_options or {}).items()))
-        self.gains = GainSet.default() if gains is None else gains
+        self.gains = GainSet.of(gains, scenario)
         self.objective = DEFAULT_OBJECTIVE if objective is None else objective
+        if self.objective.columns != RMS_COLUMNS or self.objective.needs_costs:
+            raise InputError(
+                f"objective {self.objective.kind!r} with its bounds: the global optimiser scores the four RMS "
+                "ratios only; tune these with the sensitivity study (railride.tune)"
+            )
         self.damper = damper
         self.executor = executor
         self.table = RunTable() if table is None else table

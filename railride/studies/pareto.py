@@ -271,8 +271,8 @@ def pareto(
     n_samples = _power_of_two("n_samples", n_samples)
     seed = validation.seed("seed", seed)
     damper_model(damper)  # a known name
-    base = GainSet.default() if gains is None else gains
     scen = make_scenario(scenario, **dict(scenario_options or {}))
+    base = GainSet.of(gains, scen)
     # its runs, checked by the check every simulation makes (railride.run.checks), before the first
     check(scen, vehicle, Suspension.named(suspension, base, damper), solver, "mark")
     record = scen.describe()

@@ -193,7 +193,7 @@ def study(
     solver = SolverSettings.of(solver)
     base, source = resolve_argument(vehicle, params)
     vehicle = base
-    gains = GainSet.default() if gains is None else gains
+    gains = GainSet.of(gains, scenario)
     random = scenario in SPECTRA
     if track_seeds is not None and not random:
         raise InputError(

@@ -85,7 +85,7 @@ def evaluate(
     from railride.secondary.control import GainSet
     from railride.run.simulation import simulate
 
-    base_gains = GainSet.default() if base_gains is None else base_gains
+    base_gains = GainSet.of(base_gains, [c.scenario for c in cases])
     vehicle = VehicleParams.of(params)
     solver = SolverSettings.of(solver)
     rows: dict[int, dict] = {}
@@ -158,7 +158,10 @@ def _costs(res, case: Case, window) -> np.ndarray:
     from railride.analysis.metrics import select_window
     from railride.secondary.suspension import damper_model
 
-    v_max = getattr(damper_model(case.damper, case.damper_scale), "v_max", None) if case.closed_loop else None
+    # every suspension with MR dampers has a command voltage (a law's, or a constant one)
+    v_max = (
+        getattr(damper_model(case.damper, case.damper_scale), "v_max", None) if case.suspension != "passive" else None
+    )
     return damper_costs(select_window(res.dataset, window), v_max)
 
 
@@ -249,7 +252,7 @@ def run_cases(
     # resumed sweep with another step, window, base gain set or vehicle does not reuse old rows
     from railride.secondary.control import GainSet
 
-    base = GainSet.default() if base_gains is None else base_gains
+    base = GainSet.of(base_gains, [c.scenario for c in cases])
     settings = {
         "dt": solver.dt,
         "window": None if window is None else [float(w) for w in window],
@@ -258,8 +261,10 @@ def run_cases(
     }
     if comfort:  # only then: the keys of sweeps without comfort stay as they were
         settings["comfort"] = True
-    if costs:  # the same
-        settings["costs"] = True
+    if costs:  # the same; the revision of the columns: a table with other columns is not reused
+        from railride.analysis.costs import COSTS_REVISION
+
+        settings["costs"] = COSTS_REVISION
     settings_text = json.dumps(settings, sort_keys=True)
     keys = [hashlib.sha1((c.key + settings_text).encode()).hexdigest()[:16] for c in cases]
     pending, seen = [], set()

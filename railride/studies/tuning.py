@@ -306,9 +306,13 @@ def tune(
             window=window,
             progress=progress,
             vehicle_columns=[{"vehicle": vehicle_name, "load": load_of[c.vehicle]} for c in cases],
+            # only what the objective reads: the keys of plain tunings stay as they were
+            comfort=objective.needs_comfort,
+            costs=objective.needs_costs,
         )
 
-    passives = _rms(run([Case(c.scenario, c.options, vehicle=ld) for c, ld in zip(cases_set, loads)]))
+    passive_rows = run([Case(c.scenario, c.options, vehicle=ld) for c, ld in zip(cases_set, loads)])
+    passives = _rms(passive_rows)
     passive = passives[0]
     result = dataclasses.replace(result, passive=dict(zip(RESPONSES, passive)))  # a result is frozen
     inner: dict[str, float] = {}  # the inner loop's changes, which every law's runs carry
@@ -335,10 +339,9 @@ def tune(
 
         def score(change_sets, name=name):
             k = len(cases_set)
-            rms = _rms(run([case(name, cs, j) for cs in change_sets for j in range(k)])).reshape(
-                len(change_sets), k, -1
-            )
-            per_case = np.stack([objective(rms[:, j], passives[j]) for j in range(k)], axis=1)
+            rows = run([case(name, cs, j) for cs in change_sets for j in range(k)])
+            # rows run change set by change set, each over the k cases: case j's are j, j + k, ...
+            per_case = np.stack([objective.of_runs(rows.iloc[j::k], passive_rows.iloc[j]) for j in range(k)], axis=1)
             return per_case.mean(axis=1) if aggregate == "mean" else per_case.max(axis=1)
 
         study, tuned[name] = _study(name, gains, score, budget, n_values, float(span), tol, min_span, result, log)

@@ -6,6 +6,8 @@ import json
 import pandas as pd
 import pytest
 
+from railride.output.files import DESIGN_FILES
+
 from clihelp import PNG, assert_input_error, ok, ok_json, run
 
 TINY = (
@@ -46,7 +48,8 @@ def test_design_out_and_resume(tmp_path):
     out = tmp_path / "d"
     first = ok_json(*TINY, "--out", out)
     names = sorted(p.name for p in out.iterdir())
-    assert names == ["design.csv", "design.json", "design.png", "design_runs.csv", "gains.toml", "runs.csv"]
+    assert names == sorted([*DESIGN_FILES, "runs.csv"])  # the files of the result, and the run table
+    assert (out / "design_costs.png").read_bytes().startswith(PNG)
     assert (out / "design.png").read_bytes().startswith(PNG)
     assert json.loads((out / "design.json").read_text())["ranking"] == first["ranking"]
     assert len(pd.read_csv(out / "design_runs.csv")) == 3
@@ -62,9 +65,28 @@ def test_design_out_and_resume(tmp_path):
         (("--budget", "5"), ("--budget = 5", "try every gain once")),
         (("--controllers", "lqr"), ("--controllers = 'lqr'",)),
         (("--track", "fra9"), ("--track = 'fra9'",)),
-        (("--objective", "sperling"), ("--objective = 'sperling'", "not built yet")),
+        (("--objective", "comfy"), ("--objective = 'comfy'", "n_mv, sperling")),
+        (("--max-travel", "0"), ("--max-travel = 0.0", "> 0")),
+        (("--max-peak", "x"), ("--max-peak",)),
+        (("--report", "/dev/null/r.html"), ("--report",)),
         (("--resume",), ("--resume needs --out",)),
     ],
 )
 def test_design_bad_input(args, fragments):
     assert_input_error(run(*TINY, *args), *fragments)
+
+
+def test_design_on_comfort_with_a_travel_bound_and_a_report(tmp_path):
+    """A comfort objective and a bound reach the tuning, the ranking and the words; the report
+    holds the recommendation and both figures; the ideal devices' scores and the fault are in the
+    document."""
+    report = tmp_path / "d.html"
+    doc = ok_json(*TINY, "--objective", "n_mv", "--max-travel", "0.05", "--report", report)
+    objective = doc["settings"]["objective"]
+    assert objective["kind"] == "n_mv" and objective["travel_bound_m"] == 0.05
+    assert "N_MV,z ratio to passive over the floor points" in doc["recommendation"]["text"]
+    assert "travel <= 50 mm" in doc["recommendation"]["text"]
+    assert set(doc["references"]) == {"ideal", "ideal-damper"}
+    assert doc["fault"]["fault"] == "1R-off" and "1R-off" in doc["recommendation"]["text"]
+    html = report.read_text()
+    assert "Recommended:" in html and html.count("<img") + html.count("plotly") >= 2

@@ -12,6 +12,7 @@ import pytest
 
 import railride as rr
 from railride.errors import InputError
+from railride.output.files import DESIGN_FILES
 from railride.studies.design import min_budget
 from railride.studies.design_result import METRICS, RMS_COLUMNS, rank, recommend
 from railride.studies.objectives import Objective
@@ -86,7 +87,7 @@ def test_the_document_the_files_and_the_gains_file(tiny, tmp_path):
     assert doc["recommendation"]["controller"] == tiny.recommended
     assert doc["runs"] == {"training": tiny.settings["training_runs"], "judging": 3}
     paths = tiny.save(tmp_path / "d", command="railride design --budget 13")
-    assert sorted(p.name for p in paths) == ["design.csv", "design.json", "design.png", "design_runs.csv", "gains.toml"]
+    assert sorted(p.name for p in paths) == sorted(DESIGN_FILES)
     gains = rr.GainSet.load(tmp_path / "d" / "gains.toml")
     assert gains.provenance["aggregate"] == "mean"
     assert {r["seed"] for r in gains.provenance["tuning_set"]} == {0}
@@ -195,7 +196,8 @@ def test_min_budget_lets_every_gain_be_swept_once():
         ({"budget": 5}, ("budget = 5", ">= 13", "try every gain once")),
         ({"controllers": ["lqr"]}, ("controllers = 'lqr'", "allowed: pid")),
         ({"tracks": ["paper-sine"]}, ("tracks = 'paper-sine'", "fra4")),
-        ({"objective": "sperling"}, ("objective = 'sperling'", "not built yet")),
+        ({"objective": "comfy"}, ("objective = 'comfy'", "n_mv, sperling")),
+        ({"objective": "weighted"}, ("objective = 'weighted'", "needs its settings")),
         ({"aggregate": "median"}, ("aggregate",)),
         ({"values": 2}, ("values = 2",)),
         ({"duration": -1.0}, ("duration",)),
@@ -237,6 +239,7 @@ def test_run_cases_with_costs_adds_the_damper_columns_and_its_own_keys():
     passive, pid, ideal = (rows.iloc[i] for i in range(3))
     assert passive["force_rms_n"] > 0 and passive["travel_max_m"] > 0 and math.isnan(passive["voltage_at_max_fraction"])
     assert 0 <= pid["voltage_at_max_fraction"] <= 1 and pid["force_max_n"] >= pid["force_rms_n"]
+    assert 0 < pid["coil_power_fraction"] <= 1 and math.isnan(passive["coil_power_fraction"])
     assert math.isnan(ideal["voltage_at_max_fraction"])  # an ideal device has no voltage
     plain = run_cases(cases, table=table)
     assert not set(COST_COLUMNS) & set(plain.columns)
@@ -308,3 +311,18 @@ def test_a_law_that_diverged_in_tuning_or_judging_is_listed_with_where():
             "where": [{"track": "fra4", "track_seed": 7, "speed_m_s": 40.0, "load": 1.3, "diverged_at_s": 0.75}],
         },
     ]
+
+
+def test_the_coil_power_at_a_constant_voltage_is_its_square_over_v_max_squared():
+    """A resistive coil held at v draws (v / v_max)^2 of its power at v_max once its lag has
+    settled (eta = 50 1/s: within 0.3 s; a run of 4 s from 0 V spends 1/(2 eta) s of its mean
+    catching up): the mean over the run is (v / v_max)^2 (1 - 1/(2 eta T)) to first order."""
+    from railride.secondary.dampers import RAILWAY
+    from railride.studies.sweep import Case, run_cases
+
+    v, T = 1.125, 4.0
+    opts = (("duration", T), ("seed", 0), ("speed", 40.0))
+    row = run_cases([Case("fra4", opts, suspension="mr", voltage=v)], table=RunTable(), costs=True).iloc[0]
+    expected = (v / RAILWAY.v_max) ** 2
+    assert row["coil_power_fraction"] == pytest.approx(expected, rel=3.0 / (2 * RAILWAY.eta * T))
+    assert row["voltage_at_max_fraction"] == 0.0

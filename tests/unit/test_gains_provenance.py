@@ -76,9 +76,12 @@ def test_a_robust_tuning_records_its_tracks_and_loads_and_any_of_them_matches(ro
     runs = [track("fra4", seed=s, duration=0.5) for s in (0, 1)]
     assert gains.mismatch(record("paper", [1.0, 1.3]), runs) is None
     assert gains.mismatch(record("paper", 1.3), runs[1]) is None
-    line = gains.mismatch(record("paper", [1.0, 1.5]), [*runs, track("fra4", seed=2, duration=0.5)])
-    assert "load 1.5" in line and "track fra4 (seed 2)" in line
-    assert "railride tune --load 1,1.5 --scenario fra4 --track-seed 0,1,2 --duration 0.5" in line
+    # what it spans: another seed of the spectrum at its speed, a load between its loads
+    assert gains.mismatch(record("paper", 1.15), track("fra4", seed=7, duration=0.5)) is None
+    line = gains.mismatch(record("paper", [1.0, 1.5]), [*runs, track("fra4", seed=2, duration=0.5, speed=60.0)])
+    assert "load 1.5" in line and "track fra4 (speed 60 m/s" in line
+    assert "railride tune --load 1,1.5 --scenario fra4 --speed 55.56 --track-seed 0,1,2 --duration 0.5" in line
+    assert line.endswith("(and one tuning each for speed 60 m/s)")
 
 
 def check_schema(doc: dict) -> None:
@@ -207,11 +210,14 @@ def test_a_vehicle_is_matched_by_its_values_and_a_file_names_itself():
         ({}, None),
         ({"vehicle": "crh380a"}, "railride tune --vehicle crh380a --duration 0.2"),
         ({"load": 1.3}, "railride tune --load 1.3 --duration 0.2"),
-        ({"scenario": "fra4"}, "railride tune --scenario fra4 --duration 0.2"),
+        ({"scenario": "fra4", "gains": "paper"}, "railride tune --scenario fra4 --duration 0.2"),
+        ({"scenario": "fra4"}, None),  # the robust set, tuned on fra4 and fra5 at 30-70 m/s, covers it
     ],
 )
 def test_compare_records_the_line_in_its_settings(options, command):
     scenario = rr.scenario(options.pop("scenario", "paper-sine"), duration=0.2)
+    if "gains" in options:
+        options["gains"] = GainSet.named(options["gains"])
     settings = rr.compare(scenario, controllers=["pid"], bounds=False, **options).to_dict()["settings"]
     if command is None:
         assert "gains_mismatch" not in settings  # the paper's case: its document as it was
