@@ -38,8 +38,11 @@ SPECTRUM_OPTIONS = {
 }
 
 
-#: what the note says of the shipped gains
-SHIPPED = " (tuned on the paper's sine track, not on this one)"
+#: what the note says of the shipped gains: the robust set, tuned on random track with the MR dampers
+SHIPPED = (
+    " (the shipped robust set, tuned on FRA classes 4 and 5 with the MR dampers; "
+    "--gains paper: the set tuned on the paper's sine)"
+)
 
 
 class SpectrumFormat(str, Enum):
@@ -204,7 +207,8 @@ def _tables(result) -> list:
         f"{st['track']} at V = {st['speed_m_s']:g} m/s, wavelengths {st['min_wavelength_m']:g}-"
         f"{st['max_wavelength_m']:g} m ({st['fmin_hz']:.3g}-{st['fmax_hz']:.3g} Hz, {st['points']} "
         f"frequencies). Controllers on the ideal actuator (force = demand), applied {rate}; "
-        f"gains {st['gains']}{SHIPPED if st['gains'] == 'shipped' else ''}. {vehicle_text(st['vehicle'])}."
+        f"gains {st.get('gains_source', st['gains'])}{SHIPPED if st['gains'] == 'shipped' else ''}. "
+        f"{vehicle_text(st['vehicle'])}."
     )
     parts: list = [floor, body, note]
     for name, reason in st["not_run"].items():

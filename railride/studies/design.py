@@ -403,12 +403,16 @@ def _training_frame(frame: pd.DataFrame | None, plan: Plan) -> pd.DataFrame:
     return frame[keep].reset_index(drop=True)
 
 
-def _judge(plan: Plan, gains, executor, table, progress, laws=None, damper=None, faults=()) -> pd.DataFrame:
+def _judge(
+    plan: Plan, gains, executor, table, progress, laws=None, damper=None, faults=(), full: bool = True
+) -> pd.DataFrame:
     """Every law of ``laws`` (default the plan's) with ``gains`` and passive on the held-out
     runs: one row per run, with the run's law, track, seed, speed and load, its metrics and
     costs, and each metric's ratio to passive on the same run (``<metric>_ratio``) and the
     objective of its ratios (``score``, inf where it diverged). ``damper`` (default the plan's)
-    and ``faults`` apply to the laws, not to passive (`railride.studies.design_probes`)."""
+    and ``faults`` apply to the laws, not to passive (`railride.studies.design_probes`). Not
+    ``full``: only the comfort indices and costs the objective reads (the others NaN), for runs
+    that are only scored."""
     from railride.model.params import vehicle_record
 
     laws = plan.laws if laws is None else laws
@@ -436,10 +440,11 @@ def _judge(plan: Plan, gains, executor, table, progress, laws=None, damper=None,
         params=plan.vehicle,
         solver=plan.solver,
         progress=progress,
-        comfort=True,
-        costs=True,
+        comfort=full or plan.objective.needs_comfort,
+        costs=full or plan.objective.needs_costs,
         vehicle_columns=[{"vehicle": name, "load": float(m[4])} for m in meta],
     )
+    rows = rows.reindex(columns=list(dict.fromkeys([*rows.columns, *METRICS])))  # NaN where not computed
     info = pd.DataFrame(meta, columns=["controller", "track", "track_seed", "speed_m_s", "load"])
     metrics = rows.reset_index(drop=True)[[*METRICS, "diverged_at_s"]].astype(float)
     frame = pd.concat([info, metrics], axis=1)
@@ -465,7 +470,7 @@ def _scores(plan: Plan, gains, executor, table, progress, laws=None, damper=None
     """The points (`rank`) of ``laws`` judged with ``damper`` and ``faults``: per speed and load,
     each law's score there."""
     laws = plan.laws if laws is None else tuple(laws)
-    runs = _judge(plan, gains, executor, table, progress, laws=laws, damper=damper, faults=faults)
+    runs = _judge(plan, gains, executor, table, progress, laws=laws, damper=damper, faults=faults, full=False)
     return rank(_summary(runs, plan, laws), plan.objective, laws)[1]
 
 

@@ -13,7 +13,7 @@ from clihelp import assert_input_error, ok, ok_json, run
 def test_ride_spectrum_table_and_json():
     out = ok("ride-spectrum", "--controllers", "passive,sas-attitude", "--points", "200").stdout
     assert "Carbody floor acceleration [m/s^2]" in out and "SAS (attitude)" in out
-    assert "tuned on the paper's sine track" in out
+    assert "(the shipped robust set, tuned on FRA classes 4 and 5" in " ".join(out.split())
     doc = ok_json("ride-spectrum", "--track", "fra5", "--speed", "40", "--points", "200")
     assert doc["settings"]["track"] == "fra5" and doc["settings"]["speed_m_s"] == 40.0
     assert set(doc["rms"]) == {"passive", "pid", "sas-attitude", "sas-attitude-ride"}
@@ -34,16 +34,19 @@ def test_ride_spectrum_warns_of_gains_tuned_for_another_case(tmp_path):
     here = ok(*args, "--format", "json")
     assert here.stderr == "" and "gains_mismatch" not in json.loads(here.stdout)["settings"]
     table = " ".join(ok(*args).stdout.split())  # the note, wherever it wraps
-    assert "gains given." in table and "tuned on the paper's sine track" not in table
+    assert "fra4.toml" in table and "(the shipped robust set" not in table
     faster = ok(*args, "--speed", 40, "--load", 1.2, "--format", "json")
     (line,) = faster.stderr.splitlines()
     assert line.startswith(f"warning: the gains {gains} were tuned for vehicle paper, load 1")
     assert "this run has load 1.2, track fra4 (speed 40 m/s); tune for it with: railride tune --load 1.2" in line
     assert json.loads(faster.stdout)["settings"]["gains_mismatch"] == line.removeprefix("warning: ")
-    # the shipped gains, tuned on the paper's sine track; passive reads no gains
-    shipped = ok("ride-spectrum", "--points", 32, "--controllers", "pid").stderr
-    assert shipped.startswith("warning: the gains railride/data/gains.toml were tuned for vehicle paper, load 1, on ")
-    assert "this run has track fra4" in shipped and shipped.count("\n") == 1
+    # the paper set, tuned on the paper's sine track; passive reads no gains
+    paper = ok("ride-spectrum", "--points", 32, "--controllers", "pid", "--gains", "paper").stderr
+    assert paper.startswith("warning: the gains railride/data/gains.toml were tuned for vehicle paper, load 1, on ")
+    assert "this run has track fra4" in paper and paper.count("\n") == 1
+    # without --gains, the robust set, whose range covers fra4 at 55.56 m/s: nothing to say
+    robust = ok("ride-spectrum", "--points", 32, "--controllers", "pid")
+    assert robust.stderr == "" and "(the shipped robust set" in " ".join(robust.stdout.split())
     assert ok("ride-spectrum", "--points", 32, "--controllers", "passive", "--gains", gains, "--speed", 40).stderr == ""
 
 

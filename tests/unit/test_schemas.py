@@ -129,9 +129,12 @@ def test_pareto():
 def test_ride_spectrum():
     from railride.frequency.ride_spectrum import ride_spectrum
 
-    doc = ride_spectrum("fra4", points=64).to_dict()
-    assert "gains_mismatch" in doc["settings"]  # the shipped gains were tuned on paper-sine
+    doc = ride_spectrum("fra4", points=64, gains=rr.GainSet.default()).to_dict()
+    assert "gains_mismatch" in doc["settings"]  # the paper set was tuned on paper-sine
     check(doc, "railride.ride-spectrum/1")
+    robust = ride_spectrum("fra4", points=64).to_dict()  # the robust set, taken on random track
+    assert robust["settings"]["gains_source"].endswith("robust_gains.toml")
+    check(robust, "railride.ride-spectrum/1")
     check(ride_spectrum("fra4", points=64, controllers="passive").to_dict(), "railride.ride-spectrum/1")
 
 
