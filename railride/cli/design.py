@@ -258,7 +258,10 @@ def design_command(
     track: Annotated[
         str,
         typer.Option(
-            "--track", metavar="NAME[,NAME...]", help="Random track classes: fra1..fra6, german-low, german-high."
+            "--track",
+            metavar="NAME[,NAME...]",
+            help="Random track classes (fra1..fra6, german-low, german-high) or a measured line (file:PATH, "
+            "whose seeds are its sections, each the fastest speed x the duration long).",
         ),
     ] = "fra4,fra5",
     speed: Annotated[

@@ -278,6 +278,24 @@ class MeasuredTrack(RailProfile):
                     ) from None
         return cls(np.array(data["s"]), np.array(data["z_l"]), np.array(data["z_r"]), source=str(path))
 
+    def section(self, start: float, lead_in: float = 20.0) -> "MeasuredTrack":
+        """The profile from ``start`` [m] of this one on, as a profile that starts at s = 0 and
+        fades in over its first ``lead_in`` metres (raised cosine, as `RandomTrack`), so the
+        vehicle enters a stretch of the line from level track. A section of a line is another
+        track of the same kind: what `railride.design` holds out of a measured profile."""
+        start = _check("start", start, "nonnegative", "a finite number >= 0 (m)")
+        if not self.s[0] <= start < self.s[-1]:
+            raise InputError(
+                f"start = {start:g} m: outside the profile {self.source}, which runs from s = {self.s[0]:g} "
+                f"to {self.s[-1]:g} m"
+            )
+        keep = self.s > start  # and the height at start itself, interpolated
+        s = np.concatenate([[0.0], self.s[keep] - start])
+        z0 = self._evaluate(np.array([start]))
+        zl, zr = np.concatenate([z0[0], self.z_L[keep]]), np.concatenate([z0[1], self.z_R[keep]])
+        r = np.where(s < lead_in, 0.5 * (1.0 - np.cos(np.pi * np.clip(s / max(lead_in, 1e-300), 0.0, 1.0))), 1.0)
+        return MeasuredTrack(s, r * zl, r * zr, source=f"{self.source} from s = {start:g} m")
+
     def _evaluate(self, s):
         if np.any(s > self.s[-1] + 1e-9):
             raise InputError(
@@ -346,6 +364,7 @@ def scenario(
     min_wavelength: float | None = None,
     max_wavelength: float | None = None,
     taper: float | None = None,
+    start: float | None = None,
 ) -> Scenario:
     """A named scenario with optional overrides.
 
@@ -353,7 +372,8 @@ def scenario(
     60 m, 90 deg) and the length of its entry taper in wavelengths (default 1; 0 for none).
     ``bump``: amplitude is the bump height [m] (negative for a dip, default 0.02 m)
     and wavelength its length [m] (default 10 m), starting at s = 10 m on both rails.
-    ``file:PATH``: a measured CSV profile (s, z_L, z_R). ``fra1`` ... ``fra6``, ``german-low``,
+    ``file:PATH``: a measured CSV profile (s, z_L, z_R); with ``start`` [m], its section from
+    there on, faded in over 20 m (`MeasuredTrack.section`). ``fra1`` ... ``fra6``, ``german-low``,
     ``german-high``: a random realisation of that spectrum (`RandomTrack`) with ``seed`` (default
     0) over the wavelength band [min_wavelength, max_wavelength] (default 1 to 100 m). Speed
     defaults to 55.56 m/s and duration to 10 s for every scenario.
@@ -370,6 +390,8 @@ def scenario(
         )
     if taper is not None and name != "paper-sine":
         raise InputError(f"taper applies to paper-sine only, not to {name}")
+    if start is not None and not name.startswith("file:"):
+        raise InputError(f"start applies to a measured profile (file:PATH) only, not to {name}")
     track: RailProfile
     if name == "paper-sine":
         track = SineTrack(
@@ -417,6 +439,8 @@ def scenario(
         if not path:
             raise InputError("scenario 'file:' needs a path, as in file:track.csv")
         track = MeasuredTrack.from_csv(path)
+        if start is not None:
+            track = track.section(start)
     else:
         raise InputError(f"unknown scenario {name!r}; allowed: {', '.join(SCENARIOS)}")
     return Scenario(track=track, name=name, **common)

@@ -19,7 +19,7 @@ for both stages, so a design resumes where it stopped).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -38,7 +38,7 @@ from railride.studies.design_result import (
 )
 from railride.studies.objectives import DEFAULT_OBJECTIVE, OBJECTIVE_KINDS, TRAVEL_COLUMN, Objective
 from railride.studies.sweep import Case, RunTable, run_cases
-from railride.studies.tuning import PARAMETERS, STAGES, TUNED_CONTROLLERS, tune, tuning_set
+from railride.studies.tuning import PARAMETERS, STAGES, TUNED_CONTROLLERS, TuningCase, tune
 
 #: the defaults of `design` (docs/design.md): FRA classes 4 and 5, 30-70 m/s, load factors 1
 #: and 1.3, three training seeds and five held-out seeds, 20 s of track a run
@@ -79,6 +79,16 @@ class Plan:
     values: int
     damper: Any
     solver: Any
+    #: a measured profile's sections: track -> (the first section's start, a section's length) [m]
+    sections: dict = field(default_factory=dict)
+
+    def track_options(self, track: str, seed: int) -> tuple:
+        """The scenario options that make "seed" ``seed`` of ``track``: a random track's
+        realisation, or a measured profile's section ``seed`` (its start, `sections`)."""
+        if track in self.sections:
+            first, length = self.sections[track]
+            return (("start", first + seed * length),)
+        return (("seed", seed),)
 
 
 def min_budget(law: str, values: int) -> int:
@@ -184,8 +194,10 @@ def check_design(
     )
     track_list = []
     for t in _items("tracks", tracks):
-        if not isinstance(t, str) or t.strip() not in SPECTRA:
-            raise InputError(f"tracks = {t!r}: not a random track; allowed {', '.join(SPECTRA)}")
+        if not isinstance(t, str) or not (t.strip() in SPECTRA or t.strip().startswith("file:")):
+            raise InputError(
+                f"tracks = {t!r}: not a random track or a measured profile; allowed {', '.join(SPECTRA)}, file:PATH"
+            )
         track_list.append(t.strip())
     speed_list = tuple(
         sorted(dict.fromkeys(validation.number("speeds", v, "positive", "m/s") for v in _items("speeds", speeds)))
@@ -199,6 +211,7 @@ def check_design(
             "the held-out seeds must be seeds that tuning never sees"
         )
     duration = validation.number("duration", duration, "positive", "s")
+    sections = {t: _sections(t, max(speed_list) * duration, train + test) for t in track_list if t.startswith("file:")}
     obj = _objective(objective)
     validation.choice("aggregate", aggregate, AGGREGATES)
     values = validation.integer("values", values, 3, what="values per gain and sweep")
@@ -216,7 +229,8 @@ def check_design(
     gains = GainSet.reference()
     for track in track_list:
         for v in speed_list:
-            sc = make_scenario(track, seed=test[0], speed=v, duration=duration)
+            where = {"start": sections[track][0]} if track in sections else {"seed": test[0]}
+            sc = make_scenario(track, **where, speed=v, duration=duration)
             for load in load_list:
                 for law in laws:
                     check(sc, base.loaded(load), Suspension.named(law, gains, model), solver, "mark")
@@ -236,7 +250,31 @@ def check_design(
         values,
         damper,
         solver,
+        sections,
     )
+
+
+def _sections(track: str, length: float, seeds) -> tuple:
+    """(the first section's start, a section's length) [m] of the measured profile ``track``:
+    sections of ``length`` (the fastest run's distance) from its start at s >= 0 on, section k
+    the "seed" k, disjoint whatever the speed; an `InputError` naming the seed options where a
+    seed has no section."""
+    from railride.model.track import MeasuredTrack
+    from railride.model.track import scenario as make_scenario
+
+    profile = make_scenario(track).track
+    assert isinstance(profile, MeasuredTrack)  # a file: scenario
+    first = max(0.0, float(profile.s[0]))
+    count = int((float(profile.s[-1]) - first) // length)
+    beyond = [k for k in seeds if k >= count]
+    if beyond:
+        raise InputError(
+            f"train_seeds, test_seeds = {list(seeds)}: {track} runs to s = {float(profile.s[-1]):g} m and holds "
+            f"{count} section{'s' * (count != 1)} of {length:g} m (the fastest speed x the duration); a measured "
+            f"profile's seeds are its sections, so give seeds below {count} (e.g. --train-seeds 0,1 --test-seeds "
+            f"{min(2, max(count - 1, 0))}), or a shorter duration"
+        )
+    return first, length
 
 
 def design(
@@ -301,11 +339,11 @@ def design(
     )
     table = RunTable() if table is None else table
     over = tuple(
-        case
+        TuningCase(track, _options(plan, track, seed, v), load)
         for track in plan.tracks
-        for case in tuning_set(
-            track, track_seeds=plan.train_seeds, speeds=plan.speeds, loads=plan.loads, duration=plan.duration
-        )
+        for load in plan.loads
+        for seed in plan.train_seeds
+        for v in plan.speeds
     )
     from railride.secondary import dampers
 
@@ -393,13 +431,33 @@ def _versions() -> dict:
     return out
 
 
+def _options(plan: Plan, track: str, seed: int, speed: float) -> tuple:
+    """The scenario options of one run: the track's seed or section, the speed, the duration."""
+    return tuple(sorted((*plan.track_options(track, seed), ("speed", speed), ("duration", plan.duration))))
+
+
+def _seed_of(plan: Plan, row) -> int | None:
+    """The design's seed of a run-table row: its track seed, or its measured section's index."""
+    track = str(row["scenario"])
+    if track in plan.sections:
+        first, length = plan.sections[track]
+        return int(round((float(row["scenario.start"]) - first) / length))
+    seed = row.get("scenario.seed")
+    return None if seed is None or seed != seed else int(seed)
+
+
 def _training_frame(frame: pd.DataFrame | None, plan: Plan) -> pd.DataFrame:
     """The rows of the run table that tuning ran: the training seeds of the design's tracks
     (a resumed table may also hold the held-out runs of an earlier session)."""
-    if frame is None or not len(frame) or "scenario.seed" not in frame:
+    if frame is None or not len(frame):
         return pd.DataFrame()
-    seeds = frame["scenario.seed"].map(lambda s: s if s != s else int(s))
-    keep = frame["scenario"].isin(plan.tracks) & seeds.isin(plan.train_seeds)
+    keep = pd.Series(False, index=frame.index)
+    for track in plan.tracks:
+        key = "start" if track in plan.sections else "seed"
+        if f"scenario.{key}" not in frame:
+            continue
+        values = {dict(plan.track_options(track, k))[key] for k in plan.train_seeds}
+        keep |= (frame["scenario"] == track) & frame[f"scenario.{key}"].isin(values)
     return frame[keep].reset_index(drop=True)
 
 
@@ -423,7 +481,7 @@ def _judge(
         for track in plan.tracks:
             for seed in plan.test_seeds:
                 for v in plan.speeds:
-                    opts = (("duration", plan.duration), ("seed", seed), ("speed", v))
+                    opts = _options(plan, track, seed, v)
                     for name in ("passive", *laws):
                         if name == "passive":
                             cases.append(Case(track, opts, vehicle=changes))
@@ -527,7 +585,7 @@ def _diverged(tuned, training: pd.DataFrame, runs: pd.DataFrame, plan: Plan) -> 
         places = [
             {
                 "track": str(r["scenario"]),
-                "track_seed": int(r["scenario.seed"]),
+                "track_seed": _seed_of(plan, r),
                 "speed_m_s": float(r["scenario.speed"]),
                 "load": None,
                 "diverged_at_s": float(r["diverged_at_s"]),

@@ -1,7 +1,8 @@
 """Where the runs of a study go and where they are kept: executors and the run table.
 
 An executor runs chunks of cases (`railride.studies.sweep.evaluate` on each) and yields their rows:
-`LocalExecutor` on this machine, one chunk after another, each batch over every core;
+`LocalExecutor` on this machine, each batch over every core and the next chunk stepping while
+the last one's rows are made;
 `DaskExecutor` on a dask.distributed cluster. `RunTable` keeps every finished run in a CSV
 file rewritten atomically after each chunk, so an interrupted study resumes where it stopped
 (`railride.studies.sweep.run_cases`).
@@ -24,13 +25,43 @@ from railride._io import atomic_write
 
 # -- executors ---------------------------------------------------------------------------------
 class LocalExecutor:
-    """Chunks run one after another in this process; each chunk's batch uses every core."""
+    """Chunks run in this process, each chunk's batch over every core, and ``ahead`` chunks
+    (default 1; 0: one after another) run beside the one whose rows are being made: a chunk's
+    serial work in Python (its input tables, metrics, comfort and rows) then overlaps the
+    stepping of the next, which the compiled stepper does without the GIL. Rows come back in
+    the order of the chunks, as they would one after another. At most ``ahead`` + 1 chunks are
+    in memory at once."""
 
     name = "local"
 
+    def __init__(self, ahead: int = 1):
+        self.ahead = max(0, int(ahead))
+
     def map(self, fn, chunks):
-        for i, chunk in enumerate(chunks):
-            yield i, fn(chunk)
+        if self.ahead == 0:
+            for i, chunk in enumerate(chunks):
+                yield i, fn(chunk)
+            return
+        from collections import deque
+        from concurrent.futures import ThreadPoolExecutor
+
+        pool = ThreadPoolExecutor(self.ahead + 1, thread_name_prefix="railride-chunk")
+        pending: deque = deque()
+        try:
+            for i, chunk in enumerate(chunks):
+                pending.append((i, pool.submit(fn, chunk)))
+                if len(pending) > self.ahead:
+                    k, job = pending.popleft()
+                    yield k, job.result()
+            while pending:
+                k, job = pending.popleft()
+                yield k, job.result()
+        finally:
+            # stopped early (Ctrl-C, an error, a closed generator): the chunks not begun are
+            # dropped; one already stepping ends in its thread, its rows unused
+            for _, job in pending:
+                job.cancel()
+            pool.shutdown(wait=False, cancel_futures=True)
 
     def close(self):
         pass

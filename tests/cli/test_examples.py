@@ -27,7 +27,16 @@ def run_example(name: str, out: Path, *args: str) -> str:
 
 
 @pytest.mark.parametrize(
-    "name", ["paper_comparison", "speed_sweep_random_track", "custom_vehicle", "damper_size", "flexible_carbody"]
+    "name",
+    [
+        "paper_comparison",
+        "speed_sweep_random_track",
+        "custom_vehicle",
+        "damper_size",
+        "flexible_carbody",
+        "robust_gains",
+        "roll_cost",
+    ],
 )
 def test_example_has_a_docstring_and_uses_no_private_names(name):
     text = (ROOT / "examples" / f"{name}.py").read_text()
@@ -75,6 +84,20 @@ def test_flexible_carbody(tmp_path):
     out = run_example("flexible_carbody", tmp_path / "flex", "--seeds", "1", "--duration", "10")
     assert re.search(r"^\| passive \| 0\.\d{3} \| 0\.\d{3} \(\d\.\d\dx\) \|", out, re.M)
     assert (tmp_path / "flex" / "flexible_carbody.csv").is_file()
+
+
+def test_robust_gains(tmp_path):
+    out = run_example("robust_gains", tmp_path / "rg", "--seeds", "1", "--duration", "4")
+    assert out.startswith("gains: robust; mean RMS ratio to passive over 2 held-out runs")
+    assert re.search(r"^\| clipped-optimal \| \d\.\d{3} \| \d+ m/s, load 1(\.3)? \|", out, re.M)
+    assert "no mean ratio above 1 anywhere:" in out
+    assert (tmp_path / "rg" / "robust_gains.csv").is_file()
+
+
+@pytest.mark.slow
+def test_roll_cost(tmp_path):
+    run_example("roll_cost", tmp_path / "roll")
+    assert (tmp_path / "roll" / "remedy.csv").is_file()
 
 
 def test_readme_python_block_runs():

@@ -73,6 +73,29 @@ def test_measured_profile_reproduces_the_sine_it_was_sampled_from(tmp_path):
     assert np.allclose(a.values, b.values, rtol=1e-2)
 
 
+def test_a_section_of_a_measured_profile_is_the_line_from_its_start_faded_in(tmp_path):
+    """A section starting at 137.3 m (between samples) holds the line's heights from there on,
+    past its 20 m fade-in exactly those of the whole profile at start + s, and starts level; a
+    run on it is a run of the line's section. Outside the line, or on another track, refused."""
+    sine = SineTrack(amplitude=0.05, wavelength=60.0, rail_phase_deg=90.0)
+    s = np.arange(0.0, 600.25, 0.25)
+    zl, zr, _, _ = sine.evaluate(s)
+    whole = MeasuredTrack.from_csv(_write_csv(tmp_path / "line.csv", s, zl, zr))
+    part = whole.section(137.3)
+    probe = np.linspace(21.0, 400.0, 501)  # past the fade-in and the samples whose slopes it touches
+    for k in (0, 1):
+        assert np.abs(part.evaluate(probe)[k] - whole.evaluate(probe + 137.3)[k]).max() < 1e-9 * 0.05
+    assert part.evaluate(np.array([1e-9]))[1][0] == pytest.approx(0.0, abs=1e-9)  # level at the start
+    fade = part.evaluate(np.array([10.0]))[1][0] / whole.evaluate(np.array([147.3]))[1][0]
+    assert fade == pytest.approx(0.5, rel=1e-2)  # the raised cosine at half its length (between samples)
+    sc = scenario(f"file:{tmp_path / 'line.csv'}", start=137.3, speed=40.0, duration=2.0)
+    assert sc.describe()["source"].endswith("line.csv from s = 137.3 m")
+    with pytest.raises(ValueError, match="start = 700 m: outside the profile"):
+        whole.section(700.0)
+    with pytest.raises(ValueError, match="start applies to a measured profile"):
+        scenario("fra4", start=10.0)
+
+
 @pytest.mark.parametrize(
     "content, match",
     [

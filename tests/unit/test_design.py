@@ -326,3 +326,28 @@ def test_the_coil_power_at_a_constant_voltage_is_its_square_over_v_max_squared()
     expected = (v / RAILWAY.v_max) ** 2
     assert row["coil_power_fraction"] == pytest.approx(expected, rel=3.0 / (2 * RAILWAY.eta * T))
     assert row["voltage_at_max_fraction"] == 0.0
+
+
+def test_a_measured_profile_is_cut_into_sections_for_training_and_judging(tmp_path):
+    """A measured line (here 600 m of a FRA class 4 realisation, sampled every 0.25 m) is split
+    into sections of the fastest run's length (40 m/s x 2 s = 80 m): tuning runs on section 0,
+    judging on section 2, and a held-out run is the run of that section by itself."""
+    s = np.arange(0.0, 600.25, 0.25)
+    zl, zr, _, _ = rr.scenario("fra4", seed=5).track.evaluate(s)
+    path = tmp_path / "line.csv"
+    pd.DataFrame({"s": s, "z_L": zl, "z_R": zr}).to_csv(path, index=False)
+    track = f"file:{path}"
+    table = RunTable()
+    result = rr.design(
+        ["skyhook"], tracks=[track], speeds=[40.0], loads=[1.0], train_seeds=[0], test_seeds=[2],
+        duration=2.0, budget=13, values=3, table=table,
+    )  # fmt: skip
+    starts = set(table.frame.loc[table.frame["scenario"] == track, "scenario.start"])
+    assert starts == {0.0, 160.0}  # section 0 (tuning) and section 2 (judging), nothing else
+    assert set(result.runs["track_seed"]) == {2}
+    passive = result.runs[result.runs["controller"] == "passive"].iloc[0]
+    alone = rr.simulate(rr.scenario(track, start=160.0, speed=40.0, duration=2.0)).metrics()
+    assert passive["roll_deg_rms"] == pytest.approx(float(alone.sel(response="roll_deg", statistic="rms")), rel=1e-12)
+    with pytest.raises(InputError, match="holds 7 sections of 80 m"):
+        rr.design(["skyhook"], tracks=[track], speeds=[40.0], loads=[1.0], train_seeds=[0], test_seeds=[7],
+                  duration=2.0, budget=13, values=3)  # fmt: skip
