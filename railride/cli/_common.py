@@ -367,9 +367,10 @@ class RunProgress:
         return False
 
 
-def make_executor(workers: Optional[int], scheduler: Optional[str], scheduler_file: Optional[Path]):
+def make_executor(workers: Optional[int], scheduler: Optional[str], scheduler_file: Optional[Path], ahead: int = 1):
     """(executor, record for the JSON): Dask with --scheduler / --scheduler-file, else the local
-    executor, whose batches use --workers threads (numba's thread count, 1..cores)."""
+    executor, whose batches use --workers threads (numba's thread count, 1..cores), with
+    ``ahead`` chunks stepping beside the one whose rows are made (`LocalExecutor`)."""
     from railride.studies import sweep as sweep_lib
 
     if scheduler is not None and scheduler_file is not None:
@@ -403,7 +404,8 @@ def make_executor(workers: Optional[int], scheduler: Optional[str], scheduler_fi
                 f"--workers = {workers}: must be a whole number from 1 to {cores} (the cores of this machine)"
             )
         numba.set_num_threads(workers)
-    return sweep_lib.LocalExecutor(), {"type": "local", "threads": int(numba.get_num_threads())}
+    record = {"type": "local", "threads": int(numba.get_num_threads()), "chunks_ahead": ahead}
+    return sweep_lib.LocalExecutor(ahead), record
 
 
 def open_run_table(out: Optional[Path], resume: bool):
@@ -445,6 +447,7 @@ def interruptible(table, path: Optional[Path]):
     try:
         yield
     except KeyboardInterrupt:
+        table.flush()  # every finished run, before the count
         n = _saved_runs(table, path)
         if path is not None:
             typer.echo(f"interrupted: {n} runs saved in {path}; run again with --resume to continue", err=True)

@@ -207,7 +207,7 @@ CompareDamperOption = _damper(
     (
         "Dampers of the controlled suspensions: the MR models railway, dyke1996 or "
         "spencer1997; ideal-damper (the ideal semi-active damper: the demand where it "
-        "dissipates, else 0, the bound of any damper) or ideal (an ideal actuator: force = "
+        "dissipates, else 0; a reference, not a bound) or ideal (an ideal actuator: force = "
         "the outer loop's demand)."
     ),
 )

@@ -65,6 +65,8 @@ DESIGN_FIELDS = {
     "objective": "--objective",
     **FIXED_RATE_FIELDS,
 }
+#: chunks that step beside the one whose rows are made (`LocalExecutor`): none for the design
+DESIGN_AHEAD = 0
 #: the metrics of the table of ratios, and their headings
 RATIO_METRICS = {
     "acceleration_m_s2_rms": "accel.",
@@ -371,7 +373,9 @@ def design_command(
         )
         check_design(None if controllers.strip() == "all" else names, **settings)  # before the folder
         table, table_path = open_run_table(out, resume)
-        executor, executor_record = make_executor(workers, scheduler, scheduler_file)
+        # one chunk at a time: two chunks of 20 s runs at once took the default design to 2.09 GiB,
+        # above its 2 GiB (docs/performance.md)
+        executor, executor_record = make_executor(workers, scheduler, scheduler_file, ahead=DESIGN_AHEAD)
     try:
         with interruptible(table, table_path), errors(), option_names(DESIGN_FIELDS):
             from railride.studies.design import design

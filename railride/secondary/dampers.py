@@ -23,9 +23,10 @@ terms act on x, not x - x0.
 Each law also has a plain NumPy reference here (`rates`), used by the tests to check the
 compiled version in `railride.engine.kernels`.
 
-`Ideal` is no damper but the bound the MR dampers approach: a force actuator that applies the
-outer loop's demand exactly (closed loop only). `BoucWen.scaled` / `Spencer.scaled` give the
-same damper with its force capacity multiplied by a factor.
+`Ideal` is no damper but a reference for the MR dampers: a force actuator that applies the
+outer loop's demand exactly (closed loop only; with the same gains the MR dampers can do
+better). `BoucWen.scaled` / `Spencer.scaled` give the same damper with its force capacity
+multiplied by a factor.
 """
 
 from __future__ import annotations
@@ -235,7 +236,7 @@ class Spencer(BoucWen):
 class Ideal(_Damper):
     """The ideal actuator: the corner force on the carbody equals the outer loop's demand f_d,
     sampled and held like every demand, with no inner loop, voltage or clipping. It may push
-    energy in, which a damper cannot, and is the bound a semi-active damper approaches. It has
+    energy in, which a damper cannot: a reference for a law's gains, not a bound. It has
     no states and no parameters, and works in a closed loop only (`railride.Suspension.ideal`).
 
     In the stepper its command slot carries the held demand f_d (on the carbody, up +), so
@@ -243,8 +244,9 @@ class Ideal(_Damper):
     """
 
     #: True: the ideal *semi-active* damper ("ideal-damper"): the demand when it dissipates
-    #: energy (F x' >= 0), no force otherwise. The bound of any damper, MR or other, that can
-    #: only resist the relative motion across it.
+    #: energy (F x' >= 0), no force otherwise: what any damper that can only resist the relative
+    #: motion across it could give of a demand, a reference for a law's gains (not a bound: with
+    #: the same gains an MR damper's lag and hysteresis change the loop, and can do better).
     dissipative: bool = False
 
     law = LAW_IDEAL

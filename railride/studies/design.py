@@ -338,6 +338,10 @@ def design(
         solver=solver,
     )
     table = RunTable() if table is None else table
+    if executor is None:  # one chunk at a time: two at once took the default design above 2 GiB
+        from railride.studies.executors import LocalExecutor
+
+        executor = LocalExecutor(ahead=0)
     over = tuple(
         TuningCase(track, _options(plan, track, seed, v), load)
         for track in plan.tracks

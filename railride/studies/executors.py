@@ -11,6 +11,7 @@ file rewritten atomically after each chunk, so an interrupted study resumes wher
 from __future__ import annotations
 
 import json
+import math
 import os
 import socket
 import time
@@ -307,10 +308,21 @@ def _reach(address: str, timeout: float, security, where: str) -> None:
 LOCK_SUFFIX = ".lock"
 
 
+#: a run table on disk is rewritten at most every max(`WRITE_EVERY_S`, `WRITE_SHARE` x the last
+#: write's time) seconds, and always by `RunTable.flush` and `RunTable.close`: writing a table of
+#: 35,000 runs takes over a second, and after every chunk it took most of a long design's time
+WRITE_EVERY_S = 2.0
+WRITE_SHARE = 20.0
+
+
 class RunTable:
-    """Every finished run, one row each, kept in a CSV file rewritten atomically after each
-    chunk: a reader never sees half a file, and an interrupted sweep loses at most the chunks
-    in flight.
+    """Every finished run, one row each, kept in a CSV file rewritten atomically: a reader
+    never sees half a file. The file is rewritten after a chunk when the last write is more
+    than max(`WRITE_EVERY_S`, `WRITE_SHARE` x its own time) seconds old, so that writing takes
+    at most about 5 % of a study's time however long the table grows, and always by `flush`
+    and `close` (leaving a ``with`` block; the command line's Ctrl-C and every command's end)
+    and when `railride.studies.sweep.run_cases` returns. A process that is killed outright loses
+    the runs since the last write, at most that interval; Ctrl-C loses none.
 
     A table on disk belongs to one process at a time: opening it takes an exclusive lock on the
     file ``.runs.csv.lock`` beside it (the folder is created for it), which names the process
@@ -323,7 +335,12 @@ class RunTable:
 
     def __init__(self, path: str | Path | None = None, resume: bool = False):
         self.path = None if path is None else Path(path)
-        self.frame = pd.DataFrame()
+        self._parts: list[pd.DataFrame] = []  # the rows, in the order added; concatenated when read
+        self._frame: pd.DataFrame | None = pd.DataFrame()
+        self._done: dict[str, dict] = {}
+        self._unwritten = False
+        self._written_at = -math.inf
+        self._write_s = 0.0
         self._lock = None
         if self.path is None:
             return
@@ -334,16 +351,43 @@ class RunTable:
                     raise InputError(
                         f"{self.path} exists: pass resume to continue that sweep, or choose another output folder"
                     )
-                self.frame = read_run_table(self.path)
+                frame = read_run_table(self.path)
+                self._parts = [frame]
+                self._frame = frame
+                self._done = {row["key"]: row for row in frame.to_dict("records")}
         except BaseException:
             self.close()
             raise
 
+    @property
+    def frame(self) -> pd.DataFrame:
+        """Every run so far, one row each, in the order they finished."""
+        if self._frame is None:
+            self._frame = pd.concat(self._parts, ignore_index=True) if self._parts else pd.DataFrame()
+            self._parts = [self._frame]
+        return self._frame
+
+    def flush(self) -> None:
+        """Write every run so far to the file now (nothing for a table in memory)."""
+        if self.path is None or not self._unwritten:
+            return
+        frame = self.frame
+        t0 = time.perf_counter()
+        atomic_write(self.path, lambda p: frame.to_csv(p, index=False))
+        self._write_s = time.perf_counter() - t0
+        self._written_at = time.perf_counter()
+        self._unwritten = False
+
     def close(self) -> None:
-        """Release the table's lock (nothing for a table in memory); the table stays readable."""
-        if self._lock is not None:
-            self._lock.release()
-            self._lock = None
+        """Write what is left and release the table's lock (nothing for a table in memory); the
+        table stays readable."""
+        try:
+            if self._lock is not None:
+                self.flush()
+        finally:
+            if self._lock is not None:
+                self._lock.release()
+                self._lock = None
 
     def __enter__(self):
         return self
@@ -353,16 +397,20 @@ class RunTable:
         return False
 
     def done(self) -> dict[str, dict]:
-        if self.frame.empty:
-            return {}
-        return {row["key"]: row for row in self.frame.to_dict("records")}
+        """The finished runs by key (a new dict: the caller may add to it)."""
+        return dict(self._done)
 
     def add(self, rows: list[dict]) -> None:
         if not rows:
             return
-        self.frame = pd.concat([self.frame, pd.DataFrame(rows)], ignore_index=True)
-        if self.path is not None:
-            atomic_write(self.path, lambda p: self.frame.to_csv(p, index=False))
+        self._parts.append(pd.DataFrame(rows))
+        self._frame = None
+        self._done.update((row["key"], row) for row in rows)
+        self._unwritten = True
+        if self.path is not None and time.perf_counter() - self._written_at >= max(
+            WRITE_EVERY_S, WRITE_SHARE * self._write_s
+        ):
+            self.flush()
 
 
 def read_run_table(path: Path) -> pd.DataFrame:

@@ -291,6 +291,7 @@ def run_cases(
         if progress is not None:
             elapsed = time.perf_counter() - t0
             progress(n_done, len(pending), n_done / elapsed if elapsed > 0 else math.inf)
+    table.flush()  # the table on disk holds every run when this returns (chunks write it at intervals)
     # a row of a table from before the vehicle columns: the same key is the same vehicle values
     return pd.DataFrame([{**done[k], **columns_of[k]} for k in keys])
 
