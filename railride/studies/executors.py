@@ -4,7 +4,7 @@ An executor runs chunks of cases (`railride.studies.sweep.evaluate` on each) and
 `LocalExecutor` on this machine, each batch over every core and the next chunk stepping while
 the last one's rows are made;
 `DaskExecutor` on a dask.distributed cluster. `RunTable` keeps every finished run in a CSV
-file rewritten atomically after each chunk, so an interrupted study resumes where it stopped
+file rewritten atomically as chunks finish, so an interrupted study resumes where it stopped
 (`railride.studies.sweep.run_cases`).
 """
 
