@@ -1,6 +1,6 @@
 """Cost of a study over many tracks (railride.studies.study): wall time and peak memory.
 
-Run:  python benchmarks/bench_study.py [--seeds N] [--dask]
+Run:  python benchmarks/bench_study.py [--seeds N] [--dask | --ahead N]
 Prints a Markdown row for docs/performance.md: one study of 1000 closed-loop and passive runs
 of 10 s (fra4, N = 20 track seeds x 5 speeds x 2 loads x (passive + 4 controllers)), with its
 wall time (compilation excluded: a warm-up study runs first) and peak resident memory. Locally:
@@ -21,11 +21,16 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--seeds", type=int, default=20)
     ap.add_argument("--dask", action="store_true")
+    ap.add_argument("--ahead", type=int, default=None, help="local: chunks stepping beside the one whose rows are made")
     args = ap.parse_args()
 
     from railride.studies.study import study
 
     executor, cluster, where = None, None, "local, one process"
+    if args.ahead is not None:
+        from railride.studies.executors import LocalExecutor
+
+        executor, where = LocalExecutor(ahead=args.ahead), f"local, one process, {args.ahead} chunk(s) ahead"
     if args.dask:
         from distributed import LocalCluster
 
@@ -43,7 +48,7 @@ def main():
     wall = time.perf_counter() - t0
     peak_mib = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
     memory = f"{peak_mib:.0f} MiB"
-    if executor is not None:
+    if cluster is not None:
         worker = executor.client.run(lambda: resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0)
         memory = f"client {peak_mib:.0f} MiB, worker {max(worker.values()):.0f} MiB"
         executor.close()

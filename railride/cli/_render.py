@@ -226,7 +226,9 @@ def gains_text(source: str, shipped: bool) -> str:
     (the library takes the robust set on random and measured track, `GainSet.for_tracks`)."""
     if not shipped:
         return f"gains file {source}"
-    if source.endswith("robust_gains.toml"):
+    from railride.secondary.control import SHIPPED
+
+    if source.endswith(SHIPPED["robust"]):
         return (
             f"gains: the shipped robust set {source}, tuned on random track and taken on random and measured "
             "track (--gains paper: the set tuned on the paper's sine)"

@@ -89,11 +89,7 @@ def plot_design_costs(result, ax=None):
         (a,) = given_axes(ax, 1, "the score against the damper force")
         fig = a.figure
     force = summary[summary["metric"] == "force_rms_n"].set_index(["controller", "speed_m_s", "load"])["mean"]
-    objective = result.tuning.objective
-    # passive's own score: every ratio to itself is 1
-    ones = {c: np.float64(1.0) for c in objective.columns}
-    travel = objective.travel_bound if objective.needs_costs else None
-    baseline = float(objective.of_ratios(ones, travel))
+    baseline = result.tuning.objective.passive_score
     for k, point in enumerate(result.points):
         v, load = point["speed_m_s"], point["load"]
         if ("passive", v, load) in force.index:

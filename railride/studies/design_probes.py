@@ -84,8 +84,7 @@ def fault_check(plan, leaders: list, points: list, scores) -> dict | None:
     text += " and ".join(
         f"{label[law]} scores {_text(v['faulted'])} at worst (healthy {_text(v['healthy'])})" for law, v in laws.items()
     )
-    ones = {c: np.float64(1.0) for c in plan.objective.columns}
-    baseline = float(plan.objective.of_ratios(ones, plan.objective.travel_bound))  # passive's own score
+    baseline = plan.objective.passive_score
     worse = [label[law] for law, v in laws.items() if v["faulted"] is None or v["faulted"] >= baseline]
     text += f" (passive {baseline:g})"
     if worse:

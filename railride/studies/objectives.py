@@ -153,6 +153,12 @@ class Objective:
         comfort = tuple(f"{p}_{COMFORT_KINDS[self.kind]}" for p in FLOOR_POINTS) if self.needs_comfort else ()
         return (*RMS_COLUMNS, *comfort, *((PEAK_COLUMN,) if self.peak_bound is not None else ()))
 
+    @property
+    def passive_score(self) -> float:
+        """J of passive itself: every ratio 1 (4 for the sums, 1 for minimax and comfort)."""
+        ones = {c: np.float64(1.0) for c in self.columns}
+        return float(self.of_ratios(ones, self.travel_bound))
+
     def of_runs(self, runs, passive) -> np.ndarray:
         """J of each run of ``runs`` (a table with the run-table columns, `columns` and for
         the travel constraint `TRAVEL_COLUMN`) against ``passive`` (one row, or a table of as
