@@ -36,3 +36,9 @@ class Interrupted(KeyboardInterrupt):
         super().__init__("interrupted")
         self.result = result
         self.until = until
+
+
+class BackendWarning(UserWarning):
+    """The backend asked for could not be used, and the run went on with another: for example
+    "auto" with no GPU for a large batch (`railride.SolverSettings`). The command line shows it
+    as one "warning:" line."""

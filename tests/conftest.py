@@ -2,12 +2,23 @@
 
 The tests are split by what they check: unit/ (parameters, metrics, controllers, studies'
 bookkeeping), physics/ (the model against analytic limits, invariants and a second method),
-cli/ (the command line, the examples and the README)."""
+cli/ (the command line, the examples and the README).
 
+The GPU kernel runs in numba's CUDA simulator (NUMBA_ENABLE_CUDASIM=1, set here before numba is
+imported, and inherited by the commands the tests start) unless the environment sets it: with
+NUMBA_ENABLE_CUDASIM=0 on a machine with a GPU the same tests run the kernel on the device."""
+
+import os
 import sys
 from pathlib import Path
 
 import pytest
+from numba.core import config as _numba_config
+
+os.environ.setdefault("NUMBA_ENABLE_CUDASIM", "1")
+# pytest has imported numba already (the warning filters in pyproject.toml name its classes):
+# have it read the environment again, before anything imports its CUDA target
+_numba_config.reload_config()
 
 sys.path.insert(0, str(Path(__file__).parent / "cli"))
 

@@ -221,7 +221,7 @@ def _load4_strided(builder, base, start, stride):
 
 @intrinsic
 def bouc_wen1_corners(typingctx, P, s, cx, cv, vcmd, conn, y, K, koff):
-    """The four corners' Bouc-Wen dampers with n = 1 (`kernels.damper_law`, LAW_BOUC_WEN), as
+    """The four corners' Bouc-Wen dampers with n = 1 (`laws.damper_law`, LAW_BOUC_WEN), as
     one vector of four: with z, u the damper states s[2N + 3c], s[2N + 2 + 3c] (N = N_DOF) and
     (x, x') = (cx[c], cv[c]), F = (P0 + P1 u) z + (P2 + P3 u) x' + P4 x, and y[2N + c] = -F conn[c];
     K[koff + 2N + 3c ...] = (z', 0, u') with z' = -P7 |x'| z - P8 x' |z| + P5 x' and

@@ -219,7 +219,7 @@ def _splat(builder, x):
 
 @intrinsic
 def lanes_mr_damper(typingctx, spencer, P, CC, ST, rf, rd, VC, CONN, K, kb):
-    """The MR damper law of `railride.engine.kernels.damper_law` at the four corners, every lane at
+    """The MR damper law of `railride.engine.laws.damper_law` at the four corners, every lane at
     once: Bouc-Wen, or Spencer where ``spencer``. Corner c's deflection and rate are CC[c] and
     CC[4 + c], its states (z, y, u) ST[rd + 3c ...], its command VC[c]; ST[rf + c] receives the
     force on the carbody -F CONN[c] and K[kb + rd + 3c ...] the rates (z', y', u'). P holds the

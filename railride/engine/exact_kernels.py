@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from railride.engine.kernels import _rail_inputs
+from railride.engine.laws import _rail_inputs
 from railride.engine.layout import DIVERGED, N_CORNER, N_DOF, N_RAIL, STATUS_DIVERGED, STATUS_OK
 from railride.engine.layout import FASTMATH as _FAST
 

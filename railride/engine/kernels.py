@@ -27,78 +27,59 @@ from numba.core.errors import NumbaPerformanceWarning
 
 from railride.engine.cache_guard import guard as _guard_cache
 from railride.engine._simd import bouc_wen1_corners, corner_pairs, forcing_rows, mv9_simd
+from railride.engine.laws import (
+    _hermite,
+    _one_step_limit,
+    add_stops,
+    damper_law,
+    damper_stiffness,
+    fault_at,
+    substeps,
+    voltage_law,
+)
+from railride.engine.sample_parts import (
+    accelerometer_filters,
+    controller_sample,
+    hold_failed_coils,
+    inner_loop,
+    record_row,
+    rk4_advance,
+    rk4_stage_state,
+    substep_count,
+)
 from railride.engine.layout import (  # sizes, codes and slots: compile-time constants to numba
-    DIVERGED,
     FAULT_DISCONNECTED,
     FAULT_NONE,
-    FAULT_OFF,
-    FAULT_ON,
     FD_HELD,
-    FD_NEXT,
     F_MODE,
-    F_STEP,
     I_B,
     I_DELAY,
     I_G,
     I_LAW,
     LAW_BOUC_WEN,
     LAW_IDEAL,
-    LAW_SPENCER,
-    LAW_VISCOUS,
     LAW_VISCOUS_IN_C,
-    MAX_SUBSTEPS,
     NS_MAX,
     NY,
     N_CORNER,
     N_DAMPER_STATES,
     N_DOF,
-    N_DS,
     ROW_BENDING,
     N_RAIL,
-    N_SENS_STATES,
-    NOISE_Q,
-    NOISE_V,
-    P_A,
-    P_ALPHA_A,
-    P_ALPHA_B,
-    P_DISSIPATIVE,
     P_BETA,
-    P_C0A,
-    P_C0B,
-    P_C1A,
-    P_C1B,
-    P_ETA,
     P_GAMMA,
-    P_K0,
-    P_K1,
     P_N,
     P_V_MAX,
     P_V_MIN,
-    P_Z_BOUND,
     RIG_COMMANDED,
     RIG_CONSTANT,
     RIG_TRACKING,
-    S_BIAS,
-    S_MAP,
     S_ON,
     S_W_AA,
     S_W_C,
-    SENS,
-    SS_DISP,
-    SS_FILTERED,
-    SS_HP1,
-    SS_HP2,
-    SS_LAST,
-    SS_VEL,
-    SS_VEL_LAST,
     STATUS_DIVERGED,
     STATUS_OK,
-    SUBSTEP_DT_REF,
-    SUBSTEP_LIMIT,
-    VOLTAGE_CLIPPED,
-    VOLTAGE_ON_OFF,
     VOLTAGE_TRACKING,
-    XI,
 )
 from railride.engine.layout import FASTMATH as _FAST, NO_PARFORS as _NO_PARFORS
 from railride.engine.layout import R_E, R_F, R_T, R_U, R_V, R_X, R_XD, R_Y, R_Z  # the rig's output columns
@@ -115,34 +96,6 @@ warnings.filterwarnings(
 
 
 @njit(cache=True, inline="always", fastmath=_FAST)
-def _hermite(t, n_nodes, interval):
-    """Node index k of time t on the input grid and the cubic Hermite weights there.
-
-    Returns (k, h00, h10, h01, h11, d00, d10, d11): a quantity with node values y, slopes y'
-    is y(t) = h00 y_k + h10 y'_k + h01 y_k+1 + h11 y'_k+1 and its rate is
-    y'(t) = d00 (y_k - y_k+1) + d10 y'_k + d11 y'_k+1 (the interval is folded in).
-    """
-    u = t / interval
-    k = int(u)
-    if k > n_nodes - 2:
-        k = n_nodes - 2
-    tau = u - k
-    if tau > 1.0:
-        tau = 1.0
-    om = 1.0 - tau
-    return (
-        k,
-        (1.0 + 2.0 * tau) * om * om,
-        tau * om * om * interval,
-        tau * tau * (3.0 - 2.0 * tau),
-        tau * tau * (tau - 1.0) * interval,
-        6.0 * tau * (tau - 1.0) / interval,
-        om * (1.0 - 3.0 * tau),
-        tau * (3.0 * tau - 2.0),
-    )
-
-
-@njit(cache=True, inline="always", fastmath=_FAST)
 def _forcing(t, ftab, off, n_nodes, interval, out, ooff):
     """Rail forcing r = Bw w + Bwd w' at time t, from the forcing table.
 
@@ -154,17 +107,6 @@ def _forcing(t, ftab, off, n_nodes, interval, out, ooff):
     """
     k, h00, h10, h01, h11, d00, d10, d11 = _hermite(t, n_nodes, interval)
     forcing_rows(ftab, off + k, h00, h10, h01, h11, d00, d10, d11, out, ooff)
-
-
-@njit(cache=True, inline="always", fastmath=_FAST)
-def _rail_inputs(t, utab, off, n_nodes, interval, w, wd):
-    """Rail heights w and velocities w' at the wheelsets at time t, from the input table."""
-    k, h00, h10, h01, h11, d00, d10, d11 = _hermite(t, n_nodes, interval)
-    a = off + k
-    b = a + 1
-    for c in range(N_RAIL):
-        w[c] = h00 * utab[a, c] + h10 * utab[a, 8 + c] + h01 * utab[b, c] + h11 * utab[b, 8 + c]
-        wd[c] = d00 * (utab[a, c] - utab[b, c]) + d10 * utab[a, 8 + c] + d11 * utab[b, 8 + c]
 
 
 @njit(cache=True, inline="always", fastmath=_FAST)
@@ -183,179 +125,6 @@ def _mv9(AT, x, xf, n_cols, r, roff, out, ooff, idx8, val8, idx9, val9, n8, whic
         j = idx9[k]
         acc += val9[k] * (x[j] if j < 2 * N_DOF else xf[j])
     out[ooff + ROW_BENDING] = acc
-
-
-@njit(cache=True, inline="always", fastmath=_FAST)
-def _corner_values(TT, s, offset, out):
-    """out[c] = sum_j TT[j, c] s[offset + j]: the secondary deflections (offset 0, from q) or
-    their rates (offset N_DOF, from q') at the four corners (TT = T, (N_DOF, 4))."""
-    b0 = 0.0
-    b1 = 0.0
-    b2 = 0.0
-    b3 = 0.0
-    for j in range(N_DOF):
-        sj = s[offset + j]
-        b0 += TT[j, 0] * sj
-        b1 += TT[j, 1] * sj
-        b2 += TT[j, 2] * sj
-        b3 += TT[j, 3] * sj
-    out[0] = b0
-    out[1] = b1
-    out[2] = b2
-    out[3] = b3
-
-
-@njit(cache=True, inline="always", fastmath=_FAST)
-def _bouc_wen_rate(z, w, A, n, gamma, beta):
-    """z' = -gamma |w| z |z|^(n-1) - beta w |z|^n + A w (see railride.secondary.dampers)."""
-    az = abs(z)
-    if n == 1.0:
-        zn1 = 1.0
-    elif n == 2.0:
-        zn1 = az
-    else:
-        zn1 = az ** (n - 1.0)
-    return -gamma * abs(w) * z * zn1 - beta * w * zn1 * az + A * w
-
-
-@njit(cache=True, inline="always", fastmath=_FAST)
-def damper_law(law, P, x, xd, z, y, u, v):
-    """Force F (tension +) and the rates (z', y', u') of one damper; P as `Damper.pack()`.
-    LAW_IDEAL: v is the held demand on the carbody, so F = -v and the carbody gets f = v."""
-    if law == LAW_VISCOUS:
-        return P[P_C0A] * xd, 0.0, 0.0, 0.0
-    if law == LAW_IDEAL:  # P[P_DISSIPATIVE] > 0: dissipative only, no force where it would push energy in
-        if P[P_DISSIPATIVE] > 0.0 and v * xd > 0.0:
-            return 0.0, 0.0, 0.0, 0.0
-        return -v, 0.0, 0.0, 0.0
-    alpha = P[P_ALPHA_A] + P[P_ALPHA_B] * u
-    c0 = P[P_C0A] + P[P_C0B] * u
-    du = coil_rate(P, u, v)
-    if law == LAW_BOUC_WEN:
-        dz = _bouc_wen_rate(z, xd, P[P_A], P[P_N], P[P_GAMMA], P[P_BETA])
-        return c0 * xd + P[P_K0] * x + alpha * z, dz, 0.0, du
-    c1 = P[P_C1A] + P[P_C1B] * u
-    dy = (alpha * z + c0 * xd + P[P_K0] * (x - y)) / (c0 + c1)
-    dz = _bouc_wen_rate(z, xd - dy, P[P_A], P[P_N], P[P_GAMMA], P[P_BETA])
-    return c1 * dy + P[P_K1] * x, dz, dy, du
-
-
-@njit(cache=True, inline="always", fastmath=_FAST)
-def coil_rate(P, u, v):
-    """u' of an MR damper's coil voltage u lagging the command v (rate P[P_ETA])."""
-    return -P[P_ETA] * (u - v)
-
-
-@njit(cache=True, inline="always", fastmath=_FAST)
-def voltage_law(mode, B, G, f, fd, xd, P):
-    """The command voltage the closed loop's inner loop gives an MR damper (voltage law ``mode``,
-    `layout.VOLTAGE_LAWS`; both steppers call this) from the damper force f on the carbody, the
-    demand fd there and the corner's deflection rate xd, within P's v_min..v_max: tracking,
-    v = clip(G (fd - B f) sgn(f), v_min, v_max); on-off, v_max where fd xd < 0; clipped, v_max
-    where (fd - f) f > 0; else v_min."""
-    if mode == VOLTAGE_ON_OFF:
-        return P[P_V_MAX] if fd * xd < 0.0 else P[P_V_MIN]
-    if mode == VOLTAGE_CLIPPED:
-        return P[P_V_MAX] if (fd - f) * f > 0.0 else P[P_V_MIN]
-    sgn = 1.0 if f > 0.0 else (-1.0 if f < 0.0 else 0.0)
-    return min(max(G * (fd - B * f) * sgn, P[P_V_MIN]), P[P_V_MAX])
-
-
-@njit(cache=True, inline="always")
-def fault_at(fm, c, step):
-    """The fault of corner c at ``step`` (FAULT_*) from a sample's row fm of the fault table
-    (columns `layout.F_MODE`, `layout.F_STEP`): its mode from its step on, FAULT_NONE before."""
-    return fm[F_MODE + c] if step >= fm[F_STEP + c] else FAULT_NONE
-
-
-@njit(cache=True, inline="always", fastmath=_FAST)
-def fault_command(fault, v, P):
-    """(command, held) of a corner with ``fault`` whose voltage law asked v: a failed coil driver
-    holds v_min (FAULT_OFF) or v_max (FAULT_ON) whatever the law asks (held True); otherwise v.
-    (FAULT_DISCONNECTED leaves the command and removes the force: the steppers' ``conn``.)"""
-    if fault == FAULT_OFF:
-        return P[P_V_MIN], True
-    if fault == FAULT_ON:
-        return P[P_V_MAX], True
-    return v, False
-
-
-@njit(cache=True, fastmath=_FAST)
-def damper_stiffness(law, P, xd, z, u):
-    """A bound on the fastest rate of the damper's internal states [1/s]
-    (same as railride.secondary.dampers.stiffness_estimate). |z| is taken at least at the bound of the
-    hysteretic variable (P[P_Z_BOUND]): starting from z = 0 the rate grows within the step."""
-    if law == LAW_VISCOUS or law == LAW_VISCOUS_IN_C or law == LAW_IDEAL:
-        return 0.0
-    gb = abs(P[P_GAMMA]) + abs(P[P_BETA])
-    n = P[P_N]
-    az = max(abs(z), P[P_Z_BOUND])
-    lam = n * gb * abs(xd) * (1.0 if n == 1.0 else az ** (n - 1.0)) + P[P_ETA]
-    if law == LAW_SPENCER:
-        cs = P[P_C0A] + P[P_C0B] * u + P[P_C1A] + P[P_C1B] * u
-        lam += ((P[P_A] + gb * az**n) * (P[P_ALPHA_A] + P[P_ALPHA_B] * u) + P[P_K0]) / cs
-    return lam
-
-
-@njit(cache=True)
-def substeps(lam, dt):
-    """Sub-steps per step (a power of two) for a fastest damper rate lam [1/s].
-
-    The count depends on lam alone, lam * SUBSTEP_DT_REF / m <= SUBSTEP_LIMIT, so a smaller dt
-    gives proportionally smaller sub-steps and step halving refines the whole scheme; a floor
-    keeps lam * dt / m <= 2 * SUBSTEP_LIMIT for stability when dt is large.
-    """
-    m = 1
-    while (lam * SUBSTEP_DT_REF > SUBSTEP_LIMIT * m or lam * dt > 2.0 * SUBSTEP_LIMIT * m) and m < MAX_SUBSTEPS:
-        m *= 2
-    return m
-
-
-@njit(cache=True)
-def _one_step_limit(dt):
-    """The largest rate bound lam for which `substeps` gives one step (by bisection on its own
-    test, so that lam <= this is exactly substeps(lam, dt) == 1)."""
-    lo = 0.0
-    hi = 1.0
-    while substeps(hi, dt) == 1:
-        hi *= 2.0
-    for _ in range(200):
-        mid = 0.5 * (lo + hi)
-        if mid <= lo or mid >= hi:
-            break
-        if substeps(mid, dt) == 1:
-            lo = mid
-        else:
-            hi = mid
-    return lo
-
-
-@njit(cache=True, inline="always", fastmath=_FAST)
-def stop_force(z_stop, k_stop, x):
-    """The force of a corner's bump stop on the carbody (up +) at the secondary deflection x
-    (extension +): none within the clearance +-z_stop, k_stop times the travel beyond it,
-    against it (`railride.model.params.VehicleParams`, z_stop and k_stop)."""
-    if x > z_stop:
-        return -k_stop * (x - z_stop)
-    if x < -z_stop:
-        return -k_stop * (x + z_stop)
-    return 0.0
-
-
-@njit(cache=True, inline="always", fastmath=_FAST)
-def add_stops(zk, cx, f, foff, fsave):
-    """Add the bump stops' forces (clearance zk[0], stiffness zk[1]) at the corner deflections
-    cx to the corner forces f[foff:foff + 4], the forces before in fsave, where any corner is
-    beyond the clearance; whether one is. The damper forces go back in place after the
-    product: what the record and the inner loop read is the damper's force alone, as a load
-    cell on the damper measures it. Off the stops (almost every step) this is four comparisons."""
-    z = zk[0]
-    if not (abs(cx[0]) > z or abs(cx[1]) > z or abs(cx[2]) > z or abs(cx[3]) > z):
-        return False
-    for c in range(N_CORNER):
-        fsave[c] = f[foff + c]
-        f[foff + c] = fsave[c] + stop_force(z, zk[1], cx[c])
-    return True
 
 
 @njit(cache=True, inline="always", fastmath=_FAST)
@@ -495,11 +264,12 @@ def _run_samples(
     # damper states to integrate (the ideal actuator has none: its law ignores them)
     has_states = law != LAW_VISCOUS_IN_C and law != LAW_IDEAL
     ns = NS_MAX if has_states else 2 * N_DOF
-    record_d = out_d.shape[1] > 1
-    record_c = out_fd.shape[1] > 1
+    out4 = (out_q, out_v, out_a, out_f)
+    out5 = (out_w, out_wd, out_d, out_fd, out_vc)
     for smp in range(lo, hi):
         if status[smp] != STATUS_OK:
             continue
+        xs = x[smp]  # the sample's row: its controller and sensor states are updated in place
         s = x[smp].copy()
         st = np.zeros(NS_MAX)  # stage state (zeros: the states a law without any still reads)
         y = np.empty(NY)  # stage vector (q, q', f)
@@ -522,11 +292,10 @@ def _run_samples(
         gm, hm = Gm[smp], Hm[smp]
         delay = int(inner[smp, I_DELAY])  # controller periods from a sample to its demand taking effect
         tc = ctrl_stride * dt
-        sens = closed_loop and sensing[smp, S_ON] > 0.0
-        w_aa, w_c = sensing[smp, S_W_AA], sensing[smp, S_W_C]
+        srow = sensing[smp]
+        sens = closed_loop and srow[S_ON] > 0.0
+        w_aa, w_c = srow[S_W_AA], srow[S_W_C]
         hp = 1.0 / (1.0 + w_c * tc)  # backward Euler of s / (s + w) and of 1 / (s + w)
-        n_snoise = snoise.shape[0]
-        n_noise = noise.shape[0]
         bw1 = law == LAW_BOUC_WEN and pp[P_N] == 1.0
         gb1 = pp[P_N] * (abs(pp[P_GAMMA]) + abs(pp[P_BETA]))
         lam1 = _one_step_limit(dt)  # the largest rate bound that needs no sub-steps
@@ -555,129 +324,33 @@ def _run_samples(
             step = step0 + n
             t = step * dt
             if closed_loop and step % ctrl_stride == 0:
-                k = step // ctrl_stride
-                # the demand computed `delay` periods ago takes effect; its slot takes the new one
-                slot = FD_NEXT + N_CORNER * (k % delay)
-                for c in range(N_CORNER):
-                    x[smp, FD_HELD + c] = x[smp, slot + c]
-                for j in range(2 * N_DOF):
-                    meas[j] = 0.0 if sens else s[j]
-                if sens:  # the accelerometers, sampled, and the band-limited integration
-                    for c in range(N_CORNER):
-                        b = SENS + N_SENS_STATES * c
-                        a_m = x[smp, b + SS_FILTERED] + sensing[smp, S_BIAS + c]
-                        a_m += snoise[k, c] if k < n_snoise else 0.0
-                        x[smp, b + SS_HP1] = hp * (x[smp, b + SS_HP1] + a_m - x[smp, b + SS_LAST])
-                        x[smp, b + SS_LAST] = a_m
-                        v_new = hp * (x[smp, b + SS_VEL] + tc * x[smp, b + SS_HP1])
-                        x[smp, b + SS_HP2] = hp * (x[smp, b + SS_HP2] + v_new - x[smp, b + SS_VEL_LAST])
-                        x[smp, b + SS_VEL_LAST] = v_new
-                        x[smp, b + SS_VEL] = v_new
-                        x[smp, b + SS_DISP] = hp * (x[smp, b + SS_DISP] + tc * x[smp, b + SS_HP2])
-                    for j in range(3):
-                        for c in range(N_CORNER):
-                            pm = sensing[smp, S_MAP + N_CORNER * j + c]
-                            meas[j] += pm * x[smp, SENS + N_SENS_STATES * c + SS_DISP]
-                            meas[N_DOF + j] += pm * x[smp, SENS + N_SENS_STATES * c + SS_VEL]
-                if k < n_noise:  # sensor noise on the carbody's (z, phi, theta) and their rates
-                    for j in range(3):
-                        meas[j] += noise[k, NOISE_Q + j]
-                        meas[N_DOF + j] += noise[k, NOISE_V + j]
-                for j in range(3):
-                    x[smp, XI + j] += tc * meas[j]
-                for c in range(N_CORNER):
-                    acc_fd = 0.0
-                    for j in range(2 * N_DOF):
-                        acc_fd += gm[c, j] * meas[j]
-                    for j in range(3):
-                        acc_fd += hm[c, j] * x[smp, XI + j]
-                    x[smp, slot + c] = acc_fd
+                controller_sample(xs, step // ctrl_stride, delay, s, meas, sens, srow, snoise, noise, tc, hp, gm, hm)
             if closed_loop and law == LAW_IDEAL:
                 # the ideal actuator applies the held demand itself (no inner loop); its force
                 # is the command, so it is set before the step-start rates use it
                 for c in range(N_CORNER):
-                    vc[c] = x[smp, FD_HELD + c]
+                    vc[c] = xs[FD_HELD + c]
             if faulty:  # a fault takes effect at its step
                 for c in range(N_CORNER):
                     if fault_at(fm, c, step) == FAULT_DISCONNECTED:
                         conn[c] = 0.0
             # rates at the step's start: for the record, the sub-step choice and stage 1
             _derivative(law, s, R, 0, at, tt, pp, vc, conn, y, cx, cv, K, 0, i8, v8, i9, v9, n8, bw1, zk, fsave)
-            if sens:  # each accelerometer's anti-alias filter follows its corner's acceleration
-                for c in range(N_CORNER):
-                    a_c = tt[ROW_BENDING, c] * K[N_DOF + ROW_BENDING]  # the floor, bending included
-                    for j in range(3):
-                        a_c += tt[j, c] * K[N_DOF + j]
-                    b = SENS + N_SENS_STATES * c
-                    x[smp, b + SS_FILTERED] += dt * w_aa * (a_c - x[smp, b + SS_FILTERED])
-            if closed_loop and law != LAW_IDEAL:
-                # inner loop from the damper forces at the step's start (they do not depend on
-                # the command, only on the coil state); then correct stage 1's coil rate
-                mode = int(inner[smp, I_LAW])
-                for c in range(N_CORNER):  # cv: the deflection rates at the step's start
-                    vc[c] = voltage_law(
-                        mode, inner[smp, I_B], inner[smp, I_G], y[2 * N_DOF + c], x[smp, FD_HELD + c], cv[c], pp
-                    )
-                    b = 2 * N_DOF + N_DAMPER_STATES * c + 2
-                    K[b] = coil_rate(pp, s[b], vc[c])
-            if faulty:  # a failed coil driver: the command held whatever the law asks
-                for c in range(N_CORNER):
-                    v, held = fault_command(fault_at(fm, c, step), vc[c], pp)
-                    if held:
-                        vc[c] = v
-                        b = 2 * N_DOF + N_DAMPER_STATES * c + 2
-                        K[b] = coil_rate(pp, s[b], v)
+            if sens:
+                accelerometer_filters(xs, tt, K, dt, w_aa)
+            if closed_loop and law != LAW_IDEAL:  # cv: the deflection rates at the step's start
+                inner_loop(int(inner[smp, I_LAW]), inner[smp, I_B], inner[smp, I_G], y, xs, cv, pp, vc, s, K)
+            if faulty:
+                hold_failed_coils(fm, step, vc, pp, s, K)
             if step % stride == 0:
                 row = step // stride
-                bad = False
-                for i in range(N_DOF):
-                    out_q[smp, row, i] = s[i]
-                    out_v[smp, row, i] = s[N_DOF + i]
-                    out_a[smp, row, i] = K[N_DOF + i]
-                    if not (abs(s[i]) < DIVERGED and abs(s[N_DOF + i]) < 1e3 * DIVERGED):
-                        bad = True
-                if law == LAW_VISCOUS_IN_C:
-                    _corner_values(tt, s, N_DOF, cv)
-                    for c in range(N_CORNER):
-                        y[2 * N_DOF + c] = -cs[c] * cv[c]
-                for c in range(N_CORNER):
-                    out_f[smp, row, c] = y[2 * N_DOF + c]
-                if record_d:
-                    for i in range(N_DS):
-                        out_d[smp, row, i] = s[2 * N_DOF + i]
-                        if not abs(s[2 * N_DOF + i]) < DIVERGED:
-                            bad = True
-                _rail_inputs(t, utab, uo, nn, itv, w, wd)
-                for c in range(N_RAIL):
-                    out_w[smp, row, c] = w[c]
-                    out_wd[smp, row, c] = wd[c]
-                if record_c:
-                    for c in range(N_CORNER):
-                        out_fd[smp, row, c] = x[smp, FD_HELD + c]
-                        out_vc[smp, row, c] = vc[c]
-                if bad:
+                if record_row(smp, row, t, law, s, K, y, cv, tt, cs, xs, vc, utab, uo, nn, itv, w, wd, out4, out5):
                     status[smp] = STATUS_DIVERGED
                     fail_step[smp] = step
                     break
             if n == n_steps:
                 break
-            m = 1
-            if bw1:
-                # Bouc-Wen with n = 1 (the railway dampers): the bound n gb |x'| + eta of
-                # `damper_stiffness` grows with |x'| alone, so the fastest corner decides, and
-                # one comparison with the one-step limit skips `substeps` at almost every step
-                vmax = 0.0
-                for c in range(N_CORNER):
-                    vmax = max(vmax, abs(cv[c]))
-                lam = gb1 * vmax + pp[P_ETA]
-                if lam > lam1:
-                    m = substeps(lam, dt)
-            elif law != LAW_VISCOUS_IN_C:
-                lam = 0.0
-                for c in range(N_CORNER):
-                    b = 2 * N_DOF + N_DAMPER_STATES * c
-                    lam = max(lam, damper_stiffness(law, pp, cv[c], s[b], s[b + 2]))
-                m = substeps(lam, dt)
+            m = substep_count(law, bw1, gb1, lam1, pp, cv, s, dt)
             h = dt / m
             for sub in range(m):
                 ts = t + sub * h
@@ -691,20 +364,12 @@ def _run_samples(
                     ch = h * (0.0 if stage == 0 else (0.5 if stage < 3 else 1.0))
                     roff = N_DOF * (0 if stage == 0 else (1 if stage < 3 else 2))
                     prev = NS_MAX * (stage - 1 if stage > 0 else 0)  # stage 0 adds 0 * K_0
-                    for i in range(2 * N_DOF):  # constant trip counts: LLVM unrolls them
-                        st[i] = s[i] + ch * K[prev + i]
-                    if has_states:
-                        for i in range(2 * N_DOF, NS_MAX):
-                            st[i] = s[i] + ch * K[prev + i]
+                    rk4_stage_state(st, s, K, prev, ch, has_states)
                     kb = NS_MAX * stage
                     _derivative(
                         law, st, R, roff, at, tt, pp, vc, conn, y, cx, cv, K, kb, i8, v8, i9, v9, n8, bw1, zk, fsave
                     )
-                for i in range(2 * N_DOF):
-                    s[i] += h / 6.0 * (K[i] + 2.0 * K[NS_MAX + i] + 2.0 * K[2 * NS_MAX + i] + K[3 * NS_MAX + i])
-                if has_states:
-                    for i in range(2 * N_DOF, NS_MAX):
-                        s[i] += h / 6.0 * (K[i] + 2.0 * K[NS_MAX + i] + 2.0 * K[2 * NS_MAX + i] + K[3 * NS_MAX + i])
+                rk4_advance(s, K, h, has_states)
                 for i in range(N_DOF):
                     R[i] = R[2 * N_DOF + i]
         for i in range(ns):
@@ -783,18 +448,18 @@ def rig_batch(lo, hi, law, P, n_steps, stride, dt, xtab, x_interval, mode, vcons
                 E += h / 6.0 * (ke[0] + 2.0 * ke[1] + 2.0 * ke[2] + ke[3])
 
 
-def run_parallel(kernel, n_samples: int, *args) -> None:
-    """Call ``kernel(lo, hi, *args)`` on sample ranges that cover 0..n_samples, one range per
+def run_parallel(kernel, n_samples: int, *args, start: int = 0) -> None:
+    """Call ``kernel(lo, hi, *args)`` on sample ranges that cover start..n_samples, one range per
     thread (numba's thread count as set by `numba.set_num_threads`, at most one per sample)."""
     from concurrent.futures import ThreadPoolExecutor
 
     import numba
 
-    n_threads = max(1, min(n_samples, numba.get_num_threads()))
+    n_threads = max(1, min(n_samples - start, numba.get_num_threads()))
     if n_threads == 1:
-        kernel(0, n_samples, *args)
+        kernel(start, n_samples, *args)
         return
-    bounds = np.linspace(0, n_samples, n_threads + 1).round().astype(int)
+    bounds = np.linspace(start, n_samples, n_threads + 1).round().astype(int)
     with ThreadPoolExecutor(n_threads) as pool:
         jobs = [pool.submit(kernel, int(bounds[i]), int(bounds[i + 1]), *args) for i in range(n_threads)]
         for job in jobs:

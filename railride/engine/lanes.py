@@ -11,7 +11,8 @@ import numpy as np
 from numba import njit
 
 from railride.engine._simd_lanes import LANES, lanes_axpy, lanes_move, lanes_mr_damper, lanes_rk4, lanes_spmv
-from railride.engine.kernels import (  # the scalar laws and helpers, inlined here too
+from railride.engine.kernels import run_parallel
+from railride.engine.laws import (  # the scalar laws and helpers, inlined here too
     _hermite,
     stop_force,
     _one_step_limit,
@@ -21,7 +22,6 @@ from railride.engine.kernels import (  # the scalar laws and helpers, inlined he
     damper_stiffness,
     fault_at,
     fault_command,
-    run_parallel,
     substeps,
     voltage_law,
 )

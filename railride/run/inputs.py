@@ -105,7 +105,7 @@ def _system_arrays(vehicle: Vehicle, passive: bool = True) -> dict[str, np.ndarr
         "A": np.hstack([-minv * m["K"], -minv * (m["C"] if passive else m["C0"]), minv * m["T"]]).T,
         "TS": m["T"].copy(),
         "c_sec": np.full(4, vehicle.params.c_sz),
-        # the bump stops (clearance, stiffness; stiffness 0: none), `railride.engine.kernels.stop_force`
+        # the bump stops (clearance, stiffness; stiffness 0: none), `railride.engine.laws.stop_force`
         "stops": _stops(vehicle.params),
         "Bw": -minv * m["K_w"],
         "Bwd": -minv * m["C_w"],

@@ -308,8 +308,13 @@ def step(plan: RunPlan, tables: Inputs, packed: Packed, progress=None) -> Steppe
             progress(1.0)
         return Stepped(out, status, fail_step, rows, False)
     arrays, P = tables.arrays, packed.P
-    # a batch that fills groups of lanes.LANES samples runs them in vector form (run_lanes)
-    if lanes.lanes_fit(n, P, packed.control[7]):
+    # the GPU where the settings take it (`SolverSettings.backend_for`); on the CPU a batch that
+    # fills groups of lanes.LANES samples runs them in vector form (run_lanes)
+    if stepped_on(plan) == "gpu":
+        from railride.engine import gpu
+
+        step_batch = gpu.stepper(_gpu_failed)
+    elif lanes.lanes_fit(n, P, packed.control[7]):
         step_batch = lanes.lanes_stepper(n, packed.law, arrays["A"], arrays["TS"], P, arrays["stops"])
     else:
         step_batch = functools.partial(kernels.run_parallel, kernels.run_batch)
@@ -343,6 +348,21 @@ def step(plan: RunPlan, tables: Inputs, packed: Packed, progress=None) -> Steppe
             raise KeyboardInterrupt
         out = {key: v[:, :rows] if v.shape[1] > 1 else v for key, v in out.items()}
     return Stepped(out, status, fail_step, rows, stop.requested)
+
+
+def stepped_on(plan: RunPlan) -> str:
+    """ "cpu" or "gpu": where the RK4 steps of this run go (the exact steps are always the CPU's)."""
+    return "cpu" if plan.exact else plan.solver.backend_for(plan.n)
+
+
+def _gpu_failed(exc: BaseException) -> None:
+    """A GPU failure during a run: one warning line; the stepper finishes the chunk on the CPU."""
+    import warnings
+
+    from railride.errors import BackendWarning
+
+    text = " ".join(str(exc).split())[:200] or type(exc).__name__
+    warnings.warn(f"the GPU failed ({text}); the run goes on on the CPU", BackendWarning, 2)
 
 
 # -- assemble -------------------------------------------------------------------------------------

@@ -17,6 +17,13 @@ from railride.defaults import DEFAULT_CONTROL_RATE, DEFAULT_DT, DEFAULT_OUTPUT_R
 #: linear, the passive viscous dampers; RK4 otherwise), "rk4" (always the fixed-step RK4) or
 #: "exact" (refused where the suspension is not linear)
 METHODS = ("auto", "rk4", "exact")
+#: where `railride.simulate` steps a batch: "cpu" (the compiled CPU steppers, on every core),
+#: "gpu" (the GPU kernel, `railride.engine.gpu`; an input error where there is none) or "auto"
+#: (the GPU for a batch of at least GPU_MIN_BATCH samples where one is usable, else the CPU)
+BACKENDS = ("auto", "cpu", "gpu")
+#: the smallest batch "auto" sends to a GPU: below it the transfers and the launch outweigh the
+#: stepping (a choice, not yet measured on a GPU; docs/gpu.md)
+GPU_MIN_BATCH = 4096
 #: a random track's shortest wavelength must pass at speed / min_wavelength <= output_rate /
 #: RESOLUTION: a component above that shows in the stored histories only as a few samples a cycle
 RESOLUTION = 2.5
@@ -33,7 +40,10 @@ class SolverSettings:
     """The fixed RK4 step ``dt`` [s], the rate of the stored time histories ``output_rate``
     [Hz], the sample rate of the outer-loop controllers ``control_rate`` [Hz] and the
     integration ``method`` (`METHODS`; default "auto": exact discretisation for the passive
-    viscous suspension, one step per output sample, where dt only sets the input grid).
+    viscous suspension, one step per output sample, where dt only sets the input grid), and the
+    ``backend`` that steps a batch (`BACKENDS`; default "auto": a GPU for batches of at least
+    `GPU_MIN_BATCH` samples where one is usable; "gpu" is refused at construction where none is,
+    saying whether the extra or the device is missing).
 
     Checked at construction: each a finite number > 0, and the output interval 1/output_rate
     a whole number of steps (at most one output sample per step). The controller period
@@ -47,11 +57,19 @@ class SolverSettings:
     output_rate: float = DEFAULT_OUTPUT_RATE
     control_rate: float = DEFAULT_CONTROL_RATE
     method: str = "auto"
+    backend: str = "auto"
 
     def __post_init__(self):
         for name, unit in (("dt", "s"), ("output_rate", "Hz"), ("control_rate", "Hz")):
             object.__setattr__(self, name, validation.number(name, getattr(self, name), "positive", unit))
         validation.choice("method", self.method, METHODS)
+        validation.choice("backend", self.backend, BACKENDS)
+        if self.backend == "gpu":
+            missing = gpu_missing()
+            if missing is not None:
+                raise InputError(
+                    f"backend = 'gpu': {missing}; use backend 'cpu', or 'auto' (the GPU where there is one)"
+                )
         if self.dt * self.output_rate > 1.0 + 1e-6:
             raise InputError(
                 f"dt = {self.dt:g} s is too large for output_rate = {self.output_rate:g} Hz: "
@@ -96,7 +114,27 @@ class SolverSettings:
         out: dict = {"dt_s": self.dt, "output_rate_hz": self.output_rate, "control_rate_hz": self.control_rate}
         if self.method != "auto":
             out["method"] = self.method
+        if self.backend != "auto":
+            out["backend"] = self.backend
         return out
+
+    def backend_for(self, n: int) -> str:
+        """ "cpu" or "gpu": where a batch of n samples steps under these settings (`BACKENDS`).
+        "auto" with a batch of `GPU_MIN_BATCH` or more and no usable GPU warns once
+        (`railride.errors.BackendWarning`) and takes the CPU."""
+        if self.backend != "auto":
+            return self.backend
+        if n < GPU_MIN_BATCH:
+            return "cpu"
+        missing = gpu_missing()
+        if missing is None:
+            return "gpu"
+        import warnings
+
+        from railride.errors import BackendWarning
+
+        warnings.warn(f"backend auto: {missing}; large batches run on the CPU", BackendWarning, 2)
+        return "cpu"
 
     @classmethod
     def of(cls, solver) -> "SolverSettings":
@@ -106,6 +144,14 @@ class SolverSettings:
         if not isinstance(solver, cls):
             raise InputError(f"solver = {solver!r}: must be a railride.SolverSettings or None (the defaults)")
         return solver
+
+
+def gpu_missing() -> str | None:
+    """None where the GPU stepper can run; otherwise what is missing (the gpu extra, or a CUDA
+    device and driver), in words."""
+    from railride.engine.gpu import why_not
+
+    return why_not()
 
 
 def shortest_wavelength(track) -> tuple[str, float] | None:

@@ -1,4 +1,4 @@
-"""The secondary bump stops (`VehicleParams.z_stop`, `k_stop`; `railride.engine.kernels.stop_force`):
+"""The secondary bump stops (`VehicleParams.z_stop`, `k_stop`; `railride.engine.laws.stop_force`):
 against a second method (SciPy's adaptive integrator on the same equations), invariants (no
 contact, no change; the lane stepper and the sample stepper agree), the exact discretisation
 handing over to RK4 at contact, and step halving."""

@@ -9,7 +9,7 @@ from hypothesis import given, settings, strategies as st
 from railride import dampers
 
 from railride.run import rig
-from railride.engine.kernels import damper_law
+from railride.engine.laws import damper_law
 from railride.testing.reference import rig_reference, simulate_reference
 from railride.run.simulation import simulate
 from railride.secondary.suspension import Suspension
@@ -109,7 +109,7 @@ def test_spencer_force_rolls_off_at_low_velocity_where_bouc_wen_does_not():
 
 @pytest.mark.parametrize("name", list(MODELS))
 def test_step_halving_converges_at_the_default_step(name):
-    # Halve dt from the default 1e-4 s (sub-steps shrink in proportion, see kernels.substeps).
+    # Halve dt from the default 1e-4 s (sub-steps shrink in proportion, see laws.substeps).
     # The Bouc-Wen law has kinks (|x'| at stroke reversals, |z| at z = 0 for n = 1), where RK4
     # loses its fourth order and the gain per halving depends on where a kink falls in a step:
     # require a smaller error at every halving, at least first order over three, and a small

@@ -10,7 +10,7 @@ import pytest
 from numba.core import event
 
 import railride as rr
-from railride.engine import compiled, kernels, lanes
+from railride.engine import compiled, kernels, lanes, laws
 
 
 def test_an_empty_cache_means_compiling(tmp_path):
@@ -40,7 +40,7 @@ def _compile_event(dispatcher):
 def test_watch_hears_the_stepper_compile_only():
     heard: list[str] = []
     with compiled.watch_compiles(heard.append):
-        with _compile_event(kernels.substeps):  # compiles in well under a second: unannounced
+        with _compile_event(laws.substeps):  # compiles in well under a second: unannounced
             pass
         with _compile_event(kernels.run_batch):
             pass
