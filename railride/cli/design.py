@@ -63,6 +63,8 @@ DESIGN_FIELDS = {
     "values": "--values",
     "aggregate": "--aggregate",
     "objective": "--objective",
+    "optimiser": "--optimiser",
+    "optimiser_seed": "--optimiser-seed",
     **FIXED_RATE_FIELDS,
 }
 #: chunks that step beside the one whose rows are made (`LocalExecutor`): none for the design
@@ -128,6 +130,7 @@ def _tables(doc: dict) -> list:
     from rich.text import Text
 
     from railride.cli._width import FitTable, Split
+    from railride.studies.design_result import optimiser_text
     from railride.model.params import vehicle_text
     from railride.secondary.control import LABELS
 
@@ -226,6 +229,7 @@ def _tables(doc: dict) -> list:
         f"{', '.join(f'{x:g}' for x in s['loads'])}; {s['duration_s']:g} s a run. Tuned on seeds "
         f"{', '.join(map(str, s['train_seeds']))} ({s['training_runs_per_gain_set']} runs per gain set, the "
         f"{s['aggregate']} objective, at most {s['budget']} gain sets per law); judged on seeds {seeds}.",
+        f"Tuned by {optimiser_text(s)}.",
         vehicle_text(s["vehicle"]) + f"; {s['damper'] if isinstance(s['damper'], str) else 'own'} dampers.",
         f"{doc['runs']['training']} training and {doc['runs']['judging']} held-out runs"
         + (
@@ -303,6 +307,19 @@ def design_command(
             help="A gain set's objective over the training runs: their mean, or the worst.",
         ),
     ] = "mean",
+    optimiser: Annotated[
+        str,
+        typer.Option(
+            "--optimiser",
+            metavar="sensitivity|evolution",
+            help="How each law's gains are tuned within the budget: the paper's one-at-a-time sensitivity "
+            "study, or differential evolution over all of a law's gains at once (SciPy).",
+        ),
+    ] = "sensitivity",
+    optimiser_seed: Annotated[
+        int,
+        typer.Option("--optimiser-seed", metavar="N", help="The seed of the evolution (with --optimiser evolution)."),
+    ] = 0,
     objective_kind: ObjectiveOption = None,
     weights: WeightsOption = None,
     bound: BoundOption = None,
@@ -365,6 +382,8 @@ def design_command(
             aggregate=aggregate,
             budget=budget,
             values=values,
+            optimiser=optimiser.strip(),
+            optimiser_seed=optimiser_seed,
             train_seeds=train,
             test_seeds=test,
             duration=duration,

@@ -36,6 +36,8 @@ from railride.studies.design_result import (
     rank,
     recommend,
 )
+from railride.studies.design_result import diverged_laws as _diverged
+from railride.studies import evolution
 from railride.studies.objectives import DEFAULT_OBJECTIVE, OBJECTIVE_KINDS, TRAVEL_COLUMN, Objective
 from railride.studies.sweep import Case, RunTable, run_cases
 from railride.studies.tuning import PARAMETERS, STAGES, TUNED_CONTROLLERS, TuningCase, tune
@@ -81,6 +83,10 @@ class Plan:
     solver: Any
     #: a measured profile's sections: track -> (the first section's start, a section's length) [m]
     sections: dict = field(default_factory=dict)
+    #: how each law's gains are tuned (`railride.studies.evolution.OPTIMISERS`) and the seed of
+    #: the evolution
+    optimiser: str = "sensitivity"
+    optimiser_seed: int = 0
 
     def track_options(self, track: str, seed: int) -> tuple:
         """The scenario options that make "seed" ``seed`` of ``track``: a random track's
@@ -174,6 +180,8 @@ def check_design(
     duration: float = DEFAULT_DURATION,
     damper=DEFAULT_DAMPER,
     solver=None,
+    optimiser: str = "sensitivity",
+    optimiser_seed: int = 0,
 ) -> Plan:
     """Every input of `design`, checked before any work: an `InputError` names the option, the
     value and what is allowed. Returns the `Plan`."""
@@ -186,6 +194,8 @@ def check_design(
     from railride.secondary.suspension import Suspension, damper_model
     from railride.studies.tuning import AGGREGATES
 
+    optimiser = validation.choice("optimiser", optimiser, evolution.OPTIMISERS)
+    optimiser_seed = validation.seed("optimiser_seed", optimiser_seed)
     laws = _laws(controllers)
     base, source = resolve_argument(vehicle, None)
     rule = "a finite number > 0 (load factor)"
@@ -221,7 +231,10 @@ def check_design(
         f"gain sets per law: fewer cannot try every gain once; {worst} has {len(PARAMETERS[worst])} gains, "
         f"swept with {values} values and 0 each"
     )
-    budget = validation.integer("budget", budget, need[worst], what=what)
+    if optimiser == "evolution":  # the sweeps' values do not apply
+        budget = validation.integer("budget", budget, evolution.MIN_BUDGET, what=evolution.BUDGET_RULE)
+    else:
+        budget = validation.integer("budget", budget, need[worst], what=what)
     model = damper_model(damper, 1.0)  # a known name or a model
     solver = SolverSettings.of(solver)
     # every held-out run, checked by the check every simulation makes before the first run of the
@@ -251,6 +264,8 @@ def check_design(
         damper,
         solver,
         sections,
+        optimiser,
+        optimiser_seed,
     )
 
 
@@ -293,6 +308,8 @@ def design(
     duration: float = DEFAULT_DURATION,
     damper=DEFAULT_DAMPER,
     solver=None,
+    optimiser: str = "sensitivity",
+    optimiser_seed: int = 0,
     executor=None,
     table: RunTable | None = None,
     progress=None,
@@ -308,7 +325,10 @@ def design(
     `DEFAULT_OBJECTIVE`, the worst RMS ratio to passive) combined over those runs by
     ``aggregate`` ("mean" or "worst"), at most ``budget`` gain sets per law with ``values``
     values per gain and sweep, from the neutral reference gains; the inner loop first, on the
-    damper rig, when a law tracks a force and the damper is an MR damper.
+    damper rig, when a law tracks a force and the damper is an MR damper. ``optimiser``:
+    "sensitivity" (that study) or "evolution" (SciPy's differential evolution over all of a
+    law's gains at once, seeded by ``optimiser_seed``, within the same budget:
+    `railride.studies.evolution`); either way every law's candidates of a round are one batch.
 
     Judging: every law with its tuned gains and passive on every track x ``test_seeds`` x speed
     x load (seeds that tuning never saw). ``executor``, ``table`` (one `RunTable` for both
@@ -336,6 +356,8 @@ def design(
         duration=duration,
         damper=damper,
         solver=solver,
+        optimiser=optimiser,
+        optimiser_seed=optimiser_seed,
     )
     table = RunTable() if table is None else table
     if executor is None:  # one chunk at a time: two at once took the default design above 2 GiB
@@ -367,6 +389,8 @@ def design(
         progress=progress,
         log=log,
         before_after=False,
+        optimiser=plan.optimiser,
+        optimiser_seed=plan.optimiser_seed,
     )
     training = _training_frame(tuned.runs, plan)
     runs = _judge(plan, tuned.gains, executor, table, progress)
@@ -389,6 +413,7 @@ def design(
         "controllers": list(plan.laws),
         "objective": plan.objective.to_dict(),
         "aggregate": plan.aggregate,
+        "optimiser": tuned.settings.get("optimiser", {"name": "sensitivity"}),
         "budget": plan.budget,
         "values": plan.values,
         "train_seeds": list(plan.train_seeds),
@@ -438,16 +463,6 @@ def _versions() -> dict:
 def _options(plan: Plan, track: str, seed: int, speed: float) -> tuple:
     """The scenario options of one run: the track's seed or section, the speed, the duration."""
     return tuple(sorted((*plan.track_options(track, seed), ("speed", speed), ("duration", plan.duration))))
-
-
-def _seed_of(plan: Plan, row) -> int | None:
-    """The design's seed of a run-table row: its track seed, or its measured section's index."""
-    track = str(row["scenario"])
-    if track in plan.sections:
-        first, length = plan.sections[track]
-        return int(round((float(row["scenario.start"]) - first) / length))
-    seed = row.get("scenario.seed")
-    return None if seed is None or seed != seed else int(seed)
 
 
 def _training_frame(frame: pd.DataFrame | None, plan: Plan) -> pd.DataFrame:
@@ -567,50 +582,6 @@ def _summary(runs: pd.DataFrame, plan: Plan, laws=None) -> pd.DataFrame:
                         }
                     )
     return pd.DataFrame(out)
-
-
-#: the most places a law's divergence is listed at (the count is always given)
-MAX_PLACES = 5
-
-
-def _diverged(tuned, training: pd.DataFrame, runs: pd.DataFrame, plan: Plan) -> list[dict]:
-    """The laws that diverged: in tuning, where the tuned gains' objective over the training
-    runs is not finite (a training run with them diverged), with the training runs of that law
-    that diverged; on held-out track, every law (or passive) with a held-out run that diverged.
-    Each: controller, stage, the number of runs that diverged and up to `MAX_PLACES` of them
-    (track, seed, speed, load where known, time)."""
-    out = []
-    for st in tuned.studies:
-        if st.controller == "inner" or np.isfinite(st.objective):
-            continue
-        part = training[training["suspension"] == st.controller] if len(training) else training
-        if len(part):
-            part = part[np.isfinite(part["diverged_at_s"].astype(float))]
-        places = [
-            {
-                "track": str(r["scenario"]),
-                "track_seed": _seed_of(plan, r),
-                "speed_m_s": float(r["scenario.speed"]),
-                "load": None,
-                "diverged_at_s": float(r["diverged_at_s"]),
-            }
-            for _, r in part.head(MAX_PLACES).iterrows()
-        ]
-        out.append({"controller": st.controller, "stage": "tuning", "runs": int(len(part)), "where": places})
-    bad = runs[np.isfinite(runs["diverged_at_s"])]
-    for name, part in bad.groupby("controller", sort=False):
-        places = [
-            {
-                "track": str(r.track),
-                "track_seed": int(r.track_seed),
-                "speed_m_s": float(r.speed_m_s),
-                "load": float(r.load),
-                "diverged_at_s": float(r.diverged_at_s),
-            }
-            for r in part.head(MAX_PLACES).itertuples()
-        ]
-        out.append({"controller": str(name), "stage": "judging", "runs": int(len(part)), "where": places})
-    return out
 
 
 __all__ = ["COST_COLUMNS", "DesignResult", "check_design", "design", "min_budget"]

@@ -174,6 +174,7 @@ class DesignResult:
             f"tracks = {json.dumps(list(s['tracks']))}",
             f"speeds_m_s = {json.dumps(list(s['speeds_m_s']))}",
             f"loads = {json.dumps(list(s['loads']))}",
+            f"optimiser = {json.dumps(optimiser_text(s))}",
             f"recommended = {json.dumps(self.recommended or '')}",
             f"ranking = {json.dumps([r['controller'] for r in ranked])}",
             "scores = {" + ", ".join(f"{json.dumps(r['controller'])} = {float(r['score'])!r}" for r in ranked) + "}",
@@ -211,6 +212,14 @@ class DesignResult:
         doc = {**self.to_dict(), **(extra or {})}
         figures = FigureOptions(figure_formats, dpi)
         return write_design_outputs(self, folder, doc, self.gains_toml(command), figures=figures)
+
+
+def optimiser_text(settings: dict) -> str:
+    """How a design's gains were tuned, in a few words (its ``settings["optimiser"]``)."""
+    o = settings.get("optimiser") or {"name": "sensitivity"}
+    if o["name"] == "evolution":
+        return f"differential evolution over all of a law's gains at once (SciPy, seed {o['seed']})"
+    return "the one-at-a-time sensitivity study (the paper's)"
 
 
 def _plain(value):
@@ -452,6 +461,61 @@ def _passive_unbeaten(points, some_diverged: bool) -> str:
         + "; ".join(f"{w} at {', '.join(where)}" for w, where in by_response.items())
         + "."
     )
+
+
+# -- the laws that diverged (`railride.studies.design.design`) -----------------------------------
+def seed_of(plan, row) -> int | None:
+    """The design's seed of a run-table row: its track seed, or its measured section's index."""
+    track = str(row["scenario"])
+    if track in plan.sections:
+        first, length = plan.sections[track]
+        return int(round((float(row["scenario.start"]) - first) / length))
+    seed = row.get("scenario.seed")
+    return None if seed is None or seed != seed else int(seed)
+
+
+#: the most places a law's divergence is listed at (the count is always given)
+MAX_PLACES = 5
+
+
+def diverged_laws(tuned, training: pd.DataFrame, runs: pd.DataFrame, plan) -> list[dict]:
+    """The laws that diverged: in tuning, where the tuned gains' objective over the training
+    runs is not finite (a training run with them diverged), with the training runs of that law
+    that diverged; on held-out track, every law (or passive) with a held-out run that diverged.
+    Each: controller, stage, the number of runs that diverged and up to `MAX_PLACES` of them
+    (track, seed, speed, load where known, time)."""
+    out = []
+    for st in tuned.studies:
+        if st.controller == "inner" or np.isfinite(st.objective):
+            continue
+        part = training[training["suspension"] == st.controller] if len(training) else training
+        if len(part):
+            part = part[np.isfinite(part["diverged_at_s"].astype(float))]
+        places = [
+            {
+                "track": str(r["scenario"]),
+                "track_seed": seed_of(plan, r),
+                "speed_m_s": float(r["scenario.speed"]),
+                "load": None,
+                "diverged_at_s": float(r["diverged_at_s"]),
+            }
+            for _, r in part.head(MAX_PLACES).iterrows()
+        ]
+        out.append({"controller": st.controller, "stage": "tuning", "runs": int(len(part)), "where": places})
+    bad = runs[np.isfinite(runs["diverged_at_s"])]
+    for name, part in bad.groupby("controller", sort=False):
+        places = [
+            {
+                "track": str(r.track),
+                "track_seed": int(r.track_seed),
+                "speed_m_s": float(r.speed_m_s),
+                "load": float(r.load),
+                "diverged_at_s": float(r.diverged_at_s),
+            }
+            for r in part.head(MAX_PLACES).itertuples()
+        ]
+        out.append({"controller": str(name), "stage": "judging", "runs": int(len(part)), "where": places})
+    return out
 
 
 def dumps(result: DesignResult) -> str:

@@ -34,7 +34,8 @@ from railride.run.solver import SolverSettings
 from railride.studies.sweep import Case, RunTable, run_cases
 from railride.studies.objectives import DEFAULT_OBJECTIVE, RMS_COLUMNS, Objective
 from railride.plots import PNG_DPI, FigureOptions
-from railride.studies.tuning import PARAMETERS, REFERENCE, _rms
+from railride.studies.evolution import log_gain_bounds  # noqa: F401 (re-exported: its home before)
+from railride.studies.tuning import PARAMETERS, _rms
 from railride.secondary.suspension import damper_record
 
 #: the paper's fourteen SAS parameters
@@ -45,11 +46,6 @@ SCHEMA_SENSITIVITY = "railride.sensitivity/1"
 #: the files `OptimiseResult.save` and `SensitivityResult.save` write, in this order
 OPTIMISE_FILES = ("optimise.png", "optimise.csv", "optimise.json")
 SENSITIVITY_FILES = ("sobol.png", "sobol.csv", "sobol.json")
-
-
-def log_gain_bounds(parameters):
-    """(low, high) log10 of each parameter: REFERENCE / 1000 to REFERENCE x 100."""
-    return [(math.log10(REFERENCE[p] / 1e3), math.log10(REFERENCE[p] * 1e2)) for p in parameters]
 
 
 class GainEvaluator:

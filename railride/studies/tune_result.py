@@ -44,7 +44,12 @@ class Study:
     ``passes`` begun, the objective at the start and at the end, the sweep's span factor at
     the end, and why it stopped (``stopped``: "budget", the next sweep would not fit, or
     "converged", the span narrowed below the study's floor). For "inner" (the force-tracking
-    loop on the damper rig) ``runs`` counts rig evaluations and ``budget`` is None."""
+    loop on the damper rig) ``runs`` counts rig evaluations and ``budget`` is None.
+
+    ``optimiser``: "sensitivity" (the study above) or "evolution" (differential evolution,
+    `railride.studies.evolution`): then ``passes`` counts generations, ``population`` is the
+    gain sets of one, ``seed`` its seed, ``convergence`` per generation the runs done by its
+    end and the best objective so far, ``span`` is NaN, and ``stopped`` is "budget"."""
 
     controller: str
     entries: tuple
@@ -55,9 +60,15 @@ class Study:
     objective: float = float("nan")
     span: float = float("nan")
     stopped: str = ""
+    optimiser: str = "sensitivity"
+    population: int | None = None
+    seed: int | None = None
+    convergence: list = field(default_factory=list)
 
     def to_dict(self) -> dict:
-        return {
+        """The study's record; an evolution's also has ``optimiser``, ``population``, ``seed``
+        and ``convergence`` (per generation: ``generation``, ``runs``, ``objective``)."""
+        out = {
             "controller": self.controller,
             "entries": list(self.entries),
             "budget": self.budget,
@@ -65,9 +76,20 @@ class Study:
             "passes": self.passes,
             "objective_start": _finite(self.objective_start),
             "objective": _finite(self.objective),
-            "span": self.span,
+            "span": _finite(self.span),
             "stopped": self.stopped,
         }
+        if self.optimiser != "sensitivity":
+            out.update(
+                optimiser=self.optimiser,
+                population=self.population,
+                seed=self.seed,
+                convergence=[
+                    {"generation": i + 1, "runs": int(runs), "objective": _finite(best)}
+                    for i, (runs, best) in enumerate(self.convergence)
+                ],
+            )
+        return out
 
 
 @dataclass(frozen=True, eq=False)
@@ -159,9 +181,18 @@ class TuneResult:
         statement = self.objective.describe()
         tool = "railride tune" if command is not None else "railride.studies.tuning.tune"
         laws = [st for st in self.studies if st.controller != "inner"]
+        evolution = s.get("optimiser", {}).get("name") == "evolution"
+        how = (
+            ["# differential evolution (Storn and Price 1997; SciPy), objective and budget of vehicle runs"]
+            if evolution
+            else [
+                "# one-at-a-time",
+                "# sensitivity study (the paper's section V), objective and budget of vehicle runs",
+            ]
+        )
         lines = [
-            f"# railride controller gains, tuned by `{tool}`: every law by the same one-at-a-time",
-            "# sensitivity study (the paper's section V), objective and budget of vehicle runs",
+            f"# railride controller gains, tuned by `{tool}`: every law by the same{how[0][1:]}",
+            *how[1:],
             "# (docs/tuning.md). Read by `railride compare --gains FILE`.",
             *([f"# command: {command}"] if command is not None else []),
             f"# date: {doc['date']}; railride {doc['railride_version']}",
@@ -179,11 +210,7 @@ class TuneResult:
             *textwrap.wrap(
                 f"study: each law from the start values, with at most {s['budget']} "
                 + (f"gain sets ({len(s['tuning_set'])} runs each)" if "tuning_set" in s else "vehicle runs")
-                + "; per gain "
-                f"and pass {s['values']} values from 1/{s['span']:g} to {s['span']:g} x the current value "
-                f"(and 0); a pass that improves by less than {s['tolerance'] * 100:g} % narrows the span to "
-                f"its square root; a study ends when its next sweep would not fit the budget "
-                f"(budget) or the span falls below {s['min_span']:g} (converged)",
+                + (self._evolution_text() if evolution else self._sensitivity_text()),
                 98,
                 initial_indent="# ",
                 subsequent_indent="#   ",
@@ -195,15 +222,20 @@ class TuneResult:
             ),
             *[
                 f"#   {st.controller}: {len(st.entries)} gain{'s' * (len(st.entries) != 1)}, {st.runs} runs, "
-                f"{st.passes} pass{'es' * (st.passes != 1)}, "
-                f"objective {st.objective_start:.4g} -> {st.objective:.4g} ({st.stopped})"
+                + (
+                    f"{st.passes} generation{'s' * (st.passes != 1)} of {st.population}, "
+                    if st.optimiser == "evolution"
+                    else f"{st.passes} pass{'es' * (st.passes != 1)}, "
+                )
+                + f"objective {st.objective_start:.4g} -> {st.objective:.4g} ({st.stopped})"
                 for st in laws
             ],
             f"# start values: {s['start_gains']}",
             "# Units: SI. Forces are desired forces on the carbody (up +) at corners 1R, 1L, 2R, 2L.",
             "",
             "[provenance]",
-            f"method = {json.dumps(f'{tool} (one-at-a-time sensitivity study, equal budget per law)')}",
+            f"method = {json.dumps(f'{tool} ({self._method()}, equal budget per law)')}",
+            *([f"optimiser = {_toml_inline(s['optimiser'])}"] if evolution else []),
             f"date = {json.dumps(doc['date'])}",
             f"railride_version = {json.dumps(doc['railride_version'])}",
             f"scenario = {json.dumps(run_text)}",
@@ -240,7 +272,11 @@ class TuneResult:
         for st in self.studies:
             d = st.to_dict()
             lines.append(f"[provenance.studies.{st.controller}]")
-            lines += [f"{k} = {_toml_value(v)}" for k, v in d.items() if k != "controller" and v is not None]
+            lines += [
+                f"{k} = {_toml_value(v)}"
+                for k, v in d.items()
+                if k not in ("controller", "convergence") and v is not None
+            ]
             lines.append("")
         lines.append(self.gains.to_toml())
         return "\n".join(lines)
@@ -282,6 +318,29 @@ class TuneResult:
         doc = {**self.to_dict(), **(extra or {})}
         gains = self.gains_toml(command)
         return write_tune_outputs(self.curves, folder, doc, gains, title=self._title(), figures=figures)
+
+    def _method(self) -> str:
+        if self.settings.get("optimiser", {}).get("name") == "evolution":
+            return "differential evolution over each law's gains at once"
+        return "one-at-a-time sensitivity study"
+
+    def _sensitivity_text(self) -> str:
+        s = self.settings
+        return (
+            f"; per gain and pass {s['values']} values from 1/{s['span']:g} to {s['span']:g} x the current value "
+            f"(and 0); a pass that improves by less than {s['tolerance'] * 100:g} % narrows the span to "
+            f"its square root; a study ends when its next sweep would not fit the budget "
+            f"(budget) or the span falls below {s['min_span']:g} (converged)"
+        )
+
+    def _evolution_text(self) -> str:
+        o = self.settings["optimiser"]
+        return (
+            f"; the start, then SciPy's differential evolution ({o['strategy']}, mutation "
+            f"{o['mutation'][0]:g}-{o['mutation'][1]:g}, recombination {o['recombination']:g}, seed {o['seed']}) "
+            f"over all of a law's gains at once, each in log10 from 1/1000 to 100 x its reference value; a "
+            f"population of {o['population']}; generations: {o['generations']}; the best gain set scored is kept"
+        )
 
     def _case_lines(self) -> list[str]:
         """The [provenance] lines of the case it tuned for: ``vehicle`` (the name of its record),

@@ -52,6 +52,8 @@ from railride.secondary import dampers
 from railride import limits, validation
 from railride.run.checks import check
 from railride.run.solver import SolverSettings
+from railride.studies import evolution
+from railride.studies.lockstep import OwnChunks, lockstep
 from railride.studies.sweep import Case, RunTable, run_cases
 from railride.studies.tune_result import SCHEMA, Curve, Study, TuneResult  # noqa: F401 (their home before)
 from railride.secondary.suspension import Suspension, damper_record
@@ -185,6 +187,8 @@ def tune(
     before_after: bool = True,
     over=None,
     aggregate: str = "mean",
+    optimiser: str = "sensitivity",
+    optimiser_seed: int = 0,
 ) -> TuneResult:
     """Tune ``controllers`` (names from `TUNABLE`; default all: the inner loop, then every law)
     from ``gains`` (default the neutral `GainSet.reference`), minimising ``objective`` (default
@@ -212,7 +216,14 @@ def tune(
     factors) in place of ``scenario``: each gain set is scored on every case, against the
     passive run of the same case, and the case objectives become one by ``aggregate`` ("mean"
     or "worst"). The budget still counts gain sets; each costs one run per case. No
-    before/after rows (they belong to one scenario). Returns a `TuneResult`.
+    before/after rows (they belong to one scenario).
+
+    ``optimiser``: "sensitivity" (the study above) or "evolution": SciPy's differential
+    evolution over all of a law's gains at once, in the log10 box of
+    `railride.studies.optimise`, with the same objective, runs and budget
+    (`railride.studies.evolution`; ``optimiser_seed`` seeds it; ``n_values``, ``span``, ``tol``
+    and ``min_span`` are the study's and do not apply). Either way the laws step together: each
+    round's gain sets of every law are one batch of runs (`lockstep`). Returns a `TuneResult`.
     """
     from railride.secondary.suspension import damper_model
     from railride.studies.sweep import other_settings
@@ -232,10 +243,15 @@ def tune(
             "tune; leave out the inner loop"
         )
     damper_scale = dampers.check_scale("damper_scale", damper_scale)
+    validation.choice("optimiser", optimiser, evolution.OPTIMISERS)
+    optimiser_seed = validation.seed("optimiser_seed", optimiser_seed)
     validation.integer("n_values", n_values, 3)
     # room for the start and one whole sweep (the values and 0): a smaller budget tunes nothing
     what = f"the start run and one sweep of {n_values} values and 0"
-    budget = validation.integer("budget", budget, n_values + 2, what=what)
+    if optimiser == "evolution":  # the sweeps' values do not apply
+        budget = validation.integer("budget", budget, evolution.MIN_BUDGET, what=evolution.BUDGET_RULE)
+    else:
+        budget = validation.integer("budget", budget, n_values + 2, what=what)
     limits.check(
         CANDIDATE_BYTES * n_values,
         f"a sweep of {n_values} candidate values",
@@ -277,6 +293,7 @@ def tune(
             "tolerance": float(tol),
             "min_span": float(min_span),
             "start_gains": gains.source,
+            **({"optimiser": evolution.record(optimiser_seed)} if optimiser == "evolution" else {}),
             "vehicle": vehicle_record(vehicle, source, list(dict.fromkeys(c.load for c in cases_set))),
             **other_settings(vehicle, solver),
             **(
@@ -295,7 +312,7 @@ def tune(
     vehicle_name = result.settings["vehicle"]["name"]
     load_of = {Case(vehicle=ld).vehicle: float(c.load) for c, ld in zip(cases_set, loads)}
 
-    def run(cases):
+    def run(cases, executor=executor):
         return run_cases(
             cases,
             executor=executor,
@@ -332,20 +349,30 @@ def tune(
             gains=gains,
         )
 
+    def score(asked: dict) -> dict:
+        """The objective of every gain set asked, by law: one batch of runs for all of them."""
+        k = len(cases_set)
+        parts = [[case(name, cs, j) for cs in sets for j in range(k)] for name, sets in asked.items()]
+        rows = run([c for part in parts for c in part], executor=OwnChunks(executor, parts))
+        out, at = {}, 0
+        for name, sets in asked.items():
+            # each law's rows, change set by change set, each over the k cases: case j's are j, j + k, ...
+            part, at = rows.iloc[at : at + len(sets) * k], at + len(sets) * k
+            per_case = np.stack([objective.of_runs(part.iloc[j::k], passive_rows.iloc[j]) for j in range(k)], axis=1)
+            out[name] = per_case.mean(axis=1) if aggregate == "mean" else per_case.max(axis=1)
+        return out
+
+    laws = [name for name in controllers if name != "inner"]
+    if optimiser == "evolution":
+        searches = {n: evolution.search(n, PARAMETERS[n], _start(n, gains), budget, optimiser_seed, log) for n in laws}
+    else:
+        searches = {n: _study(n, gains, budget, n_values, float(span), tol, min_span, log) for n in laws}
     tuned: dict[str, dict] = {}  # each law's gains as its study left them
-    for name in controllers:
-        if name == "inner":
-            continue
-
-        def score(change_sets, name=name):
-            k = len(cases_set)
-            rows = run([case(name, cs, j) for cs in change_sets for j in range(k)])
-            # rows run change set by change set, each over the k cases: case j's are j, j + k, ...
-            per_case = np.stack([objective.of_runs(rows.iloc[j::k], passive_rows.iloc[j]) for j in range(k)], axis=1)
-            return per_case.mean(axis=1) if aggregate == "mean" else per_case.max(axis=1)
-
-        study, tuned[name] = _study(name, gains, score, budget, n_values, float(span), tol, min_span, result, log)
+    for name, (study, tuned[name], *traces) in lockstep(searches, score).items():
         result.studies.append(study)
+        if traces:  # the sensitivity study's curves and passes, law by law
+            result.curves.extend(traces[0])
+            result.history.extend(traces[1])
     tuned_gains = gains.apply({**inner, **{k: v for own in tuned.values() for k, v in own.items()}})
     result = dataclasses.replace(result, gains=tuned_gains)
     if before_after and over is None:
@@ -353,14 +380,25 @@ def tune(
     return dataclasses.replace(result, runs=table.frame, date=_utc_now())
 
 
-def _study(name, start, score, budget, n_values, start_span, tol, min_span, result, log) -> tuple[Study, dict]:
-    """One law's study: passes over its gains until the budget or the span runs out. Returns
-    the `Study` and the law's gains at the end, by "table.entry"."""
+def _start(name: str, start: GainSet) -> dict:
+    """Every gain of law ``name`` where its study starts, by "table.entry": ``start``'s, the ride
+    loop of SAS (attitude+ride) at zero (the paper's phase 2)."""
+    own = dict.fromkeys(GainSet.entry_names("ride"), 0.0) if name == "sas-attitude-ride" else {}
+    return {e: own.get(e, start.value(e)) for e in PARAMETERS[name]}
+
+
+def _study(name, start, budget, n_values, start_span, tol, min_span, log):
+    """One law's study, as a generator (`lockstep`): passes over its gains until the budget or
+    the span runs out; yields the gain sets of each sweep (each every gain of the law, by
+    "table.entry") and receives their objectives. Returns the `Study`, the law's gains at the
+    end (by "table.entry"), its `Curve` list and its history (the objective after each pass)."""
     entries = PARAMETERS[name]
     own: dict[str, float] = {}
     if name == "sas-attitude-ride":  # the paper's phase 2: the ride loop joins with zero gains
         own.update(dict.fromkeys(GainSet.entry_names("ride"), 0.0))
     study = Study(name, entries, budget, span=start_span)
+    curves: list[Curve] = []
+    history: list[dict] = []
 
     def value(p):
         return own.get(p, start.value(p))
@@ -373,7 +411,7 @@ def _study(name, start, score, budget, n_values, start_span, tol, min_span, resu
         return tuple(sorted(full(change).items()))
 
     seen = {key({})}
-    best = float(score([full({})])[0])
+    best = float((yield [full({})])[0])
     study.runs, study.objective_start = 1, best
     stages = STAGES.get(name, (entries,))
     for k, stage in enumerate(stages):
@@ -389,16 +427,16 @@ def _study(name, start, score, budget, n_values, start_span, tol, min_span, resu
                 if study.runs + len(new) > cap:
                     stopped = "budget"
                     break
-                obj = score([full({p: v}) for v in vals])
+                obj = yield [full({p: v}) for v in vals]
                 study.runs += len(new)
                 seen |= new
                 swept += 1
                 i = int(np.argmin(obj))
                 if obj[i] < best - 1e-12:
                     own[p], best = vals[i], float(obj[i])
-                result.curves.append(Curve(name, study.passes, p, np.array(vals), np.asarray(obj), value(p)))
+                curves.append(Curve(name, study.passes, p, np.array(vals), np.asarray(obj), value(p)))
             if swept:
-                result.history.append(
+                history.append(
                     {"controller": name, "pass": study.passes, "objective": best, "span": span, "runs": study.runs}
                 )
                 if log is not None:
@@ -410,7 +448,7 @@ def _study(name, start, score, budget, n_values, start_span, tol, min_span, resu
                 if span < min_span:
                     stopped = "converged"
     study.objective, study.span, study.stopped = best, span, stopped
-    return study, full({})
+    return study, full({}), curves, history
 
 
 def _before_after(result: TuneResult, run, case, tuned: dict, inner: dict, damper: str) -> list[dict]:

@@ -1,0 +1,72 @@
+"""Every law's tuning in one batch a round (`railride.studies.tuning.tune`).
+
+A law's search (the paper's sensitivity study, or differential evolution:
+`railride.studies.evolution`) is a generator: it yields the gain sets it wants scored and
+receives their objectives. `lockstep` steps the searches of every law together, so that each
+round's gain sets of every law, over every case of the tuning set, are one call of
+`railride.studies.sweep.run_cases`: one pass over the executor's workers, a Dask cluster's
+included.
+
+Each search sees exactly what it would see alone, so its path, and the gains it ends with, do not
+depend on the other laws. So that the runs do not either, to the last bit, `OwnChunks` runs each
+law's cases in the chunks that law's own call of `run_cases` would make: a chunk is one compiled
+batch, and the compiled stepper's results depend on a run's batch-mates in the last bits (the
+lane stepper for batches of `railride.engine.lanes.LANES` runs or more, the scalar one below).
+"""
+
+from __future__ import annotations
+
+
+def lockstep(searches: dict, score) -> dict:
+    """Step the ``searches`` (by law: generators that yield lists of gain sets and receive their
+    objectives) together: each round, one request of every live search goes to ``score`` (a
+    dict of them by law, which it scores in one batch of runs and answers by law), and each
+    answer goes back to its search. Returns what each search returned, in the order given.
+    Searches left unfinished (an error, Ctrl-C) are closed."""
+    asked, done = {}, {}
+    try:
+        for name, gen in searches.items():
+            try:
+                asked[name] = next(gen)
+            except StopIteration as stop:
+                done[name] = stop.value
+        while asked:
+            scores = score(asked)
+            for name in list(asked):
+                try:
+                    asked[name] = searches[name].send(scores[name])
+                except StopIteration as stop:
+                    done[name] = stop.value
+                    del asked[name]
+    finally:
+        for gen in searches.values():
+            gen.close()
+    return {name: done[name] for name in searches}
+
+
+class OwnChunks:
+    """The executor of one `lockstep` round: ``executor`` (default a `LocalExecutor`) runs the
+    chunks of every law in one pass, each law's as its own `run_cases` call of ``parts`` (its
+    cases, in the order asked; one list per law) would chunk them."""
+
+    def __init__(self, executor, parts):
+        from railride.studies.executors import LocalExecutor
+
+        self.executor = LocalExecutor() if executor is None else executor
+        self.parts = parts
+
+    def map(self, fn, chunks):
+        """``executor.map`` of the chunks of each law's cases among those in ``chunks`` (the
+        cases `run_cases` found missing from its table)."""
+        from railride.studies.sweep import CHUNK, _chunks
+
+        pending = {c.key for chunk in chunks for c in chunk}
+        own = []
+        for part in self.parts:
+            seen: set = set()
+            mine = [c for c in part if c.key in pending and not (c.key in seen or seen.add(c.key))]
+            own += _chunks(mine, CHUNK)
+        return self.executor.map(fn, own)
+
+    def close(self) -> None:
+        """Nothing: the executor is the caller's, and closed by it."""
