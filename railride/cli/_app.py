@@ -88,12 +88,14 @@ class RailrideGroup(TyperGroup):
 
 @contextlib.contextmanager
 def _warnings_on_stderr():
-    """A `railride.model.plausible.PlausibilityWarning` (a vehicle outside the typical ranges) as one
-    line "warning: ..." on stderr, once per text, beside the result it qualifies."""
+    """A `railride.model.plausible.PlausibilityWarning` (a vehicle outside the typical ranges) or a
+    `railride.errors.BackendWarning` (the run went on on the CPU) as one line "warning: ..." on
+    stderr, once per text, beside the result it qualifies."""
+    from railride.errors import BackendWarning
     from railride.model.plausible import PlausibilityWarning
 
     def show(message, category, filename, lineno, file=None, line=None):
-        if issubclass(category, PlausibilityWarning):
+        if issubclass(category, (PlausibilityWarning, BackendWarning)):
             typer.echo(f"warning: {message}", err=True)
         else:
             shown(message, category, filename, lineno, file, line)
@@ -101,6 +103,7 @@ def _warnings_on_stderr():
     with warnings.catch_warnings():
         shown = warnings.showwarning
         warnings.simplefilter("default", PlausibilityWarning)
+        warnings.simplefilter("default", BackendWarning)
         warnings.showwarning = show
         yield
 

@@ -145,6 +145,15 @@ RunDurationOption = Annotated[
     Optional[float], typer.Option("--duration", metavar="S", help="Simulated time of each run [s] (default 10).")
 ]
 DtOption = Annotated[Optional[float], typer.Option("--dt", metavar="S", help="Fixed RK4 time step [s] (default 1e-4).")]
+BackendOption = Annotated[
+    Optional[str],
+    typer.Option(
+        "--backend",
+        metavar="auto|cpu|gpu",
+        help="Where batches of runs step: auto (the default: a GPU for batches of 4096 runs or more where one is "
+        "usable), cpu, or gpu (an error where there is none; pip install 'railride[gpu]').",
+    ),
+]
 OutputRateOption = Annotated[
     Optional[float],
     typer.Option(

@@ -117,14 +117,14 @@ def default_of(fn, name: str):
 
 # -- solver settings ------------------------------------------------------------------------------
 #: the library's names of the step and rate options, for its errors (`_common.option_names`)
-SOLVER_FIELDS = {"dt": "--dt", "output_rate": "--output-rate", "control_rate": "--control-rate"}
+SOLVER_FIELDS = {"dt": "--dt", "output_rate": "--output-rate", "control_rate": "--control-rate", "backend": "--backend"}
 #: the solver's fields in a command whose output rate is not an option (sweep, study): the rate is
 #: named in words, not as a setting the user could pass
-FIXED_RATE_FIELDS = {"dt": "--dt", "output_rate": "output rate"}
+FIXED_RATE_FIELDS = {"dt": "--dt", "output_rate": "output rate", "backend": "--backend"}
 
 
 def solver_from_options(**given):
-    """--dt, --output-rate, --control-rate (None: not given) -> a railride.SolverSettings, the
+    """--dt, --output-rate, --control-rate, --backend (None: not given) -> a railride.SolverSettings, the
     others at their defaults; the settings check themselves."""
     from railride.run.solver import SolverSettings
 

@@ -27,6 +27,7 @@ from railride.cli._options import (
     CompareScenarioOption,
     ControlRateOption,
     DpiOption,
+    BackendOption,
     DtOption,
     DurationOption,
     FigureFormatOption,
@@ -521,6 +522,7 @@ def compare(
     ] = None,
     duration: DurationOption = None,
     dt: DtOption = None,
+    backend: BackendOption = None,
     output_rate: OutputRateOption = None,
     window: WindowOption = None,
     vehicle: VehicleOption = None,
@@ -586,7 +588,7 @@ def compare(
                 gains=gains,
                 damper=damper,
                 damper_scale=damper_scale,
-                solver=solver_from_options(dt=dt, output_rate=output_rate, control_rate=control_rate),
+                solver=solver_from_options(dt=dt, output_rate=output_rate, control_rate=control_rate, backend=backend),
                 duration=duration,
                 window=window,
                 vehicle=vehicle,
@@ -607,7 +609,7 @@ def compare(
         damper_preset("--damper", damper)
         scale = parse_scale("--damper-scale", damper_scale)
         noise = _sensor_noise(sensor_noise, seed)
-        solver = solver_from_options(dt=dt, output_rate=output_rate, control_rate=control_rate)
+        solver = solver_from_options(dt=dt, output_rate=output_rate, control_rate=control_rate, backend=backend)
         vehicle_options = vehicle_arguments(vehicle, preset, loads[0] if loads else None)
         window_value = parse_window(window) if window is not None else None
         track = track_options(scenario, seed_value, min_wavelength, max_wavelength)

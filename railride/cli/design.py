@@ -25,6 +25,7 @@ from railride.cli._common import (
 from railride.cli._options import (
     BoundOption,
     DpiOption,
+    BackendOption,
     DtOption,
     FigureFormatOption,
     FormatOption,
@@ -332,6 +333,7 @@ def design_command(
         str, typer.Option("--damper", metavar="MODEL", help="Damper model of the laws.")
     ] = DEFAULT_DAMPER,
     dt: DtOption = None,
+    backend: BackendOption = None,
     workers: WorkersOption = None,
     scheduler: SchedulerOption = None,
     scheduler_file: SchedulerFileOption = None,
@@ -370,7 +372,7 @@ def design_command(
             objective = objective_kind  # the library names what it allows, and knows other spellings
         else:
             objective = _objective(objective_kind, weights, bound, penalty, max_peak, max_travel)
-        solver = solver_from_options(dt=dt)
+        solver = solver_from_options(dt=dt, backend=backend)
         from railride.studies.design import check_design
 
         settings = dict(

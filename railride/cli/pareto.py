@@ -26,6 +26,7 @@ from railride.cli._options import (
     MaxStepsOption,
     AmplitudeOption,
     DpiOption,
+    BackendOption,
     DtOption,
     FigureFormatOption,
     FormatOption,
@@ -67,6 +68,7 @@ from railride.cli._render import RESPONSE_LABELS, damper_text, fmt, warn_gains_m
 #: scenario is built, the sample's after)
 PARETO_FIELDS = {
     "dt": SOLVER_FIELDS["dt"],
+    "backend": SOLVER_FIELDS["backend"],
     **TRACK_FIELDS,
     "suspension": "--suspension",
     "n_samples": "--samples",
@@ -140,6 +142,7 @@ def pareto_command(
     speed: SpeedOption = None,
     duration: RunDurationOption = None,
     dt: DtOption = None,
+    backend: BackendOption = None,
     vehicle: VehicleOption = None,
     preset: PresetOption = None,
     load: LoadOption = None,
@@ -177,7 +180,7 @@ def pareto_command(
         vehicle_options = vehicle_arguments(vehicle, preset, load)
         damper_preset("--damper", damper)
         base = load_gains(gains)
-        solver = solver_from_options(dt=dt)
+        solver = solver_from_options(dt=dt, backend=backend)
         scen, options = study_scenario(
             scenario,
             amplitude=amplitude,

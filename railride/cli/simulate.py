@@ -26,6 +26,7 @@ from railride.cli._options import (
     MaxStepsOption,
     AmplitudeOption,
     ComfortOption,
+    BackendOption,
     DtOption,
     DpiOption,
     DurationOption,
@@ -69,6 +70,7 @@ SUSPENSIONS = ("passive", "mr")
 #: the library's names of simulate's options, for its errors
 SIMULATE_FIELDS = {
     "dt": SOLVER_FIELDS["dt"],
+    "backend": SOLVER_FIELDS["backend"],
     "output_rate": SOLVER_FIELDS["output_rate"],
     "damper": "--damper",
     "damper_scale": "--damper-scale",
@@ -154,6 +156,7 @@ def simulate(
     speed: SpeedOption = None,
     duration: DurationOption = None,
     dt: DtOption = None,
+    backend: BackendOption = None,
     output_rate: OutputRateOption = None,
     window: SimulateWindowOption = None,
     suspension: Annotated[
@@ -215,6 +218,7 @@ def simulate(
             load=load,
             figures=figures,
             histories=histories,
+            backend=backend,
         )
     if "partial" in doc:  # Ctrl-C, what was computed saved in --out
         part = doc["partial"]
@@ -282,6 +286,7 @@ def _run(
     load=None,
     figures=None,
     histories=("nc", "csv"),
+    backend=None,
 ):
     from railride.errors import Interrupted
     from railride.output.files import check_out_dir, write_outputs
@@ -289,7 +294,7 @@ def _run(
     from railride.run.simulation import simulate as run_simulation
 
     with option_names(SIMULATE_FIELDS, not_given(dt=dt, output_rate=output_rate)):
-        solver = solver_from_options(dt=dt, output_rate=output_rate)
+        solver = solver_from_options(dt=dt, output_rate=output_rate, backend=backend)
         vehicle_params, vehicle_record = vehicle_from_options(vehicle, preset, load)
         secondary = _suspension(suspension, damper_name, voltage_text, damper_scale)
         window = parse_window(window_text) if window_text is not None else None

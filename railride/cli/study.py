@@ -27,6 +27,7 @@ from railride.cli._options import (
     MaxMemoryOption,
     MaxStepsOption,
     DpiOption,
+    BackendOption,
     DtOption,
     FigureFormatOption,
     FormatOption,
@@ -238,6 +239,7 @@ def study_command(
         Optional[float], typer.Option("--duration", metavar="S", help="Run length [s] (default 10).")
     ] = None,
     dt: DtOption = None,
+    backend: BackendOption = None,
     window: WindowOption = None,
     vehicle: VehicleOption = None,
     preset: PresetOption = None,
@@ -276,7 +278,7 @@ def study_command(
         delays = value_list("--delay", delay, integer=True)
         damper_preset("--damper", damper)
         gain_set = load_gains(gains)
-        solver = solver_from_options(dt=dt)
+        solver = solver_from_options(dt=dt, backend=backend)
         window_value = parse_window(window) if window is not None else None
         check_report_option(report)
         table, table_path = open_run_table(out, resume)

@@ -32,6 +32,7 @@ from railride.cli._options import (
     MaxMemoryOption,
     MaxStepsOption,
     DpiOption,
+    BackendOption,
     DtOption,
     FigureFormatOption,
     LoadOption,
@@ -196,6 +197,7 @@ def sweep_command(
     scenario: RunsScenarioOption = "paper-sine",
     duration: RunDurationOption = None,
     dt: DtOption = None,
+    backend: BackendOption = None,
     damper: SweepDamperOption = None,
     damper_scale: SweepDamperScaleOption = None,
     gains: SweepGainsOption = None,
@@ -252,6 +254,7 @@ def sweep_command(
             gains=gains,
             dt=dt,
             window=window,
+            backend=backend,
         )
         grid = make_grid(
             scenario=scenario,
@@ -318,13 +321,14 @@ def _parse(
     gains,
     dt,
     window,
+    backend=None,
 ) -> tuple[dict, dict]:
     """(the keyword arguments of railride.studies.sweep.grid, the text each was read from): only the
     syntax of the options is checked here; what their values may be is the grid's to check."""
     from railride.analysis.metrics import parse_window
 
     with option_names(FIXED_RATE_FIELDS):
-        solver = None if dt is None else solver_from_options(dt=dt)
+        solver = None if dt is None and backend is None else solver_from_options(dt=dt, backend=backend)
     values = {
         "suspensions": _names("--suspension", suspension),
         "damper": damper,

@@ -31,6 +31,7 @@ from railride.cli._options import (
     AmplitudeOption,
     BoundOption,
     DpiOption,
+    BackendOption,
     DtOption,
     FigureFormatOption,
     FormatOption,
@@ -79,6 +80,7 @@ from railride.cli._render import check_report_option, save_report
 #: the library's names of tune's options, for its errors
 TUNE_FIELDS = {
     "dt": SOLVER_FIELDS["dt"],
+    "backend": SOLVER_FIELDS["backend"],
     **TRACK_FIELDS,
     "damper": "--damper",
     "damper_scale": "--damper-scale",
@@ -413,6 +415,7 @@ def tune_command(
     speed: SpeedOption = None,
     duration: RunDurationOption = None,
     dt: DtOption = None,
+    backend: BackendOption = None,
     vehicle: VehicleOption = None,
     preset: PresetOption = None,
     damper: TuneDamperOption = DEFAULT_DAMPER,
@@ -480,7 +483,7 @@ def tune_command(
         scale = parse_scale("--damper-scale", damper_scale)
         start = _tune_start(gains)
         objective = _objective(objective_kind, weights, bound, penalty, max_peak, max_travel)
-        solver = solver_from_options(dt=dt)
+        solver = solver_from_options(dt=dt, backend=backend)
         seeds = value_list("--track-seed", track_seed, integer=True) if track_seed is not None else None
         loads = value_list("--load", load) if load is not None else None
         over = None

@@ -254,6 +254,7 @@ class Stepped:
     fail_step: np.ndarray
     rows: int
     stopped: bool
+    on: str = "CPU"  # what stepped it, for the record: the CPU, or the GPU by name
 
 
 def step(plan: RunPlan, tables: Inputs, packed: Packed, progress=None) -> Stepped:
@@ -310,10 +311,12 @@ def step(plan: RunPlan, tables: Inputs, packed: Packed, progress=None) -> Steppe
     arrays, P = tables.arrays, packed.P
     # the GPU where the settings take it (`SolverSettings.backend_for`); on the CPU a batch that
     # fills groups of lanes.LANES samples runs them in vector form (run_lanes)
+    on = "CPU"
     if stepped_on(plan) == "gpu":
         from railride.engine import gpu
 
         step_batch = gpu.stepper(_gpu_failed)
+        on = f"GPU ({gpu.device_name()})"
     elif lanes.lanes_fit(n, P, packed.control[7]):
         step_batch = lanes.lanes_stepper(n, packed.law, arrays["A"], arrays["TS"], P, arrays["stops"])
     else:
@@ -347,7 +350,7 @@ def step(plan: RunPlan, tables: Inputs, packed: Packed, progress=None) -> Steppe
         if rows < 2:
             raise KeyboardInterrupt
         out = {key: v[:, :rows] if v.shape[1] > 1 else v for key, v in out.items()}
-    return Stepped(out, status, fail_step, rows, stop.requested)
+    return Stepped(out, status, fail_step, rows, stop.requested, on)
 
 
 def stepped_on(plan: RunPlan) -> str:
@@ -415,7 +418,9 @@ def assemble(plan: RunPlan, stepped: Stepped) -> RideResult:
             plan.vcmd,
             plan.closed,
             [s.faults for s in suspensions],
-            INTEGRATOR_EXACT if plan.exact else INTEGRATOR_RK4,
+            INTEGRATOR_EXACT
+            if plan.exact
+            else INTEGRATOR_RK4 + ("" if stepped.on == "CPU" else f", on the {stepped.on}"),
         ),
         suspension=suspensions if batch else suspensions[0],
         solver=plan.solver,
