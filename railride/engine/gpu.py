@@ -83,6 +83,9 @@ from railride.engine.sample_parts import (
 THREADS_PER_BLOCK = 128
 #: the share of the device's free memory one group of samples may take
 MEMORY_SHARE = 0.6
+#: what the last call of `run_gpu` took: seconds in the kernels and in the transfers, its
+#: groups, and the most device memory in use while it ran [bytes] (read by benchmarks/bench_gpu.py)
+last_call: dict = {}
 # the sizes of the kernel's thread-local arrays: names, since a local array's size must be a
 # constant, not an expression
 _N_RATES = 4 * NS_MAX  # the four RK4 stage rates
@@ -447,6 +450,8 @@ def run_gpu(n, law, x, step0, n_steps, final, stride, dt, vehicle, dampers, inpu
     bytes_per_sample = sum(a[0].nbytes for a in per_sample) + n_rows * row_bytes
     lam1 = _one_step_limit(dt)
     lo = 0
+    last_call.clear()
+    last_call.update(kernel_s=0.0, transfer_s=0.0, groups=0, device_bytes=0)
     try:
         shared = [cuda.to_device(np.ascontiguousarray(a)) for a in (A_u, TS_u, utab, ftab, noise, snoise)]
         size = group_size(n, bytes_per_sample)
@@ -469,6 +474,9 @@ def _run_group(kernel, shared, lo, hi, law, step0, n_steps, final, stride, r0, r
     x = per_sample[0]
     _, u_off, _, f_off, n_nodes, interval = inputs
     closed_loop, ctrl_stride = control[0], control[1]
+    import time
+
+    started = time.perf_counter()
     m = hi - lo
     dev = [cuda.to_device(np.ascontiguousarray(a[lo:hi])) for a in per_sample]
     small = [cuda.to_device(np.ascontiguousarray(a[lo:hi])) for a in (vid, u_off, f_off, n_nodes, interval)]
@@ -478,6 +486,7 @@ def _run_group(kernel, shared, lo, hi, law, step0, n_steps, final, stride, r0, r
     xd, cs, sp, pd, vd, gd, hd, ind, fd, sd = dev
     vidd, uod, fod, nnd, itd = small
     Ad, TSd, ud, fdd, nod, snd = shared
+    launched = time.perf_counter()
     blocks = -(-m // THREADS_PER_BLOCK) if not simulated() else -(-m // 8)
     threads = THREADS_PER_BLOCK if not simulated() else 8
     kernel[blocks, threads](
@@ -485,6 +494,10 @@ def _run_group(kernel, shared, lo, hi, law, step0, n_steps, final, stride, r0, r
         fod, nnd, itd, closed_loop, ctrl_stride, gd, hd, ind, nod, fd, sd, snd, *outs, st, fs,
     )  # fmt: skip
     cuda.synchronize()
+    finished = time.perf_counter()
+    if not simulated():
+        free, total = cuda.current_context().get_memory_info()
+        last_call["device_bytes"] = max(last_call["device_bytes"], int(total - free))
     # all back from the device before any host array changes: a failure up to here leaves the
     # group as it was, for the CPU to run
     back = [xd.copy_to_host(), st.copy_to_host(), fs.copy_to_host()]
@@ -493,3 +506,6 @@ def _run_group(kernel, shared, lo, hi, law, step0, n_steps, final, stride, r0, r
     for h, r in zip(histories, rows):
         if r is not None:
             h[lo:hi, r0:r1] = r
+    last_call["kernel_s"] += finished - launched
+    last_call["transfer_s"] += (launched - started) + (time.perf_counter() - finished)
+    last_call["groups"] += 1

@@ -1,0 +1,126 @@
+"""The GPU stepper (railride.engine.gpu): throughput, memory and agreement with the CPU.
+
+Run:  python benchmarks/bench_gpu.py [--samples 32768] [--duration 1] [--law sas-attitude-ride]
+                                     [--output-rate 200] [--check 64] [--cpu] [--design]
+Needs a CUDA GPU and the gpu extra (pip install 'railride[gpu]'); NUMBA_ENABLE_CUDASIM=1 runs it
+in numba's CUDA simulator with tiny sizes (a smoke test of the script, no figure).
+
+Prints Markdown rows for docs/gpu.md, each with the device, the machine's cores and the date:
+* a batch of ``--samples`` closed loops of ``--law`` (MR dampers, Bouc-Wen n = 1, the law's
+  voltage law) on fra4 (8 track seeds x 8 speeds 30-70 m/s, shared tables), ``--duration`` s at
+  dt = 1e-4 s, stepped once to compile and once timed: sample-steps per second of the kernels
+  alone and of the whole `simulate` call (transfers, tables and results included), peak device
+  memory, host peak memory;
+* with ``--check N``, the largest difference of the first N samples from the CPU stepper, over
+  each history's largest value (the issue's bound: 1e-9 for laws without switching);
+* with ``--cpu``, the same batch on this machine's CPU cores, for the GPU's factor over them;
+* with ``--design``, `railride design --backend gpu` with its defaults (wall time, runs).
+No test asserts timings.
+"""
+
+from __future__ import annotations
+
+import argparse
+import datetime
+import os
+import resource
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+
+def _batch(n: int, duration: float, law: str):
+    from railride.model.track import scenario
+    from railride.secondary.suspension import Suspension
+
+    tracks = [
+        scenario("fra4", seed=seed, speed=float(v), duration=duration)
+        for seed in range(8)
+        for v in np.linspace(30.0, 70.0, 8)
+    ]
+    return [tracks[i % len(tracks)] for i in range(n)], Suspension.named(law)
+
+
+def _worst(a, b) -> float:
+    worst = 0.0
+    for k in b.dataset.data_vars:
+        x, y = a.dataset[k].values, b.dataset[k].values
+        if y.dtype.kind != "f":
+            continue
+        scale = np.nanmax(np.abs(y)) if np.any(np.isfinite(y)) else 0.0
+        if scale > 0.0:
+            worst = max(worst, float(np.nanmax(np.abs(x - y))) / scale)
+    return worst
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--samples", type=int, default=32768)
+    ap.add_argument("--duration", type=float, default=1.0)
+    ap.add_argument("--law", default="sas-attitude-ride")
+    ap.add_argument("--output-rate", type=float, default=200.0)
+    ap.add_argument("--check", type=int, default=64)
+    ap.add_argument("--cpu", action="store_true")
+    ap.add_argument("--design", action="store_true")
+    args = ap.parse_args()
+
+    import numba
+
+    from railride.engine import gpu
+    from railride.run.simulation import simulate
+    from railride.run.solver import SolverSettings
+
+    missing = gpu.why_not()
+    if missing is not None:
+        sys.exit(f"bench_gpu: {missing}")
+    device = gpu.device_name()
+    where = f"{device}; {os.cpu_count()} CPU cores; {datetime.date.today().isoformat()}"
+    on_gpu = SolverSettings(output_rate=args.output_rate, backend="gpu")
+    scs, susp = _batch(min(args.samples, 256), args.duration if args.duration < 0.1 else 0.1, args.law)
+    simulate(scs, suspension=susp, solver=on_gpu)  # compiles the kernel (and the CPU's, for the tables)
+
+    scs, susp = _batch(args.samples, args.duration, args.law)
+    t0 = time.perf_counter()
+    result = simulate(scs, suspension=susp, solver=on_gpu)
+    wall = time.perf_counter() - t0
+    call = dict(gpu.last_call)
+    work = args.samples * round(args.duration / on_gpu.dt)
+    host = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024**2
+    print(f"Device: {where}; {result.dataset.attrs['integrator']}")
+    print()
+    columns = ("batch", "kernels", "sample-steps/s (kernels)", "whole call", "sample-steps/s (call)", "groups")
+    print("| " + " | ".join(columns + ("device memory", "host peak")) + " |")
+    print("|---|---|---|---|---|---|---|---|")
+    print(
+        f"| {args.samples} x {args.law}, fra4, {args.duration:g} s at dt 1e-4 s, output {args.output_rate:g} Hz "
+        f"| {call['kernel_s']:.2f} s | {work / max(call['kernel_s'], 1e-9):.3g} | {wall:.2f} s | {work / wall:.3g} "
+        f"| {call['groups']} | {call['device_bytes'] / 1024**3:.2f} GiB | {host:.2f} GiB |"
+    )
+    if args.check:
+        k = min(args.check, args.samples)
+        cpu = simulate(scs[:k], suspension=susp, solver=SolverSettings(output_rate=args.output_rate, backend="cpu"))
+        gpu_part = simulate(scs[:k], suspension=susp, solver=on_gpu)
+        print(f"\nFirst {k} samples against the CPU stepper: largest difference / history's largest value = "
+              f"{_worst(gpu_part, cpu):.2e}")  # fmt: skip
+    if args.cpu:
+        on_cpu = SolverSettings(output_rate=args.output_rate, backend="cpu")
+        simulate(scs[:16], suspension=susp, solver=on_cpu)  # compiles the CPU steppers
+        t0 = time.perf_counter()
+        simulate(scs, suspension=susp, solver=on_cpu)
+        cpu_wall = time.perf_counter() - t0
+        print(f"\nThe same batch on the CPU ({numba.get_num_threads()} threads): {cpu_wall:.2f} s, "
+              f"{work / cpu_wall:.3g} sample-steps/s; GPU call / CPU call: {cpu_wall / wall:.1f}x")  # fmt: skip
+    if args.design:
+        out = Path(tempfile.mkdtemp(prefix="railride-design-gpu-")) / "d"
+        t0 = time.perf_counter()
+        cmd = [sys.executable, "-m", "railride.cli", "design", "--backend", "gpu", "--out", str(out)]
+        subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)
+        print(f"\nrailride design --backend gpu (defaults): {(time.perf_counter() - t0) / 60:.1f} min ({where})")
+
+
+if __name__ == "__main__":
+    main()
