@@ -27,3 +27,22 @@ def test_design_by_evolution_records_and_prints_it():
     doc = ok_json(*TINY, "--optimiser", "evolution", "--optimiser-seed", "2")
     assert doc["settings"]["optimiser"]["name"] == "evolution" and doc["settings"]["optimiser"]["seed"] == 2
     assert doc["tuning"]["studies"][-1]["optimiser"] == "evolution"
+
+
+@pytest.mark.slow  # two small designs of every law: about 35 s on 2 cores
+def test_the_example_compares_the_optimisers_on_equal_budgets():
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[2]
+    proc = subprocess.run(
+        [sys.executable, "examples/optimisers.py", "--quick", "--controllers", "pid,skyhook"],
+        cwd=root,
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    assert proc.returncode == 0, proc.stderr
+    for fragment in ("held-out score", "pid", "skyhook", "sensitivity  tuning", "evolution    tuning"):
+        assert fragment in proc.stdout, fragment
