@@ -1,13 +1,19 @@
 """Cost of a study over many tracks (railride.studies.study): wall time and peak memory.
 
-Run:  python benchmarks/bench_study.py [--seeds N] [--dask | --ahead N]
+Run:  python benchmarks/bench_study.py [--seeds N] [--dask [--workers N] [--worker-threads T] | --ahead N] [--profile]
 Prints a Markdown row for docs/performance.md: one study of 1000 closed-loop and passive runs
 of 10 s (fra4, N = 20 track seeds x 5 speeds x 2 loads x (passive + 4 controllers)), with its
 wall time (compilation excluded: a warm-up study runs first) and peak resident memory. Locally:
 this machine's cores, one process. With --dask: a dask.distributed LocalCluster of one worker
 process with one Dask thread (its batches use every core, as docs/distributed.md advises),
-reached by address like a remote cluster; the memory of the client and of the worker. No test
-asserts timings.
+reached by address like a remote cluster; the memory of the client and of the worker. With
+--workers N, N worker processes of one Dask thread each; --worker-threads T sets the numba
+threads of each worker (NUMBA_NUM_THREADS in the workers' environment; default: the machine's
+cores shared among the workers, as railride's Dask executor shares them). The scaling of N
+workers is their rate over that of one worker with the same threads. With --profile (local
+only), the serial share: the part of the wall time in which no chunk is in the compiled
+stepper (the step stage of `railride.run.simulation`), from the union of the step stage's
+intervals in every thread. No test asserts timings.
 """
 
 from __future__ import annotations
@@ -21,7 +27,10 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--seeds", type=int, default=20)
     ap.add_argument("--dask", action="store_true")
+    ap.add_argument("--workers", type=int, default=1, help="--dask: worker processes")
+    ap.add_argument("--worker-threads", type=int, default=None, help="--dask: numba threads of each worker")
     ap.add_argument("--ahead", type=int, default=None, help="local: chunks stepping beside the one whose rows are made")
+    ap.add_argument("--profile", action="store_true", help="local: the serial share of the wall time")
     args = ap.parse_args()
 
     from railride.studies.study import study
@@ -32,20 +41,27 @@ def main():
 
         executor, where = LocalExecutor(ahead=args.ahead), f"local, one process, {args.ahead} chunk(s) ahead"
     if args.dask:
+        import os
+
         from distributed import LocalCluster
 
         from railride.studies.executors import DaskExecutor
 
-        cluster = LocalCluster(n_workers=1, threads_per_worker=1, processes=True, dashboard_address=None)
+        if args.worker_threads is not None:  # the workers are child processes: they read it as numba starts
+            os.environ["NUMBA_NUM_THREADS"] = str(args.worker_threads)
+        cluster = LocalCluster(n_workers=args.workers, threads_per_worker=1, processes=True, dashboard_address=None)
         executor = DaskExecutor(address=cluster.scheduler_address)
-        where = "Dask LocalCluster, 1 worker process"
+        threads = "" if args.worker_threads is None else f", {args.worker_threads} numba thread(s) each"
+        where = f"Dask LocalCluster, {args.workers} worker process(es){threads}"
     controllers = ["pid", "sas-attitude", "sas-attitude-ride", "clipped-optimal"]
     study(controllers, track_seeds=[0], speeds=[40.0], duration=1.0, executor=executor)  # compile
     seeds = list(range(args.seeds))
     speeds = [30.0, 37.5, 45.0, 52.5, 60.0]
+    intervals = _watch_steps() if args.profile else None
     t0 = time.perf_counter()
     res = study(controllers, track_seeds=seeds, speeds=speeds, loads=[1.0, 1.3], faults=["none"], executor=executor)
     wall = time.perf_counter() - t0
+    t1 = t0 + wall
     peak_mib = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
     memory = f"{peak_mib:.0f} MiB"
     if cluster is not None:
@@ -60,6 +76,47 @@ def main():
         f"| fra4, {args.seeds} seeds x 5 speeds x 2 loads x (passive + 4 controllers), 10 s runs | {where} | {n} | "
         f"{wall:.1f} s | {n / wall:.1f} | {memory} |"
     )
+    if intervals is not None:
+        stepping = _union([(max(a, t0), min(b, t1)) for a, b in intervals if b > t0 and a < t1])
+        print(
+            f"\nthreads {_threads()}: the stepper ran {stepping:.1f} s of the {wall:.1f} s; no chunk was stepping for "
+            f"{wall - stepping:.1f} s, the serial share: {(wall - stepping) / wall * 100:.1f} %"
+        )
+
+
+def _threads() -> int:
+    import numba
+
+    return numba.get_num_threads()
+
+
+def _watch_steps() -> list:
+    """Record the (start, end) of every call of the simulation's step stage, in any thread."""
+    from railride.run import simulation
+
+    intervals: list = []
+    step = simulation.step
+
+    def timed(*args, **kwargs):
+        start = time.perf_counter()
+        try:
+            return step(*args, **kwargs)
+        finally:
+            intervals.append((start, time.perf_counter()))
+
+    simulation.step = timed
+    return intervals
+
+
+def _union(intervals) -> float:
+    """The length of the union of (start, end) intervals."""
+    total, end = 0.0, float("-inf")
+    for a, b in sorted(intervals):
+        if b <= end:
+            continue
+        total += b - max(a, end)
+        end = b
+    return total
 
 
 if __name__ == "__main__":
