@@ -179,6 +179,11 @@ class Hybrid(GainTable):
         return self.alpha * _full_state(sky, vehicle.M.shape[0]) + (1.0 - self.alpha) * ground, np.zeros((4, 3))
 
 
+#: the LQR designs solved, by (weights, vehicle parameters), at most _LQR_SIZE of them
+_LQR: dict = {}
+_LQR_SIZE = 256
+
+
 @dataclass(frozen=True)
 class ClippedOptimal(GainTable):
     """Clipped-optimal control (Dyke et al. 1996): the LQR state feedback f_d = -K x on the
@@ -225,10 +230,18 @@ class ClippedOptimal(GainTable):
 
     def lqr(self, vehicle: Vehicle) -> tuple[np.ndarray, np.ndarray]:
         """(K, P): the LQR gain K = R^-1 B^T P (4 x 18) and P, the stabilising solution of the
-        continuous algebraic Riccati equation A^T P + P A - P B R^-1 B^T P + Q = 0."""
-        A, B, Q, R = self.design_model(vehicle)
-        P = scipy.linalg.solve_continuous_are(A, B, Q, R)
-        return np.linalg.solve(R, B.T @ P), P
+        continuous algebraic Riccati equation A^T P + P A - P B R^-1 B^T P + Q = 0. Kept for
+        the weights and vehicle (`_LQR`): a study solves the same design for every run of a
+        chunk, 10 ms each."""
+        key = (self, vehicle.params)
+        if key not in _LQR:
+            A, B, Q, R = self.design_model(vehicle)
+            P = scipy.linalg.solve_continuous_are(A, B, Q, R)
+            if len(_LQR) >= _LQR_SIZE:
+                _LQR.clear()
+            _LQR[key] = (np.linalg.solve(R, B.T @ P), P)
+        K, P = _LQR[key]
+        return K.copy(), P.copy()
 
     def gains(self, vehicle: Vehicle) -> tuple[np.ndarray, np.ndarray]:
         K, _ = self.lqr(vehicle)
