@@ -2,7 +2,7 @@
 
 Run:  python benchmarks/bench_study.py [--seeds N] [--dask [--workers N] [--worker-threads T] | --ahead N] [--profile]
 Prints a Markdown row for docs/performance.md: one study of 1000 closed-loop and passive runs
-of 10 s (fra4, N = 20 track seeds x 5 speeds x 2 loads x (passive + 4 controllers)), with its
+of 10 s (--duration) (fra4, N = 20 track seeds x 5 speeds x 2 loads x (passive + 4 controllers)), with its
 wall time (compilation excluded: a warm-up study runs first) and peak resident memory. Locally:
 this machine's cores, one process. With --dask: a dask.distributed LocalCluster of one worker
 process with one Dask thread (its batches use every core, as docs/distributed.md advises),
@@ -26,6 +26,7 @@ import time
 def main():
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--seeds", type=int, default=20)
+    ap.add_argument("--duration", type=float, default=10.0, help="seconds of each run")
     ap.add_argument("--dask", action="store_true")
     ap.add_argument("--workers", type=int, default=1, help="--dask: worker processes")
     ap.add_argument("--worker-threads", type=int, default=None, help="--dask: numba threads of each worker")
@@ -59,7 +60,15 @@ def main():
     speeds = [30.0, 37.5, 45.0, 52.5, 60.0]
     intervals = _watch_steps() if args.profile else None
     t0 = time.perf_counter()
-    res = study(controllers, track_seeds=seeds, speeds=speeds, loads=[1.0, 1.3], faults=["none"], executor=executor)
+    res = study(
+        controllers,
+        track_seeds=seeds,
+        speeds=speeds,
+        loads=[1.0, 1.3],
+        faults=["none"],
+        executor=executor,
+        duration=args.duration,
+    )
     wall = time.perf_counter() - t0
     t1 = t0 + wall
     peak_mib = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
@@ -73,7 +82,8 @@ def main():
     print("| study | where | runs | wall time | runs/s | peak memory |")
     print("|---|---|---|---|---|---|")
     print(
-        f"| fra4, {args.seeds} seeds x 5 speeds x 2 loads x (passive + 4 controllers), 10 s runs | {where} | {n} | "
+        f"| fra4, {args.seeds} seeds x 5 speeds x 2 loads x (passive + 4 controllers), {args.duration:g} s runs "
+        f"| {where} | {n} | "
         f"{wall:.1f} s | {n / wall:.1f} | {memory} |"
     )
     if intervals is not None:
