@@ -464,7 +464,7 @@ class _FolderLock:
         self.created = not folder.exists()
         folder.mkdir(parents=True, exist_ok=True)
         while True:
-            fd = os.open(self.path, os.O_RDWR | os.O_CREAT, 0o644)
+            fd = self._open()
             try:
                 fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
             except BlockingIOError:
@@ -477,7 +477,7 @@ class _FolderLock:
             # the file may have been removed by its holder between our open and flock: retry on
             # the new one, or two processes would hold locks on different files
             try:
-                same = os.path.samestat(os.fstat(fd), os.stat(self.path))
+                same = os.path.samestat(os.fstat(fd), os.lstat(self.path))
             except FileNotFoundError:
                 same = False
             if same:
@@ -488,6 +488,28 @@ class _FolderLock:
         os.write(fd, f"railride process {os.getpid()} on {socket.gethostname()}, since {_now()}\n".encode())
         for part in folder.glob(f".{path.name}.*.part"):  # a killed atomic write's leftovers
             part.unlink(missing_ok=True)
+
+    def _open(self) -> int:
+        """The lock file, opened without following a link (O_NOFOLLOW) and refused unless it is a
+        regular file: a link planted there would have the run truncate the file it points to."""
+        import errno
+        import stat
+
+        try:
+            fd = os.open(self.path, os.O_RDWR | os.O_CREAT | getattr(os, "O_NOFOLLOW", 0), 0o644)
+        except OSError as exc:
+            if exc.errno == errno.EISDIR:
+                raise InputError(f"lock {self.path} is not a regular file: refused; remove it") from None
+            if exc.errno != errno.ELOOP:
+                raise
+            raise InputError(
+                f"lock {self.path} is a symbolic link: refused, since writing the lock would write where it "
+                "points; remove it"
+            ) from None
+        if not stat.S_ISREG(os.fstat(fd).st_mode):
+            os.close(fd)
+            raise InputError(f"lock {self.path} is not a regular file: refused; remove it")
+        return fd
 
     def release(self) -> None:
         if self.fd is None:

@@ -212,6 +212,24 @@ def test_the_lock_of_a_process_gone_is_taken_over(tmp_path):
     assert (out / "runs.csv").is_file() and not (out / ".runs.csv.lock").exists()
 
 
+def test_a_planted_lock_link_or_folder_is_refused_and_its_target_left_alone(tmp_path):
+    from railride.errors import InputError
+    from railride.studies.executors import RunTable
+
+    out = tmp_path / "run"
+    out.mkdir()
+    victim = tmp_path / "precious.txt"
+    victim.write_text("keep me\n")
+    (out / ".runs.csv.lock").symlink_to(victim)
+    with pytest.raises(InputError, match="is a symbolic link: refused"):
+        RunTable(out / "runs.csv")
+    assert victim.read_text() == "keep me\n" and not (out / "runs.csv").exists()
+    (out / ".runs.csv.lock").unlink()
+    (out / ".runs.csv.lock").mkdir()
+    with pytest.raises(InputError, match="lock .* is not a regular file: refused"):
+        RunTable(out / "runs.csv")
+
+
 def test_the_lock_holds_within_one_process_until_closed(tmp_path):
     from railride.studies.executors import RunTable
 
