@@ -166,7 +166,11 @@ def write_folder(out_dir, files) -> list[Path]:
     names = [name for name, _ in files]
     if len(set(names)) != len(names) or any(Path(n).name != n or n.startswith(".") for n in names):
         raise InputError(f"write_folder: file names must be distinct plain names, got {names}")
-    out_dir = check_out_dir(out_dir)
+    given = out_dir = check_out_dir(out_dir)
+    if out_dir.is_symlink() and out_dir.is_dir():
+        # a link to a folder elsewhere: stage beside the folder itself, on its file system,
+        # where the renames work (beside the link they would cross file systems)
+        out_dir = Path(os.path.realpath(out_dir))
     parent = out_dir.absolute().parent
     parent.mkdir(parents=True, exist_ok=True)
     remove_leftovers(out_dir)
@@ -200,7 +204,7 @@ def write_folder(out_dir, files) -> list[Path]:
         if stage is not None:
             shutil.rmtree(stage, ignore_errors=True)
         os.close(held)
-    return [out_dir / name for name in names]
+    return [given / name for name in names]
 
 
 #: a staging folder younger than this is never taken for a leftover (it may be one just made,

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import os
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -154,3 +155,40 @@ def test_check_out_dir_rejects_file(tmp_path):
         files.check_out_dir(f)
     with pytest.raises(ValueError, match="not a folder"):
         files.check_out_dir(f / "sub")
+
+
+def _other_file_system(tmp_path):
+    """A writable folder on another file system than tmp_path, or None."""
+    for root in ("/dev/shm", "/run/user", "/tmp"):
+        try:
+            if os.path.isdir(root) and os.stat(root).st_dev != os.stat(tmp_path).st_dev:
+                return root
+        except OSError:
+            continue
+    return None
+
+
+@pytest.mark.parametrize("elsewhere", ["same file system", "another file system"])
+def test_out_through_a_link_writes_into_the_folder_it_leads_to(result, tmp_path, elsewhere):
+    import tempfile
+
+    if elsewhere == "same file system":
+        target = tmp_path / "real"
+    else:
+        root = _other_file_system(tmp_path)
+        if root is None:
+            pytest.skip("no second file system to link to")
+        target = Path(tempfile.mkdtemp(dir=root))
+    try:
+        target.mkdir(exist_ok=True)
+        link = tmp_path / "out"
+        link.symlink_to(target)
+        files.write_folder(link, [("a.txt", lambda p: p.write_text("a")), ("b.txt", lambda p: p.write_text("b"))])
+        # renamed on the target's file system (beside the link they would cross: EXDEV)
+        assert sorted(p.name for p in target.iterdir()) == ["a.txt", "b.txt"]
+        assert link.is_symlink() and not list(tmp_path.glob(".out.staging-*"))
+    finally:
+        if elsewhere != "same file system":
+            import shutil
+
+            shutil.rmtree(target, ignore_errors=True)
