@@ -252,7 +252,7 @@ def study(
         opts: dict[str, Any] = {
             **({"seed": seed} if seed is not None else {}),
             **({"speed": v} if v is not None else {}),
-            **({"duration": duration} if duration else {}),
+            **({"duration": duration} if duration is not None else {}),
         }
         return tuple(sorted(opts.items()))
 

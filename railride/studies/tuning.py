@@ -142,7 +142,7 @@ def tuning_set(scenario: str = "fra4", *, track_seeds=None, speeds=None, loads=(
                 opts = {
                     **({"seed": seed} if seed is not None else {}),
                     **({"speed": v} if v is not None else {}),
-                    **({"duration": duration} if duration else {}),
+                    **({"duration": duration} if duration is not None else {}),
                 }
                 out.append(TuningCase(scenario, tuple(sorted(opts.items())), load))
     return tuple(out)
