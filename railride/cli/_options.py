@@ -145,6 +145,15 @@ RunDurationOption = Annotated[
     Optional[float], typer.Option("--duration", metavar="S", help="Simulated time of each run [s] (default 10).")
 ]
 DtOption = Annotated[Optional[float], typer.Option("--dt", metavar="S", help="Fixed RK4 time step [s] (default 1e-4).")]
+MethodOption = Annotated[
+    Optional[str],
+    typer.Option(
+        "--method",
+        metavar="auto|rk4|exact",
+        help="How runs are integrated: auto (the default: the exact discretisation where the suspension is linear "
+        "and its maps are few, RK4 otherwise), rk4 (always), exact (the passive or ideal-actuator vehicle only).",
+    ),
+]
 BackendOption = Annotated[
     Optional[str],
     typer.Option(

@@ -117,14 +117,20 @@ def default_of(fn, name: str):
 
 # -- solver settings ------------------------------------------------------------------------------
 #: the library's names of the step and rate options, for its errors (`_common.option_names`)
-SOLVER_FIELDS = {"dt": "--dt", "output_rate": "--output-rate", "control_rate": "--control-rate", "backend": "--backend"}
+SOLVER_FIELDS = {
+    "dt": "--dt",
+    "output_rate": "--output-rate",
+    "control_rate": "--control-rate",
+    "backend": "--backend",
+    "method": "--method",
+}
 #: the solver's fields in a command whose output rate is not an option (sweep, study): the rate is
 #: named in words, not as a setting the user could pass
-FIXED_RATE_FIELDS = {"dt": "--dt", "output_rate": "output rate", "backend": "--backend"}
+FIXED_RATE_FIELDS = {"dt": "--dt", "output_rate": "output rate", "backend": "--backend", "method": "--method"}
 
 
 def solver_from_options(**given):
-    """--dt, --output-rate, --control-rate, --backend (None: not given) -> a railride.SolverSettings, the
+    """--dt, --output-rate, --control-rate, --backend, --method (None: not given) -> a railride.SolverSettings, the
     others at their defaults; the settings check themselves."""
     from railride.run.solver import SolverSettings
 

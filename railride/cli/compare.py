@@ -28,6 +28,7 @@ from railride.cli._options import (
     ControlRateOption,
     DpiOption,
     BackendOption,
+    MethodOption,
     DtOption,
     DurationOption,
     FigureFormatOption,
@@ -523,6 +524,7 @@ def compare(
     duration: DurationOption = None,
     dt: DtOption = None,
     backend: BackendOption = None,
+    method: MethodOption = None,
     output_rate: OutputRateOption = None,
     window: WindowOption = None,
     vehicle: VehicleOption = None,
@@ -588,7 +590,9 @@ def compare(
                 gains=gains,
                 damper=damper,
                 damper_scale=damper_scale,
-                solver=solver_from_options(dt=dt, output_rate=output_rate, control_rate=control_rate, backend=backend),
+                solver=solver_from_options(
+                    dt=dt, output_rate=output_rate, control_rate=control_rate, backend=backend, method=method
+                ),
                 duration=duration,
                 window=window,
                 vehicle=vehicle,
@@ -609,7 +613,9 @@ def compare(
         damper_preset("--damper", damper)
         scale = parse_scale("--damper-scale", damper_scale)
         noise = _sensor_noise(sensor_noise, seed)
-        solver = solver_from_options(dt=dt, output_rate=output_rate, control_rate=control_rate, backend=backend)
+        solver = solver_from_options(
+            dt=dt, output_rate=output_rate, control_rate=control_rate, backend=backend, method=method
+        )
         vehicle_options = vehicle_arguments(vehicle, preset, loads[0] if loads else None)
         window_value = parse_window(window) if window is not None else None
         track = track_options(scenario, seed_value, min_wavelength, max_wavelength)

@@ -27,6 +27,7 @@ from railride.cli._options import (
     AmplitudeOption,
     ComfortOption,
     BackendOption,
+    MethodOption,
     DtOption,
     DpiOption,
     DurationOption,
@@ -71,6 +72,7 @@ SUSPENSIONS = ("passive", "mr")
 SIMULATE_FIELDS = {
     "dt": SOLVER_FIELDS["dt"],
     "backend": SOLVER_FIELDS["backend"],
+    "method": SOLVER_FIELDS["method"],
     "output_rate": SOLVER_FIELDS["output_rate"],
     "damper": "--damper",
     "damper_scale": "--damper-scale",
@@ -157,6 +159,7 @@ def simulate(
     duration: DurationOption = None,
     dt: DtOption = None,
     backend: BackendOption = None,
+    method: MethodOption = None,
     output_rate: OutputRateOption = None,
     window: SimulateWindowOption = None,
     suspension: Annotated[
@@ -219,6 +222,7 @@ def simulate(
             figures=figures,
             histories=histories,
             backend=backend,
+            method=method,
         )
     if "partial" in doc:  # Ctrl-C, what was computed saved in --out
         part = doc["partial"]
@@ -287,6 +291,7 @@ def _run(
     figures=None,
     histories=("nc", "csv"),
     backend=None,
+    method=None,
 ):
     from railride.errors import Interrupted
     from railride.output.files import check_out_dir, write_outputs
@@ -294,7 +299,7 @@ def _run(
     from railride.run.simulation import simulate as run_simulation
 
     with option_names(SIMULATE_FIELDS, not_given(dt=dt, output_rate=output_rate)):
-        solver = solver_from_options(dt=dt, output_rate=output_rate, backend=backend)
+        solver = solver_from_options(dt=dt, output_rate=output_rate, backend=backend, method=method)
         vehicle_params, vehicle_record = vehicle_from_options(vehicle, preset, load)
         secondary = _suspension(suspension, damper_name, voltage_text, damper_scale)
         window = parse_window(window_text) if window_text is not None else None

@@ -452,7 +452,8 @@ def input_table_nodes(scenario: Scenario, dt: float, duration: float | None = No
     duration = scenario.duration if duration is None else duration
     # m is a power of two, so halving dt doubles m and leaves the grid (and the input) alone
     ratio = scenario.track.table_spacing() / (scenario.speed * dt)
-    m = 1 << max(0, int(math.floor(math.log2(ratio)))) if ratio >= 1 else 1
+    # (at most 2**52 steps between nodes: a speed near 0 would make the ratio infinite)
+    m = 1 << min(52, max(0, int(math.floor(math.log2(min(ratio, 2.0**52)))))) if ratio >= 1 else 1
     interval = m * dt
     return int(math.ceil((duration + dt) / interval)) + 2, interval
 

@@ -168,6 +168,15 @@ def _check_bending(params: VehicleParams, solver: SolverSettings) -> None:
         )
 
 
+def _exact_phases(scenarios, solver: SolverSettings, duration: float) -> int:
+    """The step maps the exact discretisation would build for these scenarios: the phases of the
+    output steps against the input table's node spacing (the slowest scenario's)."""
+    stride = solver.output_steps
+    _, interval = max(input_table_nodes(sc, solver.dt, duration) for sc in scenarios)
+    m = int(round(interval / solver.dt))
+    return math.lcm(stride, m) // stride
+
+
 def _check_size(scenarios, solver: SolverSettings, damper, closed, exact: bool, n_out: int, duration: float):
     """`railride.limits.check` on what a run allocates before it allocates it: the stored
     histories (samples x output rows x channels), the rail input and forcing tables, and the
@@ -191,8 +200,7 @@ def _check_size(scenarios, solver: SolverSettings, damper, closed, exact: bool, 
         raise InputError(
             f"dt = {shown(dt)} s: the exact discretisation would build {period} step maps (the output "
             f"interval, {stride} steps, and the input table's node spacing, {m} steps, line up again "
-            f"only every {period} output samples); use a dt that divides both evenly, such as the "
-            f"default {DEFAULT_DT:g} s (or, from Python, SolverSettings(method='rk4'))"
+            f"only every {period} output samples); use method 'rk4', or 'auto', which takes RK4 there"
         )
     # time, which memory does not bound (the histories are strided): the exact method steps
     # once per output sample (and controller sample), RK4 once per dt
@@ -359,6 +367,8 @@ def check(scenario=None, params=None, suspension=None, solver=None, on_divergenc
     vcmd = np.array([[_command_voltage(s)] * 4 for s in suspensions], dtype=float)
     closed = _closed_loop(suspensions, solver, duration)
     exact = _exact(solver, damper, closed, suspensions, len(set(param_sets)))
+    if exact and solver.method == "auto" and _exact_phases(scenarios, solver, duration) > _MAX_EXACT_PHASES:
+        exact = False  # "auto" takes RK4 where the exact steps would need too many maps (a slow speed)
     vehicles = {}
     for p in param_sets:
         if id(p) not in vehicles:
@@ -367,6 +377,11 @@ def check(scenario=None, params=None, suspension=None, solver=None, on_divergenc
             if not exact:  # the exact steps are stable at any dt
                 _check_dt(vehicles[id(p)], dt, damper)
     n_out_f = duration * output_rate
+    if not n_out_f <= limits.MAX_STEPS:  # inf or beyond any run: no int of it
+        raise InputError(
+            f"duration = {duration:g} s at output rate {output_rate:g} Hz is {n_out_f:.3g} output samples, more "
+            f"than a run can count (at most {limits.MAX_STEPS:.4g}); shorten the run"
+        )
     n_out = int(round(n_out_f))
     if abs(n_out - n_out_f) > 1e-6 * max(1.0, n_out_f) or n_out < 1:
         raise InputError(f"duration = {duration:g} s must be a whole number of output intervals (1/{output_rate:g} Hz)")

@@ -31,6 +31,8 @@ RESOLUTION = 2.5
 
 def _steps(steps: float) -> int | None:
     """``steps`` as a whole number >= 1, or None when it is not one (to a part in a million)."""
+    if not steps <= 2**53:  # inf, nan or beyond what a float counts exactly: no whole number
+        return None
     whole = int(round(steps))
     return whole if whole >= 1 and abs(whole - steps) <= 1e-6 * steps else None
 

@@ -21,3 +21,36 @@ from clihelp import assert_input_error, run
 def test_duration_0_is_refused_everywhere(command):
     # study once ran its default 10 s and recorded 0
     assert_input_error(run(*command, "--duration", "0"), "duration = 0.0", "> 0")
+
+
+def test_a_slow_speed_runs_and_the_method_can_be_chosen():
+    from clihelp import ok
+
+    from railride.model.track import scenario
+    from railride.run.checks import INTEGRATOR_RK4
+    from railride.run.simulation import simulate
+
+    # at 1 m/s the exact steps would need 1024 maps: "auto" takes RK4 instead of refusing
+    ok("simulate", "--speed", "1", "--duration", "0.5")
+    assert simulate(scenario("paper-sine", speed=1.0, duration=0.5)).dataset.attrs["integrator"] == INTEGRATOR_RK4
+    assert simulate(scenario("paper-sine", duration=0.5)).dataset.attrs["integrator"] != INTEGRATOR_RK4
+    assert_input_error(
+        run("simulate", "--speed", "1", "--duration", "0.5", "--method", "exact"), "1024 step maps", "'rk4'"
+    )
+    assert_input_error(run("simulate", "--method", "euler"), "--method = 'euler'", "auto, rk4, exact")
+
+
+@pytest.mark.parametrize(
+    "option, value, fragment",
+    [
+        ("--duration", "1e308", "more than a run can count"),
+        ("--speed", "1e-308", "memory"),
+        ("--output-rate", "1e-308", "--output-rate = 1e-308"),
+    ],
+)
+def test_extreme_values_are_input_errors_not_overflows(option, value, fragment):
+    result = run("simulate", "--suspension", "mr", option, value)
+    if option == "--speed":  # MR dampers at 1e-308 m/s: a run that stands still, or a clear refusal
+        assert result.exit_code in (0, 2) and "bug in railride" not in result.stderr
+        return
+    assert_input_error(result, fragment)

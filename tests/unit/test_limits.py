@@ -80,8 +80,11 @@ def test_damper_rig_at_a_microhertz_or_a_billion_cycles_is_refused(no_work):
 
 
 def test_a_picosecond_step_is_refused_with_what_the_run_would_need(no_work):
+    # "auto" takes RK4 where the exact maps would not line up: refused for its work
     solver = SolverSettings(dt=1e-12)
-    _refused(lambda: rr.simulate("paper-sine", solver=solver), "memory", "dt 1e-12 s")
+    _refused(lambda: rr.simulate("paper-sine", solver=solver), "1e+13 sample-steps", "dt 1e-12 s")
+    exact = SolverSettings(dt=1e-12, method="exact")  # the exact steps: for their tables' memory
+    _refused(lambda: rr.simulate("paper-sine", solver=exact), "memory", "dt 1e-12 s")
 
 
 def test_a_control_rate_slower_than_the_run_is_refused(no_work):
@@ -184,7 +187,7 @@ def test_an_exact_run_whose_grids_never_line_up_is_refused_before_its_exponentia
     # dt = 3e-9 s: 333 333 steps per output sample against 2**20 per input node, so the maps
     # would repeat only after a million output samples (minutes of matrix exponentials)
     _refused(
-        lambda: rr.simulate("paper-sine", solver=SolverSettings(dt=3e-9)),
+        lambda: rr.simulate("paper-sine", solver=SolverSettings(dt=3e-9, method="exact")),
         "1048576 step maps",
-        "the default 0.0001 s",
+        "use method 'rk4', or 'auto', which takes RK4 there",
     )
