@@ -139,6 +139,8 @@ def memory_limit(size):
 
 def shown_bytes(n: float) -> str:
     """Bytes to three significant digits in binary units: 1.5 GiB, 312 MiB."""
+    if not n < 2.0**1000:  # an integer beyond any float (a 400-digit count), or inf
+        return "more than 1e300 B"
     for unit, size in (("TiB", 2**40), ("GiB", 2**30), ("MiB", 2**20), ("KiB", 2**10)):
         if n >= size:
             return f"{n / size:.3g} {unit}" if n / size < 1000 else f"{n / size:.4g} {unit}"

@@ -37,6 +37,9 @@ RAILS = (*FRF_PATTERNS, "both")
 #: the files `FrfResult.save` writes, in this order
 FILES = FRF_FILES
 
+#: the highest fmax a frequency response takes [Hz]
+FMAX_LIMIT = 1e4
+
 
 @dataclass(frozen=True, eq=False)
 class FrfResult:
@@ -183,7 +186,12 @@ def frequency_responses(
     fmax = validation.number("fmax", fmax, "positive", "Hz")
     if not fmax > fmin:
         raise InputError(f"fmax = {fmax:g} Hz: must be above fmin = {fmin:g} Hz")
-    points = validation.integer("points", points, 2)
+    if fmax > FMAX_LIMIT:  # far beyond the model's modes the products overflow to inf and nan
+        raise InputError(
+            f"fmax = {fmax:g} Hz: at most {FMAX_LIMIT:g} Hz (the vehicle's modes are below 100 Hz, the "
+            "rigid-body model means nothing far above them)"
+        )
+    points = validation.integer("points", points, 2, 10**6, "400 resolve every mode of the vehicle")
     patterns = list(FRF_PATTERNS) if rails == "both" else [rails]
     base, source = resolve_argument(vehicle, params)
     record = vehicle_record(base, source, load)
@@ -193,7 +201,7 @@ def frequency_responses(
     # acceleration, 3 floor points and 8 corner values (complex), and as much again while the
     # Dataset and its table are built
     limits.check(
-        8.0 * points * (1 + len(patterns) * 2 * (car.n_dof + 12) * 2),
+        8 * points * (1 + len(patterns) * 2 * (car.n_dof + 12) * 2),  # an int: points may have 400 digits
         f"the frequency responses on {points} points",
         "use fewer points (400 resolve every mode of the vehicle)",
     )

@@ -573,7 +573,8 @@ class RandomTrack(RailProfile):
             raise InputError(f"length = {length:g} m: must be at least max_wavelength = {hi:g} m")
         lead = _check("lead_in", self.lead_in, "nonnegative", "a finite number >= 0 (m)")
         ds = lo / 20.0  # 20 samples on the shortest wavelength
-        n = int(2 ** math.ceil(math.log2(length / ds)))
+        samples = length / ds
+        n = int(2 ** math.ceil(math.log2(samples))) if samples <= 2**24 else 2**25  # inf: no int of it
         if n > 2**24:
             raise InputError(
                 f"the realisation needs {n:.4g} samples ({length:.4g} m at {ds:.4g} m), more than "

@@ -102,6 +102,18 @@ def _check_number(name, value, rule, unit):
     return validation.number(name, value, rule, unit)
 
 
+#: the largest rig amplitudes taken: a displacement [m] far beyond a damper's stroke (tens of mm)
+#: and a demanded force [N] far beyond its capacity (about 20 kN), below where squares overflow
+MAX_STROKE_M = 10.0
+MAX_DEMAND_N = 1e9
+
+
+def _at_most(name: str, value: float, limit: float, unit: str, why: str) -> float:
+    if value > limit:
+        raise InputError(f"{name} = {value:g} {unit}: at most {limit:g} {unit} ({why})")
+    return value
+
+
 def _motion_table(motion, duration: float, dt: float):
     ratio = motion.spacing() / dt
     m = 1 << max(0, int(math.floor(math.log2(ratio)))) if ratio >= 1 else 1
@@ -351,7 +363,8 @@ def cycles(
     ``n_cycles`` cycles and keep the last one, a steady state: the hysteretic and coil states
     forget their start within a cycle or two."""
     damper = _resolve(damper)
-    _check_number("amplitude", amplitude, "positive", "m")
+    amplitude = _check_number("amplitude", amplitude, "positive", "m")
+    _at_most("amplitude", amplitude, MAX_STROKE_M, "m", "a damper's stroke is tens of mm")
     motion = SineMotion(amplitude, frequency)
     n_cycles = validation.integer("n_cycles", n_cycles, 2, what=START_UP)
     dt = _check_number("dt", dt, "positive", "s")
@@ -517,6 +530,7 @@ def track(
     (start-up)."""
     damper = _resolve(damper)
     amplitude = _check_number("amplitude", amplitude, "positive", "N")
+    _at_most("amplitude", amplitude, MAX_DEMAND_N, "N", "an MR damper gives tens of kN")
     fd = desired_force_signal(desired, amplitude, frequency)
     frequency = float(frequency)
     stroke = _check_number("stroke", stroke, "positive", "m")

@@ -54,3 +54,23 @@ def test_extreme_values_are_input_errors_not_overflows(option, value, fragment):
         assert result.exit_code in (0, 2) and "bug in railride" not in result.stderr
         return
     assert_input_error(result, fragment)
+
+
+BIG = "1" + "0" * 400  # a 401-digit count
+
+
+@pytest.mark.parametrize(
+    "args, fragment",
+    [
+        (("frf", "--fmax", "1e300", "--format", "json"), "--fmax = 1e+300 Hz: at most"),
+        (("frf", "--points", BIG), "--points = 1e+400"),
+        (("tracking", "--amplitude", "1e308", "--format", "json"), "--amplitude = 1e+308 N: at most"),
+        (("damper", "--amplitude", "1e308", "--frequency", "1", "--voltage", "0"), "--amplitude = 1e+308 m: at most"),
+        (("sweep", "--suspension", "passive", "--speed", f"20:80:{BIG}"), "--speed"),
+        (("simulate", "--scenario", "fra4", "--min-wavelength", "1e-308"), "--min-wavelength"),
+    ],
+    ids=["frf fmax", "frf points", "tracking amplitude", "rig amplitude", "sweep count", "min wavelength"],
+)
+def test_values_at_the_extremes_are_one_error_line(args, fragment):
+    # each once a traceback, an exit 0 with nan or inf, or JSON that could not be written
+    assert_input_error(run(*args), fragment)
