@@ -137,6 +137,23 @@ def memory_limit(size):
     return _memory_limit(size)
 
 
+#: the largest track file read [bytes]: 256 MiB holds about 5 million rows (s, z_L, z_R), a line
+#: of 1,000 km at 0.2 m spacing (docs/track.md)
+MAX_TRACK_FILE_BYTES = 256 * 2**20
+
+
+def check_file(path, what: str, most: int) -> None:
+    """ValueError unless ``path`` is a regular file of at most ``most`` bytes: a device such as
+    /dev/zero, or a pipe, would be read without end. OSError where it cannot be read."""
+    import stat
+
+    info = os.stat(path)
+    if not stat.S_ISREG(info.st_mode):
+        raise InputError(f"{what} {path}: not a regular file")
+    if info.st_size > most:
+        raise InputError(f"{what} {path}: {shown_bytes(info.st_size)}, more than the {shown_bytes(most)} allowed")
+
+
 def shown_bytes(n: float) -> str:
     """Bytes to three significant digits in binary units: 1.5 GiB, 312 MiB."""
     if not n < 2.0**1000:  # an integer beyond any float (a 400-digit count), or inf

@@ -21,6 +21,8 @@ line ``error: <message>`` on stderr, never a traceback.
 
 from __future__ import annotations
 
+import errno
+import os
 import sys
 
 TYPE_CHECKING = False  # typing.TYPE_CHECKING, without importing typing before main() runs
@@ -72,6 +74,8 @@ def main() -> None:
     no traceback); a stdout closed early is not an error (`railride.cli._app.RailrideGroup`
     handles both within a command)."""
     status: str | int | None = 0
+    if sys.stdout is None:  # started with stdout closed (>&-): the output goes nowhere, as to a closed pipe
+        sys.stdout = open(os.devnull, "w")
     try:
         app = _load()
         app(prog_name="railride")
@@ -87,6 +91,10 @@ def main() -> None:
         sys.stdout.flush()
     except BrokenPipeError:
         _quiet()
+    except OSError as exc:  # a full disk behind stdout (> /dev/full); a closed one is no error
+        if exc.errno != errno.EBADF:
+            print(f"error: cannot write: {exc.strerror or exc}", file=sys.stderr)
+            status = 2
     sys.exit(status)
 
 

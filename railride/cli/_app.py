@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import contextlib
+import errno
 import os
 import sys
 import warnings
@@ -34,6 +35,15 @@ def _closed(stream) -> bool:
         poller.register(stream.fileno(), select.POLLOUT)
         return any(events & select.POLLERR for _, events in poller.poll(0))
     except (AttributeError, OSError, ValueError):  # no file descriptor (a test's capture)
+        return False
+
+
+def _writable(stream) -> bool:
+    """Whether ``stream``'s file descriptor is open."""
+    try:
+        os.fstat(stream.fileno())
+        return True
+    except (AttributeError, OSError, ValueError):
         return False
 
 
@@ -79,11 +89,28 @@ class RailrideGroup(TyperGroup):
             raise typer.Exit(OK) from None
         except (typer.Exit, typer.Abort):
             raise
+        except OSError as exc:
+            if exc.errno == errno.EBADF and not _writable(sys.stdout):  # stdout closed (os.close(1))
+                quiet_closed_pipe()
+                raise typer.Exit(OK) from None
+            if exc.errno not in _FULL:
+                if _common.DEBUG:
+                    raise
+                typer.echo(bug_line(exc), err=True)
+                raise typer.Exit(INTERNAL) from None
+            # a full disk or a read-only place, stdout's included: the machine's state, not a bug
+            typer.echo(f"error: cannot write: {exc.strerror or exc}", err=True)
+            raise typer.Exit(USER) from None
         except Exception as exc:  # what no command's error handling took: a bug in railride
             if _common.DEBUG:
                 raise
             typer.echo(bug_line(exc), err=True)
             raise typer.Exit(INTERNAL) from None
+
+
+#: the errors of writing to a full disk (stdout to /dev/full too), over a quota or to a
+#: read-only file system
+_FULL = {errno.ENOSPC, errno.EDQUOT, errno.EROFS, errno.EFBIG}
 
 
 @contextlib.contextmanager

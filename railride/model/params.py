@@ -277,6 +277,8 @@ class VehicleParams:
             data = tomllib.loads(text)
         except ValueError as exc:
             raise InputError(f"{source}: not valid TOML: {toml_error(exc)}") from None
+        except RecursionError:  # tomllib recurses into nested arrays and tables
+            raise InputError(f"{source}: nested too deeply to be a railride file") from None
         table = data.get("vehicle")
         if not isinstance(table, dict):
             raise InputError(f"{source}: needs a [vehicle] table of parameters")

@@ -30,7 +30,7 @@ from pathlib import Path
 import numpy as np
 
 from railride.errors import InputError
-from railride import validation
+from railride import limits, validation
 from railride.defaults import DEFAULT_SPEED
 from railride._cache import MiB, BytesLRU
 
@@ -242,6 +242,7 @@ class MeasuredTrack(RailProfile):
         as "s [m]" is allowed, other columns are ignored)."""
         path = Path(path)
         try:
+            limits.check_file(path, "track file", limits.MAX_TRACK_FILE_BYTES)
             with path.open(newline="", encoding="utf-8") as fh:
                 rows = list(csv.reader(fh))
         except OSError as exc:
@@ -378,6 +379,10 @@ def scenario(
     0) over the wavelength band [min_wavelength, max_wavelength] (default 1 to 100 m). Speed
     defaults to 55.56 m/s and duration to 10 s for every scenario.
     """
+    if isinstance(name, Path):  # a measured profile's path
+        name = f"file:{name}"
+    if not isinstance(name, str):
+        raise InputError(f"scenario = {name!r}: must be a scenario name ({', '.join(SCENARIOS)}) or a Path")
     common = {"speed": 55.56 if speed is None else speed, "duration": 10.0 if duration is None else duration}
     random_only = [
         k

@@ -205,8 +205,9 @@ class Vehicle:
     `dof_names`). A bending frequency at or below the carbody's rigid modes on its suspension
     is an InputError naming the field."""
 
-    def __init__(self, params: VehicleParams | None = None):
-        self.params = params if params is not None else VehicleParams.preset("paper")
+    def __init__(self, params: VehicleParams | str | None = None):
+        # a preset name or a parameters file as well, as everywhere a vehicle is asked for
+        self.params = VehicleParams.of(params)
         p = self.params
         #: the number of DOFs: 9 (rigid carbody) or 10 (the carbody's bending last)
         self.n_dof = N_DOF + 1 if p.flexible else N_DOF

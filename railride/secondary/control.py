@@ -455,6 +455,8 @@ class GainSet:
             data = tomllib.loads(text)
         except ValueError as exc:
             raise InputError(f"{source}: not valid TOML: {validation.toml_error(exc)}") from None
+        except RecursionError:  # tomllib recurses into nested arrays and tables
+            raise InputError(f"{source}: nested too deeply to be a railride file") from None
         unknown_top = sorted(set(data) - {"inner", "pid", "sas", "provenance", *_LATER_TABLES, "skyhook_on_off"})
         if unknown_top:
             allowed = ", ".join(f"[{key}]" for key, _ in _TABLES.values())

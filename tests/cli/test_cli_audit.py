@@ -74,3 +74,51 @@ BIG = "1" + "0" * 400  # a 401-digit count
 def test_values_at_the_extremes_are_one_error_line(args, fragment):
     # each once a traceback, an exit 0 with nan or inf, or JSON that could not be written
     assert_input_error(run(*args), fragment)
+
+
+def test_a_full_or_closed_stdout_is_no_traceback():
+    import subprocess
+    import sys
+
+    full = subprocess.run(
+        [sys.executable, "-m", "railride.cli", "modes"],
+        stdout=open("/dev/full", "w"),
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    assert full.returncode == 2 and full.stderr.strip() == "error: cannot write: No space left on device"
+    closed = subprocess.run(
+        [sys.executable, "-m", "railride.cli", "modes"], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE
+    )
+    assert closed.returncode == 0
+    shut = subprocess.run(
+        [sys.executable, "-c", "import os, runpy, sys; os.close(1); sys.argv = ['railride', 'modes']; "
+         "runpy.run_module('railride.cli', run_name='__main__')"],
+        stderr=subprocess.PIPE, text=True,
+    )  # fmt: skip
+    assert shut.returncode == 0 and "Traceback" not in shut.stderr, shut.stderr
+
+
+def test_nested_and_endless_files_are_refused(tmp_path):
+    deep = tmp_path / "deep.toml"
+    deep.write_text("[vehicle]\nx = " + "[" * 5000 + "]" * 5000 + "\n")
+    assert_input_error(run("simulate", "--vehicle", deep), "nested too deeply")
+    assert_input_error(run("compare", "--gains", deep), "nested too deeply")
+    assert_input_error(run("simulate", "--scenario", "file:/dev/zero"), "/dev/zero: not a regular file")
+
+
+def test_the_api_takes_names_and_paths_and_names_a_wrong_type(tmp_path):
+    from pathlib import Path
+
+    import railride as rr
+    from railride.errors import InputError
+
+    assert rr.Vehicle("paper").params == rr.Vehicle().params
+    track = tmp_path / "line.csv"
+    track.write_text("s,z_L,z_R\n" + "".join(f"{s},0,0\n" for s in range(0, 1001, 2)))
+    assert rr.scenario(Path(track), duration=1.0).name == f"file:{track}"
+    for wrong in (None, 3):
+        with pytest.raises(InputError, match="scenario = "):
+            rr.scenario(wrong)
+    with pytest.raises(InputError, match="params = 3"):
+        rr.Vehicle(3)
