@@ -1,6 +1,7 @@
 """Cost of a study over many tracks (railride.studies.study): wall time and peak memory.
 
-Run:  python benchmarks/bench_study.py [--seeds N] [--dask [--workers N] [--worker-threads T] | --ahead N] [--profile]
+Run:  python benchmarks/bench_study.py [--seeds N] [--dask [--workers N] [--worker-threads T] | --ahead N |
+                                       --processes N] [--profile]
 Prints a Markdown row for docs/performance.md: one study of 1000 closed-loop and passive runs
 of 10 s (--duration) (fra4, N = 20 track seeds x 5 speeds x 2 loads x (passive + 4 controllers)), with its
 wall time (compilation excluded: a warm-up study runs first) and peak resident memory. Locally:
@@ -32,6 +33,7 @@ def main():
     ap.add_argument("--worker-threads", type=int, default=None, help="--dask: numba threads of each worker")
     ap.add_argument("--ahead", type=int, default=None, help="local: chunks stepping beside the one whose rows are made")
     ap.add_argument("--profile", action="store_true", help="local: the serial share of the wall time")
+    ap.add_argument("--processes", type=int, default=None, help="ProcessExecutor: worker processes of this machine")
     args = ap.parse_args()
 
     from railride.studies.study import study
@@ -41,6 +43,10 @@ def main():
         from railride.studies.executors import LocalExecutor
 
         executor, where = LocalExecutor(ahead=args.ahead), f"local, one process, {args.ahead} chunk(s) ahead"
+    if args.processes is not None:
+        from railride.studies.executors import ProcessExecutor
+
+        executor, where = ProcessExecutor(args.processes), f"{args.processes} worker processes (ProcessExecutor)"
     if args.dask:
         import os
 
@@ -73,6 +79,8 @@ def main():
     t1 = t0 + wall
     peak_mib = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
     memory = f"{peak_mib:.0f} MiB"
+    if args.processes is not None:
+        executor.close()
     if cluster is not None:
         worker = executor.client.run(lambda: resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0)
         memory = f"client {peak_mib:.0f} MiB, worker {max(worker.values()):.0f} MiB"

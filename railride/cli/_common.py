@@ -367,12 +367,26 @@ class RunProgress:
         return False
 
 
-def make_executor(workers: Optional[int], scheduler: Optional[str], scheduler_file: Optional[Path], ahead: int = 1):
+def make_executor(
+    workers: Optional[int],
+    scheduler: Optional[str],
+    scheduler_file: Optional[Path],
+    ahead: int = 1,
+    processes: Optional[int] = None,
+):
     """(executor, record for the JSON): Dask with --scheduler / --scheduler-file, else the local
     executor, whose batches use --workers threads (numba's thread count, 1..cores), with
-    ``ahead`` chunks stepping beside the one whose rows are made (`LocalExecutor`)."""
+    ``ahead`` chunks stepping beside the one whose rows are made (`LocalExecutor`), or with
+    --processes N worker processes (`ProcessExecutor`)."""
     from railride.studies import sweep as sweep_lib
 
+    if processes is not None:
+        for given, option in ((workers, "--workers"), (scheduler, "--scheduler"), (scheduler_file, "--scheduler-file")):
+            if given is not None:
+                raise InputError(f"--processes with {option}: give one (processes share this machine's cores)")
+        with option_names({"processes": "--processes"}):
+            pool = sweep_lib.ProcessExecutor(processes)
+        return pool, {"type": "processes", "processes": pool.processes}
     if scheduler is not None and scheduler_file is not None:
         raise InputError("give either --scheduler ADDRESS or --scheduler-file FILE, not both")
     if scheduler is not None or scheduler_file is not None:

@@ -386,6 +386,15 @@ WorkersOption = Annotated[
         "--workers", metavar="N", help="Local executor: threads of each batch, 1..cores (default: every core)."
     ),
 ]
+ProcessesOption = Annotated[
+    Optional[int],
+    typer.Option(
+        "--processes",
+        metavar="N",
+        help="Local executor: N worker processes, each with its share of the cores, so that the chunks' Python work "
+        "runs in parallel too (for many cores; docs/performance.md).",
+    ),
+]
 SchedulerOption = Annotated[
     Optional[str],
     typer.Option(

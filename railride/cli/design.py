@@ -42,6 +42,7 @@ from railride.cli._options import (
     SchedulerOption,
     VehicleOption,
     WeightsOption,
+    ProcessesOption,
     WorkersOption,
     DesignOutOption,
     DesignResumeOption,
@@ -335,6 +336,7 @@ def design_command(
     dt: DtOption = None,
     backend: BackendOption = None,
     workers: WorkersOption = None,
+    processes: ProcessesOption = None,
     scheduler: SchedulerOption = None,
     scheduler_file: SchedulerFileOption = None,
     out: DesignOutOption = None,
@@ -396,7 +398,9 @@ def design_command(
         table, table_path = open_run_table(out, resume)
         # one chunk at a time: two chunks of 20 s runs at once took the default design to 2.09 GiB,
         # above its 2 GiB (docs/performance.md)
-        executor, executor_record = make_executor(workers, scheduler, scheduler_file, ahead=DESIGN_AHEAD)
+        executor, executor_record = make_executor(
+            workers, scheduler, scheduler_file, ahead=DESIGN_AHEAD, processes=processes
+        )
     try:
         with interruptible(table, table_path), errors(), option_names(DESIGN_FIELDS):
             from railride.studies.design import design

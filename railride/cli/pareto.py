@@ -48,6 +48,7 @@ from railride.cli._options import (
     TrackSeedOption,
     VehicleOption,
     WavelengthOption,
+    ProcessesOption,
     WorkersOption,
     figure_options,
 )
@@ -149,6 +150,7 @@ def pareto_command(
     damper: ParetoDamperOption = DEFAULT_DAMPER,
     gains: ParetoGainsOption = None,
     workers: WorkersOption = None,
+    processes: ProcessesOption = None,
     scheduler: SchedulerOption = None,
     scheduler_file: SchedulerFileOption = None,
     out: ParetoOutOption = None,
@@ -194,7 +196,7 @@ def pareto_command(
         )
         scenario_text = describe_scenario(scen.describe())
         table, table_path = open_run_table(out, resume)
-        executor, executor_record = make_executor(workers, scheduler, scheduler_file)
+        executor, executor_record = make_executor(workers, scheduler, scheduler_file, processes=processes)
     try:
         with interruptible(table, table_path), errors(), option_names(PARETO_FIELDS, defaults):
             with RunProgress(stderr_is_terminal(), "sampling the gains") as progress:

@@ -41,6 +41,7 @@ from railride.cli._options import (
     StudyResumeOption,
     VehicleOption,
     WindowOption,
+    ProcessesOption,
     WorkersOption,
     figure_options,
 )
@@ -248,6 +249,7 @@ def study_command(
     ] = DEFAULT_DAMPER,
     gains: StudyGainsOption = None,
     workers: WorkersOption = None,
+    processes: ProcessesOption = None,
     scheduler: SchedulerOption = None,
     scheduler_file: SchedulerFileOption = None,
     out: StudyOutOption = None,
@@ -282,7 +284,7 @@ def study_command(
         window_value = parse_window(window) if window is not None else None
         check_report_option(report)
         table, table_path = open_run_table(out, resume)
-        executor, executor_record = make_executor(workers, scheduler, scheduler_file)
+        executor, executor_record = make_executor(workers, scheduler, scheduler_file, processes=processes)
     try:
         with interruptible(table, table_path), errors(), option_names(STUDY_FIELDS):
             from railride.studies.study import study

@@ -52,6 +52,7 @@ from railride.cli._options import (
     SweepResumeOption,
     VehicleOption,
     WindowOption,
+    ProcessesOption,
     WorkersOption,
     figure_options,
 )
@@ -206,6 +207,7 @@ def sweep_command(
     preset: PresetOption = None,
     load: LoadOption = None,
     workers: WorkersOption = None,
+    processes: ProcessesOption = None,
     scheduler: SchedulerOption = None,
     scheduler_file: SchedulerFileOption = None,
     out: SweepOutOption = None,
@@ -267,7 +269,7 @@ def sweep_command(
         )
         check_report_option(report)
         table, table_path = open_run_table(out, resume)
-        executor, executor_record = make_executor(workers, scheduler, scheduler_file)
+        executor, executor_record = make_executor(workers, scheduler, scheduler_file, processes=processes)
     try:
         with interruptible(table, table_path), errors():
             with RunProgress(stderr_is_terminal(), "sweeping") as progress:

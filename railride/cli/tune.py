@@ -58,6 +58,7 @@ from railride.cli._options import (
     VehicleOption,
     WavelengthOption,
     WeightsOption,
+    ProcessesOption,
     WorkersOption,
     figure_options,
 )
@@ -447,6 +448,7 @@ def tune_command(
         ),
     ] = 400,
     workers: WorkersOption = None,
+    processes: ProcessesOption = None,
     scheduler: SchedulerOption = None,
     scheduler_file: SchedulerFileOption = None,
     out: TuneOutOption = None,
@@ -514,7 +516,7 @@ def tune_command(
         scenario_text = describe_scenario(scen.describe())
         check_report_option(report)
         table, table_path = open_run_table(out, resume)
-        executor, executor_record = make_executor(workers, scheduler, scheduler_file)
+        executor, executor_record = make_executor(workers, scheduler, scheduler_file, processes=processes)
     try:
         with interruptible(table, table_path), errors(), option_names(TUNE_FIELDS, defaults):
             with RunProgress(stderr_is_terminal(), "tuning") as progress:

@@ -3,6 +3,7 @@
 An executor runs chunks of cases (`railride.studies.sweep.evaluate` on each) and yields their rows:
 `LocalExecutor` on this machine, each batch over every core and the next chunk stepping while
 the last one's rows are made;
+`ProcessExecutor` on worker processes of this machine (the chunks' Python work in parallel too);
 `DaskExecutor` on a dask.distributed cluster. `RunTable` keeps every finished run in a CSV
 file rewritten atomically as chunks finish, so an interrupted study resumes where it stopped
 (`railride.studies.sweep.run_cases`).
@@ -66,6 +67,65 @@ class LocalExecutor:
 
     def close(self):
         pass
+
+
+class ProcessExecutor:
+    """Chunks on ``processes`` worker processes of this machine, each with its share of the cores
+    for its batches (numba threads = cores // processes, at least 1). A chunk's Python work
+    (its input tables, metrics, comfort and rows) holds the GIL, so threads can overlap it with
+    the stepping but not split it; processes run it in parallel too, which is what many cores
+    need (docs/performance.md). Workers are started fresh (spawn: a fork would copy numba's
+    running thread pool), which costs each a second or two of imports, so this pays for
+    studies of hundreds of runs and more. Rows come back as chunks finish, as on Dask."""
+
+    name = "processes"
+
+    def __init__(self, processes: int):
+        from railride import validation
+
+        self.processes = validation.integer("processes", processes, 1, 1024, "worker processes")
+        self._pool = None
+
+    def _start(self):
+        if self._pool is None:
+            import multiprocessing
+            from concurrent.futures import ProcessPoolExecutor
+
+            import numba
+
+            cores = int(numba.config.NUMBA_NUM_THREADS)
+            threads = max(1, cores // self.processes)
+            self._pool = ProcessPoolExecutor(
+                self.processes,
+                mp_context=multiprocessing.get_context("spawn"),
+                initializer=_worker_threads,
+                initargs=(threads,),
+            )
+        return self._pool
+
+    def map(self, fn, chunks):
+        from concurrent.futures import as_completed
+
+        pool = self._start()
+        futures = {pool.submit(fn, chunk): i for i, chunk in enumerate(chunks)}
+        try:
+            for fut in as_completed(futures):
+                yield futures.pop(fut), fut.result()
+        finally:  # stopped early (an error, Ctrl-C): drop what has not begun
+            for fut in futures:
+                fut.cancel()
+
+    def close(self):
+        if self._pool is not None:
+            self._pool.shutdown(wait=False, cancel_futures=True)
+            self._pool = None
+
+
+def _worker_threads(threads: int) -> None:
+    """A `ProcessExecutor` worker's start: its share of the cores for its batches."""
+    import numba
+
+    numba.set_num_threads(threads)
 
 
 class DaskExecutor:

@@ -30,7 +30,7 @@ import pandas as pd
 
 from railride.errors import InputError
 from railride.defaults import DEFAULT_CONTROL_RATE, DEFAULT_OUTPUT_RATE
-from railride.studies.executors import DaskExecutor, LocalExecutor, RunTable  # noqa: F401 (their home before)
+from railride.studies.executors import DaskExecutor, LocalExecutor, ProcessExecutor, RunTable  # noqa: F401 (their home before)
 from railride.analysis.metrics import RESPONSES, STATISTICS
 from railride.plots import PNG_DPI, FigureOptions
 from railride.model.params import VehicleParams, resolve_argument, resolve_vehicle, vehicle_record
