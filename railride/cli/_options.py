@@ -386,6 +386,20 @@ WorkersOption = Annotated[
         "--workers", metavar="N", help="Local executor: threads of each batch, 1..cores (default: every core)."
     ),
 ]
+#: design and tune
+OptimiserOption = Annotated[
+    str,
+    typer.Option(
+        "--optimiser",
+        metavar="sensitivity|evolution",
+        help="How each law's gains are tuned within the budget: the paper's one-at-a-time sensitivity "
+        "study, or differential evolution over all of a law's gains at once (SciPy).",
+    ),
+]
+OptimiserSeedOption = Annotated[
+    int,
+    typer.Option("--optimiser-seed", metavar="N", help="The seed of the evolution (with --optimiser evolution)."),
+]
 ProcessesOption = Annotated[
     Optional[int],
     typer.Option(

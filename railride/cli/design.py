@@ -42,6 +42,8 @@ from railride.cli._options import (
     SchedulerOption,
     VehicleOption,
     WeightsOption,
+    OptimiserOption,
+    OptimiserSeedOption,
     ProcessesOption,
     WorkersOption,
     DesignOutOption,
@@ -309,19 +311,8 @@ def design_command(
             help="A gain set's objective over the training runs: their mean, or the worst.",
         ),
     ] = "mean",
-    optimiser: Annotated[
-        str,
-        typer.Option(
-            "--optimiser",
-            metavar="sensitivity|evolution",
-            help="How each law's gains are tuned within the budget: the paper's one-at-a-time sensitivity "
-            "study, or differential evolution over all of a law's gains at once (SciPy).",
-        ),
-    ] = "sensitivity",
-    optimiser_seed: Annotated[
-        int,
-        typer.Option("--optimiser-seed", metavar="N", help="The seed of the evolution (with --optimiser evolution)."),
-    ] = 0,
+    optimiser: OptimiserOption = "sensitivity",
+    optimiser_seed: OptimiserSeedOption = 0,
     objective_kind: ObjectiveOption = None,
     weights: WeightsOption = None,
     bound: BoundOption = None,

@@ -58,6 +58,8 @@ from railride.cli._options import (
     VehicleOption,
     WavelengthOption,
     WeightsOption,
+    OptimiserOption,
+    OptimiserSeedOption,
     ProcessesOption,
     WorkersOption,
     figure_options,
@@ -81,6 +83,8 @@ from railride.cli._render import check_report_option, save_report
 #: the library's names of tune's options, for its errors
 TUNE_FIELDS = {
     "dt": SOLVER_FIELDS["dt"],
+    "optimiser": "--optimiser",
+    "optimiser_seed": "--optimiser-seed",
     "backend": SOLVER_FIELDS["backend"],
     **TRACK_FIELDS,
     "damper": "--damper",
@@ -449,6 +453,8 @@ def tune_command(
     ] = 400,
     workers: WorkersOption = None,
     processes: ProcessesOption = None,
+    optimiser: OptimiserOption = "sensitivity",
+    optimiser_seed: OptimiserSeedOption = 0,
     scheduler: SchedulerOption = None,
     scheduler_file: SchedulerFileOption = None,
     out: TuneOutOption = None,
@@ -540,6 +546,8 @@ def tune_command(
                     solver=solver,
                     progress=progress,
                     log=progress.log,
+                    optimiser=optimiser.strip(),
+                    optimiser_seed=optimiser_seed,
                 )
                 wall = time.perf_counter() - t0
             # the facts of this command line, after the library's document

@@ -46,3 +46,9 @@ def test_the_example_compares_the_optimisers_on_equal_budgets():
     assert proc.returncode == 0, proc.stderr
     for fragment in ("held-out score", "pid", "skyhook", "sensitivity  tuning", "evolution    tuning"):
         assert fragment in proc.stdout, fragment
+
+
+def test_tune_takes_the_optimiser_too():
+    assert_input_error(run("tune", "--optimiser", "annealing"), "--optimiser = 'annealing'", "sensitivity, evolution")
+    doc = ok_json("tune", "--controllers", "skyhook", "--optimiser", "evolution", "--budget", "15", "--duration", "1")
+    assert doc["settings"]["optimiser"]["name"] == "evolution" and doc["settings"]["optimiser"]["seed"] == 0
