@@ -9,11 +9,19 @@ imported, and inherited by the commands the tests start) unless the environment 
 NUMBA_ENABLE_CUDASIM=0 on a machine with a GPU the same tests run the kernel on the device."""
 
 import os
+import signal
 import sys
 from pathlib import Path
 
 import pytest
 from numba.core import config as _numba_config
+
+# A shell that starts the tests in the background (`cmd &` in a script) hands them SIGINT
+# ignored, and every command a test starts would inherit that, so the Ctrl-C tests would send a
+# signal nobody hears: take Python's own handler back (a caught signal is reset to the default in
+# a child, an ignored one is not)
+if signal.getsignal(signal.SIGINT) == signal.SIG_IGN:
+    signal.signal(signal.SIGINT, signal.default_int_handler)
 
 os.environ.setdefault("NUMBA_ENABLE_CUDASIM", "1")
 # pytest has imported numba already (the warning filters in pyproject.toml name its classes):
