@@ -12,6 +12,7 @@ import pytest
 from railride import dampers
 from railride.engine import gpu
 from railride.engine import lanes as engine_lanes
+from railride.testing.agreement import histories, worst_difference
 from railride.errors import BackendWarning, InputError
 from railride.model.params import VehicleParams
 from railride.model.track import scenario
@@ -65,24 +66,11 @@ def _runs(monkeypatch, **kw):
         return simulate(**kw, solver=GPU), simulate(**kw, solver=CPU)
 
 
-def _histories(result) -> dict[str, np.ndarray]:
-    ds = result.dataset
-    return {k: ds[k].values for k in ds.data_vars if ds[k].dtype.kind == "f" and "sample" in ds[k].dims}
-
-
 def _worst(a, b) -> float:
-    """The largest difference of any history over that history's largest value (inf where the
-    NaNs of a diverged tail differ)."""
-    worst = 0.0
-    ha, hb = _histories(a), _histories(b)
+    """The largest difference of any history of run a from run b's, over that history's largest value."""
+    ha, hb = histories(a), histories(b)
     assert ha.keys() == hb.keys()
-    for k in hb:
-        if not np.array_equal(np.isnan(ha[k]), np.isnan(hb[k])):
-            return np.inf
-        scale = np.nanmax(np.abs(hb[k])) if np.any(np.isfinite(hb[k])) else 0.0
-        if scale > 0.0:
-            worst = max(worst, float(np.nanmax(np.abs(ha[k] - hb[k]))) / scale)
-    return worst
+    return worst_difference(ha, hb)
 
 
 @pytest.mark.parametrize("case", list(CASES))

@@ -8,6 +8,7 @@ import pytest
 from railride import dampers
 
 from railride.engine import lanes as engine_lanes
+from railride.testing.agreement import histories, worst_difference
 from railride.secondary.control import SensorNoise
 from railride.errors import DivergenceError
 from railride.model.params import VehicleParams
@@ -95,24 +96,6 @@ def _reference(monkeypatch, **kw):
         return simulate(**kw)
 
 
-def _histories(result) -> dict[str, np.ndarray]:
-    ds = result.dataset
-    return {k: ds[k].values for k in ds.data_vars if ds[k].dtype.kind == "f" and "sample" in ds[k].dims}
-
-
-def _worst(a: dict, b: dict) -> float:
-    """The largest difference of any history, over that history's largest value; inf where
-    the NaNs (a diverged sample's tail) differ."""
-    worst = 0.0
-    for k in b:
-        if not np.array_equal(np.isnan(a[k]), np.isnan(b[k])):
-            return np.inf
-        scale = np.nanmax(np.abs(b[k])) if np.any(np.isfinite(b[k])) else 0.0
-        if scale > 0.0:
-            worst = max(worst, float(np.nanmax(np.abs(a[k] - b[k]))) / scale)
-    return worst
-
-
 @pytest.mark.parametrize("case", list(CASES))
 def test_lanes_agree_with_the_sample_stepper(case, monkeypatch, lane_calls):
     kw = dict(CASES[case], solver=RK4, on_divergence="mark")
@@ -121,13 +104,13 @@ def test_lanes_agree_with_the_sample_stepper(case, monkeypatch, lane_calls):
     ref = _reference(monkeypatch, **kw)
     assert len(lane_calls) == 1  # ... and the reference did not
     # the same arithmetic in another order: differences at rounding level (measured <= 1e-13)
-    assert _worst(_histories(lanes), _histories(ref)) < 1e-11
+    assert worst_difference(histories(lanes), histories(ref)) < 1e-11
     # (groundhook's gains are not stable on the ideal actuator: diverged alike in both)
     assert np.array_equal(lanes.diverged_at, ref.diverged_at, equal_nan=True)
 
 
 def _sample(result, i):
-    return {k: v[i] for k, v in _histories(result).items()}
+    return {k: v[i] for k, v in histories(result).items()}
 
 
 @pytest.mark.parametrize(
@@ -158,7 +141,7 @@ def test_a_diverging_lane_is_marked_and_the_others_go_on(monkeypatch, lane_calls
     assert lane_calls
     assert np.isfinite(lanes.diverged_at[4]) and lanes.diverged_at[4] == ref.diverged_at[4]
     assert np.all(np.isnan(np.delete(lanes.diverged_at, 4)))
-    assert _worst(_histories(lanes), _histories(ref)) < 1e-11  # NaN from the same row on
+    assert worst_difference(histories(lanes), histories(ref)) < 1e-11  # NaN from the same row on
     with pytest.raises(DivergenceError, match="sample 4 at t ="):
         simulate(**kw)
 
@@ -181,7 +164,7 @@ def test_chunked_runs_continue_and_sensing_takes_the_sample_stepper(lane_calls):
     seen = []
     chunked = simulate(SHORT, suspension=batch, progress=seen.append)
     assert len(seen) > 1 and len(lane_calls) == len(seen) + 1
-    assert _worst(_histories(chunked), _histories(whole)) < 1e-11
+    assert worst_difference(histories(chunked), histories(whole)) < 1e-11
     sensed = [Suspension.named("sas-attitude").with_sensing(Accelerometers())] * L
     simulate(SHORT, suspension=sensed)
     assert len(lane_calls) == len(seen) + 1  # realistic sensing: run_batch only
