@@ -120,6 +120,12 @@ class SolverSettings:
             out["backend"] = self.backend
         return out
 
+    def backend_record(self) -> dict:
+        """``{"backend": ...}`` for a result's settings where it is not "auto", else nothing (the
+        records of runs before it existed stay as they were). Not part of any run's key: the
+        backends' results agree to rounding."""
+        return {"backend": self.backend} if self.backend != "auto" else {}
+
     def backend_for(self, n: int) -> str:
         """ "cpu" or "gpu": where a batch of n samples steps under these settings (`BACKENDS`).
         "auto" with a batch of `GPU_MIN_BATCH` or more and no usable GPU warns once

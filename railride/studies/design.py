@@ -421,6 +421,7 @@ def design(
         "duration_s": plan.duration,
         "damper": damper_record(plan.damper),
         "dt_s": float(plan.solver.dt),
+        **plan.solver.backend_record(),
         "inner_loop_tuned": inner,
         "training_runs_per_gain_set": len(over),
         "training_runs": int(len(training)),

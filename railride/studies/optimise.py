@@ -141,6 +141,7 @@ class GainEvaluator:
             **settings,
             "damper": damper_record(self.damper),
             "dt_s": self.solver.dt,
+            **self.solver.backend_record(),
             "base_gains": self.gains.source,
             **other_settings(vehicle, self.solver),
         }

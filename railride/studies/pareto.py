@@ -306,6 +306,7 @@ def pareto(
         "sampling": SAMPLING,
         "damper": damper_record(damper),
         "dt_s": solver.dt,
+        **solver.backend_record(),
         "base_gains": base.source,
         "base_gains_tuned_on": (base.provenance or {}).get("scenario"),
         "vehicle": vehicle_rec,

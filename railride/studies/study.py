@@ -344,6 +344,7 @@ def study(
         "window_s": window_record,
         "vehicle": record,
         **other_settings(vehicle, solver),
+        **solver.backend_record(),
     }
     # gains tuned for another vehicle, load or track: one line for every run (`GainSet.mismatch`)
     tracks = [scenario_of(scenario, options).describe() for options, _ in opts_of.values()]

@@ -424,6 +424,7 @@ class SweepResult:
             if g.noise is None
             else dict(zip(("displacement", "angle", "velocity", "angular_rate"), g.noise)),
             "dt_s": float(g.solver.dt),
+            **g.solver.backend_record(),
             "window_s": None if g.window is None else list(g.window),
             **({"comfort": comfort_settings(g.duration, g.window)} if self.comfort else {}),
             "vehicle": record,

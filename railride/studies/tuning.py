@@ -287,6 +287,7 @@ def tune(
             "damper": damper_record(damper),
             "damper_scale": damper_scale,
             "dt_s": solver.dt,
+            **solver.backend_record(),
             "budget": budget,
             "values": n_values,
             "span": float(span),

@@ -42,3 +42,13 @@ def test_compare_on_the_gpu_matches_the_cpu_and_records_where_it_ran():
         for response, stats in b["metrics"].items():
             for stat, value in stats.items():
                 assert a["metrics"][response][stat] == pytest.approx(value, rel=1e-9), (b["name"], response, stat)
+
+
+def test_studies_record_the_backend_and_resume_across_backends(tmp_path):
+    out = tmp_path / "st"
+    common = ("study", "--controllers", "pid", "--duration", "1", "--track-seed", "0", "--out", out)
+    first = ok_json(*common)
+    assert "backend" not in first["settings"]  # "auto", the default: records stay as they were
+    again = ok_json(*common, "--backend", "cpu", "--resume")
+    assert again["settings"]["backend"] == "cpu"
+    assert again["runs_evaluated"] == 0  # the backend is not in the runs' keys: nothing ran again
