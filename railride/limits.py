@@ -138,7 +138,7 @@ def memory_limit(size):
 
 
 #: the largest track file read [bytes]: 256 MiB holds about 5 million rows (s, z_L, z_R), a line
-#: of 1,000 km at 0.2 m spacing (docs/track.md)
+#: of 1,000 km at 0.2 m spacing (docs/cli.md, --scenario)
 MAX_TRACK_FILE_BYTES = 256 * 2**20
 
 

@@ -21,6 +21,7 @@ Python sources (`_python_mirror`), since the simulator's arrays cannot enter com
 from __future__ import annotations
 
 import importlib.util
+import time
 import types
 
 import numpy as np
@@ -125,7 +126,7 @@ def device_name() -> str:
 
 # -- the kernel -----------------------------------------------------------------------------------
 @njit(inline="always", fastmath=_FAST)
-def _qdd(law, s, y, n_cols, R, roff, at, K, koff):
+def _qdd(s, y, n_cols, R, roff, at, K, koff):
     """K[koff + N_DOF + i] = R[roff + i] + sum_j at[j, i] y_j for the N_DOF rows of q'', with
     y = (s[:2 N_DOF], y[2 N_DOF:n_cols]): (q, q') read from the state, the corner forces from the
     stage vector; at (NY, N_DOF) is the transposed matrix (`kernels.run_batch`)."""
@@ -150,9 +151,9 @@ def _derivative(law, s, R, roff, at, tt, pp, vcmd, conn, y, cx, cv, K, koff, zk,
             for c in range(N_CORNER):
                 y[2 * N_DOF + c] = 0.0
             if add_stops(zk, cx, y, 2 * N_DOF, fsave):
-                _qdd(law, s, y, NY, R, roff, at, K, koff)
+                _qdd(s, y, NY, R, roff, at, K, koff)
                 return
-        _qdd(law, s, y, 2 * N_DOF, R, roff, at, K, koff)
+        _qdd(s, y, 2 * N_DOF, R, roff, at, K, koff)
         return
     for c in range(N_CORNER):
         b = 2 * N_DOF + N_DAMPER_STATES * c
@@ -162,11 +163,11 @@ def _derivative(law, s, R, roff, at, tt, pp, vcmd, conn, y, cx, cv, K, koff, zk,
         K[koff + b + 1] = dyy
         K[koff + b + 2] = du
     if zk[1] > 0.0 and add_stops(zk, cx, y, 2 * N_DOF, fsave):
-        _qdd(law, s, y, NY, R, roff, at, K, koff)
+        _qdd(s, y, NY, R, roff, at, K, koff)
         for c in range(N_CORNER):
             y[2 * N_DOF + c] = fsave[c]
         return
-    _qdd(law, s, y, NY, R, roff, at, K, koff)
+    _qdd(s, y, NY, R, roff, at, K, koff)
 
 
 @njit(inline="always", fastmath=_FAST)
@@ -474,8 +475,6 @@ def _run_group(kernel, shared, lo, hi, law, step0, n_steps, final, stride, r0, r
     x = per_sample[0]
     _, u_off, _, f_off, n_nodes, interval = inputs
     closed_loop, ctrl_stride = control[0], control[1]
-    import time
-
     started = time.perf_counter()
     m = hi - lo
     dev = [cuda.to_device(np.ascontiguousarray(a[lo:hi])) for a in per_sample]

@@ -458,7 +458,7 @@ def input_table_nodes(scenario: Scenario, dt: float, duration: float | None = No
     # m is a power of two, so halving dt doubles m and leaves the grid (and the input) alone
     ratio = scenario.track.table_spacing() / (scenario.speed * dt)
     # (at most 2**52 steps between nodes: a speed near 0 would make the ratio infinite)
-    m = 1 << min(52, max(0, int(math.floor(math.log2(min(ratio, 2.0**52)))))) if ratio >= 1 else 1
+    m = 1 << int(math.floor(math.log2(min(ratio, 2.0**52)))) if ratio >= 1 else 1
     interval = m * dt
     return int(math.ceil((duration + dt) / interval)) + 2, interval
 
@@ -578,13 +578,13 @@ class RandomTrack(RailProfile):
             raise InputError(f"length = {length:g} m: must be at least max_wavelength = {hi:g} m")
         lead = _check("lead_in", self.lead_in, "nonnegative", "a finite number >= 0 (m)")
         ds = lo / 20.0  # 20 samples on the shortest wavelength
-        samples = length / ds
-        n = int(2 ** math.ceil(math.log2(samples))) if samples <= 2**24 else 2**25  # inf: no int of it
-        if n > 2**24:
+        samples = length / ds  # checked before any int of it: it may be inf
+        if not samples <= 2**24:
             raise InputError(
-                f"the realisation needs {n:.4g} samples ({length:.4g} m at {ds:.4g} m), more than "
+                f"the realisation needs {samples:.4g} samples ({length:.4g} m at {ds:.4g} m), more than "
                 f"2**24: shorten it or raise min_wavelength"
             )
+        n = int(2 ** math.ceil(math.log2(samples)))
         ds = length / n
         dW = 2 * np.pi / length
         k = np.arange(n // 2 + 1)

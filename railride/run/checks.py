@@ -168,13 +168,14 @@ def _check_bending(params: VehicleParams, solver: SolverSettings) -> None:
         )
 
 
-def _exact_phases(scenarios, solver: SolverSettings, duration: float) -> int:
-    """The step maps the exact discretisation would build for these scenarios: the phases of the
-    output steps against the input table's node spacing (the slowest scenario's)."""
+def _exact_phases(scenarios, solver: SolverSettings, duration: float) -> tuple[int, int]:
+    """(maps, m): the step maps the exact discretisation would build for these scenarios, the
+    phases of the output steps against the input table's node spacing of m steps (that of the
+    scenario with the most nodes)."""
     stride = solver.output_steps
     _, interval = max(input_table_nodes(sc, solver.dt, duration) for sc in scenarios)
     m = int(round(interval / solver.dt))
-    return math.lcm(stride, m) // stride
+    return math.lcm(stride, m) // stride, m
 
 
 def _check_size(scenarios, solver: SolverSettings, damper, closed, exact: bool, n_out: int, duration: float):
@@ -188,8 +189,8 @@ def _check_size(scenarios, solver: SolverSettings, damper, closed, exact: bool, 
     nodes, interval = max(input_table_nodes(sc, dt, duration) for sc in scenarios)
     need += 8.0 * n * nodes * (16 + 36)  # input and forcing tables, at most one each per sample
     if exact:  # discrete.ExactStepper: period x 18 x (span x 8)
-        m = int(round(interval / dt))
-        period, span = math.lcm(stride, m) // stride, (stride + m - 1) // m + 2
+        period, m = _exact_phases(scenarios, solver, duration)
+        span = (stride + m - 1) // m + 2
         need += 8.0 * period * 2 * N_DOF * span * 8
     limits.check(
         need,
@@ -367,7 +368,7 @@ def check(scenario=None, params=None, suspension=None, solver=None, on_divergenc
     vcmd = np.array([[_command_voltage(s)] * 4 for s in suspensions], dtype=float)
     closed = _closed_loop(suspensions, solver, duration)
     exact = _exact(solver, damper, closed, suspensions, len(set(param_sets)))
-    if exact and solver.method == "auto" and _exact_phases(scenarios, solver, duration) > _MAX_EXACT_PHASES:
+    if exact and solver.method == "auto" and _exact_phases(scenarios, solver, duration)[0] > _MAX_EXACT_PHASES:
         exact = False  # "auto" takes RK4 where the exact steps would need too many maps (a slow speed)
     vehicles = {}
     for p in param_sets:

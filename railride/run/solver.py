@@ -116,9 +116,7 @@ class SolverSettings:
         out: dict = {"dt_s": self.dt, "output_rate_hz": self.output_rate, "control_rate_hz": self.control_rate}
         if self.method != "auto":
             out["method"] = self.method
-        if self.backend != "auto":
-            out["backend"] = self.backend
-        return out
+        return {**out, **self.backend_record()}
 
     def backend_record(self) -> dict:
         """``{"backend": ...}`` for a result's settings where it is not "auto", else nothing (the
