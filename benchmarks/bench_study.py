@@ -64,7 +64,8 @@ def main():
     study(controllers, track_seeds=[0], speeds=[40.0], duration=1.0, executor=executor)  # compile
     seeds = list(range(args.seeds))
     speeds = [30.0, 37.5, 45.0, 52.5, 60.0]
-    intervals = _watch_steps() if args.profile else None
+    intervals = _watch_steps() if args.profile and args.processes is None else None
+    parent = resource.getrusage(resource.RUSAGE_SELF)
     t0 = time.perf_counter()
     res = study(
         controllers,
@@ -77,6 +78,8 @@ def main():
     )
     wall = time.perf_counter() - t0
     t1 = t0 + wall
+    after = resource.getrusage(resource.RUSAGE_SELF)
+    parent_cpu = (after.ru_utime - parent.ru_utime) + (after.ru_stime - parent.ru_stime)
     peak_mib = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
     memory = f"{peak_mib:.0f} MiB"
     if args.processes is not None:
@@ -99,6 +102,12 @@ def main():
         print(
             f"\nthreads {_threads()}: the stepper ran {stepping:.1f} s of the {wall:.1f} s; no chunk was stepping for "
             f"{wall - stepping:.1f} s, the serial share: {(wall - stepping) / wall * 100:.1f} %"
+        )
+
+    if args.profile and args.processes is not None:
+        print(
+            f"\nthe parent process's CPU time during the study: {parent_cpu:.2f} s of the {wall:.1f} s wall time, "
+            f"the serial share: {parent_cpu / wall * 100:.1f} %"
         )
 
 
