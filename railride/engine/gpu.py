@@ -189,15 +189,37 @@ def _forcing(t, ftab, off, n_nodes, interval, R, roff):
         )
 
 
+#: the columns of a sample's metric sums in reduce mode: the sums of squares, the least and the
+#: largest values of the metric channels (`METRIC_CHANNELS`), and the rows summed
+ACC_SQUARES, ACC_MIN, ACC_MAX, ACC_ROWS = 0, 4, 8, 12
+N_ACC = 13
+#: the channels of `railride.analysis.metrics.RESPONSES` as (history, column): the carbody's
+#: vertical acceleration (out_a), bounce, pitch and roll (out_q), in that order
+METRIC_CHANNELS = (("a", 0), ("q", 0), ("q", 1), ("q", 2))
+
+
+@njit(inline="always", fastmath=_FAST)
+def _accumulate(acc, smp, out_q, out_a):
+    """Add the row just written (row 0 of out_q, out_a) to sample smp's metric sums."""
+    for k in range(4):
+        v = out_a[smp, 0, 0] if k == 0 else out_q[smp, 0, k - 1]
+        acc[smp, ACC_SQUARES + k] += v * v
+        acc[smp, ACC_MIN + k] = min(acc[smp, ACC_MIN + k], v)
+        acc[smp, ACC_MAX + k] = max(acc[smp, ACC_MAX + k], v)
+    acc[smp, ACC_ROWS] += 1.0
+
+
 # fmt: off
 def _kernel(
     n, law, x, step0, n_steps, final, stride, row0, dt, lam1, vid, A, TS, c_sec, stops, P, vcmd, utab, u_off, ftab,
     f_off, n_nodes, interval, closed_loop, ctrl_stride, Gm, Hm, inner, noise, faults, sensing, snoise, out_q, out_v,
-    out_a, out_f, out_w, out_wd, out_d, out_fd, out_vc, status, fail_step,
+    out_a, out_f, out_w, out_wd, out_d, out_fd, out_vc, status, fail_step, reduce, win, acc,
 ):
     # fmt: on
     """One thread per sample smp < n: `kernels._run_samples`'s loop body for that sample. The
-    vehicle's matrices are A[vid[smp]], TS[vid[smp]]; the outputs hold the rows from row0 on."""
+    vehicle's matrices are A[vid[smp]], TS[vid[smp]]; the outputs hold the rows from row0 on.
+    With ``reduce``, the outputs hold one row, rewritten at every output step, and the rows
+    win[0] <= row <= win[1] go into the sample's metric sums acc[smp] (`_accumulate`)."""
     smp = cuda.grid(1)
     if smp >= n or status[smp] != STATUS_OK:
         return
@@ -277,11 +299,13 @@ def _kernel(
         if faulty:
             hold_failed_coils(fm, step, vc, pp, s, K)
         if step % stride == 0:
-            row = step // stride - row0
+            row = 0 if reduce else step // stride - row0
             if record_row(smp, row, t, law, s, K, y, cv, tt, cs, xs, vc, utab, uo, nn, itv, w, wd, out4, out5):
                 status[smp] = STATUS_DIVERGED
                 fail_step[smp] = step
                 break
+            if reduce and win[0] <= step // stride <= win[1]:
+                _accumulate(acc, smp, out_q, out_a)
         if n_ == n_steps:
             break
         m = substep_count(law, bw1, gb1, lam1, pp, cv, s, dt)
@@ -349,7 +373,7 @@ def kernel_signature() -> tuple:
         (i, i, a(2), i, i, b, i, i, f, f, a(1, i), a(3), a(3), a(2), a(2), a(2), a(2), a(2), a(1, i), a(2))
         + (a(1, i), a(1, i), a(1), b, i, a(3), a(3), a(2), a(2), a(2, i), a(2), a(2))
         + (a(3),) * 9
-        + (a(1, i), a(1, i))
+        + (a(1, i), a(1, i), b, a(1, i), a(2))
     )
 
 
@@ -425,12 +449,19 @@ class _Failed(Exception):
         self.done = done
 
 
-def run_gpu(n, law, x, step0, n_steps, final, stride, dt, vehicle, dampers, inputs, control, outputs) -> int:
+def run_gpu(
+    n, law, x, step0, n_steps, final, stride, dt, vehicle, dampers, inputs, control, outputs, reduce=None
+) -> int:
     """`kernels.run_parallel(kernels.run_batch, ...)`'s work on the GPU, with the same arguments:
     samples 0..n advance n_steps steps from step0; x, the outputs' rows of these steps, status
     and fail_step are written back. The samples go in groups that fit the device's memory; a
     group's results reach the host arrays only when the group has finished. Returns n; a
-    failure raises `_Failed` with the samples finished before it."""
+    failure raises `_Failed` with the samples finished before it.
+
+    ``reduce`` = (win, acc): no histories leave the device. The outputs hold one row per sample
+    (two where the run records that history, one where it does not: the stepper reads which from
+    their shapes), rewritten at each output step, and the output rows win[0]..win[1] (both
+    included) are added to acc (n, `N_ACC`), whose sums go on from what acc holds."""
     from railride.engine.laws import _one_step_limit
 
     try:
@@ -448,13 +479,17 @@ def run_gpu(n, law, x, step0, n_steps, final, stride, dt, vehicle, dampers, inpu
     histories = (out_q, out_v, out_a, out_f, out_w, out_wd, out_d, out_fd, out_vc)
     per_sample = [x, c_sec, stops, P, vcmd, Gm, Hm, inner, faults, sensing]
     row_bytes = sum(h.shape[2] * 8 for h in histories if h.shape[1] > 1)
+    if reduce is not None:
+        per_sample.append(reduce[1])
+        n_rows, row_bytes = 1, sum(h.shape[1] * h.shape[2] * 8 for h in histories)
     bytes_per_sample = sum(a[0].nbytes for a in per_sample) + n_rows * row_bytes
     lam1 = _one_step_limit(dt)
     lo = 0
     last_call.clear()
     last_call.update(kernel_s=0.0, transfer_s=0.0, groups=0, device_bytes=0)
     try:
-        shared = [cuda.to_device(np.ascontiguousarray(a)) for a in (A_u, TS_u, utab, ftab, noise, snoise)]
+        win = np.zeros(2, dtype=np.int64) if reduce is None else np.asarray(reduce[0], dtype=np.int64)
+        shared = [cuda.to_device(np.ascontiguousarray(a)) for a in (A_u, TS_u, utab, ftab, noise, snoise, win)]
         size = group_size(n, bytes_per_sample)
     except Exception as exc:
         raise _Failed(exc, 0) from exc
@@ -462,7 +497,7 @@ def run_gpu(n, law, x, step0, n_steps, final, stride, dt, vehicle, dampers, inpu
         hi = min(n, lo + size)
         try:
             _run_group(kernel, shared, lo, hi, law, step0, n_steps, final, stride, r0, r1, n_rows, dt, lam1, vid,
-                       per_sample, histories, inputs, control, status, fail_step)  # fmt: skip
+                       per_sample, histories, inputs, control, status, fail_step, reduce is not None)  # fmt: skip
         except Exception as exc:
             raise _Failed(exc, lo) from exc
         lo = hi
@@ -470,8 +505,9 @@ def run_gpu(n, law, x, step0, n_steps, final, stride, dt, vehicle, dampers, inpu
 
 
 def _run_group(kernel, shared, lo, hi, law, step0, n_steps, final, stride, r0, r1, n_rows, dt, lam1, vid,
-               per_sample, histories, inputs, control, status, fail_step):  # fmt: skip
-    """Samples lo..hi on the device, their results into the host arrays once they finished."""
+               per_sample, histories, inputs, control, status, fail_step, reduce):  # fmt: skip
+    """Samples lo..hi on the device, their results into the host arrays once they finished
+    (with ``reduce``, the metric sums: per_sample's last array)."""
     x = per_sample[0]
     _, u_off, _, f_off, n_nodes, interval = inputs
     closed_loop, ctrl_stride = control[0], control[1]
@@ -481,16 +517,21 @@ def _run_group(kernel, shared, lo, hi, law, step0, n_steps, final, stride, r0, r
     small = [cuda.to_device(np.ascontiguousarray(a[lo:hi])) for a in (vid, u_off, f_off, n_nodes, interval)]
     st = cuda.to_device(np.ascontiguousarray(status[lo:hi]))
     fs = cuda.to_device(np.ascontiguousarray(fail_step[lo:hi]))
-    outs = [cuda.device_array((m, n_rows if h.shape[1] > 1 else 1, h.shape[2])) for h in histories]
+    if reduce:  # the host's one or two rows: the stepper writes row 0
+        outs = [cuda.device_array((m, h.shape[1], h.shape[2])) for h in histories]
+        acd = dev.pop()
+    else:
+        outs = [cuda.device_array((m, n_rows if h.shape[1] > 1 else 1, h.shape[2])) for h in histories]
+        acd = cuda.device_array((1, N_ACC))  # not read
     xd, cs, sp, pd, vd, gd, hd, ind, fd, sd = dev
     vidd, uod, fod, nnd, itd = small
-    Ad, TSd, ud, fdd, nod, snd = shared
+    Ad, TSd, ud, fdd, nod, snd, wind = shared
     launched = time.perf_counter()
     blocks = -(-m // THREADS_PER_BLOCK) if not simulated() else -(-m // 8)
     threads = THREADS_PER_BLOCK if not simulated() else 8
     kernel[blocks, threads](
         m, law, xd, step0, n_steps, final, stride, r0, dt, lam1, vidd, Ad, TSd, cs, sp, pd, vd, ud, uod, fdd,
-        fod, nnd, itd, closed_loop, ctrl_stride, gd, hd, ind, nod, fd, sd, snd, *outs, st, fs,
+        fod, nnd, itd, closed_loop, ctrl_stride, gd, hd, ind, nod, fd, sd, snd, *outs, st, fs, reduce, wind, acd,
     )  # fmt: skip
     cuda.synchronize()
     finished = time.perf_counter()
@@ -500,8 +541,11 @@ def _run_group(kernel, shared, lo, hi, law, step0, n_steps, final, stride, r0, r
     # all back from the device before any host array changes: a failure up to here leaves the
     # group as it was, for the CPU to run
     back = [xd.copy_to_host(), st.copy_to_host(), fs.copy_to_host()]
-    rows = [o.copy_to_host()[:, : r1 - r0] if h.shape[1] > 1 else None for h, o in zip(histories, outs)]
+    rows = [o.copy_to_host()[:, : r1 - r0] if h.shape[1] > 1 and not reduce else None for h, o in zip(histories, outs)]
+    sums = acd.copy_to_host() if reduce else None
     x[lo:hi], status[lo:hi], fail_step[lo:hi] = back
+    if sums is not None:
+        per_sample[-1][lo:hi] = sums
     for h, r in zip(histories, rows):
         if r is not None:
             h[lo:hi, r0:r1] = r

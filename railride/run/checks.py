@@ -18,7 +18,7 @@ from railride.defaults import DEFAULT_DT
 from railride.engine import lanes, layout
 from railride.errors import InputError
 from railride.model.params import VehicleParams
-from railride.model.track import Scenario, as_scenario, input_table_nodes
+from railride.model.track import Scenario, as_scenario, input_table_nodes, table_key
 from railride.engine.layout import N_DOF, N_RIGID
 from railride.model.vehicle import Vehicle
 from railride.run.inputs import _vehicle, engine_matrices, engine_state_matrix
@@ -178,16 +178,20 @@ def _exact_phases(scenarios, solver: SolverSettings, duration: float) -> tuple[i
     return math.lcm(stride, m) // stride, m
 
 
-def _check_size(scenarios, solver: SolverSettings, damper, closed, exact: bool, n_out: int, duration: float):
+def _check_size(
+    scenarios, solver: SolverSettings, damper, closed, exact: bool, n_out: int, duration: float, tables=None
+):
     """`railride.limits.check` on what a run allocates before it allocates it: the stored
     histories (samples x output rows x channels), the rail input and forcing tables, and the
-    exact stepper's maps (one per phase of the output steps against the table's nodes)."""
+    exact stepper's maps (one per phase of the output steps against the table's nodes). Given
+    ``tables``, the number of distinct tracks and vehicles of a metrics-only run on the GPU
+    (`railride.run.reduced`): two rows a sample, and that many tables."""
     n, dt, stride = len(scenarios), solver.dt, solver.output_steps
     limits.check_steps("dt", n_out * stride, "raise dt or shorten the run")
     channels = 3 * N_DOF + 4 + 16 + (layout.N_DS if has_damper_states(damper) else 0) + (8 if closed else 0)
-    need = 8.0 * n * (n_out + 1) * channels
+    need = 8.0 * n * ((n_out + 1) if tables is None else 2) * channels
     nodes, interval = max(input_table_nodes(sc, dt, duration) for sc in scenarios)
-    need += 8.0 * n * nodes * (16 + 36)  # input and forcing tables, at most one each per sample
+    need += 8.0 * (n if tables is None else tables) * nodes * (16 + 36)  # input and forcing tables, at most one a sample
     if exact:  # discrete.ExactStepper: period x 18 x (span x 8)
         period, m = _exact_phases(scenarios, solver, duration)
         span = (stride + m - 1) // m + 2
@@ -324,9 +328,13 @@ class RunPlan:
         return self.n_out * self.stride
 
 
-def check(scenario=None, params=None, suspension=None, solver=None, on_divergence="raise", initial_state=None):
+def check(
+    scenario=None, params=None, suspension=None, solver=None, on_divergence="raise", initial_state=None, histories=True
+):
     """Every input of `railride.simulate` checked, before any work: an InputError names the
-    first that is wrong. Returns the `RunPlan` of the run."""
+    first that is wrong. Returns the `RunPlan` of the run. ``histories=False``: the run keeps
+    only its metrics where it steps on the GPU (`railride.run.reduced.batch_metrics`), and its
+    memory is checked for that."""
     solver = SolverSettings.of(solver)
     dt, output_rate = solver.dt, solver.output_rate
     if on_divergence not in ("raise", "mark"):
@@ -388,7 +396,10 @@ def check(scenario=None, params=None, suspension=None, solver=None, on_divergenc
         raise InputError(f"duration = {duration:g} s must be a whole number of output intervals (1/{output_rate:g} Hz)")
     for sc in scenarios:  # the track's shortest wavelength must show in the output
         check_resolution(sc, output_rate)
-    _check_size(scenarios, solver, damper, closed, exact, n_out, duration)
+    tables = None
+    if not histories and not exact and solver.backend_for(n) == "gpu":  # metrics summed on the device
+        tables = len({(table_key(sc) or id(sc), id(p)) for sc, p in zip(scenarios, param_sets)})
+    _check_size(scenarios, solver, damper, closed, exact, n_out, duration, tables)
     gm, hm, modes, sensing = _outer_loops(closed, param_sets, vehicles, n)
     faults = fault_table([s.faults for s in suspensions], dt, duration)  # their times within the run
     x0 = None

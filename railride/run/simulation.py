@@ -206,9 +206,12 @@ class Packed:
     control: tuple  # closed loop, control stride, G, H, inner loop rows, noise, faults, sensing, sensing noise
 
 
-def pack(plan: RunPlan, tables: Inputs) -> Packed:
-    """The pack stage: the arrays the stepper reads and writes, allocated once."""
-    n, rows, damper, closed = plan.n, plan.n_out + 1, plan.damper, plan.closed
+def pack(plan: RunPlan, tables: Inputs, rows: int | None = None) -> Packed:
+    """The pack stage: the arrays the stepper reads and writes, allocated once. ``rows``: the
+    rows of the histories it records (default the run's; the GPU's metrics-only runs take two,
+    `railride.run.reduced`), one for those it does not."""
+    n, damper, closed = plan.n, plan.damper, plan.closed
+    rows = plan.n_out + 1 if rows is None else rows
     law = layout.LAW_VISCOUS_IN_C if damper is None else damper.law
     x = np.zeros((n, layout.NX))
     x[:, 2 * N_DOF + 2 : layout.NS_MAX : dampers.N_DAMPER_STATES] = plan.vcmd  # coils settled at the command
@@ -322,14 +325,7 @@ def step(plan: RunPlan, tables: Inputs, packed: Packed, progress=None) -> Steppe
     else:
         step_batch = functools.partial(kernels.run_parallel, kernels.run_batch)
     stop = _StopRequest(progress is not None)
-    # the stepper's argument groups (`kernels.run_batch`): vehicle, dampers, inputs, control, outputs
-    kernel_groups = (
-        (arrays["A"], arrays["TS"], arrays["c_sec"], arrays["stops"]),
-        (P, plan.vcmd),
-        (utab, u_off, tables.ftab, tables.f_off, n_nodes, interval),
-        packed.control,
-        tuple(out[key] for key in ("q", "v", "a", "f", "w", "wd", "d", "fd", "vc")) + (status, fail_step),
-    )
+    kernel_groups = stepper_arguments(plan, tables, packed)
     step_batch = stop.around(step_batch)
     chunk = n_steps if progress is None else max(stride, (_CHUNK_WORK // n) // stride * stride)
     done = 0
@@ -353,6 +349,19 @@ def step(plan: RunPlan, tables: Inputs, packed: Packed, progress=None) -> Steppe
     return Stepped(out, status, fail_step, rows, stop.requested, on)
 
 
+def stepper_arguments(plan: RunPlan, tables: Inputs, packed: Packed) -> tuple:
+    """The stepper's argument groups after its scalars (`kernels.run_batch`): vehicle, dampers,
+    inputs, control, outputs."""
+    arrays, out = tables.arrays, packed.out
+    return (
+        (arrays["A"], arrays["TS"], arrays["c_sec"], arrays["stops"]),
+        (packed.P, plan.vcmd),
+        (tables.utab, tables.u_off, tables.ftab, tables.f_off, tables.n_nodes, tables.interval),
+        packed.control,
+        tuple(out[key] for key in ("q", "v", "a", "f", "w", "wd", "d", "fd", "vc")) + (packed.status, packed.fail_step),
+    )
+
+
 def stepped_on(plan: RunPlan) -> str:
     """ "cpu" or "gpu": where the RK4 steps of this run go (the exact steps are always the CPU's)."""
     return "cpu" if plan.exact else plan.solver.backend_for(plan.n)
@@ -369,6 +378,16 @@ def _gpu_failed(exc: BaseException) -> None:
 
 
 # -- assemble -------------------------------------------------------------------------------------
+def divergence_message(status: np.ndarray, fail_step: np.ndarray, dt: float) -> str:
+    """What a `DivergenceError` says: the first samples that diverged, and when."""
+    bad = np.flatnonzero(status != layout.STATUS_OK)
+    which = ", ".join(f"sample {i} at t = {fail_step[i] * dt:.4g} s" for i in bad[:5])
+    return (
+        f"the simulation diverged ({which}): a response left +-{layout.DIVERGED:g} "
+        f"or stopped being finite; check the parameters or reduce dt"
+    )
+
+
 def assemble(plan: RunPlan, stepped: Stepped) -> RideResult:
     """The assemble stage: divergence (raised, or marked with NaN from its time on), and the
     `RideResult`, whose Dataset is built when first asked for (`railride.run.ride.build_dataset`).
@@ -378,13 +397,8 @@ def assemble(plan: RunPlan, stepped: Stepped) -> RideResult:
     diverged_at = np.full(n, np.nan)
     if np.any(status != layout.STATUS_OK):
         bad = np.flatnonzero(status != layout.STATUS_OK)
-        which = ", ".join(f"sample {i} at t = {fail_step[i] * dt:.4g} s" for i in bad[:5])
-        message = (
-            f"the simulation diverged ({which}): a response left +-{layout.DIVERGED:g} "
-            f"or stopped being finite; check the parameters or reduce dt"
-        )
         if plan.on_divergence != "mark":
-            raise DivergenceError(message)
+            raise DivergenceError(divergence_message(status, fail_step, dt))
         for i in bad.tolist():  # the stepper stopped there: what follows is not a response
             diverged_at[i] = fail_step[i] * dt
             cut = fail_step[i] // stride

@@ -51,21 +51,23 @@ class OwnChunks:
 
     def __init__(self, executor, parts):
         from railride.studies.executors import LocalExecutor
+        from railride.studies.sweep import CHUNK
 
         self.executor = LocalExecutor() if executor is None else executor
         self.parts = parts
+        self.chunk = CHUNK  # the runs of a chunk: `run_cases` sets it (larger on a GPU)
 
     def map(self, fn, chunks):
         """``executor.map`` of the chunks of each law's cases among those in ``chunks`` (the
         cases `run_cases` found missing from its table)."""
-        from railride.studies.sweep import CHUNK, _chunks
+        from railride.studies.sweep import _chunks
 
         pending = {c.key for chunk in chunks for c in chunk}
         own = []
         for part in self.parts:
             seen: set = set()
             mine = [c for c in part if c.key in pending and not (c.key in seen or seen.add(c.key))]
-            own += _chunks(mine, CHUNK)
+            own += _chunks(mine, self.chunk)
         return self.executor.map(fn, own)
 
     def close(self) -> None:

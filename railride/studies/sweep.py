@@ -42,6 +42,10 @@ from railride.studies.grid import SweepGrid, grid  # noqa: F401 (the grid of the
 #: samples per compiled batch: bounds the memory of the time histories (about 5 MB a sample
 #: for 10 s at 1 kHz)
 CHUNK = 32
+#: runs per batch where a study keeps only the metrics and the GPU takes them (`gpu_batches`):
+#: their sums stay on the device (`railride.run.reduced`), a few bytes a run, and a GPU pays from
+#: thousands of samples (a choice: not yet measured on a GPU, docs/gpu.md)
+GPU_CHUNK = 8192
 #: (position, index) of `railride.analysis.comfort.ride_comfort` in a row with comfort, as the column
 #: ``<position>_<index>``
 COMFORT_INDICES = (
@@ -93,14 +97,15 @@ def evaluate(
     by_group: dict[tuple, list[int]] = {}
     for i, c in enumerate(cases):
         by_group.setdefault(c.group, []).append(i)
+    metrics_only = not (comfort or costs)
     for group, idx in by_group.items():
-        for start in range(0, len(idx), CHUNK):
-            part = [cases[i] for i in idx[start : start + CHUNK]]
+        for part_idx in _batches(idx, solver, metrics_only):
+            part = [cases[i] for i in part_idx]
             scs = [_scenario(made, c) for c in part]
             pars = [vehicle.replace(**dict(c.vehicle)) for c in part]
             suspensions = [c.to_suspension(base_gains) for c in part]
             if batch_conflict(suspensions) is not None:  # the inner loop is one setting per batch
-                for i in idx[start : start + CHUNK]:  # positions, not lookups: cases may repeat
+                for i in part_idx:  # positions, not lookups: cases may repeat
                     rows[i] = evaluate(
                         [cases[i]],
                         base_gains,
@@ -110,6 +115,14 @@ def evaluate(
                         comfort=comfort,
                         costs=costs,
                     )[0]
+                continue
+            if metrics_only:  # on the GPU, summed on the device with no histories
+                from railride.run.checks import check
+                from railride.run.reduced import batch_metrics
+
+                plan = check(scs, pars, suspensions, solver, "mark", histories=False)
+                m, diverged_at = batch_metrics(plan, window)
+                _add_rows(rows, cases, part_idx, m, diverged_at)
                 continue
             res = simulate(scs, pars, suspensions, solver=solver, on_divergence="mark")
             # a diverged run keeps its row, with NaN metrics and the time it diverged: the other
@@ -129,27 +142,59 @@ def evaluate(
                     indices = ride_comfort(ds if ok.size == ds.sizes["sample"] else ds.isel(sample=ok), window=window)
                     cf = np.stack([indices.sel(position=p, index=x).values for p, x in COMFORT_INDICES], -1)
             paid = _costs(res, part[0], window) if costs else None
-            for j, i in enumerate(idx[start : start + CHUNK]):
-                if i in rows:
-                    continue
-                row = {"key": cases[i].key, **_flat(cases[i]), "diverged_at_s": float(diverged_at[j])}
-                for r, resp in enumerate(RESPONSES):
-                    for s, stat in enumerate(STATISTICS):
-                        row[f"{resp}_{stat}"] = float(m[j, r, s])
-                if comfort:
-                    for k, column in enumerate(COMFORT_COLUMNS):
-                        row[column] = (
-                            float(cf[int(np.searchsorted(ok, j)), k])
-                            if np.isnan(diverged_at[j]) and cf is not None
-                            else np.nan
-                        )
-                if paid is not None:
-                    from railride.analysis.costs import COST_COLUMNS
-
-                    for k, column in enumerate(COST_COLUMNS):
-                        row[column] = float(paid[j, k]) if np.isnan(diverged_at[j]) else np.nan
-                rows[i] = row
+            _add_rows(rows, cases, part_idx, m, diverged_at, (cf, ok) if comfort else None, paid)
     return [rows[i] for i in range(len(cases))]
+
+
+def _batches(idx: list[int], solver: SolverSettings, metrics_only: bool) -> list[list[int]]:
+    """The compiled batches of one group's cases (positions ``idx``): `CHUNK` runs each, or, for
+    runs that keep only their metrics where the GPU takes them (`gpu_batches`), `GPU_CHUNK`."""
+    size = GPU_CHUNK if metrics_only and gpu_batches(solver, min(len(idx), GPU_CHUNK)) else CHUNK
+    out = []
+    for start in range(0, len(idx), size):
+        part = idx[start : start + size]
+        if size > CHUNK and not gpu_batches(solver, len(part)):  # a group's last part, too few for "auto"
+            out += [part[k : k + CHUNK] for k in range(0, len(part), CHUNK)]
+        else:
+            out.append(part)
+    return out
+
+
+def gpu_batches(solver: SolverSettings, n: int) -> bool:
+    """Whether a study's metrics-only batch of n runs goes to the GPU: with backend "gpu", or
+    "auto" where one is usable and n >= `railride.run.solver.GPU_MIN_BATCH`. Where "auto" finds
+    none, a study runs its usual batches on the CPU without a word: it never asked for more."""
+    from railride.run.solver import GPU_MIN_BATCH, gpu_missing
+
+    if solver.backend != "auto":
+        return solver.backend == "gpu"
+    return n >= GPU_MIN_BATCH and gpu_missing() is None
+
+
+def _add_rows(rows: dict, cases: list[Case], part_idx: list[int], m, diverged_at, comfort=None, paid=None) -> None:
+    """The rows of a batch's runs (positions ``part_idx`` in ``cases``) into ``rows``: key,
+    settings, metrics ``m`` (run, response, statistic), the time each diverged, and the comfort
+    indices ((indices of the runs that did not diverge, their positions), `COMFORT_COLUMNS`) and
+    costs (`railride.analysis.costs.COST_COLUMNS`) where given."""
+    for j, i in enumerate(part_idx):
+        if i in rows:
+            continue
+        row = {"key": cases[i].key, **_flat(cases[i]), "diverged_at_s": float(diverged_at[j])}
+        for r, resp in enumerate(RESPONSES):
+            for s, stat in enumerate(STATISTICS):
+                row[f"{resp}_{stat}"] = float(m[j, r, s])
+        if comfort is not None:
+            cf, ok = comfort
+            for k, column in enumerate(COMFORT_COLUMNS):
+                row[column] = (
+                    float(cf[int(np.searchsorted(ok, j)), k]) if np.isnan(diverged_at[j]) and cf is not None else np.nan
+                )
+        if paid is not None:
+            from railride.analysis.costs import COST_COLUMNS
+
+            for k, column in enumerate(COST_COLUMNS):
+                row[column] = float(paid[j, k]) if np.isnan(diverged_at[j]) else np.nan
+        rows[i] = row
 
 
 def _costs(res, case: Case, window) -> np.ndarray:
@@ -275,6 +320,10 @@ def run_cases(
         if k not in done and k not in seen:
             pending.append(c)
             seen.add(k)
+    if chunk == CHUNK and not (comfort or costs) and gpu_batches(solver, min(len(pending), GPU_CHUNK)):
+        chunk = GPU_CHUNK  # metrics summed on the GPU (`evaluate`)
+    if hasattr(executor, "chunk"):  # `railride.studies.lockstep.OwnChunks` chunks each law's cases itself
+        executor.chunk = chunk
     chunks = _chunks(pending, chunk)
     fn = functools.partial(
         evaluate, base_gains=base, params=vehicle, solver=solver, window=window, comfort=comfort, costs=costs

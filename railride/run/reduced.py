@@ -1,0 +1,96 @@
+"""Runs that keep only their ride metrics: on the GPU, summed on the device.
+
+A study that reads only the RMS and peak-to-peak of the four carbody responses (a sweep, a tuning
+round or a design's search without comfort or costs) needs no time history on the host. On the
+GPU (`railride.engine.gpu`, ``reduce``) each sample adds every output row inside the window to its
+own sums of squares, least and largest values, so that a batch of 1e4 runs takes a few bytes per
+run instead of megabytes, and a study can send the GPU the large batches that pay there. Every
+other run (the CPU, the exact discretisation) runs whole and takes `RideResult.metrics`, the one
+definition of the metrics, so that both give the same numbers to rounding.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+
+from railride.analysis.metrics import RESPONSES, check_window
+from railride.engine import layout
+from railride.errors import DivergenceError, InputError
+from railride.run.simulation import (
+    RunPlan,
+    _gpu_failed,
+    divergence_message,
+    inputs,
+    pack,
+    run,
+    stepped_on,
+    stepper_arguments,
+)
+
+
+def batch_metrics(plan: RunPlan, window=None) -> tuple[np.ndarray, np.ndarray]:
+    """(metrics, diverged_at) of the runs of a checked ``plan``: metrics (sample, response,
+    statistic) as `RideResult.metrics` gives them (`railride.analysis.metrics.RESPONSES`, RMS
+    and peak-to-peak, over ``window`` = (start, end) s), NaN for a run that diverged, and the
+    time each diverged [s] (NaN where it did not). On the GPU the sums are made on the device,
+    with no histories; a GPU failure says so in one line and runs the batch again on the CPU."""
+    if stepped_on(plan) != "gpu":
+        res = run(plan)
+        values = res.metrics(window).values
+        return (values if values.ndim == 3 else values[None]), np.atleast_1d(res.diverged_at)
+    from railride.engine import gpu
+
+    w0, w1 = window_rows(plan.n_out + 1, plan.solver.output_rate, window)
+    tables = inputs(plan)
+    packed = pack(plan, tables, rows=2)  # two rows: "recorded" for the stepper, one row rewritten
+    acc = np.zeros((plan.n, gpu.N_ACC))
+    acc[:, gpu.ACC_MIN : gpu.ACC_MIN + 4] = math.inf
+    acc[:, gpu.ACC_MAX : gpu.ACC_MAX + 4] = -math.inf
+    dt, stride = plan.solver.dt, plan.stride
+    vehicle, dampers, rails, control, outputs = stepper_arguments(plan, tables, packed)
+    try:
+        gpu.run_gpu(
+            plan.n, packed.law, packed.x, 0, plan.n_steps, True, stride, dt, vehicle, dampers, rails, control, outputs,
+            reduce=((w0, w1), acc),
+        )  # fmt: skip
+    except gpu._Failed as failed:  # nothing of the batch is kept: it runs again, whole, on the CPU
+        _gpu_failed(failed.cause)
+        cpu = dataclasses.replace(plan, solver=dataclasses.replace(plan.solver, backend="cpu"))
+        return batch_metrics(cpu, window)
+    return metrics_from_sums(acc, packed.status, packed.fail_step, dt, plan.on_divergence)
+
+
+def window_rows(n_rows: int, output_rate: float, window) -> tuple[int, int]:
+    """(first, last) output row inside ``window`` = (start, end) s, both included, as
+    `RideResult.metrics` selects them; an input error where it holds fewer than two rows."""
+    if window is None:
+        return 0, n_rows - 1
+    t = np.arange(n_rows) / output_rate
+    start, end = check_window(window, float(t[-1]), float(t[0]))
+    keep = np.flatnonzero((t >= start - 1e-12) & (t <= end + 1e-12))
+    if keep.size < 2:
+        raise InputError(f"window = {start:g}:{end:g} s holds fewer than two output samples")
+    return int(keep[0]), int(keep[-1])
+
+
+def metrics_from_sums(acc, status, fail_step, dt: float, on_divergence: str = "mark"):
+    """(metrics, diverged_at) from the device's sums (`railride.engine.gpu.N_ACC` columns a
+    sample): RMS = sqrt(sum x^2 / rows), peak-to-peak = largest - least, in the units of
+    `RESPONSES`. A run that diverged raises `DivergenceError` unless ``on_divergence`` is "mark"."""
+    from railride.engine.gpu import ACC_MAX, ACC_MIN, ACC_ROWS, ACC_SQUARES
+
+    bad = status != layout.STATUS_OK
+    if bad.any() and on_divergence != "mark":
+        raise DivergenceError(divergence_message(status, fail_step, dt))
+    factor = np.array([f for _, f in RESPONSES.values()])
+    with np.errstate(invalid="ignore", divide="ignore"):
+        rms = np.sqrt(acc[:, ACC_SQUARES : ACC_SQUARES + 4] / acc[:, ACC_ROWS, None]) * factor
+        ptp = (acc[:, ACC_MAX : ACC_MAX + 4] - acc[:, ACC_MIN : ACC_MIN + 4]) * factor
+    values = np.stack([rms, ptp], axis=-1)
+    values[bad] = np.nan
+    if not np.all(np.isfinite(values[~bad])):
+        raise RuntimeError("a ride metric is not finite: the run did not produce finite responses")
+    return values, np.where(bad, fail_step * dt, np.nan)
