@@ -191,7 +191,7 @@ def _check_size(
     channels = 3 * N_DOF + 4 + 16 + (layout.N_DS if has_damper_states(damper) else 0) + (8 if closed else 0)
     need = 8.0 * n * ((n_out + 1) if tables is None else 2) * channels
     nodes, interval = max(input_table_nodes(sc, dt, duration) for sc in scenarios)
-    need += 8.0 * (n if tables is None else tables) * nodes * (16 + 36)  # input and forcing tables, at most one a sample
+    need += 8.0 * (n if tables is None else tables) * nodes * (16 + 36)  # input, forcing tables: one a sample at most
     if exact:  # discrete.ExactStepper: period x 18 x (span x 8)
         period, m = _exact_phases(scenarios, solver, duration)
         span = (stride + m - 1) // m + 2
