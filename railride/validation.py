@@ -238,3 +238,30 @@ def toml_error(exc: ValueError) -> str:
 def rule_words(rule: str) -> str:
     """The words of a rule, for tables of parameters."""
     return RULES[rule][0]
+
+
+# -- places to write ----------------------------------------------------------------------------
+def creatable(path, name: str) -> None:
+    """InputError starting with ``name`` unless a file or folder can be made at ``path``: the
+    nearest folder that exists at or above its parent must be a folder and take a new entry
+    (the missing ones between are made on writing)."""
+    parent = Path(path).absolute().parent
+    nearest = next(p for p in (parent, *parent.parents) if p.exists() or p == p.parent)
+    if not nearest.is_dir():
+        raise InputError(f"{name}: {nearest} is a file, not a folder")
+    takes_entries(nearest, name)
+
+
+def takes_entries(folder, name: str) -> None:
+    """InputError starting with ``name`` unless a new entry can be made in the existing
+    ``folder``. Tried by making a hidden folder there and removing it at once: the permission
+    bits do not tell (root passes them, yet nothing can be made in /proc or on a read-only file
+    system)."""
+    import os
+    import tempfile
+
+    try:
+        probe = tempfile.mkdtemp(prefix=".railride-probe-", dir=folder)
+    except OSError as exc:
+        raise InputError(f"{name}: nothing can be written in {folder} ({exc.strerror or exc})") from None
+    os.rmdir(probe)

@@ -431,7 +431,7 @@ def open_run_table(out: Optional[Path], resume: bool):
         if resume:
             raise InputError("--resume needs --out DIR: the run table it continues is DIR/runs.csv")
         return sweep_lib.RunTable(), None
-    check_out_dir(out)
+    check_out_dir(out, "--out")
     path = out / "runs.csv"
     if path.exists() and not resume:
         raise InputError(

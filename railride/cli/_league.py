@@ -70,7 +70,7 @@ def run_league(
         vehicle_options = vehicle_arguments(vehicle, preset, x)
     vehicle_options["load"] = loads if len(loads) > 1 else loads[0]
     if out is not None:
-        check_out_dir(out)
+        check_out_dir(out, "--out")
     with ProgressBar(stderr_is_terminal(), lambda done: "running the league table...") as progress:
         table = league(
             scenarios,

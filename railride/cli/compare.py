@@ -632,7 +632,7 @@ def compare(
             solver.output_rate,
         )
         if out is not None:
-            check_out_dir(out)
+            check_out_dir(out, "--out")
         check_report_option(report)
         # check the window before the runs, and record it resolved
         window_value = check_window(window_value or (0.0, math.inf), scen.duration)

@@ -89,7 +89,7 @@ def frf(
         figures = figure_options(figure_format, dpi, out)
         vehicle_options = vehicle_arguments(vehicle, preset, load)
         if out is not None:
-            check_out_dir(out)
+            check_out_dir(out, "--out")
         result = frequency_responses(**vehicle_options, speed=speed, rails=rails, fmin=fmin, fmax=fmax, points=points)
         doc = result.to_dict()
         if out is not None:

@@ -10,7 +10,6 @@ from typing import Annotated, Optional
 
 import typer
 
-from railride.errors import InputError
 from railride.cli._app import app
 from railride.cli._common import errors, option_names, print_json, stdout_console, write_folder
 from railride.cli._options import (
@@ -136,7 +135,7 @@ def ride_spectrum(
         check_report_option(report)
         vehicle_options = vehicle_arguments(vehicle, preset, load)
         if out is not None:
-            check_out_dir(out)
+            check_out_dir(out, "--out")
         result = run(
             track,
             speed=speed,
@@ -260,12 +259,12 @@ def state_space(
     """The linear vehicle as state-space matrices x' = A x + B u, y = C x + D u, with named
     states, inputs and outputs, for MATLAB or python-control."""
     with errors(), option_names({"suspension": "--suspension", "controllers": "--suspension"}):
-        from railride.output.files import write_model
+        from railride.output.files import check_model_path, write_model
         from railride.frequency.linear import linear_model, linear_suspensions
 
         vehicle_options = vehicle_arguments(vehicle, preset, load)
-        if out is not None and out.suffix.lower() not in (".mat", ".json"):
-            raise InputError(f"--out = {str(out)!r}: the file name must end in .mat or .json")
+        if out is not None:
+            check_model_path(out, "--out")
         (secondary,) = linear_suspensions([suspension], None if gains is None else load_gains(gains)).values()
         model = linear_model(suspension=secondary, **vehicle_options)
         if out is not None:

@@ -87,7 +87,7 @@ def damper(
         damper_model = damper_preset("--damper", model, rig=True)
         volts = parse_voltages("--voltage", voltage, damper_model)
         if out is not None:
-            check_out_dir(out)
+            check_out_dir(out, "--out")
         with status_note("driving the damper..."):
             result = rig.cycles(damper_model, amplitude, frequency, volts, n_cycles=cycles)
         doc = result.to_dict()
@@ -186,7 +186,7 @@ def tracking(
         figures = figure_options(figure_format, dpi, out)
         damper_model = damper_preset("--damper", model, rig=True)
         if out is not None:
-            check_out_dir(out)
+            check_out_dir(out, "--out")
         with status_note("tracking..."):
             result = rig.track(
                 damper_model, desired, amplitude, frequency, B=gain_b, G=gain_g, stroke=stroke, n_cycles=cycles

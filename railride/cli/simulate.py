@@ -316,7 +316,7 @@ def _run(
             solver.output_rate,
         )
         if out is not None:
-            check_out_dir(out)
+            check_out_dir(out, "--out")
         if window is not None:  # check the window before the run, not after it
             check_window(window, scen.duration)
 

@@ -27,6 +27,7 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
+from railride import validation
 from railride.errors import InputError
 from railride.analysis.spectra import PSD_SEGMENT_S, comparison_psd
 from railride.analysis.labels import CARBODY_RESPONSES, psd_title
@@ -107,19 +108,23 @@ def json_text(doc: dict) -> str:
 
 
 # -- the output folder ----------------------------------------------------------------------------
-def check_out_dir(out_dir) -> Path:
-    """Reject an output location that cannot be a folder, before any work is done."""
+def check_out_dir(out_dir, field: str | None = None) -> Path:
+    """Reject an output location that cannot be a folder, or where no folder can be made, before
+    any work is done. ``field`` (e.g. ``"--out"``) names it in the error: ``--out =
+    '/proc/x': ...``; without it, ``output folder /proc/x: ...``."""
     if isinstance(out_dir, str) and not out_dir.strip():
         # Path("") is the current folder: an empty name is a mistake, not a choice of "."
-        raise InputError(f'output folder {out_dir!r}: an empty name; give a folder ("." for the current one)')
+        name = "output folder" if field is None else f"{field} ="
+        raise InputError(f'{name} {out_dir!r}: an empty name; give a folder ("." for the current one)')
     out_dir = Path(out_dir)
+    name = f"output folder {out_dir}" if field is None else f"{field} = {str(out_dir)!r}"
     if out_dir.exists() and not out_dir.is_dir():
-        raise InputError(f"output folder {out_dir} exists and is not a folder")
-    for parent in out_dir.absolute().parents:
-        if parent.exists():
-            if not parent.is_dir():
-                raise InputError(f"output folder {out_dir}: {parent} is not a folder")
-            break
+        raise InputError(f"{name}: exists and is not a folder; give a folder to write into")
+    # write_folder stages beside the folder, then moves the files into it: both places must take
+    # new entries
+    validation.creatable(out_dir, name)
+    if out_dir.is_dir():
+        validation.takes_entries(out_dir, name)
     return out_dir
 
 
@@ -612,12 +617,30 @@ def write_ride_spectrum_outputs(result, out_dir, *, figures: FigureOptions | Non
     return write_folder(out_dir, _entries(RIDE_SPECTRUM_FILES, writers, figures))
 
 
+#: the suffixes of `write_model`'s files
+MODEL_SUFFIXES = (".mat", ".json")
+
+
+def check_model_path(path, field: str = "path") -> Path:
+    """``path`` as a Path if `write_model` can write there: a file name ending in .mat or
+    .json, not a folder, at a place where a file can be made. InputError naming ``field``
+    otherwise."""
+    path = Path(path)
+    name = f"{field} = {str(path)!r}"
+    if path.suffix.lower() not in MODEL_SUFFIXES:
+        raise InputError(f"{name}: the file name must end in .mat or .json")
+    if path.is_dir():
+        raise InputError(f"{name}: a folder; give the name of the file to write, e.g. model.mat")
+    validation.creatable(path, name)
+    return path
+
+
 def write_model(model, path) -> Path:
     """Write a `railride.frequency.linear.LinearModel` to ``path``, atomically: a MATLAB file for a
     ``.mat`` suffix (`LinearModel.to_mat`), else its JSON document (``to_dict()``)."""
     from railride._io import atomic_write
 
-    path = Path(path)
+    path = check_model_path(path)
     if path.suffix.lower() == ".mat":
         model.to_mat(path)
     else:

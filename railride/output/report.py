@@ -281,9 +281,9 @@ def check_report_path(path, field: str = "path") -> Path:
         )
     if path.suffix.lower() not in SUFFIXES:
         raise InputError(f"{field} = {str(path)!r}: must end in .html or .htm (one HTML file), e.g. report.html")
-    parent = next((p for p in path.absolute().parents if p.exists()), None)
-    if parent is not None and not parent.is_dir():
-        raise InputError(f"{field} = {str(path)!r}: {parent} is a file, not a folder")
+    from railride import validation
+
+    validation.creatable(path, f"{field} = {str(path)!r}")
     return path
 
 
