@@ -96,8 +96,9 @@ def checked_modes(vehicle, record: dict | None = None) -> Modes:
     (rounding below 0 shown as 0), with ``record``, the vehicle's record (`vehicle_record`;
     None: none, and no document). A vehicle whose bodies and
     springs are so far apart in size that double precision cannot separate its modes (a
-    bogie of a gram on a stiff primary, a carbody of a billion tonnes) is a ValueError naming
-    what went wrong and the parameters outside the typical ranges."""
+    bogie of a gram on a stiff primary, a carbody of a billion tonnes: a mode not
+    `Mode.resolved`, whose numbers are bounds) is a ValueError naming what went wrong and the
+    parameters outside the typical ranges."""
     problem = None
     try:
         with np.errstate(all="ignore"):  # the failures are reported below, not as NumPy warnings
@@ -107,10 +108,11 @@ def checked_modes(vehicle, record: dict | None = None) -> Modes:
     out = []
     for i, m in enumerate(found, 1):
         values = (m.frequency_hz, m.damped_frequency_hz, m.damping_ratio)
-        if not all(np.isfinite(values)) or min(values) < -ROUNDING_ZETA:
+        if not m.resolved or not all(np.isfinite(values)) or min(values) < -ROUNDING_ZETA:
+            lost = "" if m.resolved else ", within the rounding of the vehicle's fastest root"
             problem = problem or (
                 f"mode {i} ({m.label}) came out at {validation.shown(m.frequency_hz)} Hz with a damping "
-                f"ratio of {validation.shown(m.damping_ratio)}"
+                f"ratio of {validation.shown(m.damping_ratio)}{lost}"
             )
             continue
         out.append(dataclasses.replace(m, damping_ratio=max(m.damping_ratio, 0.0)))

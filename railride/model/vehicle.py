@@ -184,11 +184,18 @@ def element_table(p: VehicleParams) -> list[Element]:
 
 @dataclass(frozen=True)
 class Mode:
+    """One mode of the passive vehicle (`Vehicle.modes`); every number is finite.
+
+    ``resolved`` is False where one of the mode's roots lies within the eigen-solvers' rounding
+    of zero, which grows with the vehicle's fastest root (`resolution`): its numbers are then
+    bounds, not values (docs/model.md, Modes and frequency response)."""
+
     label: str
     frequency_hz: float  # undamped natural frequency, from (K, M)
-    damped_frequency_hz: float
-    damping_ratio: float
+    damped_frequency_hz: float  # |Im lambda|: 0 for an overdamped mode
+    damping_ratio: float  # -Re lambda/|lambda|; an overdamped pair of real roots: >= 1
     shape: np.ndarray  # undamped mode shape, normalised to unit kinetic energy
+    resolved: bool = True
 
     def to_dict(self) -> dict:
         return {
@@ -305,24 +312,34 @@ class Vehicle:
 
     # -- modal analysis ---------------------------------------------------------------------
     def modes(self) -> list[Mode]:
-        """Undamped and damped modes of the passive vehicle, sorted by undamped frequency.
+        """Undamped and damped modes of the passive vehicle, sorted by undamped frequency;
+        every number finite.
 
         Undamped modes solve K phi = w^2 M phi. Damped modes are the eigenvalues lambda of the
-        state matrix: damped frequency |Im lambda|, damping ratio -Re lambda / |lambda| (an
-        overdamped pair of real roots gives one mode with ratio >= 1). Damped and undamped
-        modes are paired by the modal assurance criterion of their displacement shapes.
-        Labels name the DOF group holding most of the mode's kinetic energy ("carbody bending"
-        for the flexible carbody's bending mode).
+        state matrix: damped frequency |Im lambda|, damping ratio -Re lambda / |lambda|. An
+        overdamped mode is a pair of real roots -s1, -s2: damped frequency 0 and damping
+        ratio (s1 + s2) / (2 sqrt(s1 s2)) >= 1, which is c / (2 sqrt(k m)) for one DOF. Damped
+        and undamped modes are paired by the modal assurance criterion of their displacement
+        shapes. Labels name the DOF group holding most of the mode's kinetic energy ("carbody
+        bending" for the flexible carbody's bending mode).
+
+        No vehicle the ranges allow has a rigid-body mode (every spring is > 0, so K is
+        positive definite) or a growing one (C >= 0): a root at or past zero is rounding. A
+        mode with a root within `resolution` of zero (the solvers' rounding, which grows with
+        the fastest root) is not ``resolved``: its numbers are finite but say only that it is
+        slow (w^2 <= 0 shown as 0 Hz) or, for an overdamped pair whose slower root rounding
+        hides, heavily damped (the ratio of a root at the resolution: a lower bound).
         """
         n = self.n_dof
         w2, shapes = scipy.linalg.eigh(self.K, self.M)
         lam, vecs = np.linalg.eig(self.state_matrix)
         damped = _damped_modes(lam, vecs[:n])
-        mac = np.array([[_mac(shapes[:, i], d[3]) for d in damped] for i in range(n)])
-        _, match = scipy.optimize.linear_sum_assignment(-mac)  # rows come back as 0..n-1
+        mac = np.array([[_mac(shapes[:, i], d[2]) for d in damped] for i in range(n)])
+        _, match = scipy.optimize.linear_sum_assignment(-np.nan_to_num(mac))  # rows come back as 0..n-1
+        floor = resolution(w2)
         out = []
         for i in range(n):  # eigh sorts by frequency
-            _, omega_d, zeta, _ = damped[match[i]]
+            omega_d, zeta, _, damped_resolved = damped[match[i]]
             out.append(
                 Mode(
                     _label(shapes[:, i], np.diag(self.M), self.dof_names),
@@ -330,6 +347,7 @@ class Vehicle:
                     float(omega_d / (2 * np.pi)),
                     float(zeta),
                     shapes[:, i],
+                    bool(w2[i] > floor and damped_resolved),
                 )
             )
         return out
@@ -424,25 +442,39 @@ def _mac(u: np.ndarray, v: np.ndarray) -> float:
     return float(abs(np.vdot(u, v)) ** 2 / (np.vdot(u, u).real * np.vdot(v, v).real))
 
 
-def _damped_modes(lam: np.ndarray, shapes: np.ndarray) -> list[tuple[float, float, float, np.ndarray]]:
-    """(omega_n, omega_d, zeta, shape) per mode from the state-matrix eigenpairs."""
+def resolution(roots: np.ndarray) -> float:
+    """How close to zero a root of an eigen-solver is rounding: the solver's backward error,
+    double precision's eps times the largest root, times the matrix's size (Anderson et al.,
+    LAPACK Users' Guide, 3rd ed., SIAM 1999, ch. 4: a backward-stable solver's eigenvalues are
+    off by about eps times the matrix's norm)."""
+    return float(roots.size * np.finfo(float).eps * np.max(np.abs(roots)))
+
+
+def _damped_modes(lam: np.ndarray, shapes: np.ndarray) -> list[tuple[float, float, np.ndarray, bool]]:
+    """(omega_d, zeta, shape, resolved) per mode from the state-matrix eigenpairs: a complex
+    pair, or an overdamped pair of real roots. LAPACK returns real roots with an imaginary part
+    of exactly 0 and complex ones in conjugate pairs, so that split takes no tolerance (one
+    relative to the fastest root took the slow complex pairs of a stiff vehicle for real roots)."""
     out = []
-    tol = 1e-9 * max(1.0, float(np.max(np.abs(lam))))
-    complex_idx = [i for i in range(lam.size) if lam[i].imag > tol]
-    real_idx = [i for i in range(lam.size) if abs(lam[i].imag) <= tol]
-    for i in complex_idx:
+    floor = resolution(lam)
+    for i in np.flatnonzero(lam.imag > 0.0):
         wn = abs(lam[i])
-        out.append((wn, lam[i].imag, -lam[i].real / wn, shapes[:, i]))
+        # no root of a passive vehicle grows (C >= 0): a real part past 0 is rounding (a
+        # lightly damped mode's ratio of -2e-6), shown as 0; past the floor, not resolved
+        decay = -lam[i].real
+        out.append((lam[i].imag, max(decay, 0.0) / wn, shapes[:, i], bool(wn > floor and decay > -floor)))
     # overdamped: pair the real roots whose shapes agree best
-    remaining = list(real_idx)
+    remaining = list(np.flatnonzero(lam.imag == 0.0))
     while len(remaining) >= 2:
         i = remaining.pop(0)
-        j = max(remaining, key=lambda r: _mac(shapes[:, i], shapes[:, r]))
+        j = max(remaining, key=lambda r: np.nan_to_num(_mac(shapes[:, i], shapes[:, r])))
         remaining.remove(j)
-        l1, l2 = lam[i].real, lam[j].real
-        wn = np.sqrt(l1 * l2) if l1 * l2 > 0 else 0.0
-        zeta = -(l1 + l2) / (2 * wn) if wn > 0 else np.inf
-        out.append((wn, 0.0, zeta, shapes[:, i].real))
+        # a passive vehicle's real roots lie below 0; one at or past -floor is a slower root
+        # that rounding hides: taken at -floor, the ratio is a lower bound, not an infinity
+        s1, s2 = sorted((-lam[i].real, -lam[j].real))
+        resolved = s1 > floor
+        s1, s2 = max(s1, floor), max(s2, floor)
+        out.append((0.0, (s1 + s2) / (2.0 * np.sqrt(s1 * s2)), shapes[:, i].real, resolved))
     return out
 
 

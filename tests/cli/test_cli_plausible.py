@@ -50,7 +50,7 @@ def test_modes_of_an_unusual_vehicle_are_finite_json_with_a_warning(vehicle):
 
 
 def test_modes_beyond_double_precision_exit_2(vehicle):
-    result = run("modes", "--params", vehicle(I_cx="1e-6", c_pz="0.0"), "--format", "json")
+    result = run("modes", "--params", vehicle(m_b="1e-3", I_by="1e-6", I_bx="1e-6", k_pz="1e11"), "--format", "json")
     assert result.exit_code == 2 and result.stdout == ""
     assert "error: the modes of this vehicle cannot be computed in double precision" in result.stderr
 
