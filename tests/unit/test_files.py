@@ -11,6 +11,7 @@ import pandas as pd
 import pytest
 import xarray as xr
 
+from railride import _io
 from railride.output import files
 from railride.run.simulation import simulate
 from railride.model.track import scenario
@@ -192,3 +193,29 @@ def test_out_through_a_link_writes_into_the_folder_it_leads_to(result, tmp_path,
             import shutil
 
             shutil.rmtree(target, ignore_errors=True)
+
+
+# -- the umask of atomic writes ---------------------------------------------------------------------
+def _refuse_umask(mask):
+    raise AssertionError("os.umask called: setting the umask to read it changes it for every thread")
+
+
+@pytest.mark.skipif(_io._proc_umask() is None, reason="needs the Umask: line of /proc/self/status (Linux 4.7+)")
+def test_an_atomic_write_reads_the_umask_without_setting_it(tmp_path, monkeypatch):
+    previous = os.umask(0o027)
+    try:
+        monkeypatch.setattr(os, "umask", _refuse_umask)
+        assert _io.umask() == 0o027  # the umask now, not the one at import
+        _io.atomic_write_text(tmp_path / "a.txt", "a")
+        assert (tmp_path / "a.txt").stat().st_mode & 0o777 == 0o666 & ~0o027
+    finally:
+        monkeypatch.undo()
+        os.umask(previous)
+
+
+def test_without_proc_an_atomic_write_takes_the_umask_read_at_import(tmp_path, monkeypatch):
+    monkeypatch.setattr(_io, "_proc_umask", lambda: None)
+    monkeypatch.setattr(_io, "_IMPORT_UMASK", 0o077)
+    monkeypatch.setattr(os, "umask", _refuse_umask)
+    _io.atomic_write_text(tmp_path / "a.txt", "a")
+    assert (tmp_path / "a.txt").stat().st_mode & 0o777 == 0o600
