@@ -404,7 +404,11 @@ def check(
     faults = fault_table([s.faults for s in suspensions], dt, duration)  # their times within the run
     x0 = None
     if initial_state is not None:
-        x0 = np.asarray(initial_state, dtype=float)
+        rule = f"{2 * N_RIGID} finite numbers (q then q'; {2 * N_DOF} with the carbody's bending)"
+        try:
+            x0 = np.asarray(initial_state, dtype=float)
+        except (TypeError, ValueError, OverflowError):
+            raise InputError(f"initial_state = {shown(initial_state)[:80]}: must hold {rule}") from None
         sizes = ((2 * N_RIGID,), (n, 2 * N_RIGID), (2 * N_DOF,), (n, 2 * N_DOF))
         if x0.shape not in sizes or not np.all(np.isfinite(x0)):
             raise InputError(

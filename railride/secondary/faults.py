@@ -75,7 +75,13 @@ def parse_faults(faults) -> tuple:
         return ()
     if isinstance(faults, (str, DamperFault)):
         faults = (faults,)
-    out = [f if isinstance(f, DamperFault) else DamperFault.parse(f) for f in faults]
+    from railride import arguments
+
+    given = arguments.sequence("faults", faults, "allowed a fault (e.g. '1R-off@2'), a DamperFault or a list of them")
+    bad = [f for f in given if not isinstance(f, (str, DamperFault))]
+    if bad:
+        raise InputError(f"faults: {bad[0]!r} is not a fault; allowed text such as '1R-off@2' or a DamperFault")
+    out = [f if isinstance(f, DamperFault) else DamperFault.parse(f) for f in given]
     corners = [f.corner for f in out]
     twice = sorted({c for c in corners if corners.count(c) > 1})
     if twice:

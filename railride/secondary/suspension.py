@@ -302,8 +302,10 @@ class Suspension:
         used by "passive", but must be a known name; a scale other than 1 there is refused, as
         is a voltage with a controller or with passive-on / passive-off (their name sets it),
         and an ideal device with mr, passive-on or passive-off (it has no voltage)."""
-        if name not in NAMES:
+        if not isinstance(name, str) or name not in NAMES:
             raise InputError(f"suspension = {name!r}; allowed: {', '.join(NAMES)}")
+        if gains is not None:  # a GainSet, or what names one (a shipped set, a gains file)
+            gains = GainSet.of(gains)
         model = damper_model(damper, 1.0)  # an unknown name fails here, for passive too
         if name == "passive":
             scale = dampers.check_scale("damper_scale", damper_scale)

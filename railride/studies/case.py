@@ -175,3 +175,15 @@ def _plain(name: str, value):
         return float(value)
     except OverflowError:  # a whole number past any float: the scenario's check names it
         return int(value)
+
+
+def scenario_options(name: str, value) -> dict:
+    """``value`` (None or a mapping) as the options `railride.model.track.scenario` takes: an
+    input error naming ``name`` for anything else, or an option it does not take."""
+    import inspect
+
+    from railride import arguments
+    from railride.model.track import scenario
+
+    allowed = [p for p in inspect.signature(scenario).parameters if p != "name"]
+    return arguments.options(name, value, allowed)

@@ -51,9 +51,11 @@ PAPER_REDUCTION = {
 def check_controllers(names) -> list[str]:
     """The requested controllers in the order of `CONTROLLERS`; passive is always the baseline;
     "all" is every one. ``names``: a sequence of names, or one string of comma-separated names."""
+    from railride import arguments
+
     if isinstance(names, str):
         names = names.split(",")
-    names = [n.strip() for n in names if n.strip()]
+    names = [n.strip() for n in arguments.names("controllers", names, "controller names") if n.strip()]
     if "all" in names:
         names = list(CONTROLLERS)
     unknown = [n for n in names if n not in CONTROLLERS]
@@ -391,6 +393,10 @@ def compare(
     ``sensing``: what every controller measures (`railride.secondary.sensing.Accelerometers`; None: the
     exact states; the bounds measure the same); a law that reads the bogies' states is not run
     with it (``settings["not_run"]`` says why). Every setting is checked before the first run."""
+    from railride import arguments
+
+    window = arguments.window("window", window)
+    comfort, bounds = arguments.flag("comfort", comfort), arguments.flag("bounds", bounds)
     given = vehicle_argument(vehicle, params)
     car, record = resolve_vehicle(given, load=load)
     solver = SolverSettings.of(solver)

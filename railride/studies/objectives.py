@@ -42,6 +42,8 @@ def _number(name: str, value, rule: str, ok) -> float:
         x = float(value) if number else math.nan
     except (TypeError, ValueError):
         x = math.nan
+    except OverflowError:  # a whole number too large for a float
+        x = math.inf
     if not (math.isfinite(x) and ok(x)):
         raise InputError(f"objective {name} = {value!r}: {rule}")
     return x

@@ -204,12 +204,14 @@ def _power_of_two(name: str, value) -> int:
 
 
 def _parameters(suspension: str, parameters) -> tuple:
-    if suspension not in CONTROLLER_PARAMETERS:
+    from railride import arguments
+
+    if not isinstance(suspension, str) or suspension not in CONTROLLER_PARAMETERS:
         raise InputError(f"suspension = {suspension!r}: allowed {', '.join(CONTROLLER_PARAMETERS)}")
     allowed = CONTROLLER_PARAMETERS[suspension]
     if parameters is None:
         return allowed
-    parameters = tuple(parameters)
+    parameters = tuple(arguments.names("parameters", parameters, "gain names"))
     for p in parameters:
         if p not in allowed:
             raise InputError(f"parameter {p!r}: not a gain of {suspension}; allowed: {', '.join(allowed)}")
@@ -271,7 +273,9 @@ def pareto(
     n_samples = _power_of_two("n_samples", n_samples)
     seed = validation.seed("seed", seed)
     damper_model(damper)  # a known name
-    scen = make_scenario(scenario, **dict(scenario_options or {}))
+    from railride.studies.case import scenario_options as scenario_options_of
+
+    scen = make_scenario(scenario, **scenario_options_of("scenario_options", scenario_options))
     base = GainSet.of(gains, scen)
     # its runs, checked by the check every simulation makes (railride.run.checks), before the first
     check(scen, vehicle, Suspension.named(suspension, base, damper), solver, "mark")

@@ -189,7 +189,16 @@ def study(
     from railride.studies.sweep import other_settings
     from railride.model.track import SPECTRA
 
+    from railride import arguments
+
     names = check_controllers(controllers)
+    if not isinstance(scenario, str):
+        raise InputError(f"scenario = {scenario!r}: allowed a scenario's name (e.g. fra4, paper-sine) or file:PATH")
+    for name, value in (("track_seeds", track_seeds), ("speeds", speeds), ("loads", loads), ("stiffness", stiffness)):
+        if value is not None:
+            arguments.numbers(name, value)
+    arguments.numbers("delays", delays, "whole numbers of controller periods")
+    window = arguments.window("window", window)
     solver = SolverSettings.of(solver)
     base, source = resolve_argument(vehicle, params)
     vehicle = base
@@ -214,7 +223,7 @@ def study(
         for v in _items(stiffness)
     ]
     conditions = []
-    for f in _items(faults):
+    for f in arguments.names("faults", faults, "fault conditions ('none', or faults joined by '+')"):
         try:
             conditions.append(fault_condition(f))
         except ValueError as exc:

@@ -153,9 +153,9 @@ AGGREGATES = ("mean", "worst")
 
 
 def _check_controllers(controllers) -> tuple:
-    if isinstance(controllers, str):
-        controllers = (controllers,)
-    for c in controllers:
+    from railride import arguments
+
+    for c in arguments.names("controllers", controllers, "controller names"):
         if c not in TUNABLE:
             fixed = " (it has no gains to tune)" if c in ("passive", "passive-on", "passive-off") else ""
             raise InputError(f"controller = {c!r}{fixed}: allowed {', '.join(TUNABLE)}")
@@ -232,9 +232,14 @@ def tune(
     controllers = _check_controllers(controllers)
     solver = SolverSettings.of(solver)
     vehicle, source = resolve_argument(vehicle, params)
-    gains = GainSet.reference() if gains is None else gains
-    objective = DEFAULT_OBJECTIVE if objective is None else objective
-    opts = tuple(sorted((scenario_options or {}).items()))
+    from railride import arguments
+    from railride.studies.case import scenario_options as scenario_options_of
+
+    gains = GainSet.reference() if gains is None else GainSet.of(gains)
+    objective = arguments.instance("objective", objective, Objective, "an Objective") or DEFAULT_OBJECTIVE
+    opts = tuple(sorted(scenario_options_of("scenario_options", scenario_options).items()))
+    window = arguments.window("window", window)
+    before_after = arguments.flag("before_after", before_after)
     table = RunTable() if table is None else table
     damper_model(damper, damper_scale)  # a known name, and a scale it has
     if "inner" in controllers and damper in dampers.IDEAL_NAMES:
@@ -263,7 +268,7 @@ def tune(
     validation.number("tol", tol, "nonnegative")
     validation.choice("aggregate", aggregate, AGGREGATES)
     if over is not None:
-        cases_set = tuple(over)
+        cases_set = tuple(arguments.sequence("over", over, "allowed a list of TuningCase (tuning_set())"))
         if not cases_set or not all(isinstance(c, TuningCase) for c in cases_set):
             raise InputError("over: give a non-empty sequence of railride.studies.tuning.TuningCase (tuning_set())")
         if scenario_options:
