@@ -15,7 +15,7 @@ from pathlib import Path
 
 import pytest
 
-from clihelp import assert_input_error, ok, run
+from clihelp import assert_input_error, interrupt, ok, ran_a_chunk, run
 
 SWEEP = ("sweep", "--duration", 1)
 #: the command line as a user runs it: a fresh interpreter (the CLI's entry point, not CliRunner)
@@ -131,28 +131,17 @@ def test_ctrl_c_at_start_up_and_in_a_run_is_130_without_a_traceback(after_s):
 
 def test_ctrl_c_in_a_long_run_is_honoured_at_the_next_chunk(tmp_path):
     out = tmp_path / "run"
-    proc = subprocess.Popen(
-        [*RAILRIDE, "simulate", "--suspension", "mr", "--duration", "3000", "--output-rate", "10", "--out", out],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-    )
-    time.sleep(6)  # start-up and a compile from numba's cache are over: the stepper runs
-    assert proc.poll() is None, "the run ended before it could be interrupted"
-    proc.send_signal(signal.SIGINT)
-    try:
-        _, err = proc.communicate(timeout=120)
-    except subprocess.TimeoutExpired:  # a guard against hanging, not a measure of speed
-        proc.kill()
-        pytest.fail("the run went on for 120 s after Ctrl-C")
-    assert proc.returncode == 130, err.decode()
-    last = err.decode().strip().splitlines()[-1]
-    if last == "interrupted":  # still in its first chunk (a cold compile): stopped, with nothing to keep
-        assert not out.exists()
-        return
+    # 6000 s at 1e-4 s: far longer than the wait for its first chunk, which start-up and a
+    # compile stretch on a slow machine; Ctrl-C then (`interrupt` fails the test if the run goes
+    # on for long after it)
+    args = ["simulate", "--suspension", "mr", "--duration", "6000", "--output-rate", "10", "--out", out]
+    status, _, err = interrupt(args, ran_a_chunk)
+    assert status == 130, err
     # stopped at the end of the chunk that ran when Ctrl-C came, not at the end of the run
-    assert last.startswith("interrupted at t = ") and "marked partial" in last, err.decode()
+    last = err.strip().splitlines()[-1]
+    assert last.startswith("interrupted at t = ") and "marked partial" in last, err
     partial = json.loads((out / "metrics.json").read_text())["partial"]
-    assert 0 < partial["until_s"] < partial["duration_s"] == 3000
+    assert 0 < partial["until_s"] < partial["duration_s"] == 6000
 
 
 # -- run folders ------------------------------------------------------------------------------------
