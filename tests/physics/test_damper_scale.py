@@ -57,6 +57,7 @@ def test_scaled_multiplies_the_force_parameters_and_nothing_else():
     spencer = dampers.preset("spencer1997")
     scaled = spencer.scaled(2.5)
     force = {"alpha_a", "alpha_b", "c0a", "c0b", "k0", "c1a", "c1b", "k1"}
+    assert force <= {f[0] for f in spencer.describe()}  # the loop below reaches every force parameter
     for f in spencer.describe():
         name = f[0]
         want = 2.5 * getattr(spencer, name) if name in force else getattr(spencer, name)

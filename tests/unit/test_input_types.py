@@ -153,6 +153,7 @@ def test_a_seed_past_2_53_is_not_rounded_anywhere():
     assert Accelerometers(seed=np.uint64(BIG)).seed == BIG
     assert rr.scenario("fra4", seed=BIG).track.seed == BIG
     g = grid(["passive", "pid"], scenario="fra4", track_seed=[BIG], noise=[0.0] * 4, seed=[BIG + 2])
+    assert len(g.cases) == len(g.values) > 0  # zip would stop at the shorter
     for case, values in zip(g.cases, g.values):
         assert dict(case.scenario_options)["seed"] == BIG and values["track_seed"] == BIG
     pid = g.cases[-1]

@@ -65,6 +65,7 @@ def test_the_optimise_document(found):
     assert doc["objective"]["kind"] == found.objective_definition.kind
     assert doc["objective_value"] == found.objective and doc["runs"] == found.n_runs
     assert [p["name"] for p in doc["parameters"]] == list(found.parameters)
+    assert len(found.log10_gains) == len(doc["parameters"]) > 0  # zip would stop at the shorter
     for p, lg in zip(doc["parameters"], found.log10_gains):
         assert p["value"] == 10.0**lg and p["low"] <= p["value"] <= p["high"]
     assert doc["gains"]["attitude"]["kd_z"] == found.gains.attitude.kd_z
@@ -107,6 +108,7 @@ def test_the_sensitivity_document_and_table(indices):
     doc = json.loads(json_text(indices.to_dict()))
     assert doc["schema"] == "railride.sensitivity/1" and doc["runs"] == indices.n_runs == 1 + 4 * (2 + 2)
     assert doc["settings"]["n"] == 4 and doc["suspension"] == "sas-attitude"
+    assert len(doc["parameters"]) == len(indices.first_order) == len(indices.total) == 2  # zip stops at the shortest
     for row, s, t in zip(doc["parameters"], indices.first_order, indices.total):
         assert row["first_order"] == s and row["total"] == t
 

@@ -1,3 +1,4 @@
+import dataclasses
 import math
 
 import pytest
@@ -58,6 +59,7 @@ def test_paper_preset_matches_the_published_appendix():
 
 
 def test_every_field_documents_its_unit():
+    assert len(VehicleParams.describe()) == len(dataclasses.fields(VehicleParams))  # every field, none missed
     for name, unit, doc, rule in VehicleParams.describe():
         assert unit and doc and rule, name
 

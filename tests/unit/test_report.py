@@ -72,6 +72,7 @@ def page(page_text):
 def test_nothing_is_fetched(page, page_text):
     """No script, stylesheet, image or frame comes from the network; plotly's JavaScript is
     inlined once."""
+    assert page.tags  # the loop below checks something
     for tag, attrs in page.tags:
         for name in ("src", "href"):
             value = attrs.get(name) or ""
