@@ -7,6 +7,7 @@ from __future__ import annotations
 import hashlib
 import json
 import numbers
+import functools
 from dataclasses import asdict, dataclass
 
 from railride.errors import InputError
@@ -108,11 +109,12 @@ class Case:
         base = GainSet.of(base_gains, self.scenario)
         return self._named(base.apply(self.gains))
 
-    @property
+    @functools.cached_property
     def key(self) -> str:
         """A stable identity for the run table (same settings and model, same key, in any
         session). The model revision is part of it, so a run table from an earlier model is
-        not taken for this one's on resume."""
+        not taken for this one's on resume. Made once a case (a study asks for it several times
+        a run); the fields it is made from are frozen."""
         d = self.to_dict()
         if "seed" in d["scenario_options"]:
             # as text, as when the track seed travelled as a NumPy integer: the keys of runs on

@@ -102,7 +102,7 @@ def evaluate(
         for part_idx in _batches(idx, solver, metrics_only):
             part = [cases[i] for i in part_idx]
             scs = [_scenario(made, c) for c in part]
-            pars = [vehicle.replace(**dict(c.vehicle)) for c in part]
+            pars = [_vehicle(made, vehicle, c) for c in part]
             suspensions = [c.to_suspension(base_gains) for c in part]
             if batch_conflict(suspensions) is not None:  # the inner loop is one setting per batch
                 for i in part_idx:  # positions, not lookups: cases may repeat
@@ -208,6 +208,15 @@ def _costs(res, case: Case, window) -> np.ndarray:
         getattr(damper_model(case.damper, case.damper_scale), "v_max", None) if case.suspension != "passive" else None
     )
     return damper_costs(select_window(res.dataset, window), v_max)
+
+
+def _vehicle(made: dict, vehicle: VehicleParams, c: Case) -> VehicleParams:
+    """The case's vehicle, one object per distinct change in this call (checked once, and one
+    vehicle model a batch builds for all the runs that share it)."""
+    key = ("vehicle", c.vehicle)
+    if key not in made:
+        made[key] = vehicle.replace(**dict(c.vehicle))
+    return made[key]
 
 
 def _scenario(made: dict, c: Case):
