@@ -14,7 +14,13 @@ Prints Markdown rows for docs/gpu.md, each with the device, the machine's cores 
 * with ``--check N``, the largest difference of the first N samples from the CPU stepper, over
   each history's largest value (the issue's bound: 1e-9 for laws without switching);
 * with ``--cpu``, the same batch on this machine's CPU cores, for the GPU's factor over them;
-* with ``--design``, `railride design --backend gpu` with its defaults (wall time, runs).
+* with ``--metrics-only``, the same batch as the studies run it when they keep only the metrics
+  (`railride.run.reduced.batch_metrics`: sums on the device, no histories), and its largest
+  difference from the metrics of the histories above;
+* with ``--design``, `railride design --backend gpu` with its defaults (wall time, runs);
+* with ``--memory-plan`` (no GPU needed: the simulator does), the bytes a metrics-only run of 60 s
+  takes on the device, from the sizes of the arrays a 64-run batch packs (computed, not measured):
+  a run's own arrays, and the tables each distinct track and vehicle adds.
 No test asserts timings.
 """
 
@@ -66,7 +72,12 @@ def main():
     ap.add_argument("--check", type=int, default=64)
     ap.add_argument("--cpu", action="store_true")
     ap.add_argument("--design", action="store_true")
+    ap.add_argument("--metrics-only", action="store_true")
+    ap.add_argument("--memory-plan", action="store_true")
     args = ap.parse_args()
+    if args.memory_plan:
+        _memory_plan()
+        return
 
     import numba
 
@@ -106,6 +117,19 @@ def main():
         gpu_part = simulate(scs[:k], suspension=susp, solver=on_gpu)
         print(f"\nFirst {k} samples against the CPU stepper: largest difference / history's largest value = "
               f"{_worst(gpu_part, cpu):.2e}")  # fmt: skip
+    if args.metrics_only:
+        from railride.run.checks import check
+        from railride.run.reduced import batch_metrics
+
+        t0 = time.perf_counter()
+        sums, _ = batch_metrics(check(scs, None, susp, on_gpu, "mark", histories=False))
+        reduced = time.perf_counter() - t0
+        call = dict(gpu.last_call)
+        full = result.metrics().values
+        diff = float(np.nanmax(np.abs(sums - full) / np.nanmax(np.abs(full), axis=0)))
+        print(f"\nMetrics only (sums on the device): kernels {call['kernel_s']:.2f} s, whole call {reduced:.2f} s, "
+              f"{work / reduced:.3g} sample-steps/s, device memory {call['device_bytes'] / 1024**3:.2f} GiB; "
+              f"largest difference from the histories' metrics / largest metric: {diff:.2e}")  # fmt: skip
     if args.cpu:
         on_cpu = SolverSettings(output_rate=args.output_rate, backend="cpu")
         simulate(scs[:16], suspension=susp, solver=on_cpu)  # compiles the CPU steppers
@@ -120,6 +144,38 @@ def main():
         cmd = [sys.executable, "-m", "railride.cli", "design", "--backend", "gpu", "--out", str(out)]
         subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)
         print(f"\nrailride design --backend gpu (defaults): {(time.perf_counter() - t0) / 60:.1f} min ({where})")
+
+
+def _memory_plan():
+    """The device bytes of metrics-only runs of 60 s (`railride.run.reduced`), from the arrays a
+    64-run batch of SAS (attitude) loops on fra4 at 30 and 70 m/s packs: computed, not measured."""
+    from railride.engine import gpu
+    from railride.model.track import scenario
+    from railride.run.checks import check
+    from railride.run.simulation import inputs, pack, stepper_arguments
+    from railride.run.solver import SolverSettings
+    from railride.secondary.suspension import Suspension
+
+    if gpu.why_not() is not None:
+        sys.exit(f"bench_gpu: {gpu.why_not()} (NUMBA_ENABLE_CUDASIM=1 is enough for --memory-plan)")
+    n, duration = 64, 60.0
+    speeds = (30.0, 70.0)
+    scs = [scenario("fra4", seed=1, speed=v, duration=duration) for v in speeds] * (n // 2)
+    loops = [Suspension.named("sas-attitude")] * n
+    plan = check(scs, None, loops, SolverSettings(backend="gpu"), "mark", histories=False)
+    tables = inputs(plan)
+    packed = pack(plan, tables, rows=2)
+    vehicle, dampers, rails, control, outputs = stepper_arguments(plan, tables, packed)
+    own = [packed.x, vehicle[2], vehicle[3], dampers[0], dampers[1], *control[2:5], control[6], control[7]]
+    per_run = sum(a[0].nbytes for a in own) + sum(h[0].nbytes for h in outputs[:9]) + (gpu.N_ACC + 5) * 8
+    rows = {float(v): int(k) for v, k in zip(speeds, rails[4][:2])}  # nodes of each speed's table
+    per_track = {v: k * (rails[0].shape[1] + rails[2].shape[1]) * 8 for v, k in rows.items()}
+    full = 8 * (plan.n_out + 1) * sum(h.shape[2] for h in outputs[:9] if h.shape[1] > 1)
+    print(f"Metrics-only runs of {duration:g} s, SAS (attitude), fra4, dt 1e-4 s (computed from the arrays' sizes):")
+    print(f"- a run's own arrays on the device: {per_run} bytes; 1e5 runs: {per_run * 1e5 / 2**30:.2f} GiB")
+    for v, b in per_track.items():
+        print(f"- one distinct track and vehicle at {v:g} m/s: {b / 2**20:.1f} MiB of input and forcing tables")
+    print(f"- one such run's histories at 1 kHz: {full / 2**20:.1f} MiB; 1e5 runs: {full * 1e5 / 2**40:.1f} TiB")
 
 
 if __name__ == "__main__":
