@@ -19,6 +19,7 @@ import numpy as np
 from railride.analysis.metrics import RESPONSES, check_window
 from railride.engine import layout
 from railride.errors import DivergenceError, InputError
+from railride.run.checks import check
 from railride.run.simulation import (
     RunPlan,
     _gpu_failed,
@@ -36,11 +37,10 @@ def batch_metrics(plan: RunPlan, window=None) -> tuple[np.ndarray, np.ndarray]:
     statistic) as `RideResult.metrics` gives them (`railride.analysis.metrics.RESPONSES`, RMS
     and peak-to-peak, over ``window`` = (start, end) s), NaN for a run that diverged, and the
     time each diverged [s] (NaN where it did not). On the GPU the sums are made on the device,
-    with no histories; a GPU failure says so in one line and runs the batch again on the CPU."""
+    with no histories; a GPU failure says so in one line and runs the batch again on the CPU.
+    On the CPU the runs go in batches of `CPU_BATCH`, whose histories bound the memory."""
     if stepped_on(plan) != "gpu":
-        res = run(plan)
-        values = res.metrics(window).values
-        return (values if values.ndim == 3 else values[None]), np.atleast_1d(res.diverged_at)
+        return _on_cpu(plan, window)
     from railride.engine import gpu
 
     w0, w1 = window_rows(plan.n_out + 1, plan.solver.output_rate, window)
@@ -58,9 +58,33 @@ def batch_metrics(plan: RunPlan, window=None) -> tuple[np.ndarray, np.ndarray]:
         )  # fmt: skip
     except gpu._Failed as failed:  # nothing of the batch is kept: it runs again, whole, on the CPU
         _gpu_failed(failed.cause)
-        cpu = dataclasses.replace(plan, solver=dataclasses.replace(plan.solver, backend="cpu"))
-        return batch_metrics(cpu, window)
+        return _on_cpu(plan, window)
     return metrics_from_sums(acc, packed.status, packed.fail_step, dt, plan.on_divergence)
+
+
+#: runs per CPU batch of a metrics-only plan: histories of the size a study's chunk holds
+CPU_BATCH = 32
+
+
+def _on_cpu(plan: RunPlan, window) -> tuple[np.ndarray, np.ndarray]:
+    """`batch_metrics` on the CPU: whole runs, `RideResult.metrics` of their histories, in
+    batches of `CPU_BATCH` runs (each checked again, for its own size)."""
+    solver = dataclasses.replace(plan.solver, backend="cpu")
+    values, diverged = [], []
+    for lo in range(0, plan.n, CPU_BATCH):
+        hi = min(plan.n, lo + CPU_BATCH)
+        if hi - lo == plan.n and stepped_on(plan) == "cpu":
+            part = plan
+        else:
+            x0 = None if plan.x0 is None or plan.x0.ndim == 1 else plan.x0[lo:hi]
+            x0 = plan.x0 if x0 is None and plan.x0 is not None else x0
+            on = (plan.scenarios[lo:hi], plan.param_sets[lo:hi], plan.suspensions[lo:hi])
+            part = check(*on, solver, plan.on_divergence, x0)
+        res = run(part)
+        got = res.metrics(window).values
+        values.append(got if got.ndim == 3 else got[None])
+        diverged.append(np.atleast_1d(res.diverged_at))
+    return np.concatenate(values), np.concatenate(diverged)
 
 
 def window_rows(n_rows: int, output_rate: float, window) -> tuple[int, int]:

@@ -99,7 +99,9 @@ def evaluate(
         by_group.setdefault(c.group, []).append(i)
     metrics_only = not (comfort or costs)
     for group, idx in by_group.items():
-        for part_idx in _batches(idx, solver, metrics_only):
+        parts = _batches(idx, solver, metrics_only)
+        while parts:
+            part_idx = parts.pop(0)
             part = [cases[i] for i in part_idx]
             scs = [_scenario(made, c) for c in part]
             pars = [_vehicle(made, vehicle, c) for c in part]
@@ -116,13 +118,15 @@ def evaluate(
                         costs=costs,
                     )[0]
                 continue
-            if metrics_only:  # on the GPU, summed on the device with no histories
-                from railride.run.checks import check
+            plan = _device_plan(scs, pars, suspensions, solver) if metrics_only else None
+            if plan is not None:  # on the GPU, summed on the device with no histories
                 from railride.run.reduced import batch_metrics
 
-                plan = check(scs, pars, suspensions, solver, "mark", histories=False)
                 m, diverged_at = batch_metrics(plan, window)
                 _add_rows(rows, cases, part_idx, m, diverged_at)
+                continue
+            if len(part_idx) > CHUNK:  # runs the GPU does not take (the exact steps): the CPU's batches
+                parts[:0] = [part_idx[k : k + CHUNK] for k in range(0, len(part_idx), CHUNK)]
                 continue
             res = simulate(scs, pars, suspensions, solver=solver, on_divergence="mark")
             # a diverged run keeps its row, with NaN metrics and the time it diverged: the other
@@ -158,6 +162,21 @@ def _batches(idx: list[int], solver: SolverSettings, metrics_only: bool) -> list
         else:
             out.append(part)
     return out
+
+
+def _device_plan(scenarios, params, suspensions, solver: SolverSettings):
+    """The checked plan of a metrics-only batch that steps on the GPU (`railride.run.reduced`);
+    None where it does not: the CPU runs those in batches of `CHUNK`, with their histories."""
+    from railride.run.checks import check
+    from railride.run.simulation import stepped_on
+
+    if not gpu_batches(solver, len(scenarios)):
+        return None
+    try:
+        plan = check(scenarios, params, suspensions, solver, "mark", histories=False)
+    except InputError:  # said again, where it holds, by the check of each CPU-sized batch
+        return None
+    return plan if stepped_on(plan) == "gpu" else None
 
 
 def gpu_batches(solver: SolverSettings, n: int) -> bool:

@@ -14,6 +14,7 @@ from railride.errors import BackendWarning, InputError
 from railride.model.track import scenario
 from railride.run.checks import check
 from railride.run.reduced import batch_metrics, window_rows
+from railride.run import simulation
 from railride.run.simulation import simulate
 from railride.run.solver import SolverSettings
 from railride.secondary.control import OUTER_LOOPS
@@ -144,3 +145,34 @@ def test_auto_sends_a_study_to_the_gpu_only_from_the_smallest_gpu_batch(monkeypa
     parts = sweep._batches(idx, GPU, metrics_only=True)
     assert [len(p) for p in parts] == [sweep.GPU_CHUNK, 40]
     assert [len(p) for p in sweep._batches(idx, GPU, metrics_only=False)][:2] == [sweep.CHUNK] * 2
+
+
+def test_runs_the_gpu_does_not_take_go_in_cpu_sized_batches(monkeypatch):
+    # passive runs take the exact steps on the CPU whatever the backend: not one batch of the
+    # whole group (its histories), but the CPU's batches of CHUNK
+    cases = [Case("paper-sine", (("duration", 0.02), ("speed", v))) for v in (30.0, 35.0, 40.0, 45.0, 50.0)]
+    sizes = []
+    run = simulation.run
+
+    def counted(plan, *args, **kw):
+        sizes.append(plan.n)
+        return run(plan, *args, **kw)
+
+    monkeypatch.setattr(simulation, "run", counted)
+    monkeypatch.setattr(sweep, "CHUNK", 2)
+    auto_gpu = SolverSettings(backend="gpu")  # method auto: the exact steps for passive runs
+    rows = sweep.run_cases(cases, solver=auto_gpu)
+    assert sizes == [2, 2, 1] and len(rows) == 5
+    assert np.all(rows["acceleration_m_s2_rms"] > 0)
+
+
+def test_a_gpu_failure_reruns_a_large_batch_on_the_cpu_in_small_batches(monkeypatch):
+    from railride.run import reduced
+
+    reference, _ = _cpu_metrics(SHORT, LAWS[:5], None)
+    monkeypatch.setattr(gpu, "_run_group", lambda *args: (_ for _ in ()).throw(RuntimeError("made up")))
+    monkeypatch.setattr(reduced, "CPU_BATCH", 2)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", BackendWarning)
+        got, when = batch_metrics(check(SHORT, None, LAWS[:5], GPU, "mark", histories=False))
+    assert got.shape == (5, 4, 2) and np.isnan(when).all() and _relative(got, reference) < 1e-9
