@@ -55,7 +55,18 @@ UNITS = {
     "rad/s2": ({"rad": 1, "s": -2}, 1.0),
     "N": ({"kg": 1, "m": 1, "s": -2}, 1.0),
     "V": ({"kg": 1, "m": 2, "s": -3, "A": -1}, 1.0),
+    "V/N": ({"m": 1, "s": -1, "A": -1}, 1.0),
 }
+
+
+#: the groups of variables the C code reads by their first value reference and their count
+#: (RR_VR_<block>, RR_N_<block>; both 0 where an export has none)
+BLOCKS = (
+    *("DT", "SPEED", "AMPLITUDE", "WAVELENGTH", "RAIL_PHASE", "TAPER", "INITIAL_Q", "INITIAL_QD"),
+    *("COMMAND", "FORCE_DEMAND", "INNER_B", "INNER_G", "RAIL_HEIGHT", "RAIL_RATE"),
+    *("Q", "QD", "QDD", "FLOOR", "DEFLECTION", "DEFLECTION_RATE", "FORCE", "COIL", "HYSTERETIC", "CLEARANCE"),
+    *("SCENARIO", "INNER_LOOP"),
+)
 
 
 @dataclass(frozen=True)
@@ -97,6 +108,15 @@ def _variables(vehicle: Vehicle, secondary: str, dt: float) -> list[Variable]:
         stem = "damper_command" if secondary != "ideal" else "force_demand"
         for k, c in enumerate(CORNER_NAMES):
             out.append(Variable("COMMAND" if k == 0 else "", f"{stem}_{c}", "input", unit, 0.0, f"corner {c}: {what}"))
+    if secondary not in ("passive", "ideal"):  # the inner loop, inside: force demands in, as railride's
+        from railride.secondary.control import GainSet
+
+        inner = GainSet.default().inner
+        for k, c in enumerate(CORNER_NAMES):
+            text = f"corner {c}: force demand on the carbody, for the inner loop (inner_loop 1-3)"
+            out.append(Variable("FORCE_DEMAND" if k == 0 else "", f"force_demand_{c}", "input", "N", 0.0, text))
+        out.append(Variable("INNER_B", "inner_B", "parameter", "", inner.B, "the inner loop's weight of the force"))
+        out.append(Variable("INNER_G", "inner_G", "parameter", "V/N", inner.G, "the inner loop's gain"))
     rails = [f"{w}{r}" for w in WHEELSETS for r in RAILS]
     for k, r in enumerate(rails):
         out.append(Variable("RAIL_HEIGHT" if k == 0 else "", f"rail_height_{r}", "input", "m", 0.0, "scenario 0"))
@@ -126,6 +146,10 @@ def _variables(vehicle: Vehicle, secondary: str, dt: float) -> list[Variable]:
             out.append(Variable(block if k == 0 else "", f"{stem}_{c}", "output", unit, None, f"corner {c}: {text}"))
     text = "0: the rail inputs, carried on over a step with their rates; 1: the paper's sine"
     out.append(Variable("SCENARIO", "scenario", "parameter", "", 1, text, integer=True))
+    if secondary not in ("passive", "ideal"):
+        text = "0: the coil commands are the inputs; 1, 2, 3: the force demands, through railride's inner loop "
+        text += "(tracking, on-off, clipped) at every step dt"
+        out.append(Variable("INNER_LOOP", "inner_loop", "parameter", "", 0, text, integer=True))
     return out
 
 
@@ -222,9 +246,14 @@ def _build(compiler: str, root: Path) -> None:
 
 
 def _c_array(name: str, values: np.ndarray) -> str:
-    body = ", ".join(repr(float(v)) if math.isfinite(v) else "1e300" for v in np.ravel(values))
+    """A static const double array in C, a row a line (an infinite value as 1e300)."""
+
+    def row(v) -> str:
+        return "{" + ", ".join(repr(float(x)) if math.isfinite(x) else "1e300" for x in np.ravel(v)) + "}"
+
     dims = "".join(f"[{n}]" for n in values.shape)
-    return f"static const double {name}{dims} = {{{body}}};\n"
+    body = row(values) if values.ndim == 1 else "{\n    " + ",\n    ".join(row(r) for r in values) + "}"
+    return f"static const double {name}{dims} = {body};\n"
 
 
 def _header(car: Vehicle, secondary: str, variables: list[Variable], dt: float) -> str:
@@ -266,9 +295,7 @@ def _header(car: Vehicle, secondary: str, variables: list[Variable], dt: float) 
     integers = [v for v in variables if v.integer]
     lines.append(f"#define RR_N_REAL {len(reals)}\n#define RR_N_INTEGER {len(integers)}\n")
     lines.append(f"#define RR_VR_INTEGER0 {len(reals)}\n")
-    blocks = ("DT SPEED AMPLITUDE WAVELENGTH RAIL_PHASE TAPER INITIAL_Q INITIAL_QD COMMAND RAIL_HEIGHT RAIL_RATE Q QD "
-              "QDD FLOOR DEFLECTION DEFLECTION_RATE FORCE COIL HYSTERETIC CLEARANCE SCENARIO").split()  # fmt: skip
-    for block in blocks:
+    for block in BLOCKS:
         at = [i for i, v in enumerate(variables) if v.block == block]
         lines.append(f"#define RR_VR_{block} {at[0] if at else 0}\n")
         count = 0

@@ -70,6 +70,7 @@ typedef struct {
     long step;                    /* steps of dt since the start */
     int mode;
     int clipped_said;             /* a command outside the damper's range was said once */
+    double vc[4];                 /* the command voltages the inner loop last set */
     fmi2String name;
     fmi2CallbackFunctions cb;
     int logging;
@@ -166,12 +167,14 @@ static double stop_force(double x) {
     return 0.0;
 }
 
+#if RR_SECONDARY == RR_SECONDARY_MR
 /* The Bouc-Wen rate z' (railride.engine.laws._bouc_wen_rate). */
 static double bouc_wen_rate(double z, double w) {
     const double az = fabs(z);
     const double zn1 = RR_BW_N == 1.0 ? 1.0 : (RR_BW_N == 2.0 ? az : pow(az, RR_BW_N - 1.0));
     return -RR_BW_GAMMA * fabs(w) * z * zn1 - RR_BW_BETA * w * zn1 * az + RR_BW_A * w;
 }
+#endif
 
 /* ds/dt at time t for the held commands v (volts, or newtons on the carbody for the actuator);
    f: each corner's damper force on the carbody (the stops not included, as a load cell on the
@@ -201,6 +204,7 @@ static void derivative(const Instance *m, const double *s, double t, double t0, 
 #elif RR_SECONDARY == RR_SECONDARY_ACTUATOR
         f[c] = v[c];
 #else
+        (void)v;
         f[c] = -RR_C_SEC * xd[c]; /* the dashpots sit in RR_A: reported, not added */
 #endif
         y[2 * NQ + c] = RR_SECONDARY == RR_SECONDARY_PASSIVE ? 0.0 : f[c];
@@ -240,8 +244,16 @@ static int substeps(const double *s, const double *xd, double dt) {
 }
 
 /* The commands the dampers see: the inputs, an MR damper's within its voltage range. */
+static int inner_loop(const Instance *m) {
+    return RR_N_INNER_LOOP ? m->i[RR_VR_INNER_LOOP - RR_VR_INTEGER0] : 0;
+}
+
 static void commands(Instance *m, double *v) {
     int c;
+    if (inner_loop(m)) { /* the voltages the inner loop set */
+        for (c = 0; c < 4; c++) v[c] = m->vc[c];
+        return;
+    }
     for (c = 0; c < 4; c++) v[c] = RR_N_COMMAND ? m->r[RR_VR_COMMAND + c] : 0.0;
 #if RR_SECONDARY == RR_SECONDARY_MR
     for (c = 0; c < 4; c++) {
@@ -284,14 +296,35 @@ static void outputs(Instance *m, double t0) {
     }
 }
 
-/* One step dt from step m->step with the held commands v: RK4 in sub-steps, as the engine. */
-static int step_once(Instance *m, double t0, const double *v) {
+/* The inner loop's law (parameter inner_loop: 1 tracking, 2 on-off, 3 clipped;
+   railride.engine.laws.voltage_law): the voltage from the damper force f on the carbody, the
+   demand fd there and the deflection rate xd. */
+static double voltage_law(int mode, double B, double G, double f, double fd, double xd) {
+    double sgn;
+    if (mode == 2) return fd * xd < 0.0 ? RR_V_MAX : RR_V_MIN;
+    if (mode == 3) return (fd - f) * f > 0.0 ? RR_V_MAX : RR_V_MIN;
+    sgn = f > 0.0 ? 1.0 : (f < 0.0 ? -1.0 : 0.0);
+    return fmin(fmax(G * (fd - B * f) * sgn, RR_V_MIN), RR_V_MAX);
+}
+
+/* One step dt from step m->step with the held commands v: RK4 in sub-steps, as the engine.
+   With the inner loop, v is first set from the demands fd at the step's start, and the first
+   stage's coil rate follows it (railride.engine.sample_parts.inner_loop). */
+static int step_once(Instance *m, double t0, double *v, const double *fd) {
     double K[4][NS], st[NS], f[4], x[4], xd[4];
     const double dt = m->r[RR_VR_DT], t = m->t_start + m->step * dt;
     int i, sub, n;
     double h;
     memset(K, 0, sizeof K);
     derivative(m, m->s, t, t0, v, K[0], f, x, xd);
+    if (fd != NULL) {
+        const int mode = m->i[RR_VR_INNER_LOOP - RR_VR_INTEGER0];
+        int c;
+        for (c = 0; c < 4; c++) {
+            v[c] = voltage_law(mode, m->r[RR_VR_INNER_B], m->r[RR_VR_INNER_G], f[c], fd[c], xd[c]);
+            K[0][2 * NQ + 4 + c] = -RR_BW_ETA * (m->s[2 * NQ + 4 + c] - v[c]);
+        }
+    }
     n = substeps(m->s, xd, dt);
     h = dt / n;
     for (sub = 0; sub < n; sub++) {
@@ -324,6 +357,7 @@ static void start(Instance *m) {
         m->s[i] = m->r[RR_VR_INITIAL_Q + i];
         m->s[NQ + i] = m->r[RR_VR_INITIAL_QD + i];
     }
+    for (c = 0; c < 4; c++) m->vc[c] = RR_V_MIN; /* a closed loop's coils start at v_min */
     commands(m, v);
     for (c = 0; c < 4; c++)
         if (RR_SECONDARY == RR_SECONDARY_MR) m->s[2 * NQ + 4 + c] = v[c];
@@ -348,6 +382,12 @@ static int parameters_ok(Instance *m) {
     if (m->i[RR_VR_SCENARIO - RR_VR_INTEGER0] != 0 && m->i[RR_VR_SCENARIO - RR_VR_INTEGER0] != 1) {
         say(m, fmi2Error, "logStatusError", "scenario = %d: allowed 0 (the rail inputs) or 1 (the paper's sine)",
             m->i[RR_VR_SCENARIO - RR_VR_INTEGER0]);
+        return 0;
+    }
+    if (inner_loop(m) < 0 || inner_loop(m) > 3) {
+        say(m, fmi2Error, "logStatusError",
+            "inner_loop = %d: allowed 0 (the coil commands are the inputs), 1 (tracking), 2 (on-off) or 3 (clipped)",
+            inner_loop(m));
         return 0;
     }
     if (m->i[RR_VR_SCENARIO - RR_VR_INTEGER0] == 1) {
@@ -622,8 +662,9 @@ RR_EXPORT fmi2Status fmi2CancelStep(fmi2Component c) {
 
 RR_EXPORT fmi2Status fmi2DoStep(fmi2Component c, fmi2Real now, fmi2Real size, fmi2Boolean no_prior) {
     Instance *m = (Instance *)c;
-    double v[4], dt, t0, steps;
+    double v[4], fd[4], dt, t0, steps;
     long n, k;
+    int j;
     (void)no_prior;
     if (m == NULL) return fmi2Error;
     if (m->mode != MODE_STEPPING) {
@@ -646,8 +687,9 @@ RR_EXPORT fmi2Status fmi2DoStep(fmi2Component c, fmi2Real now, fmi2Real size, fm
     }
     t0 = m->time;
     commands(m, v);
+    for (j = 0; j < 4; j++) fd[j] = RR_N_FORCE_DEMAND ? m->r[RR_VR_FORCE_DEMAND + j] : 0.0;
     for (k = 0; k < n; k++) {
-        if (!step_once(m, t0, v)) {
+        if (!step_once(m, t0, v, inner_loop(m) ? fd : NULL)) {
             say(m, fmi2Error, "logStatusError",
                 "the vehicle diverged at t = %g s: a response left +-%g (m or rad) or stopped being finite; "
                 "check the inputs and parameters, or export with a smaller dt", m->time, DIVERGED);
@@ -655,6 +697,7 @@ RR_EXPORT fmi2Status fmi2DoStep(fmi2Component c, fmi2Real now, fmi2Real size, fm
             return fmi2Error;
         }
     }
+    for (j = 0; j < 4; j++) m->vc[j] = v[j];
     outputs(m, t0);
     return fmi2OK;
 }
