@@ -16,6 +16,7 @@ The public API, in the order a run needs it::
     rr.run_sweep(rr.sweep.grid(["passive", "pid"], speed=[20, 40, 60]))  # every combination
     rr.frequency_responses(params)                    # carbody FRFs, their peaks, the modes
     rr.write_report(rr.compare(sc), "ride.html")      # any result as one HTML page
+    rr.export_fmu("vehicle.fmu")                      # the vehicle for Simulink, SIMPACK, FMPy (FMI 2.0)
 """
 
 from railride._version import __version__ as __version__
@@ -56,6 +57,7 @@ _HOMES = {
     "Vehicle": "model.vehicle",
     "dampers": "secondary.dampers",
     "write_report": "output.report",
+    "export_fmu": "frequency.fmu",
 }
 
 
@@ -104,6 +106,7 @@ if TYPE_CHECKING:
     from railride.secondary.control import GainSet
     from railride.secondary.faults import DamperFault
     from railride.frequency.frf import FrfResult, frequency_responses
+    from railride.frequency.fmu import export_fmu
     from railride.studies.objectives import Objective
     from railride.model.params import VehicleParams
     from railride.studies.pareto import ParetoResult, pareto
@@ -169,6 +172,7 @@ __all__ = [
     "compare",
     "dampers",
     "design",
+    "export_fmu",
     "frequency_responses",
     "pareto",
     "scenario",

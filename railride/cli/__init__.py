@@ -45,6 +45,7 @@ COMMANDS = (
     "study",
     "design",
     "ride_spectrum",
+    "fmu",
 )
 
 if TYPE_CHECKING:

@@ -172,8 +172,9 @@ def export_fmu(
     checked, and the compiler found, before anything is written."""
     path = Path(os.fspath(out)) if isinstance(out, (str, os.PathLike)) else None
     if path is None or path.suffix != ".fmu":
-        raise InputError(f"out = {out!r}: give the path of the FMU to write, ending in .fmu")
-    validation.creatable(path, "out")
+        shown = str(path) if path is not None else out
+        raise InputError(f"out = {shown!r}: give the path of the FMU to write, ending in .fmu")
+    validation.creatable(path, f"out = {str(path)!r}")
     params_, record = resolve_vehicle(vehicle, params, load)
     if not isinstance(damper, str) or damper not in SECONDARIES:
         raise InputError(
@@ -256,6 +257,19 @@ def _c_array(name: str, values: np.ndarray) -> str:
     return f"static const double {name}{dims} = {body};\n"
 
 
+def _qdd_function(A: np.ndarray, Bw: np.ndarray, Bwd: np.ndarray) -> str:
+    """rr_qdd(y, w, wd, qdd): q'' = Bw w + Bwd w' + A^T y written out with the nonzero entries
+    alone (most are zero: a rail moves its bogie, a corner force two bodies), which makes the
+    step about twice as fast as the full products."""
+    lines = ["static void rr_qdd(const double *y, const double *w, const double *wd, double *qdd) {\n"]
+    for i in range(A.shape[1]):
+        terms = [f"{float(Bw[i, j])!r} * w[{j}]" for j in range(8) if Bw[i, j]]
+        terms += [f"{float(Bwd[i, j])!r} * wd[{j}]" for j in range(8) if Bwd[i, j]]
+        terms += [f"{float(A[j, i])!r} * y[{j}]" for j in range(A.shape[0]) if A[j, i]]
+        lines.append(f"    qdd[{i}] = {' + '.join(terms) or '0.0'};\n")
+    return "".join(lines) + "}\n"
+
+
 def _header(car: Vehicle, secondary: str, variables: list[Variable], dt: float) -> str:
     """model.h: the vehicle's matrices at its own size, the damper and the value references."""
     p, nd = car.params, car.n_dof
@@ -269,18 +283,16 @@ def _header(car: Vehicle, secondary: str, variables: list[Variable], dt: float) 
         f"#define RR_N_DOF {nd}\n",
         "#define RR_SECONDARY_PASSIVE 0\n#define RR_SECONDARY_MR 1\n#define RR_SECONDARY_ACTUATOR 2\n",
         f"#define RR_SECONDARY {kinds.get(secondary, 1)}\n",
-        _c_array("RR_A", A),
         _c_array("RR_T", system["TS"][:nd]),
-        _c_array("RR_BW_RAIL", system["Bw"][:nd]),
-        _c_array("RR_BWD_RAIL", system["Bwd"][:nd]),
         _c_array("RR_FLOOR", floor),
         _c_array("RR_LAG", np.asarray(car.wheelset_lag_distance, dtype=float)),
         f"#define RR_C_SEC {p.c_sz!r}\n",
-        f"#define RR_Z_STOP {system['stops'][0] if math.isfinite(system['stops'][0]) else 1e300!r}\n",
+        f"#define RR_Z_STOP {float(system['stops'][0]) if math.isfinite(system['stops'][0]) else 1e300!r}\n",
         f"#define RR_K_STOP {float(system['stops'][1])!r}\n",
         f"#define RR_SUBSTEP_DT_REF {layout.SUBSTEP_DT_REF!r}\n#define RR_SUBSTEP_LIMIT {layout.SUBSTEP_LIMIT!r}\n",
         f"#define RR_MAX_SUBSTEPS {layout.MAX_SUBSTEPS}\n",
         f"#define RR_NODES_PER_FEATURE {float(NODES_PER_FEATURE)!r}\n",
+        _qdd_function(A, system["Bw"][:nd], system["Bwd"][:nd]),
     ]
     model = dampers.preset(secondary) if secondary not in ("passive", "ideal") else None
     P = model.pack() if model is not None else np.zeros(layout.N_PACKED)

@@ -36,6 +36,7 @@ def run_example(name: str, out: Path, *args: str) -> str:
         "flexible_carbody",
         "robust_gains",
         "roll_cost",
+        "fmu_cosimulation",
     ],
 )
 def test_example_has_a_docstring_and_uses_no_private_names(name):
@@ -108,3 +109,12 @@ def test_readme_python_block_runs():
     kept = "\n".join(line for line in code.splitlines() if "rr.tune(" not in line)
     assert "rr.compare(" in kept and "rr.simulate(" in kept
     exec(compile(kept, "README.md", "exec"), {})
+
+
+def test_fmu_cosimulation(tmp_path):
+    pytest.importorskip("fmpy")
+    out = run_example("fmu_cosimulation", tmp_path / "fmu")
+    for name in ("carbody_bounce", "carbody_pitch", "carbody_roll", "carbody_acceleration"):
+        match = re.search(rf"^{name}\s+\S+\s+\S+\s+(\S+)$", out, re.M)
+        assert match and float(match.group(1)) < 1e-6, out
+    assert (tmp_path / "fmu" / "vehicle.fmu").is_file() and (tmp_path / "fmu" / "cosimulation.csv").is_file()

@@ -70,8 +70,11 @@ typedef struct {
     long step;                    /* steps of dt since the start */
     int mode;
     int clipped_said;             /* a command outside the damper's range was said once */
+    int stale;                    /* inputs set since the outputs were made */
     double vc[4];                 /* the command voltages the inner loop last set */
-    fmi2String name;
+    long node;                    /* the sine's input-grid node whose values are kept, -1: none */
+    double node_w[2][8], node_wd[2][8]; /* the values and rates at nodes node and node + 1 */
+    char name[128];               /* the instance's name, copied (the host's string may go) */
     fmi2CallbackFunctions cb;
     int logging;
 } Instance;
@@ -123,7 +126,7 @@ static void sine(const Instance *m, double t, double *w, double *wd) {
    the nodes of the input grid (railride.model.track.input_table_nodes: a node every 2^j steps
    dt, about RR_NODES_PER_FEATURE a wavelength) joined by cubic Hermite pieces, and the rate the
    derivative of that curve (railride.engine.laws._hermite). */
-static void rails(const Instance *m, double t, double t0, double *w, double *wd) {
+static void rails(Instance *m, double t, double t0, double *w, double *wd) {
     int j;
     t -= m->t_start; /* the track starts with the experiment */
     t0 -= m->t_start;
@@ -141,7 +144,7 @@ static void rails(const Instance *m, double t, double t0, double *w, double *wd)
         const double u = t / interval;
         const long k = (long)u;
         double tau = u - (double)k, om, h00, h10, h01, h11, d00, d10, d11;
-        double wa[8], wda[8], wb[8], wdb[8];
+        const double *wa, *wda, *wb, *wdb;
         if (tau > 1.0) tau = 1.0;
         om = 1.0 - tau;
         h00 = (1.0 + 2.0 * tau) * om * om;
@@ -151,8 +154,20 @@ static void rails(const Instance *m, double t, double t0, double *w, double *wd)
         d00 = 6.0 * tau * (tau - 1.0) / interval;
         d10 = om * (1.0 - 3.0 * tau);
         d11 = tau * (3.0 * tau - 2.0);
-        sine(m, (double)k * interval, wa, wda);
-        sine(m, (double)(k + 1) * interval, wb, wdb);
+        if (k != m->node) { /* a node every 2^j steps: the sine is evaluated there once */
+            if (k == m->node + 1) {
+                memcpy(m->node_w[0], m->node_w[1], sizeof m->node_w[0]);
+                memcpy(m->node_wd[0], m->node_wd[1], sizeof m->node_wd[0]);
+            } else {
+                sine(m, (double)k * interval, m->node_w[0], m->node_wd[0]);
+            }
+            sine(m, (double)(k + 1) * interval, m->node_w[1], m->node_wd[1]);
+            m->node = k;
+        }
+        wa = m->node_w[0];
+        wda = m->node_wd[0];
+        wb = m->node_w[1];
+        wdb = m->node_wd[1];
         for (j = 0; j < 8; j++) {
             w[j] = h00 * wa[j] + h10 * wda[j] + h01 * wb[j] + h11 * wdb[j];
             wd[j] = d00 * (wa[j] - wb[j]) + d10 * wda[j] + d11 * wdb[j];
@@ -179,7 +194,7 @@ static double bouc_wen_rate(double z, double w) {
 /* ds/dt at time t for the held commands v (volts, or newtons on the carbody for the actuator);
    f: each corner's damper force on the carbody (the stops not included, as a load cell on the
    damper would read it); x, xd: the corners' deflections and rates. */
-static void derivative(const Instance *m, const double *s, double t, double t0, const double *v, double *ds,
+static void derivative(Instance *m, const double *s, double t, double t0, const double *v, double *ds,
                        double *f, double *x, double *xd) {
     double y[NY], w[8], wd[8];
     int i, j, c;
@@ -211,12 +226,7 @@ static void derivative(const Instance *m, const double *s, double t, double t0, 
         if (RR_K_STOP > 0.0) y[2 * NQ + c] += stop_force(x[c]);
     }
     rails(m, t, t0, w, wd);
-    for (i = 0; i < NQ; i++) {
-        double a = 0.0;
-        for (j = 0; j < 8; j++) a += RR_BW_RAIL[i][j] * w[j] + RR_BWD_RAIL[i][j] * wd[j];
-        for (j = 0; j < NY; j++) a += RR_A[j][i] * y[j];
-        ds[NQ + i] = a;
-    }
+    rr_qdd(y, w, wd, ds + NQ); /* q'' = Bw w + Bwd w' + A^T y, its nonzero terms (model.h) */
 }
 
 /* Sub-steps for a step: a power of two resolving the fastest damper rate at the deflection
@@ -363,6 +373,7 @@ static void start(Instance *m) {
         if (RR_SECONDARY == RR_SECONDARY_MR) m->s[2 * NQ + 4 + c] = v[c];
     m->step = 0;
     m->time = m->t_start;
+    m->node = -1;
     outputs(m, m->t_start);
 }
 
@@ -440,7 +451,7 @@ RR_EXPORT fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2Stri
     m = (Instance *)calloc(1, sizeof(Instance));
     if (m == NULL) return NULL;
     memcpy((void *)&m->cb, functions, sizeof(fmi2CallbackFunctions));
-    m->name = name;
+    snprintf(m->name, sizeof m->name, "%s", name != NULL ? name : "");
     m->logging = logging;
     defaults(m);
     return m;
@@ -496,6 +507,10 @@ RR_EXPORT fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[],
     size_t k;
     if (m == NULL) return fmi2Error;
     if (m->mode == MODE_INITIALISATION && parameters_ok(m)) start(m); /* the initial unknowns */
+    if (m->mode == MODE_STEPPING && m->stale) { /* the outputs that feed through from the inputs */
+        outputs(m, m->time);
+        m->stale = 0;
+    }
     for (k = 0; k < nvr; k++) {
         if (vr[k] >= RR_N_REAL) {
             say(m, fmi2Error, "logStatusError", "no Real variable has value reference %u", vr[k]);
@@ -526,6 +541,7 @@ RR_EXPORT fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[],
             return fmi2Error;
         }
         m->r[vr[k]] = value[k];
+        m->stale = 1;
     }
     return fmi2OK;
 }
@@ -699,6 +715,7 @@ RR_EXPORT fmi2Status fmi2DoStep(fmi2Component c, fmi2Real now, fmi2Real size, fm
     }
     for (j = 0; j < 4; j++) m->vc[j] = v[j];
     outputs(m, t0);
+    m->stale = 0;
     return fmi2OK;
 }
 

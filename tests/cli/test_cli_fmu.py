@@ -1,0 +1,48 @@
+"""``railride fmu``: an FMU written, or one error line naming the option, before anything is written."""
+
+import shutil
+import zipfile
+
+import pytest
+
+from clihelp import assert_input_error, ok, run
+
+pytestmark = pytest.mark.skipif(shutil.which("cc") is None, reason="no C compiler to build the FMU")
+
+
+def test_fmu_writes_an_fmu_with_its_sources_and_a_binary(tmp_path):
+    result = ok("fmu", "--out", tmp_path / "v.fmu", "--vehicle", "crh380a", "--load", "1.3", "--damper", "passive")
+    assert f"wrote {tmp_path / 'v.fmu'}" in result.stdout
+    with zipfile.ZipFile(tmp_path / "v.fmu") as z:
+        names = set(z.namelist())
+        xml = z.read("modelDescription.xml").decode()
+    assert {"modelDescription.xml", "sources/railride_fmu.c", "sources/model.h"} <= names
+    assert any(n.startswith("binaries/") for n in names)
+    assert "crh380a, load 1.3" in xml and "secondary_clearance_1R" in xml  # its bump stops
+
+
+def test_sources_only_ships_no_binary(tmp_path):
+    ok("fmu", "--out", tmp_path / "v.fmu", "--sources-only")
+    with zipfile.ZipFile(tmp_path / "v.fmu") as z:
+        assert not any(n.startswith("binaries/") for n in z.namelist())
+
+
+@pytest.mark.parametrize(
+    ("args", "fragments"),
+    [
+        (["--damper", "spencer1997"], ["--damper = 'spencer1997'", "implements passive", "railway", "ideal"]),
+        (["--dt", "0.5"], ["--dt = 0.5 s", "at most 0.01 s"]),
+        (["--dt", "-1"], ["--dt"]),
+        (["--load", "0"], ["--load"]),
+        (["--vehicle", "nothing"], ["--vehicle"]),
+    ],
+)
+def test_bad_options_are_one_error_line_and_nothing_is_written(tmp_path, args, fragments):
+    assert_input_error(run("fmu", "--out", tmp_path / "v.fmu", *args), *fragments)
+    assert not (tmp_path / "v.fmu").exists()
+
+
+def test_an_out_that_is_no_fmu_or_cannot_be_written_is_refused(tmp_path):
+    assert_input_error(run("fmu", "--out", tmp_path / "v.zip"), "--out", "ending in .fmu")
+    (tmp_path / "file").write_text("")
+    assert_input_error(run("fmu", "--out", tmp_path / "file" / "v.fmu"), "--out", "is a file")
