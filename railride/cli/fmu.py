@@ -9,8 +9,22 @@ import typer
 
 from railride.cli._app import app
 from railride.cli._common import errors, option_names, stdout_console
-from railride.cli._options import DtOption, LoadOption, PresetOption, VehicleOption
-from railride.cli._parsing import vehicle_arguments
+from railride.cli._options import (
+    AmplitudeOption,
+    DtOption,
+    DurationOption,
+    LoadOption,
+    MaxWavelengthOption,
+    MinWavelengthOption,
+    PresetOption,
+    RailPhaseOption,
+    ScenarioOption,
+    SpeedOption,
+    TrackSeedOption,
+    VehicleOption,
+    WavelengthOption,
+)
+from railride.cli._parsing import PROFILE_FIELDS, make_scenario, track_options, vehicle_arguments
 
 
 @app.command()
@@ -32,18 +46,48 @@ def fmu(
         ),
     ] = "railway",
     dt: DtOption = None,
+    scenario: ScenarioOption = "paper-sine",
+    amplitude: AmplitudeOption = None,
+    wavelength: WavelengthOption = None,
+    rail_phase: RailPhaseOption = None,
+    track_seed: TrackSeedOption = None,
+    min_wavelength: MinWavelengthOption = None,
+    max_wavelength: MaxWavelengthOption = None,
+    speed: SpeedOption = None,
+    duration: DurationOption = None,
     sources_only: Annotated[
         bool,
         typer.Option("--sources-only", help="Ship the C sources alone; build no binary for this machine."),
     ] = False,
 ) -> None:
     """Write the vehicle as an FMI 2.0 co-simulation FMU with C sources and a binary for this
-    machine, for Simulink's FMU block, SIMPACK, Dymola, OpenModelica or FMPy (docs/fmu.md)."""
+    machine, for Simulink's FMU block, SIMPACK, Dymola, OpenModelica or FMPy (docs/fmu.md). The
+    scenario options set the track the FMU starts with: the paper's sine (its settings and speed
+    the defaults of the FMU's parameters), or a random track, whose realisation the FMU carries;
+    every run can also take its rails from the FMU's inputs."""
     with errors():
         from railride.defaults import DEFAULT_DT
         from railride.frequency.fmu import export_fmu
 
         given = vehicle_arguments(vehicle, preset, load)
-        with option_names({"out": "--out", "damper": "--damper", "dt": "--dt", "binary": "--sources-only"}):
-            path = export_fmu(out, **given, damper=damper, dt=DEFAULT_DT if dt is None else dt, binary=not sources_only)
+        track = track_options(scenario, track_seed, min_wavelength, max_wavelength)
+        options = dict(amplitude=amplitude, wavelength=wavelength, rail_phase=rail_phase, speed=speed)
+        with option_names(PROFILE_FIELDS):
+            sc = make_scenario(scenario, dict(options, duration=duration, **(track or {})))
+        fields = {
+            "out": "--out",
+            "damper": "--damper",
+            "dt": "--dt",
+            "binary": "--sources-only",
+            "scenario": "--scenario",
+        }
+        with option_names(fields):
+            path = export_fmu(
+                out,
+                **given,
+                damper=damper,
+                dt=DEFAULT_DT if dt is None else dt,
+                scenario=sc,
+                binary=not sources_only,
+            )
     stdout_console().print(f"wrote {path}")

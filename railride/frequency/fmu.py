@@ -32,7 +32,7 @@ from railride.defaults import DEFAULT_DT
 from railride.engine import layout
 from railride.errors import InputError
 from railride.model.params import resolve_vehicle
-from railride.model.track import NODES_PER_FEATURE, SineTrack
+from railride.model.track import NODES_PER_FEATURE, RandomTrack, SineTrack, as_scenario
 from railride.model.vehicle import CORNER_NAMES, RAILS, WHEELSETS, Vehicle
 from railride.run.inputs import _system_arrays
 from railride.secondary import dampers
@@ -83,13 +83,15 @@ class Variable:
     integer: bool = False
 
 
-def _variables(vehicle: Vehicle, secondary: str, dt: float) -> list[Variable]:
-    """Every variable of the FMU in value-reference order: Reals, then Integers."""
-    sine = SineTrack()
+def _variables(vehicle: Vehicle, secondary: str, dt: float, sc) -> list[Variable]:
+    """Every variable of the FMU in value-reference order: Reals, then Integers. ``sc``: the
+    scenario the export starts with (None: the paper's sine at 40 m/s)."""
+    sine = sc.track if sc is not None and isinstance(sc.track, SineTrack) else SineTrack()
+    speed = 40.0 if sc is None else sc.speed
     names, units = vehicle.dof_names, vehicle.dof_units
     out = [
         Variable("DT", "dt", "parameter", "s", dt, "the fixed RK4 step; a communication step is a whole multiple"),
-        Variable("SPEED", "speed", "parameter", "m/s", 40.0, "the vehicle's speed on the paper's sine (scenario 1)"),
+        Variable("SPEED", "speed", "parameter", "m/s", speed, "the vehicle's speed (scenarios 1 and 2)"),
         Variable("AMPLITUDE", "amplitude", "parameter", "m", sine.amplitude, "the sine's amplitude (scenario 1)"),
         Variable("WAVELENGTH", "wavelength", "parameter", "m", sine.wavelength, "the sine's wavelength (scenario 1)"),
         Variable("RAIL_PHASE", "rail_phase", "parameter", "deg", sine.rail_phase_deg, "the right rail's lag"),
@@ -145,7 +147,10 @@ def _variables(vehicle: Vehicle, secondary: str, dt: float) -> list[Variable]:
         for k, c in enumerate(CORNER_NAMES):
             out.append(Variable(block if k == 0 else "", f"{stem}_{c}", "output", unit, None, f"corner {c}: {text}"))
     text = "0: the rail inputs, carried on over a step with their rates; 1: the paper's sine"
-    out.append(Variable("SCENARIO", "scenario", "parameter", "", 1, text, integer=True))
+    random = sc is not None and isinstance(sc.track, RandomTrack)
+    if random:
+        text += f"; 2: the random track of the export ({_track_words(sc.track)})"
+    out.append(Variable("SCENARIO", "scenario", "parameter", "", 2 if random else 1, text, integer=True))
     if secondary not in ("passive", "ideal"):
         text = "0: the coil commands are the inputs; 1, 2, 3: the force demands, through railride's inner loop "
         text += "(tracking, on-off, clipped) at every step dt"
@@ -161,13 +166,18 @@ def export_fmu(
     load: float = 1.0,
     damper: str = "railway",
     dt: float = DEFAULT_DT,
+    scenario=None,
     binary: bool = True,
 ) -> Path:
     """Write the vehicle as an FMI 2.0 co-simulation FMU to ``out`` (a path ending in .fmu) and
     return it. ``vehicle`` (``params`` is an alias): a preset name, a parameters file or
     `VehicleParams` (default "paper"), with the load factor ``load``; ``damper``: the secondary,
     one of `SECONDARIES` ("passive": the vehicle's dashpots c_sz; an MR preset; "ideal": force
-    inputs); ``dt``: the FMU's fixed step [s]. ``binary``: also build this platform's binary with
+    inputs); ``dt``: the FMU's fixed step [s]. ``scenario`` (a `Scenario` or a name, default the
+    paper's sine at 40 m/s): the track the FMU starts with, its speed the default of the FMU's
+    ``speed``; the paper's sine (scenario 1, its settings the defaults of the FMU's), or a random
+    track, whose realisation the FMU carries (scenario 2, in its resources). ``binary``: also build
+    this platform's binary with
     the C compiler (``CC``, else cc or gcc); False ships the sources alone. Every value is
     checked, and the compiler found, before anything is written."""
     path = Path(os.fspath(out)) if isinstance(out, (str, os.PathLike)) else None
@@ -184,11 +194,18 @@ def export_fmu(
     dt = validation.number("dt", dt, "positive", "s")
     if dt > 1e-2:
         raise InputError(f"dt = {validation.shown(dt)} s: at most 0.01 s; railride's default is {DEFAULT_DT:g} s")
+    sc = None if scenario is None else as_scenario(scenario)
+    if sc is not None and not isinstance(sc.track, (SineTrack, RandomTrack)):
+        raise InputError(
+            f"scenario = {sc.name!r}: the FMU carries the paper's sine or a random track (fra1..fra6, german-low, "
+            "german-high); give it other profiles through its rail inputs (scenario 0)"
+        )
     binary = arguments.flag("binary", binary)
     compiler = _compiler() if binary else None
     car = Vehicle(params_)
-    variables = _variables(car, damper, dt)
-    header = _header(car, damper, variables, dt)
+    variables = _variables(car, damper, dt, sc)
+    track = sc.track if sc is not None and isinstance(sc.track, RandomTrack) else None
+    header = _header(car, damper, variables, dt) + _track_header(track)
     guid = str(uuid.uuid5(uuid.NAMESPACE_URL, "railride-fmu:" + hashlib.sha1(header.encode()).hexdigest()))
     header = f'#define RR_GUID "{{{guid}}}"\n' + header
     xml = _model_description(variables, guid, record, damper, dt)
@@ -199,15 +216,43 @@ def export_fmu(
         (root / "modelDescription.xml").write_text(xml)
         (root / "sources" / "railride_fmu.c").write_text(source)
         (root / "sources" / "model.h").write_text(header)
+        if track is not None:
+            (root / "resources").mkdir()
+            (root / "resources" / "track.bin").write_bytes(_track_pieces(track))
         if compiler is not None:
             _build(compiler, root)
         staged = path.with_name(f".{path.name}.{os.getpid()}.part")
-        with zipfile.ZipFile(staged, "w", zipfile.ZIP_DEFLATED) as z:
-            for f in sorted(root.rglob("*")):
-                if f.is_file():
-                    z.write(f, f.relative_to(root).as_posix())
-        os.replace(staged, path)
+        try:
+            with zipfile.ZipFile(staged, "w", zipfile.ZIP_DEFLATED) as z:
+                for f in sorted(root.rglob("*")):
+                    if f.is_file():
+                        z.write(f, f.relative_to(root).as_posix())
+            os.replace(staged, path)
+        finally:
+            staged.unlink(missing_ok=True)
     return path
+
+
+def _track_words(track: RandomTrack) -> str:
+    band = f"{track.min_wavelength:g}-{track.max_wavelength:g} m"
+    return f"{track.name}, seed {track.seed}, {track.length:g} m, wavelengths {band}"
+
+
+def _track_header(track: RandomTrack | None) -> str:
+    """model.h's lines of the random track: whether there is one, and its input grid's spacing."""
+    if track is None:
+        return "#define RR_HAS_TRACK 0\n#define RR_TRACK_SPACING 1.0\n"
+    return f"#define RR_HAS_TRACK 1\n#define RR_TRACK_SPACING {float(track.table_spacing())!r}\n"
+
+
+def _track_pieces(track: RandomTrack) -> bytes:
+    """resources/track.bin: the pieces n and the spacing, then the n x 4 coefficients of the left
+    rail's cubic spline pieces (highest power first) and the right's, little-endian doubles."""
+    s, _, _ = track.samples()
+    left, right = (np.ascontiguousarray(spline.c.T) for spline in track._interp[0])  # its CubicSplines
+    n, ds = left.shape[0], float(s[1])  # the samples are k ds: s[1] is ds itself
+    data = np.concatenate([[float(n), ds], left.ravel(), right.ravel()]).astype("<f8")
+    return data.tobytes()
 
 
 def _compiler() -> str:

@@ -46,3 +46,13 @@ def test_an_out_that_is_no_fmu_or_cannot_be_written_is_refused(tmp_path):
     assert_input_error(run("fmu", "--out", tmp_path / "v.zip"), "--out", "ending in .fmu")
     (tmp_path / "file").write_text("")
     assert_input_error(run("fmu", "--out", tmp_path / "file" / "v.fmu"), "--out", "is a file")
+
+
+def test_a_random_track_goes_into_the_fmus_resources(tmp_path):
+    ok("fmu", "--out", tmp_path / "r.fmu", "--scenario", "fra5", "--track-seed", "2", "--speed", "30",
+       "--duration", "5", "--sources-only")  # fmt: skip
+    with zipfile.ZipFile(tmp_path / "r.fmu") as z:
+        xml = z.read("modelDescription.xml").decode()
+        assert "resources/track.bin" in z.namelist()
+    assert "the random track of the export (fra5, seed 2" in xml
+    assert_input_error(run("fmu", "--out", tmp_path / "b.fmu", "--scenario", "bump"), "--scenario = 'bump'")

@@ -218,3 +218,26 @@ def test_the_sources_alone_compile_cleanly(tmp_path):
     done = subprocess.run([*cmd, "-o", str(tmp_path / "x.so"), str(tmp_path / "u/sources/railride_fmu.c"), "-lm"],
                           capture_output=True, text=True)  # fmt: skip
     assert done.returncode == 0, done.stderr
+
+
+@pytest.mark.parametrize("damper", ["passive", "railway"])
+def test_a_random_track_the_fmu_carries_is_railrides(tmp_path, damper):
+    sc = scenario("fra4", seed=3, speed=45.0, duration=2.0)
+    path = str(export_fmu(tmp_path / "r.fmu", damper=damper, scenario=sc))  # scenario 2 by default, at 45 m/s
+    with zipfile.ZipFile(path) as z:
+        assert "resources/track.bin" in z.namelist()
+    names = [n for n in OUTPUTS if not n.startswith("secondary_damper_force") or damper != "railway"]
+    corners = [f"damper_command_{c}" for c in CORNER_NAMES]
+    v = 0.0 if damper == "passive" else 1.0
+    inputs = np.array([(0.0, *[v] * 4), (10.0, *[v] * 4)], dtype=[("time", float)] + [(c, float) for c in corners])
+    rows = fmpy.simulate_fmu(path, stop_time=sc.duration, step_size=1e-3, output_interval=1e-3, output=names,
+                             input=inputs if damper != "passive" else None)  # fmt: skip
+    suspension = None if damper == "passive" else Suspension.semi_active("railway", voltage=v)
+    ds = simulate(sc, suspension=suspension, solver=RK4).dataset
+    assert _worst(rows, ds, names) < 1e-6  # measured 1e-14: the same realisation on the same input grid
+
+
+def test_the_fmu_takes_no_track_it_cannot_carry(tmp_path):
+    with pytest.raises(InputError, match="scenario = 'bump': the FMU carries the paper's sine or a random track"):
+        export_fmu(tmp_path / "b.fmu", scenario="bump")
+    assert list(tmp_path.iterdir()) == []

@@ -74,6 +74,9 @@ typedef struct {
     double vc[4];                 /* the command voltages the inner loop last set */
     long node;                    /* the sine's input-grid node whose values are kept, -1: none */
     double node_w[2][8], node_wd[2][8]; /* the values and rates at nodes node and node + 1 */
+    double *track;                /* scenario 2: the random track's spline pieces (resources/track.bin) */
+    long track_pieces;            /* its pieces: the realisation's samples - 1 */
+    double track_ds;              /* its sample spacing [m] */
     char name[128];               /* the instance's name, copied (the host's string may go) */
     fmi2CallbackFunctions cb;
     int logging;
@@ -120,6 +123,27 @@ static void sine(const Instance *m, double t, double *w, double *wd) {
     }
 }
 
+/* The random track of the export (scenario 2) at the wheelsets at time t: heights and rates of
+   its cubic spline pieces (scipy's CubicSpline of the realisation, railride.model.track.RandomTrack),
+   level before s = 0, held (with no slope) past the realisation's end, as railride's input table. */
+static void random_track(const Instance *m, double t, double *w, double *wd) {
+    const double V = m->r[RR_VR_SPEED], end = m->track_pieces * m->track_ds;
+    int j, r;
+    for (j = 0; j < 4; j++) {
+        const double s0 = V * t - RR_LAG[j], s = s0 < end ? s0 : end;
+        long i = (long)floor(s / m->track_ds);
+        double dx;
+        if (i > m->track_pieces - 1) i = m->track_pieces - 1;
+        if (i < 0) i = 0;
+        dx = s - (double)i * m->track_ds;
+        for (r = 0; r < 2; r++) { /* left, right */
+            const double *c = m->track + 4 * (r * m->track_pieces + i);
+            w[2 * j + r] = s0 > 0.0 ? ((c[0] * dx + c[1]) * dx + c[2]) * dx + c[3] : 0.0;
+            wd[2 * j + r] = s0 > 0.0 && s0 <= end ? V * ((3.0 * c[0] * dx + 2.0 * c[1]) * dx + c[2]) : 0.0;
+        }
+    }
+}
+
 /* The rail heights w and rates w' at the wheelsets at time t (order 1L, 1R, ..., 4R).
    Scenario 0: the inputs, carried on from the communication step's start t0 with their rates
    (w' held). Scenario 1: the paper's sine as railride's engine sees it: its values and slopes at
@@ -138,8 +162,10 @@ static void rails(Instance *m, double t, double t0, double *w, double *wd) {
         return;
     }
     {
+        const int random = m->i[RR_VR_SCENARIO - RR_VR_INTEGER0] == 2;
         const double dt = m->r[RR_VR_DT];
-        const double ratio = m->r[RR_VR_WAVELENGTH] / RR_NODES_PER_FEATURE / (m->r[RR_VR_SPEED] * dt);
+        const double spacing = random ? RR_TRACK_SPACING : m->r[RR_VR_WAVELENGTH] / RR_NODES_PER_FEATURE;
+        const double ratio = spacing / (m->r[RR_VR_SPEED] * dt);
         const double interval = (ratio >= 1.0 ? ldexp(1.0, (int)floor(log2(fmin(ratio, 4503599627370496.0)))) : 1.0) * dt;
         const double u = t / interval;
         const long k = (long)u;
@@ -158,10 +184,15 @@ static void rails(Instance *m, double t, double t0, double *w, double *wd) {
             if (k == m->node + 1) {
                 memcpy(m->node_w[0], m->node_w[1], sizeof m->node_w[0]);
                 memcpy(m->node_wd[0], m->node_wd[1], sizeof m->node_wd[0]);
+            } else if (random) {
+                random_track(m, (double)k * interval, m->node_w[0], m->node_wd[0]);
             } else {
                 sine(m, (double)k * interval, m->node_w[0], m->node_wd[0]);
             }
-            sine(m, (double)(k + 1) * interval, m->node_w[1], m->node_wd[1]);
+            if (random)
+                random_track(m, (double)(k + 1) * interval, m->node_w[1], m->node_wd[1]);
+            else
+                sine(m, (double)(k + 1) * interval, m->node_w[1], m->node_wd[1]);
             m->node = k;
         }
         wa = m->node_w[0];
@@ -390,9 +421,14 @@ static int parameters_ok(Instance *m) {
             say(m, fmi2Error, "logStatusError", "%s = %g: must be a finite number", RR_NAMES[i], m->r[i]);
             return 0;
         }
-    if (m->i[RR_VR_SCENARIO - RR_VR_INTEGER0] != 0 && m->i[RR_VR_SCENARIO - RR_VR_INTEGER0] != 1) {
-        say(m, fmi2Error, "logStatusError", "scenario = %d: allowed 0 (the rail inputs) or 1 (the paper's sine)",
-            m->i[RR_VR_SCENARIO - RR_VR_INTEGER0]);
+    if (m->i[RR_VR_SCENARIO - RR_VR_INTEGER0] < 0 || m->i[RR_VR_SCENARIO - RR_VR_INTEGER0] > 2 ||
+        (m->i[RR_VR_SCENARIO - RR_VR_INTEGER0] == 2 && m->track == NULL)) {
+        say(m, fmi2Error, "logStatusError", "scenario = %d: allowed 0 (the rail inputs), 1 (the paper's sine)%s",
+            m->i[RR_VR_SCENARIO - RR_VR_INTEGER0], RR_HAS_TRACK ? " or 2 (the random track of the export)" : "");
+        return 0;
+    }
+    if (m->i[RR_VR_SCENARIO - RR_VR_INTEGER0] == 2 && !(m->r[RR_VR_SPEED] > 0.0)) {
+        say(m, fmi2Error, "logStatusError", "the random track needs speed > 0 m/s");
         return 0;
     }
     if (inner_loop(m) < 0 || inner_loop(m) > 3) {
@@ -433,11 +469,60 @@ static void defaults(Instance *m) {
     m->mode = MODE_INSTANTIATED;
 }
 
+/* The random track's pieces from resources/track.bin (scenario 2), where the export has one:
+   little-endian doubles, the number of pieces n and the spacing, then the left rail's n x 4
+   coefficients and the right rail's. Returns whether they were read (or none were needed). */
+static int load_track(Instance *m, fmi2String location) {
+    char path[4096];
+    const char *p = location;
+    size_t k = 0;
+    FILE *f;
+    double head[2];
+    long n;
+    if (!RR_HAS_TRACK) return 1;
+    if (p == NULL) return 0;
+    if (strncmp(p, "file://", 7) == 0) p += 7; /* file:///dir, or file://host/dir: the path from / */
+    else if (strncmp(p, "file:", 5) == 0) p += 5;
+    if (*p != '/' && strchr(p, '/') != NULL) p = strchr(p, '/');
+    while (*p && k + 16 < sizeof path) { /* %XX escapes, as a URI writes spaces */
+        if (p[0] == '%' && p[1] && p[2]) {
+            char hex[3];
+            hex[0] = p[1];
+            hex[1] = p[2];
+            hex[2] = 0;
+            path[k++] = (char)strtol(hex, NULL, 16);
+            p += 3;
+        } else {
+            path[k++] = *p++;
+        }
+    }
+    if (k > 0 && path[k - 1] == '/') k--;
+    path[k] = 0;
+    strcat(path, "/track.bin");
+    f = fopen(path, "rb");
+    if (f == NULL) return 0;
+    if (fread(head, sizeof(double), 2, f) != 2 || !(head[0] >= 1.0) || !(head[1] > 0.0)) {
+        fclose(f);
+        return 0;
+    }
+    n = (long)head[0];
+    m->track = (double *)malloc(sizeof(double) * 8 * (size_t)n);
+    if (m->track == NULL || fread(m->track, sizeof(double), 8 * (size_t)n, f) != 8 * (size_t)n) {
+        free(m->track);
+        m->track = NULL;
+        fclose(f);
+        return 0;
+    }
+    fclose(f);
+    m->track_pieces = n;
+    m->track_ds = head[1];
+    return 1;
+}
+
 RR_EXPORT fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2String guid, fmi2String location,
                                         const fmi2CallbackFunctions *functions, fmi2Boolean visible,
                                         fmi2Boolean logging) {
     Instance *m;
-    (void)location;
     (void)visible;
     if (functions == NULL) return NULL;
     if (type != fmi2CoSimulation || guid == NULL || strcmp(guid, RR_GUID) != 0) {
@@ -454,10 +539,21 @@ RR_EXPORT fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2Stri
     snprintf(m->name, sizeof m->name, "%s", name != NULL ? name : "");
     m->logging = logging;
     defaults(m);
+    if (!load_track(m, location)) {
+        if (functions->logger != NULL)
+            functions->logger(functions->componentEnvironment, name, fmi2Error, "logStatusError",
+                              "the random track (resources/track.bin) could not be read from %s",
+                              location != NULL ? location : "(no resource location)");
+        free(m);
+        return NULL;
+    }
     return m;
 }
 
-RR_EXPORT void fmi2FreeInstance(fmi2Component c) { free(c); }
+RR_EXPORT void fmi2FreeInstance(fmi2Component c) {
+    if (c != NULL) free(((Instance *)c)->track);
+    free(c);
+}
 
 RR_EXPORT fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean tolerance_defined, fmi2Real tolerance,
                                          fmi2Real start_time, fmi2Boolean stop_defined, fmi2Real stop_time) {
