@@ -107,6 +107,19 @@ def integer(name: str, value, minimum: int, maximum: int | None = None, what: st
     return int(value)
 
 
+#: the largest count (of cycles, values, steps) taken: 2**53, the whole numbers a float holds
+#: exactly, as counts are multiplied by floats (a 400-digit count overflows them)
+COUNT_MAX = 2**53
+
+
+def count(name: str, value, minimum: int, what: str = "") -> int:
+    """``value`` as an int if it is a whole number from ``minimum`` to `COUNT_MAX`."""
+    n = integer(name, value, minimum, what=what)
+    if n > COUNT_MAX:
+        raise InputError(f"{name} = {shown(n)}: at most 2**53 = {COUNT_MAX} (the counts a float holds exactly)")
+    return n
+
+
 def seed(name: str, value) -> int:
     """``value`` as a Python int if it is a seed: a whole number in [0, `SEED_MAX`], Python or
     NumPy; a whole float (3.0) too, as studies once stored seeds. Never passed through a float,

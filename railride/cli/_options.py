@@ -494,7 +494,7 @@ DpiOption = Annotated[
     typer.Option(
         "--dpi",
         metavar="N",
-        help="With --out: the resolution of PNG figures [dots per inch], a number > 0 and <= 1200 "
+        help="With --out: the resolution of PNG figures [dots per inch], a number >= 10 and <= 1200 "
         "(default 120; 300 or 600 for print). PDF and SVG are vector.",
     ),
 ]

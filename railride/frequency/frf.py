@@ -29,6 +29,7 @@ from railride.output.files import FRF_FILES
 from railride.defaults import DEFAULT_SPEED
 from railride.model.modes import Modes as Modes, checked_modes, modes as modes  # the modes as frf's, too
 from railride.model.params import VehicleParams, resolve_argument, vehicle_record
+from railride.model.track import frequency_speed
 from railride.plots import PNG_DPI, FigureOptions
 
 SCHEMA = "railride.frf/1"
@@ -180,7 +181,7 @@ def frequency_responses(
     grid). Returns an `FrfResult` with the vehicle's modes."""
     from railride.model.vehicle import Vehicle
 
-    speed = DEFAULT_SPEED if speed is None else validation.number("speed", speed, "positive", "m/s")
+    speed = DEFAULT_SPEED if speed is None else frequency_speed(speed)
     validation.choice("rails", rails, RAILS)
     fmin = validation.number("fmin", fmin, "positive", "Hz")
     fmax = validation.number("fmax", fmax, "positive", "Hz")

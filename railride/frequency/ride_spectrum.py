@@ -32,9 +32,10 @@ from railride.errors import InputError
 from railride import limits, validation
 from railride.defaults import DEFAULT_SPEED
 from railride.analysis.comfort import FLOOR
+from railride.frequency.frf import FMAX_LIMIT
 from railride.frequency.linear import LinearModel, linear_model, linear_suspensions
 from railride.model.params import VehicleParams, resolve_vehicle
-from railride.model.track import SPECTRA, spectrum
+from railride.model.track import SPECTRA, frequency_speed, spectrum
 from railride.model.vehicle import CORNER_NAMES, Vehicle
 
 SCHEMA = "railride.ride-spectrum/1"
@@ -227,11 +228,17 @@ def ride_spectrum(
     (`GainSet.mismatch`) when the gains of the outer loops run by name were tuned for another
     vehicle, load or track (`gains_mismatch`)."""
     validation.choice("track", track, SPECTRA)
-    speed = DEFAULT_SPEED if speed is None else validation.number("speed", speed, "positive", "m/s")
+    speed = DEFAULT_SPEED if speed is None else frequency_speed(speed)
     lo = validation.number("min_wavelength", min_wavelength, "positive", "m")
     hi = validation.number("max_wavelength", max_wavelength, "positive", "m")
     if not hi > lo:
         raise InputError(f"max_wavelength = {hi:g} m: must be above min_wavelength = {lo:g} m")
+    if speed / lo > FMAX_LIMIT:  # before a grid to inf Hz (1e-308 m) is made
+        raise InputError(
+            f"min_wavelength = {lo:g} m: at {speed:.4g} m/s it passes at {speed / lo:.4g} Hz, above the "
+            f"{FMAX_LIMIT:g} Hz of any frequency response (the vehicle's modes are below 100 Hz); the "
+            f"shortest allowed is {speed / FMAX_LIMIT:.4g} m"
+        )
     points = validation.integer("points", points, 16, 200_000)
     if control_rate is not None:
         control_rate = validation.number("control_rate", control_rate, "positive", "Hz")

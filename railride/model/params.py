@@ -8,6 +8,7 @@ field carries its SI unit and the rule it must satisfy in its metadata;
 from __future__ import annotations
 
 import dataclasses
+import warnings
 import os
 import tomllib
 from dataclasses import MISSING, dataclass
@@ -217,7 +218,10 @@ class VehicleParams:
         changes = {n: factor * getattr(self, n) for n in carbody}
         if self.f_bend is not None:  # the same EI: the bending frequency falls as 1/sqrt(mass)
             changes["f_bend"] = self.f_bend / factor**0.5
-        return self.replace(**changes)
+        try:
+            return self.replace(**changes)
+        except InputError as exc:  # the factor is the user's input: name it, then the field it broke
+            raise InputError(f"load = {factor:g}: the loaded carbody is no vehicle: {exc}") from None
 
     def load_changes(self, load: float, stiffness: float = 1.0) -> tuple:
         """The (field, value) changes of a payload (`loaded`) and of a secondary stiffness
@@ -233,6 +237,12 @@ class VehicleParams:
             changes += tuple((n, getattr(loaded, n)) for n in carbody)
         k = number("stiffness", stiffness, "positive", allowed="a finite number > 0 (the factor on k_sz)")
         if k != 1.0:
+            try:  # the factor is the user's input: name it, then the field it broke
+                with warnings.catch_warnings():  # the run's own vehicle warns, once
+                    warnings.simplefilter("ignore")
+                    self.replace(k_sz=k * self.k_sz)
+            except InputError as exc:
+                raise InputError(f"stiffness = {k:g}: the secondary spring is no spring: {exc}") from None
             changes += (("k_sz", k * self.k_sz),)
         return changes
 

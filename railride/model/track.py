@@ -44,6 +44,9 @@ MAX_RAIL_AMPLITUDE = 1.0  # m, sine amplitude and bump height
 MAX_SPEED = 200.0  # m/s
 MAX_RAIL_PHASE = 360.0  # deg, either way
 MAX_WAVELENGTH = 1.0e5  # m, a sine's wavelength and a bump's length
+#: the longest random track a run may cover [m]: the Trans-Siberian line is 9.3e6 m; ten times it
+#: leaves any real journey inside (its realisation's size is limited by memory besides)
+MAX_RANDOM_LENGTH = 1.0e8
 
 
 def _check(name: str, value, rule: str, allowed: str) -> float:
@@ -325,6 +328,24 @@ def _check_speed(value) -> float:
     return speed
 
 
+#: the slowest speed of the frequency-domain results [m/s]: the wheelsets behind the leading one
+#: see the rail input their distance / speed later, half an hour at this speed; far slower the
+#: delays and the spectra's wavenumbers overflow (1e-308 m/s gave NaN)
+MIN_FREQUENCY_SPEED = 0.01
+
+
+def frequency_speed(value) -> float:
+    """A speed [m/s] for `railride.frequency`: within the plausible range of a run, and at least
+    `MIN_FREQUENCY_SPEED`; ValueError naming ``speed`` otherwise."""
+    speed = _check_speed(value)
+    if speed < MIN_FREQUENCY_SPEED:
+        raise InputError(
+            f"speed = {speed:.4g} m/s: at least {MIN_FREQUENCY_SPEED:g} m/s (slower, the rail input "
+            "reaches the rear wheelsets over half an hour after the front)"
+        )
+    return speed
+
+
 @dataclass(frozen=True)
 class Scenario:
     """A run: a rail profile passed at constant speed for a duration."""
@@ -424,6 +445,11 @@ def scenario(
             )
         V = _check_speed(common["speed"])  # before the track, whose length it sets
         T = _check("duration", common["duration"], "positive", "a finite number > 0 (s)")
+        if not V * T <= MAX_RANDOM_LENGTH:  # before a length of inf m is made a track
+            raise InputError(
+                f"duration = {T:g} s: at {V:g} m/s the run covers {V * T:.4g} m of random track, more than "
+                f"the {MAX_RANDOM_LENGTH:g} m allowed (ten times the longest railway line); shorten the run"
+            )
         # long enough that the realisation does not repeat within the run
         track = _random_track(
             name,

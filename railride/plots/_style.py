@@ -26,6 +26,9 @@ from railride.validation import number, shown
 PNG_DPI = 120
 #: the highest resolution accepted: 1200 dpi is what print asks of line art
 MAX_DPI = 1200
+#: the lowest: a figure a few dozen pixels wide, whose text no one can read (below 1 dpi matplotlib
+#: draws an image of no pixels at all and cannot write it)
+MIN_DPI = 10
 #: the file formats a figure can be written in
 FIGURE_FORMATS = ("png", "pdf", "svg")
 #: figure widths [in]: one column of a two-column journal page (88-90 mm) and the full text
@@ -218,7 +221,7 @@ def window_note(window) -> str:
 class FigureOptions:
     """How figures are written: ``figure_formats`` (one or more of `FIGURE_FORMATS`, a sequence
     or one comma-separated text; order kept, repeats dropped) and ``dpi``, the resolution of PNG
-    files (a finite number > 0 and <= `MAX_DPI`; PDF and SVG are vector, drawn at any size)."""
+    files (a finite number >= `MIN_DPI` and <= `MAX_DPI`; PDF and SVG are vector, drawn at any size)."""
 
     figure_formats: Any = ("png",)
     dpi: float = PNG_DPI
@@ -237,9 +240,9 @@ class FigureOptions:
                 f"figure_formats = {shown(given)}: {what}; allowed one or more of {', '.join(FIGURE_FORMATS)}"
             )
         object.__setattr__(self, "figure_formats", tuple(dict.fromkeys(names)))
-        allowed = f"a finite number > 0 and <= {MAX_DPI} (dots per inch)"
+        allowed = f"a finite number >= {MIN_DPI} and <= {MAX_DPI} (dots per inch)"
         dpi = number("dpi", self.dpi, "positive", allowed=allowed)
-        if dpi > MAX_DPI:
+        if not MIN_DPI <= dpi <= MAX_DPI:
             raise InputError(f"dpi = {shown(self.dpi)}: must be {allowed}")
         object.__setattr__(self, "dpi", dpi)
 

@@ -106,12 +106,25 @@ def _check_number(name, value, rule, unit):
 #: and a demanded force [N] far beyond its capacity (about 20 kN), below where squares overflow
 MAX_STROKE_M = 10.0
 MAX_DEMAND_N = 1e9
+#: the smallest demanded force [N]: far below a damper's friction (tens of N), and above where
+#: the squares of the tracking metrics underflow (their ratio would be NaN)
+MIN_DEMAND_N = 1.0
 
 
 def _at_most(name: str, value: float, limit: float, unit: str, why: str) -> float:
     if value > limit:
         raise InputError(f"{name} = {value:g} {unit}: at most {limit:g} {unit} ({why})")
     return value
+
+
+def _check_cycle_steps(frequency: float, n_cycles: int, dt: float) -> None:
+    """`railride.limits.check_steps` on n_cycles periods of dt steps, before any count of them
+    is made an int (a period of 1e308 s has more steps than any int of a float can hold)."""
+    limits.check_steps(
+        f"frequency = {frequency:g} Hz",
+        n_cycles / frequency / dt,
+        "raise the frequency, drive fewer cycles or raise dt",
+    )
 
 
 def _motion_table(motion, duration: float, dt: float):
@@ -366,8 +379,9 @@ def cycles(
     amplitude = _check_number("amplitude", amplitude, "positive", "m")
     _at_most("amplitude", amplitude, MAX_STROKE_M, "m", "a damper's stroke is tens of mm")
     motion = SineMotion(amplitude, frequency)
-    n_cycles = validation.integer("n_cycles", n_cycles, 2, what=START_UP)
+    n_cycles = validation.count("n_cycles", n_cycles, 2, START_UP)
     dt = _check_number("dt", dt, "positive", "s")
+    _check_cycle_steps(motion.frequency, n_cycles, dt)
     if np.ndim(voltages) == 0:
         voltages = [voltages]
     if len(set(float(v) for v in voltages)) != len(voltages):
@@ -531,11 +545,17 @@ def track(
     damper = _resolve(damper)
     amplitude = _check_number("amplitude", amplitude, "positive", "N")
     _at_most("amplitude", amplitude, MAX_DEMAND_N, "N", "an MR damper gives tens of kN")
+    if amplitude < MIN_DEMAND_N:
+        raise InputError(
+            f"amplitude = {amplitude:g} N: at least {MIN_DEMAND_N:g} N (a damper's friction alone is tens of N)"
+        )
     fd = desired_force_signal(desired, amplitude, frequency)
     frequency = float(frequency)
     stroke = _check_number("stroke", stroke, "positive", "m")
-    n_cycles = validation.integer("n_cycles", n_cycles, 2, what=START_UP)
+    _at_most("stroke", stroke, MAX_STROKE_M, "m", "a damper's stroke is tens of mm")
+    n_cycles = validation.count("n_cycles", n_cycles, 2, START_UP)
     dt = _check_number("dt", dt, "positive", "s")
+    _check_cycle_steps(frequency, n_cycles, dt)
     motion = SineMotion(stroke, frequency, phase_deg=-90.0)
     period = 1.0 / frequency
     if period < 100 * dt:

@@ -62,7 +62,7 @@ def test_compare_writes_every_figure_in_every_format(tmp_path):
 @pytest.mark.parametrize(
     "args, fragments",
     [
-        (("--dpi", 0), ("--dpi = 0", "> 0 and <= 1200")),
+        (("--dpi", 0), ("--dpi = 0", ">= 10 and <= 1200")),
         (("--dpi", -5), ("--dpi = -5",)),
         (("--dpi", "abc"), ("--dpi = 'abc'",)),
         (("--dpi", 5000), ("--dpi = 5000", "<= 1200")),

@@ -206,7 +206,7 @@ def test_png_size_follows_dpi(result, tmp_path):
     [
         ({"figure_formats": ("tiff",)}, "figure_formats = ('tiff',): 'tiff' is not a figure format"),
         ({"figure_formats": ()}, "figure_formats = (): no format given"),
-        ({"dpi": 0}, "dpi = 0: must be a finite number > 0 and <= 1200"),
+        ({"dpi": 0}, "dpi = 0: must be a finite number >= 10 and <= 1200"),
         ({"dpi": 1201}, "dpi = 1201: must be"),
         ({"dpi": float("nan")}, "dpi = nan: must be"),
         ({"dpi": "300"}, "dpi = '300': must be"),
