@@ -314,6 +314,11 @@ PROFILE_FIELDS = {
 }
 
 
+#: a run's fields in the library's errors -> the options (compare, simulate): the solver's and
+#: the profile's, which the run's own checks name too (``duration = 1e-308 s must be ...``)
+RUN_FIELDS = {**SOLVER_FIELDS, **PROFILE_FIELDS}
+
+
 def random_tracks() -> tuple:
     from railride.model.track import SPECTRA
 

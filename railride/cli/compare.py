@@ -48,7 +48,7 @@ from railride.cli._options import (
     history_options,
 )
 from railride.cli._parsing import (
-    SOLVER_FIELDS,
+    RUN_FIELDS,
     damper_preset,
     load_gains,
     make_scenario,
@@ -108,7 +108,7 @@ CompareLoadOption = Annotated[
 ]
 #: the library's names of compare's options, for its errors
 COMPARE_FIELDS = {
-    **SOLVER_FIELDS,
+    **RUN_FIELDS,
     "damper": "--damper",
     "damper_scale": "--damper-scale",
     "delay": "--delay",

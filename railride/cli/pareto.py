@@ -53,6 +53,7 @@ from railride.cli._options import (
     figure_options,
 )
 from railride.cli._parsing import (
+    PROFILE_FIELDS,
     SOLVER_FIELDS,
     TRACK_FIELDS,
     damper_preset,
@@ -74,6 +75,9 @@ PARETO_FIELDS = {
     "suspension": "--suspension",
     "n_samples": "--samples",
     "seed": "--seed",
+    **PROFILE_FIELDS,
+    "load": "--load",
+    "output_rate": "output rate",
 }
 
 

@@ -54,6 +54,7 @@ from railride.cli._options import (
     history_options,
 )
 from railride.cli._parsing import (
+    PROFILE_FIELDS,
     SOLVER_FIELDS,
     damper_preset,
     make_scenario,
@@ -78,6 +79,7 @@ SIMULATE_FIELDS = {
     "damper_scale": "--damper-scale",
     "voltage": "--voltage",
     "window": "--window",
+    **PROFILE_FIELDS,
 }
 
 

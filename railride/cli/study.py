@@ -60,7 +60,9 @@ from railride.cli._render import check_report_option, save_report, warn_gains_mi
 STUDY_FIELDS = {
     "track_seeds": "--track-seed",
     "speeds": "--speed",
+    "speed": "--speed",
     "loads": "--load",
+    "load": "--load",
     "stiffness": "--stiffness",
     "fault": "--fault",
     "faults": "--fault",

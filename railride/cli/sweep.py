@@ -86,6 +86,7 @@ OPTION_NAMES = {
     "window": "--window",
     "damper": "--damper",
     "damper_scale": "--damper-scale",
+    "duration": "--duration",
 }
 
 #: (column, heading) of the comfort indices the sweep table shows with --comfort
@@ -331,13 +332,15 @@ def _parse(
 
     with option_names(FIXED_RATE_FIELDS):
         solver = None if dt is None and backend is None else solver_from_options(dt=dt, backend=backend)
+    with option_names({"window": "--window"}):
+        window_value = None if window is None else parse_window(window)
     values = {
         "suspensions": _names("--suspension", suspension),
         "damper": damper,
         "noise": None if noise is None else tuple(parse_noise("--noise", noise)),
         "base_gains": None if gains is None else load_gains(gains),
         "solver": solver,
-        "window": None if window is None else parse_window(window),
+        "window": window_value,
     }
     for option, key, text in (
         ("--speed", "speed", speed),

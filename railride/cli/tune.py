@@ -65,6 +65,7 @@ from railride.cli._options import (
     figure_options,
 )
 from railride.cli._parsing import (
+    PROFILE_FIELDS,
     SOLVER_FIELDS,
     TRACK_FIELDS,
     damper_preset,
@@ -93,6 +94,9 @@ TUNE_FIELDS = {
     "budget": "--budget",
     "span": "--span",
     "aggregate": "--aggregate",
+    **PROFILE_FIELDS,
+    "load": "--load",
+    "output_rate": "output rate",
 }
 
 
@@ -152,7 +156,9 @@ def _objective(
     try:
         return Objective(name, w, b, p, **limits)
     except ValueError as exc:  # what the checks above cannot see, e.g. a bound too large
-        text = str(exc).replace("objective peak_bound", "--max-peak").replace("objective travel_bound", "--max-travel")
+        text = str(exc)
+        for field, option in (("peak_bound", "--max-peak"), ("travel_bound", "--max-travel"), ("bound", "--bound")):
+            text = text.replace(f"objective {field}", option)
         raise InputError(text if text != str(exc) else f"--objective {name}: {exc}") from None
 
 
@@ -176,6 +182,12 @@ def _weights(weights: str) -> tuple:
     if sum(values) == 0:
         raise InputError(f"--weights = {weights!r}: at least one weight must be > 0")
     return tuple(values)
+
+
+def _score(value) -> str:
+    """An objective as the tables show it: the document holds null for J = inf (every candidate
+    diverged or broke a hard bound)."""
+    return "inf" if value is None else f"{value:.4f}"
 
 
 def _tunable_list(text: str) -> list[str]:
@@ -248,8 +260,8 @@ def _tune_tables(doc: dict, start, tuned, scenario_text: str):
         "gains": ("right", lambda st: str(len(st["entries"]))),
         "runs": ("right", lambda st: f"{st['runs']}" + ("" if st["budget"] is None else f" / {st['budget']}")),
         "passes": ("right", lambda st: str(st["passes"])),
-        "objective\nstart": ("right", lambda st: f"{st['objective_start']:.4f}"),
-        "objective\ntuned": ("right", lambda st: f"{st['objective']:.4f}"),
+        "objective\nstart": ("right", lambda st: _score(st["objective_start"])),
+        "objective\ntuned": ("right", lambda st: _score(st["objective"])),
         "stopped": ("left", lambda st: stopped.get(st["stopped"], st["stopped"])),
     }
 
@@ -277,12 +289,12 @@ def _tune_tables(doc: dict, start, tuned, scenario_text: str):
         passes.add_column("within\nbound")
     previous: dict[str, float] = {}
     for h in doc["history"]:
-        before = previous.get(h["controller"])
-        change = "" if before is None else f"{(h['objective'] - before) / abs(before) * 100:+.2f}"
-        cells = [h["controller"], str(h["pass"]), f"{h['span']:.3g}", str(h["runs"]), f"{h['objective']:.4f}", change]
+        before, now = previous.get(h["controller"]), h["objective"]
+        change = "" if before is None or now is None else f"{(now - before) / abs(before) * 100:+.2f}"
+        cells = [h["controller"], str(h["pass"]), f"{h['span']:.3g}", str(h["runs"]), _score(now), change]
         if infeasible:
             inner = h["controller"] == "inner"
-            cells.append("" if inner else "yes" if h["objective"] < infeasible["offset"] else "no")
+            cells.append("" if inner else "yes" if now is not None and now < infeasible["offset"] else "no")
         passes.add_row(*cells)
         previous[h["controller"]] = h["objective"]
     parts += [

@@ -369,6 +369,9 @@ def check(
             "every sample of a batch must have the same duration; got "
             + ", ".join(sorted({f"{s.duration:g} s" for s in scenarios}))
         )
+    # the count of output samples first: the checks below make ints of the run's length
+    # (1e308 s is no int)
+    n_out = output_samples(duration, output_rate)
     conflict = batch_conflict(suspensions)
     if conflict is not None:
         raise InputError(conflict)
@@ -385,15 +388,6 @@ def check(
             _check_bending(p, solver)
             if not exact:  # the exact steps are stable at any dt
                 _check_dt(vehicles[id(p)], dt, damper)
-    n_out_f = duration * output_rate
-    if not n_out_f <= limits.MAX_STEPS:  # inf or beyond any run: no int of it
-        raise InputError(
-            f"duration = {duration:g} s at output rate {output_rate:g} Hz is {n_out_f:.3g} output samples, more "
-            f"than a run can count (at most {limits.MAX_STEPS:.4g}); shorten the run"
-        )
-    n_out = int(round(n_out_f))
-    if abs(n_out - n_out_f) > 1e-6 * max(1.0, n_out_f) or n_out < 1:
-        raise InputError(f"duration = {duration:g} s must be a whole number of output intervals (1/{output_rate:g} Hz)")
     for sc in scenarios:  # the track's shortest wavelength must show in the output
         check_resolution(sc, output_rate)
     tables = None
@@ -423,6 +417,21 @@ def check(
         batch, scenarios, param_sets, suspensions, solver, duration, damper, closed, exact, vehicles, n_out, vcmd,
         gm, hm, modes, sensing, x0, faults, on_divergence,
     )  # fmt: skip
+
+
+def output_samples(duration: float, output_rate: float) -> int:
+    """The output samples of a run of ``duration`` [s] stored at ``output_rate`` [Hz]: a whole
+    number from 1 to `railride.limits.MAX_STEPS`, else InputError naming ``duration``."""
+    n_out_f = duration * output_rate
+    if not n_out_f <= limits.MAX_STEPS:  # inf or beyond any run: no int of it
+        raise InputError(
+            f"duration = {duration:g} s at output rate {output_rate:g} Hz is {n_out_f:.3g} output samples, more "
+            f"than a run can count (at most {limits.MAX_STEPS:.4g}); shorten the run"
+        )
+    n_out = int(round(n_out_f))
+    if abs(n_out - n_out_f) > 1e-6 * max(1.0, n_out_f) or n_out < 1:
+        raise InputError(f"duration = {duration:g} s must be a whole number of output intervals (1/{output_rate:g} Hz)")
+    return n_out
 
 
 def _outer_loops(closed, param_sets, vehicles, n: int):

@@ -66,6 +66,24 @@ def check_controllers(names) -> list[str]:
     return [n for n in CONTROLLERS if n in names or n == "passive"]
 
 
+def _still(scenario: dict) -> str:
+    """Why the reductions against passive are undefined: its carbody did not move (a flat or
+    vanishing rail, a vehicle standing all but still), naming the scenario's settings."""
+    given = [
+        f"{name} = {scenario[key]:g} {unit}"
+        for name, key, unit in (
+            ("amplitude", "amplitude_m", "m"),
+            ("height", "height_m", "m"),
+            ("speed", "speed_m_s", "m/s"),
+        )
+        if key in scenario
+    ]
+    return (
+        f"the passive run's carbody did not move ({', '.join(given) or scenario.get('name', 'this scenario')}): an RMS "
+        "response of 0, against which no reduction in % is defined; give a rail input and a speed that move the vehicle"
+    )
+
+
 @dataclass(frozen=True, eq=False)
 class Comparison:
     """Results of `compare`: ``datasets[name]`` per suspension, ``metrics`` (controller,
@@ -93,8 +111,14 @@ class Comparison:
     @property
     def reductions(self) -> xr.DataArray:
         """RMS reduction in % against passive, (passive - controlled) / passive x 100."""
-        base = self.metrics.sel(controller="passive")
-        return reduction(self.metrics, base)
+        return self._reduction(self.metrics.sel(controller="passive"))
+
+    def _reduction(self, base) -> xr.DataArray:
+        """`reduction` against ``base``, or an error that says why passive did not move."""
+        try:
+            return reduction(self.metrics, base)
+        except InputError:
+            raise InputError(_still(self.settings.get("scenario") or {})) from None
 
     def demands(self) -> dict:
         """Per suspension, over the metrics window: RMS and peak damper force on the carbody [N],
@@ -291,7 +315,7 @@ class Comparison:
 
         keys = ["controller", "response", "statistic"]
         values = self.metrics.to_dataframe(name="value").reset_index()[keys + ["value"]]
-        red = reduction(self.metrics, self.metrics.sel(controller="passive", drop=True))
+        red = self._reduction(self.metrics.sel(controller="passive", drop=True))
         red = red.to_dataframe(name="reduction_percent").reset_index()[keys + ["reduction_percent"]]
         frame = pd.merge(values, red, on=keys, how="left")
         frame.loc[frame["controller"] == "passive", "reduction_percent"] = float("nan")

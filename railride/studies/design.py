@@ -224,7 +224,7 @@ def check_design(
     sections = {t: _sections(t, max(speed_list) * duration, train + test) for t in track_list if t.startswith("file:")}
     obj = _objective(objective)
     validation.choice("aggregate", aggregate, AGGREGATES)
-    values = validation.integer("values", values, 3, what="values per gain and sweep")
+    values = validation.count("values", values, 3, what="values per gain and sweep")
     need = {law: min_budget(law, values) for law in laws}
     worst = max(need, key=lambda law: need[law])
     what = (

@@ -292,7 +292,13 @@ def grid(
                 f"({words.name('damper')} {damper_name}) applies the demand itself and has no "
                 "force capacity to scale"
             )
-        scales = _numbers(words, "damper_scale", damper_scale, "positive")
+        from railride.secondary.dampers import check_scale
+
+        # each factor within the plausible range here, before any run, named as the user named it
+        scales = [
+            check_scale(words.name("damper_scale"), x)
+            for x in _numbers(words, "damper_scale", damper_scale, "positive")
+        ]
     band = _band(words, scenario, min_wavelength, max_wavelength)
     axes = _scenario_axes(
         words,
@@ -316,7 +322,7 @@ def grid(
     seeds = [0] if seed is None else _seeds(words, "seed", seed, "seeds")
     base_gains = GainSet.of(base_gains, scenario)
     solver = SolverSettings.of(solver)
-    common = {} if duration is None else {"duration": float(duration)}
+    common = {} if duration is None else {"duration": _duration(words, duration, solver.output_rate)}
     common.update(band)
     combos, record, run_duration = _scenarios(
         words, scenario, axes, common, min_wavelength is not None, solver.output_rate
@@ -516,6 +522,20 @@ def _scenarios(words: _Words, scenario: str, axes: list, common: dict, min_given
             record = scen.describe()
         duration = scen.duration
     return combos, record, duration
+
+
+def _duration(words: _Words, duration, output_rate: float) -> float:
+    """The runs' duration, checked once for the whole grid (a scenario's check would name the
+    first grid point as if that point were wrong), in the caller's words."""
+    from railride.run.checks import output_samples
+
+    name = words.name("duration")
+    try:
+        value = validation.number("duration", duration, "positive", "s")
+        output_samples(value, output_rate)
+    except ValueError as exc:
+        raise InputError(name + str(exc)[len("duration") :]) from None
+    return value
 
 
 def _key(keyword: str) -> str:

@@ -250,7 +250,7 @@ def tune(
     damper_scale = dampers.check_scale("damper_scale", damper_scale)
     validation.choice("optimiser", optimiser, evolution.OPTIMISERS)
     optimiser_seed = validation.seed("optimiser_seed", optimiser_seed)
-    validation.integer("n_values", n_values, 3)
+    validation.count("n_values", n_values, 3)
     # room for the start and one whole sweep (the values and 0): a smaller budget tunes nothing
     what = f"the start run and one sweep of {n_values} values and 0"
     if optimiser == "evolution":  # the sweeps' values do not apply
@@ -449,7 +449,9 @@ def _study(name, start, budget, n_values, start_span, tol, min_span, log):
                     log(f"{name} pass {study.passes}: objective {best:.4g} ({study.runs} runs)")
             else:
                 study.passes -= 1
-            if not stopped and before - best < tol * abs(before):
+            # "not >=": a pass from inf to inf (every run diverged) improves nothing either,
+            # where inf - inf < tol * inf is False and the span would never shrink
+            if not stopped and not before - best >= tol * abs(before):
                 span = math.sqrt(span)
                 if span < min_span:
                     stopped = "converged"
