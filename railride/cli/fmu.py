@@ -90,4 +90,4 @@ def fmu(
                 scenario=sc,
                 binary=not sources_only,
             )
-    stdout_console().print(f"wrote {path}")
+    stdout_console().print(f"wrote {path}", soft_wrap=True, markup=False, highlight=False)

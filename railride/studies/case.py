@@ -7,7 +7,6 @@ from __future__ import annotations
 import hashlib
 import json
 import numbers
-import functools
 from dataclasses import asdict, dataclass
 
 from railride.errors import InputError
@@ -109,12 +108,20 @@ class Case:
         base = GainSet.of(base_gains, self.scenario)
         return self._named(base.apply(self.gains))
 
-    @functools.cached_property
+    @property
     def key(self) -> str:
         """A stable identity for the run table (same settings and model, same key, in any
         session). The model revision is part of it, so a run table from an earlier model is
-        not taken for this one's on resume. Made once a case (a study asks for it several times
-        a run); the fields it is made from are frozen."""
+        not taken for this one's on resume. Made once a case and revision (a study asks for it
+        several times a run); the fields it is made from are frozen."""
+        kept = self.__dict__.get("_key")
+        if kept is not None and kept[0] == MODEL_REVISION:
+            return kept[1]
+        key = self._make_key()
+        object.__setattr__(self, "_key", (MODEL_REVISION, key))
+        return key
+
+    def _make_key(self) -> str:
         d = self.to_dict()
         if "seed" in d["scenario_options"]:
             # as text, as when the track seed travelled as a NumPy integer: the keys of runs on

@@ -104,7 +104,10 @@ def test_a_reader_leaving_the_pipe_early_is_not_an_error():
     proc.wait(timeout=120)
     assert first.startswith(b"Ride comparison")
     assert proc.returncode == 0, err
-    assert err == ""
+    # nothing on stderr but the note of a first compile, which comes where the command's process
+    # meets a cold cache (here the source tree's, imported from the working folder, warm or cold by
+    # which test ran first)
+    assert [line for line in err.splitlines() if not line.startswith("compiling the stepper once")] == [], err
 
 
 def test_the_shell_pipeline_to_head_exits_0():
