@@ -122,6 +122,26 @@ def reduction(metrics: xr.DataArray, baseline: xr.DataArray) -> xr.DataArray:
     return out
 
 
+def still_passive(scenario: dict) -> str:
+    """Why ratios or reductions against passive are undefined: its carbody did not move (a flat
+    or vanishing rail, a vehicle all but standing still), naming the scenario's settings
+    (``Scenario.describe()``)."""
+    given = [
+        f"{name} = {scenario[key]:g} {unit}"
+        for name, key, unit in (
+            ("amplitude", "amplitude_m", "m"),
+            ("height", "height_m", "m"),
+            ("speed", "speed_m_s", "m/s"),
+        )
+        if key in scenario
+    ]
+    return (
+        f"the passive run's carbody did not move ({', '.join(given) or scenario.get('name', 'this scenario')}): "
+        "an RMS response of 0, against which no ratio or reduction is defined; give a rail input and a speed "
+        "that move the vehicle"
+    )
+
+
 def to_dict(metrics: xr.DataArray) -> dict:
     """{response: {rms, ptp}} for one run (the JSON schema of docs/cli.md)."""
     if "sample" in metrics.dims:

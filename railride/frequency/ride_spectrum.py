@@ -35,7 +35,7 @@ from railride.analysis.comfort import FLOOR
 from railride.frequency.frf import FMAX_LIMIT
 from railride.frequency.linear import LinearModel, linear_model, linear_suspensions
 from railride.model.params import VehicleParams, resolve_vehicle
-from railride.model.track import SPECTRA, frequency_speed, spectrum
+from railride.model.track import MAX_WAVELENGTH, SPECTRA, frequency_speed, spectrum
 from railride.model.vehicle import CORNER_NAMES, Vehicle
 
 SCHEMA = "railride.ride-spectrum/1"
@@ -51,6 +51,8 @@ RESPONSES = (
 )
 #: the ISO 2631-1 weightings applied at the floor points
 WEIGHTINGS = ("Wb", "Wk")
+#: the slowest controller rate of a sampled loop [Hz]
+MIN_CONTROL_RATE = 1.0
 
 
 def rail_patterns(vehicle: Vehicle, frequency: np.ndarray, speed: float) -> dict[str, np.ndarray]:
@@ -240,8 +242,18 @@ def ride_spectrum(
             f"shortest allowed is {speed / FMAX_LIMIT:.4g} m"
         )
     points = validation.integer("points", points, 16, 200_000)
+    if hi > MAX_WAVELENGTH:  # the spectra's 1 / wavenumber**2 overflow far beyond (1e308 m)
+        raise InputError(
+            f"max_wavelength = {hi:g} m: at most {MAX_WAVELENGTH:g} m (the track spectra are fitted to "
+            "wavelengths of metres to hundreds of metres)"
+        )
     if control_rate is not None:
         control_rate = validation.number("control_rate", control_rate, "positive", "Hz")
+        if control_rate < MIN_CONTROL_RATE:  # a hold of 1e308 s overflows the sampled loop
+            raise InputError(
+                f"control_rate = {control_rate:g} Hz: at least {MIN_CONTROL_RATE:g} Hz (a loop sampled less "
+                "than once a second cannot act on the carbody's modes of about 1 Hz)"
+            )
     delay = validation.integer("delay", delay, 0, 64, "controller periods")
     vehicle_params, record = resolve_vehicle(vehicle, params, load)
     vehicle = Vehicle(vehicle_params)

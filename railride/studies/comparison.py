@@ -25,7 +25,7 @@ from railride.secondary.faults import check_faults, degradation
 from railride.analysis.comfort import comfort_record
 from railride.model.params import VehicleParams, resolve_vehicle, vehicle_argument
 from railride.model.plausible import notes
-from railride.analysis.metrics import STATISTICS, reduction, ride_metrics, select_window
+from railride.analysis.metrics import STATISTICS, reduction, ride_metrics, select_window, still_passive
 from railride.plots import PNG_DPI, FigureOptions
 from railride.run.checks import check
 from railride.run.simulation import run as run_plan, simulate
@@ -66,24 +66,6 @@ def check_controllers(names) -> list[str]:
     return [n for n in CONTROLLERS if n in names or n == "passive"]
 
 
-def _still(scenario: dict) -> str:
-    """Why the reductions against passive are undefined: its carbody did not move (a flat or
-    vanishing rail, a vehicle standing all but still), naming the scenario's settings."""
-    given = [
-        f"{name} = {scenario[key]:g} {unit}"
-        for name, key, unit in (
-            ("amplitude", "amplitude_m", "m"),
-            ("height", "height_m", "m"),
-            ("speed", "speed_m_s", "m/s"),
-        )
-        if key in scenario
-    ]
-    return (
-        f"the passive run's carbody did not move ({', '.join(given) or scenario.get('name', 'this scenario')}): an RMS "
-        "response of 0, against which no reduction in % is defined; give a rail input and a speed that move the vehicle"
-    )
-
-
 @dataclass(frozen=True, eq=False)
 class Comparison:
     """Results of `compare`: ``datasets[name]`` per suspension, ``metrics`` (controller,
@@ -118,7 +100,7 @@ class Comparison:
         try:
             return reduction(self.metrics, base)
         except InputError:
-            raise InputError(_still(self.settings.get("scenario") or {})) from None
+            raise InputError(still_passive(self.settings.get("scenario") or {})) from None
 
     def demands(self) -> dict:
         """Per suspension, over the metrics window: RMS and peak damper force on the carbody [N],

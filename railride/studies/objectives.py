@@ -33,6 +33,9 @@ RATIO_NAMES = ("acceleration", "displacement", "pitch", "roll")
 #: the offset rises (by powers of ten) above the largest J a feasible candidate can have
 INFEASIBLE_OFFSET = 1000.0
 INFEASIBLE_SCALE = 1000.0
+#: the smallest bound on the secondary travel [m]: below it the excess of any real travel over it
+#: overflows the infeasible score (1e-308 m)
+MIN_TRAVEL_BOUND = 1e-6
 
 
 def _number(name: str, value, rule: str, ok) -> float:
@@ -127,12 +130,18 @@ class Objective:
         elif self.bound is not None:
             raise InputError(f"objective bound = {self.bound!r}: for kind 'constrained' only (kind is {self.kind!r})")
         object.__setattr__(self, "penalty", _number("penalty", self.penalty, "a finite number >= 0", lambda v: v >= 0))
-        for name, rule in (
-            ("peak_bound", "a finite number > 0 (the largest peak-to-peak acceleration as a ratio to passive's)"),
-            ("travel_bound", "a finite number > 0 [m] (the largest secondary travel)"),
+        for name, rule, least in (
+            ("peak_bound", "a finite number > 0 (the largest peak-to-peak acceleration as a ratio to passive's)", 0.0),
+            (
+                "travel_bound",
+                f"a finite number >= {MIN_TRAVEL_BOUND:g} [m] (the largest secondary travel; a micrometre is "
+                "below any suspension's tolerances)",
+                MIN_TRAVEL_BOUND,
+            ),
         ):
             if getattr(self, name) is not None:
-                object.__setattr__(self, name, _number(name, getattr(self, name), rule, lambda v: v > 0))
+                value = _number(name, getattr(self, name), rule, lambda v, least=least: v > 0 and v >= least)
+                object.__setattr__(self, name, value)
         if self.kind == "constrained" and not math.isfinite(self.feasible_max):
             raise InputError(
                 f"objective bound = {self.bound!r} with penalty = {self.penalty!r}: "

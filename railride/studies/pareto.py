@@ -27,7 +27,7 @@ from railride.errors import InputError
 from railride.secondary.control import PAPER_CONTROLLERS, GainSet
 from railride.defaults import DEFAULT_DAMPER
 from railride.output.files import PARETO_FILES
-from railride.analysis.metrics import RESPONSES
+from railride.analysis.metrics import RESPONSES, still_passive
 from railride.model.params import resolve_vehicle
 from railride.plots import PNG_DPI, FigureOptions
 from railride.studies.optimise import GainEvaluator, log_gain_bounds
@@ -303,6 +303,8 @@ def pareto(
     points = scipy.stats.qmc.scale(unit, bounds[:, 0], bounds[:, 1])
     base_case = Case(scenario, ev.opts, suspension=suspension, damper=damper)
     rms = ev.rms([base_case, *ev.cases(points)])
+    if not np.all(np.asarray(ev.passive, float) > 0):  # every ratio would be nan or inf
+        raise InputError(still_passive(record))
     gains_si = np.vstack([[base.value(p) for p in names], 10.0**points])
     settings = {
         "n_samples": n_samples,

@@ -94,6 +94,9 @@ def _rms(rows: pd.DataFrame) -> np.ndarray:
 #: what a candidate value of a sweep holds while it waits to run: the value, its case (a gain
 #: set) and its row in the run table, about 2 kB; the runs themselves are checked by simulate
 CANDIDATE_BYTES = 2048
+#: the widest span of a sweep (`_candidates`): 28 decades around the current value, where the
+#: outer-loop gains are allowed 0 to 1e14 (docs/cli.md); far wider the candidates overflow (1e308)
+MAX_SPAN = 1e14
 
 
 def _candidates(current: float, parameter: str, n_values: int, span: float, gains: GainSet) -> list[float]:
@@ -263,8 +266,11 @@ def tune(
         "use fewer values (13 a gain and pass is the default)",
     )
     for name, value in (("span", span), ("min_span", min_span)):
-        if not validation.number(name, value, "finite", allowed="a finite number > 1") > 1:
-            raise InputError(f"{name} = {validation.shown(value)}: must be a finite number > 1")
+        if not 1 < validation.number(name, value, "finite", allowed="a finite number > 1") <= MAX_SPAN:
+            raise InputError(
+                f"{name} = {validation.shown(value)}: must be a finite number > 1 and <= {MAX_SPAN:g} (28 "
+                "decades around the current value, more than any sweep needs)"
+            )
     validation.number("tol", tol, "nonnegative")
     validation.choice("aggregate", aggregate, AGGREGATES)
     if over is not None:

@@ -66,7 +66,7 @@ def test_design_out_and_resume(tmp_path):
         (("--controllers", "lqr"), ("--controllers = 'lqr'",)),
         (("--track", "fra9"), ("--track = 'fra9'",)),
         (("--objective", "comfy"), ("--objective = 'comfy'", "n_mv, sperling")),
-        (("--max-travel", "0"), ("--max-travel = 0.0", "> 0")),
+        (("--max-travel", "0"), ("--max-travel = 0.0", ">= 1e-06")),
         (("--max-peak", "x"), ("--max-peak",)),
         (("--report", "/dev/null/r.html"), ("--report",)),
         (("--resume",), ("--resume needs --out",)),

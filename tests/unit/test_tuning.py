@@ -582,3 +582,16 @@ def test_robust_tuning_refuses_what_it_cannot_use():
         tune(("pid",), over=tuning_set("fra4", track_seeds=[0]), scenario_options={"speed": 30.0})
     with pytest.raises(ValueError, match="loads = 0"):
         tuning_set("fra4", loads=[0])
+
+
+def test_a_study_whose_every_candidate_scores_inf_ends():
+    # inf - inf is NaN, which no "improved by less than tol" test took for no improvement: the
+    # span never shrank and the study swept the same (already scored) values for ever
+    from railride.studies.tuning import _study
+
+    study = _study("pid", GainSet.default(), 1000, 3, 30.0, 1e-3, 1.05, None)
+    sets, sweeps = next(study), 0
+    with pytest.raises(StopIteration) as end:
+        while sweeps < 1000:
+            sets, sweeps = study.send([np.inf] * len(sets)), sweeps + 1
+    assert end.value.value[0].stopped == "converged" and sweeps < 1000
