@@ -50,16 +50,18 @@ WRITERS = {
         {"--out": "dir", "--report": "html"},
     ),
     "state-space": (("state-space",), {"--out": "model"}),
+    "fmu": (("fmu", "--damper", "passive"), {"--out": "fmu"}),
 }
 
 #: what each kind of place is called at the bad locations
-NAMES = {"dir": "out", "html": "page.html", "model": "model.json"}
+NAMES = {"dir": "out", "html": "page.html", "model": "model.json", "fmu": "model.fmu"}
 
 
 #: the modules that take the stages below by name when first imported: imported before the
 #: stages are replaced, so that none keeps a replaced one after the test
 USERS = (
     "railride.cli",
+    "railride.frequency.fmu",
     "railride.frequency.frf",
     "railride.frequency.ride_spectrum",
     "railride.run.rig",
@@ -73,6 +75,7 @@ USERS = (
 
 #: (module, name) of each stage of work: the engine's stages and its entry points (also where a
 #: module holds them under its own name), the damper rig's stepper, the frequency-domain models
+#: and the FMU's build
 STAGES = (
     ("railride.run.simulation", "inputs"),
     ("railride.run.simulation", "pack"),
@@ -86,6 +89,8 @@ STAGES = (
     ("railride.frequency.ride_spectrum", "ride_spectrum"),
     ("railride.frequency.ride_spectrum", "linear_model"),
     ("railride.frequency.linear", "linear_model"),
+    ("railride.frequency.fmu", "_variables"),
+    ("railride.frequency.fmu", "_build"),
 )
 
 
