@@ -249,7 +249,7 @@ def _track_pieces(track: RandomTrack) -> bytes:
     """resources/track.bin: the pieces n and the spacing, then the n x 4 coefficients of the left
     rail's cubic spline pieces (highest power first) and the right's, little-endian doubles."""
     s, _, _ = track.samples()
-    left, right = (np.ascontiguousarray(spline.c.T) for spline in track._interp[0])  # its CubicSplines
+    left, right = (np.ascontiguousarray(spline.c.T) for spline in track.splines())
     n, ds = left.shape[0], float(s[1])  # the samples are k ds: s[1] is ds itself
     data = np.concatenate([[float(n), ds], left.ravel(), right.ravel()]).astype("<f8")
     return data.tobytes()
