@@ -72,7 +72,7 @@ def test_compare_comfort():
     base, ctrl = passive["positions"]["centre"], pid["positions"]["centre"]
     assert red["N_MV_z"] == pytest.approx((base["N_MV_z"] - ctrl["N_MV_z"]) / base["N_MV_z"] * 100)
     assert "Wz" not in red
-    assert all("comfort" not in r for r in plain["controllers"])
+    assert len(plain["controllers"]) == 2 and all("comfort" not in r for r in plain["controllers"])
     strip = [{k: v for k, v in r.items() if k != "comfort"} for r in doc["controllers"]]
     assert strip == plain["controllers"]
     table = ok("compare", *TRACK, "--speed", 30, "--controllers", "pid", "--comfort").stdout
@@ -88,7 +88,7 @@ def test_sweep_comfort(tmp_path):
     doc = json.loads((out / "sweep.json").read_text())
     for column in ("centre_aw_Wk", "centre_N_MV_z", "front_N_MV_z", "rear_N_MV_z", "centre_Wz"):
         assert column in doc["columns"]
-        assert all(math.isfinite(r[column]) and r[column] > 0 for r in doc["rows"])
+        assert len(doc["rows"]) == 4 and all(math.isfinite(r[column]) and r[column] > 0 for r in doc["rows"])
     assert doc["settings"]["comfort"]["columns"] == list(COMFORT_COLUMNS)
     runs = pd.read_csv(out / "runs.csv", dtype={"key": str})
     assert set(COMFORT_COLUMNS) <= set(runs.columns) and len(runs) == 4

@@ -428,6 +428,7 @@ def test_compare_refuses_bad_faults(args, fragments):
 def test_the_papers_table_stands_beside_the_papers_case_only(args, paper):
     doc = ok_json("compare", "--duration", 1, *args)
     assert doc["paper_case"] is paper
+    assert len(doc["controllers"]) == len(PAPER_CONTROLLERS)
     assert all((r["paper"] is not None) is paper for r in doc["controllers"])
     text = " ".join(ok("compare", "--duration", 1, *args).stdout.split())
     assert ("beside the paper's Table 1" in text) is paper

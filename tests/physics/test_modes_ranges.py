@@ -126,6 +126,7 @@ def test_the_damped_modes_are_the_roots_of_the_quadratic_eigenproblem(name):
     roots = scipy.linalg.eig(np.block([[zero, eye], [-v.K, -v.C]]), np.block([[eye, zero], [zero, v.M]]))[0]
     upper = np.sort_complex(roots[roots.imag > 0])
     found = v.modes()
+    assert len(found) == n
     assert all(0.0 < m.damping_ratio < 1.0 and m.resolved for m in found)  # all underdamped: complex pairs
     wd = np.array([2 * np.pi * m.damped_frequency_hz for m in found])
     zeta = np.array([m.damping_ratio for m in found])

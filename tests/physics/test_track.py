@@ -29,7 +29,7 @@ def test_sine_enters_through_a_raised_cosine_taper_over_one_wavelength():
     # no step: the right rail starts at 0, not at -A, and both heights and slopes are
     # continuous at s = 0 and at the end of the taper
     start = tr.evaluate(np.array([1e-6]))
-    assert all(abs(v[0]) < 1e-9 for v in start)
+    assert len(start) == 4 and all(abs(v[0]) < 1e-9 for v in start)
     for v in (zl, zr, dzl, dzr):
         assert np.abs(np.diff(v)).max() < 1e-4
     # slopes are the derivative of the heights, taper included
@@ -43,7 +43,7 @@ def test_sine_enters_through_a_raised_cosine_taper_over_one_wavelength():
 def test_every_profile_is_level_before_the_start():
     for tr in (SineTrack(), CosineBump(start=0.0)):
         out = tr.evaluate(np.array([-30.0, -1e-9, 0.0]))
-        assert all(np.all(o == 0) for o in out)
+        assert len(out) == 4 and all(np.all(o == 0) for o in out)
 
 
 def test_cosine_bump_shape():

@@ -336,7 +336,7 @@ def test_comparison_and_tracking_use_their_metric_window():
     assert high - low < 1.2 * (inside.max() - inside.min())
     assert (whole.max() - whole.min()) > 1.2 * (inside.max() - inside.min())  # the window matters here
     forces = plot_comparison_damper_forces(comparison).get_axes()
-    assert all(len(f.patches) == 2 for f in forces)  # every panel shaded before 0.1 s and after 0.6 s
+    assert forces and all(len(f.patches) == 2 for f in forces)  # every panel shaded before 0.1 s and after 0.6 s
     tracking = rig.track(n_cycles=3)
     f_axes = plot_tracking(tracking).get_axes()[0]
     start, end = tracking.window

@@ -87,6 +87,7 @@ def test_grid_order_and_count():
         "attitude.kp_z": [0.0, 1e5, 2e5],
         "seed": [0, 1],
     }
+    assert any(c.closed_loop for c in g.cases)
     assert all(c.noise == (1e-4, 0.0, 0.0, 0.0) for c in g.cases if c.closed_loop)
 
 
