@@ -265,6 +265,8 @@ class VehicleParams:
         double, so the round trip is lossless.
         """
         lines = ["# railride vehicle parameters (SI units)", "[vehicle]"]
+        if not self.flexible:  # said, so that reading it back gives no warning of a rigid carbody
+            lines.append("rigid_carbody = true  # the carbody does not bend (no L_c with f_bend or EI_c)")
         for name, unit, doc, _ in self.describe():
             value = getattr(self, name)
             if value is None:  # an element left out: TOML has no null
