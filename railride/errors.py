@@ -42,3 +42,9 @@ class BackendWarning(UserWarning):
     """The backend asked for could not be used, and the run went on with another: for example
     "auto" with no GPU for a large batch (`railride.SolverSettings`). The command line shows it
     as one "warning:" line."""
+
+
+class TuningWarning(UserWarning):
+    """A tuning that leaves gains its result depends on at their start values: the inner loop
+    of the MR dampers that a listed law drives, when "inner" is not listed
+    (`railride.studies.tuning.tune`). The command line shows it as one "warning:" line."""

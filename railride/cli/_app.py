@@ -118,11 +118,11 @@ def _warnings_on_stderr():
     """A `railride.model.plausible.PlausibilityWarning` (a vehicle outside the typical ranges) or a
     `railride.errors.BackendWarning` (the run went on on the CPU) as one line "warning: ..." on
     stderr, once per text, beside the result it qualifies."""
-    from railride.errors import BackendWarning
+    from railride.errors import BackendWarning, TuningWarning
     from railride.model.plausible import PlausibilityWarning
 
     def show(message, category, filename, lineno, file=None, line=None):
-        if issubclass(category, (PlausibilityWarning, BackendWarning)):
+        if issubclass(category, (PlausibilityWarning, BackendWarning, TuningWarning)):
             typer.echo(f"warning: {message}", err=True)
         else:
             shown(message, category, filename, lineno, file, line)
@@ -131,6 +131,7 @@ def _warnings_on_stderr():
         shown = warnings.showwarning
         warnings.simplefilter("default", PlausibilityWarning)
         warnings.simplefilter("default", BackendWarning)
+        warnings.simplefilter("default", TuningWarning)
         warnings.showwarning = show
         yield
 

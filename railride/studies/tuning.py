@@ -165,6 +165,22 @@ def _check_controllers(controllers) -> tuple:
     return tuple(c for c in TUNABLE if c in controllers)  # the order they run
 
 
+def _inner_left_out(controllers, gains, damper) -> str | None:
+    """What a tuning that lists laws using the MR dampers' tracking inner loop, but not "inner",
+    leaves untuned, in one line; None where nothing is (the inner loop listed, the ideal devices,
+    or only laws with on-off or clipped voltages, which read no inner-loop gain)."""
+    if "inner" in controllers or damper in dampers.IDEAL_NAMES:
+        return None
+    users = [n for n in controllers if "inner" in GainSet.tables_read(n)]  # as `design` lists it
+    if not users:
+        return None
+    inner = gains.inner
+    return (
+        f"the inner loop is not tuned: its B = {inner.B:g} and G = {inner.G:g} V/N stay at the start values, "
+        f"though the MR dampers of {', '.join(users)} follow it; list 'inner' to tune it too"
+    )
+
+
 def tune(
     controllers=TUNABLE,
     *,
@@ -288,6 +304,13 @@ def tune(
     for c, sc in zip(cases_set, scens):
         check(sc, vehicle.loaded(c.load), Suspension.named(law, gains, damper, damper_scale), solver, "mark")
     scen = scens[0]
+    untuned = _inner_left_out(controllers, gains, damper)
+    if untuned is not None:
+        import warnings
+
+        from railride.errors import TuningWarning
+
+        warnings.warn(untuned, TuningWarning, stacklevel=2)
     result = TuneResult(
         gains,
         objective=objective,
@@ -305,6 +328,7 @@ def tune(
             "tolerance": float(tol),
             "min_span": float(min_span),
             "start_gains": gains.source,
+            **({"inner_loop_not_tuned": untuned} if untuned is not None else {}),
             **({"optimiser": evolution.record(optimiser_seed)} if optimiser == "evolution" else {}),
             "vehicle": vehicle_record(vehicle, source, list(dict.fromkeys(c.load for c in cases_set))),
             **other_settings(vehicle, solver),

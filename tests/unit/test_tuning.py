@@ -286,6 +286,9 @@ def test_tune_result_to_dict_is_the_tune_document(short_tune):
     [study] = doc["studies"]
     assert (study["controller"], study["budget"], study["runs"], study["passes"]) == ("pid", 10, 10, 1)
     assert doc["scenario"]["duration_s"] == 1.0
+    # PID alone drives the dampers through the inner loop, which is not tuned with it: said
+    note = doc["settings"].pop("inner_loop_not_tuned")
+    assert note.startswith("the inner loop is not tuned: its B = 1 and G = ") and "dampers of pid" in note
     assert doc["settings"] == {
         "damper": "railway",
         "damper_scale": 1.0,
