@@ -458,7 +458,9 @@ def entries(text: str) -> list[tuple[int, str, str, float]]:
             table = line.strip("[] ")
         elif " = " in line:
             key, _, rest = line.partition(" = ")
-            found.append((i, table, key, float(rest.split("#")[0])))
+            value = rest.split("#")[0].strip()
+            if value not in ("true", "false"):  # the numbers: a switch (rigid_carbody) is not one
+                found.append((i, table, key, float(value)))
     return found
 
 

@@ -304,8 +304,12 @@ def test_the_toml_round_trip_keeps_the_bending_and_a_file_without_it_is_rigid():
     text = P.to_toml()
     assert "# f_bend not set" in text and "# L_c not set" in text
     assert VehicleParams.from_toml(text) == P
+    # a file of before the bending mode: no bending entries, no rigid_carbody switch: rigid, said
     old = "\n".join(
-        line for line in text.splitlines() if not line.startswith(("# L_c", "# f_bend", "# EI_c", "zeta_bend"))
+        line
+        for line in text.splitlines()
+        if not line.startswith(("# L_c", "# f_bend", "# EI_c", "zeta_bend", "rigid_carbody"))
     )
-    assert not VehicleParams.from_toml(old).flexible
+    with pytest.warns(PlausibilityWarning, match="gives no bending mode of the carbody"):
+        assert not VehicleParams.from_toml(old).flexible
     assert VehicleParams.from_toml('[vehicle]\npreset = "paper"\nL_c = 24.0\nf_bend = 10.0\n') == F
