@@ -71,7 +71,7 @@ BLOCKS = (
 
 @dataclass(frozen=True)
 class Variable:
-    """One FMU variable: its block (the C name of the group it starts or belongs to), name,
+    """One FMU variable: its block (the C name of its group, `BLOCKS`), name,
     causality ("parameter", "input", "output"), unit, start value and description."""
 
     block: str
@@ -98,39 +98,35 @@ def _variables(vehicle: Vehicle, secondary: str, dt: float, sc) -> list[Variable
         Variable("TAPER", "taper", "parameter", "", sine.taper, "the sine's entry taper, in wavelengths"),
     ]
     for i, (d, u) in enumerate(zip(names, units)):
-        out.append(Variable("INITIAL_Q" if i == 0 else "", f"initial_{d}", "parameter", u, 0.0, f"{d} at the start"))
+        out.append(Variable("INITIAL_Q", f"initial_{d}", "parameter", u, 0.0, f"{d} at the start"))
     for i, (d, u) in enumerate(zip(names, units)):
-        out.append(
-            Variable(
-                "INITIAL_QD" if i == 0 else "", f"initial_{d}_velocity", "parameter", f"{u}/s", 0.0, "at the start"
-            )
-        )
+        out.append(Variable("INITIAL_QD", f"initial_{d}_velocity", "parameter", f"{u}/s", 0.0, "at the start"))
     if secondary != "passive":
         what, unit = ("command voltage of the coil driver", "V") if secondary != "ideal" else ("force demand", "N")
         stem = "damper_command" if secondary != "ideal" else "force_demand"
         for k, c in enumerate(CORNER_NAMES):
-            out.append(Variable("COMMAND" if k == 0 else "", f"{stem}_{c}", "input", unit, 0.0, f"corner {c}: {what}"))
+            out.append(Variable("COMMAND", f"{stem}_{c}", "input", unit, 0.0, f"corner {c}: {what}"))
     if secondary not in ("passive", "ideal"):  # the inner loop, inside: force demands in, as railride's
         from railride.secondary.control import GainSet
 
         inner = GainSet.default().inner
         for k, c in enumerate(CORNER_NAMES):
             text = f"corner {c}: force demand on the carbody, for the inner loop (inner_loop 1-3)"
-            out.append(Variable("FORCE_DEMAND" if k == 0 else "", f"force_demand_{c}", "input", "N", 0.0, text))
+            out.append(Variable("FORCE_DEMAND", f"force_demand_{c}", "input", "N", 0.0, text))
         out.append(Variable("INNER_B", "inner_B", "parameter", "", inner.B, "the inner loop's weight of the force"))
         out.append(Variable("INNER_G", "inner_G", "parameter", "V/N", inner.G, "the inner loop's gain"))
     rails = [f"{w}{r}" for w in WHEELSETS for r in RAILS]
     for k, r in enumerate(rails):
-        out.append(Variable("RAIL_HEIGHT" if k == 0 else "", f"rail_height_{r}", "input", "m", 0.0, "scenario 0"))
+        out.append(Variable("RAIL_HEIGHT", f"rail_height_{r}", "input", "m", 0.0, "scenario 0"))
     for k, r in enumerate(rails):
-        out.append(Variable("RAIL_RATE" if k == 0 else "", f"rail_rate_{r}", "input", "m/s", 0.0, "scenario 0"))
+        out.append(Variable("RAIL_RATE", f"rail_rate_{r}", "input", "m/s", 0.0, "scenario 0"))
     for block, suffix, tail in (("Q", "", ""), ("QD", "_velocity", "/s"), ("QDD", "_acceleration", "/s2")):
         for i, (d, u) in enumerate(zip(names, units)):
             name = "carbody_acceleration" if f"{d}{suffix}" == "carbody_bounce_acceleration" else f"{d}{suffix}"
-            out.append(Variable(block if i == 0 else "", name, "output", f"{u}{tail}", None, d))
+            out.append(Variable(block, name, "output", f"{u}{tail}", None, d))
     for k, p in enumerate(FLOOR_POINTS):
         text = f"vertical acceleration of the carbody floor at the {p}"
-        out.append(Variable("FLOOR" if k == 0 else "", f"floor_acceleration_{p}", "output", "m/s2", None, text))
+        out.append(Variable("FLOOR", f"floor_acceleration_{p}", "output", "m/s2", None, text))
     corner: list[tuple[str, str, str, str]] = [
         ("DEFLECTION", "secondary_deflection", "m", "secondary deflection, carbody minus bogie (extension +)"),
         ("DEFLECTION_RATE", "secondary_deflection_velocity", "m/s", "its rate"),
@@ -145,7 +141,7 @@ def _variables(vehicle: Vehicle, secondary: str, dt: float, sc) -> list[Variable
         corner += [("CLEARANCE", "secondary_clearance", "m", "travel left to the bump stop: z_stop - |deflection|")]
     for block, stem, unit, text in corner:
         for k, c in enumerate(CORNER_NAMES):
-            out.append(Variable(block if k == 0 else "", f"{stem}_{c}", "output", unit, None, f"corner {c}: {text}"))
+            out.append(Variable(block, f"{stem}_{c}", "output", unit, None, f"corner {c}: {text}"))
     text = "0: the rail inputs, carried on over a step with their rates; 1: the paper's sine"
     random = sc is not None and isinstance(sc.track, RandomTrack)
     if random:
@@ -353,12 +349,8 @@ def _header(car: Vehicle, secondary: str, variables: list[Variable], dt: float) 
     lines.append(f"#define RR_N_REAL {len(reals)}\n#define RR_N_INTEGER {len(integers)}\n")
     lines.append(f"#define RR_VR_INTEGER0 {len(reals)}\n")
     for block in BLOCKS:
-        at = [i for i, v in enumerate(variables) if v.block == block]
-        lines.append(f"#define RR_VR_{block} {at[0] if at else 0}\n")
-        count = 0
-        if at:
-            count = 1 + next((k for k, v in enumerate(variables[at[0] + 1 :]) if v.block), len(variables) - at[0] - 1)
-        lines.append(f"#define RR_N_{block} {count}\n")
+        at = [i for i, v in enumerate(variables) if v.block == block]  # consecutive value references
+        lines.append(f"#define RR_VR_{block} {at[0] if at else 0}\n#define RR_N_{block} {len(at)}\n")
     lines.append(_c_array("RR_START", np.array([v.start or 0.0 for v in reals])))
     starts = ", ".join(str(int(v.start or 0)) for v in integers)
     lines.append(f"static const int RR_START_INTEGER[{len(integers)}] = {{{starts}}};\n")

@@ -76,8 +76,7 @@ def _on_cpu(plan: RunPlan, window) -> tuple[np.ndarray, np.ndarray]:
         if hi - lo == plan.n and stepped_on(plan) == "cpu":
             part = plan
         else:
-            x0 = None if plan.x0 is None or plan.x0.ndim == 1 else plan.x0[lo:hi]
-            x0 = plan.x0 if x0 is None and plan.x0 is not None else x0
+            x0 = plan.x0 if plan.x0 is None or plan.x0.ndim == 1 else plan.x0[lo:hi]  # one row, or a row a run
             on = (plan.scenarios[lo:hi], plan.param_sets[lo:hi], plan.suspensions[lo:hi])
             part = check(*on, solver, plan.on_divergence, x0)
         res = run(part)

@@ -125,7 +125,8 @@ def evaluate(
                 m, diverged_at = batch_metrics(plan, window)
                 _add_rows(rows, cases, part_idx, m, diverged_at)
                 continue
-            if len(part_idx) > CHUNK:  # runs the GPU does not take (the exact steps): the CPU's batches
+            # runs the GPU does not take (the exact steps, a remainder too small for "auto"): CPU batches
+            if len(part_idx) > CHUNK:
                 parts[:0] = [part_idx[k : k + CHUNK] for k in range(0, len(part_idx), CHUNK)]
                 continue
             res = simulate(scs, pars, suspensions, solver=solver, on_divergence="mark")
@@ -152,16 +153,11 @@ def evaluate(
 
 def _batches(idx: list[int], solver: SolverSettings, metrics_only: bool) -> list[list[int]]:
     """The compiled batches of one group's cases (positions ``idx``): `CHUNK` runs each, or, for
-    runs that keep only their metrics where the GPU takes them (`gpu_batches`), `GPU_CHUNK`."""
+    runs that keep only their metrics where the GPU takes them (`gpu_batches`), `GPU_CHUNK`. A
+    large batch the GPU does not take after all (a remainder too small for "auto", the exact
+    steps) is split into `CHUNK`s by `evaluate`."""
     size = GPU_CHUNK if metrics_only and gpu_batches(solver, min(len(idx), GPU_CHUNK)) else CHUNK
-    out = []
-    for start in range(0, len(idx), size):
-        part = idx[start : start + size]
-        if size > CHUNK and not gpu_batches(solver, len(part)):  # a group's last part, too few for "auto"
-            out += [part[k : k + CHUNK] for k in range(0, len(part), CHUNK)]
-        else:
-            out.append(part)
-    return out
+    return [idx[start : start + size] for start in range(0, len(idx), size)]
 
 
 def _device_plan(scenarios, params, suspensions, solver: SolverSettings):
