@@ -12,6 +12,7 @@ import typer
 
 from railride.errors import InputError
 from railride.secondary.dampers import IDEAL_NAMES
+from railride.output.trade_offs import trade_off_lines
 from railride.defaults import DEFAULT_CONTROL_RATE, DEFAULT_DAMPER
 from railride.cli._app import app
 from railride.cli._common import ProgressBar, errors, option_names, stderr_is_terminal, stdout_console, write_folder
@@ -195,25 +196,6 @@ def _sensor_noise(text: Optional[str], seed: Optional[int]):
         raise InputError(f"--sensor-noise = {text!r}: {exc}") from None
 
 
-def _trade_off_lines(doc: dict) -> list[str]:
-    """One line per trade-off of `Comparison.trade_offs`: what a controller loses for what it
-    wins, against passive and against each other controller."""
-    labels = {r["name"]: r["label"] for r in doc["controllers"]}
-    words = {k: v.split(" (")[0] for k, v in RESPONSE_LABELS.items()}
-    lines = []
-    for t in doc.get("trade_offs", []):
-        if not t["worse_on"]:
-            continue
-        a, b = labels[t["controller"]], labels.get(t["than"], t["than"])
-        better = ", ".join(words[r] for r in t["better_on"])
-        worse = ", ".join(words[r] for r in t["worse_on"])
-        if better:
-            lines.append(f"trade-off: {a} beats {b} on {better} but is worse on {worse}")
-        else:  # not a trade: one is better wherever they differ
-            lines.append(f"no trade-off: {b} beats {a} on {worse} and is worse on nothing")
-    return lines
-
-
 def _compare_tables(doc: dict, shipped: bool):
     """The three tables of `compare`: Table 1 beside the paper, peak-to-peak, damper demands."""
     from rich.markup import escape
@@ -269,7 +251,7 @@ def _compare_tables(doc: dict, shipped: bool):
             info.append(alike_text(tuning["alike"]))
         if tuning.get("untuned"):
             info.append(untuned_text(tuning["untuned"]))
-        info += _trade_off_lines(doc)
+        info += trade_off_lines(doc)
     for name, why in (settings.get("not_run") or {}).items():
         info.append(f"{name}: not run ({why})")
     paper_case = doc.get("paper_case", True)
