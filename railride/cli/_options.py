@@ -144,7 +144,16 @@ DurationOption = Annotated[
 RunDurationOption = Annotated[
     Optional[float], typer.Option("--duration", metavar="S", help="Simulated time of each run [s] (default 10).")
 ]
-DtOption = Annotated[Optional[float], typer.Option("--dt", metavar="S", help="Fixed RK4 time step [s] (default 1e-4).")]
+DtOption = Annotated[
+    Optional[float],
+    typer.Option(
+        "--dt",
+        metavar="S",
+        help="Fixed time step [s] (default 1e-4): RK4's step, which must keep it stable; a run by the "
+        "exact discretisation (the linear vehicle: passive dampers, or the ideal actuator with exact states; "
+        "never in an FMU) steps once per output and controller sample, and dt only spaces its rail-input grid.",
+    ),
+]
 MethodOption = Annotated[
     Optional[str],
     typer.Option(
