@@ -285,6 +285,15 @@ CompareDamperScaleOption = _damper_scale(
     "Factor on the MR damper's force capacity, a finite number > 0 (every force "
     "parameter times X; default 1). Not with --damper ideal."
 )
+LevelToleranceOption = Annotated[
+    Optional[float],
+    typer.Option(
+        "--level-tolerance",
+        metavar="FRACTION",
+        help="Two RMS values closer than this fraction of the larger are level on the trade-off "
+        "lines, neither better nor worse: a finite number >= 0 and < 1 (default 0.01, 1 %).",
+    ),
+]
 SimulateDamperScaleOption = _damper_scale(
     "--suspension mr only: factor on the damper's force capacity, a finite number > 0 "
     "(every force parameter times X; default 1)."

@@ -23,6 +23,7 @@ from railride.cli._options import (
     ComfortOption,
     CompareDamperOption,
     CompareDamperScaleOption,
+    LevelToleranceOption,
     CompareGainsOption,
     CompareOutOption,
     CompareScenarioOption,
@@ -114,6 +115,7 @@ COMPARE_FIELDS = {
     "damper_scale": "--damper-scale",
     "delay": "--delay",
     "window": "--window",
+    "level_tolerance": "--level-tolerance",
 }
 
 
@@ -522,6 +524,7 @@ def compare(
     history_format: HistoryFormatOption = None,
     max_memory: MaxMemoryOption = None,
     max_steps: MaxStepsOption = None,
+    level_tolerance: LevelToleranceOption = None,
 ) -> None:
     """Compare passive, PID and SAS suspensions on one scenario, as in the paper's Table 1.
 
@@ -551,6 +554,8 @@ def compare(
                     "--history-format: a league table (several --scenario, --speed, --track-seed or --load "
                     "values) writes no time histories"
                 )
+            if level_tolerance is not None:
+                raise InputError("--level-tolerance: a league table (several values) prints no trade-offs")
             given = dict(
                 amplitude=amplitude,
                 wavelength=wavelength,
@@ -644,6 +649,7 @@ def compare(
                 faults=faults,
                 delay=1 if delay is None else delay,
                 sensing=_sensing(sensing),
+                **({} if level_tolerance is None else {"level_tolerance": level_tolerance}),
             )
         doc = result.to_dict()
         text = json.dumps(doc, indent=2, allow_nan=False)  # refuses NaN before anything is written

@@ -1,6 +1,10 @@
-"""The trade-offs of a controller comparison in words: one line per pair of suspensions where one
+"""The trade-offs of a controller comparison in words: one line per group of suspensions where one
 wins a response by losing another (`railride.studies.comparison.Comparison.trade_offs`), shared by
-the command line and the HTML report so that both say the same thing."""
+the command line and the HTML report so that both say the same thing.
+
+Pairs with the same winner and the same responses won, lost and level are one line, so that
+eleven suspensions give a list one can read; responses within the comparison's level tolerance
+are neither won nor lost, and the last line states that tolerance."""
 
 from __future__ import annotations
 
@@ -13,19 +17,39 @@ RESPONSE_WORDS = {
 }
 
 
+def _words(responses) -> str:
+    return ", ".join(RESPONSE_WORDS.get(r, r) for r in responses)
+
+
 def trade_off_lines(doc: dict) -> list[str]:
-    """One line per trade-off of a comparison's ``to_dict()``: what a controller loses for what
-    it wins, against passive and against each other controller."""
+    """The trade-offs of a comparison's ``to_dict()`` in sentences: ``trade-off:`` where a
+    suspension beats others on some responses and is worse on others, ``no trade-off:`` where
+    one is better wherever they differ, ``level:`` where two differ on no response by more than
+    the tolerance; then the tolerance itself. Empty when nothing is compared."""
     labels = {r["name"]: r["label"] for r in doc["controllers"]}
-    lines = []
+    groups: dict[tuple, list[str]] = {}
+    level_pairs = []
     for t in doc.get("trade_offs", []):
-        if not t["worse_on"]:
-            continue
-        a, b = labels[t["controller"]], labels.get(t["than"], t["than"])
-        better = ", ".join(RESPONSE_WORDS.get(r, r) for r in t["better_on"])
-        worse = ", ".join(RESPONSE_WORDS.get(r, r) for r in t["worse_on"])
-        if better:
-            lines.append(f"trade-off: {a} beats {b} on {better} but is worse on {worse}")
-        else:  # not a trade: one is better wherever they differ
-            lines.append(f"no trade-off: {b} beats {a} on {worse} and is worse on nothing")
+        level = tuple(t.get("level_on", ()))
+        better, worse = tuple(t["better_on"]), tuple(t["worse_on"])
+        a, b = labels.get(t["controller"], t["controller"]), labels.get(t["than"], t["than"])
+        if better and worse:
+            groups.setdefault(("trade-off", a, better, worse, level), []).append(b)
+        elif worse:  # not a trade: the other is better wherever they differ
+            groups.setdefault(("no trade-off", b, worse, (), level), []).append(a)
+        elif not better:
+            level_pairs.append(f"{a} and {b}")
+    lines = []
+    for (kind, winner, won, lost, level), losers in groups.items():
+        text = f"{kind}: {winner} beats {', '.join(losers)} on {_words(won)}"
+        text += f" but is worse on {_words(lost)}" if kind == "trade-off" else " and is worse on nothing"
+        lines.append(text + (f"; level on {_words(level)}" if level else ""))
+    if level_pairs:
+        lines.append(f"level on every response: {'; '.join(level_pairs)}")
+    tol = doc.get("settings", {}).get("level_tolerance")
+    if doc.get("trade_offs") and tol is not None:
+        lines.append(
+            f"(RMS values within {100 * tol:.3g} % of the larger count as level, neither better nor worse: "
+            "--level-tolerance)"
+        )
     return lines

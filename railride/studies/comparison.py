@@ -48,6 +48,28 @@ PAPER_REDUCTION = {
 }
 
 
+#: two RMS values that differ by less than this fraction of the larger are level (1 %, a choice):
+#: a list of "beats" read off the fourth digit of one run hides the trade-offs that matter
+LEVEL_TOLERANCE = 0.01
+
+
+def is_level(x: float, y: float, tolerance: float) -> bool:
+    """Whether two non-negative RMS values are level: |x - y| <= tolerance x max(|x|, |y|)
+    (two zeros are level; a NaN is level with nothing)."""
+    return bool(abs(x - y) <= tolerance * max(abs(x), abs(y)))
+
+
+def _check_level(value) -> float:
+    """``level_tolerance`` as a float in [0, 1)."""
+    from railride.validation import number
+
+    allowed = "a finite number >= 0 and < 1 (a fraction of the larger RMS; 0.01 is 1 %)"
+    tol = number("level_tolerance", value, "nonnegative", allowed=allowed)
+    if tol >= 1.0:
+        raise InputError(f"level_tolerance = {value!r}: must be {allowed}")
+    return tol
+
+
 def check_controllers(names) -> list[str]:
     """The requested controllers in the order of `CONTROLLERS`; passive is always the baseline;
     "all" is every one. ``names``: a sequence of names, or one string of comma-separated names."""
@@ -142,36 +164,37 @@ class Comparison:
 
     def trade_offs(self) -> list[dict]:
         """Where a suspension wins one response by losing another: for each controller, the
-        responses (RMS) it makes worse than passive, and for each pair of controllers, the
-        responses on which each beats the other. Pairs where one is at least as good on every
-        response are listed with an empty ``worse_on``."""
+        responses (RMS) it makes better and worse than passive, and for each pair of controllers,
+        the responses on which each beats the other. Two RMS values within the comparison's
+        level tolerance (``settings["level_tolerance"]``, relative to the larger, `is_level`) are
+        level: on ``level_on``, neither better nor worse. Pairs where one is at least as good on
+        every response are listed with an empty ``worse_on``."""
         rms = self.metrics.sel(statistic="rms")
         responses = [str(r) for r in rms.response.values]
-        out = []
+        tol = self.level_tolerance
         controlled = [n for n in self.names if n != "passive"]
-        base = rms.sel(controller="passive").values
-        for n in controlled:
-            worse = [r for r, a, b in zip(responses, rms.sel(controller=n).values, base) if a > b]
+        pairs = [(n, "passive") for n in controlled]
+        pairs += [(a, b) for i, a in enumerate(controlled) for b in controlled[i + 1 :]]
+        out = []
+        for a, b in pairs:
+            va, vb = rms.sel(controller=a).values, rms.sel(controller=b).values
+            level = [r for r, x, y in zip(responses, va, vb) if is_level(x, y, tol)]
             out.append(
                 {
-                    "controller": n,
-                    "than": "passive",
-                    "better_on": [r for r in responses if r not in worse],
-                    "worse_on": worse,
+                    "controller": a,
+                    "than": b,
+                    "better_on": [r for r, x, y in zip(responses, va, vb) if r not in level and x < y],
+                    "worse_on": [r for r, x, y in zip(responses, va, vb) if r not in level and x > y],
+                    "level_on": level,
                 }
             )
-        for i, a in enumerate(controlled):
-            for b in controlled[i + 1 :]:
-                va, vb = rms.sel(controller=a).values, rms.sel(controller=b).values
-                out.append(
-                    {
-                        "controller": a,
-                        "than": b,
-                        "better_on": [r for r, x, y in zip(responses, va, vb) if x < y],
-                        "worse_on": [r for r, x, y in zip(responses, va, vb) if x > y],
-                    }
-                )
         return out
+
+    @property
+    def level_tolerance(self) -> float:
+        """The relative difference of two RMS values below which they count as level (a
+        fraction; `LEVEL_TOLERANCE` unless `compare` was given another)."""
+        return float(self.settings.get("level_tolerance", LEVEL_TOLERANCE))
 
     def bounds_record(self) -> dict | None:
         """The JSON of `bounds`: per device and controller, the RMS of each response and its
@@ -366,6 +389,7 @@ def compare(
     faults=(),
     delay: int = 1,
     sensing=None,
+    level_tolerance: float = LEVEL_TOLERANCE,
 ) -> Comparison:
     """Run the passive vehicle and each controller on ``scenario`` and collect the metrics.
 
@@ -398,10 +422,13 @@ def compare(
     and communication delay in controller periods (`Suspension.delay`; the bounds have it too).
     ``sensing``: what every controller measures (`railride.secondary.sensing.Accelerometers`; None: the
     exact states; the bounds measure the same); a law that reads the bogies' states is not run
-    with it (``settings["not_run"]`` says why). Every setting is checked before the first run."""
+    with it (``settings["not_run"]`` says why). ``level_tolerance``: two RMS values closer than
+    this fraction of the larger are level in `Comparison.trade_offs` (default 0.01, 1 %;
+    recorded in ``settings``). Every setting is checked before the first run."""
     from railride import arguments
 
     window = arguments.window("window", window)
+    level_tolerance = _check_level(level_tolerance)
     comfort, bounds = arguments.flag("comfort", comfort), arguments.flag("bounds", bounds)
     given = vehicle_argument(vehicle, params)
     car, record = resolve_vehicle(given, load=load)
@@ -498,6 +525,7 @@ def compare(
         **solver.to_dict(),
         "window_s": None if window is None else [float(w) for w in window],
         "sensor_noise": None if sensor_noise is None else sensor_noise.__dict__,
+        "level_tolerance": level_tolerance,
         **({"not_run": not_run} if not_run else {}),
         **({"faults": [f.label for f in faults]} if faults else {}),
         **({"delay_periods": int(delay)} if delay != 1 else {}),
@@ -526,6 +554,7 @@ def compare(
             bounds=False,
             delay=delay,
             sensing=sensing,
+            level_tolerance=level_tolerance,
         )
     return Comparison(
         names,

@@ -324,12 +324,16 @@ def test_diverged_run_status_2(tmp_path, monkeypatch):
 def test_trade_offs_name_every_response_a_controller_loses(short_doc):
     rows = {r["name"]: r for r in short_doc["controllers"]}
     rms = {n: {k: r["metrics"][k]["rms"] for k in RESPONSES} for n, r in rows.items()}
+    tol = short_doc["settings"]["level_tolerance"]
     seen = set()
     for t in short_doc["trade_offs"]:
         a, b = t["controller"], t["than"]
         seen.add((a, b))
-        assert sorted(t["worse_on"]) == sorted(k for k in RESPONSES if rms[a][k] > rms[b][k])
-        assert sorted(t["better_on"]) == sorted(k for k in RESPONSES if rms[a][k] < rms[b][k])
+        # level: within the tolerance of the larger value; otherwise better or worse
+        level = sorted(k for k in RESPONSES if abs(rms[a][k] - rms[b][k]) <= tol * max(rms[a][k], rms[b][k]))
+        assert sorted(t["level_on"]) == level
+        assert sorted(t["worse_on"]) == sorted(k for k in RESPONSES if rms[a][k] > rms[b][k] and k not in level)
+        assert sorted(t["better_on"]) == sorted(k for k in RESPONSES if rms[a][k] < rms[b][k] and k not in level)
     controlled = [n for n in rows if n != "passive"]
     assert seen == {(n, "passive") for n in controlled} | {
         (a, b) for i, a in enumerate(controlled) for b in controlled[i + 1 :]
@@ -363,7 +367,10 @@ def test_compare_table_shows_the_trade_offs_and_the_bounds(short_doc):
     assert "not bounds" in text and "upper bound" not in text and "best any" not in text
     losing = [t for t in short_doc["trade_offs"] if t["worse_on"]]
     assert losing  # with the shipped gains, PID beats SAS on pitch and loses the rest
-    assert result.stdout.count("trade-off:") == len(losing)
+    # one line per winner and sets of responses won, lost and level (pairs alike share a line)
+    groups = {(t["controller"], tuple(t["better_on"]), tuple(t["worse_on"]), tuple(t["level_on"])) for t in losing}
+    assert 0 < result.stdout.count("trade-off:") == len(groups) <= len(losing)
+    assert "within 1 % of the larger count as level" in text
     assert "beside the references" not in run(*SHORT, "--no-bounds").stdout
 
 
