@@ -27,6 +27,7 @@ from scipy import signal as sp_signal
 from railride.errors import InputError
 from railride import validation
 from railride.analysis.metrics import check_window
+from railride.model.vehicle import LABEL_ATTRS
 
 # -- frequency weightings ---------------------------------------------------------------------
 
@@ -522,10 +523,14 @@ def _floor(ds, positions):
     bending = _bending(ds, lead, x)
     if bending is not None:
         floor = floor + bending
-    coords = {"position": names, "time": ds["time"].values}
-    x_coord = (lead + ["position"], x if lead else x[0])
+    coords: dict[str, Any] = {
+        "position": ("position", names, LABEL_ATTRS["position"]),
+        "time": ("time", ds["time"].values, LABEL_ATTRS["time"]),
+    }
+    x_attrs = {"long_name": "x of the floor position from the carbody centre (front +)", "units": "m"}
+    x_coord = (lead + ["position"], x if lead else x[0], x_attrs)
     if lead:
-        coords["sample"] = ds["sample"].values
+        coords["sample"] = ("sample", ds["sample"].values, LABEL_ATTRS["sample"])
     else:
         floor = floor[0]
     da = xr.DataArray(
@@ -589,10 +594,12 @@ def ride_comfort(ds: xr.Dataset, positions=POSITION_KEYWORDS, window=None, weigh
     notes.append("N_MV_z is the vertical term of EN 12299 only: the model has no lateral or longitudinal motion")
     dims = list(floor.dims[:-1]) + ["index"]
     coords = {k: v for k, v in floor.coords.items() if "time" not in v.dims}
-    coords["index"] = names
+    coords["index"] = ("index", names, {"long_name": "comfort index", "units": ""})
     out = xr.DataArray(data, dims=dims, coords=coords, name="ride_comfort")
-    out = out.assign_coords(unit=("index", units))
+    out = out.assign_coords(unit=("index", units, {"long_name": "unit of each index", "units": ""}))
     out.attrs = {
+        "long_name": "ride comfort on the carbody floor",
+        "units": "per index, as the coordinate unit gives",
         "n_intervals": int(rms.shape[-1]),
         "notes": "; ".join(notes),
         "pitch_acceleration": floor.attrs["pitch_acceleration"],

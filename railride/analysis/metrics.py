@@ -22,6 +22,17 @@ RESPONSES = {
     "roll_deg": ("carbody_roll", 180.0 / math.pi),
 }
 STATISTICS = ("rms", "ptp")
+#: the attributes of the metrics and their coordinates (CF conventions; a label has the units "").
+#: The responses differ in unit: each response's name ends in its own
+METRICS_ATTRS = {
+    "long_name": "carbody ride metrics: RMS about zero and peak-to-peak",
+    "units": "per response, as its name ends: m/s^2, m, deg, deg",
+}
+COORD_ATTRS = {
+    "response": {"long_name": "carbody response (the name ends in its unit)", "units": ""},
+    "statistic": {"long_name": "statistic (rms: RMS about zero; ptp: peak-to-peak)", "units": ""},
+    "sample": {"long_name": "sample of the batch", "units": ""},
+}
 
 
 def parse_window(text: str) -> tuple[float, float]:
@@ -100,10 +111,15 @@ def metrics_from_arrays(acceleration, bounce, pitch, roll, sample=None, diverged
         values.append(np.stack([np.sqrt(np.mean(x**2, axis=-1)), np.ptp(x, axis=-1)], axis=-1))
     data = np.stack(values, axis=-2)  # (..., response, statistic)
     lead = [] if data.ndim == 2 else ["sample"]
-    coords: dict[str, Any] = {"response": list(RESPONSES), "statistic": list(STATISTICS)}
+    coords: dict[str, Any] = {
+        "response": ("response", list(RESPONSES), COORD_ATTRS["response"]),
+        "statistic": ("statistic", list(STATISTICS), COORD_ATTRS["statistic"]),
+    }
     if lead:
-        coords["sample"] = np.arange(data.shape[0]) if sample is None else sample
-    out = xr.DataArray(data, dims=lead + ["response", "statistic"], coords=coords, name="ride_metrics")
+        coords["sample"] = ("sample", np.arange(data.shape[0]) if sample is None else sample, COORD_ATTRS["sample"])
+    out = xr.DataArray(
+        data, dims=lead + ["response", "statistic"], coords=coords, name="ride_metrics", attrs=dict(METRICS_ATTRS)
+    )
     finite = np.isfinite(data)
     if diverged is not None:
         mask = np.atleast_1d(np.asarray(diverged, dtype=bool))
@@ -119,6 +135,7 @@ def reduction(metrics: xr.DataArray, baseline: xr.DataArray) -> xr.DataArray:
         raise InputError("a baseline metric is zero: the reduction in % is undefined")
     out = (baseline - metrics) / baseline * 100.0
     out.name = "reduction_percent"
+    out.attrs = {"long_name": "reduction against the baseline, (baseline - value) / baseline", "units": "%"}
     return out
 
 

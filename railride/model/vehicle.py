@@ -54,9 +54,33 @@ DOF_UNITS = ("m", "rad", "rad") * 3
 #: the tenth DOF of a flexible carbody: its first vertical bending mode, the centre's deflection
 BENDING_NAME = "carbody_bending"
 BENDING_UNIT = "m"
+#: what each DOF is, in words (the ``long_name`` of its channel)
+DOF_LONG_NAMES = tuple(
+    f"{body} {motion}"
+    for body in ("carbody", "front bogie", "rear bogie")
+    for motion in ("bounce displacement", "pitch angle", "roll angle")
+)
+#: ... and of its velocity
+DOF_RATE_LONG_NAMES = tuple(
+    f"{body} {motion}"
+    for body in ("carbody", "front bogie", "rear bogie")
+    for motion in ("bounce velocity", "pitch rate", "roll rate")
+)
+BENDING_LONG_NAME = "carbody first vertical bending: the centre's deflection from the rigid body"
 CORNER_NAMES = ("1R", "1L", "2R", "2L")
 WHEELSETS = (1, 2, 3, 4)
 RAILS = ("L", "R")
+#: the attributes of the label coordinates of the results (CF conventions: a label has the units
+#: "", a dimensionless number "1"): secondary corners, wheelsets, rails, floor positions, the
+#: samples of a batch and time
+LABEL_ATTRS = {
+    "corner": {"long_name": "secondary suspension corner (bogie 1 leads; R at y = -d_s)", "units": ""},
+    "wheelset": {"long_name": "wheelset (1 leads)", "units": ""},
+    "rail": {"long_name": "rail (L left, R right)", "units": ""},
+    "position": {"long_name": "carbody floor position", "units": ""},
+    "sample": {"long_name": "sample of the batch", "units": ""},
+    "time": {"long_name": "time", "units": "s"},
+}
 N_RAIL_INPUT = N_RAIL
 
 _BODY_OFFSET = {"carbody": 0, "front_bogie": 3, "rear_bogie": 6}
@@ -388,26 +412,44 @@ class Vehicle:
         positions = {"centre": 0.0, "front": self.params.l, "rear": -self.params.l}
         ds = xr.Dataset(
             coords={
-                "frequency": ("frequency", f, {"units": "Hz"}),
-                "corner": list(CORNER_NAMES),
-                "position": list(positions),
+                "frequency": ("frequency", f, {"long_name": "frequency", "units": "Hz"}),
+                "corner": ("corner", list(CORNER_NAMES), LABEL_ATTRS["corner"]),
+                "position": ("position", list(positions), LABEL_ATTRS["position"]),
             }
         )
+
+        def per_metre(long_name: str, units: str) -> dict:
+            return {"long_name": f"{long_name} per metre of rail amplitude (complex)", "units": units}
+
+        long_names = (*DOF_LONG_NAMES, BENDING_LONG_NAME)
         for i, name in enumerate(self.dof_names):
-            ds[name] = ("frequency", H[:, i], {"units": f"{self.dof_units[i]}/m"})
-        ds["carbody_acceleration"] = ("frequency", -(omega**2) * H[:, 0], {"units": "(m/s^2)/m"})
+            ds[name] = ("frequency", H[:, i], per_metre(long_names[i], f"{self.dof_units[i]}/m"))
+        ds["carbody_acceleration"] = (
+            "frequency",
+            -(omega**2) * H[:, 0],
+            per_metre("carbody CG vertical acceleration", "(m/s^2)/m"),
+        )
         floor = np.array([self.floor_point(x) for x in positions.values()]).T  # (n_dof, 3)
         ds["floor_acceleration"] = (
             ("frequency", "position"),
             -(omega**2)[:, None] * (H @ floor),
-            {"units": "(m/s^2)/m"},
+            per_metre("carbody floor vertical acceleration at (x, 0)", "(m/s^2)/m"),
         )
-        ds = ds.assign_coords(x_m=("position", list(positions.values()), {"units": "m"}))
+        x_attrs = {"long_name": "x of the floor position from the carbody centre (front +)", "units": "m"}
+        ds = ds.assign_coords(x_m=("position", list(positions.values()), x_attrs))
         corner = H @ self.T  # T^T q: the secondary deflection at each corner
         body = list(self.carbody_dofs)
         corner_body = H[:, body] @ self.T[body]  # the carbody part alone: corner displacement
-        ds["carbody_corner_displacement"] = (("frequency", "corner"), corner_body, {"units": "m/m"})
-        ds["secondary_deflection"] = (("frequency", "corner"), corner, {"units": "m/m"})
+        ds["carbody_corner_displacement"] = (
+            ("frequency", "corner"),
+            corner_body,
+            per_metre("carbody vertical displacement above each secondary corner", "m/m"),
+        )
+        ds["secondary_deflection"] = (
+            ("frequency", "corner"),
+            corner,
+            per_metre("secondary vertical deflection, carbody minus bogie (extension +)", "m/m"),
+        )
         ds.attrs.update(
             speed_m_s=speed,
             rail_L=str(cL),

@@ -17,10 +17,31 @@ from railride.secondary import dampers
 from railride.model.params import PRESETS, VehicleParams
 from railride.plots import PNG_DPI, FigureOptions
 from railride.run.solver import SolverSettings
-from railride.model.vehicle import CORNER_NAMES, DOF_NAMES, DOF_UNITS, RAILS, WHEELSETS
+from railride.model.vehicle import (
+    BENDING_LONG_NAME,
+    CORNER_NAMES,
+    DOF_LONG_NAMES,
+    DOF_NAMES,
+    DOF_RATE_LONG_NAMES,
+    DOF_UNITS,
+    LABEL_ATTRS,
+    RAILS,
+    WHEELSETS,
+)
 
 #: the schema of `RideResult.to_dict`, the document of ``railride simulate``
 SCHEMA = "railride.simulation/1"
+
+
+#: the attributes of the text variables of a result (per sample in a batch); CF conventions:
+#: text has the units ""
+TEXT_ATTRS = {
+    "scenario": {"long_name": "the scenario's record (JSON)", "units": ""},
+    "vehicle_params": {"long_name": "the vehicle's parameters (JSON)", "units": ""},
+    "damper_faults": {"long_name": "damper faults (corner-kind[@time s], comma-separated; empty: none)", "units": ""},
+    "controller": {"long_name": "outer-loop controller", "units": ""},
+    "controller_gains": {"long_name": "the controller's gains (JSON)", "units": ""},
+}
 
 
 def has_damper_states(damper) -> bool:
@@ -65,14 +86,26 @@ def build_dataset(
     # name -> (extra dims, values with leading (sample, time), attrs)
     channels: dict[str, tuple[tuple[str, ...], Any, dict[str, str]]] = {}
     for i, name in enumerate(DOF_NAMES):
-        channels[name] = ((), out["q"][:, :, i], {"units": DOF_UNITS[i]})
-        channels[f"{name}_velocity"] = ((), out["v"][:, :, i], {"units": f"{DOF_UNITS[i]}/s"})
+        channels[name] = ((), out["q"][:, :, i], {"units": DOF_UNITS[i], "long_name": DOF_LONG_NAMES[i]})
+        channels[f"{name}_velocity"] = (
+            (),
+            out["v"][:, :, i],
+            {"units": f"{DOF_UNITS[i]}/s", "long_name": DOF_RATE_LONG_NAMES[i]},
+        )
     if flexible:  # the carbody's first vertical bending mode (a rigid sample's is 0)
         b = len(DOF_NAMES)
-        long = "carbody first vertical bending: the centre's deflection from the rigid body"
+        long = BENDING_LONG_NAME
         channels["carbody_bending"] = ((), out["q"][:, :, b], {"units": "m", "long_name": long})
-        channels["carbody_bending_velocity"] = ((), out["v"][:, :, b], {"units": "m/s", "long_name": long})
-        channels["carbody_bending_acceleration"] = ((), out["a"][:, :, b], {"units": "m/s^2", "long_name": long})
+        channels["carbody_bending_velocity"] = (
+            (),
+            out["v"][:, :, b],
+            {"units": "m/s", "long_name": f"{long}, its rate"},
+        )
+        channels["carbody_bending_acceleration"] = (
+            (),
+            out["a"][:, :, b],
+            {"units": "m/s^2", "long_name": f"{long}, its acceleration"},
+        )
     channels["carbody_acceleration"] = (
         (),
         out["a"][:, :, 0],
@@ -98,7 +131,11 @@ def build_dataset(
         deflection,
         {"units": "m", "long_name": "secondary vertical deflection, carbody minus bogie (extension +)"},
     )
-    channels["secondary_deflection_velocity"] = (("corner",), out["v"] @ T, {"units": "m/s"})
+    channels["secondary_deflection_velocity"] = (
+        ("corner",),
+        out["v"] @ T,
+        {"units": "m/s", "long_name": "secondary vertical deflection rate, carbody minus bogie (extension +)"},
+    )
     channels["secondary_spring_force"] = (
         ("corner",),
         -ksz * deflection,
@@ -163,29 +200,27 @@ def build_dataset(
         }
         controller_names = np.array([c.name for c in ctrl])
         controller_gains = np.array([json.dumps(c.to_dict()) for c in ctrl])
-    data: dict[str, tuple]  # name -> (dims, values[, attrs]), as xr.Dataset takes them
+    texts = {"scenario": scen, "vehicle_params": pars}
+    if any(faults):  # e.g. "1R-off@2.5,2L-disconnected"; empty for a healthy sample
+        texts["damper_faults"] = np.array([",".join(f.label for f in fs) for fs in faults])
+    if closed is not None:
+        texts["controller"] = controller_names
+        texts["controller_gains"] = controller_gains
+    data: dict[str, tuple]  # name -> (dims, values, attrs), as xr.Dataset takes them
     if batch:
         data = {k: (("sample", "time") + d, v, a) for k, (d, v, a) in channels.items()}
-        data["scenario"] = ("sample", scen)
-        data["vehicle_params"] = ("sample", pars)
+        data.update({k: ("sample", v, TEXT_ATTRS[k]) for k, v in texts.items()})
     else:
         data = {k: (("time",) + d, v[0], a) for k, (d, v, a) in channels.items()}
-        data["scenario"] = ((), scen[0])
-        data["vehicle_params"] = ((), pars[0])
-    if any(faults):  # e.g. "1R-off@2.5,2L-disconnected"; empty for a healthy sample
-        labels = np.array([",".join(f.label for f in fs) for fs in faults])
-        data["damper_faults"] = ("sample", labels) if batch else ((), labels[0])
-    if closed is not None:
-        data["controller"] = ("sample", controller_names) if batch else ((), controller_names[0])
-        data["controller_gains"] = ("sample", controller_gains) if batch else ((), controller_gains[0])
+        data.update({k: ((), v[0], TEXT_ATTRS[k]) for k, v in texts.items()})
     coords = {
-        "time": ("time", time, {"units": "s"}),
-        "corner": ("corner", list(CORNER_NAMES)),
-        "wheelset": ("wheelset", list(WHEELSETS)),
-        "rail": ("rail", list(RAILS)),
+        "time": ("time", time, LABEL_ATTRS["time"]),
+        "corner": ("corner", list(CORNER_NAMES), LABEL_ATTRS["corner"]),
+        "wheelset": ("wheelset", list(WHEELSETS), LABEL_ATTRS["wheelset"]),
+        "rail": ("rail", list(RAILS), LABEL_ATTRS["rail"]),
     }
     if batch:
-        coords["sample"] = ("sample", np.arange(len(param_sets)))
+        coords["sample"] = ("sample", np.arange(len(param_sets)), LABEL_ATTRS["sample"])
     attrs = {
         "title": "railride ride simulation",
         "railride_version": __version__,

@@ -260,15 +260,17 @@ def drive(
         values = out[:, :, j] if voltage is not None else out[0, :, j]
         unit, long = attrs[name]
         data[name] = (dims, values, {"units": unit, "long_name": long})
-    coords = {"time": ("time", time, {"units": "s"})}
+    coords = {"time": ("time", time, {"long_name": "time", "units": "s"})}
     if voltage is not None:
-        coords["voltage"] = ("voltage", vconst, {"units": "V"})
+        coords["voltage"] = ("voltage", vconst, {"long_name": "constant command voltage of the run", "units": "V"})
     else:
         fn_name = "desired_force" if desired_force is not None else "command"
         data[fn_name] = (
             "time",
             np.broadcast_to(fn(time), time.shape).astype(float),
-            {"units": "N" if desired_force is not None else "V"},
+            {"units": "N", "long_name": "desired damper force, tension +"}
+            if desired_force is not None
+            else {"units": "V", "long_name": "command voltage as the function gives it"},
         )
     ds = xr.Dataset(data, coords=coords)
     ds.attrs.update(damper=json.dumps(damper.to_dict()), dt_s=dt, integrator="RK4 with stiffness sub-steps")
