@@ -2,13 +2,17 @@
 
 `write_report(result, path)` writes, for a result this module knows (`KNOWN`: `Comparison`,
 `SweepResult`, `TuneResult`, `StudyResult`, `LeagueTable`, `RideResult`, `FrfResult`), a page
-with the run's settings and provenance (railride version, scenario, vehicle parameters, the
-command line), the vehicle's modal table, the tables the command line printed (HTML fragments
-given by the caller, ``console_html``), the result's own table (``to_pandas()``) and every
-figure its ``save()`` writes: time histories, spectra and frequency responses as interactive
-plotly figures (`railride.plots.interactive`), the others as the package's matplotlib figures
-inlined as images. Nothing is fetched when the page opens: plotly's JavaScript is inlined once
-and every image is a data URI. See docs/report.md.
+that gives the answer first: the result's own table (``to_pandas()``), the trade-offs in words and
+the recommendation where the result has them; then every figure its ``save()`` writes (time
+histories, spectra and frequency responses as interactive plotly figures,
+`railride.plots.interactive`; the others as the package's matplotlib figures), the tables the
+command line printed (HTML fragments given by the caller, ``console_html``), the run's settings
+and provenance (railride version, scenario, the command line) and the vehicle's modal table.
+
+Nothing is fetched when the page opens, and the page fits an e-mail: plotly's JavaScript and
+each figure's data are inlined once, gzip-compressed and base64-encoded, and unpacked by the
+browser (``DecompressionStream``, `LOADER`); a static figure is a compressed SVG, or a PNG data
+URI where that is smaller. See docs/report.md.
 
 A new result type is one function returning its `Contents`, which the result's ``report_contents()``
 method calls: the report is chosen by what a result has, never by its class's name.
@@ -18,6 +22,8 @@ from __future__ import annotations
 
 import base64
 import datetime as _dt
+import functools
+import gzip
 import html
 import io
 import json
@@ -34,20 +40,23 @@ from railride._io import atomic_write_text
 
 #: rows of a result table shown in the report; a longer table shows its first rows and says so
 MAX_TABLE_ROWS = 500
-#: a matplotlib figure is inlined as SVG (sharp at any zoom) up to this many bytes, else as PNG:
-#: a long noisy history in SVG keeps every vertex matplotlib cannot simplify away
-SVG_LIMIT = 500_000
+#: gzip level of what the page packs (plotly's JavaScript, the figures' data, the SVG figures)
+GZIP_LEVEL = 9
 #: file names a report may take
 SUFFIXES = (".html", ".htm")
 
 
 @dataclass
 class Contents:
-    """What a result contributes to its report. ``figures``: (name, caption, figure) with a
-    plotly or matplotlib figure, one per figure file its ``save()`` writes (``name``.png), in
-    that order; ``tables``: (caption, DataFrame); ``settings``: nested values shown flat;
-    ``scenario``: the scenario's record (`Scenario.describe()`), if one; ``params``: the
-    `VehicleParams` of the modal table (None: the vehicles differ, no single table)."""
+    """What a result contributes to its report. ``figures``: (name, caption, figure) or (name,
+    caption, figure, note) with a plotly or matplotlib figure, one per figure file its ``save()``
+    writes (``name``.png), in that order; the note, if any, is printed under the figure (a
+    caveat the figure's reader needs); ``tables``: (caption, DataFrame), the first of them the
+    answer at the top of the page; ``findings``: sentences under it (a comparison's trade-offs);
+    ``recommendation``: what the result recommends, in words, above it ("" if nothing);
+    ``settings``: nested values shown flat; ``scenario``: the scenario's record
+    (`Scenario.describe()`), if one; ``params``: the `VehicleParams` of the modal table (None:
+    the vehicles differ, no single table)."""
 
     title: str
     settings: dict
@@ -55,6 +64,8 @@ class Contents:
     scenario: dict | None = None
     figures: list = field(default_factory=list)
     tables: list = field(default_factory=list)
+    findings: list = field(default_factory=list)
+    recommendation: str = ""
 
 
 #: the result types with a report (each has a ``report_contents()`` method that calls one of the
@@ -103,6 +114,7 @@ def comparison_contents(result) -> Contents:
     from railride.analysis.spectra import PSD_SEGMENT_S, comparison_psd
     from railride.analysis.labels import CARBODY_RESPONSES, psd_title
     from railride.plots import comparison as plots
+    from railride.output.trade_offs import trade_off_lines
     from railride.plots.interactive import comparison_psd_figure, comparison_response_figure
 
     doc = result.to_dict()
@@ -126,15 +138,37 @@ def comparison_contents(result) -> Contents:
         params=_vehicle(settings),
         scenario=settings.get("scenario"),
         figures=figures,
-        tables=[("RMS and peak-to-peak per suspension and response, reduction % against passive", result.to_pandas())],
+        tables=[
+            (
+                "RMS and peak-to-peak per response (rows) and suspension (columns), reduction % against passive",
+                _wide(result.to_pandas()),
+            )
+        ],
+        findings=trade_off_lines(doc),
     )
+
+
+def _wide(frame: pd.DataFrame) -> pd.DataFrame:
+    """A comparison's table (one row per suspension, response and statistic) as one row per
+    response and statistic, a column per suspension and, where it has one, its reduction in %
+    (one decimal, as the command line prints it)."""
+    index = frame.set_index(["controller", "response", "statistic"])
+    rows = list(dict.fromkeys(zip(frame["response"], frame["statistic"])))
+    out = pd.DataFrame(rows, columns=["response", "statistic"])
+    for name in dict.fromkeys(frame["controller"]):
+        keys = [(name, r, s) for r, s in zip(out["response"], out["statistic"])]
+        part = index.reindex(keys)
+        out[name] = part["value"].to_numpy()
+        if part["reduction_percent"].notna().any():
+            out[f"{name} red. %"] = part["reduction_percent"].round(1).to_numpy()
+    return out
 
 
 def sweep_contents(result) -> Contents:
     """The report of a `railride.studies.sweep.SweepResult`."""
     from railride.plots.sweep import has_comfort, sweep_plot_axis
 
-    settings = result.settings()
+    settings = result.settings
     axis = sweep_plot_axis(result)  # None: no numeric axis with several values, no figure
     figures = [] if axis is None else [("sweep", f"RMS against {axis}", result.plot(axis=axis))]
     if axis is not None and has_comfort(result):
@@ -187,6 +221,7 @@ def design_contents(result) -> Contents:
             ("design_costs", "each law's score against the RMS damper force it asks for", plot_design_costs(result)),
         ],
         tables=[("one row per law, speed, load and metric (held out)", result.to_pandas())],
+        recommendation=result.recommendation,
     )
 
 
@@ -298,47 +333,61 @@ def report_html(result, *, console_html=(), title: str | None = None, command: s
     """The report of ``result`` as one HTML document. ``console_html``: HTML fragments (or whole
     documents, whose body is taken) of the tables a command printed, e.g. rich's
     ``Console.export_html(inline_styles=True)``, inlined as given; ``title`` replaces the
-    result's; ``command``: the command line that made the result."""
-    import plotly.offline
+    result's; ``command``: the command line that made the result.
 
+    The answer comes first (the result's table, its findings and recommendation), then the
+    figures, what the command printed, the settings and provenance, the vehicle; the packed
+    data and their loader close the page."""
     from railride.model.modes import modes
 
     part = contents(result)
     heading = title or part.title
-    sections = [("settings", "Settings and provenance", _settings_html(part, command))]
+    packs: dict[str, bytes | None] = {}
+    sections = [("answer", "Results", _answer_html(part))]
+    if part.figures:
+        sections.append(("figures", "Figures", "\n".join(_figure_html(packs, *f) for f in part.figures)))
+    if part.tables[1:]:
+        sections.append(("tables", "More tables", "\n".join(_caption_table(c, t) for c, t in part.tables[1:])))
+    if console_html:
+        sections.append(("console", "What the command printed", "\n".join(_fragment(f) for f in console_html)))
+    sections.append(("settings", "Settings and provenance", _settings_html(part, command)))
     if part.params is not None:
         table = modes(part.params).to_pandas()
         sections.append(("vehicle", "Vehicle: modes and parameters", _table_html(table) + _params_html(part.params)))
     else:
         sections.append(("vehicle", "Vehicle", "<p>The runs' vehicles differ: no single modal table.</p>"))
-    if console_html:
-        sections.append(("console", "What the command printed", "\n".join(_fragment(f) for f in console_html)))
-    if part.figures:
-        sections.append(("figures", "Figures", "\n".join(_figure_html(*f) for f in part.figures)))
-    if part.tables:
-        sections.append(("tables", "Tables", "\n".join(_caption_table(c, t) for c, t in part.tables)))
     nav = " | ".join(f'<a href="#{key}">{html.escape(name)}</a>' for key, name, _ in sections)
     body = "\n".join(
         f'<section id="{key}"><h2>{html.escape(name)}</h2>\n{text}</section>' for key, name, text in sections
     )
     when = _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
-    # plotly's JavaScript, once, and only for a page with an interactive figure (it is 4.8 MB)
-    interactive = any(hasattr(figure, "to_html") for _, _, figure in part.figures)
-    script = f'<script type="text/javascript">{plotly.offline.get_plotlyjs()}</script>' if interactive else ""
     return f"""<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8">
 <meta name="viewport" content="width=device-width, initial-scale=1">
 <meta name="generator" content="railride {__version__}">
 <title>railride: {html.escape(heading)}</title>
 <style>{STYLE}</style>
-{script}
 </head><body>
 <header><h1>{html.escape(heading)}</h1>
 <p class="meta">railride {__version__}, written {when}</p>
 <nav>{nav}</nav></header>
 {body}
+{_packed_html(packs)}
 </body></html>
 """
+
+
+def _answer_html(part: Contents) -> str:
+    """The top of the page: the recommendation, the result's own table, the findings."""
+    lines = []
+    if part.recommendation:
+        lines.append(f'<p class="recommendation"><b>Recommendation.</b> {html.escape(part.recommendation)}</p>')
+    if part.tables:
+        lines.append(_caption_table(*part.tables[0]))
+    if part.findings:
+        items = "".join(f"<li>{html.escape(line)}</li>" for line in part.findings)
+        lines.append(f'<ul class="findings">{items}</ul>')
+    return "\n".join(lines) or "<p>This result has no table.</p>"
 
 
 STYLE = """
@@ -355,6 +404,76 @@ pre.console { font-family: "DejaVu Sans Mono", Menlo, Consolas, monospace; font-
   background: #fcfcfc; border: 1px solid #e6e6e6; padding: 0.6em; overflow-x: auto; }
 figure { margin: 1.2em 0; } figcaption { color: #444; font-size: 0.9em; margin-bottom: 0.3em; }
 figure img { max-width: 100%; height: auto; border: 1px solid #eee; }
+.recommendation { background: #f3f8ef; border-left: 4px solid #5a9a3c; padding: 0.5em 0.8em; }
+ul.findings { padding-left: 1.2em; } ul.findings li { margin: 0.2em 0; }
+"""
+
+#: what a figure says until it is drawn (and stays saying where the page's script does not run)
+WAITING = "Unpacking the figure... (it needs JavaScript: Chrome or Edge 80, Firefox 113, Safari 16.4 or later)"
+
+#: the page's one script: unpacks each <script type="application/gzip"> (base64 of gzip) with
+#: the browser's DecompressionStream, runs plotly's JavaScript, draws each plotly figure
+#: (Plotly.newPlot with __CONFIG__) and shows each packed SVG from a blob: URL; nothing is
+#: fetched. When done, <html data-figures="drawn"> (or "failed", with the reason in the figure
+#: and the console), which the browser test waits for.
+LOADER = """
+(function () {
+  "use strict";
+  var config = __CONFIG__;
+  var root = document.documentElement;
+  var plots = Array.prototype.slice.call(document.querySelectorAll("div[data-pack]"));
+  var images = Array.prototype.slice.call(document.querySelectorAll("img[data-pack]"));
+  function say(node, text) {
+    var p = document.createElement("p");
+    p.className = "note";
+    p.textContent = text;
+    if (node.tagName === "IMG") { node.replaceWith(p); } else { node.replaceChildren(p); }
+  }
+  function unpack(id) {
+    var text = atob(document.getElementById(id).textContent.replace(/\\s+/g, ""));
+    var bytes = new Uint8Array(text.length);
+    for (var i = 0; i < text.length; i++) { bytes[i] = text.charCodeAt(i); }
+    return new Response(new Blob([bytes]).stream().pipeThrough(new DecompressionStream("gzip")));
+  }
+  if (typeof DecompressionStream === "undefined") {
+    plots.concat(images).forEach(function (node) {
+      say(node, "This browser cannot unpack the figures (it lacks DecompressionStream): " +
+        "open the page in Chrome or Edge 80, Firefox 113, Safari 16.4 or later.");
+    });
+    root.dataset.figures = "failed";
+    return;
+  }
+  var plotly = !plots.length ? Promise.resolve() : unpack("pack-plotly").text().then(function (code) {
+    window.PlotlyConfig = { MathJaxConfig: "local" };
+    var script = document.createElement("script");
+    script.text = code;
+    document.head.appendChild(script);
+  });
+  function failed(node) {
+    return function (error) {
+      say(node, "This figure could not be drawn: " + error);
+      throw error;
+    };
+  }
+  var jobs = plots.map(function (div) {
+    return Promise.all([plotly, unpack(div.dataset.pack).json()]).then(function (done) {
+      div.replaceChildren();
+      return Plotly.newPlot(div, done[1].data, done[1].layout, config);
+    }).catch(failed(div));
+  }).concat(images.map(function (img) {
+    return unpack(img.dataset.pack).blob().then(function (blob) {
+      return new Promise(function (resolve, reject) {
+        img.onload = resolve;
+        img.onerror = function () { reject(new Error("the image did not decode")); };
+        img.src = URL.createObjectURL(new Blob([blob], { type: img.dataset.type }));
+      });
+    }).catch(failed(img));
+  }));
+  Promise.all(jobs).then(function () { root.dataset.figures = "drawn"; }, function (error) {
+    root.dataset.figures = "failed";
+    console.error("railride report: " + error);
+  });
+})();
 """
 
 
@@ -439,29 +558,75 @@ def _fragment(text: str) -> str:
     return found.group(1) if found else text
 
 
-def _figure_html(name: str, caption: str, figure) -> str:
-    if hasattr(figure, "to_html"):  # plotly
-        from railride.plots.interactive import CONFIG
+def _figure_html(packs: dict, name: str, caption: str, figure, note: str | None = None) -> str:
+    """A figure: a plotly figure as an empty plot whose data go into ``packs`` (drawn by
+    `LOADER`), a matplotlib one as an image (`_image`); the caption above, the note below."""
+    key = f"figure-{name}"
+    if hasattr(figure, "to_plotly_json"):  # plotly
+        import plotly.io
 
-        inner = figure.to_html(full_html=False, include_plotlyjs=False, div_id=f"plot-{name}", config=CONFIG)
+        packs[key] = _gzip(plotly.io.to_json(figure, validate=False, pretty=False).encode("utf-8"))
+        packs.setdefault("plotly", None)  # plotly's JavaScript, once, and only with a plotly figure
+        height = figure.layout.height or 450
+        inner = (
+            f'<div id="plot-{html.escape(name)}" class="plotly-graph-div" data-pack="pack-{html.escape(key)}" '
+            f'style="height:{int(height)}px; width:100%;"><p class="note">{WAITING}</p></div>'
+        )
         kind = "interactive"
     else:  # matplotlib
-        inner = _image(figure, caption)
+        inner = _image(packs, key, figure, caption)
         kind = "static"
     caption = f"{caption} ({name}.png in the output folder)"
-    return f'<figure id="figure-{name}" class="{kind}"><figcaption>{html.escape(caption)}</figcaption>{inner}</figure>'
+    after = f'<p class="note">{html.escape(note)}</p>' if note else ""
+    return (
+        f'<figure id="{html.escape(key)}" class="{kind}"><figcaption>{html.escape(caption)}</figcaption>'
+        f"{inner}{after}</figure>"
+    )
 
 
-def _image(figure, alt: str) -> str:
-    """A matplotlib figure as an <img> with a data URI (its SVG ids stay its own): SVG when small
-    enough, else PNG."""
+def _image(packs: dict, key: str, figure, alt: str) -> str:
+    """A matplotlib figure as an <img>, whichever is smaller: its SVG (sharp at any zoom),
+    gzip-compressed into ``packs`` and shown by `LOADER` from a blob: URL (an <img> keeps each
+    SVG's ids to itself), or its PNG as a data URI. A long noisy history in SVG keeps every
+    vertex matplotlib cannot simplify away, and comes out larger than its PNG."""
     from railride.plots._style import PNG_DPI
 
     buffer = io.BytesIO()
     figure.savefig(buffer, format="svg", metadata={"Date": None})
-    data, mime = buffer.getvalue(), "image/svg+xml"
-    if len(data) > SVG_LIMIT:
-        buffer = io.BytesIO()
-        figure.savefig(buffer, format="png", dpi=PNG_DPI)
-        data, mime = buffer.getvalue(), "image/png"
-    return f'<img alt="{html.escape(alt)}" src="data:{mime};base64,{base64.b64encode(data).decode("ascii")}">'
+    svg = _gzip(buffer.getvalue())
+    buffer = io.BytesIO()
+    figure.savefig(buffer, format="png", dpi=PNG_DPI)
+    png = buffer.getvalue()
+    if len(svg) <= len(png):
+        packs[key] = svg
+        return f'<img alt="{html.escape(alt)}" data-pack="pack-{html.escape(key)}" data-type="image/svg+xml">'
+    return f'<img alt="{html.escape(alt)}" src="data:image/png;base64,{base64.b64encode(png).decode("ascii")}">'
+
+
+def _gzip(data: bytes) -> bytes:
+    return gzip.compress(data, GZIP_LEVEL, mtime=0)
+
+
+@functools.lru_cache(maxsize=1)
+def _plotly_pack() -> bytes:
+    """plotly's JavaScript (4.8 MB), gzip-compressed: once per process."""
+    import plotly.offline
+
+    return _gzip(plotly.offline.get_plotlyjs().encode("utf-8"))
+
+
+def _packed_html(packs: dict) -> str:
+    """The packed data of the figures (``packs``: id -> gzip bytes; "plotly": None for plotly's
+    JavaScript, once), each a base64 text in a <script> the browser does not run, and `LOADER`,
+    which unpacks them."""
+    if not packs:
+        return ""
+    from railride.plots.interactive import CONFIG
+
+    scripts = [
+        f'<script type="application/gzip" id="pack-{html.escape(key)}">'
+        f"{base64.b64encode(_plotly_pack() if data is None else data).decode('ascii')}</script>"
+        for key, data in packs.items()
+    ]
+    loader = LOADER.replace("__CONFIG__", json.dumps(CONFIG))
+    return "\n".join(scripts) + f"\n<script>{loader}</script>"

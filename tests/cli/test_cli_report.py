@@ -4,7 +4,11 @@ run."""
 
 from __future__ import annotations
 
+import base64
+import gzip
+import html
 import json
+import re
 
 import pytest
 from clihelp import assert_input_error, ok, run
@@ -16,7 +20,21 @@ def _page(path) -> str:
     assert path.is_file()
     text = path.read_text(encoding="utf-8")
     assert text.startswith("<!DOCTYPE html>") and text.rstrip().endswith("</html>")
+    # nothing from the network: no script, style, image or frame with a remote source
+    assert not re.search(r"""(src|href)\s*=\s*["']?(https?:)?//""", text, flags=re.I)
     return text
+
+
+def _packs(page: str) -> dict[str, bytes]:
+    """The page's packed data by id, unpacked here (base64, then gzip) as a browser would."""
+    found = re.findall(r'<script type="application/gzip" id="([^"]+)">([^<]*)</script>', page)
+    return {key: gzip.decompress(base64.b64decode(text)) for key, text in found}
+
+
+def _findings(page: str) -> list[str]:
+    """The sentences under the answer's table."""
+    found = re.search(r'<ul class="findings">(.*?)</ul>', page, flags=re.S)
+    return [html.unescape(item) for item in re.findall(r"<li>(.*?)</li>", found.group(1))] if found else []
 
 
 def test_report_command(tmp_path):
@@ -30,6 +48,48 @@ def test_report_command(tmp_path):
     assert "railride report --controllers passive,pid --speed 40.0 --duration 1.0 --no-bounds --out" in page
     assert page.count('class="plotly-graph-div"') == 5  # the four responses and the spectra
     assert [p.name for p in out.parent.iterdir()] == ["ride.html"]
+    # the answer first: the results' table and the trade-offs before the first figure
+    assert page.index('<section id="answer">') < page.index('<table class="data">') < page.index("<figure")
+    assert page.index('<ul class="findings">') < page.index("<figure") < page.index('<section id="settings">')
+    printed = " ".join(result.stdout.split())  # the trade-offs the command printed, unwrapped
+    assert _findings(page) and all(line in printed for line in _findings(page))
+    assert any(line.startswith(("trade-off: ", "no trade-off: ")) for line in _findings(page))
+
+
+def test_report_figures_unpack(tmp_path):
+    """Each figure's packed data is gzip of what the browser draws: plotly's JavaScript once, a
+    figure's JSON with a trace per suspension, an SVG per static figure (or a PNG data URI)."""
+    out = tmp_path / "ride.html"
+    ok("report", *SHORT, "--out", out)
+    page = _page(out)
+    packs = _packs(page)
+    assert page.count('id="pack-plotly"') == 1 and b"Plotly" in packs["pack-plotly"][:5000]
+    assert len(packs["pack-plotly"]) > 3_000_000  # the whole library, not a stub
+    for name in ("acceleration", "displacement", "pitch", "roll", "psd"):
+        figure = json.loads(packs[f"pack-figure-{name}"])
+        assert [t["name"] for t in figure["data"]] == ["Passive", "PID"], name
+        assert f'data-pack="pack-figure-{name}"' in page
+    for name in ("damper_forces", "damper_hysteresis", "voltages"):
+        tag = re.search(rf'<figure id="figure-{name}".*?<img [^>]*>', page, flags=re.S).group(0)
+        if "data:image/png;base64," not in tag:
+            assert packs[f"pack-figure-{name}"].lstrip().startswith(b"<?xml"), name
+            assert b"<svg" in packs[f"pack-figure-{name}"][:2000]
+
+
+def test_paper_report_fits_an_email(tmp_path):
+    """The paper's comparison at its full size (four suspensions, 10 s at dt 1e-4) makes a page of
+    at most 3 MB, with the answer on top and nothing fetched from the network."""
+    out = tmp_path / "paper.html"
+    result = ok("report", "--out", out)
+    page = _page(out)
+    assert out.stat().st_size <= 3_000_000, out.stat().st_size
+    assert page.index('<table class="data">') < page.index("<figure")
+    assert "<script src" not in page.replace(" ", "") and 'src="http' not in page
+    printed = " ".join(result.stdout.split())
+    assert len(_findings(page)) >= 2 and all(line in printed for line in _findings(page))
+    assert page.count('class="plotly-graph-div"') == 5 and page.count("<img ") == 3
+    # plotly's JavaScript, the five interactive figures, and the static ones packed as SVG
+    assert len(_packs(page)) == 1 + 5 + page.count('data-type="image/svg+xml"')
 
 
 def test_compare_report_with_json(tmp_path):
