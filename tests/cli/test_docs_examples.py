@@ -25,6 +25,7 @@ import typer.main
 
 import railride
 from railride.cli import app
+from railride.run import simulation
 from clihelp import run
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -133,6 +134,10 @@ def _earlier_tune(folder: Path) -> None:
     (folder / "paper-tune" / "runs.csv").write_text("study,run\n", encoding="utf-8")
 
 
+def _no_run(*args, **kwargs):
+    raise AssertionError("a documented error example reached a vehicle run: it must fail before any")
+
+
 #: the files a documented error needs in the folder it runs in, by its command line (after
 #: ``$ railride``); the docs show the command and the error, not how the file came to be
 SETUP = {
@@ -153,13 +158,17 @@ def test_the_docs_hold_the_error_examples():
 )
 def test_a_documented_error_is_the_error_the_command_prints(line, error, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
+    # an example that no longer fails would run its command in full (a tune: minutes); the
+    # stepper of the vehicle runs refuses, so that it fails at once (as an internal error)
+    monkeypatch.setattr(simulation, "step", _no_run)
     command = line.text.removeprefix("$ railride ")
     if command in SETUP:
         SETUP[command](tmp_path)
     result = run(*shlex.split(command))
     # the note of a first compile comes where the process meets a cold cache (by test order)
     printed = [text for text in result.stderr.splitlines() if not text.startswith("compiling the stepper once")]
-    assert (result.exit_code, printed) == (2, [error]), f"{line.where}: railride {command}\n{result.stdout}"
+    said = f"{line.where}: railride {command}\n{result.stderr}{result.stdout}"
+    assert (result.exit_code, printed) == (2, [error]), said
     assert result.stdout == ""
 
 
