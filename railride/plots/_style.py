@@ -306,6 +306,14 @@ def given_axes(ax, count: int, what: str) -> list:
     return axes
 
 
+def say_not_excited(ax, text: str = "not excited") -> None:
+    """Write ``text`` in the middle of ``ax`` in grey and leave its y-axis without ticks: the
+    panel of a response that the input does not excite (its trace would be rounding noise,
+    autoscaled to the panel's height), which keeps its axes and labels."""
+    ax.text(0.5, 0.5, text, transform=ax.transAxes, fontsize="medium", color="0.35", ha="center", va="center")
+    ax.set_yticks([])
+
+
 def grid_shape(count: int, max_columns: int = 4) -> tuple[int, int]:
     """(rows, columns) of a grid of ``count`` panels at most ``max_columns`` wide."""
     columns = max(1, min(max_columns, count))

@@ -448,13 +448,19 @@ class RideResult:
 
         return to_frame(self.dataset)
 
-    def plot(self, ax=None, window=None):
+    def plot(self, ax=None, window=None, *, response=None):
         """The four body responses against time (`railride.plots.ride.plot_body_responses`),
-        the y-axes fitting the metric ``window`` (start, end) s (None: the whole run); ``ax``:
-        four Axes to draw in, or None for a new figure. Returns the figure."""
+        the y-axes fitting the metric ``window`` (start, end) s (None: the whole run).
+        ``response``: one of "acceleration", "displacement", "pitch", "roll" (the names of
+        `metrics` without their units), or a list of them, to draw only those (None: all four).
+        ``ax``: None for a new figure, or one matplotlib Axes per response drawn: four Axes,
+        or one Axes with ``response`` naming one (``plot(ax=ax, response="pitch")``; one Axes
+        without it is an InputError). A response the run does not excite (roll on symmetric
+        rails) says "not excited" in its panel instead of a trace of rounding noise. Returns the
+        matplotlib Figure (the given Axes' figure), as every result's ``plot`` does."""
         from railride.plots.ride import plot_body_responses
 
-        return plot_body_responses(self.dataset, ax=ax, window=window)
+        return plot_body_responses(self.dataset, ax=ax, window=window, response=response)
 
     def save(
         self,
