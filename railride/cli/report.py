@@ -84,11 +84,12 @@ def report_command(
 ) -> None:
     """Run the paper's comparison as `railride compare` does and write it as one HTML file.
 
-    The page needs nothing but a browser, offline: the settings and provenance, the vehicle's
-    modes and parameters, the tables compare prints (also printed here), the metrics table, the
-    carbody responses and acceleration spectra as interactive figures (zoom, pan, click a
-    legend entry to hide a suspension) and the damper figures. The options are compare's for
-    one scenario; see docs/report.md.
+    The page opens on the answer: the metrics table and the trade-offs; then the carbody
+    responses and acceleration spectra as interactive figures (zoom, pan, click a legend entry
+    to hide a suspension), the damper figures, the tables compare prints (also printed here),
+    the settings and provenance and the vehicle's modes and parameters. It needs nothing but a
+    browser, offline, and is small enough to send by e-mail (its script and figures packed).
+    The options are compare's for one scenario; see docs/report.md.
     """
     with errors():
         check_report_option(out, "--out")

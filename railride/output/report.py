@@ -381,7 +381,7 @@ def _answer_html(part: Contents) -> str:
     """The top of the page: the recommendation, the result's own table, the findings."""
     lines = []
     if part.recommendation:
-        lines.append(f'<p class="recommendation"><b>Recommendation.</b> {html.escape(part.recommendation)}</p>')
+        lines.append(f'<p class="recommendation">{html.escape(part.recommendation)}</p>')
     if part.tables:
         lines.append(_caption_table(*part.tables[0]))
     if part.findings:
@@ -427,7 +427,9 @@ LOADER = """
     var p = document.createElement("p");
     p.className = "note";
     p.textContent = text;
-    if (node.tagName === "IMG") { node.replaceWith(p); } else { node.replaceChildren(p); }
+    if (node.tagName === "IMG") { node.parentNode.replaceChild(p, node); return; }
+    node.textContent = "";
+    node.appendChild(p);
   }
   function unpack(id) {
     var text = atob(document.getElementById(id).textContent.replace(/\\s+/g, ""));
@@ -457,7 +459,7 @@ LOADER = """
   }
   var jobs = plots.map(function (div) {
     return Promise.all([plotly, unpack(div.dataset.pack).json()]).then(function (done) {
-      div.replaceChildren();
+      div.textContent = "";
       return Plotly.newPlot(div, done[1].data, done[1].layout, config);
     }).catch(failed(div));
   }).concat(images.map(function (img) {

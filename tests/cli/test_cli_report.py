@@ -144,3 +144,62 @@ def test_bad_report_command_paths(tmp_path):
     assert_input_error(run("compare", "--speed", "30,40", "--report", tmp_path), "--report", "a folder")
     assert_input_error(run("report", "--speed", "-1", "--out", tmp_path / "r.html"), "speed = -1.0")
     assert not (tmp_path / "r.html").exists()
+
+
+def test_design_report_recommends_first(tmp_path):
+    """A design's page opens on its recommendation, the words of its JSON document."""
+    out = tmp_path / "design.html"
+    doc = json.loads(
+        ok(
+            "design",
+            *("--controllers", "pid,skyhook", "--track", "fra4", "--speed", 40, "--load", 1),
+            *("--train-seeds", 0, "--test-seeds", 1, "--duration", 2, "--budget", 13, "--values", 3),
+            *("--format", "json", "--report", out),
+        ).stdout
+    )
+    page = _page(out)
+    found = re.search(r'<p class="recommendation">(.*?)</p>', page, flags=re.S)
+    assert found and html.unescape(found.group(1)) == doc["recommendation"]["text"]
+    assert doc["recommendation"]["text"].startswith("Recommended: ")
+    assert page.index('<section id="answer">') < found.start() < page.index("<figure")
+
+
+class _Drawn:
+    """A result of two matplotlib figures: a smooth line (a few kB of SVG) and 200,000 samples
+    of noise (megabytes of SVG, far more than its PNG), the first with a note under it."""
+
+    def report_contents(self):
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+        import numpy as np
+
+        from railride.model.params import VehicleParams
+        from railride.output.report import Contents
+
+        smooth, ax = plt.subplots()
+        ax.plot(np.linspace(0, 1, 50) ** 2)
+        noisy, ax = plt.subplots()
+        ax.plot(np.random.default_rng(0).normal(size=200_000), lw=0.3)
+        return Contents(
+            title="two figures",
+            settings={},
+            params=VehicleParams.preset("paper"),
+            figures=[("smooth", "a parabola", smooth, "drawn from 50 points & no more"), ("noisy", "noise", noisy)],
+        )
+
+
+def test_static_figures_svg_or_png():
+    """Each static figure goes in as the smaller of its compressed SVG and its PNG; a figure's
+    note is printed under it."""
+    from railride.output.report import report_html
+
+    page = report_html(_Drawn())
+    smooth = re.search(r'<figure id="figure-smooth".*?</figure>', page, flags=re.S).group(0)
+    noisy = re.search(r'<figure id="figure-noisy".*?</figure>', page, flags=re.S).group(0)
+    assert 'data-type="image/svg+xml"' in smooth and b"<svg" in _packs(page)["pack-figure-smooth"]
+    assert 'src="data:image/png;base64,' in noisy and "pack-figure-noisy" not in _packs(page)
+    assert smooth.index("<img") < smooth.index('<p class="note">drawn from 50 points &amp; no more</p>')
+    assert "pack-plotly" not in _packs(page)  # no interactive figure: no plotly
+    assert page.index('<section id="answer">') < page.index("This result has no table.") < page.index("<figure")

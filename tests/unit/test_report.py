@@ -4,6 +4,8 @@ thins long histories."""
 
 from __future__ import annotations
 
+import base64
+import gzip
 import re
 from html.parser import HTMLParser
 
@@ -52,6 +54,20 @@ class Page(HTMLParser):
         return next(t for t in self.tables if t and tuple(t[0][: len(heads)]) == heads)
 
 
+def unpacked(text: str) -> dict[str, bytes]:
+    """The page's packed data by id (base64 of gzip), unpacked as the browser does."""
+    found = re.findall(r'<script type="application/gzip" id="([^"]+)">([^<]*)</script>', text)
+    return {key: gzip.decompress(base64.b64decode(data)) for key, data in found}
+
+
+def image_kinds(text: str) -> list[str]:
+    """The type of each <img>: a packed SVG's, or its data URI's."""
+    page = Page(text)
+    return [
+        a.get("data-type") or re.match(r"data:(image/[a-z+]+);", a["src"]).group(1) for t, a in page.tags if t == "img"
+    ]
+
+
 @pytest.fixture(scope="module")
 def comparison():
     # short and small: the report's content, not the physics, is under test
@@ -71,7 +87,7 @@ def page(page_text):
 
 def test_nothing_is_fetched(page, page_text):
     """No script, stylesheet, image or frame comes from the network; plotly's JavaScript is
-    inlined once."""
+    inlined once (packed)."""
     assert page.tags  # the loop below checks something
     for tag, attrs in page.tags:
         for name in ("src", "href"):
@@ -81,7 +97,7 @@ def test_nothing_is_fetched(page, page_text):
             raise AssertionError(f"a <link> in a self-contained page: {attrs}")
     scripts = [a for t, a in page.tags if t == "script"]
     assert scripts and all("src" not in a for a in scripts)
-    assert page_text.count("* plotly.js v") == 1
+    assert [key for key, data in unpacked(page_text).items() if b"* plotly.js v" in data[:5000]] == ["pack-plotly"]
 
 
 def test_settings_and_provenance(page, page_text):
@@ -115,23 +131,37 @@ def test_one_figure_per_saved_figure(page, page_text):
     assert {k for k, v in page.figures.items() if v == "interactive"} == interactive
     assert {k for k, v in page.figures.items() if v == "static"} == static
     assert page_text.count('class="plotly-graph-div"') == len(interactive)
-    images = [a["src"] for t, a in page.tags if t == "img"]
+    images = [a for t, a in page.tags if t == "img"]
     assert len(images) == len(static)
-    assert all(re.match(r"data:image/(png|svg\+xml);base64,", src) for src in images)
+    packs = unpacked(page_text)
+    for image in images:  # a packed SVG, or a PNG data URI
+        if "data-pack" in image:
+            assert image["data-type"] == "image/svg+xml" and b"<svg" in packs[image["data-pack"]][:2000]
+        else:
+            assert image["src"].startswith("data:image/png;base64,")
 
 
 def test_console_fragment_and_result_table(page, page_text, comparison):
     assert "<pre>what the console printed</pre>" in page_text
     assert "<style>x</style>" not in page_text  # the body of a whole document, not its head
-    rows = page.table_with("controller", "response", "statistic", "value")
-    assert len(rows) - 1 == len(comparison.to_pandas())
+    # the answer's table: a row per response and statistic, a column per suspension and reduction
+    rows = page.table_with("response", "statistic", "passive", "pid", "pid red. %")
+    metrics = comparison.metrics
+    assert len(rows) - 1 == metrics.sizes["response"] * metrics.sizes["statistic"] == 8
+    for response, statistic, passive, pid, reduction in rows[1:]:
+        value = metrics.sel(response=response, statistic=statistic)
+        assert float(passive) == pytest.approx(float(value.sel(controller="passive")), rel=1e-5)
+        assert float(pid) == pytest.approx(float(value.sel(controller="pid")), rel=1e-5)
+        expected = 100 * (1 - value.sel(controller="pid") / value.sel(controller="passive"))
+        assert float(reduction) == pytest.approx(float(expected), abs=0.051)
 
 
 def test_long_histories_are_thinned_and_say_so(comparison):
     html = report.report_html(comparison)
     assert "envelope" not in html  # 2 s at 1000 Hz: 2001 samples, drawn as they are
     longer = rr.compare(rr.scenario("paper-sine", duration=6.0), controllers=["passive"], bounds=False)
-    assert "max envelope of its 6001 samples in at most 4000 points" in report.report_html(longer)
+    figure = unpacked(report.report_html(longer))["pack-figure-acceleration"].decode()
+    assert "max envelope of its 6001 samples in at most 4000 points" in figure
     figure = comparison_response_figure(longer.combined(), "acceleration")
     assert len(figure.data[0].x) <= 4000 < longer.combined().sizes["time"]
 
@@ -181,9 +211,9 @@ def test_frf_and_ride_results(tmp_path):
 def test_long_tables_are_cut(monkeypatch, comparison):
     monkeypatch.setattr(report, "MAX_TABLE_ROWS", 5)
     page = Page(report.report_html(comparison))
-    rows = page.table_with("controller", "response", "statistic", "value")
+    rows = page.table_with("response", "statistic", "passive")
     assert len(rows) - 1 == 5
-    assert f"the first 5 of {len(comparison.to_pandas())} rows" in report.report_html(comparison)
+    assert "the first 5 of 8 rows" in report.report_html(comparison)
 
 
 def test_unknown_results_and_paths(tmp_path):
@@ -199,10 +229,13 @@ def test_unknown_results_and_paths(tmp_path):
     assert report.check_report_path(tmp_path / "new" / "r.HTML") == tmp_path / "new" / "r.HTML"
 
 
-def test_static_figures_svg_when_small(monkeypatch, comparison):
-    def kinds(text):
-        return [re.match(r"data:(image/[a-z+]+);", a["src"]).group(1) for t, a in Page(text).tags if t == "img"]
+def test_static_figures_svg_when_smaller(monkeypatch, comparison):
+    """A static figure is its packed SVG (sharp at any zoom) unless that is larger than its PNG."""
+    assert image_kinds(report.report_html(comparison)) == ["image/svg+xml"] * 3
+    pack = report._gzip
 
-    assert kinds(report.report_html(comparison)) == ["image/svg+xml"] * 3  # sharp at any zoom
-    monkeypatch.setattr(report, "SVG_LIMIT", 1000)
-    assert kinds(report.report_html(comparison)) == ["image/png"] * 3
+    def bulky(data: bytes) -> bytes:  # an SVG that packs to 3 MB, far more than any PNG
+        return pack(data) + bytes(3_000_000) if data.lstrip().startswith(b"<?xml") else pack(data)
+
+    monkeypatch.setattr(report, "_gzip", bulky)
+    assert image_kinds(report.report_html(comparison)) == ["image/png"] * 3
