@@ -175,13 +175,14 @@ def comparison_title(ds: xr.Dataset) -> str:
 
 def psd_title(ds: xr.Dataset, window, segment: float) -> str:
     """The title of the acceleration spectra of a comparison (combined Dataset ``ds``) over
-    ``window`` (start, end) [s] (None: the whole run), Welch segments of at most ``segment`` s."""
+    ``window`` (start, end) [s] (None: the whole run), as `railride.analysis.psd_plan.psd_plan`
+    takes them (Welch segments of at most ``segment`` s where the track is not periodic): the
+    method and the bin width."""
+    from railride.analysis.psd_plan import psd_plan
+
     start, end = window if window is not None else (float(ds["time"][0]), float(ds["time"][-1]))
-    segment = min(segment, end - start)
-    title = (
-        f"PSD of the carbody CG vertical acceleration, {start:g}-{end:g} s (Welch, "
-        f"{segment:g} s Hann segments, 50 % overlap)"
-    )
+    method = psd_plan(ds, window, segment)["text"]
+    title = f"PSD of the carbody CG vertical acceleration, {start:g}-{end:g} s\n" + textwrap.fill(method, 120)
     context = comparison_title(ds)
     if context:
         title += "\n" + textwrap.fill(context, 120)

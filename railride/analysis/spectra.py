@@ -1,7 +1,9 @@
 """Analysis of railride's results beyond the RMS metrics: pure functions from Datasets and
 DataFrames to data, drawn by `railride.plots` and written by `railride.output.files`.
 
-* `comparison_psd`: the Welch spectra of the carbody acceleration of a controller comparison.
+* `comparison_psd`: the spectra of the carbody acceleration of a controller comparison: on a
+  periodic track (the paper's sine) one Hann-windowed segment of whole periods of the input, on
+  any other track Welch's method (`psd_plan`).
 * `frf_frame` and `frf_peaks`: the carbody frequency responses of
   `railride.model.vehicle.Vehicle.frequency_response` as magnitudes and phases, and their peaks.
 """
@@ -16,9 +18,8 @@ import xarray as xr
 
 from railride.errors import InputError
 from railride.analysis.labels import controller_names
+from railride.analysis.psd_plan import PSD_SEGMENT_S, psd_plan
 
-#: the Welch segment length of the acceleration spectra of a comparison [s]
-PSD_SEGMENT_S = 4.0
 #: the rail patterns of `frf_frame`, in order
 FRF_PATTERNS = ("in-phase", "anti-phase")
 #: per carbody response: (name, channel of the frequency response, magnitude columns with their
@@ -56,13 +57,14 @@ FRF_NOT_EXCITED = 1e-9
 
 def comparison_psd(ds: xr.Dataset, window=None, segment: float = PSD_SEGMENT_S) -> pd.DataFrame:
     """The PSD of the carbody CG vertical acceleration of each suspension of a comparison, from
-    its combined Dataset (`Comparison.combined()`), by Welch's method.
-
-    ``scipy.signal.welch`` over the time ``window`` (start, end) [s] (None: the whole run):
-    Hann-windowed segments of ``segment`` seconds (the whole window if shorter), overlapping by
-    half, each with its mean removed; one-sided density. Columns ``frequency_hz`` [Hz, from 0 in
-    steps of 1/segment] and one per suspension (its name) in (m/s^2)^2/Hz."""
-    from scipy.signal import welch
+    its combined Dataset (`Comparison.combined()`), over the time ``window`` (start, end) [s]
+    (None: the whole run), as `psd_plan` chooses: on a periodic track (the paper's sine) one
+    Hann-windowed segment of whole periods of the input (``scipy.signal.periodogram``), else
+    Welch's method (``scipy.signal.welch``) with Hann segments of ``segment`` seconds (the whole
+    window if shorter) overlapping by half; each segment's mean removed; one-sided density.
+    Columns ``frequency_hz`` [Hz, from 0 in steps of the bin width] and one per suspension (its
+    name) in (m/s^2)^2/Hz; ``attrs``: the plan (`psd_plan`)."""
+    from scipy.signal import periodogram, welch
 
     from railride.analysis.metrics import select_window
 
@@ -73,19 +75,22 @@ def comparison_psd(ds: xr.Dataset, window=None, segment: float = PSD_SEGMENT_S) 
     if "carbody_acceleration" not in ds.variables:
         raise InputError("the dataset lacks the channel carbody_acceleration")
     part = select_window(ds, None if window is None else tuple(window))
-    time = part["time"].values
-    # the output rate, without the float noise of the time stamps' differences
-    fs = float(f"{(time.size - 1) / (time[-1] - time[0]):.9g}")
-    nperseg = max(2, min(time.size, int(round(segment * fs))))
+    plan = psd_plan(ds, window, segment)
+    fs, n = plan["fs_hz"], plan["samples"]
     columns = {}
     freq = None
     for i, name in enumerate(controller_names(ds)):
         x = part["carbody_acceleration"].isel(controller=i).values
-        freq, pxx = welch(
-            x, fs=fs, window="hann", nperseg=nperseg, noverlap=nperseg // 2, detrend="constant", scaling="density"
-        )
+        if plan["method"] == "periodic":
+            freq, pxx = periodogram(x[-n:], fs=fs, window="hann", detrend="constant", scaling="density")
+        else:
+            freq, pxx = welch(
+                x, fs=fs, window="hann", nperseg=n, noverlap=n // 2, detrend="constant", scaling="density"
+            )
         columns[name] = pxx
-    return pd.DataFrame({"frequency_hz": freq, **columns})
+    frame = pd.DataFrame({"frequency_hz": freq, **columns})
+    frame.attrs.update(plan)
+    return frame
 
 
 def frf_frame(responses: dict) -> pd.DataFrame:

@@ -23,6 +23,7 @@ from railride.cli._options import (
     figure_options,
 )
 from railride.cli._parsing import load_gains, vehicle_arguments
+from railride.frequency.ride_spectrum import PASSIVE_DEVICE
 
 #: the library's names of the options, for its errors
 SPECTRUM_OPTIONS = {
@@ -164,30 +165,51 @@ def ride_spectrum(
         save_report(report, result, parts, ctx)
 
 
+#: the first line of the tables: which device each number is for
+HEADLINE = (
+    "Controllers on the ideal actuator (force = demand: an active device with no lag and no force "
+    "limit), passive on its viscous dampers; not the MR dampers, which are not linear: their ride "
+    "is railride compare's, whose 'ideal actuator' column is this device. A reference for these "
+    "gains, not a bound."
+)
+
+
 def _tables(result) -> list:
-    """The floor table (RMS, Wb, Wk and Wb against passive, per suspension and point), the
-    carbody table and the note."""
+    """The headline (which device), the floor table (RMS, Wb, Wk and their reductions against
+    passive, per suspension and point), the carbody table and the note."""
     from rich.markup import escape
     from railride.cli._width import FitTable
     from rich.text import Text
 
+    from railride.cli._render import reduction_text
     from railride.secondary.control import LABELS
     from railride.frequency.ride_spectrum import FLOOR
     from railride.model.params import vehicle_text
 
     doc = result.to_dict()
     st = doc["settings"]
-    floor = FitTable(title=escape("Carbody floor acceleration [m/s^2], frequency domain"))
-    for head in ("suspension", "point", "RMS", "aw Wb", "aw Wk", "Wb vs\npassive"):
-        floor.add_column(escape(head), justify="left" if head in ("suspension", "point") else "right")
-    passive = doc["weighted_rms_m_s2"].get("passive")
+    red_rms, red_weighted = doc["rms_reduction_percent"], doc["weighted_rms_reduction_percent"]
+    floor = FitTable(
+        title=escape("Carbody floor acceleration [m/s^2], frequency domain"),
+        caption="red. % = (passive - controlled) / passive x 100 (negative: worse than passive, in red)."
+        if red_rms
+        else None,
+    )
+    heads = ("suspension", "point", "RMS", "red. %", "aw Wb", "red. %", "aw Wk")
+    for i, head in enumerate(heads):
+        floor.add_column(escape(head), justify="left" if i < 2 else "right", no_wrap=head == "red. %")
     for s in result.suspensions:
         for k, point in enumerate(FLOOR):
             wb, wk = (doc["weighted_rms_m_s2"][s][point][w] for w in ("Wb", "Wk"))
-            change = f"{100 * (wb / passive[point]['Wb'] - 1):+.1f} %" if passive and s != "passive" else ""
             rms = doc["rms"][s][f"floor_acceleration_{point}"]
             floor.add_row(
-                escape(LABELS.get(s, s)) if k == 0 else "", point, f"{rms:.4g}", f"{wb:.4g}", f"{wk:.4g}", change
+                escape(LABELS.get(s, s)) if k == 0 else "",
+                point,
+                f"{rms:.4g}",
+                reduction_text(red_rms.get(s, {}).get(f"floor_acceleration_{point}")),
+                f"{wb:.4g}",
+                reduction_text(red_weighted.get(s, {}).get(point, {}).get("Wb")),
+                f"{wk:.4g}",
             )
     body = FitTable(title="Carbody accelerations and secondary travel (RMS)")
     for head in ("suspension", "bounce\n[m/s^2]", "pitch\n[rad/s^2]", "roll\n[rad/s^2]", "travel 1R\n[mm]"):
@@ -209,7 +231,8 @@ def _tables(result) -> list:
         f"gains {st.get('gains_source', st['gains'])}{SHIPPED if st['gains'] == 'shipped' else ''}. "
         f"{vehicle_text(st['vehicle'])}."
     )
-    parts: list = [floor, body, note]
+    controlled = any(d != PASSIVE_DEVICE for d in doc["devices"].values())
+    parts: list = ([Text(HEADLINE)] if controlled else []) + [floor, body, note]
     for name, reason in st["not_run"].items():
         parts.append(Text(f"not run: {name}: {reason}"))
     return parts

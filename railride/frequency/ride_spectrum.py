@@ -53,6 +53,18 @@ RESPONSES = (
 WEIGHTINGS = ("Wb", "Wk")
 #: the slowest controller rate of a sampled loop [Hz]
 MIN_CONTROL_RATE = 1.0
+#: the device that makes each suspension's secondary force: the passive vehicle's viscous
+#: dashpots, or the ideal actuator (force = demand) under an outer loop; never the MR dampers,
+#: which switch and clip and so have no frequency response (`railride compare` runs them)
+PASSIVE_DEVICE = "passive viscous dampers"
+ACTUATOR_DEVICE = "ideal actuator"
+
+
+def reduction_percent(passive: float, value: float) -> float | None:
+    """The reduction against passive as `railride compare` gives it, (passive - value) /
+    passive x 100: positive where the suspension is better, negative where worse; None where
+    the passive value is not positive."""
+    return (passive - value) / passive * 100.0 if passive > 0 else None
 
 
 def rail_patterns(vehicle: Vehicle, frequency: np.ndarray, speed: float) -> dict[str, np.ndarray]:
@@ -122,10 +134,13 @@ class RideSpectrum:
     """The frequency-domain ride of one or more linear suspensions on a track spectrum.
 
     ``psd``: a Dataset over (suspension, frequency) with one variable per response of
-    `RESPONSES`, one-sided PSDs in (unit)^2/Hz; ``rms`` and ``weighted``: DataArrays over
+    `RESPONSES`, one-sided PSDs in (unit)^2/Hz, and the coordinate ``device`` (per suspension:
+    `PASSIVE_DEVICE` or `ACTUATOR_DEVICE`); ``rms`` and ``weighted``: DataArrays over
     (suspension, response) and (suspension, position, weighting); ``settings``: what made it.
-    The result protocol: `to_dict`, `to_pandas` (one row per suspension and response: RMS and,
-    at the floor points, the weighted RMS), `plot` (PSDs at the floor points), `save`.
+    Every variable and coordinate carries ``long_name`` and ``units`` (CF; "1" where there is
+    no unit). The result protocol: `to_dict`, `to_pandas` (one row per suspension and response:
+    its device, RMS and, at the floor points, the weighted RMS, with their reductions against
+    passive), `plot` (PSDs at the floor points), `save`.
     """
 
     psd: xr.Dataset
@@ -138,19 +153,57 @@ class RideSpectrum:
     def suspensions(self) -> tuple[str, ...]:
         return tuple(str(s) for s in self.psd["suspension"].values)
 
+    @property
+    def devices(self) -> dict[str, str]:
+        """Per suspension, the device that makes its secondary force: `PASSIVE_DEVICE` or
+        `ACTUATOR_DEVICE`."""
+        return {s: str(d) for s, d in zip(self.suspensions, self.psd["device"].values)}
+
+    def reductions(self) -> tuple[dict, dict]:
+        """The reductions against passive (`reduction_percent`, positive where better) of every
+        suspension but passive: ({suspension: {response: % of RMS}}, {suspension: {point:
+        {weighting: % of weighted RMS}}}); both empty when passive did not run."""
+        if "passive" not in self.suspensions:
+            return {}, {}
+        rms, weighted = {}, {}
+        for s in self.suspensions:
+            if s == "passive":
+                continue
+            rms[s] = {
+                r: reduction_percent(
+                    float(self.rms.sel(suspension="passive", response=r)), float(self.rms.sel(suspension=s, response=r))
+                )
+                for r in RESPONSES
+            }
+            weighted[s] = {
+                p: {
+                    w: reduction_percent(
+                        float(self.weighted.sel(suspension="passive", position=p, weighting=w)),
+                        float(self.weighted.sel(suspension=s, position=p, weighting=w)),
+                    )
+                    for w in WEIGHTINGS
+                }
+                for p in FLOOR
+            }
+        return rms, weighted
+
     def to_pandas(self):
         import pandas as pd
 
+        rms_red, weighted_red = self.reductions()
+        devices = self.devices
         rows = []
         for s in self.suspensions:
             for r in RESPONSES:
-                row = {"suspension": s, "response": r, "unit": self.psd[r].attrs["rms_units"]}
+                row = {"suspension": s, "device": devices[s], "response": r, "unit": self.psd[r].attrs["rms_units"]}
                 row["rms"] = float(self.rms.sel(suspension=s, response=r))
+                row["rms_reduction_percent"] = rms_red.get(s, {}).get(r)
                 point = r.removeprefix("floor_acceleration_")
                 for w in WEIGHTINGS:
                     row[f"aw_{w}"] = (
                         float(self.weighted.sel(suspension=s, position=point, weighting=w)) if point in FLOOR else None
                     )
+                    row[f"aw_{w}_reduction_percent"] = weighted_red.get(s, {}).get(point, {}).get(w)
                 rows.append(row)
         return pd.DataFrame(rows)
 
@@ -163,6 +216,7 @@ class RideSpectrum:
     def to_dict(self) -> dict:
         from railride._version import __version__
 
+        rms_red, weighted_red = self.reductions()
         return {
             "schema": SCHEMA,
             "railride_version": __version__,
@@ -176,13 +230,16 @@ class RideSpectrum:
                 }
                 for s in self.suspensions
             },
+            "devices": self.devices,
+            "rms_reduction_percent": rms_red,
+            "weighted_rms_reduction_percent": weighted_red,
         }
 
     def title(self) -> str:
         st = self.settings
         return (
-            f"Carbody floor acceleration PSD - {st['track']} at V = {st['speed_m_s']:g} m/s, "
-            "frequency domain, controllers on the ideal actuator"
+            f"Carbody floor acceleration PSD - {st['track']} at V = {st['speed_m_s']:g} m/s, frequency domain; "
+            "controllers on the ideal actuator (force = demand), not the MR dampers"
         )
 
     def plot(self, ax=None):
@@ -269,7 +326,9 @@ def ride_spectrum(
     h = hold(frequency, control_rate, delay)
     plant = linear_model(vehicle_params, "plant")
     psd: dict[str, list] = {r: [] for r in RESPONSES}
-    names, not_run = [], {}
+    names: list[str] = []
+    devices: list[str] = []
+    not_run = {}
     from railride.secondary.control import GainSet
 
     given = gains is not None
@@ -282,7 +341,9 @@ def ride_spectrum(
             not_run[name] = str(exc)
             continue
         names.append(name)
-        base, gain = (model, None) if model.secondary in ("passive", "plant") else (plant, model.corner_forces())
+        passive = model.secondary in ("passive", "plant")
+        devices.append(PASSIVE_DEVICE if passive else ACTUATOR_DEVICE)
+        base, gain = (model, None) if passive else (plant, model.corner_forces())
         y = {k: responses(base, gain, u, h, frequency) for k, u in inputs.items()}
         for r in RESPONSES:
             i = base.index("outputs", r)
@@ -292,15 +353,38 @@ def ride_spectrum(
             )
     if not names:
         raise InputError("; ".join(not_run.values()))
-    ds = xr.Dataset(coords={"suspension": names, "frequency": ("frequency", frequency, {"units": "Hz"})})
+    ds = xr.Dataset(coords=_coords(names, devices))
+    ds.coords["frequency"] = ("frequency", frequency, {"long_name": "frequency", "units": "Hz"})
     for r in RESPONSES:
         unit = plant.units[r]
-        ds[r] = (("suspension", "frequency"), np.array(psd[r]), {"units": f"({unit})^2/Hz", "rms_units": unit})
+        ds[r] = (
+            ("suspension", "frequency"),
+            np.array(psd[r]),
+            {
+                "long_name": f"one-sided power spectral density of {r.replace('_', ' ')}",
+                "units": f"({unit})^2/Hz",
+                "rms_units": unit,
+            },
+        )
     rms = xr.DataArray(
         np.sqrt(np.array([[np.trapezoid(ds[r].values[k], frequency) for r in RESPONSES] for k in range(len(names))])),
         dims=("suspension", "response"),
-        coords={"suspension": names, "response": list(RESPONSES)},
+        coords={
+            **_coords(names, devices),
+            "response": (
+                "response",
+                list(RESPONSES),
+                {"long_name": "response (output of the linear model)", "units": "1"},
+            ),
+            "unit": (
+                "response",
+                [plant.units[r] for r in RESPONSES],
+                {"long_name": "unit of the response's RMS", "units": "1"},
+            ),
+        },
         name="rms",
+        # one array over responses of different units: each its own, in the coordinate "unit"
+        attrs={"long_name": "RMS of each response", "units": "see the coordinate unit (per response)"},
     )
     from railride.analysis.comfort import weighting
 
@@ -312,9 +396,17 @@ def ride_spectrum(
     weighted_da = xr.DataArray(
         weighted,
         dims=("suspension", "position", "weighting"),
-        coords={"suspension": names, "position": list(FLOOR), "weighting": list(WEIGHTINGS)},
+        coords={
+            **_coords(names, devices),
+            "position": ("position", list(FLOOR), {"long_name": "point on the carbody floor", "units": "1"}),
+            "weighting": (
+                "weighting",
+                list(WEIGHTINGS),
+                {"long_name": "frequency weighting (EN 12299 Wb, ISO 2631-1 Wk)", "units": "1"},
+            ),
+        },
         name="weighted_rms",
-        attrs={"units": "m/s^2"},
+        attrs={"long_name": "frequency-weighted RMS of the floor's vertical acceleration", "units": "m/s^2"},
     )
     settings = {
         "vehicle": record,
@@ -336,6 +428,19 @@ def ride_spectrum(
     if mismatch:
         settings["gains_mismatch"] = mismatch
     return RideSpectrum(ds, rms, weighted_da, settings, vehicle_params)
+
+
+def _coords(names: list[str], devices: list[str]) -> dict:
+    """The coordinates along ``suspension`` of every array of a `RideSpectrum`: the names and
+    the device of each (CF attributes; "1": a label, no unit)."""
+    return {
+        "suspension": ("suspension", names, {"long_name": "suspension (passive or controller)", "units": "1"}),
+        "device": (
+            "suspension",
+            devices,
+            {"long_name": "device that makes the secondary force", "units": "1"},
+        ),
+    }
 
 
 def gains_mismatch(gains, controllers, vehicle: dict, track: str, speed: float, band) -> str | None:

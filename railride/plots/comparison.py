@@ -175,8 +175,9 @@ def plot_comparison_voltages(comparison, ax=None):
 def plot_comparison_psd(psd: pd.DataFrame, ax=None, *, title: str | None = None):
     """The acceleration spectra of `railride.analysis.spectra.comparison_psd` (its DataFrame) on log-log
     axes, one line per suspension in the paper's style; the 0 Hz bin is left out. Drawn into
-    ``ax`` when given (no title then), else into a new figure titled ``title``; returns the
-    `Figure`."""
+    ``ax`` when given (no title then), else into a new figure titled ``title`` (default: what
+    was plotted and how the spectra were taken, with their bin width, from the DataFrame's
+    ``attrs``, `railride.analysis.psd_plan.psd_plan`); returns the `Figure`."""
     own = ax is None
     fig = new_figure((PAGE_WIDTH, 3.8)) if own else ax.figure
     if own:
@@ -199,7 +200,9 @@ def plot_comparison_psd(psd: pd.DataFrame, ax=None, *, title: str | None = None)
     ax.grid(True, which="minor", linewidth=0.3, alpha=0.4)
     ax.legend(loc="lower center", bbox_to_anchor=(0.5, 1.0), ncols=min(4, max(1, len(psd.columns) - 1)), frameon=False)
     if own:
-        set_title(fig, title or "PSD of the carbody CG vertical acceleration")
+        method = psd.attrs.get("text")
+        default = "PSD of the carbody CG vertical acceleration" + (f"\n{method}" if method else "")
+        set_title(fig, title or default)
     return fig
 
 

@@ -19,6 +19,27 @@ def test_ride_spectrum_table_and_json():
     assert set(doc["rms"]) == {"passive", "pid", "sas-attitude", "sas-attitude-ride"}
 
 
+def test_ride_spectrum_says_which_device_and_signs_reductions_as_compare():
+    """The first line names the ideal actuator; red. % is (passive - controlled) / passive x 100,
+    positive where the controller is better, worked out here from the document's RMS values."""
+    args = ("ride-spectrum", "--controllers", "passive,pid", "--points", "64")
+    out = ok(*args).stdout
+    assert "ideal actuator" in out.splitlines()[0].lower()
+    assert "MR dampers" in " ".join(out.split()) and "red. % = (passive - controlled) / passive x 100" in out
+    doc = ok_json(*args)
+    rms = {s: doc["rms"][s]["floor_acceleration_centre"] for s in ("passive", "pid")}
+    wb = {s: doc["weighted_rms_m_s2"][s]["centre"]["Wb"] for s in ("passive", "pid")}
+    (row,) = [line for line in out.splitlines() if line.startswith("│ PID") and "centre" in line]
+    cells = [c.strip() for c in row.strip("│").split("│")]
+    assert cells[:2] == ["PID", "centre"]
+    assert cells[3] == f"{100 * (rms['passive'] - rms['pid']) / rms['passive']:.1f}" and float(cells[3]) > 0
+    assert cells[5] == f"{100 * (wb['passive'] - wb['pid']) / wb['passive']:.1f}" and float(cells[5]) > 0
+    assert doc["devices"] == {"passive": "passive viscous dampers", "pid": "ideal actuator"}
+    # passive alone: no controller, no device to warn of, no reductions
+    alone = ok("ride-spectrum", "--controllers", "passive", "--points", "32").stdout
+    assert "ideal actuator" not in alone.splitlines()[0] and "red. % =" not in alone
+
+
 def test_ride_spectrum_warns_of_gains_tuned_for_another_case(tmp_path):
     """Gains tuned for another vehicle, load or track: one ``warning:`` line on stderr before the
     results, recorded as ``settings.gains_mismatch`` (as compare says it). Gains tuned on any

@@ -295,14 +295,17 @@ def test_compare_writes_the_acceleration_psd(tmp_path):
     psd = pd.read_csv(out / "psd.csv")
     assert list(psd.columns) == ["frequency_hz", "passive", "pid"]
     f = psd["frequency_hz"].values
-    assert f[0] == 0 and np.allclose(np.diff(f), 0.25) and f[-1] == pytest.approx(500.0)
+    # the sine at 55.56 / 60 Hz: one segment of the 3 whole periods in the 4 s window, bins f0 / 3
+    f0, n = 55.56 / 60, round(3 * 1000 * 60 / 55.56)
+    assert f[0] == 0 and np.allclose(np.diff(f), 1000 / n) and 1000 / n == pytest.approx(f0 / 3, rel=1e-3)
+    assert f[-1] == pytest.approx(500.0) and abs(f[np.argmax(psd["passive"])] - f0) <= f[1]
     assert (psd[["passive", "pid"]].values >= 0).all()
-    # Parseval: the PSD integrates to the variance of the acceleration over the window
+    # Parseval: the PSD integrates to the variance of the acceleration over that segment
     runs = pd.read_csv(out / "compare.csv")
     for name in ("passive", "pid"):
-        part = runs[(runs["controller"] == name) & (runs["time"] >= 2 - 1e-9)]
+        part = runs[runs["controller"] == name].tail(n)
         variance = part["carbody_acceleration"].var()
-        assert psd[name].sum() * 0.25 == pytest.approx(variance, rel=0.1)
+        assert psd[name].sum() * f[1] == pytest.approx(variance, rel=0.1)
 
 
 def test_sweep_writes_the_plot_for_one_numeric_axis(tmp_path):
