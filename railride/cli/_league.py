@@ -113,7 +113,7 @@ def league_table(table, doc) -> list:
     from railride.cli._width import FitTable, Split
     from railride.model.params import vehicle_text
 
-    summary = table.summary()
+    summary = table.summary
     cases = table.cases[table.cases.controller == "passive"]
     tuned = doc["tuned_on"]
     tuned_text = describe_scenario(tuned) if tuned else "not recorded in the gains file"

@@ -32,7 +32,7 @@ def plot_league(table, ax=None):
     """Bars of the mean RMS reduction [%] of each response (groups) per controller (bars),
     outlines at the ideal actuator's mean reduction with the same gains. ``table``: a
     `railride.studies.league.LeagueTable`. Returns the figure."""
-    summary = table.summary()
+    summary = table.summary
     controlled = [n for n in table.controllers if n != "passive"]
     if ax is None:
         fig = new_figure((PAGE_WIDTH, 3.2))

@@ -403,6 +403,14 @@ class GainSet:
 
         return mismatch(self, vehicle, scenarios, controllers)
 
+    def record(self, controllers) -> dict:
+        """What a result records of these gains for the runs of ``controllers``: ``source`` (as
+        far as it is still true), ``provenance`` (JSON's values, or None) and ``values`` (per
+        controller, every gain it reads), `railride.secondary.provenance.gains_record`."""
+        from railride.secondary.provenance import gains_record
+
+        return gains_record(self, controllers)
+
     def controller(self, name: str):
         """The outer loop called ``name`` (None for the passive suspension and the
         constant-voltage baselines, which have none)."""

@@ -160,6 +160,78 @@ def tune_command(vehicle: dict | None, scenarios=()) -> str:
     return " ".join(parts) + (f" (and one tuning each for {'; '.join(others)})" if others else "")
 
 
+def gains_record(gains, controllers) -> dict:
+    """What a result records of the gains it ran (docs/study.md, The gains): ``source``, where
+    they came from as far as it is still true (`stated_source`); ``provenance``, their
+    [provenance] table in JSON's values (`json_values`: how they were found, e.g. by `railride
+    tune`), None where they record none; ``values``, per controller of ``controllers``, every
+    gain it reads by its "table.entry" name (`gain_values`)."""
+    return {
+        "source": stated_source(gains),
+        "provenance": json_values(gains.provenance) if gains.provenance else None,
+        "values": {n: gain_values(gains, n) for n in controllers},
+    }
+
+
+def gain_values(gains, controller: str) -> dict[str, float]:
+    """Every gain that ``controller`` reads (its outer loop's tables and its inner loop's,
+    `GainSet.tables_read`), by "table.entry"; empty for passive and the constant voltages."""
+    return gains.entries(() if controller == "passive" else gains.tables_read(controller))
+
+
+def stated_source(gains) -> str:
+    """The source of ``gains`` as a record may state it: ``gains.source``, with ", changed: ..."
+    and the gains that differ where it names a gains file (packaged, e.g. "railride/data/gains.toml",
+    or on disk) whose values these no longer are (`GainSet.apply` keeps the source of the
+    gains it changes): a reader is never told a file's gains ran when others did."""
+    source = str(gains.source)
+    original = _file_gains(type(gains), source)
+    if original is None:
+        return source
+    ours, theirs = gains.entries(), original.entries()
+    changed = [e for e in ours if ours[e] != theirs.get(e)]
+    return f"{source}, changed: {_words(changed)}" if changed else source
+
+
+def _file_gains(kind, source: str):
+    """The gains the file ``source`` holds (a packaged file by its "railride/data/NAME" name,
+    else a path on disk), or None where it names no readable gains file."""
+    from importlib import resources
+    from pathlib import Path
+
+    from railride.errors import InputError
+
+    packaged = source.removeprefix("railride/data/")
+    try:
+        if packaged != source and packaged.endswith(".toml"):
+            text = resources.files("railride").joinpath(f"data/{packaged}").read_text(encoding="utf-8")
+        elif source.endswith(".toml") and Path(source).is_file():
+            text = Path(source).read_text(encoding="utf-8")
+        else:
+            return None
+        return kind.from_toml(text, source)
+    except (OSError, InputError, ValueError):
+        return None
+
+
+def json_values(value):
+    """``value`` (a [provenance] table as `tomllib` reads it) in JSON's values: dates and times
+    as ISO 8601 text, a number that is not finite as None, tuples as lists, keys as text."""
+    if isinstance(value, dict):
+        return {str(k): json_values(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [json_values(v) for v in value]
+    if isinstance(value, (datetime.datetime, datetime.date, datetime.time)):
+        return value.isoformat()
+    if isinstance(value, bool) or value is None or isinstance(value, str):
+        return value
+    if isinstance(value, numbers.Integral):
+        return int(value)
+    if isinstance(value, numbers.Real):
+        return float(value) if math.isfinite(value) else None
+    return str(value)
+
+
 def provenance_toml(provenance: dict, name: str = "provenance") -> str:
     """``provenance`` as the TOML table [``name``] (text ending in a blank line): numbers,
     strings, booleans, dates, lists, flat records of up to 12 plain values as inline tables,

@@ -50,6 +50,7 @@ class LeagueTable:
     settings: dict = field(default_factory=dict)
     tuned_on: dict | None = None
 
+    @property
     def summary(self) -> pd.DataFrame:
         """One row per controller (passive first): the mean over all the cases of every column
         of `cases` that is a number, and the number of cases (rows of `cases`). Where the league
@@ -113,7 +114,7 @@ class LeagueTable:
                 return bool(v)
             return v
 
-        summary = self.summary()
+        summary = self.summary
         return {
             "schema": SCHEMA,
             "settings": self.settings,
@@ -218,6 +219,7 @@ def league(
         rows.extend(_rows(comp, name, sc.speed, seed, record["name"], x))
         if progress is not None:
             progress(k + 1, len(runs))
+    record_of_gains = gains.record(names)
     settings = {
         "scenarios": scenarios,
         "vehicle": record,
@@ -227,7 +229,10 @@ def league(
         "damper_scale": float(damper_scale),
         "duration_s": duration,
         "window_s": None if window is None else [float(w) for w in window],
-        "gains": gains.source,
+        # the gains every case ran: where they came from, how they were found, every value
+        "gains": record_of_gains["source"],
+        "gains_provenance": record_of_gains["provenance"],
+        "gains_values": record_of_gains["values"],
         "objective": gains.provenance.get("objective"),
         "untuned": gains.untuned(names),
         "tuned_alike": gains.tuning_budget(names),

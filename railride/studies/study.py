@@ -63,12 +63,15 @@ class StudyResult:
     """The result of `study`. ``cases``: one row per run (the run table's metrics, with the
     study's ``controller``, ``load``, ``stiffness``, ``fault``, ``delay``, ``track_seed`` and
     ``speed_m_s`` and, for the controlled runs, each metric's reduction in % against passive on
-    the same track, speed, load and stiffness, ``<metric>_reduction``). ``summary``: one row per
+    the same track, speed, load and stiffness, ``<metric>_reduction``; then the gains each run's
+    controller ran with, one column per gain a controller of the study reads, ``gain_pid_kp``
+    for "pid.kp" (`gain_column`), NaN where it reads none). ``summary``: one row per
     controller, speed, condition (load, stiffness, fault, delay) and metric, over the track
     seeds: ``n`` (runs that did not diverge), ``mean``, ``p5``, ``p95`` of the value and
     ``reduction_mean``, ``reduction_p5``, ``reduction_p95``. Speeds and loads are design
     variables: they are never pooled into one band. ``failed``: the runs that diverged
-    (controller, condition, seed, speed, time). ``settings``: what was run."""
+    (controller, condition, seed, speed, time). ``settings``: what was run, the gains among it
+    (``gains``, ``gains_provenance``, ``gains_values``: `GainSet.record`)."""
 
     cases: pd.DataFrame
     summary: pd.DataFrame
@@ -183,7 +186,9 @@ def study(
     table names it in its ``vehicle`` column). Every setting is checked before the first run. ``executor``, ``table``
     and ``progress`` as for `railride.studies.sweep.run_cases`. ``settings["gains_mismatch"]``:
     one line (`GainSet.mismatch`) when the gains were tuned for another vehicle, load or track
-    than some of the runs'. Returns a `StudyResult`."""
+    than some of the runs'. ``settings["gains"]``, ``["gains_provenance"]`` and
+    ``["gains_values"]``: the gains the runs ran, their source, how they were found and every
+    value per controller (`GainSet.record`; docs/study.md, The gains). Returns a `StudyResult`."""
     from railride.analysis.metrics import check_window
     from railride.secondary.suspension import damper_model
     from railride.studies.sweep import other_settings
@@ -321,6 +326,8 @@ def study(
     info.insert(1, "vehicle", record["name"])
     frame = pd.concat([info, frame.drop(columns=[c for c in info.columns if c in frame.columns])], axis=1)
     frame = _reductions(frame)
+    gains_record = gains.record(names)
+    frame = _with_gains(frame, gains_record["values"])
     speeds_run = list(dict.fromkeys(float(v) for v in frame["speed_m_s"]))
     summary = _summary(frame, names, speeds_run, load_list, stiffness_list, conditions, delay_list)
     failed = [
@@ -349,7 +356,10 @@ def study(
         "sensing": sensing,
         "duration_s": duration,
         "damper": damper_record(damper),
-        "gains": gains.source,
+        # the gains the runs ran: where they came from, how they were found, every value
+        "gains": gains_record["source"],
+        "gains_provenance": gains_record["provenance"],
+        "gains_values": gains_record["values"],
         "window_s": window_record,
         "vehicle": record,
         **other_settings(vehicle, solver),
@@ -366,6 +376,24 @@ def _items(values) -> list:
     if isinstance(values, (str, bool)) or validation.is_number(values):  # one value (a bool is refused later)
         return [values]
     return list(values)
+
+
+def gain_column(entry: str) -> str:
+    """The column of the runs' table that holds the gain "table.entry": "pid.kp" -> "gain_pid_kp"."""
+    return "gain_" + entry.replace(".", "_")
+
+
+def _with_gains(frame: pd.DataFrame, values: dict) -> pd.DataFrame:
+    """``frame`` with one column per gain that a controller of the study reads (`gain_column`):
+    on each run the value its controller ran with, empty (NaN) where it reads none (passive)."""
+    entries = list(dict.fromkeys(e for own in values.values() for e in own))
+    table = pd.DataFrame(
+        [[values[n].get(e, np.nan) for e in entries] for n in frame["controller"]],
+        columns=[gain_column(e) for e in entries],
+        index=frame.index,
+        dtype=float,
+    )
+    return pd.concat([frame, table], axis=1)
 
 
 def _reductions(frame: pd.DataFrame) -> pd.DataFrame:

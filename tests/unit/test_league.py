@@ -22,7 +22,7 @@ def test_every_case_once_and_seeds_only_on_random_track(table):
 
 
 def test_summary_is_the_mean_over_the_cases(table):
-    summary = table.summary()
+    summary = table.summary
     pid = table.cases[table.cases.controller == "pid"]
     for column in ("acceleration_m_s2_reduction_percent", "centre_aw_Wk", "force_max_n"):
         assert summary.loc["pid", column] == pytest.approx(np.mean(pid[column].to_numpy()))

@@ -89,7 +89,7 @@ def test_a_heavier_carbody_rides_otherwise(two):
 
 
 def test_the_summary_is_the_mean_over_all_cases_and_loads(two):
-    summary = two.summary()
+    summary = two.summary
     assert "load" not in summary
     pid = two.cases[two.cases.controller == "pid"]
     assert summary.loc["pid", "cases"] == 6
