@@ -159,6 +159,7 @@ class RideSpectrum:
         `ACTUATOR_DEVICE`."""
         return {s: str(d) for s, d in zip(self.suspensions, self.psd["device"].values)}
 
+    @property
     def reductions(self) -> tuple[dict, dict]:
         """The reductions against passive (`reduction_percent`, positive where better) of every
         suspension but passive: ({suspension: {response: % of RMS}}, {suspension: {point:
@@ -190,7 +191,7 @@ class RideSpectrum:
     def to_pandas(self):
         import pandas as pd
 
-        rms_red, weighted_red = self.reductions()
+        rms_red, weighted_red = self.reductions
         devices = self.devices
         rows = []
         for s in self.suspensions:
@@ -216,7 +217,7 @@ class RideSpectrum:
     def to_dict(self) -> dict:
         from railride._version import __version__
 
-        rms_red, weighted_red = self.reductions()
+        rms_red, weighted_red = self.reductions
         return {
             "schema": SCHEMA,
             "railride_version": __version__,
