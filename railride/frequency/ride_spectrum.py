@@ -375,12 +375,12 @@ def ride_spectrum(
             "response": (
                 "response",
                 list(RESPONSES),
-                {"long_name": "response (output of the linear model)", "units": "1"},
+                {"long_name": "response (output of the linear model)", "units": ""},
             ),
             "unit": (
                 "response",
                 [plant.units[r] for r in RESPONSES],
-                {"long_name": "unit of the response's RMS", "units": "1"},
+                {"long_name": "unit of the response's RMS", "units": ""},
             ),
         },
         name="rms",
@@ -399,11 +399,11 @@ def ride_spectrum(
         dims=("suspension", "position", "weighting"),
         coords={
             **_coords(names, devices),
-            "position": ("position", list(FLOOR), {"long_name": "point on the carbody floor", "units": "1"}),
+            "position": ("position", list(FLOOR), {"long_name": "point on the carbody floor", "units": ""}),
             "weighting": (
                 "weighting",
                 list(WEIGHTINGS),
-                {"long_name": "frequency weighting (EN 12299 Wb, ISO 2631-1 Wk)", "units": "1"},
+                {"long_name": "frequency weighting (EN 12299 Wb, ISO 2631-1 Wk)", "units": ""},
             ),
         },
         name="weighted_rms",
@@ -435,11 +435,11 @@ def _coords(names: list[str], devices: list[str]) -> dict:
     """The coordinates along ``suspension`` of every array of a `RideSpectrum`: the names and
     the device of each (CF attributes; "1": a label, no unit)."""
     return {
-        "suspension": ("suspension", names, {"long_name": "suspension (passive or controller)", "units": "1"}),
+        "suspension": ("suspension", names, {"long_name": "suspension (passive or controller)", "units": ""}),
         "device": (
             "suspension",
             devices,
-            {"long_name": "device that makes the secondary force", "units": "1"},
+            {"long_name": "device that makes the secondary force", "units": ""},
         ),
     }
 

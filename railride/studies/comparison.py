@@ -356,8 +356,9 @@ class Comparison:
         first = self.datasets[self.names[0]]
         out["scenario"] = first["scenario"]
         out["vehicle_params"] = first["vehicle_params"]
-        out["controller_gains"] = ("controller", np.array(gains))
-        out["inner_loop_gains"] = ((), json.dumps(self.gains.inner.to_dict()))
+        out["controller_gains"] = ("controller", np.array(gains), {"long_name": GAINS_NAME, "units": ""})
+        out["inner_loop_gains"] = ((), json.dumps(self.gains.inner.to_dict()), {"long_name": INNER_NAME, "units": ""})
+        out["controller"].attrs.update(SUSPENSION_ATTRS)
         out.attrs.update(
             title="railride controller comparison", gains_source=self.gains.source, settings=json.dumps(self.settings)
         )
@@ -513,7 +514,7 @@ def compare(
             for i, n in enumerate(closed)
         }
     metrics = xr.concat([ride_metrics(datasets[n], window) for n in names], dim="controller")
-    metrics = metrics.assign_coords(controller=names)
+    metrics = metrics.assign_coords(controller=("controller", names, SUSPENSION_ATTRS))
     # the settings from the objects, not read back from the runs
     settings = {
         "scenario": scenario.describe(),
@@ -576,6 +577,10 @@ def _named(name, gains, damper, damper_scale, sensor_noise, delay, sensing=None)
     s = Suspension.named(name, gains, damper, damper_scale, sensor_noise=sensor_noise)
     return s.with_delay(delay).with_sensing(sensing) if s.closed_loop else s
 
+
+#: the ``controller`` coordinate's attributes (CF: "" for a label) and the gains' record names
+SUSPENSION_ATTRS = {"long_name": "suspension (passive or controller)", "units": ""}
+GAINS_NAME, INNER_NAME = "the gains of each suspension (JSON)", "the inner loop's gains (JSON)"
 
 #: the ideal devices `compare` runs beside the MR dampers: the best a damper could do with the
 #: same control laws and gains, and what a force actuator would do

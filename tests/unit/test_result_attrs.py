@@ -91,3 +91,11 @@ def test_the_frequency_response_of_the_vehicle_is_named():
         ds = Vehicle(preset).frequency_response(np.array([0.5, 1.0, 2.0]), 30.0)
         assert _unlabelled(ds) == []
         assert ds["carbody_pitch"].attrs["units"] == "rad/m"
+
+
+def test_the_comparison_is_named():
+    import railride as rr
+
+    c = rr.compare(rr.scenario("paper-sine", duration=0.5), bounds=False)
+    for obj in (c.metrics, c.reductions, c.combined()):
+        assert _unlabelled(obj) == []
