@@ -206,15 +206,22 @@ def status_note(message: str):
     return stderr_console().status(message)
 
 
-def write_folder(out: Path, write) -> None:
+def write_folder(out: Path, write, *, own_folder: bool = True) -> None:
     """Run ``write()`` (a `railride.output.files` writer or a result's ``save``) with a status note;
-    OSError -> status 2."""
+    OSError -> status 2. ``own_folder``: ``out`` is the command's result folder, so a line says
+    when it also holds files the command did not write (another command's results,
+    `railride.cli._folders.others_note`)."""
+    from railride.cli._folders import entries, others_note
+
+    before = entries(Path(out)) if own_folder else set()
     try:
         with status_note(f"writing outputs to {out}..."):
             paths = write()
     except OSError as exc:
         raise CliError(f"cannot write the output folder {out}: {exc.strerror or exc}", 2) from None
     typer.echo(f"wrote {', '.join(p.name for p in paths)} to {out}", err=True)
+    if note := others_note(Path(out), before, paths):
+        typer.echo(note, err=True)
 
 
 def print_json(doc) -> None:

@@ -291,7 +291,7 @@ def state_space(
         (secondary,) = linear_suspensions([suspension], None if gains is None else load_gains(gains)).values()
         model = linear_model(suspension=secondary, **vehicle_options)
         if out is not None:
-            write_folder(out.parent, lambda: [write_model(model, out)])
+            write_folder(out.parent, lambda: [write_model(model, out)], own_folder=False)
     if format is StateSpaceFormat.json:
         print_json(model.to_dict())
         return
