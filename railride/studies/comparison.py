@@ -32,6 +32,7 @@ from railride.run.simulation import run as run_plan, simulate
 from railride.model.track import as_scenario
 from railride.run.solver import SolverSettings
 from railride.secondary.suspension import Suspension, damper_model, damper_record
+from railride.studies.progress import shows_progress
 
 #: Table 1 of Harun et al. (RMS values): for display beside railride's results.
 PAPER_TABLE1 = {
@@ -371,6 +372,7 @@ class Comparison:
         return out
 
 
+@shows_progress("compare", fraction=True)
 def compare(
     scenario,
     vehicle=None,
@@ -384,7 +386,7 @@ def compare(
     window=None,
     solver=None,
     sensor_noise=None,
-    progress=None,
+    progress=True,
     comfort: bool = False,
     bounds: bool = True,
     faults=(),
@@ -425,7 +427,9 @@ def compare(
     exact states; the bounds measure the same); a law that reads the bogies' states is not run
     with it (``settings["not_run"]`` says why). ``level_tolerance``: two RMS values closer than
     this fraction of the larger are level in `Comparison.trade_offs` (default 0.01, 1 %;
-    recorded in ``settings``). Every setting is checked before the first run."""
+    recorded in ``settings``). ``progress``: True (the fraction done, shown on stderr after 2 s),
+    False, or a callable taking the fraction done (`railride.studies.progress`). Every setting
+    is checked before the first run."""
     from railride import arguments
 
     window = arguments.window("window", window)
@@ -556,6 +560,7 @@ def compare(
             delay=delay,
             sensing=sensing,
             level_tolerance=level_tolerance,
+            progress=False,
         )
     return Comparison(
         names,

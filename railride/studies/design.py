@@ -41,6 +41,7 @@ from railride.studies import evolution
 from railride.studies.objectives import DEFAULT_OBJECTIVE, OBJECTIVE_KINDS, TRAVEL_COLUMN, Objective
 from railride.studies.sweep import Case, RunTable, run_cases
 from railride.studies.tuning import PARAMETERS, STAGES, TUNED_CONTROLLERS, TuningCase, tune
+from railride.studies.progress import shows_progress
 
 #: the defaults of `design` (docs/design.md): FRA classes 4 and 5, 30-70 m/s, load factors 1
 #: and 1.3, three training seeds and five held-out seeds, 20 s of track a run
@@ -292,6 +293,7 @@ def _sections(track: str, length: float, seeds) -> tuple:
     return first, length
 
 
+@shows_progress("design")
 def design(
     controllers=None,
     *,
@@ -312,7 +314,7 @@ def design(
     optimiser_seed: int = 0,
     executor=None,
     table: RunTable | None = None,
-    progress=None,
+    progress=True,
     log=None,
 ) -> DesignResult:
     """Which law for ``vehicle`` (a preset name, a parameters file or `VehicleParams`, default
@@ -332,8 +334,9 @@ def design(
 
     Judging: every law with its tuned gains and passive on every track x ``test_seeds`` x speed
     x load (seeds that tuning never saw). ``executor``, ``table`` (one `RunTable` for both
-    stages: resumable) and ``progress(done, total, runs_per_second)`` as for
-    `railride.studies.sweep.run_cases`; ``log(text)`` after each pass of tuning. Every input
+    stages: resumable) as for `railride.studies.sweep.run_cases`; ``progress``: True (shown on
+    stderr after 2 s), False, or a callable ``progress(done, total, runs_per_second)``
+    (`railride.studies.progress`); ``log(text)`` after each pass of tuning. Every input
     is checked before the first run (`check_design`). Returns a `DesignResult`.
     """
     from railride.model.params import vehicle_record
