@@ -1,6 +1,8 @@
 """The defaults of a run, in one place: every module and the command line read them here."""
 
-#: fixed RK4 step [s]: resolves the MR dampers' hysteresis (docs/model.md, Integration)
+#: fixed step [s], RK4's: resolves the MR dampers' hysteresis (docs/model.md, Integration); the
+#: exact discretisation of a linear vehicle steps once per output sample and reads it as the
+#: spacing of its rail-input grid
 DEFAULT_DT = 1e-4
 #: rate of the stored time histories [Hz]
 DEFAULT_OUTPUT_RATE = 1000.0

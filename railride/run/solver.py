@@ -39,7 +39,8 @@ def _steps(steps: float) -> int | None:
 
 @dataclass(frozen=True)
 class SolverSettings:
-    """The fixed RK4 step ``dt`` [s], the rate of the stored time histories ``output_rate``
+    """The fixed step ``dt`` [s] (RK4's; where a run goes by the exact discretisation, only the
+    spacing of its rail-input grid), the rate of the stored time histories ``output_rate``
     [Hz], the sample rate of the outer-loop controllers ``control_rate`` [Hz] and the
     integration ``method`` (`METHODS`; default "auto": exact discretisation for the passive
     viscous suspension, one step per output sample, where dt only sets the input grid), and the
