@@ -130,7 +130,7 @@ def plot_sweep(result, ax=None, *, axis: str | None = None):
     if ax is not None:
         axes[0].legend(fontsize="small")
         return fig
-    settings = result.settings()
+    settings = result.settings
     context = describe_scenario(settings.get("scenario") or {})
     duration = (settings.get("scenario") or {}).get("duration_s")
     extra = [

@@ -478,6 +478,7 @@ class SweepResult:
             rows.append({**row, "key": case.key})
         return rows
 
+    @property
     def settings(self) -> dict:
         """What the sweep ran: the scenario's fixed settings, each axis and its values, the
         damper, the base gains' source, the sensor noise, the step and the metrics window;
@@ -532,7 +533,7 @@ class SweepResult:
             "schema": SCHEMA,
             "railride_version": __version__,
             "date": self.date,
-            "settings": self.settings(),
+            "settings": self.settings,
             "columns": self.columns(),
             "rows": self.rows(),
             "runs": int(self.runs),

@@ -278,7 +278,7 @@ class TuneResult:
                 if k not in ("controller", "convergence") and v is not None
             ]
             lines.append("")
-        lines.append(self.gains.to_toml())
+        lines.append(self.gains.to_toml(provenance=False))
         return "\n".join(lines)
 
     def to_pandas(self) -> pd.DataFrame:

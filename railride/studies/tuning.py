@@ -65,6 +65,9 @@ TUNED_CONTROLLERS = tuple(n for n in OUTER_LOOPS if GainSet.tuned_entries(n))
 TUNABLE = ("inner", *TUNED_CONTROLLERS)
 #: the gains each study varies, by "table.entry"
 PARAMETERS = {"inner": GainSet.entry_names("inner"), **{n: GainSet.tuned_entries(n) for n in TUNED_CONTROLLERS}}
+#: the source of the gains `tune` returns (their [provenance] says how they were found, and
+#: from which start gains)
+TUNED_SOURCE = "<tuned by railride.studies.tuning.tune>"
 #: the default budget of vehicle runs per law: two full passes of the law with the most gains
 #: (SAS attitude+ride: 14 gains x 14 new values per sweep = 196 runs a pass)
 DEFAULT_BUDGET = 400
@@ -413,7 +416,12 @@ def tune(
     result = dataclasses.replace(result, gains=tuned_gains)
     if before_after and over is None:
         result = dataclasses.replace(result, before_after=_before_after(result, run, case, tuned, inner, damper))
-    return dataclasses.replace(result, runs=table.frame, date=_utc_now())
+    result = dataclasses.replace(result, runs=table.frame, date=_utc_now())
+    # the tuned gains carry the [provenance] their gains file holds, not the start's source: a
+    # run with them records how they were found (`GainSet.record`, `GainSet.mismatch`)
+    provenance = GainSet.from_toml(result.gains_toml()).provenance
+    gains = dataclasses.replace(result.gains, source=TUNED_SOURCE, provenance=provenance)
+    return dataclasses.replace(result, gains=gains)
 
 
 def _start(name: str, start: GainSet) -> dict:

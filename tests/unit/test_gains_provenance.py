@@ -237,9 +237,9 @@ def test_study_sweep_and_league_record_one_line():
     assert res.settings["gains_mismatch"].endswith("railride tune --load 1,1.3 --duration 0.2")
     assert "this run has load 1.3; " in res.settings["gains_mismatch"]
     sweep = run_sweep(grid(["pid"], speed=[40.0, 55.56], duration=0.2), comfort=False)
-    line = sweep.settings()["gains_mismatch"]
+    line = sweep.settings["gains_mismatch"]
     assert "track paper-sine (speed 40 m/s)" in line and line.endswith("railride tune --speed 40 --duration 0.2")
-    assert "gains_mismatch" not in run_sweep(grid(["pid"], duration=0.2), comfort=False).settings()
+    assert "gains_mismatch" not in run_sweep(grid(["pid"], duration=0.2), comfort=False).settings
     table = league(["paper-sine"], speeds=[40.0, 55.56], controllers=["pid"], duration=0.2, comfort=False)
     assert table.to_dict()["settings"]["gains_mismatch"] == line
     for doc in (res.to_dict(), sweep.to_dict(), table.to_dict()):

@@ -104,6 +104,23 @@ def test_changed_gains_never_keep_their_file_as_the_whole_source():
     assert GainSet.default().record(["pid"])["source"] == "railride/data/gains.toml"
 
 
+@pytest.mark.filterwarnings("ignore::railride.errors.TuningWarning")  # the inner loop left as it starts
+def test_the_gains_tune_returns_carry_their_provenance():
+    res = rr.tune(["pid"], budget=5, n_values=3, scenario_options={"duration": 0.5}, before_after=False)
+    gains = res.gains
+    assert gains.source != res.start.source == "railride/data/reference_gains.toml"
+    assert gains.provenance["controllers"] == ["pid"]
+    assert gains.provenance["start_gains"] == "railride/data/reference_gains.toml"
+    # the gains file still holds one [provenance], the same one
+    back = GainSet.from_toml(res.gains_toml(), source="tuned.toml")
+    assert back.provenance == gains.provenance
+    assert back.entries() == gains.entries()
+    study = rr.study(["pid"], scenario="paper-sine", duration=0.5, gains=gains)
+    assert study.settings["gains"] == gains.source
+    assert study.settings["gains_provenance"]["start_gains"] == "railride/data/reference_gains.toml"
+    assert study.settings["gains_values"]["pid"]["pid.kp"] == gains.value("pid.kp")
+
+
 def test_a_league_records_the_gains_it_ran(tuned):
     table = league(["paper-sine"], [40.0], controllers=["passive", "pid"], gains=tuned, duration=0.5)
     s = table.settings
