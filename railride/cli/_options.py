@@ -476,15 +476,15 @@ TrackingOutOption = _out(
 )
 TuneOutOption = _out(
     "Keep the run table DIR/runs.csv (updated as runs finish) and write gains.toml, "
-    "sensitivity.png, curves.csv and tune.json into DIR at the end."
+    "sensitivity.png (sensitivity_2.png, ... beyond 12 gains), curves.csv and tune.json into DIR at the end."
 )
 ParetoOutOption = _out(
-    "Keep the run table DIR/runs.csv (updated as runs finish) and write pareto.png, "
+    "Keep the run table DIR/runs.csv (updated as runs finish) and write pareto.png, pareto_caption.txt, "
     "pareto.csv and pareto.json into DIR at the end."
 )
 SweepOutOption = _out(
     "Keep the run table DIR/runs.csv (updated as runs finish) and write sweep.json "
-    "(and sweep.png when one numeric axis has several values) into DIR at the "
+    "(and sweep.png when one or two axes have several values) into DIR at the "
     "end."
 )
 

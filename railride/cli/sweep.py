@@ -296,6 +296,8 @@ def sweep_command(
         executor.close()
     printed = _sweep_table(doc["rows"], list(grid.columns), _caption(grid, doc, wall))
     warn_gains_mismatch(doc["settings"])
+    if out is not None and result.figure_note:  # the folder has sweep.json but no sweep.png: say why
+        typer.echo(f"note: {result.figure_note}", err=True)
     if format is SweepFormat.json:
         typer.echo(text)
     elif format is SweepFormat.csv:

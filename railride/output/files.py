@@ -40,11 +40,11 @@ from railride.plots.comparison import (
     plot_comparison_voltages,
 )
 from railride.plots.frf import plot_frf
-from railride.plots.pareto import plot_pareto
+from railride.plots.pareto import pareto_caption, plot_pareto
 from railride.plots.ride import plot_body_responses
 from railride.plots.rig import plot_hysteresis, plot_tracking
 from railride.plots.sweep import has_comfort, plot_sweep, plot_sweep_comfort, sweep_plot_axis
-from railride.plots.tuning import plot_sensitivity
+from railride.plots.tuning import plot_sensitivity, sensitivity_pages, sensitivity_stem
 from railride.output.tables import comparison_frame, curves_frame, cycles_frame, modes_frame, to_frame
 
 #: the files `write_outputs` produces, in the order they are written
@@ -68,16 +68,17 @@ COMPARE_FILES = (
     "psd.png",
     "psd.csv",
 )
-#: the files `write_tune_outputs` produces, in the order they are written
+#: the files `write_tune_outputs` produces, in the order they are written; sensitivity.png is
+#: followed by sensitivity_2.png, ... where the figure has several pages (`sensitivity_pages`)
 TUNE_FILES = ("gains.toml", "sensitivity.png", "curves.csv", "tune.json")
 #: the files `write_sweep_outputs` always produces (the run table runs.csv is the library's);
-#: ``sweep.png`` is added when the sweep has one numeric axis (`sweep_plot_axis`), and with it
+#: ``sweep.png`` is added when one or two axes have several values (`sweep_plot_axis`), and with it
 #: ``comfort.png`` when the rows hold the comfort indices (`railride sweep --comfort`)
 SWEEP_FILES = ("sweep.json",)
 #: the files `write_frf_outputs` produces, in the order they are written
 FRF_FILES = ("frf.csv", "frf.json", "frf.png", "modes.csv")
 #: the files `write_pareto_outputs` produces, in the order they are written
-PARETO_FILES = ("pareto.png", "pareto.csv", "pareto.json")
+PARETO_FILES = ("pareto.png", "pareto_caption.txt", "pareto.csv", "pareto.json")
 
 
 # -- NetCDF and JSON ------------------------------------------------------------------------------
@@ -465,18 +466,17 @@ def write_tune_outputs(
     """Write the results of a tuning study into ``out_dir``, all or nothing (`write_folder`;
     other files there, such as the run table ``runs.csv``, stay): ``gains.toml``
     (``gains_text``, a gains file), ``sensitivity.png`` (`plot_sensitivity` of ``curves``,
-    ``TuneResult.curves``), ``curves.csv`` (`curves_frame`) and ``tune.json`` (``doc`` as
-    indented strict JSON). Returns the written paths."""
+    ``TuneResult.curves``; sensitivity_2.png, ... for its further pages), ``curves.csv``
+    (`curves_frame`) and ``tune.json`` (``doc`` as indented strict JSON). Returns the written paths."""
     text = json_text(doc)  # refuse NaN before any file is written
     curves = list(curves)
     frame = curves_frame(curves)
-    writers = {
-        "gains.toml": _text(gains_text),
-        "sensitivity.png": _png(lambda: plot_sensitivity(curves, title=title)),
-        "curves.csv": _csv(frame),
-        "tune.json": _text(text),
-    }
-    return write_folder(out_dir, _entries(TUNE_FILES, writers, figures))
+    pages = [f"{sensitivity_stem(k + 1)}.png" for k in range(max(1, len(sensitivity_pages(curves))))]
+    writers = {"gains.toml": _text(gains_text), "curves.csv": _csv(frame), "tune.json": _text(text)}
+    for k, name in enumerate(pages, 1):
+        writers[name] = _png(lambda k=k: plot_sensitivity(curves, title=title, page=k))
+    names = [n for name in TUNE_FILES for n in (pages if name == "sensitivity.png" else [name])]
+    return write_folder(out_dir, _entries(names, writers, figures))
 
 
 def write_sweep_outputs(
@@ -484,7 +484,7 @@ def write_sweep_outputs(
 ) -> list[Path]:
     """Write a `railride.studies.sweep.SweepResult` into ``out_dir`` beside the run table ``runs.csv``
     that `railride.studies.sweep.run_cases` keeps there, all or nothing: ``sweep.json`` (``doc``,
-    default ``result.to_dict()``) and, when the grid has one numeric axis with several values
+    default ``result.to_dict()``) and, when one or two axes have several values
     (`sweep_plot_axis`), ``sweep.png`` (`plot_sweep`) and, if the rows hold the comfort indices,
     ``comfort.png`` (`plot_sweep_comfort`). Returns the written paths."""
     _expect(result, "result", "railride.studies.sweep.SweepResult", ("grid", "frame"))
@@ -518,12 +518,14 @@ def write_frf_outputs(
 
 def write_pareto_outputs(result, out_dir, *, figures: FigureOptions | None = None) -> list[Path]:
     """Write a `railride.studies.pareto.ParetoResult` into ``out_dir``, all or nothing (other files,
-    such as a run table, stay): ``pareto.png`` (`plot_pareto`), ``pareto.csv``
+    such as a run table, stay): ``pareto.png`` (`plot_pareto`), ``pareto_caption.txt`` (its
+    caption, `pareto_caption`, with the in-sample note), ``pareto.csv``
     (``to_pandas()``) and ``pareto.json`` (``to_dict()``). Returns the paths."""
     text = json_text(result.to_dict())  # refuse NaN before any file is written
     frame = result.to_pandas()
     writers = {
         "pareto.png": _png(lambda: plot_pareto(result)),
+        "pareto_caption.txt": _text(pareto_caption(result) + "\n"),
         "pareto.csv": _csv(frame),
         "pareto.json": _text(text),
     }

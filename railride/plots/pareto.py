@@ -1,11 +1,12 @@
-"""The Pareto view of a controller's gains (`railride.studies.pareto.ParetoResult`)."""
+"""The Pareto view of a controller's gains (`railride.studies.pareto.ParetoResult`): the figure
+(`plot_pareto`) and its caption (`pareto_caption`), which carries the in-sample note."""
 
 from __future__ import annotations
 
 import numpy as np
 
 from railride.analysis.labels import describe_scenario
-from railride.plots._style import PAGE_WIDTH, fit_text, given_axes, new_figure, set_title, styled, suspension_label
+from railride.plots._style import PAGE_WIDTH, given_axes, new_figure, set_title, styled, suspension_label
 
 #: axis label of each ratio
 RATIO_LABELS = {
@@ -94,12 +95,28 @@ def plot_pareto(result, ax=None):
     )
     if ax is None:
         set_title(fig, title)
-        if result.note:
-            note = fit_text(result.note, fig.get_figwidth() - 0.2, 7.5)
-            fig.text(0.5, 0.005, note, ha="center", va="bottom", fontsize="small", color="tab:red")
-            fig.get_layout_engine().set(rect=(0, 0.03 + 0.03 * note.count("\n"), 1, 0.96))
     else:
         axes[0].set_title(title, fontsize="small", loc="left")
-        if result.note:
-            axes[-1].set_title(result.note, fontsize="x-small", color="tab:red", wrap=True)
+    # the in-sample note is the caption's (`pareto_caption`), not drawn: a journal sets it there
     return fig
+
+
+def pareto_caption(result) -> str:
+    """The caption of `plot_pareto`'s figure of ``result`` (a
+    `railride.studies.pareto.ParetoResult`): what each mark is and, where it applies, the
+    in-sample note (``result.note``). Written beside the figure as pareto_caption.txt
+    (`railride.output.files.write_pareto_outputs`) and printed by ``railride pareto``."""
+    st = result.settings
+    (x, y1), (_, y2) = result.PROJECTIONS[:2]
+    text = (
+        f"{suspension_label(result.suspension)}: the RMS of the carbody responses of "
+        f"{len(result.ratios)} gain sets as ratios to the passive suspension's (RMS / RMS(passive), "
+        f"lower is better; {st.get('n_samples', '?')} Sobol' samples of the gains, seed "
+        f"{st.get('seed', '?')}, and the base gains), {x} ratio against the {y1} ratio (left) and "
+        f"against the {y2} ratio (right), log axes. Grey: every sampled gain set; blue: the gain sets "
+        "non-dominated over all four ratios; orange staircase through open circles: those "
+        "non-dominated in the plane drawn; black cross: passive (1, 1); red star: the base gains "
+        f"({st.get('base_gains', '?')}). {describe_scenario(result.scenario)}, "
+        f"{result.scenario.get('duration_s', 0):g} s, {st.get('damper', '?')} dampers."
+    )
+    return text + (f" {result.note}" if result.note else "")

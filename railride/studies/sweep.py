@@ -543,20 +543,29 @@ class SweepResult:
         """One row per run, the columns of `columns` (empty where an axis does not act)."""
         return pd.DataFrame(self.rows(), columns=self.columns())
 
-    def plot(self, ax=None, *, comfort: bool = False, axis: str | None = None):
+    def plot(self, ax=None, *, comfort: bool = False, axis: str | None = None, series: str | None = None):
         """The RMS of the four carbody responses against the swept axis (four panels,
         `railride.plots.sweep.plot_sweep`), or with ``comfort`` N_MV,z and a_w Wk against it
-        (two panels, `plot_sweep_comfort`). ``ax``: the Axes to draw in, or None for a new
-        figure. Returns the figure."""
+        (two panels, `plot_sweep_comfort`); with a second swept axis, one line per value of it
+        (``series``). ``ax``: the Axes to draw in, or None for a new figure. Returns the
+        figure; InputError where there is none to draw (`figure_note` says why)."""
         from railride.plots.sweep import plot_sweep, plot_sweep_comfort
 
-        return (plot_sweep_comfort if comfort else plot_sweep)(self, ax, axis=axis)
+        return (plot_sweep_comfort if comfort else plot_sweep)(self, ax, axis=axis, series=series)
+
+    @property
+    def figure_note(self) -> str | None:
+        """One line saying why this sweep has no figure (no sweep.png: no axis, or more than two,
+        with several values; `railride.plots.sweep.sweep_figure_note`), or None when it has one."""
+        from railride.plots.sweep import sweep_figure_note
+
+        return sweep_figure_note(self)
 
     def save(self, folder, *, extra: dict | None = None, figure_formats=("png",), dpi: float = PNG_DPI) -> list:
         """sweep.json (`to_dict`, then the entries of ``extra``, such as a command line's
-        facts) and, when the grid has one numeric axis with several values, sweep.png and,
-        with comfort, comfort.png (each in every one of ``figure_formats``: png, pdf, svg; PNG
-        at ``dpi``) into ``folder``, all or nothing (other files, such as the run table
+        facts) and, when one or two axes have several values (`figure_note` is None), sweep.png
+        and, with comfort, comfort.png (each in every one of ``figure_formats``: png, pdf, svg;
+        PNG at ``dpi``) into ``folder``, all or nothing (other files, such as the run table
         runs.csv, stay). Returns the paths."""
         from railride.output.files import write_sweep_outputs
 

@@ -2,7 +2,8 @@
 (`Curve`) and the gains file it writes, with the provenance of every law's gains.
 
 `TuneResult` follows the result protocol: `to_dict` (tune.json, schema ``railride.tune/3``),
-`to_pandas` (curves.csv), `plot` (sensitivity.png), `save` (the four files, all or nothing);
+`to_pandas` (curves.csv), `plot` (sensitivity.png, and `plot_pages` its further pages,
+sensitivity_2.png, ...), `save` (the four files, all or nothing);
 `gains_toml` is gains.toml with its provenance.
 """
 
@@ -289,14 +290,22 @@ class TuneResult:
 
         return curves_frame(self.curves)
 
-    def plot(self, ax=None):
+    def plot(self, ax=None, *, page: int = 1):
         """The sensitivity figure (`railride.plots.tuning.plot_sensitivity`): one panel per gain,
         the objective against its value, one line per pass. ``ax``: one Axes per gain, in the
-        order tuned, or None for a new figure (titled with the scenario and the objective).
-        Returns the figure."""
+        order tuned, or None for a new figure (titled with the scenario and the objective) of
+        page ``page`` (at most 12 panels a page; `plot_pages` draws them all). Returns the
+        figure."""
         from railride.plots.tuning import plot_sensitivity
 
-        return plot_sensitivity(self.curves, title=self._title(), ax=ax)
+        return plot_sensitivity(self.curves, title=self._title(), ax=ax, page=page)
+
+    def plot_pages(self) -> list:
+        """Every page of the sensitivity figure, in order: what `save` writes as
+        sensitivity.png, sensitivity_2.png, ... (`railride.plots.tuning.plot_sensitivity_pages`)."""
+        from railride.plots.tuning import plot_sensitivity_pages
+
+        return plot_sensitivity_pages(self.curves, title=self._title())
 
     def save(
         self,
@@ -307,7 +316,8 @@ class TuneResult:
         figure_formats=("png",),
         dpi: float = PNG_DPI,
     ) -> list:
-        """gains.toml (`gains_toml` with ``command``), sensitivity.png (`plot`; in each of
+        """gains.toml (`gains_toml` with ``command``), sensitivity.png (`plot`; sensitivity_2.png,
+        ... for the further pages of `plot_pages`; in each of
         ``figure_formats``, png, pdf, svg, PNG at ``dpi``), curves.csv (`to_pandas`) and
         tune.json (`to_dict`, then the entries of ``extra``, such as a command line's facts)
         into ``folder``, all or nothing (each file replaced atomically; other files, such as

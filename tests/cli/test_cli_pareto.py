@@ -15,7 +15,8 @@ PARETO = ("pareto", "--suspension", "pid", "--samples", 4, "--duration", 1)
 def test_pareto_folder_json_and_resume(tmp_path):
     out = tmp_path / "p"
     doc = json.loads(ok(*PARETO, "--seed", 2, "--out", out, "--format", "json").stdout)
-    assert sorted(p.name for p in out.iterdir()) == ["pareto.csv", "pareto.json", "pareto.png", "runs.csv"]
+    names = ["pareto.csv", "pareto.json", "pareto.png", "pareto_caption.txt", "runs.csv"]
+    assert sorted(p.name for p in out.iterdir()) == names
     assert json.loads((out / "pareto.json").read_text()) == doc
     assert doc["schema"] == "railride.pareto/1" and doc["suspension"] == "pid"
     assert doc["settings"]["n_samples"] == 4 and doc["settings"]["seed"] == 2

@@ -315,7 +315,8 @@ def test_sweep_writes_the_plot_for_one_numeric_axis(tmp_path):
     # comfort is on by default: its plot comes with the RMS one
     assert sorted(p.name for p in out.iterdir()) == ["comfort.png", "runs.csv", "sweep.json", "sweep.png"]
     assert is_png(out / "sweep.png")
-    # two axes with several values, or none: no plot
+    # none with several values: no plot, and a line that says why
     other = tmp_path / "grid"
-    ok("sweep", "--speed", "20,40", "--wavelength", "30,60", "--duration", 1, "--out", other)
+    result = ok("sweep", "--duration", 1, "--out", other)
     assert sorted(p.name for p in other.iterdir()) == ["runs.csv", "sweep.json"]
+    assert "note: no figure" in result.stderr

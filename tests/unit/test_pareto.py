@@ -94,7 +94,7 @@ def test_a_tiny_study(tiny, tmp_path):
     assert frame["non_dominated_acceleration_roll"].tolist() == brute_force(ratio[:, [0, 3]])
 
     paths = tiny.save(tmp_path / "p")
-    assert [p.name for p in paths] == list(FILES) == ["pareto.png", "pareto.csv", "pareto.json"]
+    assert [p.name for p in paths] == list(FILES) == ["pareto.png", "pareto_caption.txt", "pareto.csv", "pareto.json"]
     assert (tmp_path / "p" / "pareto.png").read_bytes().startswith(PNG)
     reloaded = pd.read_csv(tmp_path / "p" / "pareto.csv")
     pd.testing.assert_frame_equal(reloaded, frame, check_exact=False, rtol=1e-12)

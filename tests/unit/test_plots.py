@@ -279,7 +279,7 @@ def test_titles_fit_the_figure_width(results):
 
 
 def test_sensitivity_panel_titles_do_not_run_into_each_other():
-    # the longest gain names with their units, four panels to a row as `railride tune` draws them
+    # the longest gain names with their units, side by side as `railride tune` draws them
     names = ["ride_attitude.kd_theta", "clipped_optimal.qd_theta", "ride_attitude.kp_theta", "skyhook_on_off.c_phi"]
     values, scores = np.array([0.0, 1e5, 1e6]), np.array([1.0, 0.8, 0.9])
     curves = [Curve("sas-attitude-ride", 1, n, values, scores, 1e5) for n in names]
@@ -289,7 +289,8 @@ def test_sensitivity_panel_titles_do_not_run_into_each_other():
     boxes = [ax.title.get_window_extent(renderer) for ax in fig.get_axes() if ax.title.get_text()]
     assert len(boxes) == 4
     for left, right in zip(boxes, boxes[1:]):
-        assert left.x1 <= right.x0, (left, right)
+        if abs(left.y0 - right.y0) < 1:  # on the same row
+            assert left.x1 <= right.x0, (left, right)
 
 
 # -- the metric window: the start-up transient ----------------------------------------------------
