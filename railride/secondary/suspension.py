@@ -322,7 +322,9 @@ class Suspension:
         if (name == "mr" or name in CONSTANT_VOLTAGE) and model.law == dampers.LAW_IDEAL:
             raise InputError(
                 f"damper = {damper!r} with suspension {name!r}: the ideal actuator applies a "
-                "controller's demand and has no constant voltage; use a controller"
+                "controller's demand and has no constant voltage; it needs a controller (a suspension "
+                "named after one, e.g. 'sas-attitude'), as railride compare --damper ideal and railride "
+                "sweep --damper ideal run it"
             )
         model = damper_model(damper, damper_scale)
         scale = float(damper_scale)
