@@ -18,7 +18,7 @@ from railride.plots._style import (
 @styled
 def plot_ride_spectrum(result, path=None, *, ax=None):
     """One log-log panel per floor point (centre, front, rear) of the acceleration PSD
-    [(m/s^2)^2/Hz] against frequency [Hz]; the legend gives each suspension's RMS and
+    ((m/s^2)^2/Hz) against frequency (Hz); the legend gives each suspension's RMS and
     Wb-weighted RMS there. ``ax``: three Axes, or None for a new figure. Returns the figure."""
     from railride.analysis.comfort import FLOOR
 
@@ -39,10 +39,10 @@ def plot_ride_spectrum(result, path=None, *, ax=None):
             label = f"{suspension_label(s)}: {rms:.3g}, {wb:.3g} m/s²"
             a.loglog(f, result.psd[name].sel(suspension=s).values, label=label, **suspension_style(s))
         a.set_title(f"floor, {point}")
-        a.set_xlabel("frequency [Hz]")
+        a.set_xlabel("frequency (Hz)")
         # the wheelbase filter's notches reach zero: six decades below the peak show the ride
         a.set_ylim(top * 1e-6, top * 3)
         # below the panel: the PSDs fill the axes
         a.legend(loc="upper center", bbox_to_anchor=(0.5, -0.22), fontsize="x-small", title="RMS, Wb-weighted RMS")
-    axes[0].set_ylabel("PSD [(m/s²)²/Hz]")
+    axes[0].set_ylabel("PSD ((m/s²)²/Hz)")
     return fig

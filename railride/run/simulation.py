@@ -68,7 +68,8 @@ def simulate(
     (v_min under a closed loop) and their hysteretic states at 0. A closed loop samples the
     carbody states at the solver's control rate.
     ``solver`` (`railride.SolverSettings`, default: its defaults) holds the fixed step dt
-    [s] (RK4's, or the input grid's under the exact discretisation), the output rate [Hz] of the stored time histories and the controllers' rate [Hz].
+    [s] (RK4's, or the input grid's under the exact discretisation), the output rate [Hz] of
+    the stored time histories and the controllers' rate [Hz].
     ``initial_state`` is (q, q') at t = 0 as 18 numbers in DOF order (m, rad, m/s, rad/s), or
     one row per sample; by default the vehicle starts at rest in equilibrium.
     ``progress(done_fraction)`` is called between chunks of a long run.

@@ -230,19 +230,7 @@ def test_the_pattern_finds_a_bracketed_unit_and_passes_a_parenthesised_one():
     assert not BRACKETED_UNIT.search("axes[0]") and not BRACKETED_UNIT.search("$10^{3}$")
 
 
-# ride_spectrum.py is another part's: strict, so that this marker goes once its labels are changed
-@pytest.mark.parametrize(
-    "module",
-    [
-        pytest.param(
-            p.name,
-            marks=[pytest.mark.xfail(strict=True, reason="frequency [Hz] and PSD [...] in its labels")]
-            if p.name == "ride_spectrum.py"
-            else [],
-        )
-        for p in sorted(PLOTS.glob("*.py"))
-    ],
-)
+@pytest.mark.parametrize("module", [p.name for p in sorted(PLOTS.glob("*.py"))])
 def test_figures_give_units_in_parentheses_never_in_brackets(module):
     found = [(line, text) for line, text in _strings(PLOTS / module) if BRACKETED_UNIT.search(text)]
     assert not found, f"{module}: units in brackets; write them as 'quantity (unit)': {found}"
