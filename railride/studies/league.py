@@ -22,6 +22,7 @@ import pandas as pd
 
 from railride.errors import InputError
 from railride import validation
+from railride.studies.progress import shows_progress
 from railride.studies.comparison import check_controllers, compare
 from railride.secondary.control import LABELS, PAPER_CONTROLLERS, GainSet
 from railride.defaults import DEFAULT_DAMPER
@@ -156,6 +157,7 @@ def _cases(scenarios, speeds, track_seeds):
             yield name, v, seed
 
 
+@shows_progress("league")
 def league(
     scenarios=("paper-sine",),
     speeds=None,
@@ -172,7 +174,7 @@ def league(
     window=None,
     solver=None,
     comfort: bool = True,
-    progress=None,
+    progress=True,
 ) -> LeagueTable:
     """Run `compare` on every (scenario, speed, track seed) at every load factor with the same
     gains and collect the league table. ``scenarios``: names (`railride.scenario`); ``speeds``
@@ -187,7 +189,9 @@ def league(
     ``settings["gains_mismatch"]``: the one line of `GainSet.mismatch` over every case and
     load, when the gains were tuned for another vehicle, load or track.
     `LeagueTable.summary` pools the speeds and loads; `LeagueTable.by_speed` keeps them apart.
-    ``progress(done_runs, total_runs)`` is called after each case at each load."""
+    ``progress``: True (the default: shown on stderr after 2 s, `railride.studies.progress`),
+    False (silent) or a callable ``progress(done_runs, total_runs)``, called after each case at
+    each load."""
     scenarios = list(scenarios) if not isinstance(scenarios, str) else [scenarios]
     if not scenarios:
         raise InputError("scenarios: give at least one scenario name")
@@ -215,6 +219,7 @@ def league(
             solver=solver,
             comfort=comfort,
             bounds=True,
+            progress=False,
         )
         rows.extend(_rows(comp, name, sc.speed, seed, record["name"], x))
         if progress is not None:

@@ -30,6 +30,7 @@ from railride.output.files import PARETO_FILES
 from railride.analysis.metrics import RESPONSES, still_passive
 from railride.model.params import resolve_vehicle
 from railride.plots import PNG_DPI, FigureOptions
+from railride.studies.progress import shows_progress
 from railride.studies.optimise import GainEvaluator, log_gain_bounds
 from railride import validation
 from railride.run.checks import check
@@ -231,6 +232,7 @@ def in_sample_note(gains: GainSet, record: dict) -> str | None:
     )
 
 
+@shows_progress("pareto")
 def pareto(
     suspension: str = "sas-attitude-ride",
     *,
@@ -246,7 +248,7 @@ def pareto(
     params=None,
     load: float = 1.0,
     solver=None,
-    progress=None,
+    progress=True,
     parameters=None,
 ) -> ParetoResult:
     """Sample the gains of ``suspension`` (pid, sas-attitude, sas-attitude-ride; by default all
@@ -256,7 +258,9 @@ def pareto(
     REFERENCE / 1000 and REFERENCE x 100 (the box of `railride.studies.optimise`), the other gains at
     ``gains`` (default the shipped `GainSet.default`), which are also run as sample 0. One call
     of `run_cases`: 32-run batches, ``table`` to resume, ``executor`` for Dask;
-    ``progress(done, total, runs_per_second)`` after each chunk. ``vehicle`` (``params`` is
+    ``progress``: True (the default: shown on stderr after 2 s, `railride.studies.progress`),
+    False (silent) or a callable ``progress(done, total, runs_per_second)`` after each chunk.
+    ``vehicle`` (``params`` is
     an alias): a preset name, the path of a parameters file or `VehicleParams` (default
     "paper"), with the load factor ``load`` on its carbody, recorded in ``settings["vehicle"]``
     (`railride.model.params.vehicle_record`); ``solver``: the `SolverSettings` of every run;

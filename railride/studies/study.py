@@ -27,6 +27,7 @@ import pandas as pd
 
 from railride.errors import InputError
 from railride import validation
+from railride.studies.progress import shows_progress
 from railride.studies.comparison import check_controllers
 from railride.secondary.control import PAPER_CONTROLLERS, GainSet
 from railride.defaults import DEFAULT_DAMPER
@@ -147,6 +148,7 @@ def _finite(value):
     return value if np.isfinite(value) else None
 
 
+@shows_progress("study")
 def study(
     controllers=PAPER_CONTROLLERS,
     *,
@@ -167,7 +169,7 @@ def study(
     window=None,
     executor=None,
     table: RunTable | None = None,
-    progress=None,
+    progress=True,
 ) -> StudyResult:
     """Run ``controllers`` (names of `railride.secondary.control.CONTROLLERS`; passive is always the
     baseline) on ``scenario`` for every track seed (a random track's realisation; default 0 to
@@ -184,7 +186,9 @@ def study(
     parameters file or `VehicleParams`, default "paper"; the loads scale its carbody;
     ``settings["vehicle"]`` records it, `railride.model.params.vehicle_record`, and the runs'
     table names it in its ``vehicle`` column). Every setting is checked before the first run. ``executor``, ``table``
-    and ``progress`` as for `railride.studies.sweep.run_cases`. ``settings["gains_mismatch"]``:
+    and ``progress`` as for `railride.studies.sweep.run_cases` (True, the default: shown on
+    stderr after 2 s, `railride.studies.progress`; False: silent).
+    ``settings["gains_mismatch"]``:
     one line (`GainSet.mismatch`) when the gains were tuned for another vehicle, load or track
     than some of the runs'. ``settings["gains"]``, ``["gains_provenance"]`` and
     ``["gains_values"]``: the gains the runs ran, their source, how they were found and every

@@ -30,6 +30,7 @@ import pandas as pd
 
 from railride.errors import InputError
 from railride.defaults import DEFAULT_CONTROL_RATE, DEFAULT_OUTPUT_RATE
+from railride.studies.progress import shows_progress
 from railride.studies.executors import DaskExecutor, LocalExecutor, ProcessExecutor, RunTable  # noqa: F401 (their home before)
 from railride.analysis.metrics import RESPONSES, STATISTICS
 from railride.plots import PNG_DPI, FigureOptions
@@ -602,6 +603,7 @@ def comfort_settings(duration: float, window) -> dict:
     }
 
 
+@shows_progress("sweep")
 def run_sweep(
     grid: SweepGrid,  # noqa: F811 (the argument shadows the function `grid` on purpose)
     *,
@@ -610,15 +612,17 @@ def run_sweep(
     vehicle=None,
     params=None,
     load: float = 1.0,
-    progress=None,
+    progress=True,
     comfort: bool = True,
 ) -> SweepResult:
     """Run every case of ``grid`` (`railride.studies.sweep.grid`) and return a `SweepResult`.
 
     One call of `run_cases`: compiled batches of 32 runs, on ``executor`` (default
     `LocalExecutor`; `DaskExecutor` for a cluster), skipping the runs already in ``table``
-    (a `RunTable`; one kept on disk makes the sweep resumable), ``progress(done, total,
-    runs_per_second)`` after each chunk. ``vehicle`` (``params`` is an alias): a preset name,
+    (a `RunTable`; one kept on disk makes the sweep resumable), ``progress``: True (the
+    default: shown on stderr after 2 s, `railride.studies.progress`), False (silent) or a
+    callable ``progress(done, total, runs_per_second)`` after each chunk. ``vehicle``
+    (``params`` is an alias): a preset name,
     the path of a parameters file or `VehicleParams` (default "paper"), with the load factor
     ``load`` on its carbody; `SweepResult.settings` records both (``vehicle``). ``comfort``:
     also the ride comfort indices of every run over the grid's window

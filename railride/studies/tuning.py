@@ -40,6 +40,7 @@ from railride.secondary.control import OUTER_LOOPS, GainSet
 from railride.defaults import DEFAULT_DAMPER
 from railride.analysis.metrics import RESPONSES
 from railride.model.params import resolve_argument, vehicle_record
+from railride.studies.progress import shows_progress
 from railride.studies.objectives import (  # noqa: F401 (re-exported: the objectives' old home)
     DEFAULT_OBJECTIVE,
     INFEASIBLE_OFFSET,
@@ -184,6 +185,7 @@ def _inner_left_out(controllers, gains, damper) -> str | None:
     )
 
 
+@shows_progress("tuning")
 def tune(
     controllers=TUNABLE,
     *,
@@ -203,7 +205,7 @@ def tune(
     params=None,
     solver=None,
     window=None,
-    progress=None,
+    progress=True,
     log=None,
     damper_scale: float = 1.0,
     before_after: bool = True,
@@ -227,7 +229,9 @@ def tune(
     in ``settings["vehicle"]`` with the load factors of the runs
     (`railride.model.params.vehicle_record`); ``solver``: the `SolverSettings` of every vehicle
     run; both are recorded in ``settings`` where they differ from the defaults (the run keys). Every setting is
-    checked before the first run. ``progress(done, total, runs_per_second)`` after each chunk;
+    checked before the first run. ``progress``: True (the default: shown on stderr after 2 s,
+    `railride.studies.progress`), False (silent) or a callable ``progress(done, total,
+    runs_per_second)`` after each chunk;
     ``log(text)`` after each pass.
 
     ``before_after``: at the end, run each law tuned (and, when the inner loop was tuned, each

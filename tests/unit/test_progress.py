@@ -1,0 +1,78 @@
+"""Long library calls show their progress unless told not to: True (the default) shows it on
+stderr after a delay, False says nothing, a callable receives the numbers."""
+
+from __future__ import annotations
+
+import io
+
+import pytest
+
+import railride as rr
+from railride.errors import InputError
+from railride.studies import progress as prog
+
+
+class Clock:
+    def __init__(self):
+        self.t = 0.0
+
+    def __call__(self):
+        return self.t
+
+
+def test_resolve_maps_the_three_kinds():
+    assert prog.resolve(False, "x") is None and prog.resolve(None, "x") is None
+    mine = lambda *a: None  # noqa: E731
+    assert prog.resolve(mine, "x") is mine
+    assert isinstance(prog.resolve(True, "x"), prog.Shown)
+    with pytest.raises(InputError, match="progress = 'yes'"):
+        prog.resolve("yes", "x")
+
+
+def test_a_short_call_says_nothing_and_a_long_one_a_line_now_and_then():
+    clock, out = Clock(), io.StringIO()
+    shown = prog.Shown("tuning", clock=clock, stream=out)
+    shown(0, 40, 0.0)
+    clock.t = prog.DELAY / 2
+    shown(10, 40, 12.0)
+    assert out.getvalue() == ""  # within the delay: silent
+    clock.t = prog.DELAY + 0.1
+    shown(20, 40, 12.5)
+    assert out.getvalue() == "tuning: 20/40 runs, 12.5 runs/s (2 s)\n"
+    clock.t += prog.EVERY / 2
+    shown(30, 40, 12.5)
+    assert out.getvalue().count("\n") == 1  # not before EVERY seconds
+    clock.t += prog.EVERY
+    shown(40, 40, 12.5)
+    assert out.getvalue().splitlines()[-1].startswith("tuning: 40/40 runs")
+
+
+def test_a_fraction_is_shown_in_percent():
+    clock, out = Clock(), io.StringIO()
+    shown = prog.Shown("compare", fraction=True, clock=clock, stream=out)
+    clock.t = prog.DELAY
+    shown(0.25)
+    assert out.getvalue().startswith("compare: 25/100 %")
+
+
+SC = rr.scenario("paper-sine", duration=0.5)
+
+
+def test_a_study_shows_progress_by_default_and_not_when_told(monkeypatch, capsys):
+    monkeypatch.setattr(prog, "DELAY", 0.0)
+    rr.compare(SC, bounds=False)
+    assert "compare:" in capsys.readouterr().err
+    rr.compare(SC, bounds=False, progress=False)
+    assert capsys.readouterr().err == ""
+    seen = []
+    rr.compare(SC, bounds=False, progress=seen.append)
+    assert seen and seen[-1] == pytest.approx(1.0) and capsys.readouterr().err == ""
+
+
+def test_every_long_call_takes_progress_and_shows_it_by_default():
+    import inspect
+
+    from railride.studies.league import league
+
+    for f in (rr.compare, rr.design, rr.tune, rr.study, rr.pareto, rr.run_sweep, league):
+        assert inspect.signature(f).parameters["progress"].default is True, f.__name__
