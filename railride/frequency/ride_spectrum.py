@@ -286,7 +286,10 @@ def ride_spectrum(
     ``delay`` periods. A closed loop that is unstable is not run: ``settings["not_run"]``
     gives the reason (ValueError when none is left). ``settings["gains_mismatch"]``: one line
     (`GainSet.mismatch`) when the gains of the outer loops run by name were tuned for another
-    vehicle, load or track (`gains_mismatch`)."""
+    vehicle, load or track (`gains_mismatch`). ``settings["gains_source"]``,
+    ``["gains_provenance"]`` and ``["gains_values"]``: the gains those loops ran, their source,
+    how they were found and every value per suspension (`GainSet.record`; ``["gains"]`` says
+    "given" or "shipped")."""
     validation.choice("track", track, SPECTRA)
     speed = DEFAULT_SPEED if speed is None else frequency_speed(speed)
     lo = validation.number("min_wavelength", min_wavelength, "positive", "m")
@@ -409,6 +412,8 @@ def ride_spectrum(
         name="weighted_rms",
         attrs={"long_name": "frequency-weighted RMS of the floor's vertical acceleration", "units": "m/s^2"},
     )
+    by_name = _by_name(controllers, names)
+    ran = gains.record([n for n in names if n == "passive" or n in by_name])
     settings = {
         "vehicle": record,
         "track": track,
@@ -422,10 +427,14 @@ def ride_spectrum(
         "delay_periods": delay if control_rate is not None else None,
         "actuator": "ideal (force = demand)",
         "gains": "given" if given else "shipped",
-        "gains_source": gains.source,
+        # the gains the outer loops named ran (`GainSet.record`): their source as far as it is
+        # still true, their [provenance] and every value per suspension run by name
+        "gains_source": ran["source"],
+        "gains_provenance": ran["provenance"],
+        "gains_values": ran["values"],
         "not_run": not_run,
     }
-    mismatch = gains_mismatch(gains, _by_name(controllers, names), record, track, speed, (lo, hi))
+    mismatch = gains_mismatch(gains, by_name, record, track, speed, (lo, hi))
     if mismatch:
         settings["gains_mismatch"] = mismatch
     return RideSpectrum(ds, rms, weighted_da, settings, vehicle_params)

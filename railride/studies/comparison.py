@@ -289,10 +289,18 @@ class Comparison:
                     self.comfort[name], None if name == "passive" else self.comfort["passive"]
                 )
             rows.append(row)
+        ran = self.gains.record(self.names)  # the gains the runs ran (GainSet.record)
         return {
             "schema": "railride.comparison/1",
             "railride_version": __version__,
-            "settings": self.settings,
+            # the gains record as every result's settings hold it: their source as far as it is
+            # still true, their [provenance] and every value per suspension run
+            "settings": {
+                **self.settings,
+                "gains": ran["source"],
+                "gains_provenance": ran["provenance"],
+                "gains_values": ran["values"],
+            },
             "paper_case": paper_case,
             "controllers": rows,
             "trade_offs": self.trade_offs(),
@@ -308,7 +316,7 @@ class Comparison:
                 **({"alike": a} if (a := self.gains.tuning_budget(self.names)) else {}),
             },
             "gains": {
-                "source": self.gains.source,
+                "source": ran["source"],  # a file changed since it was read is not that file
                 "inner": self.gains.inner.to_dict(),
                 **{n: self._gains_record(n) for n in self.names if n != "passive"},
             },

@@ -128,7 +128,10 @@ class GainEvaluator:
         return values
 
     def record(self, **settings) -> tuple[dict, dict]:
-        """(the scenario's record, the study's settings with ``settings`` first)."""
+        """(the scenario's record, the study's settings with ``settings`` first): among them the
+        base gains' record (``gains``, ``gains_provenance``, ``gains_values``: `GainSet.record`
+        of the suspension; ``base_gains`` as ``gains``) and ``gains_varied``, the parameters
+        the search sets instead."""
         from railride.model.params import VehicleParams
         from railride.studies.sweep import other_settings
         from railride.model.track import scenario as make_scenario
@@ -137,12 +140,17 @@ class GainEvaluator:
         vehicle = (
             self.params if isinstance(self.params, VehicleParams) else VehicleParams.preset(self.params or "paper")
         )
+        ran = self.gains.record([self.suspension])
         return scenario, {
             **settings,
             "damper": damper_record(self.damper),
             "dt_s": self.solver.dt,
             **self.solver.backend_record(),
-            "base_gains": self.gains.source,
+            "base_gains": ran["source"],
+            "gains": ran["source"],
+            "gains_provenance": ran["provenance"],
+            "gains_values": ran["values"],
+            "gains_varied": list(self.parameters),
             **other_settings(vehicle, self.solver),
         }
 
@@ -222,6 +230,7 @@ class OptimiseResult:
         its search box and tuned value, the gains and the convergence (None for an objective
         that is not finite: a generation whose runs all diverged)."""
         from railride._version import __version__
+        from railride.secondary.provenance import stated_source
 
         rows = _parameter_rows(self.parameters)
         for row, lg in zip(rows, np.asarray(self.log10_gains, dtype=float)):
@@ -240,7 +249,8 @@ class OptimiseResult:
             "runs": int(self.n_runs),
             "message": self.message,
             "gains": {
-                "source": g.source,
+                # the base gains' source with the entries the search changed
+                "source": stated_source(g),
                 **{t: g.table(t).to_dict() for t in GainSet.TABLES},
             },
             "convergence": [

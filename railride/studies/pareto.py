@@ -264,8 +264,10 @@ def pareto(
     an alias): a preset name, the path of a parameters file or `VehicleParams` (default
     "paper"), with the load factor ``load`` on its carbody, recorded in ``settings["vehicle"]``
     (`railride.model.params.vehicle_record`); ``solver``: the `SolverSettings` of every run;
-    both recorded in ``settings`` where they differ from the defaults (the run keys). Every setting is
-    checked before the first run.
+    both recorded in ``settings`` where they differ from the defaults (the run keys). The base
+    gains are recorded in ``settings["gains"]``, ``["gains_provenance"]`` and
+    ``["gains_values"]`` (`GainSet.record`), the sampled entries in ``["gains_varied"]``. Every
+    setting is checked before the first run.
     """
     from railride.secondary.suspension import damper_model
     from railride.studies.sweep import other_settings
@@ -310,6 +312,7 @@ def pareto(
     if not np.all(np.asarray(ev.passive, float) > 0):  # every ratio would be nan or inf
         raise InputError(still_passive(record))
     gains_si = np.vstack([[base.value(p) for p in names], 10.0**points])
+    ran = base.record([suspension])  # the base gains (sample 0); the samples vary ``names``
     settings = {
         "n_samples": n_samples,
         "seed": seed,
@@ -317,8 +320,14 @@ def pareto(
         "damper": damper_record(damper),
         "dt_s": solver.dt,
         **solver.backend_record(),
-        "base_gains": base.source,
+        "base_gains": ran["source"],
         "base_gains_tuned_on": (base.provenance or {}).get("scenario"),
+        # the gains record (`GainSet.record`) of the base gains, and the entries the samples set
+        # instead (their values in ``samples``)
+        "gains": ran["source"],
+        "gains_provenance": ran["provenance"],
+        "gains_values": ran["values"],
+        "gains_varied": list(names),
         "vehicle": vehicle_rec,
         **other_settings(vehicle, solver),
         # base gains tuned for another vehicle, load or track: one line (`GainSet.mismatch`)

@@ -482,7 +482,9 @@ class SweepResult:
     @property
     def settings(self) -> dict:
         """What the sweep ran: the scenario's fixed settings, each axis and its values, the
-        damper, the base gains' source, the sensor noise, the step and the metrics window;
+        damper, the base gains (``gains``, ``gains_provenance``, ``gains_values``:
+        `GainSet.record` of the controllers; ``gains_varied``: the entries the gain axes set
+        instead; ``gains_source`` as ``gains``), the sensor noise, the step and the metrics window;
         with comfort, what its columns are (`comfort_settings`); the vehicle's record
         (``vehicle``: name, load, values); a solver's rates and a vehicle other than the
         defaults (`other_settings`); ``gains_mismatch`` where the base gains were tuned for
@@ -490,11 +492,19 @@ class SweepResult:
         g = self.grid
         vehicle = VehicleParams.preset("paper") if self.vehicle is None else self.vehicle
         record = self.record()
+        none: dict = {"source": None, "provenance": None, "values": {}}  # no controller reads gains
+        ran = g.base_gains.record(g.controllers) if g.controllers else none
         return {
             "scenario": g.scenario_record(),
             "grid": g.grid_values(),
             "damper": damper_record(g.damper) if ("mr" in g.suspensions or g.controllers) else None,
-            "gains_source": g.base_gains.source if g.controllers else None,
+            "gains_source": ran["source"],
+            # the base gains the controllers ran (`GainSet.record`); the entries of a gain axis
+            # ran with the values of their row instead (``gains_varied``, their values in ``grid``)
+            "gains": ran["source"],
+            "gains_provenance": ran["provenance"],
+            "gains_values": ran["values"],
+            "gains_varied": [name for name, _ in g.gains],
             "sensor_noise": None
             if g.noise is None
             else dict(zip(("displacement", "angle", "velocity", "angular_rate"), g.noise)),
