@@ -240,7 +240,8 @@ class TuneResult:
             f"date = {json.dumps(doc['date'])}",
             f"railride_version = {json.dumps(doc['railride_version'])}",
             f"scenario = {json.dumps(run_text)}",
-            f"damper = {json.dumps(s['damper'])}",
+            # a preset by its name; a damper object by its parameters (JSON's null is no TOML)
+            f"damper = {_toml_inline(s['damper']) if isinstance(s['damper'], dict) else json.dumps(s['damper'])}",
             f"damper_scale = {s.get('damper_scale', 1.0)!r}",
             f"dt_s = {s['dt_s']!r}",
             *([f"command = {json.dumps(command)}"] if command is not None else []),

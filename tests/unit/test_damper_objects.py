@@ -7,6 +7,8 @@ from __future__ import annotations
 import json
 
 import numpy as np
+import tomllib
+
 import pytest
 
 import railride as rr
@@ -43,6 +45,8 @@ def test_a_model_of_ones_own_runs_and_is_recorded_in_every_study(tmp_path):
 def test_tune_and_pareto_take_a_model():
     tuned = rr.tune(controllers=["pid"], damper=MINE, budget=15, scenario_options=SC)
     assert tuned.to_dict()["settings"]["damper"] == MINE.to_dict()
+    # its gains file is TOML (a damper object has no preset: JSON's null has no TOML form)
+    assert tomllib.loads(tuned.gains_toml())["provenance"]["damper"]["alpha_a"] == MINE.alpha_a
     front = rr.pareto("pid", damper=MINE, n_samples=8, scenario_options=SC)
     assert front.to_dict()["settings"]["damper"] == MINE.to_dict()
 
