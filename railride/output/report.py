@@ -1,13 +1,15 @@
 """One self-contained HTML file of a result, to open in any browser and send to colleagues.
 
-`write_report(result, path)` writes, for a result this module knows (`KNOWN`: `Comparison`,
-`SweepResult`, `TuneResult`, `StudyResult`, `LeagueTable`, `RideResult`, `FrfResult`), a page
-that gives the answer first: the result's own table (``to_pandas()``), the trade-offs in words and
-the recommendation where the result has them; then every figure its ``save()`` writes (time
-histories, spectra and frequency responses as interactive plotly figures,
-`railride.plots.interactive`; the others as the package's matplotlib figures), the tables the
-command line printed (HTML fragments given by the caller, ``console_html``), the run's settings
-and provenance (railride version, scenario, the command line) and the vehicle's modal table.
+`write_report(result, path)` writes, for a result with a report (`REPORTED`: `Comparison`,
+`DesignResult`, `SweepResult`, `TuneResult`, `StudyResult`, `LeagueTable`, `RideResult`,
+`RideSpectrum`, `FrfResult`), a page that gives the answer first: the result's own table
+(``to_pandas()``), the trade-offs in words and the recommendation where the result has them;
+then every figure its ``save()`` writes, every page of a figure in pages (time histories, spectra
+and frequency responses as interactive plotly figures, `railride.plots.interactive`; the others
+as the package's matplotlib figures; where a result has none, the line that says why), the
+tables the command line printed (HTML fragments given by the caller, ``console_html``), the
+run's settings and provenance (railride version, scenario, the command line) and the vehicle's
+modal table.
 
 Nothing is fetched when the page opens, and the page fits an e-mail: plotly's JavaScript and
 each figure's data are inlined once, gzip-compressed and base64-encoded, and unpacked by the
@@ -56,7 +58,8 @@ class Contents:
     ``recommendation``: what the result recommends, in words, above it ("" if nothing);
     ``settings``: nested values shown flat; ``scenario``: the scenario's record
     (`Scenario.describe()`), if one; ``params``: the `VehicleParams` of the modal table (None:
-    the vehicles differ, no single table)."""
+    the vehicles differ, no single table); ``figure_note``: where the result has no figure,
+    one line saying why, printed where the figures would be (a sweep over three axes)."""
 
     title: str
     settings: dict
@@ -66,6 +69,7 @@ class Contents:
     tables: list = field(default_factory=list)
     findings: list = field(default_factory=list)
     recommendation: str = ""
+    figure_note: str = ""
 
 
 #: the result types with a report (each has a ``report_contents()`` method that calls one of the
@@ -165,14 +169,23 @@ def _wide(frame: pd.DataFrame) -> pd.DataFrame:
 
 
 def sweep_contents(result) -> Contents:
-    """The report of a `railride.studies.sweep.SweepResult`."""
-    from railride.plots.sweep import has_comfort, sweep_plot_axis
+    """The report of a `railride.studies.sweep.SweepResult`: its figures where one or two axes
+    have several values (the first along x, one line per value of the second), else the line
+    ``figure_note`` that says why there is none."""
+    from railride.analysis.labels import grid_axis_label
+    from railride.plots.sweep import has_comfort, sweep_plot_axes
 
     settings = result.settings
-    axis = sweep_plot_axis(result)  # None: no numeric axis with several values, no figure
-    figures = [] if axis is None else [("sweep", f"RMS against {axis}", result.plot(axis=axis))]
-    if axis is not None and has_comfort(result):
-        figures.append(("comfort", f"comfort against {axis}", result.plot(comfort=True, axis=axis)))
+    axes = sweep_plot_axes(result)  # None: no figure, and figure_note says why
+    figures = []
+    if axes is not None:
+        x, series = axes
+        against = grid_axis_label(x)
+        if series is not None:
+            against += f", one line per {grid_axis_label(series).split(' (')[0]}"
+        figures.append(("sweep", f"RMS against {against}", result.plot(axis=x, series=series)))
+        if has_comfort(result):
+            figures.append(("comfort", f"comfort against {against}", result.plot(comfort=True, axis=x, series=series)))
     return Contents(
         title="Sweep",
         settings={**settings, "date": result.date, "runs": int(result.runs)},
@@ -180,19 +193,32 @@ def sweep_contents(result) -> Contents:
         scenario=settings.get("scenario"),
         figures=figures,
         tables=[("one row per run", result.to_pandas())],
+        figure_note=result.figure_note or "",
     )
 
 
 def tune_contents(result) -> Contents:
-    """The report of a `railride.studies.tune_result.TuneResult`."""
+    """The report of a `railride.studies.tune_result.TuneResult`: every page of its sensitivity
+    figure (``plot_pages``: sensitivity.png, sensitivity_2.png, ...)."""
+    from railride.plots.tuning import sensitivity_stem
+
     doc = result.to_dict()
     keys = ("controllers", "scenario", "settings", "objective", "date", "runs", "gains")
+    pages = result.plot_pages() if result.curves else []
+    figures = [
+        (
+            sensitivity_stem(k),
+            "sensitivity curves" + (f", page {k} of {len(pages)}" if len(pages) > 1 else ""),
+            page,
+        )
+        for k, page in enumerate(pages, start=1)
+    ]
     return Contents(
         title="Tuning: every law by the sensitivity study",
         settings={k: doc[k] for k in keys},
         params=_vehicle(doc["settings"]),
         scenario=doc["scenario"],
-        figures=[("sensitivity", "sensitivity curves", result.plot())] if result.curves else [],
+        figures=figures,
         tables=[("the sensitivity curves, one row per value tried", result.to_pandas())],
     )
 
@@ -346,6 +372,8 @@ def report_html(result, *, console_html=(), title: str | None = None, command: s
     sections = [("answer", "Results", _answer_html(part))]
     if part.figures:
         sections.append(("figures", "Figures", "\n".join(_figure_html(packs, *f) for f in part.figures)))
+    elif part.figure_note:
+        sections.append(("figures", "Figures", f'<p class="note">{html.escape(part.figure_note)}</p>'))
     if part.tables[1:]:
         sections.append(("tables", "More tables", "\n".join(_caption_table(c, t) for c, t in part.tables[1:])))
     if console_html:

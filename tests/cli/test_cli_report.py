@@ -203,3 +203,20 @@ def test_static_figures_svg_or_png():
     assert smooth.index("<img") < smooth.index('<p class="note">drawn from 50 points &amp; no more</p>')
     assert "pack-plotly" not in _packs(page)  # no interactive figure: no plotly
     assert page.index('<section id="answer">') < page.index("This result has no table.") < page.index("<figure")
+
+
+def test_sweep_reports_draw_two_axes_and_say_why_three_have_no_figure(tmp_path):
+    """--report of a sweep over two axes holds its figure, one line per value of the second axis;
+    over three axes, no figure and, where the figures would be, the line the command printed."""
+    two = tmp_path / "two.html"
+    ok("sweep", "--speed", "20,40", "--wavelength", "30,60", "--duration", 0.2, "--no-comfort", "--report", two)
+    page = _page(two)
+    figure = re.search(r'<figure id="figure-sweep".*?</figure>', page, flags=re.S)
+    assert figure and "one line per wavelength" in figure.group(0)
+    three = tmp_path / "three.html"
+    args = ("--speed", "20,40", "--wavelength", "30,60", "--amplitude", "0.01,0.02", "--duration", 0.2)
+    ok("sweep", *args, "--no-comfort", "--report", three)
+    page = _page(three)
+    assert "<figure" not in page
+    section = re.search(r'<section id="figures">(.*?)</section>', page, flags=re.S)
+    assert section and "no figure: 3 axes have several values" in html.unescape(section.group(1))

@@ -239,3 +239,64 @@ def test_static_figures_svg_when_smaller(monkeypatch, comparison):
 
     monkeypatch.setattr(report, "_gzip", bulky)
     assert image_kinds(report.report_html(comparison)) == ["image/png"] * 3
+
+
+# -- figures in pages, a sweep's two axes, a sweep without a figure -----------------------------------
+def _fake_sweep(g):
+    """A sweep's result without its runs: made-up metrics (run i has 0.1 + 0.01 i everywhere)."""
+    import pandas as pd
+
+    from railride.studies.sweep import COMFORT_COLUMNS, SweepResult, metric_columns
+
+    rows = [dict.fromkeys(metric_columns() + list(COMFORT_COLUMNS), 0.1 + 0.01 * i) for i in range(len(g.cases))]
+    return SweepResult(g, pd.DataFrame(rows), comfort=True)
+
+
+def _figure(text: str, name: str) -> str:
+    found = re.search(rf'<figure id="figure-{name}".*?</figure>', text, flags=re.S)
+    assert found, name
+    return found.group(0)
+
+
+def test_a_sweep_over_two_axes_shows_its_figures_one_line_per_value():
+    """Speed along x, one line per voltage: the RMS and the comfort figures, each captioned so."""
+    g = rr.sweep.grid(["passive", "mr"], speed=[20.0, 40.0, 60.0], voltage=[0.0, 1.0], duration=1.0)
+    text = report.report_html(_fake_sweep(g))
+    assert set(Page(text).figures) == {"figure-sweep", "figure-comfort"}
+    for name in ("sweep", "comfort"):
+        caption = re.search(r"<figcaption>(.*?)</figcaption>", _figure(text, name)).group(1)
+        assert "speed" in caption and "one line per command voltage" in caption, caption
+    assert "no figure:" not in text
+
+
+def test_a_sweep_without_a_figure_says_why_where_the_figures_would_be():
+    """Three swept axes: no figure, and the Figures section holds the one line that says why."""
+    g = rr.sweep.grid(["mr"], speed=[20.0, 40.0], wavelength=[30.0, 60.0], voltage=[0.0, 1.0], duration=1.0)
+    text = report.report_html(_fake_sweep(g))
+    assert not Page(text).figures
+    section = re.search(r'<section id="figures">(.*?)</section>', text, flags=re.S)
+    assert section, "no Figures section"
+    note = re.search(r'<p class="note">(.*?)</p>', section.group(1)).group(1)
+    assert note.startswith("no figure: 3 axes have several values") and "speed_m_s" in note
+    assert text.index('<section id="answer">') < section.start() < text.index('<section id="settings">')
+
+
+@pytest.mark.filterwarnings("ignore:the inner loop is not tuned")
+def test_every_page_of_the_sensitivity_figure_is_in_the_tune_report():
+    """25 gains of one law make three pages (12, 12 and 1 panels): three figures, named as the
+    files the tuning writes (sensitivity.png, sensitivity_2.png, sensitivity_3.png)."""
+    import dataclasses
+
+    from railride.studies.tune_result import Curve
+
+    tuned = rr.tune(
+        ["pid"], scenario_options={"duration": 0.2}, n_values=3, budget=5, before_after=False, progress=False
+    )
+    rng = np.random.default_rng(0)
+    curves = [Curve("pid", 1, f"pid.k{k}", np.geomspace(0.1, 10.0, 5), 1 + rng.random(5), 1.0) for k in range(25)]
+    text = report.report_html(dataclasses.replace(tuned, curves=curves))
+    figures = re.findall(r'<figure id="figure-(sensitivity[^"]*)"', text)
+    assert figures == ["sensitivity", "sensitivity_2", "sensitivity_3"]
+    for k, name in enumerate(figures, start=1):
+        caption = re.search(r"<figcaption>(.*?)</figcaption>", _figure(text, name)).group(1)
+        assert f"page {k} of 3" in caption and f"({name}.png in the output folder)" in caption
