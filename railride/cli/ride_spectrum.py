@@ -190,7 +190,7 @@ def _tables(result) -> list:
     st = doc["settings"]
     red_rms, red_weighted = doc["rms_reduction_percent"], doc["weighted_rms_reduction_percent"]
     floor = FitTable(
-        title=escape("Carbody floor acceleration [m/s^2], frequency domain"),
+        title=escape("Carbody floor acceleration (m/s^2), frequency domain"),
         caption="red. % = (passive - controlled) / passive x 100 (negative: worse than passive, in red)."
         if red_rms
         else None,
@@ -212,7 +212,7 @@ def _tables(result) -> list:
                 f"{wk:.4g}",
             )
     body = FitTable(title="Carbody accelerations and secondary travel (RMS)")
-    for head in ("suspension", "bounce\n[m/s^2]", "pitch\n[rad/s^2]", "roll\n[rad/s^2]", "travel 1R\n[mm]"):
+    for head in ("suspension", "bounce\n(m/s^2)", "pitch\n(rad/s^2)", "roll\n(rad/s^2)", "travel 1R\n(mm)"):
         body.add_column(escape(head), justify="left" if head == "suspension" else "right")
     for s in result.suspensions:
         r = doc["rms"][s]

@@ -12,7 +12,7 @@ from clihelp import assert_input_error, ok, ok_json, run
 
 def test_ride_spectrum_table_and_json():
     out = ok("ride-spectrum", "--controllers", "passive,sas-attitude", "--points", "200").stdout
-    assert "Carbody floor acceleration [m/s^2]" in out and "SAS (attitude)" in out
+    assert "Carbody floor acceleration (m/s^2)" in out and "SAS (attitude)" in out
     assert "(the shipped robust set, tuned on FRA classes 4 and 5" in " ".join(out.split())
     doc = ok_json("ride-spectrum", "--track", "fra5", "--speed", "40", "--points", "200")
     assert doc["settings"]["track"] == "fra5" and doc["settings"]["speed_m_s"] == 40.0
