@@ -317,7 +317,9 @@ def tune(
 
         from railride.errors import TuningWarning
 
-        warnings.warn(untuned, TuningWarning, stacklevel=2)
+        warnings.warn(
+            untuned, TuningWarning, stacklevel=validation.caller_level()
+        )  # the user's call, past the progress wrapper
     result = TuneResult(
         gains,
         objective=objective,

@@ -200,8 +200,8 @@ SYNOPSES = _synopses()
 
 #: lines that are neither a command nor a synopsis of one, and the commands they stand for
 STANDS_FOR = {
-    "railride compare | sweep | tune | study ... --report FILE.html": [
-        [name, "--report", "page.html"] for name in ("compare", "sweep", "tune", "study")
+    "railride compare | sweep | tune | study | design | ride-spectrum ... --report FILE.html": [
+        [name, "--report", "page.html"] for name in ("compare", "sweep", "tune", "study", "design", "ride-spectrum")
     ],
 }
 

@@ -76,3 +76,13 @@ def test_every_long_call_takes_progress_and_shows_it_by_default():
 
     for f in (rr.compare, rr.design, rr.tune, rr.study, rr.pareto, rr.run_sweep, league):
         assert inspect.signature(f).parameters["progress"].default is True, f.__name__
+
+
+def test_a_warning_inside_a_wrapped_study_points_at_the_callers_line():
+    import warnings
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        rr.tune(("pid",), scenario_options={"duration": 0.3}, n_values=3, budget=5, before_after=False)
+    tuning = [w for w in caught if issubclass(w.category, rr.errors.TuningWarning)]
+    assert tuning and all(w.filename == __file__ for w in tuning), [(w.filename, w.lineno) for w in tuning]
