@@ -237,9 +237,9 @@ def plot_sensitivity(curves, ax=None, *, title: str | None = None, page: int = 1
         any_zero = _draw_parameter(a, [c for c in curves if c.parameter == parameter], colour) or any_zero
     for a in axes[len(parameters) :]:
         a.set_visible(False)
-    handles: list = [
-        Line2D([], [], color=colour(k), marker="o", markersize=3, label=f"pass {k}") for k in range(1, max_pass + 1)
-    ]
+    # the passes drawn on this page (their colours as on every page)
+    drawn = sorted({int(c.sweep_pass) for c in curves if c.parameter in set(parameters)})
+    handles: list = [Line2D([], [], color=colour(k), marker="o", markersize=3, label=f"pass {k}") for k in drawn]
     handles.append(
         Line2D(
             [],

@@ -247,3 +247,16 @@ def test_the_labels_of_the_figures_built_here_give_their_units_in_parentheses():
     labels = [text for fig in figures for ax in fig.get_axes() for text in (ax.get_xlabel(), ax.get_ylabel())]
     assert "speed (m/s)" in labels and "acceleration RMS (m/s$^2$)" in labels
     assert not [text for text in labels if BRACKETED_UNIT.search(text)]
+
+
+def test_a_page_lists_only_the_passes_it_draws():
+    from railride.plots.tuning import plot_sensitivity_pages
+
+    curves = _every_law_curves()
+    # a third pass of the first gain only: on the first page, not on the others
+    first = curves[1]
+    curves.append(Curve(first.controller, 3, first.parameter, first.values, first.objective, first.chosen))
+    pages = plot_sensitivity_pages(curves)
+    labels = [[t.get_text() for leg in fig.legends for t in leg.get_texts()] for fig in pages]
+    assert "pass 3" in labels[0]
+    assert len(pages) > 1 and all("pass 3" not in page and "pass 1" in page for page in labels[1:])
