@@ -11,15 +11,32 @@ reader's shell.
   nothing run). A value an option's metavar lists the choices of (``--method auto|rk4|exact``)
   must be one of them. A usage synopsis (a line with ``[...]``, and its continuation lines)
   cannot parse; every option it names must be an option of its command.
+* Every documented command that is cheap also runs, in-process in an empty folder, and must exit
+  with status 0: a value out of range, a refused combination or a file the docs assume fails
+  here. The files a command names (``--gains my_gains.toml``, ``file:track.csv``) are made from
+  a table below (`FILES`). Cheap is a rule: each documented line's run was timed once on a
+  2-core machine and the lines that took at most about 5 s run; no test asserts a time. By that
+  rule these stay parse-only (`parse_only`): ``tune``, ``design``, ``study``, ``sweep`` and
+  ``pareto`` (minutes); ``--backend gpu`` (it needs a GPU, and under the tests' CUDA simulator
+  a run takes far longer); a comparison that draws its figures or page for ``--controllers all``
+  (``report``, ``--report``, ``--out``: 11 to 13 s measured here). The ``fmu`` lines that build
+  a binary need a C compiler, and are skipped without one, as the FMU tests are.
+* A parse-only command runs up to its first vehicle run, where a stand-in stepper stops it: its
+  values and their combination passed every check the command makes before it runs. Not the
+  lines that need what a test has not: a cluster (``--scheduler``, ``--scheduler-file``) or a
+  GPU (``--backend gpu``).
 """
 
 from __future__ import annotations
 
+import csv
 import re
 import shlex
+import shutil
 from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
 import pytest
 import typer.main
 
@@ -302,3 +319,156 @@ def test_the_checks_fail_where_they_should():
         ["compare", "--speed", "40"]
     ]
     assert _railride_words("│ acceleration │ railride │ 0.56 │") == []
+    # the rule of what runs, and a run that fails is a failure
+    assert parse_only(["tune", "--out", "t"]) and parse_only(["compare", "--backend", "gpu"])
+    assert parse_only(["compare", "--controllers", "all", "--comfort", "--report", "all.html"])
+    assert parse_only(["report", "--controllers", "all"])
+    assert parse_only(["compare", "--controllers", "all"]) is None
+    assert parse_only(["fmu", "--out", "v.fmu"]) is None
+    with pytest.raises(AssertionError, match="exited with status 2"):
+        _run_documented(["simulate", "--speed", "-1"])
+
+
+# ---------------------------------------------------------------------------------------------
+# every cheap documented command runs
+
+#: the commands that run for minutes (a tuning, a study, a sweep over speeds or seeds)
+LONG = ("tune", "design", "study", "sweep", "pareto")
+
+
+def _name(words: list[str]) -> str:
+    """The command's name: its first word that is not an option of railride itself."""
+    return next((w for w in words if not w.startswith("-")), "")
+
+
+def _value(words: list[str], option: str) -> str | None:
+    return next((value for word, value in zip(words, words[1:]) if word == option), None)
+
+
+def parse_only(words: list[str]) -> str | None:
+    """Why a documented command (the words after railride) only parses, by the module's rule;
+    None where it runs."""
+    name = _name(words)
+    if name in LONG:
+        return f"railride {name} runs for minutes"
+    if _value(words, "--backend") == "gpu":
+        return "--backend gpu needs a GPU (under the tests' CUDA simulator a run takes far longer)"
+    draws = name == "report" or "--report" in words or "--out" in words
+    if name in ("compare", "report") and _value(words, "--controllers") == "all" and draws:
+        return "the figures of every law take over the rule's 5 s"
+    return None
+
+
+def _shipped_gains(path: Path) -> None:
+    """The gains file railride ships (railride/data/gains.toml), as the reader's own."""
+    shutil.copyfile(Path(railride.__file__).parent / "data" / "gains.toml", path)
+
+
+def _measured_track(path: Path) -> None:
+    """A measured profile (s, z_L, z_R): the rails of railride's FRA class 4 track, seed 0, every
+    0.25 m from s = 0 to 1000 m (the default run, 55.56 m/s for 10 s, covers 556 m)."""
+    s = np.arange(0.0, 1000.0 + 0.125, 0.25)
+    z_left, z_right, *_ = railride.scenario("fra4", seed=0).track.evaluate(s)
+    with path.open("w", newline="", encoding="utf-8") as fh:
+        writer = csv.writer(fh)
+        writer.writerow(["s [m]", "z_L [m]", "z_R [m]"])
+        writer.writerows(zip(s, z_left, z_right))
+
+
+#: the files a documented command names and the docs assume the reader has, by their name on
+#: the command line (``file:NAME`` for a scenario), and how the test makes them
+FILES = {
+    "my_gains.toml": _shipped_gains,
+    "track.csv": _measured_track,
+}
+
+RUNS = [(line, words) for line, words in COMMANDS if parse_only(words) is None]
+
+
+def _files(words: list[str]) -> list[str]:
+    return [name for word in words if (name := word.removeprefix("file:")) in FILES]
+
+
+def _run_documented(words: list[str]) -> None:
+    """Run the command in the current folder, after making the files it names; fail unless it
+    exits with status 0."""
+    for name in _files(words):
+        FILES[name](Path(name))
+    result = run(*words)
+    assert result.exit_code == 0, (
+        f"railride {' '.join(words)} exited with status {result.exit_code}\n{result.stderr}{result.stdout}"
+    )
+
+
+def test_the_docs_hold_commands_that_run():
+    """The rule leaves a run for each cheap command the docs show, and every file the table
+    makes is named by a command that runs (no file for a line that is gone)."""
+    names = {_name(words) for _, words in RUNS}
+    cheap = {"simulate", "compare", "report", "frf", "modes", "vehicles", "damper", "tracking", "ride-spectrum", "fmu"}
+    assert cheap <= names, cheap - names
+    assert len(RUNS) >= 40, [line.where for line, _ in RUNS]
+    named = {name for _, words in RUNS + CHECKED for name in _files(words)}
+    assert named == set(FILES), set(FILES) ^ named
+
+
+@pytest.mark.parametrize(("line", "words"), RUNS, ids=[f"{line.where} {' '.join(words)}"[:120] for line, words in RUNS])
+def test_a_documented_command_runs(line, words, tmp_path, monkeypatch):
+    if _name(words) == "fmu" and "--sources-only" not in words and shutil.which("cc") is None:
+        pytest.skip("no C compiler to build the FMU")
+    monkeypatch.chdir(tmp_path)
+    try:
+        _run_documented(words)
+    except AssertionError as exc:
+        pytest.fail(f"{line.where}: {exc}")
+
+
+class _FirstRun(Exception):
+    """The stand-in stepper's signal: the command got to its first vehicle run."""
+
+
+def _needs_what_a_test_has_not(words: list[str]) -> bool:
+    """A Dask cluster (its address or its scheduler file) or a GPU."""
+    return "--scheduler" in words or "--scheduler-file" in words or _value(words, "--backend") == "gpu"
+
+
+CHECKED = [(line, words) for line, words in COMMANDS if parse_only(words) and not _needs_what_a_test_has_not(words)]
+
+
+def test_the_long_commands_are_checked_up_to_their_first_run():
+    names = {_name(words) for _, words in CHECKED}
+    assert set(LONG) <= names, set(LONG) - names
+
+
+def _up_to_the_first_run(words: list[str], monkeypatch) -> None:
+    """Run the command in the current folder, after making the files it names, with a stepper
+    that stops it at its first vehicle run; fail unless it got there."""
+    reached = []
+
+    def first_run(*args, **kwargs):
+        reached.append(True)
+        raise _FirstRun
+
+    monkeypatch.setattr(simulation, "step", first_run)
+    for name in _files(words):
+        FILES[name](Path(name))
+    result = run(*words)
+    assert reached, f"railride {' '.join(words)} stopped before its first run, with status {result.exit_code}\n" + (
+        result.stderr + result.stdout
+    )
+
+
+def test_a_long_command_refused_before_its_first_run_fails_the_check(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(AssertionError, match="stopped before its first run, with status 2"):
+        _up_to_the_first_run(["tune", "--budget", "0", "--out", "t"], monkeypatch)
+
+
+@pytest.mark.parametrize(
+    ("line", "words"), CHECKED, ids=[f"{line.where} {' '.join(words)}"[:120] for line, words in CHECKED]
+)
+def test_a_long_documented_command_gets_to_its_first_run(line, words, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    try:
+        _up_to_the_first_run(words, monkeypatch)
+    except AssertionError as exc:
+        pytest.fail(f"{line.where}: {exc}")
