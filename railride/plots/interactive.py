@@ -23,8 +23,9 @@ from railride.analysis.spectra import FRF_RESPONSES, frf_excited
 from railride.analysis.labels import CARBODY_RESPONSES, comparison_title, controller_names
 from railride.plots._style import suspension_label, suspension_style
 
-#: the most points one time-history trace keeps (`envelope`)
-MAX_POINTS = 4000
+#: the most points one time-history trace keeps (`envelope`): min/max pairs at two a pixel or more
+#: on a page up to 1500 px wide, and a 60 s comparison's page under 3 MB
+MAX_POINTS = 3000
 #: matplotlib line style -> plotly dash
 DASHES = {"-": "solid", "--": "dash", ":": "dot", "-.": "dashdot"}
 #: colour and dash per rail pattern of the frequency responses (as `railride.plots.frf`)

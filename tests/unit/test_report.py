@@ -161,9 +161,9 @@ def test_long_histories_are_thinned_and_say_so(comparison):
     assert "envelope" not in html  # 2 s at 1000 Hz: 2001 samples, drawn as they are
     longer = rr.compare(rr.scenario("paper-sine", duration=6.0), controllers=["passive"], bounds=False)
     figure = unpacked(report.report_html(longer))["pack-figure-acceleration"].decode()
-    assert "max envelope of its 6001 samples in at most 4000 points" in figure
+    assert "max envelope of its 6001 samples in at most 3000 points" in figure
     figure = comparison_response_figure(longer.combined(), "acceleration")
-    assert len(figure.data[0].x) <= 4000 < longer.combined().sizes["time"]
+    assert len(figure.data[0].x) <= 3000 < longer.combined().sizes["time"]
 
 
 def test_envelope_keeps_every_peak():
