@@ -383,9 +383,9 @@ class TuneResult:
                     f"Sensitivity of the tuning objective - {self._scenario_text()}, "
                     f"{self.scenario.get('duration_s', 0):g} s, {self.settings.get('damper')} dampers"
                 ),
-                *textwrap.wrap(
-                    f"{', '.join(self.controllers)}; at most {budget} runs per law; {self.objective.describe()}", 100
-                ),
+                # one line: the figure's title fits it to the page at spaces (a wrap here split
+                # "clipped-optimal" at its hyphen)
+                f"{', '.join(self.controllers)}; at most {budget} runs per law; {self.objective.describe()}",
             ]
         )
 

@@ -260,3 +260,19 @@ def test_a_page_lists_only_the_passes_it_draws():
     labels = [[t.get_text() for leg in fig.legends for t in leg.get_texts()] for fig in pages]
     assert "pass 3" in labels[0]
     assert len(pages) > 1 and all("pass 3" not in page and "pass 1" in page for page in labels[1:])
+
+
+def test_the_tuning_figure_title_breaks_lines_at_spaces_only():
+    import dataclasses
+
+    import railride as rr
+
+    result = rr.tune(("pid",), scenario_options={"duration": 0.3}, n_values=3, budget=5, before_after=False)
+    # every law's name in the title, as `railride tune` lists them: a wrap at 100 characters
+    # split "clipped-optimal" at its hyphen
+    every = ["inner", "pid", "sas-attitude", "sas-attitude-ride", "skyhook", "skyhook-on-off", "groundhook"]
+    result = dataclasses.replace(result, controllers=every + ["hybrid", "clipped-optimal"])
+    for fig in result.plot_pages():
+        title = fig._suptitle.get_text()
+        assert "clipped-optimal" in title.replace("\n", " ")
+        assert not any(line.endswith("-") for line in title.splitlines()), title
