@@ -90,7 +90,8 @@ def _panel_title(ax, name: str, unit: str | None, final: float) -> dict:
 
     spec = ax.get_subplotspec()
     columns = spec.get_gridspec().ncols if spec is not None else 1
-    width = ax.figure.get_figwidth() / columns - 0.3
+    # a column less a margin: a title centred on its axes may not reach the page's edge
+    width = ax.figure.get_figwidth() / columns - 0.45
     size = FontProperties(size="small").get_size_in_points()
     head = f"{name} ({unit})" if unit else name
     if unit and "\n" in fit_text(head, width, size):
