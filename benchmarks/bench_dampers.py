@@ -1,6 +1,7 @@
 """MR damper benchmarks: the vehicle with four MR dampers, the damper rig.
 
 Run:  python benchmarks/bench_dampers.py [--repeat N] [--batches]
+      python benchmarks/bench_dampers.py --lane-sizes [--threads 1,2,4,8,16] [--sizes 8,16,...]
 Prints a Markdown table for docs/performance.md (wall-clock minima; no test asserts timings).
 """
 
@@ -72,11 +73,64 @@ def batch_rows(repeat: int) -> list[tuple[str, str, str]]:
     return rows
 
 
+def lane_size_rows(threads, sizes, repeat: int) -> list[tuple[str, str, str]]:
+    """`run_batch` against the lane stepper by batch size and numba thread count: where the lane
+    groups (`lanes.LANES` samples each) are fewer than the threads, the lane stepper leaves
+    threads idle, and the question is from which size it still wins. SAS (attitude+ride) closed
+    loops and MR dampers at spread voltages, 1 s (10 000 steps) each, best of ``repeat``."""
+    import numba
+
+    from railride.engine import lanes
+    from railride.run.simulation import simulate
+    from railride.secondary.suspension import Suspension
+    from railride.model.track import scenario
+
+    sc = scenario("paper-sine", duration=1.0)
+    fit = lanes.lanes_fit
+
+    def rate(n: int, stepper: str, kind: str) -> float:
+        if kind == "SAS (attitude+ride)":
+            sus = [Suspension.named("sas-attitude-ride")] * n
+        else:
+            sus = [Suspension.semi_active("railway", voltage=float(v)) for v in np.linspace(0.0, 2.25, n)]
+        lanes.lanes_fit = fit if stepper == "lanes" else (lambda *a: False)
+        try:
+            simulate(sc, suspension=sus)  # compiles or loads the stepper
+            t = min_time(lambda: simulate(sc, suspension=sus), repeat)
+        finally:
+            lanes.lanes_fit = fit
+        return n * 10_000 / t / 1e6
+
+    rows = []
+    for k in threads:
+        numba.set_num_threads(k)
+        for kind in ("SAS (attitude+ride)", "voltages"):
+            for n in sizes:
+                b, ln = rate(n, "batch", kind), rate(n, "lanes", kind)
+                groups = -(-n // lanes.LANES)
+                rows.append(
+                    (
+                        f"{k} thread(s), {n} {kind} ({groups} lane group(s)): `run_batch` -> `run_lanes`",
+                        f"{b:.2f} -> {ln:.2f} M sample-steps/s ({ln / b:.2f}x)",
+                        "",
+                    )
+                )
+    return rows
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--repeat", type=int, default=5)
     ap.add_argument("--batches", action="store_true", help="only the batch rows (run_batch against run_lanes)")
+    ap.add_argument("--lane-sizes", action="store_true", help="run_batch against run_lanes by batch size and threads")
+    ap.add_argument("--threads", default="1,2", help="numba thread counts for --lane-sizes (default 1,2)")
+    ap.add_argument("--sizes", default="8,16,24,32,64", help="batch sizes for --lane-sizes")
     args = ap.parse_args()
+    if args.lane_sizes:
+        threads = [int(v) for v in args.threads.split(",")]
+        sizes = [int(v) for v in args.sizes.split(",")]
+        _print(lane_size_rows(threads, sizes, args.repeat))
+        return
     if args.batches:
         _print(batch_rows(args.repeat))
         return
