@@ -7,55 +7,23 @@ against its schema."""
 
 from __future__ import annotations
 
-import dataclasses
-import json
-import tomllib
-from importlib import resources
-from pathlib import Path
-
 import pytest
 
 import railride as rr
 from railride.secondary.control import GainSet
 
-jsonschema = pytest.importorskip("jsonschema")
+pytest.importorskip("jsonschema")
 
-SCHEMAS = Path(__file__).resolve().parents[2] / "docs" / "schemas"
+from tuned_gains import PROVENANCE, TUNED_KP, as_validated_json, packaged, pid_values, tuned_gains  # noqa: E402
+
 SHORT = {"duration": 0.5}
-#: the [provenance] a tuning would write (the date as JSON holds it)
-PROVENANCE = {
-    "method": "railride tune (one-at-a-time sensitivity study, equal budget per law)",
-    "date": "2026-11-26T10:00:00Z",
-    "objective": "mean of the four RMS ratios to passive",
-    "controllers": ["pid"],
-    "budget": 5,
-    "start_gains": "railride/data/gains.toml",
-}
-#: the value the "tuning" changed, and the file name its gains claim
-TUNED_KP = 123456.5
+#: the file name the tuned gains claim
 SOURCE = "tuned-for-this-test.toml"
 
 
-def _shipped() -> dict:
-    """railride/data/gains.toml as TOML reads it, without railride."""
-    text = resources.files("railride").joinpath("data/gains.toml").read_text(encoding="utf-8")
-    return tomllib.loads(text)
-
-
 def _pid_values(**changes) -> dict:
-    """What the PID law reads of the shipped file (the inner loop and [pid]), with ``changes``."""
-    data = _shipped()
-    values = {f"inner.{k}": float(v) for k, v in data["inner"].items()}
-    values.update({f"pid.{k}": float(v) for k, v in data["pid"].items()})
-    return {**values, **changes}
-
-
-def _as_json(doc: dict, name: str) -> dict:
-    """``doc`` as its JSON file holds it, after checking it against the schema of ``name``."""
-    doc = json.loads(json.dumps(doc, allow_nan=False))
-    schema = json.loads((SCHEMAS / f"{name}.json").read_text(encoding="utf-8"))
-    jsonschema.validate(doc, schema, cls=jsonschema.Draft202012Validator)
-    return doc
+    """What the PID law reads of the shipped file, with ``changes``."""
+    return pid_values(packaged(), **changes)
 
 
 def _assert_tuned(settings: dict, controllers: dict, source_key: str = "gains") -> None:
@@ -68,15 +36,12 @@ def _assert_tuned(settings: dict, controllers: dict, source_key: str = "gains") 
 
 @pytest.fixture(scope="module")
 def tuned() -> GainSet:
-    """The shipped gains with one value changed, and a provenance that says a tuning found it."""
-    changed = GainSet.default().apply({"pid.kp": TUNED_KP})
-    assert changed.value("pid.kp") == TUNED_KP
-    return dataclasses.replace(changed, source=SOURCE, provenance=PROVENANCE)
+    return tuned_gains(SOURCE)
 
 
 def test_a_comparison_records_the_gains_it_ran(tuned):
     result = rr.compare(rr.scenario("paper-sine", **SHORT), controllers=["passive", "pid"], gains=tuned, bounds=False)
-    doc = _as_json(result.to_dict(), "railride.comparison-1")
+    doc = as_validated_json(result.to_dict(), "railride.comparison-1")
     _assert_tuned(doc["settings"], {"passive": {}, "pid": _pid_values(**{"pid.kp": TUNED_KP})})
     # the keys the document had before stay as they were
     assert doc["gains"]["source"] == SOURCE
@@ -96,14 +61,14 @@ def test_a_sweep_records_its_base_gains_and_the_gains_its_axes_vary(tuned):
     from railride.studies.grid import grid
 
     plain = rr.run_sweep(grid(["passive", "pid"], speed=[30.0], base_gains=tuned, **SHORT), progress=False)
-    doc = _as_json(plain.to_dict(), "railride.sweep-1")
+    doc = as_validated_json(plain.to_dict(), "railride.sweep-1")
     _assert_tuned(doc["settings"], {"pid": _pid_values(**{"pid.kp": TUNED_KP})})
     assert doc["settings"]["gains_source"] == SOURCE  # the key of older files, the same source
     assert doc["settings"]["gains_varied"] == []
 
     kd = [1.0e4, 3.0e4]
     varied = rr.run_sweep(grid(["pid"], gains={"pid.kd": kd}, base_gains=tuned, **SHORT), progress=False)
-    doc = _as_json(varied.to_dict(), "railride.sweep-1")
+    doc = as_validated_json(varied.to_dict(), "railride.sweep-1")
     # the base gains, the axis named; its values per run in the rows
     _assert_tuned(doc["settings"], {"pid": _pid_values(**{"pid.kp": TUNED_KP})})
     assert doc["settings"]["gains_varied"] == ["pid.kd"]
@@ -123,14 +88,14 @@ def test_a_ride_spectrum_records_the_gains_it_ran(tuned):
 
     result = ride_spectrum("fra4", points=64, controllers=["passive", "pid"], gains=tuned)
     assert list(result.suspensions) == ["passive", "pid"]  # both ran
-    doc = _as_json(result.to_dict(), "railride.ride-spectrum-1")
+    doc = as_validated_json(result.to_dict(), "railride.ride-spectrum-1")
     _assert_tuned(doc["settings"], {"passive": {}, "pid": _pid_values(**{"pid.kp": TUNED_KP})}, "gains_source")
     assert doc["settings"]["gains"] == "given"  # the key of older files keeps its meaning
 
 
 def test_a_pareto_view_records_its_base_gains_and_the_sampled_ones(tuned):
     result = rr.pareto("pid", n_samples=2, seed=3, scenario_options=SHORT, gains=tuned, parameters=["pid.kd"])
-    doc = _as_json(result.to_dict(), "railride.pareto-1")
+    doc = as_validated_json(result.to_dict(), "railride.pareto-1")
     expected = _pid_values(**{"pid.kp": TUNED_KP})
     _assert_tuned(doc["settings"], {"pid": expected})
     assert doc["settings"]["base_gains"] == SOURCE
@@ -142,7 +107,7 @@ def test_the_optimiser_and_the_sensitivity_study_record_their_base_gains(tuned):
     from railride.studies.optimise import optimise, sensitivity
 
     found = optimise(("pid.kd",), suspension="pid", scenario_options=SHORT, gains=tuned, popsize=2, maxiter=1, seed=1)
-    doc = _as_json(found.to_dict(), "railride.optimise-1")
+    doc = as_validated_json(found.to_dict(), "railride.optimise-1")
     expected = {"pid": _pid_values(**{"pid.kp": TUNED_KP})}
     _assert_tuned(doc["settings"], expected)
     assert doc["settings"]["base_gains"] == SOURCE
@@ -151,7 +116,7 @@ def test_the_optimiser_and_the_sensitivity_study_record_their_base_gains(tuned):
 
     # two parameters: SciPy's indices take at least two
     indices = sensitivity(("pid.kd", "pid.ki"), suspension="pid", scenario_options=SHORT, gains=tuned, n=2)
-    doc = _as_json(indices.to_dict(), "railride.sensitivity-1")
+    doc = as_validated_json(indices.to_dict(), "railride.sensitivity-1")
     _assert_tuned(doc["settings"], expected)
     assert doc["settings"]["gains_varied"] == ["pid.kd", "pid.ki"]
 
@@ -162,5 +127,5 @@ def test_the_optimised_gains_never_claim_to_be_the_shipped_file():
     found = optimise(("pid.kd",), suspension="pid", scenario_options=SHORT, popsize=2, maxiter=1, seed=1)
     doc = found.to_dict()
     assert doc["settings"]["gains"] == doc["settings"]["base_gains"] == "railride/data/gains.toml"
-    assert doc["gains"]["pid"]["kd"] != _shipped()["pid"]["kd"]  # the search moved it
+    assert doc["gains"]["pid"]["kd"] != packaged()["pid"]["kd"]  # the search moved it
     assert doc["gains"]["source"] == "railride/data/gains.toml, changed: pid.kd"

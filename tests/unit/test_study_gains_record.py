@@ -4,12 +4,8 @@ study.json (`settings`) and as columns of study_runs.csv; `league` records the s
 
 from __future__ import annotations
 
-import dataclasses
 import json
 import math
-import tomllib
-from importlib import resources
-from pathlib import Path
 
 import pandas as pd
 import pytest
@@ -18,45 +14,16 @@ import railride as rr
 from railride.secondary.control import GainSet
 from railride.studies.league import league
 
-jsonschema = pytest.importorskip("jsonschema")
+pytest.importorskip("jsonschema")
 
-SCHEMAS = Path(__file__).resolve().parents[2] / "docs" / "schemas"
+from tuned_gains import PROVENANCE, TUNED_KP, as_validated_json, packaged, pid_values, tuned_gains  # noqa: E402
+
 SHORT = {"track_seeds": [0], "speeds": [40.0], "duration": 0.5}
-#: the [provenance] of a tuning, as `railride tune` writes one (a date as TOML reads it back is text here)
-PROVENANCE = {
-    "method": "railride tune (one-at-a-time sensitivity study, equal budget per law)",
-    "date": "2026-11-26T10:00:00Z",
-    "objective": "mean of the four RMS ratios to passive",
-    "controllers": ["pid"],
-    "budget": 5,
-    "start_gains": "railride/data/gains.toml",
-}
-#: the value the "tuning" changed
-TUNED_KP = 123456.5
-
-
-def _file(name: str) -> dict:
-    """A packaged gains file as TOML reads it, without railride."""
-    return tomllib.loads(resources.files("railride").joinpath(f"data/{name}").read_text(encoding="utf-8"))
-
-
-def _pid_values(data: dict, **changes) -> dict:
-    """What the PID law reads, from a gains file's tables: the inner loop and [pid]."""
-    values = {f"inner.{k}": float(v) for k, v in data["inner"].items()}
-    values.update({f"pid.{k}": float(v) for k, v in data["pid"].items()})
-    return {**values, **changes}
-
-
-def _validate(doc: dict, name: str) -> None:
-    schema = json.loads((SCHEMAS / f"{name}.json").read_text(encoding="utf-8"))
-    jsonschema.validate(json.loads(json.dumps(doc)), schema, cls=jsonschema.Draft202012Validator)
 
 
 @pytest.fixture(scope="module")
 def tuned() -> GainSet:
-    """The shipped gains with one value changed and a provenance that says a tuning found it."""
-    changed = GainSet.default().apply({"pid.kp": TUNED_KP})
-    return dataclasses.replace(changed, source="tuned.toml", provenance=PROVENANCE)
+    return tuned_gains("tuned.toml")
 
 
 def test_a_study_with_tuned_gains_records_their_values_and_provenance(tuned, tmp_path):
@@ -64,12 +31,12 @@ def test_a_study_with_tuned_gains_records_their_values_and_provenance(tuned, tmp
     s = result.settings
     assert s["gains"] == "tuned.toml"  # not the file the tuning started from
     assert s["gains_provenance"] == PROVENANCE
-    expected = _pid_values(_file("gains.toml"), **{"pid.kp": TUNED_KP})
+    expected = pid_values(packaged("gains.toml"), **{"pid.kp": TUNED_KP})
     assert s["gains_values"] == {"passive": {}, "pid": expected}
 
     result.save(tmp_path)
     doc = json.loads((tmp_path / "study.json").read_text(encoding="utf-8"))
-    _validate(doc, "railride.study-1")
+    as_validated_json(doc, "railride.study-1")
     assert doc["settings"]["gains_provenance"] == PROVENANCE
     assert doc["settings"]["gains_values"]["pid"] == expected
     runs = pd.read_csv(tmp_path / "study_runs.csv")
@@ -85,10 +52,10 @@ def test_a_study_with_tuned_gains_records_their_values_and_provenance(tuned, tmp
 def test_a_study_with_the_shipped_gains_says_so():
     # random track: the shipped robust set (docs/tuning.md, Shipped gains)
     result = rr.study(["pid"], **SHORT)
-    data = _file("robust_gains.toml")
+    data = packaged("robust_gains.toml")
     s = result.settings
     assert s["gains"] == "railride/data/robust_gains.toml"
-    assert s["gains_values"]["pid"] == _pid_values(data)
+    assert s["gains_values"]["pid"] == pid_values(data)
     provenance = s["gains_provenance"]
     assert provenance["method"] == data["provenance"]["method"]
     assert provenance["controllers"] == data["provenance"]["controllers"]
@@ -126,6 +93,6 @@ def test_a_league_records_the_gains_it_ran(tuned):
     s = table.settings
     assert s["gains"] == "tuned.toml"
     assert s["gains_provenance"] == PROVENANCE
-    assert s["gains_values"]["pid"] == _pid_values(_file("gains.toml"), **{"pid.kp": TUNED_KP})
-    _validate(table.to_dict(), "railride.league-1")
+    assert s["gains_values"]["pid"] == pid_values(packaged("gains.toml"), **{"pid.kp": TUNED_KP})
+    as_validated_json(table.to_dict(), "railride.league-1")
     assert not math.isnan(table.summary.loc["pid", "acceleration_m_s2_rms"])
