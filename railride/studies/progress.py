@@ -62,17 +62,17 @@ def shows_progress(verb: str, *, fraction: bool = False):
 
 class Shown:
     """Progress on stderr, from the first report after `DELAY` s: a rich bar where rich can draw
-    one live (a terminal, Jupyter), else a plain line every `EVERY` s and at the end of each
-    batch. ``clock`` and ``stream`` are for tests."""
+    one live (a terminal, Jupyter), else a plain line every `EVERY` s. ``clock`` and ``stream``
+    (where the lines go; never a live bar) are for tests."""
 
     def __init__(self, verb: str, *, fraction: bool = False, clock=time.monotonic, stream=None):
         self.verb, self.fraction, self.clock = verb, fraction, clock
         self.stream = stream
         self.start = clock()
         self.last_line = -math.inf
+        self.console: Any = None  # rich's console on stderr, made at the first report shown
         self.bar: Any = None  # a rich Progress once shown live
         self.task: Any = None
-        self.lines = 0
 
     def __call__(self, done, total=None, runs_per_second: float = math.nan) -> None:
         now = self.clock()
@@ -81,12 +81,14 @@ class Shown:
         if self.fraction:
             done, total = round(100 * float(done)), 100
         text = self._text(done, total, runs_per_second)
-        console = self._console()
-        if console is not None and (console.is_terminal or console.is_jupyter):
-            self._bar(console, done, total, text)
+        if self.console is None and self.stream is None:
+            from rich.console import Console
+
+            self.console = Console(stderr=True)
+        if self.console is not None and (self.console.is_terminal or self.console.is_jupyter):
+            self._bar(self.console, done, total, text)
         elif now - self.last_line >= EVERY:
             self.last_line = now
-            self.lines += 1
             print(text, file=self.stream or sys.stderr, flush=True)
 
     def _text(self, done, total, rate) -> str:
@@ -94,15 +96,6 @@ class Shown:
         count = f"{done}/{total} {unit}" if total else f"{done} {unit}"
         speed = f", {rate:.1f} runs/s" if isinstance(rate, float) and math.isfinite(rate) and rate > 0 else ""
         return f"{self.verb}: {count}{speed} ({self.clock() - self.start:.0f} s)"
-
-    def _console(self):
-        if self.stream is not None:
-            return None
-        try:
-            from rich.console import Console
-        except ImportError:  # pragma: no cover - rich is a dependency
-            return None
-        return Console(stderr=True)
 
     def _bar(self, console, done, total, text) -> None:
         if self.bar is None:
