@@ -4,7 +4,9 @@ in-process, split into its parts; the file's size; and, when Chromium and playwr
 there, how long the page takes to load and draw.
 
 Run:  python benchmarks/bench_report.py [--repeat N]
-Target: `railride report`, second run, <= 10 s. Prints a Markdown table for docs/performance.md.
+      python benchmarks/bench_report.py --sizes   (the size of each kind of page, docs/report.md)
+Target: `railride report`, second run, <= 10 s; the paper's page <= 3 MB. Prints a Markdown table
+for docs/performance.md or docs/report.md.
 """
 
 from __future__ import annotations
@@ -53,12 +55,39 @@ def _browser_load(path: Path, repeat: int) -> float | None:
     return best
 
 
+#: the pages of docs/report.md's table of sizes: (what, the command's arguments after railride)
+PAGES = (
+    ("the paper's comparison", ["report", "--out", "{out}"]),
+    ("every law, with comfort", ["compare", "--controllers", "all", "--comfort", "--report", "{out}"]),
+    ("a long random track", ["compare", "--scenario", "fra4", "--duration", "60", "--report", "{out}"]),
+    ("ride spectrum", ["ride-spectrum", "--track", "fra4", "--report", "{out}"]),
+)
+
+
+def sizes(base) -> None:
+    """Write each page of `PAGES` and print its size."""
+    folder = Path(tempfile.mkdtemp(prefix="railride-bench-report-"))
+    print("| page | command | size |")
+    print("|---|---|---|")
+    for k, (what, args) in enumerate(PAGES):
+        out = folder / f"page{k}.html"
+        subprocess.run(base + [a.format(out=out) for a in args], check=True, capture_output=True)
+        shown = " ".join("..." if a == "{out}" else a for a in args)
+        size = out.stat().st_size
+        print(f"| {what} | `railride {shown}` | {size / 1e6:.2f} MB ({size:,} bytes) |")
+    shutil.rmtree(folder, ignore_errors=True)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--sizes", action="store_true", help="only the size of each kind of page")
     args = ap.parse_args()
     exe = shutil.which("railride")
     base = [exe] if exe else [sys.executable, "-m", "railride.cli"]
+    if args.sizes:
+        sizes(base)
+        return
     folder = Path(tempfile.mkdtemp(prefix="railride-bench-report-"))
     out = folder / "report.html"
     report = base + ["report", "--out", str(out)]
