@@ -169,18 +169,17 @@ class _Drawn:
     of noise (megabytes of SVG, far more than its PNG), the first with a note under it."""
 
     def report_contents(self):
-        import matplotlib
-
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
         import numpy as np
+        from matplotlib.figure import Figure
 
         from railride.model.params import VehicleParams
         from railride.output.report import Contents
 
-        smooth, ax = plt.subplots()
-        ax.plot(np.linspace(0, 1, 50) ** 2)
-        noisy, ax = plt.subplots()
+        # not through pyplot: its registry stays empty for the other tests
+        smooth = Figure()
+        smooth.subplots().plot(np.linspace(0, 1, 50) ** 2)
+        noisy = Figure()
+        ax = noisy.subplots()
         ax.plot(np.random.default_rng(0).normal(size=200_000), lw=0.3)
         return Contents(
             title="two figures",
