@@ -69,6 +69,8 @@ def _signatures() -> dict[str, tuple]:
         + (a(2),) * 6
         + (i, i)
         + (a(2),) * 8,
+        # a random track's rails at the wheelsets: breakpoints, two coefficient arrays, s, out
+        "cubic_on_grid": (a(1), a(2), a(2), a(1), a(2)),
     }
 
 
@@ -85,11 +87,11 @@ def build_cache(kernels: tuple[str, ...] | None = None) -> list[str]:
 
 
 def _dispatcher(kernel: str):
-    from railride.engine import exact_kernels, kernels, lanes
+    from railride.engine import exact_kernels, kernels, lanes, splines
 
     found = {
         n: v
-        for m in (kernels, lanes, exact_kernels)
+        for m in (kernels, lanes, exact_kernels, splines)
         for n, v in vars(m).items()
         if hasattr(v, "py_func") and not n.startswith("_")
     }

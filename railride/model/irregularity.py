@@ -133,8 +133,14 @@ class RandomTrack(RailProfile):
         return float(self._interp[3][-1])
 
     def _evaluate(self, s):
+        from railride.engine.splines import cubic_on_grid
+
         (sl, sr), *_ = self._interp
-        return sl(s), sr(s), sl(s, 1), sr(s, 1)
+        s = np.ascontiguousarray(s, dtype=float).ravel()
+        out = np.empty((4, s.size))
+        # scipy's values, compiled without the GIL: a study's chunks build tables beside the stepping
+        cubic_on_grid(sl.x, sl.c, sr.c, s, out)
+        return out[0], out[1], out[2], out[3]
 
     def splines(self) -> tuple:
         """The left and right rails' cubic splines of the realisation (scipy ``CubicSpline``, on

@@ -60,6 +60,27 @@ def test_rails_are_the_profile_plus_and_minus_half_the_cross_level():
     assert np.all(np.abs(tr.evaluate(np.array([0.0, 1e-3]))[0]) < 1e-6)  # enters level track
 
 
+def test_compiled_rails_are_scipys_splines_to_the_bit():
+    # the input tables read the rails through a compiled evaluation (railride.engine.splines);
+    # scipy's CubicSpline of the same samples is the second method, at random points, at every
+    # breakpoint (the interval a point on one belongs to), at the ends and past the last one
+    tr = RandomTrack("german-high", seed=8, length=600.0)
+    sl, sr = tr.splines()
+    rng = np.random.default_rng(3)
+    s = np.concatenate([rng.uniform(0.0, tr.end(), 5000), sl.x, np.nextafter(sl.x, -1.0), [tr.end() + 0.3]])
+    ours = tr._evaluate(s)
+    assert all(np.array_equal(a, b) for a, b in zip(ours, (sl(s), sr(s), sl(s, 1), sr(s, 1))))
+
+
+def test_rail_slopes_are_the_derivative_of_the_heights():
+    tr = RandomTrack("fra4", seed=6)
+    s, h = np.linspace(25.0, 400.0, 3001), 1e-4
+    zl, zr, dzl, dzr = tr.evaluate(s)
+    fd = [(a - b) / (2 * h) for a, b in zip(tr.evaluate(s + h)[:2], tr.evaluate(s - h)[:2])]
+    scale = np.max(np.abs(dzl))
+    assert np.max(np.abs(dzl - fd[0])) < 1e-5 * scale and np.max(np.abs(dzr - fd[1])) < 1e-5 * scale
+
+
 def test_seeds_are_reproducible_and_distinct():
     a = RandomTrack("german-low", seed=1).samples()[1]
     b = RandomTrack("german-low", seed=1).samples()[1]

@@ -58,6 +58,7 @@ def test_the_build_compiles_what_compare_and_studies_call():
     rr.compare(rr.scenario("paper-sine", duration=0.3))
     sc = rr.scenario("paper-sine", duration=0.1)  # and a batch that fills the lane stepper, as studies do
     rr.simulate([sc] * lanes.LANES, None, rr.Suspension.named("pid"))
+    rr.simulate(rr.scenario("fra4", duration=0.1))  # a random track's rails: its splines, compiled
 
     def home(name):
         return compiled._dispatcher(name)
