@@ -1,0 +1,97 @@
+#!/usr/bin/env bash
+# The GPU and 16-core measurements of docs/gpu.md and docs/performance.md in one prepared run,
+# for a lent machine with one NVIDIA GPU and 16 cores, no network, and numba, numba-cuda,
+# numpy, scipy, xarray, pandas, typer and rich already installed (the package runs from this
+# tree through PYTHONPATH; nothing is installed).
+#
+# Run:  bash benchmarks/device_check.sh [BUDGET_S]      (default 500 s in all)
+#       bash benchmarks/device_check.sh --smoke          (here: the simulator, tiny sizes, a check of the script)
+#
+# Steps, most wanted first; each gets at most its cap and what is left of the budget, and one
+# that runs out is cut and said so in the log, so the run ends inside the budget:
+#   1. the machine: GPU, driver, cores, versions, and whether railride sees a usable GPU
+#   2. bench_gpu.py: 32,768 SAS closed loops on the GPU, their agreement with the CPU over 64
+#      samples, the same batch on the CPU's cores, and the metrics-only batch of the studies
+#   3. bench_study.py: the 1,000-run study on 2 cores, on all cores, and in one process per core
+#   4. bench_gpu.py --design: the default design on the GPU (target: at most 2 minutes)
+#   5. bench_dampers.py --lane-sizes: run_batch against the lane stepper, 1 to 16 threads
+#   6. the GPU tests of tests/physics on the device instead of the simulator
+# Everything printed goes to $OUT/device_check.log as well (the device tool brings $OUT back).
+# No figure is written anywhere else: copy the rows into the docs with the machine and date.
+set -u
+cd "$(dirname "$0")/.."
+SMOKE=0
+BUDGET=500
+if [ "${1:-}" = "--smoke" ]; then SMOKE=1; BUDGET=900; elif [ -n "${1:-}" ]; then BUDGET=$1; fi
+OUT=${OUT:-/tmp/railride_device_check}
+mkdir -p "$OUT"
+LOG="$OUT/device_check.log"
+: >"$LOG"
+export PYTHONPATH="$PWD${PYTHONPATH:+:$PYTHONPATH}" PYTHONUNBUFFERED=1
+PY=${PYTHON:-python3}
+if [ "$SMOKE" = 1 ]; then
+  export NUMBA_ENABLE_CUDASIM=1
+  PY=${PYTHON:-.venv/bin/python}
+else
+  export NUMBA_ENABLE_CUDASIM=0
+fi
+START=$(date +%s)
+
+# step NAME CAP_S COMMAND...: run it with what is left of the budget, at most CAP_S
+step() {
+  local name=$1 cap=$2
+  shift 2
+  local left=$((BUDGET - ($(date +%s) - START)))
+  local t=$((cap < left ? cap : left))
+  echo "" | tee -a "$LOG"
+  echo "## $name (at $(($(date +%s) - START)) s; at most $t s)" | tee -a "$LOG"
+  if [ "$t" -lt 10 ]; then
+    echo "skipped: the budget is spent" | tee -a "$LOG"
+    return
+  fi
+  echo "\$ $*" | tee -a "$LOG"
+  local t0=$(date +%s)
+  timeout -k 5 "$t" "$@" 2>&1 | tee -a "$LOG"
+  local rc=${PIPESTATUS[0]}
+  local took=$(($(date +%s) - t0))
+  if [ "$rc" = 124 ] || [ "$rc" = 137 ]; then
+    echo "cut: still running after $took s (its limit)" | tee -a "$LOG"
+  else
+    echo "exit $rc after $took s" | tee -a "$LOG"
+  fi
+}
+
+if [ "$SMOKE" = 1 ]; then
+  GPU_SAMPLES=16 DURATION=0.005 CHECK=4 SEEDS=1 THREADS=1,2 SIZES=8,16
+else
+  GPU_SAMPLES=32768 DURATION=1 CHECK=64 SEEDS=20 THREADS=1,2,4,8,16 SIZES=8,16,32,64,128,256
+fi
+CORES=$(nproc)
+
+step machine 30 bash -c "date -u; nproc; (nvidia-smi --query-gpu=name,memory.total,driver_version --format=csv || echo 'no nvidia-smi'); \
+$PY -c 'import sys, numpy, scipy, numba; print(sys.version.split()[0], \"numpy\", numpy.__version__, \"scipy\", scipy.__version__, \"numba\", numba.__version__)'; \
+$PY -c 'import importlib.metadata as m; print(\"numba-cuda\", m.version(\"numba-cuda\"))' || echo 'no numba-cuda'; \
+$PY -c 'from railride.run.solver import gpu_missing; print(\"railride sees a usable GPU\" if gpu_missing() is None else \"railride: \" + gpu_missing())'"
+
+step gpu-throughput 200 $PY benchmarks/bench_gpu.py --samples "$GPU_SAMPLES" --duration "$DURATION" --cpu --check "$CHECK" --metrics-only
+
+if [ "$SMOKE" = 1 ]; then
+  step study-2-cores 120 $PY benchmarks/bench_study.py --seeds "$SEEDS" --duration 1 --profile
+else
+  step study-2-cores 60 env NUMBA_NUM_THREADS=2 taskset -c 0,1 $PY benchmarks/bench_study.py --seeds "$SEEDS" --profile
+  step study-all-cores 45 $PY benchmarks/bench_study.py --seeds "$SEEDS" --profile
+  step study-processes 60 $PY benchmarks/bench_study.py --seeds "$SEEDS" --processes "$CORES" --profile
+fi
+
+if [ "$SMOKE" = 1 ]; then  # the simulator would take hours over a design
+  step design-on-gpu 30 echo "not in the simulator"
+else
+  step design-on-gpu 180 $PY benchmarks/bench_gpu.py --samples 1024 --design
+fi
+
+step lane-sizes 90 $PY benchmarks/bench_dampers.py --lane-sizes --repeat 3 --threads "$THREADS" --sizes "$SIZES"
+
+step gpu-tests 150 $PY -m pytest -q -x -p no:randomly -p no:cacheprovider tests/physics/test_gpu.py tests/physics/test_gpu_metrics.py
+
+echo "" | tee -a "$LOG"
+echo "done in $(($(date +%s) - START)) s of a $BUDGET s budget" | tee -a "$LOG"
