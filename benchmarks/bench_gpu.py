@@ -18,6 +18,9 @@ Prints Markdown rows for docs/gpu.md, each with the device, the machine's cores 
   (`railride.run.reduced.batch_metrics`: sums on the device, no histories), and its largest
   difference from the metrics of the histories above;
 * with ``--design``, `railride design --backend gpu` with its defaults (wall time, runs);
+* with ``--host-only`` (in the simulator: NUMBA_ENABLE_CUDASIM=1; ``--controllers`` to pick laws),
+  the default design with its GPU kernel replaced by a stand-in that returns at once: the host's
+  share of the design, which no GPU takes away (wall time, runs, host peak);
 * with ``--memory-plan`` (no GPU needed: the simulator does), the bytes a metrics-only run of 60 s
   takes on the device, from the sizes of the arrays a 64-run batch packs (computed, not measured):
   a run's own arrays, and the tables each distinct track and vehicle adds.
@@ -74,9 +77,14 @@ def main():
     ap.add_argument("--design", action="store_true")
     ap.add_argument("--metrics-only", action="store_true")
     ap.add_argument("--memory-plan", action="store_true")
+    ap.add_argument("--host-only", action="store_true")
+    ap.add_argument("--controllers", default=None, help="--host-only: the design's laws (comma-separated; default all)")
     args = ap.parse_args()
     if args.memory_plan:
         _memory_plan()
+        return
+    if args.host_only:
+        _host_only(args.controllers)
         return
 
     import numba
@@ -176,6 +184,78 @@ def _memory_plan():
     for v, b in per_track.items():
         print(f"- one distinct track and vehicle at {v:g} m/s: {b / 2**20:.1f} MiB of input and forcing tables")
     print(f"- one such run's histories at 1 kHz: {full / 2**20:.1f} MiB; 1e5 runs: {full * 1e5 / 2**40:.1f} TiB")
+
+
+def _host_only(controllers) -> None:
+    """The default design with ``backend="gpu"`` in numba's CUDA simulator, its kernel replaced by
+    a stand-in that returns at once (`_StandIn`): the wall time of everything but the GPU's
+    stepping, which no GPU takes away (cases, scenarios, tables, packing, the CPU's damper rig,
+    comfort, rows, the design's own work): the wall time less the time in the GPU calls
+    (`railride.engine.gpu.run_gpu`: the simulator's copies of the arrays a GPU would be sent and
+    send back, its device arrays in host memory, and the stand-in), which a real device's
+    transfers and kernels replace (not measured here; the simulator's device arrays also count
+    in the host peak). Its metrics are arbitrary, so its tuning takes other paths than a real
+    design's and may make another number of runs: both are printed."""
+    from railride.engine import gpu
+    from railride.run.solver import SolverSettings
+    from railride.studies.design import design
+
+    if not gpu.simulated():
+        sys.exit("bench_gpu: --host-only runs in the simulator: set NUMBA_ENABLE_CUDASIM=1")
+    gpu._device_functions = lambda: _StandIn()
+    inside = [0.0]  # in the GPU calls: the simulator's copies and device arrays, the stand-in
+    run_gpu = gpu.run_gpu
+
+    def counted(*args, **kw):
+        t = time.perf_counter()
+        try:
+            return run_gpu(*args, **kw)
+        finally:
+            inside[0] += time.perf_counter() - t
+
+    gpu.run_gpu = counted
+    laws = None if controllers is None else controllers.split(",")
+    t0 = time.perf_counter()
+    cpu0 = time.process_time()
+    result = design(laws, solver=SolverSettings(backend="gpu"), progress=False)
+    wall, cpu = time.perf_counter() - t0, time.process_time() - cpu0
+    s = result.settings
+    runs = s["training_runs"] + s["judging_runs"]
+    host = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024**2
+    print(f"{os.cpu_count()} CPU cores; {datetime.date.today().isoformat()}")
+    host_s = wall - inside[0]
+    print("\n| design (defaults, backend gpu), the kernel a stand-in | runs | wall time | in the GPU calls "
+          "| the host's work | per run | CPU time | host peak |")  # fmt: skip
+    print("|---|---|---|---|---|---|---|---|")
+    print(f"| {'all laws' if laws is None else ', '.join(laws)} | {runs:,} ({s['training_runs']:,} training, "
+          f"{s['judging_runs']:,} held out) | {wall:.1f} s | {inside[0]:.1f} s | **{host_s:.1f} s** "
+          f"| {host_s / runs * 1e3:.2f} ms | {cpu:.1f} s | {host:.2f} GiB |")  # fmt: skip
+
+
+class _StandIn:
+    """In place of the GPU kernel (`--host-only`): a launch returns at once. Sums of metrics get
+    one row of random values between 0.5 and 1.5 a run, and histories a slow sine, so that the
+    study's arithmetic goes on; the states and status stay as they were (every run finishes)."""
+
+    def __init__(self):
+        self.rng = np.random.default_rng(0)
+
+    def __getitem__(self, launch):
+        return self._launch
+
+    def _launch(self, m, *args):
+        from railride.engine.gpu import ACC_MAX, ACC_MIN, ACC_ROWS, ACC_SQUARES
+
+        outs, reduce, acc = args[-14:-5], args[-3], args[-1]
+        if reduce:
+            v = self.rng.uniform(0.5, 1.5, (m, 4))
+            acc[:, ACC_SQUARES : ACC_SQUARES + 4] = v * v
+            acc[:, ACC_MIN : ACC_MIN + 4] = -v
+            acc[:, ACC_MAX : ACC_MAX + 4] = v
+            acc[:, ACC_ROWS] = 1.0
+        else:  # a slow sine of 1e-3 in every channel: cheap, and something for comfort to weigh
+            for out in outs:
+                out[:] = 1e-3 * np.sin(0.01 * np.arange(out.shape[1]))[None, :, None]
 
 
 if __name__ == "__main__":

@@ -7,7 +7,7 @@ from __future__ import annotations
 import hashlib
 import json
 import numbers
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass, fields
 
 from railride.errors import InputError
 from railride.defaults import DEFAULT_DAMPER
@@ -131,7 +131,9 @@ class Case:
         return hashlib.sha1(text.encode()).hexdigest()[:16]
 
     def to_dict(self) -> dict:
-        d = asdict(self)
+        # the fields as they are: plain numbers, text and tuples of them (made so at construction),
+        # which dataclasses.asdict would copy item by item, a study's largest Python cost a run
+        d = {f.name: getattr(self, f.name) for f in fields(self)}
         for name in ("scenario_options", "vehicle", "gains"):
             d[name] = dict(d[name])
         if d["damper_scale"] == 1.0:  # the default is left out: a scale appears only when set

@@ -12,6 +12,13 @@ depend on the other laws. So that the runs do not either, to the last bit, `OwnC
 law's cases in the chunks that law's own call of `run_cases` would make: a chunk is one compiled
 batch, and the compiled stepper's results depend on a run's batch-mates in the last bits (the
 lane stepper for batches of `railride.engine.lanes.LANES` runs or more, the scalar one below).
+The chunks of all laws go in the order of the tables they read, so that the laws' chunks on
+the same tracks and speeds run one after another and find those tables kept
+(`railride.run.inputs`): a round builds each of its tables about once, not once a law.
+
+On the GPU a run is one thread, whose arithmetic has no batch-mates: there the round's runs of
+every law are one batch (as many as fit `railride.studies.sweep.GPU_CHUNK`), which builds and
+sends each table once.
 """
 
 from __future__ import annotations
@@ -59,15 +66,18 @@ class OwnChunks:
 
     def map(self, fn, chunks):
         """``executor.map`` of the chunks of each law's cases among those in ``chunks`` (the
-        cases `run_cases` found missing from its table)."""
-        from railride.studies.sweep import _chunks
+        cases `run_cases` found missing from its table), in the order of the tables they read;
+        with the GPU's chunks (larger than `railride.studies.sweep.CHUNK`), every law's together."""
+        from railride.studies.sweep import CHUNK, _chunks, table_order
 
         pending = {c.key for chunk in chunks for c in chunk}
-        own = []
-        for part in self.parts:
-            seen: set = set()
-            mine = [c for c in part if c.key in pending and not (c.key in seen or seen.add(c.key))]
-            own += _chunks(mine, self.chunk)
+        seen: set = set()
+        mine = [[c for c in part if c.key in pending and not (c.key in seen or seen.add(c.key))] for part in self.parts]
+        if self.chunk > CHUNK:  # one thread a run: no batch-mates in its arithmetic
+            return self.executor.map(fn, _chunks([c for part in mine for c in part], self.chunk))
+        own = [chunk for part in mine for chunk in _chunks(part, self.chunk)]
+        near = table_order([c for chunk in own for c in chunk])
+        own.sort(key=lambda chunk: near(chunk[0]))  # stable: a tie keeps the laws' order
         return self.executor.map(fn, own)
 
     def close(self) -> None:

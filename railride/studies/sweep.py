@@ -383,15 +383,10 @@ def _vehicle_columns(given, cases: list[Case], vehicle, source) -> list[dict]:
     return given
 
 
-def _chunks(cases: list[Case], chunk: int) -> list[list[Case]]:
-    """``cases`` in chunks of at most ``chunk``, each of one group (one compiled batch), with
-    the runs that share tables together: by vehicle, then track (realisation or profile), then
-    scenario (speed), each in the order first met. The chunks of the groups are interleaved by
-    the first scenario they hold, so the controllers' chunks run next to the passive chunk on
-    the same scenarios and find its tables kept (bounded by bytes, `railride.run.simulation`): a
-    study's tables are built about once each, and its memory does not grow with its runs. The
-    vehicle comes first so that a batch mixes vehicles only where one vehicle's runs end, as
-    before: "auto" gives a passive batch of several vehicles RK4 rather than the exact steps."""
+def table_order(cases: list[Case]):
+    """A sort key of cases that puts the runs that share input tables together: the ranks of
+    their vehicle, track (realisation or profile) and scenario (speed), each in the order first
+    met in ``cases`` (a case not among them gets the next rank)."""
     ranks: tuple[dict, dict, dict] = ({}, {}, {})
 
     def rank(level: int, value) -> int:
@@ -403,6 +398,19 @@ def _chunks(cases: list[Case], chunk: int) -> list[list[Case]]:
 
     for c in cases:  # ranks in the order given
         near(c)
+    return near
+
+
+def _chunks(cases: list[Case], chunk: int) -> list[list[Case]]:
+    """``cases`` in chunks of at most ``chunk``, each of one group (one compiled batch), with
+    the runs that share tables together: by vehicle, then track (realisation or profile), then
+    scenario (speed), each in the order first met. The chunks of the groups are interleaved by
+    the first scenario they hold, so the controllers' chunks run next to the passive chunk on
+    the same scenarios and find its tables kept (bounded by bytes, `railride.run.simulation`): a
+    study's tables are built about once each, and its memory does not grow with its runs. The
+    vehicle comes first so that a batch mixes vehicles only where one vehicle's runs end, as
+    before: "auto" gives a passive batch of several vehicles RK4 rather than the exact steps."""
+    near = table_order(cases)
     groups: dict[str, list[Case]] = {}
     for c in sorted(cases, key=near):
         groups.setdefault(str(c.group), []).append(c)

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from railride.studies.lockstep import OwnChunks, lockstep
-from railride.studies.sweep import CHUNK, Case, RunTable, _chunks
+from railride.studies.sweep import CHUNK, GPU_CHUNK, Case, RunTable, _chunks
 from railride.studies.tuning import PARAMETERS, tune, tuning_set
 
 #: a robust tuning set of two cases (two seeds) of 1 s runs, and a budget of a few sweeps
@@ -77,10 +77,18 @@ def test_each_law_runs_in_the_chunks_its_own_call_would_make():
 
     inner = Record()
     list(OwnChunks(inner, parts).map(None, mixed))
-    assert [[c.key for c in ch] for ch in inner.chunks] == [
-        [c.key for c in ch] for p in parts for ch in _chunks(p, CHUNK)
-    ]
+    got = [[c.key for c in ch] for ch in inner.chunks]
+    assert sorted(got) == sorted([c.key for c in ch] for p in parts for ch in _chunks(p, CHUNK))
     assert any(len({c.suspension for c in ch}) > 1 for ch in mixed)  # mixing is what it undoes
+    # the laws' chunks in the order of the tables they read: both laws' chunks on seed 0, then seed 2
+    seeds = [dict(ch[0].scenario_options)["seed"] for ch in inner.chunks]
+    assert seeds == [0, 0, 2] and {ch[0].suspension for ch in inner.chunks[:2]} == {"pid", "sas-attitude"}
+
+    # GPU batches: a run is one thread with no batch-mates, so every law's runs go in one batch
+    on_gpu = OwnChunks(inner, parts)
+    on_gpu.chunk = GPU_CHUNK
+    list(on_gpu.map(None, mixed))
+    assert len(inner.chunks) == 1 and sorted(c.key for c in inner.chunks[0]) == sorted(c.key for p in parts for c in p)
 
 
 def _law(result, name):
@@ -108,3 +116,31 @@ def test_a_law_tuned_beside_others_ends_exactly_where_it_ends_alone():
     assert len(common) == len(theirs)
     cols = [c for c in theirs.columns if c.endswith("_rms") or c.endswith("_ptp")]
     assert (ours.loc[common, cols].to_numpy() == theirs.loc[common, cols].to_numpy()).all()
+
+
+@pytest.mark.filterwarnings("ignore::railride.errors.TuningWarning")  # the inner loop not tuned
+def test_on_the_gpu_every_law_of_a_round_is_one_batch_and_each_law_ends_as_alone(monkeypatch):
+    # a run is one GPU thread, so the laws' runs share one batch (each table built once a round)
+    # and every law still ends exactly where it ends tuned alone (the CUDA simulator here)
+    from railride.run import reduced
+    from railride.run.solver import SolverSettings
+
+    batches = []
+    metrics = reduced.batch_metrics
+
+    def counted(plan, *args, **kw):
+        batches.append(sorted({s.label for s in plan.suspensions}))
+        return metrics(plan, *args, **kw)
+
+    monkeypatch.setattr(reduced, "batch_metrics", counted)
+    tiny = dict(
+        over=tuning_set("fra4", track_seeds=[0], speeds=[40.0], duration=0.02),
+        budget=9,
+        n_values=3,
+        before_after=False,
+        solver=SolverSettings(backend="gpu"),
+    )
+    together = tune(["pid", "skyhook"], **tiny)
+    assert batches and all(b == ["PID", "Skyhook"] for b in batches)
+    alone = tune(["skyhook"], **tiny)
+    assert _law(together, "skyhook") == _law(alone, "skyhook")
