@@ -1,5 +1,5 @@
 """The rail heights of a random track at the wheelsets, as a study's input tables read them:
-railride's compiled spline (`railride.engine.splines`) against scipy's ``CubicSpline``, one
+railride's compiled spline (`railride.engine.tables`) against scipy's ``CubicSpline``, one
 thread and two, the second showing whether the GIL is held.
 
 Run:  python benchmarks/bench_tables.py [--points 400000] [--repeat 5]
@@ -41,7 +41,7 @@ def main():
         return track._evaluate(s)
 
     rows = []
-    for name, fn in (("scipy `CubicSpline`", scipy_rails), ("railride (`railride.engine.splines`)", compiled_rails)):
+    for name, fn in (("scipy `CubicSpline`", scipy_rails), ("railride (`railride.engine.tables`)", compiled_rails)):
         fn()  # compiles or loads
         one = min(_time(fn) for _ in range(args.repeat))
         two = min(_two_threads(fn) for _ in range(args.repeat))

@@ -71,6 +71,8 @@ def _signatures() -> dict[str, tuple]:
         + (a(2),) * 8,
         # a random track's rails at the wheelsets: breakpoints, two coefficient arrays, s, out
         "cubic_on_grid": (a(1), a(2), a(2), a(1), a(2)),
+        # the rail forcing at the input table's nodes: utab, Bw, Bwd, out
+        "forcing_nodes": (a(2), a(2), a(2), a(2)),
     }
 
 
@@ -87,11 +89,11 @@ def build_cache(kernels: tuple[str, ...] | None = None) -> list[str]:
 
 
 def _dispatcher(kernel: str):
-    from railride.engine import exact_kernels, kernels, lanes, splines
+    from railride.engine import exact_kernels, kernels, lanes, tables
 
     found = {
         n: v
-        for m in (kernels, lanes, exact_kernels, splines)
+        for m in (kernels, lanes, exact_kernels, tables)
         for n, v in vars(m).items()
         if hasattr(v, "py_func") and not n.startswith("_")
     }

@@ -133,7 +133,7 @@ class RandomTrack(RailProfile):
         return float(self._interp[3][-1])
 
     def _evaluate(self, s):
-        from railride.engine.splines import cubic_on_grid
+        from railride.engine.tables import cubic_on_grid
 
         (sl, sr), *_ = self._interp
         s = np.ascontiguousarray(s, dtype=float).ravel()

@@ -121,11 +121,15 @@ def _stops(params: VehicleParams) -> np.ndarray:
 
 
 def _forcing_table(utab: np.ndarray, Bw: np.ndarray, Bwd: np.ndarray) -> np.ndarray:
-    """Node values (Bw w, Bw w', Bwd w, Bwd w') of the rail forcing, see kernels._forcing.
-    einsum, not ``@``: a threaded BLAS on these thin products took 90-130 ms instead of 6-10 ms
-    while other work kept the cores busy."""
-    w, wd = utab[:, :8], utab[:, 8:]
-    return np.hstack([np.einsum("nk,jk->nj", x, B) for B in (Bw, Bwd) for x in (w, wd)])
+    """Node values (Bw w, Bw w', Bwd w, Bwd w') of the rail forcing, see kernels._forcing:
+    compiled (`railride.engine.tables.forcing_nodes`), without the GIL and skipping the input
+    matrices' zeros (two thirds of them). Not a threaded BLAS ``@``: on these thin products it
+    took 90-130 ms instead of 6-10 ms while other work kept the cores busy."""
+    from railride.engine.tables import forcing_nodes
+
+    out = np.empty((utab.shape[0], 4 * Bw.shape[0]))
+    forcing_nodes(np.ascontiguousarray(utab), np.ascontiguousarray(Bw), np.ascontiguousarray(Bwd), out)
+    return out
 
 
 def _forcing(key, lag: tuple, dt: float, duration: float, params: VehicleParams, table: np.ndarray):

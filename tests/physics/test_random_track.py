@@ -61,7 +61,7 @@ def test_rails_are_the_profile_plus_and_minus_half_the_cross_level():
 
 
 def test_compiled_rails_are_scipys_splines_to_the_bit():
-    # the input tables read the rails through a compiled evaluation (railride.engine.splines);
+    # the input tables read the rails through a compiled evaluation (railride.engine.tables);
     # scipy's CubicSpline of the same samples is the second method, at random points, at every
     # breakpoint (the interval a point on one belongs to), at the ends and past the last one
     tr = RandomTrack("german-high", seed=8, length=600.0)
@@ -113,3 +113,24 @@ def test_a_band_the_output_rate_cannot_resolve_is_refused():
         scenario("paper-sine", seed=3)
     with pytest.raises(ValueError, match="unknown scenario"):
         scenario("fra9")
+
+
+def test_rail_forcing_at_the_nodes_is_the_input_matrices_times_the_rails():
+    # the compiled forcing table (railride.engine.tables.forcing_nodes) against NumPy's matrix
+    # products of the same input table: (Bw w, Bw w', Bwd w, Bwd w') at every node
+    from railride.model.params import VehicleParams
+    from railride.model.track import wheelset_input_table
+    from railride.run.inputs import _forcing_table, _system_arrays, _vehicle
+
+    for preset in ("paper", "crh380a"):
+        vehicle = _vehicle(VehicleParams.preset(preset))
+        arrays = _system_arrays(vehicle)
+        Bw, Bwd = arrays["Bw"], arrays["Bwd"]
+        table, _ = wheelset_input_table(
+            scenario("fra4", seed=3, speed=45.0, duration=2.0), vehicle.wheelset_lag_distance, 1e-4
+        )
+        w, wd = table[:, :8], table[:, 8:]
+        expected = np.hstack([w @ Bw.T, wd @ Bw.T, w @ Bwd.T, wd @ Bwd.T])
+        got = _forcing_table(table, Bw, Bwd)
+        assert got.shape == expected.shape and np.abs(expected).max() > 0
+        assert np.max(np.abs(got - expected)) <= 1e-14 * np.abs(expected).max()
