@@ -72,7 +72,7 @@ def _signatures() -> dict[str, tuple]:
         # a random track's rails at the wheelsets: breakpoints, two coefficient arrays, s, out
         "cubic_on_grid": (a(1), a(2), a(2), a(1), a(2)),
         # the rail forcing at the input table's nodes: utab, Bw, Bwd, out
-        "forcing_nodes": (a(2), a(2), a(2), a(2)),
+        "forcing_nodes": (types.Array(f, 2, "C", readonly=True), a(2), a(2), a(2)),
     }
 
 

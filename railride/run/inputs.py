@@ -128,7 +128,9 @@ def _forcing_table(utab: np.ndarray, Bw: np.ndarray, Bwd: np.ndarray) -> np.ndar
     from railride.engine.tables import forcing_nodes
 
     out = np.empty((utab.shape[0], 4 * Bw.shape[0]))
-    forcing_nodes(np.ascontiguousarray(utab), np.ascontiguousarray(Bw), np.ascontiguousarray(Bwd), out)
+    table = np.ascontiguousarray(utab).view()
+    table.flags.writeable = False  # one compiled signature: the kept tables are read-only
+    forcing_nodes(table, np.ascontiguousarray(Bw), np.ascontiguousarray(Bwd), out)
     return out
 
 
