@@ -88,6 +88,13 @@ def main() -> None:
     except BrokenPipeError:  # outside a command: typer's own output (--help)
         _quiet()
         status = 0
+    except Exception as exc:
+        # Ctrl-C in the middle of loading a module can come back wrapped: Python 3.11 turns it into
+        # a RuntimeError when it lands in a class's __set_name__ (a dataclass field of pandas)
+        if not _caused_by_interrupt(exc):
+            raise
+        print("interrupted", file=sys.stderr)
+        status = 130
     try:  # what is still buffered goes now, and a reader gone by then is no error either
         sys.stdout.flush()
     except BrokenPipeError:
@@ -97,6 +104,17 @@ def main() -> None:
             print(f"error: cannot write: {exc.strerror or exc}", file=sys.stderr)
             status = 2
     sys.exit(status)
+
+
+def _caused_by_interrupt(exc: BaseException | None) -> bool:
+    """Whether ``exc`` came from a KeyboardInterrupt (its cause or context, at any depth)."""
+    seen: set[int] = set()
+    while exc is not None and id(exc) not in seen:
+        if isinstance(exc, KeyboardInterrupt):
+            return True
+        seen.add(id(exc))
+        exc = exc.__cause__ or exc.__context__
+    return False
 
 
 def _quiet() -> None:
