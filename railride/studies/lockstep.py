@@ -63,17 +63,18 @@ class OwnChunks:
         self.executor = LocalExecutor() if executor is None else executor
         self.parts = parts
         self.chunk = CHUNK  # the runs of a chunk: `run_cases` sets it (larger on a GPU)
+        self.on_gpu = False  # whether the chunks step on the GPU: `run_cases` sets it
 
     def map(self, fn, chunks):
         """``executor.map`` of the chunks of each law's cases among those in ``chunks`` (the
         cases `run_cases` found missing from its table), in the order of the tables they read;
-        with the GPU's chunks (larger than `railride.studies.sweep.CHUNK`), every law's together."""
-        from railride.studies.sweep import CHUNK, _chunks, table_order
+        on the GPU, every law's together."""
+        from railride.studies.sweep import _chunks, table_order
 
         pending = {c.key for chunk in chunks for c in chunk}
         seen: set = set()
         mine = [[c for c in part if c.key in pending and not (c.key in seen or seen.add(c.key))] for part in self.parts]
-        if self.chunk > CHUNK:  # one thread a run: no batch-mates in its arithmetic
+        if self.on_gpu:  # one thread a run: no batch-mates in its arithmetic
             return self.executor.map(fn, _chunks([c for part in mine for c in part], self.chunk))
         own = [chunk for part in mine for chunk in _chunks(part, self.chunk)]
         near = table_order([c for chunk in own for c in chunk])

@@ -345,10 +345,11 @@ def run_cases(
         if k not in done and k not in seen:
             pending.append(c)
             seen.add(k)
-    if chunk == CHUNK and not (comfort or costs) and gpu_batches(solver, min(len(pending), GPU_CHUNK)):
+    on_gpu = chunk == CHUNK and not (comfort or costs) and gpu_batches(solver, min(len(pending), GPU_CHUNK))
+    if on_gpu:
         chunk = GPU_CHUNK  # metrics summed on the GPU (`evaluate`)
     if hasattr(executor, "chunk"):  # `railride.studies.lockstep.OwnChunks` chunks each law's cases itself
-        executor.chunk = chunk
+        executor.chunk, executor.on_gpu = chunk, on_gpu
     chunks = _chunks(pending, chunk)
     fn = functools.partial(
         evaluate, base_gains=base, params=vehicle, solver=solver, window=window, comfort=comfort, costs=costs

@@ -86,7 +86,7 @@ def test_each_law_runs_in_the_chunks_its_own_call_would_make():
 
     # GPU batches: a run is one thread with no batch-mates, so every law's runs go in one batch
     on_gpu = OwnChunks(inner, parts)
-    on_gpu.chunk = GPU_CHUNK
+    on_gpu.chunk, on_gpu.on_gpu = GPU_CHUNK, True  # as run_cases sets them when the GPU takes the batches
     list(on_gpu.map(None, mixed))
     assert len(inner.chunks) == 1 and sorted(c.key for c in inner.chunks[0]) == sorted(c.key for p in parts for c in p)
 
