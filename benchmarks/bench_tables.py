@@ -5,7 +5,12 @@ against what they replaced, one thread and two, the second showing whether the G
 * the rail forcing at the table's nodes (a table of fra4 at 30 and 70 m/s, 20 s, the paper's
   vehicle): against NumPy's ``einsum``, as `railride.run.inputs` built it before.
 
-Run:  python benchmarks/bench_tables.py [--points 400000] [--repeat 5]
+With ``--round``, instead: the inputs stage (`railride.run.simulation.inputs`) of one round of
+the default design's tuning, all its laws in one batch as on the GPU: the 36 training conditions
+(fra4 and fra5, seeds 1-3, 30, 50 and 70 m/s, loads 1 and 1.3, 20 s), eight closed loops each,
+the tables' store emptied before each try (a round's tables do not fit it).
+
+Run:  python benchmarks/bench_tables.py [--points 400000] [--repeat 5] [--round]
 
 Prints a Markdown table for docs/performance.md: the best of ``--repeat`` times on one thread,
 and of two such calls on two threads at once. Work that holds the GIL takes twice as long on two
@@ -28,7 +33,11 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--points", type=int, default=400_000)
     ap.add_argument("--repeat", type=int, default=5)
+    ap.add_argument("--round", action="store_true", help="the inputs stage of a design's tuning round")
     args = ap.parse_args()
+    if args.round:
+        _round(args.repeat)
+        return
 
     from railride.model.irregularity import RandomTrack
 
@@ -60,7 +69,8 @@ def main():
 def _forcing_cases() -> list:
     from railride.model.params import VehicleParams
     from railride.model.track import scenario, wheelset_input_table
-    from railride.run.inputs import _forcing_table, _system_arrays, _vehicle
+    from railride.engine.tables import forcing_nodes
+    from railride.run.inputs import _system_arrays, _vehicle
 
     vehicle = _vehicle(VehicleParams.preset("paper"))
     arrays = _system_arrays(vehicle)
@@ -76,8 +86,54 @@ def _forcing_cases() -> list:
         table, _ = wheelset_input_table(sc, np.asarray(vehicle.wheelset_lag_distance), 1e-4)
         what = f"forcing table, {table.shape[0]:,} nodes ({speed:g} m/s, 20 s)"
         cases.append((f"{what}: NumPy `einsum`", lambda t=table: einsum(t)))
-        cases.append((f"{what}: railride", lambda t=table: _forcing_table(t, Bw, Bwd)))
+        table.flags.writeable = False  # as the kept tables are
+        cases.append((f"{what}: railride", lambda t=table: _compiled(forcing_nodes, t, Bw, Bwd)))
     return cases
+
+
+def _compiled(forcing_nodes, table, Bw, Bwd):
+    """The compiled forcing table on the calling thread alone (`forcing_nodes` over all rows)."""
+    out = np.empty((table.shape[0], 4 * Bw.shape[0]))
+    forcing_nodes(table, Bw, Bwd, out)
+    return out
+
+
+def _round(repeat: int) -> None:
+    """The inputs stage of one tuning round of the default design in one batch (see the module)."""
+    import numba
+
+    from railride.model.params import VehicleParams
+    from railride.model.track import scenario
+    from railride.run import inputs, simulation
+    from railride.secondary.suspension import Suspension
+
+    laws = ["pid", "sas-attitude", "sas-attitude-ride", "skyhook", "skyhook-on-off", "groundhook", "hybrid"]
+    laws.append("clipped-optimal")
+    conditions = [
+        (scenario(track, seed=seed, speed=speed, duration=20.0), VehicleParams.preset("paper").loaded(load))
+        for track in ("fra4", "fra5")
+        for seed in (1, 2, 3)
+        for speed in (30.0, 50.0, 70.0)
+        for load in (1.0, 1.3)
+    ]
+    scs = [sc for sc, _ in conditions for _ in laws]
+    pars = [p for _, p in conditions for _ in laws]
+    plan = simulation.check(scs, pars, [Suspension.named(law) for _ in conditions for law in laws])
+    times = []
+    for _ in range(repeat + 1):  # the first compiles or loads
+        inputs._INPUT_TABLES.clear()
+        inputs._FORCING_TABLES.clear()
+        t0 = time.perf_counter()
+        tables = simulation.inputs(plan)
+        times.append(time.perf_counter() - t0)
+    print(f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores, {datetime.date.today().isoformat()}")
+    print("\n| work | numba threads | best | median |")
+    print("|---|---|---|---|")
+    print(
+        f"| inputs of one tuning round: {plan.n} runs, 36 conditions, forcing tables "
+        f"{tables.ftab.nbytes / 1e6:.0f} MB | {numba.get_num_threads()} | {min(times[1:]):.3f} s "
+        f"| {float(np.median(times[1:])):.3f} s |"
+    )
 
 
 def _time(fn) -> float:

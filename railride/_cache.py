@@ -38,12 +38,22 @@ class BytesLRU(Generic[V]):
         self.misses = 0
 
     def get(self, key, build: Callable[[], V]) -> V:
-        try:
-            hash(key)
-        except TypeError:
-            key = None
+        key = _hashable(key)
         if key is None:
             return build()
+        value = self.lookup(key)
+        if value is not None:
+            return value
+        value = build()  # outside the lock: a build takes milliseconds, other threads go on
+        self.put(key, value)
+        return value
+
+    def lookup(self, key) -> V | None:
+        """The value kept under ``key`` (a hit), or None (a miss; a key that is None or cannot be
+        hashed is never kept and counts as neither)."""
+        key = _hashable(key)
+        if key is None:
+            return None
         with self._lock:
             item = self._items.get(key)
             if item is not None:
@@ -51,17 +61,22 @@ class BytesLRU(Generic[V]):
                 self.hits += 1
                 return item[0]
             self.misses += 1
-        value = build()  # outside the lock: a build takes milliseconds, other threads go on
+        return None
+
+    def put(self, key, value: V) -> None:
+        """Keep ``value`` under ``key`` within the budget (the least recently used go first); one
+        larger than the budget, or a key that is None or cannot be hashed, is not kept."""
+        key = _hashable(key)
         nbytes = int(self._size(value))
-        if nbytes <= self.budget:
-            with self._lock:
-                if key not in self._items:
-                    self._items[key] = (value, nbytes)
-                    self._bytes += nbytes
-                while self._bytes > self.budget:
-                    _, (_, dropped) = self._items.popitem(last=False)
-                    self._bytes -= dropped
-        return value
+        if key is None or nbytes > self.budget:
+            return
+        with self._lock:
+            if key not in self._items:
+                self._items[key] = (value, nbytes)
+                self._bytes += nbytes
+            while self._bytes > self.budget:
+                _, (_, dropped) = self._items.popitem(last=False)
+                self._bytes -= dropped
 
     @property
     def nbytes(self) -> int:
@@ -75,3 +90,12 @@ class BytesLRU(Generic[V]):
         with self._lock:
             self._items.clear()
             self._bytes = 0
+
+
+def _hashable(key):
+    """``key``, or None where it cannot be hashed (such a value is built, never kept)."""
+    try:
+        hash(key)
+    except TypeError:
+        return None
+    return key

@@ -125,23 +125,77 @@ def _forcing_table(utab: np.ndarray, Bw: np.ndarray, Bwd: np.ndarray) -> np.ndar
     compiled (`railride.engine.tables.forcing_nodes`), without the GIL and skipping the input
     matrices' zeros (two thirds of them). Not a threaded BLAS ``@``: on these thin products it
     took 90-130 ms instead of 6-10 ms while other work kept the cores busy."""
-    from railride.engine.tables import forcing_nodes
-
     out = np.empty((utab.shape[0], 4 * Bw.shape[0]))
-    table = np.ascontiguousarray(utab).view()
-    table.flags.writeable = False  # one compiled signature: the kept tables are read-only
-    forcing_nodes(table, np.ascontiguousarray(Bw), np.ascontiguousarray(Bwd), out)
+    _fill_forcing([(utab, Bw, Bwd, out)])
     return out
 
 
-def _forcing(key, lag: tuple, dt: float, duration: float, params: VehicleParams, table: np.ndarray):
-    """`_forcing_table` of the input ``table`` (of the scenario with `table_key` ``key``) and
-    the vehicle ``params``, kept within `FORCING_CACHE_BYTES` beside the input tables."""
+#: the rows of one piece of a forcing table that a thread builds (`_fill_forcing`): a table of a
+#: 20 s run at 70 m/s has 50,000 nodes
+_FORCING_PIECE_ROWS = 16_384
 
-    def build():
-        sysm = _system_arrays(_vehicle(params))
-        forcing = _forcing_table(table, sysm["Bw"], sysm["Bwd"])
-        forcing.flags.writeable = False
-        return forcing
 
-    return _FORCING_TABLES.get(None if key is None else (key, lag, dt, duration, params), build)
+def _fill_forcing(work) -> None:
+    """`forcing_nodes` for each (utab, Bw, Bwd, out) of ``work``, in pieces of rows over numba's
+    threads: the tables of a tuning round (36 of them, 302 MB) are the host's largest work beside
+    a GPU. Each node is its own sum, so a piece gives the rows the whole table would."""
+    import numba
+
+    from railride.engine.tables import forcing_nodes
+
+    pieces = []
+    for utab, Bw, Bwd, out in work:
+        table = np.ascontiguousarray(utab).view()
+        table.flags.writeable = False  # one compiled signature: the kept tables are read-only
+        Bw, Bwd = np.ascontiguousarray(Bw), np.ascontiguousarray(Bwd)
+        for lo in range(0, table.shape[0], _FORCING_PIECE_ROWS):
+            hi = min(lo + _FORCING_PIECE_ROWS, table.shape[0])
+            pieces.append((table[lo:hi], Bw, Bwd, out[lo:hi]))
+    threads = min(len(pieces), numba.get_num_threads())
+    if threads <= 1:
+        for piece in pieces:
+            forcing_nodes(*piece)
+        return
+    from concurrent.futures import ThreadPoolExecutor
+
+    with ThreadPoolExecutor(threads, thread_name_prefix="railride-forcing") as pool:
+        for job in [pool.submit(forcing_nodes, *piece) for piece in pieces]:
+            job.result()
+
+
+def forcing_tables(jobs, dt: float, duration: float) -> tuple[np.ndarray, list[int]]:
+    """The rail forcing tables of a batch in one array, and the row where each begins: one table
+    (`_forcing_table`) for each (key, lag, params, table) of ``jobs``, the input ``table`` of the
+    scenario with `table_key` ``key`` and wheelset lags ``lag``, and the vehicle ``params``.
+    Tables kept from earlier batches (within `FORCING_CACHE_BYTES`) are copied in; the others are
+    built in place, over every core, and kept only where the batch's tables fit the store: a
+    larger set (a tuning round's) would push each other out, and each would be a copy more."""
+    if not jobs:
+        return np.zeros((1, 4 * N_DOF)), []
+    offsets, total = [], 0
+    for *_, table in jobs:
+        offsets.append(total)
+        total += len(table)
+    ftab = np.empty((total, 4 * N_DOF))
+    keep = ftab.nbytes <= _FORCING_TABLES.budget
+    systems: dict = {}
+    work, built = [], []
+    for (key, lag, params, table), off in zip(jobs, offsets):
+        out = ftab[off : off + len(table)]
+        store_key = None if key is None else (key, lag, dt, duration, params)
+        kept = _FORCING_TABLES.lookup(store_key)
+        if kept is not None:
+            out[...] = kept
+            continue
+        if params not in systems:
+            systems[params] = _system_arrays(_vehicle(params))
+        work.append((table, systems[params]["Bw"], systems[params]["Bwd"], out))
+        built.append((store_key, out))
+    _fill_forcing(work)
+    if keep:
+        for store_key, out in built:
+            if store_key is not None:
+                table = out.copy()
+                table.flags.writeable = False
+                _FORCING_TABLES.put(store_key, table)
+    return ftab, offsets

@@ -26,13 +26,13 @@ from railride.run.checks import (  # noqa: F401  (max_stable_dt and the integrat
 from railride.run.inputs import (  # noqa: F401  (the stores, read here by tests and benchmarks)
     _FORCING_TABLES,
     _INPUT_TABLES,
-    _forcing,
     _forcing_table,
     _input_table,
     _system_arrays,
     _vehicle,
     engine_matrices,
     engine_state_matrix,
+    forcing_tables,
 )
 from railride.run.ride import RideResult, build_dataset, has_damper_states
 from railride.secondary import dampers
@@ -157,10 +157,10 @@ def inputs(plan: RunPlan) -> Inputs:
     # rail inputs depend on the scenario and the wheelset spacing, the forcing also on the
     # vehicle: tables are shared between the samples that agree on those
     utabs: list[np.ndarray] = []
-    ftabs: list[np.ndarray] = []
+    forcing_jobs: list[tuple] = []
     u_index: dict[tuple, tuple] = {}
     f_index: dict[tuple, int] = {}
-    u_off, f_off, n_nodes, interval = (
+    u_off, f_job, n_nodes, interval = (
         np.zeros(n, dtype=np.int64),
         np.zeros(n, dtype=np.int64),
         np.zeros(n, dtype=np.int64),
@@ -183,11 +183,12 @@ def inputs(plan: RunPlan) -> Inputs:
         n_nodes[i] = len(tab)
         fkey = (ukey, p)
         if fkey not in f_index and not exact:  # the exact steps take the inputs themselves
-            f_index[fkey] = sum(len(t) for t in ftabs)
-            ftabs.append(_forcing(skey, lag, dt, duration, p, tab))
-        f_off[i] = f_index.get(fkey, 0)
+            f_index[fkey] = len(forcing_jobs)
+            forcing_jobs.append((skey, lag, p, tab))
+        f_job[i] = f_index.get(fkey, -1)
     utab = np.ascontiguousarray(np.concatenate(utabs))
-    ftab = np.ascontiguousarray(np.concatenate(ftabs)) if ftabs else np.zeros((1, 36))
+    ftab, starts = forcing_tables(forcing_jobs, dt, duration)
+    f_off = np.array([starts[j] if j >= 0 else 0 for j in f_job], dtype=np.int64)
     return Inputs(systems, arrays, utab, ftab, u_off, f_off, n_nodes, interval)
 
 

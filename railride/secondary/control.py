@@ -25,6 +25,7 @@ garbled).
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import functools
 import tomllib
@@ -566,9 +567,18 @@ class GainSet:
 
     @classmethod
     def _packaged(cls, name: str) -> "GainSet":
-        # complete: the packaged files hold every table (the reference fills the others' gaps)
-        text = resources.files("railride").joinpath(f"data/{name}").read_text(encoding="utf-8")
-        return cls.from_toml(text, source=f"railride/data/{name}", complete=True)
+        # read once a process (a study asks for the shipped set every chunk, and parsing the
+        # file took 10 ms); each caller gets its own copy of the provenance, the one mutable part
+        kept = _packaged_gains(name)
+        return dataclasses.replace(kept, provenance=copy.deepcopy(kept.provenance))
+
+
+@functools.lru_cache(maxsize=None)
+def _packaged_gains(name: str) -> GainSet:
+    """A gains file installed with the package, parsed: complete, as the packaged files hold
+    every table (the reference fills the others' gaps)."""
+    text = resources.files("railride").joinpath(f"data/{name}").read_text(encoding="utf-8")
+    return GainSet.from_toml(text, source=f"railride/data/{name}", complete=True)
 
 
 #: the shipped gain sets by name (`GainSet.named`; --gains NAME on the command line)

@@ -4,6 +4,7 @@ changes, suspension, gain changes), so that it can travel to a Dask worker and h
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import json
 import numbers
@@ -75,28 +76,30 @@ class Case:
         )
         if self.noise and len(self.noise) != 4:
             raise InputError(f"noise = {self.noise!r}: four standard deviations or none")
-        self._named(None)  # the suspension's checks, here rather than in a batch
+        # the suspension's checks, here rather than in a batch: once per setting (a tuning
+        # round makes tens of thousands of cases of a few suspensions)
+        _check_suspension(self._suspension_key())
+
+    def _suspension_key(self) -> tuple:
+        """The settings `Suspension.named` reads (`_named_suspension`), gains aside."""
+        return (
+            self.suspension,
+            self.damper,
+            self.damper_scale,
+            self.voltage,
+            self.noise,
+            self.seed,
+            self.delay,
+            self.sensing,
+            self.faults,
+        )
 
     @property
     def closed_loop(self) -> bool:
         return self.suspension not in ("passive", "mr", *CONSTANT_VOLTAGE)
 
     def _named(self, gains) -> Suspension:
-        from railride.secondary.control import SensorNoise
-
-        # noise reaches the controllers only (passive and mr runs ignore it, as they always did)
-        noise = None
-        if self.noise and self.closed_loop:
-            displacement, angle, velocity, angular_rate = self.noise
-            noise = SensorNoise(displacement, angle, velocity, angular_rate, seed=self.seed)
-        named = Suspension.named(self.suspension, gains, self.damper, self.damper_scale, self.voltage, noise)
-        if self.delay != 1:
-            named = named.with_delay(self.delay)
-        if self.sensing != "ideal":
-            from railride.secondary.sensing import Accelerometers
-
-            named = named.with_sensing(Accelerometers(seed=self.seed))
-        return named.with_faults(self.faults) if self.faults else named
+        return _named_suspension(self._suspension_key(), gains)
 
     def to_suspension(self, base_gains=None) -> Suspension:
         """The run's `Suspension`: `Suspension.named` with the case's gain changes applied to
@@ -107,6 +110,26 @@ class Case:
             return self._named(None)
         base = GainSet.of(base_gains, self.scenario)
         return self._named(base.apply(self.gains))
+
+    @staticmethod
+    def suspensions(cases, base_gains=None) -> list[Suspension]:
+        """`to_suspension` of each case, one object for the cases that differ only in their
+        track options and vehicle (a tuning round's runs of one gain set over its conditions):
+        the same suspension, made once."""
+        made: dict[tuple, Suspension] = {}
+        out = []
+        for c in cases:
+            # the shipped gains are chosen by the track's name (`GainSet.of`)
+            settings = (c.scenario, c.gains, *c._suspension_key())
+            try:
+                hash(settings)
+            except TypeError:  # a setting that is no plain value: its own suspension
+                out.append(c.to_suspension(base_gains))
+                continue
+            if settings not in made:
+                made[settings] = c.to_suspension(base_gains)
+            out.append(made[settings])
+        return out
 
     @property
     def key(self) -> str:
@@ -160,6 +183,44 @@ class Case:
             self.damper_scale if kind != "passive" else 1.0,
             self.sensing if kind == "closed" else "ideal",  # one sensing model per batch
         )
+
+
+def _named_suspension(settings: tuple, gains) -> Suspension:
+    """A case's `Suspension` from its settings (`Case._suspension_key`) and ``gains``."""
+    from railride.secondary.control import SensorNoise
+
+    suspension, damper, damper_scale, voltage, noise, seed, delay, sensing, faults = settings
+
+    # noise reaches the controllers only (passive and mr runs ignore it, as they always did)
+    sensor_noise = None
+    if noise and suspension not in ("passive", "mr", *CONSTANT_VOLTAGE):
+        displacement, angle, velocity, angular_rate = noise
+        sensor_noise = SensorNoise(displacement, angle, velocity, angular_rate, seed=seed)
+    named = Suspension.named(suspension, gains, damper, damper_scale, voltage, sensor_noise)
+    if delay != 1:
+        named = named.with_delay(delay)
+    if sensing != "ideal":
+        from railride.secondary.sensing import Accelerometers
+
+        named = named.with_sensing(Accelerometers(seed=seed))
+    return named.with_faults(faults) if faults else named
+
+
+def _check_suspension(settings: tuple) -> None:
+    """`Suspension.named`'s checks of a case's suspension settings (`Case._suspension_key`), once
+    per setting (an error is raised again each time, as it is not kept); every time for settings
+    that cannot be hashed, whose checks then name what is wrong."""
+    try:
+        hash(settings)
+    except TypeError:
+        _named_suspension(settings, None)
+        return
+    _checked(settings)
+
+
+@functools.lru_cache(maxsize=1024)
+def _checked(settings: tuple) -> None:
+    _named_suspension(settings, None)
 
 
 def scenario_of(name: str, options):

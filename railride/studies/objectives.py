@@ -235,7 +235,11 @@ class Objective:
         if r.shape[-1:] != (4,):
             raise InputError(f"ratios of shape {r.shape}: the last axis must hold the four responses")
         if self.kind == "weighted":
-            j = r @ np.array(self.weights)
+            assert self.weights is not None  # a weighted objective has them, checked at construction
+            w = [float(x) for x in self.weights]
+            # term by term: a run's J must not depend on how many runs share the call, and a
+            # matrix product's BLAS sums a row in another order for another number of rows
+            j = r[..., 0] * w[0] + r[..., 1] * w[1] + r[..., 2] * w[2] + r[..., 3] * w[3]
         elif self.kind == "minimax":
             j = r.max(axis=-1)
         else:

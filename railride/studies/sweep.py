@@ -106,7 +106,7 @@ def evaluate(
             part = [cases[i] for i in part_idx]
             scs = [_scenario(made, c) for c in part]
             pars = [_vehicle(made, vehicle, c) for c in part]
-            suspensions = [c.to_suspension(base_gains) for c in part]
+            suspensions = Case.suspensions(part, base_gains)
             if batch_conflict(suspensions) is not None:  # the inner loop is one setting per batch
                 for i in part_idx:  # positions, not lookups: cases may repeat
                     rows[i] = evaluate(

@@ -403,7 +403,9 @@ def tune(
         for name, sets in asked.items():
             # each law's rows, change set by change set, each over the k cases: case j's are j, j + k, ...
             part, at = rows.iloc[at : at + len(sets) * k], at + len(sets) * k
-            per_case = np.stack([objective.of_runs(part.iloc[j::k], passive_rows.iloc[j]) for j in range(k)], axis=1)
+            # every run against the passive run of its case, in one call (row by row, as k calls were)
+            per_case = objective.of_runs(part, passive_rows.iloc[np.tile(np.arange(k), len(sets))])
+            per_case = per_case.reshape(len(sets), k)
             out[name] = per_case.mean(axis=1) if aggregate == "mean" else per_case.max(axis=1)
         return out
 

@@ -82,3 +82,28 @@ def test_a_tuning_with_a_travel_bound_keeps_it_on_its_runs():
     assert "travel_max_m" in bounded.runs
     kept = rr.compare(sc, controllers=["passive", "skyhook"], gains=bounded.gains).demands()["skyhook"]["travel_max_m"]
     assert kept <= bound < reached
+
+
+@pytest.mark.parametrize(
+    "objective",
+    [
+        Objective("minimax"),
+        Objective("sum", penalty=1.5),
+        Objective("weighted", weights=(0.4, 0.3, 0.2, 0.1)),
+        Objective("constrained", bound=1.0, penalty=2.0),
+        Objective("n_mv"),
+    ],
+    ids=lambda o: o.kind,
+)
+def test_a_runs_score_does_not_depend_on_the_runs_scored_beside_it(objective):
+    # tuning scores a round's runs in one call: each run's J must be what it is alone, to the
+    # bit (a matrix product's BLAS summed a row in another order for another number of rows)
+    rng = np.random.default_rng(4)
+    n = 257
+    cols = list(objective.columns)
+    runs = pd.DataFrame(rng.uniform(0.2, 2.0, (n, len(cols))), columns=cols)
+    passive = pd.DataFrame(rng.uniform(0.5, 1.5, (n, len(cols))), columns=cols)
+    together = objective.of_runs(runs, passive)
+    alone = np.array([objective.of_runs(runs.iloc[[i]], passive.iloc[i])[0] for i in range(n)])
+    assert together.shape == (n,) and np.unique(together).size > 100
+    assert np.array_equal(together, alone)

@@ -132,3 +132,59 @@ def test_a_sweep_keeps_no_histories(fresh_stores):
     gc.collect()
     assert len(frame) == 4 and frame["centre_N_MV_z"].notna().all()
     assert sum(isinstance(o, RideResult) for o in gc.get_objects()) <= before
+
+
+def test_a_batch_builds_its_forcing_tables_in_pieces_over_threads_with_the_rows_of_one_call(fresh_stores, monkeypatch):
+    # a batch's forcing tables are built in place, in pieces of rows on numba's threads: each
+    # node is its own sum, so the pieces must give what one call over a whole table gives
+    import numba
+
+    from railride.engine.tables import forcing_nodes
+    from railride.model.params import VehicleParams
+    from railride.run import inputs
+
+    scs = [track.scenario("fra4", seed=s, speed=v, duration=1.0) for s in (1, 2) for v in (30.0, 60.0)]
+    pars = [VehicleParams.preset("paper"), VehicleParams.preset("paper").loaded(1.3)]
+    plan = simulation.check(
+        [sc for sc in scs for _ in pars], [p for _ in scs for p in pars], rr.Suspension.named("skyhook")
+    )
+    monkeypatch.setattr(inputs, "_FORCING_PIECE_ROWS", 200)  # tables of 600-1,300 nodes: 4-7 pieces
+    threads = []
+    real = inputs._fill_forcing
+
+    def counted(work):
+        threads.append(numba.get_num_threads())
+        real(work)
+
+    monkeypatch.setattr(inputs, "_fill_forcing", counted)
+    tables = simulation.inputs(plan)
+    assert threads  # the batch's tables went through the pieces
+    for i, (sc, p) in enumerate(zip(plan.scenarios, plan.param_sets)):
+        n = int(tables.n_nodes[i])
+        utab = tables.utab[tables.u_off[i] : tables.u_off[i] + n]
+        arrays = inputs._system_arrays(inputs._vehicle(p))
+        whole = np.empty((n, tables.ftab.shape[1]))
+        ro = utab.copy()
+        ro.flags.writeable = False
+        forcing_nodes(ro, arrays["Bw"], arrays["Bwd"], whole)
+        assert n > 400 and np.array_equal(tables.ftab[tables.f_off[i] : tables.f_off[i] + n], whole), i
+
+
+def test_a_batch_keeps_its_forcing_tables_only_where_they_fit_the_store(fresh_stores):
+    # a tuning round's tables (300 MB) would push each other out of the store (64 MiB): a batch
+    # whose tables do not fit keeps none of them; one that fits keeps each, and a later batch
+    # copies them in, the same to the bit
+    scs = [track.scenario("fra4", seed=s, speed=45.0, duration=1.0) for s in (1, 2, 3)]
+    plan = simulation.check(scs, suspension=rr.Suspension.named("skyhook"))
+    forcing = simulation._FORCING_TABLES
+    forcing.budget = 1000  # smaller than the batch's tables
+    hits, misses = forcing.hits, forcing.misses
+    first = simulation.inputs(plan)
+    assert len(forcing) == 0 and forcing.misses - misses == 3
+    forcing.budget = 64 << 20
+    second = simulation.inputs(plan)
+    assert len(forcing) == 3 and forcing.misses - misses == 6
+    third = simulation.inputs(plan)
+    assert forcing.hits - hits == 3 and len(forcing) == 3
+    assert np.array_equal(first.ftab, second.ftab) and np.array_equal(second.ftab, third.ftab)
+    assert np.array_equal(first.f_off, third.f_off) and first.ftab.shape[0] == first.utab.shape[0]

@@ -357,6 +357,35 @@ def test_a_case_gives_its_suspension_and_keeps_its_key():
         Case(suspension="mr", voltage=3.0)
 
 
+def test_cases_that_differ_in_track_and_vehicle_alone_share_one_suspension():
+    # a tuning round makes one suspension per gain set, not one per run: the shared one must be
+    # what each case makes alone, and cases with other settings must get their own
+    cases = [
+        Case("fra4", {"seed": seed, "speed": v}, vehicle=load, suspension="pid", gains={"pid.kd": kd})
+        for kd in (1e5, 2e5)
+        for seed in (1, 2)
+        for v in (30.0, 60.0)
+        for load in ((), (("m_c", 4.0e4),))
+    ]
+    cases += [Case("paper-sine", suspension="pid", gains={"pid.kd": 1e5}), Case("fra4", suspension="skyhook")]
+    cases += [Case("fra4", suspension="pid", gains={"pid.kd": 1e5}, delay=2)]
+    cases += [Case("fra4", suspension="mr", voltage=1.0)]
+    made = Case.suspensions(cases)
+    assert [m == c.to_suspension() for m, c in zip(made, cases)] == [True] * len(cases)
+    assert len({id(m) for m in made}) == 2 + 4  # a suspension per gain set on fra4, one per other setting
+    assert made[0].controller != made[-4].controller  # paper-sine takes the paper's gains, fra4 the robust set
+    for _ in range(2):  # a setting's check is kept, its error is not: raised each time
+        with pytest.raises(ValueError, match="voltage = 3.0 V: must lie in"):
+            Case("fra4", {"seed": 1}, suspension="mr", voltage=3.0)
+
+
+def test_the_shipped_gains_are_read_once_and_each_caller_gets_its_own_provenance():
+    first, second = GainSet.robust(), GainSet.robust()
+    assert first == second and first.provenance == second.provenance and first.provenance
+    first.provenance["note"] = "changed by a caller"
+    assert "note" not in GainSet.robust().provenance
+
+
 def test_run_cases_takes_the_vehicle_and_keys_it_only_when_not_the_paper_one():
     cases = [Case(scenario_options={"duration": 1.0})]
     solver = SolverSettings(dt=5e-5)
