@@ -169,9 +169,11 @@ class RandomTrack(RailProfile):
 
 
 #: the random-track realisations kept for the next runs (`_random_track`): 6.8 MB each for the
-#: default band over 2000 m, so four; a study takes its runs realisation by realisation
-#: (`railride.studies.sweep.run_cases`), so it needs one or two at a time
-TRACK_CACHE_BYTES = 32 * MiB
+#: default band over 2000 m, so nine. A study takes its runs realisation by realisation
+#: (`railride.studies.sweep.run_cases`), so it needs one or two at a time; a design's tuning
+#: rounds read the same six (fra4 and fra5, three seeds: 41 MB) every round, and a store of four
+#: built each of them again every round
+TRACK_CACHE_BYTES = 64 * MiB
 
 
 def _track_bytes(track: RandomTrack) -> int:

@@ -442,9 +442,13 @@ def _outer_loops(closed, param_sets, vehicles, n: int):
     modes = np.zeros(n)  # the voltage law of each sample (dampers.VOLTAGE_LAWS)
     sensing = np.zeros((n, layout.SENSING_COLS))
     if closed is not None:
+        made: dict[tuple, tuple] = {}  # a controller and vehicle that samples share: their gains once
         for i, (c, p) in enumerate(zip(closed["controllers"], param_sets)):
-            G, hm[i] = c.gains(vehicles[id(p)])
-            gm[i] = _full_state_gains(G, c)
+            key = (id(c), id(p))  # both held by the lists for the whole loop
+            if key not in made:
+                G, H = c.gains(vehicles[id(p)])
+                made[key] = (_full_state_gains(G, c), H)
+            gm[i], hm[i] = made[key]
             modes[i] = dampers.VOLTAGE_LAWS.index(getattr(c, "voltage_law", "tracking"))
             if closed["sensing"] is not None:
                 if reads_bogies(gm[i]):

@@ -25,8 +25,11 @@ def _vehicle(params: VehicleParams) -> Vehicle:
 #: the wheelset input tables kept for the next batches (`_input_table`): (nodes x 16) doubles,
 #: 0.8 MB for 10 s at 30 m/s on a random track, 1.6 MB at 45 m/s, 3.2 MB at 65 m/s. A passive
 #: chunk's 32 scenarios fit at the usual speeds, so the controllers' chunks on the same
-#: scenarios, which run next to it (`railride.studies.sweep.run_cases`), find theirs
-INPUT_CACHE_BYTES = 64 * MiB
+#: scenarios, which run next to it (`railride.studies.sweep.run_cases`), find theirs. The
+#: default design's 36 training conditions take 67.2 MB, read again every tuning round: a store
+#: smaller than that kept none of them from one round to the next (the least recently used went
+#: first, each just before it was wanted), so each round built its tables and tracks again
+INPUT_CACHE_BYTES = 128 * MiB
 #: the rail forcing tables kept (`_forcing`): (nodes x 36) doubles, 2.25 times the input table;
 #: shared by the closed-loop runs of a scenario and vehicle, which a study puts in one batch,
 #: and kept for the repeated rounds of tuning (a tuning set of about 16 scenarios and loads)

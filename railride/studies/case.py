@@ -237,6 +237,8 @@ def _plain(name: str, value):
     """A number of a case as a plain Python number: a seed a whole one as given (an int, never
     through a float, which rounds seeds past 2**53), any other a float; NumPy scalars too, so
     that keys and records hold plain numbers. Anything else is left for the checks that own it."""
+    if type(value) is float or type(value) is str:  # most values, as they are (and quickly: a
+        return value  # tuning round makes tens of thousands of cases)
     from railride import validation
 
     if not validation.is_number(value):
