@@ -168,11 +168,13 @@ def _fill_forcing(work) -> None:
 
 def forcing_tables(jobs, dt: float, duration: float) -> tuple[np.ndarray, list[int]]:
     """The rail forcing tables of a batch in one array, and the row where each begins: one table
-    (`_forcing_table`) for each (key, lag, params, table) of ``jobs``, the input ``table`` of the
-    scenario with `table_key` ``key`` and wheelset lags ``lag``, and the vehicle ``params``.
-    Tables kept from earlier batches (within `FORCING_CACHE_BYTES`) are copied in; the others are
-    built in place, over every core, and kept only where the batch's tables fit the store: a
-    larger set (a tuning round's) would push each other out, and each would be a copy more."""
+    (`_forcing_table`) for each (key, lag, Bw, Bwd, table) of ``jobs``, the input ``table`` of
+    the scenario with `table_key` ``key`` and wheelset lags ``lag``, and a vehicle's input
+    matrices ``Bw``, ``Bwd`` (`_system_arrays`). Tables kept from earlier batches (within
+    `FORCING_CACHE_BYTES`, by the matrices' values: vehicles that differ only where no wheelset
+    reaches share them) are copied in; the others are built in place, over every core, and kept
+    only where the batch's tables fit the store: a larger set (a tuning round's) would push each
+    other out, and each would be a copy more."""
     if not jobs:
         return np.zeros((1, 4 * N_DOF)), []
     offsets, total = [], 0
@@ -181,18 +183,15 @@ def forcing_tables(jobs, dt: float, duration: float) -> tuple[np.ndarray, list[i
         total += len(table)
     ftab = np.empty((total, 4 * N_DOF))
     keep = ftab.nbytes <= _FORCING_TABLES.budget
-    systems: dict = {}
     work, built = [], []
-    for (key, lag, params, table), off in zip(jobs, offsets):
+    for (key, lag, Bw, Bwd, table), off in zip(jobs, offsets):
         out = ftab[off : off + len(table)]
-        store_key = None if key is None else (key, lag, dt, duration, params)
+        store_key = None if key is None else (key, lag, dt, duration, Bw.tobytes(), Bwd.tobytes())
         kept = _FORCING_TABLES.lookup(store_key)
         if kept is not None:
             out[...] = kept
             continue
-        if params not in systems:
-            systems[params] = _system_arrays(_vehicle(params))
-        work.append((table, systems[params]["Bw"], systems[params]["Bwd"], out))
+        work.append((table, Bw, Bwd, out))
         built.append((store_key, out))
     _fill_forcing(work)
     if keep:

@@ -181,11 +181,17 @@ def inputs(plan: RunPlan) -> Inputs:
             utabs.append(tab)
         u_off[i], tab, interval[i] = u_index[ukey]
         n_nodes[i] = len(tab)
-        fkey = (ukey, p)
-        if fkey not in f_index and not exact:  # the exact steps take the inputs themselves
+        if exact:  # the exact steps take the inputs themselves
+            f_job[i] = -1
+            continue
+        # by the input matrices, not the vehicle: a payload changes the carbody, which no
+        # wheelset reaches, so a design's loads share their tables
+        Bw, Bwd = systems[id(p)]["Bw"], systems[id(p)]["Bwd"]
+        fkey = (ukey, Bw.tobytes(), Bwd.tobytes())
+        if fkey not in f_index:
             f_index[fkey] = len(forcing_jobs)
-            forcing_jobs.append((skey, lag, p, tab))
-        f_job[i] = f_index.get(fkey, -1)
+            forcing_jobs.append((skey, lag, Bw, Bwd, tab))
+        f_job[i] = f_index[fkey]
     utab = np.ascontiguousarray(np.concatenate(utabs))
     ftab, starts = forcing_tables(forcing_jobs, dt, duration)
     f_off = np.array([starts[j] if j >= 0 else 0 for j in f_job], dtype=np.int64)

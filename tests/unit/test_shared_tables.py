@@ -188,3 +188,24 @@ def test_a_batch_keeps_its_forcing_tables_only_where_they_fit_the_store(fresh_st
     assert forcing.hits - hits == 3 and len(forcing) == 3
     assert np.array_equal(first.ftab, second.ftab) and np.array_equal(second.ftab, third.ftab)
     assert np.array_equal(first.f_off, third.f_off) and first.ftab.shape[0] == first.utab.shape[0]
+
+
+def test_vehicles_that_differ_where_no_wheelset_reaches_share_a_forcing_table(fresh_stores):
+    # a payload changes the carbody, which the rail inputs reach only through the bogies: the
+    # loaded car's forcing table is the empty car's, built once; a stiffer primary is its own
+    from railride.model.params import VehicleParams
+    from railride.run import inputs
+
+    sc = track.scenario("fra4", seed=1, speed=45.0, duration=1.0)
+    empty = VehicleParams.preset("paper")
+    stiff = empty.replace(k_pz=2.0 * empty.k_pz)
+    pars = [empty, empty.loaded(1.3), stiff]
+    plan = simulation.check([sc] * 3, pars, rr.Suspension.named("skyhook"))
+    tables = simulation.inputs(plan)
+    n = int(tables.n_nodes[0])
+    assert tables.f_off[0] == tables.f_off[1] != tables.f_off[2] and tables.ftab.shape[0] == 2 * n
+    utab = tables.utab[:n]
+    for i, p in enumerate(pars):  # each vehicle's rows are its own matrices times the rails
+        arrays = inputs._system_arrays(inputs._vehicle(p))
+        own = inputs._forcing_table(utab, arrays["Bw"], arrays["Bwd"])
+        assert np.array_equal(tables.ftab[tables.f_off[i] : tables.f_off[i] + n], own), i
