@@ -156,7 +156,7 @@ class Case:
     def to_dict(self) -> dict:
         # the fields as they are: plain numbers, text and tuples of them (made so at construction),
         # which dataclasses.asdict would copy item by item, a study's largest Python cost a run
-        d = {f.name: getattr(self, f.name) for f in fields(self)}
+        d = {name: getattr(self, name) for name in _FIELDS}
         for name in ("scenario_options", "vehicle", "gains"):
             d[name] = dict(d[name])
         if d["damper_scale"] == 1.0:  # the default is left out: a scale appears only when set
@@ -183,6 +183,10 @@ class Case:
             self.damper_scale if kind != "passive" else 1.0,
             self.sensing if kind == "closed" else "ideal",  # one sensing model per batch
         )
+
+
+#: the fields of a case, in their order (`Case.to_dict`: `dataclasses.fields` took 9 us a call)
+_FIELDS = tuple(f.name for f in fields(Case))
 
 
 def _named_suspension(settings: tuple, gains) -> Suspension:
