@@ -425,20 +425,20 @@ def _summary(frame: pd.DataFrame, names, speeds, loads, stiffness, conditions, d
     the track seeds (the speeds and loads kept apart, never pooled)."""
     rows = []
     labels = ["+".join(c) if c else HEALTHY for c in conditions]
+    # the rows of each setting, in the frame's order, found once (a mask per setting scanned the
+    # whole frame each time: most of a study's last, serial, step)
+    by = ["controller", "speed_m_s", "load", "stiffness", "fault", "delay"]
+    groups = frame.groupby(by, sort=False).indices if len(frame) else {}
+    finite = np.isfinite(frame["diverged_at_s"].to_numpy(dtype=float))
+    values = {m: frame[m].to_numpy(dtype=float) for m in METRICS}
+    values.update({f"{m}_reduction": frame[f"{m}_reduction"].to_numpy(dtype=float) for m in METRICS})
     for name in names:
         for speed, load, k in [(v, load, k) for v in speeds for load in loads for k in stiffness]:
             for label, delay in [(HEALTHY, 1)] if name == "passive" else [(f, d) for f in labels for d in delays]:
-                part = frame[
-                    (frame["controller"] == name)
-                    & (frame["speed_m_s"] == speed)
-                    & (frame["load"] == load)
-                    & (frame["stiffness"] == k)
-                    & (frame["fault"] == label)
-                ]
-                part = part[(part["delay"] == delay) & ~np.isfinite(part["diverged_at_s"])]
+                at = groups.get((name, speed, load, k, label, delay), np.zeros(0, dtype=int))
+                at = at[~finite[at]]  # the runs that did not diverge
                 for m in METRICS:
-                    x = part[m].to_numpy(dtype=float)
-                    r = part[f"{m}_reduction"].to_numpy(dtype=float)
+                    x, r = values[m][at], values[f"{m}_reduction"][at]
                     x, r = x[np.isfinite(x)], r[np.isfinite(r)]
                     # both percentiles in one call: the same numbers, half the calls
                     px = np.percentile(x, PERCENTILES) if x.size else (np.nan, np.nan)
