@@ -38,7 +38,7 @@ class BytesLRU(Generic[V]):
         self.misses = 0
 
     def get(self, key, build: Callable[[], V]) -> V:
-        key = _hashable(key)
+        key = hashable(key)
         if key is None:
             return build()
         value = self.lookup(key)
@@ -51,7 +51,7 @@ class BytesLRU(Generic[V]):
     def lookup(self, key) -> V | None:
         """The value kept under ``key`` (a hit), or None (a miss; a key that is None or cannot be
         hashed is never kept and counts as neither)."""
-        key = _hashable(key)
+        key = hashable(key)
         if key is None:
             return None
         with self._lock:
@@ -66,7 +66,7 @@ class BytesLRU(Generic[V]):
     def put(self, key, value: V) -> None:
         """Keep ``value`` under ``key`` within the budget (the least recently used go first); one
         larger than the budget, or a key that is None or cannot be hashed, is not kept."""
-        key = _hashable(key)
+        key = hashable(key)
         nbytes = int(self._size(value))
         if key is None or nbytes > self.budget:
             return
@@ -92,8 +92,9 @@ class BytesLRU(Generic[V]):
             self._bytes = 0
 
 
-def _hashable(key):
-    """``key``, or None where it cannot be hashed (such a value is built, never kept)."""
+def hashable(key):
+    """``key``, or None where it cannot be hashed (a store builds such a value, never keeps it;
+    `railride.studies.case` makes such a setting's suspension each time)."""
     try:
         hash(key)
     except TypeError:

@@ -140,8 +140,8 @@ _FORCING_PIECE_ROWS = 16_384
 
 def _fill_forcing(work) -> None:
     """`forcing_nodes` for each (utab, Bw, Bwd, out) of ``work``, in pieces of rows over numba's
-    threads: the tables of a tuning round (36 of them, 302 MB) are the host's largest work beside
-    a GPU. Each node is its own sum, so a piece gives the rows the whole table would."""
+    threads: the tables of a tuning round (18 for the default design, 168 MB) are the host's
+    largest work beside a GPU. Each node is its own sum, so a piece gives the rows the whole table would."""
     import numba
 
     from railride.engine.tables import forcing_nodes
@@ -166,11 +166,19 @@ def _fill_forcing(work) -> None:
             job.result()
 
 
+def forcing_identity(system: dict) -> bytes:
+    """The values of a vehicle's input matrices (`_system_arrays`' ``Bw``, ``Bwd``), by which its
+    forcing tables are shared and kept: a payload changes the carbody, which no wheelset
+    reaches, so a design's loads share their tables."""
+    return system["Bw"].tobytes() + system["Bwd"].tobytes()
+
+
 def forcing_tables(jobs, dt: float, duration: float) -> tuple[np.ndarray, list[int]]:
     """The rail forcing tables of a batch in one array, and the row where each begins: one table
-    (`_forcing_table`) for each (key, lag, Bw, Bwd, table) of ``jobs``, the input ``table`` of
-    the scenario with `table_key` ``key`` and wheelset lags ``lag``, and a vehicle's input
-    matrices ``Bw``, ``Bwd`` (`_system_arrays`). Tables kept from earlier batches (within
+    (`_forcing_table`) for each (key, lag, Bw, Bwd, matrices, table) of ``jobs``, the input
+    ``table`` of the scenario with `table_key` ``key`` and wheelset lags ``lag``, and a vehicle's
+    input matrices ``Bw``, ``Bwd`` (`_system_arrays`), whose values ``matrices`` identify
+    (`forcing_identity`). Tables kept from earlier batches (within
     `FORCING_CACHE_BYTES`, by the matrices' values: vehicles that differ only where no wheelset
     reaches share them) are copied in; the others are built in place, over every core, and kept
     only where the batch's tables fit the store: a larger set (a tuning round's) would push each
@@ -184,9 +192,9 @@ def forcing_tables(jobs, dt: float, duration: float) -> tuple[np.ndarray, list[i
     ftab = np.empty((total, 4 * N_DOF))
     keep = ftab.nbytes <= _FORCING_TABLES.budget
     work, built = [], []
-    for (key, lag, Bw, Bwd, table), off in zip(jobs, offsets):
+    for (key, lag, Bw, Bwd, matrices, table), off in zip(jobs, offsets):
         out = ftab[off : off + len(table)]
-        store_key = None if key is None else (key, lag, dt, duration, Bw.tobytes(), Bwd.tobytes())
+        store_key = None if key is None else (key, lag, dt, duration, matrices)
         kept = _FORCING_TABLES.lookup(store_key)
         if kept is not None:
             out[...] = kept

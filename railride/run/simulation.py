@@ -32,6 +32,7 @@ from railride.run.inputs import (  # noqa: F401  (the stores, read here by tests
     _vehicle,
     engine_matrices,
     engine_state_matrix,
+    forcing_identity,
     forcing_tables,
 )
 from railride.run.ride import RideResult, build_dataset, has_damper_states
@@ -167,6 +168,7 @@ def inputs(plan: RunPlan) -> Inputs:
         np.zeros(n),
     )
     keys: dict[int, object] = {}
+    matrices = {key: forcing_identity(system) for key, system in systems.items()}  # once per vehicle
     for i, (sc, p) in enumerate(zip(plan.scenarios, param_sets)):
         lag = tuple(vehicles[id(p)].wheelset_lag_distance)
         if id(sc) not in keys:
@@ -184,13 +186,12 @@ def inputs(plan: RunPlan) -> Inputs:
         if exact:  # the exact steps take the inputs themselves
             f_job[i] = -1
             continue
-        # by the input matrices, not the vehicle: a payload changes the carbody, which no
-        # wheelset reaches, so a design's loads share their tables
-        Bw, Bwd = systems[id(p)]["Bw"], systems[id(p)]["Bwd"]
-        fkey = (ukey, Bw.tobytes(), Bwd.tobytes())
+        # by the input matrices' values, not the vehicle (`forcing_identity`)
+        system = systems[id(p)]
+        fkey = (ukey, matrices[id(p)])
         if fkey not in f_index:
             f_index[fkey] = len(forcing_jobs)
-            forcing_jobs.append((skey, lag, Bw, Bwd, tab))
+            forcing_jobs.append((skey, lag, system["Bw"], system["Bwd"], matrices[id(p)], tab))
         f_job[i] = f_index[fkey]
     utab = np.ascontiguousarray(np.concatenate(utabs))
     ftab, starts = forcing_tables(forcing_jobs, dt, duration)

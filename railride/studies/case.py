@@ -10,6 +10,7 @@ import json
 import numbers
 from dataclasses import dataclass, fields
 
+from railride._cache import hashable
 from railride.errors import InputError
 from railride.defaults import DEFAULT_DAMPER
 from railride.secondary.control import CONSTANT_VOLTAGE
@@ -96,7 +97,7 @@ class Case:
 
     @property
     def closed_loop(self) -> bool:
-        return self.suspension not in ("passive", "mr", *CONSTANT_VOLTAGE)
+        return _closed_loop(self.suspension)
 
     def _named(self, gains) -> Suspension:
         return _named_suspension(self._suspension_key(), gains)
@@ -121,9 +122,7 @@ class Case:
         for c in cases:
             # the shipped gains are chosen by the track's name (`GainSet.of`)
             settings = (c.scenario, c.gains, *c._suspension_key())
-            try:
-                hash(settings)
-            except TypeError:  # a setting that is no plain value: its own suspension
+            if hashable(settings) is None:  # a setting that is no plain value: its own suspension
                 out.append(c.to_suspension(base_gains))
                 continue
             if settings not in made:
@@ -189,6 +188,10 @@ class Case:
 _FIELDS = tuple(f.name for f in fields(Case))
 
 
+def _closed_loop(suspension: str) -> bool:
+    return suspension not in ("passive", "mr", *CONSTANT_VOLTAGE)
+
+
 def _named_suspension(settings: tuple, gains) -> Suspension:
     """A case's `Suspension` from its settings (`Case._suspension_key`) and ``gains``."""
     from railride.secondary.control import SensorNoise
@@ -197,7 +200,7 @@ def _named_suspension(settings: tuple, gains) -> Suspension:
 
     # noise reaches the controllers only (passive and mr runs ignore it, as they always did)
     sensor_noise = None
-    if noise and suspension not in ("passive", "mr", *CONSTANT_VOLTAGE):
+    if noise and _closed_loop(suspension):
         displacement, angle, velocity, angular_rate = noise
         sensor_noise = SensorNoise(displacement, angle, velocity, angular_rate, seed=seed)
     named = Suspension.named(suspension, gains, damper, damper_scale, voltage, sensor_noise)
@@ -214,12 +217,10 @@ def _check_suspension(settings: tuple) -> None:
     """`Suspension.named`'s checks of a case's suspension settings (`Case._suspension_key`), once
     per setting (an error is raised again each time, as it is not kept); every time for settings
     that cannot be hashed, whose checks then name what is wrong."""
-    try:
-        hash(settings)
-    except TypeError:
+    if hashable(settings) is None:
         _named_suspension(settings, None)
-        return
-    _checked(settings)
+    else:
+        _checked(settings)
 
 
 @functools.lru_cache(maxsize=1024)
