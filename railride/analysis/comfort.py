@@ -283,15 +283,24 @@ def weighted_rms(acceleration, rate_hz: float, weighting: str = "Wk", window=Non
     vertical); any name of `WEIGHTINGS`. Returns a float, or an array for a batch.
     """
     x, _ = _weighted_part(acceleration, rate_hz, weighting, window)
-    return _scalar(np.sqrt(np.mean(x * x, axis=-1)))
+    return _scalar(_rms(x))
+
+
+def _rms(x: np.ndarray) -> np.ndarray:
+    """The RMS along the last axis of a weighted signal's window."""
+    return np.sqrt(np.mean(x * x, axis=-1))
 
 
 def vdv(acceleration, rate_hz: float, weighting: str = "Wk", window=None):
     """Vibration dose value VDV [m/s^1.75] (ISO 2631-1, 6.3.2):
     VDV = [ integral a_w(t)^4 dt ]^(1/4), the integral a rectangle sum with dt = 1/rate_hz."""
     x, rate = _weighted_part(acceleration, rate_hz, weighting, window)
+    return _scalar(_fourth_power_sum(x) / rate) ** 0.25
+
+
+def _fourth_power_sum(x: np.ndarray) -> np.ndarray:
     x2 = x * x  # (x^2)^2: two products, far cheaper than a power
-    return _scalar(np.sum(x2 * x2, axis=-1) / rate) ** 0.25
+    return np.sum(x2 * x2, axis=-1)
 
 
 def _scalar(v):
@@ -322,6 +331,11 @@ def comfort_intervals(acceleration, rate_hz: float, window=None) -> np.ndarray:
     the start of ``window`` (last axis: interval). An incomplete last interval is dropped; a
     signal shorter than 5 s gives one interval over all of it, with a `ShortRunWarning`."""
     x, rate = _weighted_part(acceleration, rate_hz, "Wb", window)
+    return _intervals(x, rate)
+
+
+def _intervals(x: np.ndarray, rate: float) -> np.ndarray:
+    """`comfort_intervals` of the window ``x`` of a Wb-weighted signal."""
     per = int(round(INTERVAL_S * rate))
     n = x.shape[-1] // per
     if n == 0:
@@ -329,7 +343,7 @@ def comfort_intervals(acceleration, rate_hz: float, window=None) -> np.ndarray:
             f"only {x.shape[-1] / rate:g} s of signal: EN 12299 takes RMS values over "
             f"{INTERVAL_S:g} s intervals; one interval over the whole signal is used",
             ShortRunWarning,
-            stacklevel=2,
+            stacklevel=3,
         )
         return np.sqrt(np.mean(x * x, axis=-1))[..., None]
     parts = x[..., : n * per].reshape(x.shape[:-1] + (n, per))
@@ -572,15 +586,20 @@ def ride_comfort(ds: xr.Dataset, positions=POSITION_KEYWORDS, window=None, weigh
     rel = None if window is None else (start - t0, end - t0 + 0.5 / rate)
     a = floor.values
     values, names, units = [], [], []
+    # each weighting filters the floor once: its a_w, VDV and (Wb) the 5 s intervals read it
+    weighted: dict[str, np.ndarray] = {}
+    for w in dict.fromkeys([*(get_weighting(w).name for w in weightings), "Wb"]):
+        weighted[w], _ = _weighted_part(a, rate, w, rel)
     for w in weightings:
-        for key, fn in (("aw", weighted_rms), ("vdv", vdv)):
-            values.append(np.asarray(fn(a, rate, w, window=rel)))
-            names.append(f"{key}_{get_weighting(w).name}")
-            units.append(INDEX_UNITS[key])
+        name = get_weighting(w).name
+        x = weighted[name]
+        values += [_rms(x), (_fourth_power_sum(x) / rate) ** 0.25]
+        names += [f"aw_{name}", f"vdv_{name}"]
+        units += [INDEX_UNITS["aw"], INDEX_UNITS["vdv"]]
     notes = []
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", ShortRunWarning)
-        rms = comfort_intervals(a, rate, window=rel)
+        rms = _intervals(weighted["Wb"], rate)
     notes += [str(c.message) for c in caught if issubclass(c.category, ShortRunWarning)]
     values.append(6.0 * np.percentile(rms, 95.0, axis=-1))
     names.append("N_MV_z")

@@ -4,7 +4,9 @@ through named stages: `check` (`railride.run.checks`), `inputs`, `pack`, `step`,
 from __future__ import annotations
 
 import dataclasses
+import contextlib
 import functools
+import threading
 import time
 from dataclasses import dataclass
 from datetime import datetime, timezone
@@ -43,6 +45,12 @@ from railride.secondary import dampers
 #: only between calls, come a few times a second whatever the damper law costs per step
 _CHUNK_WORK = 20_000
 _CHUNK_SECONDS = 0.25
+#: held while a batch steps on the CPU's threads: each such batch uses every core, so batches in
+#: threads of one process (a study's chunks, `railride.studies.executors.LocalExecutor`) step one
+#: after another, and each steps while the others make their input tables, metrics and comfort.
+#: Stepping beside each other they shared the cores and ended together, then made their rows
+#: together while no core stepped (docs/performance.md)
+_CPU_STEPPING = threading.RLock()  # re-entrant: a progress callback may run a batch itself
 
 
 def simulate(
@@ -96,7 +104,8 @@ def run(plan: RunPlan, progress=None) -> RideResult:
     plans it checked before its first run, so that nothing is checked twice)."""
     tables = inputs(plan)
     packed = pack(plan, tables)
-    stepped = step(plan, tables, packed, progress)
+    with _stepping(plan):
+        stepped = step(plan, tables, packed, progress)
     if plan.exact and reaches_stops(plan, stepped.out["q"], stepped.status):
         # the exact discretisation holds while the secondary stays off its bump stops: beyond
         # them the vehicle is not linear, and the run is stepped again by RK4
@@ -111,6 +120,14 @@ def run(plan: RunPlan, progress=None) -> RideResult:
             _check_dt(vehicle, plan.solver.dt, plan.damper)
         return run(dataclasses.replace(plan, exact=False), progress)
     return assemble(plan, stepped)
+
+
+def _stepping(plan: RunPlan):
+    """`_CPU_STEPPING` for a batch that steps on every core (RK4 on the CPU); nothing for the
+    exact steps (one core, sample by sample) and the GPU."""
+    if plan.exact or stepped_on(plan) == "gpu":
+        return contextlib.nullcontext()
+    return _CPU_STEPPING
 
 
 def reaches_stops(plan: RunPlan, q: np.ndarray, status: np.ndarray) -> bool:

@@ -139,14 +139,19 @@ def evaluate(
             if comfort:
                 from railride.analysis.comfort import ride_comfort
 
-                ds = res.dataset
+                ds = res.comfort_channels()  # the channels comfort reads, not the run's whole Dataset
                 if "sample" not in ds.dims:
                     ds = ds.expand_dims(sample=[0])
                 ok = np.flatnonzero(np.isnan(diverged_at))  # a diverged run has no comfort
                 if ok.size:  # the columns as one array (sample, column): xarray per value cost 4x the indices
                     # every run ok (the rule): no copy of the histories
                     indices = ride_comfort(ds if ok.size == ds.sizes["sample"] else ds.isel(sample=ok), window=window)
-                    cf = np.stack([indices.sel(position=p, index=x).values for p, x in COMFORT_INDICES], -1)
+                    values = indices.transpose("sample", "position", "index").values
+                    where = [
+                        (list(indices["position"].values).index(p), list(indices["index"].values).index(x))
+                        for p, x in COMFORT_INDICES
+                    ]
+                    cf = np.stack([values[:, p, x] for p, x in where], -1)
             paid = _costs(res, part[0], window) if costs else None
             _add_rows(rows, cases, part_idx, m, diverged_at, (cf, ok) if comfort else None, paid)
     return [rows[i] for i in range(len(cases))]

@@ -161,3 +161,21 @@ def test_the_studies_take_solver_settings_only():
         with pytest.raises(TypeError, match="'dt'"):
             call()
     assert np.isfinite(simulate(SC, solver=SolverSettings(dt=5e-5)).metrics().values).all()
+
+
+@pytest.mark.parametrize("vehicle", ["paper", "crh380a"])
+def test_comfort_before_the_dataset_is_built_equals_comfort_from_it(vehicle):
+    """A study's comfort reads only the channels it needs (`RideResult.comfort_channels`) where
+    the run's Dataset is not built: the same indices as from the Dataset, bending (crh380a's
+    carbody bends) and the vehicle record (front and rear floor points) included."""
+    susp = Suspension.named("sas-attitude")
+    params = VehicleParams.of(vehicle)
+    scs = [scenario("fra4", seed=s, speed=40.0, duration=2.0) for s in (1, 2)]
+    for res in (simulate(scs, [params] * 2, [susp] * 2), simulate(scs[0], params, susp)):
+        light = res.comfort(window=(0.5, 2.0))
+        assert res._dataset is None  # the light channels only
+        if vehicle == "crh380a":
+            assert "carbody_bending_acceleration" in res.comfort_channels()
+        full = res.comfort(window=(0.5, 2.0)) if res.dataset is not None else None
+        np.testing.assert_array_equal(light.values, full.values)
+        assert light.dims == full.dims and light.attrs == full.attrs

@@ -1,0 +1,75 @@
+"""Batches in threads of one process step one at a time on the CPU (each uses every core), and
+a study's chunks give the same rows stepped beside their neighbours' Python work as one after
+another."""
+
+import threading
+
+import numpy as np
+import pandas as pd
+
+from railride.model.params import VehicleParams
+from railride.model.track import scenario
+from railride.run import simulation
+from railride.secondary.suspension import Suspension
+from railride.studies.executors import LocalExecutor
+from railride.studies.study import study
+
+
+def _batch(seed: int):
+    susp = Suspension.named("sas-attitude")
+    scs = [scenario("fra4", seed=seed + k, speed=40.0, duration=0.5) for k in range(2)]
+    return simulation.simulate(scs, [VehicleParams.of("paper")] * 2, [susp, susp])
+
+
+def test_batches_in_threads_step_one_after_another(monkeypatch):
+    _batch(0)  # compiled before the threads start
+    intervals, step = [], simulation.step
+    beside = threading.Event()
+
+    def watched(*args, **kwargs):
+        me = [sum(1 for _, end in intervals if end is None), None]  # how many were stepping
+        intervals.append(me)
+        if me[0]:
+            beside.set()
+        if len(intervals) == 1:  # the first waits for another to step beside it: none may
+            beside.wait(timeout=1.0)
+        try:
+            return step(*args, **kwargs)
+        finally:
+            me[1] = True
+
+    monkeypatch.setattr(simulation, "step", watched)
+    results: dict = {}
+    threads = [threading.Thread(target=lambda k=k: results.setdefault(k, _batch(10 * k))) for k in range(4)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert len(intervals) == 4
+    # each batch found no other stepping when it began
+    assert [entered for entered, _ in intervals] == [0, 0, 0, 0]
+    # and the results are those of the batches run alone
+    for k in range(4):
+        alone = _batch(10 * k)
+        np.testing.assert_array_equal(results[k]._raw["q"], alone._raw["q"])
+
+
+def test_a_progress_callback_may_run_a_batch_itself():
+    inner = []
+
+    def progress(fraction):
+        if not inner:  # in the stepping of the outer batch: the gate lets its own thread in
+            inner.append(_batch(5))
+
+    susp = Suspension.named("pid")
+    res = simulation.simulate(scenario("fra4", seed=1, speed=40.0, duration=0.5), "paper", susp, progress=progress)
+    assert inner and np.all(np.isfinite(res._raw["q"]))
+
+
+def test_a_study_in_threads_equals_one_chunk_after_another():
+    options = dict(track_seeds=[0, 1, 2], speeds=[40.0], loads=[1.0, 1.3], duration=1.0, progress=False)
+    laws = ["pid", "sas-attitude"]
+    threaded = study(laws, executor=LocalExecutor(ahead=2), **options)
+    serial = study(laws, executor=LocalExecutor(ahead=0), **options)
+    pd.testing.assert_frame_equal(threaded.cases, serial.cases)
+    pd.testing.assert_frame_equal(threaded.summary, serial.summary)
