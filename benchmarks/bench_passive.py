@@ -89,6 +89,20 @@ def bench_batch(n_samples, repeat, method="auto"):
     return n_samples * 20_000 / t, t
 
 
+def bench_exact_tracks(repeat):
+    """32 passive runs of one vehicle on 32 fra4 realisations, 10 s at 40 m/s, by the exact
+    steps ("auto" takes them for passive): a study's passive chunk, its samples on numba's
+    threads (NUMBA_NUM_THREADS sets how many)."""
+    from railride.model.params import VehicleParams
+    from railride.run.simulation import simulate
+    from railride.model.track import scenario
+
+    scs = [scenario("fra4", seed=s, speed=40.0, duration=10.0) for s in range(32)]
+    params = [VehicleParams.preset("paper")] * 32
+    simulate(scs, params)  # the matrix exponentials, the tables and the kernel's cache
+    return min_time(lambda: simulate(scs, params), repeat)
+
+
 def bench_cli(repeat):
     """Cold start of `railride simulate`: first call with an empty numba cache, then warm."""
     import railride
@@ -143,6 +157,7 @@ def main():
     for n in (64, 512):
         res[f"batch_{n}_sample_steps_per_s"], res[f"batch_{n}_s"] = bench_batch(n, max(2, args.repeat // 2))
     res["batch_64_exact_s"] = bench_batch(64, max(2, args.repeat // 2), "exact")[1]
+    res["exact_32_tracks_s"] = bench_exact_tracks(args.repeat)
     if not args.no_cli:
         res["cli_cold_s"], res["cli_warm_s"], res["import_s"] = bench_cli(max(2, args.repeat // 2))
 
@@ -164,6 +179,11 @@ def main():
         )
     exact = res["batch_64_exact_s"]
     print(f'| batch of 64 x 20 000 steps, `method="exact"` (64 matrix exponentials) | {exact:.2f} s | |')
+    tracks = res["exact_32_tracks_s"]
+    print(
+        f"| 32 passive runs, one vehicle, 32 fra4 tracks, 10 s, exact steps ({res['threads']} threads) "
+        f"| {tracks:.3f} s | |"
+    )
     if not args.no_cli:
         cold = res["cli_cold_s"]
         print(f"| `railride simulate`, first call (empty numba cache, compile included) | {cold:.1f} s | |")

@@ -175,9 +175,16 @@ def run_exact(out: dict, samples: list, x0: np.ndarray, dt: float, stride: int, 
     n = len(samples)
     status = np.zeros(n, dtype=np.int64)
     fail_step = np.full(n, -1, dtype=np.int64)
-    for i, (A, Bw, Bwd, T, c_sz, utab, interval) in enumerate(samples):
-        m = int(round(interval / dt))
-        st = stepper(A.tobytes(), Bw.tobytes(), Bwd.tobytes(), float(dt), int(stride), m)
+
+    # made (or found) before the threads start: a batch's samples share a few vehicles
+    steppers = [
+        stepper(A.tobytes(), Bw.tobytes(), Bwd.tobytes(), float(dt), int(stride), int(round(interval / dt)))
+        for A, Bw, Bwd, _, _, _, interval in samples
+    ]
+
+    def one(i: int) -> None:
+        A, Bw, Bwd, T, c_sz, utab, interval = samples[i]
+        st, m = steppers[i], int(round(interval / dt))
         kernels.exact_run(
             st.Phi,
             st.maps,
@@ -206,7 +213,26 @@ def run_exact(out: dict, samples: list, x0: np.ndarray, dt: float, stride: int, 
         if np.any(bad):
             status[i] = kernels.STATUS_DIVERGED
             fail_step[i] = int(np.argmax(bad)) * stride
+
+    _each_sample(one, n)
     return status, fail_step
+
+
+def _each_sample(one, n: int) -> None:
+    """``one(i)`` for the samples i < n, on numba's threads (the kernels release the GIL): a
+    sample's run is independent of the others', so the results are those of one after another."""
+    import numba
+
+    threads = min(n, numba.get_num_threads())
+    if threads <= 1:
+        for i in range(n):
+            one(i)
+        return
+    from concurrent.futures import ThreadPoolExecutor
+
+    with ThreadPoolExecutor(threads, thread_name_prefix="railride-exact") as pool:
+        for done in [pool.submit(one, i) for i in range(n)]:
+            done.result()  # an error in a sample's run is raised here
 
 
 class ClosedStepper:
@@ -260,9 +286,16 @@ def run_exact_closed(out: dict, samples: list, x0: np.ndarray, dt: float, stride
     n = len(samples)
     status = np.zeros(n, dtype=np.int64)
     fail_step = np.full(n, -1, dtype=np.int64)
-    for i, (A, Bw, Bwd, Bf, G, H, delay, utab, interval) in enumerate(samples):
-        m = int(round(interval / dt))
-        st = closed_stepper(A.tobytes(), Bw.tobytes(), Bwd.tobytes(), Bf.tobytes(), float(dt), stride, ctrl, m)
+    steppers = [  # made (or found) before the threads start, as run_exact's
+        closed_stepper(
+            A.tobytes(), Bw.tobytes(), Bwd.tobytes(), Bf.tobytes(), float(dt), stride, ctrl, int(round(interval / dt))
+        )
+        for A, Bw, Bwd, Bf, _, _, _, _, interval in samples
+    ]
+
+    def one(i: int) -> None:
+        A, Bw, Bwd, Bf, G, H, delay, utab, interval = samples[i]
+        st, m = steppers[i], int(round(interval / dt))
         utab = _padded(utab, (n_out * stride) // m + 2)
         status[i], fail_step[i] = kernels.exact_closed_run(
             st.phi,
@@ -294,4 +327,6 @@ def run_exact_closed(out: dict, samples: list, x0: np.ndarray, dt: float, stride
             out["fd"][i],
             out["vc"][i],
         )
+
+    _each_sample(one, n)
     return status, fail_step

@@ -123,11 +123,9 @@ def run(plan: RunPlan, progress=None) -> RideResult:
 
 
 def _stepping(plan: RunPlan):
-    """`_CPU_STEPPING` for a batch that steps on every core (RK4 on the CPU); nothing for the
-    exact steps (one core, sample by sample) and the GPU."""
-    if plan.exact or stepped_on(plan) == "gpu":
-        return contextlib.nullcontext()
-    return _CPU_STEPPING
+    """`_CPU_STEPPING` for a batch that steps on the CPU (RK4, or the exact steps, sample by
+    sample on every core); nothing for the GPU."""
+    return contextlib.nullcontext() if stepped_on(plan) == "gpu" else _CPU_STEPPING
 
 
 def reaches_stops(plan: RunPlan, q: np.ndarray, status: np.ndarray) -> bool:

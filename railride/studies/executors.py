@@ -30,9 +30,11 @@ class LocalExecutor:
     """Chunks run in this process, each chunk's batch over every core, and ``ahead`` chunks
     (default 1; 0: one after another) run beside the one whose rows are being made: a chunk's
     serial work in Python (its input tables, metrics, comfort and rows) then overlaps the
-    stepping of the next, which the compiled stepper does without the GIL. Rows come back in
-    the order of the chunks, as they would one after another. At most ``ahead`` + 1 chunks are
-    in memory at once."""
+    stepping of the next, which the compiled stepper does without the GIL. One batch steps at a
+    time (`railride.run.simulation` holds a lock while a batch steps on the CPU): batches that
+    stepped beside each other shared the cores, ended together and then made their rows together
+    while no core stepped. Rows come back in the order of the chunks, as they would one after
+    another. At most ``ahead`` + 1 chunks are in memory at once."""
 
     name = "local"
 

@@ -73,3 +73,34 @@ def test_a_study_in_threads_equals_one_chunk_after_another():
     serial = study(laws, executor=LocalExecutor(ahead=0), **options)
     pd.testing.assert_frame_equal(threaded.cases, serial.cases)
     pd.testing.assert_frame_equal(threaded.summary, serial.summary)
+
+
+def test_the_exact_steps_on_threads_equal_them_one_after_another():
+    """The exact steps run a batch's samples on numba's threads: the same arrays as on one
+    thread, a diverging sample (the shipped groundhook on the ideal actuator) marked as there."""
+    import numba
+
+    scs = [scenario("fra4", seed=s, speed=40.0, duration=1.0) for s in range(4)]
+    params = [VehicleParams.of("paper")] * 4
+    names = ("pid", "groundhook", "sas-attitude", "skyhook")
+    closed = [Suspension.named(n, damper="ideal") for n in names]
+
+    def both():
+        return (
+            simulation.simulate(scs, params),
+            simulation.simulate(scs, params, closed, on_divergence="mark"),
+        )
+
+    threaded = both()
+    threads = numba.get_num_threads()
+    numba.set_num_threads(1)
+    try:
+        alone = both()
+    finally:
+        numba.set_num_threads(threads)
+    for many, one in zip(threaded, alone):
+        assert many.dataset.attrs["integrator"].startswith("exact discretisation")
+        for key in ("q", "a"):
+            np.testing.assert_array_equal(many._raw[key], one._raw[key])
+        np.testing.assert_array_equal(many.diverged_at, one.diverged_at)
+    assert np.isfinite(threaded[1].diverged_at[1]) and np.isnan(threaded[1].diverged_at[[0, 2, 3]]).all()
