@@ -4,9 +4,7 @@ through named stages: `check` (`railride.run.checks`), `inputs`, `pack`, `step`,
 from __future__ import annotations
 
 import dataclasses
-import contextlib
 import functools
-import threading
 import time
 from dataclasses import dataclass
 from datetime import datetime, timezone
@@ -37,6 +35,7 @@ from railride.run.inputs import (  # noqa: F401  (the stores, read here by tests
     forcing_identity,
     forcing_tables,
 )
+from railride.run.cores import CPU_THREADS
 from railride.run.ride import RideResult, build_dataset, has_damper_states
 from railride.secondary import dampers
 
@@ -45,12 +44,6 @@ from railride.secondary import dampers
 #: only between calls, come a few times a second whatever the damper law costs per step
 _CHUNK_WORK = 20_000
 _CHUNK_SECONDS = 0.25
-#: held while a batch steps on the CPU's threads: each such batch uses every core, so batches in
-#: threads of one process (a study's chunks, `railride.studies.executors.LocalExecutor`) step one
-#: after another, and each steps while the others make their input tables, metrics and comfort.
-#: Stepping beside each other they shared the cores and ended together, then made their rows
-#: together while no core stepped (docs/performance.md)
-_CPU_STEPPING = threading.RLock()  # re-entrant: a progress callback may run a batch itself
 
 
 def simulate(
@@ -104,7 +97,9 @@ def run(plan: RunPlan, progress=None) -> RideResult:
     plans it checked before its first run, so that nothing is checked twice)."""
     tables = inputs(plan)
     packed = pack(plan, tables)
-    with _stepping(plan):
+    # the threads it steps on, held while it steps: a study's chunks in threads step one after
+    # another where each fills the cores (`railride.run.cores`)
+    with CPU_THREADS.taken(threads_used(plan, packed)):
         stepped = step(plan, tables, packed, progress)
     if plan.exact and reaches_stops(plan, stepped.out["q"], stepped.status):
         # the exact discretisation holds while the secondary stays off its bump stops: beyond
@@ -122,10 +117,17 @@ def run(plan: RunPlan, progress=None) -> RideResult:
     return assemble(plan, stepped)
 
 
-def _stepping(plan: RunPlan):
-    """`_CPU_STEPPING` for a batch that steps on the CPU (RK4, or the exact steps, sample by
-    sample on every core); nothing for the GPU."""
-    return contextlib.nullcontext() if stepped_on(plan) == "gpu" else _CPU_STEPPING
+def threads_used(plan: RunPlan, packed: Packed) -> int:
+    """The CPU threads the step stage of this batch runs on: one per sample (per group of
+    `lanes.LANES` samples on the lane stepper) up to numba's thread count; 0 on the GPU."""
+    import numba
+
+    if stepped_on(plan) == "gpu":
+        return 0
+    units = plan.n
+    if not plan.exact and lanes.lanes_fit(plan.n, packed.P, packed.control[7]):
+        units = -(-plan.n // lanes.LANES)
+    return max(1, min(units, numba.get_num_threads()))
 
 
 def reaches_stops(plan: RunPlan, q: np.ndarray, status: np.ndarray) -> bool:

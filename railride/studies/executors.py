@@ -31,10 +31,10 @@ class LocalExecutor:
     (default 1; 0: one after another) run beside the one whose rows are being made: a chunk's
     serial work in Python (its input tables, metrics, comfort and rows) then overlaps the
     stepping of the next, which the compiled stepper does without the GIL. One batch steps at a
-    time (`railride.run.simulation` holds a lock while a batch steps on the CPU): batches that
-    stepped beside each other shared the cores, ended together and then made their rows together
-    while no core stepped. Rows come back in the order of the chunks, as they would one after
-    another. At most ``ahead`` + 1 chunks are in memory at once."""
+    time where each fills numba's threads (`railride.run.cores`): batches that stepped beside
+    each other shared the cores, ended together and then made their rows together while no core
+    stepped. The chunks step on the caller's numba thread count. Rows come back in the order of
+    the chunks, as they would one after another. At most ``ahead`` + 1 chunks are in memory at once."""
 
     name = "local"
 
@@ -49,7 +49,16 @@ class LocalExecutor:
         from collections import deque
         from concurrent.futures import ThreadPoolExecutor
 
-        pool = ThreadPoolExecutor(self.ahead + 1, thread_name_prefix="railride-chunk")
+        import numba
+
+        # numba's thread count is the thread's own (`numba.set_num_threads`, e.g. --workers N):
+        # the chunks' threads take the caller's, where they would start with every core
+        pool = ThreadPoolExecutor(
+            self.ahead + 1,
+            thread_name_prefix="railride-chunk",
+            initializer=numba.set_num_threads,
+            initargs=(numba.get_num_threads(),),
+        )
         pending: deque = deque()
         try:
             for i, chunk in enumerate(chunks):

@@ -1,12 +1,15 @@
-"""Batches in threads of one process step one at a time on the CPU (each uses every core), and
-a study's chunks give the same rows stepped beside their neighbours' Python work as one after
-another."""
+"""Batches in threads of one process share numba's threads (`railride.run.cores`): those that
+fill them step one at a time, smaller ones beside each other; a study's chunks step on the
+caller's thread count and give the same rows as one after another."""
 
 import threading
 
+import numba
 import numpy as np
 import pandas as pd
+import pytest
 
+from railride.engine.lanes import LANES
 from railride.model.params import VehicleParams
 from railride.model.track import scenario
 from railride.run import simulation
@@ -15,14 +18,20 @@ from railride.studies.executors import LocalExecutor
 from railride.studies.study import study
 
 
-def _batch(seed: int):
+def _batch(seed: int, n: int | None = None):
+    """n runs (default: enough to fill numba's threads, one per run below `lanes.LANES` runs, one
+    per group of LANES above)."""
+    if n is None:
+        threads = max(2, numba.get_num_threads())
+        n = threads if threads < LANES else threads * LANES
     susp = Suspension.named("sas-attitude")
-    scs = [scenario("fra4", seed=seed + k, speed=40.0, duration=0.5) for k in range(2)]
-    return simulation.simulate(scs, [VehicleParams.of("paper")] * 2, [susp, susp])
+    scs = [scenario("fra4", seed=seed + k, speed=40.0, duration=0.5) for k in range(n)]
+    return simulation.simulate(scs, [VehicleParams.of("paper")] * n, [susp] * n)
 
 
-def test_batches_in_threads_step_one_after_another(monkeypatch):
-    _batch(0)  # compiled before the threads start
+def _watch(monkeypatch) -> list:
+    """[how many batches were stepping when it began, ended] of every step stage; the first
+    waits up to 1 s for another to begin beside it."""
     intervals, step = [], simulation.step
     beside = threading.Event()
 
@@ -39,6 +48,12 @@ def test_batches_in_threads_step_one_after_another(monkeypatch):
             me[1] = True
 
     monkeypatch.setattr(simulation, "step", watched)
+    return intervals
+
+
+def test_batches_that_fill_the_threads_step_one_after_another(monkeypatch):
+    _batch(0)  # compiled before the threads start
+    intervals = _watch(monkeypatch)
     results: dict = {}
     threads = [threading.Thread(target=lambda k=k: results.setdefault(k, _batch(10 * k))) for k in range(4)]
     for t in threads:
@@ -52,6 +67,29 @@ def test_batches_in_threads_step_one_after_another(monkeypatch):
     for k in range(4):
         alone = _batch(10 * k)
         np.testing.assert_array_equal(results[k]._raw["q"], alone._raw["q"])
+
+
+@pytest.mark.skipif(numba.config.NUMBA_NUM_THREADS < 2, reason="one thread: no room beside a batch")
+def test_batches_that_leave_threads_free_step_beside_each_other(monkeypatch):
+    _batch(0, 1)
+    intervals = _watch(monkeypatch)
+    threads = [threading.Thread(target=lambda k=k: _batch(10 * k, 1)) for k in range(2)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert sorted(entered for entered, _ in intervals) == [0, 1]
+    assert simulation.CPU_THREADS.used == 0
+
+
+def test_the_chunks_step_on_the_callers_thread_count():
+    threads = numba.get_num_threads()
+    numba.set_num_threads(1)
+    try:
+        seen = list(LocalExecutor(ahead=1).map(lambda chunk: numba.get_num_threads(), range(3)))
+    finally:
+        numba.set_num_threads(threads)
+    assert seen == [(0, 1), (1, 1), (2, 1)]
 
 
 def test_a_progress_callback_may_run_a_batch_itself():
