@@ -187,7 +187,7 @@ def build_dataset(
         {"units": "m/s", "long_name": "rail vertical velocity under each wheel"},
     )
     scen = np.array([json.dumps(s.describe()) for s in scenarios])
-    records = {id(p): json.dumps(p.to_dict()) for p in param_sets}  # a batch shares a few vehicles
+    records = _records(param_sets)
     pars = np.array([records[id(p)] for p in param_sets])
     if closed is not None:
         ctrl = closed["controllers"]
@@ -244,6 +244,12 @@ def build_dataset(
     if warned:  # the vehicle outside full-size rail vehicles' ranges: kept with the result
         attrs["plausibility_warnings"] = json.dumps(warned)
     return xr.Dataset(data, coords=coords, attrs=attrs)
+
+
+def _records(param_sets) -> dict[int, str]:
+    """The JSON record of each distinct vehicle object of a batch, by id: its runs share a few."""
+    distinct = {id(p): p for p in param_sets}
+    return {key: json.dumps(p.to_dict()) for key, p in distinct.items()}
 
 
 def plausibility_notes(param_sets) -> list[str]:
@@ -364,7 +370,7 @@ class RideResult:
         names = {"carbody_acceleration": 0, "carbody_pitch_acceleration": 1}
         if a.shape[2] > len(DOF_NAMES) and any(p.flexible for p in params):
             names["carbody_bending_acceleration"] = len(DOF_NAMES)
-        records = {id(p): json.dumps(p.to_dict()) for p in params}  # a batch shares a few vehicles
+        records = _records(params)
         lead = ("sample",) if batch else ()
         data: dict[str, tuple] = {
             name: (lead + ("time",), a[:, :, k] if batch else a[0, :, k]) for name, k in names.items()
