@@ -25,6 +25,7 @@ from functools import lru_cache
 import numpy as np
 import scipy.linalg
 
+from railride.engine.kernels import run_each
 from railride.engine.layout import N_DOF
 
 #: the cubic Hermite basis as powers of tau in [0, 1]: rows tau^0..tau^3, columns the node data
@@ -214,25 +215,8 @@ def run_exact(out: dict, samples: list, x0: np.ndarray, dt: float, stride: int, 
             status[i] = kernels.STATUS_DIVERGED
             fail_step[i] = int(np.argmax(bad)) * stride
 
-    _each_sample(one, n)
+    run_each(one, n)  # on numba's threads: the kernels release the GIL, the samples are independent
     return status, fail_step
-
-
-def _each_sample(one, n: int) -> None:
-    """``one(i)`` for the samples i < n, on numba's threads (the kernels release the GIL): a
-    sample's run is independent of the others', so the results are those of one after another."""
-    import numba
-
-    threads = min(n, numba.get_num_threads())
-    if threads <= 1:
-        for i in range(n):
-            one(i)
-        return
-    from concurrent.futures import ThreadPoolExecutor
-
-    with ThreadPoolExecutor(threads, thread_name_prefix="railride-exact") as pool:
-        for done in [pool.submit(one, i) for i in range(n)]:
-            done.result()  # an error in a sample's run is raised here
 
 
 class ClosedStepper:
@@ -328,5 +312,5 @@ def run_exact_closed(out: dict, samples: list, x0: np.ndarray, dt: float, stride
             out["vc"][i],
         )
 
-    _each_sample(one, n)
+    run_each(one, n)  # on numba's threads: the kernels release the GIL, the samples are independent
     return status, fail_step

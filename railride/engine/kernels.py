@@ -448,14 +448,36 @@ def rig_batch(lo, hi, law, P, n_steps, stride, dt, xtab, x_interval, mode, vcons
                 E += h / 6.0 * (ke[0] + 2.0 * ke[1] + 2.0 * ke[2] + ke[3])
 
 
+def threads_for(units: int) -> int:
+    """The threads `run_parallel` runs ``units`` independent pieces of work on: numba's thread
+    count (`numba.set_num_threads`), at most one per piece, at least one."""
+    import numba
+
+    return max(1, min(int(units), numba.get_num_threads()))
+
+
+def run_each(work, n: int) -> None:
+    """``work(i)`` for i < n on numba's threads (`threads_for`), each i taken by the next thread
+    that comes free: for pieces of unequal cost (a batch's exact runs, the pieces of its forcing
+    tables) that release the GIL. An error in one is raised here."""
+    threads = threads_for(n)
+    if threads == 1:
+        for i in range(n):
+            work(i)
+        return
+    from concurrent.futures import ThreadPoolExecutor
+
+    with ThreadPoolExecutor(threads, thread_name_prefix="railride-work") as pool:
+        for job in [pool.submit(work, i) for i in range(n)]:
+            job.result()
+
+
 def run_parallel(kernel, n_samples: int, *args, start: int = 0) -> None:
     """Call ``kernel(lo, hi, *args)`` on sample ranges that cover start..n_samples, one range per
     thread (numba's thread count as set by `numba.set_num_threads`, at most one per sample)."""
     from concurrent.futures import ThreadPoolExecutor
 
-    import numba
-
-    n_threads = max(1, min(n_samples - start, numba.get_num_threads()))
+    n_threads = threads_for(n_samples - start)
     if n_threads == 1:
         kernel(start, n_samples, *args)
         return

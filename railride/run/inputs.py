@@ -140,10 +140,10 @@ _FORCING_PIECE_ROWS = 16_384
 
 def _fill_forcing(work) -> None:
     """`forcing_nodes` for each (utab, Bw, Bwd, out) of ``work``, in pieces of rows over numba's
-    threads: the tables of a tuning round (18 for the default design, 168 MB) are the host's
-    largest work beside a GPU. Each node is its own sum, so a piece gives the rows the whole table would."""
-    import numba
-
+    threads (`run_each`): the tables of a tuning round (18 for the default design, 168 MB)
+    are the host's largest work beside a GPU. Each node is its own sum, so a piece gives the
+    rows the whole table would."""
+    from railride.engine.kernels import run_each
     from railride.engine.tables import forcing_nodes
 
     pieces = []
@@ -154,16 +154,7 @@ def _fill_forcing(work) -> None:
         for lo in range(0, table.shape[0], _FORCING_PIECE_ROWS):
             hi = min(lo + _FORCING_PIECE_ROWS, table.shape[0])
             pieces.append((table[lo:hi], Bw, Bwd, out[lo:hi]))
-    threads = min(len(pieces), numba.get_num_threads())
-    if threads <= 1:
-        for piece in pieces:
-            forcing_nodes(*piece)
-        return
-    from concurrent.futures import ThreadPoolExecutor
-
-    with ThreadPoolExecutor(threads, thread_name_prefix="railride-forcing") as pool:
-        for job in [pool.submit(forcing_nodes, *piece) for piece in pieces]:
-            job.result()
+    run_each(lambda i: forcing_nodes(*pieces[i]), len(pieces))
 
 
 def forcing_identity(system: dict) -> bytes:

@@ -120,14 +120,12 @@ def run(plan: RunPlan, progress=None) -> RideResult:
 def threads_used(plan: RunPlan, packed: Packed) -> int:
     """The CPU threads the step stage of this batch runs on: one per sample (per group of
     `lanes.LANES` samples on the lane stepper) up to numba's thread count; 0 on the GPU."""
-    import numba
-
     if stepped_on(plan) == "gpu":
         return 0
     units = plan.n
     if not plan.exact and lanes.lanes_fit(plan.n, packed.P, packed.control[7]):
         units = -(-plan.n // lanes.LANES)
-    return max(1, min(units, numba.get_num_threads()))
+    return kernels.threads_for(units)
 
 
 def reaches_stops(plan: RunPlan, q: np.ndarray, status: np.ndarray) -> bool:
