@@ -25,6 +25,11 @@ COST_COLUMNS = ("force_rms_n", "force_max_n", "travel_max_m", "voltage_at_max_fr
 COSTS_REVISION = 2
 
 
+#: the channels of a run's Dataset that `damper_costs` reads (the last two only where the dampers
+#: have a voltage)
+COST_CHANNELS = ("secondary_damper_force", "secondary_deflection", "damper_command_voltage", "damper_voltage")
+
+
 def damper_costs(ds: xr.Dataset, v_max=None) -> np.ndarray:
     """`COST_COLUMNS` of every sample of ``ds`` (a run's Dataset, with or without a ``sample``
     dimension, already cut to its window): an array (sample, 4). ``v_max``: the dampers'

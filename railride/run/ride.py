@@ -75,117 +75,7 @@ def build_dataset(
 
     damper = suspension.damper
     time = np.arange(rows) / output_rate
-    from railride.run.inputs import engine_matrices
-
-    # T at the engine's size (a rigid carbody's bending row is 0): (n, N_DOF, 4)
-    T = np.stack([engine_matrices(vehicles[id(p)])["T"] for p in param_sets])
-    ksz = np.array([p.k_sz for p in param_sets])[:, None, None]
-    deflection = out["q"] @ T  # (n, time, N_DOF) @ (n, N_DOF, 4): T^T q at every sample
-    flexible = any(vehicles[id(p)].M.shape[0] > len(DOF_NAMES) for p in param_sets)
-    shape = out["w"].shape[:2] + (4, 2)
-    # name -> (extra dims, values with leading (sample, time), attrs)
-    channels: dict[str, tuple[tuple[str, ...], Any, dict[str, str]]] = {}
-    for i, name in enumerate(DOF_NAMES):
-        channels[name] = ((), out["q"][:, :, i], {"units": DOF_UNITS[i], "long_name": DOF_LONG_NAMES[i]})
-        channels[f"{name}_velocity"] = (
-            (),
-            out["v"][:, :, i],
-            {"units": f"{DOF_UNITS[i]}/s", "long_name": DOF_RATE_LONG_NAMES[i]},
-        )
-    if flexible:  # the carbody's first vertical bending mode (a rigid sample's is 0)
-        b = len(DOF_NAMES)
-        long = BENDING_LONG_NAME
-        channels["carbody_bending"] = ((), out["q"][:, :, b], {"units": "m", "long_name": long})
-        channels["carbody_bending_velocity"] = (
-            (),
-            out["v"][:, :, b],
-            {"units": "m/s", "long_name": f"{long}, its rate"},
-        )
-        channels["carbody_bending_acceleration"] = (
-            (),
-            out["a"][:, :, b],
-            {"units": "m/s^2", "long_name": f"{long}, its acceleration"},
-        )
-    channels["carbody_acceleration"] = (
-        (),
-        out["a"][:, :, 0],
-        {"units": "m/s^2", "long_name": "carbody CG vertical acceleration"},
-    )
-    channels["carbody_pitch_acceleration"] = (
-        (),
-        out["a"][:, :, 1],
-        {"units": "rad/s^2", "long_name": "carbody pitch acceleration"},
-    )
-    channels["carbody_roll_acceleration"] = (
-        (),
-        out["a"][:, :, 2],
-        {"units": "rad/s^2", "long_name": "carbody roll acceleration"},
-    )
-    channels["carbody_corner_displacement"] = (
-        ("corner",),
-        out["q"][:, :, :3] @ T[:, :3] + out["q"][:, :, len(DOF_NAMES) :] @ T[:, len(DOF_NAMES) :],
-        {"units": "m", "long_name": "carbody vertical displacement above each secondary corner"},
-    )
-    channels["secondary_deflection"] = (
-        ("corner",),
-        deflection,
-        {"units": "m", "long_name": "secondary vertical deflection, carbody minus bogie (extension +)"},
-    )
-    channels["secondary_deflection_velocity"] = (
-        ("corner",),
-        out["v"] @ T,
-        {"units": "m/s", "long_name": "secondary vertical deflection rate, carbody minus bogie (extension +)"},
-    )
-    channels["secondary_spring_force"] = (
-        ("corner",),
-        -ksz * deflection,
-        {"units": "N", "long_name": "secondary vertical spring force on the carbody (up +)"},
-    )
-    channels["secondary_damper_force"] = (
-        ("corner",),
-        out["f"],
-        {"units": "N", "long_name": "secondary vertical damper force on the carbody (up +)"},
-    )
-    if has_damper_states(damper):  # the ideal actuator has no states and no voltage
-        d = out["d"]
-        channels["damper_hysteretic_z"] = (
-            ("corner",),
-            d[:, :, 0::3],
-            {"units": "m", "long_name": "Bouc-Wen hysteretic variable z of each damper"},
-        )
-        if damper.law == dampers.LAW_SPENCER:
-            channels["damper_internal_displacement"] = (
-                ("corner",),
-                d[:, :, 1::3],
-                {"units": "m", "long_name": "Spencer model internal displacement y"},
-            )
-        channels["damper_voltage"] = (
-            ("corner",),
-            d[:, :, 2::3],
-            {"units": "V", "long_name": "damper coil voltage u after the coil lag"},
-        )
-        command = out["vc"] if closed is not None else np.broadcast_to(vcmd[:, None, :], d[:, :, 2::3].shape)
-        channels["damper_command_voltage"] = (
-            ("corner",),
-            command,
-            {"units": "V", "long_name": "commanded damper voltage v"},
-        )
-    if closed is not None:
-        channels["damper_demand_force"] = (
-            ("corner",),
-            out["fd"],
-            {"units": "N", "long_name": "desired damper force on the carbody (up +) from the outer loop"},
-        )
-    channels["rail_displacement"] = (
-        ("wheelset", "rail"),
-        out["w"].reshape(shape),
-        {"units": "m", "long_name": "rail height under each wheel"},
-    )
-    channels["rail_velocity"] = (
-        ("wheelset", "rail"),
-        out["wd"].reshape(shape),
-        {"units": "m/s", "long_name": "rail vertical velocity under each wheel"},
-    )
+    channels = ride_channels(out, vehicles, param_sets, damper, vcmd, closed)
     scen = np.array([json.dumps(s.describe()) for s in scenarios])
     records = _records(param_sets)
     pars = np.array([records[id(p)] for p in param_sets])
@@ -244,6 +134,131 @@ def build_dataset(
     if warned:  # the vehicle outside full-size rail vehicles' ranges: kept with the result
         attrs["plausibility_warnings"] = json.dumps(warned)
     return xr.Dataset(data, coords=coords, attrs=attrs)
+
+
+def ride_channels(out, vehicles, param_sets, damper, vcmd, closed, names=None) -> dict:
+    """The time-history channels of a run's Dataset (`build_dataset`) from the stepper's arrays
+    ``out``: name -> (extra dims, values with leading (sample, time), attrs). ``names``: only
+    those of them the run has, computing none of the others (a study's costs read four of
+    them: `RideResult.channels`)."""
+    from railride.run.inputs import engine_matrices
+
+    # T at the engine's size (a rigid carbody's bending row is 0): (n, N_DOF, 4)
+    T = np.stack([engine_matrices(vehicles[id(p)])["T"] for p in param_sets])
+    ksz = np.array([p.k_sz for p in param_sets])[:, None, None]
+    want = (lambda name: True) if names is None else set(names).__contains__
+    # (n, time, N_DOF) @ (n, N_DOF, 4): T^T q at every sample; the products only where asked for
+    deflection = out["q"] @ T if want("secondary_deflection") or want("secondary_spring_force") else None
+    flexible = any(vehicles[id(p)].M.shape[0] > len(DOF_NAMES) for p in param_sets)
+    shape = out["w"].shape[:2] + (4, 2)
+    # name -> (extra dims, values with leading (sample, time), attrs)
+    channels: dict[str, tuple[tuple[str, ...], Any, dict[str, str]]] = {}
+    for i, name in enumerate(DOF_NAMES):
+        channels[name] = ((), out["q"][:, :, i], {"units": DOF_UNITS[i], "long_name": DOF_LONG_NAMES[i]})
+        channels[f"{name}_velocity"] = (
+            (),
+            out["v"][:, :, i],
+            {"units": f"{DOF_UNITS[i]}/s", "long_name": DOF_RATE_LONG_NAMES[i]},
+        )
+    if flexible:  # the carbody's first vertical bending mode (a rigid sample's is 0)
+        b = len(DOF_NAMES)
+        long = BENDING_LONG_NAME
+        channels["carbody_bending"] = ((), out["q"][:, :, b], {"units": "m", "long_name": long})
+        channels["carbody_bending_velocity"] = (
+            (),
+            out["v"][:, :, b],
+            {"units": "m/s", "long_name": f"{long}, its rate"},
+        )
+        channels["carbody_bending_acceleration"] = (
+            (),
+            out["a"][:, :, b],
+            {"units": "m/s^2", "long_name": f"{long}, its acceleration"},
+        )
+    channels["carbody_acceleration"] = (
+        (),
+        out["a"][:, :, 0],
+        {"units": "m/s^2", "long_name": "carbody CG vertical acceleration"},
+    )
+    channels["carbody_pitch_acceleration"] = (
+        (),
+        out["a"][:, :, 1],
+        {"units": "rad/s^2", "long_name": "carbody pitch acceleration"},
+    )
+    channels["carbody_roll_acceleration"] = (
+        (),
+        out["a"][:, :, 2],
+        {"units": "rad/s^2", "long_name": "carbody roll acceleration"},
+    )
+    if want("carbody_corner_displacement"):
+        channels["carbody_corner_displacement"] = (
+            ("corner",),
+            out["q"][:, :, :3] @ T[:, :3] + out["q"][:, :, len(DOF_NAMES) :] @ T[:, len(DOF_NAMES) :],
+            {"units": "m", "long_name": "carbody vertical displacement above each secondary corner"},
+        )
+    if want("secondary_deflection"):
+        channels["secondary_deflection"] = (
+            ("corner",),
+            deflection,
+            {"units": "m", "long_name": "secondary vertical deflection, carbody minus bogie (extension +)"},
+        )
+    if want("secondary_deflection_velocity"):
+        channels["secondary_deflection_velocity"] = (
+            ("corner",),
+            out["v"] @ T,
+            {"units": "m/s", "long_name": "secondary vertical deflection rate, carbody minus bogie (extension +)"},
+        )
+    if want("secondary_spring_force"):
+        channels["secondary_spring_force"] = (
+            ("corner",),
+            -ksz * deflection,
+            {"units": "N", "long_name": "secondary vertical spring force on the carbody (up +)"},
+        )
+    channels["secondary_damper_force"] = (
+        ("corner",),
+        out["f"],
+        {"units": "N", "long_name": "secondary vertical damper force on the carbody (up +)"},
+    )
+    if has_damper_states(damper):  # the ideal actuator has no states and no voltage
+        d = out["d"]
+        channels["damper_hysteretic_z"] = (
+            ("corner",),
+            d[:, :, 0::3],
+            {"units": "m", "long_name": "Bouc-Wen hysteretic variable z of each damper"},
+        )
+        if damper.law == dampers.LAW_SPENCER:
+            channels["damper_internal_displacement"] = (
+                ("corner",),
+                d[:, :, 1::3],
+                {"units": "m", "long_name": "Spencer model internal displacement y"},
+            )
+        channels["damper_voltage"] = (
+            ("corner",),
+            d[:, :, 2::3],
+            {"units": "V", "long_name": "damper coil voltage u after the coil lag"},
+        )
+        command = out["vc"] if closed is not None else np.broadcast_to(vcmd[:, None, :], d[:, :, 2::3].shape)
+        channels["damper_command_voltage"] = (
+            ("corner",),
+            command,
+            {"units": "V", "long_name": "commanded damper voltage v"},
+        )
+    if closed is not None:
+        channels["damper_demand_force"] = (
+            ("corner",),
+            out["fd"],
+            {"units": "N", "long_name": "desired damper force on the carbody (up +) from the outer loop"},
+        )
+    channels["rail_displacement"] = (
+        ("wheelset", "rail"),
+        out["w"].reshape(shape),
+        {"units": "m", "long_name": "rail height under each wheel"},
+    )
+    channels["rail_velocity"] = (
+        ("wheelset", "rail"),
+        out["wd"].reshape(shape),
+        {"units": "m/s", "long_name": "rail vertical velocity under each wheel"},
+    )
+    return channels if names is None else {k: v for k, v in channels.items() if want(k)}
 
 
 def _records(param_sets) -> dict[int, str]:
@@ -358,28 +373,40 @@ class RideResult:
         return ride_comfort(self.comfort_channels(), positions=positions, window=window, weightings=weightings)
 
     def comfort_channels(self) -> xr.Dataset:
-        """What `railride.analysis.comfort.ride_comfort` reads: the Dataset where it is built,
-        else one of those channels alone, from the raw arrays (the carbody's vertical, pitch and,
-        where it bends, bending accelerations, and each run's vehicle record). A study's comfort
-        then does not build every channel of every run (0.8 s of a 1,000-run study's serial work,
-        docs/performance.md)."""
-        if self._dataset is not None or self._raw is None:
-            return self.dataset
-        a, batch = self._raw["a"], bool(self._raw["batch"])
-        params = list(self.params) if batch else [self.params]
-        names = {"carbody_acceleration": 0, "carbody_pitch_acceleration": 1}
-        if a.shape[2] > len(DOF_NAMES) and any(p.flexible for p in params):
-            names["carbody_bending_acceleration"] = len(DOF_NAMES)
-        records = _records(params)
+        """What `railride.analysis.comfort.ride_comfort` reads (`channels`): the carbody's
+        vertical, pitch and, where it bends, bending accelerations, and each run's vehicle
+        record. A study's comfort then does not build every channel of every run (0.8 s of a
+        1,000-run study's serial work, docs/performance.md)."""
+        names = ("carbody_acceleration", "carbody_pitch_acceleration", "carbody_bending_acceleration")
+        return self.channels(names, texts=("vehicle_params",))
+
+    def channels(self, names, texts=()) -> xr.Dataset:
+        """A Dataset of the channels ``names`` alone (those of them the run has) and the text
+        variables ``texts`` ("vehicle_params"): the Dataset's where it is built, else from the
+        stepper's arrays, computing no other channel (`ride_channels`). A study reads a few
+        channels of every run: its comfort and its damper costs."""
+        raw = self._raw
+        if self._dataset is not None or raw is None or "channels" not in raw:
+            ds = self.dataset
+            return ds[[name for name in (*names, *texts) if name in ds.variables]]
+        batch = bool(raw["batch"])
         lead = ("sample",) if batch else ()
-        data: dict[str, tuple] = {
-            name: (lead + ("time",), a[:, :, k] if batch else a[0, :, k]) for name, k in names.items()
-        }
-        texts = np.array([records[id(p)] for p in params])
-        data["vehicle_params"] = (lead, texts if batch else texts[0], TEXT_ATTRS["vehicle_params"])
-        coords = {"time": ("time", self._raw["time"], LABEL_ATTRS["time"])}
+        found = raw["channels"](names)
+        data: dict[str, tuple] = {}
+        for name in (n for n in names if n in found):  # in the order asked, as ``Dataset[names]``
+            dims, values, attrs = found[name]
+            data[name] = (lead + ("time",) + dims, values if batch else values[0], attrs)
+        if "vehicle_params" in texts:
+            params = list(self.params) if batch else [self.params]
+            records = _records(params)
+            text = np.array([records[id(p)] for p in params])
+            data["vehicle_params"] = (lead, text if batch else text[0], TEXT_ATTRS["vehicle_params"])
+        labels = {"corner": CORNER_NAMES, "wheelset": WHEELSETS, "rail": RAILS}
+        used = {dim for dims, *_ in data.values() for dim in dims}
+        coords = {"time": ("time", raw["time"], LABEL_ATTRS["time"])}
+        coords.update({dim: (dim, list(values), LABEL_ATTRS[dim]) for dim, values in labels.items() if dim in used})
         if batch:
-            coords["sample"] = ("sample", np.arange(len(params)), LABEL_ATTRS["sample"])
+            coords["sample"] = ("sample", np.arange(len(self.params)), LABEL_ATTRS["sample"])
         return xr.Dataset(data, coords=coords)
 
     def report_contents(self):

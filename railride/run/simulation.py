@@ -36,7 +36,7 @@ from railride.run.inputs import (  # noqa: F401  (the stores, read here by tests
     forcing_tables,
 )
 from railride.run.cores import CPU_THREADS
-from railride.run.ride import RideResult, build_dataset, has_damper_states
+from railride.run.ride import RideResult, build_dataset, has_damper_states, ride_channels
 from railride.secondary import dampers
 
 #: sample-steps of the first kernel call when a progress callback is given; later calls are
@@ -438,6 +438,10 @@ def assemble(plan: RunPlan, stepped: Stepped) -> RideResult:
         "a": out["a"],
         "batch": batch,
         "diverged_at": diverged_at,
+        # a few channels without the whole Dataset (`RideResult.channels`)
+        "channels": functools.partial(
+            ride_channels, out, plan.vehicles, plan.param_sets, suspensions[0].damper, plan.vcmd, plan.closed
+        ),
     }
     result = RideResult(
         raw=raw,

@@ -220,7 +220,7 @@ def _add_rows(rows: dict, cases: list[Case], part_idx: list[int], m, diverged_at
 
 def _costs(res, case: Case, window) -> np.ndarray:
     """`railride.analysis.costs.damper_costs` of a batch's runs (one damper model per batch)."""
-    from railride.analysis.costs import damper_costs
+    from railride.analysis.costs import COST_CHANNELS, damper_costs
     from railride.analysis.metrics import select_window
     from railride.secondary.suspension import damper_model
 
@@ -228,7 +228,8 @@ def _costs(res, case: Case, window) -> np.ndarray:
     v_max = (
         getattr(damper_model(case.damper, case.damper_scale), "v_max", None) if case.suspension != "passive" else None
     )
-    return damper_costs(select_window(res.dataset, window), v_max)
+    # the channels the costs read, not the run's whole Dataset
+    return damper_costs(select_window(res.channels(COST_CHANNELS), window), v_max)
 
 
 def _vehicle(made: dict, vehicle: VehicleParams, c: Case) -> VehicleParams:

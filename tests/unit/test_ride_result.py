@@ -179,3 +179,30 @@ def test_comfort_before_the_dataset_is_built_equals_comfort_from_it(vehicle):
         full = res.comfort(window=(0.5, 2.0)) if res.dataset is not None else None
         np.testing.assert_array_equal(light.values, full.values)
         assert light.dims == full.dims and light.attrs == full.attrs
+
+
+@pytest.mark.parametrize("name", ["passive", "pid", "sas-attitude"])
+def test_channels_before_the_dataset_is_built_equal_the_datasets(name):
+    """`RideResult.channels` (a study's damper costs read four channels of every run) gives,
+    without building the run's Dataset, the Dataset's own variables: values, dimensions,
+    coordinates and attributes, for a batch and a single run. A channel the run does not have
+    (passive dampers have no voltage) is left out, as the Dataset leaves it out."""
+    from railride.analysis.costs import COST_CHANNELS
+
+    susp = Suspension.named(name)
+    params = VehicleParams.of("crh380a")  # a bending carbody: T has its bending row
+    scs = [scenario("fra4", seed=s, speed=40.0, duration=1.0) for s in (1, 2)]
+    names = (*COST_CHANNELS, "carbody_corner_displacement", "rail_velocity", "carbody_bending")
+    for res in (simulate(scs, [params] * 2, [susp] * 2), simulate(scs[0], params, susp)):
+        light = res.channels(names)
+        assert res._dataset is None
+        full = res.dataset[[n for n in names if n in res.dataset.variables]]
+        assert list(light.data_vars) == list(full.data_vars)
+        assert ("damper_voltage" in light) == (name != "passive")
+        for var in full.data_vars:
+            assert light[var].dims == full[var].dims and light[var].attrs == full[var].attrs
+            np.testing.assert_array_equal(light[var].values, full[var].values)
+        for coord in light.coords:
+            np.testing.assert_array_equal(light[coord].values, full[coord].values)
+        built = res.channels(names)  # once the Dataset is built, from it
+        assert list(built.data_vars) == list(full.data_vars)
