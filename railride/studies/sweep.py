@@ -539,7 +539,9 @@ class SweepResult:
         g = self.grid
         if record is None:
             record = self.vehicle_record
-        controlled = {(c.scenario, c.scenario_options) for c in g.cases if c.suspension in g.controllers}
+        # in the grid's order (a set's order changes from one process to the next, and the line with it)
+        ran = [(c.scenario, c.scenario_options) for c in g.cases if c.suspension in g.controllers]
+        controlled = list(dict.fromkeys(ran))
         if not controlled:
             return None
         return g.base_gains.mismatch(record, [scenario_of(name, opts).describe() for name, opts in controlled])

@@ -240,6 +240,10 @@ def test_study_sweep_and_league_record_one_line():
     line = sweep.settings["gains_mismatch"]
     assert "track paper-sine (speed 40 m/s)" in line and line.endswith("railride tune --speed 40 --duration 0.2")
     assert "gains_mismatch" not in run_sweep(grid(["pid"], duration=0.2), comfort=False).settings
+    # several tracks off: named in the grid's order, the same line in every process (not a set's order)
+    three = run_sweep(grid(["pid"], speed=[50.0, 30.0, 40.0], duration=0.2), comfort=False).settings["gains_mismatch"]
+    assert "(speed 50, 30, 40 m/s)" in three
+    assert three.endswith("railride tune --speed 50 --duration 0.2 (and one tuning each for speed 30, 40 m/s)")
     table = league(["paper-sine"], speeds=[40.0, 55.56], controllers=["pid"], duration=0.2, comfort=False)
     assert table.to_dict()["settings"]["gains_mismatch"] == line
     for doc in (res.to_dict(), sweep.to_dict(), table.to_dict()):
