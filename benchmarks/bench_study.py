@@ -1,7 +1,7 @@
 """Cost of a study over many tracks (railride.studies.study): wall time and peak memory.
 
 Run:  python benchmarks/bench_study.py [--seeds N] [--dask [--workers N] [--worker-threads T] | --ahead N |
-                                       --processes N] [--profile]
+                                       --processes N] [--profile] [--held]
 Prints a Markdown row for docs/performance.md: one study of 1000 closed-loop and passive runs
 of 10 s (--duration) (fra4, N = 20 track seeds x 5 speeds x 2 loads x (passive + 4 controllers)), with its
 wall time (compilation excluded: a warm-up study runs first) and peak resident memory. Locally:
@@ -14,12 +14,16 @@ cores shared among the workers, as railride's Dask executor shares them). The sc
 workers is their rate over that of one worker with the same threads. With --profile (local
 only), the serial share: the part of the wall time in which no chunk is in the compiled
 stepper (the step stage of `railride.run.simulation`), from the union of the step stage's
-intervals in every thread. No test asserts timings.
+intervals in every thread. With --held (local only), the threads of numba's pool that stepping
+chunks held (`railride.run.cores.CPU_THREADS`), sampled every 2 ms: their mean over the study and
+the share of its time at each count (run with NUMBA_NUM_THREADS=16 to see how many chunks step at
+once on 16 threads, even on fewer cores). No test asserts timings.
 """
 
 from __future__ import annotations
 
 import argparse
+import collections
 import resource
 import time
 
@@ -34,15 +38,15 @@ def main():
     ap.add_argument("--ahead", type=int, default=None, help="local: chunks stepping beside the one whose rows are made")
     ap.add_argument("--profile", action="store_true", help="local: the serial share of the wall time")
     ap.add_argument("--processes", type=int, default=None, help="ProcessExecutor: worker processes of this machine")
+    ap.add_argument("--held", action="store_true", help="local: the threads that stepping chunks held")
     args = ap.parse_args()
 
     from railride.studies.study import study
 
-    executor, cluster, where = None, None, "local, one process"
-    if args.ahead is not None:
-        from railride.studies.executors import LocalExecutor
+    from railride.studies.executors import LocalExecutor
 
-        executor, where = LocalExecutor(ahead=args.ahead), f"local, one process, {args.ahead} chunk(s) ahead"
+    executor, cluster = LocalExecutor(ahead=args.ahead), None  # ahead None: chunks_ahead of the threads
+    where = f"local, one process, {executor.ahead} chunk(s) ahead" + (" (default)" if args.ahead is None else "")
     if args.processes is not None:
         from railride.studies.executors import ProcessExecutor
 
@@ -65,6 +69,7 @@ def main():
     seeds = list(range(args.seeds))
     speeds = [30.0, 37.5, 45.0, 52.5, 60.0]
     intervals = _watch_steps() if args.profile and args.processes is None else None
+    held = _watch_held() if args.held and args.processes is None and not args.dask else None
     parent = resource.getrusage(resource.RUSAGE_SELF)
     t0 = time.perf_counter()
     res = study(
@@ -78,6 +83,7 @@ def main():
     )
     wall = time.perf_counter() - t0
     t1 = t0 + wall
+    counts = held() if held is not None else None
     after = resource.getrusage(resource.RUSAGE_SELF)
     parent_cpu = (after.ru_utime - parent.ru_utime) + (after.ru_stime - parent.ru_stime)
     peak_mib = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
@@ -104,11 +110,44 @@ def main():
             f"{wall - stepping:.1f} s, the serial share: {(wall - stepping) / wall * 100:.1f} %"
         )
 
+    if counts:
+        by_count = sorted(collections.Counter(counts).items())
+        shares = ", ".join(f"{k}: {100 * v / len(counts):.0f} %" for k, v in by_count)
+        print(
+            f"\nthreads {_threads()}: stepping chunks held {sum(counts) / len(counts):.1f} threads on average; "
+            f"the time at each count held: {shares}"
+        )
     if args.profile and args.processes is not None:
         print(
             f"\nthe parent process's CPU time during the study: {parent_cpu:.2f} s of the {wall:.1f} s wall time, "
             f"the serial share: {parent_cpu / wall * 100:.1f} %"
         )
+
+
+def _watch_held():
+    """Sample `railride.run.cores.CPU_THREADS.used` every 2 ms in a thread; the function returned
+    stops it and gives the samples."""
+    import threading
+
+    from railride.run.cores import CPU_THREADS
+
+    samples: list = []
+    stop = threading.Event()
+
+    def watch():
+        while not stop.is_set():
+            samples.append(CPU_THREADS.used)
+            time.sleep(0.002)
+
+    watcher = threading.Thread(target=watch, daemon=True)
+    watcher.start()
+
+    def done() -> list:
+        stop.set()
+        watcher.join()
+        return samples
+
+    return done
 
 
 def _threads() -> int:

@@ -12,7 +12,7 @@
 #   1. the machine: GPU, driver, cores, versions, and whether railride sees a usable GPU
 #   2. bench_gpu.py: 32,768 SAS closed loops on the GPU, their agreement with the CPU over 64
 #      samples, the same batch on the CPU's cores, and the metrics-only batch of the studies
-#   3. bench_study.py: the 1,000-run study on 2 cores, on all cores (also with 3 chunks ahead),
+#   3. bench_study.py: the 1,000-run study on 2 cores, on all cores (also with 1 chunk ahead),
 #      and in one process per core
 #   4. bench_gpu.py --design: the default design on the GPU (target: at most 2 minutes)
 #   5. bench_dampers.py --lane-sizes: run_batch against the lane stepper, 1 to 16 threads
@@ -81,8 +81,9 @@ if [ "$SMOKE" = 1 ]; then
 else
   step study-2-cores 60 env NUMBA_NUM_THREADS=2 taskset -c 0,1 $PY benchmarks/bench_study.py --seeds "$SEEDS" --profile
   step study-all-cores 45 $PY benchmarks/bench_study.py --seeds "$SEEDS" --profile
-  # a 32-run chunk on the lane stepper holds 4 of 16 threads: do more chunks in flight fill them?
-  step study-all-cores-ahead-3 30 $PY benchmarks/bench_study.py --seeds "$SEEDS" --ahead 3 --profile
+  # a 32-run chunk on the lane stepper holds 4 of 16 threads: the default (chunks_ahead, 4 chunks
+  # ahead on 16 threads) against the one chunk ahead of before, which held at most 8
+  step study-all-cores-ahead-1 30 $PY benchmarks/bench_study.py --seeds "$SEEDS" --ahead 1 --profile
   step study-processes 60 $PY benchmarks/bench_study.py --seeds "$SEEDS" --processes "$CORES" --profile
 fi
 

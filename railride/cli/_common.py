@@ -378,13 +378,15 @@ def make_executor(
     workers: Optional[int],
     scheduler: Optional[str],
     scheduler_file: Optional[Path],
-    ahead: int = 1,
+    ahead: Optional[int] = None,
     processes: Optional[int] = None,
+    rows_beside: bool = True,
 ):
     """(executor, record for the JSON): Dask with --scheduler / --scheduler-file, else the local
     executor, whose batches use --workers threads (numba's thread count, 1..cores), with
-    ``ahead`` chunks stepping beside the one whose rows are made (`LocalExecutor`), or with
-    --processes N worker processes (`ProcessExecutor`)."""
+    ``ahead`` chunks stepping beside the one whose rows are made (default: by its thread count,
+    `LocalExecutor` with ``rows_beside``), or with --processes N worker processes
+    (`ProcessExecutor`)."""
     from railride.studies import sweep as sweep_lib
 
     if processes is not None:
@@ -425,8 +427,9 @@ def make_executor(
                 f"--workers = {workers}: must be a whole number from 1 to {cores} (the cores of this machine)"
             )
         numba.set_num_threads(workers)
-    record = {"type": "local", "threads": int(numba.get_num_threads()), "chunks_ahead": ahead}
-    return sweep_lib.LocalExecutor(ahead), record
+    local = sweep_lib.LocalExecutor(ahead, rows_beside)  # ahead None: by the thread count just set
+    record = {"type": "local", "threads": int(numba.get_num_threads()), "chunks_ahead": local.ahead}
+    return local, record
 
 
 def open_run_table(out: Optional[Path], resume: bool):

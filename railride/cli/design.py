@@ -73,8 +73,6 @@ DESIGN_FIELDS = {
     "optimiser_seed": "--optimiser-seed",
     **FIXED_RATE_FIELDS,
 }
-#: chunks that step beside the one whose rows are made (`LocalExecutor`): none for the design
-DESIGN_AHEAD = 0
 #: the metrics of the table of ratios, and their headings
 RATIO_METRICS = {
     "acceleration_m_s2_rms": "accel.",
@@ -389,10 +387,10 @@ def design_command(
         )
         check_design(None if controllers.strip() == "all" else names, **settings)  # before the folder
         table, table_path = open_run_table(out, resume)
-        # one chunk at a time: two chunks of 20 s runs at once took the default design to 2.09 GiB,
-        # above its 2 GiB (docs/performance.md)
+        # only the chunks that fill the threads (one on 2 cores): one more, whose rows are made
+        # beside them, took the default design to 2.09 GiB, above its 2 GiB (docs/performance.md)
         executor, executor_record = make_executor(
-            workers, scheduler, scheduler_file, ahead=DESIGN_AHEAD, processes=processes
+            workers, scheduler, scheduler_file, processes=processes, rows_beside=False
         )
     try:
         with interruptible(table, table_path), errors(), option_names(DESIGN_FIELDS):

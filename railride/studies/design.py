@@ -363,10 +363,10 @@ def design(
         optimiser_seed=optimiser_seed,
     )
     table = RunTable() if table is None else table
-    if executor is None:  # one chunk at a time: two at once took the default design above 2 GiB
+    if executor is None:  # the chunks that fill the threads, none more: one more took the default design above 2 GiB
         from railride.studies.executors import LocalExecutor
 
-        executor = LocalExecutor(ahead=0)
+        executor = LocalExecutor(rows_beside=False)
     over = tuple(
         TuningCase(track, _options(plan, track, seed, v), load)
         for track in plan.tracks

@@ -26,20 +26,46 @@ from railride._io import atomic_write
 
 
 # -- executors ---------------------------------------------------------------------------------
+#: samples per compiled batch (a study's chunk, `railride.studies.sweep.run_cases`): bounds the
+#: memory of the time histories (about 5 MB a sample for 10 s at 1 kHz)
+CHUNK = 32
+
+
+def chunks_ahead(threads: int | None = None, rows_beside: bool = True) -> int:
+    """The chunks a `LocalExecutor` runs beside the one whose rows are being made, by default:
+    enough for the chunks that step at once to hold every one of ``threads`` (default numba's
+    thread count). A chunk of `CHUNK` runs on the lane stepper steps on one thread per group of
+    `railride.engine.lanes.LANES` runs (`railride.run.cores`): 4 threads, so 16 threads want
+    four chunks stepping, where one chunk ahead held at most 8 (docs/performance.md).
+    ``rows_beside``: one chunk more, whose rows are made while the others step (at least 1);
+    False: none more (a design's chunks of 20 s runs, whose memory that would double on 2
+    cores, for nothing there: docs/performance.md)."""
+    import numba
+
+    from railride.engine.lanes import LANES
+
+    threads = int(numba.get_num_threads()) if threads is None else int(threads)
+    per_chunk = max(1, min(threads, -(-CHUNK // LANES)))
+    stepping = -(-threads // per_chunk)
+    return max(1, stepping) if rows_beside else max(0, stepping - 1)
+
+
 class LocalExecutor:
     """Chunks run in this process, each chunk's batch over every core, and ``ahead`` chunks
-    (default 1; 0: one after another) run beside the one whose rows are being made: a chunk's
-    serial work in Python (its input tables, metrics, comfort and rows) then overlaps the
-    stepping of the next, which the compiled stepper does without the GIL. One batch steps at a
-    time where each fills numba's threads (`railride.run.cores`): batches that stepped beside
-    each other shared the cores, ended together and then made their rows together while no core
-    stepped. The chunks step on the caller's numba thread count. Rows come back in the order of
-    the chunks, as they would one after another. At most ``ahead`` + 1 chunks are in memory at once."""
+    run beside the one whose rows are being made: a chunk's serial work in Python (its input
+    tables, metrics, comfort and rows) then overlaps the stepping of the next, which the
+    compiled stepper does without the GIL. One batch steps at a time where each fills numba's
+    threads (`railride.run.cores`): batches that stepped beside each other shared the cores,
+    ended together and then made their rows together while no core stepped. The chunks step on
+    the caller's numba thread count. Rows come back in the order of the chunks, as they would one
+    after another. At most ``ahead`` + 1 chunks are in memory at once. ``ahead``: default
+    `chunks_ahead` of numba's thread count (1 on up to 4 threads, 4 on 16; with ``rows_beside``
+    False, 0 and 3); 0: one after another."""
 
     name = "local"
 
-    def __init__(self, ahead: int = 1):
-        self.ahead = max(0, int(ahead))
+    def __init__(self, ahead: int | None = None, rows_beside: bool = True):
+        self.ahead = chunks_ahead(rows_beside=rows_beside) if ahead is None else max(0, int(ahead))
 
     def map(self, fn, chunks):
         if self.ahead == 0:

@@ -31,7 +31,7 @@ import pandas as pd
 from railride.errors import InputError
 from railride.defaults import DEFAULT_CONTROL_RATE, DEFAULT_OUTPUT_RATE
 from railride.studies.progress import shows_progress
-from railride.studies.executors import DaskExecutor, LocalExecutor, ProcessExecutor, RunTable  # noqa: F401 (their home before)
+from railride.studies.executors import CHUNK, DaskExecutor, LocalExecutor, ProcessExecutor, RunTable  # noqa: F401 (their home before)
 from railride.analysis.metrics import RESPONSES, STATISTICS
 from railride.plots import PNG_DPI, FigureOptions
 from railride.model.params import VehicleParams, resolve_argument, resolve_vehicle, vehicle_record
@@ -40,9 +40,6 @@ from railride.secondary.suspension import batch_conflict, damper_label, damper_r
 from railride.studies.case import MODEL_REVISION, SUSPENSIONS, Case, scenario_of  # noqa: F401 (their home before)
 from railride.studies.grid import SweepGrid, grid  # noqa: F401 (the grid of the sweep study, here too)
 
-#: samples per compiled batch: bounds the memory of the time histories (about 5 MB a sample
-#: for 10 s at 1 kHz)
-CHUNK = 32
 #: runs per batch where a study keeps only the metrics and the GPU takes them (`gpu_batches`):
 #: their sums stay on the device (`railride.run.reduced`), a few bytes a run, and a GPU pays from
 #: thousands of samples (a choice: not yet measured on a GPU, docs/gpu.md)

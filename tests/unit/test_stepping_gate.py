@@ -142,3 +142,17 @@ def test_the_exact_steps_on_threads_equal_them_one_after_another():
             np.testing.assert_array_equal(many._raw[key], one._raw[key])
         np.testing.assert_array_equal(many.diverged_at, one.diverged_at)
     assert np.isfinite(threaded[1].diverged_at[1]) and np.isnan(threaded[1].diverged_at[[0, 2, 3]]).all()
+
+
+def test_enough_chunks_ahead_to_fill_the_threads():
+    # a 32-run chunk on the lane stepper steps on one thread per group of 8 runs: 4 threads, so
+    # 16 threads want four chunks stepping beside the one whose rows are made; one chunk ahead
+    # would hold at most 8. Never fewer than one: a chunk's rows overlap the next one's stepping
+    from railride.studies.executors import chunks_ahead
+
+    assert [chunks_ahead(t) for t in (1, 2, 4, 8, 16, 64)] == [1, 1, 1, 2, 4, 16]
+    # without a chunk whose rows are made beside the stepping ones (a design's): one less
+    assert [chunks_ahead(t, rows_beside=False) for t in (1, 2, 4, 8, 16, 64)] == [0, 0, 0, 1, 3, 15]
+    assert LocalExecutor().ahead == chunks_ahead(numba.get_num_threads())
+    assert LocalExecutor(rows_beside=False).ahead == chunks_ahead(numba.get_num_threads(), rows_beside=False)
+    assert LocalExecutor(0).ahead == 0 and LocalExecutor(3).ahead == 3
