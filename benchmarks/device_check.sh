@@ -80,10 +80,10 @@ if [ "$SMOKE" = 1 ]; then
   step study-2-cores 120 $PY benchmarks/bench_study.py --seeds "$SEEDS" --duration 1 --profile
 else
   step study-2-cores 60 env NUMBA_NUM_THREADS=2 taskset -c 0,1 $PY benchmarks/bench_study.py --seeds "$SEEDS" --profile
-  step study-all-cores 45 $PY benchmarks/bench_study.py --seeds "$SEEDS" --profile
+  step study-all-cores 45 $PY benchmarks/bench_study.py --seeds "$SEEDS" --profile --held
   # a 32-run chunk on the lane stepper holds 4 of 16 threads: the default (chunks_ahead, 4 chunks
   # ahead on 16 threads) against the one chunk ahead of before, which held at most 8
-  step study-all-cores-ahead-1 30 $PY benchmarks/bench_study.py --seeds "$SEEDS" --ahead 1 --profile
+  step study-all-cores-ahead-1 30 $PY benchmarks/bench_study.py --seeds "$SEEDS" --ahead 1 --profile --held
   step study-processes 60 $PY benchmarks/bench_study.py --seeds "$SEEDS" --processes "$CORES" --profile
 fi
 
