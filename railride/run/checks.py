@@ -178,6 +178,14 @@ def _exact_phases(scenarios, solver: SolverSettings, duration: float) -> tuple[i
     return math.lcm(stride, m) // stride, m
 
 
+def history_bytes(samples: int, rows: int, damper_states: bool = True, closed: bool = True) -> float:
+    """Bytes of the time histories of ``samples`` runs of ``rows`` output rows each: the stepper's
+    output channels (q, q', q'', the rail inputs, the damper forces; the damper states with
+    ``damper_states``, the demands and commands of a closed loop with ``closed``)."""
+    channels = 3 * N_DOF + 4 + 16 + (layout.N_DS if damper_states else 0) + (8 if closed else 0)
+    return 8.0 * samples * rows * channels
+
+
 def _check_size(
     scenarios, solver: SolverSettings, damper, closed, exact: bool, n_out: int, duration: float, tables=None
 ):
@@ -188,8 +196,7 @@ def _check_size(
     (`railride.run.reduced`): two rows a sample, and that many tables."""
     n, dt, stride = len(scenarios), solver.dt, solver.output_steps
     limits.check_steps("dt", n_out * stride, "raise dt or shorten the run")
-    channels = 3 * N_DOF + 4 + 16 + (layout.N_DS if has_damper_states(damper) else 0) + (8 if closed else 0)
-    need = 8.0 * n * ((n_out + 1) if tables is None else 2) * channels
+    need = history_bytes(n, (n_out + 1) if tables is None else 2, has_damper_states(damper), closed is not None)
     nodes, interval = max(input_table_nodes(sc, dt, duration) for sc in scenarios)
     need += 8.0 * (n if tables is None else tables) * nodes * (16 + 36)  # input, forcing tables: one a sample at most
     if exact:  # discrete.ExactStepper: period x 18 x (span x 8)

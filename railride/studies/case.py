@@ -169,9 +169,15 @@ class Case:
         return d
 
     @property
+    def duration(self) -> float:
+        """The run's duration [s] as its options give it (10 s, the scenarios' default, where they
+        give none)."""
+        return float(dict(self.scenario_options).get("duration", 10.0))
+
+    @property
     def group(self) -> tuple:
         """Cases that can share one compiled batch."""
-        duration = dict(self.scenario_options).get("duration", 10.0)
+        duration = dict(self.scenario_options).get("duration", 10.0)  # as given: the group's key
         kind = "passive" if self.suspension == "passive" else ("closed" if self.closed_loop else "mr")
         # sensor noise is one setting per batch
         return (

@@ -67,6 +67,15 @@ class LocalExecutor:
     def __init__(self, ahead: int | None = None, rows_beside: bool = True):
         self.ahead = chunks_ahead(rows_beside=rows_beside) if ahead is None else max(0, int(ahead))
 
+    def bounded(self, chunk_bytes: float) -> "LocalExecutor":
+        """This executor with no more chunks in flight than the memory limit holds
+        (`railride.limits.max_memory`: half the machine's by default), each chunk taking
+        ``chunk_bytes``; at least one chunk (whose own size each run checks)."""
+        from railride.limits import max_memory
+
+        fit = int(max_memory() // max(float(chunk_bytes), 1.0))  # chunks in flight that fit
+        return LocalExecutor(max(0, min(self.ahead, fit - 1)))
+
     def map(self, fn, chunks):
         if self.ahead == 0:
             for i, chunk in enumerate(chunks):

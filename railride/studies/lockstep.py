@@ -81,5 +81,11 @@ class OwnChunks:
         own.sort(key=lambda chunk: near(chunk[0]))  # stable: a tie keeps the laws' order
         return self.executor.map(fn, own)
 
+    def bounded(self, chunk_bytes: float) -> "OwnChunks":
+        """The same, over ``executor.bounded(chunk_bytes)`` where it has that (`LocalExecutor`)."""
+        if not hasattr(self.executor, "bounded"):
+            return self
+        return OwnChunks(self.executor.bounded(chunk_bytes), self.parts)
+
     def close(self) -> None:
         """Nothing: the executor is the caller's, and closed by it."""

@@ -351,6 +351,12 @@ def run_cases(
     on_gpu = chunk == CHUNK and not (comfort or costs) and gpu_batches(solver, min(len(pending), GPU_CHUNK))
     if on_gpu:
         chunk = GPU_CHUNK  # metrics summed on the GPU (`evaluate`)
+    if pending and not on_gpu and hasattr(executor, "bounded"):
+        # the chunks in flight within the memory limit (a chunk of 60 s runs holds about 1 GB)
+        from railride.run.checks import history_bytes
+
+        longest = max(c.duration for c in pending)
+        executor = executor.bounded(history_bytes(min(chunk, len(pending)), longest * solver.output_rate + 2))
     if hasattr(executor, "chunk"):  # `railride.studies.lockstep.OwnChunks` chunks each law's cases itself
         executor.chunk, executor.on_gpu = chunk, on_gpu
     chunks = _chunks(pending, chunk)

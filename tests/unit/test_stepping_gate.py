@@ -156,3 +156,31 @@ def test_enough_chunks_ahead_to_fill_the_threads():
     assert LocalExecutor().ahead == chunks_ahead(numba.get_num_threads())
     assert LocalExecutor(rows_beside=False).ahead == chunks_ahead(numba.get_num_threads(), rows_beside=False)
     assert LocalExecutor(0).ahead == 0 and LocalExecutor(3).ahead == 3
+
+
+def test_the_chunks_in_flight_fit_the_memory_limit(monkeypatch):
+    # each chunk in flight holds its runs' histories: no more of them than the memory limit
+    # holds, and at least one (whose own size each run checks)
+    from railride.limits import memory_limit
+    from railride.studies.sweep import grid, run_sweep
+
+    with memory_limit("100M"):
+        assert LocalExecutor(4).bounded(30 * 2**20).ahead == 2  # three chunks of 30 MiB
+        assert LocalExecutor(4).bounded(60 * 2**20).ahead == 0  # one
+        assert LocalExecutor(1).bounded(2**20).ahead == 1  # never more than asked
+    used = []
+    map_ = LocalExecutor.map
+
+    def recorded(self, fn, chunks):
+        used.append(self.ahead)
+        return map_(self, fn, chunks)
+
+    monkeypatch.setattr(LocalExecutor, "map", recorded)
+    # 40 runs of 1 s: chunks of 32 runs hold 32 x 1,001 rows x 70 channels, 18 MB each
+    g = grid(["pid"], speed=[30.0 + k for k in range(40)], duration=1.0)
+    rows = {}
+    for limit in ("30M", "64M"):
+        with memory_limit(limit):
+            rows[limit] = run_sweep(g, executor=LocalExecutor(3), progress=False, comfort=False).to_pandas()
+    assert used == [0, 2]  # one chunk fits 30 MB, three fit 64 MB
+    pd.testing.assert_frame_equal(rows["30M"], rows["64M"])
