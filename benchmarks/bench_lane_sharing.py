@@ -14,7 +14,8 @@ the second or third kind. No test asserts timings.
 from __future__ import annotations
 
 import argparse
-import time
+
+from bench_study import _watch_steps  # this folder: run as a script
 
 
 def main():
@@ -24,7 +25,6 @@ def main():
     args = ap.parse_args()
 
     from railride.model.params import VehicleParams
-    from railride.run import simulation
     from railride.studies.case import Case
     from railride.studies.sweep import evaluate
 
@@ -42,25 +42,15 @@ def main():
         "4 cases x 8 gain sets": [case(*c, kp) for c in tracks for kp in gains][:32],
         "4.6 cases x 7 gain sets": [case(*c, kp) for c in tracks for kp in gains[:7]][:32],
     }
-    seconds: list[float] = []
-    step = simulation.step
-
-    def timed(*a, **k):
-        t0 = time.perf_counter()
-        try:
-            return step(*a, **k)
-        finally:
-            seconds.append(time.perf_counter() - t0)
-
-    simulation.step = timed
+    intervals = _watch_steps()  # (start, end) of every step stage
     for cases in batches.values():
         evaluate(cases[:8])  # compile and warm
     best = dict.fromkeys(batches, float("inf"))
     for _ in range(args.repeat):
         for name, cases in batches.items():
-            seconds.clear()
+            intervals.clear()
             evaluate(cases)
-            best[name] = min(best[name], sum(seconds))
+            best[name] = min(best[name], sum(end - start for start, end in intervals))
     steps = round(args.duration / 1e-4)
     print(f"| batch of 32 runs of {args.duration:g} s | step stage | sample-steps/s |")
     print("|---|---|---|")
