@@ -448,12 +448,12 @@ def rig_batch(lo, hi, law, P, n_steps, stride, dt, xtab, x_interval, mode, vcons
                 E += h / 6.0 * (ke[0] + 2.0 * ke[1] + 2.0 * ke[2] + ke[3])
 
 
-def threads_for(units: int) -> int:
-    """The threads `run_parallel` runs ``units`` independent pieces of work on: numba's thread
-    count (`numba.set_num_threads`), at most one per piece, at least one."""
+def threads_for(units: int, threads: int | None = None) -> int:
+    """The threads `run_parallel` runs ``units`` independent pieces of work on: ``threads``
+    (default numba's thread count, `numba.set_num_threads`), at most one per piece, at least one."""
     import numba
 
-    return max(1, min(int(units), numba.get_num_threads()))
+    return max(1, min(int(units), numba.get_num_threads() if threads is None else int(threads)))
 
 
 def run_each(work, n: int) -> None:

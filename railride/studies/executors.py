@@ -42,10 +42,11 @@ def chunks_ahead(threads: int | None = None, rows_beside: bool = True) -> int:
     cores, for nothing there: docs/performance.md)."""
     import numba
 
+    from railride.engine.kernels import threads_for
     from railride.engine.lanes import LANES
 
     threads = int(numba.get_num_threads()) if threads is None else int(threads)
-    per_chunk = max(1, min(threads, -(-CHUNK // LANES)))
+    per_chunk = threads_for(-(-CHUNK // LANES), threads)  # as `railride.run.simulation.threads_used`
     stepping = -(-threads // per_chunk)
     return max(1, stepping) if rows_beside else max(0, stepping - 1)
 
