@@ -5,6 +5,7 @@
 # tree through PYTHONPATH; nothing is installed).
 #
 # Run:  bash benchmarks/device_check.sh [BUDGET_S]      (default 560 s in all)
+#       bash benchmarks/device_check.sh --gpu [BUDGET_S]  (steps 1, 2, 4 and 6 alone: the GPU's)
 #       bash benchmarks/device_check.sh --smoke          (here: the simulator, tiny sizes, a check of the script)
 #
 # Steps, most wanted first; each gets at most its cap and what is left of the budget, and one
@@ -23,7 +24,9 @@
 set -u
 cd "$(dirname "$0")/.."
 SMOKE=0
+GPU_ONLY=0
 BUDGET=560
+if [ "${1:-}" = "--gpu" ]; then GPU_ONLY=1; shift; fi
 if [ "${1:-}" = "--smoke" ]; then SMOKE=1; BUDGET=900; elif [ -n "${1:-}" ]; then BUDGET=$1; fi
 OUT=${OUT:-/tmp/railride_device_check}
 mkdir -p "$OUT"
@@ -75,8 +78,9 @@ $PY -c 'import sys, numpy, scipy, numba; print(sys.version.split()[0], \"numpy\"
 $PY -c 'import importlib.metadata as m; print(\"numba-cuda\", m.version(\"numba-cuda\"))' || echo 'no numba-cuda'; \
 $PY -c 'from railride.run.solver import gpu_missing; print(\"railride sees a usable GPU\" if gpu_missing() is None else \"railride: \" + gpu_missing())'"
 
-step gpu-throughput 200 $PY benchmarks/bench_gpu.py --samples "$GPU_SAMPLES" --duration "$DURATION" --cpu --check "$CHECK" --metrics-only
+step gpu-throughput 120 $PY benchmarks/bench_gpu.py --samples "$GPU_SAMPLES" --duration "$DURATION" --cpu --check "$CHECK" --metrics-only
 
+if [ "$GPU_ONLY" = 0 ]; then
 # compile the CPU kernels once (numba's cache), so that no timed step below is cut by compiling
 step compile-cpu 90 $PY -c "from railride.studies.study import study; \
 study(['pid', 'sas-attitude', 'sas-attitude-ride', 'clipped-optimal'], track_seeds=[0], speeds=[40.0], duration=1.0)"
@@ -92,15 +96,17 @@ else
   step study-processes 60 $PY benchmarks/bench_study.py --seeds "$SEEDS" --processes "$CORES" --profile
 fi
 
+fi
+
 if [ "$SMOKE" = 1 ]; then  # the simulator would take hours over a design
   step design-on-gpu 30 echo "not in the simulator"
 else
-  step design-on-gpu 180 $PY benchmarks/bench_gpu.py --samples 1024 --design
+  step design-on-gpu 150 $PY benchmarks/bench_gpu.py --samples 1024 --design
 fi
 
-step lane-sizes 90 $PY benchmarks/bench_dampers.py --lane-sizes --repeat 3 --threads "$THREADS" --sizes "$SIZES"
+[ "$GPU_ONLY" = 1 ] || step lane-sizes 90 $PY benchmarks/bench_dampers.py --lane-sizes --repeat 3 --threads "$THREADS" --sizes "$SIZES"
 
-step gpu-tests 150 $PY -m pytest -q -x -p no:randomly -p no:cacheprovider tests/physics/test_gpu.py tests/physics/test_gpu_metrics.py
+step gpu-tests 90 $PY -m pytest -q -p no:randomly -p no:cacheprovider tests/physics/test_gpu.py tests/physics/test_gpu_metrics.py
 
 echo "" | tee -a "$LOG"
 echo "done in $(($(date +%s) - START)) s of a $BUDGET s budget" | tee -a "$LOG"

@@ -350,12 +350,28 @@ def _python_mirror(*functions):
 _compiled: dict = {}
 
 
+def _array_overloads() -> None:
+    """Loads numba-cuda's numpy overloads on a numpy without ``np.row_stack`` (removed in numpy
+    2.5): numba-cuda 0.30.4 registers one for it on every numpy 2, so its first compile fails with
+    an AttributeError. The alias of ``np.vstack`` lives only while that module loads."""
+    if simulated() or hasattr(np, "row_stack"):
+        return
+    np.row_stack = np.vstack  # type: ignore[attr-defined]
+    try:
+        import numba.cuda.np.arrayobj  # noqa: F401
+    except ImportError:  # numba's own CUDA target: nothing of numba-cuda to load
+        pass
+    finally:
+        del np.row_stack  # type: ignore[attr-defined]
+
+
 def _device_functions():
     """The kernel, compiled for the device on first use (or mirrored for the simulator)."""
     if "kernel" not in _compiled:
         if simulated():
             _compiled["kernel"] = cuda.jit(_python_mirror(_kernel)[0])
         else:
+            _array_overloads()
             _compiled["kernel"] = cuda.jit(_kernel)
     return _compiled["kernel"]
 
@@ -388,6 +404,7 @@ def ptx(cc: tuple[int, int] = (9, 0)) -> str:
     # a device function the kernel calls (not inlined) asks the current device for its compute
     # capability: with no device, the one asked for here
     device = types.SimpleNamespace(compute_capability=cc)
+    _array_overloads()
     with mock.patch.object(dispatcher, "get_current_device", lambda: device):
         code, _ = cuda.compile_ptx(_kernel, kernel_signature(), cc=cc)
     return code
