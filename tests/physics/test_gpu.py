@@ -174,3 +174,23 @@ def test_the_kernel_compiles_for_a_gpu():
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=600)
     assert done.returncode == 0, done.stderr[-2000:]
     assert done.stdout.split()[1] == "True"
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not _nvvm(), reason="no NVVM (install railride[gpu]) to compile the kernel for a GPU")
+def test_the_kernel_compiles_on_a_numpy_without_row_stack():
+    """numpy 2.5 removed ``np.row_stack``; numba-cuda 0.30.4 still registers an overload for it,
+    which made every kernel compile fail (seen on an H100). Removed here as numpy 2.5 has it
+    removed: from the module and from its ``__all__``; the alias used while loading is gone after."""
+    import subprocess
+    import sys
+
+    code = (
+        "import numpy as np; vars(np).pop('row_stack', None)\n"
+        "np.__all__ = [n for n in np.__all__ if n != 'row_stack']\n"
+        "from railride.engine import gpu; p = gpu.ptx((9, 0)); print('.entry' in p, hasattr(np, 'row_stack'))"
+    )
+    env = {**__import__("os").environ, "NUMBA_ENABLE_CUDASIM": "0"}
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=600)
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert done.stdout.split() == ["True", "False"]
