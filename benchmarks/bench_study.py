@@ -109,6 +109,14 @@ def main():
             f"\nthreads {_threads()}: the stepper ran {stepping:.1f} s of the {wall:.1f} s; no chunk was stepping for "
             f"{wall - stepping:.1f} s, the serial share: {(wall - stepping) / wall * 100:.1f} %"
         )
+        inside = [(a, b) for a, b in intervals if b > t0 and a < t1]
+        if inside:
+            head = min(a for a, _ in inside) - t0
+            tail = t1 - max(b for _, b in inside)
+            print(
+                f"of which {head:.2f} s before the first chunk stepped, {tail:.2f} s after the last one, and "
+                f"{wall - stepping - head - tail:.2f} s between ({len(inside)} step calls)"
+            )
 
     if counts:
         by_count = sorted(collections.Counter(counts).items())
