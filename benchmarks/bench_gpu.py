@@ -100,7 +100,9 @@ def main():
     where = f"{device}; {os.cpu_count()} CPU cores; {datetime.date.today().isoformat()}"
     on_gpu = SolverSettings(output_rate=args.output_rate, backend="gpu")
     scs, susp = _batch(min(args.samples, 256), args.duration if args.duration < 0.1 else 0.1, args.law)
+    t0 = time.perf_counter()
     simulate(scs, suspension=susp, solver=on_gpu)  # compiles the kernel (and the CPU's, for the tables)
+    print(f"The first call, which compiles the kernel: {time.perf_counter() - t0:.1f} s")
 
     scs, susp = _batch(args.samples, args.duration, args.law)
     t0 = time.perf_counter()
