@@ -356,13 +356,13 @@ def _array_overloads() -> None:
     an AttributeError. The alias of ``np.vstack`` lives only while that module loads."""
     if simulated() or hasattr(np, "row_stack"):
         return
-    np.row_stack = np.vstack  # type: ignore[attr-defined]
+    setattr(np, "row_stack", np.vstack)  # setattr: numpy 2.5 and its stubs have no such name
     try:
         import numba.cuda.np.arrayobj  # noqa: F401
     except ImportError:  # numba's own CUDA target: nothing of numba-cuda to load
         pass
     finally:
-        del np.row_stack  # type: ignore[attr-defined]
+        delattr(np, "row_stack")
 
 
 def _device_functions():
