@@ -21,6 +21,9 @@ Prints Markdown rows for docs/gpu.md, each with the device, the machine's cores 
 * with ``--host-only`` (in the simulator: NUMBA_ENABLE_CUDASIM=1; ``--controllers`` to pick laws),
   the default design with its GPU kernel replaced by a stand-in that returns at once: the host's
   share of the design, which no GPU takes away (wall time, runs, host peak);
+* with ``--host-batch`` (in the simulator), the ``--samples``-run metrics-only batch above with
+  its kernel a stand-in: the host's share of one such call (checking the runs, then
+  `batch_metrics`: tables, packing, the simulator's copies in place of transfers), best of 3;
 * with ``--memory-plan`` (no GPU needed: the simulator does), the bytes a metrics-only run of 60 s
   takes on the device, from the sizes of the arrays a 64-run batch packs (computed, not measured):
   a run's own arrays, and the tables each distinct track and vehicle adds.
@@ -78,6 +81,7 @@ def main():
     ap.add_argument("--metrics-only", action="store_true")
     ap.add_argument("--memory-plan", action="store_true")
     ap.add_argument("--host-only", action="store_true")
+    ap.add_argument("--host-batch", action="store_true")
     ap.add_argument("--controllers", default=None, help="--host-only: the design's laws (comma-separated; default all)")
     args = ap.parse_args()
     if args.memory_plan:
@@ -85,6 +89,9 @@ def main():
         return
     if args.host_only:
         _host_only(args.controllers)
+        return
+    if args.host_batch:
+        _host_batch(args.samples, args.duration, args.law, args.output_rate)
         return
 
     import numba
@@ -232,6 +239,34 @@ def _host_only(controllers) -> None:
     print(f"| {'all laws' if laws is None else ', '.join(laws)} | {runs:,} ({s['training_runs']:,} training, "
           f"{s['judging_runs']:,} held out) | {wall:.1f} s | {inside[0]:.1f} s | **{host_s:.1f} s** "
           f"| {host_s / runs * 1e3:.2f} ms | {cpu:.1f} s | {host:.2f} GiB |")  # fmt: skip
+
+
+def _host_batch(samples: int, duration: float, law: str, output_rate: float):
+    """The host's share of a metrics-only batch (``--host-batch``): `check` and `batch_metrics`
+    of ``samples`` runs with the kernel a stand-in, in the simulator, best of 3."""
+    from railride.engine import gpu
+    from railride.run.checks import check
+    from railride.run.reduced import batch_metrics
+    from railride.run.solver import SolverSettings
+
+    if not gpu.simulated():
+        sys.exit("bench_gpu: --host-batch runs in the simulator: set NUMBA_ENABLE_CUDASIM=1")
+    gpu._device_functions = lambda: _StandIn()
+    on_gpu = SolverSettings(output_rate=output_rate, backend="gpu")
+    scs, susp = _batch(min(samples, 256), duration, law)
+    batch_metrics(check(scs, None, susp, on_gpu, "mark", histories=False))  # compiles the tables' parts
+    scs, susp = _batch(samples, duration, law)
+    best = (np.inf, np.inf)
+    for _ in range(3):
+        t0 = time.perf_counter()
+        plan = check(scs, None, susp, on_gpu, "mark", histories=False)
+        t1 = time.perf_counter()
+        batch_metrics(plan)
+        best = min(best, (t1 - t0, time.perf_counter() - t1), key=sum)
+    print(f"{os.cpu_count()} CPU cores; {datetime.date.today().isoformat()}")
+    print(f"\n{samples} x {law}, fra4 (64 tracks and speeds), {duration:g} s, metrics only, the kernel a "
+          f"stand-in: check {best[0]:.2f} s, batch_metrics {best[1]:.2f} s, "
+          f"the host's share {sum(best):.2f} s")  # fmt: skip
 
 
 class _StandIn:

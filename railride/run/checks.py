@@ -383,7 +383,8 @@ def check(
     if conflict is not None:
         raise InputError(conflict)
     damper = suspensions[0].damper
-    vcmd = np.array([[_command_voltage(s)] * 4 for s in suspensions], dtype=float)
+    voltages = {id(s): _command_voltage(s) for s in suspensions}  # a batch repeats its suspensions
+    vcmd = np.array([[voltages[id(s)]] * 4 for s in suspensions], dtype=float)
     closed = _closed_loop(suspensions, solver, duration)
     exact = _exact(solver, damper, closed, suspensions, len(set(param_sets)))
     if exact and solver.method == "auto" and _exact_phases(scenarios, solver, duration)[0] > _MAX_EXACT_PHASES:
@@ -399,7 +400,8 @@ def check(
         check_resolution(sc, output_rate)
     tables = None
     if not histories and not exact and solver.backend_for(n) == "gpu":  # metrics summed on the device
-        tables = len({(table_key(sc) or id(sc), id(p)) for sc, p in zip(scenarios, param_sets)})
+        pairs = {(id(sc), id(p)): (sc, p) for sc, p in zip(scenarios, param_sets)}  # a batch repeats them
+        tables = len({(table_key(sc) or id(sc), id(p)) for sc, p in pairs.values()})
     _check_size(scenarios, solver, damper, closed, exact, n_out, duration, tables)
     gm, hm, modes, sensing = _outer_loops(closed, param_sets, vehicles, n)
     faults = fault_table([s.faults for s in suspensions], dt, duration)  # their times within the run

@@ -165,8 +165,12 @@ def inputs(plan: RunPlan) -> Inputs:
     n, dt, duration, exact = plan.n, plan.solver.dt, plan.duration, plan.exact
     vehicles, param_sets = plan.vehicles, plan.param_sets
     systems = {key: _system_arrays(v, passive=plan.damper is None) for key, v in vehicles.items()}
+    # each sample's copy taken from the distinct vehicles by index: one gather, not a stack of
+    # a list as long as the batch
+    order = {key: i for i, key in enumerate(systems)}
+    which = np.array([order[id(p)] for p in param_sets], dtype=np.int64)
     arrays = {
-        k: np.ascontiguousarray(np.stack([systems[id(p)][k] for p in param_sets]))
+        k: np.ascontiguousarray(np.stack([system[k] for system in systems.values()])[which])
         for k in ("A", "TS", "c_sec", "stops")
     }
 

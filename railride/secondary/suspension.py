@@ -427,6 +427,8 @@ def batch_conflict(suspensions) -> str | None:
 
     first = suspensions[0]
     for i, s in enumerate(suspensions[1:], start=1):
+        if s is first:  # a batch often repeats one suspension
+            continue
         for field in ("damper", "closed_loop", "inner", "sensor_noise", "sensing"):
             a, b = getattr(first, field), getattr(s, field)
             if a != b:

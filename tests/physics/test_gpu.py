@@ -194,3 +194,17 @@ def test_the_kernel_compiles_on_a_numpy_without_row_stack():
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=600)
     assert done.returncode == 0, done.stderr[-2000:]
     assert done.stdout.split() == ["True", "False"]
+
+
+def test_a_batchs_distinct_vehicles_are_found_once_and_indexed_back():
+    """`gpu._vehicles`: each distinct (A, TS) once, and every sample's index gives its own back."""
+    rng = np.random.default_rng(3)
+    A0, TS0 = rng.standard_normal((3, 24, 10)), rng.standard_normal((3, 10, 4))
+    which = rng.integers(0, 3, 500)
+    A, TS = A0[which], TS0[which]
+    TS[which == 2] = TS0[0]  # a vehicle that differs from another only in A
+    A_u, TS_u, vid = gpu._vehicles(A, TS)
+    assert len(A_u) == 3 and vid.dtype == np.int64
+    assert np.array_equal(A_u[vid], A) and np.array_equal(TS_u[vid], TS)
+    A_1, _, vid_1 = gpu._vehicles(A0[[1] * 7], TS0[[1] * 7])
+    assert len(A_1) == 1 and not vid_1.any()
