@@ -22,7 +22,7 @@ METHODS = ("auto", "rk4", "exact")
 #: (the GPU for a batch of at least GPU_MIN_BATCH samples where one is usable, else the CPU)
 BACKENDS = ("auto", "cpu", "gpu")
 #: the smallest batch "auto" sends to a GPU: below it the transfers and the launch outweigh the
-#: stepping (a choice, not yet measured on a GPU; docs/gpu.md)
+#: stepping (a choice: on one H100 the crossover lay between 1,024 and 32,768 runs; docs/gpu.md)
 GPU_MIN_BATCH = 4096
 #: a random track's shortest wavelength must pass at speed / min_wavelength <= output_rate /
 #: RESOLUTION: a component above that shows in the stored histories only as a few samples a cycle

@@ -42,7 +42,7 @@ from railride.studies.grid import SweepGrid, grid  # noqa: F401 (the grid of the
 
 #: runs per batch where a study keeps only the metrics and the GPU takes them (`gpu_batches`):
 #: their sums stay on the device (`railride.run.reduced`), a few bytes a run, and a GPU pays from
-#: thousands of samples (a choice: not yet measured on a GPU, docs/gpu.md)
+#: thousands of samples (a choice: this size was not measured on a GPU, docs/gpu.md)
 GPU_CHUNK = 8192
 #: (position, index) of `railride.analysis.comfort.ride_comfort` in a row with comfort, as the column
 #: ``<position>_<index>``
