@@ -4,31 +4,33 @@
 # numpy, scipy, xarray, pandas, typer and rich already installed (the package runs from this
 # tree through PYTHONPATH; nothing is installed).
 #
-# Run:  bash benchmarks/device_check.sh [BUDGET_S]      (default 560 s in all)
-#       bash benchmarks/device_check.sh --gpu [BUDGET_S]  (steps 1, 2, 3 and 5: the GPU's)
+# Run:  bash benchmarks/device_check.sh [BUDGET_S]      (default 580 s in all)
+#       bash benchmarks/device_check.sh --gpu [BUDGET_S]  (steps 1 to 5: the GPU's)
 #       bash benchmarks/device_check.sh --smoke          (here: the simulator, tiny sizes, a check of the script)
 #
 # Steps, most wanted first; each gets at most its cap and what is left of the budget, and one
 # that runs out is cut and said so in the log, so the run ends inside the budget:
 #   1. the machine: GPU, driver, cores (and whether they are threads of fewer cores), versions,
-#      and whether railride sees a usable GPU
+#      a profiler (nsys, ncu) if there is one, and whether railride sees a usable GPU
 #   2. bench_gpu.py: 32,768 SAS closed loops on the GPU (and how long its first call, which
 #      compiles the kernel, takes), their agreement with the CPU over 64 samples, the same batch
 #      on the CPU's cores, and the metrics-only batch of the studies
 #   3. the GPU tests of tests/physics on the device instead of the simulator
-#   4. the CPU kernels compiled into numba's cache by a one-run study (about 35 s on a 2-core
-#      VM), then bench_study.py: the 1,000-run study on 2 cores, on all cores (also with 1 chunk
-#      ahead), and in one process per core
-#   5. railride design --backend gpu with its defaults, the command itself (target: at most 2
+#   4. railride design --backend gpu with its defaults, the command itself (target: at most 2
 #      minutes; the log's "exit 0 after N s")
-#   6. bench_dampers.py --lane-sizes: run_batch against the lane stepper, 1 to 16 threads
+#   5. bench_gpu_cache.py: whether numba-cuda's file cache keeps the kernel between processes,
+#      and the compile each process would save
+#   6. the CPU's figures, measured once on 16 cores already (2026-11-27): the CPU kernels
+#      compiled into numba's cache by a one-run study, then bench_study.py (the 1,000-run study
+#      on 2 cores, on all cores, also with 1 chunk ahead, and in one process per core), and
+#      bench_dampers.py --lane-sizes (run_batch against the lane stepper, 1 to 16 threads)
 # Everything printed goes to $OUT/device_check.log as well (the device tool brings $OUT back).
 # No figure is written anywhere else: copy the rows into the docs with the machine and date.
 set -u
 cd "$(dirname "$0")/.."
 SMOKE=0
 GPU_ONLY=0
-BUDGET=560
+BUDGET=580
 if [ "${1:-}" = "--gpu" ]; then GPU_ONLY=1; shift; fi
 if [ "${1:-}" = "--smoke" ]; then SMOKE=1; BUDGET=900; elif [ -n "${1:-}" ]; then BUDGET=$1; fi
 OUT=${OUT:-/tmp/railride_device_check}
@@ -76,7 +78,7 @@ else
 fi
 CORES=$(nproc)
 
-step machine 30 bash -c "date -u; nproc; (lscpu | grep -E 'Model name|Thread|Core|Socket|NUMA node\(s\)' || true); (nvidia-smi --query-gpu=name,memory.total,driver_version --format=csv || echo 'no nvidia-smi'); \
+step machine 30 bash -c "date -u; nproc; (lscpu | grep -E 'Model name|Thread|Core|Socket|NUMA node\(s\)' || true); (nvidia-smi --query-gpu=name,memory.total,driver_version --format=csv || echo 'no nvidia-smi'); (command -v nsys ncu || echo 'no nsys or ncu on the PATH'); \
 $PY -c 'import sys, numpy, scipy, numba; print(sys.version.split()[0], \"numpy\", numpy.__version__, \"scipy\", scipy.__version__, \"numba\", numba.__version__)'; \
 $PY -c 'import importlib.metadata as m; print(\"numba-cuda\", m.version(\"numba-cuda\"))' || echo 'no numba-cuda'; \
 $PY -c 'from railride.run.solver import gpu_missing; print(\"railride sees a usable GPU\" if gpu_missing() is None else \"railride: \" + gpu_missing())'"
@@ -85,6 +87,17 @@ step gpu-throughput 120 $PY benchmarks/bench_gpu.py --samples "$GPU_SAMPLES" --d
 
 step gpu-tests 120 $PY -m pytest -q -p no:randomly -p no:cacheprovider tests/physics/test_gpu.py tests/physics/test_gpu_metrics.py
 
+if [ "$SMOKE" = 1 ]; then  # the simulator would take hours over a design
+  step design-on-gpu 30 echo "not in the simulator"
+else
+  # the command itself, so that "exit 0 after N s" is its time (start-up and compiling included)
+  step design-on-gpu 240 $PY -m railride.cli design --backend gpu --out /tmp/railride-design-gpu
+fi
+
+# whether numba-cuda's file cache keeps the kernel between processes, and the compile it saves
+step gpu-cache 150 $PY benchmarks/bench_gpu_cache.py
+
+# the CPU's figures (measured on a lent 16-core machine on 2026-11-27: docs/performance.md)
 if [ "$GPU_ONLY" = 0 ]; then
 # compile the CPU kernels once (numba's cache), so that no timed step below is cut by compiling
 step compile-cpu 90 $PY -c "from railride.studies.study import study; \
@@ -100,18 +113,8 @@ else
   step study-all-cores-ahead-1 30 $PY benchmarks/bench_study.py --seeds "$SEEDS" --ahead 1 --profile --held
   step study-processes 60 $PY benchmarks/bench_study.py --seeds "$SEEDS" --processes "$CORES" --profile
 fi
-
+step lane-sizes 90 $PY benchmarks/bench_dampers.py --lane-sizes --repeat 3 --threads "$THREADS" --sizes "$SIZES"
 fi
-
-if [ "$SMOKE" = 1 ]; then  # the simulator would take hours over a design
-  step design-on-gpu 30 echo "not in the simulator"
-else
-  # the command itself, so that "exit 0 after N s" is its time (start-up and compiling included)
-  step design-on-gpu 240 $PY -m railride.cli design --backend gpu --out /tmp/railride-design-gpu
-fi
-
-[ "$GPU_ONLY" = 1 ] || step lane-sizes 90 $PY benchmarks/bench_dampers.py --lane-sizes --repeat 3 --threads "$THREADS" --sizes "$SIZES"
-
 
 echo "" | tee -a "$LOG"
 echo "done in $(($(date +%s) - START)) s of a $BUDGET s budget" | tee -a "$LOG"
