@@ -413,7 +413,7 @@ def ptx(cc: tuple[int, int] = (9, 0)) -> str:
 def _vehicles(A: np.ndarray, TS: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The distinct vehicles of a batch: (A, TS) once each, in the order they first come, and
     every sample's index into them. Keyed by the matrices' bytes: NumPy's ``unique`` over rows
-    sorted them and took 0.31 s of a 32,768-run batch's host work, this 0.04 s."""
+    sorted them, the largest part of a 32,768-run batch's host work (docs/gpu.md)."""
     n = len(A)
     a, ts = np.ascontiguousarray(A).reshape(n, -1), np.ascontiguousarray(TS).reshape(n, -1)
     seen: dict[tuple[bytes, bytes], int] = {}
