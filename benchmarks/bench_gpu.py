@@ -115,7 +115,7 @@ def main():
     t0 = time.perf_counter()
     result = simulate(scs, suspension=susp, solver=on_gpu)
     wall = time.perf_counter() - t0
-    call = dict(gpu.last_call)
+    call = gpu.last_call()
     work = args.samples * round(args.duration / on_gpu.dt)
     host = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024**2
     print(f"Device: {where}; {result.dataset.attrs['integrator']}")
@@ -141,7 +141,7 @@ def main():
         t0 = time.perf_counter()
         sums, _ = batch_metrics(check(scs, None, susp, on_gpu, "mark", histories=False))
         reduced = time.perf_counter() - t0
-        call = dict(gpu.last_call)
+        call = gpu.last_call()
         full = result.metrics().values
         diff = float(np.nanmax(np.abs(sums - full) / np.nanmax(np.abs(full), axis=0)))
         print(f"\nMetrics only (sums on the device): kernels {call['kernel_s']:.2f} s, whole call {reduced:.2f} s, "

@@ -20,7 +20,9 @@ Python sources (`_python_mirror`), since the simulator's arrays cannot enter com
 
 from __future__ import annotations
 
+import contextlib
 import importlib.util
+import threading
 import time
 import types
 
@@ -82,11 +84,20 @@ from railride.engine.sample_parts import (
 
 #: threads per block on a GPU (a multiple of the warp, 32)
 THREADS_PER_BLOCK = 128
+#: the most registers a thread of the kernel may use (None: the compiler's choice, 255 at most);
+#: set before the first compile. Fewer registers let more threads share a multiprocessor, at the
+#: cost of more spills to local memory (`benchmarks/bench_gpu.py --resources`, docs/gpu.md)
+MAX_REGISTERS: int | None = None
 #: the share of the device's free memory one group of samples may take
 MEMORY_SHARE = 0.6
-#: what the last call of `run_gpu` took: seconds in the kernels and in the transfers, its
-#: groups, and the most device memory in use while it ran [bytes] (read by benchmarks/bench_gpu.py)
-last_call: dict = {}
+# what the calling thread's last `run_gpu` took (`last_call`)
+_calls = threading.local()
+# held while a group of samples is sized against the free memory and given its device arrays:
+# calls from several threads (a study's chunks in flight) then never size their groups on the
+# same free memory
+_ALLOCATING = threading.Lock()
+_COMPILING = threading.Lock()
+_SIMULATOR = threading.Lock()
 # the sizes of the kernel's thread-local arrays: names, since a local array's size must be a
 # constant, not an expression
 _N_RATES = 4 * NS_MAX  # the four RK4 stage rates
@@ -366,14 +377,27 @@ def _array_overloads() -> None:
 
 
 def _device_functions():
-    """The kernel, compiled for the device on first use (or mirrored for the simulator)."""
-    if "kernel" not in _compiled:
-        if simulated():
-            _compiled["kernel"] = cuda.jit(_python_mirror(_kernel)[0])
-        else:
-            _array_overloads()
-            _compiled["kernel"] = cuda.jit(_kernel)
-    return _compiled["kernel"]
+    """The kernel, compiled for the device on first use (or mirrored for the simulator), once
+    though several threads ask at once."""
+    with _COMPILING:
+        if "kernel" not in _compiled:
+            _compiled["kernel"] = _compile()
+        return _compiled["kernel"]
+
+
+def _compile():
+    if simulated():
+        return cuda.jit(_python_mirror(_kernel)[0])
+    _array_overloads()
+    limit = {} if MAX_REGISTERS is None else {"max_registers": MAX_REGISTERS}
+    return cuda.jit(_kernel, **limit)
+
+
+def last_call() -> dict:
+    """What the calling thread's last `run_gpu` took: seconds in the kernels (``kernel_s``) and
+    in the transfers (``transfer_s``), its sample groups (``groups``) and the most device memory in
+    use while it ran (``device_bytes``). Read by benchmarks/bench_gpu.py."""
+    return dict(getattr(_calls, "last", {}))
 
 
 def kernel_signature() -> tuple:
@@ -514,70 +538,93 @@ def run_gpu(
     bytes_per_sample = sum(a[0].nbytes for a in per_sample) + n_rows * row_bytes
     lam1 = _one_step_limit(dt)
     lo = 0
-    last_call.clear()
-    last_call.update(kernel_s=0.0, transfer_s=0.0, groups=0, device_bytes=0)
+    record = _calls.last = {"kernel_s": 0.0, "transfer_s": 0.0, "groups": 0, "device_bytes": 0}
     try:
+        # a stream of this call's own: the kernels and copies of calls from other threads (a
+        # study's chunks in flight) overlap on the device, where the default stream would queue them
+        stream = cuda.stream()
         win = np.zeros(2, dtype=np.int64) if reduce is None else np.asarray(reduce[0], dtype=np.int64)
-        shared = [cuda.to_device(np.ascontiguousarray(a)) for a in (A_u, TS_u, utab, ftab, noise, snoise, win)]
-        size = group_size(n, bytes_per_sample)
+        with _ALLOCATING:
+            shared = [_to_device(a, stream) for a in (A_u, TS_u, utab, ftab, noise, snoise, win)]
     except Exception as exc:
         raise _Failed(exc, 0) from exc
     while lo < n:
-        hi = min(n, lo + size)
         try:
-            _run_group(kernel, shared, lo, hi, law, step0, n_steps, final, stride, r0, r1, n_rows, dt, lam1, vid,
-                       per_sample, histories, inputs, control, status, fail_step, reduce is not None)  # fmt: skip
+            started = time.perf_counter()
+            with _ALLOCATING:  # sized on the memory that the other threads' groups have left
+                hi = lo + group_size(n - lo, bytes_per_sample)
+                arrays = _group_arrays(stream, lo, hi, n_rows, vid, per_sample, histories, inputs, status, fail_step,
+                                       reduce is not None)  # fmt: skip
+            record["transfer_s"] += time.perf_counter() - started
+            _run_group(kernel, stream, shared, arrays, lo, hi, law, step0, n_steps, final, stride, r0, r1, dt, lam1,
+                       per_sample, histories, control, status, fail_step, reduce is not None, record)  # fmt: skip
         except Exception as exc:
             raise _Failed(exc, lo) from exc
         lo = hi
     return n
 
 
-def _run_group(kernel, shared, lo, hi, law, step0, n_steps, final, stride, r0, r1, n_rows, dt, lam1, vid,
-               per_sample, histories, inputs, control, status, fail_step, reduce):  # fmt: skip
-    """Samples lo..hi on the device, their results into the host arrays once they finished
-    (with ``reduce``, the metric sums: per_sample's last array)."""
-    x = per_sample[0]
+def _to_device(a: np.ndarray, stream):
+    return cuda.to_device(np.ascontiguousarray(a), stream=stream)
+
+
+def _group_arrays(stream, lo, hi, n_rows, vid, per_sample, histories, inputs, status, fail_step, reduce):  # fmt: skip
+    """The device arrays of samples lo..hi: their rows of the per-sample arrays and tables'
+    offsets, status, and the outputs (with ``reduce``, one row each and the metric sums)."""
     _, u_off, _, f_off, n_nodes, interval = inputs
-    closed_loop, ctrl_stride = control[0], control[1]
-    started = time.perf_counter()
     m = hi - lo
-    dev = [cuda.to_device(np.ascontiguousarray(a[lo:hi])) for a in per_sample]
-    small = [cuda.to_device(np.ascontiguousarray(a[lo:hi])) for a in (vid, u_off, f_off, n_nodes, interval)]
-    st = cuda.to_device(np.ascontiguousarray(status[lo:hi]))
-    fs = cuda.to_device(np.ascontiguousarray(fail_step[lo:hi]))
+    dev = [_to_device(a[lo:hi], stream) for a in per_sample]
+    small = [_to_device(a[lo:hi], stream) for a in (vid, u_off, f_off, n_nodes, interval)]
+    st, fs = _to_device(status[lo:hi], stream), _to_device(fail_step[lo:hi], stream)
     if reduce:  # the host's one or two rows: the stepper writes row 0
-        outs = [cuda.device_array((m, h.shape[1], h.shape[2])) for h in histories]
+        outs = [cuda.device_array((m, h.shape[1], h.shape[2]), stream=stream) for h in histories]
         acd = dev.pop()
     else:
-        outs = [cuda.device_array((m, n_rows if h.shape[1] > 1 else 1, h.shape[2])) for h in histories]
-        acd = cuda.device_array((1, N_ACC))  # not read
+        outs = [cuda.device_array((m, n_rows if h.shape[1] > 1 else 1, h.shape[2]), stream=stream) for h in histories]
+        acd = cuda.device_array((1, N_ACC), stream=stream)  # not read
+    return dev, small, st, fs, outs, acd
+
+
+def _run_group(kernel, stream, shared, arrays, lo, hi, law, step0, n_steps, final, stride, r0, r1, dt, lam1,
+               per_sample, histories, control, status, fail_step, reduce, record):  # fmt: skip
+    """Samples lo..hi on the device (their ``arrays``, `_group_arrays`), their results into the
+    host arrays once they finished (with ``reduce``, the metric sums: per_sample's last array)."""
+    x = per_sample[0]
+    closed_loop, ctrl_stride = control[0], control[1]
+    m = hi - lo
+    dev, small, st, fs, outs, acd = arrays
     xd, cs, sp, pd, vd, gd, hd, ind, fd, sd = dev
     vidd, uod, fod, nnd, itd = small
     Ad, TSd, ud, fdd, nod, snd, wind = shared
     launched = time.perf_counter()
     blocks = -(-m // THREADS_PER_BLOCK) if not simulated() else -(-m // 8)
     threads = THREADS_PER_BLOCK if not simulated() else 8
-    kernel[blocks, threads](
-        m, law, xd, step0, n_steps, final, stride, r0, dt, lam1, vidd, Ad, TSd, cs, sp, pd, vd, ud, uod, fdd,
-        fod, nnd, itd, closed_loop, ctrl_stride, gd, hd, ind, nod, fd, sd, snd, *outs, st, fs, reduce, wind, acd,
-    )  # fmt: skip
-    cuda.synchronize()
+    # the simulator runs one kernel at a time: it swaps the kernel's `cuda` for its own per launch
+    with _SIMULATOR if simulated() else contextlib.nullcontext():
+        kernel[blocks, threads, stream](
+            m, law, xd, step0, n_steps, final, stride, r0, dt, lam1, vidd, Ad, TSd, cs, sp, pd, vd, ud, uod, fdd,
+            fod, nnd, itd, closed_loop, ctrl_stride, gd, hd, ind, nod, fd, sd, snd, *outs, st, fs, reduce, wind, acd,
+        )  # fmt: skip
+        stream.synchronize()
     finished = time.perf_counter()
     if not simulated():
         free, total = cuda.current_context().get_memory_info()
-        last_call["device_bytes"] = max(last_call["device_bytes"], int(total - free))
+        record["device_bytes"] = max(record["device_bytes"], int(total - free))
     # all back from the device before any host array changes: a failure up to here leaves the
     # group as it was, for the CPU to run
-    back = [xd.copy_to_host(), st.copy_to_host(), fs.copy_to_host()]
-    rows = [o.copy_to_host()[:, : r1 - r0] if h.shape[1] > 1 and not reduce else None for h, o in zip(histories, outs)]
-    sums = acd.copy_to_host() if reduce else None
+    back = [xd.copy_to_host(stream=stream), st.copy_to_host(stream=stream), fs.copy_to_host(stream=stream)]
+    rows = [
+        o.copy_to_host(stream=stream)[:, : r1 - r0] if h.shape[1] > 1 and not reduce else None
+        for h, o in zip(histories, outs)
+    ]
+    sums = acd.copy_to_host(stream=stream) if reduce else None
+    stream.synchronize()
     x[lo:hi], status[lo:hi], fail_step[lo:hi] = back
     if sums is not None:
         per_sample[-1][lo:hi] = sums
     for h, r in zip(histories, rows):
         if r is not None:
             h[lo:hi, r0:r1] = r
-    last_call["kernel_s"] += finished - launched
-    last_call["transfer_s"] += (launched - started) + (time.perf_counter() - finished)
-    last_call["groups"] += 1
+    record["kernel_s"] += finished - launched
+    record["transfer_s"] += time.perf_counter() - finished
+    record["groups"] += 1

@@ -111,17 +111,37 @@ def test_chunks_continue_and_groups_that_fit_memory_give_the_same_run(monkeypatc
     assert _worst(parts, whole) < 1e-12
 
 
+def test_batches_from_several_threads_at_once_each_get_their_own_runs(monkeypatch):
+    """A study's chunks in flight call the GPU from their threads at once, each on a stream of
+    its own: every batch gets the runs it gets alone, and each thread reads its own call's record."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    batches = [[Suspension.named(n) for n in LAWS[k : k + 2]] for k in range(0, 6, 2)]
+    alone = [simulate(SHORT, suspension=b, solver=GPU) for b in batches]
+    monkeypatch.setattr(gpu, "group_size", lambda n, b, free=None: 1)  # several groups each, interleaved
+
+    def run(b):
+        result = simulate(SHORT, suspension=b, solver=GPU)
+        return result, gpu.last_call()["groups"]
+
+    with ThreadPoolExecutor(len(batches)) as pool:
+        together = list(pool.map(run, batches))
+    for (result, groups), one in zip(together, alone):
+        assert groups == 2  # this thread's call: its two samples, one group each
+        assert _worst(result, one) == 0.0
+
+
 def test_a_gpu_failure_goes_on_on_the_cpu_with_one_warning_and_loses_nothing(monkeypatch):
     batch = [Suspension.named(n) for n in LAWS[:4]]
     reference = simulate(SHORT, suspension=batch, solver=CPU)
     run_group = gpu._run_group
     calls = []
 
-    def failing(kernel, shared, lo, hi, *args):
+    def failing(kernel, stream, shared, arrays, lo, hi, *args):
         calls.append(lo)
         if len(calls) == 2:  # the second group: the first has finished and reached the host
             raise RuntimeError("CUDA_ERROR_LAUNCH_FAILED (made up)")
-        return run_group(kernel, shared, lo, hi, *args)
+        return run_group(kernel, stream, shared, arrays, lo, hi, *args)
 
     monkeypatch.setattr(gpu, "_run_group", failing)
     monkeypatch.setattr(gpu, "group_size", lambda n, b, free=None: 2)
