@@ -5,7 +5,7 @@
 # tree through PYTHONPATH; nothing is installed).
 #
 # Run:  bash benchmarks/device_check.sh [BUDGET_S]      (default 580 s in all)
-#       bash benchmarks/device_check.sh --gpu [BUDGET_S]  (steps 1 to 5: the GPU's)
+#       bash benchmarks/device_check.sh --gpu [BUDGET_S]  (steps 1 to 8: the GPU's and the design)
 #       bash benchmarks/device_check.sh --smoke          (here: the simulator, tiny sizes, a check of the script)
 #
 # Steps, most wanted first; each gets at most its cap and what is left of the budget, and one
@@ -15,12 +15,18 @@
 #   2. bench_gpu.py: 32,768 SAS closed loops on the GPU (and how long its first call, which
 #      compiles the kernel, takes), their agreement with the CPU over 64 samples, the same batch
 #      on the CPU's cores, and the metrics-only batch of the studies
-#   3. the GPU tests of tests/physics on the device instead of the simulator
-#   4. railride design --backend gpu with its defaults, the command itself (target: at most 2
-#      minutes; the log's "exit 0 after N s")
-#   5. bench_gpu_cache.py: whether numba-cuda's file cache keeps the kernel between processes,
+#   3. bench_gpu_kernel.py: the kernel under register limits (none, 128, 96) on 1,024 and 32,768
+#      runs: its rate and the microseconds one thread takes per step
+#   4. bench_gpu_kernel.py --concurrent 8: eight 32-run batches from eight threads at once against
+#      one after another (a design's held-out runs): whether calls on their own streams overlap
+#   5. railride design with its defaults (backend auto: the CPU's cores for its batches, all under
+#      4,096 runs), the command itself; its cap is the target of 2 minutes and start-up: "cut"
+#      says it took longer
+#   6. railride design --backend gpu, likewise
+#   7. bench_gpu_cache.py: whether numba-cuda's file cache keeps the kernel between processes,
 #      and the compile each process would save
-#   6. the CPU's figures, measured once on 16 cores already (2026-11-27): the CPU kernels
+#   8. the GPU tests of tests/physics on the device instead of the simulator
+#   9. the CPU's figures, measured once on 16 cores already (2026-11-27): the CPU kernels
 #      compiled into numba's cache by a one-run study, then bench_study.py (the 1,000-run study
 #      on 2 cores, on all cores, also with 1 chunk ahead, and in one process per core), and
 #      bench_dampers.py --lane-sizes (run_batch against the lane stepper, 1 to 16 threads)
@@ -83,19 +89,23 @@ $PY -c 'import sys, numpy, scipy, numba; print(sys.version.split()[0], \"numpy\"
 $PY -c 'import importlib.metadata as m; print(\"numba-cuda\", m.version(\"numba-cuda\"))' || echo 'no numba-cuda'; \
 $PY -c 'from railride.run.solver import gpu_missing; print(\"railride sees a usable GPU\" if gpu_missing() is None else \"railride: \" + gpu_missing())'"
 
-step gpu-throughput 120 $PY benchmarks/bench_gpu.py --samples "$GPU_SAMPLES" --duration "$DURATION" --cpu --check "$CHECK" --metrics-only
+step gpu-throughput 90 $PY benchmarks/bench_gpu.py --samples "$GPU_SAMPLES" --duration "$DURATION" --cpu --check "$CHECK" --metrics-only
 
-step gpu-tests 120 $PY -m pytest -q -p no:randomly -p no:cacheprovider tests/physics/test_gpu.py tests/physics/test_gpu_metrics.py
-
-if [ "$SMOKE" = 1 ]; then  # the simulator would take hours over a design
-  step design-on-gpu 30 echo "not in the simulator"
+if [ "$SMOKE" = 1 ]; then  # the kernel steps need a GPU; the design would take hours in the simulator
+  step gpu-kernel 60 env NUMBA_ENABLE_CUDASIM=0 $PY benchmarks/bench_gpu_kernel.py --resources --registers none,128
+  step design 30 echo "not in the simulator"
 else
-  # the command itself, so that "exit 0 after N s" is its time (start-up and compiling included)
-  step design-on-gpu 240 $PY -m railride.cli design --backend gpu --out /tmp/railride-design-gpu
+  step gpu-kernel 150 $PY benchmarks/bench_gpu_kernel.py --registers none,128,96 --samples 1024,32768
+  step gpu-concurrent 60 $PY benchmarks/bench_gpu_kernel.py --concurrent 8 --duration 2
+  # the commands themselves, so that "exit 0 after N s" is their time (start-up and compiling included)
+  step design 150 $PY -m railride.cli design --out /tmp/railride-design-auto
+  step design-on-gpu 150 $PY -m railride.cli design --backend gpu --out /tmp/railride-design-gpu
 fi
 
 # whether numba-cuda's file cache keeps the kernel between processes, and the compile it saves
 step gpu-cache 150 $PY benchmarks/bench_gpu_cache.py
+
+step gpu-tests 120 $PY -m pytest -q -p no:randomly -p no:cacheprovider tests/physics/test_gpu.py tests/physics/test_gpu_metrics.py
 
 # the CPU's figures (measured on a lent 16-core machine on 2026-11-27: docs/performance.md)
 if [ "$GPU_ONLY" = 0 ]; then

@@ -400,10 +400,11 @@ def design(
     summary = _summary(runs, plan)
     diverged = _diverged(tuned, training, runs, plan)
     ranking, points = rank(summary, plan.objective, plan.laws, {d["controller"] for d in diverged})
-    from railride.studies.design_probes import fault_check, references
+    from railride.studies.design_probes import asks, fault_check, references
 
-    refs = references(plan, tuned.gains, lambda **kw: _scores(plan, tuned.gains, executor, table, progress, **kw))
     leaders = [r["controller"] for r in ranking if r["ranked"]][:2]
+    _run_ahead(plan, tuned.gains, executor, table, progress, asks(plan, leaders))
+    refs = references(plan, tuned.gains, lambda **kw: _scores(plan, tuned.gains, executor, table, progress, **kw))
     faulted = fault_check(
         plan, leaders, points, lambda **kw: _scores(plan, tuned.gains, executor, table, progress, **kw)
     )
@@ -494,37 +495,9 @@ def _judge(
     and ``faults`` apply to the laws, not to passive (`railride.studies.design_probes`). Not
     ``full``: only the comfort indices and costs the objective reads (the others NaN), for runs
     that are only scored."""
-    from railride.model.params import vehicle_record
-
     laws = plan.laws if laws is None else laws
-    damper = plan.damper if damper is None else damper
-    cases, meta = [], []
-    for load in plan.loads:
-        changes = plan.vehicle.load_changes(load)
-        for track in plan.tracks:
-            for seed in plan.test_seeds:
-                for v in plan.speeds:
-                    opts = _options(plan, track, seed, v)
-                    for name in ("passive", *laws):
-                        if name == "passive":
-                            cases.append(Case(track, opts, vehicle=changes))
-                        else:
-                            law = Case(track, opts, vehicle=changes, suspension=name, damper=damper, faults=faults)
-                            cases.append(law)
-                        meta.append((name, track, seed, v, load))
-    name = vehicle_record(plan.vehicle, plan.source)["name"]
-    rows = run_cases(
-        cases,
-        executor=executor,
-        table=table,
-        base_gains=gains,
-        params=plan.vehicle,
-        solver=plan.solver,
-        progress=progress,
-        comfort=full or plan.objective.needs_comfort,
-        costs=full or plan.objective.needs_costs,
-        vehicle_columns=[{"vehicle": name, "load": float(m[4])} for m in meta],
-    )
+    cases, meta = _judge_cases(plan, laws, damper, faults)
+    rows = _run_judged(plan, gains, executor, table, progress, cases, meta, full)
     rows = rows.reindex(columns=list(dict.fromkeys([*rows.columns, *METRICS])))  # NaN where not computed
     info = pd.DataFrame(meta, columns=["controller", "track", "track_seed", "speed_m_s", "load"])
     metrics = rows.reset_index(drop=True)[[*METRICS, "diverged_at_s"]].astype(float)
@@ -545,6 +518,61 @@ def _judge(
     score = plan.objective.of_runs(read, alone.reindex(pd.MultiIndex.from_frame(read[key])))
     frame["score"] = np.where(np.isfinite(frame["diverged_at_s"]), np.inf, score)
     return frame
+
+
+def _judge_cases(plan: Plan, laws, damper=None, faults=()) -> tuple[list[Case], list[tuple]]:
+    """The held-out runs of ``laws`` (with ``damper``, default the plan's, and ``faults``) and
+    passive (`_judge`), and each one's (law, track, seed, speed, load)."""
+    damper = plan.damper if damper is None else damper
+    cases, meta = [], []
+    for load in plan.loads:
+        changes = plan.vehicle.load_changes(load)
+        for track in plan.tracks:
+            for seed in plan.test_seeds:
+                for v in plan.speeds:
+                    opts = _options(plan, track, seed, v)
+                    for name in ("passive", *laws):
+                        if name == "passive":
+                            cases.append(Case(track, opts, vehicle=changes))
+                        else:
+                            law = Case(track, opts, vehicle=changes, suspension=name, damper=damper, faults=faults)
+                            cases.append(law)
+                        meta.append((name, track, seed, v, load))
+    return cases, meta
+
+
+def _run_judged(plan: Plan, gains, executor, table, progress, cases, meta, full: bool) -> pd.DataFrame:
+    """`run_cases` of judged runs (`_judge_cases`): their rows, with comfort and costs where
+    ``full`` or the objective reads them."""
+    from railride.model.params import vehicle_record
+
+    name = vehicle_record(plan.vehicle, plan.source)["name"]
+    return run_cases(
+        cases,
+        executor=executor,
+        table=table,
+        base_gains=gains,
+        params=plan.vehicle,
+        solver=plan.solver,
+        progress=progress,
+        comfort=full or plan.objective.needs_comfort,
+        costs=full or plan.objective.needs_costs,
+        vehicle_columns=[{"vehicle": name, "load": float(m[4])} for m in meta],
+    )
+
+
+def _run_ahead(plan: Plan, gains, executor, table, progress, asks: list[dict]) -> None:
+    """The runs of several `_scores` calls (their keyword arguments, ``asks``) as one
+    `run_cases` call into ``table``, where those calls then find them: on a GPU one batch, not
+    one per call, and on the CPU one batch that fills the cores."""
+    if not asks:
+        return
+    cases, meta = [], []
+    for ask in asks:
+        c, m = _judge_cases(plan, ask["laws"], ask.get("damper"), ask.get("faults", ()))
+        cases += c
+        meta += m
+    _run_judged(plan, gains, executor, table, progress, cases, meta, full=False)
 
 
 def _scores(plan: Plan, gains, executor, table, progress, laws=None, damper=None, faults=()) -> list:

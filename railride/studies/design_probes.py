@@ -43,15 +43,24 @@ def _worst(points: list, law: str) -> float | None:
     return float(max(values))
 
 
+def asks(plan, leaders: list) -> list[dict]:
+    """The keyword arguments of every ``scores`` call that `references` and `fault_check` make,
+    in their order: the design runs them all as one batch before either asks (a GPU then steps
+    them in one call, not one a device and one for the fault)."""
+    out = [] if _ideal(plan.damper) else [{"laws": tuple(plan.laws), "damper": device} for device in DEVICES]
+    if leaders:
+        out.append({"laws": tuple(leaders), "faults": (FAULT_NO_COIL if _ideal(plan.damper) else FAULT,)})
+    return out
+
+
 def references(plan, gains, scores) -> dict:
     """Per device of `DEVICES`, per law: its score with the design's tuned ``gains`` on that
     device (``score``, the largest over the speeds and loads, None where a run diverged) and its
     score at each (``points``). Empty where the design's own damper is an ideal device."""
-    if _ideal(plan.damper):
-        return {}
     out = {}
-    for device in DEVICES:
-        points = scores(laws=plan.laws, damper=device)
+    for ask in asks(plan, []):
+        device = ask["damper"]
+        points = scores(**ask)
         out[device] = {
             law: {
                 "score": _worst(points, law),
@@ -73,8 +82,9 @@ def fault_check(plan, leaders: list, points: list, scores) -> dict | None:
 
     if not leaders:
         return None
-    fault = FAULT_NO_COIL if _ideal(plan.damper) else FAULT
-    faulted = scores(laws=leaders, faults=(fault,))
+    ask = asks(plan, leaders)[-1]
+    fault = ask["faults"][0]
+    faulted = scores(**ask)
     laws = {law: {"healthy": _worst(points, law), "faulted": _worst(faulted, law)} for law in leaders}
     label = {law: LABELS.get(law, law) for law in leaders}
     if fault == FAULT:

@@ -351,3 +351,27 @@ def test_a_measured_profile_is_cut_into_sections_for_training_and_judging(tmp_pa
     with pytest.raises(InputError, match="holds 7 sections of 80 m"):
         rr.design(["skyhook"], tracks=[track], speeds=[40.0], loads=[1.0], train_seeds=[0], test_seeds=[7],
                   duration=2.0, budget=13, values=3)  # fmt: skip
+
+
+def test_the_probes_runs_go_in_one_call_and_the_probes_then_run_nothing(monkeypatch):
+    """The references on the ideal devices and the fault check of the leaders (`design_probes`)
+    make their runs in one `run_cases` call ahead of them (a GPU then has them in flight
+    together); when they ask, the run table holds every run, so their calls make none."""
+    from railride.studies import design as design_module
+
+    calls = []
+    run_cases = design_module.run_cases
+
+    def counted(cases, *, table, **kw):
+        before = len(table.done())
+        rows = run_cases(cases, table=table, **kw)
+        calls.append((len(cases), len(table.done()) - before))
+        return rows
+
+    monkeypatch.setattr(design_module, "run_cases", counted)
+    rr.design(["pid", "skyhook"], **TINY)
+    # judging (2 laws and passive), then the probes: 2 laws on 2 devices, passive, 2 leaders faulted
+    judged, ahead, *probes = calls
+    assert judged == (3, 3)
+    assert ahead == (3 * 3, 3 * 2 + 1)  # passive is in every ask, and runs once
+    assert probes == [(3, 0), (3, 0), (3, 0)]  # two devices and the fault, all found in the table

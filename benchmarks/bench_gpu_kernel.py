@@ -1,0 +1,204 @@
+"""The GPU kernel's resources and what they cost (railride.engine.gpu).
+
+Run:  python benchmarks/bench_gpu_kernel.py --resources [--registers none,168,128,96]
+      python benchmarks/bench_gpu_kernel.py [--registers none,128] [--samples 1024,32768] [--duration 1]
+      python benchmarks/bench_gpu_kernel.py --concurrent 8 [--duration 2]
+
+* ``--resources`` needs no GPU, only the gpu extra: the kernel compiled to PTX for an H100
+  (compute capability 9.0) and assembled by ``ptxas -v`` (the gpu extra's, else the one on the
+  PATH) under each register limit of ``--registers``: registers per thread, stack frame, spill
+  stores and loads as ptxas reports them, and the occupancy that register count allows by the
+  limits of compute capability 9.0 (NVIDIA, CUDA C++ Programming Guide, "Technical
+  Specifications per Compute Capability": 65,536 registers, 64 warps and 32 blocks per
+  multiprocessor; registers given to a warp in units of 256). A driver's own compile of the PTX
+  may differ from this ptxas's.
+* With a GPU, the same register limits on batches of ``--samples`` SAS closed loops
+  (`bench_gpu._batch`): the kernels' seconds, sample-steps per second, the microseconds one thread
+  takes per step, and the largest difference from the first limit's runs (none expected: a
+  limit moves values between registers and memory, not the arithmetic).
+* ``--concurrent K`` (GPU): K batches of 32 runs, as a study's chunks in flight send them (a
+  design's held-out runs with their comfort), from K threads at once and then one after another:
+  whether the kernels of calls on their own streams overlap on the device.
+Prints Markdown rows for docs/gpu.md with the device and date. No test asserts timings.
+"""
+
+from __future__ import annotations
+
+import argparse
+import datetime
+import os
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+# compute capability 9.0 (CUDA C++ Programming Guide, technical specifications)
+REGISTERS_PER_SM = 65536
+WARPS_PER_SM = 64
+BLOCKS_PER_SM = 32
+REGISTER_UNIT = 256  # registers are given to a warp in units of this many
+
+
+def occupancy(registers: int, block: int) -> tuple[int, float]:
+    """(resident blocks per multiprocessor, resident warps / the most) for a kernel of
+    ``registers`` per thread in blocks of ``block`` threads, no shared memory."""
+    warps = -(-block // 32)
+    per_warp = -(-registers * 32 // REGISTER_UNIT) * REGISTER_UNIT
+    blocks = min(BLOCKS_PER_SM, WARPS_PER_SM // warps, (REGISTERS_PER_SM // per_warp) // warps)
+    return blocks, blocks * warps / WARPS_PER_SM
+
+
+def _limits(text: str) -> list[int | None]:
+    return [None if v.strip().lower() in ("none", "0", "") else int(v) for v in text.split(",")]
+
+
+def _ptxas() -> str:
+    try:
+        import nvidia.cuda_nvcc  # the gpu extra's toolkit (nvidia-cuda-nvcc-cu12)
+
+        shipped = Path(list(nvidia.cuda_nvcc.__path__)[0]) / "bin" / "ptxas"
+        if shipped.exists():
+            return str(shipped)
+    except ImportError:
+        pass
+    found = shutil.which("ptxas")
+    if found is None:
+        sys.exit("bench_gpu_kernel: no ptxas (install railride[gpu], which brings one)")
+    return found
+
+
+def _resources(limits) -> None:
+    from railride.engine import gpu
+
+    if gpu.simulated():
+        sys.exit("bench_gpu_kernel: --resources compiles for a GPU: run it with NUMBA_ENABLE_CUDASIM=0")
+    t0 = time.perf_counter()
+    code = gpu.ptx((9, 0))
+    compiled = time.perf_counter() - t0
+    ptxas = _ptxas()
+    version = subprocess.run([ptxas, "--version"], capture_output=True, text=True).stdout.strip().splitlines()[-1]
+    print(f"ptxas: {version}; sm_90; {datetime.date.today().isoformat()}; PTX made in {compiled:.1f} s")
+    print(
+        "\n| register limit | registers | stack frame | spill stores | spill loads "
+        "| blocks of 128 per SM | occupancy |"
+    )  # fmt: skip
+    print("|---|---|---|---|---|---|---|")
+    with tempfile.TemporaryDirectory() as tmp:
+        src = Path(tmp) / "kernel.ptx"
+        src.write_text(code)
+        for limit in limits:
+            cmd = [ptxas, "-v", "-arch=sm_90", str(src), "-o", str(Path(tmp) / "kernel.cubin")]
+            if limit is not None:
+                cmd[2:2] = ["-maxrregcount", str(limit)]
+            out = subprocess.run(cmd, capture_output=True, text=True, check=True).stderr
+            kernel = out[out.index("_kernel") :]  # the kernel's lines, not a helper's
+            regs = int(re.search(r"Used (\d+) registers", kernel).group(1))
+            frame, stores, loads = re.search(
+                r"(\d+) bytes stack frame, (\d+) bytes spill stores, (\d+) bytes spill loads", kernel
+            ).groups()
+            blocks, occ = occupancy(regs, gpu.THREADS_PER_BLOCK)
+            print(
+                f"| {'none' if limit is None else limit} | {regs} | {frame} B | {stores} B | {loads} B "
+                f"| {blocks} | {occ * 100:.1f} % |"
+            )
+
+
+def _timed(limits, sizes, duration: float) -> None:
+    from bench_gpu import _batch
+
+    from railride.engine import gpu
+    from railride.run.simulation import simulate
+    from railride.run.solver import SolverSettings
+
+    on_gpu = SolverSettings(output_rate=200.0, backend="gpu")
+    steps = round(duration / on_gpu.dt)
+    print(f"{gpu.device_name()}; {os.cpu_count()} CPU cores; {datetime.date.today().isoformat()}")
+    print(
+        "\n| register limit | compile | samples | kernels | sample-steps/s | us per step per thread "
+        "| largest difference from the first limit |"
+    )  # fmt: skip
+    print("|---|---|---|---|---|---|---|")
+    first: dict = {}
+    for limit in limits:
+        gpu.MAX_REGISTERS = limit
+        gpu._compiled.clear()
+        scs, susp = _batch(32, 0.01, "sas-attitude-ride")
+        t0 = time.perf_counter()
+        simulate(scs, suspension=susp, solver=on_gpu)
+        compile_s = time.perf_counter() - t0
+        for n in sizes:
+            scs, susp = _batch(n, duration, "sas-attitude-ride")
+            q = simulate(scs, suspension=susp, solver=on_gpu).dataset["q"].values
+            k = gpu.last_call()["kernel_s"]
+            ref = first.setdefault(n, q)
+            diff = float(np.nanmax(np.abs(q - ref)) / np.nanmax(np.abs(ref)))
+            print(
+                f"| {'none' if limit is None else limit} | {compile_s:.1f} s | {n:,} | {k:.3f} s "
+                f"| {n * steps / k:.3g} | {k / steps * 1e6:.1f} | {diff:.1e} |"
+            )
+
+
+def _concurrent(k: int, duration: float) -> None:
+    from concurrent.futures import ThreadPoolExecutor
+
+    from bench_gpu import _batch
+
+    from railride.engine import gpu
+    from railride.run.simulation import simulate
+    from railride.run.solver import SolverSettings
+
+    on_gpu = SolverSettings(output_rate=1000.0, backend="gpu")
+    batches = [_batch(32 * (i + 1), duration, "sas-attitude-ride") for i in range(k)]
+    batches = [(scs[-32:], susp) for scs, susp in batches]  # 32 runs each, on other tracks
+    simulate(*_batch(32, 0.01, "sas-attitude-ride"), solver=on_gpu)  # compiles
+
+    def run(batch):
+        return simulate(batch[0], suspension=batch[1], solver=on_gpu)
+
+    t0 = time.perf_counter()
+    serial = [run(b) for b in batches]
+    one_by_one = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    with ThreadPoolExecutor(k) as pool:
+        together = list(pool.map(run, batches))
+    at_once = time.perf_counter() - t0
+    same = all(np.array_equal(a.dataset["q"].values, b.dataset["q"].values) for a, b in zip(serial, together))
+    print(f"{gpu.device_name()}; {os.cpu_count()} CPU cores; {datetime.date.today().isoformat()}")
+    print(
+        f"\n{k} batches of 32 SAS runs of {duration:g} s (histories at 1 kHz): one after another "
+        f"{one_by_one:.2f} s, from {k} threads at once {at_once:.2f} s ({one_by_one / at_once:.1f}x); "
+        f"the same runs: {same}"
+    )
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--resources", action="store_true")
+    ap.add_argument("--registers", default="none,168,128,96", help="register limits (none: the compiler's)")
+    ap.add_argument("--samples", default="1024,32768", help="batch sizes, comma-separated")
+    ap.add_argument("--duration", type=float, default=1.0)
+    ap.add_argument("--concurrent", type=int, default=0)
+    args = ap.parse_args()
+    if args.resources:
+        _resources(_limits(args.registers))
+        return
+    from railride.engine import gpu
+
+    missing = gpu.why_not()
+    if missing is not None or gpu.simulated():
+        sys.exit(f"bench_gpu_kernel: needs a GPU ({missing or 'not in the simulator'})")
+    if args.concurrent:
+        _concurrent(args.concurrent, args.duration)
+        return
+    _timed(_limits(args.registers), [int(v) for v in args.samples.split(",")], args.duration)
+
+
+if __name__ == "__main__":
+    main()
