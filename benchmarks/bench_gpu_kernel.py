@@ -13,9 +13,10 @@ Run:  python benchmarks/bench_gpu_kernel.py --resources [--registers none,168,12
   multiprocessor; registers given to a warp in units of 256). A driver's own compile of the PTX
   may differ from this ptxas's.
 * With a GPU, the same register limits on batches of ``--samples`` SAS closed loops
-  (`bench_gpu._batch`): the kernels' seconds, sample-steps per second, the microseconds one thread
-  takes per step, and the largest difference from the first limit's runs (none expected: a
-  limit moves values between registers and memory, not the arithmetic).
+  (`bench_gpu._batch`): the kernels' seconds, sample-steps per second, the kernels' time per
+  step (what one thread takes per step where all the batch's threads are resident at once),
+  and the largest difference from the first limit's runs (none expected: a limit moves values
+  between registers and memory, not the arithmetic).
 * ``--concurrent K`` (GPU): K batches of 32 runs, as a study's chunks in flight send them (a
   design's held-out runs with their comfort), from K threads at once and then one after another:
   whether the kernels of calls on their own streams overlap on the device.
@@ -44,6 +45,8 @@ REGISTERS_PER_SM = 65536
 WARPS_PER_SM = 64
 BLOCKS_PER_SM = 32
 REGISTER_UNIT = 256  # registers are given to a warp in units of this many
+#: the histories compared between runs
+CHANNELS = ("carbody_bounce", "carbody_pitch", "carbody_roll")
 
 
 def occupancy(registers: int, block: int) -> tuple[int, float]:
@@ -121,7 +124,7 @@ def _timed(limits, sizes, duration: float) -> None:
     steps = round(duration / on_gpu.dt)
     print(f"{gpu.device_name()}; {os.cpu_count()} CPU cores; {datetime.date.today().isoformat()}")
     print(
-        "\n| register limit | compile | samples | kernels | sample-steps/s | us per step per thread "
+        "\n| register limit | compile | samples | kernels | sample-steps/s | kernel time per step "
         "| largest difference from the first limit |"
     )  # fmt: skip
     print("|---|---|---|---|---|---|---|")
@@ -135,7 +138,8 @@ def _timed(limits, sizes, duration: float) -> None:
         compile_s = time.perf_counter() - t0
         for n in sizes:
             scs, susp = _batch(n, duration, "sas-attitude-ride")
-            q = simulate(scs, suspension=susp, solver=on_gpu).dataset["q"].values
+            ds = simulate(scs, suspension=susp, solver=on_gpu).dataset
+            q = np.stack([ds[k].values for k in CHANNELS])
             k = gpu.last_call()["kernel_s"]
             ref = first.setdefault(n, q)
             diff = float(np.nanmax(np.abs(q - ref)) / np.nanmax(np.abs(ref)))
@@ -157,7 +161,8 @@ def _concurrent(k: int, duration: float) -> None:
     on_gpu = SolverSettings(output_rate=1000.0, backend="gpu")
     batches = [_batch(32 * (i + 1), duration, "sas-attitude-ride") for i in range(k)]
     batches = [(scs[-32:], susp) for scs, susp in batches]  # 32 runs each, on other tracks
-    simulate(*_batch(32, 0.01, "sas-attitude-ride"), solver=on_gpu)  # compiles
+    warm, susp = _batch(32, 0.01, "sas-attitude-ride")
+    simulate(warm, suspension=susp, solver=on_gpu)  # compiles
 
     def run(batch):
         return simulate(batch[0], suspension=batch[1], solver=on_gpu)
@@ -169,7 +174,9 @@ def _concurrent(k: int, duration: float) -> None:
     with ThreadPoolExecutor(k) as pool:
         together = list(pool.map(run, batches))
     at_once = time.perf_counter() - t0
-    same = all(np.array_equal(a.dataset["q"].values, b.dataset["q"].values) for a, b in zip(serial, together))
+    same = all(
+        np.array_equal(a.dataset[k].values, b.dataset[k].values) for a, b in zip(serial, together) for k in CHANNELS
+    )
     print(f"{gpu.device_name()}; {os.cpu_count()} CPU cores; {datetime.date.today().isoformat()}")
     print(
         f"\n{k} batches of 32 SAS runs of {duration:g} s (histories at 1 kHz): one after another "

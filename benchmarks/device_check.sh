@@ -16,16 +16,16 @@
 #      compiles the kernel, takes), their agreement with the CPU over 64 samples, the same batch
 #      on the CPU's cores, and the metrics-only batch of the studies
 #   3. bench_gpu_kernel.py: the kernel under register limits (none, 128, 96) on 1,024 and 32,768
-#      runs: its rate and the microseconds one thread takes per step
+#      runs: its rate and the kernels' time per step
 #   4. bench_gpu_kernel.py --concurrent 8: eight 32-run batches from eight threads at once against
 #      one after another (a design's held-out runs): whether calls on their own streams overlap
 #   5. railride design with its defaults (backend auto: the CPU's cores for its batches, all under
 #      4,096 runs), the command itself; its cap is the target of 2 minutes and start-up: "cut"
 #      says it took longer
-#   6. railride design --backend gpu, likewise
+#   6. the GPU tests of tests/physics on the device instead of the simulator (never run there yet)
 #   7. bench_gpu_cache.py: whether numba-cuda's file cache keeps the kernel between processes,
 #      and the compile each process would save
-#   8. the GPU tests of tests/physics on the device instead of the simulator
+#   8. railride design --backend gpu, capped like step 5
 #   9. the CPU's figures, measured once on 16 cores already (2026-11-27): the CPU kernels
 #      compiled into numba's cache by a one-run study, then bench_study.py (the 1,000-run study
 #      on 2 cores, on all cores, also with 1 chunk ahead, and in one process per core), and
@@ -95,23 +95,27 @@ if [ "$SMOKE" = 1 ]; then  # the kernel steps need a GPU; the design would take 
   step gpu-kernel 60 env NUMBA_ENABLE_CUDASIM=0 $PY benchmarks/bench_gpu_kernel.py --resources --registers none,128
   step design 30 echo "not in the simulator"
 else
-  step gpu-kernel 150 $PY benchmarks/bench_gpu_kernel.py --registers none,128,96 --samples 1024,32768
+  step gpu-kernel 120 $PY benchmarks/bench_gpu_kernel.py --registers none,128,96 --samples 1024,32768
   step gpu-concurrent 60 $PY benchmarks/bench_gpu_kernel.py --concurrent 8 --duration 2
-  # the commands themselves, so that "exit 0 after N s" is their time (start-up and compiling included)
+  # the CPU kernels compiled once into numba's cache, so that no timed step below is cut by compiling
+  step compile-cpu 90 $PY -c "from railride.studies.study import study; \
+study(['pid', 'sas-attitude', 'sas-attitude-ride', 'clipped-optimal'], track_seeds=[0], speeds=[40.0], duration=1.0)"
+  # the commands themselves, so that "exit 0 after N s" is their time (start-up included)
   step design 150 $PY -m railride.cli design --out /tmp/railride-design-auto
-  step design-on-gpu 150 $PY -m railride.cli design --backend gpu --out /tmp/railride-design-gpu
 fi
+
+# never run on a device yet
+step gpu-tests 120 $PY -m pytest -q -p no:randomly -p no:cacheprovider tests/physics/test_gpu.py tests/physics/test_gpu_metrics.py
 
 # whether numba-cuda's file cache keeps the kernel between processes, and the compile it saves
 step gpu-cache 150 $PY benchmarks/bench_gpu_cache.py
 
-step gpu-tests 120 $PY -m pytest -q -p no:randomly -p no:cacheprovider tests/physics/test_gpu.py tests/physics/test_gpu_metrics.py
+if [ "$SMOKE" = 0 ]; then  # cut at 150 s on the H100 before: the rounds' kernels, not the host
+  step design-on-gpu 150 $PY -m railride.cli design --backend gpu --out /tmp/railride-design-gpu
+fi
 
 # the CPU's figures (measured on a lent 16-core machine on 2026-11-27: docs/performance.md)
 if [ "$GPU_ONLY" = 0 ]; then
-# compile the CPU kernels once (numba's cache), so that no timed step below is cut by compiling
-step compile-cpu 90 $PY -c "from railride.studies.study import study; \
-study(['pid', 'sas-attitude', 'sas-attitude-ride', 'clipped-optimal'], track_seeds=[0], speeds=[40.0], duration=1.0)"
 
 if [ "$SMOKE" = 1 ]; then
   step study-2-cores 120 $PY benchmarks/bench_study.py --seeds "$SEEDS" --duration 1 --profile
