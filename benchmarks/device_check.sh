@@ -28,7 +28,8 @@
 #   8. railride design --backend gpu, capped like step 5
 #   9. the CPU's figures, measured once on 16 cores already (2026-11-27): the CPU kernels
 #      compiled into numba's cache by a one-run study, then bench_study.py (the 1,000-run study
-#      on 2 cores, on all cores, also with 1 chunk ahead, and in one process per core), and
+#      on 2 cores, on all cores, also with 1 chunk ahead, in one process per core and in four
+#      processes of a quarter of the cores each), and
 #      bench_dampers.py --lane-sizes (run_batch against the lane stepper, 1 to 16 threads)
 # Everything printed goes to $OUT/device_check.log as well (the device tool brings $OUT back).
 # No figure is written anywhere else: copy the rows into the docs with the machine and date.
@@ -126,6 +127,9 @@ else
   # ahead on 16 threads) against the one chunk ahead of before, which held at most 8
   step study-all-cores-ahead-1 30 $PY benchmarks/bench_study.py --seeds "$SEEDS" --ahead 1 --profile --held
   step study-processes 60 $PY benchmarks/bench_study.py --seeds "$SEEDS" --processes "$CORES" --profile
+  # four processes of four threads: a chunk's Python work split four ways, its 4 lane groups on
+  # the process's own threads, each track's tables made four times instead of sixteen
+  step study-processes-4 45 $PY benchmarks/bench_study.py --seeds "$SEEDS" --processes 4 --profile
 fi
 step lane-sizes 90 $PY benchmarks/bench_dampers.py --lane-sizes --repeat 3 --threads "$THREADS" --sizes "$SIZES"
 fi
