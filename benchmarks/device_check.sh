@@ -15,7 +15,7 @@
 #   2. bench_gpu.py: 32,768 SAS closed loops on the GPU (and how long its first call, which
 #      compiles the kernel, takes), their agreement with the CPU over 64 samples, the same batch
 #      on the CPU's cores, and the metrics-only batch of the studies
-#   3. bench_gpu_kernel.py: the kernel under register limits (none, 128, 96) on 1,024 and 32,768
+#   3. bench_gpu_kernel.py: the kernel under register limits (none, 128, 96) on 1,024, 8,192 and 32,768
 #      runs: its rate and the kernels' time per step
 #   4. bench_gpu_kernel.py --concurrent 8: eight 32-run batches from eight threads at once against
 #      one after another (a design's held-out runs): whether calls on their own streams overlap
@@ -96,7 +96,7 @@ if [ "$SMOKE" = 1 ]; then  # the kernel steps need a GPU; the design would take 
   step gpu-kernel 60 env NUMBA_ENABLE_CUDASIM=0 $PY benchmarks/bench_gpu_kernel.py --resources --registers none,128
   step design 30 echo "not in the simulator"
 else
-  step gpu-kernel 120 $PY benchmarks/bench_gpu_kernel.py --registers none,128,96 --samples 1024,32768
+  step gpu-kernel 120 $PY benchmarks/bench_gpu_kernel.py --registers none,128,96 --samples 1024,8192,32768
   step gpu-concurrent 60 $PY benchmarks/bench_gpu_kernel.py --concurrent 8 --duration 2
   # the CPU kernels compiled once into numba's cache, so that no timed step below is cut by compiling
   step compile-cpu 90 $PY -c "from railride.studies.study import study; \
