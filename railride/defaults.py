@@ -12,3 +12,5 @@ DEFAULT_CONTROL_RATE = 1000.0
 DEFAULT_DAMPER = "railway"
 #: the vehicle's speed [m/s] (V, the paper's value)
 DEFAULT_SPEED = 55.56
+#: the length of a run [s] where its scenario gives none
+DEFAULT_DURATION = 10.0

@@ -30,7 +30,7 @@ import numpy as np
 
 from railride.errors import InputError
 from railride import limits
-from railride.defaults import DEFAULT_SPEED
+from railride.defaults import DEFAULT_DURATION, DEFAULT_SPEED
 from railride.model.profiles import (  # noqa: F401 (the profiles' constants: their home before)
     MAX_RAIL_AMPLITUDE,
     MAX_RAIL_PHASE,
@@ -321,7 +321,7 @@ class Scenario:
 
     track: RailProfile = field(default_factory=SineTrack)
     speed: float = DEFAULT_SPEED  # m/s, V (the paper's value)
-    duration: float = 10.0  # s
+    duration: float = DEFAULT_DURATION  # s
     name: str = "paper-sine"
 
     def __post_init__(self):
@@ -373,7 +373,10 @@ def scenario(
         name = f"file:{name}"
     if not isinstance(name, str):
         raise InputError(f"scenario = {name!r}: must be a scenario name ({', '.join(SCENARIOS)}) or a Path")
-    common = {"speed": 55.56 if speed is None else speed, "duration": 10.0 if duration is None else duration}
+    common = {
+        "speed": DEFAULT_SPEED if speed is None else speed,
+        "duration": DEFAULT_DURATION if duration is None else duration,
+    }
     random_only = [
         k
         for k, v in (("seed", seed), ("min_wavelength", min_wavelength), ("max_wavelength", max_wavelength))

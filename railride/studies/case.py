@@ -12,7 +12,7 @@ from dataclasses import dataclass, fields
 
 from railride._cache import hashable
 from railride.errors import InputError
-from railride.defaults import DEFAULT_DAMPER
+from railride.defaults import DEFAULT_DAMPER, DEFAULT_DURATION
 from railride.secondary.control import CONSTANT_VOLTAGE
 from railride.secondary.suspension import NAMES, Suspension
 
@@ -170,14 +170,19 @@ class Case:
 
     @property
     def duration(self) -> float:
-        """The run's duration [s] as its options give it (10 s, the scenarios' default, where they
-        give none)."""
-        return float(dict(self.scenario_options).get("duration", 10.0))
+        """The run's duration [s] as its options give it (the scenarios' default,
+        `railride.defaults.DEFAULT_DURATION`, where they give none)."""
+        return float(self._duration_given())
+
+    def _duration_given(self):
+        """The duration as the options hold it (a number made a float at construction, `_plain`;
+        anything else as given, for the scenario's check to name)."""
+        return dict(self.scenario_options).get("duration", DEFAULT_DURATION)
 
     @property
     def group(self) -> tuple:
         """Cases that can share one compiled batch."""
-        duration = dict(self.scenario_options).get("duration", 10.0)  # as given: the group's key
+        duration = self._duration_given()
         kind = "passive" if self.suspension == "passive" else ("closed" if self.closed_loop else "mr")
         # sensor noise is one setting per batch
         return (
