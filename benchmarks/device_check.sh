@@ -26,8 +26,9 @@
 #   7. bench_gpu_cache.py: whether numba-cuda's file cache keeps the kernel between processes,
 #      and the compile each process would save
 #   8. railride design --backend gpu, capped like step 5
-#   9. the CPU's figures, measured once on 16 cores already (2026-11-27): the CPU kernels
-#      compiled into numba's cache by a one-run study, then bench_study.py (the 1,000-run study
+#   9. bench_gil.py --threads <cores>: how much of a study chunk's work beside its stepping runs
+#      in parallel when every core has a chunk (measured on 2 cores only)
+#  10. the CPU's figures, measured once on 16 cores already (2026-11-27): bench_study.py (the 1,000-run study
 #      on 2 cores, on all cores, also with 1 chunk ahead, in one process per core and in four
 #      processes of a quarter of the cores each), and
 #      bench_dampers.py --lane-sizes (run_batch against the lane stepper, 1 to 16 threads)
@@ -117,6 +118,14 @@ fi
 
 # the CPU's figures (measured on a lent 16-core machine on 2026-11-27: docs/performance.md)
 if [ "$GPU_ONLY" = 0 ]; then
+
+# how much of a chunk's work beside its stepping runs in parallel on every core (never measured
+# on more than 2): the share that does not bounds a study in threads
+if [ "$SMOKE" = 1 ]; then
+  step gil 60 $PY benchmarks/bench_gil.py --threads 2 --duration 1 --repeat 1
+else
+  step gil 90 $PY benchmarks/bench_gil.py --threads "$CORES" --duration 5 --repeat 3
+fi
 
 if [ "$SMOKE" = 1 ]; then
   step study-2-cores 120 $PY benchmarks/bench_study.py --seeds "$SEEDS" --duration 1 --profile
