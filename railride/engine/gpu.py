@@ -86,7 +86,7 @@ from railride.engine.sample_parts import (
 THREADS_PER_BLOCK = 128
 #: the most registers a thread of the kernel may use (None: the compiler's choice, 255 at most);
 #: set before the first compile. Fewer registers let more threads share a multiprocessor, at the
-#: cost of more spills to local memory (`benchmarks/bench_gpu.py --resources`, docs/gpu.md)
+#: cost of more spills to local memory (`benchmarks/bench_gpu_kernel.py --resources`, docs/gpu.md)
 MAX_REGISTERS: int | None = None
 #: the share of the device's free memory one group of samples may take
 MEMORY_SHARE = 0.6
