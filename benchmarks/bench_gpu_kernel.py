@@ -3,6 +3,7 @@
 Run:  python benchmarks/bench_gpu_kernel.py --resources [--registers none,168,128,96]
       python benchmarks/bench_gpu_kernel.py [--registers none,128] [--samples 1024,32768] [--duration 1]
       python benchmarks/bench_gpu_kernel.py --concurrent 8 [--duration 2]
+      ncu --set full -k regex:_kernel -c 1 python benchmarks/bench_gpu_kernel.py --profile-run
 
 * ``--resources`` needs no GPU, only the gpu extra: the kernel compiled to PTX for an H100
   (compute capability 9.0) and assembled by ``ptxas -v`` (the gpu extra's, else the one on the
@@ -20,6 +21,9 @@ Run:  python benchmarks/bench_gpu_kernel.py --resources [--registers none,168,12
 * ``--concurrent K`` (GPU): K batches of 32 runs, as a study's chunks in flight send them (a
   design's held-out runs with their comfort), from K threads at once and then one after another:
   whether the kernels of calls on their own streams overlap on the device.
+* ``--profile-run`` (GPU): one launch of the kernel on ``--samples`` runs (the first size given)
+  of 0.01 s and nothing else, for a profiler to attach to (NVIDIA Nsight Compute, ``ncu``:
+  where its time goes, occupancy, memory traffic and what its warps wait on).
 Prints Markdown rows for docs/gpu.md with the device and date. No test asserts timings.
 """
 
@@ -185,6 +189,18 @@ def _concurrent(k: int, duration: float) -> None:
     )
 
 
+def _profile_run(n: int) -> None:
+    from bench_gpu import _batch
+
+    from railride.engine import gpu
+    from railride.run.simulation import simulate
+    from railride.run.solver import SolverSettings
+
+    scs, susp = _batch(n, 0.01, "sas-attitude-ride")
+    simulate(scs, suspension=susp, solver=SolverSettings(output_rate=200.0, backend="gpu"))
+    print(f"{gpu.device_name()}: one launch of {n} runs of 0.01 s; kernels {gpu.last_call()['kernel_s']:.3f} s")
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--resources", action="store_true")
@@ -192,6 +208,7 @@ def main():
     ap.add_argument("--samples", default="1024,32768", help="batch sizes, comma-separated")
     ap.add_argument("--duration", type=float, default=1.0)
     ap.add_argument("--concurrent", type=int, default=0)
+    ap.add_argument("--profile-run", action="store_true")
     args = ap.parse_args()
     if args.resources:
         _resources(_limits(args.registers))
@@ -203,6 +220,9 @@ def main():
         sys.exit(f"bench_gpu_kernel: needs a GPU ({missing or 'not in the simulator'})")
     if args.concurrent:
         _concurrent(args.concurrent, args.duration)
+        return
+    if args.profile_run:
+        _profile_run(int(args.samples.split(",")[0]))
         return
     _timed(_limits(args.registers), [int(v) for v in args.samples.split(",")], args.duration)
 

@@ -18,7 +18,9 @@
 #   3. bench_gpu_kernel.py: the kernel under register limits (none, 128, 96) on 1,024, 8,192 and 32,768
 #      runs: its rate and the kernels' time per step
 #   4. bench_gpu_kernel.py --concurrent 8: eight 32-run batches from eight threads at once against
-#      one after another (a design's held-out runs): whether calls on their own streams overlap
+#      one after another (a design's held-out runs): whether calls on their own streams overlap;
+#      then, where the image has Nsight Compute (ncu), one launch of the kernel profiled: its
+#      occupancy, memory traffic and what its warps wait on
 #   5. railride design with its defaults (backend auto: the CPU's cores for its batches, all under
 #      4,096 runs), the command itself; its cap is the target of 2 minutes and start-up: "cut"
 #      says it took longer
@@ -99,6 +101,14 @@ if [ "$SMOKE" = 1 ]; then  # the kernel steps need a GPU; the design would take 
 else
   step gpu-kernel 120 $PY benchmarks/bench_gpu_kernel.py --registers none,128,96 --samples 1024,8192,32768
   step gpu-concurrent 60 $PY benchmarks/bench_gpu_kernel.py --concurrent 8 --duration 2
+  # where the kernel's time goes (Nsight Compute, where the image has it): one launch of 1,024 runs
+  if command -v ncu >/dev/null 2>&1; then
+    step gpu-ncu 120 ncu --section LaunchStats --section Occupancy --section SpeedOfLight \
+      --section MemoryWorkloadAnalysis --section WarpStateStats -k regex:_kernel -c 1 \
+      $PY benchmarks/bench_gpu_kernel.py --profile-run --samples 1024
+  else
+    step gpu-ncu 10 echo "no ncu on the PATH: the kernel not profiled"
+  fi
   # the CPU kernels compiled once into numba's cache, so that no timed step below is cut by compiling
   step compile-cpu 90 $PY -c "from railride.studies.study import study; \
 study(['pid', 'sas-attitude', 'sas-attitude-ride', 'clipped-optimal'], track_seeds=[0], speeds=[40.0], duration=1.0)"
