@@ -113,7 +113,8 @@ else
   step compile-cpu 90 $PY -c "from railride.studies.study import study; \
 study(['pid', 'sas-attitude', 'sas-attitude-ride', 'clipped-optimal'], track_seeds=[0], speeds=[40.0], duration=1.0)"
   # the commands themselves, so that "exit 0 after N s" is their time (start-up included)
-  step design 150 $PY -m railride.cli design --out /tmp/railride-design-auto
+  # (bash's time: user + sys over real is how many cores it kept busy)
+  step design 150 bash -c "time $PY -m railride.cli design --out /tmp/railride-design-auto"
 fi
 
 # never run on a device yet
@@ -123,7 +124,7 @@ step gpu-tests 120 $PY -m pytest -q -p no:randomly -p no:cacheprovider tests/phy
 step gpu-cache 150 $PY benchmarks/bench_gpu_cache.py
 
 if [ "$SMOKE" = 0 ]; then  # cut at 150 s on the H100 before: the rounds' kernels, not the host
-  step design-on-gpu 150 $PY -m railride.cli design --backend gpu --out /tmp/railride-design-gpu
+  step design-on-gpu 150 bash -c "time $PY -m railride.cli design --backend gpu --out /tmp/railride-design-gpu"
 fi
 
 # the CPU's figures (measured on a lent 16-core machine on 2026-11-27: docs/performance.md)
