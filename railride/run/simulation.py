@@ -357,18 +357,21 @@ def step(plan: RunPlan, tables: Inputs, packed: Packed, progress=None) -> Steppe
     step_batch = stop.around(step_batch)
     chunk = n_steps if progress is None else max(stride, (_CHUNK_WORK // n) // stride * stride)
     done = 0
-    while True:
-        todo = min(chunk, n_steps - done)
-        final = done + todo == n_steps
-        started = time.perf_counter()
-        step_batch(n, packed.law, x, done, todo, final, stride, dt, *kernel_groups)
-        done += todo
-        if progress is not None:
-            took = max(time.perf_counter() - started, 1e-6)  # the first call may include compiling
-            chunk = max(stride, min(4 * todo, int(todo * _CHUNK_SECONDS / took)) // stride * stride)
-            progress(done / n_steps)
-        if final or stop.requested:
-            break
+    try:
+        while True:
+            todo = min(chunk, n_steps - done)
+            final = done + todo == n_steps
+            started = time.perf_counter()
+            step_batch(n, packed.law, x, done, todo, final, stride, dt, *kernel_groups)
+            done += todo
+            if progress is not None:
+                took = max(time.perf_counter() - started, 1e-6)  # the first call may include compiling
+                chunk = max(stride, min(4 * todo, int(todo * _CHUNK_SECONDS / took)) // stride * stride)
+                progress(done / n_steps)
+            if final or stop.requested:
+                break
+    finally:
+        stop.restore()
     if stop.requested:  # Ctrl-C: keep the output rows of the finished chunks
         rows = done // stride  # the row at `done` itself is written by the chunk after it
         if rows < 2:
@@ -482,17 +485,20 @@ def assemble(plan: RunPlan, stepped: Stepped) -> RideResult:
 
 
 class _StopRequest:
-    """Ctrl-C while a chunk of the stepper runs, taken as a request to stop after it (the
-    compiled chunk cannot be left half way) instead of a KeyboardInterrupt that would lose the
-    chunks before it. Only in the main thread with Python's own handler in place, and from the
-    second chunk on: the first is short and may compile the stepper, which Ctrl-C should stop
-    at once. A second Ctrl-C raises at once; between chunks Ctrl-C is a KeyboardInterrupt."""
+    """Ctrl-C while the stepper runs its chunks, taken as a request to stop after the chunk it
+    came in (the compiled chunk cannot be left half way) instead of a KeyboardInterrupt that
+    would lose the chunks before it. Only in the main thread with Python's own handler in place,
+    and once the first chunk has finished: the first is short and may compile the stepper,
+    which Ctrl-C should stop at once. From then until `restore`, between chunks too (a Ctrl-C
+    right after a progress report had raised, losing the run, where it came before the next
+    chunk took the handler); a second Ctrl-C raises at once."""
 
     def __init__(self, enabled: bool):
         import signal
         import threading
 
         self.requested = False
+        self.installed = False
         self.enabled = (
             enabled
             and threading.current_thread() is threading.main_thread()
@@ -509,19 +515,24 @@ class _StopRequest:
             return step
         import signal
 
-        calls = []
-
         def guarded(*args):
-            calls.append(None)
-            if len(calls) == 1:
+            if self.installed:
                 return step(*args)
-            signal.signal(signal.SIGINT, self._handler)
             try:
                 return step(*args)
-            finally:
-                signal.signal(signal.SIGINT, signal.default_int_handler)
+            finally:  # the first chunk has finished (or failed: `restore` undoes it)
+                signal.signal(signal.SIGINT, self._handler)
+                self.installed = True
 
         return guarded
+
+    def restore(self) -> None:
+        """Python's own Ctrl-C again, once the chunks are done (or one failed)."""
+        if self.installed:
+            import signal
+
+            signal.signal(signal.SIGINT, signal.default_int_handler)
+            self.installed = False
 
 
 def _marked_partial(build, text: str):
