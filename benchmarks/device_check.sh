@@ -156,3 +156,7 @@ fi
 
 echo "" | tee -a "$LOG"
 echo "done in $(($(date +%s) - START)) s of a $BUDGET s budget" | tee -a "$LOG"
+# each step and how it ended, at the end of the log (the device tool returns the last 12,000 characters)
+echo "" | tee -a "$LOG"
+echo "## summary" | tee -a "$LOG"
+grep -E '^## |^exit [0-9]+ after|^cut: |^skipped: ' "$LOG" | grep -v '^## summary' | paste - - | tee -a "$LOG"
