@@ -81,7 +81,8 @@ def _stages(duration: float, n: int) -> dict:
 
     def plumbing():
         plan = check(scs[0], None, suspensions[0], None, "mark")
-        assemble(plan, stepped[0]) if pack(plan, inputs(plan)) is not None else None
+        pack(plan, inputs(plan))
+        assemble(plan, stepped[0])
 
     def tracks(k):
         for c in chunks[k]:

@@ -163,8 +163,8 @@ def _concurrent(k: int, duration: float) -> None:
     from railride.run.solver import SolverSettings
 
     on_gpu = SolverSettings(output_rate=1000.0, backend="gpu")
-    batches = [_batch(32 * (i + 1), duration, "sas-attitude-ride") for i in range(k)]
-    batches = [(scs[-32:], susp) for scs, susp in batches]  # 32 runs each, on other tracks
+    scs, susp = _batch(32 * k, duration, "sas-attitude-ride")
+    batches = [(scs[32 * i : 32 * (i + 1)], susp) for i in range(k)]  # 32 runs each
     warm, susp = _batch(32, 0.01, "sas-attitude-ride")
     simulate(warm, suspension=susp, solver=on_gpu)  # compiles
 

@@ -516,13 +516,11 @@ class _StopRequest:
         import signal
 
         def guarded(*args):
-            if self.installed:
-                return step(*args)
-            try:
-                return step(*args)
-            finally:  # the first chunk has finished (or failed: `restore` undoes it)
+            done = step(*args)
+            if not self.installed:  # the first chunk has finished: Ctrl-C is a request from now on
                 signal.signal(signal.SIGINT, self._handler)
                 self.installed = True
+            return done
 
         return guarded
 
