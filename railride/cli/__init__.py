@@ -77,6 +77,7 @@ def main() -> None:
     status: str | int | None = 0
     if sys.stdout is None:  # started with stdout closed (>&-): the output goes nowhere, as to a closed pipe
         sys.stdout = open(os.devnull, "w")
+    hook, sys.unraisablehook = sys.unraisablehook, _interrupt_again
     try:
         app = _load()
         app(prog_name="railride")
@@ -95,6 +96,8 @@ def main() -> None:
             raise
         print("interrupted", file=sys.stderr)
         status = 130
+    finally:
+        sys.unraisablehook = hook
     try:  # what is still buffered goes now, and a reader gone by then is no error either
         sys.stdout.flush()
     except BrokenPipeError:
@@ -104,6 +107,24 @@ def main() -> None:
             print(f"error: cannot write: {exc.strerror or exc}", file=sys.stderr)
             status = 2
     sys.exit(status)
+
+
+def _interrupt_again(unraisable) -> None:
+    """`sys.unraisablehook` while a command runs. Python drops an exception raised where it cannot
+    propagate (a weakref callback, a ``__del__``) with "Exception ignored in ..." and a traceback.
+    Ctrl-C once landed there (importlib's module-lock callback, as the commands loaded), and the
+    command ran on to its end with status 0. A KeyboardInterrupt is therefore delivered again, a
+    moment later from another thread: raised within this hook it would be dropped too. Anything
+    else goes to Python's own hook."""
+    if not issubclass(unraisable.exc_type, KeyboardInterrupt):
+        sys.__unraisablehook__(unraisable)
+        return
+    import _thread
+    import threading
+
+    again = threading.Timer(0.01, _thread.interrupt_main)  # as Ctrl-C: the handler in place takes it
+    again.daemon = True  # never holds the interpreter's exit
+    again.start()
 
 
 def _caused_by_interrupt(exc: BaseException | None) -> bool:
