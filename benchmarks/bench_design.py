@@ -1,10 +1,17 @@
 """Cost of `railride design` with its defaults: wall time, CPU share and peak memory.
 
 Run:  python benchmarks/bench_design.py [--out DIR] [other railride design options]
+      python benchmarks/bench_design.py --profile [--controllers A,B] [--budget N] [--duration S]
 Runs `railride design --out DIR` (default: a new temporary folder) in a child process and
 prints a Markdown row for docs/performance.md: the runs it evaluated, its wall time, the CPU
 time of the child as a share of one core, and the child's peak resident memory. The default
-design takes about 17-30 minutes on a 2-core machine. No test asserts timings.
+design takes about 12-30 minutes on a 2-core machine. No test asserts timings.
+
+--profile runs `railride.design` in this process (its defaults, but for the options named, no
+files written) and says where its wall time went: by stage (the inner loop, the tuning rounds,
+the held-out runs, the probes, the rest), how long some chunk was stepping in each, and how
+long none was. On N threads the time no chunk steps is what keeps N - 1 cores idle (Amdahl), so
+it bounds what more cores can give.
 """
 
 from __future__ import annotations
@@ -20,6 +27,8 @@ from pathlib import Path
 
 def main():
     args = sys.argv[1:]
+    if "--profile" in args:
+        return profile([a for a in args if a != "--profile"])
     if "--out" in args:
         out = Path(args[args.index("--out") + 1])
     else:
@@ -40,6 +49,99 @@ def main():
         f"| {' '.join(args)} | {doc.get('runs_evaluated', '?')} | {wall / 60:.1f} min | "
         f"{(usage.ru_utime + usage.ru_stime) / wall * 100:.0f} % | {usage.ru_maxrss / 1024**2:.2f} GiB |"
     )
+
+
+def profile(args: list) -> None:
+    import argparse
+
+    import railride as rr
+    from railride.run import simulation
+    from railride.studies import design as design_module
+    from railride.studies import design_probes, tuning
+
+    ap = argparse.ArgumentParser(prog="bench_design.py --profile")
+    ap.add_argument("--controllers", default=None)
+    ap.add_argument("--budget", type=int, default=design_module.DEFAULT_BUDGET)
+    ap.add_argument("--duration", type=float, default=design_module.DEFAULT_DURATION)
+    opts = ap.parse_args(args)
+    steps: list = []  # (start, end) of every chunk's stepping, any thread
+    stages: list = []  # (name, start, end)
+
+    inside: list = []  # the stage running: a stage called within another is counted in the outer one
+
+    def timed(module, name, into, label=None):
+        original = getattr(module, name)
+
+        def wrapper(*a, **kw):
+            if label and inside:
+                return original(*a, **kw)
+            inside.extend([label] if label else [])
+            start = time.perf_counter()
+            try:
+                return original(*a, **kw)
+            finally:
+                if label:
+                    inside.pop()
+                into.append((label, start, time.perf_counter()) if label else (start, time.perf_counter()))
+
+        setattr(module, name, wrapper)
+
+    timed(simulation, "step", steps)
+    timed(tuning, "_tune_inner", stages, "inner loop (damper rig)")
+    timed(tuning, "run_cases", stages, "tuning rounds")
+    timed(design_module, "_judge", stages, "held-out runs")
+    timed(design_module, "_run_ahead", stages, "probes' runs")
+    timed(design_probes, "references", stages, "probes' scores")
+    timed(design_probes, "fault_check", stages, "probes' scores")
+    controllers = opts.controllers.split(",") if opts.controllers else None
+    t0 = time.perf_counter()
+    res = rr.design(controllers, budget=opts.budget, duration=opts.duration, progress=False)
+    t1 = time.perf_counter()
+    wall = t1 - t0
+    by: dict = {}
+    for label, a, b in stages:
+        by.setdefault(label, []).append((a, b))
+    covered = _union([(a, b) for spans in by.values() for a, b in spans])
+    print(
+        f"design {opts.controllers or 'all laws'}, budget {opts.budget}, {opts.duration:g} s runs: "
+        f"{res.settings['training_runs']} training and {res.settings['judging_runs']} held-out runs, "
+        f"wall {wall:.1f} s, numba threads {_threads()}"
+    )
+    print("\n| stage | calls | wall | some chunk stepping | none stepping |")
+    print("|---|---|---|---|---|")
+    for label, spans in by.items():
+        w = _union(spans)
+        s = _union(_clip(steps, spans))
+        print(f"| {label} | {len(spans)} | {w:.1f} s | {s:.1f} s | {w - s:.1f} s |")
+    rest = wall - covered
+    print(f"| the rest (checks, start, tuning between rounds, summary) | - | {rest:.1f} s | - | {rest:.1f} s |")
+    stepping = _union(_clip(steps, [(t0, t1)]))
+    print(
+        f"| **the whole design** | - | {wall:.1f} s | {stepping:.1f} s | {wall - stepping:.1f} s "
+        f"({(wall - stepping) / wall * 100:.1f} %) |"
+    )
+
+
+def _clip(intervals, spans) -> list:
+    """The parts of ``intervals`` within any of ``spans``."""
+    return [(max(a, c), min(b, d)) for a, b in intervals for c, d in spans if b > c and a < d]
+
+
+def _union(intervals) -> float:
+    """The length of the union of (start, end) intervals."""
+    total, end = 0.0, float("-inf")
+    for a, b in sorted(intervals):
+        if b <= end:
+            continue
+        total += b - max(a, end)
+        end = b
+    return total
+
+
+def _threads() -> int:
+    import numba
+
+    return numba.get_num_threads()
 
 
 if __name__ == "__main__":
