@@ -17,6 +17,7 @@ it bounds what more cores can give.
 from __future__ import annotations
 
 import json
+import os
 import resource
 import subprocess
 import sys
@@ -53,9 +54,11 @@ def main():
 
 def profile(args: list) -> None:
     import argparse
+    import signal
+    import threading
 
     import railride as rr
-    from railride.run import simulation
+    from railride.run import reduced, simulation
     from railride.studies import design as design_module
     from railride.studies import design_probes, sweep, tuning
 
@@ -63,14 +66,16 @@ def profile(args: list) -> None:
     ap.add_argument("--controllers", default=None)
     ap.add_argument("--budget", type=int, default=design_module.DEFAULT_BUDGET)
     ap.add_argument("--duration", type=float, default=design_module.DEFAULT_DURATION)
+    ap.add_argument("--backend", default="auto", choices=["auto", "cpu", "gpu"])
     opts = ap.parse_args(args)
-    steps: list = []  # (start, end) of every chunk's stepping, any thread
+    steps: list = []  # (start, end) of every batch's stepping (on the GPU: its call), any thread
     chunks: list = []  # (start, end) of every chunk's whole work (`evaluate`), any thread
     stages: list = []  # (name, start, end)
-
+    sample_steps = [0]
     inside: list = []  # the stage running: a stage called within another is counted in the outer one
+    lock = threading.Lock()
 
-    def timed(module, name, into, label=None):
+    def timed(module, name, into, label=None, count=None):
         original = getattr(module, name)
 
         def wrapper(*a, **kw):
@@ -84,10 +89,15 @@ def profile(args: list) -> None:
                 if label:
                     inside.pop()
                 into.append((label, start, time.perf_counter()) if label else (start, time.perf_counter()))
+                if count is not None and count(a[0]):
+                    with lock:
+                        sample_steps[0] += a[0].n * a[0].n_steps
 
         setattr(module, name, wrapper)
 
-    timed(simulation, "step", steps)
+    timed(simulation, "step", steps, count=lambda plan: True)
+    # metrics-only batches on the GPU: the call (copies, kernels, sums) counts as stepping
+    timed(reduced, "batch_metrics", steps, count=lambda plan: simulation.stepped_on(plan) == "gpu")
     timed(sweep, "evaluate", chunks)
     timed(tuning, "_tune_inner", stages, "inner loop (damper rig)")
     timed(tuning, "run_cases", stages, "tuning rounds")
@@ -95,42 +105,67 @@ def profile(args: list) -> None:
     timed(design_module, "_run_ahead", stages, "probes' runs")
     timed(design_probes, "references", stages, "probes' scores")
     timed(design_probes, "fault_check", stages, "probes' scores")
+
+    class Cut(Exception):
+        pass
+
+    def cut(signum, frame):
+        raise Cut
+
+    signal.signal(signal.SIGTERM, cut)  # `timeout` (device_check.sh): report what was done by then
     controllers = opts.controllers.split(",") if opts.controllers else None
+    cpu0 = time.process_time()
     t0 = time.perf_counter()
-    res = rr.design(controllers, budget=opts.budget, duration=opts.duration, progress=False)
+    head = f"design {opts.controllers or 'all laws'}, budget {opts.budget}, {opts.duration:g} s runs"
+    head += f", backend {opts.backend}"
+    try:
+        res = rr.design(
+            controllers,
+            budget=opts.budget,
+            duration=opts.duration,
+            solver=rr.SolverSettings(backend=opts.backend),
+            progress=False,
+        )
+        head += f": {res.settings['training_runs']} training and {res.settings['judging_runs']} held-out runs"
+    except Cut:
+        head += ": CUT by SIGTERM before its end; what it had done by then"
+        was_cut = True
+    else:
+        was_cut = False
     t1 = time.perf_counter()
+    cpu = time.process_time() - cpu0
     wall = t1 - t0
     by: dict = {}
     for label, a, b in stages:
         by.setdefault(label, []).append((a, b))
     covered = _union([(a, b) for spans in by.values() for a, b in spans])
+    stepping = _union(_clip(steps, [(t0, t1)]))
+    busy = _union(_clip(chunks, [(t0, t1)]))
     print(
-        f"design {opts.controllers or 'all laws'}, budget {opts.budget}, {opts.duration:g} s runs: "
-        f"{res.settings['training_runs']} training and {res.settings['judging_runs']} held-out runs, "
-        f"wall {wall:.1f} s, numba threads {_threads()}"
+        f"{head}; wall {wall:.1f} s, CPU {cpu:.1f} s ({cpu / wall:.2f} cores busy), numba threads {_threads()}; "
+        f"{sample_steps[0]:.3g} sample-steps, {sample_steps[0] / max(stepping, 1e-9):.3g} a second of stepping"
     )
-    print("\n| stage | calls | wall | some chunk stepping | none stepping | no chunk at all |")
+    print("\n| stage | calls | wall | some batch stepping | none stepping | no chunk at all |")
     print("|---|---|---|---|---|---|")
     for label, spans in by.items():
         w = _union(spans)
-        s = _union(_clip(steps, spans))
+        st = _union(_clip(steps, spans))
         c = _union(_clip(chunks, spans))
-        print(f"| {label} | {len(spans)} | {w:.1f} s | {s:.1f} s | {w - s:.1f} s | {w - c:.1f} s |")
+        print(f"| {label} | {len(spans)} | {w:.1f} s | {st:.1f} s | {w - st:.1f} s | {w - c:.1f} s |")
     rest = wall - covered
-    print(
-        f"| the rest (checks, start, tuning between rounds, summary) | - | {rest:.1f} s | - | {rest:.1f} s | {rest:.1f} s |"
-    )
-    stepping = _union(_clip(steps, [(t0, t1)]))
-    busy = _union(_clip(chunks, [(t0, t1)]))
+    print(f"| the rest (checks, start, between rounds, summary) | - | {rest:.1f} s | - | {rest:.1f} s | {rest:.1f} s |")
     print(
         f"| **the whole design** | {len(chunks)} chunks | {wall:.1f} s | {stepping:.1f} s | {wall - stepping:.1f} s "
         f"({(wall - stepping) / wall * 100:.1f} %) | {wall - busy:.1f} s ({(wall - busy) / wall * 100:.1f} %) |"
     )
     print(
-        "\nnone stepping: no chunk's batch was stepping (a chunk's tables, metrics and rows, and all below); "
+        "\nnone stepping: no batch was stepping (a chunk's tables, metrics and rows, and all below); "
         "no chunk at all: no chunk was being worked on (the cases, keys and run table of a round, the searches, "
         "the summary), work that more threads do not overlap"
     )
+    if was_cut:  # chunks still stepping in their threads would hold the exit
+        sys.stdout.flush()
+        os._exit(124)
 
 
 def _clip(intervals, spans) -> list:

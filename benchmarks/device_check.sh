@@ -21,13 +21,14 @@
 #      one after another (a design's held-out runs): whether calls on their own streams overlap;
 #      then, where the image has Nsight Compute (ncu), one launch of the kernel profiled: its
 #      occupancy, memory traffic and what its warps wait on
-#   5. railride design with its defaults (backend auto: the CPU's cores for its batches, all under
-#      4,096 runs), the command itself; its cap is the target of 2 minutes and start-up: "cut"
-#      says it took longer
+#   5. the default design (backend auto: the CPU's cores for its batches, all under 4,096 runs),
+#      through bench_design.py --profile: its wall and CPU time, its stepping rate, and by stage
+#      how long some batch stepped and how long none did; its cap is the target of 2 minutes and
+#      start-up, and one that is cut prints the same for what it had done by then
 #   6. the GPU tests of tests/physics on the device instead of the simulator (never run there yet)
 #   7. bench_gpu_cache.py: whether numba-cuda's file cache keeps the kernel between processes,
 #      and the compile each process would save
-#   8. railride design --backend gpu, capped like step 5
+#   8. the same with --backend gpu (every tuning round a GPU call), capped like step 5
 #   9. bench_gil.py --threads <cores>: how much of a study chunk's work beside its stepping runs
 #      in parallel when every core has a chunk (measured on 2 cores only)
 #  10. the CPU's figures, measured once on 16 cores already (2026-11-27): bench_study.py (the 1,000-run study
@@ -95,9 +96,9 @@ $PY -c 'from railride.run.solver import gpu_missing; print(\"railride sees a usa
 
 step gpu-throughput 90 $PY benchmarks/bench_gpu.py --samples "$GPU_SAMPLES" --duration "$DURATION" --cpu --check "$CHECK" --metrics-only
 
-if [ "$SMOKE" = 1 ]; then  # the kernel steps need a GPU; the design would take hours in the simulator
+if [ "$SMOKE" = 1 ]; then  # the kernel steps need a GPU; the default design would take too long here: a small one
   step gpu-kernel 60 env NUMBA_ENABLE_CUDASIM=0 $PY benchmarks/bench_gpu_kernel.py --resources --registers none,128
-  step design 30 echo "not in the simulator"
+  step design 60 $PY benchmarks/bench_design.py --profile --controllers pid --budget 25 --duration 0.5
 else
   step gpu-kernel 120 $PY benchmarks/bench_gpu_kernel.py --registers none,128,96 --samples 1024,8192,32768
   step gpu-concurrent 60 $PY benchmarks/bench_gpu_kernel.py --concurrent 8 --duration 2
@@ -112,9 +113,9 @@ else
   # the CPU kernels compiled once into numba's cache, so that no timed step below is cut by compiling
   step compile-cpu 90 $PY -c "from railride.studies.study import study; \
 study(['pid', 'sas-attitude', 'sas-attitude-ride', 'clipped-optimal'], track_seeds=[0], speeds=[40.0], duration=1.0)"
-  # the commands themselves, so that "exit 0 after N s" is their time (start-up included)
-  # (bash's time: user + sys over real is how many cores it kept busy)
-  step design 150 bash -c "time $PY -m railride.cli design --out /tmp/railride-design-auto"
+  # the design in the library (no files written): "exit 0 after N s" is its time with start-up;
+  # cut at the cap (SIGTERM), it prints what it had done by then
+  step design 150 $PY benchmarks/bench_design.py --profile
 fi
 
 # never run on a device yet
@@ -124,7 +125,7 @@ step gpu-tests 120 $PY -m pytest -q -p no:randomly -p no:cacheprovider tests/phy
 step gpu-cache 150 $PY benchmarks/bench_gpu_cache.py
 
 if [ "$SMOKE" = 0 ]; then  # cut at 150 s on the H100 before: the rounds' kernels, not the host
-  step design-on-gpu 150 bash -c "time $PY -m railride.cli design --backend gpu --out /tmp/railride-design-gpu"
+  step design-on-gpu 150 $PY benchmarks/bench_design.py --profile --backend gpu
 fi
 
 # the CPU's figures (measured on a lent 16-core machine on 2026-11-27: docs/performance.md)
