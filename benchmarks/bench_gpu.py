@@ -166,7 +166,7 @@ def main():
 def _memory_plan():
     """The device bytes of metrics-only runs of 60 s (`railride.run.reduced`), from the arrays a
     64-run batch of SAS (attitude) loops on fra4 at 30 and 70 m/s packs: computed, not measured."""
-    from railride.engine import gpu
+    from railride.engine import gpu, sample_parts
     from railride.model.track import scenario
     from railride.run.checks import check
     from railride.run.simulation import inputs, pack, stepper_arguments
@@ -184,7 +184,7 @@ def _memory_plan():
     packed = pack(plan, tables, rows=2)
     vehicle, dampers, rails, control, outputs = stepper_arguments(plan, tables, packed)
     own = [packed.x, vehicle[2], vehicle[3], dampers[0], dampers[1], *control[2:5], control[6], control[7]]
-    per_run = sum(a[0].nbytes for a in own) + sum(h[0].nbytes for h in outputs[:9]) + (gpu.N_ACC + 5) * 8
+    per_run = sum(a[0].nbytes for a in own) + sum(h[0].nbytes for h in outputs[:9]) + (sample_parts.N_ACC + 5) * 8
     rows = {float(v): int(k) for v, k in zip(speeds, rails[4][:2])}  # nodes of each speed's table
     per_track = {v: k * (rails[0].shape[1] + rails[2].shape[1]) * 8 for v, k in rows.items()}
     full = 8 * (plan.n_out + 1) * sum(h.shape[2] for h in outputs[:9] if h.shape[1] > 1)
@@ -281,7 +281,7 @@ class _StandIn:
         return self._launch
 
     def _launch(self, m, *args):
-        from railride.engine.gpu import ACC_MAX, ACC_MIN, ACC_ROWS, ACC_SQUARES
+        from railride.engine.sample_parts import ACC_MAX, ACC_MIN, ACC_ROWS, ACC_SQUARES
 
         outs, reduce, acc = args[-14:-5], args[-3], args[-1]
         if reduce:

@@ -51,7 +51,7 @@ def _signatures() -> dict[str, tuple]:
         "run_batch": run + (types.Tuple((a(3), a(3), a(2), a(2))), types.Tuple((a(2), a(2))), inputs, control, outputs),
         # lo, hi, lane_smp, lane_own, then run_batch's arguments after hi, with vehicle = the q'' product's
         # structure and values (a_ptr, a_col, a_val, a_uni), the corner product's (t_*), c_sec, stops;
-        # dampers = (P, vcmd)
+        # dampers = (P, vcmd); last, the metric sums (reduce, win, acc)
         "run_lanes": (i, i, a(2, i), a(2, b))
         + run[2:]
         + (
@@ -60,6 +60,7 @@ def _signatures() -> dict[str, tuple]:
             inputs,
             control,
             outputs,
+            types.Tuple((b, a(1, i), a(2))),
         ),
         # Phi (a slice), maps, used, stride, m, utab, interval, x0, A, Bw, Bwd, TS, c_sec, six outputs
         "exact_run": (a(2, layout="A"), a(3), a(1, i), i, i, a(2), f, a(1), a(2), a(2), a(2), a(2), a(1)) + (a(2),) * 6,

@@ -72,7 +72,9 @@ from railride.engine.layout import (
 )
 from railride.engine.layout import FASTMATH as _FAST
 from railride.engine.sample_parts import (
+    N_ACC,
     accelerometer_filters,
+    accumulate_metrics,
     controller_sample,
     hold_failed_coils,
     inner_loop,
@@ -200,26 +202,6 @@ def _forcing(t, ftab, off, n_nodes, interval, R, roff):
         )
 
 
-#: the columns of a sample's metric sums in reduce mode: the sums of squares, the least and the
-#: largest values of the metric channels (`METRIC_CHANNELS`), and the rows summed
-ACC_SQUARES, ACC_MIN, ACC_MAX, ACC_ROWS = 0, 4, 8, 12
-N_ACC = 13
-#: the channels of `railride.analysis.metrics.RESPONSES` as (history, column): the carbody's
-#: vertical acceleration (out_a), bounce, pitch and roll (out_q), in that order
-METRIC_CHANNELS = (("a", 0), ("q", 0), ("q", 1), ("q", 2))
-
-
-@njit(inline="always", fastmath=_FAST)
-def _accumulate(acc, smp, out_q, out_a):
-    """Add the row just written (row 0 of out_q, out_a) to sample smp's metric sums."""
-    for k in range(4):
-        v = out_a[smp, 0, 0] if k == 0 else out_q[smp, 0, k - 1]
-        acc[smp, ACC_SQUARES + k] += v * v
-        acc[smp, ACC_MIN + k] = min(acc[smp, ACC_MIN + k], v)
-        acc[smp, ACC_MAX + k] = max(acc[smp, ACC_MAX + k], v)
-    acc[smp, ACC_ROWS] += 1.0
-
-
 # fmt: off
 def _kernel(
     n, law, x, step0, n_steps, final, stride, row0, dt, lam1, vid, A, TS, c_sec, stops, P, vcmd, utab, u_off, ftab,
@@ -230,7 +212,7 @@ def _kernel(
     """One thread per sample smp < n: `kernels._run_samples`'s loop body for that sample. The
     vehicle's matrices are A[vid[smp]], TS[vid[smp]]; the outputs hold the rows from row0 on.
     With ``reduce``, the outputs hold one row, rewritten at every output step, and the rows
-    win[0] <= row <= win[1] go into the sample's metric sums acc[smp] (`_accumulate`)."""
+    win[0] <= row <= win[1] go into the sample's metric sums acc[smp] (`sample_parts.accumulate_metrics`)."""
     smp = cuda.grid(1)
     if smp >= n or status[smp] != STATUS_OK:
         return
@@ -316,7 +298,7 @@ def _kernel(
                 fail_step[smp] = step
                 break
             if reduce and win[0] <= step // stride <= win[1]:
-                _accumulate(acc, smp, out_q, out_a)
+                accumulate_metrics(acc, smp, out_q, out_a)
         if n_ == n_steps:
             break
         m = substep_count(law, bw1, gb1, lam1, pp, cv, s, dt)

@@ -60,6 +60,7 @@ from railride.engine.layout import (  # sizes, codes and slots: compile-time con
     STATUS_OK,
 )
 from railride.engine.layout import FASTMATH as _FAST, NO_PARFORS as _NO_PARFORS
+from railride.engine.sample_parts import N_ACC, accumulate_metrics
 
 
 #: rows of a lane state: q, q', the corner forces f (the stage vector y = (q, q', f), so the
@@ -167,8 +168,9 @@ def _lane_derivative(
 
 @njit(cache=True, nogil=True, fastmath=_FAST, parallel=_NO_PARFORS)
 def run_lanes(
-    lo, hi, lane_smp, lane_own, law, x, step0, n_steps, final, stride, dt, vehicle, dampers, inputs, control, outputs
-):
+    lo, hi, lane_smp, lane_own, law, x, step0, n_steps, final, stride, dt, vehicle, dampers, inputs, control, outputs,
+    sums,
+):  # fmt: skip
     """`run_batch` for the groups lo <= g < hi of LANES samples: lane l of group g is sample
     lane_smp[g, l], and writes its state, outputs and status only where lane_own[g, l] (a
     padding lane repeats a sample of its group and discards what it computes). The arguments
@@ -181,6 +183,11 @@ def run_lanes(
     and rates over (t_ptr, t_col, t_val[g]) (rows cx then cv, columns of q, q'); a_val[g, k, l]
     is lane l's entry k, and a_uni[g] (t_uni[g]) says that every lane of group g has the same
     entries (one vehicle), which are then read once and broadcast.
+
+    sums = (reduce, win, acc): with reduce, a run that keeps no history, as on the GPU: the
+    outputs hold one row a sample (two where that history is recorded: the records read which
+    from the shapes), rewritten at every output step, and the rows win[0]..win[1] (both
+    included) go into the sample's metric sums acc[i] (`sample_parts.accumulate_metrics`).
 
     Every lane runs exactly its own sample's arithmetic: its own sub-step count (the group
     loops to the largest, the lanes that are done masked), its delay, voltage law, faults and
@@ -195,6 +202,7 @@ def run_lanes(
     utab, u_off, ftab, f_off, n_nodes, interval = inputs
     closed_loop, ctrl_stride, Gm, Hm, inner, noise, faults, _sensing, _snoise = control
     out_q, out_v, out_a, out_f, out_w, out_wd, out_d, out_fd, out_vc, status, fail_step = outputs
+    reduce, win, acc = sums
     has_states = law != LAW_VISCOUS_IN_C and law != LAW_IDEAL
     record_d = out_d.shape[1] > 1
     record_c = out_fd.shape[1] > 1
@@ -335,7 +343,8 @@ def run_lanes(
                             b = ROW_D + N_DAMPER_STATES * c + 2
                             K[b, l] = coil_rate(P, S[b, l], v)
             if step % stride == 0:
-                row = step // stride
+                row = 0 if reduce else step // stride
+                summed = reduce and win[0] <= step // stride <= win[1]
                 if law == LAW_VISCOUS_IN_C:  # the dashpots' forces, for the record
                     lanes_spmv(t_ptr, t_col, tval, tu, S, ZL, 0, CC, 0)
                     for c in range(N_CORNER):
@@ -374,6 +383,8 @@ def run_lanes(
                         if bad:
                             status[i] = STATUS_DIVERGED
                             fail_step[i] = step
+                        elif summed:
+                            accumulate_metrics(acc, i, out_q, out_a)
                     if bad:
                         alive[l] = 0.0
             if n == n_steps:
@@ -463,6 +474,10 @@ def run_lanes(
                 x[i, NS_MAX + j] = XC[j, l]
 
 
+#: `run_lanes`' sums where a run keeps its histories whole
+_NO_SUMS = (False, np.zeros(2, dtype=np.int64), np.zeros((1, N_ACC)))
+
+
 def lane_groups(n: int):
     """Groups of LANES samples covering 0..n: (sample of each lane, whether the lane owns it);
     the last group is padded with copies of the last sample, which write nothing."""
@@ -503,12 +518,12 @@ def lanes_stepper(n, law, A, TS, P, stops):
     products = (a_ptr, a_col, a_val, a_uni, t_ptr, t_col, t_val, t_uni)
     damper = np.ascontiguousarray(P[P_ALPHA_A])
 
-    def step(_n, _law, x, step0, n_steps, final, stride, dt, vehicle, dampers, inputs, control, outputs):
+    def step(_n, _law, x, step0, n_steps, final, stride, dt, vehicle, dampers, inputs, control, outputs, sums=None):
         # run_batch's groups: the products and run_batch's c_sec and stops, the one damper and vcmd,
-        # the rest as they are
+        # the rest as they are; sums: `run_lanes`' (default: the histories whole, no sums)
         run_parallel(
             run_lanes, len(smp), smp, own, law, x, step0, n_steps, final, stride, dt, products + vehicle[2:4],
-            (damper, dampers[1]), inputs, control, outputs,
+            (damper, dampers[1]), inputs, control, outputs, _NO_SUMS if sums is None else sums,
         )  # fmt: skip
 
     return step

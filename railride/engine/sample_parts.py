@@ -2,7 +2,8 @@
 and the GPU kernel (`railride.engine.gpu`) share, each written once: the controller's sample (the
 accelerometers' integration, sensor noise, the demand and its delay), the accelerometers'
 anti-alias filters, the inner loop and the failed coil drivers, the sub-step count, the RK4
-combinations, and the record of a step. Plain numba, no allocation: the steppers hand in their
+combinations, the record of a step, and the metric sums of a run that keeps no history (the lane
+stepper's and the kernel's, `railride.run.reduced`). Plain numba, no allocation: the steppers hand in their
 own work arrays (numpy on the CPU, thread-local arrays on the GPU).
 
 ``xs`` is one sample's row of the state array x (`railride.engine.layout`: q, q', damper states,
@@ -212,3 +213,23 @@ def record_row(smp, row, t, law, s, K, y, cv, tt, cs, xs, vc, utab, uo, nn, itv,
             out_fd[smp, row, c] = xs[FD_HELD + c]
             out_vc[smp, row, c] = vc[c]
     return bad
+
+
+#: the columns of a sample's metric sums where a run keeps no history: the sums of squares, the
+#: least and the largest values of the metric channels (`METRIC_CHANNELS`), and the rows summed
+ACC_SQUARES, ACC_MIN, ACC_MAX, ACC_ROWS = 0, 4, 8, 12
+N_ACC = 13
+#: the channels of `railride.analysis.metrics.RESPONSES` as (history, column): the carbody's
+#: vertical acceleration (out_a), bounce, pitch and roll (out_q), in that order
+METRIC_CHANNELS = (("a", 0), ("q", 0), ("q", 1), ("q", 2))
+
+
+@njit(cache=True, inline="always", fastmath=_FAST)
+def accumulate_metrics(acc, smp, out_q, out_a):
+    """Add the row just written (row 0 of out_q, out_a) to sample smp's metric sums."""
+    for k in range(4):
+        v = out_a[smp, 0, 0] if k == 0 else out_q[smp, 0, k - 1]
+        acc[smp, ACC_SQUARES + k] += v * v
+        acc[smp, ACC_MIN + k] = min(acc[smp, ACC_MIN + k], v)
+        acc[smp, ACC_MAX + k] = max(acc[smp, ACC_MAX + k], v)
+    acc[smp, ACC_ROWS] += 1.0

@@ -1,12 +1,15 @@
-"""Runs that keep only their ride metrics: on the GPU, summed on the device.
+"""Runs that keep only their ride metrics, summed as they step.
 
 A study that reads only the RMS and peak-to-peak of the four carbody responses (a sweep, a tuning
-round or a design's search without comfort or costs) needs no time history on the host. On the
-GPU (`railride.engine.gpu`, ``reduce``) each sample adds every output row inside the window to its
-own sums of squares, least and largest values, so that a batch of 1e4 runs takes a few bytes per
-run instead of megabytes, and a study can send the GPU the large batches that pay there. Every
-other run (the CPU, the exact discretisation) runs whole and takes `RideResult.metrics`, the one
-definition of the metrics, so that both give the same numbers to rounding.
+round or a design's search without comfort or costs) needs no time history. On the GPU
+(`railride.engine.gpu`, ``reduce``) and on the CPU's lane stepper (`railride.engine.lanes`,
+``sums``) each sample adds every output row inside the window to its own sums of squares, least
+and largest values (`railride.engine.sample_parts.accumulate_metrics`), so that a run takes a few
+bytes instead of megabytes: a GPU can take the large batches that pay there, and the CPU no longer
+writes, and the system no longer maps and clears, 11 MB of histories a 20-s run. Every other run
+(a batch too small for the lanes, realistic sensing, the exact discretisation) runs whole and
+takes `RideResult.metrics`, the one definition of the metrics; the sums give the same numbers to
+rounding (the RMS is a sum in another order), tested against it.
 """
 
 from __future__ import annotations
@@ -18,6 +21,7 @@ import numpy as np
 
 from railride.analysis.metrics import RESPONSES, check_window
 from railride.engine import layout
+from railride.engine.sample_parts import ACC_MAX, ACC_MIN, ACC_ROWS, ACC_SQUARES, N_ACC
 from railride.errors import DivergenceError, InputError
 from railride.run.checks import check
 from railride.run.simulation import (
@@ -38,17 +42,16 @@ def batch_metrics(plan: RunPlan, window=None) -> tuple[np.ndarray, np.ndarray]:
     and peak-to-peak, over ``window`` = (start, end) s), NaN for a run that diverged, and the
     time each diverged [s] (NaN where it did not). On the GPU the sums are made on the device,
     with no histories; a GPU failure says so in one line and runs the batch again on the CPU.
-    On the CPU the runs go in batches of `CPU_BATCH`, whose histories bound the memory."""
+    On the CPU the lane stepper sums them likewise where it takes the batch; other batches run
+    whole, in batches of `CPU_BATCH` whose histories bound the memory."""
     if stepped_on(plan) != "gpu":
-        return _on_cpu(plan, window)
+        return _on_lanes(plan, window) if _lanes_take(plan) else _on_cpu(plan, window)
     from railride.engine import gpu
 
     w0, w1 = window_rows(plan.n_out + 1, plan.solver.output_rate, window)
     tables = inputs(plan)
     packed = pack(plan, tables, rows=2)  # two rows: "recorded" for the stepper, one row rewritten
-    acc = np.zeros((plan.n, gpu.N_ACC))
-    acc[:, gpu.ACC_MIN : gpu.ACC_MIN + 4] = math.inf
-    acc[:, gpu.ACC_MAX : gpu.ACC_MAX + 4] = -math.inf
+    acc = _fresh_sums(plan.n)
     dt, stride = plan.solver.dt, plan.stride
     vehicle, dampers, rails, control, outputs = stepper_arguments(plan, tables, packed)
     try:
@@ -64,6 +67,42 @@ def batch_metrics(plan: RunPlan, window=None) -> tuple[np.ndarray, np.ndarray]:
 
 #: runs per CPU batch of a metrics-only plan: histories of the size a study's chunk holds
 CPU_BATCH = 32
+
+
+def _fresh_sums(n: int) -> np.ndarray:
+    """n samples' metric sums before the first row: zero sums, +inf least, -inf largest."""
+    acc = np.zeros((n, N_ACC))
+    acc[:, ACC_MIN : ACC_MIN + 4] = math.inf
+    acc[:, ACC_MAX : ACC_MAX + 4] = -math.inf
+    return acc
+
+
+def _lanes_take(plan: RunPlan) -> bool:
+    """Whether the CPU's lane stepper may run this plan's batch: RK4 and enough runs (one damper
+    and no realistic sensing, the rest of `railride.engine.lanes.lanes_fit`, need the packed
+    arrays: `_on_lanes` checks them)."""
+    from railride.engine.lanes import LANES
+
+    return not plan.exact and plan.n >= LANES
+
+
+def _on_lanes(plan: RunPlan, window) -> tuple[np.ndarray, np.ndarray]:
+    """`batch_metrics` on the CPU's lane stepper, summed as it steps (`run_lanes`' ``sums``);
+    a batch the lanes do not take after all (`lanes_fit`) runs whole (`_on_cpu`)."""
+    from railride.engine import lanes
+
+    w0, w1 = window_rows(plan.n_out + 1, plan.solver.output_rate, window)
+    tables = inputs(plan)
+    packed = pack(plan, tables, rows=2)  # two rows: "recorded" for the stepper, one row rewritten
+    if not lanes.lanes_fit(plan.n, packed.P, packed.control[7]):
+        return _on_cpu(plan, window)
+    acc = _fresh_sums(plan.n)
+    arrays = tables.arrays
+    step = lanes.lanes_stepper(plan.n, packed.law, arrays["A"], arrays["TS"], packed.P, arrays["stops"])
+    sums = (True, np.array([w0, w1], dtype=np.int64), acc)
+    dt, groups = plan.solver.dt, stepper_arguments(plan, tables, packed)
+    step(plan.n, packed.law, packed.x, 0, plan.n_steps, True, plan.stride, dt, *groups, sums)
+    return metrics_from_sums(acc, packed.status, packed.fail_step, dt, plan.on_divergence)
 
 
 def _on_cpu(plan: RunPlan, window) -> tuple[np.ndarray, np.ndarray]:
@@ -100,11 +139,9 @@ def window_rows(n_rows: int, output_rate: float, window) -> tuple[int, int]:
 
 
 def metrics_from_sums(acc, status, fail_step, dt: float, on_divergence: str = "mark"):
-    """(metrics, diverged_at) from the device's sums (`railride.engine.gpu.N_ACC` columns a
+    """(metrics, diverged_at) from the sums (`railride.engine.sample_parts.N_ACC` columns a
     sample): RMS = sqrt(sum x^2 / rows), peak-to-peak = largest - least, in the units of
     `RESPONSES`. A run that diverged raises `DivergenceError` unless ``on_divergence`` is "mark"."""
-    from railride.engine.gpu import ACC_MAX, ACC_MIN, ACC_ROWS, ACC_SQUARES
-
     bad = status != layout.STATUS_OK
     if bad.any() and on_divergence != "mark":
         raise DivergenceError(divergence_message(status, fail_step, dt))

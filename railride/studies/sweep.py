@@ -127,6 +127,13 @@ def evaluate(
             if len(part_idx) > CHUNK:
                 parts[:0] = [part_idx[k : k + CHUNK] for k in range(0, len(part_idx), CHUNK)]
                 continue
+            if metrics_only:  # summed as the lane stepper steps, with no histories, where it takes the batch
+                from railride.run.checks import check
+                from railride.run.reduced import batch_metrics
+
+                m, diverged_at = batch_metrics(check(scs, pars, suspensions, solver, "mark"), window)
+                _add_rows(rows, cases, part_idx, m, diverged_at)
+                continue
             res = simulate(scs, pars, suspensions, solver=solver, on_divergence="mark")
             # a diverged run keeps its row, with NaN metrics and the time it diverged: the other
             # runs of the study go on

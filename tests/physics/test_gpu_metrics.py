@@ -14,7 +14,7 @@ from railride.errors import BackendWarning, InputError
 from railride.model.track import scenario
 from railride.run.checks import check
 from railride.run.reduced import batch_metrics, window_rows
-from railride.run import simulation
+from railride.run import reduced, simulation
 from railride.run.simulation import simulate
 from railride.run.solver import SolverSettings
 from railride.secondary.control import OUTER_LOOPS
@@ -159,6 +159,7 @@ def test_runs_the_gpu_does_not_take_go_in_cpu_sized_batches(monkeypatch):
         return run(plan, *args, **kw)
 
     monkeypatch.setattr(simulation, "run", counted)
+    monkeypatch.setattr(reduced, "run", counted)  # a metrics-only batch the lanes do not take
     monkeypatch.setattr(sweep, "CHUNK", 2)
     auto_gpu = SolverSettings(backend="gpu")  # method auto: the exact steps for passive runs
     rows = sweep.run_cases(cases, solver=auto_gpu)
@@ -167,7 +168,6 @@ def test_runs_the_gpu_does_not_take_go_in_cpu_sized_batches(monkeypatch):
 
 
 def test_a_gpu_failure_reruns_a_large_batch_on_the_cpu_in_small_batches(monkeypatch):
-    from railride.run import reduced
 
     reference, _ = _cpu_metrics(SHORT, LAWS[:5], None)
     monkeypatch.setattr(gpu, "_run_group", lambda *args: (_ for _ in ()).throw(RuntimeError("made up")))
