@@ -58,6 +58,7 @@ def profile(args: list) -> None:
     import threading
 
     import railride as rr
+    from railride.engine import lanes
     from railride.run import reduced, simulation
     from railride.studies import design as design_module
     from railride.studies import design_probes, sweep, tuning
@@ -81,6 +82,8 @@ def profile(args: list) -> None:
         def wrapper(*a, **kw):
             if label and inside:
                 return original(*a, **kw)
+            if count is not None and not count(a[0]):
+                return original(*a, **kw)
             inside.extend([label] if label else [])
             start = time.perf_counter()
             try:
@@ -89,7 +92,7 @@ def profile(args: list) -> None:
                 if label:
                     inside.pop()
                 into.append((label, start, time.perf_counter()) if label else (start, time.perf_counter()))
-                if count is not None and count(a[0]):
+                if count is not None:
                     with lock:
                         sample_steps[0] += a[0].n * a[0].n_steps
 
@@ -98,6 +101,27 @@ def profile(args: list) -> None:
     timed(simulation, "step", steps, count=lambda plan: True)
     # metrics-only batches on the GPU: the call (copies, kernels, sums) counts as stepping
     timed(reduced, "batch_metrics", steps, count=lambda plan: simulation.stepped_on(plan) == "gpu")
+    # metrics-only batches summed on the CPU's lanes (`reduced._on_lanes`, which passes ``sums``):
+    # their stepping, which `simulation.step` does not see
+    make_stepper = lanes.lanes_stepper
+
+    def lanes_stepper(*a, **kw):
+        step = make_stepper(*a, **kw)
+
+        def stepping(*args):
+            if len(args) < 14:  # no sums: `simulation.step`'s call, timed there
+                return step(*args)
+            start = time.perf_counter()
+            try:
+                return step(*args)
+            finally:
+                steps.append((start, time.perf_counter()))
+                with lock:
+                    sample_steps[0] += args[0] * args[4]  # runs x steps
+
+        return stepping
+
+    lanes.lanes_stepper = lanes_stepper
     timed(sweep, "evaluate", chunks)
     timed(tuning, "_tune_inner", stages, "inner loop (damper rig)")
     timed(tuning, "run_cases", stages, "tuning rounds")
