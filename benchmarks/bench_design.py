@@ -5,7 +5,7 @@ Run:  python benchmarks/bench_design.py [--out DIR] [other railride design optio
 Runs `railride design --out DIR` (default: a new temporary folder) in a child process and
 prints a Markdown row for docs/performance.md: the runs it evaluated, its wall time, the CPU
 time of the child as a share of one core, and the child's peak resident memory. The default
-design takes about 12-30 minutes on a 2-core machine. No test asserts timings.
+design takes about 10-30 minutes on a 2-core machine. No test asserts timings.
 
 --profile runs `railride.design` in this process (its defaults, but for the options named, no
 files written) and says where its wall time went: by stage (the inner loop, the tuning rounds,
