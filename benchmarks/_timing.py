@@ -1,5 +1,6 @@
 """What the benchmark scripts share: the best wall-clock time of a few repeats (the minimum is
-the least disturbed by other work on the machine)."""
+the least disturbed by other work on the machine), and the time covered by (start, end)
+intervals recorded in several threads."""
 
 import time
 
@@ -13,3 +14,19 @@ def min_time(fn, repeat: int, clock=time.perf_counter) -> float:
         fn()
         best = min(best, clock() - t0)
     return best
+
+
+def covered(intervals) -> float:
+    """The length of the union of (start, end) intervals [s]: the time at least one was open."""
+    total, end = 0.0, float("-inf")
+    for a, b in sorted(intervals):
+        if b <= end:
+            continue
+        total += b - max(a, end)
+        end = b
+    return total
+
+
+def clipped(intervals, spans) -> list:
+    """The parts of (start, end) ``intervals`` that lie within any of ``spans``."""
+    return [(max(a, c), min(b, d)) for a, b in intervals for c, d in spans if b > c and a < d]

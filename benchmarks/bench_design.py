@@ -9,9 +9,9 @@ design takes about 10-30 minutes on a 2-core machine. No test asserts timings.
 
 --profile runs `railride.design` in this process (its defaults, but for the options named, no
 files written) and says where its wall time went: by stage (the inner loop, the tuning rounds,
-the held-out runs, the probes, the rest), how long some chunk was stepping in each, and how
-long none was. On N threads the time no chunk steps is what keeps N - 1 cores idle (Amdahl), so
-it bounds what more cores can give.
+the held-out runs, the probes, the rest), how long some batch was stepping in each, how long
+none was, and how long no chunk was being worked on at all: work that more threads do not
+overlap as the design runs its chunks today.
 """
 
 from __future__ import annotations
@@ -24,6 +24,8 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+
+from _timing import clipped, covered  # benchmarks/_timing.py: run as a script, this folder is on the path
 
 
 def main():
@@ -56,6 +58,8 @@ def profile(args: list) -> None:
     import argparse
     import signal
     import threading
+
+    import numba
 
     import railride as rr
     from railride.engine import lanes
@@ -162,21 +166,22 @@ def profile(args: list) -> None:
     by: dict = {}
     for label, a, b in stages:
         by.setdefault(label, []).append((a, b))
-    covered = _union([(a, b) for spans in by.values() for a, b in spans])
-    stepping = _union(_clip(steps, [(t0, t1)]))
-    busy = _union(_clip(chunks, [(t0, t1)]))
+    in_stages = covered([(a, b) for spans in by.values() for a, b in spans])
+    stepping = covered(clipped(steps, [(t0, t1)]))
+    busy = covered(clipped(chunks, [(t0, t1)]))
     print(
-        f"{head}; wall {wall:.1f} s, CPU {cpu:.1f} s ({cpu / wall:.2f} cores busy), numba threads {_threads()}; "
+        f"{head}; wall {wall:.1f} s, CPU {cpu:.1f} s ({cpu / wall:.2f} cores busy), "
+        f"numba threads {numba.get_num_threads()}; "
         f"{sample_steps[0]:.3g} sample-steps, {sample_steps[0] / max(stepping, 1e-9):.3g} a second of stepping"
     )
     print("\n| stage | calls | wall | some batch stepping | none stepping | no chunk at all |")
     print("|---|---|---|---|---|---|")
     for label, spans in by.items():
-        w = _union(spans)
-        st = _union(_clip(steps, spans))
-        c = _union(_clip(chunks, spans))
+        w = covered(spans)
+        st = covered(clipped(steps, spans))
+        c = covered(clipped(chunks, spans))
         print(f"| {label} | {len(spans)} | {w:.1f} s | {st:.1f} s | {w - st:.1f} s | {w - c:.1f} s |")
-    rest = wall - covered
+    rest = wall - in_stages
     print(f"| the rest (checks, start, between rounds, summary) | - | {rest:.1f} s | - | {rest:.1f} s | {rest:.1f} s |")
     print(
         f"| **the whole design** | {len(chunks)} chunks | {wall:.1f} s | {stepping:.1f} s | {wall - stepping:.1f} s "
@@ -190,28 +195,6 @@ def profile(args: list) -> None:
     if was_cut:  # chunks still stepping in their threads would hold the exit
         sys.stdout.flush()
         os._exit(124)
-
-
-def _clip(intervals, spans) -> list:
-    """The parts of ``intervals`` within any of ``spans``."""
-    return [(max(a, c), min(b, d)) for a, b in intervals for c, d in spans if b > c and a < d]
-
-
-def _union(intervals) -> float:
-    """The length of the union of (start, end) intervals."""
-    total, end = 0.0, float("-inf")
-    for a, b in sorted(intervals):
-        if b <= end:
-            continue
-        total += b - max(a, end)
-        end = b
-    return total
-
-
-def _threads() -> int:
-    import numba
-
-    return numba.get_num_threads()
 
 
 if __name__ == "__main__":

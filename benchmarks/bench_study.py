@@ -27,6 +27,8 @@ import collections
 import resource
 import time
 
+from _timing import clipped, covered  # benchmarks/_timing.py: run as a script, this folder is on the path
+
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__)
@@ -104,7 +106,7 @@ def main():
         f"{wall:.1f} s | {n / wall:.1f} | {memory} |"
     )
     if intervals is not None:
-        stepping = _union([(max(a, t0), min(b, t1)) for a, b in intervals if b > t0 and a < t1])
+        stepping = covered(clipped(intervals, [(t0, t1)]))
         print(
             f"\nthreads {_threads()}: the stepper ran {stepping:.1f} s of the {wall:.1f} s; no chunk was stepping for "
             f"{wall - stepping:.1f} s, the serial share: {(wall - stepping) / wall * 100:.1f} %"
@@ -180,17 +182,6 @@ def _watch_steps() -> list:
 
     simulation.step = timed
     return intervals
-
-
-def _union(intervals) -> float:
-    """The length of the union of (start, end) intervals."""
-    total, end = 0.0, float("-inf")
-    for a, b in sorted(intervals):
-        if b <= end:
-            continue
-        total += b - max(a, end)
-        end = b
-    return total
 
 
 if __name__ == "__main__":

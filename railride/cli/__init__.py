@@ -77,7 +77,8 @@ def main() -> None:
     status: str | int | None = 0
     if sys.stdout is None:  # started with stdout closed (>&-): the output goes nowhere, as to a closed pipe
         sys.stdout = open(os.devnull, "w")
-    hook, sys.unraisablehook = sys.unraisablehook, _interrupt_again
+    hook = sys.unraisablehook
+    sys.unraisablehook = lambda unraisable: _interrupt_again(unraisable, hook)
     try:
         app = _load()
         app(prog_name="railride")
@@ -109,15 +110,15 @@ def main() -> None:
     sys.exit(status)
 
 
-def _interrupt_again(unraisable) -> None:
+def _interrupt_again(unraisable, hook) -> None:
     """`sys.unraisablehook` while a command runs. Python drops an exception raised where it cannot
     propagate (a weakref callback, a ``__del__``) with "Exception ignored in ..." and a traceback.
     Ctrl-C once landed there (importlib's module-lock callback, as the commands loaded), and the
     command ran on to its end with status 0. A KeyboardInterrupt is therefore delivered again, a
     moment later from another thread: raised within this hook it would be dropped too. Anything
-    else goes to Python's own hook."""
+    else goes to ``hook``, the one in place before."""
     if not issubclass(unraisable.exc_type, KeyboardInterrupt):
-        sys.__unraisablehook__(unraisable)
+        hook(unraisable)
         return
     import _thread
     import threading

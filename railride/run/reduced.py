@@ -45,7 +45,7 @@ def batch_metrics(plan: RunPlan, window=None) -> tuple[np.ndarray, np.ndarray]:
     On the CPU the lane stepper sums them likewise where it takes the batch; other batches run
     whole, in batches of `CPU_BATCH` whose histories bound the memory."""
     if stepped_on(plan) != "gpu":
-        return _on_lanes(plan, window) if _lanes_take(plan) else _on_cpu(plan, window)
+        return _on_lanes(plan, window)
     from railride.engine import gpu
 
     w0, w1 = window_rows(plan.n_out + 1, plan.solver.output_rate, window)
@@ -77,20 +77,14 @@ def _fresh_sums(n: int) -> np.ndarray:
     return acc
 
 
-def _lanes_take(plan: RunPlan) -> bool:
-    """Whether the CPU's lane stepper may run this plan's batch: RK4 and enough runs (one damper
-    and no realistic sensing, the rest of `railride.engine.lanes.lanes_fit`, need the packed
-    arrays: `_on_lanes` checks them)."""
-    from railride.engine.lanes import LANES
-
-    return not plan.exact and plan.n >= LANES
-
-
 def _on_lanes(plan: RunPlan, window) -> tuple[np.ndarray, np.ndarray]:
-    """`batch_metrics` on the CPU's lane stepper, summed as it steps (`run_lanes`' ``sums``);
-    a batch the lanes do not take after all (`lanes_fit`) runs whole (`_on_cpu`)."""
+    """`batch_metrics` on the CPU's lane stepper, summed as it steps (`run_lanes`' ``sums``); a
+    batch the lanes do not take (the exact steps, too few runs, or the rest of `lanes_fit`, which
+    reads the packed arrays) runs whole (`_on_cpu`)."""
     from railride.engine import lanes
 
+    if plan.exact or plan.n < lanes.LANES:  # before any packing
+        return _on_cpu(plan, window)
     w0, w1 = window_rows(plan.n_out + 1, plan.solver.output_rate, window)
     tables = inputs(plan)
     packed = pack(plan, tables, rows=2)  # two rows: "recorded" for the stepper, one row rewritten

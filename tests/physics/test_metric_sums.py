@@ -11,7 +11,6 @@ import pytest
 
 from railride.engine import lanes as engine_lanes
 from railride.model.track import scenario
-from railride.run import reduced
 from railride.run.checks import check
 from railride.run.reduced import batch_metrics
 from railride.run.simulation import run
@@ -44,8 +43,8 @@ def test_the_lane_sums_give_the_metrics_of_the_histories(batch, window, monkeypa
     tracks, suspensions = BATCHES[batch]
     assert len(suspensions) > engine_lanes.LANES
     used = []
-    on_lanes = reduced._on_lanes
-    monkeypatch.setattr(reduced, "_on_lanes", lambda *a: used.append(1) or on_lanes(*a))
+    stepper = engine_lanes.lanes_stepper
+    monkeypatch.setattr(engine_lanes, "lanes_stepper", lambda *a: used.append(1) or stepper(*a))
     summed, when = batch_metrics(check(tracks, None, suspensions, RK4, "mark"), window)
     assert used  # the lanes summed them: no histories
     kept, _ = _histories(check(tracks, None, suspensions, RK4, "mark"), window)
@@ -68,7 +67,7 @@ def test_a_diverging_run_has_nan_sums_its_time_and_the_others_stand():
 def test_batches_the_lanes_do_not_take_keep_their_histories(monkeypatch):
     # too few runs for a group of lanes: run whole, the metrics of their histories exactly
     few = LAWS[: engine_lanes.LANES - 1]
-    monkeypatch.setattr(reduced, "_on_lanes", lambda *a: pytest.fail("the lanes took a batch too small for them"))
+    monkeypatch.setattr(engine_lanes, "lanes_stepper", lambda *a: pytest.fail("the lanes took a batch too small"))
     summed, _ = batch_metrics(check(TRACK, None, few, RK4, "mark"))
     kept, _ = _histories(check(TRACK, None, few, RK4, "mark"), None)
     assert np.array_equal(summed, kept)
