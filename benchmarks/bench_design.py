@@ -2,6 +2,7 @@
 
 Run:  python benchmarks/bench_design.py [--out DIR] [other railride design options]
       python benchmarks/bench_design.py --profile [--controllers A,B] [--budget N] [--duration S]
+                                        [--backend auto|cpu|gpu] [--gpu-kernel general|special|lean|special-lean]
 Runs `railride design --out DIR` (default: a new temporary folder) in a child process and
 prints a Markdown row for docs/performance.md: the runs it evaluated, its wall time, the CPU
 time of the child as a share of one core, and the child's peak resident memory. The default
@@ -72,7 +73,17 @@ def profile(args: list) -> None:
     ap.add_argument("--budget", type=int, default=design_module.DEFAULT_BUDGET)
     ap.add_argument("--duration", type=float, default=design_module.DEFAULT_DURATION)
     ap.add_argument("--backend", default="auto", choices=["auto", "cpu", "gpu"])
+    ap.add_argument(
+        "--gpu-kernel", default=None, choices=["general", "special", "lean", "special-lean"],
+        help="the GPU kernel's build (bench_gpu_kernel.py --kernels); default: the package's",
+    )  # fmt: skip
     opts = ap.parse_args(args)
+    if opts.gpu_kernel is not None:
+        from bench_gpu_kernel import KERNELS
+
+        from railride.engine import gpu
+
+        gpu.SPECIALISE, gpu.LEAN_RK4 = KERNELS[opts.gpu_kernel]
     steps: list = []  # (start, end) of every batch's stepping (on the GPU: its call), any thread
     chunks: list = []  # (start, end) of every chunk's whole work (`evaluate`), any thread
     stages: list = []  # (name, start, end)
@@ -134,7 +145,7 @@ def profile(args: list) -> None:
     timed(design_probes, "references", stages, "probes' scores")
     timed(design_probes, "fault_check", stages, "probes' scores")
 
-    class Cut(Exception):
+    class Cut(BaseException):  # not an Exception: the GPU path takes those for its failures
         pass
 
     def cut(signum, frame):
@@ -145,7 +156,7 @@ def profile(args: list) -> None:
     cpu0 = time.process_time()
     t0 = time.perf_counter()
     head = f"design {opts.controllers or 'all laws'}, budget {opts.budget}, {opts.duration:g} s runs"
-    head += f", backend {opts.backend}"
+    head += f", backend {opts.backend}" + (f", GPU kernel {opts.gpu_kernel}" if opts.gpu_kernel else "")
     try:
         res = rr.design(
             controllers,

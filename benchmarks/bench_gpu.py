@@ -211,7 +211,7 @@ def _host_only(controllers) -> None:
 
     if not gpu.simulated():
         sys.exit("bench_gpu: --host-only runs in the simulator: set NUMBA_ENABLE_CUDASIM=1")
-    gpu._device_functions = lambda: _StandIn()
+    gpu._device_functions = lambda *key: _StandIn()
     inside = [0.0]  # in the GPU calls: the simulator's copies and device arrays, the stand-in
     run_gpu = gpu.run_gpu
 
@@ -251,7 +251,7 @@ def _host_batch(samples: int, duration: float, law: str, output_rate: float):
 
     if not gpu.simulated():
         sys.exit("bench_gpu: --host-batch runs in the simulator: set NUMBA_ENABLE_CUDASIM=1")
-    gpu._device_functions = lambda: _StandIn()
+    gpu._device_functions = lambda *key: _StandIn()
     on_gpu = SolverSettings(output_rate=output_rate, backend="gpu")
     scs, susp = _batch(min(samples, 256), duration, law)
     batch_metrics(check(scs, None, susp, on_gpu, "mark", histories=False))  # compiles the tables' parts

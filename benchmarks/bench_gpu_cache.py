@@ -33,7 +33,7 @@ from railride.run.solver import SolverSettings
 warnings.simplefilter("always")
 with warnings.catch_warnings(record=True) as caught:
     gpu._array_overloads()
-    gpu._compiled["kernel"] = cuda.jit(gpu._kernel, cache=True)
+    gpu._compile = lambda key: cuda.jit(gpu._kernel_for(*key), cache=True)
     scs, susp = _batch(64, 0.1, "sas-attitude-ride")
     on_gpu, on_cpu = SolverSettings(backend="gpu"), SolverSettings(backend="cpu")
     t0 = time.perf_counter()

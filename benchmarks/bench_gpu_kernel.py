@@ -1,7 +1,7 @@
 """The GPU kernel's resources and what they cost (railride.engine.gpu).
 
-Run:  python benchmarks/bench_gpu_kernel.py --resources [--registers none,168,128,96]
-      python benchmarks/bench_gpu_kernel.py [--registers none,128] [--samples 1024,32768] [--duration 1]
+Run:  python benchmarks/bench_gpu_kernel.py --resources [--registers none,168,128,96] [--kernels general,lean]
+      python benchmarks/bench_gpu_kernel.py [--registers none,128] [--kernels ...] [--samples 1024,32768] [--duration 1]
       python benchmarks/bench_gpu_kernel.py --concurrent 8 [--duration 2]
       ncu --set full -k regex:_kernel -c 1 python benchmarks/bench_gpu_kernel.py --profile-run
 
@@ -13,6 +13,9 @@ Run:  python benchmarks/bench_gpu_kernel.py --resources [--registers none,168,12
   Specifications per Compute Capability": 65,536 registers, 64 warps and 32 blocks per
   multiprocessor; registers given to a warp in units of 256). A driver's own compile of the PTX
   may differ from this ptxas's.
+* ``--kernels``: which builds of the kernel (`gpu._kernel_for`): ``general`` (the one for any
+  batch), ``special`` (the damper law fixed, faults and sensing left out: the batches below),
+  ``lean`` (one RK4 stage rate and a running sum) and ``special-lean``; each under each limit.
 * With a GPU, the same register limits on batches of ``--samples`` SAS closed loops
   (`bench_gpu._batch`): the kernels' seconds, sample-steps per second, the kernels' time per
   step (what one thread takes per step where all the batch's threads are resident at once),
@@ -21,9 +24,10 @@ Run:  python benchmarks/bench_gpu_kernel.py --resources [--registers none,168,12
 * ``--concurrent K`` (GPU): K batches of 32 runs, as a study's chunks in flight send them (a
   design's held-out runs with their comfort), from K threads at once and then one after another:
   whether the kernels of calls on their own streams overlap on the device.
-* ``--profile-run`` (GPU): one launch of the kernel on ``--samples`` runs (the first size given)
-  of 0.01 s and nothing else, for a profiler to attach to (NVIDIA Nsight Compute, ``ncu``:
-  where its time goes, occupancy, memory traffic and what its warps wait on).
+* ``--profile-run`` (GPU): one launch of the kernel (the first of ``--kernels``) on ``--samples``
+  runs (the first size given) of 0.01 s and nothing else, for a profiler to attach to (NVIDIA
+  Nsight Compute, ``ncu``: where its time goes, occupancy, memory traffic and what its warps
+  wait on).
 Prints Markdown rows for docs/gpu.md with the device and date. No test asserts timings.
 """
 
@@ -81,22 +85,49 @@ def _ptxas() -> str:
     return found
 
 
-def _resources(limits) -> None:
+#: the builds of ``--kernels``: (SPECIALISE, LEAN_RK4)
+KERNELS = {"general": (False, False), "special": (True, False), "lean": (False, True), "special-lean": (True, True)}
+
+
+def _kernels(text: str) -> list[str]:
+    names = text.split(",")
+    unknown = [k for k in names if k not in KERNELS]
+    if unknown:
+        sys.exit(f"bench_gpu_kernel: --kernels {','.join(unknown)}: not one of {', '.join(KERNELS)}")
+    return names
+
+
+def _key(name: str) -> tuple:
+    """The kernel key of build ``name`` for the benchmark's batches (Bouc-Wen, SAS, healthy, exact
+    sensing)."""
+    from railride.engine.layout import LAW_BOUC_WEN
+
+    special, lean = KERNELS[name]
+    return (LAW_BOUC_WEN, False, False, lean) if special else (-1, True, True, lean)
+
+
+def _resources(limits, kernels) -> None:
     from railride.engine import gpu
 
     if gpu.simulated():
         sys.exit("bench_gpu_kernel: --resources compiles for a GPU: run it with NUMBA_ENABLE_CUDASIM=0")
-    t0 = time.perf_counter()
-    code = gpu.ptx((9, 0))
-    compiled = time.perf_counter() - t0
     ptxas = _ptxas()
     version = subprocess.run([ptxas, "--version"], capture_output=True, text=True).stdout.strip().splitlines()[-1]
-    print(f"ptxas: {version}; sm_90; {datetime.date.today().isoformat()}; PTX made in {compiled:.1f} s")
+    print(f"ptxas: {version}; sm_90; {datetime.date.today().isoformat()}")
     print(
-        "\n| register limit | registers | stack frame | spill stores | spill loads "
-        "| blocks of 128 per SM | occupancy |"
+        "\n| kernel | register limit | registers | stack frame | spill stores | spill loads "
+        "| blocks of 128 per SM | occupancy | PTX made in |"
     )  # fmt: skip
-    print("|---|---|---|---|---|---|---|")
+    print("|---|---|---|---|---|---|---|---|---|")
+    for name in kernels:
+        t0 = time.perf_counter()
+        code = gpu.ptx((9, 0), _key(name))
+        _assemble(ptxas, code, limits, name, time.perf_counter() - t0)
+
+
+def _assemble(ptxas, code, limits, name, compiled) -> None:
+    from railride.engine import gpu
+
     with tempfile.TemporaryDirectory() as tmp:
         src = Path(tmp) / "kernel.ptx"
         src.write_text(code)
@@ -112,12 +143,12 @@ def _resources(limits) -> None:
             ).groups()
             blocks, occ = occupancy(regs, gpu.THREADS_PER_BLOCK)
             print(
-                f"| {'none' if limit is None else limit} | {regs} | {frame} B | {stores} B | {loads} B "
-                f"| {blocks} | {occ * 100:.1f} % |"
+                f"| {name} | {'none' if limit is None else limit} | {regs} | {frame} B | {stores} B | {loads} B "
+                f"| {blocks} | {occ * 100:.1f} % | {compiled:.1f} s |"
             )
 
 
-def _timed(limits, sizes, duration: float) -> None:
+def _timed(limits, kernels, sizes, duration: float) -> None:
     from bench_gpu import _batch
 
     from railride.engine import gpu
@@ -128,12 +159,13 @@ def _timed(limits, sizes, duration: float) -> None:
     steps = round(duration / on_gpu.dt)
     print(f"{gpu.device_name()}; {os.cpu_count()} CPU cores; {datetime.date.today().isoformat()}")
     print(
-        "\n| register limit | compile | samples | kernels | sample-steps/s | kernel time per step "
-        "| largest difference from the first limit |"
+        "\n| kernel | register limit | compile | samples | kernels | sample-steps/s | kernel time per step (us) "
+        "| largest difference from the first |"
     )  # fmt: skip
-    print("|---|---|---|---|---|---|---|")
+    print("|---|---|---|---|---|---|---|---|")
     first: dict = {}
-    for limit in limits:
+    for name, limit in [(k, r) for k in kernels for r in limits]:
+        gpu.SPECIALISE, gpu.LEAN_RK4 = KERNELS[name]
         gpu.MAX_REGISTERS = limit
         gpu._compiled.clear()
         scs, susp = _batch(32, 0.01, "sas-attitude-ride")
@@ -148,7 +180,7 @@ def _timed(limits, sizes, duration: float) -> None:
             ref = first.setdefault(n, q)
             diff = float(np.nanmax(np.abs(q - ref)) / np.nanmax(np.abs(ref)))
             print(
-                f"| {'none' if limit is None else limit} | {compile_s:.1f} s | {n:,} | {k:.3f} s "
+                f"| {name} | {'none' if limit is None else limit} | {compile_s:.1f} s | {n:,} | {k:.3f} s "
                 f"| {n * steps / k:.3g} | {k / steps * 1e6:.1f} | {diff:.1e} |"
             )
 
@@ -189,29 +221,34 @@ def _concurrent(k: int, duration: float) -> None:
     )
 
 
-def _profile_run(n: int) -> None:
+def _profile_run(n: int, kernel: str) -> None:
     from bench_gpu import _batch
 
     from railride.engine import gpu
     from railride.run.simulation import simulate
     from railride.run.solver import SolverSettings
 
+    gpu.SPECIALISE, gpu.LEAN_RK4 = KERNELS[kernel]
     scs, susp = _batch(n, 0.01, "sas-attitude-ride")
     simulate(scs, suspension=susp, solver=SolverSettings(output_rate=200.0, backend="gpu"))
-    print(f"{gpu.device_name()}: one launch of {n} runs of 0.01 s; kernels {gpu.last_call()['kernel_s']:.3f} s")
+    print(
+        f"{gpu.device_name()}: one launch of the {kernel} kernel on {n} runs of 0.01 s; "
+        f"kernels {gpu.last_call()['kernel_s']:.3f} s"
+    )
 
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--resources", action="store_true")
     ap.add_argument("--registers", default="none,168,128,96", help="register limits (none: the compiler's)")
+    ap.add_argument("--kernels", default="general", help=f"builds of the kernel: {', '.join(KERNELS)}")
     ap.add_argument("--samples", default="1024,32768", help="batch sizes, comma-separated")
     ap.add_argument("--duration", type=float, default=1.0)
     ap.add_argument("--concurrent", type=int, default=0)
     ap.add_argument("--profile-run", action="store_true")
     args = ap.parse_args()
     if args.resources:
-        _resources(_limits(args.registers))
+        _resources(_limits(args.registers), _kernels(args.kernels))
         return
     from railride.engine import gpu
 
@@ -222,9 +259,9 @@ def main():
         _concurrent(args.concurrent, args.duration)
         return
     if args.profile_run:
-        _profile_run(int(args.samples.split(",")[0]))
+        _profile_run(int(args.samples.split(",")[0]), _kernels(args.kernels)[0])
         return
-    _timed(_limits(args.registers), [int(v) for v in args.samples.split(",")], args.duration)
+    _timed(_limits(args.registers), _kernels(args.kernels), [int(v) for v in args.samples.split(",")], args.duration)
 
 
 if __name__ == "__main__":

@@ -6,7 +6,15 @@
 #
 # Run:  bash benchmarks/device_check.sh [BUDGET_S]      (default 580 s in all)
 #       bash benchmarks/device_check.sh --gpu [BUDGET_S]  (steps 1 to 8: the GPU's and the design)
+#       bash benchmarks/device_check.sh --kernels [BUDGET_S]  (the machine, then the kernel's builds: below)
 #       bash benchmarks/device_check.sh --smoke          (here: the simulator, tiny sizes, a check of the script)
+#
+# --kernels: the builds of the GPU kernel (bench_gpu_kernel.py --kernels: general, special, lean,
+# special-lean) timed on 1,024, 8,192 and 32,768 SAS closed loops; Nsight Compute on one launch of
+# the general and the special-lean kernel on 32,768 runs (where the image has ncu); the GPU tests
+# on the device (the general kernel: a build for every case of the tests would compile a dozen
+# kernels); the default design on the GPU with the special-lean kernel (cut at 150 s);
+# special-lean under register limits of 128 and 96 with what the budget leaves.
 #
 # Steps, most wanted first; each gets at most its cap and what is left of the budget, and one
 # that runs out is cut and said so in the log, so the run ends inside the budget:
@@ -41,8 +49,10 @@ set -u
 cd "$(dirname "$0")/.."
 SMOKE=0
 GPU_ONLY=0
+KERNELS_ONLY=0
 BUDGET=580
 if [ "${1:-}" = "--gpu" ]; then GPU_ONLY=1; shift; fi
+if [ "${1:-}" = "--kernels" ]; then KERNELS_ONLY=1; shift; fi
 if [ "${1:-}" = "--smoke" ]; then SMOKE=1; BUDGET=900; elif [ -n "${1:-}" ]; then BUDGET=$1; fi
 OUT=${OUT:-/tmp/railride_device_check}
 mkdir -p "$OUT"
@@ -93,6 +103,44 @@ step machine 30 bash -c "date -u; nproc; (lscpu | grep -E 'Model name|Thread|Cor
 $PY -c 'import sys, numpy, scipy, numba; print(sys.version.split()[0], \"numpy\", numpy.__version__, \"scipy\", scipy.__version__, \"numba\", numba.__version__)'; \
 $PY -c 'import importlib.metadata as m; print(\"numba-cuda\", m.version(\"numba-cuda\"))' || echo 'no numba-cuda'; \
 $PY -c 'from railride.run.solver import gpu_missing; print(\"railride sees a usable GPU\" if gpu_missing() is None else \"railride: \" + gpu_missing())'"
+
+# each step and how it ended, at the end of the log (the device tool returns the last 12,000 characters)
+finish() {
+  echo "" | tee -a "$LOG"
+  echo "done in $(($(date +%s) - START)) s of a $BUDGET s budget" | tee -a "$LOG"
+  echo "" | tee -a "$LOG"
+  echo "## summary" | tee -a "$LOG"
+  grep -E '^## |^exit [0-9]+ after|^cut: |^skipped: ' "$LOG" | grep -v '^## summary' | paste - - | tee -a "$LOG"
+}
+
+if [ "$KERNELS_ONLY" = 1 ]; then
+  if [ "$SMOKE" = 1 ]; then  # the simulator times nothing: the kernels' resources instead, and a small design
+    step gpu-kernel-builds 200 env NUMBA_ENABLE_CUDASIM=0 $PY benchmarks/bench_gpu_kernel.py --resources \
+      --registers none --kernels general,special-lean
+    step design-on-gpu 30 $PY benchmarks/bench_design.py --profile --backend gpu --gpu-kernel special-lean \
+      --controllers pid --budget 25 --duration 0.05
+    finish
+    exit 0
+  fi
+  step gpu-kernel-builds 200 $PY benchmarks/bench_gpu_kernel.py --kernels general,special,lean,special-lean \
+    --registers none --samples 1024,8192,32768
+  for k in general special-lean; do
+    if command -v ncu >/dev/null 2>&1; then
+      step "gpu-ncu-$k" 75 ncu --section LaunchStats --section Occupancy --section SpeedOfLight \
+        --section MemoryWorkloadAnalysis --section WarpStateStats -k regex:_kernel -c 1 \
+        $PY benchmarks/bench_gpu_kernel.py --profile-run --samples 32768 --kernels "$k"
+    else
+      step "gpu-ncu-$k" 10 echo "no ncu on the PATH: the kernel not profiled"
+    fi
+  done
+  step gpu-tests 100 $PY -m pytest -q -p no:randomly -p no:cacheprovider -k "not specialised" \
+    tests/physics/test_gpu.py tests/physics/test_gpu_metrics.py
+  step design-on-gpu 150 $PY benchmarks/bench_design.py --profile --backend gpu --gpu-kernel special-lean
+  step gpu-kernel-registers 80 $PY benchmarks/bench_gpu_kernel.py --kernels special-lean --registers 128,96 \
+    --samples 8192,32768
+  finish
+  exit 0
+fi
 
 step gpu-throughput 90 $PY benchmarks/bench_gpu.py --samples "$GPU_SAMPLES" --duration "$DURATION" --cpu --check "$CHECK" --metrics-only
 
@@ -155,9 +203,4 @@ fi
 step lane-sizes 90 $PY benchmarks/bench_dampers.py --lane-sizes --repeat 3 --threads "$THREADS" --sizes "$SIZES"
 fi
 
-echo "" | tee -a "$LOG"
-echo "done in $(($(date +%s) - START)) s of a $BUDGET s budget" | tee -a "$LOG"
-# each step and how it ended, at the end of the log (the device tool returns the last 12,000 characters)
-echo "" | tee -a "$LOG"
-echo "## summary" | tee -a "$LOG"
-grep -E '^## |^exit [0-9]+ after|^cut: |^skipped: ' "$LOG" | grep -v '^## summary' | paste - - | tee -a "$LOG"
+finish

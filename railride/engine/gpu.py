@@ -90,6 +90,12 @@ THREADS_PER_BLOCK = 128
 #: set before the first compile. Fewer registers let more threads share a multiprocessor, at the
 #: cost of more spills to local memory (`benchmarks/bench_gpu_kernel.py --resources`, docs/gpu.md)
 MAX_REGISTERS: int | None = None
+#: compile a kernel for each kind of batch (`kernel_key`): its damper law fixed, and faults and
+#: realistic sensing left out where no sample has them, for less thread-local memory; False:
+#: one kernel for every batch (one compile a process)
+SPECIALISE = False
+#: RK4 with one stage rate and a running sum in place of the four stage rates (`_lean_rk4`)
+LEAN_RK4 = False
 #: the share of the device's free memory one group of samples may take
 MEMORY_SHARE = 0.6
 # what the calling thread's last `run_gpu` took (`last_call`)
@@ -102,7 +108,6 @@ _COMPILING = threading.Lock()
 _SIMULATOR = threading.Lock()
 # the sizes of the kernel's thread-local arrays: names, since a local array's size must be a
 # constant, not an expression
-_N_RATES = 4 * NS_MAX  # the four RK4 stage rates
 _N_FORCING = 3 * N_DOF  # the rail forcing at a sub-step's start, middle and end
 _N_MEAS = 2 * N_DOF  # the controller's sample of (q, q')
 
@@ -202,124 +207,169 @@ def _forcing(t, ftab, off, n_nodes, interval, R, roff):
         )
 
 
-# fmt: off
-def _kernel(
-    n, law, x, step0, n_steps, final, stride, row0, dt, lam1, vid, A, TS, c_sec, stops, P, vcmd, utab, u_off, ftab,
-    f_off, n_nodes, interval, closed_loop, ctrl_stride, Gm, Hm, inner, noise, faults, sensing, snoise, out_q, out_v,
-    out_a, out_f, out_w, out_wd, out_d, out_fd, out_vc, status, fail_step, reduce, win, acc,
-):
-    # fmt: on
-    """One thread per sample smp < n: `kernels._run_samples`'s loop body for that sample. The
-    vehicle's matrices are A[vid[smp]], TS[vid[smp]]; the outputs hold the rows from row0 on.
-    With ``reduce``, the outputs hold one row, rewritten at every output step, and the rows
-    win[0] <= row <= win[1] go into the sample's metric sums acc[smp] (`sample_parts.accumulate_metrics`)."""
-    smp = cuda.grid(1)
-    if smp >= n or status[smp] != STATUS_OK:
-        return
-    has_states = law != LAW_VISCOUS_IN_C and law != LAW_IDEAL
-    ns = NS_MAX if has_states else 2 * N_DOF
-    xs = x[smp]
-    s = cuda.local.array(NS_MAX, float64)
-    st = cuda.local.array(NS_MAX, float64)
-    K = cuda.local.array(_N_RATES, float64)
-    for i in range(NS_MAX):
-        s[i] = xs[i]
-        st[i] = 0.0  # the states a law without any still reads
-    for i in range(4 * NS_MAX):
-        K[i] = 0.0
-    y = cuda.local.array(NY, float64)
-    cx = cuda.local.array(N_CORNER, float64)
-    cv = cuda.local.array(N_CORNER, float64)
-    R = cuda.local.array(_N_FORCING, float64)
-    w = cuda.local.array(N_RAIL, float64)
-    wd = cuda.local.array(N_RAIL, float64)
-    fsave = cuda.local.array(N_CORNER, float64)
-    vc = cuda.local.array(N_CORNER, float64)
-    conn = cuda.local.array(N_CORNER, float64)
-    meas = cuda.local.array(_N_MEAS, float64)
-    # the small rows the laws read, in thread-local copies
-    pp = cuda.local.array(N_PACKED, float64)
-    for i in range(N_PACKED):
-        pp[i] = P[smp, i]
-    tt = cuda.local.array((N_DOF, N_CORNER), float64)
-    for i in range(N_DOF):
+def _kernel_for(fixed_law: int, with_faults: bool, with_sensing: bool, lean: bool):
+    """The kernel's Python function for one kind of batch. Its arguments are constants of the
+    compile: ``fixed_law`` >= 0 is the damper law of every sample (LAW_*; -1: read from the
+    ``law`` argument), ``with_faults`` / ``with_sensing`` False leave the fault checks and the
+    accelerometers out (a batch with no faulty sample, no realistic sensing), and ``lean`` steps
+    RK4 with one stage rate and a running sum of them instead of the four stage rates side by
+    side. A kernel without what it does not need has less thread-local memory (docs/gpu.md)."""
+    # local arrays' sizes must be constants of the compile
+    n_rates, n_sum = (NS_MAX, NS_MAX) if lean else (4 * NS_MAX, 1)
+
+    # fmt: off
+    def _kernel(
+        n, law_arg, x, step0, n_steps, final, stride, row0, dt, lam1, vid, A, TS, c_sec, stops, P, vcmd, utab, u_off,
+        ftab, f_off, n_nodes, interval, closed_loop, ctrl_stride, Gm, Hm, inner, noise, faults, sensing, snoise, out_q,
+        out_v, out_a, out_f, out_w, out_wd, out_d, out_fd, out_vc, status, fail_step, reduce, win, acc,
+    ):
+        # fmt: on
+        """One thread per sample smp < n: `kernels._run_samples`'s loop body for that sample. The
+        vehicle's matrices are A[vid[smp]], TS[vid[smp]]; the outputs hold the rows from row0 on.
+        With ``reduce``, the outputs hold one row, rewritten at every output step, and the rows
+        win[0] <= row <= win[1] go into the sample's metric sums acc[smp] (`sample_parts.accumulate_metrics`)."""
+        smp = cuda.grid(1)
+        if smp >= n or status[smp] != STATUS_OK:
+            return
+        law = law_arg if fixed_law < 0 else fixed_law
+        has_states = law != LAW_VISCOUS_IN_C and law != LAW_IDEAL
+        ns = NS_MAX if has_states else 2 * N_DOF
+        xs = x[smp]
+        s = cuda.local.array(NS_MAX, float64)
+        st = cuda.local.array(NS_MAX, float64)
+        K = cuda.local.array(n_rates, float64)
+        ksum = cuda.local.array(n_sum, float64)  # lean: the stage rates' weighted sum
+        for i in range(NS_MAX):
+            s[i] = xs[i]
+            st[i] = 0.0  # the states a law without any still reads
+        for i in range(n_rates):
+            K[i] = 0.0
+        y = cuda.local.array(NY, float64)
+        cx = cuda.local.array(N_CORNER, float64)
+        cv = cuda.local.array(N_CORNER, float64)
+        R = cuda.local.array(_N_FORCING, float64)
+        w = cuda.local.array(N_RAIL, float64)
+        wd = cuda.local.array(N_RAIL, float64)
+        fsave = cuda.local.array(N_CORNER, float64)
+        vc = cuda.local.array(N_CORNER, float64)
+        conn = cuda.local.array(N_CORNER, float64)
+        meas = cuda.local.array(_N_MEAS, float64)
+        # the small rows the laws read, in thread-local copies
+        pp = cuda.local.array(N_PACKED, float64)
+        for i in range(N_PACKED):
+            pp[i] = P[smp, i]
+        tt = cuda.local.array((N_DOF, N_CORNER), float64)
+        for i in range(N_DOF):
+            for c in range(N_CORNER):
+                tt[i, c] = TS[vid[smp], i, c]
+        zk = cuda.local.array(2, float64)
+        zk[0] = stops[smp, 0]
+        zk[1] = stops[smp, 1]
+        fm = cuda.local.array(N_FAULT_COLS, int64)
+        faulty = False  # a healthy sample skips the fault checks
+        for i in range(N_FAULT_COLS):
+            fm[i] = faults[smp, i]
         for c in range(N_CORNER):
-            tt[i, c] = TS[vid[smp], i, c]
-    zk = cuda.local.array(2, float64)
-    zk[0] = stops[smp, 0]
-    zk[1] = stops[smp, 1]
-    fm = cuda.local.array(N_FAULT_COLS, int64)
-    faulty = False  # a healthy sample skips the fault checks
-    for i in range(N_FAULT_COLS):
-        fm[i] = faults[smp, i]
-    for c in range(N_CORNER):
-        vc[c] = vcmd[smp, c]
-        conn[c] = 1.0
-        faulty = faulty or fm[F_MODE + c] != FAULT_NONE
-    at = A[vid[smp]]
-    cs = c_sec[smp]
-    uo, fo, nn, itv = u_off[smp], f_off[smp], n_nodes[smp], interval[smp]
-    gm, hm = Gm[smp], Hm[smp]
-    delay = int(inner[smp, I_DELAY])
-    tc = ctrl_stride * dt
-    srow = sensing[smp]
-    sens = closed_loop and srow[S_ON] > 0.0
-    w_aa = srow[S_W_AA]
-    hp = 1.0 / (1.0 + srow[S_W_C] * tc)
-    bw1 = law == LAW_BOUC_WEN and pp[P_N] == 1.0
-    gb1 = pp[P_N] * (abs(pp[P_GAMMA]) + abs(pp[P_BETA]))
-    out4 = (out_q, out_v, out_a, out_f)
-    out5 = (out_w, out_wd, out_d, out_fd, out_vc)
-    _forcing(step0 * dt, ftab, fo, nn, itv, R, 0)
-    last = n_steps + 1 if final else n_steps
-    for n_ in range(last):
-        step = step0 + n_
-        t = step * dt
-        if closed_loop and step % ctrl_stride == 0:
-            controller_sample(xs, step // ctrl_stride, delay, s, meas, sens, srow, snoise, noise, tc, hp, gm, hm)
-        if closed_loop and law == LAW_IDEAL:
-            for c in range(N_CORNER):
-                vc[c] = xs[FD_HELD + c]
-        if faulty:
-            for c in range(N_CORNER):
-                if fault_at(fm, c, step) == FAULT_DISCONNECTED:
-                    conn[c] = 0.0
-        _derivative(law, s, R, 0, at, tt, pp, vc, conn, y, cx, cv, K, 0, zk, fsave)
-        if sens:
-            accelerometer_filters(xs, tt, K, dt, w_aa)
-        if closed_loop and law != LAW_IDEAL:
-            inner_loop(int(inner[smp, I_LAW]), inner[smp, I_B], inner[smp, I_G], y, xs, cv, pp, vc, s, K)
-        if faulty:
-            hold_failed_coils(fm, step, vc, pp, s, K)
-        if step % stride == 0:
-            row = 0 if reduce else step // stride - row0
-            if record_row(smp, row, t, law, s, K, y, cv, tt, cs, xs, vc, utab, uo, nn, itv, w, wd, out4, out5):
-                status[smp] = STATUS_DIVERGED
-                fail_step[smp] = step
+            vc[c] = vcmd[smp, c]
+            conn[c] = 1.0
+            faulty = faulty or fm[F_MODE + c] != FAULT_NONE
+        faulty = with_faults and faulty
+        at = A[vid[smp]]
+        cs = c_sec[smp]
+        uo, fo, nn, itv = u_off[smp], f_off[smp], n_nodes[smp], interval[smp]
+        gm, hm = Gm[smp], Hm[smp]
+        delay = int(inner[smp, I_DELAY])
+        tc = ctrl_stride * dt
+        srow = sensing[smp]
+        sens = with_sensing and closed_loop and srow[S_ON] > 0.0
+        w_aa = srow[S_W_AA]
+        hp = 1.0 / (1.0 + srow[S_W_C] * tc)
+        bw1 = law == LAW_BOUC_WEN and pp[P_N] == 1.0
+        gb1 = pp[P_N] * (abs(pp[P_GAMMA]) + abs(pp[P_BETA]))
+        out4 = (out_q, out_v, out_a, out_f)
+        out5 = (out_w, out_wd, out_d, out_fd, out_vc)
+        _forcing(step0 * dt, ftab, fo, nn, itv, R, 0)
+        last = n_steps + 1 if final else n_steps
+        for n_ in range(last):
+            step = step0 + n_
+            t = step * dt
+            if closed_loop and step % ctrl_stride == 0:
+                controller_sample(xs, step // ctrl_stride, delay, s, meas, sens, srow, snoise, noise, tc, hp, gm, hm)
+            if closed_loop and law == LAW_IDEAL:
+                for c in range(N_CORNER):
+                    vc[c] = xs[FD_HELD + c]
+            if faulty:
+                for c in range(N_CORNER):
+                    if fault_at(fm, c, step) == FAULT_DISCONNECTED:
+                        conn[c] = 0.0
+            _derivative(law, s, R, 0, at, tt, pp, vc, conn, y, cx, cv, K, 0, zk, fsave)
+            if sens:
+                accelerometer_filters(xs, tt, K, dt, w_aa)
+            if closed_loop and law != LAW_IDEAL:
+                inner_loop(int(inner[smp, I_LAW]), inner[smp, I_B], inner[smp, I_G], y, xs, cv, pp, vc, s, K)
+            if faulty:
+                hold_failed_coils(fm, step, vc, pp, s, K)
+            if step % stride == 0:
+                row = 0 if reduce else step // stride - row0
+                if record_row(smp, row, t, law, s, K, y, cv, tt, cs, xs, vc, utab, uo, nn, itv, w, wd, out4, out5):
+                    status[smp] = STATUS_DIVERGED
+                    fail_step[smp] = step
+                    break
+                if reduce and win[0] <= step // stride <= win[1]:
+                    accumulate_metrics(acc, smp, out_q, out_a)
+            if n_ == n_steps:
                 break
-            if reduce and win[0] <= step // stride <= win[1]:
-                accumulate_metrics(acc, smp, out_q, out_a)
-        if n_ == n_steps:
-            break
-        m = substep_count(law, bw1, gb1, lam1, pp, cv, s, dt)
-        h = dt / m
-        for sub in range(m):
-            ts = t + sub * h
-            _forcing(ts + 0.5 * h, ftab, fo, nn, itv, R, N_DOF)
-            _forcing(ts + h, ftab, fo, nn, itv, R, 2 * N_DOF)
-            for stage in range(4):
-                if stage == 0 and sub == 0:
-                    continue
-                ch = h * (0.0 if stage == 0 else (0.5 if stage < 3 else 1.0))
-                roff = N_DOF * (0 if stage == 0 else (1 if stage < 3 else 2))
-                prev = NS_MAX * (stage - 1 if stage > 0 else 0)
-                rk4_stage_state(st, s, K, prev, ch, has_states)
-                _derivative(law, st, R, roff, at, tt, pp, vc, conn, y, cx, cv, K, NS_MAX * stage, zk, fsave)
-            rk4_advance(s, K, h, has_states)
-            for i in range(N_DOF):
-                R[i] = R[2 * N_DOF + i]
-    for i in range(ns):
-        xs[i] = s[i]
+            m = substep_count(law, bw1, gb1, lam1, pp, cv, s, dt)
+            h = dt / m
+            for sub in range(m):
+                ts = t + sub * h
+                _forcing(ts + 0.5 * h, ftab, fo, nn, itv, R, N_DOF)
+                _forcing(ts + h, ftab, fo, nn, itv, R, 2 * N_DOF)
+                if lean:
+                    _lean_rk4(law, s, st, K, ksum, h, sub, has_states, R, at, tt, pp, vc, conn, y, cx, cv, zk, fsave)
+                else:
+                    for stage in range(4):
+                        if stage == 0 and sub == 0:
+                            continue
+                        ch = h * (0.0 if stage == 0 else (0.5 if stage < 3 else 1.0))
+                        roff = N_DOF * (0 if stage == 0 else (1 if stage < 3 else 2))
+                        prev = NS_MAX * (stage - 1 if stage > 0 else 0)
+                        rk4_stage_state(st, s, K, prev, ch, has_states)
+                        _derivative(law, st, R, roff, at, tt, pp, vc, conn, y, cx, cv, K, NS_MAX * stage, zk, fsave)
+                    rk4_advance(s, K, h, has_states)
+                for i in range(N_DOF):
+                    R[i] = R[2 * N_DOF + i]
+        for i in range(ns):
+            xs[i] = s[i]
+
+    return _kernel
+
+
+@njit(inline="always", fastmath=_FAST)
+def _lean_rk4(law, s, st, K, ksum, h, sub, has_states, R, at, tt, pp, vc, conn, y, cx, cv, zk, fsave):
+    """One RK4 sub-step of length h with one stage rate K (its first NS_MAX) and the running sum
+    ksum = K1 + 2 K2 + 2 K3 (+ K4), summed in the order of `rk4_advance`: the same arithmetic as
+    the four stage rates side by side, in half their memory. At sub-step 0, K holds stage 1's
+    rate already (the step's start, with the inner loop's coil rates)."""
+    n = NS_MAX if has_states else 2 * N_DOF
+    if sub > 0:
+        _derivative(law, s, R, 0, at, tt, pp, vc, conn, y, cx, cv, K, 0, zk, fsave)
+    for i in range(n):
+        ksum[i] = K[i]
+    for stage in range(1, 4):
+        ch = h * (0.5 if stage < 3 else 1.0)
+        for i in range(n):
+            st[i] = s[i] + ch * K[i]
+        _derivative(law, st, R, N_DOF * (1 if stage < 3 else 2), at, tt, pp, vc, conn, y, cx, cv, K, 0, zk, fsave)
+        wgt = 2.0 if stage < 3 else 1.0
+        for i in range(n):
+            ksum[i] += wgt * K[i]
+    for i in range(n):
+        s[i] += h / 6.0 * ksum[i]
+
+
+#: the kernel for any batch: every damper law, faults and sensing, the four stage rates
+_kernel = _kernel_for(-1, True, True, False)
 
 
 def _python_mirror(*functions):
@@ -337,7 +387,8 @@ def _python_mirror(*functions):
         if isinstance(obj, types.FunctionType) and obj.__module__ in (laws.__name__, sample_parts.__name__, __name__):
             space[name] = types.FunctionType(obj.__code__, space, name, obj.__defaults__, obj.__closure__)
     space["laws"] = types.SimpleNamespace(**{k: space.get(k, v) for k, v in vars(laws).items()})
-    return [space[f.__name__] for f in functions]
+    # from each function itself, not its name: a kernel of `_kernel_for` keeps its constants
+    return [types.FunctionType(f.__code__, space, f.__name__, f.__defaults__, f.__closure__) for f in functions]
 
 
 _compiled: dict = {}
@@ -358,21 +409,32 @@ def _array_overloads() -> None:
         delattr(np, "row_stack")
 
 
-def _device_functions():
-    """The kernel, compiled for the device on first use (or mirrored for the simulator), once
-    though several threads ask at once."""
+def kernel_key(law: int, faults: np.ndarray, sensing: np.ndarray, closed_loop: bool) -> tuple:
+    """Which kernel a batch runs (`_kernel_for`'s arguments): with SPECIALISE, the batch's damper
+    law, and faults and sensing only where some sample has them; else the one for any batch."""
+    if not SPECIALISE:
+        return (-1, True, True, LEAN_RK4)
+    with_faults = bool(np.any(faults[:, F_MODE : F_MODE + N_CORNER] != FAULT_NONE))
+    with_sensing = bool(closed_loop and np.any(sensing[:, S_ON] > 0.0))
+    return (int(law), with_faults, with_sensing, LEAN_RK4)
+
+
+def _device_functions(key: tuple = (-1, True, True, False)):
+    """The kernel of ``key`` (`kernel_key`), compiled for the device on first use (or mirrored
+    for the simulator), once though several threads ask at once."""
     with _COMPILING:
-        if "kernel" not in _compiled:
-            _compiled["kernel"] = _compile()
-        return _compiled["kernel"]
+        if key not in _compiled:
+            _compiled[key] = _compile(key)
+        return _compiled[key]
 
 
-def _compile():
+def _compile(key: tuple):
+    kernel = _kernel_for(*key)
     if simulated():
-        return cuda.jit(_python_mirror(_kernel)[0])
+        return cuda.jit(_python_mirror(kernel)[0])
     _array_overloads()
     limit = {} if MAX_REGISTERS is None else {"max_registers": MAX_REGISTERS}
-    return cuda.jit(_kernel, **limit)
+    return cuda.jit(kernel, **limit)
 
 
 def last_call() -> dict:
@@ -399,10 +461,11 @@ def kernel_signature() -> tuple:
     )
 
 
-def ptx(cc: tuple[int, int] = (9, 0)) -> str:
-    """The kernel compiled to PTX for compute capability ``cc``, with no device present (needs
-    numba-cuda's NVVM, the toolkit of the gpu extra): the check that every law the kernel calls
-    compiles for a GPU, where no GPU is at hand."""
+def ptx(cc: tuple[int, int] = (9, 0), key: tuple = (-1, True, True, False)) -> str:
+    """The kernel of ``key`` (`kernel_key`; default: the one for any batch) compiled to PTX for
+    compute capability ``cc``, with no device present (needs numba-cuda's NVVM, the toolkit of
+    the gpu extra): the check that every law the kernel calls compiles for a GPU, where no GPU
+    is at hand."""
     from unittest import mock
 
     from numba.cuda import dispatcher
@@ -412,7 +475,7 @@ def ptx(cc: tuple[int, int] = (9, 0)) -> str:
     device = types.SimpleNamespace(compute_capability=cc)
     _array_overloads()
     with mock.patch.object(dispatcher, "get_current_device", lambda: device):
-        code, _ = cuda.compile_ptx(_kernel, kernel_signature(), cc=cc)
+        code, _ = cuda.compile_ptx(_kernel_for(*key), kernel_signature(), cc=cc)
     return code
 
 
@@ -499,14 +562,14 @@ def run_gpu(
     included) are added to acc (n, `N_ACC`), whose sums go on from what acc holds."""
     from railride.engine.laws import _one_step_limit
 
-    try:
-        kernel = _device_functions()
-    except Exception as exc:
-        raise _Failed(exc, 0) from exc
     A, TS, c_sec, stops = vehicle
     P, vcmd = dampers
     utab, u_off, ftab, f_off, n_nodes, interval = inputs
     closed_loop, ctrl_stride, Gm, Hm, inner, noise, faults, sensing, snoise = control
+    try:
+        kernel = _device_functions(kernel_key(law, faults[:n], sensing[:n], closed_loop))
+    except Exception as exc:
+        raise _Failed(exc, 0) from exc
     out_q, out_v, out_a, out_f, out_w, out_wd, out_d, out_fd, out_vc, status, fail_step = outputs
     A_u, TS_u, vid = _vehicles(A, TS)
     r0, r1 = _rows(step0, n_steps, final, stride)

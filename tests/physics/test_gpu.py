@@ -73,12 +73,44 @@ def _worst(a, b) -> float:
     return worst_difference(ha, hb)
 
 
+@pytest.mark.parametrize("kernel", ["general", "specialised, lean RK4"])
 @pytest.mark.parametrize("case", list(CASES))
-def test_the_gpu_agrees_with_the_cpu_stepper(case, monkeypatch):
+def test_the_gpu_agrees_with_the_cpu_stepper(case, kernel, monkeypatch):
+    # the kernel for any batch, and the one built for the batch's law, faults and sensing with
+    # one stage rate at a time (`gpu._kernel_for`)
+    special = kernel != "general"
+    monkeypatch.setattr(gpu, "SPECIALISE", special)
+    monkeypatch.setattr(gpu, "LEAN_RK4", special)
     on_gpu, on_cpu = _runs(monkeypatch, **CASES[case])
     # the same laws in the same order, the products as plain sums: rounding-level differences
     # (measured <= 1e-15 in the simulator); the issue's bound for laws without switching is 1e-9
     assert _worst(on_gpu, on_cpu) < 1e-9
+
+
+def test_each_batch_gets_the_kernel_of_its_damper_law_faults_and_sensing(monkeypatch):
+    """`gpu.kernel_key`: with SPECIALISE, a batch's kernel fixes its damper law and leaves out
+    faults and sensing where no sample has them; without, every batch gets the general kernel."""
+    from railride.engine.layout import LAW_BOUC_WEN, LAW_VISCOUS_IN_C
+
+    keys = []
+    build = gpu._device_functions
+    monkeypatch.setattr(gpu, "_device_functions", lambda key: keys.append(key) or build(key))
+    sas = Suspension.named("sas-attitude")
+    batches = {
+        "healthy": [sas],
+        "one faulty": [sas, sas.with_faults(["1R-off"])],
+        "sensing": [sas.with_sensing(Accelerometers())],
+        "passive": [None],
+    }
+    for special in (True, False):
+        monkeypatch.setattr(gpu, "SPECIALISE", special)
+        for suspensions in batches.values():
+            kw = {"params": [PAPER.replace(c_sz=3e4)]} if suspensions == [None] else {"suspension": suspensions}
+            simulate(scenario=SHORT, solver=GPU, **kw)
+    lean = gpu.LEAN_RK4
+    special = [(LAW_BOUC_WEN, False, False), (LAW_BOUC_WEN, True, False), (LAW_BOUC_WEN, False, True)]
+    special.append((LAW_VISCOUS_IN_C, False, False))
+    assert keys == [(*k, lean) for k in special] + [(-1, True, True, lean)] * 4
 
 
 def test_bump_stops_on_the_gpu(monkeypatch):
