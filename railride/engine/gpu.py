@@ -92,10 +92,12 @@ THREADS_PER_BLOCK = 128
 MAX_REGISTERS: int | None = None
 #: compile a kernel for each kind of batch (`kernel_key`): its damper law fixed, and faults and
 #: realistic sensing left out where no sample has them, for less thread-local memory; False:
-#: one kernel for every batch (one compile a process)
-SPECIALISE = False
-#: RK4 with one stage rate and a running sum in place of the four stage rates (`_lean_rk4`)
-LEAN_RK4 = False
+#: one kernel for every batch (one compile a process). With LEAN_RK4, twice the general
+#: kernel's rate on an H100 (docs/gpu.md, "The kernel built for its batch")
+SPECIALISE = True
+#: RK4 with one stage rate and a running sum in place of the four stage rates (`_lean_rk4`):
+#: faster with SPECIALISE, slower without it (measured on an H100, docs/gpu.md)
+LEAN_RK4 = True
 #: the share of the device's free memory one group of samples may take
 MEMORY_SHARE = 0.6
 # what the calling thread's last `run_gpu` took (`last_call`)
@@ -419,7 +421,7 @@ def kernel_key(law: int, faults: np.ndarray, sensing: np.ndarray, closed_loop: b
     return (int(law), with_faults, with_sensing, LEAN_RK4)
 
 
-def _device_functions(key: tuple = (-1, True, True, False)):
+def _device_functions(key: tuple):
     """The kernel of ``key`` (`kernel_key`), compiled for the device on first use (or mirrored
     for the simulator), once though several threads ask at once."""
     with _COMPILING:

@@ -221,11 +221,16 @@ def test_the_kernel_compiles_for_a_gpu():
     import subprocess
     import sys
 
-    code = "from railride.engine import gpu; p = gpu.ptx((9, 0)); print(len(p), '.entry' in p)"
+    # the general kernel, and the build a healthy Bouc-Wen batch runs (`gpu.kernel_key`)
+    code = (
+        "import numpy as np; from railride.engine import gpu; from railride.engine.layout import LAW_BOUC_WEN\n"
+        "key = gpu.kernel_key(LAW_BOUC_WEN, np.zeros((1, 8), np.int64), np.zeros((1, 3)), True)\n"
+        "print(key, '.entry' in gpu.ptx((9, 0)), '.entry' in gpu.ptx((9, 0), key))"
+    )
     env = {**__import__("os").environ, "NUMBA_ENABLE_CUDASIM": "0"}
-    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=600)
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=900)
     assert done.returncode == 0, done.stderr[-2000:]
-    assert done.stdout.split()[1] == "True"
+    assert done.stdout.split()[-2:] == ["True", "True"], done.stdout
 
 
 @pytest.mark.slow
