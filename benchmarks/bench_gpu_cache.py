@@ -26,14 +26,14 @@ import sys, time, warnings
 sys.path.insert(0, "benchmarks")
 from numba import cuda
 from bench_gpu import _batch, _worst
-from railride.engine import gpu
+from railride.engine import gpu, gpu_kernel
 from railride.run.simulation import simulate
 from railride.run.solver import SolverSettings
 
 warnings.simplefilter("always")
 with warnings.catch_warnings(record=True) as caught:
     gpu._array_overloads()
-    gpu._compile = lambda key: cuda.jit(gpu._kernel_for(*key), cache=True)
+    gpu._compile = lambda key: cuda.jit(gpu_kernel._kernel_for(*key), cache=True)
     scs, susp = _batch(64, 0.1, "sas-attitude-ride")
     on_gpu, on_cpu = SolverSettings(backend="gpu"), SolverSettings(backend="cpu")
     t0 = time.perf_counter()

@@ -13,7 +13,7 @@ Run:  python benchmarks/bench_gpu_kernel.py --resources [--registers none,168,12
   Specifications per Compute Capability": 65,536 registers, 64 warps and 32 blocks per
   multiprocessor; registers given to a warp in units of 256). A driver's own compile of the PTX
   may differ from this ptxas's.
-* ``--kernels``: which builds of the kernel (`gpu._kernel_for`): ``general`` (the one for any
+* ``--kernels``: which builds of the kernel (`gpu_kernel._kernel_for`): ``general`` (the one for any
   batch), ``special`` (the damper law fixed, faults and sensing left out: the batches below),
   ``lean`` (one RK4 stage rate and a running sum) and ``special-lean``; each under each limit.
 * With a GPU, the same register limits on batches of ``--samples`` SAS closed loops
