@@ -1,7 +1,8 @@
 """The GPU kernel's resources and what they cost (railride.engine.gpu).
 
 Run:  python benchmarks/bench_gpu_kernel.py --resources [--registers none,168,128,96] [--kernels general,lean]
-      python benchmarks/bench_gpu_kernel.py [--registers none,128] [--kernels ...] [--samples 1024,32768] [--duration 1]
+      python benchmarks/bench_gpu_kernel.py [--registers none,128] [--kernels ...] [--blocks 32,128]
+                                            [--samples 1024,32768] [--duration 1]
       python benchmarks/bench_gpu_kernel.py --concurrent 8 [--duration 2]
       ncu --set full -k regex:_kernel -c 1 python benchmarks/bench_gpu_kernel.py --profile-run
 
@@ -16,6 +17,9 @@ Run:  python benchmarks/bench_gpu_kernel.py --resources [--registers none,168,12
 * ``--kernels``: which builds of the kernel (`gpu_kernel._kernel_for`): ``general`` (the one for any
   batch), ``special`` (the damper law fixed, faults and sensing left out: the batches below),
   ``lean`` (one RK4 stage rate and a running sum) and ``special-lean``; each under each limit.
+* ``--blocks 32,64,128``: each size also launched in blocks of that many threads (default: the
+  package's `gpu.THREADS_PER_BLOCK`, 128). A small batch in small blocks spreads over more
+  multiprocessors, so fewer of its warps share each one's L1 (whether that pays: not yet timed).
 * With a GPU, the same register limits on batches of ``--samples`` SAS closed loops
   (`bench_gpu._batch`): the kernels' seconds, sample-steps per second, the kernels' time per
   step (what one thread takes per step where all the batch's threads are resident at once),
@@ -148,7 +152,7 @@ def _assemble(ptxas, code, limits, name, compiled) -> None:
             )
 
 
-def _timed(limits, kernels, sizes, duration: float) -> None:
+def _timed(limits, kernels, sizes, duration: float, blocks=(None,)) -> None:
     from bench_gpu import _batch
 
     from railride.engine import gpu
@@ -159,20 +163,23 @@ def _timed(limits, kernels, sizes, duration: float) -> None:
     steps = round(duration / on_gpu.dt)
     print(f"{gpu.device_name()}; {os.cpu_count()} CPU cores; {datetime.date.today().isoformat()}")
     print(
-        "\n| kernel | register limit | compile | samples | kernels | sample-steps/s | kernel time per step (us) "
-        "| largest difference from the first |"
+        "\n| kernel | register limit | compile | samples | threads a block | kernels | sample-steps/s "
+        "| kernel time per step (us) | largest difference from the first |"
     )  # fmt: skip
-    print("|---|---|---|---|---|---|---|---|")
+    print("|---|---|---|---|---|---|---|---|---|")
     first: dict = {}
+    default_block = gpu.THREADS_PER_BLOCK
     for name, limit in [(k, r) for k in kernels for r in limits]:
         gpu.SPECIALISE, gpu.LEAN_RK4 = KERNELS[name]
         gpu.MAX_REGISTERS = limit
         gpu._compiled.clear()
+        gpu.THREADS_PER_BLOCK = default_block
         scs, susp = _batch(32, 0.01, "sas-attitude-ride")
         t0 = time.perf_counter()
         simulate(scs, suspension=susp, solver=on_gpu)
         compile_s = time.perf_counter() - t0
-        for n in sizes:
+        for n, block in [(n, b) for n in sizes for b in blocks]:
+            gpu.THREADS_PER_BLOCK = default_block if block is None else block
             scs, susp = _batch(n, duration, "sas-attitude-ride")
             ds = simulate(scs, suspension=susp, solver=on_gpu).dataset
             q = np.stack([ds[k].values for k in CHANNELS])
@@ -180,7 +187,8 @@ def _timed(limits, kernels, sizes, duration: float) -> None:
             ref = first.setdefault(n, q)
             diff = float(np.nanmax(np.abs(q - ref)) / np.nanmax(np.abs(ref)))
             print(
-                f"| {name} | {'none' if limit is None else limit} | {compile_s:.1f} s | {n:,} | {k:.3f} s "
+                f"| {name} | {'none' if limit is None else limit} | {compile_s:.1f} s | {n:,} "
+                f"| {gpu.THREADS_PER_BLOCK} | {k:.3f} s "
                 f"| {n * steps / k:.3g} | {k / steps * 1e6:.1f} | {diff:.1e} |"
             )
 
@@ -242,6 +250,7 @@ def main():
     ap.add_argument("--resources", action="store_true")
     ap.add_argument("--registers", default="none,168,128,96", help="register limits (none: the compiler's)")
     ap.add_argument("--kernels", default="general", help=f"builds of the kernel: {', '.join(KERNELS)}")
+    ap.add_argument("--blocks", default="none", help="threads a block, comma-separated (none: gpu.THREADS_PER_BLOCK)")
     ap.add_argument("--samples", default="1024,32768", help="batch sizes, comma-separated")
     ap.add_argument("--duration", type=float, default=1.0)
     ap.add_argument("--concurrent", type=int, default=0)
@@ -261,7 +270,8 @@ def main():
     if args.profile_run:
         _profile_run(int(args.samples.split(",")[0]), _kernels(args.kernels)[0])
         return
-    _timed(_limits(args.registers), _kernels(args.kernels), [int(v) for v in args.samples.split(",")], args.duration)
+    sizes = [int(v) for v in args.samples.split(",")]
+    _timed(_limits(args.registers), _kernels(args.kernels), sizes, args.duration, _limits(args.blocks))
 
 
 if __name__ == "__main__":

@@ -5,7 +5,7 @@
 # tree through PYTHONPATH; nothing is installed).
 #
 # Run:  bash benchmarks/device_check.sh [BUDGET_S]      (default 580 s in all)
-#       bash benchmarks/device_check.sh --gpu [BUDGET_S]  (steps 1 to 8: the GPU's and the design)
+#       bash benchmarks/device_check.sh --gpu [BUDGET_S]  (steps 1 to 8: the GPU's and the designs)
 #       bash benchmarks/device_check.sh --kernels [BUDGET_S]  (the machine, then the kernel's builds: below)
 #       bash benchmarks/device_check.sh --smoke          (here: the simulator, tiny sizes, a check of the script)
 #
@@ -23,20 +23,21 @@
 #   2. bench_gpu.py: 32,768 SAS closed loops on the GPU (and how long its first call, which
 #      compiles the kernel, takes), their agreement with the CPU over 64 samples, the same batch
 #      on the CPU's cores, and the metrics-only batch of the studies
-#   3. bench_gpu_kernel.py: the kernel under register limits (none, 128, 96) on 1,024, 8,192 and 32,768
-#      runs: its rate and the kernels' time per step
-#   4. bench_gpu_kernel.py --concurrent 8: eight 32-run batches from eight threads at once against
-#      one after another (a design's held-out runs): whether calls on their own streams overlap;
-#      then, where the image has Nsight Compute (ncu), one launch of the kernel profiled: its
-#      occupancy, memory traffic and what its warps wait on
-#   5. the default design (backend auto: the CPU's cores for its batches, all under 4,096 runs),
-#      through bench_design.py --profile: its wall and CPU time, its stepping rate, and by stage
-#      how long some batch stepped and how long none did; its cap is the target of 2 minutes and
-#      start-up, and one that is cut prints the same for what it had done by then
-#   6. the GPU tests of tests/physics on the device instead of the simulator (never run there yet)
-#   7. bench_gpu_cache.py: whether numba-cuda's file cache keeps the kernel between processes,
+#   3. the default design (backend auto: the CPU's cores for its batches, all under 4,096 runs),
+#      through bench_design.py --profile, after the CPU's kernels are compiled: its wall and CPU
+#      time, its stepping rate, and by stage how long some batch stepped and how long none did;
+#      its cap is the target of 2 minutes and start-up, and one that is cut prints the same for
+#      what it had done by then (never measured on 16 cores)
+#   4. bench_gpu_kernel.py --blocks 32,64,128: the kernel on 1,024, 2,048 and 8,192 runs in
+#      blocks of 32, 64 and 128 threads (a design's rounds last a lone thread's time)
+#   5. bench_gpu_cache.py: whether numba-cuda's file cache keeps the kernel between processes,
 #      and the compile each process would save
-#   8. the same with --backend gpu (every tuning round a GPU call), capped like step 5
+#   6. the design with --backend gpu (every tuning round a GPU call), cut at 200 s
+#   7. bench_gpu_kernel.py --concurrent 8: eight 32-run batches from eight threads at once against
+#      one after another (a design's held-out runs): whether calls on their own streams overlap;
+#      then, where the image has Nsight Compute (ncu), one launch of 1,024 runs profiled
+#   8. the GPU tests of tests/physics on the device, every build the cases make (the general
+#      kernel's passed there on 2026-11-27)
 #   9. bench_gil.py --threads <cores>: how much of a study chunk's work beside its stepping runs
 #      in parallel when every core has a chunk (measured on 2 cores only)
 #  10. the CPU's figures, measured once on 16 cores already (2026-11-27): bench_study.py (the 1,000-run study
@@ -145,36 +146,40 @@ fi
 step gpu-throughput 90 $PY benchmarks/bench_gpu.py --samples "$GPU_SAMPLES" --duration "$DURATION" --cpu --check "$CHECK" --metrics-only
 
 if [ "$SMOKE" = 1 ]; then  # the kernel steps need a GPU; the default design would take too long here: a small one
-  step gpu-kernel 60 env NUMBA_ENABLE_CUDASIM=0 $PY benchmarks/bench_gpu_kernel.py --resources --registers none,128
   step design 60 $PY benchmarks/bench_design.py --profile --controllers pid --budget 25 --duration 0.5
+  step gpu-kernel 60 env NUMBA_ENABLE_CUDASIM=0 $PY benchmarks/bench_gpu_kernel.py --resources --registers none \
+    --kernels special-lean
 else
-  step gpu-kernel 120 $PY benchmarks/bench_gpu_kernel.py --registers none,128,96 --samples 1024,8192,32768
-  step gpu-concurrent 60 $PY benchmarks/bench_gpu_kernel.py --concurrent 8 --duration 2
-  # where the kernel's time goes (Nsight Compute, where the image has it): one launch of 1,024 runs
-  if command -v ncu >/dev/null 2>&1; then
-    step gpu-ncu 120 ncu --section LaunchStats --section Occupancy --section SpeedOfLight \
-      --section MemoryWorkloadAnalysis --section WarpStateStats -k regex:_kernel -c 1 \
-      $PY benchmarks/bench_gpu_kernel.py --profile-run --samples 1024
-  else
-    step gpu-ncu 10 echo "no ncu on the PATH: the kernel not profiled"
-  fi
   # the CPU kernels compiled once into numba's cache, so that no timed step below is cut by compiling
   step compile-cpu 90 $PY -c "from railride.studies.study import study; \
 study(['pid', 'sas-attitude', 'sas-attitude-ride', 'clipped-optimal'], track_seeds=[0], speeds=[40.0], duration=1.0)"
   # the design in the library (no files written): "exit 0 after N s" is its time with start-up;
   # cut at the cap (SIGTERM), it prints what it had done by then
   step design 150 $PY benchmarks/bench_design.py --profile
+  # small batches in small blocks: a design's rounds (256 to 2,048 runs) last a lone thread's time
+  step gpu-kernel-blocks 120 $PY benchmarks/bench_gpu_kernel.py --kernels special-lean --registers none \
+    --blocks 32,64,128 --samples 1024,2048,8192
 fi
-
-# never run on a device yet
-step gpu-tests 120 $PY -m pytest -q -p no:randomly -p no:cacheprovider tests/physics/test_gpu.py tests/physics/test_gpu_metrics.py
 
 # whether numba-cuda's file cache keeps the kernel between processes, and the compile it saves
+# (each kind of batch now compiles its own kernel, 19 to 43 s on the H100)
 step gpu-cache 150 $PY benchmarks/bench_gpu_cache.py
 
-if [ "$SMOKE" = 0 ]; then  # cut at 150 s on the H100 before: the rounds' kernels, not the host
-  step design-on-gpu 150 $PY benchmarks/bench_design.py --profile --backend gpu
+if [ "$SMOKE" = 0 ]; then  # cut at 150 s on the H100 twice: the rounds' kernels, not the host
+  step design-on-gpu 200 $PY benchmarks/bench_design.py --profile --backend gpu
+  step gpu-concurrent 60 $PY benchmarks/bench_gpu_kernel.py --concurrent 8 --duration 2
+  # where a small batch's time goes (Nsight Compute, where the image has it): one launch of 1,024 runs
+  if command -v ncu >/dev/null 2>&1; then
+    step gpu-ncu 120 ncu --section LaunchStats --section Occupancy --section SpeedOfLight \
+      --section MemoryWorkloadAnalysis --section WarpStateStats -k regex:_kernel -c 1 \
+      $PY benchmarks/bench_gpu_kernel.py --profile-run --samples 1024 --kernels special-lean
+  else
+    step gpu-ncu 10 echo "no ncu on the PATH: the kernel not profiled"
+  fi
 fi
+
+# run once on a device (2026-11-27, the general kernel): now with every build the cases make
+step gpu-tests 120 $PY -m pytest -q -p no:randomly -p no:cacheprovider tests/physics/test_gpu.py tests/physics/test_gpu_metrics.py
 
 # the CPU's figures (measured on a lent 16-core machine on 2026-11-27: docs/performance.md)
 if [ "$GPU_ONLY" = 0 ]; then
