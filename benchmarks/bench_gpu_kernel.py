@@ -102,12 +102,13 @@ def _kernels(text: str) -> list[str]:
 
 
 def _key(name: str) -> tuple:
-    """The kernel key of build ``name`` for the benchmark's batches (Bouc-Wen, SAS, healthy, exact
-    sensing)."""
-    from railride.engine.layout import LAW_BOUC_WEN
+    """The kernel key (`gpu.kernel_key`) of build ``name`` for the benchmark's batches: Bouc-Wen,
+    SAS, healthy, exact sensing."""
+    from railride.engine import gpu
+    from railride.engine.layout import LAW_BOUC_WEN, N_FAULT_COLS
 
-    special, lean = KERNELS[name]
-    return (LAW_BOUC_WEN, False, False, lean) if special else (-1, True, True, lean)
+    gpu.SPECIALISE, gpu.LEAN_RK4 = KERNELS[name]
+    return gpu.kernel_key(LAW_BOUC_WEN, np.zeros((1, N_FAULT_COLS), np.int64), np.zeros((1, 3)), True)
 
 
 def _resources(limits, kernels) -> None:

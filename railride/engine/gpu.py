@@ -27,7 +27,7 @@ try:  # numba-cuda (the gpu extra) when installed; numba's own CUDA target other
 except ImportError:  # pragma: no cover - a numba without a CUDA target and no numba-cuda
     cuda = None  # type: ignore[assignment]
 
-from railride.engine.gpu_kernel import _kernel_for, _python_mirror, kernel_signature
+from railride.engine.gpu_kernel import GENERAL, _kernel_for, _python_mirror, kernel_signature
 from railride.engine.layout import F_MODE, FAULT_NONE, N_CORNER, S_ON
 from railride.engine.sample_parts import N_ACC
 
@@ -109,7 +109,7 @@ def kernel_key(law: int, faults: np.ndarray, sensing: np.ndarray, closed_loop: b
     """Which kernel a batch runs (`_kernel_for`'s arguments): with SPECIALISE, the batch's damper
     law, and faults and sensing only where some sample has them; else the one for any batch."""
     if not SPECIALISE:
-        return (-1, True, True, LEAN_RK4)
+        return (*GENERAL[:3], LEAN_RK4)
     with_faults = bool(np.any(faults[:, F_MODE : F_MODE + N_CORNER] != FAULT_NONE))
     with_sensing = bool(closed_loop and np.any(sensing[:, S_ON] > 0.0))
     return (int(law), with_faults, with_sensing, LEAN_RK4)
@@ -140,7 +140,7 @@ def last_call() -> dict:
     return dict(getattr(_calls, "last", {}))
 
 
-def ptx(cc: tuple[int, int] = (9, 0), key: tuple = (-1, True, True, False)) -> str:
+def ptx(cc: tuple[int, int] = (9, 0), key: tuple = GENERAL) -> str:
     """The kernel of ``key`` (`kernel_key`; default: the one for any batch) compiled to PTX for
     compute capability ``cc``, with no device present (needs numba-cuda's NVVM, the toolkit of
     the gpu extra): the check that every law the kernel calls compiles for a GPU, where no GPU

@@ -144,6 +144,11 @@ def _forcing(t, ftab, off, n_nodes, interval, R, roff):
         )
 
 
+#: `_kernel_for`'s arguments for the kernel of any batch: every damper law, faults and sensing,
+#: the four stage rates side by side
+GENERAL = (-1, True, True, False)
+
+
 def _kernel_for(fixed_law: int, with_faults: bool, with_sensing: bool, lean: bool):
     """The kernel's Python function for one kind of batch. Its arguments are constants of the
     compile: ``fixed_law`` >= 0 is the damper law of every sample (LAW_*; -1: read from the
@@ -303,10 +308,6 @@ def _lean_rk4(law, s, st, K, ksum, h, sub, has_states, R, at, tt, pp, vc, conn, 
             ksum[i] += wgt * K[i]
     for i in range(n):
         s[i] += h / 6.0 * ksum[i]
-
-
-#: the kernel for any batch: every damper law, faults and sensing, the four stage rates
-_kernel = _kernel_for(-1, True, True, False)
 
 
 def _python_mirror(*functions):
