@@ -3,6 +3,7 @@
 Run:  python benchmarks/bench_design.py [--out DIR] [other railride design options]
       python benchmarks/bench_design.py --profile [--controllers A,B] [--budget N] [--duration S]
                                         [--backend auto|cpu|gpu] [--gpu-kernel general|special|lean|special-lean]
+                                        [--gpu-threads N] [--gpu-file-cache]
 Runs `railride design --out DIR` (default: a new temporary folder) in a child process and
 prints a Markdown row for docs/performance.md: the runs it evaluated, its wall time, the CPU
 time of the child as a share of one core, and the child's peak resident memory. The default
@@ -77,13 +78,21 @@ def profile(args: list) -> None:
         "--gpu-kernel", default=None, choices=["general", "special", "lean", "special-lean"],
         help="the GPU kernel's build (bench_gpu_kernel.py --kernels); default: the package's",
     )  # fmt: skip
+    ap.add_argument("--gpu-threads", type=int, default=None, help="threads a block (default: gpu.THREADS_PER_BLOCK)")
+    ap.add_argument(
+        "--gpu-file-cache", action="store_true",
+        help="keep the GPU kernels in numba's file cache (gpu.FILE_CACHE): a second run loads them",
+    )  # fmt: skip
     opts = ap.parse_args(args)
+    from railride.engine import gpu
+
     if opts.gpu_kernel is not None:
         from bench_gpu_kernel import KERNELS
 
-        from railride.engine import gpu
-
         gpu.SPECIALISE, gpu.LEAN_RK4 = KERNELS[opts.gpu_kernel]
+    if opts.gpu_threads is not None:
+        gpu.THREADS_PER_BLOCK = opts.gpu_threads
+    gpu.FILE_CACHE = opts.gpu_file_cache
     steps: list = []  # (start, end) of every batch's stepping (on the GPU: its call), any thread
     chunks: list = []  # (start, end) of every chunk's whole work (`evaluate`), any thread
     stages: list = []  # (name, start, end)
@@ -157,6 +166,8 @@ def profile(args: list) -> None:
     t0 = time.perf_counter()
     head = f"design {opts.controllers or 'all laws'}, budget {opts.budget}, {opts.duration:g} s runs"
     head += f", backend {opts.backend}" + (f", GPU kernel {opts.gpu_kernel}" if opts.gpu_kernel else "")
+    head += f", {opts.gpu_threads} threads a block" if opts.gpu_threads else ""
+    head += ", GPU kernels in the file cache" if opts.gpu_file_cache else ""
     try:
         res = rr.design(
             controllers,

@@ -3,7 +3,7 @@
 Run:  python benchmarks/bench_gpu_cache.py        (on a machine with a CUDA GPU and the gpu extra)
 
 Every process that steps on the GPU compiles the kernel (`railride.engine.gpu`, compiled on
-first use without a cache). This script tries the kernel with ``cuda.jit(cache=True)`` in two
+first use without a cache). This script tries the kernel with ``cuda.jit(cache=True)`` (`gpu.FILE_CACHE`) in two
 fresh processes that share an empty ``NUMBA_CACHE_DIR``: the first compiles and writes the
 cache, the second should load it (a process before them fills the cache with the CPU's kernels,
 which the GPU path also calls to build its tables). Each prints the time of its first call (a batch of 64 SAS
@@ -24,16 +24,15 @@ import tempfile
 CHILD = r"""
 import sys, time, warnings
 sys.path.insert(0, "benchmarks")
-from numba import cuda
 from bench_gpu import _batch, _worst
-from railride.engine import gpu, gpu_kernel
+from railride.engine import gpu
 from railride.run.simulation import simulate
 from railride.run.solver import SolverSettings
 
 warnings.simplefilter("always")
 with warnings.catch_warnings(record=True) as caught:
     gpu._array_overloads()
-    gpu._compile = lambda key: cuda.jit(gpu_kernel._kernel_for(*key), cache=True)
+    gpu.FILE_CACHE = True
     scs, susp = _batch(64, 0.1, "sas-attitude-ride")
     on_gpu, on_cpu = SolverSettings(backend="gpu"), SolverSettings(backend="cpu")
     t0 = time.perf_counter()

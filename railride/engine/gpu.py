@@ -45,6 +45,12 @@ SPECIALISE = True
 #: RK4 with one stage rate and a running sum in place of the four stage rates (`_lean_rk4`):
 #: faster with SPECIALISE, slower without it (measured on an H100, docs/gpu.md)
 LEAN_RK4 = True
+#: keep each compiled kernel in numba's file cache beside the engine's CPU kernels
+#: (``cuda.jit(cache=True)``; cleared with them when an engine source changes,
+#: `railride.engine.cache_guard`), so that a later process loads it instead of compiling it
+#: again (19-43 s a kind of batch on an H100). Off until a device has shown that a second
+#: process loads it and gets the same results (`benchmarks/bench_gpu_cache.py`, docs/gpu.md)
+FILE_CACHE = False
 #: the share of the device's free memory one group of samples may take
 MEMORY_SHARE = 0.6
 # what the calling thread's last `run_gpu` took (`last_call`)
@@ -130,7 +136,7 @@ def _compile(key: tuple):
         return cuda.jit(_python_mirror(kernel)[0])
     _array_overloads()
     limit = {} if MAX_REGISTERS is None else {"max_registers": MAX_REGISTERS}
-    return cuda.jit(kernel, **limit)
+    return cuda.jit(kernel, cache=FILE_CACHE, **limit)
 
 
 def last_call() -> dict:

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from railride import dampers
-from railride.engine import gpu
+from railride.engine import gpu, gpu_kernel
 from railride.engine import lanes as engine_lanes
 from railride.testing.agreement import histories, worst_difference
 from railride.errors import BackendWarning, InputError
@@ -111,6 +111,21 @@ def test_each_batch_gets_the_kernel_of_its_damper_law_faults_and_sensing(monkeyp
     special = [(LAW_BOUC_WEN, False, False), (LAW_BOUC_WEN, True, False), (LAW_BOUC_WEN, False, True)]
     special.append((LAW_VISCOUS_IN_C, False, False))
     assert keys == [(*k, lean) for k in special] + [(-1, True, True, lean)] * 4
+
+
+def test_the_file_cache_setting_reaches_the_compile(monkeypatch):
+    """`gpu.FILE_CACHE` is what numba-cuda's ``cuda.jit`` is given as ``cache`` (a stand-in for
+    cuda.jit: the simulator compiles nothing)."""
+    import types
+
+    given = []
+    monkeypatch.setattr(gpu, "simulated", lambda: False)
+    monkeypatch.setattr(gpu, "_array_overloads", lambda: None)
+    monkeypatch.setattr(gpu, "cuda", types.SimpleNamespace(jit=lambda kernel, **kw: given.append(kw)))
+    for keep in (False, True):
+        monkeypatch.setattr(gpu, "FILE_CACHE", keep)
+        gpu._compile(gpu_kernel.GENERAL)
+    assert [kw["cache"] for kw in given] == [False, True]
 
 
 def test_bump_stops_on_the_gpu(monkeypatch):
