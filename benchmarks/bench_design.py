@@ -2,8 +2,8 @@
 
 Run:  python benchmarks/bench_design.py [--out DIR] [other railride design options]
       python benchmarks/bench_design.py --profile [--controllers A,B] [--budget N] [--duration S]
-                                        [--backend auto|cpu|gpu] [--gpu-kernel general|special|lean|special-lean]
-                                        [--gpu-threads N] [--gpu-file-cache]
+                                        [--backend auto|cpu|gpu] [--gpu-kernel BUILD] [--gpu-threads N]
+                                        [--gpu-file-cache]
 Runs `railride design --out DIR` (default: a new temporary folder) in a child process and
 prints a Markdown row for docs/performance.md: the runs it evaluated, its wall time, the CPU
 time of the child as a share of one core, and the child's peak resident memory. The default
@@ -75,7 +75,7 @@ def profile(args: list) -> None:
     ap.add_argument("--duration", type=float, default=design_module.DEFAULT_DURATION)
     ap.add_argument("--backend", default="auto", choices=["auto", "cpu", "gpu"])
     ap.add_argument(
-        "--gpu-kernel", default=None, choices=["general", "special", "lean", "special-lean"],
+        "--gpu-kernel", default=None, choices=["general", "special", "lean", "special-lean", "special-lean-n1"],
         help="the GPU kernel's build (bench_gpu_kernel.py --kernels); default: the package's",
     )  # fmt: skip
     ap.add_argument("--gpu-threads", type=int, default=None, help="threads a block (default: gpu.THREADS_PER_BLOCK)")
@@ -89,7 +89,7 @@ def profile(args: list) -> None:
     if opts.gpu_kernel is not None:
         from bench_gpu_kernel import KERNELS
 
-        gpu.SPECIALISE, gpu.LEAN_RK4 = KERNELS[opts.gpu_kernel]
+        gpu.SPECIALISE, gpu.LEAN_RK4, gpu.UNIT_N = KERNELS[opts.gpu_kernel]
     if opts.gpu_threads is not None:
         gpu.THREADS_PER_BLOCK = opts.gpu_threads
     gpu.FILE_CACHE = opts.gpu_file_cache

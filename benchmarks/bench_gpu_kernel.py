@@ -13,10 +13,15 @@ Run:  python benchmarks/bench_gpu_kernel.py --resources [--registers none,168,12
   limits of compute capability 9.0 (NVIDIA, CUDA C++ Programming Guide, "Technical
   Specifications per Compute Capability": 65,536 registers, 64 warps and 32 blocks per
   multiprocessor; registers given to a warp in units of 256). A driver's own compile of the PTX
-  may differ from this ptxas's.
+  may differ from this ptxas's. Where nvdisasm is found (``NVDISASM``, else the PATH; the gpu
+  extra has none, NVIDIA's nvidia-cuda-nvdisasm wheel has one), the assembled kernel's machine
+  instructions are counted too: all, local loads and stores, global loads, branches and calls,
+  each as written once in the code (static counts, not how often they run).
 * ``--kernels``: which builds of the kernel (`gpu_kernel._kernel_for`): ``general`` (the one for any
   batch), ``special`` (the damper law fixed, faults and sensing left out: the batches below),
-  ``lean`` (one RK4 stage rate and a running sum) and ``special-lean``; each under each limit.
+  ``lean`` (one RK4 stage rate and a running sum), ``special-lean`` and ``special-lean-n1`` (the
+  package's default: also the Bouc-Wen exponent n = 1 known to the compile, `gpu.UNIT_N`); each
+  under each limit.
 * ``--blocks 32,64,128``: each size also launched in blocks of that many threads (default: the
   package's `gpu.THREADS_PER_BLOCK`, 128). A small batch in small blocks spreads over more
   multiprocessors, so fewer of its warps share each one's L1 (whether that pays: not yet timed).
@@ -89,8 +94,14 @@ def _ptxas() -> str:
     return found
 
 
-#: the builds of ``--kernels``: (SPECIALISE, LEAN_RK4)
-KERNELS = {"general": (False, False), "special": (True, False), "lean": (False, True), "special-lean": (True, True)}
+#: build -> (gpu.SPECIALISE, gpu.LEAN_RK4, gpu.UNIT_N)
+KERNELS = {
+    "general": (False, False, False),
+    "special": (True, False, False),
+    "lean": (False, True, False),
+    "special-lean": (True, True, False),
+    "special-lean-n1": (True, True, True),
+}
 
 
 def _kernels(text: str) -> list[str]:
@@ -107,8 +118,11 @@ def _key(name: str) -> tuple:
     from railride.engine import gpu
     from railride.engine.layout import LAW_BOUC_WEN, N_FAULT_COLS
 
-    gpu.SPECIALISE, gpu.LEAN_RK4 = KERNELS[name]
-    return gpu.kernel_key(LAW_BOUC_WEN, np.zeros((1, N_FAULT_COLS), np.int64), np.zeros((1, 3)), True)
+    gpu.SPECIALISE, gpu.LEAN_RK4, gpu.UNIT_N = KERNELS[name]
+    from railride.secondary.suspension import Suspension
+
+    paper = Suspension.named("sas-attitude-ride").damper.pack()[None, :]  # n = 1, as bench_gpu's batches
+    return gpu.kernel_key(LAW_BOUC_WEN, np.zeros((1, N_FAULT_COLS), np.int64), np.zeros((1, 3)), True, paper)
 
 
 def _resources(limits, kernels) -> None:
@@ -119,18 +133,32 @@ def _resources(limits, kernels) -> None:
     ptxas = _ptxas()
     version = subprocess.run([ptxas, "--version"], capture_output=True, text=True).stdout.strip().splitlines()[-1]
     print(f"ptxas: {version}; sm_90; {datetime.date.today().isoformat()}")
+    disasm = os.environ.get("NVDISASM") or shutil.which("nvdisasm")
+    print(f"nvdisasm: {disasm or 'none (NVDISASM or the PATH): no SASS counts'}")
     print(
         "\n| kernel | register limit | registers | stack frame | spill stores | spill loads "
-        "| blocks of 128 per SM | occupancy | PTX made in |"
+        "| blocks of 128 per SM | occupancy | PTX made in | SASS instructions | local loads / stores "
+        "| global loads | branches | calls |"
     )  # fmt: skip
-    print("|---|---|---|---|---|---|---|---|---|")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     for name in kernels:
         t0 = time.perf_counter()
         code = gpu.ptx((9, 0), _key(name))
-        _assemble(ptxas, code, limits, name, time.perf_counter() - t0)
+        _assemble(ptxas, code, limits, name, time.perf_counter() - t0, disasm)
 
 
-def _assemble(ptxas, code, limits, name, compiled) -> None:
+def _sass_counts(disasm, cubin) -> str:
+    """The kernel's machine instructions as nvdisasm lists them (static counts, each written
+    instruction once: not how often it runs): all, LDL / STL, LDG, BRA and CALL."""
+    if not disasm:
+        return "| - | - | - | - | - |"
+    text = subprocess.run([disasm, "-c", str(cubin)], capture_output=True, text=True, check=True).stdout
+    ops = [m.group(1) for m in re.finditer(r"/\*[0-9a-f]{4,}\*/\s+(?:@!?U?P\w+\s+)?([A-Z][A-Z0-9_]*)", text)]
+    n = {op: ops.count(op) for op in ("LDL", "STL", "LDG", "BRA", "CALL")}
+    return f"| {len(ops)} | {n['LDL']} / {n['STL']} | {n['LDG']} | {n['BRA']} | {n['CALL']} |"
+
+
+def _assemble(ptxas, code, limits, name, compiled, disasm=None) -> None:
     from railride.engine import gpu
 
     with tempfile.TemporaryDirectory() as tmp:
@@ -149,7 +177,7 @@ def _assemble(ptxas, code, limits, name, compiled) -> None:
             blocks, occ = occupancy(regs, gpu.THREADS_PER_BLOCK)
             print(
                 f"| {name} | {'none' if limit is None else limit} | {regs} | {frame} B | {stores} B | {loads} B "
-                f"| {blocks} | {occ * 100:.1f} % | {compiled:.1f} s |"
+                f"| {blocks} | {occ * 100:.1f} % | {compiled:.1f} s " + _sass_counts(disasm, Path(tmp) / "kernel.cubin")
             )
 
 
@@ -171,7 +199,7 @@ def _timed(limits, kernels, sizes, duration: float, blocks=(None,)) -> None:
     first: dict = {}
     default_block = gpu.THREADS_PER_BLOCK
     for name, limit in [(k, r) for k in kernels for r in limits]:
-        gpu.SPECIALISE, gpu.LEAN_RK4 = KERNELS[name]
+        gpu.SPECIALISE, gpu.LEAN_RK4, gpu.UNIT_N = KERNELS[name]
         gpu.MAX_REGISTERS = limit
         gpu._compiled.clear()
         gpu.THREADS_PER_BLOCK = default_block
@@ -237,7 +265,7 @@ def _profile_run(n: int, kernel: str) -> None:
     from railride.run.simulation import simulate
     from railride.run.solver import SolverSettings
 
-    gpu.SPECIALISE, gpu.LEAN_RK4 = KERNELS[kernel]
+    gpu.SPECIALISE, gpu.LEAN_RK4, gpu.UNIT_N = KERNELS[kernel]
     scs, susp = _batch(n, 0.01, "sas-attitude-ride")
     simulate(scs, suspension=susp, solver=SolverSettings(output_rate=200.0, backend="gpu"))
     print(

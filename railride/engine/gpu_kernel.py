@@ -145,17 +145,20 @@ def _forcing(t, ftab, off, n_nodes, interval, R, roff):
 
 
 #: `_kernel_for`'s arguments for the kernel of any batch: every damper law, faults and sensing,
-#: the four stage rates side by side
-GENERAL = (-1, True, True, False)
+#: the four stage rates side by side, any Bouc-Wen exponent
+GENERAL = (-1, True, True, False, False)
 
 
-def _kernel_for(fixed_law: int, with_faults: bool, with_sensing: bool, lean: bool):
+def _kernel_for(fixed_law: int, with_faults: bool, with_sensing: bool, lean: bool, unit_n: bool = False):
     """The kernel's Python function for one kind of batch. Its arguments are constants of the
     compile: ``fixed_law`` >= 0 is the damper law of every sample (LAW_*; -1: read from the
     ``law`` argument), ``with_faults`` / ``with_sensing`` False leave the fault checks and the
     accelerometers out (a batch with no faulty sample, no realistic sensing), and ``lean`` steps
     RK4 with one stage rate and a running sum of them instead of the four stage rates side by
-    side. A kernel without what it does not need has less thread-local memory (docs/gpu.md)."""
+    side. A kernel without what it does not need has less thread-local memory (docs/gpu.md).
+    ``unit_n``: every sample's Bouc-Wen exponent n is 1 (the paper's damper), which the kernel
+    then knows when it compiles, so the laws' powers |z|^(n-1) and their branches are compiled
+    out (`laws._bouc_wen_rate`, `laws.damper_stiffness`)."""
     # local arrays' sizes must be constants of the compile
     n_rates, n_sum = (NS_MAX, NS_MAX) if lean else (4 * NS_MAX, 1)
 
@@ -200,6 +203,8 @@ def _kernel_for(fixed_law: int, with_faults: bool, with_sensing: bool, lean: boo
         pp = cuda.local.array(N_PACKED, float64)
         for i in range(N_PACKED):
             pp[i] = P[smp, i]
+        if unit_n:  # the value it holds, now a constant of the compile: the laws' branches on n fold
+            pp[P_N] = 1.0
         tt = cuda.local.array((N_DOF, N_CORNER), float64)
         for i in range(N_DOF):
             for c in range(N_CORNER):

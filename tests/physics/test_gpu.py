@@ -88,9 +88,10 @@ def test_the_gpu_agrees_with_the_cpu_stepper(case, kernel, monkeypatch):
 
 
 def test_each_batch_gets_the_kernel_of_its_damper_law_faults_and_sensing(monkeypatch):
-    """`gpu.kernel_key`: with SPECIALISE, a batch's kernel fixes its damper law and leaves out
-    faults and sensing where no sample has them; without, every batch gets the general kernel."""
-    from railride.engine.layout import LAW_BOUC_WEN, LAW_VISCOUS_IN_C
+    """`gpu.kernel_key`: with SPECIALISE, a batch's kernel fixes its damper law, leaves out faults
+    and sensing where no sample has them, and knows a Bouc-Wen exponent of 1 where every damper
+    has it; without, every batch gets the general kernel."""
+    from railride.engine.layout import LAW_BOUC_WEN, LAW_SPENCER, LAW_VISCOUS_IN_C
 
     keys = []
     build = gpu._device_functions
@@ -101,6 +102,7 @@ def test_each_batch_gets_the_kernel_of_its_damper_law_faults_and_sensing(monkeyp
         "one faulty": [sas, sas.with_faults(["1R-off"])],
         "sensing": [sas.with_sensing(Accelerometers())],
         "passive": [None],
+        "n = 2": [Suspension.named("skyhook", damper="spencer1997")],
     }
     for special in (True, False):
         monkeypatch.setattr(gpu, "SPECIALISE", special)
@@ -108,9 +110,10 @@ def test_each_batch_gets_the_kernel_of_its_damper_law_faults_and_sensing(monkeyp
             kw = {"params": [PAPER.replace(c_sz=3e4)]} if suspensions == [None] else {"suspension": suspensions}
             simulate(scenario=SHORT, solver=GPU, **kw)
     lean = gpu.LEAN_RK4
-    special = [(LAW_BOUC_WEN, False, False), (LAW_BOUC_WEN, True, False), (LAW_BOUC_WEN, False, True)]
-    special.append((LAW_VISCOUS_IN_C, False, False))
-    assert keys == [(*k, lean) for k in special] + [(-1, True, True, lean)] * 4
+    special = [(LAW_BOUC_WEN, False, False, True), (LAW_BOUC_WEN, True, False, True), (LAW_BOUC_WEN, False, True, True)]
+    special += [(LAW_VISCOUS_IN_C, False, False, False), (LAW_SPENCER, False, False, False)]
+    general = (-1, True, True, lean, False)
+    assert keys == [(*k[:3], lean, k[3]) for k in special] + [general] * 5
 
 
 def test_the_file_cache_setting_reaches_the_compile(monkeypatch):
@@ -236,10 +239,10 @@ def test_the_kernel_compiles_for_a_gpu():
     import subprocess
     import sys
 
-    # the general kernel, and the build a healthy Bouc-Wen batch runs (`gpu.kernel_key`)
+    # the general kernel, and the build a healthy Bouc-Wen batch with n = 1 runs (`gpu.kernel_key`)
     code = (
         "import numpy as np; from railride.engine import gpu; from railride.engine.layout import LAW_BOUC_WEN\n"
-        "key = gpu.kernel_key(LAW_BOUC_WEN, np.zeros((1, 8), np.int64), np.zeros((1, 3)), True)\n"
+        "key = gpu.kernel_key(LAW_BOUC_WEN, np.zeros((1, 8), np.int64), np.zeros((1, 3)), True, np.ones((1, 16)))\n"
         "print(key, '.entry' in gpu.ptx((9, 0)), '.entry' in gpu.ptx((9, 0), key))"
     )
     env = {**__import__("os").environ, "NUMBA_ENABLE_CUDASIM": "0"}
