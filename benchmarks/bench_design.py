@@ -69,13 +69,15 @@ def profile(args: list) -> None:
     from railride.studies import design as design_module
     from railride.studies import design_probes, sweep, tuning
 
+    from bench_gpu_kernel import KERNELS  # benchmarks/: run as a script, this folder is on the path
+
     ap = argparse.ArgumentParser(prog="bench_design.py --profile")
     ap.add_argument("--controllers", default=None)
     ap.add_argument("--budget", type=int, default=design_module.DEFAULT_BUDGET)
     ap.add_argument("--duration", type=float, default=design_module.DEFAULT_DURATION)
     ap.add_argument("--backend", default="auto", choices=["auto", "cpu", "gpu"])
     ap.add_argument(
-        "--gpu-kernel", default=None, choices=["general", "special", "lean", "special-lean", "special-lean-n1"],
+        "--gpu-kernel", default=None, choices=list(KERNELS),
         help="the GPU kernel's build (bench_gpu_kernel.py --kernels); default: the package's",
     )  # fmt: skip
     ap.add_argument("--gpu-threads", type=int, default=None, help="threads a block (default: gpu.THREADS_PER_BLOCK)")
@@ -87,9 +89,7 @@ def profile(args: list) -> None:
     from railride.engine import gpu
 
     if opts.gpu_kernel is not None:
-        from bench_gpu_kernel import KERNELS
-
-        gpu.SPECIALISE, gpu.LEAN_RK4, gpu.UNIT_N = KERNELS[opts.gpu_kernel]
+        gpu.SPECIALISE, gpu.LEAN_RK4, gpu.UNIT_N, gpu.SPARSE_PRODUCT = KERNELS[opts.gpu_kernel]
     if opts.gpu_threads is not None:
         gpu.THREADS_PER_BLOCK = opts.gpu_threads
     gpu.FILE_CACHE = opts.gpu_file_cache

@@ -19,9 +19,10 @@ Run:  python benchmarks/bench_gpu_kernel.py --resources [--registers none,168,12
   each as written once in the code (static counts, not how often they run).
 * ``--kernels``: which builds of the kernel (`gpu_kernel._kernel_for`): ``general`` (the one for any
   batch), ``special`` (the damper law fixed, faults and sensing left out: the batches below),
-  ``lean`` (one RK4 stage rate and a running sum), ``special-lean`` and ``special-lean-n1`` (the
-  package's default: also the Bouc-Wen exponent n = 1 known to the compile, `gpu.UNIT_N`); each
-  under each limit.
+  ``lean`` (one RK4 stage rate and a running sum), ``special-lean``, ``special-lean-n1`` (also
+  the Bouc-Wen exponent n = 1 known to the compile, `gpu.UNIT_N`) and ``special-lean-n1-sparse``
+  (the package's default: also only the q'' product's terms that are not 0,
+  `gpu.SPARSE_PRODUCT`); each under each limit.
 * ``--blocks 32,64,128``: each size also launched in blocks of that many threads (default: the
   package's `gpu.THREADS_PER_BLOCK`, 128). A small batch in small blocks spreads over more
   multiprocessors, so fewer of its warps share each one's L1 (whether that pays: not yet timed).
@@ -94,13 +95,14 @@ def _ptxas() -> str:
     return found
 
 
-#: build -> (gpu.SPECIALISE, gpu.LEAN_RK4, gpu.UNIT_N)
+#: build -> (gpu.SPECIALISE, gpu.LEAN_RK4, gpu.UNIT_N, gpu.SPARSE_PRODUCT)
 KERNELS = {
-    "general": (False, False, False),
-    "special": (True, False, False),
-    "lean": (False, True, False),
-    "special-lean": (True, True, False),
-    "special-lean-n1": (True, True, True),
+    "general": (False, False, False, False),
+    "special": (True, False, False, False),
+    "lean": (False, True, False, False),
+    "special-lean": (True, True, False, False),
+    "special-lean-n1": (True, True, True, False),
+    "special-lean-n1-sparse": (True, True, True, True),
 }
 
 
@@ -118,11 +120,15 @@ def _key(name: str) -> tuple:
     from railride.engine import gpu
     from railride.engine.layout import LAW_BOUC_WEN, N_FAULT_COLS
 
-    gpu.SPECIALISE, gpu.LEAN_RK4, gpu.UNIT_N = KERNELS[name]
+    gpu.SPECIALISE, gpu.LEAN_RK4, gpu.UNIT_N, gpu.SPARSE_PRODUCT = KERNELS[name]
+    from railride.model.vehicle import Vehicle
+    from railride.run.inputs import _system_arrays
     from railride.secondary.suspension import Suspension
 
-    paper = Suspension.named("sas-attitude-ride").damper.pack()[None, :]  # n = 1, as bench_gpu's batches
-    return gpu.kernel_key(LAW_BOUC_WEN, np.zeros((1, N_FAULT_COLS), np.int64), np.zeros((1, 3)), True, paper)
+    # as bench_gpu's batches: the paper's vehicle and damper (n = 1)
+    damper = Suspension.named("sas-attitude-ride").damper.pack()[None, :]
+    A = _system_arrays(Vehicle("paper"), passive=False)["A"][None]
+    return gpu.kernel_key(LAW_BOUC_WEN, np.zeros((1, N_FAULT_COLS), np.int64), np.zeros((1, 3)), True, damper, A)
 
 
 def _resources(limits, kernels) -> None:
@@ -199,7 +205,7 @@ def _timed(limits, kernels, sizes, duration: float, blocks=(None,)) -> None:
     first: dict = {}
     default_block = gpu.THREADS_PER_BLOCK
     for name, limit in [(k, r) for k in kernels for r in limits]:
-        gpu.SPECIALISE, gpu.LEAN_RK4, gpu.UNIT_N = KERNELS[name]
+        gpu.SPECIALISE, gpu.LEAN_RK4, gpu.UNIT_N, gpu.SPARSE_PRODUCT = KERNELS[name]
         gpu.MAX_REGISTERS = limit
         gpu._compiled.clear()
         gpu.THREADS_PER_BLOCK = default_block
@@ -265,7 +271,7 @@ def _profile_run(n: int, kernel: str) -> None:
     from railride.run.simulation import simulate
     from railride.run.solver import SolverSettings
 
-    gpu.SPECIALISE, gpu.LEAN_RK4, gpu.UNIT_N = KERNELS[kernel]
+    gpu.SPECIALISE, gpu.LEAN_RK4, gpu.UNIT_N, gpu.SPARSE_PRODUCT = KERNELS[kernel]
     scs, susp = _batch(n, 0.01, "sas-attitude-ride")
     simulate(scs, suspension=susp, solver=SolverSettings(output_rate=200.0, backend="gpu"))
     print(

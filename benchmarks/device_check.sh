@@ -11,11 +11,12 @@
 #
 # --kernels: builds of the GPU kernel (bench_gpu_kernel.py --kernels) timed on 1,024, 8,192 and
 # 32,768 SAS closed loops: special-lean (9.21e8 sample-steps/s at 32,768 on an H100, 2026-11-27)
-# against special-lean-n1, the default since (the Bouc-Wen exponent known to the compile; never
-# timed); Nsight Compute on one launch of each on 32,768 runs (where the image has ncu); the GPU
-# tests on the device (the general kernel: a build for every case of the tests would compile a
-# dozen kernels); the default design on the GPU (cut at 150 s); special-lean-n1 under register
-# limits of 168 and 128 with what the budget leaves.
+# against special-lean-n1 (the Bouc-Wen exponent known to the compile) and
+# special-lean-n1-sparse, the default since (the q'' product's zeros left out too; neither
+# timed yet); Nsight Compute on one launch of the first and the last on 32,768 runs (where the
+# image has ncu); the GPU tests on the device (the general kernel: a build for every case of the
+# tests would compile a dozen kernels); the default design on the GPU (cut at 150 s); the
+# default build under register limits of 168 and 128 with what the budget leaves.
 #
 # Steps, most wanted first; each gets at most its cap and what is left of the budget, and one
 # that runs out is cut and said so in the log, so the run ends inside the budget:
@@ -120,15 +121,16 @@ finish() {
 if [ "$KERNELS_ONLY" = 1 ]; then
   if [ "$SMOKE" = 1 ]; then  # the simulator times nothing: the kernels' resources instead, and a small design
     step gpu-kernel-builds 200 env NUMBA_ENABLE_CUDASIM=0 $PY benchmarks/bench_gpu_kernel.py --resources \
-      --registers none --kernels special-lean,special-lean-n1
-    step design-on-gpu 30 $PY benchmarks/bench_design.py --profile --backend gpu --gpu-kernel special-lean-n1 \
+      --registers none --kernels special-lean,special-lean-n1-sparse
+    step design-on-gpu 30 $PY benchmarks/bench_design.py --profile --backend gpu --gpu-kernel special-lean-n1-sparse \
       --controllers pid --budget 25 --duration 0.05
     finish
     exit 0
   fi
-  step gpu-kernel-builds 150 $PY benchmarks/bench_gpu_kernel.py --kernels special-lean,special-lean-n1 \
+  step gpu-kernel-builds 200 $PY benchmarks/bench_gpu_kernel.py \
+    --kernels special-lean,special-lean-n1,special-lean-n1-sparse \
     --registers none --samples 1024,8192,32768
-  for k in special-lean special-lean-n1; do
+  for k in special-lean special-lean-n1-sparse; do
     if command -v ncu >/dev/null 2>&1; then
       step "gpu-ncu-$k" 75 ncu --section LaunchStats --section Occupancy --section SpeedOfLight \
         --section MemoryWorkloadAnalysis --section WarpStateStats -k regex:_kernel -c 1 \
@@ -140,7 +142,7 @@ if [ "$KERNELS_ONLY" = 1 ]; then
   step gpu-tests 100 $PY -m pytest -q -p no:randomly -p no:cacheprovider -k "not specialised" \
     tests/physics/test_gpu.py tests/physics/test_gpu_metrics.py
   step design-on-gpu 150 $PY benchmarks/bench_design.py --profile --backend gpu
-  step gpu-kernel-registers 80 $PY benchmarks/bench_gpu_kernel.py --kernels special-lean-n1 --registers 168,128 \
+  step gpu-kernel-registers 80 $PY benchmarks/bench_gpu_kernel.py --kernels special-lean-n1-sparse --registers 168,128 \
     --samples 8192,32768
   finish
   exit 0
@@ -151,7 +153,7 @@ step gpu-throughput 90 $PY benchmarks/bench_gpu.py --samples "$GPU_SAMPLES" --du
 if [ "$SMOKE" = 1 ]; then  # the kernel steps need a GPU; the default design would take too long here: a small one
   step design 60 $PY benchmarks/bench_design.py --profile --controllers pid --budget 25 --duration 0.5
   step gpu-kernel 60 env NUMBA_ENABLE_CUDASIM=0 $PY benchmarks/bench_gpu_kernel.py --resources --registers none \
-    --kernels special-lean-n1
+    --kernels special-lean-n1-sparse
 else
   # the CPU kernels compiled once into numba's cache, so that no timed step below is cut by compiling
   step compile-cpu 90 $PY -c "from railride.studies.study import study; \
@@ -160,7 +162,7 @@ study(['pid', 'sas-attitude', 'sas-attitude-ride', 'clipped-optimal'], track_see
   # cut at the cap (SIGTERM), it prints what it had done by then
   step design 150 $PY benchmarks/bench_design.py --profile
   # small batches in small blocks: a design's rounds (256 to 2,048 runs) last a lone thread's time
-  step gpu-kernel-blocks 120 $PY benchmarks/bench_gpu_kernel.py --kernels special-lean-n1 --registers none \
+  step gpu-kernel-blocks 120 $PY benchmarks/bench_gpu_kernel.py --kernels special-lean-n1-sparse --registers none \
     --blocks 32,64,128 --samples 1024,2048,8192
 fi
 
@@ -180,7 +182,7 @@ if [ "$SMOKE" = 0 ]; then
   if command -v ncu >/dev/null 2>&1; then
     step gpu-ncu 120 ncu --section LaunchStats --section Occupancy --section SpeedOfLight \
       --section MemoryWorkloadAnalysis --section WarpStateStats -k regex:_kernel -c 1 \
-      $PY benchmarks/bench_gpu_kernel.py --profile-run --samples 1024 --kernels special-lean-n1
+      $PY benchmarks/bench_gpu_kernel.py --profile-run --samples 1024 --kernels special-lean-n1-sparse
   else
     step gpu-ncu 10 echo "no ncu on the PATH: the kernel not profiled"
   fi

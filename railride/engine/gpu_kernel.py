@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import types
 
+import numpy as np
 from numba import float64, int64, njit
 
 try:  # numba-cuda (the gpu extra) when installed; numba's own CUDA target otherwise, while it has one
@@ -81,21 +82,25 @@ _N_MEAS = 2 * N_DOF  # the controller's sample of (q, q')
 
 
 @njit(inline="always", fastmath=_FAST)
-def _qdd(s, y, n_cols, R, roff, at, K, koff):
+def _qdd(s, y, n_cols, R, roff, at, nz, K, koff):
     """K[koff + N_DOF + i] = R[roff + i] + sum_j at[j, i] y_j for the N_DOF rows of q'', with
     y = (s[:2 N_DOF], y[2 N_DOF:n_cols]): (q, q') read from the state, the corner forces from the
-    stage vector; at (NY, N_DOF) is the transposed matrix (`kernels.run_batch`)."""
+    stage vector; at (NY, N_DOF) is the transposed matrix (`kernels.run_batch`). Only the terms
+    where nz[j, i] (a constant of the compile: `_kernel_for`'s ``pattern``) are summed, in the
+    order of j: a term left out is one whose coefficient is 0 in every vehicle of the batch."""
     for i in range(N_DOF):
         acc = R[roff + i]
         for j in range(2 * N_DOF):
-            acc += at[j, i] * s[j]
+            if nz[j, i]:
+                acc += at[j, i] * s[j]
         for j in range(2 * N_DOF, n_cols):
-            acc += at[j, i] * y[j]
+            if nz[j, i]:
+                acc += at[j, i] * y[j]
         K[koff + N_DOF + i] = acc
 
 
 @njit(inline="always", fastmath=_FAST)
-def _derivative(law, s, R, roff, at, tt, pp, vcmd, conn, y, cx, cv, K, koff, zk, fsave):
+def _derivative(law, s, R, roff, at, nz, tt, pp, vcmd, conn, y, cx, cv, K, koff, zk, fsave):
     """K[koff:koff + NS_MAX] = d/dt of s: `kernels._derivative` with plain loops (see there)."""
     for i in range(N_DOF):
         K[koff + i] = s[N_DOF + i]
@@ -106,9 +111,9 @@ def _derivative(law, s, R, roff, at, tt, pp, vcmd, conn, y, cx, cv, K, koff, zk,
             for c in range(N_CORNER):
                 y[2 * N_DOF + c] = 0.0
             if add_stops(zk, cx, y, 2 * N_DOF, fsave):
-                _qdd(s, y, NY, R, roff, at, K, koff)
+                _qdd(s, y, NY, R, roff, at, nz, K, koff)
                 return
-        _qdd(s, y, 2 * N_DOF, R, roff, at, K, koff)
+        _qdd(s, y, 2 * N_DOF, R, roff, at, nz, K, koff)
         return
     for c in range(N_CORNER):
         b = 2 * N_DOF + N_DAMPER_STATES * c
@@ -118,11 +123,11 @@ def _derivative(law, s, R, roff, at, tt, pp, vcmd, conn, y, cx, cv, K, koff, zk,
         K[koff + b + 1] = dyy
         K[koff + b + 2] = du
     if zk[1] > 0.0 and add_stops(zk, cx, y, 2 * N_DOF, fsave):
-        _qdd(s, y, NY, R, roff, at, K, koff)
+        _qdd(s, y, NY, R, roff, at, nz, K, koff)
         for c in range(N_CORNER):
             y[2 * N_DOF + c] = fsave[c]
         return
-    _qdd(s, y, NY, R, roff, at, K, koff)
+    _qdd(s, y, NY, R, roff, at, nz, K, koff)
 
 
 @njit(inline="always", fastmath=_FAST)
@@ -145,11 +150,19 @@ def _forcing(t, ftab, off, n_nodes, interval, R, roff):
 
 
 #: `_kernel_for`'s arguments for the kernel of any batch: every damper law, faults and sensing,
-#: the four stage rates side by side, any Bouc-Wen exponent
-GENERAL = (-1, True, True, False, False)
+#: the four stage rates side by side, any Bouc-Wen exponent, every term of the q'' product
+GENERAL = (-1, True, True, False, False, -1)
 
 
-def _kernel_for(fixed_law: int, with_faults: bool, with_sensing: bool, lean: bool, unit_n: bool = False):
+def pattern_of(A) -> int:
+    """`_kernel_for`'s ``pattern`` for the matrices A (vehicles, NY, N_DOF): bit j N_DOF + i set
+    where A[:, j, i] is not 0 in some vehicle."""
+    return sum(1 << k for k, nonzero in enumerate(np.any(A != 0.0, axis=0).ravel()) if nonzero)
+
+
+def _kernel_for(
+    fixed_law: int, with_faults: bool, with_sensing: bool, lean: bool, unit_n: bool = False, pattern: int = -1
+):
     """The kernel's Python function for one kind of batch. Its arguments are constants of the
     compile: ``fixed_law`` >= 0 is the damper law of every sample (LAW_*; -1: read from the
     ``law`` argument), ``with_faults`` / ``with_sensing`` False leave the fault checks and the
@@ -158,9 +171,13 @@ def _kernel_for(fixed_law: int, with_faults: bool, with_sensing: bool, lean: boo
     side. A kernel without what it does not need has less thread-local memory (docs/gpu.md).
     ``unit_n``: every sample's Bouc-Wen exponent n is 1 (the paper's damper), which the kernel
     then knows when it compiles, so the laws' powers |z|^(n-1) and their branches are compiled
-    out (`laws._bouc_wen_rate`, `laws.damper_stiffness`)."""
+    out (`laws._bouc_wen_rate`, `laws.damper_stiffness`). ``pattern`` (`pattern_of`; -1: every
+    term): the terms of the q'' product that some vehicle of the batch has; the others, zeros in
+    every vehicle, are compiled out (the paper's vehicle with dampers has 56 of the 240)."""
     # local arrays' sizes must be constants of the compile
     n_rates, n_sum = (NS_MAX, NS_MAX) if lean else (4 * NS_MAX, 1)
+    # a constant array of the compile: the product's tests on it fold
+    nz = np.array([pattern < 0 or (pattern >> k) & 1 == 1 for k in range(NY * N_DOF)]).reshape(NY, N_DOF)
 
     # fmt: off
     def _kernel(
@@ -249,7 +266,7 @@ def _kernel_for(fixed_law: int, with_faults: bool, with_sensing: bool, lean: boo
                 for c in range(N_CORNER):
                     if fault_at(fm, c, step) == FAULT_DISCONNECTED:
                         conn[c] = 0.0
-            _derivative(law, s, R, 0, at, tt, pp, vc, conn, y, cx, cv, K, 0, zk, fsave)
+            _derivative(law, s, R, 0, at, nz, tt, pp, vc, conn, y, cx, cv, K, 0, zk, fsave)
             if sens:
                 accelerometer_filters(xs, tt, K, dt, w_aa)
             if closed_loop and law != LAW_IDEAL:
@@ -273,7 +290,9 @@ def _kernel_for(fixed_law: int, with_faults: bool, with_sensing: bool, lean: boo
                 _forcing(ts + 0.5 * h, ftab, fo, nn, itv, R, N_DOF)
                 _forcing(ts + h, ftab, fo, nn, itv, R, 2 * N_DOF)
                 if lean:
-                    _lean_rk4(law, s, st, K, ksum, h, sub, has_states, R, at, tt, pp, vc, conn, y, cx, cv, zk, fsave)
+                    _lean_rk4(
+                        law, s, st, K, ksum, h, sub, has_states, R, at, nz, tt, pp, vc, conn, y, cx, cv, zk, fsave
+                    )
                 else:
                     for stage in range(4):
                         if stage == 0 and sub == 0:
@@ -282,7 +301,7 @@ def _kernel_for(fixed_law: int, with_faults: bool, with_sensing: bool, lean: boo
                         roff = N_DOF * (0 if stage == 0 else (1 if stage < 3 else 2))
                         prev = NS_MAX * (stage - 1 if stage > 0 else 0)
                         rk4_stage_state(st, s, K, prev, ch, has_states)
-                        _derivative(law, st, R, roff, at, tt, pp, vc, conn, y, cx, cv, K, NS_MAX * stage, zk, fsave)
+                        _derivative(law, st, R, roff, at, nz, tt, pp, vc, conn, y, cx, cv, K, NS_MAX * stage, zk, fsave)
                     rk4_advance(s, K, h, has_states)
                 for i in range(N_DOF):
                     R[i] = R[2 * N_DOF + i]
@@ -293,21 +312,21 @@ def _kernel_for(fixed_law: int, with_faults: bool, with_sensing: bool, lean: boo
 
 
 @njit(inline="always", fastmath=_FAST)
-def _lean_rk4(law, s, st, K, ksum, h, sub, has_states, R, at, tt, pp, vc, conn, y, cx, cv, zk, fsave):
+def _lean_rk4(law, s, st, K, ksum, h, sub, has_states, R, at, nz, tt, pp, vc, conn, y, cx, cv, zk, fsave):
     """One RK4 sub-step of length h with one stage rate K (its first NS_MAX) and the running sum
     ksum = K1 + 2 K2 + 2 K3 (+ K4), summed in the order of `rk4_advance`: the same arithmetic as
     the four stage rates side by side, in half their memory. At sub-step 0, K holds stage 1's
     rate already (the step's start, with the inner loop's coil rates)."""
     n = NS_MAX if has_states else 2 * N_DOF
     if sub > 0:
-        _derivative(law, s, R, 0, at, tt, pp, vc, conn, y, cx, cv, K, 0, zk, fsave)
+        _derivative(law, s, R, 0, at, nz, tt, pp, vc, conn, y, cx, cv, K, 0, zk, fsave)
     for i in range(n):
         ksum[i] = K[i]
     for stage in range(1, 4):
         ch = h * (0.5 if stage < 3 else 1.0)
         for i in range(n):
             st[i] = s[i] + ch * K[i]
-        _derivative(law, st, R, N_DOF * (1 if stage < 3 else 2), at, tt, pp, vc, conn, y, cx, cv, K, 0, zk, fsave)
+        _derivative(law, st, R, N_DOF * (1 if stage < 3 else 2), at, nz, tt, pp, vc, conn, y, cx, cv, K, 0, zk, fsave)
         wgt = 2.0 if stage < 3 else 1.0
         for i in range(n):
             ksum[i] += wgt * K[i]

@@ -112,8 +112,28 @@ def test_each_batch_gets_the_kernel_of_its_damper_law_faults_and_sensing(monkeyp
     lean = gpu.LEAN_RK4
     special = [(LAW_BOUC_WEN, False, False, True), (LAW_BOUC_WEN, True, False, True), (LAW_BOUC_WEN, False, True, True)]
     special += [(LAW_VISCOUS_IN_C, False, False, False), (LAW_SPENCER, False, False, False)]
-    general = (-1, True, True, lean, False)
-    assert keys == [(*k[:3], lean, k[3]) for k in special] + [general] * 5
+    general = (-1, True, True, lean, False, -1)
+    assert [k[:5] for k in keys[:5]] == [(*k[:3], lean, k[3]) for k in special]
+    assert keys[5:] == [general] * 5
+    # the q'' product's terms: the paper's vehicle has 56 of its 240 coefficients not 0 with
+    # dampers, 66 with its dashpots in the matrix (counted from its matrices, ad hoc)
+    assert [bin(k[5]).count("1") for k in keys[:5]] == [56, 56, 56, 66, 56]
+
+
+def test_the_sparse_product_leaves_out_only_zeros(monkeypatch):
+    """The q'' product of only the terms that some vehicle has (`gpu.SPARSE_PRODUCT`) gives the
+    runs of the whole product to the bit: a bending carbody and a rigid one in one batch."""
+    kw = dict(
+        params=[VehicleParams.preset("manchester-1"), PAPER.replace(m_c=4.2e4)],
+        scenario=scenario("fra4", duration=0.008),
+        suspension=Suspension.named("sas-attitude-ride"),
+    )
+    runs = []
+    for sparse in (False, True):
+        monkeypatch.setattr(gpu, "SPARSE_PRODUCT", sparse)
+        runs.append(histories(simulate(**kw, solver=GPU)))
+    for name in runs[0]:
+        np.testing.assert_array_equal(runs[1][name], runs[0][name], err_msg=name)
 
 
 def test_the_file_cache_setting_reaches_the_compile(monkeypatch):
@@ -239,10 +259,12 @@ def test_the_kernel_compiles_for_a_gpu():
     import subprocess
     import sys
 
-    # the general kernel, and the build a healthy Bouc-Wen batch with n = 1 runs (`gpu.kernel_key`)
+    # the general kernel, and the build a healthy Bouc-Wen batch of the paper's vehicle, n = 1, runs (`gpu.kernel_key`)
     code = (
         "import numpy as np; from railride.engine import gpu; from railride.engine.layout import LAW_BOUC_WEN\n"
-        "key = gpu.kernel_key(LAW_BOUC_WEN, np.zeros((1, 8), np.int64), np.zeros((1, 3)), True, np.ones((1, 16)))\n"
+        "from railride.run.inputs import _system_arrays; from railride.model.vehicle import Vehicle\n"
+        "A = _system_arrays(Vehicle('paper'), passive=False)['A'][None]\n"
+        "key = gpu.kernel_key(LAW_BOUC_WEN, np.zeros((1, 8), np.int64), np.zeros((1, 3)), True, np.ones((1, 16)), A)\n"
         "print(key, '.entry' in gpu.ptx((9, 0)), '.entry' in gpu.ptx((9, 0), key))"
     )
     env = {**__import__("os").environ, "NUMBA_ENABLE_CUDASIM": "0"}
