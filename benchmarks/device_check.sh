@@ -24,7 +24,9 @@
 #      a profiler (nsys, ncu) if there is one, and whether railride sees a usable GPU
 #   2. bench_gpu.py: 32,768 SAS closed loops on the GPU (and how long its first call, which
 #      compiles the kernel, takes), their agreement with the CPU over 64 samples, the same batch
-#      on the CPU's cores, and the metrics-only batch of the studies
+#      on the CPU's cores, and the metrics-only batch of the studies; then the default build of
+#      the kernel against the one timed on 2026-11-27 (bench_gpu_kernel.py --kernels), 1,024 and
+#      32,768 runs
 #   3. the default design (backend auto: the CPU's cores for its batches, all under 4,096 runs),
 #      through bench_design.py --profile, after the CPU's kernels are compiled: its wall and CPU
 #      time, its stepping rate, and by stage how long some batch stepped and how long none did;
@@ -149,6 +151,13 @@ if [ "$KERNELS_ONLY" = 1 ]; then
 fi
 
 step gpu-throughput 90 $PY benchmarks/bench_gpu.py --samples "$GPU_SAMPLES" --duration "$DURATION" --cpu --check "$CHECK" --metrics-only
+if [ "$SMOKE" = 0 ]; then
+  # the default build (the Bouc-Wen exponent and the matrix's zeros known to the compile, never
+  # timed) against the build timed at 9.21e8 on 2026-11-27: their rates and whether their runs
+  # are the same to the bit on the device
+  step gpu-builds 120 $PY benchmarks/bench_gpu_kernel.py --kernels special-lean,special-lean-n1-sparse \
+    --registers none --samples 1024,32768
+fi
 
 if [ "$SMOKE" = 1 ]; then  # the kernel steps need a GPU; the default design would take too long here: a small one
   step design 60 $PY benchmarks/bench_design.py --profile --controllers pid --budget 25 --duration 0.5
