@@ -12,7 +12,7 @@
 # --kernels: builds of the GPU kernel (bench_gpu_kernel.py --kernels) timed on 1,024, 8,192 and
 # 32,768 SAS closed loops: special-lean (9.21e8 sample-steps/s at 32,768 on an H100, 2026-11-27)
 # against special-lean-n1 (the Bouc-Wen exponent known to the compile) and
-# special-lean-n1-sparse, the default since (the q'' product's zeros left out too; neither
+# special-lean-n1-sparse, the default since (the vehicle matrices' zeros left out too; neither
 # timed yet); Nsight Compute on one launch of the first and the last on 32,768 runs (where the
 # image has ncu); the GPU tests on the device (the general kernel: a build for every case of the
 # tests would compile a dozen kernels); the default design on the GPU (cut at 150 s); the
@@ -152,7 +152,7 @@ fi
 
 step gpu-throughput 90 $PY benchmarks/bench_gpu.py --samples "$GPU_SAMPLES" --duration "$DURATION" --cpu --check "$CHECK" --metrics-only
 if [ "$SMOKE" = 0 ]; then
-  # the default build (the Bouc-Wen exponent and the matrix's zeros known to the compile, never
+  # the default build (the Bouc-Wen exponent and the matrices' zeros known to the compile, never
   # timed) against the build timed at 9.21e8 on 2026-11-27: their rates and whether their runs
   # are the same to the bit on the device
   step gpu-builds 120 $PY benchmarks/bench_gpu_kernel.py --kernels special-lean,special-lean-n1-sparse \

@@ -49,8 +49,9 @@ LEAN_RK4 = True
 #: knows it (`_kernel_for`'s ``unit_n``): 19 % fewer instructions and less stack for ptxas
 #: (docs/gpu.md); the same arithmetic
 UNIT_N = True
-#: with SPECIALISE, the q'' product sums only the terms whose coefficient is not 0 in some vehicle
-#: of the batch (`_kernel_for`'s ``pattern``): 56 of 240 for the paper's vehicle with dampers
+#: with SPECIALISE, the q'' product and the corner deflections sum only the terms whose
+#: coefficient is not 0 in some vehicle of the batch (`_kernel_for`'s ``pattern``): 56 of 240 and
+#: 20 of 40 for the paper's vehicle with dampers
 SPARSE_PRODUCT = True
 #: keep each compiled kernel in numba's file cache beside the engine's CPU kernels
 #: (``cuda.jit(cache=True)``; cleared with them when an engine source changes,
@@ -119,18 +120,18 @@ def _array_overloads() -> None:
 
 
 def kernel_key(
-    law: int, faults: np.ndarray, sensing: np.ndarray, closed_loop: bool, P: np.ndarray, A: np.ndarray
+    law: int, faults: np.ndarray, sensing: np.ndarray, closed_loop: bool, P: np.ndarray, A: np.ndarray, TS: np.ndarray
 ) -> tuple:
     """Which kernel a batch runs (`_kernel_for`'s arguments): with SPECIALISE, the batch's damper
     law, faults and sensing only where some sample has them, a Bouc-Wen exponent of 1 where
-    every sample's damper (P, as `Damper.pack()`) has it, and the terms of the q'' product that
-    its vehicles' matrices A have; else the one for any batch."""
+    every sample's damper (P, as `Damper.pack()`) has it, and the terms of the q'' product and
+    of the corner deflections that its vehicles' matrices A and TS have; else the one for any batch."""
     if not SPECIALISE:
         return (*GENERAL[:3], LEAN_RK4, False, -1)
     with_faults = bool(np.any(faults[:, F_MODE : F_MODE + N_CORNER] != FAULT_NONE))
     with_sensing = bool(closed_loop and np.any(sensing[:, S_ON] > 0.0))
     unit_n = UNIT_N and law in (LAW_BOUC_WEN, LAW_SPENCER) and bool(np.all(P[:, P_N] == 1.0))
-    pattern = pattern_of(A) if SPARSE_PRODUCT else -1
+    pattern = pattern_of(A, TS) if SPARSE_PRODUCT else -1
     return (int(law), with_faults, with_sensing, LEAN_RK4, unit_n, pattern)
 
 
@@ -266,7 +267,7 @@ def run_gpu(
     closed_loop, ctrl_stride, Gm, Hm, inner, noise, faults, sensing, snoise = control
     A_u, TS_u, vid = _vehicles(A, TS)
     try:
-        kernel = _device_functions(kernel_key(law, faults[:n], sensing[:n], closed_loop, P[:n], A_u))
+        kernel = _device_functions(kernel_key(law, faults[:n], sensing[:n], closed_loop, P[:n], A_u, TS_u))
     except Exception as exc:
         raise _Failed(exc, 0) from exc
     out_q, out_v, out_a, out_f, out_w, out_wd, out_d, out_fd, out_vc, status, fail_step = outputs

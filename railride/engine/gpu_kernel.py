@@ -28,7 +28,6 @@ except ImportError:  # pragma: no cover - a numba without a CUDA target and no n
 
 from railride.engine import laws, sample_parts
 from railride.engine.laws import (
-    _corner_values,
     add_stops,
     damper_law,
     fault_at,
@@ -100,12 +99,24 @@ def _qdd(s, y, n_cols, R, roff, at, nz, K, koff):
 
 
 @njit(inline="always", fastmath=_FAST)
-def _derivative(law, s, R, roff, at, nz, tt, pp, vcmd, conn, y, cx, cv, K, koff, zk, fsave):
+def _corners(tt, tnz, s, offset, out):
+    """out[c] = sum_j tt[j, c] s[offset + j], `laws._corner_values` over the terms where tnz[j, c]
+    (a constant of the compile: `_kernel_for`'s ``pattern``), in the same order."""
+    for c in range(N_CORNER):
+        acc = 0.0
+        for j in range(N_DOF):
+            if tnz[j, c]:
+                acc += tt[j, c] * s[offset + j]
+        out[c] = acc
+
+
+@njit(inline="always", fastmath=_FAST)
+def _derivative(law, s, R, roff, at, nz, tt, tnz, pp, vcmd, conn, y, cx, cv, K, koff, zk, fsave):
     """K[koff:koff + NS_MAX] = d/dt of s: `kernels._derivative` with plain loops (see there)."""
     for i in range(N_DOF):
         K[koff + i] = s[N_DOF + i]
-    _corner_values(tt, s, 0, cx)
-    _corner_values(tt, s, N_DOF, cv)
+    _corners(tt, tnz, s, 0, cx)
+    _corners(tt, tnz, s, N_DOF, cv)
     if law == LAW_VISCOUS_IN_C:
         if zk[1] > 0.0:
             for c in range(N_CORNER):
@@ -154,10 +165,12 @@ def _forcing(t, ftab, off, n_nodes, interval, R, roff):
 GENERAL = (-1, True, True, False, False, -1)
 
 
-def pattern_of(A) -> int:
-    """`_kernel_for`'s ``pattern`` for the matrices A (vehicles, NY, N_DOF): bit j N_DOF + i set
-    where A[:, j, i] is not 0 in some vehicle."""
-    return sum(1 << k for k, nonzero in enumerate(np.any(A != 0.0, axis=0).ravel()) if nonzero)
+def pattern_of(A, TS) -> int:
+    """`_kernel_for`'s ``pattern`` for the vehicles' matrices A (vehicles, NY, N_DOF) and TS
+    (vehicles, N_DOF, N_CORNER): bit j N_DOF + i set where A[:, j, i] is not 0 in some vehicle,
+    bit NY N_DOF + j N_CORNER + c where TS[:, j, c] is not 0 in some vehicle."""
+    nonzero = np.concatenate([np.any(M != 0.0, axis=0).ravel() for M in (A, TS)])
+    return sum(1 << k for k, nz in enumerate(nonzero) if nz)
 
 
 def _kernel_for(
@@ -177,7 +190,8 @@ def _kernel_for(
     # local arrays' sizes must be constants of the compile
     n_rates, n_sum = (NS_MAX, NS_MAX) if lean else (4 * NS_MAX, 1)
     # a constant array of the compile: the product's tests on it fold
-    nz = np.array([pattern < 0 or (pattern >> k) & 1 == 1 for k in range(NY * N_DOF)]).reshape(NY, N_DOF)
+    bits = np.array([pattern < 0 or (pattern >> k) & 1 == 1 for k in range(NY * N_DOF + N_DOF * N_CORNER)])
+    nz, tnz = bits[: NY * N_DOF].reshape(NY, N_DOF), bits[NY * N_DOF :].reshape(N_DOF, N_CORNER)
 
     # fmt: off
     def _kernel(
@@ -266,7 +280,7 @@ def _kernel_for(
                 for c in range(N_CORNER):
                     if fault_at(fm, c, step) == FAULT_DISCONNECTED:
                         conn[c] = 0.0
-            _derivative(law, s, R, 0, at, nz, tt, pp, vc, conn, y, cx, cv, K, 0, zk, fsave)
+            _derivative(law, s, R, 0, at, nz, tt, tnz, pp, vc, conn, y, cx, cv, K, 0, zk, fsave)
             if sens:
                 accelerometer_filters(xs, tt, K, dt, w_aa)
             if closed_loop and law != LAW_IDEAL:
@@ -291,8 +305,8 @@ def _kernel_for(
                 _forcing(ts + h, ftab, fo, nn, itv, R, 2 * N_DOF)
                 if lean:
                     _lean_rk4(
-                        law, s, st, K, ksum, h, sub, has_states, R, at, nz, tt, pp, vc, conn, y, cx, cv, zk, fsave
-                    )
+                        law, s, st, K, ksum, h, sub, has_states, R, at, nz, tt, tnz, pp, vc, conn, y, cx, cv, zk, fsave
+                    )  # fmt: skip
                 else:
                     for stage in range(4):
                         if stage == 0 and sub == 0:
@@ -301,7 +315,8 @@ def _kernel_for(
                         roff = N_DOF * (0 if stage == 0 else (1 if stage < 3 else 2))
                         prev = NS_MAX * (stage - 1 if stage > 0 else 0)
                         rk4_stage_state(st, s, K, prev, ch, has_states)
-                        _derivative(law, st, R, roff, at, nz, tt, pp, vc, conn, y, cx, cv, K, NS_MAX * stage, zk, fsave)
+                        kk = NS_MAX * stage
+                        _derivative(law, st, R, roff, at, nz, tt, tnz, pp, vc, conn, y, cx, cv, K, kk, zk, fsave)
                     rk4_advance(s, K, h, has_states)
                 for i in range(N_DOF):
                     R[i] = R[2 * N_DOF + i]
@@ -312,21 +327,22 @@ def _kernel_for(
 
 
 @njit(inline="always", fastmath=_FAST)
-def _lean_rk4(law, s, st, K, ksum, h, sub, has_states, R, at, nz, tt, pp, vc, conn, y, cx, cv, zk, fsave):
+def _lean_rk4(law, s, st, K, ksum, h, sub, has_states, R, at, nz, tt, tnz, pp, vc, conn, y, cx, cv, zk, fsave):
     """One RK4 sub-step of length h with one stage rate K (its first NS_MAX) and the running sum
     ksum = K1 + 2 K2 + 2 K3 (+ K4), summed in the order of `rk4_advance`: the same arithmetic as
     the four stage rates side by side, in half their memory. At sub-step 0, K holds stage 1's
     rate already (the step's start, with the inner loop's coil rates)."""
     n = NS_MAX if has_states else 2 * N_DOF
     if sub > 0:
-        _derivative(law, s, R, 0, at, nz, tt, pp, vc, conn, y, cx, cv, K, 0, zk, fsave)
+        _derivative(law, s, R, 0, at, nz, tt, tnz, pp, vc, conn, y, cx, cv, K, 0, zk, fsave)
     for i in range(n):
         ksum[i] = K[i]
     for stage in range(1, 4):
         ch = h * (0.5 if stage < 3 else 1.0)
         for i in range(n):
             st[i] = s[i] + ch * K[i]
-        _derivative(law, st, R, N_DOF * (1 if stage < 3 else 2), at, nz, tt, pp, vc, conn, y, cx, cv, K, 0, zk, fsave)
+        roff = N_DOF * (1 if stage < 3 else 2)
+        _derivative(law, st, R, roff, at, nz, tt, tnz, pp, vc, conn, y, cx, cv, K, 0, zk, fsave)
         wgt = 2.0 if stage < 3 else 1.0
         for i in range(n):
             ksum[i] += wgt * K[i]

@@ -115,14 +115,16 @@ def test_each_batch_gets_the_kernel_of_its_damper_law_faults_and_sensing(monkeyp
     general = (-1, True, True, lean, False, -1)
     assert [k[:5] for k in keys[:5]] == [(*k[:3], lean, k[3]) for k in special]
     assert keys[5:] == [general] * 5
-    # the q'' product's terms: the paper's vehicle has 56 of its 240 coefficients not 0 with
-    # dampers, 66 with its dashpots in the matrix (counted from its matrices, ad hoc)
-    assert [bin(k[5]).count("1") for k in keys[:5]] == [56, 56, 56, 66, 56]
+    # the terms of the q'' product and the corner deflections: the paper's vehicle has 56 of the
+    # 240 coefficients of its matrix A not 0 with dampers, 66 with its dashpots in the matrix, and
+    # 20 of the 40 of TS (counted from its matrices, ad hoc)
+    assert [bin(k[5]).count("1") for k in keys[:5]] == [76, 76, 76, 86, 76]
 
 
 def test_the_sparse_product_leaves_out_only_zeros(monkeypatch):
-    """The q'' product of only the terms that some vehicle has (`gpu.SPARSE_PRODUCT`) gives the
-    runs of the whole product to the bit: a bending carbody and a rigid one in one batch."""
+    """The q'' product and the corner deflections of only the terms that some vehicle has
+    (`gpu.SPARSE_PRODUCT`) give the runs of the whole products to the bit: a bending carbody and a
+    rigid one in one batch."""
     kw = dict(
         params=[VehicleParams.preset("manchester-1"), PAPER.replace(m_c=4.2e4)],
         scenario=scenario("fra4", duration=0.008),
@@ -263,8 +265,9 @@ def test_the_kernel_compiles_for_a_gpu():
     code = (
         "import numpy as np; from railride.engine import gpu; from railride.engine.layout import LAW_BOUC_WEN\n"
         "from railride.run.inputs import _system_arrays; from railride.model.vehicle import Vehicle\n"
-        "A = _system_arrays(Vehicle('paper'), passive=False)['A'][None]\n"
-        "key = gpu.kernel_key(LAW_BOUC_WEN, np.zeros((1, 8), np.int64), np.zeros((1, 3)), True, np.ones((1, 16)), A)\n"
+        "m = _system_arrays(Vehicle('paper'), passive=False)\n"
+        "key = gpu.kernel_key(LAW_BOUC_WEN, np.zeros((1, 8), np.int64), np.zeros((1, 3)), True, np.ones((1, 16)),"
+        " m['A'][None], m['TS'][None])\n"
         "print(key, '.entry' in gpu.ptx((9, 0)), '.entry' in gpu.ptx((9, 0), key))"
     )
     env = {**__import__("os").environ, "NUMBA_ENABLE_CUDASIM": "0"}
