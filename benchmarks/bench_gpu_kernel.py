@@ -21,8 +21,8 @@ Run:  python benchmarks/bench_gpu_kernel.py --resources [--registers none,168,12
   batch), ``special`` (the damper law fixed, faults and sensing left out: the batches below),
   ``lean`` (one RK4 stage rate and a running sum), ``special-lean``, ``special-lean-n1`` (also
   the Bouc-Wen exponent n = 1 known to the compile, `gpu.UNIT_N`) and ``special-lean-n1-sparse``
-  (the package's default: also only the terms of the q'' product and of the corner deflections
-  that are not 0, `gpu.SPARSE_PRODUCT`); each under each limit.
+  (the package's default: also only the terms of the q'' product, the corner deflections and
+  the rail forcing that are not 0, `gpu.SPARSE_PRODUCT`); each under each limit.
 * ``--blocks 32,64,128``: each size also launched in blocks of that many threads (default: the
   package's `gpu.THREADS_PER_BLOCK`, 128). A small batch in small blocks spreads over more
   multiprocessors, so fewer of its warps share each one's L1 (whether that pays: not yet timed).
@@ -129,7 +129,9 @@ def _key(name: str) -> tuple:
     damper = Suspension.named("sas-attitude-ride").damper.pack()[None, :]
     matrices = _system_arrays(Vehicle("paper"), passive=False)
     A, TS = matrices["A"][None], matrices["TS"][None]
-    return gpu.kernel_key(LAW_BOUC_WEN, np.zeros((1, N_FAULT_COLS), np.int64), np.zeros((1, 3)), True, damper, A, TS)
+    ftab = np.tile(gpu.BOGIE_ROWS, 4)[None, :].astype(float)  # the rails reach the bogies' rows
+    faults, sensing = np.zeros((1, N_FAULT_COLS), np.int64), np.zeros((1, 3))
+    return gpu.kernel_key(LAW_BOUC_WEN, faults, sensing, True, damper, A, TS, ftab)
 
 
 def _resources(limits, kernels) -> None:

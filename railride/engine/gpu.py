@@ -28,7 +28,7 @@ except ImportError:  # pragma: no cover - a numba without a CUDA target and no n
     cuda = None  # type: ignore[assignment]
 
 from railride.engine.gpu_kernel import GENERAL, _kernel_for, _python_mirror, kernel_signature, pattern_of
-from railride.engine.layout import F_MODE, FAULT_NONE, LAW_BOUC_WEN, LAW_SPENCER, N_CORNER, P_N, S_ON
+from railride.engine.layout import F_MODE, FAULT_NONE, LAW_BOUC_WEN, LAW_SPENCER, N_CORNER, N_DOF, P_N, ROW_BOGIES, S_ON
 from railride.engine.sample_parts import N_ACC
 
 #: threads per block on a GPU (a multiple of the warp, 32)
@@ -50,8 +50,9 @@ LEAN_RK4 = True
 #: (docs/gpu.md); the same arithmetic
 UNIT_N = True
 #: with SPECIALISE, the q'' product and the corner deflections sum only the terms whose
-#: coefficient is not 0 in some vehicle of the batch (`_kernel_for`'s ``pattern``): 56 of 240 and
-#: 20 of 40 for the paper's vehicle with dampers
+#: coefficient is not 0 in some vehicle of the batch (56 of 240 and 20 of 40 for the paper's
+#: vehicle with dampers), and the rail forcing only in the rows the rails reach (`forced_rows`):
+#: `_kernel_for`'s ``pattern``
 SPARSE_PRODUCT = True
 #: keep each compiled kernel in numba's file cache beside the engine's CPU kernels
 #: (``cuda.jit(cache=True)``; cleared with them when an engine source changes,
@@ -120,19 +121,41 @@ def _array_overloads() -> None:
 
 
 def kernel_key(
-    law: int, faults: np.ndarray, sensing: np.ndarray, closed_loop: bool, P: np.ndarray, A: np.ndarray, TS: np.ndarray
+    law: int,
+    faults: np.ndarray,
+    sensing: np.ndarray,
+    closed_loop: bool,
+    P: np.ndarray,
+    A: np.ndarray,
+    TS: np.ndarray,
+    ftab: np.ndarray,
 ) -> tuple:
     """Which kernel a batch runs (`_kernel_for`'s arguments): with SPECIALISE, the batch's damper
     law, faults and sensing only where some sample has them, a Bouc-Wen exponent of 1 where
-    every sample's damper (P, as `Damper.pack()`) has it, and the terms of the q'' product and
-    of the corner deflections that its vehicles' matrices A and TS have; else the one for any batch."""
+    every sample's damper (P, as `Damper.pack()`) has it, and the terms of the q'' product, of
+    the corner deflections and of the rail forcing that its vehicles' matrices A and TS and its
+    forcing table ftab have (`forced_rows`); else the one for any batch."""
     if not SPECIALISE:
         return (*GENERAL[:3], LEAN_RK4, False, -1)
     with_faults = bool(np.any(faults[:, F_MODE : F_MODE + N_CORNER] != FAULT_NONE))
     with_sensing = bool(closed_loop and np.any(sensing[:, S_ON] > 0.0))
     unit_n = UNIT_N and law in (LAW_BOUC_WEN, LAW_SPENCER) and bool(np.all(P[:, P_N] == 1.0))
-    pattern = pattern_of(A, TS) if SPARSE_PRODUCT else -1
+    pattern = pattern_of(A, TS, forced_rows(ftab)) if SPARSE_PRODUCT else -1
     return (int(law), with_faults, with_sensing, LEAN_RK4, unit_n, pattern)
+
+
+#: the rows of q'' that the rail inputs reach in every vehicle here (`forced_rows`)
+BOGIE_ROWS = np.isin(np.arange(N_DOF), np.arange(ROW_BOGIES, ROW_BOGIES + 6))
+
+
+def forced_rows(ftab: np.ndarray) -> np.ndarray:
+    """The rows of q'' (N_DOF bools) that a kernel computes the rail forcing of, for the forcing
+    table ftab (nodes, 4 N_DOF: Bw w, Bw w', Bwd w, Bwd w' side by side): the bogies' rows where
+    the table has nothing in the others (every vehicle here: the rails act on the bogies through
+    the primary suspension), else every row. Never the table's own zeros, so that a flat track
+    needs no kernel of its own."""
+    others = [g * N_DOF + i for g in range(4) for i in range(N_DOF) if not BOGIE_ROWS[i]]
+    return BOGIE_ROWS if not np.any(ftab[:, others]) else np.ones(N_DOF, bool)
 
 
 def _device_functions(key: tuple):
@@ -267,7 +290,7 @@ def run_gpu(
     closed_loop, ctrl_stride, Gm, Hm, inner, noise, faults, sensing, snoise = control
     A_u, TS_u, vid = _vehicles(A, TS)
     try:
-        kernel = _device_functions(kernel_key(law, faults[:n], sensing[:n], closed_loop, P[:n], A_u, TS_u))
+        kernel = _device_functions(kernel_key(law, faults[:n], sensing[:n], closed_loop, P[:n], A_u, TS_u, ftab))
     except Exception as exc:
         raise _Failed(exc, 0) from exc
     out_q, out_v, out_a, out_f, out_w, out_wd, out_d, out_fd, out_vc, status, fail_step = outputs

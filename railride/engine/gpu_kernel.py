@@ -142,13 +142,18 @@ def _derivative(law, s, R, roff, at, nz, tt, tnz, pp, vcmd, conn, y, cx, cv, K, 
 
 
 @njit(inline="always", fastmath=_FAST)
-def _forcing(t, ftab, off, n_nodes, interval, R, roff):
+def _forcing(t, ftab, off, n_nodes, interval, R, roff, fnz):
     """R[roff:roff + N_DOF] = the rail forcing at t from the forcing table (`kernels._forcing`:
-    the Hermite weights on the node values and slopes of Bw w and Bwd w', plain loops)."""
+    the Hermite weights on the node values and slopes of Bw w and Bwd w', plain loops); 0 in the
+    rows that no rail input reaches (not fnz[i], a constant of the compile: their columns of the
+    table are 0)."""
     k, h00, h10, h01, h11, d00, d10, d11 = laws._hermite(t, n_nodes, interval)
     a = off + k
     b = a + 1
     for i in range(N_DOF):
+        if not fnz[i]:
+            R[roff + i] = 0.0
+            continue
         R[roff + i] = (
             h00 * ftab[a, i]
             + h10 * ftab[a, N_DOF + i]
@@ -165,11 +170,13 @@ def _forcing(t, ftab, off, n_nodes, interval, R, roff):
 GENERAL = (-1, True, True, False, False, -1)
 
 
-def pattern_of(A, TS) -> int:
+def pattern_of(A, TS, forced) -> int:
     """`_kernel_for`'s ``pattern`` for the vehicles' matrices A (vehicles, NY, N_DOF) and TS
-    (vehicles, N_DOF, N_CORNER): bit j N_DOF + i set where A[:, j, i] is not 0 in some vehicle,
-    bit NY N_DOF + j N_CORNER + c where TS[:, j, c] is not 0 in some vehicle."""
-    nonzero = np.concatenate([np.any(M != 0.0, axis=0).ravel() for M in (A, TS)])
+    (vehicles, N_DOF, N_CORNER) and the rows of q'' that rail inputs reach (``forced``, N_DOF
+    bools): bit j N_DOF + i set where A[:, j, i] is not 0 in some vehicle, bit NY N_DOF +
+    j N_CORNER + c where TS[:, j, c] is not 0 in some vehicle, bit NY N_DOF + N_DOF N_CORNER + i
+    where forced[i]."""
+    nonzero = np.concatenate([np.any(M != 0.0, axis=0).ravel() for M in (A, TS)] + [np.asarray(forced, bool)])
     return sum(1 << k for k, nz in enumerate(nonzero) if nz)
 
 
@@ -190,8 +197,9 @@ def _kernel_for(
     # local arrays' sizes must be constants of the compile
     n_rates, n_sum = (NS_MAX, NS_MAX) if lean else (4 * NS_MAX, 1)
     # a constant array of the compile: the product's tests on it fold
-    bits = np.array([pattern < 0 or (pattern >> k) & 1 == 1 for k in range(NY * N_DOF + N_DOF * N_CORNER)])
-    nz, tnz = bits[: NY * N_DOF].reshape(NY, N_DOF), bits[NY * N_DOF :].reshape(N_DOF, N_CORNER)
+    n_a, n_t = NY * N_DOF, N_DOF * N_CORNER
+    bits = np.array([pattern < 0 or (pattern >> k) & 1 == 1 for k in range(n_a + n_t + N_DOF)])
+    nz, tnz, fnz = bits[:n_a].reshape(NY, N_DOF), bits[n_a : n_a + n_t].reshape(N_DOF, N_CORNER), bits[n_a + n_t :]
 
     # fmt: off
     def _kernel(
@@ -266,7 +274,7 @@ def _kernel_for(
         gb1 = pp[P_N] * (abs(pp[P_GAMMA]) + abs(pp[P_BETA]))
         out4 = (out_q, out_v, out_a, out_f)
         out5 = (out_w, out_wd, out_d, out_fd, out_vc)
-        _forcing(step0 * dt, ftab, fo, nn, itv, R, 0)
+        _forcing(step0 * dt, ftab, fo, nn, itv, R, 0, fnz)
         last = n_steps + 1 if final else n_steps
         for n_ in range(last):
             step = step0 + n_
@@ -301,8 +309,8 @@ def _kernel_for(
             h = dt / m
             for sub in range(m):
                 ts = t + sub * h
-                _forcing(ts + 0.5 * h, ftab, fo, nn, itv, R, N_DOF)
-                _forcing(ts + h, ftab, fo, nn, itv, R, 2 * N_DOF)
+                _forcing(ts + 0.5 * h, ftab, fo, nn, itv, R, N_DOF, fnz)
+                _forcing(ts + h, ftab, fo, nn, itv, R, 2 * N_DOF, fnz)
                 if lean:
                     _lean_rk4(
                         law, s, st, K, ksum, h, sub, has_states, R, at, nz, tt, tnz, pp, vc, conn, y, cx, cv, zk, fsave

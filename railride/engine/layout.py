@@ -14,6 +14,9 @@ from __future__ import annotations
 N_DOF = 10
 N_RIGID = 9
 ROW_BENDING = 9
+#: the bogies' six rows (front then rear: bounce, pitch, roll) from this one: the only rows of q''
+#: that the rail inputs reach, through the primary suspension
+ROW_BOGIES = 3
 N_CORNER = 4  # secondary suspension corners (dampers): 1R, 1L, 2R, 2L
 N_RAIL = 8  # rail inputs: four wheelsets, two rails each
 NY = 2 * N_DOF + N_CORNER  # length of the stage vector (q, q', f)

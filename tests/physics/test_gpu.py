@@ -115,16 +115,17 @@ def test_each_batch_gets_the_kernel_of_its_damper_law_faults_and_sensing(monkeyp
     general = (-1, True, True, lean, False, -1)
     assert [k[:5] for k in keys[:5]] == [(*k[:3], lean, k[3]) for k in special]
     assert keys[5:] == [general] * 5
-    # the terms of the q'' product and the corner deflections: the paper's vehicle has 56 of the
-    # 240 coefficients of its matrix A not 0 with dampers, 66 with its dashpots in the matrix, and
-    # 20 of the 40 of TS (counted from its matrices, ad hoc)
-    assert [bin(k[5]).count("1") for k in keys[:5]] == [76, 76, 76, 86, 76]
+    # the terms of the q'' product, the corner deflections and the forcing: the paper's vehicle
+    # has 56 of the 240 coefficients of its matrix A not 0 with dampers, 66 with its dashpots in
+    # the matrix, 20 of the 40 of TS (counted from its matrices, ad hoc), and the rails reach the
+    # 6 rows of its bogies
+    assert [bin(k[5]).count("1") for k in keys[:5]] == [82, 82, 82, 92, 82]
 
 
 def test_the_sparse_product_leaves_out_only_zeros(monkeypatch):
-    """The q'' product and the corner deflections of only the terms that some vehicle has
-    (`gpu.SPARSE_PRODUCT`) give the runs of the whole products to the bit: a bending carbody and a
-    rigid one in one batch."""
+    """The q'' product, the corner deflections and the rail forcing of only the terms that some
+    vehicle has (`gpu.SPARSE_PRODUCT`) give the runs of the whole products to the bit: a bending
+    carbody and a rigid one in one batch, on a random track."""
     kw = dict(
         params=[VehicleParams.preset("manchester-1"), PAPER.replace(m_c=4.2e4)],
         scenario=scenario("fra4", duration=0.008),
@@ -136,6 +137,18 @@ def test_the_sparse_product_leaves_out_only_zeros(monkeypatch):
         runs.append(histories(simulate(**kw, solver=GPU)))
     for name in runs[0]:
         np.testing.assert_array_equal(runs[1][name], runs[0][name], err_msg=name)
+
+
+def test_the_forced_rows_are_the_bogies_unless_a_table_says_otherwise():
+    """`gpu.forced_rows`: a flat track's table (all 0) gets the bogies' rows, as any other of
+    these vehicles, so no kernel of its own; a table with forcing on a carbody row gets every row."""
+    from railride.engine.layout import N_DOF
+
+    flat = np.zeros((5, 4 * N_DOF))
+    assert gpu.forced_rows(flat).tolist() == [False] * 3 + [True] * 6 + [False]
+    on_carbody = flat.copy()
+    on_carbody[2, 2 * N_DOF + 1] = 1e-3  # Bwd w of the carbody's pitch
+    assert gpu.forced_rows(on_carbody).all()
 
 
 def test_the_file_cache_setting_reaches_the_compile(monkeypatch):
@@ -266,8 +279,9 @@ def test_the_kernel_compiles_for_a_gpu():
         "import numpy as np; from railride.engine import gpu; from railride.engine.layout import LAW_BOUC_WEN\n"
         "from railride.run.inputs import _system_arrays; from railride.model.vehicle import Vehicle\n"
         "m = _system_arrays(Vehicle('paper'), passive=False)\n"
+        "ftab = np.tile(gpu.BOGIE_ROWS, 4)[None, :].astype(float)\n"
         "key = gpu.kernel_key(LAW_BOUC_WEN, np.zeros((1, 8), np.int64), np.zeros((1, 3)), True, np.ones((1, 16)),"
-        " m['A'][None], m['TS'][None])\n"
+        " m['A'][None], m['TS'][None], ftab)\n"
         "print(key, '.entry' in gpu.ptx((9, 0)), '.entry' in gpu.ptx((9, 0), key))"
     )
     env = {**__import__("os").environ, "NUMBA_ENABLE_CUDASIM": "0"}
