@@ -47,7 +47,7 @@ SPECIALISE = True
 LEAN_RK4 = True
 #: with SPECIALISE, a batch whose dampers all have the Bouc-Wen exponent n = 1 gets a kernel that
 #: knows it (`_kernel_for`'s ``unit_n``): 19 % fewer instructions and less stack for ptxas
-#: (docs/gpu.md); the same arithmetic
+#: (docs/gpu.md); the same arithmetic but for where the compiler fuses a multiply and an add
 UNIT_N = True
 #: with SPECIALISE, the q'' product and the corner deflections sum only the terms whose
 #: coefficient is not 0 in some vehicle of the batch (56 of 240 and 20 of 40 for the paper's

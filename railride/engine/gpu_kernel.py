@@ -192,8 +192,9 @@ def _kernel_for(
     ``unit_n``: every sample's Bouc-Wen exponent n is 1 (the paper's damper), which the kernel
     then knows when it compiles, so the laws' powers |z|^(n-1) and their branches are compiled
     out (`laws._bouc_wen_rate`, `laws.damper_stiffness`). ``pattern`` (`pattern_of`; -1: every
-    term): the terms of the q'' product that some vehicle of the batch has; the others, zeros in
-    every vehicle, are compiled out (the paper's vehicle with dampers has 56 of the 240)."""
+    term): the terms of the q'' product and of the corner deflections that some vehicle of the
+    batch has, and the rows of q'' that the rails reach; the others, zeros in every vehicle, are
+    compiled out (the paper's vehicle with dampers has 56 of A's 240 and 20 of T's 40)."""
     # local arrays' sizes must be constants of the compile
     n_rates, n_sum = (NS_MAX, NS_MAX) if lean else (4 * NS_MAX, 1)
     # a constant array of the compile: the product's tests on it fold
