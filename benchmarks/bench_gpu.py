@@ -16,7 +16,10 @@ Prints Markdown rows for docs/gpu.md, each with the device, the machine's cores 
 * with ``--cpu``, the same batch on this machine's CPU cores, for the GPU's factor over them;
 * with ``--metrics-only``, the same batch as the studies run it when they keep only the metrics
   (`railride.run.reduced.batch_metrics`: sums on the device, no histories), and its largest
-  difference from the metrics of the histories above;
+  difference from the metrics of the histories above; with ``--only-metrics``, that batch alone,
+  with no batch of histories first (1e5 runs of 60 s in one GPU's memory: ``--samples 100000
+  --duration 60 --only-metrics``), its device and host peaks and how many runs ended with every
+  metric finite;
 * with ``--design``, `railride design --backend gpu` with its defaults (wall time, runs);
 * with ``--host-only`` (in the simulator: NUMBA_ENABLE_CUDASIM=1; ``--controllers`` to pick laws),
   the default design with its GPU kernel replaced by a stand-in that returns at once: the host's
@@ -79,6 +82,7 @@ def main():
     ap.add_argument("--cpu", action="store_true")
     ap.add_argument("--design", action="store_true")
     ap.add_argument("--metrics-only", action="store_true")
+    ap.add_argument("--only-metrics", action="store_true", help="the metrics-only batch alone, no histories")
     ap.add_argument("--memory-plan", action="store_true")
     ap.add_argument("--host-only", action="store_true")
     ap.add_argument("--host-batch", action="store_true")
@@ -112,11 +116,14 @@ def main():
     print(f"The first call, which compiles the kernel: {time.perf_counter() - t0:.1f} s")
 
     scs, susp = _batch(args.samples, args.duration, args.law)
+    work = args.samples * round(args.duration / on_gpu.dt)
+    if args.only_metrics:
+        _only_metrics(scs, susp, on_gpu, work, where, args)
+        return
     t0 = time.perf_counter()
     result = simulate(scs, suspension=susp, solver=on_gpu)
     wall = time.perf_counter() - t0
     call = gpu.last_call()
-    work = args.samples * round(args.duration / on_gpu.dt)
     host = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024**2
     print(f"Device: {where}; {result.dataset.attrs['integrator']}")
     print()
@@ -161,6 +168,32 @@ def main():
         cmd = [sys.executable, "-m", "railride.cli", "design", "--backend", "gpu", "--out", str(out)]
         subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)
         print(f"\nrailride design --backend gpu (defaults): {(time.perf_counter() - t0) / 60:.1f} min ({where})")
+
+
+def _only_metrics(scs, susp, on_gpu, work, where, args):
+    """The batch as a study that keeps only the metrics runs it (`batch_metrics`: sums on the
+    device, no histories on either side), with no batch of histories before it: the size a GPU's
+    memory holds, measured (1e5 runs of 60 s: ``--samples 100000 --duration 60``)."""
+    from railride.engine import gpu
+    from railride.run.checks import check
+    from railride.run.reduced import batch_metrics
+
+    t0 = time.perf_counter()
+    sums, _ = batch_metrics(check(scs, None, susp, on_gpu, "mark", histories=False))
+    wall = time.perf_counter() - t0
+    call = gpu.last_call()
+    host = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024**2
+    finite = int(np.isfinite(sums.reshape(len(sums), -1)).all(axis=1).sum())
+    print(f"Device: {where}; metrics only, no histories")
+    print()
+    print("| batch | kernels | sample-steps/s (kernels) | whole call | sample-steps/s (call) | groups | device memory "
+          "| host peak | runs with every metric finite |")  # fmt: skip
+    print("|---|---|---|---|---|---|---|---|---|")
+    print(
+        f"| {args.samples} x {args.law}, fra4, {args.duration:g} s at dt 1e-4 s "
+        f"| {call['kernel_s']:.2f} s | {work / max(call['kernel_s'], 1e-9):.3g} | {wall:.2f} s | {work / wall:.3g} "
+        f"| {call['groups']} | {call['device_bytes'] / 1024**3:.2f} GiB | {host:.2f} GiB | {finite} of {len(sums)} |"
+    )
 
 
 def _memory_plan():

@@ -38,7 +38,8 @@
 #      and the compile each process would save
 #   6. the design with --backend gpu (every tuning round a GPU call) and its kernels in numba's
 #      file cache (gpu.FILE_CACHE), filled first by a small design of the same kinds of batch;
-#      cut at 200 s
+#      cut at 200 s; then 1e5 metrics-only runs of 60 s in one call (bench_gpu.py --only-metrics:
+#      whether they fit one GPU's memory, never measured)
 #   7. bench_gpu_kernel.py --concurrent 8: eight 32-run batches from eight threads at once against
 #      one after another (a design's held-out runs): whether calls on their own streams overlap;
 #      then, where the image has Nsight Compute (ncu), one launch of 1,024 runs profiled
@@ -48,7 +49,8 @@
 #      in parallel when every core has a chunk (measured on 2 cores only)
 #  10. the CPU's figures, measured once on 16 cores already (2026-11-27): bench_study.py (the 1,000-run study
 #      on 2 cores, on all cores, also with 1 chunk ahead, in one process per core and in four
-#      processes of a quarter of the cores each), and
+#      processes of a quarter of the cores each; Dask clusters of 1 and 8 workers of 2 threads,
+#      where the image has dask.distributed), and
 #      bench_dampers.py --lane-sizes (run_batch against the lane stepper, 1 to 16 threads)
 # Everything printed goes to $OUT/device_check.log as well (the device tool brings $OUT back).
 # No figure is written anywhere else: copy the rows into the docs with the machine and date.
@@ -178,6 +180,9 @@ fi
 # whether numba-cuda's file cache keeps the kernel between processes, and the compile it saves
 # (each kind of batch now compiles its own kernel, 19 to 43 s on the H100)
 step gpu-cache 150 $PY benchmarks/bench_gpu_cache.py
+if [ "$SMOKE" = 1 ]; then
+  step gpu-only-metrics 60 $PY benchmarks/bench_gpu.py --samples 8 --duration 0.01 --only-metrics
+fi
 
 if [ "$SMOKE" = 0 ]; then
   # cut at 150 s on the H100 twice with each process compiling its kernels: now with the kernels
@@ -186,6 +191,9 @@ if [ "$SMOKE" = 0 ]; then
   step design-on-gpu-fill 150 $PY benchmarks/bench_design.py --profile --backend gpu --gpu-file-cache \
     --budget 25 --duration 0.05
   step design-on-gpu-cached 200 $PY benchmarks/bench_design.py --profile --backend gpu --gpu-file-cache
+  # 1e5 runs of 60 s that keep only their metrics, in one call: whether they fit one GPU's memory
+  # (computed so far: 0.47 GiB of runs' own arrays), its device and host peaks, its rate
+  step gpu-1e5-metrics 240 $PY benchmarks/bench_gpu.py --samples 100000 --duration 60 --only-metrics
   step gpu-concurrent 60 $PY benchmarks/bench_gpu_kernel.py --concurrent 8 --duration 2
   # where a small batch's time goes (Nsight Compute, where the image has it): one launch of 1,024 runs
   if command -v ncu >/dev/null 2>&1; then
@@ -223,6 +231,13 @@ else
   # four processes of four threads: a chunk's Python work split four ways, its 4 lane groups on
   # the process's own threads, each track's tables made four times instead of sixteen
   step study-processes-4 45 $PY benchmarks/bench_study.py --seeds "$SEEDS" --processes 4 --profile
+  # N Dask workers against one with the same numba threads (2 each): measured for N = 2 only
+  if $PY -c "import distributed" 2>/dev/null; then
+    step dask-1-worker 60 $PY benchmarks/bench_study.py --seeds "$SEEDS" --dask --workers 1 --worker-threads 2
+    step dask-8-workers 60 $PY benchmarks/bench_study.py --seeds "$SEEDS" --dask --workers 8 --worker-threads 2
+  else
+    step dask 10 echo "no dask.distributed in this image: the cluster not measured"
+  fi
 fi
 step lane-sizes 90 $PY benchmarks/bench_dampers.py --lane-sizes --repeat 3 --threads "$THREADS" --sizes "$SIZES"
 fi
