@@ -95,7 +95,7 @@ step() {
   local rc=${PIPESTATUS[0]}
   local took=$(($(date +%s) - t0))
   if [ "$rc" = 124 ] || [ "$rc" = 137 ]; then
-    echo "cut: still running after $took s (its limit)" | tee -a "$LOG"
+    printf "\ncut: still running after %s s (its limit)\n" "$took" | tee -a "$LOG"  # on a line of its own
   else
     echo "exit $rc after $took s" | tee -a "$LOG"
   fi
