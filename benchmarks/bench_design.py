@@ -3,7 +3,7 @@
 Run:  python benchmarks/bench_design.py [--out DIR] [other railride design options]
       python benchmarks/bench_design.py --profile [--controllers A,B] [--budget N] [--duration S]
                                         [--backend auto|cpu|gpu] [--gpu-kernel BUILD] [--gpu-threads N]
-                                        [--gpu-file-cache]
+                                        [--gpu-file-cache] [--gpu-min-batch N]
 Runs `railride design --out DIR` (default: a new temporary folder) in a child process and
 prints a Markdown row for docs/performance.md: the runs it evaluated, its wall time, the CPU
 time of the child as a share of one core, and the child's peak resident memory. The default
@@ -82,6 +82,10 @@ def profile(args: list) -> None:
     )  # fmt: skip
     ap.add_argument("--gpu-threads", type=int, default=None, help="threads a block (default: gpu.THREADS_PER_BLOCK)")
     ap.add_argument(
+        "--gpu-min-batch", type=int, default=None,
+        help="--backend auto: the smallest batch the GPU takes (solver.GPU_MIN_BATCH; default 4096)",
+    )  # fmt: skip
+    ap.add_argument(
         "--gpu-file-cache", action="store_true",
         help="keep the GPU kernels in numba's file cache (gpu.FILE_CACHE): a second run loads them",
     )  # fmt: skip
@@ -92,6 +96,10 @@ def profile(args: list) -> None:
         gpu.SPECIALISE, gpu.LEAN_RK4, gpu.UNIT_N, gpu.SPARSE_PRODUCT = KERNELS[opts.gpu_kernel]
     if opts.gpu_threads is not None:
         gpu.THREADS_PER_BLOCK = opts.gpu_threads
+    if opts.gpu_min_batch is not None:
+        from railride.run import solver
+
+        solver.GPU_MIN_BATCH = opts.gpu_min_batch
     gpu.FILE_CACHE = opts.gpu_file_cache
     steps: list = []  # (start, end) of every batch's stepping (on the GPU: its call), any thread
     chunks: list = []  # (start, end) of every chunk's whole work (`evaluate`), any thread
@@ -167,6 +175,7 @@ def profile(args: list) -> None:
     head = f"design {opts.controllers or 'all laws'}, budget {opts.budget}, {opts.duration:g} s runs"
     head += f", backend {opts.backend}" + (f", GPU kernel {opts.gpu_kernel}" if opts.gpu_kernel else "")
     head += f", {opts.gpu_threads} threads a block" if opts.gpu_threads else ""
+    head += f", the GPU for batches of {opts.gpu_min_batch} runs or more" if opts.gpu_min_batch is not None else ""
     head += ", GPU kernels in the file cache" if opts.gpu_file_cache else ""
     try:
         res = rr.design(
