@@ -14,8 +14,10 @@ cores shared among the workers, as railride's Dask executor shares them). The sc
 workers is their rate over that of one worker with the same threads. With --profile (local
 only), the serial share: the part of the wall time in which no chunk is in the compiled
 stepper (the step stage of `railride.run.simulation`), from the union of the step stage's
-intervals in every thread. With --held (local only), the threads of numba's pool that stepping
-chunks held (`railride.run.cores.CPU_THREADS`), sampled every 2 ms: their mean over the study and
+intervals in every thread, and the process's user and system CPU time and minor page faults
+during the study (the system share is the kernel's work: on a 2-core VM, perf found most of it
+zeroing the pages of new arrays). With --held (local only), the threads of numba's pool that
+stepping chunks held (`railride.run.cores.CPU_THREADS`), sampled every 2 ms: their mean over the study and
 the share of its time at each count (run with NUMBA_NUM_THREADS=16 to see how many chunks step at
 once on 16 threads, even on fewer cores). No test asserts timings.
 """
@@ -119,6 +121,14 @@ def main():
                 f"of which {head:.2f} s before the first chunk stepped, {tail:.2f} s after the last one, and "
                 f"{wall - stepping - head - tail:.2f} s between ({len(inside)} step calls)"
             )
+
+    if args.profile and args.processes is None and not args.dask:
+        user, system = after.ru_utime - parent.ru_utime, after.ru_stime - parent.ru_stime
+        print(
+            f"\nthe process during the study: CPU {user:.1f} s user and {system:.1f} s system "
+            f"({system / max(user + system, 1e-9) * 100:.1f} % system), "
+            f"{after.ru_minflt - parent.ru_minflt} minor page faults"
+        )
 
     if counts:
         by_count = sorted(collections.Counter(counts).items())
