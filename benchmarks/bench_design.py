@@ -69,7 +69,7 @@ def profile(args: list) -> None:
     from railride.studies import design as design_module
     from railride.studies import design_probes, sweep, tuning
 
-    from bench_gpu_kernel import KERNELS  # benchmarks/: run as a script, this folder is on the path
+    from bench_gpu_kernel import KERNELS, use_build  # benchmarks/: run as a script, this folder is on the path
 
     ap = argparse.ArgumentParser(prog="bench_design.py --profile")
     ap.add_argument("--controllers", default=None)
@@ -93,7 +93,7 @@ def profile(args: list) -> None:
     from railride.engine import gpu
 
     if opts.gpu_kernel is not None:
-        gpu.SPECIALISE, gpu.LEAN_RK4, gpu.UNIT_N, gpu.SPARSE_PRODUCT = KERNELS[opts.gpu_kernel]
+        use_build(opts.gpu_kernel)
     if opts.gpu_threads is not None:
         gpu.THREADS_PER_BLOCK = opts.gpu_threads
     if opts.gpu_min_batch is not None:

@@ -106,6 +106,13 @@ KERNELS = {
 }
 
 
+def use_build(name: str) -> None:
+    """Set `railride.engine.gpu`'s build settings to those of ``name`` (`KERNELS`)."""
+    from railride.engine import gpu
+
+    gpu.SPECIALISE, gpu.LEAN_RK4, gpu.UNIT_N, gpu.SPARSE_PRODUCT = KERNELS[name]
+
+
 def _kernels(text: str) -> list[str]:
     names = text.split(",")
     unknown = [k for k in names if k not in KERNELS]
@@ -119,12 +126,11 @@ def _key(name: str) -> tuple:
     SAS, healthy, exact sensing."""
     from railride.engine import gpu
     from railride.engine.layout import LAW_BOUC_WEN, N_FAULT_COLS
-
-    gpu.SPECIALISE, gpu.LEAN_RK4, gpu.UNIT_N, gpu.SPARSE_PRODUCT = KERNELS[name]
     from railride.model.vehicle import Vehicle
     from railride.run.inputs import _system_arrays
     from railride.secondary.suspension import Suspension
 
+    use_build(name)
     # as bench_gpu's batches: the paper's vehicle and damper (n = 1)
     damper = Suspension.named("sas-attitude-ride").damper.pack()[None, :]
     matrices = _system_arrays(Vehicle("paper"), passive=False)
@@ -208,7 +214,7 @@ def _timed(limits, kernels, sizes, duration: float, blocks=(None,)) -> None:
     first: dict = {}
     default_block = gpu.THREADS_PER_BLOCK
     for name, limit in [(k, r) for k in kernels for r in limits]:
-        gpu.SPECIALISE, gpu.LEAN_RK4, gpu.UNIT_N, gpu.SPARSE_PRODUCT = KERNELS[name]
+        use_build(name)
         gpu.MAX_REGISTERS = limit
         gpu._compiled.clear()
         gpu.THREADS_PER_BLOCK = default_block
@@ -274,7 +280,7 @@ def _profile_run(n: int, kernel: str) -> None:
     from railride.run.simulation import simulate
     from railride.run.solver import SolverSettings
 
-    gpu.SPECIALISE, gpu.LEAN_RK4, gpu.UNIT_N, gpu.SPARSE_PRODUCT = KERNELS[kernel]
+    use_build(kernel)
     scs, susp = _batch(n, 0.01, "sas-attitude-ride")
     simulate(scs, suspension=susp, solver=SolverSettings(output_rate=200.0, backend="gpu"))
     print(

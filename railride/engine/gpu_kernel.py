@@ -166,7 +166,7 @@ def _forcing(t, ftab, off, n_nodes, interval, R, roff, fnz):
 
 
 #: `_kernel_for`'s arguments for the kernel of any batch: every damper law, faults and sensing,
-#: the four stage rates side by side, any Bouc-Wen exponent, every term of the q'' product
+#: the four stage rates side by side, any Bouc-Wen exponent, every term of every product
 GENERAL = (-1, True, True, False, False, -1)
 
 

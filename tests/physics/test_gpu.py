@@ -76,8 +76,8 @@ def _worst(a, b) -> float:
 @pytest.mark.parametrize("kernel", ["general", "specialised, lean RK4"])
 @pytest.mark.parametrize("case", list(CASES))
 def test_the_gpu_agrees_with_the_cpu_stepper(case, kernel, monkeypatch):
-    # the kernel for any batch, and the one built for the batch's law, faults and sensing with
-    # one stage rate at a time (`gpu_kernel._kernel_for`)
+    # the kernel for any batch, and the one built for the batch (`gpu.kernel_key`: its law,
+    # faults, sensing, exponent n = 1 and the matrices' zeros, one stage rate at a time)
     special = kernel != "general"
     monkeypatch.setattr(gpu, "SPECIALISE", special)
     monkeypatch.setattr(gpu, "LEAN_RK4", special)
