@@ -27,7 +27,14 @@ try:  # numba-cuda (the gpu extra) when installed; numba's own CUDA target other
 except ImportError:  # pragma: no cover - a numba without a CUDA target and no numba-cuda
     cuda = None  # type: ignore[assignment]
 
-from railride.engine.gpu_kernel import GENERAL, _kernel_for, _python_mirror, kernel_signature, pattern_of
+from railride.engine.gpu_kernel import (
+    GENERAL,
+    _device_mirror,
+    _kernel_for,
+    _python_mirror,
+    kernel_signature,
+    pattern_of,
+)
 from railride.engine.layout import F_MODE, FAULT_NONE, LAW_BOUC_WEN, LAW_SPENCER, N_CORNER, N_DOF, P_N, ROW_BOGIES, S_ON
 from railride.engine.sample_parts import N_ACC
 
@@ -173,7 +180,7 @@ def _compile(key: tuple):
         return cuda.jit(_python_mirror(kernel)[0])
     _array_overloads()
     limit = {} if MAX_REGISTERS is None else {"max_registers": MAX_REGISTERS}
-    return cuda.jit(kernel, cache=FILE_CACHE, **limit)
+    return cuda.jit(_device_mirror(kernel)[0], cache=FILE_CACHE, **limit)
 
 
 def last_call() -> dict:
@@ -197,7 +204,7 @@ def ptx(cc: tuple[int, int] = (9, 0), key: tuple = GENERAL) -> str:
     device = types.SimpleNamespace(compute_capability=cc)
     _array_overloads()
     with mock.patch.object(dispatcher, "get_current_device", lambda: device):
-        code, _ = cuda.compile_ptx(_kernel_for(*key), kernel_signature(), cc=cc)
+        code, _ = cuda.compile_ptx(_device_mirror(_kernel_for(*key))[0], kernel_signature(), cc=cc)
     return code
 
 

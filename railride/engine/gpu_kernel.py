@@ -363,17 +363,39 @@ def _python_mirror(*functions):
     """Copies of ``functions`` (plain Python functions of this module) whose globals are this
     module's, `laws`' and `sample_parts`' with every numba function replaced by its Python source,
     recursively: what the CUDA simulator can run, since its arrays cannot enter compiled code."""
+    return _mirror(functions, lambda f: f)
+
+
+def _device_mirror(*functions):
+    """Copies of ``functions`` as `_python_mirror` makes them, with every numba function of this
+    module, `laws` and `sample_parts` compiled for the device as a function of its own (numba's
+    ``inline="never"``), which NVVM then inlines: what the device compiles. With the engine's
+    ``inline="always"``, numba-cuda copied each callee's IR into the kernel at every call, three
+    quarters of a kernel's compile (docs/gpu.md); the kernel of the paper's batches assembles to
+    the same machine code either way. Nor the engine's fastmath flags: inlined, the laws were
+    compiled with the kernel's (none), and so they are here."""
+    return _mirror(functions, lambda f: njit(inline="never")(f))
+
+
+def _mirror(functions, wrap):
+    """Copies of ``functions`` whose globals are this module's, `laws`' and `sample_parts`' with
+    every function of those modules replaced by a copy of its Python source that reads the same
+    globals, recursively; a numba function's copy by ``wrap`` of it."""
     from numba.core.registry import CPUDispatcher
 
     space: dict = {}
     for module in (laws, sample_parts, globals()):
         space.update(vars(module) if isinstance(module, types.ModuleType) else module)
+    ours = (laws.__name__, sample_parts.__name__, __name__)
     for name, obj in list(space.items()):
-        if isinstance(obj, CPUDispatcher):
-            obj = obj.py_func
-        if isinstance(obj, types.FunctionType) and obj.__module__ in (laws.__name__, sample_parts.__name__, __name__):
-            space[name] = types.FunctionType(obj.__code__, space, name, obj.__defaults__, obj.__closure__)
-    space["laws"] = types.SimpleNamespace(**{k: space.get(k, v) for k, v in vars(laws).items()})
+        compiled = isinstance(obj, CPUDispatcher)
+        f = obj.py_func if compiled else obj
+        if isinstance(f, types.FunctionType) and f.__module__ in ours:
+            copy = types.FunctionType(f.__code__, space, name, f.__defaults__, f.__closure__)
+            space[name] = wrap(copy) if compiled else copy
+    mirror = types.ModuleType(laws.__name__)  # `laws.name` in the kernel's helpers reads the copies
+    mirror.__dict__.update({k: space.get(k, v) for k, v in vars(laws).items() if k != "__name__"})
+    space["laws"] = mirror
     # from each function itself, not its name: a kernel of `_kernel_for` keeps its constants
     return [types.FunctionType(f.__code__, space, f.__name__, f.__defaults__, f.__closure__) for f in functions]
 

@@ -292,6 +292,60 @@ def test_the_kernel_compiles_for_a_gpu():
 
 @pytest.mark.slow
 @pytest.mark.skipif(not _nvvm(), reason="no NVVM (install railride[gpu]) to compile the kernel for a GPU")
+def test_the_device_compile_has_the_arithmetic_of_the_inlined_kernel():
+    """`gpu_kernel._device_mirror` compiles the engine's functions as device functions of their
+    own, for NVVM to inline, in place of numba's copying their IR into the kernel. The build of a
+    healthy Bouc-Wen batch of the paper's vehicle gives the same PTX instruction for instruction
+    (names, labels and virtual registers aside); the general kernel, whose branches NVVM arranges
+    a little differently, the same floating-point instructions by kind and count."""
+    import subprocess
+    import sys
+
+    code = r"""
+import collections, re, types
+from unittest import mock
+import numpy as np
+from numba import cuda
+from numba.cuda import dispatcher
+from railride.engine import gpu, gpu_kernel
+from railride.engine.layout import LAW_BOUC_WEN
+from railride.run.inputs import _system_arrays
+from railride.model.vehicle import Vehicle
+
+m = _system_arrays(Vehicle('paper'), passive=False)
+ftab = np.tile(gpu.BOGIE_ROWS, 4)[None, :].astype(float)
+healthy = (np.zeros((1, 8), np.int64), np.zeros((1, 3)))
+key = gpu.kernel_key(LAW_BOUC_WEN, *healthy, True, np.ones((1, 16)), m['A'][None], m['TS'][None], ftab)
+float_ops = r'\s((?:fma|mul|add|sub|div|neg|abs|max|min)[.a-z]*f64)\s'
+
+
+def ops(p):
+    return sorted(collections.Counter(re.findall(float_ops, p)).items())
+
+
+def body(p):  # the instructions without names, labels and virtual registers
+    lines = [x for x in p.splitlines() if re.match(r'\s+[a-z@]', x)]
+    return [re.sub(r'_ZN\w*|\$L__BB\w+|%[a-z]+\d+', '', x).split() for x in lines]
+
+
+device = types.SimpleNamespace(compute_capability=(9, 0))
+for k in (gpu.GENERAL, key):
+    gpu._array_overloads()
+    with mock.patch.object(dispatcher, 'get_current_device', lambda: device):
+        inlined, _ = cuda.compile_ptx(gpu_kernel._kernel_for(*k), gpu_kernel.kernel_signature(), cc=(9, 0))
+    mirrored = gpu.ptx((9, 0), k)
+    same_ops = len(ops(inlined)) > 5 and ops(inlined) == ops(mirrored)
+    print(same_ops, len(body(inlined)) > 1000 and body(inlined) == body(mirrored))
+"""
+    env = {**__import__("os").environ, "NUMBA_ENABLE_CUDASIM": "0"}
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=900)
+    assert done.returncode == 0, done.stderr[-2000:]
+    # the general kernel: the same arithmetic, other branches; the paper's batches: the same PTX
+    assert done.stdout.split() == ["True", "False", "True", "True"], done.stdout
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not _nvvm(), reason="no NVVM (install railride[gpu]) to compile the kernel for a GPU")
 def test_the_kernel_compiles_on_a_numpy_without_row_stack():
     """numpy 2.5 removed ``np.row_stack``; numba-cuda 0.30.4 still registers an overload for it,
     which made every kernel compile fail (seen on an H100). Removed here as numpy 2.5 has it
