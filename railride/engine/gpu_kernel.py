@@ -16,6 +16,7 @@ Python sources (`_python_mirror`), since the simulator's arrays cannot enter com
 
 from __future__ import annotations
 
+import threading
 import types
 
 import numpy as np
@@ -363,23 +364,33 @@ def _python_mirror(*functions):
     """Copies of ``functions`` (plain Python functions of this module) whose globals are this
     module's, `laws`' and `sample_parts`' with every numba function replaced by its Python source,
     recursively: what the CUDA simulator can run, since its arrays cannot enter compiled code."""
-    return _mirror(functions, lambda f: f)
+    space = _mirror_space(lambda f: f)
+    # from each function itself, not its name: a kernel of `_kernel_for` keeps its constants
+    return [types.FunctionType(f.__code__, space, f.__name__, f.__defaults__, f.__closure__) for f in functions]
+
+
+#: the globals of `_device_mirror`'s copies, made once: their device functions, compiled for the
+#: first kernel, serve every later one (a later kernel compiled in half the time, docs/gpu.md)
+_DEVICE_SPACE: dict = {}
+_DEVICE_SPACE_LOCK = threading.Lock()
 
 
 def _device_mirror(*functions):
     """Copies of ``functions`` as `_python_mirror` makes them, with every numba function of this
     module, `laws` and `sample_parts` compiled for the device as a function of its own (numba's
     ``inline="never"``), which NVVM then inlines: what the device compiles. With the engine's
-    ``inline="always"``, numba-cuda copied each callee's IR into the kernel at every call, three
-    quarters of a kernel's compile (docs/gpu.md); the kernel of the paper's batches assembles to
-    the same machine code either way. Nor the engine's fastmath flags: inlined, the laws were
-    compiled with the kernel's (none), and so they are here."""
-    return _mirror(functions, lambda f: njit(inline="never")(f))
+    ``inline="always"``, numba-cuda copied each callee's IR into the kernel at every call: most
+    of a kernel's compile, for the same PTX (docs/gpu.md). The kernels compiled by numba-cuda do
+    not take the engine's fastmath flags either way."""
+    with _DEVICE_SPACE_LOCK:
+        if not _DEVICE_SPACE:
+            _DEVICE_SPACE.update(_mirror_space(lambda f: njit(inline="never")(f)))
+    return [types.FunctionType(f.__code__, _DEVICE_SPACE, f.__name__, f.__defaults__, f.__closure__) for f in functions]
 
 
-def _mirror(functions, wrap):
-    """Copies of ``functions`` whose globals are this module's, `laws`' and `sample_parts`' with
-    every function of those modules replaced by a copy of its Python source that reads the same
+def _mirror_space(wrap) -> dict:
+    """Globals for copies of this module's functions: this module's, `laws`' and `sample_parts`'
+    with every function of those modules replaced by a copy of its Python source that reads these
     globals, recursively; a numba function's copy by ``wrap`` of it."""
     from numba.core.registry import CPUDispatcher
 
@@ -396,8 +407,7 @@ def _mirror(functions, wrap):
     mirror = types.ModuleType(laws.__name__)  # `laws.name` in the kernel's helpers reads the copies
     mirror.__dict__.update({k: space.get(k, v) for k, v in vars(laws).items() if k != "__name__"})
     space["laws"] = mirror
-    # from each function itself, not its name: a kernel of `_kernel_for` keeps its constants
-    return [types.FunctionType(f.__code__, space, f.__name__, f.__defaults__, f.__closure__) for f in functions]
+    return space
 
 
 def kernel_signature() -> tuple:
