@@ -5,7 +5,7 @@
 # tree through PYTHONPATH; nothing is installed).
 #
 # Run:  bash benchmarks/device_check.sh [BUDGET_S]      (default 580 s in all)
-#       bash benchmarks/device_check.sh --gpu [BUDGET_S]  (steps 1 to 8: the GPU's and the designs)
+#       bash benchmarks/device_check.sh --gpu [BUDGET_S]  (steps 1 to 10: the GPU's and the designs)
 #       bash benchmarks/device_check.sh --kernels [BUDGET_S]  (the machine, then the kernel's builds: below)
 #       bash benchmarks/device_check.sh --smoke          (here: the simulator, tiny sizes, a check of the script)
 #
@@ -22,32 +22,34 @@
 # that runs out is cut and said so in the log, so the run ends inside the budget:
 #   1. the machine: GPU, driver, cores (and whether they are threads of fewer cores), versions,
 #      a profiler (nsys, ncu) if there is one, and whether railride sees a usable GPU
-#   2. bench_gpu.py: 32,768 SAS closed loops on the GPU (and how long its first call, which
+#   2. the default build of the kernel against the one timed on 2026-11-27 (bench_gpu_kernel.py
+#      --kernels), 1,024 and 32,768 SAS closed loops: the 1e9 target, and whether their runs are
+#      the same on the device
+#   3. the default design with --backend gpu, every kernel compiled in the run, as a user first
+#      meets it (bench_design.py --profile, cut at 150 s: the target of 2 minutes and start-up;
+#      one that is cut prints what it had done by then)
+#   4. 1e5 metrics-only runs of 60 s in one call (bench_gpu.py --only-metrics): whether they fit
+#      one GPU's memory, never measured
+#   5. bench_gpu.py: 32,768 SAS closed loops on the GPU (and how long its first call, which
 #      compiles the kernel, takes), their agreement with the CPU over 64 samples, the same batch
-#      on the CPU's cores, and the metrics-only batch of the studies; then the default build of
-#      the kernel against the one timed on 2026-11-27 (bench_gpu_kernel.py --kernels), 1,024 and
-#      32,768 runs
-#   3. the default design (backend auto: the CPU's cores for its batches, all under 4,096 runs),
-#      through bench_design.py --profile, after the CPU's kernels are compiled: its wall and CPU
-#      time, its stepping rate, and by stage how long some batch stepped and how long none did;
-#      its cap is the target of 2 minutes and start-up, and one that is cut prints the same for
-#      what it had done by then (never measured on 16 cores)
-#   4. bench_gpu_kernel.py --blocks 32,64,128: the kernel on 1,024, 2,048 and 8,192 runs in
+#      on the CPU's cores, and the metrics-only batch of the studies
+#   6. the default design with backend auto (the CPU's cores for its batches, all under 4,096
+#      runs), after the CPU's kernels are compiled: its wall and CPU time, its stepping rate, and
+#      by stage how long some batch stepped and how long none did (never measured on 16 cores)
+#   7. bench_gpu_kernel.py --blocks 32,64,128: the kernel on 1,024, 2,048 and 8,192 runs in
 #      blocks of 32, 64 and 128 threads (a design's rounds last a lone thread's time)
-#   5. bench_gpu_cache.py: whether numba-cuda's file cache keeps the kernel between processes,
-#      and the compile each process would save
-#   6. the design with --backend gpu (every tuning round a GPU call) and its kernels in numba's
-#      file cache (gpu.FILE_CACHE), filled first by a small design of the same kinds of batch;
-#      cut at 200 s; then 1e5 metrics-only runs of 60 s in one call (bench_gpu.py --only-metrics:
-#      whether they fit one GPU's memory, never measured)
-#   7. bench_gpu_kernel.py --concurrent 8: eight 32-run batches from eight threads at once against
+#   8. bench_gpu_cache.py: whether numba-cuda's file cache keeps the kernel between processes,
+#      and the compile each process would save; then the design with --backend gpu and its
+#      kernels in that cache (gpu.FILE_CACHE), filled first by a small design of the same kinds
+#      of batch, cut at 200 s
+#   9. bench_gpu_kernel.py --concurrent 8: eight 32-run batches from eight threads at once against
 #      one after another (a design's held-out runs): whether calls on their own streams overlap;
 #      then, where the image has Nsight Compute (ncu), one launch of 1,024 runs profiled
-#   8. the GPU tests of tests/physics on the device, every build the cases make (the general
+#  10. the GPU tests of tests/physics on the device, every build the cases make (the general
 #      kernel's passed there on 2026-11-27)
-#   9. bench_gil.py --threads <cores>: how much of a study chunk's work beside its stepping runs
+#  11. bench_gil.py --threads <cores>: how much of a study chunk's work beside its stepping runs
 #      in parallel when every core has a chunk (measured on 2 cores only)
-#  10. the CPU's figures, measured once on 16 cores already (2026-11-27): bench_study.py (the 1,000-run study
+#  12. the CPU's figures, measured once on 16 cores already (2026-11-27): bench_study.py (the 1,000-run study
 #      on 2 cores, on all cores, also with 1 chunk ahead, in one process per core and in four
 #      processes of a quarter of the cores each; Dask clusters of 1 and 8 workers of 2 threads,
 #      where the image has dask.distributed), and
@@ -152,48 +154,45 @@ if [ "$KERNELS_ONLY" = 1 ]; then
   exit 0
 fi
 
-step gpu-throughput 90 $PY benchmarks/bench_gpu.py --samples "$GPU_SAMPLES" --duration "$DURATION" --cpu --check "$CHECK" --metrics-only
-if [ "$SMOKE" = 0 ]; then
+if [ "$SMOKE" = 1 ]; then  # the simulator times nothing: the script's steps at tiny sizes
+  step gpu-throughput 90 $PY benchmarks/bench_gpu.py --samples "$GPU_SAMPLES" --duration "$DURATION" --cpu --check "$CHECK" --metrics-only
+  step design 60 $PY benchmarks/bench_design.py --profile --controllers pid --budget 25 --duration 0.5
+  step gpu-kernel 60 env NUMBA_ENABLE_CUDASIM=0 $PY benchmarks/bench_gpu_kernel.py --resources --registers none \
+    --kernels special-lean-n1-sparse
+  step gpu-cache 150 $PY benchmarks/bench_gpu_cache.py
+  step gpu-only-metrics 60 $PY benchmarks/bench_gpu.py --samples 8 --duration 0.01 --only-metrics
+else
   # the default build (the Bouc-Wen exponent and the matrices' zeros known to the compile, never
   # timed) against the build timed at 9.21e8 on 2026-11-27: their rates and whether their runs
   # are the same to the bit on the device
   step gpu-builds 120 $PY benchmarks/bench_gpu_kernel.py --kernels special-lean,special-lean-n1-sparse \
     --registers none --samples 1024,32768
-fi
-
-if [ "$SMOKE" = 1 ]; then  # the kernel steps need a GPU; the default design would take too long here: a small one
-  step design 60 $PY benchmarks/bench_design.py --profile --controllers pid --budget 25 --duration 0.5
-  step gpu-kernel 60 env NUMBA_ENABLE_CUDASIM=0 $PY benchmarks/bench_gpu_kernel.py --resources --registers none \
-    --kernels special-lean-n1-sparse
-else
+  # the default design on the GPU as a user first meets it: every kernel compiled in the run (cut
+  # at 150 s twice on the H100 when a compile took 19 to 43 s; its front end now takes 1.6 to 12 s
+  # a build on a 2-core VM, docs/gpu.md). Cut at the cap (SIGTERM), it prints what it had done by then
+  step design-on-gpu 150 $PY benchmarks/bench_design.py --profile --backend gpu
+  # 1e5 runs of 60 s that keep only their metrics, in one call: whether they fit one GPU's memory
+  # (computed so far: 0.47 GiB of runs' own arrays), its device and host peaks, its rate
+  step gpu-1e5-metrics 200 $PY benchmarks/bench_gpu.py --samples 100000 --duration 60 --only-metrics
+  # 32,768 runs: the first call's compile, agreement with the CPU over 64 samples, the same batch
+  # on the CPU's cores, the studies' metrics-only batch
+  step gpu-throughput 90 $PY benchmarks/bench_gpu.py --samples "$GPU_SAMPLES" --duration "$DURATION" --cpu --check "$CHECK" --metrics-only
   # the CPU kernels compiled once into numba's cache, so that no timed step below is cut by compiling
   step compile-cpu 90 $PY -c "from railride.studies.study import study; \
 study(['pid', 'sas-attitude', 'sas-attitude-ride', 'clipped-optimal'], track_seeds=[0], speeds=[40.0], duration=1.0)"
-  # the design in the library (no files written): "exit 0 after N s" is its time with start-up;
-  # cut at the cap (SIGTERM), it prints what it had done by then
+  # the design in the library on the CPU's cores (backend auto: its batches are all under 4,096
+  # runs): "exit 0 after N s" is its time with start-up; cut at the cap, it prints what it had done
   step design 150 $PY benchmarks/bench_design.py --profile
   # small batches in small blocks: a design's rounds (256 to 2,048 runs) last a lone thread's time
   step gpu-kernel-blocks 120 $PY benchmarks/bench_gpu_kernel.py --kernels special-lean-n1-sparse --registers none \
     --blocks 32,64,128 --samples 1024,2048,8192
-fi
-
-# whether numba-cuda's file cache keeps the kernel between processes, and the compile it saves
-# (each kind of batch now compiles its own kernel, 19 to 43 s on the H100)
-step gpu-cache 150 $PY benchmarks/bench_gpu_cache.py
-if [ "$SMOKE" = 1 ]; then
-  step gpu-only-metrics 60 $PY benchmarks/bench_gpu.py --samples 8 --duration 0.01 --only-metrics
-fi
-
-if [ "$SMOKE" = 0 ]; then
-  # cut at 150 s on the H100 twice with each process compiling its kernels: now with the kernels
-  # in numba's file cache, as a second design on the machine finds them. A small design first
-  # meets the same kinds of batch and fills the cache (its log gives their compiles' time)
+  # whether numba-cuda's file cache keeps the kernel between processes, and the compile it saves
+  step gpu-cache 150 $PY benchmarks/bench_gpu_cache.py
+  # the design with its kernels in numba's file cache, as a second design on the machine finds
+  # them; a small design first meets the same kinds of batch and fills the cache
   step design-on-gpu-fill 150 $PY benchmarks/bench_design.py --profile --backend gpu --gpu-file-cache \
     --budget 25 --duration 0.05
   step design-on-gpu-cached 200 $PY benchmarks/bench_design.py --profile --backend gpu --gpu-file-cache
-  # 1e5 runs of 60 s that keep only their metrics, in one call: whether they fit one GPU's memory
-  # (computed so far: 0.47 GiB of runs' own arrays), its device and host peaks, its rate
-  step gpu-1e5-metrics 240 $PY benchmarks/bench_gpu.py --samples 100000 --duration 60 --only-metrics
   step gpu-concurrent 60 $PY benchmarks/bench_gpu_kernel.py --concurrent 8 --duration 2
   # where a small batch's time goes (Nsight Compute, where the image has it): one launch of 1,024 runs
   if command -v ncu >/dev/null 2>&1; then
