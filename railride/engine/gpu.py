@@ -64,8 +64,9 @@ SPARSE_PRODUCT = True
 #: keep each compiled kernel in numba's file cache beside the engine's CPU kernels
 #: (``cuda.jit(cache=True)``; cleared with them when an engine source changes,
 #: `railride.engine.cache_guard`), so that a later process loads it instead of compiling it
-#: again (19-43 s a kind of batch on an H100 before `gpu_kernel._device_mirror`). Off until a device has shown that a second
-#: process loads it and gets the same results (`benchmarks/bench_gpu_cache.py`, docs/gpu.md)
+#: again (19-43 s a kind of batch on an H100 before `gpu_kernel._device_mirror`). Off until a
+#: device has shown that a second process loads it and gets the same results
+#: (`benchmarks/bench_gpu_cache.py`, docs/gpu.md)
 FILE_CACHE = False
 #: the share of the device's free memory one group of samples may take
 MEMORY_SHARE = 0.6
