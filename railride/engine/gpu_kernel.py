@@ -369,9 +369,9 @@ def _python_mirror(*functions):
     return [types.FunctionType(f.__code__, space, f.__name__, f.__defaults__, f.__closure__) for f in functions]
 
 
-#: the globals of `_device_mirror`'s copies, made once: their device functions, compiled for the
-#: first kernel, serve every later one (a later kernel compiled in half the time, docs/gpu.md)
-_DEVICE_SPACE: dict = {}
+#: the globals of `_device_mirror`'s copies, made once (the list's one item): their device
+#: functions, compiled for the first kernel, serve every later one (docs/gpu.md)
+_DEVICE_SPACE: list = []
 _DEVICE_SPACE_LOCK = threading.Lock()
 
 
@@ -380,12 +380,13 @@ def _device_mirror(*functions):
     module, `laws` and `sample_parts` compiled for the device as a function of its own (numba's
     ``inline="never"``), which NVVM then inlines: what the device compiles. With the engine's
     ``inline="always"``, numba-cuda copied each callee's IR into the kernel at every call: most
-    of a kernel's compile, for the same PTX (docs/gpu.md). The kernels compiled by numba-cuda do
-    not take the engine's fastmath flags either way."""
+    of a kernel's compile, for the same PTX in the build of the paper's batches (docs/gpu.md).
+    numba-cuda gives the engine's fastmath flags to neither."""
     with _DEVICE_SPACE_LOCK:
         if not _DEVICE_SPACE:
-            _DEVICE_SPACE.update(_mirror_space(lambda f: njit(inline="never")(f)))
-    return [types.FunctionType(f.__code__, _DEVICE_SPACE, f.__name__, f.__defaults__, f.__closure__) for f in functions]
+            _DEVICE_SPACE.append(_mirror_space(lambda f: njit(inline="never")(f)))
+    space = _DEVICE_SPACE[0]
+    return [types.FunctionType(f.__code__, space, f.__name__, f.__defaults__, f.__closure__) for f in functions]
 
 
 def _mirror_space(wrap) -> dict:
