@@ -25,16 +25,17 @@
 #   2. the default build of the kernel against the one timed on 2026-11-27 (bench_gpu_kernel.py
 #      --kernels), 1,024 and 32,768 SAS closed loops: the 1e9 target, and whether their runs are
 #      the same on the device
-#   3. the default design with --backend gpu, every kernel compiled in the run, as a user first
-#      meets it (bench_design.py --profile, cut at 150 s: the target of 2 minutes and start-up;
-#      one that is cut prints what it had done by then)
+#   3. the default design with --backend gpu, every GPU kernel compiled in the run, as a user
+#      first meets it (the CPU's kernels compiled first, as an install does: bench_design.py
+#      --profile, cut at 150 s: the target of 2 minutes and start-up; one that is cut prints what
+#      it had done by then)
 #   4. 1e5 metrics-only runs of 60 s in one call (bench_gpu.py --only-metrics): whether they fit
 #      one GPU's memory, never measured
 #   5. bench_gpu.py: 32,768 SAS closed loops on the GPU (and how long its first call, which
 #      compiles the kernel, takes), their agreement with the CPU over 64 samples, the same batch
 #      on the CPU's cores, and the metrics-only batch of the studies
 #   6. the default design with backend auto (the CPU's cores for its batches, all under 4,096
-#      runs), after the CPU's kernels are compiled: its wall and CPU time, its stepping rate, and
+#      runs): its wall and CPU time, its stepping rate, and
 #      by stage how long some batch stepped and how long none did (never measured on 16 cores)
 #   7. bench_gpu_kernel.py --blocks 32,64,128: the kernel on 1,024, 2,048 and 8,192 runs in
 #      blocks of 32, 64 and 128 threads (a design's rounds last a lone thread's time)
@@ -167,7 +168,11 @@ else
   # are the same to the bit on the device
   step gpu-builds 120 $PY benchmarks/bench_gpu_kernel.py --kernels special-lean,special-lean-n1-sparse \
     --registers none --samples 1024,32768
-  # the default design on the GPU as a user first meets it: every kernel compiled in the run (cut
+  # the CPU kernels compiled once into numba's cache, as an install compiles them into the package,
+  # so that no timed step below is cut by compiling them
+  step compile-cpu 90 $PY -c "from railride.studies.study import study; \
+study(['pid', 'sas-attitude', 'sas-attitude-ride', 'clipped-optimal'], track_seeds=[0], speeds=[40.0], duration=1.0)"
+  # the default design on the GPU as a user first meets it: every GPU kernel compiled in the run (cut
   # at 150 s twice on the H100 when a compile took 19 to 43 s; its front end now takes 1.6 to 12 s
   # a build on a 2-core VM, docs/gpu.md). Cut at the cap (SIGTERM), it prints what it had done by then
   step design-on-gpu 150 $PY benchmarks/bench_design.py --profile --backend gpu
@@ -177,9 +182,6 @@ else
   # 32,768 runs: the first call's compile, agreement with the CPU over 64 samples, the same batch
   # on the CPU's cores, the studies' metrics-only batch
   step gpu-throughput 90 $PY benchmarks/bench_gpu.py --samples "$GPU_SAMPLES" --duration "$DURATION" --cpu --check "$CHECK" --metrics-only
-  # the CPU kernels compiled once into numba's cache, so that no timed step below is cut by compiling
-  step compile-cpu 90 $PY -c "from railride.studies.study import study; \
-study(['pid', 'sas-attitude', 'sas-attitude-ride', 'clipped-optimal'], track_seeds=[0], speeds=[40.0], duration=1.0)"
   # the design in the library on the CPU's cores (backend auto: its batches are all under 4,096
   # runs): "exit 0 after N s" is its time with start-up; cut at the cap, it prints what it had done
   step design 150 $PY benchmarks/bench_design.py --profile
