@@ -23,7 +23,9 @@ Prints Markdown rows for docs/gpu.md, each with the device, the machine's cores 
 * with ``--design``, `railride design --backend gpu` with its defaults (wall time, runs);
 * with ``--host-only`` (in the simulator: NUMBA_ENABLE_CUDASIM=1; ``--controllers`` to pick laws),
   the default design with its GPU kernel replaced by a stand-in that returns at once: the host's
-  share of the design, which no GPU takes away (wall time, runs, host peak);
+  share of the design, which no GPU takes away (wall time, runs, host peak), and the kinds of
+  batch it sends the GPU (kernel keys, each a compile on a device), for ``bench_gpu_kernel.py
+  --resources --keys``;
 * with ``--host-batch`` (in the simulator), the ``--samples``-run metrics-only batch above with
   its kernel a stand-in: the host's share of one such call (checking the runs, then
   `batch_metrics`: tables, packing, the simulator's copies in place of transfers), best of 3;
@@ -237,14 +239,21 @@ def _host_only(controllers) -> None:
     send back, its device arrays in host memory, and the stand-in), which a real device's
     transfers and kernels replace (not measured here; the simulator's device arrays also count
     in the host peak). Its metrics are arbitrary, so its tuning takes other paths than a real
-    design's and may make another number of runs: both are printed."""
+    design's and may make another number of runs: both are printed, and the kinds of batch
+    (kernel keys) it sent the GPU, each a compile on a device, with their calls."""
     from railride.engine import gpu
     from railride.run.solver import SolverSettings
     from railride.studies.design import design
 
     if not gpu.simulated():
         sys.exit("bench_gpu: --host-only runs in the simulator: set NUMBA_ENABLE_CUDASIM=1")
-    gpu._device_functions = lambda *key: _StandIn()
+    kinds: dict = {}  # kernel key (`gpu.kernel_key`) -> GPU calls
+
+    def stand_in(key):
+        kinds[key] = kinds.get(key, 0) + 1
+        return _StandIn()
+
+    gpu._device_functions = stand_in
     inside = [0.0]  # in the GPU calls: the simulator's copies and device arrays, the stand-in
     run_gpu = gpu.run_gpu
 
@@ -272,6 +281,10 @@ def _host_only(controllers) -> None:
     print(f"| {'all laws' if laws is None else ', '.join(laws)} | {runs:,} ({s['training_runs']:,} training, "
           f"{s['judging_runs']:,} held out) | {wall:.1f} s | {inside[0]:.1f} s | **{host_s:.1f} s** "
           f"| {host_s / runs * 1e3:.2f} ms | {cpu:.1f} s | {host:.2f} GiB |")  # fmt: skip
+    print("\nkinds of batch (kernel keys: law, faults, sensing, lean, unit_n, pattern) and their GPU calls:")
+    for key, calls in kinds.items():
+        print(f"  {key}: {calls}")
+    print(f'for bench_gpu_kernel.py --resources --keys: "{list(kinds)}"')
 
 
 def _host_batch(samples: int, duration: float, law: str, output_rate: float):

@@ -17,6 +17,10 @@ Run:  python benchmarks/bench_gpu_kernel.py --resources [--registers none,168,12
   extra has none, NVIDIA's nvidia-cuda-nvdisasm wheel has one), the assembled kernel's machine
   instructions are counted too: all, local loads and stores, global loads, branches and calls,
   each as written once in the code (static counts, not how often they run).
+* ``--resources --keys "[(law, faults, sensing, lean, unit_n, pattern), ...]"``: the package's
+  default build for each of these kernel keys (`gpu.kernel_key`) in place of ``--kernels``, in
+  one process, one after another, as a process meets them: the kinds of batch a design sends the
+  GPU (`bench_gpu.py --host-only` prints them), and what their compiles take on this machine.
 * ``--kernels``: which builds of the kernel (`gpu_kernel._kernel_for`): ``general`` (the one for any
   batch), ``special`` (the damper law fixed, faults and sensing left out: the batches below),
   ``lean`` (one RK4 stage rate and a running sum), ``special-lean``, ``special-lean-n1`` (also
@@ -44,6 +48,7 @@ Prints Markdown rows for docs/gpu.md with the device and date. No test asserts t
 from __future__ import annotations
 
 import argparse
+import ast
 import datetime
 import os
 import re
@@ -156,10 +161,14 @@ def _resources(limits, kernels) -> None:
         "| global loads | branches | calls |"
     )  # fmt: skip
     print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
-    for name in kernels:
+    made = 0.0
+    for name, key in kernels:
         t0 = time.perf_counter()
-        code = gpu.ptx((9, 0), _key(name))
-        _assemble(ptxas, code, limits, name, time.perf_counter() - t0, disasm)
+        code = gpu.ptx((9, 0), key)
+        took = time.perf_counter() - t0
+        made += took
+        _assemble(ptxas, code, limits, name, took, disasm)
+    print(f"\nPTX of the {len(kernels)} kernel(s), one after another in this process: {made:.1f} s")
 
 
 def _sass_counts(disasm, cubin) -> str:
@@ -299,9 +308,16 @@ def main():
     ap.add_argument("--duration", type=float, default=1.0)
     ap.add_argument("--concurrent", type=int, default=0)
     ap.add_argument("--profile-run", action="store_true")
+    ap.add_argument(
+        "--keys", default=None, help="--resources: kernel keys (a list of tuples, as bench_gpu.py --host-only prints)"
+    )
     args = ap.parse_args()
     if args.resources:
-        _resources(_limits(args.registers), _kernels(args.kernels))
+        if args.keys:  # the package's default build, for each kind of batch given
+            builds = [(f"key {k[:5]}", tuple(k)) for k in ast.literal_eval(args.keys)]
+        else:
+            builds = [(name, _key(name)) for name in _kernels(args.kernels)]
+        _resources(_limits(args.registers), builds)
         return
     from railride.engine import gpu
 
