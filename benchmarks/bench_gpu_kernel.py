@@ -17,10 +17,11 @@ Run:  python benchmarks/bench_gpu_kernel.py --resources [--registers none,168,12
   extra has none, NVIDIA's nvidia-cuda-nvdisasm wheel has one), the assembled kernel's machine
   instructions are counted too: all, local loads and stores, global loads, branches and calls,
   each as written once in the code (static counts, not how often they run).
-* ``--resources --keys "[(law, faults, sensing, lean, unit_n, pattern), ...]"``: the package's
-  default build for each of these kernel keys (`gpu.kernel_key`) in place of ``--kernels``, in
-  one process, one after another, as a process meets them: the kinds of batch a design sends the
-  GPU (`bench_gpu.py --host-only` prints them), and what their compiles take on this machine.
+* ``--resources --keys "[(law, faults, sensing, lean, unit_n, pattern), ...]"``: the build each
+  of these kernel keys names (`gpu.kernel_key`: a key holds every constant of its compile) in
+  place of ``--kernels``, in one process, one after another, as a process meets them: the kinds
+  of batch a design sends the GPU (`bench_gpu.py --host-only` prints them), and what their
+  compiles take on this machine.
 * ``--kernels``: which builds of the kernel (`gpu_kernel._kernel_for`): ``general`` (the one for any
   batch), ``special`` (the damper law fixed, faults and sensing left out: the batches below),
   ``lean`` (one RK4 stage rate and a running sum), ``special-lean``, ``special-lean-n1`` (also
@@ -313,7 +314,7 @@ def main():
     )
     args = ap.parse_args()
     if args.resources:
-        if args.keys:  # the package's default build, for each kind of batch given
+        if args.keys:  # a key names its build whole
             builds = [(f"key {k[:5]}", tuple(k)) for k in ast.literal_eval(args.keys)]
         else:
             builds = [(name, _key(name)) for name in _kernels(args.kernels)]

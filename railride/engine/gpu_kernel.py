@@ -16,7 +16,7 @@ Python sources (`_python_mirror`), since the simulator's arrays cannot enter com
 
 from __future__ import annotations
 
-import threading
+import functools
 import types
 
 import numpy as np
@@ -364,15 +364,7 @@ def _python_mirror(*functions):
     """Copies of ``functions`` (plain Python functions of this module) whose globals are this
     module's, `laws`' and `sample_parts`' with every numba function replaced by its Python source,
     recursively: what the CUDA simulator can run, since its arrays cannot enter compiled code."""
-    space = _mirror_space(lambda f: f)
-    # from each function itself, not its name: a kernel of `_kernel_for` keeps its constants
-    return [types.FunctionType(f.__code__, space, f.__name__, f.__defaults__, f.__closure__) for f in functions]
-
-
-#: the globals of `_device_mirror`'s copies, made once (the list's one item): their device
-#: functions, compiled for the first kernel, serve every later one (docs/gpu.md)
-_DEVICE_SPACE: list = []
-_DEVICE_SPACE_LOCK = threading.Lock()
+    return _copies(functions, _mirror_space(lambda f: f))
 
 
 def _device_mirror(*functions):
@@ -382,10 +374,19 @@ def _device_mirror(*functions):
     ``inline="always"``, numba-cuda copied each callee's IR into the kernel at every call: most
     of a kernel's compile, for the same PTX in the build of the paper's batches (docs/gpu.md).
     numba-cuda gives the engine's fastmath flags to neither."""
-    with _DEVICE_SPACE_LOCK:
-        if not _DEVICE_SPACE:
-            _DEVICE_SPACE.append(_mirror_space(lambda f: njit(inline="never")(f)))
-    space = _DEVICE_SPACE[0]
+    return _copies(functions, _device_space())
+
+
+@functools.cache
+def _device_space() -> dict:
+    """`_device_mirror`'s globals, made once a process: their device functions, compiled for the
+    first kernel, serve every later one (docs/gpu.md). Two threads asking first at once may each
+    make one; their kernels then share fewer device functions, nothing else."""
+    return _mirror_space(lambda f: njit(inline="never")(f))
+
+
+def _copies(functions, space: dict) -> list:
+    # from each function itself, not its name: a kernel of `_kernel_for` keeps its constants
     return [types.FunctionType(f.__code__, space, f.__name__, f.__defaults__, f.__closure__) for f in functions]
 
 
