@@ -83,7 +83,7 @@ def profile(args: list) -> None:
     ap.add_argument("--gpu-threads", type=int, default=None, help="threads a block (default: gpu.THREADS_PER_BLOCK)")
     ap.add_argument(
         "--gpu-min-batch", type=int, default=None,
-        help="--backend auto: the smallest batch the GPU takes (solver.GPU_MIN_BATCH; default 4096)",
+        help="--backend auto: the smallest batch the GPU takes (solver.GPU_MIN_BATCH; default: solver.gpu_pays)",
     )  # fmt: skip
     ap.add_argument(
         "--gpu-file-cache", action="store_true",

@@ -25,18 +25,18 @@
 #   2. the default build of the kernel against the one timed on 2026-11-27 (bench_gpu_kernel.py
 #      --kernels), 1,024 and 32,768 SAS closed loops: the 1e9 target, and whether their runs are
 #      the same on the device
-#   3. the default design with --backend gpu, every GPU kernel compiled in the run, as a user
+#   3. the default design with backend auto (the tuning rounds that step sooner on the GPU go
+#      there, by solver.gpu_pays, the rest on the CPU's cores), as a user runs it: its wall and
+#      CPU time, its stepping rate, and by stage how long some batch stepped and how long none did
+#   4. 1e5 metrics-only runs of 60 s in one call (bench_gpu.py --only-metrics): whether they fit
+#      one GPU's memory, never measured
+#   5. the default design with --backend gpu, every GPU kernel compiled in the run, as a user
 #      first meets it (the CPU's kernels compiled first, as an install does: bench_design.py
 #      --profile, cut at 150 s: the target of 2 minutes and start-up; one that is cut prints what
 #      it had done by then)
-#   4. 1e5 metrics-only runs of 60 s in one call (bench_gpu.py --only-metrics): whether they fit
-#      one GPU's memory, never measured
-#   5. bench_gpu.py: 32,768 SAS closed loops on the GPU (and how long its first call, which
+#   6. bench_gpu.py: 32,768 SAS closed loops on the GPU (and how long its first call, which
 #      compiles the kernel, takes), their agreement with the CPU over 64 samples, the same batch
 #      on the CPU's cores, and the metrics-only batch of the studies
-#   6. the default design with backend auto (the CPU's cores for its batches, all under 4,096
-#      runs): its wall and CPU time, its stepping rate, and
-#      by stage how long some batch stepped and how long none did (never measured on 16 cores)
 #   7. bench_gpu_kernel.py --blocks 32,64,128: the kernel on 1,024, 2,048 and 8,192 runs in
 #      blocks of 32, 64 and 128 threads (a design's rounds last a lone thread's time)
 #   8. bench_gpu_cache.py: whether numba-cuda's file cache keeps the kernel between processes,
@@ -172,19 +172,21 @@ else
   # so that no timed step below is cut by compiling them
   step compile-cpu 90 $PY -c "from railride.studies.study import study; \
 study(['pid', 'sas-attitude', 'sas-attitude-ride', 'clipped-optimal'], track_seeds=[0], speeds=[40.0], duration=1.0)"
+  # the default design as a user runs it (backend auto: each batch where it steps sooner, by
+  # solver.gpu_pays: the tuning rounds from about 850 runs on the GPU, the rest on the 16 cores),
+  # its GPU kernels compiled in the run: "exit 0 after N s" is its time with start-up; cut at the
+  # cap, it prints what it had done
+  step design 150 $PY benchmarks/bench_design.py --profile
+  # 1e5 runs of 60 s that keep only their metrics, in one call: whether they fit one GPU's memory
+  # (computed so far: 0.47 GiB of runs' own arrays), its device and host peaks, its rate
+  step gpu-1e5-metrics 200 $PY benchmarks/bench_gpu.py --samples 100000 --duration 60 --only-metrics
   # the default design on the GPU as a user first meets it: every GPU kernel compiled in the run (cut
   # at 150 s twice on the H100 when a compile took 19 to 43 s; its front end now takes 1.6 to 12 s
   # a build on a 2-core VM, docs/gpu.md). Cut at the cap (SIGTERM), it prints what it had done by then
   step design-on-gpu 150 $PY benchmarks/bench_design.py --profile --backend gpu
-  # 1e5 runs of 60 s that keep only their metrics, in one call: whether they fit one GPU's memory
-  # (computed so far: 0.47 GiB of runs' own arrays), its device and host peaks, its rate
-  step gpu-1e5-metrics 200 $PY benchmarks/bench_gpu.py --samples 100000 --duration 60 --only-metrics
   # 32,768 runs: the first call's compile, agreement with the CPU over 64 samples, the same batch
   # on the CPU's cores, the studies' metrics-only batch
   step gpu-throughput 90 $PY benchmarks/bench_gpu.py --samples "$GPU_SAMPLES" --duration "$DURATION" --cpu --check "$CHECK" --metrics-only
-  # the design in the library on the CPU's cores (backend auto: its batches are all under 4,096
-  # runs): "exit 0 after N s" is its time with start-up; cut at the cap, it prints what it had done
-  step design 150 $PY benchmarks/bench_design.py --profile
   # small batches in small blocks: a design's rounds (256 to 2,048 runs) last a lone thread's time
   step gpu-kernel-blocks 120 $PY benchmarks/bench_gpu_kernel.py --kernels special-lean-n1-sparse --registers none \
     --blocks 32,64,128 --samples 1024,2048,8192

@@ -168,8 +168,9 @@ BackendOption = Annotated[
     typer.Option(
         "--backend",
         metavar="auto|cpu|gpu",
-        help="Where batches of runs step: auto (the default: a GPU for batches of 4096 runs or more where one is "
-        "usable), cpu, or gpu (an error where there is none; pip install 'railride[gpu]').",
+        help="Where batches of runs step: auto (the default: a GPU where one is usable, for batches that would "
+        "step sooner there than on the CPU's threads), cpu, or gpu (an error where there is none; "
+        "pip install 'railride[gpu]').",
     ),
 ]
 OutputRateOption = Annotated[

@@ -399,7 +399,7 @@ def check(
     for sc in scenarios:  # the track's shortest wavelength must show in the output
         check_resolution(sc, output_rate)
     tables = None
-    if not histories and not exact and solver.backend_for(n) == "gpu":  # metrics summed on the device
+    if not histories and not exact and solver.backend_for(n, duration) == "gpu":  # metrics summed on the device
         pairs = {(id(sc), id(p)): (sc, p) for sc, p in zip(scenarios, param_sets)}  # a batch repeats them
         tables = len({(table_key(sc) or id(sc), id(p)) for sc, p in pairs.values()})
     _check_size(scenarios, solver, damper, closed, exact, n_out, duration, tables)

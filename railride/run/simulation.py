@@ -395,7 +395,7 @@ def stepper_arguments(plan: RunPlan, tables: Inputs, packed: Packed) -> tuple:
 
 def stepped_on(plan: RunPlan) -> str:
     """ "cpu" or "gpu": where the RK4 steps of this run go (the exact steps are always the CPU's)."""
-    return "cpu" if plan.exact else plan.solver.backend_for(plan.n)
+    return "cpu" if plan.exact else plan.solver.backend_for(plan.n, plan.duration)
 
 
 def _gpu_failed(exc: BaseException) -> None:

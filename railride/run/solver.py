@@ -19,11 +19,22 @@ from railride.defaults import DEFAULT_CONTROL_RATE, DEFAULT_DT, DEFAULT_OUTPUT_R
 METHODS = ("auto", "rk4", "exact")
 #: where `railride.simulate` steps a batch: "cpu" (the compiled CPU steppers, on every core),
 #: "gpu" (the GPU kernel, `railride.engine.gpu`; an input error where there is none) or "auto"
-#: (the GPU for a batch of at least GPU_MIN_BATCH samples where one is usable, else the CPU)
+#: (the GPU where one is usable and a batch would step sooner there, `gpu_pays`; else the CPU)
 BACKENDS = ("auto", "cpu", "gpu")
-#: the smallest batch "auto" sends to a GPU: below it the transfers and the launch outweigh the
-#: stepping (a choice: on one H100 the crossover lay between 1,024 and 32,768 runs; docs/gpu.md)
-GPU_MIN_BATCH = 4096
+#: what "auto" weighs (`gpu_pays`; docs/gpu.md, "When auto takes the GPU"), measured on one H100
+#: beside 16 CPU cores: a GPU thread's time a step while the device is far from full (1,024 SAS
+#: closed loops, the special-lean build: so the GPU's time a call hardly grows with its runs), the
+#: host's share of a call (tables, transfers, results: a 1,024-run call's 0.50 s less its kernels'
+#: 0.29 s) and one CPU thread's sample-steps a second (32,768 SAS closed loops at 4.24e7 on the
+#: 16 threads)
+GPU_STEP_S = 18.9e-6
+GPU_CALL_S = 0.21
+CPU_THREAD_RATE = 2.65e6
+#: the smallest batch "auto" sends to numba's CUDA simulator, which tests the GPU's path, not its
+#: speed (thousands of times a device's time): the test suite's studies stay on the CPU
+SIMULATOR_MIN_BATCH = 4096
+#: a fixed smallest batch for "auto" instead of `gpu_pays` (benchmarks/bench_design.py sets it)
+GPU_MIN_BATCH: int | None = None
 #: a random track's shortest wavelength must pass at speed / min_wavelength <= output_rate /
 #: RESOLUTION: a component above that shows in the stored histories only as a few samples a cycle
 RESOLUTION = 2.5
@@ -44,9 +55,9 @@ class SolverSettings:
     [Hz], the sample rate of the outer-loop controllers ``control_rate`` [Hz] and the
     integration ``method`` (`METHODS`; default "auto": exact discretisation for the passive
     viscous suspension, one step per output sample, where dt only sets the input grid), and the
-    ``backend`` that steps a batch (`BACKENDS`; default "auto": a GPU for batches of at least
-    `GPU_MIN_BATCH` samples where one is usable; "gpu" is refused at construction where none is,
-    saying whether the extra or the device is missing).
+    ``backend`` that steps a batch (`BACKENDS`; default "auto": a GPU where one is usable for
+    batches that would step sooner there, `gpu_pays`; "gpu" is refused at construction where
+    none is, saying whether the extra or the device is missing).
 
     Checked at construction: each a finite number > 0, and the output interval 1/output_rate
     a whole number of steps (at most one output sample per step). The controller period
@@ -125,13 +136,14 @@ class SolverSettings:
         backends' results agree to rounding."""
         return {"backend": self.backend} if self.backend != "auto" else {}
 
-    def backend_for(self, n: int) -> str:
-        """ "cpu" or "gpu": where a batch of n samples steps under these settings (`BACKENDS`).
-        "auto" with a batch of `GPU_MIN_BATCH` or more and no usable GPU warns once
-        (`railride.errors.BackendWarning`) and takes the CPU."""
+    def backend_for(self, n: int, duration: float | None = None) -> str:
+        """ "cpu" or "gpu": where a batch of n samples of ``duration`` [s] each (None: long runs)
+        steps under these settings (`BACKENDS`). "auto" with a batch that would step sooner on a
+        GPU (`gpu_pays`) and no usable GPU warns once (`railride.errors.BackendWarning`) and takes
+        the CPU."""
         if self.backend != "auto":
             return self.backend
-        if n < GPU_MIN_BATCH:
+        if not auto_takes(n, None if duration is None else duration / self.dt):
             return "cpu"
         missing = gpu_missing()
         if missing is None:
@@ -151,6 +163,35 @@ class SolverSettings:
         if not isinstance(solver, cls):
             raise InputError(f"solver = {solver!r}: must be a railride.SolverSettings or None (the defaults)")
         return solver
+
+
+def gpu_pays(n: int, steps: float | None = None, threads: int | None = None) -> bool:
+    """Whether a batch of n runs of ``steps`` steps each (None: so many that a call's host share
+    does not count) would step sooner on a GPU than on ``threads`` CPU threads (default numba's),
+    by the rates measured on one machine (`GPU_STEP_S`, `GPU_CALL_S`, `CPU_THREAD_RATE`). A GPU
+    call takes about GPU_CALL_S + steps GPU_STEP_S however few its runs, while they fill less than
+    the device (a wave of some 33,000 threads on an H100); the CPU takes n steps / (threads
+    CPU_THREAD_RATE). For long runs that is n >= GPU_STEP_S CPU_THREAD_RATE threads, 50 runs a
+    CPU thread: 800 on 16 threads. Past one wave both grow with n, and the GPU stays ahead."""
+    if threads is None:
+        import numba
+
+        threads = numba.get_num_threads()
+    cpu_rate = CPU_THREAD_RATE * max(int(threads), 1)
+    if steps is None:
+        return n >= GPU_STEP_S * cpu_rate
+    return GPU_CALL_S + steps * GPU_STEP_S <= n * steps / cpu_rate
+
+
+def auto_takes(n: int, steps: float | None) -> bool:
+    """Whether "auto" would give a batch of n runs of ``steps`` steps to a GPU, were one usable."""
+    if GPU_MIN_BATCH is not None:
+        return n >= GPU_MIN_BATCH
+    from numba.core import config
+
+    if getattr(config, "ENABLE_CUDASIM", False):
+        return n >= SIMULATOR_MIN_BATCH
+    return gpu_pays(n, steps)
 
 
 def gpu_missing() -> str | None:

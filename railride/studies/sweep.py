@@ -97,7 +97,7 @@ def evaluate(
         by_group.setdefault(c.group, []).append(i)
     metrics_only = not (comfort or costs)
     for group, idx in by_group.items():
-        parts = _batches(idx, solver, metrics_only)
+        parts = _batches(idx, solver, metrics_only, [cases[i].duration for i in idx])
         while parts:
             part_idx = parts.pop(0)
             part = [cases[i] for i in part_idx]
@@ -161,12 +161,13 @@ def evaluate(
     return [rows[i] for i in range(len(cases))]
 
 
-def _batches(idx: list[int], solver: SolverSettings, metrics_only: bool) -> list[list[int]]:
-    """The compiled batches of one group's cases (positions ``idx``): `CHUNK` runs each, or, for
-    runs that keep only their metrics where the GPU takes them (`gpu_batches`), `GPU_CHUNK`. A
-    large batch the GPU does not take after all (a remainder too small for "auto", the exact
-    steps) is split into `CHUNK`s by `evaluate`."""
-    size = GPU_CHUNK if metrics_only and gpu_batches(solver, min(len(idx), GPU_CHUNK)) else CHUNK
+def _batches(idx: list[int], solver: SolverSettings, metrics_only: bool, durations=()) -> list[list[int]]:
+    """The compiled batches of one group's cases (positions ``idx``, runs of ``durations`` [s]):
+    `CHUNK` runs each, or, for runs that keep only their metrics where the GPU takes them
+    (`gpu_batches`), `GPU_CHUNK`. A large batch the GPU does not take after all (a remainder too
+    small for "auto", the exact steps) is split into `CHUNK`s by `evaluate`."""
+    on_gpu = metrics_only and gpu_batches(solver, min(len(idx), GPU_CHUNK), max(durations, default=None))
+    size = GPU_CHUNK if on_gpu else CHUNK
     return [idx[start : start + size] for start in range(0, len(idx), size)]
 
 
@@ -176,7 +177,7 @@ def _device_plan(scenarios, params, suspensions, solver: SolverSettings):
     from railride.run.checks import check
     from railride.run.simulation import stepped_on
 
-    if not gpu_batches(solver, len(scenarios)):
+    if not gpu_batches(solver, len(scenarios), max(sc.duration for sc in scenarios)):
         return None
     try:
         plan = check(scenarios, params, suspensions, solver, "mark", histories=False)
@@ -185,15 +186,16 @@ def _device_plan(scenarios, params, suspensions, solver: SolverSettings):
     return plan if stepped_on(plan) == "gpu" else None
 
 
-def gpu_batches(solver: SolverSettings, n: int) -> bool:
-    """Whether a study's metrics-only batch of n runs goes to the GPU: with backend "gpu", or
-    "auto" where one is usable and n >= `railride.run.solver.GPU_MIN_BATCH`. Where "auto" finds
-    none, a study runs its usual batches on the CPU without a word: it never asked for more."""
-    from railride.run.solver import GPU_MIN_BATCH, gpu_missing
+def gpu_batches(solver: SolverSettings, n: int, duration: float | None = None) -> bool:
+    """Whether a study's metrics-only batch of n runs of ``duration`` [s] (None: long runs) goes to
+    the GPU: with backend "gpu", or "auto" where one is usable and the batch would step sooner
+    there (`railride.run.solver.gpu_pays`). Where "auto" finds none, a study runs its usual
+    batches on the CPU without a word: it never asked for more."""
+    from railride.run.solver import auto_takes, gpu_missing
 
     if solver.backend != "auto":
         return solver.backend == "gpu"
-    return n >= GPU_MIN_BATCH and gpu_missing() is None
+    return auto_takes(n, None if duration is None else duration / solver.dt) and gpu_missing() is None
 
 
 def _add_rows(rows: dict, cases: list[Case], part_idx: list[int], m, diverged_at, comfort=None, paid=None) -> None:
@@ -355,7 +357,11 @@ def run_cases(
         if k not in done and k not in seen:
             pending.append(c)
             seen.add(k)
-    on_gpu = chunk == CHUNK and not (comfort or costs) and gpu_batches(solver, min(len(pending), GPU_CHUNK))
+    on_gpu = (
+        chunk == CHUNK
+        and not (comfort or costs)
+        and gpu_batches(solver, min(len(pending), GPU_CHUNK), max((c.duration for c in pending), default=None))
+    )
     if on_gpu:
         chunk = GPU_CHUNK  # metrics summed on the GPU (`evaluate`)
     if pending and not on_gpu and hasattr(executor, "bounded"):

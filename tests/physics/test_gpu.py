@@ -4,8 +4,10 @@
 its host side; `test_the_kernel_compiles_for_a_gpu` checks that it compiles for a device."""
 
 import importlib.util
+import math
 import warnings
 
+import numba
 import numpy as np
 import pytest
 
@@ -149,6 +151,14 @@ def test_the_forced_rows_are_the_bogies_unless_a_table_says_otherwise():
     on_carbody = flat.copy()
     on_carbody[2, 2 * N_DOF + 1] = 1e-3  # Bwd w of the carbody's pitch
     assert gpu.forced_rows(on_carbody).all()
+    for product in range(4):  # the first and last row outside the bogies, in each product
+        for row in (0, 2, 9):
+            table = flat.copy()
+            table[4, product * N_DOF + row] = -1.0
+            assert gpu.forced_rows(table).all(), (product, row)
+    on_bogies = flat.copy()
+    on_bogies[:, [p * N_DOF + r for p in range(4) for r in range(3, 9)]] = 1.0
+    assert gpu.forced_rows(on_bogies).tolist() == [False] * 3 + [True] * 6 + [False]
 
 
 def test_the_file_cache_setting_reaches_the_compile(monkeypatch):
@@ -252,13 +262,45 @@ def test_backend_gpu_without_the_extra_or_a_device_is_an_input_error(monkeypatch
 
 def test_auto_takes_the_gpu_for_large_batches_only_and_says_once_when_there_is_none(monkeypatch):
     auto = SolverSettings()
-    assert auto.backend == "auto" and auto.backend_for(solver_module.GPU_MIN_BATCH - 1) == "cpu"
-    assert auto.backend_for(solver_module.GPU_MIN_BATCH) == "gpu"  # the simulator counts as a GPU
+    # in the simulator (a test harness, not a speed) "auto" asks for SIMULATOR_MIN_BATCH runs
+    least = solver_module.SIMULATOR_MIN_BATCH
+    assert auto.backend == "auto" and auto.backend_for(least - 1, 20.0) == "cpu"
+    assert auto.backend_for(least) == "gpu"  # the simulator counts as a GPU
     assert "backend" not in auto.to_dict() and GPU.to_dict()["backend"] == "gpu"
     monkeypatch.setattr(gpu, "why_not", lambda: "no CUDA GPU or driver was found")
     with pytest.warns(BackendWarning, match="no CUDA GPU.*large batches run on the CPU"):
-        assert auto.backend_for(solver_module.GPU_MIN_BATCH) == "cpu"
+        assert auto.backend_for(least) == "cpu"
     assert SolverSettings(backend="cpu").backend_for(10**6) == "cpu"
+
+
+def test_auto_weighs_a_gpu_call_against_the_cpu_threads(monkeypatch):
+    """The crossover of `gpu_pays` by hand: a GPU call of s steps takes 0.21 s + s 18.9 us
+    whatever its runs; n runs take the CPU n s / (threads 2.65e6) s."""
+    pays = solver_module.gpu_pays
+    # 20-s runs at dt = 1e-4 s on 16 threads: 3.99 s on the GPU, 4.717 ms a run on the CPU: 845.9 runs
+    assert not pays(845, 200_000, 16) and pays(846, 200_000, 16)
+    assert not pays(105, 200_000, 2) and pays(106, 200_000, 2)  # 37.7 ms a run on 2 threads
+    # 1-s runs: the call's host share counts for more (0.399 s against 0.236 ms a run): 1,692 runs
+    assert not pays(1691, 10_000, 16) and pays(1692, 10_000, 16)
+    # long runs: 18.9 us against one thread's 1 / 2.65e6 s a step, 50.1 runs a thread
+    assert not pays(801, None, 16) and pays(802, None, 16)
+    # outside the simulator, "auto" asks that of numba's threads; a fixed GPU_MIN_BATCH overrides it
+    from numba.core import config
+
+    monkeypatch.setattr(config, "ENABLE_CUDASIM", False, raising=False)
+    monkeypatch.setattr(gpu, "why_not", lambda: None)
+    threads = numba.get_num_threads()
+    auto = SolverSettings()
+    assert (
+        auto.backend_for(pays_from(threads) - 1, 20.0) == "cpu" and auto.backend_for(pays_from(threads), 20.0) == "gpu"
+    )
+    monkeypatch.setattr(solver_module, "GPU_MIN_BATCH", 5)
+    assert auto.backend_for(4, 20.0) == "cpu" and auto.backend_for(5, 20.0) == "gpu"
+
+
+def pays_from(threads: int) -> int:
+    """The fewest 20-s runs (200,000 steps) that `gpu_pays` gives the GPU on ``threads`` threads."""
+    return math.ceil((0.21 + 200_000 * 18.9e-6) * threads * 2.65e6 / 200_000)
 
 
 def _nvvm() -> bool:
