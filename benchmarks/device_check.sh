@@ -8,6 +8,8 @@
 #       bash benchmarks/device_check.sh --gpu [BUDGET_S]  (steps 1 to 10: the GPU's and the designs)
 #       bash benchmarks/device_check.sh --kernels [BUDGET_S]  (the machine, then the kernel's builds: below)
 #       bash benchmarks/device_check.sh --smoke          (here: the simulator, tiny sizes, a check of the script)
+#       SKIP=gpu-builds,design bash benchmarks/device_check.sh --gpu 300  (a second call: the steps
+#       named in SKIP, comma-separated as the log's "## NAME" lines name them, are left out)
 #
 # --kernels: builds of the GPU kernel (bench_gpu_kernel.py --kernels) timed on 1,024, 8,192 and
 # 32,768 SAS closed loops: special-lean (9.21e8 sample-steps/s at 32,768 on an H100, 2026-11-27)
@@ -88,6 +90,12 @@ step() {
   local t=$((cap < left ? cap : left))
   echo "" | tee -a "$LOG"
   echo "## $name (at $(($(date +%s) - START)) s; at most $t s)" | tee -a "$LOG"
+  case ",${SKIP:-}," in
+  *",$name,"*)
+    echo "skipped: named in SKIP" | tee -a "$LOG"
+    return
+    ;;
+  esac
   if [ "$t" -lt 10 ]; then
     echo "skipped: the budget is spent" | tee -a "$LOG"
     return
