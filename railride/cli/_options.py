@@ -416,9 +416,26 @@ OptimiserOption = Annotated[
     ),
 ]
 OptimiserSeedOption = Annotated[
-    int,
-    typer.Option("--optimiser-seed", metavar="N", help="The seed of the evolution (with --optimiser evolution)."),
+    Optional[int],
+    typer.Option(
+        "--optimiser-seed", metavar="N", help="The seed of the evolution (with --optimiser evolution; default 0)."
+    ),
 ]
+
+
+def optimiser_seed(optimiser: str, seed: Optional[int]) -> int:
+    """--optimiser-seed, which seeds the evolution alone: 0 where it is not given; an error with
+    another optimiser, which would ignore it."""
+    if seed is None:
+        return 0
+    if optimiser.strip() != "evolution":
+        raise InputError(
+            f"--optimiser-seed = {seed}: applies with --optimiser evolution only (the sensitivity study "
+            "draws nothing at random)"
+        )
+    return seed
+
+
 ProcessesOption = Annotated[
     Optional[int],
     typer.Option(

@@ -47,6 +47,11 @@ def value_list(option: str, text: str, *, integer: bool = False, parse=None) -> 
             raise InputError(f"{option} = {text!r}: COUNT = {parts[2].strip()!r} is not a whole number") from None
         if count < 1:
             raise InputError(f"{option} = {text!r}: COUNT = {count} must be >= 1")
+        if count == 1 and start != stop:  # one value of a range is its START: STOP would be dropped unsaid
+            raise InputError(
+                f"{option} = {text!r}: COUNT = 1 gives START alone; give COUNT >= 2 for values from START to "
+                "STOP, or START alone"
+            )
         from railride.limits import VALUE_BYTES, check
 
         # each value is a Python number in a list and a set, and a case of the runs: ~1 kB
@@ -56,7 +61,12 @@ def value_list(option: str, text: str, *, integer: bool = False, parse=None) -> 
 
             # exact steps between whole numbers: seeds past 2**53 are not rounded
             span = Fraction(stop) - Fraction(start)  # exact, for floats (1e3) too
-            values = [start + i * span / max(count - 1, 1) for i in range(count)]
+            step = span / max(count - 1, 1)
+            if Fraction(start).denominator == 1 and step.denominator != 1:  # exact: 1.00001 reads as 1 at 4 digits
+                raise InputError(
+                    f"{option} = {text!r}: the step (STOP - START) / (COUNT - 1) = {step} is not a whole number"
+                )
+            values = [start + i * step for i in range(count)]
         else:
             import numpy as np
 
@@ -205,7 +215,8 @@ def damper_preset(option: str, name: str, *, rig: bool = False):
     allowed = dampers.PRESETS if rig else dampers.NAMES
     if name not in allowed:
         why = (
-            ": the ideal actuator applies a vehicle controller's demand and has no force law to drive on the rig"
+            f": {dampers.ideal_words(name)} follows a vehicle controller's demand and has no force law to drive on "
+            "the rig"
             if name in dampers.IDEAL_NAMES
             else ": unknown damper model"
         )

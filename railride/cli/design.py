@@ -44,6 +44,7 @@ from railride.cli._options import (
     WeightsOption,
     OptimiserOption,
     OptimiserSeedOption,
+    optimiser_seed as optimiser_seed_of,
     ProcessesOption,
     WorkersOption,
     DesignOutOption,
@@ -312,7 +313,7 @@ def design_command(
         ),
     ] = "mean",
     optimiser: OptimiserOption = "sensitivity",
-    optimiser_seed: OptimiserSeedOption = 0,
+    optimiser_seed: OptimiserSeedOption = None,
     objective_kind: ObjectiveOption = None,
     weights: WeightsOption = None,
     bound: BoundOption = None,
@@ -354,6 +355,7 @@ def design_command(
         check_report_option(report)
         figures = figure_options(figure_format, dpi, out)
         names = [c.strip() for c in controllers.split(",")]
+        seed_of_evolution = optimiser_seed_of(optimiser, optimiser_seed)
         tracks = [t.strip() for t in track.split(",")]
         speeds = value_list("--speed", speed)
         loads = value_list("--load", load)
@@ -378,7 +380,7 @@ def design_command(
             budget=budget,
             values=values,
             optimiser=optimiser.strip(),
-            optimiser_seed=optimiser_seed,
+            optimiser_seed=seed_of_evolution,
             train_seeds=train,
             test_seeds=test,
             duration=duration,

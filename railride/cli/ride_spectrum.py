@@ -288,7 +288,18 @@ def state_space(
         vehicle_options = vehicle_arguments(vehicle, preset, load)
         if out is not None:
             check_model_path(out, "--out")
-        (secondary,) = linear_suspensions([suspension], None if gains is None else load_gains(gains)).values()
+        from railride.errors import InputError
+        from railride.secondary.control import OUTER_LOOPS
+
+        # one model: "all" and lists, which linear_suspensions takes for ride-spectrum, are refused
+        # here in this command's terms, not unpacked into one
+        if suspension.strip() not in ("passive", "plant", *OUTER_LOOPS):
+            raise InputError(
+                f"--suspension = {suspension!r}: state-space models one suspension at a time; allowed: passive, plant, "
+                f"{', '.join(OUTER_LOOPS)} (each on the ideal actuator)"
+            )
+        named = [suspension.strip()]
+        (secondary,) = linear_suspensions(named, None if gains is None else load_gains(gains)).values()
         model = linear_model(suspension=secondary, **vehicle_options)
         if out is not None:
             write_folder(out.parent, lambda: [write_model(model, out)], own_folder=False)

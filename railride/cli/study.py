@@ -272,7 +272,10 @@ def study_command(
 
     with errors(), option_names(STUDY_FIELDS):
         figures = figure_options(figure_format, dpi, out)
-        names = check_controllers(controllers)
+        try:
+            names = check_controllers(controllers)
+        except InputError as exc:  # the library's words name no option
+            raise InputError(f"--controllers = {controllers!r}: {exc}") from None
         source = vehicle_source(vehicle, preset)
         seeds = value_list("--track-seed", track_seed, integer=True) if track_seed is not None else None
         speeds = value_list("--speed", speed) if speed is not None else None

@@ -60,6 +60,7 @@ from railride.cli._options import (
     WeightsOption,
     OptimiserOption,
     OptimiserSeedOption,
+    optimiser_seed as optimiser_seed_of,
     ProcessesOption,
     WorkersOption,
     figure_options,
@@ -200,13 +201,11 @@ def _tunable_list(text: str) -> list[str]:
         raise InputError(
             f"--controllers = {text!r}: an empty item; give names separated by commas from {', '.join(TUNABLE)}, all"
         )
-    if "all" in items:
-        return list(TUNABLE)
-    for n in items:
-        if n not in TUNABLE:
+    for n in items:  # every name checked, "all" beside others too
+        if n not in TUNABLE and n != "all":
             why = " has no gains to tune" if n in ("passive", "passive-on", "passive-off") else " is not known"
             raise InputError(f"--controllers = {text!r}: {n!r}{why}; allowed: {', '.join(TUNABLE)}, all")
-    return [n for n in TUNABLE if n in items]
+    return [n for n in TUNABLE if n in items or "all" in items]
 
 
 def _tuning_set(scenario, seeds, loads, speed, duration, *single):
@@ -466,7 +465,7 @@ def tune_command(
     workers: WorkersOption = None,
     processes: ProcessesOption = None,
     optimiser: OptimiserOption = "sensitivity",
-    optimiser_seed: OptimiserSeedOption = 0,
+    optimiser_seed: OptimiserSeedOption = None,
     scheduler: SchedulerOption = None,
     scheduler_file: SchedulerFileOption = None,
     out: TuneOutOption = None,
@@ -498,6 +497,7 @@ def tune_command(
 
         figures = figure_options(figure_format, dpi, out)
         names = _tunable_list(controllers)
+        seed_of_evolution = optimiser_seed_of(optimiser, optimiser_seed)
         source = vehicle_source(vehicle, preset)
         damper_preset("--damper", damper)
         scale = parse_scale("--damper-scale", damper_scale)
@@ -559,7 +559,7 @@ def tune_command(
                     progress=progress,
                     log=progress.log,
                     optimiser=optimiser.strip(),
-                    optimiser_seed=optimiser_seed,
+                    optimiser_seed=seed_of_evolution,
                 )
                 wall = time.perf_counter() - t0
             # the facts of this command line, after the library's document

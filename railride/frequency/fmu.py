@@ -181,6 +181,8 @@ def export_fmu(
         shown = str(path) if path is not None else out
         raise InputError(f"out = {shown!r}: give the path of the FMU to write, ending in .fmu")
     validation.creatable(path, f"out = {str(path)!r}")
+    if path.is_dir():  # the FMU replaces a file whole, never a folder
+        raise InputError(f"out = {str(path)!r}: a folder; give the path of the FMU file to write, ending in .fmu")
     params_, record = resolve_vehicle(vehicle, params, load)
     if not isinstance(damper, str) or damper not in SECONDARIES:
         raise InputError(

@@ -273,7 +273,7 @@ class Ideal(_Damper):
 
     def scaled(self, factor: float):
         raise InputError(
-            f"factor = {factor!r}: the ideal actuator applies the demand exactly and has no force capacity to scale"
+            f"factor = {factor!r}: {ideal_words(self.model)} follows the demand and has no force capacity to scale"
         )
 
 
@@ -361,6 +361,13 @@ IDEAL = Ideal()
 IDEAL_DAMPER = Ideal(dissipative=True)
 #: the names of the ideal bounds (no voltage, no inner loop, closed loop only)
 IDEAL_NAMES = ("ideal", "ideal-damper")
+
+
+def ideal_words(name: str) -> str:
+    """How a message names the ideal device ``name`` ("ideal" or "ideal-damper")."""
+    return "the ideal semi-active damper" if name == "ideal-damper" else "the ideal actuator"
+
+
 #: every name `preset` knows
 NAMES = (*PRESETS, *IDEAL_NAMES)
 

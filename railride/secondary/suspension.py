@@ -61,8 +61,8 @@ def damper_model(damper, damper_scale: float = 1.0):
         return model
     if model.law == dampers.LAW_IDEAL:
         raise InputError(
-            f"damper_scale = {scale:g}: the ideal actuator applies the demand "
-            "exactly and has no force capacity to scale (leave damper_scale at 1)"
+            f"damper_scale = {scale:g}: {dampers.ideal_words(model.model)} follows the demand and has no force "
+            "capacity to scale (leave damper_scale at 1)"
         )
     if not hasattr(model, "scaled"):
         raise InputError(f"damper_scale = {scale:g}: a {model.model} damper has no force capacity to scale")
@@ -184,7 +184,7 @@ class Suspension:
                     raise InputError(f"{name} applies to a closed loop only: give controller= as well")
             if ideal:
                 raise InputError(
-                    f"damper = {model.model!r}: the ideal actuator applies an outer loop's "
+                    f"damper = {model.model!r}: {dampers.ideal_words(model.model)} follows an outer loop's "
                     "demand and needs controller= (PID or SAS); it has no voltage to set"
                     + (f" (got voltage = {self.voltage!r})" if self.voltage is not None else "")
                 )
@@ -321,7 +321,7 @@ class Suspension:
             return cls(None, None, None, None, sensor_noise)
         if (name == "mr" or name in CONSTANT_VOLTAGE) and model.law == dampers.LAW_IDEAL:
             raise InputError(
-                f"damper = {damper!r} with suspension {name!r}: the ideal actuator applies a "
+                f"damper = {damper!r} with suspension {name!r}: {dampers.ideal_words(model.model)} follows a "
                 "controller's demand and has no constant voltage; it needs a controller (a suspension "
                 "named after one, e.g. 'sas-attitude'), as railride compare --damper ideal and railride "
                 "sweep --damper ideal run it"

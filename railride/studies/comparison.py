@@ -79,11 +79,12 @@ def check_controllers(names) -> list[str]:
     if isinstance(names, str):
         names = names.split(",")
     names = [n.strip() for n in arguments.names("controllers", names, "controller names") if n.strip()]
-    if "all" in names:
-        names = list(CONTROLLERS)
-    unknown = [n for n in names if n not in CONTROLLERS]
+    # every name checked, "all" beside others too: a misspelt name is never dropped silently
+    unknown = [n for n in names if n not in CONTROLLERS and n != "all"]
     if unknown:
         raise InputError(f"unknown controller {unknown[0]!r}; allowed: {', '.join(CONTROLLERS)}, or all")
+    if "all" in names:
+        names = list(CONTROLLERS)
     if not names:
         raise InputError(f"no controller given; allowed: {', '.join(CONTROLLERS)}")
     return [n for n in CONTROLLERS if n in names or n == "passive"]

@@ -130,6 +130,14 @@ def _items(name: str, values) -> list:
         raise InputError(f"{name} = {values!r}: give a list of values") from None
     if not out:
         raise InputError(f"{name} = []: empty; give at least one value")
+    seen: set = set()
+    for v in out:  # a value given twice is most likely a slip: said, not dropped unsaid
+        try:
+            if v in seen:
+                raise InputError(f"{name} = {out!r}: {v!r} is listed twice; give each once")
+            seen.add(v)
+        except TypeError:  # not hashable: the check that owns the value names it
+            pass
     return out
 
 
@@ -138,10 +146,10 @@ def _laws(controllers) -> tuple:
     if controllers is None or controllers == "all":
         return TUNED_CONTROLLERS
     names = [str(c).strip() if isinstance(c, str) else c for c in _items("controllers", controllers)]
-    for n in names:
-        if n not in TUNED_CONTROLLERS and n != "passive":
-            raise InputError(f"controllers = {n!r}: not a law with gains to tune; {allowed}")
-    laws = tuple(n for n in TUNED_CONTROLLERS if n in names)
+    for n in names:  # every name checked, "all" beside others too
+        if n not in TUNED_CONTROLLERS and n not in ("passive", "all"):
+            raise InputError(f"controllers = {n!r}: not a law with gains to tune; {allowed}, or all")
+    laws = tuple(n for n in TUNED_CONTROLLERS if n in names or "all" in names)
     if not laws:
         raise InputError(f"controllers = {names!r}: no law to design; {allowed}")
     return laws

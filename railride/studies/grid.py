@@ -324,6 +324,7 @@ def grid(
     solver = SolverSettings.of(solver)
     common = {} if duration is None else {"duration": _duration(words, duration, solver.output_rate)}
     common.update(band)
+    _check_count(words, axes, suspensions, scales, volts, gain_axes, seeds if noise is not None else None)
     combos, record, run_duration = _scenarios(
         words, scenario, axes, common, min_wavelength is not None, solver.output_rate
     )
@@ -522,6 +523,43 @@ def _scenarios(words: _Words, scenario: str, axes: list, common: dict, min_given
             record = scen.describe()
         duration = scen.duration
     return combos, record, duration
+
+
+def grid_size(axes: list, suspensions: list, scales, volts, gain_axes: list, seeds) -> int:
+    """The number of cases `_cases` makes of these axes, counted without making them: per
+    scenario combination, passive once, mr per scale and voltage, passive-on/off per scale, a
+    controller per scale, combination of its gains and noise seed (``seeds`` None: no noise)."""
+    n_scales = len(scales) if scales is not None else 1
+    per_combo = 0
+    for s in suspensions:
+        if s == "passive":
+            per_combo += 1
+        elif s in CONSTANT_VOLTAGE:
+            per_combo += n_scales
+        elif s == "mr":
+            per_combo += n_scales * len(volts or ())
+        else:
+            mine = [vs for n, vs in gain_axes if s in GAIN_CONTROLLERS[n.partition(".")[0]]]
+            per_combo += n_scales * math.prod(map(len, mine)) * (len(seeds) if seeds is not None else 1)
+    return math.prod(len(values) for *_, values in axes) * per_combo
+
+
+def _check_count(words: _Words, axes: list, suspensions: list, scales, volts, gain_axes: list, seeds) -> None:
+    """`railride.limits.check` on the grid's cases (`VALUE_BYTES` each, as the command line
+    counts a range's values) before any is made: each axis's values pass alone, but their
+    product can be past the memory (1e5 speeds x 1e5 amplitudes) and would take hours to build."""
+    from railride import limits
+
+    n = grid_size(axes, suspensions, scales, volts, gain_axes, seeds)
+    if limits.VALUE_BYTES * n <= limits.max_memory():
+        return
+    shape = [f"{len(values)} {words.name(_key(kw))}" for kw, _, values in axes]
+    shape.append(f"{len(suspensions)} {words.name('suspensions')}")
+    shape += [f"{len(v)} {words.name('damper_scale')}" for v in [scales] if v is not None]
+    shape += [f"{len(v)} {words.name('voltage')}" for v in [volts] if v is not None and len(v) > 1]
+    shape += [f"{len(vs)} {words.name('gains')} {name}" for name, vs in gain_axes]
+    shape += [f"{len(v)} {words.name('seed')}" for v in [seeds] if v is not None]
+    limits.check(limits.VALUE_BYTES * n, f"a grid of {n} runs ({' x '.join(shape)})", "give fewer values")
 
 
 def _duration(words: _Words, duration, output_rate: float) -> float:

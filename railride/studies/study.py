@@ -251,6 +251,9 @@ def study(
     ):
         if not values:
             raise InputError(f"{name}: give at least one value")
+        twice = _repeated(values)
+        if twice is not None:  # a repeated condition would count its runs twice in the statistics
+            raise InputError(f"{name} = {twice}: listed twice; give each once")
     validation.choice("sensing", sensing, SENSING)
     if sensing != "ideal":
         car = Vehicle(vehicle)
@@ -465,3 +468,14 @@ def _summary(frame: pd.DataFrame, names, speeds, loads, stiffness, conditions, d
                         }
                     )
     return pd.DataFrame(rows)
+
+
+def _repeated(values) -> str | None:
+    """The first value of ``values`` given twice, as text (a fault condition as "none" or its
+    faults joined by "+"), or None."""
+    seen: set = set()
+    for v in values:
+        if v in seen:
+            return HEALTHY if v == () else "+".join(v) if isinstance(v, tuple) else f"{v!r}"
+        seen.add(v)
+    return None

@@ -1,0 +1,35 @@
+"""What the command line's errors call things: each ideal device by its own name."""
+
+from __future__ import annotations
+
+import pytest
+
+from clihelp import assert_input_error, run
+
+from railride.errors import InputError
+from railride.secondary import dampers
+from railride.secondary.suspension import Suspension
+
+
+@pytest.mark.parametrize(("name", "words"), [("ideal", "ideal actuator"), ("ideal-damper", "ideal semi-active damper")])
+def test_each_ideal_device_is_named_as_itself(name, words):
+    rig = ("--amplitude", "0.01", "--frequency", "1", "--voltage", "0")
+    assert_input_error(run("damper", "--damper", name, *rig), "--damper", words)
+    assert_input_error(run("compare", "--damper", name, "--damper-scale", "2"), words)
+    with pytest.raises(InputError, match=words):
+        dampers.preset(name).scaled(2.0)
+    with pytest.raises(InputError, match=words):
+        Suspension.named("mr", damper=name)
+
+
+def test_an_fmu_path_that_is_a_folder_is_refused_before_any_work(tmp_path):
+    folder = tmp_path / "car.fmu"
+    folder.mkdir()
+    assert_input_error(run("fmu", "--out", str(folder), "--sources-only"), "--out", "a folder")
+    assert list(folder.iterdir()) == [] and sorted(p.name for p in tmp_path.iterdir()) == ["car.fmu"]
+
+
+@pytest.mark.parametrize("command", ["tune", "design"])
+def test_an_optimiser_seed_without_the_evolution_is_refused(command, tmp_path):
+    extra = ("--out", str(tmp_path / "d")) if command == "design" else ()
+    assert_input_error(run(command, "--optimiser-seed", "5", *extra), "--optimiser-seed = 5", "evolution")
