@@ -166,7 +166,7 @@ class VehicleParams:
         if isinstance(value, str):
             if value in PRESETS:
                 return PRESETS[value], value
-            if value.endswith(".toml") or Path(value).is_file():
+            if value.endswith(".toml") or Path(value).is_file() or Path(value).is_dir():  # a folder: load says so
                 return cls.load(Path(value)), Path(value)
             raise InputError(
                 f"{field} = {value!r}: unknown vehicle preset, and no such file; allowed: a preset "
@@ -297,16 +297,33 @@ class VehicleParams:
         table = dict(table)
         names = [f.name for f in dataclasses.fields(cls)]
         base_name = table.pop("preset", None)
-        rigid = table.pop("rigid_carbody", False)  # a preset's flexible carbody switched off
-        if not isinstance(rigid, bool):
+        if base_name is not None and (not isinstance(base_name, str) or base_name not in PRESETS):
+            raise InputError(
+                f"{source}: [vehicle] preset = {shown(base_name)}: unknown vehicle preset; "
+                f"allowed: {', '.join(sorted(PRESETS))}"
+            )
+        rigid = table.pop("rigid_carbody", None)  # a preset's flexible carbody switched off (None: not said)
+        if rigid is not None and not isinstance(rigid, bool):
             raise InputError(f"{source}: [vehicle] rigid_carbody = {shown(rigid)}: must be true or false")
+        frequency = [n for n in ("f_bend", "EI_c") if n in table]
+        if rigid and frequency:  # L_c alone may stay: to_toml writes it with the switch for a rigid body
+            raise InputError(
+                f"{source}: [vehicle] rigid_carbody = true and {frequency[0]} = {shown(table[frequency[0]])}: give "
+                "one of them, a rigid carbody or its bending mode, not both"
+            )
+        if rigid is False and not frequency and (base_name is None or not PRESETS[base_name].flexible):
+            preset = "" if base_name is None else f" or its preset {base_name!r}"
+            raise InputError(
+                f"{source}: [vehicle] rigid_carbody = false, but the file{preset} gives the carbody no bending "
+                "mode; give L_c with f_bend or EI_c, or leave rigid_carbody out"
+            )
         unknown = sorted(set(table) - set(names))
         if unknown:
             raise InputError(
                 f"{source}: unknown vehicle parameter(s) {', '.join(unknown)}; allowed: {', '.join(names)}"
             )
         if base_name is not None:
-            base = cls.preset(str(base_name))
+            base = PRESETS[base_name]
         else:
             missing = [f.name for f in dataclasses.fields(cls) if f.name not in table and f.default is MISSING]
             if missing:
@@ -334,10 +351,17 @@ class VehicleParams:
     @classmethod
     def load(cls, path: str | Path) -> "VehicleParams":
         path = Path(path)
+        if path.is_dir():  # reading it fails with an OS's own words ("Is a directory", "Permission denied")
+            raise InputError(
+                f"vehicle parameters {path}: a folder, not a vehicle file; give the path of a FILE.toml with a "
+                "[vehicle] table"
+            )
         try:
             text = path.read_text(encoding="utf-8")
         except OSError as exc:
             raise InputError(f"cannot read vehicle parameters from {path}: {exc.strerror}") from None
+        except UnicodeDecodeError:
+            raise InputError(f"vehicle parameters file {path}: not a UTF-8 text TOML file") from None
         return cls.from_toml(text, source=str(path))
 
 

@@ -30,6 +30,7 @@ import numpy as np
 
 from railride.errors import InputError
 from railride import limits
+from railride.validation import shown
 from railride.defaults import DEFAULT_DURATION, DEFAULT_SPEED
 from railride.model.profiles import (  # noqa: F401 (the profiles' constants: their home before)
     MAX_RAIL_AMPLITUDE,
@@ -192,15 +193,17 @@ class MeasuredTrack(RailProfile):
             bad = np.flatnonzero(~np.isfinite(col))
             if bad.size:
                 raise InputError(
-                    f"{src}: column {name} has a non-finite value {col[bad[0]]!r} at data row {bad[0] + 1}"
+                    f"{src}: column {name} has a non-finite value {shown(col[bad[0]])} at data row {bad[0] + 1}"
                 )
         steps = np.diff(s)
         if np.any(steps <= 0):
             i = int(np.flatnonzero(steps <= 0)[0])
-            raise InputError(f"{src}: s must increase strictly; data row {i + 2} has s = {s[i + 1]!r} after {s[i]!r}")
+            raise InputError(
+                f"{src}: s must increase strictly; data row {i + 2} has s = {shown(s[i + 1])} after {shown(s[i])}"
+            )
         if s[0] > 0:
             raise InputError(
-                f"{src}: the profile must start at s <= 0 m (the vehicle starts at s = 0); it starts at {s[0]!r} m"
+                f"{src}: the profile must start at s <= 0 m (the vehicle starts at s = 0); it starts at {shown(s[0])} m"
             )
         object.__setattr__(self, "s", s)
         object.__setattr__(self, "z_L", zl)
@@ -423,12 +426,20 @@ def scenario(
                 f"the {MAX_RANDOM_LENGTH:g} m allowed (ten times the longest railway line); shorten the run"
             )
         # long enough that the realisation does not repeat within the run
+        length = max(2000.0, V * T + 100.0)
+        if max_wavelength is not None:  # the realisation's length is no option: name the limit it sets
+            hi = _check("max_wavelength", max_wavelength, "positive", "a finite number > 0 (m)")
+            if hi > length:
+                raise InputError(
+                    f"max_wavelength = {hi:g} m: must be at most {length:g} m, the length of the random track "
+                    f"this run synthesises (the run's {V * T:g} m plus 100 m, and at least 2000 m)"
+                )
         track = _random_track(
             name,
             0 if seed is None else seed,
             1.0 if min_wavelength is None else min_wavelength,
             100.0 if max_wavelength is None else max_wavelength,
-            max(2000.0, V * T + 100.0),
+            length,
         )
     elif name.startswith("file:"):
         given = [
