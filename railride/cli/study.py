@@ -58,6 +58,7 @@ from railride.cli._render import check_report_option, save_report, warn_gains_mi
 
 #: the library's names of the study's options, for its errors
 STUDY_FIELDS = {
+    "scenario": "--scenario",
     "track_seeds": "--track-seed",
     "speeds": "--speed",
     "speed": "--speed",

@@ -196,7 +196,7 @@ def study(
     from railride.analysis.metrics import check_window
     from railride.secondary.suspension import damper_model
     from railride.studies.sweep import other_settings
-    from railride.model.track import SPECTRA
+    from railride.model.track import SCENARIOS, SPECTRA
 
     from railride import arguments
 
@@ -213,6 +213,9 @@ def study(
     vehicle = base
     gains = GainSet.of(gains, scenario)
     random = scenario in SPECTRA
+    if not random and scenario not in ("paper-sine", "bump") and not scenario.startswith("file:"):
+        # named before the seeds' check, which would otherwise speak of a track that is no track
+        raise InputError(f"scenario = {scenario!r}: unknown; allowed: {', '.join(SCENARIOS)}")
     if track_seeds is not None and not random:
         raise InputError(
             f"track_seeds = {list(_items(track_seeds))}: track seeds apply to the random tracks "

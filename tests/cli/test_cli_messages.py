@@ -33,3 +33,8 @@ def test_an_fmu_path_that_is_a_folder_is_refused_before_any_work(tmp_path):
 def test_an_optimiser_seed_without_the_evolution_is_refused(command, tmp_path):
     extra = ("--out", str(tmp_path / "d")) if command == "design" else ()
     assert_input_error(run(command, "--optimiser-seed", "5", *extra), "--optimiser-seed = 5", "evolution")
+
+
+def test_an_unknown_scenario_of_a_study_is_named_before_its_seeds():
+    # the seeds' check had said that seeds apply to random tracks only, hiding the unknown name
+    assert_input_error(run("study", "--scenario", "nope", "--track-seed", "0,1"), "--scenario = 'nope': unknown")
