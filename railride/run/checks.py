@@ -206,7 +206,10 @@ def _check_size(
     limits.check(
         need,
         f"{n} run(s) of {duration:.4g} s at dt {dt:.4g} s ({n_out + 1} output samples, {nodes} input nodes)",
-        "shorten the duration, lower output_rate, run fewer samples at once or use a dt nearer the default",
+        # what a single run can change: no batch to split, and a dt at the default is no lever
+        "shorten the duration or lower output_rate"
+        + (", or run fewer samples at once" if n > 1 else "")
+        + (" or use a dt nearer the default" if dt < DEFAULT_DT else ""),
     )
     if exact and period > _MAX_EXACT_PHASES:  # each phase costs matrix exponentials, 1-2 ms each
         raise InputError(
