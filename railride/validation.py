@@ -193,9 +193,10 @@ def validate_fields(obj, what: str, ranges: Mapping[str, Range] | None = None, t
         if value is None:
             continue
         if not r.low <= value <= r.high:
+            unit = _after_number(meta["unit"])
             raise InputError(
                 f"{what} {name!r} = {shown(value)} ({meta['doc']}, {meta['unit']}): must be between {r.low:g} and "
-                f"{r.high:g} {meta['unit']} ({r.why})"
+                f"{r.high:g}{unit} ({r.why})"
             )
     if then is not None:
         then()
@@ -231,10 +232,17 @@ def atypical(obj, ranges: Mapping[str, Range], what: str) -> list[str]:
         value, meta = getattr(obj, name), fields[name].metadata
         if value is not None and not low <= value <= high:
             out.append(
-                f"{what} {name!r} = {shown(value)} {meta['unit']} ({meta['doc']}) is outside the "
-                f"{low:g} to {high:g} {meta['unit']} of full-size rail vehicles; the results are for it as given"
+                f"{what} {name!r} = {shown(value)}{_after_number(meta['unit'])} ({meta['doc']}) is outside the "
+                f"{low:g} to {high:g}{_after_number(meta['unit'])} of full-size rail vehicles; the results are for it "
+                "as given"
             )
     return out
+
+
+def _after_number(unit: str) -> str:
+    """A unit as it follows a number: " kg", and nothing for a ratio (unit "1": "0.5 1" reads
+    as two numbers)."""
+    return "" if unit in ("1", "") else f" {unit}"
 
 
 def toml_error(exc: ValueError) -> str:

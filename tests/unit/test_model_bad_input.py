@@ -86,3 +86,12 @@ def test_a_random_track_wavelength_beyond_its_length_names_the_option_given():
     )
     # a longer run synthesises a longer track
     assert scenario("fra3", max_wavelength=2500.0, speed=50.0, duration=60.0).track.max_wavelength == 2500.0
+
+
+def test_a_ratio_out_of_range_is_said_without_its_unit_after_the_number():
+    # the unit of a ratio is "1": "between 0 and 1 1" read as a doubled number
+    from railride.model.params import VehicleParams
+
+    with pytest.raises(InputError, match=r"must be between 0 and 1 \(1 is critical damping") as caught:
+        VehicleParams.preset("paper").replace(f_bend=10.0, L_c=24.0, zeta_bend=5.0)
+    assert "0 and 1 1" not in str(caught.value)
