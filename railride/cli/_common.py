@@ -104,6 +104,8 @@ def usage_error_line(exc, args, command: str = "railride") -> str:
     integer ...``, the value the user typed taken from ``args`` (the command's words);
     otherwise the parser's message and where to look (``command --help``)."""
     message = _one_line(exc).rstrip(".")
+    if message.lower().startswith("value error, "):  # the parser's validator's own prefix, no word of ours
+        message = message[len("value error, ") :]
     param = getattr(exc, "param", None)
     flags = [o for o in getattr(param, "opts", ()) if o.startswith("-")]
     value = None

@@ -79,6 +79,15 @@ def value_list(option: str, text: str, *, integer: bool = False, parse=None) -> 
             )
         number = _whole if integer and not parse else parse_float
         values = [parse(item) if parse else number(option, text, item) for item in items]
+        if parse:  # a word read as a number (passive-off as 0 V): a repeat is named as the user wrote it
+            written: dict = {}
+            for item, v in zip(items, values):
+                if v in written:
+                    raise InputError(
+                        f"{option} = {text!r}: {item.strip()!r} is listed twice"
+                        + (f" (as {written[v]!r})" if written[v] != item.strip() else "")
+                    )
+                written[v] = item.strip()
     if integer:
         bad = [v for v in values if v != int(v)]
         if bad:

@@ -38,3 +38,20 @@ def test_an_optimiser_seed_without_the_evolution_is_refused(command, tmp_path):
 def test_an_unknown_scenario_of_a_study_is_named_before_its_seeds():
     # the seeds' check had said that seeds apply to random tracks only, hiding the unknown name
     assert_input_error(run("study", "--scenario", "nope", "--track-seed", "0,1"), "--scenario = 'nope': unknown")
+
+
+def test_a_choice_not_allowed_is_said_without_the_validators_prefix():
+    result = run("simulate", "--format", "xml")
+    assert_input_error(result, "--format = 'xml': 'xml' is not one of")
+    assert "value error" not in result.stderr.lower()
+
+
+@pytest.mark.parametrize(
+    ("voltages", "said"),
+    [
+        ("passive-off,passive-off", "'passive-off' is listed twice"),
+        ("0,passive-off", "'passive-off' is listed twice (as '0')"),
+    ],
+)
+def test_a_voltage_given_twice_is_named_as_written(voltages, said):
+    assert_input_error(run("sweep", "--suspension", "mr", "--voltage", voltages), "--voltage", said)
