@@ -96,8 +96,11 @@ def ride_spectrum(
         ),
     ] = None,
     delay: Annotated[
-        int, typer.Option("--delay", metavar="N", help="With --control-rate: the delay in controller periods, 0..64.")
-    ] = 1,
+        Optional[int],
+        typer.Option(
+            "--delay", metavar="N", help="With --control-rate: the delay in controller periods, 0..64 (default 1)."
+        ),
+    ] = None,
     vehicle: VehicleOption = None,
     preset: PresetOption = None,
     load: LoadOption = None,
@@ -134,6 +137,12 @@ def ride_spectrum(
 
         figures = figure_options(figure_format, dpi, out)
         check_report_option(report)
+        if delay is not None and control_rate is None:  # the loops act continuously: no period to delay by
+            from railride.errors import InputError
+
+            raise InputError(
+                f"--delay = {delay}: applies with --control-rate only (without it the loops act continuously)"
+            )
         vehicle_options = vehicle_arguments(vehicle, preset, load)
         if out is not None:
             check_out_dir(out, "--out")
@@ -147,7 +156,7 @@ def ride_spectrum(
             max_wavelength=max_wavelength,
             points=points,
             control_rate=control_rate,
-            delay=delay,
+            delay=1 if delay is None else delay,
         )
         if out is not None:
             write_folder(out, lambda: result.save(out, figure_formats=figures.figure_formats, dpi=figures.dpi))

@@ -55,3 +55,8 @@ def test_a_choice_not_allowed_is_said_without_the_validators_prefix():
 )
 def test_a_voltage_given_twice_is_named_as_written(voltages, said):
     assert_input_error(run("sweep", "--suspension", "mr", "--voltage", voltages), "--voltage", said)
+
+
+def test_a_delay_without_a_controller_rate_is_refused():
+    # without --control-rate the loops act continuously: a delay in periods would be ignored
+    assert_input_error(run("ride-spectrum", "--delay", "2"), "--delay = 2", "--control-rate")
