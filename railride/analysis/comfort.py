@@ -662,8 +662,13 @@ def comfort_record(comfort: xr.DataArray, passive: xr.DataArray | None = None) -
     text = str(comfort.attrs.get("notes", ""))
     cut = text.find("N_MV_z is the vertical term")
     notes = [text] if cut < 0 else [t for t in (text[:cut].rstrip("; "), text[cut:]) if t]
+    short = "one interval over the whole signal is used" in text  # shorter than one interval of 5 s
     notes.append(
-        f"N_MV_z from {n} interval{'s' if n != 1 else ''} of 5 s"
+        (
+            "N_MV_z from one interval, the whole signal"
+            if short
+            else f"N_MV_z from {n} interval{'s' if n != 1 else ''} of 5 s"
+        )
         + (" (EN 12299 evaluates 60, 5 minutes): an indication only" if n < 60 else "")
     )
     record = {

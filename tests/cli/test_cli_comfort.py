@@ -12,7 +12,7 @@ import pytest
 
 from railride.analysis.comfort import comfort_class
 from railride.studies.sweep import COMFORT_COLUMNS
-from clihelp import PNG, ok
+from clihelp import PNG, ok, run
 
 
 TRACK = ("--scenario", "fra4", "--track-seed", 1, "--duration", 6)
@@ -106,3 +106,12 @@ def test_sweep_comfort(tmp_path):
     assert plain["rows"] and len(plain["rows"]) == len(doc["rows"])
     for a, b in zip(plain["rows"], doc["rows"]):
         assert a["acceleration_m_s2_rms"] == pytest.approx(b["acceleration_m_s2_rms"], rel=1e-12)
+
+
+def test_a_window_shorter_than_an_interval_is_said_once_and_alike():
+    """Shorter than EN 12299's 5 s: the index is from one interval, the whole signal, and the
+    notes say so, not also "1 interval of 5 s"."""
+    result = run("simulate", "--duration", "1", "--window", "0:0.5", "--comfort", "--format", "json")
+    assert result.exit_code == 0, result.output
+    notes = json.loads(result.stdout)["comfort"]["notes"]
+    assert any("the whole signal" in note for note in notes) and not any("of 5 s" in n for n in notes)
