@@ -450,8 +450,12 @@ def open_run_table(out: Optional[Path], resume: bool):
             f"--out {out}: {path} exists (the run table of an earlier run); add "
             "--resume to continue it, or choose another folder"
         )
+    fresh = resume and not path.exists()
     # locks the folder against a second writer until `interruptible` ends (or this process)
-    return sweep_lib.RunTable(path, resume=resume), path
+    table = sweep_lib.RunTable(path, resume=resume)
+    if fresh:  # a folder mistyped would start afresh unsaid (said once the folder is ours)
+        typer.echo(f"note: --resume: {path} does not exist yet; starting afresh", err=True)
+    return table, path
 
 
 def _saved_runs(table, path: Optional[Path]) -> int:

@@ -60,3 +60,17 @@ def test_a_voltage_given_twice_is_named_as_written(voltages, said):
 def test_a_delay_without_a_controller_rate_is_refused():
     # without --control-rate the loops act continuously: a delay in periods would be ignored
     assert_input_error(run("ride-spectrum", "--delay", "2"), "--delay = 2", "--control-rate")
+
+
+def test_resume_in_a_folder_with_no_run_table_says_it_starts_afresh(tmp_path):
+    # a mistyped folder would otherwise start a new study without a word
+    out = tmp_path / "new"
+    result = run(
+        "sweep", "--suspension", "passive", "--speed", "40", "--duration", "0.05", "--out", str(out), "--resume"
+    )
+    assert result.exit_code == 0, result.output
+    assert f"note: --resume: {out / 'runs.csv'} does not exist yet; starting afresh" in result.stderr
+    again = run(
+        "sweep", "--suspension", "passive", "--speed", "40", "--duration", "0.05", "--out", str(out), "--resume"
+    )
+    assert again.exit_code == 0 and "starting afresh" not in again.stderr
