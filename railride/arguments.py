@@ -38,6 +38,20 @@ def names(name: str, value, what: str = "names") -> list:
     return items
 
 
+def repeated(values) -> tuple | None:
+    """``(value,)`` of the first of ``values`` given twice (equal to one before it), else None;
+    values that cannot be hashed are left to the checks that own them."""
+    seen: set = set()
+    for v in values:
+        try:
+            if v in seen:
+                return (v,)
+            seen.add(v)
+        except TypeError:
+            pass
+    return None
+
+
 def numbers(name: str, value, what: str = "numbers") -> list:
     """``value`` as a list of real numbers (their ranges are checked where they are used)."""
     if is_number(value):

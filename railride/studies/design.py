@@ -25,7 +25,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from railride import validation
+from railride import arguments, validation
 from railride.analysis.costs import COST_COLUMNS
 from railride.defaults import DEFAULT_DAMPER
 from railride.errors import InputError
@@ -130,14 +130,9 @@ def _items(name: str, values) -> list:
         raise InputError(f"{name} = {values!r}: give a list of values") from None
     if not out:
         raise InputError(f"{name} = []: empty; give at least one value")
-    seen: set = set()
-    for v in out:  # a value given twice is most likely a slip: said, not dropped unsaid
-        try:
-            if v in seen:
-                raise InputError(f"{name} = {out!r}: {v!r} is listed twice; give each once")
-            seen.add(v)
-        except TypeError:  # not hashable: the check that owns the value names it
-            pass
+    twice = arguments.repeated(out)  # most likely a slip: said, not dropped unsaid
+    if twice is not None:
+        raise InputError(f"{name} = {out!r}: {twice[0]!r} is listed twice; give each once")
     return out
 
 

@@ -20,7 +20,7 @@ from typing import Any
 
 
 from railride.errors import InputError
-from railride import validation
+from railride import arguments, validation
 from railride.secondary.control import CONSTANT_VOLTAGE, OUTER_LOOPS, GainSet
 from railride.defaults import DEFAULT_DAMPER
 from railride.run.solver import SolverSettings
@@ -378,7 +378,7 @@ def _suspensions(words: _Words, given) -> tuple[str, list[str]]:
         raise InputError(
             f"{words.given('suspensions', given)}: unknown suspension {unknown[0]!r}; allowed: {', '.join(NAMES)}"
         )
-    twice = [s for s in items if items.count(s) > 1]
+    twice = arguments.repeated(items)
     if twice:
         raise InputError(f"{words.given('suspensions', given)}: {twice[0]} is listed twice")
     return ", ".join(items), items

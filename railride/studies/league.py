@@ -21,7 +21,7 @@ import numpy as np
 import pandas as pd
 
 from railride.errors import InputError
-from railride import validation
+from railride import arguments, validation
 from railride.studies.progress import shows_progress
 from railride.studies.comparison import check_controllers, compare
 from railride.secondary.control import LABELS, PAPER_CONTROLLERS, GainSet
@@ -258,7 +258,7 @@ def _loads(load) -> list[float]:
         raise InputError("load = []: give at least one load factor, a finite number > 0 (e.g. 1.0 or [1.0, 1.3])")
     allowed = "a finite number > 0 (the factor on the carbody mass), or a list of them"
     loads = [validation.number("load", x, "positive", allowed=allowed) for x in items]
-    twice = [x for i, x in enumerate(loads) if x in loads[:i]]
+    twice = arguments.repeated(loads)
     if twice:
         raise InputError(f"load = {loads}: {twice[0]:g} is listed twice; give each load factor once")
     return loads

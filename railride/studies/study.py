@@ -254,9 +254,11 @@ def study(
     ):
         if not values:
             raise InputError(f"{name}: give at least one value")
-        twice = _repeated(values)
+        twice = arguments.repeated(values)
         if twice is not None:  # a repeated condition would count its runs twice in the statistics
-            raise InputError(f"{name} = {twice}: listed twice; give each once")
+            v = twice[0]  # a fault condition as its text: "none" or its faults joined by "+"
+            shown = ("+".join(v) or HEALTHY) if isinstance(v, tuple) else f"{v!r}"
+            raise InputError(f"{name} = {shown}: listed twice; give each once")
     validation.choice("sensing", sensing, SENSING)
     if sensing != "ideal":
         car = Vehicle(vehicle)
@@ -471,14 +473,3 @@ def _summary(frame: pd.DataFrame, names, speeds, loads, stiffness, conditions, d
                         }
                     )
     return pd.DataFrame(rows)
-
-
-def _repeated(values) -> str | None:
-    """The first value of ``values`` given twice, as text (a fault condition as "none" or its
-    faults joined by "+"), or None."""
-    seen: set = set()
-    for v in values:
-        if v in seen:
-            return HEALTHY if v == () else "+".join(v) if isinstance(v, tuple) else f"{v!r}"
-        seen.add(v)
-    return None
