@@ -334,6 +334,10 @@ def comfort_intervals(acceleration, rate_hz: float, window=None) -> np.ndarray:
     return _intervals(x, rate)
 
 
+#: the end of the note of a signal shorter than one interval (`_intervals`), which the record reads
+WHOLE_SIGNAL = "one interval over the whole signal is used"
+
+
 def _intervals(x: np.ndarray, rate: float) -> np.ndarray:
     """`comfort_intervals` of the window ``x`` of a Wb-weighted signal."""
     per = int(round(INTERVAL_S * rate))
@@ -341,7 +345,7 @@ def _intervals(x: np.ndarray, rate: float) -> np.ndarray:
     if n == 0:
         warnings.warn(
             f"only {x.shape[-1] / rate:g} s of signal: EN 12299 takes RMS values over "
-            f"{INTERVAL_S:g} s intervals; one interval over the whole signal is used",
+            f"{INTERVAL_S:g} s intervals; {WHOLE_SIGNAL}",
             ShortRunWarning,
             stacklevel=3,
         )
@@ -662,7 +666,7 @@ def comfort_record(comfort: xr.DataArray, passive: xr.DataArray | None = None) -
     text = str(comfort.attrs.get("notes", ""))
     cut = text.find("N_MV_z is the vertical term")
     notes = [text] if cut < 0 else [t for t in (text[:cut].rstrip("; "), text[cut:]) if t]
-    short = "one interval over the whole signal is used" in text  # shorter than one interval of 5 s
+    short = WHOLE_SIGNAL in text  # shorter than one interval of 5 s
     notes.append(
         (
             "N_MV_z from one interval, the whole signal"

@@ -162,8 +162,8 @@ def forced_rows(ftab: np.ndarray) -> np.ndarray:
     the table has nothing in the others (every vehicle here: the rails act on the bogies through
     the primary suspension), else every row. Never the table's own zeros, so that a flat track
     needs no kernel of its own."""
-    # the others as two slices of each of the four products (views, not a gathered copy: a
-    # design's round sends 168 MB of tables, which a copy of the columns took 56 ms to read)
+    # the others as two slices of each of the four products: views, not a gathered copy of
+    # columns of a round's tables (168 MB for the default design), which every GPU call made
     table = ftab.reshape(ftab.shape[0], 4, N_DOF)
     forced = np.any(table[:, :, :ROW_BOGIES]) or np.any(table[:, :, ROW_BOGIES + 6 :])
     return BOGIE_ROWS if not forced else np.ones(N_DOF, bool)
