@@ -18,9 +18,9 @@ from railride.frequency.linear import linear_model
 from railride.frequency.ride_spectrum import ride_spectrum
 from railride.model import beam
 from railride.model.modes import checked_modes
-from railride.model.params import VehicleParams
+from railride.model.params import PRESETS, VehicleParams
 from railride.model.plausible import PlausibilityWarning, notes
-from railride.model.vehicle import DOF_NAMES, Vehicle, element_table
+from railride.model.vehicle import DOF_NAMES, Vehicle
 
 P = VehicleParams.preset("paper")
 #: the paper's car with a 24 m body bending first at 10 Hz
@@ -105,18 +105,55 @@ def test_a_point_beyond_the_beam_is_refused():
 
 
 # -- the vehicle ---------------------------------------------------------------------------------
+def _by_hand(p: VehicleParams, kind: str) -> tuple[np.ndarray, np.ndarray]:
+    """(K, K_w) of the rigid vehicle, kind "k", or (C, C_w), kind "c", from the equations of
+    motion written out entry by entry (q = z_c, phi_c, theta_c, then each bogie's z, phi,
+    theta; a point at (x, y) of a body moves z - x phi + y theta; w = z_L, z_R of wheelsets 1-4).
+
+    Per bogie at x_b = +-l: two secondary vertical springs at (x_b, +-d_s), two lateral (roll,
+    arms h_cs above and h_ts below) and two longitudinal (pitch, same arms); four primary
+    vertical at (+-b, +-d_p) on wheelsets that follow their rails (z_w + y theta_w, theta_w =
+    (z_L - z_R) / 2a), four primary longitudinal and four lateral (arm h_tp on the bogie, h_wp
+    on the wheelset's roll); an anti-roll bar k_ar on theta_c - theta_b."""
+    sz, sx, sy, pz, px, py = (getattr(p, f"{kind}_{n}") for n in ("sz", "sx", "sy", "pz", "px", "py"))
+    ar = p.k_ar if kind == "k" else 0.0  # the bar has no damping
+    l, b, d_s, d_p, a = p.l, p.b, p.d_s, p.d_p, p.a
+    h_cs, h_ts, h_tp, h_wp = p.h_cs, p.h_ts, p.h_tp, p.h_wp
+    K, K_w = np.zeros((9, 9)), np.zeros((9, 8))
+    K[0, 0] = 4 * sz
+    K[1, 1] = 4 * sz * l**2 + 4 * sx * h_cs**2
+    K[2, 2] = 4 * sz * d_s**2 + 4 * sy * h_cs**2 + 2 * ar
+    for o, x_b, wheelsets in ((3, l, (0, 1)), (6, -l, (2, 3))):
+        K[o, o] = 2 * sz + 4 * pz
+        K[o + 1, o + 1] = 4 * pz * b**2 + 4 * px * h_tp**2 + 2 * sx * h_ts**2
+        K[o + 2, o + 2] = 4 * pz * d_p**2 + 4 * py * h_tp**2 + 2 * sz * d_s**2 + 2 * sy * h_ts**2 + ar
+        K[0, o] = K[o, 0] = -2 * sz
+        K[1, o] = K[o, 1] = 2 * sz * x_b
+        K[1, o + 1] = K[o + 1, 1] = 2 * sx * h_cs * h_ts
+        K[2, o + 2] = K[o + 2, 2] = 2 * sy * h_cs * h_ts - 2 * sz * d_s**2 - ar
+        for j, x_w in zip(wheelsets, (b, -b)):
+            roll = (py * h_tp * h_wp - pz * d_p**2) / a
+            K_w[o, 2 * j : 2 * j + 2] = -pz
+            K_w[o + 1, 2 * j : 2 * j + 2] = pz * x_w
+            K_w[o + 2, 2 * j : 2 * j + 2] = roll, -roll
+    return K, K_w
+
+
 def test_a_rigid_vehicle_keeps_its_nine_dofs_and_its_matrices():
     v = Vehicle(P)
     assert not P.flexible and P.bending_hz is None
     assert v.n_dof == 9 and v.dof_names == DOF_NAMES
     assert len(v.elements) == 36 and all(el.a.shape == (9,) for el in v.elements)
     assert not [el for el in v.elements if el.group == "carbody_bending"]
-    # the assembly as it always was: sums of k a a^T over the 36 elements
-    A = np.array([el.a for el in element_table(P)])
-    E = np.array([el.e for el in element_table(P)])
-    k, c = np.array([el.k for el in v.elements]), np.array([el.c for el in v.elements])
-    assert np.array_equal(v.K, A.T @ (k[:, None] * A)) and np.array_equal(v.C, A.T @ (c[:, None] * A))
-    assert np.array_equal(v.K_w, A.T @ (k[:, None] * E)) and np.array_equal(v.C_w, A.T @ (c[:, None] * E))
+    # the matrices as they always were: the equations of motion written out DOF by DOF
+    # (`_by_hand`), not the sum over the element table the code assembles them by; for every
+    # preset's rigid carbody, the anti-roll bars of two of them included
+    for name, params in PRESETS.items():
+        rigid = Vehicle(params.rigid())
+        for kind, (matrix, rails) in (("k", (rigid.K, rigid.K_w)), ("c", (rigid.C, rigid.C_w))):
+            want, want_w = _by_hand(params, kind)
+            assert np.allclose(matrix, want, rtol=0, atol=1e-12 * np.abs(want).max()), (name, kind)
+            assert np.allclose(rails, want_w, rtol=0, atol=1e-12 * np.abs(want_w).max()), (name, kind)
     assert np.array_equal(v.M, np.diag([P.m_c, P.I_cy, P.I_cx, P.m_b, P.I_by, P.I_bx, P.m_b, P.I_by, P.I_bx]))
     assert v.state_matrix.shape == (18, 18) and len(v.modes()) == 9
     # a flexible one adds a row and a column and leaves the rigid blocks as they were
