@@ -244,11 +244,8 @@ def _compare_tables(doc: dict, shipped: bool):
                 (f"gains tuned by `{tuning['command']}`, " if tuning.get("command") else "gains tuned ")
                 + f"objective {tuning['objective']}"
             )
-        if tuning.get("in_sample"):
-            info.append(
-                "The gains were tuned on this same single track: the reductions are "
-                "in-sample, not a test on another track."
-            )
+        if tuning.get("track"):  # in-sample, the tuned track at another speed, or held out
+            info.append(tuning["track"]["note"])
         if tuning.get("alike"):
             info.append(alike_text(tuning["alike"]))
         if tuning.get("untuned"):

@@ -102,7 +102,7 @@ class FrfResult:
     def to_dict(self) -> dict:
         """The ``railride.frf/1`` document (docs/cli.md): the vehicle, the settings, the grid,
         the magnitudes per pattern, the peaks and the modes."""
-        from railride._version import __version__
+        from railride._version import __version__, versions
         from railride.model.plausible import notes
 
         frame = frf_frame(self.responses)
@@ -116,6 +116,7 @@ class FrfResult:
         return {
             "schema": SCHEMA,
             "railride_version": __version__,
+            "versions": versions(),
             **vehicle,
             "vehicle": self.record(),
             "settings": {

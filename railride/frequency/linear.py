@@ -114,11 +114,12 @@ class LinearModel:
 
     def to_dict(self) -> dict:
         """The ``railride.linear/1`` document: names, units and the four matrices as lists."""
-        from railride._version import __version__
+        from railride._version import __version__, versions
 
         return {
             "schema": SCHEMA,
             "railride_version": __version__,
+            "versions": versions(),
             "secondary": self.secondary,
             "vehicle": self.record(),
             "vehicle_params": self.params.to_dict(),

@@ -215,12 +215,13 @@ class RideSpectrum:
         return ride_spectrum_contents(self)
 
     def to_dict(self) -> dict:
-        from railride._version import __version__
+        from railride._version import __version__, versions
 
         rms_red, weighted_red = self.reductions
         return {
             "schema": SCHEMA,
             "railride_version": __version__,
+            "versions": versions(),
             "vehicle_params": self.params.to_dict(),
             "settings": dict(self.settings),
             "rms": {s: {r: float(self.rms.sel(suspension=s, response=r)) for r in RESPONSES} for s in self.suspensions},

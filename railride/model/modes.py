@@ -61,13 +61,19 @@ class Modes:
 
     def to_dict(self) -> dict:
         """The ``railride.modes/1`` document (``railride modes --format json``): ``schema``,
-        ``railride_version``, ``vehicle`` (the record of the vehicle) and ``modes``
-        (`to_list`)."""
-        from railride._version import __version__
+        ``railride_version``, ``versions`` (`railride._version.versions`), ``vehicle`` (the record of
+        the vehicle) and ``modes`` (`to_list`)."""
+        from railride._version import __version__, versions
 
         if self.vehicle is None:
             raise ValueError("these modes carry no vehicle record (Modes.vehicle): make them with modes(vehicle)")
-        return {"schema": SCHEMA, "railride_version": __version__, "vehicle": self.vehicle, "modes": self.to_list()}
+        return {
+            "schema": SCHEMA,
+            "railride_version": __version__,
+            "versions": versions(),
+            "vehicle": self.vehicle,
+            "modes": self.to_list(),
+        }
 
     def to_pandas(self):
         """The modal table (`modes_frame`, modes.csv): mode number, label,

@@ -469,7 +469,7 @@ def presets_document(names=None) -> dict:
     (`Vehicle.modes`, by undamped frequency: nine rigid-body modes, and the carbody's bending
     where it bends): ``railride vehicles --format json``. An unknown name is an InputError that
     lists the presets."""
-    from railride._version import __version__
+    from railride._version import __version__, versions
 
     names = list(PRESETS) if names is None else list(names)
     presets = []
@@ -477,7 +477,7 @@ def presets_document(names=None) -> dict:
         params = VehicleParams.preset(name)
         modes = [m.to_dict() for m in Vehicle(params).modes()]
         presets.append({"name": name, "source": PRESET_SOURCES[name], "modes": modes})
-    return {"schema": SCHEMA_VEHICLES, "railride_version": __version__, "presets": presets}
+    return {"schema": SCHEMA_VEHICLES, "railride_version": __version__, "versions": versions(), "presets": presets}
 
 
 def _mac(u: np.ndarray, v: np.ndarray) -> float:

@@ -4,7 +4,8 @@ the command line and the HTML report so that both say the same thing.
 
 Pairs with the same winner and the same responses won, lost and level are one line, so that
 eleven suspensions give a list one can read; responses within the comparison's level tolerance
-are neither won nor lost, and the last line states that tolerance."""
+are neither won nor lost. One line names the suspensions whose peak-to-peak values are above
+passive's, and by how much; the last line states the tolerance."""
 
 from __future__ import annotations
 
@@ -46,10 +47,39 @@ def trade_off_lines(doc: dict) -> list[str]:
         lines.append(text + (f"; level on {_words(level)}" if level else ""))
     if level_pairs:
         lines.append(f"level on every response: {'; '.join(level_pairs)}")
+    lines += _peak_lines(doc, labels)
     tol = doc.get("settings", {}).get("level_tolerance")
     if doc.get("trade_offs") and tol is not None:
         lines.append(
-            f"(RMS values within {100 * tol:.3g} % of the larger count as level, neither better nor worse: "
-            "--level-tolerance)"
+            f"(RMS and peak-to-peak values within {100 * tol:.3g} % of the larger count as level, "
+            "neither better nor worse: --level-tolerance)"
         )
     return lines
+
+
+def _peak_lines(doc: dict, labels: dict) -> list[str]:
+    """One line on the peaks: the suspensions whose peak-to-peak is above passive's on some
+    response, by how much (a law that lowers a response's RMS may raise its peaks); or that
+    none is. Empty for a document without peak-to-peak trade-offs."""
+    against = [t for t in doc.get("trade_offs", []) if t["than"] == "passive" and "ptp_worse_on" in t]
+    if not against:
+        return []
+    ptp = {r["name"]: {k: v.get("ptp") for k, v in (r.get("metrics") or {}).items()} for r in doc["controllers"]}
+    parts = []
+    for t in against:
+        if not t["ptp_worse_on"]:
+            continue
+        own, base = ptp.get(t["controller"], {}), ptp.get("passive", {})
+        said = []
+        for r in t["ptp_worse_on"]:
+            x, b = own.get(r), base.get(r)
+            rise = f" ({_percent(100 * (x - b) / b)})" if x is not None and b else ""
+            said.append(RESPONSE_WORDS.get(r, r) + rise)
+        parts.append(f"{labels.get(t['controller'], t['controller'])} on {', '.join(said)}")
+    if not parts:
+        return ["peak-to-peak: no suspension is worse than passive on any response"]
+    return [f"peak-to-peak worse than passive: {'; '.join(parts)}"]
+
+
+def _percent(p: float) -> str:
+    return f"{p:+.3g} %" if abs(p) < 1000 else f"{p:+.0f} %"

@@ -423,7 +423,7 @@ class RideResult:
         ``{"vehicle_params_file": "car.toml"}``); by default ``{"vehicle_preset": name}`` for a
         preset's parameters, else ``{"vehicle_params": {...}}``. A batch has no such document:
         select a sample first."""
-        from railride._version import __version__
+        from railride._version import __version__, versions
         from railride.analysis.metrics import check_window, to_dict
 
         if self.is_batch:
@@ -441,6 +441,7 @@ class RideResult:
         doc = {
             "schema": SCHEMA,
             "railride_version": __version__,
+            "versions": versions(),
             "scenario": record,
             **(self._vehicle_record() if vehicle is None else vehicle),
             "suspension": _suspension_record(self.suspension),

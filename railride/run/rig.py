@@ -329,11 +329,12 @@ class Cycles:
     def to_dict(self) -> dict:
         """The ``railride.damper/1`` document (docs/cli.md): the damper's parameters, the motion
         and `table`."""
-        from railride._version import __version__
+        from railride._version import __version__, versions
 
         return {
             "schema": SCHEMA_DAMPER,
             "railride_version": __version__,
+            "versions": versions(),
             "damper": self.damper.to_dict(),
             "amplitude_m": float(self.motion.amplitude),
             "frequency_hz": float(self.motion.frequency),
@@ -477,11 +478,12 @@ class Tracking:
     def to_dict(self) -> dict:
         """The ``railride.tracking/1`` document (docs/cli.md): the damper's parameters, the
         demand, the stroke, the gains and `metrics`."""
-        from railride._version import __version__
+        from railride._version import __version__, versions
 
         return {
             "schema": SCHEMA_TRACKING,
             "railride_version": __version__,
+            "versions": versions(),
             "damper": self.damper.to_dict(),
             "desired": self.desired,
             "amplitude_n": float(self.amplitude),

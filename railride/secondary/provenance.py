@@ -119,6 +119,63 @@ def mismatch(gains, vehicle: dict | None = None, scenarios=None, controllers=Non
     )
 
 
+#: how a run's track stands to the tracks its gains were tuned on (`judged_on`)
+IN_SAMPLE, SAME_TRACK, HELD_OUT = "in-sample", "tuned track, other speed", "held out"
+#: the keys of a track record that name its rail, not the run over it
+_RUN_KEYS = ("duration_s", "speed_m_s", "load")
+
+
+def judged_on(gains, record: dict | None) -> tuple[str, str] | None:
+    """How a run on the track ``record`` (`Scenario.describe`) judges ``gains`` (a `GainSet`):
+    (kind, sentence), kind one of `IN_SAMPLE` (the gains were tuned on this rail at this speed,
+    whatever the duration and load: the run repeats part of their tuning), `SAME_TRACK` (this
+    rail, only at other speeds) and `HELD_OUT` (a rail tuning never ran on: another seed of a
+    random spectrum is another rail). None when the provenance names no tuned track or the run
+    has none."""
+    tracks = tuned_tracks(gains.provenance)
+    if not tracks or not isinstance(record, dict):
+        return None
+
+    def rail(r: dict) -> dict:
+        return {k: v for k, v in r.items() if k not in _RUN_KEYS}
+
+    same = [t for t in tracks if rail(t) == rail(record)]
+    speed = record.get("speed_m_s")
+    what = _rail_text(record)
+    if any(speed is not None and _same(t.get("speed_m_s"), speed) for t in same):
+        if len(tracks) == 1:
+            return IN_SAMPLE, (
+                "The gains were tuned on this same single track: the reductions are in-sample, not a test on "
+                "another track."
+            )
+        return IN_SAMPLE, (
+            f"In-sample: this track ({what}) at this speed is in the gains' tuning set, so these results "
+            "repeat part of their tuning; they are not a test on a track tuning never saw."
+        )
+    if same:
+        speeds = _list(dict.fromkeys(t.get("speed_m_s") for t in same))
+        return SAME_TRACK, (
+            f"Not held out: the gains were tuned on this track ({what}), at {speeds} m/s; only the speed is new."
+        )
+    return (
+        HELD_OUT,
+        f"Held out: tuning never ran on this track ({what}); the gains were tuned on {_tracks_tuned(tracks)}.",
+    )
+
+
+def _rail_text(record: dict) -> str:
+    seed = record.get("seed")
+    return str(record.get("name")) + (f", seed {seed}" if seed is not None else "")
+
+
+def _tracks_tuned(tracks: list[dict]) -> str:
+    names = list(dict.fromkeys(str(t.get("name")) for t in tracks))
+    seeds = list(dict.fromkeys(t["seed"] for t in tracks if t.get("seed") is not None))
+    speeds = list(dict.fromkeys(t["speed_m_s"] for t in tracks if t.get("speed_m_s") is not None))
+    text = ", ".join(names) + (f" (seed{'s' * (len(seeds) > 1)} {_list(seeds)})" if seeds else "")
+    return text + (f" at {_list(speeds)} m/s" if speeds else "")
+
+
 def tune_command(vehicle: dict | None, scenarios=()) -> str:
     """The `railride tune` command line that tunes for a run on ``vehicle`` (a `vehicle_record`,
     its load a number or a list) and the tracks ``scenarios`` (`Scenario.describe` records):

@@ -17,7 +17,7 @@ import numpy as np
 import xarray as xr
 
 from railride.errors import InputError
-from railride._version import __version__
+from railride._version import __version__, versions
 from railride.secondary import dampers
 from railride.secondary.control import CONSTANT_VOLTAGE, CONTROLLERS, LABELS, PAPER_CONTROLLERS, GainSet
 from railride.defaults import DEFAULT_DAMPER
@@ -170,27 +170,26 @@ class Comparison:
         the responses on which each beats the other. Two RMS values within the comparison's
         level tolerance (``settings["level_tolerance"]``, relative to the larger, `is_level`) are
         level: on ``level_on``, neither better nor worse. Pairs where one is at least as good on
-        every response are listed with an empty ``worse_on``."""
-        rms = self.metrics.sel(statistic="rms")
-        responses = [str(r) for r in rms.response.values]
+        every response are listed with an empty ``worse_on``. The same by peak-to-peak values
+        in ``ptp_better_on``, ``ptp_worse_on`` and ``ptp_level_on``."""
+        responses = [str(r) for r in self.metrics.response.values]
         tol = self.level_tolerance
         controlled = [n for n in self.names if n != "passive"]
         pairs = [(n, "passive") for n in controlled]
         pairs += [(a, b) for i, a in enumerate(controlled) for b in controlled[i + 1 :]]
-        out = []
-        for a, b in pairs:
-            va, vb = rms.sel(controller=a).values, rms.sel(controller=b).values
+
+        def sides(statistic: str, a: str, b: str, prefix: str = "") -> dict:
+            values = self.metrics.sel(statistic=statistic)
+            va, vb = values.sel(controller=a).values, values.sel(controller=b).values
             level = [r for r, x, y in zip(responses, va, vb) if is_level(x, y, tol)]
-            out.append(
-                {
-                    "controller": a,
-                    "than": b,
-                    "better_on": [r for r, x, y in zip(responses, va, vb) if r not in level and x < y],
-                    "worse_on": [r for r, x, y in zip(responses, va, vb) if r not in level and x > y],
-                    "level_on": level,
-                }
-            )
-        return out
+            return {
+                f"{prefix}better_on": [r for r, x, y in zip(responses, va, vb) if r not in level and x < y],
+                f"{prefix}worse_on": [r for r, x, y in zip(responses, va, vb) if r not in level and x > y],
+                f"{prefix}level_on": level,
+            }
+
+        # the peaks too: a law that lowers a response's RMS may raise its peak-to-peak
+        return [{"controller": a, "than": b, **sides("rms", a, b), **sides("ptp", a, b, "ptp_")} for a, b in pairs]
 
     @property
     def level_tolerance(self) -> float:
@@ -244,9 +243,21 @@ class Comparison:
         )
 
     @property
+    def judged(self) -> tuple[str, str] | None:
+        """How this run's track stands to the tracks the gains were tuned on, (kind, sentence)
+        (`railride.secondary.provenance.judged_on`: in-sample, the tuned track at another
+        speed, or held out); None where their provenance names no track."""
+        from railride.secondary.provenance import judged_on
+
+        return judged_on(self.gains, self.settings.get("scenario"))
+
+    @property
     def in_sample(self) -> bool:
-        """Whether the gains were tuned on this very track (their provenance says so)."""
-        return self.gains.tuned_on(self.settings.get("scenario"))
+        """Whether the gains were tuned on this track at this speed (their provenance says so),
+        whatever the duration and load."""
+        from railride.secondary.provenance import IN_SAMPLE
+
+        return self.judged is not None and self.judged[0] == IN_SAMPLE
 
     def report_contents(self):
         """What this result shows in its HTML report (`railride.output.report.write_report`)."""
@@ -294,6 +305,7 @@ class Comparison:
         return {
             "schema": "railride.comparison/1",
             "railride_version": __version__,
+            "versions": versions(),
             # the gains record as every result's settings hold it: their source as far as it is
             # still true, their [provenance] and every value per suspension run
             "settings": {
@@ -312,6 +324,8 @@ class Comparison:
                 "objective": self.gains.provenance.get("objective"),
                 "command": self.gains.provenance.get("command"),
                 "in_sample": self.in_sample,
+                # where the gains name the tracks they were tuned on: is this one of them
+                **({"track": {"kind": j[0], "note": j[1]}} if (j := self.judged) else {}),
                 # only when there are some: the paper's comparison's document stays as it was
                 **({"untuned": u} if (u := self.gains.untuned(self.names)) else {}),
                 **({"alike": a} if (a := self.gains.tuning_budget(self.names)) else {}),

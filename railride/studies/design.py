@@ -26,6 +26,7 @@ import numpy as np
 import pandas as pd
 
 from railride import arguments, validation
+from railride._version import versions
 from railride.analysis.costs import COST_COLUMNS
 from railride.defaults import DEFAULT_DAMPER
 from railride.errors import InputError
@@ -433,7 +434,7 @@ def design(
         "training_runs_per_gain_set": len(over),
         "training_runs": int(len(training)),
         "judging_runs": int(len(runs)),
-        "versions": _versions(),
+        "versions": versions(),
         **other_settings(plan.vehicle, plan.solver),
     }
     text = recommend(ranking, points, summary, runs, plan.objective, settings, diverged)
@@ -451,21 +452,6 @@ def design(
         settings=settings,
         date=tuned.date,
     )
-
-
-def _versions() -> dict:
-    import platform
-    from importlib.metadata import PackageNotFoundError, version
-
-    from railride._version import __version__
-
-    out: dict[str, str | None] = {"railride": __version__, "python": platform.python_version()}
-    for name in ("numpy", "numba", "pandas", "xarray"):
-        try:
-            out[name] = version(name)
-        except PackageNotFoundError:  # pragma: no cover - every install has them
-            out[name] = None
-    return out
 
 
 def _options(plan: Plan, track: str, seed: int, speed: float) -> tuple:

@@ -115,7 +115,7 @@ class DesignResult:
 
     def to_dict(self) -> dict:
         """The ``railride.design/1`` document (docs/schemas/railride.design-1.json)."""
-        from railride._version import __version__
+        from railride._version import __version__, versions
         from railride.secondary.control import GainSet
 
         results = []
@@ -134,6 +134,7 @@ class DesignResult:
         return {
             "schema": SCHEMA,
             "railride_version": __version__,
+            "versions": versions(),
             "date": self.date,
             "settings": self.settings,
             "percentiles": list(PERCENTILES),

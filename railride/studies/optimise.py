@@ -229,7 +229,7 @@ class OptimiseResult:
         """The ``railride.optimise/1`` document: the settings, the objective, each parameter with
         its search box and tuned value, the gains and the convergence (None for an objective
         that is not finite: a generation whose runs all diverged)."""
-        from railride._version import __version__
+        from railride._version import __version__, versions
         from railride.secondary.provenance import stated_source
 
         rows = _parameter_rows(self.parameters)
@@ -239,6 +239,7 @@ class OptimiseResult:
         return {
             "schema": SCHEMA_OPTIMISE,
             "railride_version": __version__,
+            "versions": versions(),
             "suspension": self.suspension,
             "scenario": self.scenario,
             "settings": self.settings,
@@ -376,7 +377,7 @@ class SensitivityResult:
     def to_dict(self) -> dict:
         """The ``railride.sensitivity/1`` document: the settings, the objective and each
         parameter with its search box and indices (None for a NaN)."""
-        from railride._version import __version__
+        from railride._version import __version__, versions
 
         rows = _parameter_rows(self.parameters)
         for row, s, t in zip(rows, self.first_order, self.total):
@@ -384,6 +385,7 @@ class SensitivityResult:
         return {
             "schema": SCHEMA_SENSITIVITY,
             "railride_version": __version__,
+            "versions": versions(),
             "suspension": self.suspension,
             "scenario": self.scenario,
             "settings": self.settings,

@@ -143,7 +143,7 @@ class ParetoResult:
     def to_dict(self) -> dict:
         """The `railride.pareto/1` document (docs/cli.md): settings, the search box, the passive
         RMS, counts, and every sample as a row of `to_pandas`."""
-        from railride._version import __version__
+        from railride._version import __version__, versions
         from railride.analysis.labels import gain_unit
 
         frame = self.to_pandas()
@@ -152,6 +152,7 @@ class ParetoResult:
         return {
             "schema": SCHEMA,
             "railride_version": __version__,
+            "versions": versions(),
             "suspension": self.suspension,
             "scenario": self.scenario,
             "settings": self.settings,

@@ -88,7 +88,7 @@ class StudyResult:
     def to_dict(self) -> dict:
         """The ``railride.study/1`` document: settings, per controller and condition every
         metric's statistics, and the failed runs."""
-        from railride._version import __version__
+        from railride._version import __version__, versions
 
         groups = []
         for (name, speed, load, k, fault, delay), part in self.summary.groupby(
@@ -114,6 +114,7 @@ class StudyResult:
         return {
             "schema": SCHEMA,
             "railride_version": __version__,
+            "versions": versions(),
             "settings": self.settings,
             "percentiles": list(PERCENTILES),
             "results": groups,

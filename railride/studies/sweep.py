@@ -571,11 +571,12 @@ class SweepResult:
     def to_dict(self) -> dict:
         """The ``railride.sweep/1`` document (docs/cli.md): the settings, the columns, every
         run as a row of `rows`, and the rows of the run table."""
-        from railride._version import __version__
+        from railride._version import __version__, versions
 
         return {
             "schema": SCHEMA,
             "railride_version": __version__,
+            "versions": versions(),
             "date": self.date,
             "settings": self.settings,
             "columns": self.columns(),

@@ -134,12 +134,13 @@ class TuneResult:
         """The ``railride.tune/3`` document (docs/cli.md) without the facts of a command line
         (``runs_evaluated``, ``runs_per_second``, ``wall_time_s``, ``executor``, ``command``,
         which `railride tune` adds after ``runs``)."""
-        from railride._version import __version__
+        from railride._version import __version__, versions
 
         start = self.gains if self.start is None else self.start
         return {
             "schema": SCHEMA,
             "railride_version": __version__,
+            "versions": versions(),
             "date": self.date,
             "controllers": list(self.controllers),
             "scenario": self.scenario,

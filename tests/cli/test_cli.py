@@ -36,7 +36,7 @@ def test_modes_json():
     result = run("modes", "--format", "json")
     assert result.exit_code == 0, result.output
     doc = json.loads(result.stdout)
-    assert list(doc) == ["schema", "railride_version", "vehicle", "modes"]
+    assert list(doc) == ["schema", "railride_version", "versions", "vehicle", "modes"]
     assert doc["schema"] == "railride.modes/1"
     assert (doc["vehicle"]["name"], doc["vehicle"]["load"]) == ("paper", 1.0)
     modes = doc["modes"]
@@ -86,6 +86,7 @@ def test_simulate_json_document():
     assert list(doc) == [
         "schema",
         "railride_version",
+        "versions",
         "scenario",
         "vehicle",
         "vehicle_preset",

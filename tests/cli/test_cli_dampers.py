@@ -20,7 +20,7 @@ DAMPER = ("damper", "--amplitude", 0.01, "--frequency", 2, "--cycles", 2)
 # -- damper ---------------------------------------------------------------------------------------
 def test_damper_json_one_cycle_per_voltage():
     doc = ok_json(*DAMPER, "--voltage", "0,1,2.25")
-    assert list(doc) == ["schema", "railride_version", "damper", "amplitude_m", "frequency_hz", "cycles"]
+    assert list(doc) == ["schema", "railride_version", "versions", "damper", "amplitude_m", "frequency_hz", "cycles"]
     assert doc["schema"] == "railride.damper/1"
     assert doc["damper"]["model"] == "bouc-wen" and doc["damper"]["v_max"] == 2.25
     assert doc["amplitude_m"] == 0.01 and doc["frequency_hz"] == 2.0
@@ -133,6 +133,7 @@ def test_tracking_json_sine():
     assert list(doc) == [
         "schema",
         "railride_version",
+        "versions",
         "damper",
         "desired",
         "amplitude_n",

@@ -47,7 +47,7 @@ def test_the_vehicle_is_recorded_as_it_was_given():
     custom = paper.replace(k_sz=5.8e5)
     doc = frequency_responses(custom, points=3).to_dict()
     assert "vehicle_preset" not in doc and doc["vehicle_params"] == custom.to_dict()
-    assert list(doc)[:4] == ["schema", "railride_version", "vehicle_params", "vehicle"]
+    assert list(doc)[:5] == ["schema", "railride_version", "versions", "vehicle_params", "vehicle"]
     assert doc["vehicle"] == {"name": "custom", "load": 1.0, "values": custom.to_dict()}
     with pytest.raises(ValueError, match="vehicle = 3"):
         frequency_responses(3)
@@ -110,7 +110,10 @@ def test_the_modes_document_records_the_vehicle_and_its_load():
     with the vehicle's record; the modes of the loaded carbody, the values before the load."""
     loaded = modes("crh380a", load=1.3)
     doc = loaded.to_dict()
-    assert list(doc) == ["schema", "railride_version", "vehicle", "modes"] and doc["schema"] == "railride.modes/1"
+    assert (
+        list(doc) == ["schema", "railride_version", "versions", "vehicle", "modes"]
+        and doc["schema"] == "railride.modes/1"
+    )
     assert doc["vehicle"] == vehicle_record(rr.VehicleParams.preset("crh380a"), "crh380a", 1.3)
     heavy = Vehicle(rr.VehicleParams.preset("crh380a").loaded(1.3)).modes()
     assert doc["modes"] == [m.to_dict() for m in heavy] != modes("crh380a").to_list()

@@ -338,3 +338,34 @@ def test_the_studies_warn_with_one_line_over_all_their_runs(args, command):
     result = ok(*args, "--duration", 0.2, *controllers)
     lines = [line for line in result.stderr.splitlines() if line.startswith("warning: ")]
     assert len(lines) == 1 and lines[0].endswith(f"tune for it with: {command}"), result.stderr
+
+
+def test_a_run_says_whether_its_track_was_in_the_tuning_set():
+    """The shipped robust gains were tuned on fra4 and fra5, seeds 1-3, at 30, 50 and 70 m/s,
+    20 s runs (their [provenance] tuning set): a 10-s run on fra4 seed 1 at 50 m/s covers half
+    of a tuning run's rail (in-sample), at 40 m/s the same rail at a new speed, seed 7 a rail
+    tuning never ran on; a 40-s run is a longer realisation, another rail."""
+    from railride.model.track import scenario
+    from railride.secondary.provenance import HELD_OUT, IN_SAMPLE, SAME_TRACK, judged_on
+
+    robust = GainSet.robust()
+    tuned = robust.provenance["tuning_set"]
+    assert {(t["name"], t["seed"], t["speed_m_s"]) for t in tuned} >= {("fra4", 1, 50.0), ("fra5", 3, 70.0)}
+
+    def kind(seed, speed, duration=10.0, name="fra4"):
+        return judged_on(robust, scenario(name, seed=seed, speed=speed, duration=duration).describe())[0]
+
+    assert kind(1, 50.0) == IN_SAMPLE
+    assert kind(3, 70.0, name="fra5") == IN_SAMPLE
+    assert kind(1, 40.0) == SAME_TRACK
+    assert kind(7, 50.0) == HELD_OUT
+    assert kind(1, 50.0, duration=40.0) == HELD_OUT  # 2,000 m of rail do not hold 40 s: 2,100 m
+    held = scenario("fra4", seed=7, speed=50.0, duration=1.0)
+    assert rr.compare(held, controllers=("pid",), bounds=False).in_sample is False
+    seen = scenario("fra4", seed=1, speed=50.0, duration=1.0)
+    doc = rr.compare(seen, controllers=("pid",), bounds=False).to_dict()
+    assert doc["tuning"]["in_sample"] and doc["tuning"]["track"]["kind"] == IN_SAMPLE
+    # gains tuned on the paper's sine, judged on it and on a random track
+    paper = GainSet.default()
+    assert judged_on(paper, scenario("paper-sine").describe())[0] == IN_SAMPLE
+    assert judged_on(paper, scenario("fra4", seed=1).describe())[0] == HELD_OUT

@@ -37,6 +37,7 @@ def test_the_document_of_a_run(mr):
     assert list(doc) == [
         "schema",
         "railride_version",
+        "versions",
         "scenario",
         "vehicle",
         "vehicle_preset",
@@ -54,7 +55,7 @@ def test_the_document_of_a_run(mr):
     # the whole run by default; comfort on request; the vehicle as the caller names it
     whole = mr.to_dict(comfort=True, vehicle={"vehicle_params_file": "car.toml"})
     assert whole["settings"]["window_s"] == [0.0, 0.5] and "comfort" in whole
-    assert list(whole)[3] == "vehicle_params_file" and "vehicle_preset" not in whole
+    assert list(whole)[4] == "vehicle_params_file" and "vehicle_preset" not in whole
 
 
 def test_the_document_names_the_vehicle_and_the_suspension():

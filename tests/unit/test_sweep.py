@@ -225,7 +225,7 @@ def test_to_pandas_one_row_per_run(swept):
 def test_to_dict_is_the_sweep_document(swept):
     doc = swept.to_dict()
     assert doc["schema"] == SCHEMA == "railride.sweep/1"
-    assert list(doc) == ["schema", "railride_version", "date", "settings", "columns", "rows", "runs"]
+    assert list(doc) == ["schema", "railride_version", "versions", "date", "settings", "columns", "rows", "runs"]
     assert doc["settings"]["grid"] == {"suspension": ["passive", "pid"], "speed_m_s": [20.0, 30.0, 40.0]}
     assert doc["settings"]["dt_s"] == 1e-4 and doc["settings"]["window_s"] is None
     assert doc["settings"]["damper"] == "railway" and doc["settings"]["comfort"]["columns"] == list(COMFORT_COLUMNS)

@@ -94,9 +94,32 @@ def test_lines_group_pairs_with_the_same_sets_and_state_the_tolerance():
         "trade-off: A beats B, C on pitch but is worse on acceleration",
         "no trade-off: C beats B on displacement and is worse on nothing; level on acceleration, pitch",
         "level on every response: C and Passive",
-        "(RMS values within 1 % of the larger count as level, neither better nor worse: --level-tolerance)",
+        "(RMS and peak-to-peak values within 1 % of the larger count as level, neither better nor worse: "
+        "--level-tolerance)",
     ]
 
 
 def test_no_comparison_no_lines():
     assert trade_off_lines(_doc([])) == []
+
+
+def test_peaks_above_passive_are_named_with_their_rise(paper):
+    """The paper case's PID lowers every RMS but raises the peak-to-peak acceleration and roll:
+    the peak line says so, with the rise read off the metrics."""
+    ptp = paper.metrics.sel(statistic="ptp")
+    doc = paper.to_dict()
+    pid = next(t for t in doc["trade_offs"] if t["controller"] == "pid" and t["than"] == "passive")
+    rises = {
+        str(r): float(ptp.sel(controller="pid", response=r)) / float(ptp.sel(controller="passive", response=r)) - 1
+        for r in ptp.response.values
+    }
+    assert sorted(pid["ptp_worse_on"]) == sorted(r for r, x in rises.items() if x > LEVEL_TOLERANCE)
+    assert pid["ptp_worse_on"] and not pid["worse_on"]  # better RMS everywhere, worse peaks somewhere
+    line = next(s for s in trade_off_lines(doc) if s.startswith("peak-to-peak worse than passive: "))
+    assert f"PID on acceleration ({100 * rises['acceleration_m_s2']:+.3g} %)" in line
+
+
+def test_no_peak_above_passive_says_so():
+    acc = "acceleration_m_s2"
+    doc = _doc([{**_t("a", "passive", better=[acc]), "ptp_better_on": [acc], "ptp_worse_on": [], "ptp_level_on": []}])
+    assert "peak-to-peak: no suspension is worse than passive on any response" in trade_off_lines(doc)

@@ -270,6 +270,7 @@ def test_tune_result_to_dict_is_the_tune_document(short_tune):
     assert list(doc) == [
         "schema",
         "railride_version",
+        "versions",
         "date",
         "controllers",
         "scenario",
