@@ -147,8 +147,14 @@ def _tables(doc: dict) -> list:
     def point(g: dict) -> str:
         return f"{g['speed_m_s']:g} m/s\nload {g['load']:g}"
 
+    # the held-out runs at each speed and load: with few, a 5-95 % band is nearly their range
+    n = len(s["tracks"]) * len(s["test_seeds"])
+    over = f"over the {n} run{'s' * (n != 1)} at each speed and load" + (
+        " (with fewer than 20, the band is close to their range)" if n < 20 else ""
+    )
+
     def ratios(keys: list):
-        table = FitTable(title="Held out: RMS ratio to passive, mean and 5-95 % band over the runs", labels=2)
+        table = FitTable(title=f"Held out: RMS ratio to passive, mean and 5-95 % band {over}", labels=2)
         table.add_column("law")
         table.add_column("speed\nload", no_wrap=True)
         for key in keys:
@@ -164,7 +170,7 @@ def _tables(doc: dict) -> list:
         return table
 
     def absolute(keys: list):
-        table = FitTable(title="Held out: passive, mean and 5-95 % band over the runs", labels=1)
+        table = FitTable(title=f"Held out: passive, mean and 5-95 % band {over}", labels=1)
         table.add_column("speed\nload", no_wrap=True)
         for key in keys:
             table.add_column(PASSIVE_METRICS[key][0], justify="right")
@@ -173,7 +179,7 @@ def _tables(doc: dict) -> list:
         return table
 
     def costs(keys: list):
-        table = FitTable(title="What each law asks of its dampers (held out, mean and 5-95 % band)", labels=2)
+        table = FitTable(title=f"What each law asks of its dampers (held out, mean and 5-95 % band {over})", labels=2)
         table.add_column("law")
         table.add_column("speed\nload", no_wrap=True)
         for key in keys:
@@ -217,7 +223,8 @@ def _tables(doc: dict) -> list:
     kind = s["objective"]["kind"]
     what = "the worst of a law's four mean RMS ratios to passive" if kind == "minimax" else f"the {kind} objective"
     ranking.caption = (
-        f"score: {what} at a speed and load (of its mean ratios to passive); a law's score is its worst "
+        f"score: {what} at a speed and load (each ratio the mean over that point's held-out runs); a law's "
+        "score is its worst "
         "over the speeds and loads. Objective: "
         + s["objective"]["statement"]
         + "."

@@ -234,7 +234,7 @@ def check_design(
     worst = max(need, key=lambda law: need[law])
     what = (
         f"gain sets per law: fewer cannot try every gain once; {worst} has {len(PARAMETERS[worst])} gains, "
-        f"swept with {values} values and 0 each"
+        f"each tried at {values} values and at 0, after the start"
     )
     if optimiser == "evolution":  # the sweeps' values do not apply
         budget = validation.integer("budget", budget, evolution.MIN_BUDGET, what=evolution.BUDGET_RULE)

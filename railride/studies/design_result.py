@@ -315,7 +315,8 @@ def rank(summary: pd.DataFrame, objective: Objective, laws, diverged=()) -> tupl
 def recommend(ranking, points, summary: pd.DataFrame, runs: pd.DataFrame, objective, settings, diverged) -> str:
     """The recommendation in a few sentences, each one a number of the ranking or the summary:
     the law ranked first and its score; the responses it makes worse than passive on average,
-    and where; where another law scores better; how sure (whether the held-out 5-95 % bands of
+    and where; where another law scores better; what it gives up to the other ranked laws
+    (`_trade_offs`); how sure (whether the held-out 5-95 % bands of
     the per-run scores of it and the runner-up overlap, and how many runs it wins run by run);
     where no law beats passive; the laws that diverged."""
     ok = [r for r in ranking if r["ranked"]]
@@ -343,6 +344,7 @@ def recommend(ranking, points, summary: pd.DataFrame, runs: pd.DataFrame, object
         out.append(f"Recommended: {_label(name)}. On {held}, {what} {score:.3f} (at {_at(w['speed_m_s'], w['load'])}).")
         out.append(_worse_than_passive(name, summary))
         out.append(_wins(name, points))
+        out.append(_trade_offs(name, ok, summary))
         out.append(_sureness(best, ok[1] if len(ok) > 1 else None, points, summary, runs))
         if objective.peak_bound is not None or objective.travel_bound is not None:
             out.append(
@@ -403,6 +405,37 @@ def _worse_than_passive(name: str, summary: pd.DataFrame) -> str:
     return (
         "On average it is worse than passive in " + "; ".join(f"{w} at {', '.join(p)}" for w, p in worse.items()) + "."
     )
+
+
+def _trade_offs(name: str, ok: list, summary: pd.DataFrame) -> str:
+    """What the recommended law gives up: the responses (RMS, and the peak-to-peak acceleration)
+    on which another ranked law's mean ratio to passive, averaged over the speeds and loads, is
+    lower than its own by more than the level tolerance of a comparison; and its largest
+    secondary travel against passive's."""
+    from railride.studies.comparison import LEVEL_TOLERANCE, is_level
+
+    mean = summary.groupby(["controller", "metric"])["ratio_mean"].mean()
+    words = {**dict(zip(RMS_COLUMNS, RATIO_NAMES)), PEAK_COLUMN: "peak-to-peak acceleration"}
+    lost = []
+    for other in (r["controller"] for r in ok if r["controller"] != name):
+        worse = []
+        for metric, word in words.items():
+            a, b = mean.get((name, metric)), mean.get((other, metric))
+            if a is not None and b is not None and np.isfinite(a) and np.isfinite(b):
+                if a > b and not is_level(a, b, LEVEL_TOLERANCE):
+                    worse.append(f"{word} ({a:.3f} against {b:.3f})")
+        if worse:
+            lost.append(f"to {_label(other)} on {', '.join(worse)}")
+    text = (
+        "Averaged over the speeds and loads (mean ratios to passive), it loses " + "; ".join(lost) + "."
+        if lost
+        else "Averaged over the speeds and loads, no other ranked law is better on any RMS response or the "
+        "peak-to-peak acceleration."
+    )
+    travel = mean.get((name, TRAVEL_COLUMN))
+    if travel is not None and np.isfinite(travel) and not is_level(travel, 1.0, LEVEL_TOLERANCE):
+        text += f" Its largest secondary travel is x{travel:.2f} passive's on average."
+    return text
 
 
 def _wins(name: str, points) -> str:

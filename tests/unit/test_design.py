@@ -77,6 +77,32 @@ def test_the_ranking_and_the_recommendation_name_the_winner(tiny):
     assert first["score"] >= ratios
 
 
+def test_the_recommendation_says_what_the_winner_gives_up(tiny):
+    """Each response on which the runner-up's mean ratio to passive (from the held-out runs
+    themselves) is lower than the winner's by more than 1 % is named with both numbers; the
+    others are not; and the winner's largest travel against passive's."""
+    win = tiny.recommended
+    other = next(r["controller"] for r in tiny.ranking if r["controller"] != win)
+    runs = tiny.runs
+    base = runs[runs["controller"] == "passive"].set_index(["track", "track_seed", "speed_m_s", "load"])
+
+    def ratio(law, column):
+        own = runs[runs["controller"] == law].set_index(base.index.names)[column]
+        return float((own / base[column]).mean())  # one speed and load: the mean over its runs
+
+    names = {"acceleration_m_s2_rms": "acceleration", "displacement_m_rms": "displacement"}
+    names.update(
+        {"pitch_deg_rms": "pitch", "roll_deg_rms": "roll", "acceleration_m_s2_ptp": "peak-to-peak acceleration"}
+    )
+    text = tiny.recommendation
+    for column, word in names.items():
+        a, b = ratio(win, column), ratio(other, column)
+        said = f"{word} ({a:.3f} against {b:.3f})"
+        assert (said in text) == (a - b > 0.01 * a), (word, a, b)  # level: within 1 % of the larger
+    travel = ratio(win, "travel_max_m")
+    assert f"Its largest secondary travel is x{travel:.2f} passive's on average." in text
+
+
 def test_the_document_the_files_and_the_gains_file(tiny, tmp_path):
     jsonschema = pytest.importorskip("jsonschema")
     from pathlib import Path
