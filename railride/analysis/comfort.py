@@ -326,6 +326,24 @@ class ShortRunWarning(UserWarning):
     """A comfort index was evaluated on less signal than its method asks for."""
 
 
+def intervals_in(window, duration: float) -> int:
+    """The whole 5 s intervals of EN 12299 that N_MV,z reads in the window (start, end) [s] of
+    a run ``duration`` s long (end None or past the run: its end); 0 where it is shorter than
+    one (`comfort_intervals` then takes the whole signal)."""
+    start, end = (0.0, duration) if window is None else window
+    end = duration if end is None else min(float(end), duration)
+    return max(0, int(np.floor((end - float(start)) / INTERVAL_S + 1e-9)))
+
+
+def n_mv_basis(n: int) -> str:
+    """What N_MV,z rests on, in words, for ``n`` intervals of 5 s (`intervals_in`; 0: the whole
+    signal, shorter than one): EN 12299 evaluates 60, so fewer make it an indication only."""
+    text = (
+        "N_MV_z from one interval, the whole signal" if n == 0 else f"N_MV_z from {n} interval{'s' * (n != 1)} of 5 s"
+    )
+    return text + (" (EN 12299 evaluates 60, 5 minutes): an indication only" if n < 60 else "")
+
+
 def comfort_intervals(acceleration, rate_hz: float, window=None) -> np.ndarray:
     """RMS values [m/s^2] of the Wb-weighted acceleration over consecutive 5 s intervals from
     the start of ``window`` (last axis: interval). An incomplete last interval is dropped; a
@@ -667,14 +685,7 @@ def comfort_record(comfort: xr.DataArray, passive: xr.DataArray | None = None) -
     cut = text.find("N_MV_z is the vertical term")
     notes = [text] if cut < 0 else [t for t in (text[:cut].rstrip("; "), text[cut:]) if t]
     short = WHOLE_SIGNAL in text  # shorter than one interval of 5 s
-    notes.append(
-        (
-            "N_MV_z from one interval, the whole signal"
-            if short
-            else f"N_MV_z from {n} interval{'s' if n != 1 else ''} of 5 s"
-        )
-        + (" (EN 12299 evaluates 60, 5 minutes): an indication only" if n < 60 else "")
-    )
+    notes.append(n_mv_basis(0 if short else n))
     record = {
         "positions": positions,
         "units": {str(i): str(u) for i, u in zip(comfort["index"].values, comfort["unit"].values)},

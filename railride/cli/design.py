@@ -243,6 +243,7 @@ def _tables(doc: dict) -> list:
         f"{s['aggregate']} objective, at most {s['budget']} gain sets per law); judged on seeds {seeds}.",
         f"Tuned by {optimiser_text(s)}.",
         vehicle_text(s["vehicle"]) + f"; {s['damper'] if isinstance(s['damper'], str) else 'own'} dampers.",
+        *([s["comfort_basis"]] if s.get("comfort_basis") else []),
         f"{doc['runs']['training']} training and {doc['runs']['judging']} held-out runs"
         + (
             f", {doc['runs_evaluated']} evaluated now, wall time {doc['wall_time_s']:.1f} s."

@@ -154,6 +154,7 @@ def _table(doc: dict):
         "(passive - controlled) / passive x 100 on the same track, speed and load, run by run; passive "
         "is always healthy.",
         vehicle_text(s["vehicle"]),
+        *[s[k] for k in ("tracks_judged", "comfort_basis") if s.get(k)],
     ]
     if doc["failed"]:
         failed = "; ".join(

@@ -163,6 +163,36 @@ def judged_on(gains, record: dict | None) -> tuple[str, str] | None:
     )
 
 
+def judged_text(gains, records: list) -> str | None:
+    """`judged_on` for a study's many runs (``records``, `Scenario.describe` records), in one
+    sentence: which track seeds (or tracks) and speeds are in-sample, which the tuned rail at a
+    new speed, which held out. None where the gains name no tuned track."""
+    kinds: dict[str, list[dict]] = {}
+    for r in records:
+        judged = judged_on(gains, r)
+        if judged is None:
+            return None
+        kinds.setdefault(judged[0], []).append(r)
+    words = {
+        IN_SAMPLE: "in-sample (tuned on this track at this speed)",
+        SAME_TRACK: "the tuned track at a new speed",
+        HELD_OUT: "held out (tuning never ran on this track)",
+    }
+    parts = []
+    for kind in (IN_SAMPLE, SAME_TRACK, HELD_OUT):
+        own = kinds.get(kind, [])
+        if not own:
+            continue
+        seeds = list(dict.fromkeys(r["seed"] for r in own if r.get("seed") is not None))
+        names = list(dict.fromkeys(str(r.get("name")) for r in own))
+        speeds = list(dict.fromkeys(r["speed_m_s"] for r in own if r.get("speed_m_s") is not None))
+        what = f"seed{'s' * (len(seeds) > 1)} {_list(sorted(seeds))}" if seeds else ", ".join(names)
+        parts.append(f"{words[kind]}: {what}" + (f" at {_list(sorted(speeds))} m/s" if speeds else ""))
+    return f"Against the tracks the gains were tuned on ({_tracks_tuned(tuned_tracks(gains.provenance))}): " + (
+        "; ".join(parts) + "."
+    )
+
+
 def _rail_text(record: dict) -> str:
     seed = record.get("seed")
     return str(record.get("name")) + (f", seed {seed}" if seed is not None else "")

@@ -27,6 +27,7 @@ import pandas as pd
 
 from railride import arguments, validation
 from railride._version import versions
+from railride.analysis.comfort import intervals_in, n_mv_basis
 from railride.analysis.costs import COST_COLUMNS
 from railride.defaults import DEFAULT_DAMPER
 from railride.errors import InputError
@@ -435,6 +436,7 @@ def design(
         "training_runs": int(len(training)),
         "judging_runs": int(len(runs)),
         "versions": versions(),
+        "comfort_basis": n_mv_basis(intervals_in(None, float(plan.duration))),
         **other_settings(plan.vehicle, plan.solver),
     }
     text = recommend(ranking, points, summary, runs, plan.objective, settings, diverged)

@@ -30,8 +30,10 @@ from railride import validation
 from railride.studies.progress import shows_progress
 from railride.studies.comparison import check_controllers
 from railride.secondary.control import PAPER_CONTROLLERS, GainSet
+from railride.secondary.provenance import judged_text
 from railride.defaults import DEFAULT_DAMPER
 from railride.secondary.faults import DamperFault, check_faults, parse_faults
+from railride.analysis.comfort import intervals_in, n_mv_basis
 from railride.analysis.metrics import RESPONSES
 from railride.model.params import resolve_argument, vehicle_record
 from railride.plots import PNG_DPI, FigureOptions
@@ -385,6 +387,10 @@ def study(
     tracks = [{**described[v], "seed": seed} if random else described[v] for seed, v in opts_of]
     if mismatch := gains.mismatch(record, tracks, names):
         settings["gains_mismatch"] = mismatch
+    # which runs' tracks the gains were tuned on: in-sample, a new speed, or held out
+    if any(gains.controller(n) is not None for n in names) and (judged := judged_text(gains, tracks)):
+        settings["tracks_judged"] = judged
+    settings["comfort_basis"] = n_mv_basis(intervals_in(window_record, float(sc.duration)))
     return StudyResult(frame, summary, settings, failed)
 
 

@@ -171,3 +171,29 @@ def test_a_secondary_stiffness_tolerance_is_a_condition_of_its_own():
     assert {g["stiffness"] for g in res.to_dict()["results"]} == {0.9, 1.1}
     with pytest.raises(ValueError, match="stiffness = 0.0: must be a finite number > 0"):
         study(["pid"], track_seeds=[0], stiffness=[0.0])
+
+
+@pytest.mark.parametrize(("duration", "window", "n"), [(2.0, None, 0), (10.0, None, 2), (12.0, (1.0, 12.0), 2)])
+def test_the_comfort_basis_counts_the_intervals_the_comfort_index_reads(duration, window, n):
+    """The study's line on N_MV,z names as many 5 s intervals as `ride_comfort` of one of its
+    runs finds in the same window (0: the whole signal)."""
+    from railride.analysis.comfort import WHOLE_SIGNAL, n_mv_basis, ride_comfort
+
+    res = study(["pid"], track_seeds=[4], speeds=[40.0], duration=duration, window=window)
+    run = simulate(scenario("fra4", seed=4, speed=40.0, duration=duration))
+    comfort = ride_comfort(run.dataset, window=window)
+    if n:
+        assert int(comfort.attrs["n_intervals"]) == n
+    else:  # shorter than one interval: the whole signal
+        assert WHOLE_SIGNAL in comfort.attrs["notes"]
+    assert res.settings["comfort_basis"] == n_mv_basis(n)
+
+
+def test_the_study_says_which_tracks_its_gains_were_tuned_on():
+    """The shipped robust gains were tuned on fra4 seeds 1-3 at 30, 50 and 70 m/s."""
+    res = study(["pid"], track_seeds=[0, 1], speeds=[40.0, 50.0], duration=0.5)
+    text = res.settings["tracks_judged"]
+    assert "in-sample (tuned on this track at this speed): seed 1 at 50 m/s" in text
+    assert "the tuned track at a new speed: seed 1 at 40 m/s" in text
+    assert "held out (tuning never ran on this track): seed 0 at 40, 50 m/s" in text
+    assert "tracks_judged" not in study(["passive"], track_seeds=[0], speeds=[40.0], duration=0.5).settings
