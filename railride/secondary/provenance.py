@@ -157,9 +157,11 @@ def judged_on(gains, record: dict | None) -> tuple[str, str] | None:
         return SAME_TRACK, (
             f"Not held out: the gains were tuned on this track ({what}), at {speeds} m/s; only the speed is new."
         )
+    if any(str(t.get("name")) == str(record.get("name")) for t in tracks):  # its name, other settings
+        what = _tracks_text([record], tracks)
     return (
         HELD_OUT,
-        f"Held out: tuning never ran on this track ({what}); the gains were tuned on {_tracks_tuned(tracks)}.",
+        f"Held out: tuning never ran on this track, {what}. The gains were tuned on {_tracks_tuned(tracks)}.",
     )
 
 
