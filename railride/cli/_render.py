@@ -154,14 +154,37 @@ def alike_text(alike: dict) -> str:
     runs = ", ".join(f"{n} {r}" for n, r in alike["runs"].items())
     per_set = alike.get("runs_per_gain_set")
     if per_set:
-        return (
+        text = (
             f"Tuned alike: every law by the same study and objective, with at most {alike['budget']} gain sets "
             f"each, every set scored on the same {per_set} runs (gain sets used: {runs})."
         )
-    return (
-        f"Tuned alike: every law by the same study and objective, with at most {alike['budget']} vehicle runs "
-        f"each (runs used: {runs})."
-    )
+    else:
+        text = (
+            f"Tuned alike: every law by the same study and objective, with at most {alike['budget']} vehicle runs "
+            f"each (runs used: {runs})."
+        )
+    return text + stopped_text(alike.get("stopped") or {})
+
+
+#: why a tuning study stopped, in words (`railride.studies.tuning`)
+STOPPED_WORDS = {
+    "budget": "stopped when its budget ran out, before it converged",
+    "converged": "converged",
+    "passes": "stopped after its last pass, before it converged",
+}
+
+
+def stopped_text(stopped: dict) -> str:
+    """The sentence on why the studies stopped (" Every study stopped when its budget ran out,
+    before it converged."), each law's reason where they differ; empty without reasons."""
+    if not stopped:
+        return ""
+    reasons = set(stopped.values())
+    if len(reasons) == 1:
+        reason = reasons.pop()
+        word = STOPPED_WORDS.get(reason, reason)
+        return f" {'Every study' if len(stopped) > 1 else 'The study'} {word}."
+    return " " + "; ".join(f"{n} {STOPPED_WORDS.get(r, r)}" for n, r in stopped.items()) + "."
 
 
 def untuned_text(names) -> str:

@@ -372,8 +372,9 @@ class GainSet:
     def tuning_budget(self, controllers) -> dict | None:
         """How alike the ``controllers`` were tuned, from the [provenance] of these gains: the
         budget of vehicle runs each law had and the runs each used ({"budget": B, "runs":
-        {name: n}}; for a robust tuning, gain sets, and ``runs_per_gain_set``), or None when the
-        gains file records no budget (files before 0.4.0)."""
+        {name: n}}; for a robust tuning, gain sets, and ``runs_per_gain_set``), and where the file
+        says, why each study stopped (``stopped``: {name: "budget", "converged" or "passes"}), or
+        None when the gains file records no budget (files before 0.4.0)."""
         budget = self.provenance.get("budget")
         studies = self.provenance.get("studies", {})
         runs = {n: studies[n]["runs"] for n in controllers if n in studies}
@@ -381,7 +382,14 @@ class GainSet:
             return None
         # a robust tuning's budget counts gain sets, each scored on every run of its tuning set
         per_set = len(self.provenance.get("tuning_set") or ()) or None
-        return {"budget": budget, "runs": runs, **({"runs_per_gain_set": per_set} if per_set else {})}
+        # why each study stopped: its budget spent, converged, or out of passes
+        stopped = {n: studies[n]["stopped"] for n in runs if studies[n].get("stopped")}
+        return {
+            "budget": budget,
+            "runs": runs,
+            **({"runs_per_gain_set": per_set} if per_set else {}),
+            **({"stopped": stopped} if stopped else {}),
+        }
 
     def tuned_on(self, record: dict | None) -> bool:
         """Whether these gains were tuned on the track ``record`` (`Scenario.describe`), as the

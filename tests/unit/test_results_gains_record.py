@@ -129,3 +129,17 @@ def test_the_optimised_gains_never_claim_to_be_the_shipped_file():
     assert doc["settings"]["gains"] == doc["settings"]["base_gains"] == "railride/data/gains.toml"
     assert doc["gains"]["pid"]["kd"] != packaged()["pid"]["kd"]  # the search moved it
     assert doc["gains"]["source"] == "railride/data/gains.toml, changed: pid.kd"
+
+
+def test_the_tuned_alike_line_says_why_each_study_stopped():
+    """A study with a budget of 5 runs cannot converge in a pass of 3 gains x 4 values: it stops
+    by its budget, and the line printed with the gains says so."""
+    from railride.cli._render import alike_text
+
+    res = rr.tune(("pid",), scenario_options={"duration": 0.5}, n_values=3, budget=5, before_after=False)
+    study = next(s for s in res.studies if s.controller == "pid")
+    assert study.runs <= 5 and study.stopped == "budget"
+    line = alike_text({"budget": 5, "runs": {"pid": 5}, "stopped": {"pid": "budget"}})
+    assert line.endswith("(runs used: pid 5). The study stopped when its budget ran out, before it converged.")
+    mixed = alike_text({"budget": 5, "runs": {"a": 5, "b": 3}, "stopped": {"a": "budget", "b": "converged"}})
+    assert mixed.endswith("a stopped when its budget ran out, before it converged; b converged.")
