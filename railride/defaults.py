@@ -14,3 +14,5 @@ DEFAULT_DAMPER = "railway"
 DEFAULT_SPEED = 55.56
 #: the length of a run [s] where its scenario gives none
 DEFAULT_DURATION = 10.0
+#: how a tuning study scores a run when no objective is named (`railride.studies.objectives.DEFAULT_OBJECTIVE`)
+DEFAULT_OBJECTIVE_KIND = "minimax"

@@ -12,6 +12,7 @@ from typing import Annotated, Optional
 
 import typer
 
+from railride.defaults import DEFAULT_OBJECTIVE_KIND
 from railride.errors import InputError
 
 
@@ -349,8 +350,7 @@ ObjectiveOption = Annotated[
         "minimax (the largest r_k), constrained (sum of r_k with every r_k <= --bound); or "
         "ride comfort: n_mv (the worst ratio to passive of EN 12299's N_MV,z over the floor's "
         "centre, front and rear), sperling (the same with Sperling's Wz). "
-        "Default: the library's DEFAULT_OBJECTIVE; the statement is printed with the "
-        "result.",
+        f"Default: {DEFAULT_OBJECTIVE_KIND}; the statement is printed with the result.",
     ),
 ]
 WeightsOption = Annotated[

@@ -241,7 +241,7 @@ def _compare_tables(doc: dict, shipped: bool):
         tuning = doc.get("tuning") or {}
         if tuning.get("objective"):
             info.append(
-                (f"gains tuned by `{tuning['command']}`, " if tuning.get("command") else "gains tuned ")
+                (f"gains tuned by `{tuning['command']}`, " if tuning.get("command") else "gains tuned, ")
                 + f"objective {tuning['objective']}"
             )
         if tuning.get("track"):  # in-sample, the tuned track at another speed, or held out

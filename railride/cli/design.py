@@ -100,7 +100,7 @@ COST_METRICS = {
     "force_max_n": ("force max\n(kN)", 1e-3, ".1f"),
     "travel_max_m": ("travel max\n(mm)", 1e3, ".1f"),
     "voltage_at_max_fraction": ("at v_max\n(%)", 100.0, ".1f"),
-    "coil_power_fraction": ("coil power\n(% of v_max)", 100.0, ".1f"),
+    "coil_power_fraction": ("coil power\n(% of full)", 100.0, ".1f"),
 }
 
 
@@ -198,7 +198,8 @@ def _tables(doc: dict) -> list:
             "force: the secondary damper force on the carbody; travel: the secondary deflection, "
             + (f"against a clearance of {clearance * 1e3:g} mm (z_stop)" if clearance else "no bump stops")
             + "; at v_max: the time the command voltage sits at the damper's largest; coil power: the mean "
-            "electrical power of the coils as a % of their power at v_max (mean (u / v_max)^2, u the coil voltage)."
+            "electrical power of the coils as a % of their full power, at v_max (mean (u / v_max)^2, u the "
+            "coil voltage)."
         )
         return table
 

@@ -459,7 +459,8 @@ def tune_command(
             "--budget",
             metavar="N",
             help="Vehicle runs per law (distinct gain sets scored, the start included), the same "
-            "for every law; a law with few gains narrows its sweeps and may stop earlier. >= 1.",
+            "for every law; a law with few gains narrows its sweeps and may stop earlier. At least "
+            "the start and one sweep, --values + 2 (with --optimiser evolution, the start and two generations).",
         ),
     ] = 400,
     workers: WorkersOption = None,

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from railride.defaults import DEFAULT_OBJECTIVE_KIND
 from railride.errors import InputError
 from railride.analysis.metrics import RESPONSES
 
@@ -320,4 +321,4 @@ class Objective:
 
 
 #: the tuner's default objective (`tune`, `railride.studies.optimise`, `railride tune`)
-DEFAULT_OBJECTIVE = Objective(kind="minimax")
+DEFAULT_OBJECTIVE = Objective(kind=DEFAULT_OBJECTIVE_KIND)
