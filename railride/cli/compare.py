@@ -12,7 +12,7 @@ import typer
 
 from railride.errors import InputError
 from railride.secondary.dampers import IDEAL_NAMES
-from railride.output.trade_offs import trade_off_lines
+from railride.output.trade_offs import paper_ranking_text, trade_off_lines
 from railride.defaults import DEFAULT_CONTROL_RATE, DEFAULT_DAMPER
 from railride.cli._app import app
 from railride.cli._common import ProgressBar, errors, option_names, stderr_is_terminal, stdout_console, write_folder
@@ -265,6 +265,8 @@ def _compare_tables(doc: dict, shipped: bool):
         )
         + "red. % = (passive - controlled) / passive x 100 (negative: worse than passive, in red)."
     )
+    if doc.get("paper_ranking"):
+        info.append(paper_ranking_text(doc["paper_ranking"]))  # where the order agrees with Table 1
     title = "Ride comparison: RMS of the carbody responses" + (" beside the paper's Table 1" if paper_case else "")
 
     def rms_table(group: list[dict]):

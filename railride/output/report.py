@@ -118,7 +118,7 @@ def comparison_contents(result) -> Contents:
     from railride.analysis.spectra import PSD_SEGMENT_S, comparison_psd
     from railride.analysis.labels import CARBODY_RESPONSES, psd_title
     from railride.plots import comparison as plots
-    from railride.output.trade_offs import trade_off_lines
+    from railride.output.trade_offs import paper_ranking_text, trade_off_lines
     from railride.plots.interactive import comparison_psd_figure, comparison_response_figure
 
     doc = result.to_dict()
@@ -148,7 +148,11 @@ def comparison_contents(result) -> Contents:
                 _wide(result.to_pandas()),
             )
         ],
-        findings=trade_off_lines(doc),
+        findings=[
+            *([doc["tuning"]["track"]["note"]] if doc.get("tuning", {}).get("track") else []),
+            *trade_off_lines(doc),
+            *([paper_ranking_text(doc["paper_ranking"])] if doc.get("paper_ranking") else []),
+        ],
     )
 
 

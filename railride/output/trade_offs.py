@@ -83,3 +83,26 @@ def _peak_lines(doc: dict, labels: dict) -> list[str]:
 
 def _percent(p: float) -> str:
     return f"{p:+.3g} %" if abs(p) < 1000 else f"{p:+.0f} %"
+
+
+def paper_ranking_text(ranking: dict) -> str:
+    """The line on how this comparison's order of the paper's controllers agrees with Table 1
+    (`Comparison.paper_ranking`): the responses ordered alike, those ordered otherwise with
+    both orders, and the range of railride's reductions over the paper's."""
+    from railride.secondary.control import LABELS
+
+    responses = {r: v for r, v in ranking.items() if r != "reduction_ratio"}
+    same = [RESPONSE_WORDS.get(r, r) for r, v in responses.items() if v["agrees"]]
+    other = [
+        f"{RESPONSE_WORDS.get(r, r)} (paper: {', '.join(LABELS[n] for n in v['paper'])}; here: "
+        f"{', '.join(LABELS[n] for n in v['railride'])})"
+        for r, v in responses.items()
+        if not v["agrees"]
+    ]
+    parts = ([f"the same on {', '.join(same)}"] if same else []) + ([f"another on {'; '.join(other)}"] if other else [])
+    lo, hi = ranking["reduction_ratio"]
+    return (
+        "Against the paper's order of its controllers by RMS reduction (best first, level within the tolerance): "
+        + "; ".join(parts)
+        + f". The reductions here are {lo:.2f} to {hi:.2f} times the paper's."
+    )

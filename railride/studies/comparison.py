@@ -242,6 +242,33 @@ class Comparison:
             vehicle is None or vehicle == VehicleParams.preset("paper").to_dict()
         )
 
+    def paper_ranking(self) -> dict | None:
+        """How this comparison's order of the paper's three controllers agrees with the paper's
+        Table 1, response by response: ``{response: {"paper": names, "railride": names,
+        "agrees": bool}}`` (names best first, by RMS reduction), plus ``reduction_ratio``, the
+        least and largest of railride's reduction over the paper's. An order agrees when every
+        pair the paper ranks is ranked alike here or level (`is_level`, the comparison's
+        tolerance). None unless this is the paper's case with its three controllers."""
+        laws = [n for n in PAPER_CONTROLLERS if n != "passive"]
+        if not self.paper_case or not all(n in self.names for n in laws):
+            return None
+        rms = self.metrics.sel(statistic="rms")
+        red = self.reductions.sel(statistic="rms")
+        out: dict = {}
+        ratios = []
+        for r in PAPER_REDUCTION:
+            paper = sorted(laws, key=lambda n: -PAPER_REDUCTION[r][n])
+            here = {n: float(rms.sel(controller=n, response=r)) for n in laws}
+            agrees = all(
+                here[a] < here[b] or is_level(here[a], here[b], self.level_tolerance)
+                for i, a in enumerate(paper)
+                for b in paper[i + 1 :]
+            )
+            out[r] = {"paper": paper, "railride": sorted(laws, key=lambda n: here[n]), "agrees": agrees}
+            ratios += [float(red.sel(controller=n, response=r)) / PAPER_REDUCTION[r][n] for n in laws]
+        out["reduction_ratio"] = [min(ratios), max(ratios)]
+        return out
+
     @property
     def judged(self) -> tuple[str, str] | None:
         """How this run's track stands to the tracks the gains were tuned on, (kind, sentence)
@@ -315,6 +342,8 @@ class Comparison:
                 "gains_values": ran["values"],
             },
             "paper_case": paper_case,
+            # only in the paper's case: the paper's comparison's order against its Table 1's
+            **({"paper_ranking": pr} if (pr := self.paper_ranking()) else {}),
             "controllers": rows,
             "trade_offs": self.trade_offs(),
             "bounds": self.bounds_record(),

@@ -123,3 +123,21 @@ def test_no_peak_above_passive_says_so():
     acc = "acceleration_m_s2"
     doc = _doc([{**_t("a", "passive", better=[acc]), "ptp_better_on": [acc], "ptp_worse_on": [], "ptp_level_on": []}])
     assert "peak-to-peak: no suspension is worse than passive on any response" in trade_off_lines(doc)
+
+
+def test_the_paper_case_says_where_its_order_agrees_with_table_1(paper):
+    """docs/results.md: the ranking of the paper's three controllers is the paper's on
+    acceleration, displacement and roll (SAS (attitude+ride) first, PID last; the two SAS level
+    on displacement), PID's first on pitch, and the reductions are smaller than the paper's."""
+    from railride.studies.comparison import PAPER_REDUCTION
+
+    ranking = paper.to_dict()["paper_ranking"]
+    assert [r for r in PAPER_REDUCTION if not ranking[r]["agrees"]] == ["pitch_deg"]
+    assert ranking["pitch_deg"]["railride"][0] == "pid"
+    red = paper.reductions.sel(statistic="rms")
+    lo, hi = ranking["reduction_ratio"]
+    for r, values in PAPER_REDUCTION.items():
+        for law, published in values.items():
+            assert lo - 1e-12 <= float(red.sel(controller=law, response=r)) / published <= hi + 1e-12
+    assert 0 < lo < hi < 1  # every reduction here is smaller than the paper's
+    assert "paper_ranking" not in rr.compare("paper-sine", controllers=("pid",), bounds=False).to_dict()
