@@ -63,7 +63,9 @@ def run_league(
                 "--track-seed or --load values) runs each scenario with its defaults"
             )
     if not bounds:
-        raise InputError("--no-bounds: a league table always shows the ideal actuator beside the MR dampers")
+        raise InputError(
+            "--no-references (or --no-bounds): a league table always shows the ideal actuator beside the MR dampers"
+        )
     damper_preset("--damper", damper)
     loads = loads or [1.0]
     for x in loads:  # each load checked before the first run, its errors naming --load

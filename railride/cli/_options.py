@@ -384,7 +384,7 @@ MaxPeakOption = Annotated[
     typer.Option(
         "--max-peak",
         metavar="X",
-        help="A bound on any objective: every run's peak-to-peak carbody acceleration at most X times "
+        help="A constraint on any objective: every run's peak-to-peak carbody acceleration at most X times "
         "passive's on the same track, > 0; a run above it is infeasible.",
     ),
 ]
@@ -393,7 +393,7 @@ MaxTravelOption = Annotated[
     typer.Option(
         "--max-travel",
         metavar="M",
-        help="A bound on any objective: every run's largest secondary travel [m] at most M (e.g. the bump "
+        help="A constraint on any objective: every run's largest secondary travel [m] at most M (e.g. the bump "
         "stops' clearance), > 0; a run above it is infeasible.",
     ),
 ]

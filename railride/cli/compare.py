@@ -75,7 +75,7 @@ from railride.cli._render import (
     untuned_text,
 )
 
-#: --controllers and --bounds, shared with `railride report`
+#: --controllers and --references, shared with `railride report`
 ControllersOption = Annotated[
     str,
     typer.Option(
@@ -90,10 +90,12 @@ ControllersOption = Annotated[
 BoundsOption = Annotated[
     bool,
     typer.Option(
+        "--references/--no-references",
         "--bounds/--no-bounds",
         help="Also run the same control laws and gains on the ideal semi-active damper and the "
         "ideal actuator, and print their reductions beside the MR dampers' (default on; "
-        "MR dampers only).",
+        "MR dampers only). References, not bounds: the MR dampers can beat them; --bounds is "
+        "the older spelling.",
     ),
 ]
 #: --load: compare's own (the shared `LoadOption` takes one factor), several make a league table

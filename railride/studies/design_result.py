@@ -348,7 +348,7 @@ def recommend(ranking, points, summary: pd.DataFrame, runs: pd.DataFrame, object
         out.append(_sureness(best, ok[1] if len(ok) > 1 else None, points, summary, runs))
         if objective.peak_bound is not None or objective.travel_bound is not None:
             out.append(
-                "Bounds, on the 95th percentile of the held-out runs at each speed and load: "
+                "Constraints, on the 95th percentile of the held-out runs at each speed and load: "
                 + _bounds_text(ok, objective)
             )
         if objective.kind == "minimax" and score >= 1.0:

@@ -440,3 +440,12 @@ def test_the_papers_table_stands_beside_the_papers_case_only(args, paper):
     text = " ".join(ok("compare", "--duration", 1, *args).stdout.split())
     assert ("beside the paper's Table 1" in text) is paper
     assert ("No published reference exists for this case" in text) is not paper
+
+
+def test_the_references_switch_and_its_older_spelling():
+    """--no-references skips the ideal devices' runs; --no-bounds, its older spelling, does the same."""
+    for off in ("--no-references", "--no-bounds"):
+        doc = ok_json("compare", "--duration", 0.2, "--controllers", "pid", off)
+        assert doc["bounds"] is None
+    doc = ok_json("compare", "--duration", 0.2, "--controllers", "pid", "--references")
+    assert set(doc["bounds"]) == {"ideal-damper", "ideal"}
