@@ -372,6 +372,7 @@ def _tune_tables(doc: dict, start, tuned, scenario_text: str):
                     f"{damper_text(s)}; start gains {s['start_gains']}",
                     vehicle_text(s["vehicle"]),
                     "red. % = (passive - controlled) / passive x 100 (negative: worse than passive, in red)",
+                    *(_tuned_against_start(rows) if rows else []),
                     f"{doc['runs']} runs in the run table, {doc['runs_evaluated']} evaluated now "
                     f"({doc['runs_per_second']:.1f} runs/s), wall time {doc['wall_time_s']:.1f} s",
                 ]
@@ -379,6 +380,30 @@ def _tune_tables(doc: dict, start, tuned, scenario_text: str):
         )
     )
     return parts
+
+
+def _tuned_against_start(rows: list[dict]) -> list[str]:
+    """The lines under the table of the start and tuned gains: that its runs are the tuning's own,
+    and per law the responses the tuned gains make better and worse than the start gains (RMS
+    within the comparisons' level tolerance of the larger: level)."""
+    from railride.output.trade_offs import RESPONSE_WORDS
+    from railride.secondary.control import LABELS
+    from railride.studies.comparison import LEVEL_TOLERANCE, is_level
+
+    lines = [
+        "Both columns are runs on the track tuned on: in-sample, not a test on another track "
+        "(railride compare --scenario ..., railride design)."
+    ]
+    for r in rows:
+        keys = [k for k in r["before"] if not is_level(r["after"][k], r["before"][k], LEVEL_TOLERANCE)]
+        better = [RESPONSE_WORDS.get(k, k) for k in keys if r["after"][k] < r["before"][k]]
+        worse = [RESPONSE_WORDS.get(k, k) for k in keys if r["after"][k] > r["before"][k]]
+        if better and worse:
+            lines.append(
+                f"{LABELS[r['suspension']]}: the tuned gains beat the start on {', '.join(better)} but are worse on "
+                f"{', '.join(worse)} (the objective scores the four together)."
+            )
+    return lines
 
 
 @app.command("tune")

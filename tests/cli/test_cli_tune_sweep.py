@@ -103,6 +103,26 @@ def test_tune_table_output():
         "acceleration (m/s^2)",
     ):
         assert fragment in result.stdout, fragment
+    flat = " ".join(result.stdout.split())
+    assert "Both columns are runs on the track tuned on: in-sample, not a test on another track" in flat
+
+
+def test_tune_says_which_responses_tuning_gave_up():
+    """From the paper's reference gains, PID tuned on a 1-s sine with 20 runs lowers the
+    acceleration and displacement but raises the pitch and roll against the start (the table's
+    own numbers, read back here): the line under the table says so."""
+    args = ("tune", "--controllers", "pid", "--budget", "20", "--values", "3", "--duration", "1")
+    doc = json.loads(ok(*args, "--format", "json").stdout)
+    row = next(r for r in doc["before_after"] if r["suspension"] == "pid")
+    up = sorted(k for k in row["before"] if row["after"][k] > 1.01 * row["before"][k])
+    down = sorted(k for k in row["before"] if row["after"][k] < 0.99 * row["before"][k])
+    assert up and down, (up, down)  # the case is one with a trade
+    flat = " ".join(ok(*args).stdout.split())
+    assert "PID: the tuned gains beat the start on" in flat
+    words = {"acceleration_m_s2": "acceleration", "displacement_m": "displacement", "pitch_deg": "pitch"}
+    words["roll_deg"] = "roll"
+    worse = flat.split("but are worse on ")[1].split(" (the objective")[0]
+    assert sorted(w.strip() for w in worse.split(",")) == sorted(words[k] for k in up)
 
 
 def test_tune_states_its_objective_in_every_output(tmp_path):
