@@ -245,9 +245,10 @@ def _tables(doc: dict) -> list:
         f"Tuned by {optimiser_text(s)}.",
         vehicle_text(s["vehicle"]) + f"; {s['damper'] if isinstance(s['damper'], str) else 'own'} dampers.",
         *([s["comfort_basis"]] if s.get("comfort_basis") else []),
-        f"{doc['runs']['training']} training and {doc['runs']['judging']} held-out runs"
+        f"{doc['runs']['training']} training and {doc['runs']['judging']} held-out runs (passive's included)"
         + (
-            f", {doc['runs_evaluated']} evaluated now, wall time {doc['wall_time_s']:.1f} s."
+            f"; {doc['runs_evaluated']} evaluated now, with the references' and the fault check's, wall time "
+            f"{doc['wall_time_s']:.1f} s."
             if "runs_evaluated" in doc
             else "."
         ),

@@ -52,8 +52,10 @@ def plot_design(result, ax=None):
                 label = suspension_label(name) + (f", load {load:g}" if len(loads) > 1 else "")
                 a.plot(v, mean, LOAD_STYLES[j % len(LOAD_STYLES)], color=colour, marker="o", markersize=3, label=label)
                 lo, hi = rows["ratio_p5"].to_numpy(dtype=float), rows["ratio_p95"].to_numpy(dtype=float)
-                if np.isfinite(lo).any():
+                if np.isfinite(lo).any() and len(v) > 1:
                     a.fill_between(v, lo, hi, color=colour, alpha=0.12, linewidth=0)
+                elif np.isfinite(lo).any():  # one speed: a band has no width, so a bar
+                    a.errorbar(v, mean, yerr=[mean - lo, hi - mean], color=colour, capsize=3, linewidth=1)
         a.axhline(1.0, color="k", linewidth=0.8, label="passive")
         a.set_title(title)
         a.set_xlabel("speed (m/s)")

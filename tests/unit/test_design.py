@@ -401,3 +401,18 @@ def test_the_probes_runs_go_in_one_call_and_the_probes_then_run_nothing(monkeypa
     assert judged == (3, 3)
     assert ahead == (3 * 3, 3 * 2 + 1)  # passive is in every ask, and runs once
     assert probes == [(3, 0), (3, 0), (3, 0)]  # two devices and the fault, all found in the table
+
+
+def test_the_figure_draws_a_bar_where_one_speed_leaves_no_band(tiny):
+    """At one speed a band has no width: each law's 5-95 % range is an error bar from its own
+    held-out runs' percentiles."""
+    from matplotlib.collections import LineCollection
+
+    fig = tiny.plot()
+    ax = fig.axes[0]  # acceleration
+    bars = [c for c in ax.collections if isinstance(c, LineCollection)]
+    assert len(bars) == 2  # pid and skyhook
+    rows = tiny.summary[(tiny.summary["metric"] == "acceleration_m_s2_rms") & (tiny.summary["controller"] != "passive")]
+    want = sorted((float(r.ratio_p5), float(r.ratio_p95)) for r in rows.itertuples())
+    got = sorted((float(seg[0][1]), float(seg[1][1])) for c in bars for seg in c.get_segments())
+    np.testing.assert_allclose(np.array(got), np.array(want), rtol=1e-12)
