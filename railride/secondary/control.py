@@ -394,11 +394,12 @@ class GainSet:
     def tuned_on(self, record: dict | None) -> bool:
         """Whether these gains were tuned on the track ``record`` (`Scenario.describe`), as the
         file's [provenance] scenario record (or, for a robust tuning, its tuning set) says:
-        judged there, they are judged in-sample."""
-        if self.provenance.get("scenario_record") == record:
-            return True
-        # a tuning set (robust tuning): any of its tracks, whatever the load
-        return any({k: v for k, v in r.items() if k != "load"} == record for r in self.provenance.get("tuning_set", []))
+        judged there, they are judged in-sample: the same track at the same speed, whatever the
+        duration and the load (`railride.secondary.provenance.judged_on`)."""
+        from railride.secondary.provenance import IN_SAMPLE, judged_on
+
+        judged = judged_on(self, record)
+        return judged is not None and judged[0] == IN_SAMPLE
 
     def mismatch(self, vehicle: dict | None = None, scenarios=None, controllers=None) -> str | None:
         """One line when a run with these gains leaves the case they were tuned for (another
