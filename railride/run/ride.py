@@ -454,7 +454,7 @@ class RideResult:
             "travel": self.travel((start, end)),
         }
         if comfort:
-            from railride.analysis.comfort import comfort_record
+            from railride.analysis.comfort_record import comfort_record
 
             doc["comfort"] = comfort_record(self.comfort(window))
         return doc

@@ -22,7 +22,7 @@ from railride.secondary import dampers
 from railride.secondary.control import CONSTANT_VOLTAGE, CONTROLLERS, LABELS, PAPER_CONTROLLERS, GainSet
 from railride.defaults import DEFAULT_DAMPER
 from railride.secondary.faults import check_faults, degradation
-from railride.analysis.comfort import comfort_record
+from railride.analysis.comfort_record import comfort_record
 from railride.model.params import VehicleParams, resolve_vehicle, vehicle_argument
 from railride.model.plausible import notes
 from railride.analysis.metrics import STATISTICS, reduction, ride_metrics, select_window, still_passive

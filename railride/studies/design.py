@@ -27,7 +27,7 @@ import pandas as pd
 
 from railride import arguments, validation
 from railride._version import versions
-from railride.analysis.comfort import intervals_in, n_mv_basis
+from railride.analysis.comfort_record import intervals_in, n_mv_basis
 from railride.analysis.costs import COST_COLUMNS
 from railride.defaults import DEFAULT_DAMPER
 from railride.errors import InputError

@@ -98,9 +98,12 @@ class DesignResult:
 
     @property
     def recommended(self) -> str | None:
-        """The law ranked first, or None when no law could be ranked (every one diverged)."""
+        """The law ranked first; "passive" where its score is worse than passive's by the same
+        objective (`passive_wins`); None when no law could be ranked (every one diverged)."""
         first = self.ranking[0] if self.ranking else None
-        return first["controller"] if first is not None and first["ranked"] else None
+        if first is None or not first["ranked"]:
+            return None
+        return "passive" if passive_wins(first, self.points) else first["controller"]
 
     def table(self, metric: str) -> pd.DataFrame:
         """One metric's rows of `summary`, indexed by law, speed and load."""
@@ -288,7 +291,15 @@ def rank(summary: pd.DataFrame, objective: Objective, laws, diverged=()) -> tupl
                 top = min(values, key=lambda n: values[n])
                 none.append({"response": word, "best_ratio": values[top], "best_controller": top})
         points.append(
-            {"speed_m_s": float(v), "load": float(load), "scores": scores, "best": best, "no_law_beats_passive": none}
+            {
+                "speed_m_s": float(v),
+                "load": float(load),
+                "scores": scores,
+                "best": best,
+                "no_law_beats_passive": none,
+                # passive by the same objective: ratios of 1, its own travel against a travel bound
+                "passive_score": _plain(_point_score(by, objective, "passive", v, load)),
+            }
         )
     ranking = []
     for n in laws:
@@ -332,6 +343,7 @@ def recommend(ranking, points, summary: pd.DataFrame, runs: pd.DataFrame, object
     else:
         best = ok[0]
         name, score, w = best["controller"], best["score"], best["worst_at"]
+        keep = passive_wins(best, points)
         if objective.kind == "minimax":
             what = "its worst mean RMS ratio to passive over the four responses, at any speed and load, is"
         elif objective.needs_comfort:
@@ -341,7 +353,16 @@ def recommend(ranking, points, summary: pd.DataFrame, runs: pd.DataFrame, object
             what = (
                 f"its largest score ({objective.kind} of the mean RMS ratios to passive) over the speeds and loads is"
             )
-        out.append(f"Recommended: {_label(name)}. On {held}, {what} {score:.3f} (at {_at(w['speed_m_s'], w['load'])}).")
+        if keep:  # by the design's own objective, passive is better than every law
+            out.append(
+                f"Recommended: keep passive. By this objective no law beats passive on held-out track: the best "
+                f"law, {_label(name)}, scores {score:.3f} at worst (at {_at(w['speed_m_s'], w['load'])}) on {held}, "
+                f"against passive's {keep:.3f}."
+            )
+        else:
+            out.append(
+                f"Recommended: {_label(name)}. On {held}, {what} {score:.3f} (at {_at(w['speed_m_s'], w['load'])})."
+            )
         out.append(_worse_than_passive(name, summary))
         out.append(_wins(name, points))
         out.append(_trade_offs(name, ok, summary))
@@ -351,7 +372,7 @@ def recommend(ranking, points, summary: pd.DataFrame, runs: pd.DataFrame, object
                 "Constraints, on the 95th percentile of the held-out runs at each speed and load: "
                 + _bounds_text(ok, objective)
             )
-        if objective.kind == "minimax" and score >= 1.0:
+        if objective.kind == "minimax" and score >= 1.0 and not keep:
             out.append(
                 "No law keeps every RMS response better than passive on average at every speed and load; "
                 "the recommended law is the one whose worst response is least worse."
@@ -375,6 +396,21 @@ def recommend(ranking, points, summary: pd.DataFrame, runs: pd.DataFrame, object
             "and is not ranked."
         )
     return " ".join(s for s in out if s)
+
+
+def passive_wins(best: dict, points: list) -> float:
+    """Passive's score (its worst over the speeds and loads, by the design's objective) where it
+    is lower than ``best``'s, the ranked law's, by more than the level tolerance of a
+    comparison; else 0.0 (falsy): a law that scores worse than passive is not recommended."""
+    from railride.studies.comparison import LEVEL_TOLERANCE, is_level
+
+    scores = [p.get("passive_score") for p in points]
+    if not scores or any(x is None or not np.isfinite(x) for x in scores):
+        return 0.0
+    own = max(scores)
+    if best["score"] > own and not is_level(best["score"], own, LEVEL_TOLERANCE):
+        return float(own)
+    return 0.0
 
 
 def _bounds_text(ok: list, objective) -> str:

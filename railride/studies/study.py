@@ -33,7 +33,7 @@ from railride.secondary.control import PAPER_CONTROLLERS, GainSet
 from railride.secondary.provenance import judged_text
 from railride.defaults import DEFAULT_DAMPER
 from railride.secondary.faults import DamperFault, check_faults, parse_faults
-from railride.analysis.comfort import intervals_in, n_mv_basis
+from railride.analysis.comfort_record import intervals_in, n_mv_basis
 from railride.analysis.metrics import RESPONSES
 from railride.model.params import resolve_argument, vehicle_record
 from railride.plots import PNG_DPI, FigureOptions

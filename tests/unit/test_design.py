@@ -166,10 +166,15 @@ def test_the_recommendation_says_where_no_law_beats_passive():
     assert [r["controller"] for r in ranking] == ["pid", "skyhook"]
     assert points[0]["no_law_beats_passive"] == [{"response": "roll", "best_ratio": 1.1, "best_controller": "pid"}]
     text = recommend(ranking, points, summary, _runs({"pid": 1.1, "skyhook": 1.2}), Objective("minimax"), SETTINGS, [])
-    assert text.startswith("Recommended: PID.")
+    # passive scores 1 by minimax (every ratio 1): the best law's 1.1 is worse, so passive is kept
+    assert points[0]["passive_score"] == 1.0
+    assert text.startswith(
+        "Recommended: keep passive. By this objective no law beats passive on held-out track: the best law, PID, "
+        "scores 1.100 at worst (at 50 m/s, load 1)"
+    )
+    assert "against passive's 1.000." in text
     assert "worse than passive in roll at 50 m/s, load 1 (x1.100)" in text
     assert "No law is better than passive on average in roll at 50 m/s, load 1" in text
-    assert "No law keeps every RMS response better than passive" in text
     # the bands (1.05-1.15 and 1.15-1.25) touch: they overlap; PID wins every run
     assert "overlap at 1 of 1" in text and "PID scores lower in 5 of 5" in text
 
@@ -416,3 +421,15 @@ def test_the_figure_draws_a_bar_where_one_speed_leaves_no_band(tiny):
     want = sorted((float(r.ratio_p5), float(r.ratio_p95)) for r in rows.itertuples())
     got = sorted((float(seg[0][1]), float(seg[1][1])) for c in bars for seg in c.get_segments())
     np.testing.assert_allclose(np.array(got), np.array(want), rtol=1e-12)
+
+
+def test_a_law_level_with_passive_is_recommended_one_worse_is_not():
+    """Within 1 % of passive's score a law is level with it and stays recommended; beyond, the
+    design keeps passive (`passive_wins` returns passive's score)."""
+    from railride.studies.design_result import passive_wins
+
+    points = [{"passive_score": 1.0}, {"passive_score": 1.0}]
+    assert not passive_wins({"score": 1.005}, points)
+    assert passive_wins({"score": 1.02}, points) == 1.0
+    assert not passive_wins({"score": 0.9}, points)
+    assert not passive_wins({"score": 1.5}, [{"passive_score": None}])  # passive's score unknown: no claim

@@ -177,7 +177,8 @@ def test_a_secondary_stiffness_tolerance_is_a_condition_of_its_own():
 def test_the_comfort_basis_counts_the_intervals_the_comfort_index_reads(duration, window, n):
     """The study's line on N_MV,z names as many 5 s intervals as `ride_comfort` of one of its
     runs finds in the same window (0: the whole signal)."""
-    from railride.analysis.comfort import WHOLE_SIGNAL, n_mv_basis, ride_comfort
+    from railride.analysis.comfort import WHOLE_SIGNAL, ride_comfort
+    from railride.analysis.comfort_record import n_mv_basis
 
     res = study(["pid"], track_seeds=[4], speeds=[40.0], duration=duration, window=window)
     run = simulate(scenario("fra4", seed=4, speed=40.0, duration=duration))
