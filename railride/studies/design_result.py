@@ -459,7 +459,7 @@ def _trade_offs(name: str, ok: list, summary: pd.DataFrame) -> str:
             a, b = mean.get((name, metric)), mean.get((other, metric))
             if a is not None and b is not None and np.isfinite(a) and np.isfinite(b):
                 if a > b and not is_level(a, b, LEVEL_TOLERANCE):
-                    worse.append(f"{word} ({a:.3f} against {b:.3f})")
+                    worse.append(f"{word} ({b:.3f} against its {a:.3f})")
         if worse:
             lost.append(f"to {_label(other)} on {', '.join(worse)}")
     text = (
@@ -479,7 +479,7 @@ def _wins(name: str, points) -> str:
     if not lost:
         return "It has the best score of the laws at every speed and load."
     where = "; ".join(
-        f"{_label(p['best'])} at {_at(p['speed_m_s'], p['load'])} ({p['scores'][p['best']]:.3f} against "
+        f"{_label(p['best'])} at {_at(p['speed_m_s'], p['load'])} ({p['scores'][p['best']]:.3f} against its "
         f"{p['scores'][name]:.3f})"
         for p in lost
     )
@@ -505,15 +505,23 @@ def _sureness(best: dict, runner: dict | None, points, summary: pd.DataFrame, ru
         f"scores (over {runs_text} each) overlap at {overlap} of {len(points)} speeds and loads"
     )
     if overlap == len(points):
-        text += ": these runs do not separate the two"
+        text += ": the spread over tracks is wider than the two laws' difference"
     elif overlap == 0:
         text += ": they are apart at every one"
     key = ["track", "track_seed", "speed_m_s", "load"]
     pair = runs[runs["controller"] == a].set_index(key)["score"].to_frame("a")
     pair = pair.join(runs[runs["controller"] == b].set_index(key)["score"].to_frame("b"))
     pair = pair[np.isfinite(pair["a"]) & np.isfinite(pair["b"])]
-    wins = int((pair["a"] < pair["b"]).sum())
-    return text + f"; run by run (the same track, speed and load) {_label(a)} scores lower in {wins} of {len(pair)}."
+    wins, losses = int((pair["a"] < pair["b"]).sum()), int((pair["a"] > pair["b"]).sum())
+    text += f"; run by run (the same track, speed and load) {_label(a)} scores lower in {wins} of {len(pair)}"
+    if wins + losses == 0:
+        return text + "."
+    # the paired runs: a two-sided sign test of "either law as likely to score lower", ties left out
+    from scipy.stats import binomtest
+
+    p = float(binomtest(wins, wins + losses, 0.5).pvalue)
+    verdict = "these runs separate the two" if p < 0.05 else "these runs do not tell that from chance"
+    return text + f" (two-sided sign test over the runs that differ, p = {p:.2g}: {verdict}, at 5 %)."
 
 
 def _passive_unbeaten(points, some_diverged: bool) -> str:

@@ -97,7 +97,7 @@ def test_the_recommendation_says_what_the_winner_gives_up(tiny):
     text = tiny.recommendation
     for column, word in names.items():
         a, b = ratio(win, column), ratio(other, column)
-        said = f"{word} ({a:.3f} against {b:.3f})"
+        said = f"{word} ({b:.3f} against its {a:.3f})"
         assert (said in text) == (a - b > 0.01 * a), (word, a, b)  # level: within 1 % of the larger
     travel = ratio(win, "travel_max_m")
     assert f"Its largest secondary travel is x{travel:.2f} passive's on average." in text
@@ -177,6 +177,8 @@ def test_the_recommendation_says_where_no_law_beats_passive():
     assert "No law is better than passive on average in roll at 50 m/s, load 1" in text
     # the bands (1.05-1.15 and 1.15-1.25) touch: they overlap; PID wins every run
     assert "overlap at 1 of 1" in text and "PID scores lower in 5 of 5" in text
+    # 5 of 5 by chance: 2 x 0.5**5 = 0.0625, two-sided
+    assert "(two-sided sign test over the runs that differ, p = 0.062: these runs do not tell that from chance" in text
 
 
 def test_apart_bands_and_a_law_that_diverged():
