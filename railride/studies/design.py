@@ -227,7 +227,7 @@ def check_design(
             "the held-out seeds must be seeds that tuning never sees"
         )
     duration = validation.number("duration", duration, "positive", "s")
-    sections = {t: _sections(t, max(speed_list) * duration, train + test) for t in track_list if t.startswith("file:")}
+    sections = {t: _sections(t, max(speed_list), duration, train + test) for t in track_list if t.startswith("file:")}
     obj = _objective(objective)
     validation.choice("aggregate", aggregate, AGGREGATES)
     values = validation.count("values", values, 3, what="values per gain and sweep")
@@ -275,15 +275,20 @@ def check_design(
     )
 
 
-def _sections(track: str, length: float, seeds) -> tuple:
+def _sections(track: str, speed: float, duration: float, seeds) -> tuple:
     """(the first section's start, a section's length) [m] of the measured profile ``track``:
-    sections of ``length`` (the fastest run's distance) from its start at s >= 0 on, section k
-    the "seed" k, disjoint whatever the speed; an `InputError` naming the seed options where a
-    seed has no section."""
+    sections of the fastest run's distance (``speed`` x ``duration``) from its start at s >= 0
+    on, section k the "seed" k, disjoint whatever the speed; an `InputError` naming the seed
+    options where a seed has no section."""
     from railride.model.track import MeasuredTrack
     from railride.model.track import scenario as make_scenario
 
-    profile = make_scenario(track).track
+    length = speed * duration
+    # the profile read at the design's own fastest run, not a scenario's default speed and length
+    try:
+        profile = make_scenario(track, speed=speed, duration=duration).track
+    except InputError as exc:  # the profile is shorter than one run: name the design's options
+        raise InputError(f"tracks = {track!r}, speeds up to {speed:g} m/s, duration = {duration:g} s: {exc}") from None
     assert isinstance(profile, MeasuredTrack)  # a file: scenario
     first = max(0.0, float(profile.s[0]))
     count = int((float(profile.s[-1]) - first) // length)

@@ -95,10 +95,17 @@ def fault_check(plan, leaders: list, points: list, scores) -> dict | None:
         f"{label[law]} scores {_text(v['faulted'])} at worst (healthy {_text(v['healthy'])})" for law, v in laws.items()
     )
     baseline = plan.objective.passive_score
-    worse = [label[law] for law, v in laws.items() if v["faulted"] is None or v["faulted"] >= baseline]
+
+    def beats(score) -> bool:
+        return score is not None and score < baseline
+
+    worse = [label[law] for law, v in laws.items() if beats(v["healthy"]) and not beats(v["faulted"])]
+    never = [label[law] for law, v in laws.items() if not beats(v["healthy"]) and not beats(v["faulted"])]
     text += f" (passive {baseline:g})"
     if worse:
         text += f"; {' and '.join(worse)} then no longer beat{'s' * (len(worse) == 1)} passive everywhere"
+    if never:
+        text += f"; {' and '.join(never)} did not beat passive everywhere healthy either"
     record = {"fault": fault, "laws": laws, "turns_at": []}
     if len(leaders) == 2:
         first, second = leaders

@@ -362,10 +362,11 @@ def test_the_coil_power_at_a_constant_voltage_is_its_square_over_v_max_squared()
 
 
 def test_a_measured_profile_is_cut_into_sections_for_training_and_judging(tmp_path):
-    """A measured line (here 600 m of a FRA class 4 realisation, sampled every 0.25 m) is split
-    into sections of the fastest run's length (40 m/s x 2 s = 80 m): tuning runs on section 0,
-    judging on section 2, and a held-out run is the run of that section by itself."""
-    s = np.arange(0.0, 600.25, 0.25)
+    """A measured line (here 500 m of a FRA class 4 realisation, sampled every 0.25 m: shorter
+    than a run at the default speed and duration, 555.6 m) is split into sections of the fastest
+    run's length (40 m/s x 2 s = 80 m): tuning runs on section 0, judging on section 2, and a
+    held-out run is the run of that section by itself."""
+    s = np.arange(0.0, 500.25, 0.25)
     zl, zr, _, _ = rr.scenario("fra4", seed=5).track.evaluate(s)
     path = tmp_path / "line.csv"
     pd.DataFrame({"s": s, "z_L": zl, "z_R": zr}).to_csv(path, index=False)
@@ -381,9 +382,12 @@ def test_a_measured_profile_is_cut_into_sections_for_training_and_judging(tmp_pa
     passive = result.runs[result.runs["controller"] == "passive"].iloc[0]
     alone = rr.simulate(rr.scenario(track, start=160.0, speed=40.0, duration=2.0)).metrics()
     assert passive["roll_deg_rms"] == pytest.approx(float(alone.sel(response="roll_deg", statistic="rms")), rel=1e-12)
-    with pytest.raises(InputError, match="holds 7 sections of 80 m"):
+    with pytest.raises(InputError, match="holds 6 sections of 80 m"):
         rr.design(["skyhook"], tracks=[track], speeds=[40.0], loads=[1.0], train_seeds=[0], test_seeds=[7],
                   duration=2.0, budget=13, values=3)  # fmt: skip
+    with pytest.raises(InputError, match=r"speeds up to 40 m/s, duration = 20 s: the run covers s = 0 to 800"):
+        rr.design(["skyhook"], tracks=[track], speeds=[40.0], loads=[1.0], train_seeds=[0], test_seeds=[1],
+                  duration=20.0, budget=13, values=3)  # fmt: skip
 
 
 def test_the_probes_runs_go_in_one_call_and_the_probes_then_run_nothing(monkeypatch):
@@ -435,3 +439,19 @@ def test_a_law_level_with_passive_is_recommended_one_worse_is_not():
     assert passive_wins({"score": 1.02}, points) == 1.0
     assert not passive_wins({"score": 0.9}, points)
     assert not passive_wins({"score": 1.5}, [{"passive_score": None}])  # passive's score unknown: no claim
+
+
+def test_the_fault_sentence_tells_a_law_that_never_beat_passive_from_one_the_fault_cost():
+    """PID beats passive healthy (0.9) and not with the failed coil (1.1): "no longer"; skyhook
+    never did (1.2, 1.3): not "no longer", but "healthy either"."""
+    from types import SimpleNamespace
+
+    from railride.studies.design_probes import fault_check
+
+    plan = SimpleNamespace(damper="railway", laws=["pid", "skyhook"], objective=Objective("minimax"))
+    healthy = [{"speed_m_s": 40.0, "load": 1.0, "scores": {"pid": 0.9, "skyhook": 1.2}}]
+    faulted = [{"speed_m_s": 40.0, "load": 1.0, "scores": {"pid": 1.1, "skyhook": 1.3}}]
+    text = fault_check(plan, ["pid", "skyhook"], healthy, lambda **kw: faulted)["text"]
+    assert "PID then no longer beats passive everywhere" in text
+    assert "Skyhook did not beat passive everywhere healthy either" in text
+    assert "Skyhook then no longer" not in text
