@@ -139,9 +139,11 @@ def judged_on(gains, record: dict | None) -> tuple[str, str] | None:
     def rail(r: dict) -> dict:
         return {k: v for k, v in r.items() if k not in _RUN_KEYS}
 
-    same = [t for t in tracks if rail(t) == rail(record)]
+    same = [t for t in tracks if rail(t) == rail(record) or _overlaps(t, record)]
     speed = record.get("speed_m_s")
     what = _rail_text(record)
+    if record.get("profile") == "measured":  # a stretch of a line: the design's sections
+        what = f"the stretch of {record.get('name')} this run covers"
     if any(speed is not None and _same(t.get("speed_m_s"), speed) for t in same):
         if len(tracks) == 1:
             return IN_SAMPLE, (
@@ -157,7 +159,13 @@ def judged_on(gains, record: dict | None) -> tuple[str, str] | None:
         return SAME_TRACK, (
             f"Not held out: the gains were tuned on this track ({what}), at {speeds} m/s; only the speed is new."
         )
-    if any(str(t.get("name")) == str(record.get("name")) for t in tracks):  # its name, other settings
+    line = [t for t in tracks if str(t.get("name")) == str(record.get("name"))]
+    if record.get("profile") == "measured" and line:
+        speeds = _list(dict.fromkeys(t.get("speed_m_s") for t in line))
+        return HELD_OUT, (
+            f"Held out: tuning never ran on {what}; the gains were tuned on other stretches of it, at {speeds} m/s."
+        )
+    if line:  # its name, other settings
         what = _tracks_text([record], tracks)
     return (
         HELD_OUT,
@@ -193,6 +201,29 @@ def judged_text(gains, records: list) -> str | None:
     return f"Against the tracks the gains were tuned on ({_tracks_tuned(tuned_tracks(gains.provenance))}): " + (
         "; ".join(parts) + "."
     )
+
+
+#: a measured profile's record keys that change with the section it starts at
+_SECTION_KEYS = ("source", "rows", "s_end_m")
+
+
+def _overlaps(tuned: dict, record: dict) -> bool:
+    """Whether a run on a measured profile covers some of the rail a tuning run on the same
+    file covered (a design's sections, `railride.studies.design`). A record names its start
+    only in words, but its ``s_end_m`` is the file's end less its start, so two records'
+    starts differ by the difference of their ends."""
+    if record.get("profile") != "measured" or tuned.get("profile") != "measured":
+        return False
+    keep = (*_RUN_KEYS, *_SECTION_KEYS)
+    if {k: v for k, v in tuned.items() if k not in keep} != {k: v for k, v in record.items() if k not in keep}:
+        return False
+    try:
+        offset = float(record["s_end_m"]) - float(tuned["s_end_m"])  # the tuning run's start, from the run's
+        run_length = float(record["speed_m_s"]) * float(record["duration_s"])
+        tuned_length = float(tuned["speed_m_s"]) * float(tuned["duration_s"])
+    except (KeyError, TypeError, ValueError):
+        return False
+    return offset < run_length and offset + tuned_length > 0.0
 
 
 def _rail_text(record: dict) -> str:

@@ -369,3 +369,26 @@ def test_a_run_says_whether_its_track_was_in_the_tuning_set():
     paper = GainSet.default()
     assert judged_on(paper, scenario("paper-sine").describe())[0] == IN_SAMPLE
     assert judged_on(paper, scenario("fra4", seed=1).describe())[0] == HELD_OUT
+
+
+def test_a_run_on_a_measured_line_overlaps_the_sections_tuning_ran_on_or_not():
+    """A design tunes on sections of a measured line; a run's record names its start only in
+    words, but its s_end_m is the file's end less its start. Tuned on the section from s = 160 m
+    (40 m/s x 4 s), a run from s = 0 at 40 m/s is held out for 4 s (0-160 m) and in-sample for
+    5 s (0-200 m); at 30 m/s for 6 s (0-180 m), the same rail at a new speed."""
+    from types import SimpleNamespace
+
+    from railride.secondary.provenance import HELD_OUT, IN_SAMPLE, SAME_TRACK, judged_on
+
+    line = {"name": "file:line.csv", "profile": "measured"}
+    tuned = {**line, "speed_m_s": 40.0, "duration_s": 4.0, "source": "line.csv from s = 160 m", "rows": 79360}
+    gains = SimpleNamespace(provenance={"tuning_set": [{**tuned, "s_end_m": 19839.75, "load": 1.0}]})
+
+    def run(speed, duration):
+        record = {**line, "speed_m_s": speed, "duration_s": duration, "source": "line.csv", "rows": 80000}
+        return judged_on(gains, {**record, "s_end_m": 19999.75})
+
+    assert run(40.0, 4.0)[0] == HELD_OUT and "other stretches" in run(40.0, 4.0)[1]
+    assert run(40.0, 5.0)[0] == IN_SAMPLE
+    assert run(30.0, 6.0)[0] == SAME_TRACK
+    assert run(30.0, 5.0)[0] == HELD_OUT  # 0-150 m
