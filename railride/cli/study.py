@@ -150,7 +150,7 @@ def _table(doc: dict):
         f"{s['scenario']} at {speeds} m/s" + (f", track seeds {', '.join(map(str, seeds))}" if seeds else "") + "; "
         f"{s['damper']} dampers, gains {s['gains']} (kept for every load and fault); "
         + ("exact states measured." if s.get("sensing", "ideal") == "ideal" else "accelerometers measured."),
-        f"Mean and {lo:g}th to {hi:g}th percentile over the runs of each row (tracks and speeds)"
+        f"Mean and {lo:g}th to {hi:g}th percentile over the runs of each row (its track seeds)"
         + (
             f"; with {len(seeds)} runs a row, fewer than 20, the band is close to their range"
             if 1 < len(seeds) < 20
