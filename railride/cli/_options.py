@@ -512,7 +512,7 @@ StudyOutOption = _out(
 )
 DesignOutOption = _out(
     "Keep the run table DIR/runs.csv (updated as runs finish) and write design.json, design.csv, "
-    "design_runs.csv, gains.toml and design.png into DIR at the end."
+    "design_runs.csv, gains.toml, design.png and design_costs.png into DIR at the end."
 )
 
 # -- figures: every command that writes an output folder -------------------------------------------
