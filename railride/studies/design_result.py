@@ -356,17 +356,18 @@ def recommend(ranking, points, summary: pd.DataFrame, runs: pd.DataFrame, object
         if keep:  # by the design's own objective, passive is better than every law
             out.append(
                 f"Recommended: keep passive. By this objective no law beats passive on held-out track: the best "
-                f"law, {_label(name)}, scores {score:.3f} at worst (at {_at(w['speed_m_s'], w['load'])}) on {held}, "
-                f"against passive's {keep:.3f}."
+                f"law, {_label(name)}, scores {score_text(score, objective)} at worst (at "
+                f"{_at(w['speed_m_s'], w['load'])}) on {held}, against passive's {score_text(keep, objective)}."
             )
         else:
             out.append(
-                f"Recommended: {_label(name)}. On {held}, {what} {score:.3f} (at {_at(w['speed_m_s'], w['load'])})."
+                f"Recommended: {_label(name)}. On {held}, {what} {score_text(score, objective)} (at "
+                f"{_at(w['speed_m_s'], w['load'])})."
             )
         out.append(_worse_than_passive(name, summary))
         out.append(_wins(name, points))
         out.append(_trade_offs(name, ok, summary))
-        out.append(_sureness(best, ok[1] if len(ok) > 1 else None, points, summary, runs))
+        out.append(_sureness(best, ok[1] if len(ok) > 1 else None, points, summary, runs, objective))
         if objective.peak_bound is not None or objective.travel_bound is not None:
             out.append(
                 "Constraints, on the 95th percentile of the held-out runs at each speed and load: "
@@ -396,6 +397,20 @@ def recommend(ranking, points, summary: pd.DataFrame, runs: pd.DataFrame, object
             "and is not ranked."
         )
     return " ".join(s for s in out if s)
+
+
+def score_text(score: float, objective) -> str:
+    """A score in words: the number, or where it breaks the objective's constraints (at or above
+    its infeasible offset), "infeasible" and by how much it breaks them (the excess, a fraction
+    of each bound summed), which the raw score hides in its offset."""
+    from railride.studies.objectives import INFEASIBLE_OFFSET, INFEASIBLE_SCALE
+
+    if objective.peak_bound is None and objective.travel_bound is None:
+        return f"{score:.3f}"
+    offset = objective.infeasible_offset or INFEASIBLE_OFFSET
+    if not np.isfinite(score) or score < offset:
+        return f"{score:.3f}"
+    return f"infeasible: over its constraints by {(score - offset) / INFEASIBLE_SCALE:.3g} of a bound"
 
 
 def passive_wins(best: dict, points: list) -> float:
@@ -486,7 +501,7 @@ def _wins(name: str, points) -> str:
     return f"It has the best score at {len(points) - len(lost)} of {len(points)} speeds and loads; it loses to {where}."
 
 
-def _sureness(best: dict, runner: dict | None, points, summary: pd.DataFrame, runs: pd.DataFrame) -> str:
+def _sureness(best: dict, runner: dict | None, points, summary: pd.DataFrame, runs: pd.DataFrame, objective) -> str:
     if runner is None:
         return "No other law was ranked: there is no runner-up to compare with."
     a, b = best["controller"], runner["controller"]
@@ -501,8 +516,8 @@ def _sureness(best: dict, runner: dict | None, points, summary: pd.DataFrame, ru
         hi = min(band.loc[key_a, "p95"], band.loc[key_b, "p95"])
         overlap += bool(lo <= hi)
     text = (
-        f"Runner-up: {_label(b)} ({runner['score']:.3f}). The held-out 5-95 % bands of the two laws' per-run "
-        f"scores (over {runs_text} each) overlap at {overlap} of {len(points)} speeds and loads"
+        f"Runner-up: {_label(b)} ({score_text(runner['score'], objective)}). The held-out 5-95 % bands of the "
+        f"two laws' per-run scores (over {runs_text} each) overlap at {overlap} of {len(points)} speeds and loads"
     )
     if overlap == len(points):
         text += ": the spread over tracks is wider than the two laws' difference"

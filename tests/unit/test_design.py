@@ -455,3 +455,16 @@ def test_the_fault_sentence_tells_a_law_that_never_beat_passive_from_one_the_fau
     assert "PID then no longer beats passive everywhere" in text
     assert "Skyhook did not beat passive everywhere healthy either" in text
     assert "Skyhook then no longer" not in text
+
+
+def test_a_score_that_breaks_the_constraints_is_said_to_not_a_raw_number():
+    """With --max-travel a run 50 % over the bound scores the infeasible offset + 1000 x 0.5:
+    the recommendation says "infeasible" and by how much, not 1500."""
+    from railride.studies.design_result import score_text
+
+    bound = Objective("minimax", travel_bound=0.04)
+    j = float(bound.of_ratios({c: np.float64(0.8) for c in RMS_COLUMNS}, travel=0.06))
+    assert j >= 1000.0
+    assert score_text(j, bound) == "infeasible: over its constraints by 0.5 of a bound"
+    assert score_text(0.8, bound) == "0.800"
+    assert score_text(1500.0, Objective("minimax")) == "1500.000"  # no constraint: a number
