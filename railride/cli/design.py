@@ -108,8 +108,10 @@ COST_METRICS = {
 REFERENCE_HEADS = {"ideal": "ideal\nactuator", "ideal-damper": "ideal\ndamper"}
 
 
-def _score(value) -> str:
-    return "-" if value is None else f"{value:.3f}"
+def _score(value, infeasible=None) -> str:
+    from railride.studies.design_result import score_text
+
+    return score_text(value, infeasible, short=True)
 
 
 def _cell(m: dict, scale: float = 1.0, spec: str = ".3f", band: bool = True) -> str:
@@ -205,17 +207,18 @@ def _tables(doc: dict) -> list:
 
     ranking = FitTable(title="Ranking on held-out track", labels=2)
     refs = doc.get("references") or {}
+    infeasible = s["objective"].get("infeasible")  # a score past its offset breaks the constraints
     heads = ["rank", "law", "score", *[REFERENCE_HEADS[d] for d in refs], "worst at", "best at"]
     for head in heads:
         ranking.add_column(head, justify="left" if head in ("law", "worst at", "best at") else "right")
     for r in doc["ranking"]:
         worst = r["worst_at"]
         best = ", ".join(f"{p['speed_m_s']:g} m/s load {p['load']:g}" for p in r["best_at"]) or "-"
-        ref_cells = [_score(refs[d].get(r["controller"], {}).get("score")) for d in refs]
+        ref_cells = [_score(refs[d].get(r["controller"], {}).get("score"), infeasible) for d in refs]
         ranking.add_row(
             "-" if r["rank"] is None else str(r["rank"]),
             escape(LABELS[r["controller"]]) + ("" if r["ranked"] else " (diverged)"),
-            _score(r["score"]),
+            _score(r["score"], infeasible),
             *ref_cells,
             f"{worst['speed_m_s']:g} m/s, load {worst['load']:g}",
             best,

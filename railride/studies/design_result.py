@@ -399,18 +399,19 @@ def recommend(ranking, points, summary: pd.DataFrame, runs: pd.DataFrame, object
     return " ".join(s for s in out if s)
 
 
-def score_text(score: float, objective) -> str:
+def score_text(score, objective, short: bool = False) -> str:
     """A score in words: the number, or where it breaks the objective's constraints (at or above
-    its infeasible offset), "infeasible" and by how much it breaks them (the excess, a fraction
-    of each bound summed), which the raw score hides in its offset."""
-    from railride.studies.objectives import INFEASIBLE_OFFSET, INFEASIBLE_SCALE
-
-    if objective.peak_bound is None and objective.travel_bound is None:
+    its infeasible offset), "infeasible" and by how much it breaks them (the excess, summed over
+    the constraints as fractions of each bound), which the raw score hides in its offset.
+    ``objective``: an `Objective`, or its record's ``infeasible`` entry (a document's);
+    ``short``: "infeasible (+excess)", for a table's cell."""
+    if score is None:
+        return "-"
+    infeasible = objective.to_dict()["infeasible"] if isinstance(objective, Objective) else objective
+    if not infeasible or not np.isfinite(score) or score < infeasible["offset"]:
         return f"{score:.3f}"
-    offset = objective.infeasible_offset or INFEASIBLE_OFFSET
-    if not np.isfinite(score) or score < offset:
-        return f"{score:.3f}"
-    return f"infeasible: over its constraints by {(score - offset) / INFEASIBLE_SCALE:.3g} of a bound"
+    excess = (score - infeasible["offset"]) / infeasible["scale"]
+    return f"infeasible (+{excess:.3g})" if short else f"infeasible: over its constraints by {excess:.3g} of a bound"
 
 
 def passive_wins(best: dict, points: list) -> float:

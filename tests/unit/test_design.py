@@ -468,3 +468,5 @@ def test_a_score_that_breaks_the_constraints_is_said_to_not_a_raw_number():
     assert score_text(j, bound) == "infeasible: over its constraints by 0.5 of a bound"
     assert score_text(0.8, bound) == "0.800"
     assert score_text(1500.0, Objective("minimax")) == "1500.000"  # no constraint: a number
+    record = bound.to_dict()["infeasible"]  # a document's, as the command line reads it
+    assert score_text(j, record, short=True) == "infeasible (+0.5)"
