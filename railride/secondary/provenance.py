@@ -113,10 +113,32 @@ def mismatch(gains, vehicle: dict | None = None, scenarios=None, controllers=Non
         return None
     # another vehicle or load wants every track tuned again; else the tracks they were not tuned on
     retune = records if len(differs) > (1 if off else 0) else off
-    return (
+    line = (
         f"the gains {gains.source} were tuned for {_tuned_text(provenance)}; this run has {', '.join(differs)}; "
         f"tune for it with: {tune_command(vehicle, retune)}"
     )
+    if retune and all(r.get("profile") == "random" for r in retune):
+        # gains tuned on one realisation fit that realisation: a design tunes on some seeds, judges on others
+        line += f"; or, for gains judged on seeds they were not tuned on: {design_command(vehicle, retune)}"
+    return line
+
+
+def design_command(vehicle: dict | None, scenarios) -> str:
+    """The `railride design` command line for a run on ``vehicle`` and the random tracks
+    ``scenarios``: its vehicle, loads, track classes and speeds (the rest its defaults)."""
+    vehicle = vehicle or {}
+    parts = ["railride", "design"]
+    name = str(vehicle.get("name", DEFAULT_VEHICLE))
+    if name != DEFAULT_VEHICLE:
+        parts += ["--vehicle", "FILE.toml" if name == "custom" else shlex.quote(name)]
+    loads = vehicle.get("load", DEFAULT_LOAD)
+    loads = list(dict.fromkeys(float(x) for x in (loads if isinstance(loads, list) else [loads])))
+    parts += ["--load", ",".join(_number(x) for x in loads)]
+    parts += ["--track", ",".join(dict.fromkeys(shlex.quote(str(r.get("name"))) for r in scenarios))]
+    speeds = list(dict.fromkeys(r["speed_m_s"] for r in scenarios if r.get("speed_m_s") is not None))
+    if speeds:
+        parts += ["--speed", ",".join(_number(v) for v in speeds)]
+    return " ".join(parts)
 
 
 #: how a run's track stands to the tracks its gains were tuned on (`judged_on`)
