@@ -81,8 +81,9 @@ def plot_design_costs(result, ax=None):
     point, its score there (the design's objective of its mean ratios to passive; lower is
     better) against the RMS damper force it asks for (mean over the held-out runs), passive's
     viscous dampers beside them at passive's own score (1 for minimax). One line per law
-    through its points, in order of speed. ``ax``: one Axes, or None for a new figure. Returns
-    the figure."""
+    through its points, in order of speed (a law's force need not grow with speed, so a line
+    may turn back); the leading law's points are named by speed (and load, with several).
+    ``ax``: one Axes, or None for a new figure. Returns the figure."""
     summary = result.summary
     if ax is None:
         fig = new_figure((PAGE_WIDTH * 0.6, 4.2))
@@ -100,15 +101,21 @@ def plot_design_costs(result, ax=None):
     for j, row in enumerate(result.ranking):
         name = row["controller"]
         colour = suspension_style(name).get("color", f"C{j}")
-        xs, ys = [], []
+        xs, ys, drawn = [], [], []
         for point in result.points:
             key = (name, point["speed_m_s"], point["load"])
             score = point["scores"].get(name)
             if key in force.index and score is not None and np.isfinite(score):
                 xs.append(force[key] / 1e3)
                 ys.append(score)
+                drawn.append(point)
         if xs:
             a.plot(xs, ys, "-o", color=colour, markersize=3, linewidth=0.8, label=suspension_label(name))
+        if j == 0:  # the leading law's points named by speed (and load): which point is which
+            several = len({p["load"] for p in result.points}) > 1
+            for x, y, point in zip(xs, ys, drawn):
+                text = f"{point['speed_m_s']:g} m/s" + (f", {point['load']:g}" if several else "")
+                a.annotate(text, (x, y), textcoords="offset points", xytext=(4, 3), fontsize="x-small", color=colour)
     a.axhline(baseline, color="k", linewidth=0.6, linestyle=":")
     a.set_xlabel("RMS damper force, held-out mean (kN)")
     a.set_ylabel("score at each speed and load\n(lower is better)")
