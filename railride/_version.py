@@ -4,6 +4,8 @@ document). This module imports nothing from railride, so that any layer may impo
 
 from __future__ import annotations
 
+import functools
+
 __version__ = "0.4.0"
 
 #: the packages whose versions a result records, besides railride and Python
@@ -13,7 +15,12 @@ _PACKAGES = ("numpy", "scipy", "numba", "pandas", "xarray")
 def versions() -> dict[str, str | None]:
     """The versions of railride, Python, NumPy, SciPy, numba, pandas and xarray, by name
     (``railride``, ``python``, ``numpy``, ``scipy``, ``numba``, ``pandas``, ``xarray``); None for
-    a package that is not installed."""
+    a package that is not installed. Looked up once a process (a new dict each call)."""
+    return dict(_versions())
+
+
+@functools.lru_cache(maxsize=1)
+def _versions() -> dict[str, str | None]:
     import platform
     from importlib.metadata import PackageNotFoundError, version
 
