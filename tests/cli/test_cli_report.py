@@ -45,7 +45,7 @@ def test_report_command(tmp_path):
     assert "Ride comparison: RMS of the carbody responses" in result.stdout  # compare's tables, printed
     # and the same tables in the page, as HTML, with the command line that made it
     assert '<pre class="console">' in page and "Peak-to-peak of the carbody responses" in page
-    assert "railride report --controllers passive,pid --speed 40.0 --duration 1.0 --no-bounds --out" in page
+    assert "railride report --controllers passive,pid --speed 40.0 --duration 1.0 --no-references --out" in page
     assert page.count('class="plotly-graph-div"') == 5  # the four responses and the spectra
     assert [p.name for p in out.parent.iterdir()] == ["ride.html"]
     # the answer first: the results' table and the trade-offs before the first figure
