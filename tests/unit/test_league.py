@@ -125,9 +125,13 @@ def test_hysteresis_plot_has_one_panel_per_suspension():
     fig = Figure()
     axes = fig.subplots(1, 3)
     assert plot_comparison_hysteresis(comp, ax=axes) is fig
-    # passive: the viscous damper's force is -c_sz x' exactly, a line through the origin
+    # passive: the viscous damper's force is -c_sz x' exactly, a line through the origin whose
+    # slope, in the panel's kN against m/s, is -c_sz / 1000 (-80 kN s/m for the paper's 8e4 N s/m)
     x, f = axes[0].lines[0].get_data()
+    assert np.ptp(x) > 0.01  # the corner moves: the slope is measured, not made up of rounding
     slope = np.polyfit(x, f, 1)
-    assert slope[0] < 0 and abs(slope[1]) < 1e-9 * abs(f).max()
+    assert slope[0] == pytest.approx(-rr.VehicleParams.preset("paper").c_sz / 1e3, rel=1e-9)
+    assert abs(slope[1]) < 1e-9 * abs(f).max()
+    assert axes[0].get_ylabel() == "force at 1R (kN)" and axes[0].get_xlabel() == "deflection rate (m/s)"
     with pytest.raises(ValueError, match="corner = '3R'"):
         plot_comparison_hysteresis(comp, corner="3R")

@@ -45,15 +45,27 @@ def test_python_control_state_space_has_the_names_and_the_response():
 
 
 def test_plant_has_force_inputs_and_no_dashpots():
-    """Without the dashpots the secondary corners feel only the springs: the plant's damping
-    is the passive one less c_sz T T^T, and a unit corner force moves the carbody by T / M."""
+    """Without the dashpots the secondary corners feel only the springs: the plant's damping is
+    that of the vehicle assembled element by element with c_sz = 0 (not the passive one less
+    c_sz T T^T: that difference is the code's own subtraction, and holds whatever T or C0 is),
+    its springs the passive vehicle's; and a unit force at corner 1R accelerates the bodies as
+    the geometry of docs/model.md says, by hand."""
     plant, passive = linear_model(None, "plant"), linear_model(None, "passive")
-    vehicle = rr.Vehicle()
-    minv = 1.0 / np.diag(vehicle.M)
-    c_sz = vehicle.params.c_sz
-    assert np.allclose(plant.A[9:, 9:] - passive.A[9:, 9:], minv[:, None] * c_sz * vehicle.T @ vehicle.T.T)
+    p = rr.VehicleParams.preset("paper")
+    # the DOFs: carbody, bogie 1, bogie 2, each bounce, pitch, roll
+    inertia = np.array([p.m_c, p.I_cy, p.I_cx, p.m_b, p.I_by, p.I_bx, p.m_b, p.I_by, p.I_bx])
+    undamped = rr.Vehicle(p.replace(c_sz=0.0)).C
+    scale = np.abs(rr.Vehicle(p).C).max() / inertia.min()
+    np.testing.assert_allclose(plant.A[9:, 9:], -undamped / inertia[:, None], rtol=0, atol=1e-12 * scale)
+    np.testing.assert_allclose(passive.A[9:, 9:], -rr.Vehicle(p).C / inertia[:, None], rtol=0, atol=1e-12 * scale)
+    np.testing.assert_array_equal(plant.A[9:, :9], passive.A[9:, :9])  # the springs stay
+    # corner 1R sits at x = +l, y = -d_s over bogie 1's centre; positive pitch lowers the front,
+    # positive roll raises the left side: a unit force up on the carbody is heave 1, pitch
+    # -l, roll -d_s, and down on bogie 1 at y = -d_s is bounce -1, roll +d_s
     force = plant.index("inputs", "secondary_force_1R")
-    assert np.allclose(plant.B[9:, force], minv * vehicle.T[:, 0])
+    moment = np.array([1.0, -p.l, -p.d_s, -1.0, 0.0, p.d_s, 0.0, 0.0, 0.0])
+    np.testing.assert_allclose(plant.B[9:, force], moment / inertia, rtol=1e-12, atol=0)
+    assert not plant.B[:9, force].any()  # a force moves no position at once
 
 
 @pytest.mark.parametrize(

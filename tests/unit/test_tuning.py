@@ -106,8 +106,14 @@ def test_sensitivity_study_never_worsens_the_objective_and_records_curves():
     history = [h["objective"] for h in res.history]
     assert len(history) >= 2 and all(b <= a + 1e-12 for a, b in zip(history, history[1:]))
     assert {c.parameter for c in res.curves} == {"pid.kp", "pid.ki", "pid.kd"}
-    for c in res.curves:  # the chosen value is the best of its curve, or the previous value
+    # the chosen value is the best of its curve, or the value the gain had before it; nothing on
+    # any curve beats the end; and the tuned gains are the last values chosen
+    last = {p: start.value(p) for p in ("pid.kp", "pid.ki", "pid.kd")}
+    for c in res.curves:
         assert c.objective.min() >= min(history) - 1e-12
+        assert c.chosen in (c.values[np.argmin(c.objective)], last[c.parameter]), (c.parameter, c.chosen)
+        last[c.parameter] = c.chosen
+    assert {p: res.gains.value(p) for p in last} == last != {p: start.value(p) for p in last}
     # re-evaluating the tuned gains gives the objective the study reports
     rows = run_cases(
         [
