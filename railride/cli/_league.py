@@ -50,6 +50,7 @@ def run_league(
         "rail_phase": "--rail-phase",
         "min_wavelength": "--min-wavelength",
         "max_wavelength": "--max-wavelength",
+        "start": "--start",
         "sensor_noise": "--sensor-noise",
         "seed": "--seed",
         "fault": "--fault",

@@ -119,6 +119,15 @@ TrackSeedOption = Annotated[
         "realisation, a whole number >= 0; the same seed gives the same track (default 0).",
     ),
 ]
+StartOption = Annotated[
+    Optional[float],
+    typer.Option(
+        "--start",
+        metavar="M",
+        help="A measured profile (--scenario file:PATH) only: run its section from s = M m on, as a "
+        "track of its own (a design's section k starts at k times its fastest speed x duration), >= 0.",
+    ),
+]
 MinWavelengthOption = Annotated[
     Optional[float],
     typer.Option(

@@ -331,6 +331,7 @@ PROFILE_FIELDS = {
     "rail_phase": "--rail-phase",
     "speed": "--speed",
     "duration": "--duration",
+    "start": "--start",
 }
 
 

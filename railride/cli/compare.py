@@ -37,6 +37,7 @@ from railride.cli._options import (
     FormatOption,
     MaxWavelengthOption,
     MinWavelengthOption,
+    StartOption,
     OutputFormat,
     OutputRateOption,
     VehicleOption,
@@ -498,6 +499,7 @@ def compare(
     ] = None,
     min_wavelength: MinWavelengthOption = None,
     max_wavelength: MaxWavelengthOption = None,
+    start: StartOption = None,
     speed: Annotated[
         Optional[str],
         typer.Option(
@@ -563,6 +565,7 @@ def compare(
                 rail_phase=rail_phase,
                 min_wavelength=min_wavelength,
                 max_wavelength=max_wavelength,
+                start=start,
                 sensor_noise=sensor_noise,
                 seed=seed,
                 fault=fault,
@@ -607,6 +610,8 @@ def compare(
         vehicle_options = vehicle_arguments(vehicle, preset, loads[0] if loads else None)
         window_value = parse_window(window) if window is not None else None
         track = track_options(scenario, seed_value, min_wavelength, max_wavelength)
+        if start is not None:  # a measured profile's section (the library checks the scenario)
+            track["start"] = start
         scen = make_scenario(
             scenario,
             dict(

@@ -47,6 +47,7 @@ from railride.cli._options import (
     SimulateOutOption,
     SimulateWindowOption,
     SpeedOption,
+    StartOption,
     TrackSeedOption,
     WavelengthOption,
     HistoryFormatOption,
@@ -157,6 +158,7 @@ def simulate(
     track_seed: TrackSeedOption = None,
     min_wavelength: MinWavelengthOption = None,
     max_wavelength: MaxWavelengthOption = None,
+    start: StartOption = None,
     speed: SpeedOption = None,
     duration: DurationOption = None,
     dt: DtOption = None,
@@ -201,6 +203,8 @@ def simulate(
         figures = figure_options(figure_format, dpi, out)
         histories = history_options(history_format, out)
         track = track_options(scenario, track_seed, min_wavelength, max_wavelength)
+        if start is not None:  # a measured profile's section (the library checks the scenario)
+            track["start"] = start
         doc, result = _run(
             scenario,
             amplitude,

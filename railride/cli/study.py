@@ -35,6 +35,7 @@ from railride.cli._options import (
     PresetOption,
     SchedulerFileOption,
     SchedulerOption,
+    StartOption,
     StudyGainsOption,
     StudyOutOption,
     ReportOption,
@@ -68,6 +69,7 @@ STUDY_FIELDS = {
     "fault": "--fault",
     "faults": "--fault",
     "duration": "--duration",
+    "start": "--start",
     "delays": "--delay",
     "sensing": "--sensing",
     **FIXED_RATE_FIELDS,
@@ -249,6 +251,7 @@ def study_command(
     duration: Annotated[
         Optional[float], typer.Option("--duration", metavar="S", help="Run length [s] (default 10).")
     ] = None,
+    start: StartOption = None,
     dt: DtOption = None,
     backend: BackendOption = None,
     window: WindowOption = None,
@@ -315,6 +318,7 @@ def study_command(
                     delays=[int(d) for d in delays],
                     sensing=sensing,
                     duration=duration,
+                    start=start,
                     gains=gain_set,
                     damper=damper,
                     vehicle=source,

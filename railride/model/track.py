@@ -392,7 +392,7 @@ def scenario(
     if taper is not None and name != "paper-sine":
         raise InputError(f"taper applies to paper-sine only, not to {name}")
     if start is not None and not name.startswith("file:"):
-        raise InputError(f"start applies to a measured profile (file:PATH) only, not to {name}")
+        raise InputError(f"start = {start!r}: applies to a measured profile (file:PATH) only, not to {name}")
     track: RailProfile
     if name == "paper-sine":
         track = SineTrack(

@@ -164,6 +164,7 @@ def study(
     delays=(1,),
     sensing: str = "ideal",
     duration: float | None = None,
+    start: float | None = None,
     gains: GainSet | None = None,
     damper: str = DEFAULT_DAMPER,
     vehicle=None,
@@ -176,7 +177,8 @@ def study(
 ) -> StudyResult:
     """Run ``controllers`` (names of `railride.secondary.control.CONTROLLERS`; passive is always the
     baseline) on ``scenario`` for every track seed (a random track's realisation; default 0 to
-    9, none for the other scenarios) and speed (m/s; None: the scenario's), for
+    9, none for the other scenarios) and speed (m/s; None: the scenario's); ``start`` [m]: a
+    measured profile's section from there on (`railride.model.track.scenario`), for
     each load factor (`VehicleParams.loaded`), secondary stiffness factor (k_sz times it: a
     tolerance; `VehicleParams.load_changes`), fault condition ("none", or faults such as
     "1R-off" joined by "+"; faults apply to the controlled suspensions, passive stays healthy)
@@ -282,6 +284,7 @@ def study(
             **({"seed": seed} if seed is not None else {}),
             **({"speed": v} if v is not None else {}),
             **({"duration": duration} if duration is not None else {}),
+            **({"start": start} if start is not None else {}),
         }
         return tuple(sorted(opts.items()))
 
@@ -371,6 +374,7 @@ def study(
         "delays_periods": delay_list,
         "sensing": sensing,
         "duration_s": duration,
+        **({"start_m": float(start)} if start is not None else {}),
         "damper": damper_record(damper),
         # the gains the runs ran: where they came from, how they were found, every value
         "gains": gains_record["source"],

@@ -61,6 +61,8 @@ NAMES = {"dir": "out", "html": "page.html", "model": "model.json", "fmu": "model
 #: stages are replaced, so that none keeps a replaced one after the test
 USERS = (
     "railride.cli",
+    "railride.engine.lanes",
+    "railride.run.reduced",  # a sweep's metrics-only batches import it when they first run
     "railride.frequency.fmu",
     "railride.frequency.frf",
     "railride.frequency.ride_spectrum",

@@ -320,3 +320,36 @@ def test_sweep_writes_the_plot_for_one_numeric_axis(tmp_path):
     result = ok("sweep", "--duration", 1, "--out", other)
     assert sorted(p.name for p in other.iterdir()) == ["runs.csv", "sweep.json"]
     assert "note: no figure" in result.stderr
+
+
+def test_a_measured_line_runs_from_start(tmp_path):
+    """--start M runs a measured profile's section from s = M on: simulate, compare and study give
+    the run of `railride.scenario("file:...", start=M)`, which is the line shifted by M (the
+    section's RMS differs from the whole line's); a scenario that is not a file, a negative start,
+    and a league table are refused (status 2) before any run."""
+    import numpy as np
+    import railride as rr
+
+    s = np.arange(0.0, 800.25, 0.25)
+    zl, zr, _, _ = rr.scenario("fra4", seed=3).track.evaluate(s)
+    path = tmp_path / "line.csv"
+    pd.DataFrame({"s": s, "z_L": zl, "z_R": zr}).to_csv(path, index=False)
+    line = f"file:{path}"
+    direct = rr.simulate(rr.scenario(line, start=160.0, speed=40.0, duration=2.0)).metrics()
+    want = float(direct.sel(response="acceleration_m_s2", statistic="rms"))
+    whole = rr.simulate(rr.scenario(line, speed=40.0, duration=2.0)).metrics()
+    assert abs(float(whole.sel(response="acceleration_m_s2", statistic="rms")) - want) > 1e-3 * want
+    doc = ok_json("simulate", "--scenario", line, "--start", 160, "--speed", 40, "--duration", 2)
+    assert doc["metrics"]["acceleration_m_s2"]["rms"] == pytest.approx(want, rel=1e-12)
+    doc = ok_json("compare", "--scenario", line, "--start", 160, "--speed", 40, "--duration", 2,
+                  "--controllers", "passive")  # fmt: skip
+    passive = next(r for r in doc["controllers"] if r["name"] == "passive")
+    assert passive["metrics"]["acceleration_m_s2"]["rms"] == pytest.approx(want, rel=1e-12)
+    doc = ok_json("study", "--scenario", line, "--start", 160, "--speed", 40, "--duration", 2,
+                  "--controllers", "passive")  # fmt: skip
+    assert doc["settings"]["start_m"] == 160.0
+    mean = next(g for g in doc["results"] if g["controller"] == "passive")["metrics"]["acceleration_m_s2_rms"]["mean"]
+    assert mean == pytest.approx(want, rel=1e-12)
+    assert_input_error(run("simulate", "--scenario", "fra4", "--start", 160), "--start = 160", "file:PATH")
+    assert_input_error(run("compare", "--scenario", line, "--start", -5), "--start = -5", ">= 0")
+    assert_input_error(run("compare", "--scenario", line, "--start", 160, "--speed", "30,40"), "--start")
