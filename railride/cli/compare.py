@@ -680,6 +680,11 @@ def _stops_note(rows: list[dict]) -> str:
     stiffness = next((r["damper"].get("stop_stiffness_n_per_m", 0.0) for r in rows), 0.0)
     hit = [r["label"] for r in rows if r["damper"].get("reached_stops")]
     if not hit:
+        if stiffness <= 0.0:  # a clearance with no stop modelled at it: a limit to read, not a force
+            return (
+                f" No suspension's travel passed the {clearance * 1e3:g} mm clearance (z_stop; this vehicle models "
+                "no stop force there, k_stop = 0)."
+            )
         return f" No suspension reached the bump stops ({clearance * 1e3:g} mm clearance)."
     if stiffness > 0.0:
         return (

@@ -131,7 +131,8 @@ def _frf_tables(doc: dict, vehicle: str) -> list:
         f"{settings['fmin_hz']:g} to {settings['fmax_hz']:g} Hz (log grid; the peak is the "
         f"largest value on it), vehicle {vehicle}. in-phase: z_L = z_R; "
         "anti-phase: z_L = -z_R; every wheelset sees the pattern delayed by its distance "
-        "behind the leading one / V."
+        "behind the leading one / V. The linear passive vehicle: viscous secondary dampers c_sz, "
+        "no MR dampers and no controller (their nonlinear ride is simulate's and compare's)."
     )
     from railride.model.params import vehicle_text
 

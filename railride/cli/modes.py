@@ -16,7 +16,8 @@ def modes(
     preset: PresetOption = None,
     load: LoadOption = None,
 ) -> None:
-    """Natural frequencies and damping of the passive vehicle (9 modes, ascending frequency)."""
+    """Natural frequencies and damping of the linear passive vehicle (viscous secondary dampers
+    c_sz; 9 modes, 10 with a bending carbody; ascending frequency)."""
     with errors():
         from railride.frequency.frf import modes as vehicle_modes
         from railride.model.params import vehicle_text

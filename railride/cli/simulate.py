@@ -146,7 +146,8 @@ def _travel_lines(travel: dict | None) -> list[str]:
     if travel["reached_stops"]:
         bounded = travel.get("stop_stiffness_n_per_m", 0.0) > 0.0
         reached = ": REACHED the bump stops, which bound it" if bounded else ": BEYOND it (no stop force: unbounded)"
-    return [f"max secondary travel {top:.1f} mm of {z * 1e3:g} mm clearance{reached}"]
+    stops = "" if travel.get("stop_stiffness_n_per_m", 0.0) > 0.0 else " (z_stop; no stop force modelled, k_stop = 0)"
+    return [f"max secondary travel {top:.1f} mm of {z * 1e3:g} mm clearance{stops}{reached}"]
 
 
 @app.command()

@@ -28,8 +28,8 @@ def vehicles(
     ] = None,
 ) -> None:
     """The named vehicles (the presets of --preset and of a parameters file's preset = "..."),
-    each with the source of its values and its nine modes (undamped and damped frequency,
-    damping ratio). docs/model.md, Presets, lists every value as source or assumed."""
+    each with the source of its values and its modes, nine or, with a bending carbody, ten
+    (undamped and damped frequency, damping ratio). docs/model.md, Presets, lists every value as source or assumed."""
     with errors():
         from railride.model.vehicle import presets_document
 

@@ -219,6 +219,7 @@ def export_fmu(
             (root / "resources" / "track.bin").write_bytes(_track_pieces(track))
         if compiler is not None:
             _build(compiler, root)
+        path.parent.mkdir(parents=True, exist_ok=True)  # a new folder, as every command's --out makes one
         staged = path.with_name(f".{path.name}.{os.getpid()}.part")
         try:
             with zipfile.ZipFile(staged, "w", zipfile.ZIP_DEFLATED) as z:

@@ -37,7 +37,7 @@ from typing import Any
 import pandas as pd
 
 from railride.errors import InputError
-from railride._version import __version__
+from railride._version import __version__, versions
 from railride._io import atomic_write_text
 
 #: rows of a result table shown in the report; a longer table shows its first rows and says so
@@ -521,7 +521,8 @@ def _settings_html(part: Contents, command: str | None) -> str:
         lines.append(f"<p>Scenario: {html.escape(describe_scenario(part.scenario))}</p>")
     from railride.model.params import vehicle_text
 
-    rows = [("railride version", __version__)]
+    # the software that made it, as every result's document records it
+    rows = [(f"{name} version" if name != "python" else "Python version", v or "-") for name, v in versions().items()]
     for k, v in part.settings.items():
         if k == "vehicle" and isinstance(v, dict) and "name" in v:  # its values: the parameters' table
             rows.append(("vehicle", vehicle_text(v).removeprefix("vehicle: ")))

@@ -24,6 +24,7 @@ import numpy as np
 import pandas as pd
 
 from railride.errors import InputError
+from railride.secondary.provenance import tuned_tracks
 from railride.secondary.control import PAPER_CONTROLLERS, GainSet
 from railride.defaults import DEFAULT_DAMPER
 from railride.output.files import PARETO_FILES
@@ -232,6 +233,11 @@ def in_sample_note(gains: GainSet, record: dict) -> str | None:
     them (`GainSet.tuned_on`)."""
     if not gains.tuned_on(record):
         return None
+    if len(tuned_tracks(gains.provenance)) > 1:  # a robust tuning's set holds this track among others
+        return (
+            f"The base gains ({gains.source}) were tuned on a set of tracks that holds this one at this "
+            "speed, and are judged on it: their place here is in-sample, not a test on a track tuning never saw."
+        )
     return (
         f"The base gains ({gains.source}) were tuned on this same single track and are judged "
         f"on it: their place here is in-sample, not a test on another track."

@@ -48,6 +48,15 @@ def test_an_out_that_is_no_fmu_or_cannot_be_written_is_refused(tmp_path):
     assert_input_error(run("fmu", "--out", tmp_path / "file" / "v.fmu"), "--out", "is a file")
 
 
+def test_an_out_in_a_new_folder_makes_the_folder(tmp_path):
+    """As every command's --out: a folder that does not exist yet is made (it failed on the
+    staged file's name)."""
+    ok("fmu", "--out", tmp_path / "new" / "sub" / "v.fmu", "--sources-only")
+    with zipfile.ZipFile(tmp_path / "new" / "sub" / "v.fmu") as z:
+        assert "modelDescription.xml" in z.namelist()
+    assert [p.name for p in (tmp_path / "new" / "sub").iterdir()] == ["v.fmu"]
+
+
 def test_a_random_track_goes_into_the_fmus_resources(tmp_path):
     ok("fmu", "--out", tmp_path / "r.fmu", "--scenario", "fra5", "--track-seed", "2", "--speed", "30",
        "--duration", "5", "--sources-only")  # fmt: skip

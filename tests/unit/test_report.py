@@ -103,6 +103,10 @@ def test_nothing_is_fetched(page, page_text):
 def test_settings_and_provenance(page, page_text):
     settings = dict(row for row in page.table_with("setting", "value")[1:])
     assert settings["railride version"] == rr.__version__
+    import numpy
+    import platform
+
+    assert settings["numpy version"] == numpy.__version__ and settings["Python version"] == platform.python_version()
     assert float(settings["scenario.speed_m_s"]) == 40.0
     assert float(settings["scenario.duration_s"]) == 2.0
     assert settings["scenario.name"] == "paper-sine"
