@@ -439,6 +439,9 @@ def _caption(grid, doc: dict, wall: float) -> str:
     if st["damper"]:
         lines.append(damper_text(st) + (f"; gains {st['gains_source']}" if grid.controllers else ""))
     lines.append(vehicle_text(st["vehicle"]))
+    if st.get("tracks_judged"):  # which rows' tracks the gains were tuned on
+        lines.append(st["tracks_judged"])
+    lines += [str(n) for n in (st.get("comfort") or {}).get("notes", [])]  # what the comfort columns rest on
     lines.append(
         f"{len(rows)} run{'s' if len(rows) != 1 else ''}: {doc['runs_evaluated']} evaluated now, "
         f"{len(rows) - doc['runs_evaluated']} from the run table; wall time {wall:.1f} s"

@@ -1,15 +1,14 @@
 """Many runs at once: cases, their batches, and the sweep study over a grid of them.
 
-A `Case` is one run described by plain settings (scenario and its options, vehicle parameter
-changes, suspension, gain changes), so it can travel to a Dask worker and has a stable key.
-`run_cases` groups compatible cases into batches for the compiled stepper, scenario by scenario
-so that runs sharing rail tables run in the same or neighbouring chunks (`_chunks`), hands the
-chunks to an executor (`railride.studies.executors`: `LocalExecutor`, this machine, the batch over both cores;
-`DaskExecutor`, a dask.distributed cluster) and appends every finished chunk to a `RunTable` on
-disk, written atomically; a sweep started again with the same table skips the runs it already
-has, so an interrupted sweep resumes where it stopped. The metrics of a case do not depend on
-the executor or on the batch it ran in (a batch equals its single runs,
-tests/physics/test_simulate.py).
+A `Case` is one run described by plain settings (scenario and its options, vehicle parameter changes,
+suspension, gain changes), so it can travel to a Dask worker and has a stable key. `run_cases` groups
+compatible cases into batches for the compiled stepper, scenario by scenario so that runs sharing rail
+tables run in the same or neighbouring chunks (`_chunks`), hands the chunks to an executor
+(`railride.studies.executors`: `LocalExecutor`, this machine, the batch over both cores; `DaskExecutor`,
+a dask.distributed cluster) and appends every finished chunk to a `RunTable` on disk, written
+atomically; a sweep started again with the same table skips the runs it already has, so an
+interrupted sweep resumes where it stopped. The metrics of a case do not depend on the executor or
+on the batch it ran in (a batch equals its single runs, tests/physics/test_simulate.py).
 
 The sweep study: `grid` (`railride.studies.grid`) turns the values of each axis into the cases
 of every combination, checked before the first run; `run_sweep` runs them and returns a
@@ -37,6 +36,7 @@ from railride.plots import PNG_DPI, FigureOptions
 from railride.model.params import VehicleParams, resolve_argument, resolve_vehicle, vehicle_record
 from railride.run.solver import SolverSettings
 from railride.secondary.suspension import batch_conflict, damper_label, damper_record
+from railride.secondary.provenance import judged_text
 from railride.studies.case import MODEL_REVISION, SUSPENSIONS, Case, scenario_of  # noqa: F401 (their home before)
 from railride.studies.grid import SweepGrid, grid  # noqa: F401 (the grid of the sweep study, here too)
 
@@ -512,14 +512,13 @@ class SweepResult:
 
     @property
     def settings(self) -> dict:
-        """What the sweep ran: the scenario's fixed settings, each axis and its values, the
-        damper, the base gains (``gains``, ``gains_provenance``, ``gains_values``:
-        `GainSet.record` of the controllers; ``gains_varied``: the entries the gain axes set
-        instead; ``gains_source`` as ``gains``), the sensor noise, the step and the metrics window;
-        with comfort, what its columns are (`comfort_settings`); the vehicle's record
-        (``vehicle``: name, load, values); a solver's rates and a vehicle other than the
-        defaults (`other_settings`); ``gains_mismatch`` where the base gains were tuned for
-        another vehicle, load or track (`gains_mismatch`)."""
+        """What the sweep ran: the scenario's fixed settings, each axis and its values, the damper, the
+        base gains (``gains``, ``gains_provenance``, ``gains_values``: `GainSet.record` of the
+        controllers; ``gains_varied``: the entries the gain axes set instead; ``gains_source`` as
+        ``gains``), the sensor noise, the step and the metrics window; with comfort, what its columns
+        are (`comfort_settings`); the vehicle's record (name, load, values); a solver's rates and a
+        vehicle other than the defaults (`other_settings`); ``gains_mismatch`` (`gains_mismatch`)
+        and ``tracks_judged`` (`tracks_judged`) where they have something to say."""
         g = self.grid
         vehicle = VehicleParams.preset("paper") if self.vehicle is None else self.vehicle
         record = self.record()
@@ -546,21 +545,25 @@ class SweepResult:
             "vehicle": record,
             **other_settings(vehicle, g.solver),
             **({"gains_mismatch": m} if (m := self.gains_mismatch(record)) else {}),
+            **({"tracks_judged": j} if (j := self.tracks_judged()) else {}),
         }
 
     def gains_mismatch(self, record: dict | None = None) -> str | None:
         """One line when the base gains were tuned for another vehicle, load or track than the
-        controllers' runs of the sweep (`GainSet.mismatch`, over every track they run), else
-        None. ``record``: the vehicle's record (default ``vehicle_record``)."""
+        controllers' runs (`GainSet.mismatch`), else None. ``record``: the vehicle's record."""
+        tracks = self._tracks()
+        return self.grid.base_gains.mismatch(record or self.vehicle_record, tracks) if tracks else None
+
+    def tracks_judged(self) -> str | None:
+        """Which of the controllers' tracks the base gains were tuned on (`judged_text`), or None."""
+        tracks = self._tracks()
+        return judged_text(self.grid.base_gains, tracks) if tracks else None
+
+    def _tracks(self) -> list[dict]:
+        """The controllers' tracks in the grid's order (a set's changes from one process to the next)."""
         g = self.grid
-        if record is None:
-            record = self.vehicle_record
-        # in the grid's order (a set's order changes from one process to the next, and the line with it)
-        ran = [(c.scenario, c.scenario_options) for c in g.cases if c.suspension in g.controllers]
-        controlled = list(dict.fromkeys(ran))
-        if not controlled:
-            return None
-        return g.base_gains.mismatch(record, [scenario_of(name, opts).describe() for name, opts in controlled])
+        ran = dict.fromkeys((c.scenario, c.scenario_options) for c in g.cases if c.suspension in g.controllers)
+        return [scenario_of(name, opts).describe() for name, opts in ran]
 
     def report_contents(self):
         """What this result shows in its HTML report (`railride.output.report.write_report`)."""
@@ -607,11 +610,10 @@ class SweepResult:
         return sweep_figure_note(self)
 
     def save(self, folder, *, extra: dict | None = None, figure_formats=("png",), dpi: float = PNG_DPI) -> list:
-        """sweep.json (`to_dict`, then the entries of ``extra``, such as a command line's
-        facts) and, when one or two axes have several values (`figure_note` is None), sweep.png
-        and, with comfort, comfort.png (each in every one of ``figure_formats``: png, pdf, svg;
-        PNG at ``dpi``) into ``folder``, all or nothing (other files, such as the run table
-        runs.csv, stay). Returns the paths."""
+        """sweep.json (`to_dict`, then the entries of ``extra``, such as a command line's facts) and,
+        when one or two axes have several values (`figure_note` is None), sweep.png and, with comfort,
+        comfort.png (each in every one of ``figure_formats``: png, pdf, svg; PNG at ``dpi``) into
+        ``folder``, all or nothing (other files, such as the run table runs.csv, stay). Returns the paths."""
         from railride.output.files import write_sweep_outputs
 
         figures = FigureOptions(figure_formats, dpi)
@@ -622,10 +624,10 @@ def comfort_settings(duration: float, window) -> dict:
     """``settings.comfort`` of a sweep with comfort: the columns and their units, where the
     positions are and what N_MV_z is (the same for every run of a grid: they share one
     duration)."""
-    from railride.analysis.comfort import INDEX_UNITS, INTERVAL_S
+    from railride.analysis.comfort import INDEX_UNITS
+    from railride.analysis.comfort_record import intervals_in, n_mv_basis
 
-    start, end = window or (0.0, duration)
-    n = max(1, int((end - start + 1e-9) // INTERVAL_S))
+    whole = intervals_in(window, duration)  # 0: shorter than one interval, the whole signal
     unit = {
         i: INDEX_UNITS["aw" if i.startswith("aw_") else "vdv" if i.startswith("vdv_") else i]
         for _, i in COMFORT_INDICES
@@ -638,11 +640,10 @@ def comfort_settings(duration: float, window) -> dict:
             "front": "x = +l (above the front bogie centre)",
             "rear": "x = -l (above the rear bogie centre)",
         },
-        "n_intervals": n,
+        "n_intervals": max(1, whole),
         "notes": [
             "N_MV_z is the vertical term of EN 12299 only: the model has no lateral or longitudinal motion",
-            f"N_MV_z from {n} interval{'s' if n != 1 else ''} of 5 s"
-            + (" (EN 12299 evaluates 60, 5 minutes): an indication only" if n < 60 else ""),
+            n_mv_basis(whole),
         ],
     }
 

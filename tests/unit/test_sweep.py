@@ -334,3 +334,19 @@ def test_the_run_table_names_the_vehicle_and_a_table_from_before_still_resumes(t
 def test_run_sweep_takes_a_grid():
     with pytest.raises(ValueError, match="railride.studies.grid.grid makes one"):
         run_sweep([rr.sweep.Case()])
+
+
+def test_a_sweep_says_which_rows_tracks_its_gains_were_tuned_on():
+    """The shipped robust gains were tuned on fra4 seeds 1-3 at 30, 50 and 70 m/s: seed 1 at 30
+    m/s is in-sample, seed 0 held out; a sweep of 2-s runs says its N_MV_z is from the whole
+    signal (no 5-s interval fits)."""
+    import railride as rr
+
+    res = rr.run_sweep(
+        rr.studies.grid.grid(["pid"], scenario="fra4", track_seed=[0, 1], speed=[30.0], duration=2.0),
+        comfort=True,
+    )
+    text = res.settings["tracks_judged"]
+    assert "in-sample (tuned on this track at this speed): seed 1 at 30 m/s" in text
+    assert "held out (tuning never ran on this track): seed 0 at 30 m/s" in text
+    assert "N_MV_z from one interval, the whole signal" in res.settings["comfort"]["notes"][1]
