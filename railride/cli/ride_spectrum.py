@@ -230,7 +230,7 @@ def _tables(result) -> list:
             f"{r['carbody_bounce_acceleration']:.4g}",
             f"{r['carbody_pitch_acceleration']:.4g}",
             f"{r['carbody_roll_acceleration']:.4g}",
-            f"{1000 * r['secondary_deflection_1R']:.4g}",
+            f"{1000 * r['secondary_deflection_1R']:#.4g}",
         )
     rate = "continuously" if st["control_rate_hz"] is None else f"held at {st['control_rate_hz']:g} Hz"
     note = Text(
@@ -242,6 +242,20 @@ def _tables(result) -> list:
     )
     controlled = any(d != PASSIVE_DEVICE for d in doc["devices"].values())
     parts: list = ([Text(HEADLINE)] if controlled else []) + [floor, body, note]
+    if "passive" in doc["rms"]:  # what the floor's gain costs in travel: a trade the tables show apart
+        base = doc["rms"]["passive"]["secondary_deflection_1R"]
+        more = [
+            f"{LABELS.get(s, s)} {100 * (doc['rms'][s]['secondary_deflection_1R'] / base - 1):+.3g} %"
+            for s in result.suspensions
+            if s != "passive" and base > 0 and doc["rms"][s]["secondary_deflection_1R"] > base * 1.01
+        ]
+        if more:
+            parts.append(
+                Text(
+                    f"Secondary travel (1R, RMS) above passive's: {', '.join(more)}: less floor acceleration, "
+                    "more travel."
+                )
+            )
     for name, reason in st["not_run"].items():
         parts.append(Text(f"not run: {name}: {reason}"))
     return parts

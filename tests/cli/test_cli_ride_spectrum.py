@@ -120,3 +120,14 @@ def test_time_histories_as_matlab_files(tmp_path):
         "--history-format = 'hdf5'",
     )
     assert_input_error(run("simulate", "--duration", 1, "--history-format", "mat"), "--history-format", "--out")
+
+
+def test_the_travel_a_law_adds_is_said_beside_the_floor():
+    """Each law whose RMS travel (1R) is above passive's by more than 1 % is named with the rise
+    read off the JSON document's own RMS values."""
+    doc = ok_json("ride-spectrum", "--format", "json")
+    base = doc["rms"]["passive"]["secondary_deflection_1R"]
+    text = " ".join(ok("ride-spectrum").stdout.split())
+    for name, label in (("pid", "PID"), ("sas-attitude", "SAS (attitude)")):
+        rise = 100 * (doc["rms"][name]["secondary_deflection_1R"] / base - 1)
+        assert rise > 1 and f"{label} {rise:+.3g} %" in text
