@@ -59,6 +59,7 @@ def _comfort_caption(record: dict) -> str:
             + ", ".join(f"{p['x_m']:g} m" for p in record["positions"].values())
             + f"; window {start:g}-{end:g} s",
             *record["notes"],
+            *([] if record.get("n_intervals", 0) >= 60 else ["*: the class of an indicative N_MV,z"]),
         ]
     )
 
@@ -76,7 +77,9 @@ def comfort_table(record: dict):
         table.add_column(escape(POSITION_LABELS.get(name, name)), justify="right")
     for key, label, spec in COMFORT_ROWS:
         table.add_row(escape(label), *[format(p[key], spec) for p in positions.values()])
-    table.add_row("comfort class (N_MV,z)", *[p["N_MV_z_class"] for p in positions.values()])
+    # EN 12299's class reads 60 intervals of 5 s; from fewer it is an indication (the caption says how many)
+    label = "comfort class (N_MV,z)" + ("" if record.get("n_intervals", 0) >= 60 else "*")
+    table.add_row(label, *[p["N_MV_z_class"] for p in positions.values()])
     return table
 
 
@@ -114,7 +117,7 @@ def compare_comfort_table(rows: list[dict]):
                         red = r["comfort"].get("reduction_percent", {}).get(pos, {}).get(key)
                         cells.append(reduction_text(red))
                 table.add_row(*cells)
-            cells = ["class (N_MV,z)"]
+            cells = ["class (N_MV,z)" + ("" if first.get("n_intervals", 0) >= 60 else "*")]
             for r in group:
                 cells.append(r["comfort"]["positions"][pos]["N_MV_z_class"])
                 if r["name"] != "passive":
