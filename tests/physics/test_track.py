@@ -92,7 +92,7 @@ def test_a_section_of_a_measured_profile_is_the_line_from_its_start_faded_in(tmp
     assert sc.describe()["source"].endswith("line.csv from s = 137.3 m")
     with pytest.raises(ValueError, match="start = 700 m: outside the profile"):
         whole.section(700.0)
-    with pytest.raises(ValueError, match="start applies to a measured profile"):
+    with pytest.raises(ValueError, match="start = 10.0: applies to a measured profile"):
         scenario("fra4", start=10.0)
 
 
