@@ -96,6 +96,11 @@ def _pareto_table(doc: dict, caption: str):
     counts.add_row(
         str(c["samples"]), str(c["non_dominated"]), *[str(c[f"non_dominated_{x}_{y}"]) for x, y in PROJECTIONS]
     )
+    if 2 * c["non_dominated"] > c["samples"]:  # four objectives: most of few points are on the front
+        counts.caption = (
+            f"{c['non_dominated']} of {c['samples']} samples are non-dominated over the four ratios: more than "
+            "half, a front this thinly sampled in four ratios (more --samples fill it)."
+        )
     front = sorted(
         (r for r in doc["samples"] if r["non_dominated"]),
         key=lambda r: (r["acceleration_m_s2_ratio"] is None, r["acceleration_m_s2_ratio"] or 0.0),

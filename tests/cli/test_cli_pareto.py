@@ -40,6 +40,10 @@ def test_pareto_table_lists_the_non_dominated_samples_by_acceleration():
     lines = [line for line in table.splitlines() if line.startswith("│")]
     listed = [line.split("│")[1].split()[0] for line in lines[1:]]  # after the counts row
     assert listed == [str(r["sample"]) for r in front]
+    # more than half of the samples on the four-ratio front: the table says it is thinly sampled
+    c = doc["counts"]
+    said = f"{c['non_dominated']} of {c['samples']} samples are non-dominated over the four ratios"
+    assert (said in " ".join(table.split())) == (2 * c["non_dominated"] > c["samples"])
 
 
 @pytest.mark.parametrize(
