@@ -126,14 +126,8 @@ def mismatch(gains, vehicle: dict | None = None, scenarios=None, controllers=Non
 def design_command(vehicle: dict | None, scenarios) -> str:
     """The `railride design` command line for a run on ``vehicle`` and the random tracks
     ``scenarios``: its vehicle, loads, track classes and speeds (the rest its defaults)."""
-    vehicle = vehicle or {}
-    parts = ["railride", "design"]
-    name = str(vehicle.get("name", DEFAULT_VEHICLE))
-    if name != DEFAULT_VEHICLE:
-        parts += ["--vehicle", "FILE.toml" if name == "custom" else shlex.quote(name)]
-    loads = vehicle.get("load", DEFAULT_LOAD)
-    loads = list(dict.fromkeys(float(x) for x in (loads if isinstance(loads, list) else [loads])))
-    parts += ["--load", ",".join(_number(x) for x in loads)]
+    named, loads = _vehicle_options(vehicle)
+    parts = ["railride", "design", *named, "--load", ",".join(_number(x) for x in loads)]
     parts += ["--track", ",".join(dict.fromkeys(shlex.quote(str(r.get("name"))) for r in scenarios))]
     speeds = list(dict.fromkeys(r["speed_m_s"] for r in scenarios if r.get("speed_m_s") is not None))
     if speeds:
@@ -253,12 +247,23 @@ def _rail_text(record: dict) -> str:
     return str(record.get("name")) + (f", seed {seed}" if seed is not None else "")
 
 
-def _tracks_tuned(tracks: list[dict]) -> str:
-    names = list(dict.fromkeys(str(t.get("name")) for t in tracks))
+def _tracks_tuned(tracks: list[dict], names=None, speeds=None) -> str:
+    """The tracks of ``tracks`` in words: their names (seeds) at their speeds; ``names`` and
+    ``speeds`` where the records give none (a provenance written by hand may hold those alone)."""
+    names = list(dict.fromkeys(str(t.get("name")) for t in tracks)) or [str(n) for n in names or []]
     seeds = list(dict.fromkeys(t["seed"] for t in tracks if t.get("seed") is not None))
-    speeds = list(dict.fromkeys(t["speed_m_s"] for t in tracks if t.get("speed_m_s") is not None))
+    speeds = list(dict.fromkeys(t["speed_m_s"] for t in tracks if t.get("speed_m_s") is not None)) or speeds or []
     text = ", ".join(names) + (f" (seed{'s' * (len(seeds) > 1)} {_list(seeds)})" if seeds else "")
     return text + (f" at {_list(speeds)} m/s" if speeds else "")
+
+
+def _vehicle_options(vehicle: dict | None) -> tuple[list[str], list[float]]:
+    """A command's ``--vehicle`` for the run's vehicle (none for the default), and its loads."""
+    vehicle = vehicle or {}
+    name = str(vehicle.get("name", DEFAULT_VEHICLE))
+    named = [] if name == DEFAULT_VEHICLE else ["--vehicle", "FILE.toml" if name == "custom" else shlex.quote(name)]
+    loads = vehicle.get("load", DEFAULT_LOAD)
+    return named, list(dict.fromkeys(float(x) for x in (loads if isinstance(loads, list) else [loads])))
 
 
 def tune_command(vehicle: dict | None, scenarios=()) -> str:
@@ -267,13 +272,8 @@ def tune_command(vehicle: dict | None, scenarios=()) -> str:
     the options that differ from the command's defaults. Several track seeds or loads are one
     robust tuning (the command takes lists); other settings that take several values (speeds,
     scenarios) name the first, and the line says which others want a tuning of their own."""
-    vehicle = vehicle or {}
-    parts = ["railride", "tune"]
-    name = str(vehicle.get("name", DEFAULT_VEHICLE))
-    if name != DEFAULT_VEHICLE:
-        parts += ["--vehicle", "FILE.toml" if name == "custom" else shlex.quote(name)]
-    loads = vehicle.get("load", DEFAULT_LOAD)
-    loads = list(dict.fromkeys(float(x) for x in (loads if isinstance(loads, list) else [loads])))
+    named, loads = _vehicle_options(vehicle)
+    parts = ["railride", "tune", *named]
     if loads != [DEFAULT_LOAD]:
         parts += ["--load", ",".join(_number(x) for x in loads)]
     records = [scenarios] if isinstance(scenarios, dict) else [r for r in scenarios if r is not None]
@@ -495,16 +495,8 @@ def _tuned_text(provenance: dict) -> str:
     if not recorded:
         text += " (assumed: the file names no vehicle)"
     tracks = tuned_tracks(provenance)
-    names = list(dict.fromkeys(str(r.get("name")) for r in tracks)) or provenance.get("scenarios") or []
-    speeds = list(dict.fromkeys(r.get("speed_m_s") for r in tracks if r.get("speed_m_s") is not None))
-    speeds = speeds or provenance.get("speeds_m_s") or []
-    seeds = list(dict.fromkeys(r["seed"] for r in tracks if r.get("seed") is not None))
-    if names:
-        text += f", on {', '.join(map(str, names))}"
-        if seeds:
-            text += f" (seed{'s' * (len(seeds) > 1)} {_list(seeds)})"
-        if speeds:
-            text += f" at {_list(speeds)} m/s"
+    if tracks or provenance.get("scenarios"):
+        text += f", on {_tracks_tuned(tracks, provenance.get('scenarios'), provenance.get('speeds_m_s'))}"
     return text
 
 

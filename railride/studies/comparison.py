@@ -22,6 +22,7 @@ from railride.secondary import dampers
 from railride.secondary.control import CONSTANT_VOLTAGE, CONTROLLERS, LABELS, PAPER_CONTROLLERS, GainSet
 from railride.defaults import DEFAULT_DAMPER
 from railride.secondary.faults import check_faults, degradation
+from railride.secondary.provenance import IN_SAMPLE, judged_on
 from railride.analysis.comfort_record import comfort_record
 from railride.model.params import VehicleParams, resolve_vehicle, vehicle_argument
 from railride.model.plausible import notes
@@ -274,17 +275,13 @@ class Comparison:
         """How this run's track stands to the tracks the gains were tuned on, (kind, sentence)
         (`railride.secondary.provenance.judged_on`: in-sample, the tuned track at another
         speed, or held out); None where their provenance names no track."""
-        from railride.secondary.provenance import judged_on
-
         return judged_on(self.gains, self.settings.get("scenario"))
 
     @property
     def in_sample(self) -> bool:
         """Whether the gains were tuned on this track at this speed (their provenance says so),
-        whatever the duration and load."""
-        from railride.secondary.provenance import IN_SAMPLE
-
-        return self.judged is not None and self.judged[0] == IN_SAMPLE
+        whatever the duration and load (`GainSet.tuned_on`)."""
+        return self.gains.tuned_on(self.settings.get("scenario"))
 
     def report_contents(self):
         """What this result shows in its HTML report (`railride.output.report.write_report`)."""
@@ -352,9 +349,9 @@ class Comparison:
             "tuning": {
                 "objective": self.gains.provenance.get("objective"),
                 "command": self.gains.provenance.get("command"),
-                "in_sample": self.in_sample,
                 # where the gains name the tracks they were tuned on: is this one of them
-                **({"track": {"kind": j[0], "note": j[1]}} if (j := self.judged) else {}),
+                "in_sample": (j := self.judged) is not None and j[0] == IN_SAMPLE,
+                **({"track": {"kind": j[0], "note": j[1]}} if j else {}),
                 # only when there are some: the paper's comparison's document stays as it was
                 **({"untuned": u} if (u := self.gains.untuned(self.names)) else {}),
                 **({"alike": a} if (a := self.gains.tuning_budget(self.names)) else {}),

@@ -103,7 +103,7 @@ class DesignResult:
         first = self.ranking[0] if self.ranking else None
         if first is None or not first["ranked"]:
             return None
-        return "passive" if passive_wins(first, self.points) else first["controller"]
+        return "passive" if passive_wins(first, self.points) is not None else first["controller"]
 
     def table(self, metric: str) -> pd.DataFrame:
         """One metric's rows of `summary`, indexed by law, speed and load."""
@@ -353,7 +353,7 @@ def recommend(ranking, points, summary: pd.DataFrame, runs: pd.DataFrame, object
             what = (
                 f"its largest score ({objective.kind} of the mean RMS ratios to passive) over the speeds and loads is"
             )
-        if keep:  # by the design's own objective, passive is better than every law
+        if keep is not None:  # by the design's own objective, passive is better than every law
             out.append(
                 f"Recommended: keep passive. By this objective no law beats passive on held-out track: the best "
                 f"law, {_label(name)}, scores {score_text(score, objective)} at worst (at "
@@ -373,7 +373,7 @@ def recommend(ranking, points, summary: pd.DataFrame, runs: pd.DataFrame, object
                 "Constraints, on the 95th percentile of the held-out runs at each speed and load: "
                 + _bounds_text(ok, objective)
             )
-        if objective.kind == "minimax" and score >= 1.0 and not keep:
+        if objective.kind == "minimax" and score >= 1.0 and keep is None:
             out.append(
                 "No law keeps every RMS response better than passive on average at every speed and load; "
                 "the recommended law is the one whose worst response is least worse."
@@ -414,19 +414,19 @@ def score_text(score, objective, short: bool = False) -> str:
     return f"infeasible (+{excess:.3g})" if short else f"infeasible: over its constraints by {excess:.3g} of a bound"
 
 
-def passive_wins(best: dict, points: list) -> float:
+def passive_wins(best: dict, points: list) -> float | None:
     """Passive's score (its worst over the speeds and loads, by the design's objective) where it
     is lower than ``best``'s, the ranked law's, by more than the level tolerance of a
-    comparison; else 0.0 (falsy): a law that scores worse than passive is not recommended."""
+    comparison; else None: a law that scores worse than passive is not recommended."""
     from railride.studies.comparison import LEVEL_TOLERANCE, is_level
 
     scores = [p.get("passive_score") for p in points]
     if not scores or any(x is None or not np.isfinite(x) for x in scores):
-        return 0.0
+        return None
     own = max(scores)
     if best["score"] > own and not is_level(best["score"], own, LEVEL_TOLERANCE):
         return float(own)
-    return 0.0
+    return None
 
 
 def _bounds_text(ok: list, objective) -> str:

@@ -517,11 +517,11 @@ class SweepResult:
         controllers; ``gains_varied``: the entries the gain axes set instead; ``gains_source`` as
         ``gains``), the sensor noise, the step and the metrics window; with comfort, what its columns
         are (`comfort_settings`); the vehicle's record (name, load, values); a solver's rates and a
-        vehicle other than the defaults (`other_settings`); ``gains_mismatch`` (`gains_mismatch`)
-        and ``tracks_judged`` (`tracks_judged`) where they have something to say."""
+        vehicle other than the defaults (`other_settings`); ``gains_mismatch`` (`GainSet.mismatch`)
+        and ``tracks_judged`` (`judged_text`) where they have something to say."""
         g = self.grid
         vehicle = VehicleParams.preset("paper") if self.vehicle is None else self.vehicle
-        record = self.record()
+        record, tracks = self.record(), self._tracks()
         none: dict = {"source": None, "provenance": None, "values": {}}  # no controller reads gains
         ran = g.base_gains.record(g.controllers) if g.controllers else none
         return {
@@ -544,20 +544,10 @@ class SweepResult:
             **({"comfort": comfort_settings(g.duration, g.window)} if self.comfort else {}),
             "vehicle": record,
             **other_settings(vehicle, g.solver),
-            **({"gains_mismatch": m} if (m := self.gains_mismatch(record)) else {}),
-            **({"tracks_judged": j} if (j := self.tracks_judged()) else {}),
+            # over the controllers' tracks: the gains tuned for another case, and the tracks tuned on
+            **({"gains_mismatch": m} if tracks and (m := g.base_gains.mismatch(record, tracks)) else {}),
+            **({"tracks_judged": j} if tracks and (j := judged_text(g.base_gains, tracks)) else {}),
         }
-
-    def gains_mismatch(self, record: dict | None = None) -> str | None:
-        """One line when the base gains were tuned for another vehicle, load or track than the
-        controllers' runs (`GainSet.mismatch`), else None. ``record``: the vehicle's record."""
-        tracks = self._tracks()
-        return self.grid.base_gains.mismatch(record or self.vehicle_record, tracks) if tracks else None
-
-    def tracks_judged(self) -> str | None:
-        """Which of the controllers' tracks the base gains were tuned on (`judged_text`), or None."""
-        tracks = self._tracks()
-        return judged_text(self.grid.base_gains, tracks) if tracks else None
 
     def _tracks(self) -> list[dict]:
         """The controllers' tracks in the grid's order (a set's changes from one process to the next)."""

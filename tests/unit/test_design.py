@@ -435,10 +435,10 @@ def test_a_law_level_with_passive_is_recommended_one_worse_is_not():
     from railride.studies.design_result import passive_wins
 
     points = [{"passive_score": 1.0}, {"passive_score": 1.0}]
-    assert not passive_wins({"score": 1.005}, points)
+    assert passive_wins({"score": 1.005}, points) is None
     assert passive_wins({"score": 1.02}, points) == 1.0
-    assert not passive_wins({"score": 0.9}, points)
-    assert not passive_wins({"score": 1.5}, [{"passive_score": None}])  # passive's score unknown: no claim
+    assert passive_wins({"score": 0.9}, points) is None
+    assert passive_wins({"score": 1.5}, [{"passive_score": None}]) is None  # passive's score unknown: no claim
 
 
 def test_the_fault_sentence_tells_a_law_that_never_beat_passive_from_one_the_fault_cost():
