@@ -256,6 +256,19 @@ def toml_error(exc: ValueError) -> str:
     return "an integer with more than 4300 digits"
 
 
+def parse_toml(text: str, source: str) -> dict:
+    """The tables of TOML ``text``, else an InputError naming ``source``: its syntax error, or
+    nesting deeper than a railride file has (tomllib recurses into nested arrays and tables)."""
+    import tomllib
+
+    try:
+        return tomllib.loads(text)
+    except ValueError as exc:
+        raise InputError(f"{source}: not valid TOML: {toml_error(exc)}") from None
+    except RecursionError:
+        raise InputError(f"{source}: nested too deeply to be a railride file") from None
+
+
 def rule_words(rule: str) -> str:
     """The words of a rule, for tables of parameters."""
     return RULES[rule][0]

@@ -134,8 +134,8 @@ def describe_dampers(settings: dict, detail: bool = False) -> str:
         "ideal-damper": ("ideal semi-active dampers", "force = demand where it dissipates, else 0"),
     }
     damper = settings.get("damper")
-    if isinstance(damper, dict):  # a model given as such: its record
-        damper = damper.get("preset") or damper.get("model", "MR")
+    if isinstance(damper, dict):  # a model given as such (a damper file): its record
+        damper = damper.get("preset") or f"{damper.get('model', 'MR')} (own parameters)"
     if damper in ideal:
         words, what = ideal[damper]
         return f"{words} ({what})" if detail else words

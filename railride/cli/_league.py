@@ -11,7 +11,7 @@ import typer
 from railride.errors import InputError
 from railride.cli._common import ProgressBar, stderr_is_terminal, stdout_console, write_folder
 from railride.cli._options import OutputFormat
-from railride.cli._parsing import damper_preset, load_gains, parse_scale, vehicle_arguments
+from railride.cli._parsing import damper_argument, load_gains, parse_scale, vehicle_arguments
 from railride.cli._render import alike_text, fmt, untuned_text, warn_gains_mismatch
 
 
@@ -67,7 +67,7 @@ def run_league(
         raise InputError(
             "--no-references (or --no-bounds): a league table always shows the ideal actuator beside the MR dampers"
         )
-    damper_preset("--damper", damper)
+    damper = damper_argument("--damper", damper)
     loads = loads or [1.0]
     for x in loads:  # each load checked before the first run, its errors naming --load
         vehicle_options = vehicle_arguments(vehicle, preset, x)

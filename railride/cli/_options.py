@@ -237,7 +237,11 @@ SweepComfortOption = Annotated[
 
 # -- dampers ------------------------------------------------------------------------------------
 def _damper(kind, help: str):
-    return Annotated[kind, typer.Option("--damper", metavar="MODEL", help=help)]
+    return Annotated[kind, typer.Option("--damper", metavar="MODEL|FILE.toml", help=help + OWN_DAMPER)]
+
+
+#: every --damper takes a user's own MR damper too
+OWN_DAMPER = " Or FILE.toml: your own MR damper's parameters, a [damper] table (docs/dampers.md)."
 
 
 CompareDamperOption = _damper(
@@ -281,8 +285,8 @@ RigModelOption = Annotated[
     typer.Option(
         "--damper",
         "--model",
-        metavar="MODEL",
-        help="Damper model: railway, dyke1996 or spencer1997 (--model: the older name of the option).",
+        metavar="MODEL|FILE.toml",
+        help="Damper model: railway, dyke1996 or spencer1997 (--model: the older name of the option)." + OWN_DAMPER,
     ),
 ]
 

@@ -216,21 +216,30 @@ def _vehicle(vehicle: Optional[str], preset: Optional[str], load: Optional[float
 
 
 def damper_preset(option: str, name: str, *, rig: bool = False):
-    """The damper ``name`` (railride.secondary.dampers.NAMES: the MR presets and "ideal"), else ValueError
-    naming the option. ``rig``: the MR presets only (the ideal actuator has no force law to
-    drive on the rig)."""
+    """The damper model of the option's text ``name``: a name of railride.secondary.dampers.NAMES
+    (the MR presets and the ideal devices) or the path of a damper file (a ``[damper]`` table,
+    railride.secondary.damper_file), else ValueError naming the option. ``rig``: MR dampers only
+    (the ideal actuator has no force law to drive on the rig)."""
     from railride.secondary import dampers
 
-    allowed = dampers.PRESETS if rig else dampers.NAMES
-    if name not in allowed:
-        why = (
-            f": {dampers.ideal_words(name)} follows a vehicle controller's demand and has no force law to drive on "
-            "the rig"
-            if name in dampers.IDEAL_NAMES
-            else ": unknown damper model"
+    value = damper_argument(option, name, rig=rig)
+    return dampers.preset(value) if isinstance(value, str) else value
+
+
+def damper_argument(option: str, name, *, rig: bool = False):
+    """What a command passes on as its ``damper=``: a preset's or ideal device's name as given,
+    the model of a damper file; the errors of `damper_preset`. None stays None (the default)."""
+    from railride.secondary import damper_file, dampers
+
+    if name is None:
+        return None
+    if rig and name in dampers.IDEAL_NAMES:
+        raise InputError(
+            f"{option} = {name!r}: {dampers.ideal_words(name)} follows a vehicle controller's demand and has no "
+            f"force law to drive on the rig; allowed: {', '.join(dampers.PRESETS)}, or the path of a FILE.toml "
+            "with a [damper] table"
         )
-        raise InputError(f"{option} = {name!r}{why}; allowed: {', '.join(allowed)}")
-    return dampers.preset(name)
+    return damper_file.resolve(name, option, allowed=dampers.PRESETS if rig else dampers.NAMES)
 
 
 def parse_scale(option: str, text: Optional[str]) -> float:

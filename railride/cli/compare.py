@@ -52,7 +52,7 @@ from railride.cli._options import (
 )
 from railride.cli._parsing import (
     RUN_FIELDS,
-    damper_preset,
+    damper_argument,
     load_gains,
     make_scenario,
     not_given,
@@ -601,7 +601,7 @@ def compare(
         seed_value = seeds[0] if seeds else None
         names = _controller_list(controllers)
         gain_set = load_gains(gains)
-        damper_preset("--damper", damper)
+        damper = damper_argument("--damper", damper)
         scale = parse_scale("--damper-scale", damper_scale)
         noise = _sensor_noise(sensor_noise, seed)
         solver = solver_from_options(

@@ -23,6 +23,7 @@ from railride.cli._common import (
     write_folder,
 )
 from railride.cli._options import (
+    OWN_DAMPER,
     BoundOption,
     DpiOption,
     BackendOption,
@@ -51,7 +52,7 @@ from railride.cli._options import (
     DesignResumeOption,
     figure_options,
 )
-from railride.cli._parsing import FIXED_RATE_FIELDS, damper_preset, solver_from_options, value_list, vehicle_source
+from railride.cli._parsing import FIXED_RATE_FIELDS, damper_argument, solver_from_options, value_list, vehicle_source
 from railride.defaults import DEFAULT_DAMPER
 
 #: the library's names of the design's options, for its errors
@@ -336,7 +337,12 @@ def design_command(
     vehicle: VehicleOption = None,
     preset: PresetOption = None,
     damper: Annotated[
-        str, typer.Option("--damper", metavar="MODEL", help="Damper model of the laws.")
+        str,
+        typer.Option(
+            "--damper",
+            metavar="MODEL|FILE.toml",
+            help="Damper of the laws: railway, dyke1996, spencer1997, ideal-damper or ideal." + OWN_DAMPER,
+        ),
     ] = DEFAULT_DAMPER,
     dt: DtOption = None,
     backend: BackendOption = None,
@@ -375,7 +381,7 @@ def design_command(
         train = [int(s) for s in value_list("--train-seeds", train_seeds, integer=True)]
         test = [int(s) for s in value_list("--test-seeds", test_seeds, integer=True)]
         source = vehicle_source(vehicle, preset)
-        damper_preset("--damper", damper)
+        damper = damper_argument("--damper", damper)
         if objective_kind is not None and objective_kind.strip() not in OBJECTIVE_KINDS:
             objective = objective_kind  # the library names what it allows, and knows other spellings
         else:

@@ -56,7 +56,7 @@ from railride.cli._parsing import (
     PROFILE_FIELDS,
     SOLVER_FIELDS,
     TRACK_FIELDS,
-    damper_preset,
+    damper_argument,
     default_of,
     load_gains,
     not_given,
@@ -189,7 +189,7 @@ def pareto_command(
         figures = figure_options(figure_format, dpi, out)
         n = default_of(run_pareto, "n_samples") if samples is None else samples
         vehicle_options = vehicle_arguments(vehicle, preset, load)
-        damper_preset("--damper", damper)
+        damper = damper_argument("--damper", damper)
         base = load_gains(gains)
         solver = solver_from_options(dt=dt, backend=backend)
         scen, options = study_scenario(

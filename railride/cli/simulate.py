@@ -57,7 +57,7 @@ from railride.cli._options import (
 from railride.cli._parsing import (
     PROFILE_FIELDS,
     SOLVER_FIELDS,
-    damper_preset,
+    damper_argument,
     make_scenario,
     not_given,
     parse_scale,
@@ -266,7 +266,7 @@ def _suspension(name: str, damper_name, voltage_text, damper_scale=None):
             )
         return Suspension.passive()
     damper = DEFAULT_DAMPER if damper_name is None else damper_name
-    damper_preset("--damper", damper)
+    damper = damper_argument("--damper", damper)
     scale = parse_scale("--damper-scale", damper_scale)
     suspension = Suspension.named("mr", damper=damper, damper_scale=scale)
     if voltage_text is None:  # the coils at v_min, "passive-off"

@@ -48,7 +48,7 @@ from railride.cli._options import (
 )
 from railride.cli._parsing import (
     FIXED_RATE_FIELDS,
-    damper_preset,
+    damper_argument,
     load_gains,
     solver_from_options,
     value_list,
@@ -294,7 +294,7 @@ def study_command(
         stiffness_factors = value_list("--stiffness", stiffness)
         faults = _faults(fault)
         delays = value_list("--delay", delay, integer=True)
-        damper_preset("--damper", damper)
+        damper = damper_argument("--damper", damper)
         gain_set = load_gains(gains)
         solver = solver_from_options(dt=dt, backend=backend)
         window_value = parse_window(window) if window is not None else None

@@ -58,6 +58,7 @@ from railride.cli._options import (
 )
 from railride.cli._parsing import (
     FIXED_RATE_FIELDS,
+    damper_argument,
     load_gains,
     parse_noise,
     solver_from_options,
@@ -338,7 +339,7 @@ def _parse(
         window_value = None if window is None else parse_window(window)
     values = {
         "suspensions": _names("--suspension", suspension),
-        "damper": damper,
+        "damper": damper_argument("--damper", damper),
         "noise": None if noise is None else tuple(parse_noise("--noise", noise)),
         "base_gains": None if gains is None else load_gains(gains),
         "solver": solver,
@@ -354,7 +355,8 @@ def _parse(
         values[key] = None if text is None else value_list(option, text)
     for option, key, text in (("--track-seed", "track_seed", track_seed), ("--seed", "seed", seed)):
         values[key] = None if text is None else value_list(option, text, integer=True)
-    values["voltage"] = None if voltage is None else value_list("--voltage", voltage, parse=_voltage_item(damper))
+    read_voltage = _voltage_item(values["damper"])
+    values["voltage"] = None if voltage is None else value_list("--voltage", voltage, parse=read_voltage)
     values["gains"], gain_texts = {}, {}
     for text in gain or []:
         name, axis = _gain_option(text)
@@ -390,13 +392,17 @@ def _names(option: str, text: str) -> list[str]:
     return items
 
 
-def _voltage_item(damper: Optional[str]):
+def _voltage_item(damper):
     """The reader of a --voltage item: volts, or passive-off / passive-on from the MR damper's
-    range (the word itself for a damper the grid refuses with mr)."""
+    range (the word itself for a damper the grid refuses with mr). ``damper``: a name or the
+    model of a damper file."""
     from railride.secondary.dampers import PRESETS
     from railride.studies.grid import VOLTAGE_WORDS, voltage_value
 
-    model = PRESETS.get(DEFAULT_DAMPER if damper is None else damper)
+    if damper is None or isinstance(damper, str):
+        model = PRESETS.get(DEFAULT_DAMPER if damper is None else damper)
+    else:
+        model = damper
 
     def read(item: str):
         item = item.strip()

@@ -69,7 +69,7 @@ from railride.cli._parsing import (
     PROFILE_FIELDS,
     SOLVER_FIELDS,
     TRACK_FIELDS,
-    damper_preset,
+    damper_argument,
     load_gains,
     not_given,
     parse_float,
@@ -525,7 +525,7 @@ def tune_command(
         names = _tunable_list(controllers)
         seed_of_evolution = optimiser_seed_of(optimiser, optimiser_seed)
         source = vehicle_source(vehicle, preset)
-        damper_preset("--damper", damper)
+        damper = damper_argument("--damper", damper)
         scale = parse_scale("--damper-scale", damper_scale)
         start = _tune_start(gains)
         objective = _objective(objective_kind, weights, bound, penalty, max_peak, max_travel)

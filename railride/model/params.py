@@ -10,14 +10,13 @@ from __future__ import annotations
 import dataclasses
 import warnings
 import os
-import tomllib
 from dataclasses import MISSING, dataclass
 from pathlib import Path
 
 from railride.errors import InputError
 from railride._io import atomic_write_text
 from railride.model.plausible import VEHICLE, rigid_note
-from railride.validation import param, rule_words, shown, toml_error, validate_fields
+from railride.validation import param, parse_toml, rule_words, shown, validate_fields
 
 
 @dataclass(frozen=True)
@@ -285,12 +284,7 @@ class VehicleParams:
         The table either lists every field, or names a base with ``preset = "paper"`` and
         lists only the fields that differ from it.
         """
-        try:
-            data = tomllib.loads(text)
-        except ValueError as exc:
-            raise InputError(f"{source}: not valid TOML: {toml_error(exc)}") from None
-        except RecursionError:  # tomllib recurses into nested arrays and tables
-            raise InputError(f"{source}: nested too deeply to be a railride file") from None
+        data = parse_toml(text, source)
         table = data.get("vehicle")
         if not isinstance(table, dict):
             raise InputError(f"{source}: needs a [vehicle] table of parameters")

@@ -28,7 +28,6 @@ from __future__ import annotations
 import copy
 import dataclasses
 import functools
-import tomllib
 from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
@@ -401,17 +400,20 @@ class GainSet:
         judged = judged_on(self, record)
         return judged is not None and judged[0] == IN_SAMPLE
 
-    def mismatch(self, vehicle: dict | None = None, scenarios=None, controllers=None) -> str | None:
+    def mismatch(
+        self, vehicle: dict | None = None, scenarios=None, controllers=None, damper=None, damper_scale=None
+    ) -> str | None:
         """One line when a run with these gains leaves the case they were tuned for (another
         vehicle, load or track, as their [provenance] says), naming what differs and the
         `railride tune` command that would tune for the run; None when it does not, or when the
         gains record no tuning. ``vehicle``: the run's `railride.model.params.vehicle_record`;
         ``scenarios``: its `Scenario.describe` record, or a study's list of them;
         ``controllers``: the suspensions it runs (None: a controller among them); none that
-        reads gains, no line (`railride.secondary.provenance.mismatch`)."""
+        reads gains, no line; ``damper``, ``damper_scale``: the run's dampers (a name, model or
+        record; None: not compared) (`railride.secondary.provenance.mismatch`)."""
         from railride.secondary.provenance import mismatch
 
-        return mismatch(self, vehicle, scenarios, controllers)
+        return mismatch(self, vehicle, scenarios, controllers, damper, damper_scale)
 
     def record(self, controllers) -> dict:
         """What a result records of these gains for the runs of ``controllers``: ``source`` (as
@@ -469,12 +471,7 @@ class GainSet:
         ``from_reference``; [sas.ride_attitude] and [skyhook_on_off] may be absent (files before
         0.4.0): they take the gains of [sas.attitude] and [skyhook]; with ``complete`` every
         table must be there."""
-        try:
-            data = tomllib.loads(text)
-        except ValueError as exc:
-            raise InputError(f"{source}: not valid TOML: {validation.toml_error(exc)}") from None
-        except RecursionError:  # tomllib recurses into nested arrays and tables
-            raise InputError(f"{source}: nested too deeply to be a railride file") from None
+        data = validation.parse_toml(text, source)
         unknown_top = sorted(set(data) - {"inner", "pid", "sas", "provenance", *_LATER_TABLES, "skyhook_on_off"})
         if unknown_top:
             allowed = ", ".join(f"[{key}]" for key, _ in _TABLES.values())

@@ -75,14 +75,19 @@ def tuned_tracks(provenance: dict) -> list[dict]:
     return [record] if isinstance(record, dict) else []
 
 
-def mismatch(gains, vehicle: dict | None = None, scenarios=None, controllers=None) -> str | None:
+def mismatch(
+    gains, vehicle: dict | None = None, scenarios=None, controllers=None, damper=None, damper_scale=None
+) -> str | None:
     """One line when a run with ``gains`` (a `GainSet`) leaves the case they were tuned for, else
     None. ``vehicle``: the run's `railride.model.params.vehicle_record` (its load a list where a
     study runs several; None: the paper's vehicle at load 1); ``scenarios``: the run's track, a
     `Scenario.describe` record or a list of them (a study's). The vehicle differs when its
     values do (by name where the gains' provenance has no values and names no preset); a load
     differs when it is none of the tuned loads; a track when the gains were not tuned on it
-    (`GainSet.tuned_on`, whatever the duration). Any track or load of a robust tuning matches,
+    (`GainSet.tuned_on`, whatever the duration); the dampers when ``damper`` (the run's damper: a
+    name, a model or its record, with its ``damper_scale``) has other parameters than those the
+    gains were tuned with (dyke1996 x 8 is railway; None: not compared). Any track or load of a
+    robust tuning matches,
     and so does what it spans: a load between its least and largest, and a random track of a
     spectrum it was tuned on with several seeds, at any seed and a speed within its speeds.
     The line names what differs and the `railride tune` command that tunes for the run
@@ -106,28 +111,96 @@ def mismatch(gains, vehicle: dict | None = None, scenarios=None, controllers=Non
     other_loads = [x for x in loads if not _load_covered(x, tuned)]
     if other_loads:
         differs.append(f"load{'s' * (len(other_loads) > 1)} {_list(other_loads)}")
+    other_damper = _other_damper(provenance, damper, damper_scale)
+    if other_damper:
+        differs.append(other_damper)
     off = [r for r in records if _on_track(gains, r) is False]
     if off:
         differs.append(f"track{'s' * (len(off) > 1)} {_tracks_text(off, tuned_tracks(provenance))}")
     if not differs:
         return None
-    # another vehicle or load wants every track tuned again; else the tracks they were not tuned on
+    # another vehicle, load or damper wants every track tuned again; else the tracks they were not tuned on
     retune = records if len(differs) > (1 if off else 0) else off
+    ran = (damper, damper_scale) if other_damper else (None, None)
     line = (
         f"the gains {gains.source} were tuned for {_tuned_text(provenance)}; this run has {', '.join(differs)}; "
-        f"tune for it with: {tune_command(vehicle, retune)}"
+        f"tune for it with: {tune_command(vehicle, retune, *ran)}"
     )
-    if retune and all(r.get("profile") == "random" for r in retune):
+    scaled = ran[1] is not None and float(ran[1]) != 1.0  # design has no --damper-scale
+    if retune and all(r.get("profile") == "random" for r in retune) and not scaled:
         # gains tuned on one realisation fit that realisation: a design tunes on some seeds, judges on others
-        line += f"; or, for gains judged on seeds they were not tuned on: {design_command(vehicle, retune)}"
+        line += f"; or, for gains judged on seeds they were not tuned on: {design_command(vehicle, retune, ran[0])}"
     return line
 
 
-def design_command(vehicle: dict | None, scenarios) -> str:
+def _damper_option(damper) -> list[str]:
+    """A command's ``--damper`` for the run's ``damper`` (none for the default or None; a model
+    of the user's own parameters as its file, ``FILE.toml``)."""
+    from railride.defaults import DEFAULT_DAMPER
+
+    if damper is None or damper == DEFAULT_DAMPER:
+        return []
+    return ["--damper", shlex.quote(damper) if isinstance(damper, str) else "FILE.toml"]
+
+
+def _damper_key(damper, scale):
+    """What makes two dampers the same to a controller's gains: the law and every parameter of
+    the model at its scale (railway = dyke1996 x 8), or the name of an ideal device or of
+    what is not a model; None for no damper."""
+    from railride.secondary import dampers
+
+    if damper is None:
+        return None
+    model = damper
+    if isinstance(damper, str):
+        model = dampers.PRESETS.get(damper)
+        if model is None:  # an ideal device, or a name this railride does not know
+            return damper
+    elif isinstance(damper, dict):  # a record: the model's fields
+        classes = {"bouc-wen": dampers.BoucWen, "spencer": dampers.Spencer}
+        values = {k: v for k, v in damper.items() if k not in ("model", "preset")}
+        try:
+            model = classes[damper.get("model")](**values)
+        except (KeyError, TypeError, ValueError):
+            return json.dumps(damper, sort_keys=True, default=str)
+    scale = 1.0 if scale is None else float(scale)
+    if scale != 1.0 and isinstance(model, dampers.BoucWen):
+        model = model.scaled(scale)
+    if not isinstance(model, dampers.BoucWen):
+        return getattr(model, "model", str(model))
+    return (model.model, tuple(float(v) for v in dataclasses.astuple(model)))
+
+
+def _damper_words(damper, scale) -> str:
+    """A damper in a line's words: its name (x the scale), or "bouc-wen of its own parameters"."""
+    if not isinstance(damper, (str, dict)) and hasattr(damper, "to_dict"):  # a model
+        damper = damper.to_dict()
+    if isinstance(damper, dict):
+        name = damper.get("preset") or f"{damper.get('model', 'MR')} of its own parameters"
+    else:
+        name = str(damper)
+    scale = 1.0 if scale is None else float(scale)
+    return f"{name} x {scale:g}" if scale != 1.0 else str(name)
+
+
+def _other_damper(provenance: dict, damper, scale) -> str | None:
+    """The words "damper X (tuned with Y)" when the run's damper is not the one the gains were
+    tuned with; None when it is, or when either is not known (old files name none)."""
+    tuned = provenance.get("damper")
+    if damper is None or tuned is None:
+        return None
+    tuned_scale = provenance.get("damper_scale", 1.0)
+    if _damper_key(damper, scale) == _damper_key(tuned, tuned_scale):
+        return None
+    return f"damper {_damper_words(damper, scale)} (tuned with {_damper_words(tuned, tuned_scale)})"
+
+
+def design_command(vehicle: dict | None, scenarios, damper=None) -> str:
     """The `railride design` command line for a run on ``vehicle`` and the random tracks
-    ``scenarios``: its vehicle, loads, track classes and speeds (the rest its defaults)."""
+    ``scenarios`` (and ``damper``, `tune_command`'s): its vehicle, loads, damper, track classes
+    and speeds (the rest its defaults)."""
     named, loads = _vehicle_options(vehicle)
-    parts = ["railride", "design", *named, "--load", ",".join(_number(x) for x in loads)]
+    parts = ["railride", "design", *named, "--load", ",".join(_number(x) for x in loads), *_damper_option(damper)]
     parts += ["--track", ",".join(dict.fromkeys(shlex.quote(str(r.get("name"))) for r in scenarios))]
     speeds = list(dict.fromkeys(r["speed_m_s"] for r in scenarios if r.get("speed_m_s") is not None))
     if speeds:
@@ -266,16 +339,21 @@ def _vehicle_options(vehicle: dict | None) -> tuple[list[str], list[float]]:
     return named, list(dict.fromkeys(float(x) for x in (loads if isinstance(loads, list) else [loads])))
 
 
-def tune_command(vehicle: dict | None, scenarios=()) -> str:
+def tune_command(vehicle: dict | None, scenarios=(), damper=None, damper_scale=None) -> str:
     """The `railride tune` command line that tunes for a run on ``vehicle`` (a `vehicle_record`,
-    its load a number or a list) and the tracks ``scenarios`` (`Scenario.describe` records):
-    the options that differ from the command's defaults. Several track seeds or loads are one
+    its load a number or a list), the tracks ``scenarios`` (`Scenario.describe` records) and the
+    dampers ``damper`` and ``damper_scale`` (None: the command's default; a damper of the user's
+    own parameters is said as ``--damper FILE.toml``, its file): the options that differ from
+    the command's defaults. Several track seeds or loads are one
     robust tuning (the command takes lists); other settings that take several values (speeds,
     scenarios) name the first, and the line says which others want a tuning of their own."""
     named, loads = _vehicle_options(vehicle)
     parts = ["railride", "tune", *named]
     if loads != [DEFAULT_LOAD]:
         parts += ["--load", ",".join(_number(x) for x in loads)]
+    parts += _damper_option(damper)
+    if damper_scale is not None and float(damper_scale) != 1.0:
+        parts += ["--damper-scale", _number(damper_scale)]
     records = [scenarios] if isinstance(scenarios, dict) else [r for r in scenarios if r is not None]
     others = []
     if records:

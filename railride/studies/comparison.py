@@ -493,7 +493,7 @@ def compare(
     scenario = as_scenario(scenario)
     gains = GainSet.of(gains, scenario)
     # gains tuned for another vehicle, load or track: one line (the command line warns with it)
-    mismatch = gains.mismatch(record, scenario.describe(), names)
+    mismatch = gains.mismatch(record, scenario.describe(), names, damper, damper_scale)
     faults = check_faults(faults, model)
     ideal = model.law == dampers.LAW_IDEAL
     # a constant voltage means nothing to the ideal devices: said in the settings, not run

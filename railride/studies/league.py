@@ -243,7 +243,7 @@ def league(
         "tuned_alike": gains.tuning_budget(names),
     }
     # gains tuned for another vehicle, load or track: one line for every case (`GainSet.mismatch`)
-    mismatch = gains.mismatch(record, [sc.describe() for *_, sc in todo], names)
+    mismatch = gains.mismatch(record, [sc.describe() for *_, sc in todo], names, damper, damper_scale)
     if mismatch:
         settings["gains_mismatch"] = mismatch
     return LeagueTable(pd.DataFrame(rows), names, settings, gains.provenance.get("scenario_record"))

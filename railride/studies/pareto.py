@@ -352,7 +352,7 @@ def pareto(
         "vehicle": vehicle_rec,
         **other_settings(vehicle, solver),
         # base gains tuned for another vehicle, load or track: one line (`GainSet.mismatch`)
-        **({"gains_mismatch": m} if (m := base.mismatch(vehicle_rec, record)) else {}),
+        **({"gains_mismatch": m} if (m := base.mismatch(vehicle_rec, record, damper=damper)) else {}),
     }
     return ParetoResult(
         suspension,

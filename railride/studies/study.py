@@ -389,7 +389,7 @@ def study(
     # described from the checked first seed's (the seeds differ in the realisation only): a
     # realisation made again here, after the runs, was serial work (20 of them, 0.19 s)
     tracks = [{**described[v], "seed": seed} if random else described[v] for seed, v in opts_of]
-    if mismatch := gains.mismatch(record, tracks, names):
+    if mismatch := gains.mismatch(record, tracks, names, damper):
         settings["gains_mismatch"] = mismatch
     # which runs' tracks the gains were tuned on: in-sample, a new speed, or held out
     if any(gains.controller(n) is not None for n in names) and (judged := judged_text(gains, tracks)):

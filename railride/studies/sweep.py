@@ -545,9 +545,18 @@ class SweepResult:
             "vehicle": record,
             **other_settings(vehicle, g.solver),
             # over the controllers' tracks: the gains tuned for another case, and the tracks tuned on
-            **({"gains_mismatch": m} if tracks and (m := g.base_gains.mismatch(record, tracks)) else {}),
+            **({"gains_mismatch": m} if tracks and (m := self._mismatch(record, tracks)) else {}),
             **({"tracks_judged": j} if tracks and (j := judged_text(g.base_gains, tracks)) else {}),
         }
+
+    def _mismatch(self, record: dict, tracks: list[dict]) -> str | None:
+        """`GainSet.mismatch` of the base gains, with the controllers' damper where the grid does
+        not vary its scale (a sweep of scales asks what other dampers give)."""
+        g = self.grid
+        if g.damper_scales is not None and len(g.damper_scales) > 1:
+            return g.base_gains.mismatch(record, tracks)
+        scale = 1.0 if g.damper_scales is None else g.damper_scales[0]
+        return g.base_gains.mismatch(record, tracks, damper=g.damper, damper_scale=scale)
 
     def _tracks(self) -> list[dict]:
         """The controllers' tracks in the grid's order (a set's changes from one process to the next)."""
