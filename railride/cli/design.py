@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import json
 import time
-from typing import Annotated
+from typing import Annotated, Optional
 
 import typer
 
@@ -70,6 +70,8 @@ DESIGN_FIELDS = {
     "budget": "--budget",
     "values": "--values",
     "aggregate": "--aggregate",
+    "speed_shares": "--speed-share",
+    "load_shares": "--load-share",
     "objective": "--objective",
     "optimiser": "--optimiser",
     "optimiser_seed": "--optimiser-seed",
@@ -138,7 +140,7 @@ def _tables(doc: dict) -> list:
     from rich.text import Text
 
     from railride.cli._width import FitTable, Split
-    from railride.studies.design_result import optimiser_text
+    from railride.studies.design_result import optimiser_text, service_text
     from railride.model.params import vehicle_text
     from railride.secondary.control import LABELS
 
@@ -209,7 +211,9 @@ def _tables(doc: dict) -> list:
     ranking = FitTable(title="Ranking on held-out track", labels=2)
     refs = doc.get("references") or {}
     infeasible = s["objective"].get("infeasible")  # a score past its offset breaks the constraints
-    heads = ["rank", "law", "score", *[REFERENCE_HEADS[d] for d in refs], "worst at", "best at"]
+    service = s.get("service")
+    heads = ["rank", "law", "score", *(["worst"] if service else []), *[REFERENCE_HEADS[d] for d in refs]]
+    heads += ["worst at", "best at"]
     for head in heads:
         ranking.add_column(head, justify="left" if head in ("law", "worst at", "best at") else "right")
     for r in doc["ranking"]:
@@ -220,6 +224,7 @@ def _tables(doc: dict) -> list:
             "-" if r["rank"] is None else str(r["rank"]),
             escape(LABELS[r["controller"]]) + ("" if r["ranked"] else " (diverged)"),
             _score(r["score"], infeasible),
+            *([_score(r.get("worst_score"), infeasible)] if service else []),
             *ref_cells,
             f"{worst['speed_m_s']:g} m/s, load {worst['load']:g}",
             best,
@@ -229,8 +234,13 @@ def _tables(doc: dict) -> list:
     what = "the worst of a law's four mean RMS ratios to passive" if kind == "minimax" else f"the {kind} objective"
     ranking.caption = (
         f"score: {what} at a speed and load (each ratio the mean over that point's held-out runs); a law's "
-        "score is its worst "
-        "over the speeds and loads. Objective: "
+        + (
+            "score is the mean of its scores at the speeds and loads weighted by their time in service, unless "
+            "one breaks a constraint (then its worst); worst: its largest. "
+            if service
+            else "score is its worst over the speeds and loads. "
+        )
+        + "Objective: "
         + s["objective"]["statement"]
         + "."
         + (
@@ -247,6 +257,11 @@ def _tables(doc: dict) -> list:
         f"{', '.join(map(str, s['train_seeds']))} ({s['training_runs_per_gain_set']} runs per gain set, the "
         f"{s['aggregate']} objective, at most {s['budget']} gain sets per law); judged on seeds {seeds}.",
         f"Tuned by {optimiser_text(s)}.",
+        *(
+            [f"Time in service: {service_text(service)} (the shares weigh the training runs' mean and the ranking)."]
+            if service
+            else []
+        ),
         vehicle_text(s["vehicle"]) + f"; {s['damper'] if isinstance(s['damper'], str) else 'own'} dampers.",
         *([s["comfort_basis"]] if s.get("comfort_basis") else []),
         f"{doc['runs']['training']} training and {doc['runs']['judging']} held-out runs (passive's included)"
@@ -326,6 +341,24 @@ def design_command(
             help="A gain set's objective over the training runs: their mean, or the worst.",
         ),
     ] = "mean",
+    speed_share: Annotated[
+        Optional[str],
+        typer.Option(
+            "--speed-share",
+            metavar="X[,X...]",
+            help="Time in service at each --speed, in its order (numbers > 0, normalised): the speeds "
+            "weigh the training runs' mean and the ranking, which then scores a law by its weighted mean "
+            "over the speeds and loads instead of its worst (default: none; every speed alike, ranked by the worst).",
+        ),
+    ] = None,
+    load_share: Annotated[
+        Optional[str],
+        typer.Option(
+            "--load-share",
+            metavar="X[,X...]",
+            help="Time in service at each --load, as --speed-share (speed and load taken as independent).",
+        ),
+    ] = None,
     optimiser: OptimiserOption = "sensitivity",
     optimiser_seed: OptimiserSeedOption = None,
     objective_kind: ObjectiveOption = None,
@@ -405,6 +438,8 @@ def design_command(
             duration=duration,
             damper=damper,
             solver=solver,
+            speed_shares=None if speed_share is None else value_list("--speed-share", speed_share),
+            load_shares=None if load_share is None else value_list("--load-share", load_share),
         )
         check_design(None if controllers.strip() == "all" else names, **settings)  # before the folder
         table, table_path = open_run_table(out, resume)

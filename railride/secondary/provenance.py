@@ -67,10 +67,10 @@ def tuned_loads(provenance: dict) -> list[float]:
 
 
 def tuned_tracks(provenance: dict) -> list[dict]:
-    """The scenario records the gains were tuned on: the tuning set's (without their loads), or
-    the one ``scenario_record``; empty where the provenance has neither."""
+    """The scenario records the gains were tuned on: the tuning set's (without their loads and
+    weights), or the one ``scenario_record``; empty where the provenance has neither."""
     if isinstance(provenance.get("tuning_set"), list):
-        return [{k: v for k, v in r.items() if k != "load"} for r in provenance["tuning_set"]]
+        return [{k: v for k, v in r.items() if k not in ("load", "weight")} for r in provenance["tuning_set"]]
     record = provenance.get("scenario_record")
     return [record] if isinstance(record, dict) else []
 

@@ -90,6 +90,9 @@ class Plan:
     #: the evolution
     optimiser: str = "sensitivity"
     optimiser_seed: int = 0
+    #: time in service: (speed, load) -> the point's share (they sum to 1); None: no weights, a
+    #: law scored by its worst point (`service_shares`)
+    service: dict | None = None
 
     def track_options(self, track: str, seed: int) -> tuple:
         """The scenario options that make "seed" ``seed`` of ``track``: a random track's
@@ -136,6 +139,40 @@ def _items(name: str, values) -> list:
     if twice is not None:
         raise InputError(f"{name} = {out!r}: {twice[0]!r} is listed twice; give each once")
     return out
+
+
+def service_shares(speeds: tuple, loads: tuple, speed_shares=None, load_shares=None) -> dict | None:
+    """The share of time in service of each (speed, load) of a design: the product of the
+    speed's share of ``speed_shares`` and the load's of ``load_shares`` (each one number > 0
+    per value of ``speeds`` and ``loads``, in their order, normalised to sum 1; None: equal),
+    speed and load taken as independent. None where neither is given."""
+    if speed_shares is None and load_shares is None:
+        return None
+
+    def shares(name: str, given, values: tuple, unit: str) -> list[float]:
+        if given is None:
+            return [1.0 / len(values)] * len(values)
+        items = [given] if validation.is_number(given) else given
+        try:
+            if isinstance(items, (str, bytes, dict)):
+                raise TypeError
+            items = list(items)
+        except TypeError:
+            raise InputError(f"{name} = {given!r}: give a list of numbers, one per {unit}") from None
+        rule = "a finite number > 0 (a share of the time in service)"
+        numbers = [float(validation.number(name, x, "positive", allowed=rule)) for x in items]
+        if len(numbers) != len(values):
+            raise InputError(
+                f"{name} = {given!r}: {len(numbers)} share{'s' * (len(numbers) != 1)} for {len(values)} "
+                f"{unit}{'s' * (len(values) != 1)} ({', '.join(f'{v:g}' for v in values)}); give one per {unit}, in "
+                "their order"
+            )
+        total = sum(numbers)
+        return [x / total for x in numbers]
+
+    by_speed = shares("speed_shares", speed_shares, speeds, "speed")
+    by_load = shares("load_shares", load_shares, loads, "load")
+    return {(float(v), float(x)): a * b for v, a in zip(speeds, by_speed) for x, b in zip(loads, by_load)}
 
 
 def _laws(controllers) -> tuple:
@@ -188,6 +225,8 @@ def check_design(
     solver=None,
     optimiser: str = "sensitivity",
     optimiser_seed: int = 0,
+    speed_shares=None,
+    load_shares=None,
 ) -> Plan:
     """Every input of `design`, checked before any work: an `InputError` names the option, the
     value and what is allowed. Returns the `Plan`."""
@@ -215,9 +254,12 @@ def check_design(
                 f"tracks = {t!r}: not a random track or a measured profile; allowed {', '.join(SPECTRA)}, file:PATH"
             )
         track_list.append(t.strip())
-    speed_list = tuple(
-        sorted(dict.fromkeys(validation.number("speeds", v, "positive", "m/s") for v in _items("speeds", speeds)))
+    given_speeds = tuple(
+        dict.fromkeys(validation.number("speeds", v, "positive", "m/s") for v in _items("speeds", speeds))
     )
+    speed_list = tuple(sorted(given_speeds))
+    # the shares follow the speeds as given, before they are sorted
+    service = service_shares(given_speeds, load_list, speed_shares, load_shares)
     train = tuple(dict.fromkeys(validation.seed("train_seeds", s) for s in _items("train_seeds", train_seeds)))
     test = tuple(dict.fromkeys(validation.seed("test_seeds", s) for s in _items("test_seeds", test_seeds)))
     shared = [s for s in test if s in train]
@@ -272,6 +314,7 @@ def check_design(
         sections,
         optimiser,
         optimiser_seed,
+        service,
     )
 
 
@@ -322,6 +365,8 @@ def design(
     solver=None,
     optimiser: str = "sensitivity",
     optimiser_seed: int = 0,
+    speed_shares=None,
+    load_shares=None,
     executor=None,
     table: RunTable | None = None,
     progress=True,
@@ -341,6 +386,12 @@ def design(
     "sensitivity" (that study) or "evolution" (SciPy's differential evolution over all of a
     law's gains at once, seeded by ``optimiser_seed``, within the same budget:
     `railride.studies.evolution`); either way every law's candidates of a round are one batch.
+
+    Time in service: ``speed_shares`` and ``load_shares`` (one number > 0 per speed and load,
+    normalised; `service_shares`) weigh each speed and load by its time in service, in the
+    training runs' mean (``aggregate`` "mean") and in the ranking: a law's score is then the
+    weighted mean of its scores at the speeds and loads, not its worst (`rank`). Without them
+    every speed and load counts alike and a law is ranked by its worst.
 
     Judging: every law with its tuned gains and passive on every track x ``test_seeds`` x speed
     x load (seeds that tuning never saw). ``executor``, ``table`` (one `RunTable` for both
@@ -371,6 +422,8 @@ def design(
         solver=solver,
         optimiser=optimiser,
         optimiser_seed=optimiser_seed,
+        speed_shares=speed_shares,
+        load_shares=load_shares,
     )
     table = RunTable() if table is None else table
     if executor is None:  # the chunks that fill the threads, none more: one more took the default design above 2 GiB
@@ -378,7 +431,7 @@ def design(
 
         executor = LocalExecutor(rows_beside=False)
     over = tuple(
-        TuningCase(track, _options(plan, track, seed, v), load)
+        TuningCase(track, _options(plan, track, seed, v), load, 1.0 if plan.service is None else plan.service[v, load])
         for track in plan.tracks
         for load in plan.loads
         for seed in plan.train_seeds
@@ -409,7 +462,7 @@ def design(
     runs = _judge(plan, tuned.gains, executor, table, progress)
     summary = _summary(runs, plan)
     diverged = _diverged(tuned, training, runs, plan)
-    ranking, points = rank(summary, plan.objective, plan.laws, {d["controller"] for d in diverged})
+    ranking, points = rank(summary, plan.objective, plan.laws, {d["controller"] for d in diverged}, plan.service)
     from railride.studies.design_probes import asks, fault_check, references
 
     leaders = [r["controller"] for r in ranking if r["ranked"]][:2]
@@ -427,6 +480,7 @@ def design(
         "controllers": list(plan.laws),
         "objective": plan.objective.to_dict(),
         "aggregate": plan.aggregate,
+        **({"service": service_record(plan.service)} if plan.service is not None else {}),
         "optimiser": tuned.settings.get("optimiser", {"name": "sensitivity"}),
         "budget": plan.budget,
         "values": plan.values,
@@ -459,6 +513,11 @@ def design(
         settings=settings,
         date=tuned.date,
     )
+
+
+def service_record(service: dict) -> list[dict]:
+    """The time in service as a result records it: each speed and load with its share."""
+    return [{"speed_m_s": v, "load": x, "share": share} for (v, x), share in service.items()]
 
 
 def _options(plan: Plan, track: str, seed: int, speed: float) -> tuple:
@@ -576,7 +635,7 @@ def _scores(plan: Plan, gains, executor, table, progress, laws=None, damper=None
     each law's score there."""
     laws = plan.laws if laws is None else tuple(laws)
     runs = _judge(plan, gains, executor, table, progress, laws=laws, damper=damper, faults=faults, full=False)
-    return rank(_summary(runs, plan, laws), plan.objective, laws)[1]
+    return rank(_summary(runs, plan, laws), plan.objective, laws, service=plan.service)[1]
 
 
 def _summary(runs: pd.DataFrame, plan: Plan, laws=None) -> pd.DataFrame:

@@ -35,12 +35,13 @@ def _ideal(damper) -> bool:
     return damper_model(damper, 1.0).law == dampers.LAW_IDEAL
 
 
-def _worst(points: list, law: str) -> float | None:
-    """A law's score over the points: its largest, None where one is missing (it diverged)."""
-    values = [p["scores"].get(law) for p in points]
-    if not values or any(v is None or not np.isfinite(v) for v in values):
-        return None
-    return float(max(values))
+def _worst(points: list, law: str, offset=None) -> float | None:
+    """A law's score over the points as the ranking takes it (its largest, or its mean weighted
+    by time in service: `law_score`), None where one is missing or not finite (it diverged)."""
+    from railride.studies.design_result import law_score
+
+    score = law_score(points, law, offset)
+    return score if score is not None and np.isfinite(score) else None
 
 
 def asks(plan, leaders: list) -> list[dict]:
@@ -63,7 +64,7 @@ def references(plan, gains, scores) -> dict:
         points = scores(**ask)
         out[device] = {
             law: {
-                "score": _worst(points, law),
+                "score": _worst(points, law, plan.objective.infeasible_offset),
                 "points": [
                     {"speed_m_s": p["speed_m_s"], "load": p["load"], "score": _plain(p["scores"].get(law))}
                     for p in points
@@ -85,14 +86,16 @@ def fault_check(plan, leaders: list, points: list, scores) -> dict | None:
     ask = asks(plan, leaders)[-1]
     fault = ask["faults"][0]
     faulted = scores(**ask)
-    laws = {law: {"healthy": _worst(points, law), "faulted": _worst(faulted, law)} for law in leaders}
+    offset = plan.objective.infeasible_offset
+    laws = {law: {"healthy": _worst(points, law, offset), "faulted": _worst(faulted, law, offset)} for law in leaders}
+    over = "in service" if plan.service is not None else "at worst"
     label = {law: LABELS.get(law, law) for law in leaders}
     if fault == FAULT:
         text = f"With the coil driver of the front right damper failed from the start ({fault}: its command at v_min), "
     else:
         text = f"With the front right damper disconnected from the start ({fault}), "
     text += " and ".join(
-        f"{label[law]} scores {_text(v['faulted'])} at worst (healthy {_text(v['healthy'])})" for law, v in laws.items()
+        f"{label[law]} scores {_text(v['faulted'])} {over} (healthy {_text(v['healthy'])})" for law, v in laws.items()
     )
     baseline = plan.objective.passive_score
 

@@ -257,13 +257,39 @@ def _point_score(by: pd.DataFrame, objective: Objective, law: str, speed: float,
     return float(objective.of_ratios({k: np.float64(x) for k, x in ratios.items()}, travel))
 
 
-def rank(summary: pd.DataFrame, objective: Objective, laws, diverged=()) -> tuple[list, list]:
+def over_points(values, shares=None, offset=None) -> float:
+    """A score over the speeds and loads from its ``values`` at each: the largest, or with
+    ``shares`` (time in service, one per value) their weighted mean, except where a value breaks
+    the objective's constraints (at or above its infeasible ``offset``): a constraint holds at
+    every point, so the largest. inf where a value is not finite (a run diverged)."""
+    x = np.asarray(values, dtype=float)
+    if not np.isfinite(x).all():
+        return float(np.inf)
+    if shares is None or (offset is not None and x.max() >= offset):
+        return float(x.max())
+    return float(np.dot(x, shares) / np.sum(shares))
+
+
+def law_score(points: list, key, offset=None) -> float | None:
+    """``key``'s score over the ``points`` (`over_points`: weighted by their ``share`` where they
+    have one); ``key``: a law's name (its ``scores``) or "passive" (``passive_score``). None where
+    a point has none."""
+    values = [p.get("passive_score") if key == "passive" else p["scores"].get(key) for p in points]
+    if not values or any(v is None for v in values):
+        return None
+    shares = [p["share"] for p in points] if all("share" in p for p in points) else None
+    return over_points(values, shares, offset)
+
+
+def rank(summary: pd.DataFrame, objective: Objective, laws, diverged=(), service=None) -> tuple[list, list]:
     """The laws ranked on held-out track, and the speeds and loads.
 
     At each speed and load (a point) a law's score is ``objective`` of its mean ratios to
     passive there (for minimax: its worst mean RMS ratio over the four responses; its bounds on
-    the 95th percentiles, `_point_score`); a law's score
-    is its largest over the points, at ``worst_at``. The laws that did not diverge (``ranked``)
+    the 95th percentiles, `_point_score`); a law's score is its largest over the points, at
+    ``worst_at``, or with ``service`` ({(speed, load): share of time in service}, each point's
+    ``share``) the weighted mean of its scores (`over_points`), its largest kept as
+    ``worst_score``. The laws that did not diverge (``ranked``)
     come first, best score first; the ``diverged`` follow. Each point lists every law's score,
     the best ranked law (``best``) and the responses that no ranked law improves on average
     (``no_law_beats_passive``, with the best ratio there and its law). Returns (ranking,
@@ -299,6 +325,7 @@ def rank(summary: pd.DataFrame, objective: Objective, laws, diverged=()) -> tupl
                 "no_law_beats_passive": none,
                 # passive by the same objective: ratios of 1, its own travel against a travel bound
                 "passive_score": _plain(_point_score(by, objective, "passive", v, load)),
+                **({"share": service[(float(v), float(load))]} if service is not None else {}),
             }
         )
     ranking = []
@@ -306,11 +333,13 @@ def rank(summary: pd.DataFrame, objective: Objective, laws, diverged=()) -> tupl
         per = [(p["scores"][n], p) for p in points]
         bad = [p for s, p in per if not np.isfinite(s)]
         worst = bad[0] if bad else max(per, key=lambda sp: sp[0])[1]
-        score = np.inf if bad else max(s for s, _ in per)
+        score = law_score(points, n, objective.infeasible_offset)
+        score = np.inf if bad or score is None else score
         ranking.append(
             {
                 "controller": n,
                 "score": score,
+                **({"worst_score": max(s for s, _ in per)} if service is not None else {}),
                 "worst_at": {"speed_m_s": worst["speed_m_s"], "load": worst["load"]},
                 "best_at": [{"speed_m_s": p["speed_m_s"], "load": p["load"]} for p in points if p["best"] == n],
                 "ranked": n not in diverged and bool(np.isfinite(score)),
@@ -344,29 +373,38 @@ def recommend(ranking, points, summary: pd.DataFrame, runs: pd.DataFrame, object
         best = ok[0]
         name, score, w = best["controller"], best["score"], best["worst_at"]
         keep = passive_wins(best, points)
+        service = settings.get("service")
         if objective.kind == "minimax":
-            what = "its worst mean RMS ratio to passive over the four responses, at any speed and load, is"
+            point = "its worst mean RMS ratio to passive over the four responses"
         elif objective.needs_comfort:
             index = "N_MV,z" if objective.kind == "n_mv" else "Wz"
-            what = f"its worst mean {index} ratio to passive over the floor points, at any speed and load, is"
+            point = f"its worst mean {index} ratio to passive over the floor points"
         else:
+            point = f"its score ({objective.kind} of the mean RMS ratios to passive)"
+        if service:  # the points weighted by their time in service: the score is their mean
             what = (
-                f"its largest score ({objective.kind} of the mean RMS ratios to passive) over the speeds and loads is"
+                f"{point} at each speed and load, averaged with their shares of the time in service "
+                f"({service_text(service)}), is"
             )
+            worst = f"worst {score_text(best['worst_score'], objective)} at {_at(w['speed_m_s'], w['load'])}"
+        elif objective.kind in ("minimax",) or objective.needs_comfort:
+            what = f"{point}, at any speed and load, is"
+        else:
+            what = f"its largest score ({objective.kind} of the mean RMS ratios to passive) over the speeds and loads"
+            what += " is"
         if keep is not None:  # by the design's own objective, passive is better than every law
+            at = f"in service ({worst})" if service else f"at worst (at {_at(w['speed_m_s'], w['load'])})"
             out.append(
                 f"Recommended: keep passive. By this objective no law beats passive on held-out track: the best "
-                f"law, {_label(name)}, scores {score_text(score, objective)} at worst (at "
-                f"{_at(w['speed_m_s'], w['load'])}) on {held}, against passive's {score_text(keep, objective)}."
+                f"law, {_label(name)}, scores {score_text(score, objective)} {at} on {held}, against passive's "
+                f"{score_text(keep, objective)}."
             )
         else:
-            out.append(
-                f"Recommended: {_label(name)}. On {held}, {what} {score_text(score, objective)} (at "
-                f"{_at(w['speed_m_s'], w['load'])})."
-            )
+            at = worst if service else f"at {_at(w['speed_m_s'], w['load'])}"
+            out.append(f"Recommended: {_label(name)}. On {held}, {what} {score_text(score, objective)} ({at}).")
         out.append(_worse_than_passive(name, summary))
         out.append(_wins(name, points))
-        out.append(_trade_offs(name, ok, summary))
+        out.append(_trade_offs(name, ok, summary, service))
         out.append(_sureness(best, ok[1] if len(ok) > 1 else None, points, summary, runs, objective))
         if objective.peak_bound is not None or objective.travel_bound is not None:
             out.append(
@@ -399,6 +437,11 @@ def recommend(ranking, points, summary: pd.DataFrame, runs: pd.DataFrame, object
     return " ".join(s for s in out if s)
 
 
+def service_text(service: list) -> str:
+    """The time in service in a few words: "30 m/s, load 1: 60 %; ..." (a design's record)."""
+    return "; ".join(f"{_at(p['speed_m_s'], p['load'])}: {100 * p['share']:.3g} %" for p in service)
+
+
 def score_text(score, objective, short: bool = False) -> str:
     """A score in words: the number, or where it breaks the objective's constraints (at or above
     its infeasible offset), "infeasible" and by how much it breaks them (the excess, summed over
@@ -415,15 +458,15 @@ def score_text(score, objective, short: bool = False) -> str:
 
 
 def passive_wins(best: dict, points: list) -> float | None:
-    """Passive's score (its worst over the speeds and loads, by the design's objective) where it
-    is lower than ``best``'s, the ranked law's, by more than the level tolerance of a
-    comparison; else None: a law that scores worse than passive is not recommended."""
+    """Passive's score (over the speeds and loads as the laws', `law_score`, by the design's
+    objective) where it is lower than ``best``'s, the ranked law's, by more than the level
+    tolerance of a comparison; else None: a law that scores worse than passive is not
+    recommended."""
     from railride.studies.comparison import LEVEL_TOLERANCE, is_level
 
-    scores = [p.get("passive_score") for p in points]
-    if not scores or any(x is None or not np.isfinite(x) for x in scores):
+    own = law_score(points, "passive")
+    if own is None or not np.isfinite(own):
         return None
-    own = max(scores)
     if best["score"] > own and not is_level(best["score"], own, LEVEL_TOLERANCE):
         return float(own)
     return None
@@ -459,14 +502,24 @@ def _worse_than_passive(name: str, summary: pd.DataFrame) -> str:
     )
 
 
-def _trade_offs(name: str, ok: list, summary: pd.DataFrame) -> str:
+def _trade_offs(name: str, ok: list, summary: pd.DataFrame, service=None) -> str:
     """What the recommended law gives up: the responses (RMS, and the peak-to-peak acceleration)
-    on which another ranked law's mean ratio to passive, averaged over the speeds and loads, is
+    on which another ranked law's mean ratio to passive, averaged over the speeds and loads
+    (weighted by their time in service where ``service``, a design's record, gives it), is
     lower than its own by more than the level tolerance of a comparison; and its largest
     secondary travel against passive's."""
     from railride.studies.comparison import LEVEL_TOLERANCE, is_level
 
-    mean = summary.groupby(["controller", "metric"])["ratio_mean"].mean()
+    if service:
+        share = {(p["speed_m_s"], p["load"]): p["share"] for p in service}
+        ratio = summary["ratio_mean"].to_numpy(dtype=float)
+        weights = np.array([share[v, x] for v, x in zip(summary["speed_m_s"], summary["load"])])
+        weights = np.where(np.isfinite(ratio), weights, 0.0)  # a point with no ratio counts for nothing, as in mean()
+        weighted = summary.assign(w=weights, wr=np.where(weights > 0, ratio * weights, 0.0))
+        sums = weighted.groupby(["controller", "metric"])[["wr", "w"]].sum()
+        mean = sums["wr"] / sums["w"]
+    else:
+        mean = summary.groupby(["controller", "metric"])["ratio_mean"].mean()
     words = {**dict(zip(RMS_COLUMNS, RATIO_NAMES)), PEAK_COLUMN: "peak-to-peak acceleration"}
     lost = []
     for other in (r["controller"] for r in ok if r["controller"] != name):
@@ -478,11 +531,11 @@ def _trade_offs(name: str, ok: list, summary: pd.DataFrame) -> str:
                     worse.append(f"{word} ({b:.3f} against its {a:.3f})")
         if worse:
             lost.append(f"to {_label(other)} on {', '.join(worse)}")
+    over = "Averaged over the speeds and loads" + (" weighted by their time in service" if service else "")
     text = (
-        "Averaged over the speeds and loads (mean ratios to passive), it loses " + "; ".join(lost) + "."
+        f"{over} (mean ratios to passive), it loses " + "; ".join(lost) + "."
         if lost
-        else "Averaged over the speeds and loads, no other ranked law is better on any RMS response or the "
-        "peak-to-peak acceleration."
+        else f"{over}, no other ranked law is better on any RMS response or the peak-to-peak acceleration."
     )
     travel = mean.get((name, TRAVEL_COLUMN))
     if travel is not None and np.isfinite(travel) and not is_level(travel, 1.0, LEVEL_TOLERANCE):

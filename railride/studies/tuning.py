@@ -128,12 +128,18 @@ def _allowed(table, entry: str, value: float) -> bool:
 
 @dataclass(frozen=True)
 class TuningCase:
-    """One run of a tuning set: a scenario (`railride.model.track.scenario` name and options) and
-    a load factor (`VehicleParams.loaded`)."""
+    """One run of a tuning set: a scenario (`railride.model.track.scenario` name and options), a
+    load factor (`VehicleParams.loaded`) and its weight in the mean over the set (``aggregate``
+    "mean"; a design's time in service at the run's speed and load: `railride.studies.design`)."""
 
     scenario: str
     options: tuple = ()
     load: float = 1.0
+    weight: float = 1.0
+
+    def __post_init__(self):
+        rule = "a finite number > 0 (the case's weight in the mean)"
+        object.__setattr__(self, "weight", float(validation.number("weight", self.weight, "positive", allowed=rule)))
 
 
 def tuning_set(scenario: str = "fra4", *, track_seeds=None, speeds=None, loads=(1.0,), duration=None) -> tuple:
@@ -305,6 +311,9 @@ def tune(
     else:
         cases_set = (TuningCase(scenario, opts, 1.0),)
     scens = [make_scenario(c.scenario, **dict(c.options)) for c in cases_set]
+    # the cases' weights in the mean (all 1 but where a design weighs its speeds and loads)
+    weighted = any(c.weight != 1.0 for c in cases_set)
+    weights = np.array([c.weight for c in cases_set])
     # the runs of every case, checked by the check every simulation makes (railride.run.checks),
     # before the first: a law of the set on the case's vehicle (the laws share the dampers)
     law = next((n for n in controllers if n != "inner"), "pid")
@@ -343,7 +352,10 @@ def tune(
             **other_settings(vehicle, solver),
             **(
                 {
-                    "tuning_set": [{**sc.describe(), "load": c.load} for c, sc in zip(cases_set, scens)],
+                    "tuning_set": [
+                        {**sc.describe(), "load": c.load, **({"weight": c.weight} if weighted else {})}
+                        for c, sc in zip(cases_set, scens)
+                    ],
                     "aggregate": aggregate,
                 }
                 if over is not None
@@ -406,7 +418,10 @@ def tune(
             # every run against the passive run of its case, in one call (row by row, as k calls were)
             per_case = objective.of_runs(part, passive_rows.iloc[np.tile(np.arange(k), len(sets))])
             per_case = per_case.reshape(len(sets), k)
-            out[name] = per_case.mean(axis=1) if aggregate == "mean" else per_case.max(axis=1)
+            if aggregate == "worst":
+                out[name] = per_case.max(axis=1)
+            else:  # all weights 1: the plain mean, bit for bit as before weights
+                out[name] = np.average(per_case, axis=1, weights=weights) if weighted else per_case.mean(axis=1)
         return out
 
     laws = [name for name in controllers if name != "inner"]

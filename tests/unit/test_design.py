@@ -448,7 +448,7 @@ def test_the_fault_sentence_tells_a_law_that_never_beat_passive_from_one_the_fau
 
     from railride.studies.design_probes import fault_check
 
-    plan = SimpleNamespace(damper="railway", laws=["pid", "skyhook"], objective=Objective("minimax"))
+    plan = SimpleNamespace(damper="railway", laws=["pid", "skyhook"], objective=Objective("minimax"), service=None)
     healthy = [{"speed_m_s": 40.0, "load": 1.0, "scores": {"pid": 0.9, "skyhook": 1.2}}]
     faulted = [{"speed_m_s": 40.0, "load": 1.0, "scores": {"pid": 1.1, "skyhook": 1.3}}]
     text = fault_check(plan, ["pid", "skyhook"], healthy, lambda **kw: faulted)["text"]

@@ -1,0 +1,127 @@
+"""A design weighted by time in service (``speed_shares``, ``load_shares``): the shares of each
+speed and load, the tuning's weighted mean, and a ranking by the weighted mean of a law's scores
+instead of its worst, a constraint still holding at every point."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import railride as rr
+from railride.errors import InputError, TuningWarning
+from railride.studies.design import service_shares
+from railride.studies.design_result import law_score, over_points, passive_wins
+from railride.studies.tuning import TuningCase, tune
+
+
+def test_the_shares_are_the_product_of_speed_and_load_normalised():
+    got = service_shares((30.0, 50.0), (1.0, 1.3), [3, 1], [1, 1])
+    assert got == pytest.approx({(30.0, 1.0): 0.375, (30.0, 1.3): 0.375, (50.0, 1.0): 0.125, (50.0, 1.3): 0.125})
+    assert sum(got.values()) == pytest.approx(1.0)
+    # one given: the other alike; none given: no weights at all
+    assert service_shares((30.0,), (1.0, 1.3), None, [1, 3]) == pytest.approx({(30.0, 1.0): 0.25, (30.0, 1.3): 0.75})
+    assert service_shares((30.0,), (1.0,)) is None
+
+
+@pytest.mark.parametrize(
+    "shares, fragments",
+    [
+        ([1, 2, 3], ("speed_shares = [1, 2, 3]", "3 shares for 2 speeds (30, 50)", "one per speed")),
+        ([1, 0], ("speed_shares = 0", "a finite number > 0")),
+        ([1, float("nan")], ("speed_shares = nan",)),
+        ("fast", ("speed_shares = 'fast'", "give a list of numbers, one per speed")),
+    ],
+)
+def test_bad_shares_are_refused_naming_the_option(shares, fragments):
+    with pytest.raises(InputError) as err:
+        service_shares((30.0, 50.0), (1.0,), shares, None)
+    for fragment in fragments:
+        assert fragment in str(err.value), str(err.value)
+
+
+def test_a_score_over_the_points_is_the_worst_or_the_weighted_mean():
+    assert over_points([1.0, 0.5]) == 1.0
+    assert over_points([1.0, 0.5], [0.25, 0.75]) == pytest.approx(0.625)
+    assert over_points([1.0, np.inf], [0.5, 0.5]) == np.inf  # a run diverged
+    # a point that breaks a constraint (at or above the infeasible offset) is not averaged away
+    assert over_points([0.8, 1500.0], [0.99, 0.01], offset=1000.0) == 1500.0
+    assert over_points([0.8, 0.9], [0.5, 0.5], offset=1000.0) == pytest.approx(0.85)
+    points = [{"scores": {"pid": 0.8}, "passive_score": 1.0, "share": 0.9}, {"scores": {"pid": 1.4}, "share": 0.1,
+              "passive_score": 1.0}]  # fmt: skip
+    assert law_score(points, "pid") == pytest.approx(0.86)
+    assert law_score(points, "passive") == pytest.approx(1.0)
+    # worst 1.4 is worse than passive's 1, but in service 0.86 is better: the law is recommended
+    assert passive_wins({"score": 0.86}, points) is None
+
+
+def test_a_case_that_weighs_next_to_nothing_leaves_the_tuning_of_the_other():
+    """Two speeds, the second weighted 1e-12: the weighted mean is the first case's objective to
+    1e-12, so the sensitivity study takes the same steps as on the first case alone."""
+    first = TuningCase("paper-sine", (("duration", 0.3), ("speed", 55.56)), 1.0)
+    second = TuningCase("paper-sine", (("duration", 0.3), ("speed", 30.0)), 1.0, 1e-12)
+    kw = dict(budget=15, n_values=3, before_after=False, progress=False)
+    with pytest.warns(TuningWarning):
+        alone = tune(["pid"], over=[first], **kw)
+    with pytest.warns(TuningWarning):
+        weighted = tune(["pid"], over=[first, second], **kw)
+    assert weighted.gains.pid == alone.gains.pid
+    # and the weights are kept with the tuning set (only where they differ from 1)
+    assert [r.get("weight") for r in weighted.settings["tuning_set"]] == [1.0, 1e-12]
+    assert "weight" not in alone.settings["tuning_set"][0]
+    with pytest.raises(InputError, match="weight = -1"):
+        TuningCase("paper-sine", (), 1.0, -1.0)
+
+
+@pytest.fixture(scope="module")
+def weighted():
+    return rr.design(
+        ["skyhook"],
+        tracks=["fra4"],
+        speeds=[50.0, 30.0],
+        speed_shares=[1, 3],
+        loads=[1.0],
+        train_seeds=[0],
+        test_seeds=[1, 2],
+        duration=2.0,
+        budget=25,
+        values=3,
+        progress=False,
+    )
+
+
+def test_a_weighted_design_ranks_by_the_mean_in_service_and_says_so(weighted):
+    # the shares follow the speeds as given (50 then 30), not their sorted order
+    assert weighted.settings["service"] == [
+        {"speed_m_s": 50.0, "load": 1.0, "share": 0.25},
+        {"speed_m_s": 30.0, "load": 1.0, "share": 0.75},
+    ]
+    by_speed = {p["speed_m_s"]: p for p in weighted.points}
+    sky = next(r for r in weighted.ranking if r["controller"] == "skyhook")
+    at = {v: by_speed[v]["scores"]["skyhook"] for v in (30.0, 50.0)}
+    assert sky["score"] == pytest.approx(0.75 * at[30.0] + 0.25 * at[50.0], rel=1e-12)
+    assert sky["worst_score"] == max(at.values())
+    text = weighted.recommendation
+    if "keep passive" in text:
+        assert f"scores {sky['score']:.3f} in service (worst {sky['worst_score']:.3f} at" in text, text
+    else:
+        assert "time in service (50 m/s, load 1: 25 %; 30 m/s, load 1: 75 %)" in text, text
+    assert "at worst" not in text
+    _check_schema(weighted.to_dict())
+
+
+def _check_schema(doc: dict) -> None:
+    import json
+    from pathlib import Path
+
+    jsonschema = pytest.importorskip("jsonschema")
+    path = Path(__file__).parents[2] / "docs" / "schemas" / "railride.design-1.json"
+    jsonschema.validate(json.loads(json.dumps(doc, default=str)), json.loads(path.read_text()))
+
+
+def test_the_command_line_takes_the_shares_and_checks_them():
+    from clihelp import assert_input_error, run
+
+    result = run("design", "--speed", "30,50", "--speed-share", "1,2,3", "--controllers", "skyhook")
+    assert_input_error(result, "--speed-share = [1.0, 2.0, 3.0]", "3 shares for 2 speeds", "one per speed")
+    result = run("design", "--load", "1,1.3", "--load-share", "1,-1", "--controllers", "skyhook")
+    assert_input_error(result, "--load-share = -1", "a finite number > 0")
