@@ -110,6 +110,8 @@ def describe_scenario(record: dict) -> str:
             text = f"random track, FRA class {spectrum[3:]}"
         elif spectrum.startswith("german-"):
             text = f"random track, German {spectrum.split('-', 1)[1]} interference"
+        elif spectrum.startswith("psd:"):
+            text = f"random track of the spectrum table {spectrum[4:]}"
         else:
             text = f"random track {spectrum}"
         if "seed" in record:

@@ -70,16 +70,20 @@ def _scenario(help: str):
 SCENARIO_HELP = (
     "paper-sine (the paper's sine rails), bump (a cosine bump on both rails), "
     "file:PATH (a measured CSV with columns s, z_L, z_R in metres), or a random "
-    "track: fra1..fra6 (FRA classes; 6 is the best track) or german-low, "
-    "german-high (see --track-seed, --min-wavelength, --max-wavelength)."
+    "track: fra1..fra6 (FRA classes; 6 is the best track), german-low, "
+    "german-high, or psd:PATH, your own spectrum table (docs/track.md) "
+    "(see --track-seed, --min-wavelength, --max-wavelength)."
 )
 #: simulate: every scenario explained
 ScenarioOption = _scenario(SCENARIO_HELP)
 CompareScenarioOption = _scenario(
-    "paper-sine (the paper's sine rails), bump, file:PATH, fra1..fra6, german-low or german-high, as for simulate."
+    "paper-sine (the paper's sine rails), bump, file:PATH, fra1..fra6, german-low, german-high or psd:PATH, as for "
+    "simulate."
 )
 #: tune, pareto and sweep
-RunsScenarioOption = _scenario("paper-sine, bump, file:PATH, fra1..fra6, german-low or german-high, as for simulate.")
+RunsScenarioOption = _scenario(
+    "paper-sine, bump, file:PATH, fra1..fra6, german-low, german-high or psd:PATH, as for simulate."
+)
 
 AmplitudeOption = Annotated[
     Optional[float],

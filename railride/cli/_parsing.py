@@ -350,9 +350,16 @@ RUN_FIELDS = {**SOLVER_FIELDS, **PROFILE_FIELDS}
 
 
 def random_tracks() -> tuple:
-    from railride.model.track import SPECTRA
+    """The random tracks by name, as messages list them (a user's table as psd:PATH)."""
+    from railride.model.track import RANDOM_NAMES
 
-    return SPECTRA
+    return RANDOM_NAMES
+
+
+def is_random_track(name) -> bool:
+    from railride.model.track import is_random
+
+    return is_random(name)
 
 
 def track_options(
@@ -362,7 +369,7 @@ def track_options(
     track.scenario that were given (their values are the track's to check, `make_scenario`)."""
     given = {"seed": seed, "min_wavelength": min_wavelength, "max_wavelength": max_wavelength}
     out = {k: v for k, v in given.items() if v is not None}
-    if out and scenario_name not in random_tracks():
+    if out and not is_random_track(scenario_name):
         option, keyword, unit = next(o for o in TRACK_OPTIONS if o[1] in out)
         value = f"{out[keyword]:g}" + (f" {unit}" if unit else "")
         raise InputError(
@@ -380,7 +387,7 @@ def make_scenario(name: str, options: dict, output_rate: Optional[float] = None,
     from railride.run.solver import check_resolution
     from railride.model.track import scenario as library_scenario
 
-    if name in random_tracks():
+    if is_random_track(name):
         for option, keyword, unit in (
             ("--amplitude", "amplitude", "m"),
             ("--wavelength", "wavelength", "m"),

@@ -300,7 +300,8 @@ def design_command(
         typer.Option(
             "--track",
             metavar="NAME[,NAME...]",
-            help="Random track classes (fra1..fra6, german-low, german-high) or a measured line (file:PATH, "
+            help="Random track classes (fra1..fra6, german-low, german-high, psd:PATH: your own spectrum table) or a "
+            "measured line (file:PATH, "
             "whose seeds are its sections, each the fastest speed x the duration long).",
         ),
     ] = "fra4,fra5",

@@ -56,7 +56,11 @@ def ride_spectrum(
     ctx: typer.Context,
     track: Annotated[
         str,
-        typer.Option("--track", metavar="SPECTRUM", help="Track spectrum: fra1..fra6, german-low or german-high."),
+        typer.Option(
+            "--track",
+            metavar="SPECTRUM",
+            help="Track spectrum: fra1..fra6, german-low, german-high, or psd:PATH, your own table (docs/track.md).",
+        ),
     ] = "fra4",
     speed: Annotated[
         Optional[float], typer.Option("--speed", metavar="M/S", help="Speed [m/s] (default 55.56).")

@@ -35,7 +35,7 @@ from railride.analysis.comfort import FLOOR
 from railride.frequency.frf import FMAX_LIMIT
 from railride.frequency.linear import LinearModel, linear_model, linear_suspensions
 from railride.model.params import VehicleParams, resolve_vehicle
-from railride.model.track import MAX_WAVELENGTH, SPECTRA, frequency_speed, spectrum
+from railride.model.track import MAX_WAVELENGTH, RANDOM_NAMES, frequency_speed, is_random, spectrum
 from railride.model.vehicle import CORNER_NAMES, Vehicle
 
 SCHEMA = "railride.ride-spectrum/1"
@@ -276,9 +276,9 @@ def ride_spectrum(
     control_rate: float | None = None,
     delay: int = 1,
 ) -> RideSpectrum:
-    """The ride on spectrum ``track`` (`railride.model.track.SPECTRA`) at ``speed`` [m/s] (default
-    the scenarios' 55.56) of ``vehicle`` (``params`` is an alias: `VehicleParams`, a preset name
-    or a parameters file; default "paper") with the load factor ``load`` on its carbody,
+    """The ride on spectrum ``track`` (`railride.model.track.SPECTRA`, or a user's table psd:PATH)
+    at ``speed`` [m/s] (default the scenarios' 55.56) of ``vehicle`` (``params`` is an alias:
+    `VehicleParams`, a preset name or a parameters file; default "paper") with the load factor ``load`` on its carbody,
     recorded in ``settings["vehicle"]``, for each of ``controllers``: "passive",
     outer-loop names (on the ideal actuator, gains from ``gains``, default the shipped) or
     linear `Suspension` values. The spectrum is taken over [min_wavelength, max_wavelength] m
@@ -291,7 +291,8 @@ def ride_spectrum(
     ``["gains_provenance"]`` and ``["gains_values"]``: the gains those loops ran, their source,
     how they were found and every value per suspension (`GainSet.record`; ``["gains"]`` says
     "given" or "shipped")."""
-    validation.choice("track", track, SPECTRA)
+    if not is_random(track):
+        validation.choice("track", track, RANDOM_NAMES)  # its error names every spectrum
     speed = DEFAULT_SPEED if speed is None else frequency_speed(speed)
     lo = validation.number("min_wavelength", min_wavelength, "positive", "m")
     hi = validation.number("max_wavelength", max_wavelength, "positive", "m")

@@ -12,6 +12,7 @@ import numpy as np
 from railride.errors import InputError
 from railride import validation
 from railride._cache import MiB, BytesLRU
+from railride.model import psd_table
 from railride.model.profiles import RailProfile, _check
 
 #: FRA track classes (Hamid and Yang 1981; the constants as in Garg and Dukkipati 1984,
@@ -24,6 +25,14 @@ FRA_K, FRA_OMEGA_C, FRA_OMEGA_S = 0.25, 0.8245, 0.4380
 GERMAN_AV = {"low": 4.032e-7, "high": 1.080e-6}
 GERMAN_OMEGA_C, GERMAN_OMEGA_R, GERMAN_OMEGA_S = 0.8246, 0.0206, 0.4380
 SPECTRA = tuple([f"fra{c}" for c in FRA_AV] + ["german-low", "german-high"])
+#: every random track by name, as messages list them: the standard spectra and a user's table
+RANDOM_NAMES = (*SPECTRA, f"{psd_table.PREFIX}PATH")
+
+
+def is_random(name) -> bool:
+    """Whether scenario ``name`` is a random track: a standard spectrum or a user's table
+    (psd:PATH, `railride.model.psd_table`)."""
+    return isinstance(name, str) and (name in SPECTRA or psd_table.is_table(name))
 
 
 def spectrum(name: str, wavenumber, component: str = "vertical") -> np.ndarray:
@@ -37,6 +46,8 @@ def spectrum(name: str, wavenumber, component: str = "vertical") -> np.ndarray:
     * FRA class c: S_v = k A_v Omega_c^2 / (Omega^2 (Omega^2 + Omega_c^2)),
       S_x = 4 k A_v Omega_c^2 / ((Omega^2 + Omega_c^2)(Omega^2 + Omega_s^2)), in cm^2/(rad/m),
       converted here to m^2/(rad/m).
+    * psd:PATH: a user's table, log-log between its rows (`railride.model.psd_table`); no
+      values outside its range.
     * German low/high: S_v = A_v Omega_c^2 / ((Omega^2 + Omega_r^2)(Omega^2 + Omega_c^2)); the
       published cross-level form (A_v / b^2) Omega_c^2 Omega^2 / ((Omega^2 + Omega_r^2)(Omega^2 +
       Omega_c^2)(Omega^2 + Omega_s^2)) is the cross-level angle with b = 0.75 m half the contact
@@ -48,6 +59,8 @@ def spectrum(name: str, wavenumber, component: str = "vertical") -> np.ndarray:
         raise InputError("wavenumber must be finite and > 0 rad/m")
     if component not in ("vertical", "cross-level"):
         raise InputError(f"component = {component!r}: allowed 'vertical', 'cross-level'")
+    if psd_table.is_table(name):
+        return psd_table.table(name)(W, component)
     W2 = W * W
     if name.startswith("fra") and name[3:].isdigit() and int(name[3:]) in FRA_AV:
         Av, k, Wc2, Ws2 = FRA_AV[int(name[3:])], FRA_K, FRA_OMEGA_C**2, FRA_OMEGA_S**2
@@ -63,7 +76,7 @@ def spectrum(name: str, wavenumber, component: str = "vertical") -> np.ndarray:
         if component == "vertical":
             return Av * Wc2 / ((W2 + Wr2) * (W2 + Wc2))
         return 4 * Av * Wc2 * W2 / ((W2 + Wr2) * (W2 + Wc2) * (W2 + Ws2))
-    raise InputError(f"unknown track spectrum {name!r}; allowed: {', '.join(SPECTRA)}")
+    raise InputError(f"unknown track spectrum {name!r}; allowed: {', '.join(RANDOM_NAMES)}")
 
 
 @dataclass(frozen=True, eq=False)
@@ -87,13 +100,22 @@ class RandomTrack(RailProfile):
     def __post_init__(self):
         from scipy.interpolate import CubicSpline
 
-        spectrum(self.name, 1.0)  # an unknown name fails here
+        table = psd_table.table(self.name) if psd_table.is_table(self.name) else None
+        if table is None:
+            spectrum(self.name, 1.0)  # an unknown name fails here
         # a Python int, never through a float (which rounds seeds past 2**53)
         object.__setattr__(self, "seed", validation.seed("seed", self.seed))
         lo = _check("min_wavelength", self.min_wavelength, "positive", "a finite number > 0 (m)")
         hi = _check("max_wavelength", self.max_wavelength, "positive", "a finite number > 0 (m)")
         if not lo < hi:
             raise InputError(f"wavelength band [{lo:g}, {hi:g}] m: min_wavelength must be below max_wavelength")
+        if table is not None and not (table.band()[0] <= lo * (1 + 1e-12) and hi <= table.band()[1] * (1 + 1e-12)):
+            short, long = table.band()
+            raise InputError(
+                f"wavelength band [{lo:g}, {hi:g}] m: beyond the {short:.4g} to {long:.4g} m that the spectrum "
+                f"table {self.name} covers; a spectrum is not extrapolated: give min_wavelength and max_wavelength "
+                "within it, or extend the table"
+            )
         length = _check("length", self.length, "positive", "a finite number > 0 (m)")
         if length < hi:
             raise InputError(f"length = {length:g} m: must be at least max_wavelength = {hi:g} m")
@@ -165,6 +187,8 @@ class RandomTrack(RailProfile):
             "max_wavelength_m": self.max_wavelength,
             "length_m": self.length,
             "lead_in_m": self.lead_in,
+            # a user's table: which version of the file made the realisation
+            **({"spectrum_sha256": psd_table.table(self.name).sha256} if psd_table.is_table(self.name) else {}),
         }
 
 
@@ -195,4 +219,6 @@ def _random_track(name, seed, min_wavelength, max_wavelength, length) -> RandomT
 
     if isinstance(seed, bool):  # True would hash as seed 1: let the constructor refuse it
         return build()
-    return _TRACKS.get((name, seed, min_wavelength, max_wavelength, length), build)
+    # a user's table by its contents too: an edited file is another spectrum
+    version = psd_table.table(name).sha256 if psd_table.is_table(name) else None
+    return _TRACKS.get((name, version, seed, min_wavelength, max_wavelength, length), build)

@@ -53,8 +53,10 @@ from railride.model.irregularity import (  # noqa: F401 (the random irregularity
     GERMAN_OMEGA_C,
     GERMAN_OMEGA_R,
     GERMAN_OMEGA_S,
+    RANDOM_NAMES,
     SPECTRA,
     TRACK_CACHE_BYTES,
+    is_random,
     RandomTrack,
     _TRACKS,
     _random_track,
@@ -343,7 +345,7 @@ class Scenario:
         return {"name": self.name, "speed_m_s": self.speed, "duration_s": self.duration, **self.track.describe()}
 
 
-SCENARIOS = ("paper-sine", "bump", "file:PATH", "fra1..fra6", "german-low", "german-high")
+SCENARIOS = ("paper-sine", "bump", "file:PATH", "fra1..fra6", "german-low", "german-high", "psd:PATH")
 
 
 def scenario(
@@ -368,7 +370,8 @@ def scenario(
     and wavelength its length [m] (default 10 m), starting at s = 10 m on both rails.
     ``file:PATH``: a measured CSV profile (s, z_L, z_R); with ``start`` [m], its section from
     there on, faded in over 20 m (`MeasuredTrack.section`). ``fra1`` ... ``fra6``, ``german-low``,
-    ``german-high``: a random realisation of that spectrum (`RandomTrack`) with ``seed`` (default
+    ``german-high``, ``psd:PATH`` (a user's spectrum table, `railride.model.psd_table`): a random
+    realisation of that spectrum (`RandomTrack`) with ``seed`` (default
     0) over the wavelength band [min_wavelength, max_wavelength] (default 1 to 100 m). Speed
     defaults to 55.56 m/s and duration to 10 s for every scenario.
     """
@@ -385,9 +388,9 @@ def scenario(
         for k, v in (("seed", seed), ("min_wavelength", min_wavelength), ("max_wavelength", max_wavelength))
         if v is not None
     ]
-    if random_only and name not in SPECTRA:
+    if random_only and not is_random(name):
         raise InputError(
-            f"{', '.join(random_only)} applies to the random tracks ({', '.join(SPECTRA)}) only, not to {name}"
+            f"{', '.join(random_only)} applies to the random tracks ({', '.join(RANDOM_NAMES)}) only, not to {name}"
         )
     if taper is not None and name != "paper-sine":
         raise InputError(f"taper applies to paper-sine only, not to {name}")
@@ -407,7 +410,7 @@ def scenario(
         track = CosineBump(
             height=0.02 if amplitude is None else amplitude, length=10.0 if wavelength is None else wavelength
         )
-    elif name in SPECTRA:
+    elif is_random(name):
         given = [
             k
             for k, v in (("amplitude", amplitude), ("wavelength", wavelength), ("rail_phase", rail_phase))

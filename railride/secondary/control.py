@@ -602,10 +602,10 @@ def _profile(scenario) -> str | None:
     if hasattr(scenario, "describe"):
         return scenario.describe().get("profile")
     if isinstance(scenario, str):
-        from railride.model.track import SPECTRA
+        from railride.model.track import is_random
 
         name = scenario.strip()
-        return "random" if name in SPECTRA else "measured" if name.startswith("file:") else "deterministic"
+        return "random" if is_random(name) else "measured" if name.startswith("file:") else "deterministic"
     return None
 
 

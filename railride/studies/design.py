@@ -231,7 +231,7 @@ def check_design(
     """Every input of `design`, checked before any work: an `InputError` names the option, the
     value and what is allowed. Returns the `Plan`."""
     from railride.model.params import resolve_argument
-    from railride.model.track import SPECTRA
+    from railride.model.track import RANDOM_NAMES, is_random
     from railride.model.track import scenario as make_scenario
     from railride.run.checks import check
     from railride.run.solver import SolverSettings
@@ -249,9 +249,10 @@ def check_design(
     )
     track_list = []
     for t in _items("tracks", tracks):
-        if not isinstance(t, str) or not (t.strip() in SPECTRA or t.strip().startswith("file:")):
+        if not isinstance(t, str) or not (is_random(t.strip()) or t.strip().startswith("file:")):
             raise InputError(
-                f"tracks = {t!r}: not a random track or a measured profile; allowed {', '.join(SPECTRA)}, file:PATH"
+                f"tracks = {t!r}: not a random track or a measured profile; allowed {', '.join(RANDOM_NAMES)}, "
+                "file:PATH"
             )
         track_list.append(t.strip())
     given_speeds = tuple(

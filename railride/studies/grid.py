@@ -412,25 +412,25 @@ def _check_applies(words: _Words, listed: str, has_mr: bool, controllers: list, 
 
 def _band(words: _Words, scenario: str, min_wavelength, max_wavelength) -> dict:
     """The wavelength band of a random track that was given, checked."""
-    from railride.model.track import SPECTRA
+    from railride.model.track import RANDOM_NAMES, is_random
 
     out = {}
     for key, unit in _BAND:
         value = {"min_wavelength": min_wavelength, "max_wavelength": max_wavelength}[key]
         if value is not None:
             out[key] = _numbers(words, key, [value], "positive", unit)[0]
-    if out and scenario not in SPECTRA:
+    if out and not is_random(scenario):
         key, unit = next(b for b in _BAND if b[0] in out)
         raise InputError(
             f"{words.name(key)} = {out[key]:g} {unit}: applies to the random-track scenarios "
-            f"({', '.join(SPECTRA)}) only, not to {words.name('scenario')} {scenario}"
+            f"({', '.join(RANDOM_NAMES)}) only, not to {words.name('scenario')} {scenario}"
         )
     return out
 
 
 def _scenario_axes(words: _Words, scenario: str, **given) -> list:
     """The swept scenario options: (keyword of track.scenario, column, values) each."""
-    from railride.model.track import SPECTRA
+    from railride.model.track import RANDOM_NAMES, is_random
 
     axes = []
     for key, keyword, column, unit in SCENARIO_AXES:
@@ -439,14 +439,14 @@ def _scenario_axes(words: _Words, scenario: str, **given) -> list:
             continue
         if keyword == "seed":
             values = _seeds(words, key, values, "track seeds")
-            if scenario not in SPECTRA:
+            if not is_random(scenario):
                 raise InputError(
                     f"{words.given(key, values)}: applies to the random-track scenarios "
-                    f"({', '.join(SPECTRA)}) only, not to {words.name('scenario')} {scenario}"
+                    f"({', '.join(RANDOM_NAMES)}) only, not to {words.name('scenario')} {scenario}"
                 )
         else:
             values = _numbers(words, key, values, unit=unit)
-            if scenario in SPECTRA and key != "speed":
+            if is_random(scenario) and key != "speed":
                 raise InputError(
                     f"{words.name(key)} = {values[0]:g} {unit}: does not apply to a random track "
                     f"({scenario}); its options are {words.name('track_seed')}, "

@@ -27,7 +27,7 @@ from railride.studies.comparison import check_controllers, compare
 from railride.secondary.control import LABELS, PAPER_CONTROLLERS, GainSet
 from railride.defaults import DEFAULT_DAMPER
 from railride.plots import PNG_DPI, FigureOptions
-from railride.model.track import SPECTRA, scenario
+from railride.model.track import is_random, scenario
 from railride.secondary.suspension import damper_record
 from railride.model.params import resolve_argument, resolve_vehicle, vehicle_record
 
@@ -153,7 +153,7 @@ def _cases(scenarios, speeds, track_seeds):
     if not seeds:
         raise InputError("track_seeds: give at least one seed (default 0)")
     for name, v in itertools.product(scenarios, speeds):
-        for seed in seeds if name in SPECTRA else [None]:
+        for seed in seeds if is_random(name) else [None]:
             yield name, v, seed
 
 

@@ -201,7 +201,7 @@ def study(
     from railride.analysis.metrics import check_window
     from railride.secondary.suspension import damper_model
     from railride.studies.sweep import other_settings
-    from railride.model.track import SCENARIOS, SPECTRA
+    from railride.model.track import RANDOM_NAMES, SCENARIOS, is_random
 
     from railride import arguments
 
@@ -217,14 +217,14 @@ def study(
     base, source = resolve_argument(vehicle, params)
     vehicle = base
     gains = GainSet.of(gains, scenario)
-    random = scenario in SPECTRA
+    random = is_random(scenario)
     if not random and scenario not in ("paper-sine", "bump") and not scenario.startswith("file:"):
         # named before the seeds' check, which would otherwise speak of a track that is no track
         raise InputError(f"scenario = {scenario!r}: unknown; allowed: {', '.join(SCENARIOS)}")
     if track_seeds is not None and not random:
         raise InputError(
             f"track_seeds = {list(_items(track_seeds))}: track seeds apply to the random tracks "
-            f"({', '.join(SPECTRA)}) only, not to {scenario!r}"
+            f"({', '.join(RANDOM_NAMES)}) only, not to {scenario!r}"
         )
     if track_seeds is None:
         track_seeds = range(10) if random else [None]
