@@ -444,11 +444,15 @@ def study_scenario(
     track_seed: Optional[int],
     min_wavelength: Optional[float],
     max_wavelength: Optional[float],
+    start: Optional[float] = None,
 ):
     """(scenario, its options for sweep.Case) of the runs of a study (tune, pareto), checked
-    before the first run (whether the runs' output rate resolves it is the study's check)."""
+    before the first run (whether the runs' output rate resolves it is the study's check);
+    ``start``: a measured profile's section (--start; the library checks the scenario)."""
     options = _scenario_options(
         amplitude=amplitude, wavelength=wavelength, rail_phase=rail_phase, speed=speed, duration=duration
     )
     options.update(track_options(name, track_seed, min_wavelength, max_wavelength))
+    if start is not None:
+        options["start"] = start
     return make_scenario(name, options), case_options(options)

@@ -27,6 +27,7 @@ from railride.cli._common import (
 )
 from railride.cli._options import (
     MaxMemoryOption,
+    StartOption,
     MaxStepsOption,
     AmplitudeOption,
     BoundOption,
@@ -208,8 +209,11 @@ def _tunable_list(text: str) -> list[str]:
     return [n for n in TUNABLE if n in items or "all" in items]
 
 
-def _tuning_set(scenario, seeds, loads, speed, duration, *single):
-    """--track-seed with several seeds, or --load: the runs every gain set is scored on."""
+def _tuning_set(scenario, seeds, loads, speed, duration, start, *single):
+    """--track-seed with several seeds, or --load: the runs every gain set is scored on (on a
+    measured profile's section from ``start``, --start, where given)."""
+    import dataclasses
+
     from railride.studies.tuning import tuning_set
 
     if any(v is not None for v in single):
@@ -218,13 +222,16 @@ def _tuning_set(scenario, seeds, loads, speed, duration, *single):
             "a single tuning scenario, not to several --track-seed values or --load"
         )
     with option_names({"track_seeds": "--track-seed", "loads": "--load"}):
-        return tuning_set(
+        cases = tuning_set(
             scenario,
             track_seeds=None if seeds is None else [int(x) for x in seeds],
             speeds=None if speed is None else [speed],
             loads=[1.0] if loads is None else loads,
             duration=duration,
         )
+    if start is None:
+        return cases
+    return tuple(dataclasses.replace(c, options=tuple(sorted((*c.options, ("start", start))))) for c in cases)
 
 
 def _tune_start(path: Optional[Path]):
@@ -453,6 +460,7 @@ def tune_command(
     ] = "mean",
     min_wavelength: MinWavelengthOption = None,
     max_wavelength: MaxWavelengthOption = None,
+    section_start: StartOption = None,
     speed: SpeedOption = None,
     duration: RunDurationOption = None,
     dt: DtOption = None,
@@ -540,6 +548,7 @@ def tune_command(
                 loads,
                 speed,
                 duration,
+                section_start,
                 amplitude,
                 wavelength,
                 rail_phase,
@@ -556,6 +565,7 @@ def tune_command(
             track_seed=None if seeds is None else int(seeds[0]),
             min_wavelength=min_wavelength,
             max_wavelength=max_wavelength,
+            start=section_start,
         )
         scenario_text = describe_scenario(scen.describe())
         check_report_option(report)

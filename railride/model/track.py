@@ -178,6 +178,8 @@ class MeasuredTrack(RailProfile):
     z_L: np.ndarray
     z_R: np.ndarray
     source: str = "<array>"
+    #: a section's start on the file's profile [m] (`section`); None: the profile as read
+    start_m: float | None = None
     _interp: tuple = field(default=(), repr=False)
 
     def __post_init__(self):
@@ -272,7 +274,9 @@ class MeasuredTrack(RailProfile):
         z0 = self._evaluate(np.array([start]))
         zl, zr = np.concatenate([z0[0], self.z_L[keep]]), np.concatenate([z0[1], self.z_R[keep]])
         r = np.where(s < lead_in, 0.5 * (1.0 - np.cos(np.pi * np.clip(s / max(lead_in, 1e-300), 0.0, 1.0))), 1.0)
-        return MeasuredTrack(s, r * zl, r * zr, source=f"{self.source} from s = {start:g} m")
+        return MeasuredTrack(
+            s, r * zl, r * zr, source=f"{self.source} from s = {start:g} m", start_m=(self.start_m or 0.0) + start
+        )
 
     def _evaluate(self, s):
         if np.any(s > self.s[-1] + 1e-9):
@@ -289,7 +293,13 @@ class MeasuredTrack(RailProfile):
         return float(np.min(np.diff(self.s))) / 2
 
     def describe(self):
-        return {"profile": "measured", "source": self.source, "rows": int(self.s.size), "s_end_m": float(self.s[-1])}
+        return {
+            "profile": "measured",
+            "source": self.source,
+            "rows": int(self.s.size),
+            "s_end_m": float(self.s[-1]),
+            **({"start_m": float(self.start_m)} if self.start_m is not None else {}),
+        }
 
 
 def _check_speed(value) -> float:

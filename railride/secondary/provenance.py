@@ -40,6 +40,7 @@ _TRACK_OPTIONS = {
     "min_wavelength_m": ("--min-wavelength", "shortest wavelength", "m"),
     "max_wavelength_m": ("--max-wavelength", "longest wavelength", "m"),
     "duration_s": ("--duration", "duration", "s"),
+    "start_m": ("--start", "start", "m"),  # a measured profile's section
 }
 #: how many values of a list a line shows before it says how many there are
 _SHOWN = 5
@@ -293,7 +294,7 @@ def judged_text(gains, records: list) -> str | None:
 
 
 #: a measured profile's record keys that change with the section it starts at
-_SECTION_KEYS = ("source", "rows", "s_end_m")
+_SECTION_KEYS = ("source", "rows", "s_end_m", "start_m")
 
 
 def _overlaps(tuned: dict, record: dict) -> bool:
