@@ -93,8 +93,14 @@ def _pareto_table(doc: dict, caption: str):
     counts.add_column("non-dominated\nover all four ratios", justify="right")
     for x, y in PROJECTIONS:
         counts.add_column(f"non-dominated in\n{x} and {y}", justify="right")
+    travel = "non_dominated_with_travel" in c
+    if travel:
+        counts.add_column("non-dominated over\nthe four and travel", justify="right")
     counts.add_row(
-        str(c["samples"]), str(c["non_dominated"]), *[str(c[f"non_dominated_{x}_{y}"]) for x, y in PROJECTIONS]
+        str(c["samples"]),
+        str(c["non_dominated"]),
+        *[str(c[f"non_dominated_{x}_{y}"]) for x, y in PROJECTIONS],
+        *([str(c["non_dominated_with_travel"])] if travel else []),
     )
     if 2 * c["non_dominated"] > c["samples"]:  # four objectives: most of few points are on the front
         counts.caption = (
@@ -105,21 +111,49 @@ def _pareto_table(doc: dict, caption: str):
         (r for r in doc["samples"] if r["non_dominated"]),
         key=lambda r: (r["acceleration_m_s2_ratio"] is None, r["acceleration_m_s2_ratio"] or 0.0),
     )
+    caption += (
+        "\n2-D fronts: the planes of the figure (acceleration against pitch, against roll) in which the sample is "
+        "also non-dominated."
+    )
     rows = FitTable(
         title="Non-dominated samples by acceleration ratio: RMS / RMS(passive)", caption=caption, caption_justify="left"
     )
     rows.add_column("sample", justify="right")
     for label in RESPONSE_LABELS.values():
         rows.add_column(label.split(" (")[0], justify="right")
-    rows.add_column("also non-dominated\nagainst acceleration in")
+    if travel:
+        rows.add_column("max\ntravel", justify="right")
+    rows.add_column("2-D fronts")
     for r in front:
-        planes = ", ".join(y for x, y in PROJECTIONS if r[f"non_dominated_{x}_{y}"])
+        planes = "/".join(y for x, y in PROJECTIONS if r[f"non_dominated_{x}_{y}"]) or "-"
         rows.add_row(
             f"{r['sample']}" + (" (base)" if r["base"] else ""),
             *[fmt(r[f"{key}_ratio"], ".3f") for key in RESPONSE_LABELS],
+            *([fmt(r["travel_ratio"], ".3f")] if travel else []),
             planes,
         )
-    return [counts, "", rows]
+    return [counts, "", rows, *([travel_text(doc, front)] if travel else [])]
+
+
+def travel_text(doc: dict, front: list) -> str:
+    """What the four-ratio front asks of the suspension's travel: how many of its samples move
+    more than passive, and by how much at most."""
+    passive = doc.get("passive_travel_m")
+    ratios = [r["travel_ratio"] for r in front if r.get("travel_ratio") is not None]
+    if not passive or not ratios:
+        return ""
+    more = [x for x in ratios if x > 1.0]
+    head = (
+        f"Travel: max travel is each sample's largest secondary travel over passive's ({passive * 1e3:.3g} mm); "
+        "the four-ratio front does not weigh it. "
+    )
+    if not more:
+        return head + f"None of the {len(front)} samples on the front needs more travel than passive."
+    return head + (
+        f"{len(more)} of the {len(front)} samples on the front need more travel than passive (up to "
+        f"x{max(more):.3g}): ride bought with rattle space. Over the four ratios and travel "
+        f"{doc['counts']['non_dominated_with_travel']} samples are non-dominated."
+    )
 
 
 @app.command("pareto")

@@ -69,6 +69,7 @@ class GainEvaluator:
         params=None,
         solver=None,
         vehicle_columns=None,
+        costs: bool = False,
     ):
         self.parameters = tuple(parameters)
         self.suspension = suspension
@@ -88,9 +89,13 @@ class GainEvaluator:
         self.solver = SolverSettings.of(solver)
         self.progress = progress
         self.vehicle_columns = vehicle_columns  # the vehicle's name and load in the run table (run_cases)
+        # with ``costs``, every run also keeps what it asks of its dampers (its travel: `rms_travel`)
+        self.costs = bool(costs)
         self.n_runs = 0
         self.batches: list[tuple[int, float]] = []
-        self.passive = _rms(self._run([Case(scenario, self.opts)]))[0]
+        passive = self._run([Case(scenario, self.opts)])
+        self.passive = _rms(passive)[0]
+        self.passive_travel = float(passive["travel_max_m"].iloc[0]) if self.costs else None
 
     def _run(self, cases):
         self.n_runs += len(cases)
@@ -103,6 +108,7 @@ class GainEvaluator:
             solver=self.solver,
             progress=self.progress,
             vehicle_columns=self.vehicle_columns,
+            costs=self.costs,
         )
 
     def cases(self, points: np.ndarray) -> list[Case]:
@@ -121,6 +127,11 @@ class GainEvaluator:
     def rms(self, cases: list[Case]) -> np.ndarray:
         """(n, 4) RMS of acceleration, displacement, pitch, roll of ``cases``."""
         return _rms(self._run(cases))
+
+    def rms_travel(self, cases: list[Case]) -> tuple[np.ndarray, np.ndarray]:
+        """((n, 4) RMS as `rms`, (n,) largest secondary travel [m]) of ``cases`` (needs ``costs``)."""
+        frame = self._run(cases)
+        return _rms(frame), frame["travel_max_m"].to_numpy(dtype=float)
 
     def __call__(self, points: np.ndarray) -> np.ndarray:
         values = self.objective(self.rms(self.cases(points)), self.passive)

@@ -4,9 +4,10 @@
 log10 over the search box of `railride.studies.optimise`, REFERENCE / 1000 to REFERENCE x 100), adds
 the base gains as a sample of their own, runs every sample through `railride.studies.sweep.run_cases`
 (compiled batches, a resumable run table, a Dask cluster if asked) and returns a `ParetoResult`:
-the four RMS ratios to passive per sample (acceleration, displacement, pitch, roll) and which
-samples are non-dominated, over the four ratios and in the two planes the plot shows
-(acceleration against pitch, acceleration against roll).
+the four RMS ratios to passive per sample (acceleration, displacement, pitch, roll), its largest
+secondary travel against passive's, and which samples are non-dominated, over the four ratios,
+in the two planes the plot shows (acceleration against pitch, acceleration against roll), and
+over the four ratios and the travel.
 
 A sample is dominated when another is at least as good in every ratio and better in one; the
 non-dominated ones are the trades no objective over these ratios can improve on all at once.
@@ -108,6 +109,9 @@ class ParetoResult:
     RATIOS: ClassVar[tuple[str, ...]] = RATIOS
     PROJECTIONS: ClassVar[tuple[tuple[str, str], ...]] = PROJECTIONS
     runs: int = 0  # rows of the run table at the end
+    #: (n,) each sample's largest secondary travel [m], and passive's (None: not measured)
+    travel: np.ndarray | None = None
+    passive_travel: float | None = None
 
     @property
     def ratios(self) -> np.ndarray:
@@ -119,14 +123,29 @@ class ParetoResult:
         """Non-dominated over the four ratios."""
         return non_dominated(self.ratios)
 
+    @property
+    def travel_ratio(self) -> np.ndarray | None:
+        """(n,) largest secondary travel / passive's (None: not measured)."""
+        if self.travel is None or not self.passive_travel:
+            return None
+        return self.travel / self.passive_travel
+
+    @property
+    def non_dominated_with_travel(self) -> np.ndarray | None:
+        """Non-dominated over the four ratios and the travel ratio: the trades that count the
+        suspension's travel too (None: not measured)."""
+        travel = self.travel_ratio
+        return None if travel is None else non_dominated(np.column_stack([self.ratios, travel]))
+
     def non_dominated_in(self, x: str, y: str) -> np.ndarray:
         """Non-dominated in the plane of ratios ``x`` and ``y`` (names of RATIOS)."""
         return non_dominated(self.ratios[:, [RATIOS.index(x), RATIOS.index(y)]])
 
     def to_pandas(self) -> pd.DataFrame:
         """One row per sample: ``sample`` (0 = the base gains), ``base``, the gains (SI, one
-        column per "table.entry"), ``<response>_rms``, ``<response>_ratio`` and the flags
-        ``non_dominated``, ``non_dominated_<x>_<y>`` for each plotted plane."""
+        column per "table.entry"), ``<response>_rms``, ``<response>_ratio``, ``travel_max_m``
+        and ``travel_ratio`` (where measured) and the flags ``non_dominated``,
+        ``non_dominated_<x>_<y>`` for each plotted plane and ``non_dominated_with_travel``."""
         n = len(self.gains)
         frame = pd.DataFrame({"sample": np.arange(n), "base": np.arange(n) == 0})
         for j, p in enumerate(self.parameters):
@@ -136,9 +155,14 @@ class ParetoResult:
             frame[f"{r}_rms"] = self.rms[:, k]
         for k, r in enumerate(RESPONSES):
             frame[f"{r}_ratio"] = ratios[:, k]
+        if self.travel is not None:
+            frame["travel_max_m"] = self.travel
+            frame["travel_ratio"] = self.travel_ratio
         frame["non_dominated"] = self.non_dominated
         for x, y in PROJECTIONS:
             frame[f"non_dominated_{x}_{y}"] = self.non_dominated_in(x, y)
+        if self.travel is not None:
+            frame["non_dominated_with_travel"] = self.non_dominated_with_travel
         return frame
 
     def to_dict(self) -> dict:
@@ -149,6 +173,7 @@ class ParetoResult:
 
         frame = self.to_pandas()
         flags = ["non_dominated"] + [f"non_dominated_{x}_{y}" for x, y in PROJECTIONS]
+        flags += ["non_dominated_with_travel"] if self.travel is not None else []
         rows = [{k: _plain(v) for k, v in row.items()} for row in frame.to_dict("records")]
         return {
             "schema": SCHEMA,
@@ -168,6 +193,7 @@ class ParetoResult:
                 for j, (p, (lo, hi)) in enumerate(zip(self.parameters, self.bounds))
             ],
             "passive_rms": dict(zip(RESPONSES, map(float, self.passive))),
+            "passive_travel_m": None if self.passive_travel is None else float(self.passive_travel),
             "counts": {"samples": len(frame), **{f: int(frame[f].sum()) for f in flags}},
             "note": self.note,
             "runs": int(self.runs),
@@ -322,6 +348,7 @@ def pareto(
         vehicle,
         solver,
         vehicle_columns={"vehicle": vehicle_rec["name"], "load": vehicle_rec["load"]},
+        costs=True,  # the travel too: a trade in ride bought with rattle space is shown as one
     )
     bounds = np.array(log_gain_bounds(names))
     import scipy.stats.qmc  # here, not at import: scipy.stats costs half a second to load
@@ -329,7 +356,7 @@ def pareto(
     unit = scipy.stats.qmc.Sobol(len(names), scramble=True, seed=seed).random_base2(int(math.log2(n_samples)))
     points = scipy.stats.qmc.scale(unit, bounds[:, 0], bounds[:, 1])
     base_case = Case(scenario, ev.opts, suspension=suspension, damper=damper)
-    rms = ev.rms([base_case, *ev.cases(points)])
+    rms, travel = ev.rms_travel([base_case, *ev.cases(points)])
     if not np.all(np.asarray(ev.passive, float) > 0):  # every ratio would be nan or inf
         raise InputError(still_passive(record))
     gains_si = np.vstack([[base.value(p) for p in names], 10.0**points])
@@ -365,4 +392,6 @@ def pareto(
         settings,
         in_sample_note(base, record),
         len(table.frame),
+        travel,
+        ev.passive_travel,
     )

@@ -87,7 +87,7 @@ def test_a_tiny_study(tiny, tmp_path):
     assert np.array_equal(again.gains, tiny.gains)
     other = pareto("sas-attitude", n_samples=4, seed=4, scenario_options=SHORT)
     assert not np.array_equal(other.gains[1:], tiny.gains[1:])
-    ratio = frame[[c for c in frame if c.endswith("_ratio")]].to_numpy()
+    ratio = frame[[c for c in frame if c.endswith("_ratio") and c != "travel_ratio"]].to_numpy()
     rms = frame[[c for c in frame if c.endswith("_rms")]].to_numpy()
     assert np.allclose(ratio * tiny.passive, rms, rtol=1e-12)
     assert frame["non_dominated"].tolist() == brute_force(ratio)
@@ -164,3 +164,25 @@ def test_pareto_refuses_bad_input(kwargs, fragment):
     with pytest.raises(ValueError) as info:
         pareto(**{"scenario_options": SHORT, **kwargs})
     assert fragment in str(info.value)
+
+
+def test_the_travel_of_every_sample_and_the_front_that_counts_it(tiny):
+    """Each sample's largest secondary travel against passive's; the base sample's is the one a
+    comparison of the same law and gains on the same track reports (another study's path to the
+    same run); a sample on the four-ratio front stays on the front with travel added (a fifth
+    objective removes no point that no other point dominates in four)."""
+    import railride as rr
+
+    frame = tiny.to_pandas()
+    np.testing.assert_allclose(frame["travel_ratio"], frame["travel_max_m"] / tiny.passive_travel, rtol=1e-15)
+    assert frame["non_dominated_with_travel"].tolist() == brute_force(
+        np.column_stack([tiny.ratios, frame["travel_ratio"]])
+    )
+    assert (frame["non_dominated_with_travel"] | ~frame["non_dominated"]).all()
+    compared = rr.compare(scenario("paper-sine", duration=1.0), controllers=["sas-attitude"], bounds=False)
+    travel = {r["name"]: r["damper"]["travel_max_m"] for r in compared.to_dict()["controllers"]}
+    assert tiny.passive_travel == pytest.approx(travel["passive"], rel=1e-12)
+    assert frame.loc[0, "travel_max_m"] == pytest.approx(travel["sas-attitude"], rel=1e-12)
+    doc = tiny.to_dict()
+    assert doc["passive_travel_m"] == tiny.passive_travel
+    assert doc["counts"]["non_dominated_with_travel"] == int(frame["non_dominated_with_travel"].sum())
