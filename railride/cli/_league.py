@@ -67,7 +67,7 @@ def run_league(
         raise InputError(
             "--no-references (or --no-bounds): a league table always shows the ideal actuator beside the MR dampers"
         )
-    damper = damper_argument("--damper", damper)
+    damper_given, damper = damper, damper_argument("--damper", damper)
     loads = loads or [1.0]
     for x in loads:  # each load checked before the first run, its errors naming --load
         vehicle_options = vehicle_arguments(vehicle, preset, x)
@@ -94,7 +94,7 @@ def run_league(
     if out is not None:
         write_folder(out, lambda: write_league_outputs(table, out, figures=figures))
     parts = league_table(table, doc)
-    warn_gains_mismatch(doc["settings"])
+    warn_gains_mismatch(doc["settings"], damper_given)
     if format is OutputFormat.json:
         typer.echo(text)
     else:

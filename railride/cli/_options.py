@@ -119,7 +119,7 @@ TrackSeedOption = Annotated[
     typer.Option(
         "--track-seed",
         metavar="N",
-        help="Random tracks (fra1..fra6, german-low, german-high) only: the seed of the track's "
+        help="Random tracks (fra1..fra6, german-low, german-high, psd:PATH) only: the seed of the track's "
         "realisation, a whole number >= 0; the same seed gives the same track (default 0).",
     ),
 ]

@@ -101,6 +101,14 @@ def value_list(option: str, text: str, *, integer: bool = False, parse=None) -> 
     return values
 
 
+def number_items(option: str, text: str) -> list[float]:
+    """a,b,c -> the numbers, repeats allowed (shares, weights), else ValueError naming the option."""
+    items = [item.strip() for item in text.split(",")]
+    if any(not item for item in items):
+        raise InputError(f"{option} = {text!r}: an empty item; give numbers separated by commas")
+    return [parse_float(option, text, item) for item in items]
+
+
 def _whole(option: str, text: str, item: str):
     """A list item of whole numbers: an int read exactly (a seed past 2**53 stays itself),
     else the number it is (3.0, 1e3; one with a fraction is refused by `value_list`)."""
@@ -419,8 +427,29 @@ def make_scenario(name: str, options: dict, output_rate: Optional[float] = None,
             raise InputError(f"{given}: {exc}") from None
         if str(exc).startswith("unknown scenario"):
             raise InputError(f"--scenario: {exc}") from None
+        table_errors(name, str(exc), "--scenario")
         raise
     return scen
+
+
+def table_errors(name: str, message: str, option: str) -> None:
+    """A spectrum table's own error (it names the scenario: "scenario 'psd:PATH': ...") as the
+    error of the option that gave the table; nothing for any other error."""
+    if message.startswith(f"scenario {name!r}"):
+        raise InputError(f"{option} {message[len('scenario ') :]}") from None
+
+
+def check_table(option: str, name: str) -> None:
+    """A spectrum table (psd:PATH) read before any work, its errors naming ``option``; nothing
+    for any other scenario (its own checks come with it)."""
+    from railride.model import psd_table
+
+    if psd_table.is_table(name):
+        try:
+            psd_table.table(name)
+        except ValueError as exc:
+            table_errors(name, str(exc), option)
+            raise
 
 
 def _scenario_options(**given) -> dict:

@@ -198,12 +198,20 @@ def untuned_text(names) -> str:
     )
 
 
-def warn_gains_mismatch(settings: dict) -> None:
+def warn_gains_mismatch(settings: dict, damper_given: Optional[str] = None) -> None:
     """The result's ``gains_mismatch`` (`GainSet.mismatch`: gains tuned for another vehicle,
     load or track, and the `railride tune` command for this one) as one warning line on
-    stderr, before the results; nothing where the settings have none."""
+    stderr, before the results; nothing where the settings have none. ``damper_given``: the
+    --damper text, whose file's path takes the place of the command's ``FILE.toml`` (the
+    library holds the damper's parameters, not the file they came from)."""
+    import shlex
+
+    from railride.secondary.dampers import NAMES
+
     line = settings.get("gains_mismatch")
     if line:
+        if damper_given and damper_given not in NAMES:
+            line = line.replace("--damper FILE.toml", f"--damper {shlex.quote(damper_given)}")
         typer.echo(f"warning: {line}", err=True)
 
 

@@ -492,7 +492,7 @@ def compare(
         typer.Option(
             "--track-seed",
             metavar="N[,N...]",
-            help="Random tracks (fra1..fra6, german-low, german-high) only: the seed of the track's "
+            help="Random tracks (fra1..fra6, german-low, german-high, psd:PATH) only: the seed of the track's "
             "realisation, a whole number >= 0; the same seed gives the same track (default 0). Several "
             "seeds make a league table.",
         ),
@@ -601,7 +601,7 @@ def compare(
         seed_value = seeds[0] if seeds else None
         names = _controller_list(controllers)
         gain_set = load_gains(gains)
-        damper = damper_argument("--damper", damper)
+        damper_given, damper = damper, damper_argument("--damper", damper)
         scale = parse_scale("--damper-scale", damper_scale)
         noise = _sensor_noise(sensor_noise, seed)
         solver = solver_from_options(
@@ -661,7 +661,7 @@ def compare(
         text = json.dumps(doc, indent=2, allow_nan=False)  # refuses NaN before anything is written
         if out is not None:
             write_folder(out, lambda: write_compare_outputs(result, out, doc, figures=figures, histories=histories))
-    warn_gains_mismatch(doc["settings"])
+    warn_gains_mismatch(doc["settings"], damper_given)
     if format is OutputFormat.json:
         typer.echo(text)
     else:

@@ -52,7 +52,15 @@ from railride.cli._options import (
     DesignResumeOption,
     figure_options,
 )
-from railride.cli._parsing import FIXED_RATE_FIELDS, damper_argument, solver_from_options, value_list, vehicle_source
+from railride.cli._parsing import (
+    FIXED_RATE_FIELDS,
+    check_table,
+    damper_argument,
+    number_items,
+    solver_from_options,
+    value_list,
+    vehicle_source,
+)
 from railride.defaults import DEFAULT_DAMPER
 
 #: the library's names of the design's options, for its errors
@@ -135,6 +143,13 @@ def _ratio_cell(m: dict) -> str:
     return text + f"\n{m['ratio_p5']:.2f}-{m['ratio_p95']:.2f}"
 
 
+def _shares_weigh(aggregate: str) -> str:
+    """What the time in service weighs, by the design's aggregate over the training runs."""
+    if aggregate == "mean":
+        return "the shares weigh the training runs' mean and the ranking"
+    return "the shares weigh the ranking; tuning takes the worst training run, which no share changes"
+
+
 def _tables(doc: dict) -> list:
     from rich.markup import escape
     from rich.text import Text
@@ -163,7 +178,13 @@ def _tables(doc: dict) -> list:
         table.add_column("law")
         table.add_column("speed\nload", no_wrap=True)
         for key in keys:
-            table.add_column(RATIO_METRICS.get(key, "score"), justify="right")
+            table.add_column(RATIO_METRICS.get(key, "run\nscore"), justify="right")
+        if "score" in keys:  # not the ranking's score at the point, which is of the mean ratios
+            table.caption = (
+                "run score: the objective of each held-out run's own ratios, its mean and band over the runs; the "
+                "ranking scores a point by the objective of the mean ratios instead (the table below), which for "
+                "minimax is at most this mean."
+            )
         last = None
         for g in laws:
             name = g["controller"]
@@ -257,11 +278,7 @@ def _tables(doc: dict) -> list:
         f"{', '.join(map(str, s['train_seeds']))} ({s['training_runs_per_gain_set']} runs per gain set, the "
         f"{s['aggregate']} objective, at most {s['budget']} gain sets per law); judged on seeds {seeds}.",
         f"Tuned by {optimiser_text(s)}.",
-        *(
-            [f"Time in service: {service_text(service)} (the shares weigh the training runs' mean and the ranking)."]
-            if service
-            else []
-        ),
+        *([f"Time in service: {service_text(service)} ({_shares_weigh(s['aggregate'])})."] if service else []),
         vehicle_text(s["vehicle"]) + f"; {s['damper'] if isinstance(s['damper'], str) else 'own'} dampers.",
         *([s["comfort_basis"]] if s.get("comfort_basis") else []),
         f"{doc['runs']['training']} training and {doc['runs']['judging']} held-out runs (passive's included)"
@@ -410,6 +427,8 @@ def design_command(
         names = [c.strip() for c in controllers.split(",")]
         seed_of_evolution = optimiser_seed_of(optimiser, optimiser_seed)
         tracks = [t.strip() for t in track.split(",")]
+        for t in tracks:
+            check_table("--track", t)
         speeds = value_list("--speed", speed)
         loads = value_list("--load", load)
         train = [int(s) for s in value_list("--train-seeds", train_seeds, integer=True)]
@@ -439,8 +458,8 @@ def design_command(
             duration=duration,
             damper=damper,
             solver=solver,
-            speed_shares=None if speed_share is None else value_list("--speed-share", speed_share),
-            load_shares=None if load_share is None else value_list("--load-share", load_share),
+            speed_shares=None if speed_share is None else number_items("--speed-share", speed_share),
+            load_shares=None if load_share is None else number_items("--load-share", load_share),
         )
         check_design(None if controllers.strip() == "all" else names, **settings)  # before the folder
         table, table_path = open_run_table(out, resume)

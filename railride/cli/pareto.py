@@ -223,7 +223,7 @@ def pareto_command(
         figures = figure_options(figure_format, dpi, out)
         n = default_of(run_pareto, "n_samples") if samples is None else samples
         vehicle_options = vehicle_arguments(vehicle, preset, load)
-        damper = damper_argument("--damper", damper)
+        damper_given, damper = damper, damper_argument("--damper", damper)
         base = load_gains(gains)
         solver = solver_from_options(dt=dt, backend=backend)
         scen, options = study_scenario(
@@ -264,7 +264,7 @@ def pareto_command(
                 write_folder(out, lambda: result.save(out, figure_formats=figures.figure_formats, dpi=figures.dpi))
     finally:
         executor.close()
-    warn_gains_mismatch(doc["settings"])
+    warn_gains_mismatch(doc["settings"], damper_given)
     if format is OutputFormat.json:
         print_json(doc)
         return

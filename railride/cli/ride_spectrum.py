@@ -22,7 +22,7 @@ from railride.cli._options import (
     VehicleOption,
     figure_options,
 )
-from railride.cli._parsing import load_gains, vehicle_arguments
+from railride.cli._parsing import load_gains, table_errors, vehicle_arguments
 from railride.frequency.ride_spectrum import PASSIVE_DEVICE
 
 #: the library's names of the options, for its errors
@@ -150,18 +150,22 @@ def ride_spectrum(
         vehicle_options = vehicle_arguments(vehicle, preset, load)
         if out is not None:
             check_out_dir(out, "--out")
-        result = run(
-            track,
-            speed=speed,
-            **vehicle_options,
-            controllers=controllers,
-            gains=None if gains is None else load_gains(gains),
-            min_wavelength=min_wavelength,
-            max_wavelength=max_wavelength,
-            points=points,
-            control_rate=control_rate,
-            delay=1 if delay is None else delay,
-        )
+        try:
+            result = run(
+                track,
+                speed=speed,
+                **vehicle_options,
+                controllers=controllers,
+                gains=None if gains is None else load_gains(gains),
+                min_wavelength=min_wavelength,
+                max_wavelength=max_wavelength,
+                points=points,
+                control_rate=control_rate,
+                delay=1 if delay is None else delay,
+            )
+        except ValueError as exc:
+            table_errors(track, str(exc), "--track")
+            raise
         if out is not None:
             write_folder(out, lambda: result.save(out, figure_formats=figures.figure_formats, dpi=figures.dpi))
     parts = _tables(result)

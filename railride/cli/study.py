@@ -24,6 +24,7 @@ from railride.cli._common import (
     write_folder,
 )
 from railride.cli._options import (
+    OWN_DAMPER,
     MaxMemoryOption,
     MaxStepsOption,
     DpiOption,
@@ -48,6 +49,7 @@ from railride.cli._options import (
 )
 from railride.cli._parsing import (
     FIXED_RATE_FIELDS,
+    check_table,
     damper_argument,
     load_gains,
     solver_from_options,
@@ -258,7 +260,12 @@ def study_command(
     vehicle: VehicleOption = None,
     preset: PresetOption = None,
     damper: Annotated[
-        str, typer.Option("--damper", metavar="MODEL", help="Damper model of the controllers (as for compare).")
+        str,
+        typer.Option(
+            "--damper",
+            metavar="MODEL|FILE.toml",
+            help="Damper model of the controllers (as for compare)." + OWN_DAMPER,
+        ),
     ] = DEFAULT_DAMPER,
     gains: StudyGainsOption = None,
     workers: WorkersOption = None,
@@ -288,13 +295,14 @@ def study_command(
         except InputError as exc:  # the library's words name no option
             raise InputError(f"--controllers = {controllers!r}: {exc}") from None
         source = vehicle_source(vehicle, preset)
+        check_table("--scenario", scenario)
         seeds = value_list("--track-seed", track_seed, integer=True) if track_seed is not None else None
         speeds = value_list("--speed", speed) if speed is not None else None
         loads = value_list("--load", load)
         stiffness_factors = value_list("--stiffness", stiffness)
         faults = _faults(fault)
         delays = value_list("--delay", delay, integer=True)
-        damper = damper_argument("--damper", damper)
+        damper_given, damper = damper, damper_argument("--damper", damper)
         gain_set = load_gains(gains)
         solver = solver_from_options(dt=dt, backend=backend)
         window_value = parse_window(window) if window is not None else None
@@ -340,7 +348,7 @@ def study_command(
                 write_folder(out, lambda: result.save(out, figure_formats=figures.figure_formats, dpi=figures.dpi))
     finally:
         executor.close()
-    warn_gains_mismatch(doc["settings"])
+    warn_gains_mismatch(doc["settings"], damper_given)
     if format is OutputFormat.json:
         typer.echo(text)
     else:

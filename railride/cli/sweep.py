@@ -58,6 +58,7 @@ from railride.cli._options import (
 )
 from railride.cli._parsing import (
     FIXED_RATE_FIELDS,
+    check_table,
     damper_argument,
     load_gains,
     parse_noise,
@@ -241,6 +242,7 @@ def sweep_command(
         from railride.studies.sweep import grid as make_grid, run_sweep
 
         figures = figure_options(figure_format, dpi, out)
+        check_table("--scenario", scenario)
         vehicle_options = vehicle_arguments(vehicle, preset, load)
         values, texts = _parse(
             suspension=suspension,

@@ -35,6 +35,7 @@ from railride.analysis.comfort import FLOOR
 from railride.frequency.frf import FMAX_LIMIT
 from railride.frequency.linear import LinearModel, linear_model, linear_suspensions
 from railride.model.params import VehicleParams, resolve_vehicle
+from railride.model import psd_table
 from railride.model.track import MAX_WAVELENGTH, RANDOM_NAMES, frequency_speed, is_random, spectrum
 from railride.model.vehicle import CORNER_NAMES, Vehicle
 
@@ -419,6 +420,8 @@ def ride_spectrum(
     settings = {
         "vehicle": record,
         "track": track,
+        # a user's table: which version of the file the spectrum was read from
+        **({"spectrum_sha256": psd_table.table(track).sha256} if psd_table.is_table(track) else {}),
         "speed_m_s": speed,
         "min_wavelength_m": lo,
         "max_wavelength_m": hi,

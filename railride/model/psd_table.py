@@ -55,8 +55,9 @@ class PsdTable:
         if W.size and (W.min() < lo * (1 - 1e-12) or W.max() > hi * (1 + 1e-12)):
             outside = W.min() if W.min() < lo else W.max()
             raise InputError(
-                f"{PREFIX}{self.path}: wavenumber {outside:.4g} rad/m (wavelength {2 * math.pi / outside:.4g} m) "
-                f"is outside the table's {lo:.4g} to {hi:.4g} rad/m (wavelengths {2 * math.pi / hi:.4g} to "
+                f"scenario {PREFIX + self.path!r}: wavenumber {outside:.4g} rad/m (wavelength "
+                f"{2 * math.pi / outside:.4g} m) is outside the table's {lo:.4g} to {hi:.4g} rad/m (wavelengths "
+                f"{2 * math.pi / hi:.4g} to "
                 f"{2 * math.pi / lo:.4g} m); a spectrum is not extrapolated: narrow the wavelength band "
                 "(min_wavelength, max_wavelength) or extend the table"
             )
@@ -92,10 +93,10 @@ def table(name: str) -> PsdTable:
 
 @functools.lru_cache(maxsize=16)
 def _read(path: str, mtime_ns: int, size: int) -> PsdTable:
-    where = f"{PREFIX}{path}"
+    where = f"scenario {PREFIX + path!r}"
     try:
         raw = Path(path).read_bytes()
-        text = raw.decode("utf-8")
+        text = raw.decode("utf-8-sig")  # a spreadsheet's byte-order mark is no part of the header
     except OSError as exc:
         raise InputError(f"{where}: cannot read the spectrum table: {exc.strerror}") from None
     except UnicodeDecodeError:

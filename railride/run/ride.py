@@ -547,9 +547,10 @@ class RideResult:
 
 def _suspension_record(suspension) -> dict:
     """The ``suspension`` of the simulation document: ``{"type": "passive"}``, or for MR dampers
-    at a constant voltage the type "mr", the damper's name, the voltage and, when the preset was
-    scaled, its ``damper_scale``; a closed loop is typed by its outer loop's name and adds its
-    controller, inner loop and sensor noise (`Suspension.to_dict`)."""
+    at a constant voltage the type "mr", the damper's name (its record, every parameter, where it
+    is no preset), the voltage and, when the preset was scaled, its ``damper_scale``; a closed
+    loop is typed by its outer loop's name and adds its controller, inner loop and sensor noise
+    (`Suspension.to_dict`)."""
     if suspension is None:
         return {"type": "passive"}
     if suspension.kind == "passive":
@@ -558,7 +559,10 @@ def _suspension_record(suspension) -> dict:
             if suspension.damper is None
             else {"type": "passive", "damper": suspension.damper.to_dict()}
         )
-    record: dict[str, Any] = {"type": suspension.name, "damper": suspension.damper_name}
+    name = suspension.damper_name
+    # a damper of the user's own parameters (a damper file): every parameter, as the studies record it
+    damper = name if name in dampers.NAMES else suspension.damper.to_dict()
+    record: dict[str, Any] = {"type": suspension.name, "damper": damper}
     if suspension.faults:
         record["faults"] = [f.label for f in suspension.faults]
     if suspension.delay != 1:

@@ -90,7 +90,7 @@ def load(path: str | Path, option: str = "damper"):
             f"{option} = {str(path)!r}: a folder, not a damper file; give a FILE.toml with a [damper] table"
         )
     try:
-        text = path.read_text(encoding="utf-8")
+        text = path.read_text(encoding="utf-8-sig")  # an editor's byte-order mark is no part of the TOML
     except OSError as exc:
         raise InputError(f"{option} = {str(path)!r}: cannot read the damper file: {exc.strerror}") from None
     except UnicodeDecodeError:

@@ -185,15 +185,30 @@ def _damper_words(damper, scale) -> str:
 
 
 def _other_damper(provenance: dict, damper, scale) -> str | None:
-    """The words "damper X (tuned with Y)" when the run's damper is not the one the gains were
-    tuned with; None when it is, or when either is not known (old files name none)."""
+    """The words "damper X (the gains': Y)" when the run's damper is not the one the gains were
+    tuned with, naming the parameters that differ where both are the same model; None when it
+    is, or when either is not known (old files name none)."""
     tuned = provenance.get("damper")
     if damper is None or tuned is None:
         return None
     tuned_scale = provenance.get("damper_scale", 1.0)
-    if _damper_key(damper, scale) == _damper_key(tuned, tuned_scale):
+    ran, before = _damper_key(damper, scale), _damper_key(tuned, tuned_scale)
+    if ran == before:
         return None
-    return f"damper {_damper_words(damper, scale)} (tuned with {_damper_words(tuned, tuned_scale)})"
+    run_words, tuned_words = _damper_words(damper, scale), _damper_words(tuned, tuned_scale)
+    words = f"damper {run_words} (the gains' damper: {tuned_words}"
+    # a preset's name (and scale) says what differs; a damper of one's own parameters, which
+    # values (of the same model)
+    own = "of its own parameters" in run_words + tuned_words
+    if own and isinstance(ran, tuple) and isinstance(before, tuple) and ran[0] == before[0]:
+        from railride.secondary import dampers
+
+        cls = dampers.Spencer if ran[0] == "spencer" else dampers.BoucWen
+        names = [f.name for f in dataclasses.fields(cls)]
+        other = [f"{n} {a:.4g} against {b:.4g}" for n, a, b in zip(names, ran[1], before[1]) if a != b]
+        shown = other[:_SHOWN] + ([f"{len(other) - _SHOWN} more"] if len(other) > _SHOWN else [])
+        words += f"; other values: {', '.join(shown)}"
+    return words + ")"
 
 
 def design_command(vehicle: dict | None, scenarios, damper=None) -> str:
@@ -593,8 +608,18 @@ def _tracks_text(records: list[dict], tuned: list[dict]) -> str:
             values = list(dict.fromkeys(r[k] for r in own if k in r and not any(_same(r[k], t.get(k)) for t in same)))
             if values:
                 found.append(f"{word} {_list(values)}{' ' + unit if unit else ''}")
+        if _table_changed(own, same):
+            found.append("the spectrum table changed since tuning")
         out.append(name + (f" ({'; '.join(found)})" if found else ""))
     return ", ".join(out)
+
+
+def _table_changed(records: list[dict], tuned: list[dict]) -> bool:
+    """Whether a user's spectrum table (psd:PATH) the runs read is not the one the gains were
+    tuned on: the same path, other contents (the records' ``spectrum_sha256``)."""
+    runs = {r.get("spectrum_sha256") for r in records} - {None}
+    before = {t.get("spectrum_sha256") for t in tuned} - {None}
+    return bool(runs and before and not runs <= before)
 
 
 def _list(values) -> str:

@@ -163,7 +163,8 @@ def service_shares(speeds: tuple, loads: tuple, speed_shares=None, load_shares=N
         numbers = [float(validation.number(name, x, "positive", allowed=rule)) for x in items]
         if len(numbers) != len(values):
             raise InputError(
-                f"{name} = {given!r}: {len(numbers)} share{'s' * (len(numbers) != 1)} for {len(values)} "
+                f"{name} = {','.join(f'{x:g}' for x in numbers)}: {len(numbers)} share{'s' * (len(numbers) != 1)} "
+                f"for {len(values)} "
                 f"{unit}{'s' * (len(values) != 1)} ({', '.join(f'{v:g}' for v in values)}); give one per {unit}, in "
                 "their order"
             )
@@ -431,8 +432,10 @@ def design(
         from railride.studies.executors import LocalExecutor
 
         executor = LocalExecutor(rows_beside=False)
+    # the shares weigh the training runs' mean; the worst run is the worst whatever its weight
+    weights = plan.service if plan.service is not None and plan.aggregate == "mean" else {}
     over = tuple(
-        TuningCase(track, _options(plan, track, seed, v), load, 1.0 if plan.service is None else plan.service[v, load])
+        TuningCase(track, _options(plan, track, seed, v), load, weights.get((v, load), 1.0))
         for track in plan.tracks
         for load in plan.loads
         for seed in plan.train_seeds

@@ -79,8 +79,9 @@ def test_another_damper_file_warns_and_is_recorded_whole(tmp_path):
     args = ("compare", "--controllers", "pid", "--duration", 0.3, "--no-references", "--damper", path)
     result = ok(*args)
     warnings = [line for line in result.stderr.splitlines() if line.startswith("warning: ")]
-    assert len(warnings) == 1 and "damper bouc-wen of its own parameters (tuned with railway)" in warnings[0]
-    assert "railride tune --damper FILE.toml" in warnings[0]
+    assert len(warnings) == 1 and "damper bouc-wen of its own parameters (the gains' damper: railway" in warnings[0]
+    assert "other values: alpha_b 5e+06 against 3.969e+06" in warnings[0]
+    assert f"railride tune --damper {path}" in warnings[0]  # the file given, where the library says FILE.toml
     assert "bouc-wen (own parameters) MR dampers" in result.stdout
     settings = ok_json(*args)["settings"]
     assert settings["damper"]["alpha_b"] == 5.0e6 and settings["damper"]["preset"] is None
@@ -108,3 +109,13 @@ def test_a_bad_damper_file_is_one_line_naming_the_file_and_key(command, tmp_path
     path.write_text('[damper]\npreset = "railway"\neta = -1.0\n')
     assert_input_error(run(*command, "--damper", path), f"{path}: [damper]", "eta")
     assert_input_error(run(*command, "--damper", tmp_path / "gone.toml"), "--damper = ", "no such damper file")
+
+
+def test_simulate_records_the_files_every_parameter_and_says_own(tmp_path):
+    path = tmp_path / "strong.toml"
+    path.write_text('[damper]\npreset = "railway"\nalpha_b = 5.0e6\n')
+    args = ("simulate", "--suspension", "mr", "--voltage", 1, "--duration", 0.2, "--damper", path)
+    record = ok_json(*args)["suspension"]["damper"]
+    assert record["preset"] is None and record["alpha_b"] == 5.0e6 and record["model"] == "bouc-wen"
+    assert "MR, bouc-wen (own parameters) dampers at 1 V" in " ".join(ok(*args).stdout.split())
+    assert ok_json("simulate", "--suspension", "mr", "--duration", 0.2)["suspension"]["damper"] == "railway"

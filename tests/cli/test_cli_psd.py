@@ -41,8 +41,18 @@ def test_compare_on_a_table_of_fra4_rides_as_on_fra4(tmp_path):
 def test_a_bad_table_or_band_is_one_line_with_status_2(tmp_path):
     bad = tmp_path / "bad.csv"
     bad.write_text("wavenumber_rad_per_m,vertical\n1,1e-6\n0.5,1e-6\n")
-    assert_input_error(run("simulate", "--scenario", f"psd:{bad}"), f"psd:{bad}: row 3", "must rise strictly")
+    result = run("simulate", "--scenario", f"psd:{bad}")
+    assert_input_error(result, f"--scenario 'psd:{bad}': row 3", "must rise strictly")
+    for command in (("study", "--scenario"), ("sweep", "--scenario"), ("design", "--track"), ("tune", "--scenario")):
+        assert_input_error(run(*command, f"psd:{bad}"), f"{command[1]} 'psd:{bad}': row 3")
     path = _fra4(tmp_path / "fra4.csv")
     result = run("compare", "--scenario", f"psd:{path}", "--max-wavelength", 300, "--controllers", "pid")
     assert_input_error(result, "--max-wavelength = 300 m", "beyond the 0.5 to 200 m")
     assert_input_error(run("ride-spectrum", "--track", f"psd:{tmp_path / 'gone.csv'}"), "no such spectrum table")
+
+
+def test_ride_spectrum_records_the_tables_sha256(tmp_path):
+    path = _fra4(tmp_path / "fra4.csv")
+    settings = ok_json("ride-spectrum", "--track", f"psd:{path}", "--points", 64)["settings"]
+    assert settings["spectrum_sha256"] == hashlib.sha256(path.read_bytes()).hexdigest()
+    assert "spectrum_sha256" not in ok_json("ride-spectrum", "--points", 64)["settings"]

@@ -91,7 +91,7 @@ def test_a_bad_table_is_refused_naming_the_row(text, fragments, tmp_path):
     path.write_text(text)
     with pytest.raises(InputError) as err:
         scenario(f"psd:{path}", speed=30.0, duration=1.0)
-    assert str(err.value).startswith(f"psd:{path}: "), str(err.value)
+    assert str(err.value).startswith(f"scenario 'psd:{path}': "), str(err.value)
     for fragment in fragments:
         assert fragment in str(err.value), str(err.value)
 

@@ -105,14 +105,15 @@ def test_the_damper_the_gains_were_tuned_with_has_no_line_by_any_name():
 
 def test_another_damper_is_named_with_its_tune_command():
     line = _line("spencer1997")
-    assert "this run has damper spencer1997 (tuned with railway)" in line, line
+    assert "this run has damper spencer1997 (the gains' damper: railway)" in line, line
     assert line.endswith("tune for it with: railride tune --damper spencer1997"), line
     line = _line("railway", 2.0)
-    assert "damper railway x 2 (tuned with railway)" in line and line.endswith("railride tune --damper-scale 2")
+    assert "damper railway x 2 (the gains' damper: railway)" in line
+    assert line.endswith("railride tune --damper-scale 2")
     own = _line(dampers.RAILWAY.replace(alpha_b=5e6))
-    assert "damper bouc-wen of its own parameters (tuned with railway)" in own
+    assert "damper bouc-wen of its own parameters (the gains' damper: railway; other values: alpha_b 5e+06" in own
     assert own.endswith("railride tune --damper FILE.toml"), own
-    assert "tuned with railway" in _line("ideal")
+    assert "damper ideal (the gains' damper: railway)" in _line("ideal")
 
 
 def test_a_sweep_of_damper_scales_is_not_warned_of_its_scales():

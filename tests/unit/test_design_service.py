@@ -26,7 +26,7 @@ def test_the_shares_are_the_product_of_speed_and_load_normalised():
 @pytest.mark.parametrize(
     "shares, fragments",
     [
-        ([1, 2, 3], ("speed_shares = [1, 2, 3]", "3 shares for 2 speeds (30, 50)", "one per speed")),
+        ([1, 2, 3], ("speed_shares = 1,2,3: 3 shares for 2 speeds (30, 50)", "one per speed")),
         ([1, 0], ("speed_shares = 0", "a finite number > 0")),
         ([1, float("nan")], ("speed_shares = nan",)),
         ("fast", ("speed_shares = 'fast'", "give a list of numbers, one per speed")),
@@ -122,6 +122,9 @@ def test_the_command_line_takes_the_shares_and_checks_them():
     from clihelp import assert_input_error, run
 
     result = run("design", "--speed", "30,50", "--speed-share", "1,2,3", "--controllers", "skyhook")
-    assert_input_error(result, "--speed-share = [1.0, 2.0, 3.0]", "3 shares for 2 speeds", "one per speed")
+    assert_input_error(result, "--speed-share = 1,2,3: 3 shares for 2 speeds", "one per speed")
+    # equal shares are shares, not a value listed twice
+    result = run("design", "--speed", "30,50,70", "--speed-share", "1,1,2", "--load", "1", "--budget", 2)
+    assert_input_error(result, "--budget = 2")
     result = run("design", "--load", "1,1.3", "--load-share", "1,-1", "--controllers", "skyhook")
     assert_input_error(result, "--load-share = -1", "a finite number > 0")
