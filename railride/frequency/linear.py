@@ -67,6 +67,8 @@ class LinearModel:
     secondary: str
     params: VehicleParams
     vehicle: dict | None = None
+    #: a closed loop's outer loop: its name and every gain it applies (None: no controller)
+    controller: dict | None = None
 
     def __post_init__(self):
         n, m, p = len(self.states), len(self.inputs), len(self.outputs)
@@ -121,6 +123,7 @@ class LinearModel:
             "railride_version": __version__,
             "versions": versions(),
             "secondary": self.secondary,
+            "controller": self.controller,
             "vehicle": self.record(),
             "vehicle_params": self.params.to_dict(),
             "states": list(self.states),
@@ -153,13 +156,17 @@ class LinearModel:
 
     def to_mat(self, path) -> None:
         """A MATLAB .mat file (scipy.io, format 5) with A, B, C, D, the names as cell arrays
-        (state_names, input_names, output_names), their units and the secondary; written
+        (state_names, input_names, output_names), their units, the secondary, the vehicle's
+        name and load, a closed loop's gains (``controller_gains``, its JSON text) and the
+        versions that made it (``railride_version``, ``versions``, JSON text); written
         atomically."""
+        import json
         from pathlib import Path
 
         from scipy.io import savemat
 
         from railride._io import atomic_write
+        from railride._version import __version__, versions
 
         def cells(names):
             return np.array(list(names), dtype=object).reshape(-1, 1)
@@ -173,6 +180,11 @@ class LinearModel:
             "input_units": cells(self.units[s] for s in self.inputs),
             "output_units": cells(self.units[s] for s in self.outputs),
             "secondary": self.secondary,
+            "vehicle_name": str(self.record()["name"]),
+            "load": float(self.record()["load"]),
+            "controller_gains": json.dumps(self.controller, default=float) if self.controller else "",
+            "railride_version": __version__,
+            "versions": json.dumps(versions()),
         }
         atomic_write(Path(path), lambda tmp: savemat(tmp, content, do_compression=True))
 
@@ -321,7 +333,17 @@ def linear_model(params=None, suspension=None, *, vehicle=None, load: float = 1.
         secondary,
         vehicle_params,
         record,
+        None if controller is None else {"name": controller.name, "gains": _plain_gains(controller.to_dict())},
     )
+
+
+def _plain_gains(value):
+    """A controller's gains as JSON values (NumPy numbers and arrays as floats and lists)."""
+    if isinstance(value, dict):
+        return {k: _plain_gains(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple, np.ndarray)):
+        return [_plain_gains(v) for v in value]
+    return float(value) if isinstance(value, (int, float, np.number)) and not isinstance(value, bool) else value
 
 
 def linear_suspensions(controllers, gains) -> dict[str, object]:

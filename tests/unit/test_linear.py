@@ -110,3 +110,26 @@ def test_ride_spectrum_result_protocol(tmp_path):
     paths = result.save(tmp_path / "out")
     assert json.loads(paths[0].read_text())["settings"]["track"] == "german-low"
     assert {p.name for p in paths} >= {"ride_spectrum.csv", "ride_spectrum_psd.csv"}
+
+
+def test_a_closed_loop_records_the_gains_it_closed_with(tmp_path):
+    """The document and the .mat name the gains of the loop their matrices hold: the state
+    matrix changes with a gain, and the record with it."""
+    import json
+
+    from railride.secondary.control import GainSet
+    from railride.secondary.suspension import Suspension
+    from railride.frequency.linear import linear_model
+
+    gains = GainSet.default()
+    model = linear_model("paper", Suspension.named("pid", gains, damper="ideal"))
+    assert model.to_dict()["controller"] == {"name": "pid", "gains": gains.pid.to_dict()}
+    softer = gains.apply({"pid.kp": gains.pid.kp / 2})
+    other = linear_model("paper", Suspension.named("pid", softer, damper="ideal"))
+    assert other.to_dict()["controller"]["gains"]["kp"] == gains.pid.kp / 2
+    assert not np.array_equal(other.A, model.A)
+    assert linear_model("paper").to_dict()["controller"] is None
+    model.to_mat(tmp_path / "m.mat")
+    mat = loadmat(tmp_path / "m.mat")
+    assert json.loads(str(mat["controller_gains"][0]))["gains"]["kd"] == gains.pid.kd
+    assert json.loads(str(mat["versions"][0]))["railride"] == str(mat["railride_version"][0])
