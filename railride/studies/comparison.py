@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import json
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 import xarray as xr
@@ -104,7 +105,7 @@ class Comparison:
     metrics: xr.DataArray
     window: tuple | None
     gains: GainSet
-    damper: str
+    damper: Any  # a name or a model of railride.secondary.dampers, as given
     settings: dict = field(default_factory=dict)
     comfort: dict | None = None
     #: per ideal device ("ideal-damper", "ideal") and controller: the ride metrics of the same
@@ -134,7 +135,10 @@ class Comparison:
         travel reached the clearance, and for the controlled ones
         with MR dampers the mean command voltage [V] and the fraction of time at v_max (the
         ideal actuator has no voltage: those two entries are absent, as for passive)."""
-        v_max = dampers.preset(self.damper).v_max if self.damper in dampers.PRESETS else np.inf
+        # the damper's own v_max (a preset's or a damper file's; the scale leaves it), inf for a
+        # device without a voltage, which records none
+        model = damper_model(self.damper)
+        v_max = model.v_max if model.law not in (dampers.LAW_IDEAL, dampers.LAW_VISCOUS) else np.inf
         vehicle = self.settings.get("vehicle_params") or VehicleParams.preset("paper").to_dict()
         clearance = vehicle.get("z_stop")  # None: no bump stops
         stiffness = vehicle.get("k_stop", 0.0)  # 0: the clearance is marked, no stop force
@@ -617,7 +621,7 @@ def compare(
         metrics,
         window,
         gains,
-        str(damper),
+        damper,
         settings,
         comfort_values,
         bound_values or None,

@@ -123,3 +123,20 @@ def test_a_sweep_of_damper_scales_is_not_warned_of_its_scales():
     assert "gains_mismatch" not in two
     one = run_sweep(grid(["pid"], damper_scale=[2.0], duration=0.2), comfort=False).settings
     assert "damper railway x 2" in one["gains_mismatch"]
+
+
+def test_time_at_v_max_is_read_at_the_own_dampers_v_max():
+    """An on-off law sits at its damper's v_max part of the time; with a damper of one's own
+    whose v_max is 2 V, that time is counted at 2 V (it read as 0 against a preset's range)."""
+    import numpy as np
+
+    import railride as rr
+
+    own = dampers.RAILWAY.replace(v_max=2.0)
+    result = rr.compare(
+        rr.scenario("paper-sine", duration=1.0), controllers=["skyhook-on-off"], damper=own, bounds=False
+    )
+    fraction = result.demands()["skyhook-on-off"]["voltage_at_max_fraction"]
+    volts = result.datasets["skyhook-on-off"]["damper_command_voltage"].values
+    assert volts.max() == 2.0 and fraction == pytest.approx(float((volts >= 2.0).mean()), rel=1e-12)
+    assert 0.05 < fraction < 0.95
