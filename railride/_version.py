@@ -31,3 +31,10 @@ def _versions() -> dict[str, str | None]:
         except PackageNotFoundError:  # pragma: no cover - every install has them
             out[name] = None
     return out
+
+
+def utc_now() -> str:
+    """The time a result is made, UTC to the second, ISO 8601 ("2026-11-28T04:40:00Z")."""
+    from datetime import datetime, timezone
+
+    return datetime.now(timezone.utc).replace(microsecond=0).isoformat().replace("+00:00", "Z")

@@ -15,7 +15,15 @@ from railride.secondary.dampers import IDEAL_NAMES
 from railride.output.trade_offs import paper_ranking_text, trade_off_lines
 from railride.defaults import DEFAULT_CONTROL_RATE, DEFAULT_DAMPER
 from railride.cli._app import app
-from railride.cli._common import ProgressBar, errors, option_names, stderr_is_terminal, stdout_console, write_folder
+from railride.cli._common import (
+    ProgressBar,
+    command_line,
+    errors,
+    option_names,
+    stderr_is_terminal,
+    stdout_console,
+    write_folder,
+)
 from railride.cli._options import (
     MaxMemoryOption,
     MaxStepsOption,
@@ -657,7 +665,9 @@ def compare(
                 sensing=_sensing(sensing),
                 **({} if level_tolerance is None else {"level_tolerance": level_tolerance}),
             )
-        doc = result.to_dict()
+        # the command line for the record: this line alone makes the result again
+        command = command_line(ctx, exclude=("out", "format", "figure_format", "dpi", "report", "history_format"))
+        doc = {**result.to_dict(), "command": command}
         text = json.dumps(doc, indent=2, allow_nan=False)  # refuses NaN before anything is written
         if out is not None:
             write_folder(out, lambda: write_compare_outputs(result, out, doc, figures=figures, histories=histories))

@@ -13,6 +13,7 @@ from railride.errors import InputError
 from railride.defaults import DEFAULT_DAMPER
 from railride.cli._app import app
 from railride.cli._common import (
+    command_line,
     errors,
     interruptible,
     make_executor,
@@ -337,15 +338,19 @@ def study_command(
                     progress=progress,
                 )
                 wall = time.perf_counter() - t0
-            doc = {
-                **result.to_dict(),
+            facts = {
                 "runs_evaluated": progress.evaluated,
                 "wall_time_s": wall,
                 "executor": executor_record,
+                "command": command_line(ctx, exclude=("out", "resume", "format", "figure_format", "dpi", "report")),
             }
+            doc = {**result.to_dict(), **facts}
             text = json.dumps(doc, indent=2, allow_nan=False)
             if out is not None:
-                write_folder(out, lambda: result.save(out, figure_formats=figures.figure_formats, dpi=figures.dpi))
+                write_folder(
+                    out,
+                    lambda: result.save(out, figure_formats=figures.figure_formats, dpi=figures.dpi, extra=facts),
+                )
     finally:
         executor.close()
     warn_gains_mismatch(doc["settings"], damper_given)

@@ -556,13 +556,16 @@ def write_league_outputs(table, out_dir, *, figures: FigureOptions | None = None
 STUDY_FILES = ("study.json", "study_summary.csv", "study_runs.csv", "study.png")
 
 
-def write_study_outputs(result, out_dir, *, figures: FigureOptions | None = None) -> list[Path]:
+def write_study_outputs(
+    result, out_dir, *, figures: FigureOptions | None = None, extra: dict | None = None
+) -> list[Path]:
     """Write a `railride.studies.study.StudyResult` into ``out_dir``, all or nothing: ``study.json``
-    (``to_dict()``), ``study_summary.csv`` (``to_pandas()``), ``study_runs.csv`` (one row per
-    run, ``cases``) and ``study.png`` (``plot()``); other files (the run table) stay."""
+    (``to_dict()``, then the entries of ``extra``), ``study_summary.csv`` (``to_pandas()``),
+    ``study_runs.csv`` (one row per run, ``cases``) and ``study.png`` (``plot()``); other files
+    (the run table) stay."""
     from railride.plots.study import plot_study
 
-    text = json_text(result.to_dict())
+    text = json_text({**result.to_dict(), **(extra or {})})
     writers = {
         "study.json": _text(text),
         "study_summary.csv": _csv(result.to_pandas()),

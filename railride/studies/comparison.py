@@ -18,7 +18,7 @@ import numpy as np
 import xarray as xr
 
 from railride.errors import InputError
-from railride._version import __version__, versions
+from railride._version import __version__, utc_now, versions
 from railride.secondary import dampers
 from railride.secondary.control import CONSTANT_VOLTAGE, CONTROLLERS, LABELS, PAPER_CONTROLLERS, GainSet
 from railride.defaults import DEFAULT_DAMPER
@@ -115,6 +115,8 @@ class Comparison:
     solver: SolverSettings | None = None
     #: with damper faults: the same comparison with healthy dampers (`railride.secondary.faults.degradation`)
     healthy: "Comparison | None" = None
+    #: when it was made (UTC, ISO 8601)
+    date: str = ""
 
     @property
     def reductions(self) -> xr.DataArray:
@@ -334,6 +336,7 @@ class Comparison:
             "schema": "railride.comparison/1",
             "railride_version": __version__,
             "versions": versions(),
+            "date": self.date,
             # the gains record as every result's settings hold it: their source as far as it is
             # still true, their [provenance] and every value per suspension run
             "settings": {
@@ -627,6 +630,7 @@ def compare(
         bound_values or None,
         solver,
         healthy,
+        utc_now(),
     )
 
 

@@ -80,6 +80,8 @@ class StudyResult:
     summary: pd.DataFrame
     settings: dict = field(default_factory=dict)
     failed: list = field(default_factory=list)
+    #: when it was made (UTC, ISO 8601)
+    date: str = ""
 
     def report_contents(self):
         """What this result shows in its HTML report (`railride.output.report.write_report`)."""
@@ -117,6 +119,7 @@ class StudyResult:
             "schema": SCHEMA,
             "railride_version": __version__,
             "versions": versions(),
+            "date": self.date,
             "settings": self.settings,
             "percentiles": list(PERCENTILES),
             "results": groups,
@@ -136,14 +139,15 @@ class StudyResult:
 
         return plot_study(self, ax=ax, metrics=metrics)
 
-    def save(self, folder, *, figure_formats=("png",), dpi: float = PNG_DPI) -> list:
-        """study.json (`to_dict`), study_summary.csv (`to_pandas`), study_runs.csv (`cases`)
-        and study.png (`plot`; in each of ``figure_formats``, png, pdf, svg, PNG at ``dpi``)
-        into ``folder``, all or nothing (other files, such as the run table runs.csv, stay).
-        Returns the paths."""
+    def save(self, folder, *, figure_formats=("png",), dpi: float = PNG_DPI, extra: dict | None = None) -> list:
+        """study.json (`to_dict`, with the entries of ``extra`` after it: what the command line
+        adds, its runs, wall time and command), study_summary.csv (`to_pandas`), study_runs.csv
+        (`cases`) and study.png (`plot`; in each of ``figure_formats``, png, pdf, svg, PNG at
+        ``dpi``) into ``folder``, all or nothing (other files, such as the run table runs.csv,
+        stay). Returns the paths."""
         from railride.output.files import write_study_outputs
 
-        return write_study_outputs(self, folder, figures=FigureOptions(figure_formats, dpi))
+        return write_study_outputs(self, folder, figures=FigureOptions(figure_formats, dpi), extra=extra)
 
 
 def _finite(value):
@@ -395,7 +399,9 @@ def study(
     if any(gains.controller(n) is not None for n in names) and (judged := judged_text(gains, tracks)):
         settings["tracks_judged"] = judged
     settings["comfort_basis"] = n_mv_basis(intervals_in(window_record, float(sc.duration)))
-    return StudyResult(frame, summary, settings, failed)
+    from railride._version import utc_now
+
+    return StudyResult(frame, summary, settings, failed, utc_now())
 
 
 def _items(values) -> list:

@@ -78,3 +78,21 @@ def test_study_stiffness_tolerance():
     doc = ok_json(*SHORT, "--stiffness", "0.9,1.1")
     assert doc["settings"]["stiffness"] == [0.9, 1.1] and {g["stiffness"] for g in doc["results"]} == {0.9, 1.1}
     assert_input_error(run(*SHORT, "--stiffness", "-1"), "--stiffness", "> 0")
+
+
+def test_the_documents_record_when_and_by_which_command(tmp_path):
+    """compare and study record the date they were made and the command line that made them
+    (its options as given), in the printed JSON and in the folder's file alike."""
+    import datetime
+
+    out = tmp_path / "s"
+    args = ("study", "--controllers", "pid", "--track-seed", 0, "--speed", 30, "--duration", 0.5)
+    doc = json.loads(ok(*args, "--format", "json", "--out", out).stdout)
+    assert doc["command"] == "railride study --controllers pid --track-seed 0 --speed 30 --duration 0.5"
+    made = datetime.datetime.fromisoformat(doc["date"].replace("Z", "+00:00"))
+    assert abs((datetime.datetime.now(datetime.timezone.utc) - made).total_seconds()) < 600
+    saved = json.loads((out / "study.json").read_text())
+    assert saved["command"] == doc["command"] and saved["runs_evaluated"] == doc["runs_evaluated"]
+    compared = json.loads(ok("compare", "--controllers", "pid", "--duration", 0.3, "--format", "json").stdout)
+    assert compared["command"] == "railride compare --controllers pid --duration 0.3"
+    assert compared["date"].endswith("Z")
