@@ -128,7 +128,6 @@ def test_a_sweep_of_damper_scales_is_not_warned_of_its_scales():
 def test_time_at_v_max_is_read_at_the_own_dampers_v_max():
     """An on-off law sits at its damper's v_max part of the time; with a damper of one's own
     whose v_max is 2 V, that time is counted at 2 V (it read as 0 against a preset's range)."""
-    import numpy as np
 
     import railride as rr
 
