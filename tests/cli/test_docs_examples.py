@@ -42,6 +42,7 @@ import typer.main
 
 import railride
 from railride.cli import app
+from railride.model.track import spectrum
 from railride.run import simulation
 from clihelp import run
 
@@ -375,18 +376,37 @@ def _measured_track(path: Path) -> None:
         writer.writerows(zip(s, z_left, z_right))
 
 
+def _own_damper(path: Path) -> None:
+    """A damper file: the railway damper with a stronger field-dependent yield force."""
+    path.write_text('[damper]\npreset = "railway"\nalpha_b = 5.0e6\n', encoding="utf-8")
+
+
+def _own_spectrum(path: Path) -> None:
+    """A spectrum table: FRA class 4 at 60 log-spaced wavenumbers over wavelengths 0.5-200 m."""
+    W = np.geomspace(2 * np.pi / 200, 2 * np.pi / 0.5, 60)
+    rows = zip(W, spectrum("fra4", W), spectrum("fra4", W, "cross-level"))
+    path.write_text(
+        "wavenumber_rad_per_m,vertical,cross_level\n"
+        + "".join(f"{float(w)!r},{float(v)!r},{float(x)!r}\n" for w, v, x in rows),
+        encoding="utf-8",
+    )
+
+
 #: the files a documented command names and the docs assume the reader has, by their name on
-#: the command line (``file:NAME`` for a scenario), and how the test makes them
+#: the command line (``file:NAME`` for a measured profile, ``psd:NAME`` for a spectrum), and how
+#: the test makes them
 FILES = {
     "my_gains.toml": _shipped_gains,
     "track.csv": _measured_track,
+    "my_damper.toml": _own_damper,
+    "my_line.csv": _own_spectrum,
 }
 
 RUNS = [(line, words) for line, words in COMMANDS if parse_only(words) is None]
 
 
 def _files(words: list[str]) -> list[str]:
-    return [name for word in words if (name := word.removeprefix("file:")) in FILES]
+    return [name for word in words if (name := word.removeprefix("file:").removeprefix("psd:")) in FILES]
 
 
 def _run_documented(words: list[str]) -> None:
