@@ -187,7 +187,7 @@ def export_fmu(
     if not isinstance(damper, str) or damper not in SECONDARIES:
         raise InputError(
             f"damper = {damper!r}: the FMU's C code implements {', '.join(SECONDARIES)} "
-            "(the Spencer model and the ideal semi-active damper are not in it)"
+            "(the Spencer model, the ideal semi-active damper and a damper file's own parameters are not in it)"
         )
     dt = validation.number("dt", dt, "positive", "s")
     if dt > 1e-2:
