@@ -110,8 +110,8 @@ class ParetoResult:
     PROJECTIONS: ClassVar[tuple[tuple[str, str], ...]] = PROJECTIONS
     runs: int = 0  # rows of the run table at the end
     #: (n,) each sample's largest secondary travel [m], and passive's (None: not measured)
-    travel: np.ndarray | None = None
-    passive_travel: float | None = None
+    travel_max: np.ndarray | None = None
+    passive_travel_max: float | None = None
 
     @property
     def ratios(self) -> np.ndarray:
@@ -126,9 +126,9 @@ class ParetoResult:
     @property
     def travel_ratio(self) -> np.ndarray | None:
         """(n,) largest secondary travel / passive's (None: not measured)."""
-        if self.travel is None or not self.passive_travel:
+        if self.travel_max is None or not self.passive_travel_max:
             return None
-        return self.travel / self.passive_travel
+        return self.travel_max / self.passive_travel_max
 
     @property
     def non_dominated_with_travel(self) -> np.ndarray | None:
@@ -155,13 +155,13 @@ class ParetoResult:
             frame[f"{r}_rms"] = self.rms[:, k]
         for k, r in enumerate(RESPONSES):
             frame[f"{r}_ratio"] = ratios[:, k]
-        if self.travel is not None:
-            frame["travel_max_m"] = self.travel
+        if self.travel_max is not None:
+            frame["travel_max_m"] = self.travel_max
             frame["travel_ratio"] = self.travel_ratio
         frame["non_dominated"] = self.non_dominated
         for x, y in PROJECTIONS:
             frame[f"non_dominated_{x}_{y}"] = self.non_dominated_in(x, y)
-        if self.travel is not None:
+        if self.travel_max is not None:
             frame["non_dominated_with_travel"] = self.non_dominated_with_travel
         return frame
 
@@ -173,7 +173,7 @@ class ParetoResult:
 
         frame = self.to_pandas()
         flags = ["non_dominated"] + [f"non_dominated_{x}_{y}" for x, y in PROJECTIONS]
-        flags += ["non_dominated_with_travel"] if self.travel is not None else []
+        flags += ["non_dominated_with_travel"] if self.travel_max is not None else []
         rows = [{k: _plain(v) for k, v in row.items()} for row in frame.to_dict("records")]
         return {
             "schema": SCHEMA,
@@ -193,7 +193,7 @@ class ParetoResult:
                 for j, (p, (lo, hi)) in enumerate(zip(self.parameters, self.bounds))
             ],
             "passive_rms": dict(zip(RESPONSES, map(float, self.passive))),
-            "passive_travel_m": None if self.passive_travel is None else float(self.passive_travel),
+            "passive_travel_m": None if self.passive_travel_max is None else float(self.passive_travel_max),
             "counts": {"samples": len(frame), **{f: int(frame[f].sum()) for f in flags}},
             "note": self.note,
             "runs": int(self.runs),

@@ -174,15 +174,15 @@ def test_the_travel_of_every_sample_and_the_front_that_counts_it(tiny):
     import railride as rr
 
     frame = tiny.to_pandas()
-    np.testing.assert_allclose(frame["travel_ratio"], frame["travel_max_m"] / tiny.passive_travel, rtol=1e-15)
+    np.testing.assert_allclose(frame["travel_ratio"], frame["travel_max_m"] / tiny.passive_travel_max, rtol=1e-15)
     assert frame["non_dominated_with_travel"].tolist() == brute_force(
         np.column_stack([tiny.ratios, frame["travel_ratio"]])
     )
     assert (frame["non_dominated_with_travel"] | ~frame["non_dominated"]).all()
     compared = rr.compare(scenario("paper-sine", duration=1.0), controllers=["sas-attitude"], bounds=False)
     travel = {r["name"]: r["damper"]["travel_max_m"] for r in compared.to_dict()["controllers"]}
-    assert tiny.passive_travel == pytest.approx(travel["passive"], rel=1e-12)
+    assert tiny.passive_travel_max == pytest.approx(travel["passive"], rel=1e-12)
     assert frame.loc[0, "travel_max_m"] == pytest.approx(travel["sas-attitude"], rel=1e-12)
     doc = tiny.to_dict()
-    assert doc["passive_travel_m"] == tiny.passive_travel
+    assert doc["passive_travel_m"] == tiny.passive_travel_max
     assert doc["counts"]["non_dominated_with_travel"] == int(frame["non_dominated_with_travel"].sum())
