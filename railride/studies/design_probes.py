@@ -105,10 +105,12 @@ def fault_check(plan, leaders: list, points: list, scores) -> dict | None:
     worse = [label[law] for law, v in laws.items() if beats(v["healthy"]) and not beats(v["faulted"])]
     never = [label[law] for law, v in laws.items() if not beats(v["healthy"]) and not beats(v["faulted"])]
     text += f" (passive {baseline:g})"
+    # the scores are worst cases (beating passive at every point) or, with time in service, means
+    where = "in service" if plan.service is not None else "everywhere"
     if worse:
-        text += f"; {' and '.join(worse)} then no longer beat{'s' * (len(worse) == 1)} passive everywhere"
+        text += f"; {' and '.join(worse)} then no longer beat{'s' * (len(worse) == 1)} passive {where}"
     if never:
-        text += f"; {' and '.join(never)} did not beat passive everywhere healthy either"
+        text += f"; {' and '.join(never)} did not beat passive {where} healthy either"
     record = {"fault": fault, "laws": laws, "turns_at": []}
     if len(leaders) == 2:
         first, second = leaders

@@ -128,3 +128,23 @@ def test_the_command_line_takes_the_shares_and_checks_them():
     assert_input_error(result, "--budget = 2")
     result = run("design", "--load", "1,1.3", "--load-share", "1,-1", "--controllers", "skyhook")
     assert_input_error(result, "--load-share = -1", "a finite number > 0")
+
+
+def test_the_fault_sentence_speaks_of_the_mean_in_service_not_everywhere():
+    """With time in service a law's score is a mean: beating passive there is not beating it at
+    every speed, and the fault sentence says "in service"."""
+    from types import SimpleNamespace
+
+    from railride.studies.design_probes import fault_check
+    from railride.studies.objectives import Objective
+
+    service = {(30.0, 1.0): 0.75, (50.0, 1.0): 0.25}
+    plan = SimpleNamespace(damper="railway", laws=["pid"], objective=Objective("minimax"), service=service)
+    healthy = [
+        {"speed_m_s": 30.0, "load": 1.0, "scores": {"pid": 0.8}, "share": 0.75},
+        {"speed_m_s": 50.0, "load": 1.0, "scores": {"pid": 1.1}, "share": 0.25},
+    ]
+    faulted = [dict(p, scores={"pid": 1.2}) for p in healthy]
+    text = fault_check(plan, ["pid"], healthy, lambda **kw: faulted)["text"]
+    assert "PID scores 1.200 in service (healthy 0.875)" in text, text
+    assert "PID then no longer beats passive in service" in text and "everywhere" not in text
