@@ -15,15 +15,8 @@ from railride.secondary.dampers import IDEAL_NAMES
 from railride.output.trade_offs import paper_ranking_text, trade_off_lines
 from railride.defaults import DEFAULT_CONTROL_RATE, DEFAULT_DAMPER
 from railride.cli._app import app
-from railride.cli._common import (
-    ProgressBar,
-    command_line,
-    errors,
-    option_names,
-    stderr_is_terminal,
-    stdout_console,
-    write_folder,
-)
+from railride.cli._common import ProgressBar, errors, option_names, stderr_is_terminal, stdout_console, write_folder
+from railride.cli._common import command_line
 from railride.cli._options import (
     MaxMemoryOption,
     MaxStepsOption,

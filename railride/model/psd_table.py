@@ -39,7 +39,8 @@ COLUMNS = ("vertical", "cross_level")
 class PsdTable:
     """A spectrum read from a table: wavenumbers [rad/m] and the one-sided PSDs there
     [m^2/(rad/m)] (``cross_level`` None: the rails the same), with the file's path and the
-    SHA-256 of its bytes (what a result records of it)."""
+    SHA-256 of those values (what a result records of it: the same spectrum, the same hash,
+    whatever the file's comments or number formats)."""
 
     path: str
     wavenumber: np.ndarray
@@ -134,5 +135,6 @@ def _read(path: str, mtime_ns: int, size: int) -> PsdTable:
         wavenumber=W,
         vertical=S[:, 0],
         cross_level=S[:, 1] if S.shape[1] > 1 else None,
-        sha256=hashlib.sha256(raw).hexdigest(),
+        # of the values read, in rad/m (a comment or a reformatted number is the same spectrum)
+        sha256=hashlib.sha256(np.ascontiguousarray(np.column_stack([W, S])).tobytes()).hexdigest(),
     )

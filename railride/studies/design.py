@@ -168,8 +168,9 @@ def service_shares(speeds: tuple, loads: tuple, speed_shares=None, load_shares=N
                 f"{unit}{'s' * (len(values) != 1)} ({', '.join(f'{v:g}' for v in values)}); give one per {unit}, in "
                 "their order"
             )
-        total = sum(numbers)
-        return [x / total for x in numbers]
+        top = max(numbers)  # scaled first: 1e308 + 1e308 would overflow to inf
+        total = sum(x / top for x in numbers)
+        return [x / top / total for x in numbers]
 
     by_speed = shares("speed_shares", speed_shares, speeds, "speed")
     by_load = shares("load_shares", load_shares, loads, "load")

@@ -64,7 +64,7 @@ def references(plan, gains, scores) -> dict:
         points = scores(**ask)
         out[device] = {
             law: {
-                "score": _worst(points, law, plan.objective.infeasible_offset),
+                "score": _worst(points, law, plan.objective.constraint_offset),
                 "points": [
                     {"speed_m_s": p["speed_m_s"], "load": p["load"], "score": _plain(p["scores"].get(law))}
                     for p in points
@@ -86,7 +86,7 @@ def fault_check(plan, leaders: list, points: list, scores) -> dict | None:
     ask = asks(plan, leaders)[-1]
     fault = ask["faults"][0]
     faulted = scores(**ask)
-    offset = plan.objective.infeasible_offset
+    offset = plan.objective.constraint_offset
     laws = {law: {"healthy": _worst(points, law, offset), "faulted": _worst(faulted, law, offset)} for law in leaders}
     over = "in service" if plan.service is not None else "at worst"
     label = {law: LABELS.get(law, law) for law in leaders}

@@ -103,7 +103,9 @@ class DesignResult:
         first = self.ranking[0] if self.ranking else None
         if first is None or not first["ranked"]:
             return None
-        return "passive" if passive_wins(first, self.points) is not None else first["controller"]
+        infeasible = (self.settings.get("objective") or {}).get("infeasible") or {}
+        keep = passive_wins(first, self.points, infeasible.get("offset"))
+        return "passive" if keep is not None else first["controller"]
 
     def table(self, metric: str) -> pd.DataFrame:
         """One metric's rows of `summary`, indexed by law, speed and load."""
@@ -333,7 +335,7 @@ def rank(summary: pd.DataFrame, objective: Objective, laws, diverged=(), service
         per = [(p["scores"][n], p) for p in points]
         bad = [p for s, p in per if not np.isfinite(s)]
         worst = bad[0] if bad else max(per, key=lambda sp: sp[0])[1]
-        score = law_score(points, n, objective.infeasible_offset)
+        score = law_score(points, n, objective.constraint_offset)
         score = np.inf if bad or score is None else score
         ranking.append(
             {
@@ -372,7 +374,7 @@ def recommend(ranking, points, summary: pd.DataFrame, runs: pd.DataFrame, object
     else:
         best = ok[0]
         name, score, w = best["controller"], best["score"], best["worst_at"]
-        keep = passive_wins(best, points)
+        keep = passive_wins(best, points, objective.constraint_offset)
         service = settings.get("service")
         if objective.kind == "minimax":
             point = "its worst mean RMS ratio to passive over the four responses"
@@ -457,14 +459,15 @@ def score_text(score, objective, short: bool = False) -> str:
     return f"infeasible (+{excess:.3g})" if short else f"infeasible: over its constraints by {excess:.3g} of a bound"
 
 
-def passive_wins(best: dict, points: list) -> float | None:
+def passive_wins(best: dict, points: list, offset: float | None = None) -> float | None:
     """Passive's score (over the speeds and loads as the laws', `law_score`, by the design's
     objective) where it is lower than ``best``'s, the ranked law's, by more than the level
     tolerance of a comparison; else None: a law that scores worse than passive is not
-    recommended."""
+    recommended. ``offset``: the objective's `Objective.constraint_offset` (a broken constraint
+    is not averaged away)."""
     from railride.studies.comparison import LEVEL_TOLERANCE, is_level
 
-    own = law_score(points, "passive")
+    own = law_score(points, "passive", offset)
     if own is None or not np.isfinite(own):
         return None
     if best["score"] > own and not is_level(best["score"], own, LEVEL_TOLERANCE):
@@ -539,7 +542,14 @@ def _trade_offs(name: str, ok: list, summary: pd.DataFrame, service=None) -> str
     )
     travel = mean.get((name, TRAVEL_COLUMN))
     if travel is not None and np.isfinite(travel) and not is_level(travel, 1.0, LEVEL_TOLERANCE):
-        text += f" Its largest secondary travel is x{travel:.2f} passive's on average."
+        text += f" Its largest secondary travel is x{travel:.2f} passive's on average"
+        # rattle space is a worst case: the speed and load where the travel grows most
+        own = summary[(summary["controller"] == name) & (summary["metric"] == TRAVEL_COLUMN)]
+        own = own[np.isfinite(own["ratio_mean"].to_numpy(dtype=float))]
+        if len(own) > 1:
+            top = own.loc[own["ratio_mean"].idxmax()]
+            text += f", x{top['ratio_mean']:.2f} at {_at(top['speed_m_s'], top['load'])}, the most"
+        text += "."
     return text
 
 

@@ -227,6 +227,14 @@ class Objective:
             offset *= 10.0
         return offset
 
+    @property
+    def constraint_offset(self) -> float | None:
+        """The score at and above which a run breaks a constraint of this objective (the
+        constrained kind's bound, ``peak_bound``, ``travel_bound``); None where it has none."""
+        if self.kind != "constrained" and self.peak_bound is None and self.travel_bound is None:
+            return None
+        return self.infeasible_offset or INFEASIBLE_OFFSET
+
     def score(self, ratio) -> np.ndarray:
         """J of RMS ratios to passive, ``ratio`` (..., 4). A run that diverged has NaN ratios
         and scores +inf: after every run that did not."""
@@ -310,9 +318,9 @@ class Objective:
             **({"peak_bound": self.peak_bound} if self.peak_bound is not None else {}),
             **({"travel_bound_m": self.travel_bound} if self.travel_bound is not None else {}),
             "infeasible": None
-            if self.kind != "constrained" and self.peak_bound is None and self.travel_bound is None
+            if self.constraint_offset is None
             else {
-                "offset": self.infeasible_offset or INFEASIBLE_OFFSET,
+                "offset": self.constraint_offset,
                 "scale": INFEASIBLE_SCALE,
                 "feasible_max": self.feasible_max if math.isfinite(self.feasible_max) else None,
             },

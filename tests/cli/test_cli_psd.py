@@ -3,11 +3,10 @@ the commands that take one, is recorded with its SHA-256, and a bad table is one
 
 from __future__ import annotations
 
-import hashlib
-
 import numpy as np
 
 from clihelp import assert_input_error, ok_json, run
+from railride.model import psd_table
 from railride.model.irregularity import spectrum
 
 
@@ -28,7 +27,7 @@ def test_compare_on_a_table_of_fra4_rides_as_on_fra4(tmp_path):
     formula = ok_json(*args, "--scenario", "fra4")
     record = table["settings"]["scenario"]
     assert record["spectrum"] == f"psd:{path}" and record["seed"] == 3
-    assert record["spectrum_sha256"] == hashlib.sha256(path.read_bytes()).hexdigest()
+    assert record["spectrum_sha256"] == psd_table.table(f"psd:{path}").sha256
     checked = 0
     for a, b in zip(table["controllers"], formula["controllers"]):  # the table's interpolation error only
         for response, values in b["metrics"].items():
@@ -54,5 +53,5 @@ def test_a_bad_table_or_band_is_one_line_with_status_2(tmp_path):
 def test_ride_spectrum_records_the_tables_sha256(tmp_path):
     path = _fra4(tmp_path / "fra4.csv")
     settings = ok_json("ride-spectrum", "--track", f"psd:{path}", "--points", 64)["settings"]
-    assert settings["spectrum_sha256"] == hashlib.sha256(path.read_bytes()).hexdigest()
+    assert settings["spectrum_sha256"] == psd_table.table(f"psd:{path}").sha256
     assert "spectrum_sha256" not in ok_json("ride-spectrum", "--points", 64)["settings"]

@@ -119,3 +119,17 @@ def test_an_edited_table_is_another_spectrum(tmp_path):
     path.write_text("\n".join(lines[:2] + [f"{w},{4 * float(v)!r},{4 * float(x)!r}" for w, v, x in rows]) + "\n")
     after = _samples(name)[1]  # 4 x the PSD: 2 x the amplitude
     np.testing.assert_allclose(after, 2 * before, rtol=0, atol=1e-12 * np.abs(before).max())
+
+
+def test_the_record_keeps_the_spectrum_not_the_files_bytes(tmp_path):
+    """The SHA-256 a result records is of the values read: a comment or another way of writing
+    the same numbers leaves it; another value changes it."""
+    from railride.model import psd_table
+
+    path = tmp_path / "t.csv"
+    path.write_text("wavenumber_rad_per_m,vertical\n0.05,1e-4\n10,1e-9\n")
+    first = psd_table.table(f"psd:{path}").sha256
+    path.write_text("# the same spectrum\nwavenumber_rad_per_m,vertical\n5e-2,0.0001\n10.0,1.0e-9\n")
+    assert psd_table.table(f"psd:{path}").sha256 == first
+    path.write_text("wavenumber_rad_per_m,vertical\n0.05,2e-4\n10,1e-9\n")
+    assert psd_table.table(f"psd:{path}").sha256 != first

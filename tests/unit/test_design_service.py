@@ -21,6 +21,8 @@ def test_the_shares_are_the_product_of_speed_and_load_normalised():
     # one given: the other alike; none given: no weights at all
     assert service_shares((30.0,), (1.0, 1.3), None, [1, 3]) == pytest.approx({(30.0, 1.0): 0.25, (30.0, 1.3): 0.75})
     assert service_shares((30.0,), (1.0,)) is None
+    # shares near the largest float still sum without overflow
+    assert service_shares((30.0, 50.0), (1.0,), [1e308, 1e308]) == {(30.0, 1.0): 0.5, (50.0, 1.0): 0.5}
 
 
 @pytest.mark.parametrize(
@@ -148,3 +150,46 @@ def test_the_fault_sentence_speaks_of_the_mean_in_service_not_everywhere():
     text = fault_check(plan, ["pid"], healthy, lambda **kw: faulted)["text"]
     assert "PID scores 1.200 in service (healthy 0.875)" in text, text
     assert "PID then no longer beats passive in service" in text and "everywhere" not in text
+
+
+def test_a_broken_constraint_is_not_averaged_away_in_service():
+    """With a travel bound no run can keep (1 micrometre), every point is infeasible: the score
+    in service is the worst, said as infeasible, not a weighted mean of offsets."""
+    from railride.studies.design_result import score_text
+    from railride.studies.objectives import Objective
+
+    bound = Objective("minimax", travel_bound=1e-6)
+    assert bound.constraint_offset == bound.to_dict()["infeasible"]["offset"]
+    assert Objective("minimax").constraint_offset is None
+    result = rr.design(
+        ["skyhook"],
+        tracks=["fra4"],
+        speeds=[30.0, 50.0],
+        speed_shares=[9, 1],
+        loads=[1.0],
+        train_seeds=[0],
+        test_seeds=[1],
+        duration=1.0,
+        budget=25,
+        values=3,
+        objective=bound,
+        progress=False,
+    )
+    sky = result.ranking[0]
+    at = [p["scores"]["skyhook"] for p in result.points]
+    assert min(at) >= bound.constraint_offset
+    assert sky["score"] == sky["worst_score"] == max(at)
+    assert score_text(sky["score"], bound).startswith("infeasible")
+
+
+def test_the_travel_sentence_names_the_speed_where_the_travel_grows_most(weighted):
+    """Rattle space is a worst case: beside its average, the recommendation names the speed and
+    load where the winner's largest travel is the most above passive's (from the runs)."""
+    runs = weighted.runs
+    key = ["track", "track_seed", "speed_m_s", "load"]
+    base = runs[runs["controller"] == "passive"].set_index(key)["travel_max_m"]
+    own = runs[runs["controller"] == "skyhook"].set_index(key)["travel_max_m"]
+    by_speed = (own / base).groupby(level="speed_m_s").mean()
+    assert by_speed.max() > 1.01  # skyhook moves the secondary more than passive here: the sentence is said
+    most = by_speed.idxmax()
+    assert f"x{by_speed.max():.2f} at {most:g} m/s, load 1, the most." in weighted.recommendation
