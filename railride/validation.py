@@ -30,6 +30,7 @@ SEED_MAX = 2**64 - 1
 RULES = {
     "positive": ("a finite number > 0", lambda v: v > 0.0),
     "nonnegative": ("a finite number >= 0", lambda v: v >= 0.0),
+    "at_least_one": ("a finite number >= 1", lambda v: v >= 1.0),
     "finite": ("a finite number", lambda v: True),
     # checked by `seed`, never through a float: the test here is not used
     "seed": ("a whole number >= 0 and <= 2**64 - 1", lambda v: False),

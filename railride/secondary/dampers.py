@@ -137,7 +137,7 @@ class BoucWen(_Damper):
         "N/m", "stiffness k0 (simple model: the accumulator; Spencer: in series with the hysteresis)", "nonnegative"
     )
     A: float = param("-", "Bouc-Wen A: initial slope dz/dx")
-    n: float = param("-", "Bouc-Wen exponent, >= 1")
+    n: float = param("-", "Bouc-Wen exponent", "at_least_one")
     gamma: float = param("1/m^n", "Bouc-Wen gamma (multiplies |w| z |z|^(n-1))", "finite")
     beta: float = param("1/m^n", "Bouc-Wen beta (multiplies w |z|^n)", "finite")
     eta: float = param("1/s", "coil lag rate: u' = -eta (u - v)")
