@@ -330,12 +330,23 @@ def state_space(
                 f"{', '.join(OUTER_LOOPS)} (each on the ideal actuator)"
             )
         named = [suspension.strip()]
-        (secondary,) = linear_suspensions(named, None if gains is None else load_gains(gains)).values()
+        gain_set = None if gains is None else load_gains(gains)
+        (secondary,) = linear_suspensions(named, gain_set).values()
         model = linear_model(suspension=secondary, **vehicle_options)
         if out is not None:
             write_folder(out.parent, lambda: [write_model(model, out)], own_folder=False)
+    # where a closed loop's gains came from, and whether the study that made them tuned this law
+    source = None
+    if model.controller is not None:
+        from railride.secondary.control import GainSet
+
+        ran = gain_set if gain_set is not None else GainSet.default()
+        untuned = ran.untuned(named)
+        source = f"gains {ran.source}" + (
+            f"; {named[0]} was not tuned by the study that made them: its start values" if untuned else ""
+        )
     if format is StateSpaceFormat.json:
-        print_json(model.to_dict())
+        print_json({**model.to_dict(), **({"gains_source": source} if source else {})})
         return
     import numpy as np
 
@@ -346,7 +357,8 @@ def state_space(
     console.print(
         f"State-space model, secondary {model.secondary}: {len(model.states)} states, "
         f"{len(model.inputs)} inputs, {len(model.outputs)} outputs; the largest real part of a "
-        f"pole is {float(np.max(poles.real)):.4g} 1/s; {vehicle_text(model.record())}."
+        f"pole is {float(np.max(poles.real)):.4g} 1/s; {vehicle_text(model.record())}"
+        + (f"; {source}." if source else ".")
     )
     for kind in ("states", "inputs", "outputs"):
         console.print(f"{kind}: " + ", ".join(getattr(model, kind)))

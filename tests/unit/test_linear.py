@@ -133,3 +133,21 @@ def test_a_closed_loop_records_the_gains_it_closed_with(tmp_path):
     mat = loadmat(tmp_path / "m.mat")
     assert json.loads(str(mat["controller_gains"][0]))["gains"]["kd"] == gains.pid.kd
     assert json.loads(str(mat["versions"][0]))["railride"] == str(mat["railride_version"][0])
+
+
+def test_the_command_says_where_a_closed_loops_gains_came_from(tmp_path):
+    """state-space names the gains file of a closed loop and says when the study that made it
+    did not tune this law (its start values)."""
+    import json
+
+    from clihelp import ok
+
+    doc = json.loads(ok("state-space", "--suspension", "pid", "--format", "json").stdout)
+    assert doc["gains_source"] == "gains railride/data/gains.toml"
+    assert "gains_source" not in json.loads(ok("state-space", "--format", "json").stdout)
+    tuned = tmp_path / "t"
+    ok("tune", "--controllers", "skyhook", "--budget", 25, "--values", 3, "--duration", 0.3, "--out", tuned)
+    doc = json.loads(
+        ok("state-space", "--suspension", "pid", "--gains", tuned / "gains.toml", "--format", "json").stdout
+    )
+    assert doc["gains_source"].endswith("pid was not tuned by the study that made them: its start values")
