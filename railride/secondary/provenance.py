@@ -267,8 +267,12 @@ def judged_on(gains, record: dict | None) -> tuple[str, str] | None:
     line = [t for t in tracks if str(t.get("name")) == str(record.get("name"))]
     if record.get("profile") == "measured" and line:
         speeds = _list(dict.fromkeys(t.get("speed_m_s") for t in line))
+        sections = list(dict.fromkeys(t.get("source") for t in line))
+        other = "another stretch" if len(sections) == 1 else "other stretches"
+        starts = list(dict.fromkeys(t["start_m"] for t in line if t.get("start_m") is not None))
+        at = f" (from s = {_list(starts)} m)" if starts else ""
         return HELD_OUT, (
-            f"Held out: tuning never ran on {what}; the gains were tuned on other stretches of it, at {speeds} m/s."
+            f"Held out: tuning never ran on {what}; the gains were tuned on {other} of it{at}, at {speeds} m/s."
         )
     if line:  # its name, other settings
         what = _tracks_text([record], tracks)
@@ -342,7 +346,9 @@ def _tracks_tuned(tracks: list[dict], names=None, speeds=None) -> str:
     names = list(dict.fromkeys(str(t.get("name")) for t in tracks)) or [str(n) for n in names or []]
     seeds = list(dict.fromkeys(t["seed"] for t in tracks if t.get("seed") is not None))
     speeds = list(dict.fromkeys(t["speed_m_s"] for t in tracks if t.get("speed_m_s") is not None)) or speeds or []
+    starts = list(dict.fromkeys(t["start_m"] for t in tracks if t.get("start_m") is not None))
     text = ", ".join(names) + (f" (seed{'s' * (len(seeds) > 1)} {_list(seeds)})" if seeds else "")
+    text += f" (from s = {_list(starts)} m)" if starts else ""  # a measured profile's sections
     return text + (f" at {_list(speeds)} m/s" if speeds else "")
 
 

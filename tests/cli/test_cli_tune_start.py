@@ -41,6 +41,8 @@ def test_another_section_is_told_to_tune_with_its_start_and_the_same_is_in_sampl
     warning = [x for x in other.stderr.splitlines() if x.startswith("warning: ")]
     assert len(warning) == 1 and "(start 900 m)" in warning[0], other.stderr
     assert warning[0].endswith(f"railride tune --scenario file:{path} --speed 30 --duration 1 --start 900")
+    assert f"on file:{path} (from s = 500 m) at 30 m/s" in warning[0]
+    assert "tuned on another stretch of it (from s = 500 m), at 30 m/s" in " ".join(other.stdout.split())
     same = ok(*args, "--start", 500)
     assert "warning" not in same.stderr and "in-sample" in same.stdout
 

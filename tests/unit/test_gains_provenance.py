@@ -392,7 +392,7 @@ def test_a_run_on_a_measured_line_overlaps_the_sections_tuning_ran_on_or_not():
         record = {**line, "speed_m_s": speed, "duration_s": duration, "source": "line.csv", "rows": 80000}
         return judged_on(gains, {**record, "s_end_m": 19999.75})
 
-    assert run(40.0, 4.0)[0] == HELD_OUT and "other stretches" in run(40.0, 4.0)[1]
+    assert run(40.0, 4.0)[0] == HELD_OUT and "another stretch of it, at 40 m/s" in run(40.0, 4.0)[1]
     assert run(40.0, 5.0)[0] == IN_SAMPLE
     assert run(30.0, 6.0)[0] == SAME_TRACK
     assert run(30.0, 5.0)[0] == HELD_OUT  # 0-150 m
