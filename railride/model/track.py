@@ -345,6 +345,13 @@ class Scenario:
         if not isinstance(self.track, RailProfile):
             raise InputError(f"track = {self.track!r}: must be a RailProfile")
         needed = self.speed * self.duration
+        start = getattr(self.track, "start_m", None)
+        if needed > self.track.end() + 1e-9 and start is not None:  # a section: in the file's metres
+            raise InputError(
+                f"start = {start:g} m: the run covers {needed:.1f} m (speed {self.speed:g} m/s x {self.duration:g} s) "
+                f"but the profile runs {self.track.end():g} m from there, to s = {start + self.track.end():g} m; "
+                f"give a start of at most {start + self.track.end() - needed:g} m, or shorten the run"
+            )
         if needed > self.track.end() + 1e-9:
             raise InputError(
                 f"the run covers s = 0 to {needed:.1f} m (speed {self.speed:g} m/s x {self.duration:g} s) "

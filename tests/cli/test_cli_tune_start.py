@@ -8,7 +8,7 @@ import json
 import numpy as np
 import pytest
 
-from clihelp import ok
+from clihelp import assert_input_error, ok, run
 
 TUNE = ("tune", "--controllers", "pid", "--budget", 15, "--values", 3, "--speed", 30, "--duration", 1)
 
@@ -52,3 +52,11 @@ def test_a_tuning_set_runs_every_member_on_the_section(line, tmp_path):
     ok(*TUNE, "--scenario", f"file:{path}", "--start", 250, "--load", "1,1.3", "--out", tmp_path / "set")
     members = json.loads((tmp_path / "set" / "tune.json").read_text())["settings"]["tuning_set"]
     assert [(m["load"], m["start_m"]) for m in members] == [(1.0, 250.0), (1.3, 250.0)]
+
+
+def test_a_start_too_near_the_end_says_the_latest_start(line):
+    path, _ = line
+    result = run(*TUNE, "--scenario", f"file:{path}", "--start", 1480)
+    assert_input_error(
+        result, "--start = 1480 m: the run covers 30.0 m", "the profile runs 19.75 m", "a start of at most 1469.75 m"
+    )
