@@ -131,13 +131,15 @@ def describe_dampers(settings: dict, detail: bool = False) -> str:
     """The controlled suspensions' dampers of a compare, sweep or tune ``settings`` record:
     "railway MR dampers (force x 4)", "ideal actuators"; ``detail`` adds what an ideal device
     does."""
+    from railride.secondary.dampers import record_name
+
     ideal = {
         "ideal": ("ideal actuators", "force = demand"),
         "ideal-damper": ("ideal semi-active dampers", "force = demand where it dissipates, else 0"),
     }
     damper = settings.get("damper")
     if isinstance(damper, dict):  # a model given as such (a damper file): its record
-        damper = damper.get("preset") or f"{damper.get('model', 'MR')} (own parameters)"
+        damper = record_name(damper)
     if damper in ideal:
         words, what = ideal[damper]
         return f"{words} ({what})" if detail else words

@@ -134,42 +134,34 @@ def _pareto_table(doc: dict, caption: str):
             *([fmt(r["travel_ratio"], ".3f")] if travel else []),
             planes,
         )
-    return [counts, "", rows, *([travel_text(doc, front)] if travel else [])]
+    return [counts, "", rows, *([travel_text(doc)] if travel else [])]
 
 
-def travel_text(doc: dict, front: list) -> str:
-    """What the four-ratio front asks of the suspension's travel: how many of its samples move
-    more than passive, and by how much at most."""
-    from railride.studies.comparison import LEVEL_TOLERANCE
-
-    passive = doc.get("passive_travel_m")
-    ratios = [r["travel_ratio"] for r in front if r.get("travel_ratio") is not None]
-    if not passive or not ratios:
+def travel_text(doc: dict) -> str:
+    """The document's ``front_travel`` (`ParetoResult.front_travel`) in words."""
+    t, passive = doc.get("front_travel"), doc.get("passive_travel_m")
+    if not t or not passive or not t["samples"]:
         return ""
-    # more than passive by more than a comparison's level tolerance (within it: level)
-    more = [x for x in ratios if x > 1.0 + LEVEL_TOLERANCE]
     head = (
         f"Travel: max travel is each sample's largest secondary travel over passive's ({passive * 1e3:.3g} mm); "
         "the four-ratio front does not weigh it. "
     )
-    if not more:
-        return head + f"None of the {len(front)} samples on the front needs more travel than passive."
+    if not t["more_than_passive"]:
+        return head + f"None of the {t['samples']} samples on the front needs more travel than passive."
     text = head + (
-        f"{len(more)} of the {len(front)} samples on the front need more travel than passive (up to "
-        f"x{max(more):.3g}): ride bought with rattle space."
+        f"{t['more_than_passive']} of the {t['samples']} samples on the front need more travel than passive (up to "
+        f"x{t['largest_ratio']:.3g}): ride bought with rattle space."
     )
-    values = (doc["settings"].get("vehicle") or {}).get("values") or {}
-    clearance, stiffness = values.get("z_stop"), values.get("k_stop") or 0.0
-    if clearance:
-        beyond = [x for x in ratios if x * passive >= clearance]
-        if beyond:
-            stops = "the stops then bound it" if stiffness > 0 else "no stop force is modelled, k_stop = 0"
-            text += (
-                f" {len(beyond)} of them go past the {clearance * 1e3:g} mm clearance (z_stop; {stops}): a real car "
-                "would be on its stops."
-            )
-        else:
-            text += f" None passes the {clearance * 1e3:g} mm clearance (z_stop)."
+    clearance = t["clearance_m"]
+    if t["past_clearance"]:
+        stiff = t["stop_stiffness_n_per_m"] > 0
+        stops = "the stops then bound it" if stiff else "no stop force is modelled, k_stop = 0"
+        text += (
+            f" {t['past_clearance']} of them go past the {clearance * 1e3:g} mm clearance (z_stop; {stops}): a real "
+            "car would be on its stops."
+        )
+    elif clearance:
+        text += f" None passes the {clearance * 1e3:g} mm clearance (z_stop)."
     front_with_travel = doc["counts"]["non_dominated_with_travel"]
     return text + f" Over the four ratios and travel {front_with_travel} samples are non-dominated."
 

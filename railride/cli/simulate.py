@@ -87,11 +87,10 @@ SIMULATE_FIELDS = {
 def _describe_suspension(record: dict) -> str:
     if record.get("type") == "mr":
         scale = record.get("damper_scale", 1.0)
-        damper = record["damper"]
-        if isinstance(damper, dict):  # a damper file's: its parameters, no preset's name
-            damper = damper.get("preset") or f"{damper.get('model', 'MR')} (own parameters)"
+        from railride.secondary.dampers import record_name
+
         return (
-            f"MR, {damper} dampers"
+            f"MR, {record_name(record['damper'])} dampers"
             + (f" (force x {scale:g})" if scale != 1.0 else "")
             + f" at {record['voltage_v']:g} V"
         )

@@ -251,6 +251,8 @@ def linear_model(params=None, suspension=None, *, vehicle=None, load: float = 1.
     carbody (`VehicleParams.loaded`), with ``suspension``: "passive" (default, or None),
     "plant", or a `railride.Suspension` that is linear (passive viscous dampers, or the ideal
     actuator under an outer loop). See the module's docstring for states, inputs and outputs."""
+    from railride.secondary.provenance import json_values
+
     vehicle_params, record = resolve_vehicle(vehicle, params, load)
     vehicle = Vehicle(vehicle_params)
     secondary, c_dashpot, controller = _check_secondary(suspension, vehicle)
@@ -333,17 +335,8 @@ def linear_model(params=None, suspension=None, *, vehicle=None, load: float = 1.
         secondary,
         vehicle_params,
         record,
-        None if controller is None else {"name": controller.name, "gains": _plain_gains(controller.to_dict())},
+        None if controller is None else {"name": controller.name, "gains": json_values(controller.to_dict())},
     )
-
-
-def _plain_gains(value):
-    """A controller's gains as JSON values (NumPy numbers and arrays as floats and lists)."""
-    if isinstance(value, dict):
-        return {k: _plain_gains(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple, np.ndarray)):
-        return [_plain_gains(v) for v in value]
-    return float(value) if isinstance(value, (int, float, np.number)) and not isinstance(value, bool) else value
 
 
 def linear_suspensions(controllers, gains) -> dict[str, object]:

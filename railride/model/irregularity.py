@@ -96,11 +96,14 @@ class RandomTrack(RailProfile):
     length: float = 2000.0  # m, the realisation's period
     lead_in: float = 20.0  # m
     _interp: tuple = field(default=(), repr=False)
+    #: a user's table the realisation was made from (psd:PATH), read once; None for a standard spectrum
+    _table: psd_table.PsdTable | None = field(default=None, repr=False)
 
     def __post_init__(self):
         from scipy.interpolate import CubicSpline
 
         table = psd_table.table(self.name) if psd_table.is_table(self.name) else None
+        object.__setattr__(self, "_table", table)
         if table is None:
             spectrum(self.name, 1.0)  # an unknown name fails here
         # a Python int, never through a float (which rounds seeds past 2**53)
@@ -138,7 +141,7 @@ class RandomTrack(RailProfile):
         profiles = []
         for component in ("vertical", "cross-level"):
             S = np.zeros_like(W)
-            S[band] = spectrum(self.name, W[band], component)
+            S[band] = table(W[band], component) if table is not None else spectrum(self.name, W[band], component)
             amp = np.sqrt(2 * S * dW)  # one-sided: variance = sum S dW
             phase = rng.uniform(0, 2 * np.pi, W.size)
             # z(s) = sum amp cos(W s + phase) as the real part of an inverse FFT
@@ -187,8 +190,8 @@ class RandomTrack(RailProfile):
             "max_wavelength_m": self.max_wavelength,
             "length_m": self.length,
             "lead_in_m": self.lead_in,
-            # a user's table: which version of the file made the realisation
-            **({"spectrum_sha256": psd_table.table(self.name).sha256} if psd_table.is_table(self.name) else {}),
+            # a user's table: the values the realisation was made from (not the file as it is now)
+            **({"spectrum_sha256": self._table.sha256} if self._table is not None else {}),
         }
 
 

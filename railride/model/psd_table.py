@@ -32,7 +32,6 @@ from railride.errors import InputError
 PREFIX = "psd:"
 #: the first column's names, and the factor from its unit to rad/m
 ABSCISSAE = {"wavenumber_rad_per_m": 1.0, "spatial_frequency_per_m": 2.0 * math.pi}
-COLUMNS = ("vertical", "cross_level")
 
 
 @dataclass(frozen=True, eq=False)

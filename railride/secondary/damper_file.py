@@ -17,7 +17,7 @@ from railride.secondary import dampers
 from railride.validation import parse_toml, shown
 
 #: the models a file may name, by the name their records give
-MODELS = {"bouc-wen": dampers.BoucWen, "spencer": dampers.Spencer}
+MODELS = dampers.MR_MODELS
 
 
 def to_toml(model) -> str:

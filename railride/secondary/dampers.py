@@ -355,6 +355,18 @@ SPENCER1997 = Spencer(
 
 #: the MR damper presets (the models the rig can drive)
 PRESETS = {"dyke1996": DYKE1996, "railway": RAILWAY, "spencer1997": SPENCER1997}
+#: the MR models by the name their records give (a damper file's ``model``)
+MR_MODELS = {"bouc-wen": BoucWen, "spencer": Spencer}
+
+
+def record_name(record) -> str:
+    """How outputs name a damper by its record (`to_dict`) or name: the preset it equals, else
+    "<model> (own parameters)" (a damper file's or a model's given as such)."""
+    if isinstance(record, dict):
+        return record.get("preset") or f"{record.get('model', 'MR')} (own parameters)"
+    return str(record)
+
+
 #: the ideal actuator, by name "ideal" beside the presets (closed loop only)
 IDEAL = Ideal()
 #: the ideal semi-active damper, by name "ideal-damper" (closed loop only)

@@ -158,10 +158,9 @@ def _damper_key(damper, scale):
         if model is None:  # an ideal device, or a name this railride does not know
             return damper
     elif isinstance(damper, dict):  # a record: the model's fields
-        classes = {"bouc-wen": dampers.BoucWen, "spencer": dampers.Spencer}
         values = {k: v for k, v in damper.items() if k not in ("model", "preset")}
         try:
-            model = classes[damper.get("model")](**values)
+            model = dampers.MR_MODELS[damper.get("model")](**values)
         except (KeyError, TypeError, ValueError):
             return json.dumps(damper, sort_keys=True, default=str)
     scale = 1.0 if scale is None else float(scale)
@@ -172,16 +171,18 @@ def _damper_key(damper, scale):
     return (model.model, tuple(float(v) for v in dataclasses.astuple(model)))
 
 
+def _damper_record(damper):
+    """A damper argument as a record: a name stays a name, a model gives its `to_dict`."""
+    return damper.to_dict() if not isinstance(damper, (str, dict)) and hasattr(damper, "to_dict") else damper
+
+
 def _damper_words(damper, scale) -> str:
-    """A damper in a line's words: its name (x the scale), or "bouc-wen of its own parameters"."""
-    if not isinstance(damper, (str, dict)) and hasattr(damper, "to_dict"):  # a model
-        damper = damper.to_dict()
-    if isinstance(damper, dict):
-        name = damper.get("preset") or f"{damper.get('model', 'MR')} of its own parameters"
-    else:
-        name = str(damper)
+    """A damper in a line's words: its name (x the scale), or "bouc-wen (own parameters)"."""
+    from railride.secondary.dampers import record_name
+
+    name = record_name(_damper_record(damper))
     scale = 1.0 if scale is None else float(scale)
-    return f"{name} x {scale:g}" if scale != 1.0 else str(name)
+    return f"{name} x {scale:g}" if scale != 1.0 else name
 
 
 def _other_damper(provenance: dict, damper, scale) -> str | None:
@@ -199,12 +200,11 @@ def _other_damper(provenance: dict, damper, scale) -> str | None:
     words = f"damper {run_words} (the gains' damper: {tuned_words}"
     # a preset's name (and scale) says what differs; a damper of one's own parameters, which
     # values (of the same model)
-    own = "of its own parameters" in run_words + tuned_words
+    own = any(isinstance(r, dict) and not r.get("preset") for r in map(_damper_record, (damper, tuned)))
     if own and isinstance(ran, tuple) and isinstance(before, tuple) and ran[0] == before[0]:
         from railride.secondary import dampers
 
-        cls = dampers.Spencer if ran[0] == "spencer" else dampers.BoucWen
-        names = [f.name for f in dataclasses.fields(cls)]
+        names = [f.name for f in dataclasses.fields(dampers.MR_MODELS[ran[0]])]
         other = [f"{n} {a:.4g} against {b:.4g}" for n, a, b in zip(names, ran[1], before[1]) if a != b]
         shown = other[:_SHOWN] + ([f"{len(other) - _SHOWN} more"] if len(other) > _SHOWN else [])
         words += f"; other values: {', '.join(shown)}"

@@ -389,7 +389,7 @@ def recommend(ranking, points, summary: pd.DataFrame, runs: pd.DataFrame, object
                 f"({service_text(service)}), is"
             )
             worst = f"worst {score_text(best['worst_score'], objective)} at {_at(w['speed_m_s'], w['load'])}"
-        elif objective.kind in ("minimax",) or objective.needs_comfort:
+        elif objective.kind == "minimax" or objective.needs_comfort:
             what = f"{point}, at any speed and load, is"
         else:
             what = f"its largest score ({objective.kind} of the mean RMS ratios to passive) over the speeds and loads"

@@ -137,6 +137,30 @@ class ParetoResult:
         travel = self.travel_ratio
         return None if travel is None else non_dominated(np.column_stack([self.ratios, travel]))
 
+    def front_travel(self) -> dict | None:
+        """What the four-ratio front asks of the travel, which its ratios do not weigh: its
+        ``samples``, how many move the secondary more than passive by more than a comparison's
+        level tolerance (``more_than_passive``, the ``largest_ratio`` among them), and how many
+        reach the vehicle's clearance z_stop (``past_clearance``; None without bump stops).
+        None where the travel was not measured."""
+        from railride.studies.comparison import LEVEL_TOLERANCE
+
+        ratio = self.travel_ratio
+        if ratio is None:
+            return None
+        on = ratio[self.non_dominated & np.isfinite(ratio)]
+        more = on[on > 1.0 + LEVEL_TOLERANCE]
+        values = (self.settings.get("vehicle") or {}).get("values") or {}
+        clearance = values.get("z_stop")
+        return {
+            "samples": int(on.size),
+            "more_than_passive": int(more.size),
+            "largest_ratio": float(more.max()) if more.size else None,
+            "clearance_m": clearance,
+            "stop_stiffness_n_per_m": values.get("k_stop") or 0.0,
+            "past_clearance": None if not clearance else int((on * self.passive_travel_max >= clearance).sum()),
+        }
+
     def non_dominated_in(self, x: str, y: str) -> np.ndarray:
         """Non-dominated in the plane of ratios ``x`` and ``y`` (names of RATIOS)."""
         return non_dominated(self.ratios[:, [RATIOS.index(x), RATIOS.index(y)]])
@@ -194,6 +218,7 @@ class ParetoResult:
             ],
             "passive_rms": dict(zip(RESPONSES, map(float, self.passive))),
             "passive_travel_m": None if self.passive_travel_max is None else float(self.passive_travel_max),
+            "front_travel": self.front_travel(),
             "counts": {"samples": len(frame), **{f: int(frame[f].sum()) for f in flags}},
             "note": self.note,
             "runs": int(self.runs),

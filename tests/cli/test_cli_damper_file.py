@@ -79,7 +79,7 @@ def test_another_damper_file_warns_and_is_recorded_whole(tmp_path):
     args = ("compare", "--controllers", "pid", "--duration", 0.3, "--no-references", "--damper", path)
     result = ok(*args)
     warnings = [line for line in result.stderr.splitlines() if line.startswith("warning: ")]
-    assert len(warnings) == 1 and "damper bouc-wen of its own parameters (the gains' damper: railway" in warnings[0]
+    assert len(warnings) == 1 and "damper bouc-wen (own parameters) (the gains' damper: railway" in warnings[0]
     assert "other values: alpha_b 5e+06 against 3.969e+06" in warnings[0]
     assert f"railride tune --damper {path}" in warnings[0]  # the file given, where the library says FILE.toml
     assert "bouc-wen (own parameters) MR dampers" in result.stdout

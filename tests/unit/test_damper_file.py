@@ -111,7 +111,7 @@ def test_another_damper_is_named_with_its_tune_command():
     assert "damper railway x 2 (the gains' damper: railway)" in line
     assert line.endswith("railride tune --damper-scale 2")
     own = _line(dampers.RAILWAY.replace(alpha_b=5e6))
-    assert "damper bouc-wen of its own parameters (the gains' damper: railway; other values: alpha_b 5e+06" in own
+    assert "damper bouc-wen (own parameters) (the gains' damper: railway; other values: alpha_b 5e+06" in own
     assert own.endswith("railride tune --damper FILE.toml"), own
     assert "damper ideal (the gains' damper: railway)" in _line("ideal")
 

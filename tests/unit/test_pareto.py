@@ -185,4 +185,16 @@ def test_the_travel_of_every_sample_and_the_front_that_counts_it(tiny):
     assert frame.loc[0, "travel_max_m"] == pytest.approx(travel["sas-attitude"], rel=1e-12)
     doc = tiny.to_dict()
     assert doc["passive_travel_m"] == tiny.passive_travel_max
+    # what the front asks of the travel, counted from the rows themselves
+    front = frame[frame["non_dominated"]]
+    more = front["travel_ratio"][front["travel_ratio"] > 1.01]
+    clearance = rr.VehicleParams.preset("paper").z_stop
+    assert doc["front_travel"] == {
+        "samples": len(front),
+        "more_than_passive": len(more),
+        "largest_ratio": float(more.max()) if len(more) else None,
+        "clearance_m": clearance,
+        "stop_stiffness_n_per_m": 0.0,
+        "past_clearance": int((front["travel_max_m"] >= clearance).sum()),
+    }
     assert doc["counts"]["non_dominated_with_travel"] == int(frame["non_dominated_with_travel"].sum())
