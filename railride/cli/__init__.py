@@ -79,8 +79,24 @@ def main() -> None:
         sys.stdout = open(os.devnull, "w")
     hook = sys.unraisablehook
     sys.unraisablehook = lambda unraisable: _interrupt_again(unraisable, hook)
+    # Ctrl-C while the commands load is recorded as it arrives: one landing in a C extension's
+    # import can come back as an unrelated error with no trace of it (a TypeError from `_ssl`'s
+    # init, seen in CI's timing). Python's own handler is back before a command runs (a long
+    # simulation takes Ctrl-C as a request to stop at its next chunk only under that handler).
+    interrupted: list[int] = []
     try:
-        app = _load()
+        previous = _record_interrupts(interrupted)
+        try:
+            app = _load()
+        except Exception:
+            if interrupted:  # the error is the interrupt's, whatever it says
+                raise KeyboardInterrupt from None
+            raise
+        finally:
+            if previous is not None:
+                import signal
+
+                signal.signal(signal.SIGINT, previous)
         app(prog_name="railride")
     except SystemExit as exc:
         status = exc.code
@@ -126,6 +142,27 @@ def _interrupt_again(unraisable, hook) -> None:
     again = threading.Timer(0.01, _thread.interrupt_main)  # as Ctrl-C: the handler in place takes it
     again.daemon = True  # never holds the interpreter's exit
     again.start()
+
+
+def _record_interrupts(seen: list):
+    """Handle SIGINT as Python does (KeyboardInterrupt), appending to ``seen`` first; returns the
+    handler it replaced, or None where none can be set (not the main thread, or Python's own
+    handler was replaced by a non-Python one)."""
+    import signal
+
+    try:
+        previous = signal.getsignal(signal.SIGINT)
+        if previous is not signal.default_int_handler:  # someone else's (a test runner's): leave it
+            return None
+
+        def on_sigint(signum, frame):
+            seen.append(signum)
+            signal.default_int_handler(signum, frame)
+
+        signal.signal(signal.SIGINT, on_sigint)
+        return previous
+    except ValueError:  # not the main thread
+        return None
 
 
 def _caused_by_interrupt(exc: BaseException | None) -> bool:

@@ -156,6 +156,40 @@ def test_ctrl_c_that_comes_back_wrapped_while_loading_is_130_too(monkeypatch, ca
         cli.main()
 
 
+def test_ctrl_c_that_comes_back_as_an_unrelated_error_while_loading_is_130(monkeypatch, capsys):
+    # Ctrl-C landing in a C extension's import can surface as an error with no trace of the
+    # interrupt (CI: "TypeError: expected a message argument" from `_ssl`'s init, under xarray)
+    import os
+
+    import railride.cli as cli
+
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+
+    def lost():
+        try:
+            os.kill(os.getpid(), signal.SIGINT)
+            time.sleep(1.0)  # the handler runs here
+        except KeyboardInterrupt:
+            pass
+        raise TypeError("expected a message argument")
+
+    try:
+        monkeypatch.setattr(cli, "_load", lost)
+        with pytest.raises(SystemExit) as stop:
+            cli.main()
+        assert stop.value.code == 130 and capsys.readouterr().err == "interrupted\n"
+        assert signal.getsignal(signal.SIGINT) is signal.default_int_handler  # given back
+
+        def broken():  # with no Ctrl-C, the same error is a bug, and says so
+            raise TypeError("expected a message argument")
+
+        monkeypatch.setattr(cli, "_load", broken)
+        with pytest.raises(TypeError, match="expected a message argument"):
+            cli.main()
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
 def test_ctrl_c_that_python_drops_in_a_callback_is_delivered_again(monkeypatch, capsys):
     # Python drops a KeyboardInterrupt raised in a weakref callback or a __del__ ("Exception
     # ignored in ..."): seen once in CI, in importlib's module-lock callback, and the command then
