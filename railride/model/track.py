@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import csv
 import dataclasses
+import functools
 import hashlib
 import math
 from dataclasses import dataclass, field
@@ -180,6 +181,9 @@ class MeasuredTrack(RailProfile):
     source: str = "<array>"
     #: a section's start on the file's profile [m] (`section`); None: the profile as read
     start_m: float | None = None
+    #: SHA-256 of the profile's values as read (s, z_L, z_R in metres); a section keeps its
+    #: profile's, so that gains tuned on a section know the file it came from
+    sha256: str = ""
     _interp: tuple = field(default=(), repr=False)
 
     def __post_init__(self):
@@ -212,6 +216,9 @@ class MeasuredTrack(RailProfile):
         object.__setattr__(self, "s", s)
         object.__setattr__(self, "z_L", zl)
         object.__setattr__(self, "z_R", zr)
+        if not self.sha256:
+            values = np.ascontiguousarray(np.column_stack([s, zl, zr]))
+            object.__setattr__(self, "sha256", hashlib.sha256(values.tobytes()).hexdigest())
         pl, pr = PchipInterpolator(s, zl), PchipInterpolator(s, zr)
         object.__setattr__(self, "_interp", (pl, pr, pl.derivative(), pr.derivative()))
 
@@ -275,7 +282,12 @@ class MeasuredTrack(RailProfile):
         zl, zr = np.concatenate([z0[0], self.z_L[keep]]), np.concatenate([z0[1], self.z_R[keep]])
         r = np.where(s < lead_in, 0.5 * (1.0 - np.cos(np.pi * np.clip(s / max(lead_in, 1e-300), 0.0, 1.0))), 1.0)
         return MeasuredTrack(
-            s, r * zl, r * zr, source=f"{self.source} from s = {start:g} m", start_m=(self.start_m or 0.0) + start
+            s,
+            r * zl,
+            r * zr,
+            source=f"{self.source} from s = {start:g} m",
+            start_m=(self.start_m or 0.0) + start,
+            sha256=self.sha256,
         )
 
     def _evaluate(self, s):
@@ -299,6 +311,7 @@ class MeasuredTrack(RailProfile):
             "rows": int(self.s.size),
             "s_end_m": float(self.s[-1]),
             **({"start_m": float(self.start_m)} if self.start_m is not None else {}),
+            "profile_sha256": self.sha256,
         }
 
 
@@ -472,7 +485,7 @@ def scenario(
         path = name[len("file:") :]
         if not path:
             raise InputError("scenario 'file:' needs a path, as in file:track.csv")
-        track = MeasuredTrack.from_csv(path)
+        track = measured(path)
         if start is not None:
             track = track.section(start)
     else:
@@ -519,6 +532,39 @@ def wheelset_input_table(
     table[:, 0:8:2], table[:, 1:8:2] = zl, zr
     table[:, 8:16:2], table[:, 9:16:2] = V * dzl, V * dzr
     return table, interval
+
+
+def measured(path) -> MeasuredTrack:
+    """The measured profile of the CSV at ``path`` (`MeasuredTrack.from_csv`), read once per
+    version of the file (its size and modification time), as a spectrum table is."""
+    try:
+        stat = Path(path).stat()
+    except OSError:
+        return MeasuredTrack.from_csv(path)  # its own message of the file that is not there
+    return _measured(str(path), stat.st_mtime_ns, stat.st_size)
+
+
+@functools.lru_cache(maxsize=16)
+def _measured(path: str, mtime_ns: int, size: int) -> MeasuredTrack:
+    return MeasuredTrack.from_csv(path)
+
+
+def source_sha256(name) -> str | None:
+    """The SHA-256 of the values a scenario reads from a file: a spectrum table's (psd:PATH) or
+    a measured profile's (file:PATH); None for a scenario of settings alone. A study's run keys
+    hold it (`railride.studies.case.Case.key`), so a table resumed after the file changed
+    does not reuse rows of the old file."""
+    if isinstance(name, Path):
+        name = f"file:{name}"
+    if not isinstance(name, str):
+        return None
+    from railride.model import psd_table
+
+    if psd_table.is_table(name):
+        return psd_table.table(name).sha256
+    if name.startswith("file:") and name != "file:":
+        return measured(name[len("file:") :]).sha256
+    return None
 
 
 def table_key(sc: Scenario):

@@ -241,10 +241,7 @@ def judged_on(gains, record: dict | None) -> tuple[str, str] | None:
     if not tracks or not isinstance(record, dict):
         return None
 
-    def rail(r: dict) -> dict:
-        return {k: v for k, v in r.items() if k not in _RUN_KEYS}
-
-    same = [t for t in tracks if rail(t) == rail(record) or _overlaps(t, record)]
+    same = [t for t in tracks if _same_but(t, record, _RUN_KEYS) or _overlaps(t, record)]
     speed = record.get("speed_m_s")
     what = _rail_text(record)
     if record.get("profile") == "measured":  # a stretch of a line: the design's sections
@@ -265,6 +262,11 @@ def judged_on(gains, record: dict | None) -> tuple[str, str] | None:
             f"Not held out: the gains were tuned on this track ({what}), at {speeds} m/s; only the speed is new."
         )
     line = [t for t in tracks if str(t.get("name")) == str(record.get("name"))]
+    if record.get("profile") == "measured" and any(_same_but(t, record, (*_RUN_KEYS, "profile_sha256")) for t in line):
+        return HELD_OUT, (
+            f"Held out: the measured profile {record.get('name')} changed since the gains were tuned on it (other "
+            "values at the same path), so tuning never ran on this rail."
+        )
     if record.get("profile") == "measured" and line:
         speeds = _list(dict.fromkeys(t.get("speed_m_s") for t in line))
         sections = list(dict.fromkeys(t.get("source") for t in line))
@@ -316,6 +318,18 @@ def judged_text(gains, records: list) -> str | None:
 _SECTION_KEYS = ("source", "rows", "s_end_m", "start_m")
 
 
+#: what a track record holds since a later version: compared only where both records hold it
+_LATER_KEYS = ("profile_sha256",)
+
+
+def _same_but(tuned: dict, record: dict, keys) -> bool:
+    """Whether two track records are equal but for ``keys`` and for what the earlier of them
+    did not record yet (`_LATER_KEYS`: gains tuned before a measured profile's values were
+    recorded match by its path)."""
+    leave = set(keys) | {k for k in _LATER_KEYS if k not in tuned or k not in record}
+    return {k: v for k, v in tuned.items() if k not in leave} == {k: v for k, v in record.items() if k not in leave}
+
+
 def _overlaps(tuned: dict, record: dict) -> bool:
     """Whether a run on a measured profile covers some of the rail a tuning run on the same
     file covered (a design's sections, `railride.studies.design`). A record names its start
@@ -323,8 +337,7 @@ def _overlaps(tuned: dict, record: dict) -> bool:
     starts differ by the difference of their ends."""
     if record.get("profile") != "measured" or tuned.get("profile") != "measured":
         return False
-    keep = (*_RUN_KEYS, *_SECTION_KEYS)
-    if {k: v for k, v in tuned.items() if k not in keep} != {k: v for k, v in record.items() if k not in keep}:
+    if not _same_but(tuned, record, (*_RUN_KEYS, *_SECTION_KEYS)):
         return False
     try:
         offset = float(record["s_end_m"]) - float(tuned["s_end_m"])  # the tuning run's start, from the run's
@@ -614,17 +627,19 @@ def _tracks_text(records: list[dict], tuned: list[dict]) -> str:
             values = list(dict.fromkeys(r[k] for r in own if k in r and not any(_same(r[k], t.get(k)) for t in same)))
             if values:
                 found.append(f"{word} {_list(values)}{' ' + unit if unit else ''}")
-        if _table_changed(own, same):
-            found.append("the spectrum table changed since tuning")
+        for key, what in (("spectrum_sha256", "spectrum table"), ("profile_sha256", "measured profile")):
+            if _file_changed(own, same, key):
+                found.append(f"the {what} changed since tuning")
         out.append(name + (f" ({'; '.join(found)})" if found else ""))
     return ", ".join(out)
 
 
-def _table_changed(records: list[dict], tuned: list[dict]) -> bool:
-    """Whether a user's spectrum table (psd:PATH) the runs read is not the one the gains were
-    tuned on: the same path, other contents (the records' ``spectrum_sha256``)."""
-    runs = {r.get("spectrum_sha256") for r in records} - {None}
-    before = {t.get("spectrum_sha256") for t in tuned} - {None}
+def _file_changed(records: list[dict], tuned: list[dict], key: str) -> bool:
+    """Whether a file the runs read (a spectrum table, psd:PATH, or a measured profile,
+    file:PATH) is not the one the gains were tuned on: the same path, other values (the
+    records' ``spectrum_sha256`` or ``profile_sha256``)."""
+    runs = {r.get(key) for r in records} - {None}
+    before = {t.get(key) for t in tuned} - {None}
     return bool(runs and before and not runs <= before)
 
 

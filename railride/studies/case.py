@@ -149,6 +149,11 @@ class Case:
             # as text, as when the track seed travelled as a NumPy integer: the keys of runs on
             # random tracks stay what they were
             d["scenario_options"]["seed"] = str(d["scenario_options"]["seed"])
+        from railride.model.track import source_sha256
+
+        sha = source_sha256(self.scenario)
+        if sha is not None:  # a file's values, not its path: an edited file's runs are run again
+            d["scenario_sha256"] = sha
         text = json.dumps({**d, "model_revision": MODEL_REVISION}, sort_keys=True, default=str)
         return hashlib.sha1(text.encode()).hexdigest()[:16]
 
