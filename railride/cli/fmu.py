@@ -42,7 +42,8 @@ def fmu(
             "--damper",
             metavar="MODEL",
             help="The secondary in the FMU: passive (the vehicle's dashpots), railway or dyke1996 (Bouc-Wen MR "
-            "dampers: coil commands or force demands in), or ideal (an actuator: force demands in).",
+            "dampers: coil commands or force demands in), the path of a FILE.toml with a [damper] table of a "
+            "Bouc-Wen model (your own MR damper), or ideal (an actuator: force demands in).",
         ),
     ] = "railway",
     dt: DtOption = None,
@@ -68,6 +69,7 @@ def fmu(
     with errors():
         from railride.defaults import DEFAULT_DT
         from railride.frequency.fmu import export_fmu
+        from railride.secondary import damper_file
 
         given = vehicle_arguments(vehicle, preset, load)
         track = track_options(scenario, track_seed, min_wavelength, max_wavelength)
@@ -85,7 +87,7 @@ def fmu(
             path = export_fmu(
                 out,
                 **given,
-                damper=damper,
+                damper=damper_file.file_model(damper, "--damper") or damper,  # a name: the FMU's to check
                 dt=DEFAULT_DT if dt is None else dt,
                 scenario=sc,
                 binary=not sources_only,

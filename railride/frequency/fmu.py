@@ -160,7 +160,7 @@ def export_fmu(
     *,
     params=None,
     load: float = 1.0,
-    damper: str = "railway",
+    damper="railway",
     dt: float = DEFAULT_DT,
     scenario=None,
     binary: bool = True,
@@ -169,7 +169,8 @@ def export_fmu(
     return it. ``vehicle`` (``params`` is an alias): a preset name, a parameters file or
     `VehicleParams` (default "paper"), with the load factor ``load``; ``damper``: the secondary,
     one of `SECONDARIES` ("passive": the vehicle's dashpots c_sz; an MR preset; "ideal": force
-    inputs); ``dt``: the FMU's fixed step [s]. ``scenario`` (a `Scenario` or a name, default the
+    inputs) or a Bouc-Wen MR damper of one's own (`railride.secondary.dampers.BoucWen`, as a
+    damper file gives it, `railride.secondary.damper_file.load`); ``dt``: the FMU's fixed step [s]. ``scenario`` (a `Scenario` or a name, default the
     paper's sine at 40 m/s): the track the FMU starts with, its speed the default of the FMU's
     ``speed``; the paper's sine (scenario 1, its settings the defaults of the FMU's), or a random
     track, whose realisation the FMU carries (scenario 2, in its resources). ``binary``: also build
@@ -184,11 +185,7 @@ def export_fmu(
     if path.is_dir():  # the FMU replaces a file whole, never a folder
         raise InputError(f"out = {str(path)!r}: a folder; give the path of the FMU file to write, ending in .fmu")
     params_, record = resolve_vehicle(vehicle, params, load)
-    if not isinstance(damper, str) or damper not in SECONDARIES:
-        raise InputError(
-            f"damper = {damper!r}: the FMU's C code implements {', '.join(SECONDARIES)} "
-            "(the Spencer model, the ideal semi-active damper and a damper file's own parameters are not in it)"
-        )
+    secondary, model, label = _secondary(damper)
     dt = validation.number("dt", dt, "positive", "s")
     if dt > 1e-2:
         raise InputError(f"dt = {validation.shown(dt)} s: at most 0.01 s; railride's default is {DEFAULT_DT:g} s")
@@ -201,12 +198,12 @@ def export_fmu(
     binary = arguments.flag("binary", binary)
     compiler = _compiler() if binary else None
     car = Vehicle(params_)
-    variables = _variables(car, damper, dt, sc)
+    variables = _variables(car, secondary, dt, sc)
     track = sc.track if sc is not None and isinstance(sc.track, RandomTrack) else None
-    header = _header(car, damper, variables, dt) + _track_header(track)
+    header = _header(car, secondary, model, variables, dt) + _track_header(track)
     guid = str(uuid.uuid5(uuid.NAMESPACE_URL, "railride-fmu:" + hashlib.sha1(header.encode()).hexdigest()))
     header = f'#define RR_GUID "{{{guid}}}"\n' + header
-    xml = _model_description(variables, guid, record, damper, dt)
+    xml = _model_description(variables, guid, record, label, dt)
     source = resources.files("railride").joinpath("data/fmu/railride_fmu.c").read_text()
     with tempfile.TemporaryDirectory(prefix="railride-fmu-") as tmp:
         root = Path(tmp) / "fmu"
@@ -230,6 +227,22 @@ def export_fmu(
         finally:
             staged.unlink(missing_ok=True)
     return path
+
+
+def _secondary(damper) -> tuple[str, object, str]:
+    """(kind, model, name) of ``damper``: kind "passive", "ideal" or "mr" as the C code tells
+    them apart, the MR damper's model (None for the others), and the name the FMU gives it."""
+    if isinstance(damper, str) and damper in SECONDARIES:
+        if damper in ("passive", "ideal"):
+            return damper, None, damper
+        return "mr", dampers.preset(damper), damper
+    if getattr(damper, "law", None) == dampers.LAW_BOUC_WEN:  # one's own parameters
+        return "mr", damper, dampers.record_name(damper.to_dict())
+    shown = dampers.record_name(damper.to_dict()) if hasattr(damper, "to_dict") else damper
+    raise InputError(
+        f"damper = {shown!r}: the FMU's C code implements {', '.join(SECONDARIES)} and Bouc-Wen MR dampers of "
+        "one's own (a damper file of model bouc-wen); the Spencer model and the ideal semi-active damper are not in it"
+    )
 
 
 def _track_words(track: RandomTrack) -> str:
@@ -314,8 +327,9 @@ def _qdd_function(A: np.ndarray, Bw: np.ndarray, Bwd: np.ndarray) -> str:
     return "".join(lines) + "}\n"
 
 
-def _header(car: Vehicle, secondary: str, variables: list[Variable], dt: float) -> str:
-    """model.h: the vehicle's matrices at its own size, the damper and the value references."""
+def _header(car: Vehicle, secondary: str, model, variables: list[Variable], dt: float) -> str:
+    """model.h: the vehicle's matrices at its own size, the damper (``model``, the MR damper's,
+    None for the others) and the value references."""
     p, nd = car.params, car.n_dof
     system = _system_arrays(car, passive=secondary == "passive")
     E = layout.N_DOF  # the engine's size, which _system_arrays pads a rigid vehicle to
@@ -338,7 +352,6 @@ def _header(car: Vehicle, secondary: str, variables: list[Variable], dt: float) 
         f"#define RR_NODES_PER_FEATURE {float(NODES_PER_FEATURE)!r}\n",
         _qdd_function(A, system["Bw"][:nd], system["Bwd"][:nd]),
     ]
-    model = dampers.preset(secondary) if secondary not in ("passive", "ideal") else None
     P = model.pack() if model is not None else np.zeros(layout.N_PACKED)
     for name, slot in (
         ("ALPHA_A", layout.P_ALPHA_A), ("ALPHA_B", layout.P_ALPHA_B), ("C0A", layout.P_C0A),

@@ -98,6 +98,16 @@ def load(path: str | Path, option: str = "damper"):
     return from_toml(text, source=str(path))
 
 
+def file_model(text, option: str = "damper"):
+    """The model of the damper file ``text`` names (a path ending in .toml, or any file that is
+    there), else None: text that names no file is the caller's to check (a name it knows)."""
+    if isinstance(text, str) and text and (text.endswith(".toml") or Path(text).is_file()):
+        if Path(text).exists():
+            return load(text, option)
+        raise InputError(f"{option} = {text!r}: no such damper file")
+    return None
+
+
 def resolve(text: str, option: str = "damper", *, allowed=None):
     """A damper option's text at the edge: a name of ``allowed`` (default every name
     `railride.secondary.dampers.preset` knows) stays a name; else the path of a damper file gives
@@ -105,10 +115,9 @@ def resolve(text: str, option: str = "damper", *, allowed=None):
     allowed = dampers.NAMES if allowed is None else allowed
     if text in allowed:
         return text
-    if isinstance(text, str) and text and (text.endswith(".toml") or Path(text).is_file()):
-        if Path(text).exists():
-            return load(text, option)
-        raise InputError(f"{option} = {text!r}: no such damper file")
+    model = file_model(text, option)
+    if model is not None:
+        return model
     why = ": unknown damper model, and no such file" if text not in dampers.NAMES else ""
     raise InputError(
         f"{option} = {text!r}{why}; allowed: {', '.join(allowed)}, or the path of a FILE.toml with a [damper] table"

@@ -21,6 +21,17 @@ def test_fmu_writes_an_fmu_with_its_sources_and_a_binary(tmp_path):
     assert "crh380a, load 1.3" in xml and "secondary_clearance_1R" in xml  # its bump stops
 
 
+def test_a_damper_file_goes_into_the_fmu_and_a_spencer_file_is_refused(tmp_path):
+    (tmp_path / "own.toml").write_text('[damper]\npreset = "railway"\nn = 2.0\n')
+    ok("fmu", "--out", tmp_path / "v.fmu", "--damper", tmp_path / "own.toml", "--sources-only")
+    with zipfile.ZipFile(tmp_path / "v.fmu") as z:
+        assert "#define RR_BW_N 2.0\n" in z.read("sources/model.h").decode()
+    (tmp_path / "spencer.toml").write_text('[damper]\npreset = "spencer1997"\nc1a = 1.0e5\n')
+    result = run("fmu", "--out", tmp_path / "s.fmu", "--damper", tmp_path / "spencer.toml")
+    assert_input_error(result, "--damper = 'spencer (own parameters)'", "the Spencer model")
+    assert not (tmp_path / "s.fmu").exists()
+
+
 def test_sources_only_ships_no_binary(tmp_path):
     ok("fmu", "--out", tmp_path / "v.fmu", "--sources-only")
     with zipfile.ZipFile(tmp_path / "v.fmu") as z:

@@ -23,6 +23,7 @@ from railride.model.vehicle import CORNER_NAMES  # noqa: E402
 from railride.run.checks import check  # noqa: E402
 from railride.run.simulation import simulate  # noqa: E402
 from railride.run.solver import SolverSettings  # noqa: E402
+from railride.secondary import dampers  # noqa: E402
 from railride.secondary.suspension import Suspension  # noqa: E402
 
 RK4 = SolverSettings(method="rk4")
@@ -92,6 +93,25 @@ def test_mr_dampers_at_a_constant_voltage_are_railrides(fmus):
     )  # fmt: skip
     ds = simulate(SINE, suspension=Suspension.semi_active("railway", voltage=1.5), solver=RK4).dataset
     assert _worst(rows, ds, names) < 1e-6
+
+
+def test_a_bouc_wen_damper_of_ones_own_in_the_fmu_is_railrides(tmp_path):
+    """A damper file's parameters reach the C code: another exponent n (the C code's pow branch),
+    other forces and rates, at a constant voltage, against railride's run of the same model."""
+    own = dampers.preset("railway").replace(alpha_a=6.0e5, alpha_b=2.5e6, n=2.0, gamma=500.0, beta=200.0, eta=80.0)
+    path = str(export_fmu(tmp_path / "own.fmu", damper=own))
+    assert "secondary bouc-wen (own parameters)" in read_model_description(path).modelName
+    corners = [f"damper_command_{c}" for c in CORNER_NAMES]
+    inputs = np.array([(0.0, *[1.5] * 4), (10.0, *[1.5] * 4)], dtype=[("time", float)] + [(c, float) for c in corners])
+    names = [*OUTPUTS, "damper_voltage_1L", "damper_hysteretic_z_2R"]
+    rows = fmpy.simulate_fmu(
+        path, stop_time=SINE.duration, step_size=1e-3, output_interval=1e-3, output=names, input=inputs,
+        start_values={"speed": SINE.speed},
+    )  # fmt: skip
+    ds = simulate(SINE, suspension=Suspension.semi_active(own, voltage=1.5), solver=RK4).dataset
+    assert _worst(rows, ds, names) < 1e-6
+    railway = simulate(SINE, suspension=Suspension.semi_active("railway", voltage=1.5), solver=RK4).dataset
+    assert _worst(rows, railway, ["secondary_damper_force_2L"]) > 1e-2  # another damper: not the preset's run
 
 
 def _co_simulation(path, law, damper, duration=2.0):
@@ -197,6 +217,8 @@ def test_a_nan_input_is_an_fmi_error_with_a_message(fmus):
 def test_bad_exports_are_input_errors_before_anything_is_written(tmp_path):
     with pytest.raises(InputError, match=r"damper = 'spencer1997': the FMU's C code implements passive, .*railway"):
         export_fmu(tmp_path / "a.fmu", damper="spencer1997")
+    with pytest.raises(InputError, match=r"damper = 'spencer \(own parameters\)': .* the Spencer model"):
+        export_fmu(tmp_path / "a.fmu", damper=dampers.preset("spencer1997").replace(c1a=1.0e5))
     with pytest.raises(InputError, match="ending in .fmu"):
         export_fmu(tmp_path / "a.zip")
     with pytest.raises(InputError, match="dt"):
