@@ -170,13 +170,13 @@ def export_fmu(
     `VehicleParams` (default "paper"), with the load factor ``load``; ``damper``: the secondary,
     one of `SECONDARIES` ("passive": the vehicle's dashpots c_sz; an MR preset; "ideal": force
     inputs) or a Bouc-Wen MR damper of one's own (`railride.secondary.dampers.BoucWen`, as a
-    damper file gives it, `railride.secondary.damper_file.load`); ``dt``: the FMU's fixed step [s]. ``scenario`` (a `Scenario` or a name, default the
-    paper's sine at 40 m/s): the track the FMU starts with, its speed the default of the FMU's
-    ``speed``; the paper's sine (scenario 1, its settings the defaults of the FMU's), or a random
-    track, whose realisation the FMU carries (scenario 2, in its resources). ``binary``: also build
-    this platform's binary with
-    the C compiler (``CC``, else cc or gcc); False ships the sources alone. Every value is
-    checked, and the compiler found, before anything is written."""
+    damper file gives it, `railride.secondary.damper_file.load`); ``dt``: the FMU's fixed step
+    [s]. ``scenario`` (a `Scenario` or a name, default the paper's sine at 40 m/s): the track
+    the FMU starts with, its speed the default of the FMU's ``speed``; the paper's sine
+    (scenario 1, its settings the defaults of the FMU's), or a random track, whose realisation
+    the FMU carries (scenario 2, in its resources). ``binary``: also build this platform's
+    binary with the C compiler (``CC``, else cc or gcc); False ships the sources alone. Every
+    value is checked, and the compiler found, before anything is written."""
     path = Path(os.fspath(out)) if isinstance(out, (str, os.PathLike)) else None
     if path is None or path.suffix != ".fmu":
         shown = str(path) if path is not None else out

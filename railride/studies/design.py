@@ -468,6 +468,12 @@ def design(
     summary = _summary(runs, plan)
     diverged = _diverged(tuned, training, runs, plan)
     ranking, points = rank(summary, plan.objective, plan.laws, {d["controller"] for d in diverged}, plan.service)
+    if plan.service is not None:  # the ride over the time in service, beside the mean of the ratios
+        from railride.studies.design_service import ranking_entries, service_rms
+
+        rms = service_rms(runs, plan.service, plan.laws)
+        for entry in ranking:
+            entry.update(ranking_entries(rms, entry["controller"]))
     from railride.studies.design_probes import asks, fault_check, references
 
     leaders = [r["controller"] for r in ranking if r["ranked"]][:2]

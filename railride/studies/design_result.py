@@ -24,6 +24,7 @@ from railride.analysis.metrics import RESPONSES
 from railride.plots import PNG_DPI, FigureOptions
 from railride.secondary.control import LABELS
 from railride.studies.objectives import PEAK_COLUMN, RATIO_NAMES, TRAVEL_COLUMN, Objective
+from railride.studies.design_service import service_sentence
 
 #: the schema of `DesignResult.to_dict` (design.json)
 SCHEMA = "railride.design/1"
@@ -407,6 +408,7 @@ def recommend(ranking, points, summary: pd.DataFrame, runs: pd.DataFrame, object
         out.append(_worse_than_passive(name, summary))
         out.append(_wins(name, points))
         out.append(_trade_offs(name, ok, summary, service))
+        out.append(service_sentence(best, _label(name), keep is not None))
         out.append(_sureness(best, ok[1] if len(ok) > 1 else None, points, summary, runs, objective))
         if objective.peak_bound is not None or objective.travel_bound is not None:
             out.append(

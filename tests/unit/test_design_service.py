@@ -193,3 +193,49 @@ def test_the_travel_sentence_names_the_speed_where_the_travel_grows_most(weighte
     assert by_speed.max() > 1.01  # skyhook moves the secondary more than passive here: the sentence is said
     most = by_speed.idxmax()
     assert f"x{by_speed.max():.2f} at {most:g} m/s, load 1, the most." in weighted.recommendation
+
+
+def test_the_ride_in_service_is_the_rms_of_the_runs_strung_together_by_their_shares(weighted):
+    """The service RMS (each law's RMS over the time in service) against a second path: the
+    held-out runs simulated one at a time (`simulate`, not the design's batches), their
+    acceleration histories strung together, each as many times as its point's share asks (the
+    shares 1:3 at 50 and 30 m/s, two seeds each), and the RMS of that one signal."""
+    from railride.secondary.suspension import Suspension
+
+    sky = next(r for r in weighted.ranking if r["controller"] == "skyhook")
+    suspensions = {"skyhook": Suspension.named("skyhook", gains=weighted.gains), "passive": None}
+    for law, suspension in suspensions.items():
+        pieces = []
+        for speed, times in ((50.0, 1), (30.0, 3)):
+            for seed in weighted.settings["test_seeds"]:
+                sc = rr.scenario("fra4", seed=seed, speed=speed, duration=weighted.settings["duration_s"])
+                a = rr.simulate(sc, suspension=suspension).dataset["carbody_acceleration"].to_numpy()
+                pieces += [a] * times
+        rms = float(np.sqrt(np.mean(np.concatenate(pieces) ** 2)))
+        recorded = sky["service_rms"]["acceleration_m_s2_rms"]["value" if law == "skyhook" else "passive"]
+        assert recorded == pytest.approx(rms, rel=1e-6), law
+    entry = sky["service_rms"]["acceleration_m_s2_rms"]
+    assert entry["ratio"] == pytest.approx(entry["value"] / entry["passive"], rel=1e-12)
+    # said in the recommendation, and absent where no time in service is given
+    shown = f"acceleration {entry['value']:.3g} against passive's {entry['passive']:.3g} m/s2 (x{entry['ratio']:.3f})"
+    assert shown in weighted.recommendation
+    assert "Over the time in service" in weighted.recommendation
+
+
+def test_the_service_sentence_weighs_a_kept_passive_against_a_better_ride_in_service():
+    from railride.studies.design_service import service_sentence
+
+    def entry(ratio):
+        row = {"value": ratio * 0.5, "passive": 0.5, "ratio": ratio}
+        return {
+            "service_rms": dict.fromkeys(
+                ("acceleration_m_s2_rms", "displacement_m_rms", "pitch_deg_rms", "roll_deg_rms"), row
+            )
+        }
+
+    better = service_sentence(entry(0.9), "Skyhook", kept_passive=True)
+    assert "acceleration 0.45 against passive's 0.5 m/s2 (x0.900); displacement 450 against passive's 500 mm" in better
+    assert "better than passive in every response, while the score keeps passive" in better
+    assert "while the score keeps passive" not in service_sentence(entry(0.9), "Skyhook", kept_passive=False)
+    assert "while the score keeps passive" not in service_sentence(entry(1.1), "Skyhook", kept_passive=True)
+    assert service_sentence({}, "Skyhook") == ""
