@@ -10,7 +10,8 @@ nothing is said about it.
 
 `mismatch` turns that into one line when a run leaves the case the gains were tuned for (another
 vehicle, load or track), with the `railride tune` command that would tune for the run
-(`tune_command`); `provenance_toml` writes the table back as TOML (`GainSet.to_toml`)."""
+(`tune_command`); `provenance_toml` (`railride.secondary.toml_text`) writes the table back as TOML
+(`GainSet.to_toml`)."""
 
 from __future__ import annotations
 
@@ -20,8 +21,9 @@ import datetime
 import json
 import math
 import numbers
-import re
 import shlex
+
+from railride.secondary.toml_text import provenance_toml  # noqa: F401 (its home before)
 
 #: what gains whose provenance names no vehicle were tuned on: the paper's vehicle, unloaded
 DEFAULT_VEHICLE = "paper"
@@ -487,30 +489,6 @@ def json_values(value):
     return str(value)
 
 
-def provenance_toml(provenance: dict, name: str = "provenance") -> str:
-    """``provenance`` as the TOML table [``name``] (text ending in a blank line): numbers,
-    strings, booleans, dates, lists, flat records of up to 12 plain values as inline tables,
-    other tables as [``name``.KEY] sub-tables ([provenance.studies.pid]). None has no TOML form
-    and is left out. `tomllib` reads it back as the same dict."""
-    lines: list[str] = []
-
-    def table(head: str, values: dict) -> None:
-        subs = [(k, v) for k, v in values.items() if isinstance(v, dict) and not _inline(v)]
-        plain = [(k, v) for k, v in values.items() if not (isinstance(v, dict) and not _inline(v))]
-        if plain or not subs:  # a table of sub-tables only needs no header of its own
-            lines.append(f"[{head}]")
-            for k, v in plain:
-                text = _value(v)
-                if text is not None:
-                    lines.append(f"{_key(k)} = {text}")
-            lines.append("")
-        for k, v in subs:
-            table(f"{head}.{_key(k)}", v)
-
-    table(_key(name), provenance)
-    return "\n".join(lines) + "\n"
-
-
 # -- comparisons --------------------------------------------------------------------------------
 def _other_values(provenance: dict, run: dict) -> list[str] | None:
     """None where the run's vehicle record is the one the gains were tuned on (the same values,
@@ -660,47 +638,3 @@ def _number(value) -> str:
         return str(int(value))
     short = f"{float(value):g}"
     return short if float(short) == float(value) else repr(float(value))
-
-
-# -- TOML ---------------------------------------------------------------------------------------
-_BARE = re.compile(r"^[A-Za-z0-9_-]+$")
-
-
-def _key(key) -> str:
-    key = str(key)
-    return key if _BARE.match(key) else _string(key)
-
-
-def _inline(values: dict) -> bool:
-    """A flat record of a few plain values: written as an inline table."""
-    return len(values) <= 12 and not any(isinstance(v, (dict, list, tuple)) for v in values.values())
-
-
-def _string(text: str) -> str:
-    # JSON's escapes are TOML's; TOML also wants DEL escaped
-    return json.dumps(text, ensure_ascii=False).replace("\x7f", "\\u007f")
-
-
-def _value(value) -> str | None:
-    """A value as TOML spells it; None for None (TOML has no null)."""
-    if value is None:
-        return None
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, numbers.Integral):
-        return str(int(value))
-    if isinstance(value, numbers.Real):
-        x = float(value)
-        if math.isnan(x):
-            return "nan"
-        return repr(x) if math.isfinite(x) else ("inf" if x > 0 else "-inf")
-    if isinstance(value, str):
-        return _string(value)
-    if isinstance(value, (datetime.datetime, datetime.date, datetime.time)):
-        return value.isoformat()
-    if isinstance(value, (list, tuple)):
-        return "[" + ", ".join(t for t in map(_value, value) if t is not None) + "]"
-    if isinstance(value, dict):
-        items = [(_key(k), _value(v)) for k, v in value.items()]
-        return "{" + ", ".join(f"{k} = {t}" for k, t in items if t is not None) + "}"
-    return _string(str(value))
