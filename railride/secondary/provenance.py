@@ -527,7 +527,7 @@ def _range_covered(tracks: list[dict], record: dict) -> bool:
     a spectrum is the same track in the statistical sense)."""
     if record.get("profile") != "random":
         return False
-    keys = ("name", "min_wavelength_m", "max_wavelength_m")
+    keys = ("name", "min_wavelength_m", "max_wavelength_m", "spectrum_sha256")  # a table's values, not its path
     same = [t for t in tracks if t.get("profile") == "random" and all(_same(t.get(k), record.get(k)) for k in keys)]
     seeds = {t.get("seed") for t in same}
     speeds = [float(t["speed_m_s"]) for t in same if t.get("speed_m_s") is not None]

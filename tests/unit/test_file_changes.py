@@ -126,3 +126,19 @@ def test_gains_tuned_on_a_spectrum_table_that_changed_say_so(tmp_path):
     _table(path, factor=2.0)
     line = gains.mismatch(None, rr.scenario(name, duration=0.5, seed=2).describe())
     assert line is not None and "(the spectrum table changed since tuning)" in line
+
+
+def test_a_robust_tuning_on_a_spectrum_table_does_not_cover_the_table_edited(tmp_path):
+    """Seeds 0 and 1 of a table cover any seed of it at the tuned speed, but not of the table
+    with other values at the same path."""
+    from railride.studies.tuning import tuning_set
+
+    path = _table(tmp_path / "line.csv")
+    name = f"psd:{path}"
+    over = tuning_set(name, track_seeds=[0, 1], duration=0.5)
+    res = tune(["pid"], over=over, budget=5, n_values=3)
+    gains = GainSet.from_toml(res.gains_toml(), source="robust.toml")
+    assert gains.mismatch(None, rr.scenario(name, duration=0.5, seed=7).describe()) is None
+    _table(path, factor=2.0)
+    line = gains.mismatch(None, rr.scenario(name, duration=0.5, seed=7).describe())
+    assert line is not None and "the spectrum table changed since tuning" in line
