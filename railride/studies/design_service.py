@@ -36,14 +36,15 @@ def service_rms(runs: pd.DataFrame, service: dict, laws) -> dict:
     groups = dict(list(finished.groupby(["controller", "speed_m_s", "load"])))
     for law in ("passive", *laws):
         total = dict.fromkeys(RMS_COLUMNS, 0.0)
-        for (speed, load), share in service.items():
-            part = groups.get((law, speed, load))
-            if part is None or part.empty:
-                total = None
-                break
+        parts = [(share, groups.get((law, speed, load))) for (speed, load), share in service.items()]
+        known = [(share, part) for share, part in parts if part is not None and not part.empty]
+        if len(known) < len(parts):
+            out[law] = None
+            continue
+        for share, part in known:
             for column in RMS_COLUMNS:
                 total[column] += share * float(np.mean(part[column].to_numpy(dtype=float) ** 2))
-        out[law] = None if total is None else {c: math.sqrt(v) for c, v in total.items()}
+        out[law] = {c: math.sqrt(v) for c, v in total.items()}
     return out
 
 

@@ -239,3 +239,19 @@ def test_the_service_sentence_weighs_a_kept_passive_against_a_better_ride_in_ser
     assert "while the score keeps passive" not in service_sentence(entry(0.9), "Skyhook", kept_passive=False)
     assert "while the score keeps passive" not in service_sentence(entry(1.1), "Skyhook", kept_passive=True)
     assert service_sentence({}, "Skyhook") == ""
+
+
+def test_a_law_with_a_point_where_every_run_diverged_has_no_ride_in_service():
+    import pandas as pd
+
+    from railride.studies.design_service import ranking_entries, service_rms
+
+    rows = []
+    for law in ("passive", "pid"):
+        for speed in (30.0, 50.0):
+            diverged = 0.4 if (law, speed) == ("pid", 50.0) else np.inf
+            rms = {"acceleration_m_s2_rms": 0.3, "displacement_m_rms": 0.01, "pitch_deg_rms": 0.1, "roll_deg_rms": 0.2}
+            rows.append({"controller": law, "speed_m_s": speed, "load": 1.0, "diverged_at_s": diverged, **rms})
+    rms = service_rms(pd.DataFrame(rows), {(30.0, 1.0): 0.5, (50.0, 1.0): 0.5}, ["pid"])
+    assert rms["pid"] is None and ranking_entries(rms, "pid") == {}
+    assert rms["passive"]["acceleration_m_s2_rms"] == pytest.approx(0.3, rel=1e-15)  # the same RMS everywhere
