@@ -263,7 +263,7 @@ def judged_on(gains, record: dict | None) -> tuple[str, str] | None:
         return SAME_TRACK, (
             f"Not held out: the gains were tuned on this track ({what}), at {speeds} m/s; only the speed is new."
         )
-    line = [t for t in tracks if str(t.get("name")) == str(record.get("name"))]
+    line = [t for t in tracks if _same_line(t, record)]
     if record.get("profile") == "measured" and any(_same_but(t, record, (*_RUN_KEYS, "profile_sha256")) for t in line):
         return HELD_OUT, (
             f"Held out: the measured profile {record.get('name')} changed since the gains were tuned on it (other "
@@ -329,7 +329,22 @@ def _same_but(tuned: dict, record: dict, keys) -> bool:
     did not record yet (`_LATER_KEYS`: gains tuned before a measured profile's values were
     recorded match by its path)."""
     leave = set(keys) | {k for k in _LATER_KEYS if k not in tuned or k not in record}
+    if _same_file(tuned, record):  # one file's values under two paths: its name and source are the path
+        leave |= {"name", "source"}
     return {k: v for k, v in tuned.items() if k not in leave} == {k: v for k, v in record.items() if k not in leave}
+
+
+def _same_file(tuned: dict, record: dict) -> bool:
+    """Whether two measured profiles' records are of the same values (their ``profile_sha256``),
+    whatever the paths they were read by (file:line.csv and file:/data/line.csv)."""
+    sha = tuned.get("profile_sha256")
+    return sha is not None and sha == record.get("profile_sha256")
+
+
+def _same_line(tuned: dict, record: dict) -> bool:
+    """Whether two track records name the same line: the same scenario name, or the same
+    measured profile under another path (`_same_file`)."""
+    return str(tuned.get("name")) == str(record.get("name")) or _same_file(tuned, record)
 
 
 def _overlaps(tuned: dict, record: dict) -> bool:
@@ -597,7 +612,7 @@ def _tracks_text(records: list[dict], tuned: list[dict]) -> str:
     out = []
     for name in dict.fromkeys(str(r.get("name")) for r in records):
         own = [r for r in records if str(r.get("name")) == name]
-        same = [t for t in tuned if str(t.get("name")) == name]
+        same = [t for t in tuned if any(_same_line(t, r) for r in own)]
         found = []
         for k, (_, word, unit) in _TRACK_OPTIONS.items():
             if k == "duration_s" or (k not in same[0] if same else k != "speed_m_s"):

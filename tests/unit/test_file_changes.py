@@ -142,3 +142,20 @@ def test_a_robust_tuning_on_a_spectrum_table_does_not_cover_the_table_edited(tmp
     _table(path, factor=2.0)
     line = gains.mismatch(None, rr.scenario(name, duration=0.5, seed=7).describe())
     assert line is not None and "the spectrum table changed since tuning" in line
+
+
+def test_a_profile_named_by_another_path_is_the_profile_the_gains_were_tuned_on(tuned_on_a_profile, tmp_path):
+    """The same values read by another path (a relative and an absolute path, or a copy) are the
+    same rail: in-sample, no mismatch; other values at another path are another line."""
+    import shutil
+
+    path, gains = tuned_on_a_profile
+    copy = tmp_path / "elsewhere.csv"
+    shutil.copy(path, copy)
+    record = rr.scenario(f"file:{copy}", duration=0.5).describe()
+    assert judged_on(gains, record)[0] == IN_SAMPLE
+    assert gains.mismatch(None, record) is None
+    _profile(copy, bump=1e-3)
+    other = rr.scenario(f"file:{copy}", duration=0.5).describe()
+    assert judged_on(gains, other)[0] == HELD_OUT
+    assert f"track file:{copy}" in gains.mismatch(None, other)
