@@ -124,7 +124,7 @@ def mismatch(
         return None
     # another vehicle, load or damper wants every track tuned again; else the tracks they were not tuned on
     retune = records if len(differs) > (1 if off else 0) else off
-    ran = (damper, damper_scale) if other_damper else (None, None)
+    ran = (damper, damper_scale)  # the run's dampers, whether or not the gains' were others: tuning for the run
     line = (
         f"the gains {gains.source} were tuned for {_tuned_text(provenance)}; this run has {', '.join(differs)}; "
         f"tune for it with: {tune_command(vehicle, retune, *ran)}"
@@ -141,9 +141,13 @@ def _damper_option(damper) -> list[str]:
     of the user's own parameters as its file, ``FILE.toml``)."""
     from railride.defaults import DEFAULT_DAMPER
 
+    if hasattr(damper, "to_dict"):
+        damper = damper.to_dict()
+    if isinstance(damper, dict):  # a record: the preset it equals by name, else the user's own file
+        damper = damper.get("preset") or damper.get("name") or "FILE.toml"
     if damper is None or damper == DEFAULT_DAMPER:
         return []
-    return ["--damper", shlex.quote(damper) if isinstance(damper, str) else "FILE.toml"]
+    return ["--damper", shlex.quote(damper) if damper != "FILE.toml" else damper]
 
 
 def _damper_key(damper, scale):

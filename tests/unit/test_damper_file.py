@@ -4,7 +4,11 @@ damper is not the one they were tuned with (`GainSet.mismatch`)."""
 
 from __future__ import annotations
 
+import json
+
 import pytest
+
+import railride as rr
 
 from railride.errors import InputError
 from railride.model.params import VehicleParams, vehicle_record
@@ -139,3 +143,22 @@ def test_time_at_v_max_is_read_at_the_own_dampers_v_max():
     volts = result.datasets["skyhook-on-off"]["damper_command_voltage"].values
     assert volts.max() == 2.0 and fraction == pytest.approx(float((volts >= 2.0).mean()), rel=1e-12)
     assert 0.05 < fraction < 0.95
+
+
+def test_the_tune_command_keeps_the_runs_damper_when_only_the_track_differs():
+    """Gains tuned with the run's own damper on another track: the line's tune command tunes
+    for the run, with its damper (it left the damper out when the dampers matched, so the
+    command tuned for the railway damper)."""
+    own = dampers.RAILWAY.replace(alpha_b=5e6)
+    tuned = GainSet.default().to_toml().replace('damper = "railway"', f"damper = {_inline(own.to_dict())}")
+    gains = GainSet.from_toml(tuned, source="own.toml")
+    fra4 = rr.scenario("fra4", duration=0.5).describe()
+    line = gains.mismatch(PAPER, fra4, ["pid"], own, 1.0)
+    assert line is not None and "damper" not in line.split("; tune for it with:")[0], line
+    assert "railride tune --damper FILE.toml --scenario fra4" in line, line
+    spencer = gains.mismatch(PAPER, fra4, ["pid"], "dyke1996", 8.0)  # the railway damper by another name
+    assert "--damper dyke1996 --damper-scale 8" in spencer, spencer
+
+
+def _inline(record: dict) -> str:
+    return "{" + ", ".join(f"{k} = {json.dumps(v)}" for k, v in record.items() if v is not None) + "}"
