@@ -95,7 +95,9 @@ def fault_check(plan, leaders: list, points: list, scores) -> dict | None:
     else:
         text = f"With the front right damper disconnected from the start ({fault}), "
     text += " and ".join(
-        f"{label[law]} scores {_text(v['faulted'])} {over} (healthy {_text(v['healthy'])})" for law, v in laws.items()
+        f"{label[law]} scores {_text(v['faulted'], plan.objective)} {over} "
+        f"(healthy {_text(v['healthy'], plan.objective)})"
+        for law, v in laws.items()
     )
     baseline = plan.objective.passive_score
 
@@ -137,5 +139,9 @@ def _plain(value) -> float | None:
     return float(value) if value is not None and math.isfinite(value) else None
 
 
-def _text(value) -> str:
-    return "-" if value is None else f"{value:.3f}"
+def _text(value, objective) -> str:
+    """A score as the ranking shows it: "infeasible (+excess)" where it breaks a constraint,
+    not the offset that encodes it (`score_text`)."""
+    from railride.studies.design_result import score_text
+
+    return score_text(value, objective, short=True)

@@ -255,3 +255,20 @@ def test_a_law_with_a_point_where_every_run_diverged_has_no_ride_in_service():
     rms = service_rms(pd.DataFrame(rows), {(30.0, 1.0): 0.5, (50.0, 1.0): 0.5}, ["pid"])
     assert rms["pid"] is None and ranking_entries(rms, "pid") == {}
     assert rms["passive"]["acceleration_m_s2_rms"] == pytest.approx(0.3, rel=1e-15)  # the same RMS everywhere
+
+
+def test_the_fault_sentence_says_infeasible_as_the_ranking_does_not_the_offset():
+    from types import SimpleNamespace
+
+    from railride.studies.design_probes import fault_check
+    from railride.studies.objectives import Objective
+
+    bound = Objective("minimax", travel_bound=0.05)
+    offset = bound.constraint_offset
+    scale = bound.to_dict()["infeasible"]["scale"]
+    plan = SimpleNamespace(damper="railway", laws=["pid"], objective=bound, service=None)
+    healthy = [{"speed_m_s": 30.0, "load": 1.0, "scores": {"pid": 0.9}}]
+    faulted = [{"speed_m_s": 30.0, "load": 1.0, "scores": {"pid": offset + 0.25 * scale}}]
+    text = fault_check(plan, ["pid"], healthy, lambda **kw: faulted)["text"]
+    assert "PID scores infeasible (+0.25) at worst (healthy 0.900)" in text, text
+    assert f"{offset:.3f}" not in text and "1000" not in text
