@@ -196,7 +196,7 @@ def _objective(objective) -> Objective:
         return DEFAULT_OBJECTIVE
     if isinstance(objective, Objective):
         return objective
-    allowed = "allowed by name: minimax, sum, n_mv, sperling; or a railride.Objective"
+    allowed = f"unknown objective; allowed: {', '.join(OBJECTIVE_KINDS)} (n_mv also as nmv, sperling as wz)"
     if isinstance(objective, str):
         name = objective.strip().lower()
         name = COMFORT_ALIASES.get(name, name)
@@ -204,7 +204,8 @@ def _objective(objective) -> Objective:
             return Objective(name)
         if name in OBJECTIVE_KINDS:
             raise InputError(
-                f"objective = {objective!r}: needs its settings; pass an Objective({name!r}, ...) ({allowed})"
+                f"objective = {objective!r}: needs its settings; pass an Objective({name!r}, ...) (its weights or "
+                "bound), or one of minimax, sum, n_mv, sperling by name"
             )
     raise InputError(f"objective = {objective!r}: {allowed}")
 

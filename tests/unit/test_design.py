@@ -229,7 +229,10 @@ def test_min_budget_lets_every_gain_be_swept_once():
         ({"budget": 5}, ("budget = 5", ">= 13", "try every gain once")),
         ({"controllers": ["lqr"]}, ("controllers = 'lqr'", "allowed: pid")),
         ({"tracks": ["paper-sine"]}, ("tracks = 'paper-sine'", "fra4")),
-        ({"objective": "comfy"}, ("objective = 'comfy'", "n_mv, sperling")),
+        (
+            {"objective": "comfy"},
+            ("objective = 'comfy'", "allowed: sum, weighted, minimax, constrained, n_mv, sperling"),
+        ),
         ({"objective": "weighted"}, ("objective = 'weighted'", "needs its settings")),
         ({"aggregate": "median"}, ("aggregate",)),
         ({"values": 2}, ("values = 2",)),
