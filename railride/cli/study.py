@@ -100,6 +100,7 @@ def _table(doc: dict):
     from rich.text import Text
 
     from railride.secondary.control import LABELS
+    from railride.secondary.dampers import record_name
     from railride.cli._width import FitTable, Split
     from railride.model.params import vehicle_text
 
@@ -153,7 +154,7 @@ def _table(doc: dict):
     speeds = ", ".join(f"{v:g}" for v in s["speeds_m_s"])
     lines = [
         f"{s['scenario']} at {speeds} m/s" + (f", track seeds {', '.join(map(str, seeds))}" if seeds else "") + "; "
-        f"{s['damper']} dampers, gains {s['gains']} (kept for every load and fault); "
+        f"{record_name(s['damper'])} dampers, gains {s['gains']} (kept for every load and fault); "
         + ("exact states measured." if s.get("sensing", "ideal") == "ideal" else "accelerometers measured."),
         f"Mean and {lo:g}th to {hi:g}th percentile over the runs of each row (its track seeds)"
         + (

@@ -90,6 +90,9 @@ def test_another_damper_file_warns_and_is_recorded_whole(tmp_path):
     ran = ok_json(*args)["controllers"]
     assert ran[0]["metrics"] == plain["controllers"][0]["metrics"]  # passive: no MR damper in it
     assert ran[1]["metrics"] != plain["controllers"][1]["metrics"]
+    # study's caption names it in words, not as a Python record
+    study = ok("study", "--controllers", "pid", "--duration", 0.2, "--track-seed", "0", "--damper", path)
+    assert "bouc-wen (own parameters) dampers" in " ".join(study.stdout.split()) and "{'model'" not in study.stdout
 
 
 @pytest.mark.parametrize(
