@@ -119,17 +119,20 @@ def league_table(table, doc) -> list:
     summary = table.summary
     cases = table.cases[table.cases.controller == "passive"]
     tuned = doc["tuned_on"]
-    tuned_text = describe_scenario(tuned) if tuned else "not recorded in the gains file"
+    tuned_text = doc["settings"].get("gains_tuned_on") or (
+        describe_scenario(tuned) if tuned else "not recorded in the gains file"
+    )
     out_of_sample = int((~cases["in_sample"]).sum())
     settings = doc["settings"]
     at = "" if settings["speeds_m_s"] is None else " at " + ", ".join(f"{v:g}" for v in settings["speeds_m_s"]) + " m/s"
-    seeds = ", ".join(map(str, settings["track_seeds"]))
+    seeds = ", ".join(map(str, sorted(set(cases["track_seed"].dropna().astype(int)))))  # random tracks' only
     loads = _loads(settings["vehicle"])
     at_loads = f", each at loads {', '.join(f'{x:g}' for x in loads)}" if len(loads) > 1 else ""
     pooled = [w for w, n in (("speeds", len(set(table.cases["speed_m_s"]))), ("loads", len(loads))) if n > 1]
     caption = (
-        f"Mean over {len(cases)} cases: {', '.join(settings['scenarios'])}{at}{at_loads}; track seeds {seeds} "
-        "(random tracks).\n"
+        f"Mean over {len(cases)} cases: {', '.join(settings['scenarios'])}{at}{at_loads}"
+        + (f"; track seeds {seeds} (random tracks)" if seeds else "")
+        + ".\n"
         + (
             f"This mean pools the {' and '.join(pooled)}: see the table per scenario, speed and load below "
             "for each on its own.\n"

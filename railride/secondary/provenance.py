@@ -374,6 +374,15 @@ def _rail_text(record: dict) -> str:
     return str(record.get("name")) + (f", seed {seed}" if seed is not None else "")
 
 
+def tuned_words(provenance: dict) -> str | None:
+    """The tracks a gains file was tuned on in words (every track of a robust tuning set, its
+    seeds or sections and speeds), or None where its provenance names none."""
+    tracks = tuned_tracks(provenance)
+    if not tracks and not provenance.get("scenarios"):
+        return None
+    return _tracks_tuned(tracks, provenance.get("scenarios"), provenance.get("speeds_m_s"))
+
+
 def _tracks_tuned(tracks: list[dict], names=None, speeds=None) -> str:
     """The tracks of ``tracks`` in words: their names (seeds) at their speeds; ``names`` and
     ``speeds`` where the records give none (a provenance written by hand may hold those alone)."""

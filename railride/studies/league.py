@@ -25,6 +25,7 @@ from railride import arguments, validation
 from railride.studies.progress import shows_progress
 from railride.studies.comparison import check_controllers, compare
 from railride.secondary.control import LABELS, PAPER_CONTROLLERS, GainSet
+from railride.secondary.provenance import tuned_words
 from railride.defaults import DEFAULT_DAMPER
 from railride.plots import PNG_DPI, FigureOptions
 from railride.model.track import is_random, scenario
@@ -241,6 +242,7 @@ def league(
         "objective": gains.provenance.get("objective"),
         "untuned": gains.untuned(names),
         "tuned_alike": gains.tuning_budget(names),
+        "gains_tuned_on": tuned_words(gains.provenance),  # every track of a robust set, in words
     }
     # gains tuned for another vehicle, load or track: one line for every case (`GainSet.mismatch`)
     mismatch = gains.mismatch(record, [sc.describe() for *_, sc in todo], names, damper, damper_scale)

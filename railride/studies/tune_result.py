@@ -198,7 +198,8 @@ class TuneResult:
             "# (docs/tuning.md). Read by `railride compare --gains FILE`.",
             *([f"# command: {command}"] if command is not None else []),
             f"# date: {doc['date']}; railride {doc['railride_version']}",
-            f"# scenario: {run_text}, dt {s['dt_s']:g} s, {describe_dampers(s, detail=True)}",
+            f"# {'first run of the tuning set' if 'tuning_set' in s else 'scenario'}: {run_text}, dt {s['dt_s']:g} s, "
+            f"{describe_dampers(s, detail=True)}",
             *([f"# {vehicle_text(s['vehicle'])}"] if s.get("vehicle") else []),
             f"# objective: {statement}",
             *(
@@ -394,10 +395,18 @@ class TuneResult:
 def _set_text(records) -> str:
     """A tuning set in a few words: its scenarios, seeds, speeds and loads."""
     parts = []
-    for key, label in (("name", ""), ("seed", "seeds "), ("speed_m_s", "speeds "), ("load", "loads ")):
+    keys = (
+        ("name", ""),
+        ("seed", "seeds "),
+        ("start_m", "sections from s = "),
+        ("speed_m_s", "speeds "),
+        ("load", "loads "),
+    )
+    for key, label in keys:
         values = list(dict.fromkeys(r.get(key) for r in records if r.get(key) is not None))
         if values:
-            parts.append(label + ", ".join(f"{v:g}" if isinstance(v, float) else str(v) for v in values))
+            unit = " m" if key == "start_m" else ""
+            parts.append(label + ", ".join(f"{v:g}" if isinstance(v, float) else str(v) for v in values) + unit)
     return "; ".join(parts)
 
 

@@ -159,3 +159,14 @@ def test_a_profile_named_by_another_path_is_the_profile_the_gains_were_tuned_on(
     other = rr.scenario(f"file:{copy}", duration=0.5).describe()
     assert judged_on(gains, other)[0] == HELD_OUT
     assert f"track file:{copy}" in gains.mismatch(None, other)
+
+
+def test_a_league_on_a_measured_profile_names_no_seeds_and_what_the_gains_were_tuned_on(tuned_on_a_profile):
+    from clihelp import ok
+
+    path, _ = tuned_on_a_profile
+    result = ok("compare", "--scenario", f"file:{path}", "--speed", "20,30", "--duration", 0.3, "--controllers", "pid")
+    text = " ".join(result.stdout.split())
+    assert f"Mean over 2 cases: file:{path} at 20, 30 m/s." in text, text
+    assert "random tracks" not in text
+    assert "Gains tuned on: fra4, fra5 (seeds 1, 2, 3) at 30, 50, 70 m/s." in text  # the robust set, whole
