@@ -167,6 +167,13 @@ class CosineBump(RailProfile):
         }
 
 
+#: the units a measured profile's columns may give in their header ("s [mm]"): metres per unit
+_LENGTH_UNITS = {"": 1.0, "m": 1.0, "mm": 1e-3}
+#: a measured profile whose height at s = 0 is further than this from level [m] is warned of
+#: (the vehicle starts on level track and meets a step there)
+START_STEP_WARNING = 5e-4
+
+
 @dataclass(frozen=True, eq=False)
 class MeasuredTrack(RailProfile):
     """A sampled profile (s, z_L, z_R), interpolated by shape-preserving cubics (PCHIP).
@@ -245,6 +252,7 @@ class MeasuredTrack(RailProfile):
             raise InputError(f"track file {path}: empty; expected a header 's,z_L,z_R' and data rows")
         head = numbered[0][1]
         header = [c.split("[")[0].strip().lower() for c in head]
+        units = [c.split("[", 1)[1].split("]")[0].strip() if "[" in c else "" for c in head]
         idx = {}
         for want in ("s", "z_l", "z_r"):
             if want not in header:
@@ -253,6 +261,14 @@ class MeasuredTrack(RailProfile):
                     f"{head!r}; expected columns s [m], z_L [m], z_R [m]"
                 )
             idx[want] = header.index(want)
+        scale = {}
+        for k, j in idx.items():  # recording cars often give millimetres: said in the header, converted
+            if units[j] not in _LENGTH_UNITS:
+                raise InputError(
+                    f"track file {path}: column {head[j].strip()!r} is in {units[j]!r}; allowed units: m or mm "
+                    "(none: metres)"
+                )
+            scale[k] = _LENGTH_UNITS[units[j]]
         data: dict[str, list[float]] = {k: [] for k in idx}
         for lineno, row in numbered[1:]:
             for k, j in idx.items():
@@ -263,7 +279,8 @@ class MeasuredTrack(RailProfile):
                     raise InputError(
                         f"track file {path}, line {lineno}: column {head[j].strip()!r} = {cell!r} is not a number"
                     ) from None
-        return cls(np.array(data["s"]), np.array(data["z_l"]), np.array(data["z_r"]), source=str(path))
+        s, zl, zr = (scale[k] * np.array(data[k]) for k in ("s", "z_l", "z_r"))
+        return cls(s, zl, zr, source=str(path))
 
     def section(self, start: float, lead_in: float = 20.0) -> "MeasuredTrack":
         """The profile from ``start`` [m] of this one on, as a profile that starts at s = 0 and
@@ -488,6 +505,8 @@ def scenario(
         track = measured(path)
         if start is not None:
             track = track.section(start)
+        else:
+            _warn_of_a_start_step(track, name)
     else:
         raise InputError(f"unknown scenario {name!r}; allowed: {', '.join(SCENARIOS)}")
     return Scenario(track=track, name=name, **common)
@@ -547,6 +566,25 @@ def measured(path) -> MeasuredTrack:
 @functools.lru_cache(maxsize=16)
 def _measured(path: str, mtime_ns: int, size: int) -> MeasuredTrack:
     return MeasuredTrack.from_csv(path)
+
+
+def _warn_of_a_start_step(track: MeasuredTrack, name: str) -> None:
+    """A `PlausibilityWarning` where a whole profile starts off level: the vehicle, at rest on
+    level track, meets a step at s = 0 (smoothed over one input interval, docs/model.md), a
+    transient no line has. A section (``start``) fades in over 20 m and has none."""
+    import warnings
+
+    from railride.validation import PlausibilityWarning, caller_level
+
+    z = [float(f(np.array([0.0]))[0]) for f in track._interp[:2]]
+    if max(abs(z[0]), abs(z[1])) > START_STEP_WARNING:
+        warnings.warn(
+            f"{name} starts at z_L = {1e3 * z[0]:.3g} mm, z_R = {1e3 * z[1]:.3g} mm at s = 0, not level: the vehicle "
+            "meets a step there, a transient in every response; start 0 (--start 0) fades the profile in over "
+            "20 m",
+            PlausibilityWarning,
+            stacklevel=caller_level(),
+        )
 
 
 def source_sha256(name) -> str | None:

@@ -598,10 +598,14 @@ def _same(a, b) -> bool:
 def _default_record(name: str) -> dict:
     """The record of scenario ``name`` with its defaults (empty where it cannot be made: a
     measured profile's file that is gone)."""
+    import warnings
+
     from railride.model.track import scenario
 
     try:
-        return scenario(name).describe()
+        with warnings.catch_warnings():  # only its defaults are read: no run, nothing to warn of
+            warnings.simplefilter("ignore")
+            return scenario(name).describe()
     except (ValueError, OSError):
         return {}
 
