@@ -334,15 +334,19 @@ def _same_but(tuned: dict, record: dict, keys) -> bool:
     recorded match by its path)."""
     leave = set(keys) | {k for k in _LATER_KEYS if k not in tuned or k not in record}
     if _same_file(tuned, record):  # one file's values under two paths: its name and source are the path
-        leave |= {"name", "source"}
+        leave |= {"name", "source", "spectrum"}
     return {k: v for k, v in tuned.items() if k not in leave} == {k: v for k, v in record.items() if k not in leave}
 
 
 def _same_file(tuned: dict, record: dict) -> bool:
-    """Whether two measured profiles' records are of the same values (their ``profile_sha256``),
-    whatever the paths they were read by (file:line.csv and file:/data/line.csv)."""
-    sha = tuned.get("profile_sha256")
-    return sha is not None and sha == record.get("profile_sha256")
+    """Whether two records read the same file's values (a measured profile's ``profile_sha256``,
+    a spectrum table's ``spectrum_sha256``), whatever the paths they were read by
+    (file:line.csv and file:/data/line.csv)."""
+    for key in ("profile_sha256", "spectrum_sha256"):
+        sha = tuned.get(key)
+        if sha is not None and sha == record.get(key):
+            return True
+    return False
 
 
 def _same_line(tuned: dict, record: dict) -> bool:
@@ -555,8 +559,12 @@ def _range_covered(tracks: list[dict], record: dict) -> bool:
     a spectrum is the same track in the statistical sense)."""
     if record.get("profile") != "random":
         return False
-    keys = ("name", "min_wavelength_m", "max_wavelength_m", "spectrum_sha256")  # a table's values, not its path
-    same = [t for t in tracks if t.get("profile") == "random" and all(_same(t.get(k), record.get(k)) for k in keys)]
+    keys = ("min_wavelength_m", "max_wavelength_m", "spectrum_sha256")  # a table's values, not its path
+    same = [
+        t
+        for t in tracks
+        if t.get("profile") == "random" and _same_line(t, record) and all(_same(t.get(k), record.get(k)) for k in keys)
+    ]
     seeds = {t.get("seed") for t in same}
     speeds = [float(t["speed_m_s"]) for t in same if t.get("speed_m_s") is not None]
     speed = record.get("speed_m_s")

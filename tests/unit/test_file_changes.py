@@ -139,6 +139,9 @@ def test_a_robust_tuning_on_a_spectrum_table_does_not_cover_the_table_edited(tmp
     res = tune(["pid"], over=over, budget=5, n_values=3)
     gains = GainSet.from_toml(res.gains_toml(), source="robust.toml")
     assert gains.mismatch(None, rr.scenario(name, duration=0.5, seed=7).describe()) is None
+    copy = tmp_path / "copy.csv"  # the same values at another path: the same spectrum
+    copy.write_bytes(path.read_bytes())
+    assert gains.mismatch(None, rr.scenario(f"psd:{copy}", duration=0.5, seed=7).describe()) is None
     _table(path, factor=2.0)
     line = gains.mismatch(None, rr.scenario(name, duration=0.5, seed=7).describe())
     assert line is not None and "the spectrum table changed since tuning" in line
