@@ -36,6 +36,7 @@ import numpy as np
 from railride.errors import InputError
 from railride.model.params import VehicleParams, resolve_vehicle, vehicle_record
 from railride.model.vehicle import CORNER_NAMES, DOF_NAMES, N_DOF, RAILS, WHEELSETS, Vehicle
+from railride.secondary.control import outer_gains
 
 SCHEMA = "railride.linear/1"
 #: the secondaries `linear_model` takes by name
@@ -227,8 +228,7 @@ def _outer_gains(controller, vehicle: Vehicle) -> tuple[np.ndarray, np.ndarray]:
     """The loop's demand f_d = G_full (q, q') + H xi with G over the vehicle's whole state (4 x
     2 n_dof): a gain on the carbody's six rigid states (4 x 6) or on the rigid vehicle's (4 x
     18) reads nothing of the carbody's bending."""
-    G, H = controller.gains(vehicle)
-    G = np.asarray(G, dtype=float)
+    G, H = outer_gains(controller, vehicle)
     n = vehicle.n_dof
     full = np.zeros((4, 2 * n))
     if G.shape == (4, 6):
@@ -242,7 +242,7 @@ def _outer_gains(controller, vehicle: Vehicle) -> tuple[np.ndarray, np.ndarray]:
             f"controller {controller.name!r}: its gain has shape {G.shape}; allowed (4, 6) on the carbody "
             f"states, (4, {2 * N_DOF}) on the rigid vehicle's (q, q') or (4, {2 * n}) on this vehicle's"
         )
-    return full, np.asarray(H, dtype=float)
+    return full, H
 
 
 def linear_model(params=None, suspension=None, *, vehicle=None, load: float = 1.0) -> LinearModel:

@@ -26,6 +26,7 @@ from railride.run.ride import has_damper_states
 from railride.run.solver import SolverSettings, check_resolution
 from railride.secondary import dampers
 from railride.secondary.faults import fault_table
+from railride.secondary.control import outer_gains
 from railride.secondary.sensing import reads_bogies
 from railride.secondary.suspension import Suspension, batch_conflict
 from railride.validation import shown
@@ -458,7 +459,7 @@ def _outer_loops(closed, param_sets, vehicles, n: int):
         for i, (c, p) in enumerate(zip(closed["controllers"], param_sets)):
             key = (id(c), id(p))  # both held by the lists for the whole loop
             if key not in made:
-                G, H = c.gains(vehicles[id(p)])
+                G, H = outer_gains(c, vehicles[id(p)])
                 made[key] = (_full_state_gains(G, c), H)
             gm[i], hm[i] = made[key]
             modes[i] = dampers.VOLTAGE_LAWS.index(getattr(c, "voltage_law", "tracking"))

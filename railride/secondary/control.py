@@ -163,6 +163,38 @@ class SAS:
         return out
 
 
+def outer_gains(controller, vehicle: Vehicle) -> tuple[np.ndarray, np.ndarray]:
+    """An outer loop's ``gains(vehicle)`` as float arrays, checked: G with 4 rows (one per
+    corner; its columns are the caller's to map), H of shape (4, 3) on the integrals, every value
+    finite. A controller of one's own that gives anything else is an InputError naming it, before
+    a run (a NaN gain would otherwise read as a diverging run)."""
+    name = getattr(controller, "name", controller)
+    try:
+        G, H = controller.gains(vehicle)
+        G, H = np.asarray(G, dtype=float), np.asarray(H, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise InputError(
+            f"controller {name!r}: gains(vehicle) must give (G, H), two arrays of numbers ({exc})"
+        ) from None
+    if G.ndim != 2 or G.shape[0] != 4:
+        raise InputError(
+            f"controller {name!r}: gains(vehicle) gave G of shape {G.shape}; it needs 4 rows, one per corner"
+        )
+    if H.shape != (4, 3):
+        raise InputError(
+            f"controller {name!r}: gains(vehicle) gave H of shape {H.shape}; allowed (4, 3), on the integrals of the "
+            "carbody's bounce, roll and pitch (zeros for none)"
+        )
+    for what, values in (("G", G), ("H", H)):
+        bad = np.argwhere(~np.isfinite(values))
+        if bad.size:
+            i, j = bad[0]
+            raise InputError(
+                f"controller {name!r}: gains(vehicle) gave {what}[{i}, {j}] = {values[i, j]}; gains must be finite"
+            )
+    return G, H
+
+
 # -- gains files --------------------------------------------------------------------------------
 class _OuterLoop(NamedTuple):
     tables: tuple  # the gain tables it reads besides the inner loop's

@@ -164,10 +164,12 @@ class Suspension:
                 )
         object.__setattr__(self, "damper_scale", dampers.check_scale("damper_scale", self.damper_scale))
         c = self.controller
-        if c is not None and not (hasattr(c, "gains") and hasattr(c, "name")):
+        missing = [] if c is None else [a for a in ("gains", "name", "to_dict") if not hasattr(c, a)]
+        if missing:  # the interface of an outer loop of one's own, checked before any run
             raise InputError(
                 f"controller = {c!r}: must be an outer loop from railride.secondary.control (PID, SAS, ZeroDemand) "
-                "or railride.secondary.controllers, or None"
+                "or railride.secondary.controllers, or one of your own with gains(vehicle), name and to_dict(); "
+                f"this one has no {', '.join(missing)}"
             )
         if c is not None and getattr(c, "voltage_law", "tracking") not in dampers.VOLTAGE_LAWS:
             raise InputError(
@@ -383,7 +385,7 @@ class Suspension:
             return "Passive"
         if not self.closed_loop:
             return f"{_damper_name(self.damper)} MR dampers at {self.voltage:g} V"
-        text = LABELS.get(self.name) or str(self.controller.label)
+        text = LABELS.get(self.name) or str(getattr(self.controller, "label", None) or self.name)
         return text if self.kind == "semi-active" else f"{text} ({self.damper.model})"
 
     def describe(self) -> str:
