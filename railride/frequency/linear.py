@@ -341,7 +341,8 @@ def linear_model(params=None, suspension=None, *, vehicle=None, load: float = 1.
 
 def linear_suspensions(controllers, gains) -> dict[str, object]:
     """Names (or linear `Suspension` values) -> {name: "passive" or a Suspension on the ideal
-    actuator}; "all" is passive and every outer loop."""
+    actuator}; "all" is passive and every outer loop. A suspension named as one before it but
+    not equal to it (one law with two gain sets) is kept as "name-2" ("-3", ...), not dropped."""
     from railride.secondary.control import OUTER_LOOPS
     from railride.secondary.suspension import Suspension
 
@@ -353,7 +354,11 @@ def linear_suspensions(controllers, gains) -> dict[str, object]:
     out: dict[str, object] = {}
     for c in controllers:
         if isinstance(c, Suspension):
-            out[c.name] = c
+            key, k = c.name, 1
+            while key in out and out[key] != c:
+                k += 1
+                key = f"{c.name}-{k}"
+            out[key] = c
         elif c in ("passive", "plant"):
             out[c] = c
         elif c in OUTER_LOOPS:

@@ -175,3 +175,16 @@ def test_hold_changes_little_at_the_default_rate():
     )
     assert abs(r1 / r0 - 1) < 0.02
     assert abs(r2 / r0 - 1) > 0.05
+
+
+def test_one_law_with_two_gain_sets_is_kept_twice_not_dropped():
+    from railride.frequency.ride_spectrum import ride_spectrum
+
+    a = rr.Suspension.named("pid", rr.GainSet.default(), damper="ideal")
+    b = rr.Suspension.named("pid", rr.GainSet.robust(), damper="ideal")
+    response = "floor_acceleration_centre"
+    alone = [float(ride_spectrum(points=64, controllers=[s]).rms.sel(response=response).values[0]) for s in (a, b)]
+    both = ride_spectrum(points=64, controllers=["passive", a, b, a])  # the same suspension twice: once
+    assert both.suspensions == ("passive", "pid", "pid-2")
+    np.testing.assert_allclose(both.rms.sel(response=response).values[1:], alone, rtol=1e-12)
+    assert alone[0] != alone[1]  # two gain sets, two rides
