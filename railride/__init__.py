@@ -15,6 +15,9 @@ The public API, in the order a run needs it::
     rr.design()                                       # which law: tuned on some tracks, judged on others
     rr.run_sweep(rr.sweep.grid(["passive", "pid"], speed=[20, 40, 60]))  # every combination
     rr.frequency_responses(params)                    # carbody FRFs, their peaks, the modes
+    rr.modes(params)                                  # the passive vehicle's modes
+    rr.linear_model(params, rr.Suspension.named("pid", damper="ideal"))  # (A, B, C, D) of a linear loop
+    rr.ride_spectrum("fra4")                          # the ride on a random track in the frequency domain
     rr.write_report(rr.compare(sc), "ride.html")      # any result as one HTML page
     rr.export_fmu("vehicle.fmu")                      # the vehicle for Simulink, SIMPACK, FMPy (FMI 2.0)
 """
@@ -35,6 +38,12 @@ _HOMES = {
     "GainSet": "secondary.control",
     "FrfResult": "frequency.frf",
     "frequency_responses": "frequency.frf",
+    "LinearModel": "frequency.linear",
+    "linear_model": "frequency.linear",
+    "Modes": "model.modes",
+    "modes": "model.modes",
+    "RideSpectrum": "frequency.ride_spectrum",
+    "ride_spectrum": "frequency.ride_spectrum",
     "VehicleParams": "model.params",
     "ParetoResult": "studies.pareto",
     "pareto": "studies.pareto",
@@ -85,7 +94,6 @@ _MOVED = {
     "plausible": "model.plausible",
     "report": "output.report",
     "ride": "run.ride",
-    "ride_spectrum": "frequency.ride_spectrum",
     "rig": "run.rig",
     "sensing": "secondary.sensing",
     "simulation": "run.simulation",
@@ -107,6 +115,9 @@ if TYPE_CHECKING:
     from railride.secondary.faults import DamperFault
     from railride.frequency.frf import FrfResult, frequency_responses
     from railride.frequency.fmu import export_fmu
+    from railride.frequency.linear import LinearModel, linear_model
+    from railride.frequency.ride_spectrum import RideSpectrum, ride_spectrum
+    from railride.model.modes import Modes, modes
     from railride.studies.objectives import Objective
     from railride.model.params import VehicleParams
     from railride.studies.pareto import ParetoResult, pareto
@@ -158,10 +169,13 @@ __all__ = [
     "DesignResult",
     "FrfResult",
     "GainSet",
+    "LinearModel",
+    "Modes",
     "Objective",
     "ParetoResult",
     "Result",
     "RideResult",
+    "RideSpectrum",
     "Scenario",
     "SolverSettings",
     "StudyResult",
@@ -174,7 +188,10 @@ __all__ = [
     "design",
     "export_fmu",
     "frequency_responses",
+    "linear_model",
+    "modes",
     "pareto",
+    "ride_spectrum",
     "scenario",
     "run_sweep",
     "simulate",
