@@ -146,19 +146,22 @@ class VehicleParams:
     def of(cls, value) -> "VehicleParams":
         """``value`` as parameters: None (the `paper` preset), a preset name, the path of a
         parameters file (`resolve`), or a VehicleParams."""
-        if value is None or isinstance(value, (str, os.PathLike, VehicleParams)):
+        if value is None or isinstance(value, (str, os.PathLike, VehicleParams)) or _vehicle_params(value):
             return cls.resolve(value, "params")[0]
         # a common slip: simulate(scenario, suspension) puts the suspension in params
         suspension = hasattr(value, "controller") and hasattr(value, "damper")  # a Suspension, not imported here
         hint = " (a Suspension is the third argument, suspension=)" if suspension else ""
-        raise InputError(f"params = {value!r}: must be VehicleParams or a preset name{hint}")
+        raise InputError(
+            f"params = {value!r}: must be VehicleParams, a Vehicle, a preset name ({', '.join(PRESETS)}) or the path "
+            f"of a parameters file (FILE.toml){hint}"
+        )
 
     @classmethod
     def resolve(cls, value, field: str = "vehicle") -> tuple["VehicleParams", str | Path | None]:
         """(the parameters, where they came from) of ``value``: None (the `paper` preset), a
         preset name (one of `PRESETS`), the path of a parameters file (an os.PathLike, or a
-        str that ends in ".toml" or names a file), or VehicleParams (its preset's name if it is
-        one, else None). A str that is neither a preset nor a file: an InputError naming
+        str that ends in ".toml" or names a file), VehicleParams (its preset's name if it is
+        one, else None) or a `Vehicle` (its parameters). A str that is neither a preset nor a file: an InputError naming
         ``field`` (the argument or option), the presets and that a FILE.toml is accepted."""
         if value is None:
             value = "paper"
@@ -173,10 +176,12 @@ class VehicleParams:
             )
         if isinstance(value, os.PathLike):
             return cls.load(Path(value)), Path(value)
+        if _vehicle_params(value):  # a Vehicle (railride.model.vehicle, above this module): its parameters
+            value = value.params
         if isinstance(value, VehicleParams):
             return value, next((name for name, p in PRESETS.items() if p == value), None)
         raise InputError(
-            f"{field} = {value!r}: must be VehicleParams, a preset name "
+            f"{field} = {value!r}: must be VehicleParams, a Vehicle, a preset name "
             f"({', '.join(PRESETS)}) or the path of a parameters file (FILE.toml)"
         )
 
@@ -395,6 +400,11 @@ def vehicle_record(params: VehicleParams, source=None, load=1.0) -> dict:
         "load": loads[0] if len(loads) == 1 else loads,
         "values": params.to_dict(),
     }
+
+
+def _vehicle_params(value) -> bool:
+    """Whether ``value`` is a `railride.model.vehicle.Vehicle` (it holds its parameters)."""
+    return not isinstance(value, VehicleParams) and isinstance(getattr(value, "params", None), VehicleParams)
 
 
 def resolve_argument(vehicle=None, params=None, field: str = "vehicle") -> tuple[VehicleParams, str | Path | None]:

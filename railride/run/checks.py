@@ -353,6 +353,8 @@ def check(
             f"on_divergence = {on_divergence!r}: allowed 'raise' (stop with an error) "
             "or 'mark' (keep the other samples; see RideResult.diverged_at)"
         )
+    if isinstance(params, Vehicle):  # a vehicle stands for its parameters: one, not a batch
+        params = params.params
     batch = (
         not (isinstance(scenario, (Scenario, str)) or scenario is None)
         or not (isinstance(params, (VehicleParams, str, os.PathLike)) or params is None)

@@ -196,6 +196,19 @@ def test_simulate_and_compare_take_a_name_a_path_or_parameters(short, car):
         rr.compare(short, vehicle="paper", params="paper")
 
 
+def test_a_vehicle_object_is_taken_wherever_its_parameters_are(short):
+    """A `Vehicle` stands for its parameters (it was refused as "must be VehicleParams")."""
+    heavy = PAPER.replace(m_c=M_C)
+    car = rr.Vehicle(heavy)
+    assert rr.simulate(short, car).metrics().equals(rr.simulate(short, heavy).metrics())
+    assert rr.simulate(short, vehicle=car).metrics().equals(rr.simulate(short, heavy).metrics())
+    assert rr.modes(car).to_dict() == rr.modes(heavy).to_dict()
+    comp = rr.compare(short, vehicle=car, controllers=["passive"], bounds=False)
+    assert comp.settings["vehicle_params"] == heavy.to_dict()
+    with pytest.raises(InputError, match=r"must be VehicleParams, a Vehicle, a preset name \(paper"):
+        rr.simulate(short, 3.0)
+
+
 def test_the_studies_take_a_name_a_path_or_parameters(car, tmp_path):
     from railride.studies.sweep import grid
 
