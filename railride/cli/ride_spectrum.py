@@ -23,7 +23,7 @@ from railride.cli._options import (
     figure_options,
 )
 from railride.cli._parsing import load_gains, table_errors, vehicle_arguments
-from railride.frequency.ride_spectrum import PASSIVE_DEVICE
+from railride.frequency.ride_spectrum import ACTUATOR_DEVICE
 
 #: the library's names of the options, for its errors
 SPECTRUM_OPTIONS = {
@@ -248,7 +248,7 @@ def _tables(result) -> list:
         f"gains {st.get('gains_source', st['gains'])}{SHIPPED if st['gains'] == 'shipped' else ''}. "
         f"{vehicle_text(st['vehicle'])}."
     )
-    controlled = any(d != PASSIVE_DEVICE for d in doc["devices"].values())
+    controlled = any(d == ACTUATOR_DEVICE for d in doc["devices"].values())
     parts: list = ([Text(HEADLINE)] if controlled else []) + [floor, body, note]
     if "passive" in doc["rms"]:  # what the floor's gain costs in travel: a trade the tables show apart
         base = doc["rms"]["passive"]["secondary_deflection_1R"]

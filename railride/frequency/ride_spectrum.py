@@ -59,6 +59,8 @@ MIN_CONTROL_RATE = 1.0
 #: which switch and clip and so have no frequency response (`railride compare` runs them)
 PASSIVE_DEVICE = "passive viscous dampers"
 ACTUATOR_DEVICE = "ideal actuator"
+#: the plant: the vehicle with no secondary dampers, its secondary springs alone
+NO_DAMPER_DEVICE = "no secondary dampers"
 
 
 def reduction_percent(passive: float, value: float) -> float | None:
@@ -136,7 +138,7 @@ class RideSpectrum:
 
     ``psd``: a Dataset over (suspension, frequency) with one variable per response of
     `RESPONSES`, one-sided PSDs in (unit)^2/Hz, and the coordinate ``device`` (per suspension:
-    `PASSIVE_DEVICE` or `ACTUATOR_DEVICE`); ``rms`` and ``weighted``: DataArrays over
+    `PASSIVE_DEVICE`, `ACTUATOR_DEVICE` or `NO_DAMPER_DEVICE`); ``rms`` and ``weighted``: DataArrays over
     (suspension, response) and (suspension, position, weighting); ``settings``: what made it.
     Every variable and coordinate carries ``long_name`` and ``units`` (CF; "1" where there is
     no unit). The result protocol: `to_dict`, `to_pandas` (one row per suspension and response:
@@ -156,8 +158,8 @@ class RideSpectrum:
 
     @property
     def devices(self) -> dict[str, str]:
-        """Per suspension, the device that makes its secondary force: `PASSIVE_DEVICE` or
-        `ACTUATOR_DEVICE`."""
+        """Per suspension, the device that makes its secondary force: `PASSIVE_DEVICE`,
+        `ACTUATOR_DEVICE` or, for the plant, `NO_DAMPER_DEVICE`."""
         return {s: str(d) for s, d in zip(self.suspensions, self.psd["device"].values)}
 
     @property
@@ -349,7 +351,7 @@ def ride_spectrum(
             continue
         names.append(name)
         passive = model.secondary in ("passive", "plant")
-        devices.append(PASSIVE_DEVICE if passive else ACTUATOR_DEVICE)
+        devices.append({"passive": PASSIVE_DEVICE, "plant": NO_DAMPER_DEVICE}.get(model.secondary, ACTUATOR_DEVICE))
         base, gain = (model, None) if passive else (plant, model.corner_forces())
         y = {k: responses(base, gain, u, h, frequency) for k, u in inputs.items()}
         for r in RESPONSES:

@@ -188,3 +188,12 @@ def test_one_law_with_two_gain_sets_is_kept_twice_not_dropped():
     assert both.suspensions == ("passive", "pid", "pid-2")
     np.testing.assert_allclose(both.rms.sel(response=response).values[1:], alone, rtol=1e-12)
     assert alone[0] != alone[1]  # two gain sets, two rides
+
+
+def test_the_plant_is_said_to_have_no_secondary_dampers():
+    from railride.frequency.ride_spectrum import ride_spectrum
+
+    result = ride_spectrum(points=64, controllers=["passive", "plant"])
+    assert result.devices == {"passive": "passive viscous dampers", "plant": "no secondary dampers"}
+    floor = result.rms.sel(response="floor_acceleration_centre").values
+    assert floor[1] > floor[0]  # no dampers in the secondary: a rougher floor than the dashpots give
