@@ -141,12 +141,6 @@ def ride_spectrum(
 
         figures = figure_options(figure_format, dpi, out)
         check_report_option(report)
-        if delay is not None and control_rate is None:  # the loops act continuously: no period to delay by
-            from railride.errors import InputError
-
-            raise InputError(
-                f"--delay = {delay}: applies with --control-rate only (without it the loops act continuously)"
-            )
         vehicle_options = vehicle_arguments(vehicle, preset, load)
         if out is not None:
             check_out_dir(out, "--out")
@@ -161,7 +155,7 @@ def ride_spectrum(
                 max_wavelength=max_wavelength,
                 points=points,
                 control_rate=control_rate,
-                delay=1 if delay is None else delay,
+                delay=delay,
             )
         except ValueError as exc:
             table_errors(track, str(exc), "--track")

@@ -277,23 +277,24 @@ def ride_spectrum(
     max_wavelength: float = 100.0,
     points: int = 2000,
     control_rate: float | None = None,
-    delay: int = 1,
+    delay: int | None = None,
 ) -> RideSpectrum:
     """The ride on spectrum ``track`` (`railride.model.track.SPECTRA`, or a user's table psd:PATH)
     at ``speed`` [m/s] (default the scenarios' 55.56) of ``vehicle`` (``params`` is an alias:
-    `VehicleParams`, a preset name or a parameters file; default "paper") with the load factor ``load`` on its carbody,
-    recorded in ``settings["vehicle"]``, for each of ``controllers``: "passive",
-    outer-loop names (on the ideal actuator, gains from ``gains``, default the shipped) or
-    linear `Suspension` values. The spectrum is taken over [min_wavelength, max_wavelength] m
-    (as the random tracks are synthesised) on ``points`` log-spaced frequencies. Without
-    ``control_rate`` a loop acts continuously; with it, through the sample-and-hold and
-    ``delay`` periods. A closed loop that is unstable is not run: ``settings["not_run"]``
-    gives the reason (ValueError when none is left). ``settings["gains_mismatch"]``: one line
-    (`GainSet.mismatch`) when the gains of the outer loops run by name were tuned for another
-    vehicle, load or track (`gains_mismatch`). ``settings["gains_source"]``,
-    ``["gains_provenance"]`` and ``["gains_values"]``: the gains those loops ran, their source,
-    how they were found and every value per suspension (`GainSet.record`; ``["gains"]`` says
-    "given" or "shipped")."""
+    `VehicleParams`, a `Vehicle`, a preset name or a parameters file; default "paper") with the
+    load factor ``load`` on its carbody, recorded in ``settings["vehicle"]``, for each of
+    ``controllers``: "passive", "plant", outer-loop names (on the ideal actuator, gains from
+    ``gains``, default the shipped) or linear `Suspension` values. The spectrum is taken over
+    [min_wavelength, max_wavelength] m (as the random tracks are synthesised) on ``points``
+    log-spaced frequencies. Without ``control_rate`` a loop acts continuously; with it, through
+    the sample-and-hold and ``delay`` periods (0 to 64, default 1; given without
+    ``control_rate``, an InputError). A closed loop that is unstable is not run:
+    ``settings["not_run"]`` gives the reason (ValueError when none is left).
+    ``settings["gains_mismatch"]``: one line (`GainSet.mismatch`) when the gains of the outer
+    loops run by name were tuned for another vehicle, load or track (`gains_mismatch`).
+    ``settings["gains_source"]``, ``["gains_provenance"]`` and ``["gains_values"]``: the gains
+    those loops ran, their source, how they were found and every value per suspension
+    (`GainSet.record`; ``["gains"]`` says "given" or "shipped")."""
     if not is_random(track):
         validation.choice("track", track, RANDOM_NAMES)  # its error names every spectrum
     speed = DEFAULT_SPEED if speed is None else frequency_speed(speed)
@@ -320,7 +321,11 @@ def ride_spectrum(
                 f"control_rate = {control_rate:g} Hz: at least {MIN_CONTROL_RATE:g} Hz (a loop sampled less "
                 "than once a second cannot act on the carbody's modes of about 1 Hz)"
             )
-    delay = validation.integer("delay", delay, 0, 64, "controller periods")
+    if delay is not None and control_rate is None:  # the loops act continuously: no period to delay by
+        raise InputError(
+            f"delay = {validation.shown(delay)}: applies with control_rate only (without it the loops act continuously)"
+        )
+    delay = 1 if delay is None else validation.integer("delay", delay, 0, 64, "controller periods")
     vehicle_params, record = resolve_vehicle(vehicle, params, load)
     vehicle = Vehicle(vehicle_params)
     # the peak is the closed loop's (points, 18, 18) complex system (20 x 20 where the carbody

@@ -11,6 +11,7 @@ import pytest
 from scipy.signal import lsim
 
 import railride as rr
+from railride.errors import InputError
 from railride.analysis.comfort import floor_acceleration, ride_comfort
 from railride.frequency.linear import linear_model
 from railride.frequency.ride_spectrum import FLOOR, ride_spectrum, track_psd
@@ -197,3 +198,12 @@ def test_the_plant_is_said_to_have_no_secondary_dampers():
     assert result.devices == {"passive": "passive viscous dampers", "plant": "no secondary dampers"}
     floor = result.rms.sel(response="floor_acceleration_centre").values
     assert floor[1] > floor[0]  # no dampers in the secondary: a rougher floor than the dashpots give
+
+
+def test_a_delay_without_a_control_rate_is_refused_not_ignored():
+    from railride.frequency.ride_spectrum import ride_spectrum
+
+    with pytest.raises(InputError, match=r"delay = 5: applies with control_rate only"):
+        ride_spectrum(points=64, delay=5)
+    held = ride_spectrum(points=64, controllers=["pid"], control_rate=100.0, delay=3)
+    assert held.settings["delay_periods"] == 3
