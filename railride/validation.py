@@ -18,9 +18,12 @@ import warnings
 from collections.abc import Mapping
 from pathlib import Path
 from types import FrameType
-from typing import Any, NamedTuple
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 from railride.errors import InputError
+
+if TYPE_CHECKING:  # numpy comes with the first check that needs it, not with this module
+    import numpy as np
 
 #: the largest seed: NumPy's generators take any whole number >= 0, but a seed must also
 #: survive the run table's CSV, whose readers hold whole numbers in 64 bits
@@ -131,6 +134,20 @@ def seed(name: str, value) -> int:
     if not (whole and 0 <= value <= SEED_MAX):
         raise InputError(f"{name} = {shown(value)}: must be {RULES['seed'][0]}")
     return int(value)
+
+
+def frequencies(name: str, value) -> "np.ndarray":
+    """``value`` (one number or an array of them) as a 1-D float array of frequencies [Hz]:
+    finite and >= 0; anything else an InputError naming ``name``."""
+    import numpy as np
+
+    try:
+        f = np.atleast_1d(np.asarray(value, dtype=float))
+    except (TypeError, ValueError):
+        f = None
+    if f is None or f.ndim != 1 or not np.all(np.isfinite(f)) or np.any(f < 0):
+        raise InputError(f"{name} = {shown(value)}: must be a number or a 1-D array of numbers, finite and >= 0 (Hz)")
+    return f
 
 
 def choice(name: str, value, allowed) -> str:

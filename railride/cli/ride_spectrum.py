@@ -319,9 +319,16 @@ def state_space(
         # one model: "all" and lists, which linear_suspensions takes for ride-spectrum, are refused
         # here in this command's terms, not unpacked into one
         if suspension.strip() not in ("passive", "plant", *OUTER_LOOPS):
+            several = "," in suspension or suspension.strip() == "all"
+            why = (
+                "state-space models one suspension at a time"
+                if several
+                else "not a linear suspension (MR dampers, in open or closed loop, have a hysteretic, clipped force "
+                "and no state-space model)"
+            )
             raise InputError(
-                f"--suspension = {suspension!r}: state-space models one suspension at a time; allowed: passive, plant, "
-                f"{', '.join(OUTER_LOOPS)} (each on the ideal actuator)"
+                f"--suspension = {suspension!r}: {why}; allowed: passive, plant, {', '.join(OUTER_LOOPS)} (each on "
+                "the ideal actuator)"
             )
         named = [suspension.strip()]
         gain_set = None if gains is None else load_gains(gains)

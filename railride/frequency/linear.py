@@ -90,7 +90,9 @@ class LinearModel:
 
     def index(self, kind: str, name: str) -> int:
         """Where ``name`` is among the ``kind`` ("states", "inputs", "outputs")."""
-        names = getattr(self, kind)
+        from railride import validation
+
+        names = getattr(self, validation.choice("kind", kind, ("states", "inputs", "outputs")))
         if name not in names:
             raise InputError(f"{kind[:-1]} {name!r} is not in the model; allowed: {', '.join(names)}")
         return names.index(name)
@@ -103,9 +105,9 @@ class LinearModel:
     def frequency_response(self, frequency_hz) -> np.ndarray:
         """G(j 2 pi f) = C (j 2 pi f I - A)^-1 B + D for every frequency [Hz]: (n_f, outputs,
         inputs), complex."""
-        f = np.atleast_1d(np.asarray(frequency_hz, dtype=float))
-        if not np.all(np.isfinite(f)) or np.any(f < 0):
-            raise InputError(f"frequency_hz must be finite numbers >= 0 Hz, got {frequency_hz!r}")
+        from railride import validation
+
+        f = validation.frequencies("frequency_hz", frequency_hz)
         s = 2j * np.pi * f
         n = self.A.shape[0]
         X = np.linalg.solve(s[:, None, None] * np.eye(n) - self.A, np.broadcast_to(self.B, (f.size, *self.B.shape)))

@@ -485,10 +485,12 @@ def gains_mismatch(gains, controllers, vehicle: dict, track: str, speed: float, 
             continue
         realisation = {"seed": tuned.get("seed", 0), "duration": tuned.get("duration_s")}
         try:
-            records.append(scenario(track, **options, **{k: v for k, v in realisation.items() if v is not None}))
+            made = scenario(track, **options, **{k: v for k, v in realisation.items() if v is not None})
         except InputError:  # a realisation this ride's band or speed cannot have: not this track
             continue
-    described = [r.describe() for r in records]
+        # a spectrum has no length: the realisation's, which grows with the speed, is not this ride's
+        records.append({**made.describe(), "length_m": tuned.get("length_m")})
+    described = [{k: v for k, v in r.items() if v is not None} for r in records]
     # the realisation they were tuned on, else the first of this spectrum: a seed is no difference
     ride = next((r for r in described if gains.tuned_on(r)), described[0] if described else None)
     return gains.mismatch(vehicle, ride or scenario(track, **options).describe(), list(controllers))

@@ -389,9 +389,7 @@ class Vehicle:
         displacements and the rail cross-level angle (z_L - z_R)/(2a) of the pattern, all over
         the ``frequency`` coordinate in Hz.
         """
-        f = np.atleast_1d(np.asarray(frequency_hz, dtype=float))
-        if not np.all(np.isfinite(f)) or np.any(f < 0):
-            raise InputError(f"frequency_hz must be finite and >= 0, got {frequency_hz!r}")
+        f = validation.frequencies("frequency_hz", frequency_hz)
         speed = validation.number("speed", speed, "positive", "m/s")
         if isinstance(rails, str):
             patterns = {"in-phase": (1.0, 1.0), "anti-phase": (1.0, -1.0)}
@@ -399,7 +397,15 @@ class Vehicle:
                 raise InputError(f"rails = {rails!r}: allowed 'in-phase', 'anti-phase' or (c_L, c_R)")
             cL, cR = patterns[rails]
         else:
-            cL, cR = rails
+            try:
+                cL, cR = (complex(c) for c in rails)
+            except (TypeError, ValueError):
+                raise InputError(
+                    f"rails = {validation.shown(rails)}: allowed 'in-phase', 'anti-phase' or a pair of complex "
+                    "weights (c_L, c_R)"
+                ) from None
+            if not (np.isfinite(cL) and np.isfinite(cR)):
+                raise InputError(f"rails = {validation.shown(rails)}: the weights must be finite")
         omega = 2 * np.pi * f
         lag = self.wheelset_lag_distance / speed
         H = np.empty((f.size, self.n_dof), dtype=complex)

@@ -91,7 +91,8 @@ def test_state_space_writes_mat_and_json(tmp_path):
     doc = ok_json("state-space", "--suspension", "plant")
     assert doc["inputs"][-1] == "secondary_force_2L" and len(doc["A"]) == 18
     assert_input_error(run("state-space", "--out", tmp_path / "m.txt"), "--out", ".mat or .json")
-    assert_input_error(run("state-space", "--suspension", "mr"), "--suspension = 'mr'")
+    assert_input_error(run("state-space", "--suspension", "mr"), "--suspension = 'mr'", "not a linear suspension")
+    assert_input_error(run("state-space", "--suspension", "pid,skyhook"), "one suspension at a time")
 
 
 def test_time_histories_as_matlab_files(tmp_path):

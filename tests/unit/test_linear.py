@@ -151,3 +151,17 @@ def test_the_command_says_where_a_closed_loops_gains_came_from(tmp_path):
         ok("state-space", "--suspension", "pid", "--gains", tuned / "gains.toml", "--format", "json").stdout
     )
     assert doc["gains_source"].endswith("pid was not tuned by the study that made them: its start values")
+
+
+def test_bad_arguments_of_the_linear_tools_name_the_argument_and_what_is_allowed():
+    from railride.errors import InputError
+
+    lm = linear_model("paper")
+    with pytest.raises(InputError, match=r"kind = 'output': allowed states, inputs, outputs"):
+        lm.index("output", "carbody_bounce")
+    with pytest.raises(InputError, match=r"frequency_hz = '1 Hz': must be a number or a 1-D array"):
+        lm.frequency_response("1 Hz")
+    car = rr.Vehicle("paper")
+    for rails in ((1, 1, 1), 5, ("a", 1)):
+        with pytest.raises(InputError, match=r"rails = .*: allowed 'in-phase', 'anti-phase' or a pair"):
+            car.frequency_response([1.0], 20.0, rails)
