@@ -392,7 +392,7 @@ class Vehicle:
         f = validation.frequencies("frequency_hz", frequency_hz)
         speed = validation.number("speed", speed, "positive", "m/s")
         if isinstance(rails, str):
-            patterns = {"in-phase": (1.0, 1.0), "anti-phase": (1.0, -1.0)}
+            patterns = {"in-phase": (1.0 + 0j, 1.0 + 0j), "anti-phase": (1.0 + 0j, -1.0 + 0j)}
             if rails not in patterns:
                 raise InputError(f"rails = {rails!r}: allowed 'in-phase', 'anti-phase' or (c_L, c_R)")
             cL, cR = patterns[rails]
