@@ -152,7 +152,7 @@ class BoucWen(_Damper):
 
     @property
     def z_bound(self) -> float:
-        """Upper bound of |z| for gamma >= beta: (A / (gamma + beta))^(1/n) [m^(1/n)]."""
+        """Upper bound of |z| for gamma >= beta: (A / (gamma + beta))^(1/n) [m] (gamma and beta in 1/m^n)."""
         return (self.A / (self.gamma + self.beta)) ** (1.0 / self.n)
 
     #: the parameters that carry force: F scales with them at the same motion and voltage
