@@ -271,3 +271,28 @@ def gains_text(source: str, shipped: bool) -> str:
         f"gains: the shipped paper set {source}, tuned on the paper's sine and taken on the sine and the bump "
         "(--gains robust: the set tuned on random track)"
     )
+
+
+def stops_note(rows: list[dict]) -> str:
+    """The bump stops under the damper table: their clearance, and which suspensions reached it."""
+    clearance = next((r["damper"].get("clearance_m") for r in rows), None)
+    if clearance is None:
+        return " The vehicle has no bump stops: the travel is unbounded."
+    stiffness = next((r["damper"].get("stop_stiffness_n_per_m", 0.0) for r in rows), 0.0)
+    hit = [r["label"] for r in rows if r["damper"].get("reached_stops")]
+    if not hit:
+        if stiffness <= 0.0:  # a clearance with no stop modelled at it: a limit to read, not a force
+            return (
+                f" No suspension's travel passed the {clearance * 1e3:g} mm clearance (z_stop; this vehicle models "
+                "no stop force there, k_stop = 0)."
+            )
+        return f" No suspension reached the bump stops ({clearance * 1e3:g} mm clearance)."
+    if stiffness > 0.0:
+        return (
+            f" *: reached the bump stops at {clearance * 1e3:g} mm ({', '.join(hit)}): the stops bound "
+            "that travel and carry force there."
+        )
+    return (
+        f" *: beyond the {clearance * 1e3:g} mm clearance to the bump stops ({', '.join(hit)}), which this "
+        "vehicle gives no stiffness (k_stop = 0): that travel is not bounded, and a real car would be on its stops."
+    )

@@ -74,6 +74,7 @@ from railride.cli._render import (
     damper_text,
     fmt,
     reduction_text,
+    stops_note,
     untuned_text,
 )
 
@@ -255,9 +256,15 @@ def _compare_tables(doc: dict, shipped: bool):
         if tuning.get("untuned"):
             info.append(untuned_text(tuning["untuned"]))
         info += trade_off_lines(doc)
+        if settings.get("faults"):  # the library runs no ideal device with faults: said, not left out silently
+            info.append(
+                "With faults the trade-offs are the faulted runs', and no ideal-device references are run (an ideal "
+                "device has no damper to fail); run without --fault for them."
+            )
     for name, why in (settings.get("not_run") or {}).items():
         info.append(f"{name}: not run ({why})")
     paper_case = doc.get("paper_case", True)
+    faults = settings.get("faults") or []
     info.append(
         (
             "The paper's absolute values depend on settings it does not give (sine wavelength, "
@@ -265,13 +272,15 @@ def _compare_tables(doc: dict, shipped: bool):
             "not the digits. "
             if paper_case
             else "No published reference exists for this case: the paper's Table 1 is for its sine "
-            "(paper-sine) at 55.56 m/s with its vehicle. "
+            "(paper-sine) at 55.56 m/s with its vehicle" + (", and healthy dampers. " if faults else ". ")
         )
         + "red. % = (passive - controlled) / passive x 100 (negative: worse than passive, in red)."
     )
     if doc.get("paper_ranking"):
         info.append(paper_ranking_text(doc["paper_ranking"]))  # where the order agrees with Table 1
     title = "Ride comparison: RMS of the carbody responses" + (" beside the paper's Table 1" if paper_case else "")
+    if faults:  # every controlled run below has them; passive is healthy
+        title += f", the controllers' dampers with the faults {', '.join(faults)} (passive healthy)"
 
     def rms_table(group: list[dict]):
         table = FitTable(title=title)
@@ -378,7 +387,7 @@ def _compare_tables(doc: dict, shipped: bool):
         "asks for; force: the secondary damper force on the carbody; travel: the "
         "secondary deflection (suspension travel); passive: the viscous dampers c_sz."
         + (" The ideal devices have no voltage." if settings.get("damper") in IDEAL_NAMES and controlled else "")
-        + _stops_note(rows)
+        + stops_note(rows)
     )
     parts = [table, Text("\n".join(info)), *bounds_parts, "", ptp, "", demands, Text(demands_note)]
     if all("comfort" in r for r in rows):
@@ -673,28 +682,3 @@ def compare(
             console.print(part)
     if report is not None:  # after the tables: a report that cannot be written loses no output
         save_report(report, result, _compare_tables(doc, shipped=gains is None), ctx)
-
-
-def _stops_note(rows: list[dict]) -> str:
-    """The bump stops under the damper table: their clearance, and which suspensions reached it."""
-    clearance = next((r["damper"].get("clearance_m") for r in rows), None)
-    if clearance is None:
-        return " The vehicle has no bump stops: the travel is unbounded."
-    stiffness = next((r["damper"].get("stop_stiffness_n_per_m", 0.0) for r in rows), 0.0)
-    hit = [r["label"] for r in rows if r["damper"].get("reached_stops")]
-    if not hit:
-        if stiffness <= 0.0:  # a clearance with no stop modelled at it: a limit to read, not a force
-            return (
-                f" No suspension's travel passed the {clearance * 1e3:g} mm clearance (z_stop; this vehicle models "
-                "no stop force there, k_stop = 0)."
-            )
-        return f" No suspension reached the bump stops ({clearance * 1e3:g} mm clearance)."
-    if stiffness > 0.0:
-        return (
-            f" *: reached the bump stops at {clearance * 1e3:g} mm ({', '.join(hit)}): the stops bound "
-            "that travel and carry force there."
-        )
-    return (
-        f" *: beyond the {clearance * 1e3:g} mm clearance to the bump stops ({', '.join(hit)}), which this "
-        "vehicle gives no stiffness (k_stop = 0): that travel is not bounded, and a real car would be on its stops."
-    )

@@ -405,6 +405,10 @@ def test_compare_with_a_fault_prints_the_degradation():
     doc = ok_json("compare", "--duration", 2, "--fault", "2R-disconnected")
     assert doc["faults"]["faults"] == ["2R-disconnected"] and doc["bounds"] is None
     assert set(doc["faults"]["controllers"]) == {"pid", "sas-attitude", "sas-attitude-ride"}
+    # the main table says its runs are faulted, and the paper's healthy table is no reference for them
+    assert "the controllers' dampers with the faults 1R-off, 2L-on@1 (passive healthy)" in flat
+    assert "beside the paper's Table 1" not in flat and "and healthy dampers" in flat
+    assert "no ideal-device references are run" in flat and not doc["paper_case"]
 
 
 @pytest.mark.parametrize(
