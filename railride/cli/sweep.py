@@ -167,7 +167,8 @@ def sweep_command(
             "--gain",
             metavar="TABLE.ENTRY=VALUES",
             help="Controllers only: values of one gain, e.g. pid.kd=1e4,1e5 or attitude.kp_z=0:4e5:5; "
-            "repeatable (each adds a grid axis). Tables inner, pid, attitude, ride.",
+            "repeatable (each adds a grid axis). Tables inner, pid, attitude (SAS attitude), ride_attitude "
+            "and ride (SAS attitude+ride), skyhook, skyhook_on_off, groundhook, hybrid, clipped_optimal.",
         ),
     ] = None,
     noise: Annotated[

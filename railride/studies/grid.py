@@ -469,7 +469,7 @@ def _gain_axes(words: _Words, gains: Mapping | None, controllers: list, listed: 
             allowed = (
                 ", ".join(GainSet.entry_names(table))
                 if table in GainSet.TABLES
-                else "inner.*, pid.*, attitude.*, ride.* (" + ", ".join(known[:5]) + ", ...)"
+                else ", ".join(f"{table}.*" for table in GainSet.TABLES) + " (" + ", ".join(known[:5]) + ", ...)"
             )
             raise InputError(f"{given}: unknown gain {name!r}; allowed: {allowed}")
         bad = [v for v in values if not _obeys(v, "nonnegative")]
@@ -480,9 +480,16 @@ def _gain_axes(words: _Words, gains: Mapping | None, controllers: list, listed: 
             )
         acts_in = GAIN_CONTROLLERS[name.partition(".")[0]]
         if not any(c in acts_in for c in controllers):
+            # the tables that do act in the listed controllers, with this entry: where the user meant
+            hint = [
+                f"{table}.{name.partition('.')[2]}"
+                for table, laws in GAIN_CONTROLLERS.items()
+                if any(c in laws for c in controllers) and f"{table}.{name.partition('.')[2]}" in known
+            ]
             raise InputError(
                 f"{given}: {name} acts in {', '.join(acts_in)} only, which "
                 f"{words.name('suspensions')} ({listed}) does not list"
+                + (f"; in {listed}: {', '.join(hint)}" if hint else "")
             )
         axes.append((name, [float(v) for v in values]))
     return axes

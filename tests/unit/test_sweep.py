@@ -124,6 +124,11 @@ def test_grid_random_track_seeds():
         ),
         (dict(suspensions="pid", gains={"pid.kd": [-1.0]}), ("gains['pid.kd'] = [-1.0]: -1 is negative",)),
         (dict(suspensions="pid", gains={"ride.kp_1R": [1.0]}), ("ride.kp_1R acts in sas-attitude-ride only",)),
+        (
+            dict(suspensions="sas-attitude-ride", gains={"attitude.kp_z": [1.0]}),
+            ("attitude.kp_z acts in sas-attitude only", "in sas-attitude-ride: ride_attitude.kp_z"),
+        ),
+        (dict(suspensions="pid", gains={"foo.x": [1.0]}), ("unknown gain 'foo.x'", "ride_attitude.*, skyhook.*")),
         (dict(suspensions="pid", seed=[1]), ("seed = [1]: applies with noise only",)),
         (dict(suspensions="pid", noise=(0, 0, 0, 0), seed=[-1]), ("seed = [-1]: -1 is negative",)),
         (dict(suspensions="pid", noise=(0, 0, 0, 0), seed=[0.5]), ("0.5 is not a whole number",)),
