@@ -47,7 +47,8 @@ def plot_study(result, ax=None, metrics=None):
     spare = None  # a free panel of the grid, where the legend covers no data
     if ax is None:
         n_rows, columns = grid_shape(len(metrics), 3)
-        fig = new_figure((PAGE_WIDTH, 0.8 + 2.6 * n_rows))
+        upright = len(conditions) * columns > 9  # as `crowded` below: room for the upright labels
+        fig = new_figure((PAGE_WIDTH, 0.8 + (2.6 + (1.4 if upright else 0.0)) * n_rows))
         axes = fig.subplots(n_rows, columns, squeeze=False).ravel()
         for a in axes[len(metrics) :]:
             a.set_visible(False)
@@ -81,7 +82,9 @@ def plot_study(result, ax=None, metrics=None):
                 label=suspension_label(name),
             )
         a.axhline(0.0, color="k", linewidth=0.8)
-        a.set_xticks(x, [_condition_label(*c, crowded) for c in conditions], fontsize="small")
+        labels = [_condition_label(*c, crowded) for c in conditions]
+        # crowded: each condition on one line, turned upright, so that neighbours cannot overlap
+        a.set_xticks(x, labels, fontsize="small", rotation=90 if crowded else 0)
         a.set_title(DEFAULT_METRICS.get(metric, metric))
         a.grid(False, axis="x")
     for k, a in enumerate(axes):
@@ -104,10 +107,11 @@ def plot_study(result, ax=None, metrics=None):
 
 
 def _condition_label(speed: float, load: float, stiffness: float, fault: str, delay: int, crowded: bool = False) -> str:
-    return (
-        f"{speed:g} m/s\n"
-        f"load{chr(10) if crowded else ' '}x{load:g}"
-        + ("" if stiffness == 1.0 else f"\nk_sz x {stiffness:g}")
-        + ("" if fault == "none" else f"\n{fault}")
-        + ("" if delay == 1 else f"\ndelay {delay}")
-    )
+    parts = [
+        f"{speed:g} m/s",
+        f"load x{load:g}",
+        *([] if stiffness == 1.0 else [f"k_sz x {stiffness:g}"]),
+        *([] if fault == "none" else [fault]),
+        *([] if delay == 1 else [f"delay {delay}"]),
+    ]
+    return (", " if crowded else "\n").join(parts)

@@ -376,7 +376,7 @@ def test_study_conditions_name_the_speed_and_the_load_factor():
     from railride.plots.study import _condition_label
 
     assert _condition_label(40.0, 1.2, 1.0, "none", 1) == "40 m/s\nload x1.2"
-    assert _condition_label(40.0, 1.2, 1.0, "none", 1, crowded=True) == "40 m/s\nload\nx1.2"
+    assert _condition_label(40.0, 1.2, 1.0, "none", 1, crowded=True) == "40 m/s, load x1.2"
     assert _condition_label(55.56, 1.0, 0.9, "1R-off", 4) == "55.56 m/s\nload x1\nk_sz x 0.9\n1R-off\ndelay 4"
 
 

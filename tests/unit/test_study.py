@@ -140,8 +140,11 @@ def test_the_result_protocol(small, tmp_path):
     (holder,) = [a for a in fig.get_axes() if a.get_legend() is not None]
     assert not holder.lines and not holder.collections and not holder.axison
     ticks = [t.get_text() for t in fig.get_axes()[0].get_xticklabels()]
-    # two speeds x four conditions a panel, three panels a row: stacked
-    assert ticks[-1] == f"{max(small.cases.speed_m_s):g} m/s\nload\nx1.3\n1R-off"
+    # two speeds x four conditions a panel, three panels a row: one line each, upright, apart
+    assert ticks[-1] == f"{max(small.cases.speed_m_s):g} m/s, load x1.3, 1R-off"
+    fig.canvas.draw()
+    boxes = [t.get_window_extent() for t in fig.get_axes()[0].get_xticklabels()]
+    assert all(a.x1 <= b.x0 for a, b in zip(boxes, boxes[1:])), [(b.x0, b.x1) for b in boxes]
     mine = Figure()
     assert small.plot(ax=mine.subplots(1, 2), metrics=["roll_deg_rms", "centre_N_MV_z"]) is mine
     paths = small.save(tmp_path / "out")
