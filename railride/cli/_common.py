@@ -492,6 +492,11 @@ def interruptible(table, path: Optional[Path]):
         table.close()
 
 
+#: the options that choose where and how results are written, not what they are: left out of
+#: the command a result records as the one that reproduces it
+OUTPUT_ONLY = ("out", "resume", "format", "figure_format", "dpi", "report", "history_format")
+
+
 def command_line(ctx: typer.Context, exclude=()) -> str:
     """The railride command being run, with the options given on the command line (not their
     defaults), for the record: reproducing a result needs only this line."""

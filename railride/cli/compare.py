@@ -16,7 +16,7 @@ from railride.output.trade_offs import paper_ranking_text, trade_off_lines
 from railride.defaults import DEFAULT_CONTROL_RATE, DEFAULT_DAMPER
 from railride.cli._app import app
 from railride.cli._common import ProgressBar, errors, option_names, stderr_is_terminal, stdout_console, write_folder
-from railride.cli._common import command_line
+from railride.cli._common import OUTPUT_ONLY, command_line
 from railride.cli._options import (
     MaxMemoryOption,
     MaxStepsOption,
@@ -668,7 +668,7 @@ def compare(
                 **({} if level_tolerance is None else {"level_tolerance": level_tolerance}),
             )
         # the command line for the record: this line alone makes the result again
-        command = command_line(ctx, exclude=("out", "format", "figure_format", "dpi", "report", "history_format"))
+        command = command_line(ctx, exclude=OUTPUT_ONLY)
         doc = {**result.to_dict(), "command": command}
         text = json.dumps(doc, indent=2, allow_nan=False)  # refuses NaN before anything is written
         if out is not None:

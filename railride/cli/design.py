@@ -11,6 +11,7 @@ import typer
 
 from railride.cli._app import app
 from railride.cli._common import (
+    OUTPUT_ONLY,
     RunProgress,
     command_line,
     errors,
@@ -420,7 +421,7 @@ def design_command(
 
     from railride.cli._render import check_report_option, save_report
 
-    command = command_line(ctx, exclude=("out", "resume", "format", "figure_format", "dpi", "report"))
+    command = command_line(ctx, exclude=OUTPUT_ONLY)
     with errors(), option_names(DESIGN_FIELDS):
         check_report_option(report)
         figures = figure_options(figure_format, dpi, out)

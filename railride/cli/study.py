@@ -13,6 +13,7 @@ from railride.errors import InputError
 from railride.defaults import DEFAULT_DAMPER
 from railride.cli._app import app
 from railride.cli._common import (
+    OUTPUT_ONLY,
     command_line,
     errors,
     interruptible,
@@ -343,7 +344,7 @@ def study_command(
                 "runs_evaluated": progress.evaluated,
                 "wall_time_s": wall,
                 "executor": executor_record,
-                "command": command_line(ctx, exclude=("out", "resume", "format", "figure_format", "dpi", "report")),
+                "command": command_line(ctx, exclude=OUTPUT_ONLY),
             }
             doc = {**result.to_dict(), **facts}
             text = json.dumps(doc, indent=2, allow_nan=False)

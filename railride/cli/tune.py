@@ -14,6 +14,7 @@ from railride.errors import InputError
 from railride.defaults import DEFAULT_DAMPER
 from railride.cli._app import app
 from railride.cli._common import (
+    OUTPUT_ONLY,
     command_line,
     errors,
     interruptible,
@@ -522,7 +523,7 @@ def tune_command(
     """
     import time
 
-    command = command_line(ctx, exclude=("out", "resume", "format", "figure_format", "dpi"))
+    command = command_line(ctx, exclude=OUTPUT_ONLY)
     defaults = not_given(dt=dt, min_wavelength=min_wavelength, max_wavelength=max_wavelength, seed=track_seed)
     seeds: Optional[list] = None
     with errors(), option_names(TUNE_FIELDS, defaults):

@@ -96,3 +96,12 @@ def test_the_documents_record_when_and_by_which_command(tmp_path):
     compared = json.loads(ok("compare", "--controllers", "pid", "--duration", 0.3, "--format", "json").stdout)
     assert compared["command"] == "railride compare --controllers pid --duration 0.3"
     assert compared["date"].endswith("Z")
+
+
+def test_the_recorded_command_leaves_out_every_output_only_option(tmp_path):
+    """The command a result records reproduces it: where and how it was written (--out,
+    --report, --figure-format, --dpi) is not part of it (tune kept --report)."""
+    out = tmp_path / "t"
+    ok("tune", "--controllers", "pid", "--budget", 15, "--duration", 0.2, "--out", out, "--report", tmp_path / "t.html")
+    gains = (out / "gains.toml").read_text()
+    assert 'command = "railride tune --controllers pid --duration 0.2 --budget 15"' in gains, gains[:600]
