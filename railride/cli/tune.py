@@ -380,7 +380,7 @@ def _tune_tables(doc: dict, start, tuned, scenario_text: str):
                     f"{damper_text(s)}; start gains {s['start_gains']}",
                     vehicle_text(s["vehicle"]),
                     "red. % = (passive - controlled) / passive x 100 (negative: worse than passive, in red)",
-                    *(_tuned_against_start(rows) if rows else []),
+                    *(_tuned_against_start(rows, {st["controller"] for st in doc["studies"]}) if rows else []),
                     f"{doc['runs']} runs in the run table, {doc['runs_evaluated']} evaluated now "
                     f"({doc['runs_per_second']:.1f} runs/s), wall time {doc['wall_time_s']:.1f} s",
                 ]
@@ -390,10 +390,11 @@ def _tune_tables(doc: dict, start, tuned, scenario_text: str):
     return parts
 
 
-def _tuned_against_start(rows: list[dict]) -> list[str]:
+def _tuned_against_start(rows: list[dict], tuned: set) -> list[str]:
     """The lines under the table of the start and tuned gains: that its runs are the tuning's own,
     and per law the responses the tuned gains make better and worse than the start gains (RMS
-    within the comparisons' level tolerance of the larger: level)."""
+    within the comparisons' level tolerance of the larger: level). A law not in ``tuned`` (the
+    laws whose own study ran) changed only through the inner loop it shares, and is said so."""
     from railride.output.trade_offs import RESPONSE_WORDS
     from railride.secondary.control import LABELS
     from railride.studies.comparison import LEVEL_TOLERANCE, is_level
@@ -407,8 +408,13 @@ def _tuned_against_start(rows: list[dict]) -> list[str]:
         better = [RESPONSE_WORDS.get(k, k) for k in keys if r["after"][k] < r["before"][k]]
         worse = [RESPONSE_WORDS.get(k, k) for k in keys if r["after"][k] > r["before"][k]]
         if better and worse:
+            what = (
+                ("the tuned gains beat", "are")
+                if r["suspension"] in tuned
+                else ("not tuned itself, with the tuned inner loop it shares it beats", "is")
+            )
             lines.append(
-                f"{LABELS[r['suspension']]}: the tuned gains beat the start on {', '.join(better)} but are worse on "
+                f"{LABELS[r['suspension']]}: {what[0]} the start on {', '.join(better)} but {what[1]} worse on "
                 f"{', '.join(worse)} (the objective scores the four together)."
             )
     return lines

@@ -397,3 +397,12 @@ def test_tune_on_several_tracks_and_loads():
     assert_input_error(run(*args, "--aggregate", "best"), "--aggregate = 'best'", "mean, worst")
     assert_input_error(run(*args, "--min-wavelength", "2"), "--min-wavelength", "single tuning scenario")
     assert_input_error(run(*args[:-2], "--load", "0"), "--load = 0", "> 0")
+
+
+def test_a_law_whose_own_gains_were_not_tuned_is_not_said_to_have_tuned_gains():
+    """Tuning inner and pid reruns every law that shares the inner loop: their lines say the
+    law was not tuned itself, only the inner loop it shares."""
+    flat = " ".join(ok("tune", "--controllers", "inner,pid", "--budget", 15, "--duration", 0.3).stdout.split())
+    for line in flat.split(". "):
+        if "beat" in line and "PID:" not in line:
+            assert "not tuned itself, with the tuned inner loop it shares it beats the start on" in line, line
