@@ -403,6 +403,7 @@ def test_a_law_whose_own_gains_were_not_tuned_is_not_said_to_have_tuned_gains():
     """Tuning inner and pid reruns every law that shares the inner loop: their lines say the
     law was not tuned itself, only the inner loop it shares."""
     flat = " ".join(ok("tune", "--controllers", "inner,pid", "--budget", 15, "--duration", 0.3).stdout.split())
-    for line in flat.split(". "):
-        if "beat" in line and "PID:" not in line:
-            assert "not tuned itself, with the tuned inner loop it shares it beats the start on" in line, line
+    others = [line for line in flat.split(". ") if "beat" in line and "PID:" not in line]
+    assert others, flat  # the case has such a line: SAS (attitude+ride) trades roll for acceleration here
+    for line in others:
+        assert "not tuned itself, with the tuned inner loop it shares it beats the start on" in line, line
