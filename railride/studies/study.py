@@ -281,7 +281,10 @@ def study(
     model = damper_model(damper, 1.0)
     for cond in conditions:
         if cond:
-            check_faults(cond, model)
+            try:
+                check_faults(cond, model)
+            except InputError as exc:  # named as the argument it came from, as every other check is
+                raise InputError(f"faults = {'+'.join(str(f) for f in cond)!r}: {exc}") from None
 
     def options_of(seed, v) -> tuple:
         opts: dict[str, Any] = {

@@ -47,6 +47,7 @@ def test_study_out_and_resume(tmp_path):
         (("--fault", "3R-off"), ("--fault = '3R-off'", "allowed 1R, 1L, 2R, 2L")),
         (("--fault", "none,,1R-off"), ("--fault", "empty item")),
         (("--fault", "1R-off@9"), ("--fault", "not within the run")),
+        (("--fault", "1R-off", "--damper", "ideal"), ("--fault = '1R-off'", "need MR dampers")),
         (("--controllers", "lqr"), ("unknown controller 'lqr'",)),
         # an unknown name is named first, not through the seeds' check (seeds apply to random tracks)
         (("--scenario", "fra9"), ("--scenario = 'fra9': unknown",)),
