@@ -178,6 +178,10 @@ def _table(doc: dict):
             for f in doc["failed"]
         )
         lines.append(f"Unstable (the run diverged), left out of the statistics: {failed}.")
+    from railride.output.trade_offs import study_trade_off_lines
+    from railride.studies.study import LEVEL_PERCENT
+
+    lines += study_trade_off_lines(doc["trade_offs"], LEVEL_PERCENT)
     return [table, Text("\n".join(lines))]
 
 

@@ -106,3 +106,37 @@ def paper_ranking_text(ranking: dict) -> str:
         + "; ".join(parts)
         + f". The reductions here are {lo:.2f} to {hi:.2f} times the paper's."
     )
+
+
+#: a study's metrics in the sentences (`study_trade_off_lines`)
+STUDY_WORDS = {f"{k}_rms": v for k, v in RESPONSE_WORDS.items()} | {"centre_N_MV_z": "N_MV,z"}
+
+
+def study_trade_off_lines(entries: list[dict], level_percent: float) -> list[str]:
+    """A study's trade-offs (`StudyResult.trade_offs`) in sentences: per controller, each set of
+    metrics won and lost against passive on average, with the conditions (speed, load, and the
+    stiffness, fault and delay where not the default) where it holds; then the level band."""
+    from railride.secondary.control import LABELS
+
+    groups: dict[tuple, list[str]] = {}
+    for e in entries:
+        if not (e["better_on"] and e["worse_on"]):
+            continue
+        where = [f"{e['speed_m_s']:g} m/s", f"load {e['load']:g}"]
+        where += [] if e["stiffness"] == 1.0 else [f"k_sz x {e['stiffness']:g}"]
+        where += [] if e["fault"] == "none" else [f"fault {e['fault']}"]
+        where += [] if e["delay"] == 1 else [f"delay {e['delay']}"]
+        key = (e["controller"], tuple(e["better_on"]), tuple(e["worse_on"]))
+        groups.setdefault(key, []).append(", ".join(where))
+    lines = []
+    for (name, won, lost), where in groups.items():
+        words = [STUDY_WORDS.get(m, m) for m in won], [STUDY_WORDS.get(m, m) for m in lost]
+        lines.append(
+            f"trade-off: {LABELS.get(name, name)} beats passive on {', '.join(words[0])} but is worse on "
+            f"{', '.join(words[1])}, on average ({'; '.join(where)})"
+        )
+    if lines:
+        lines.append(
+            f"(a mean reduction within {level_percent:g} % of passive counts as level, neither better nor worse)"
+        )
+    return lines

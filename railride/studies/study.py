@@ -48,6 +48,11 @@ from railride.secondary.suspension import Suspension, damper_record
 SCHEMA = "railride.study/1"
 #: the metrics a study summarises: the four RMS responses and the comfort indices
 METRICS = (*(f"{r}_rms" for r in RESPONSES), *COMFORT_COLUMNS)
+#: the metrics a study's trade-offs weigh: the four RMS responses and the comfort at the centre
+TRADE_METRICS = (*(f"{r}_rms" for r in RESPONSES), "centre_N_MV_z")
+#: a mean reduction within this many percent of passive is level, neither better nor worse (as
+#: `railride.studies.comparison.LEVEL_TOLERANCE`, 1 %, in a comparison)
+LEVEL_PERCENT = 1.0
 #: the percentiles of the band
 PERCENTILES = (5.0, 95.0)
 #: a fault condition with no fault
@@ -124,12 +129,39 @@ class StudyResult:
             "percentiles": list(PERCENTILES),
             "results": groups,
             "failed": self.failed,
+            "trade_offs": [
+                {k: (v.item() if isinstance(v, np.generic) else v) for k, v in entry.items()}
+                for entry in self.trade_offs()
+            ],
             "runs": int(len(self.cases)),
         }
 
     def to_pandas(self) -> pd.DataFrame:
         """The summary: one row per controller, condition and metric."""
         return self.summary.copy()
+
+    def trade_offs(self) -> list[dict]:
+        """Per controller and condition (speed, load, stiffness, fault, delay), the metrics of
+        `TRADE_METRICS` its mean reduction against passive makes better (``better_on``: above
+        `LEVEL_PERCENT`), worse (``worse_on``: below -`LEVEL_PERCENT`) and neither
+        (``level_on``), each with its mean reduction in % (``reductions``). A controller that wins
+        some by losing others has both lists filled: the study's trade-offs."""
+        out = []
+        keys = ["controller", "speed_m_s", "load", "stiffness", "fault", "delay"]
+        part = self.summary[(self.summary["controller"] != "passive") & self.summary["metric"].isin(TRADE_METRICS)]
+        for values, rows in part.groupby(keys, sort=False):
+            red = {m: float(r) for m, r in zip(rows["metric"], rows["reduction_mean"]) if np.isfinite(r)}
+            ordered = [m for m in TRADE_METRICS if m in red]
+            out.append(
+                {
+                    **dict(zip(keys, values)),
+                    "better_on": [m for m in ordered if red[m] > LEVEL_PERCENT],
+                    "worse_on": [m for m in ordered if red[m] < -LEVEL_PERCENT],
+                    "level_on": [m for m in ordered if abs(red[m]) <= LEVEL_PERCENT],
+                    "reductions": {m: red[m] for m in ordered},
+                }
+            )
+        return out
 
     def plot(self, ax=None, metrics=None):
         """Per metric (default the four RMS responses and N_MV at the carbody centre), the mean

@@ -69,6 +69,35 @@ def test_the_statistics_are_those_of_the_runs(small):
     assert set(s.metric) == set(METRICS)
 
 
+def test_the_trade_offs_are_the_runs_own_reductions_sorted_against_the_level_band(small):
+    """Each condition's better, worse and level metrics, recomputed from the runs themselves
+    (each run's RMS against passive's on the same track, speed and load, averaged), and the
+    sentences that name the trade-offs."""
+    from railride.output.trade_offs import study_trade_off_lines
+    from railride.studies.study import LEVEL_PERCENT, TRADE_METRICS
+
+    c = small.cases
+    entries = small.trade_offs()
+    assert len(entries) == 2 * 2 * 2 * 2  # laws x speeds x loads x fault conditions
+    for e in entries:
+        mine = c[
+            (c.controller == e["controller"]) & (c.speed_m_s == e["speed_m_s"]) & (c.load == e["load"])
+            & (c.fault == e["fault"])
+        ]  # fmt: skip
+        base = c[(c.controller == "passive") & (c.load == e["load"])].set_index(["track_seed", "speed_m_s"])
+        for m in TRADE_METRICS:
+            p = base.loc[list(zip(mine.track_seed, mine.speed_m_s)), m].to_numpy()
+            red = float(np.mean((p - mine[m].to_numpy()) / p * 100))
+            kind = "better_on" if red > LEVEL_PERCENT else "worse_on" if red < -LEVEL_PERCENT else "level_on"
+            assert m in e[kind], (e["controller"], e["speed_m_s"], m, red)
+            assert e["reductions"][m] == pytest.approx(red, rel=1e-9)
+    traded = [e for e in entries if e["better_on"] and e["worse_on"]]
+    assert traded  # the case has some: every law here trades displacement or pitch for comfort somewhere
+    lines = study_trade_off_lines(entries, LEVEL_PERCENT)
+    assert len(lines) >= 2 and all(line.startswith("trade-off: ") for line in lines[:-1])
+    assert small.to_dict()["trade_offs"][0]["controller"] == entries[0]["controller"]
+
+
 def test_a_run_that_diverges_is_listed_and_the_others_go_on():
     gains = GainSet.default().apply({"groundhook.c_g": 1e8})  # too stiff for the ideal actuator
     res = study(["pid", "groundhook"], damper="ideal", gains=gains, track_seeds=[0], speeds=[40.0], duration=1.0)
