@@ -16,9 +16,11 @@ from pathlib import Path
 
 
 def _clear_cache() -> None:
-    import railride
+    """Empty the folder numba caches the engine's kernels in: the engine's __pycache__, or its
+    folder under NUMBA_CACHE_DIR where that is set (as the command it times reads it)."""
+    from railride.engine.cache_guard import cache_dir
 
-    cache = Path(railride.__file__).parent / "engine" / "__pycache__"
+    cache = Path(cache_dir())
     for f in list(cache.glob("*.nbi")) + list(cache.glob("*.nbc")):
         f.unlink()
 
@@ -32,6 +34,7 @@ def _timed(cmd) -> float:
 def main():
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--out-dir", default="/tmp/railride-bench-compare", help="the folder --out writes (replaced)")
     args = ap.parse_args()
     exe = shutil.which("railride")
     cmd = [exe, "compare"] if exe else [sys.executable, "-m", "railride.cli", "compare"]
@@ -41,7 +44,7 @@ def main():
         firsts.append(_timed(cmd))
         seconds.append(_timed(cmd))
         no_bounds.append(_timed(cmd + ["--no-bounds"]))  # what the ideal-device runs cost
-    out_dir = Path("/tmp/railride-bench-compare")
+    out_dir = Path(args.out_dir)
     shutil.rmtree(out_dir, ignore_errors=True)
     with_out = _timed(cmd + ["--out", str(out_dir)])
     print("| benchmark | result | target |")

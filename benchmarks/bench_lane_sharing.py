@@ -5,7 +5,7 @@ Three 32-run batches of pid on MR dampers (`railride.studies.sweep.evaluate`, on
 batch each, given in this order): 32 track cases (fra4 and fra5, 3 seeds, 3 speeds, loads 1
 and 1.3) with one gain set; 4 cases with 8 gain sets each (a lane group of 8 is one case);
 4.6 cases with 7 gain sets each (groups straddle two cases, as in a tuning round whose current
-gain set is already in its table). Prints the step stage's rate in sample-steps per second,
+gain set is already in its table). Prints the lane stepper's rate in sample-steps per second,
 the best of --repeat rounds, the batches alternating in each round. A study's chunks are
 sorted by vehicle, track and speed (`railride.studies.sweep._chunks`), so its batches are of
 the second or third kind. No test asserts timings.
@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import argparse
 
-from bench_study import _watch_steps  # this folder: run as a script
+import time
 
 
 def main():
@@ -42,7 +42,7 @@ def main():
         "4 cases x 8 gain sets": [case(*c, kp) for c in tracks for kp in gains][:32],
         "4.6 cases x 7 gain sets": [case(*c, kp) for c in tracks for kp in gains[:7]][:32],
     }
-    intervals = _watch_steps()  # (start, end) of every step stage
+    intervals = _watch_lane_steps()  # (start, end) of every call of the lane stepper
     for cases in batches.values():
         evaluate(cases[:8])  # compile and warm
     best = dict.fromkeys(batches, float("inf"))
@@ -56,6 +56,31 @@ def main():
     print("|---|---|---|")
     for name, s in best.items():
         print(f"| {name} | {s:.3f} s | {32 * steps / s / 1e6:.1f} M |")
+
+
+def _watch_lane_steps() -> list:
+    """Record the (start, end) of every call of a lane stepper, in any thread: the stepping of
+    a batch with histories (`railride.run.simulation`) and of a metrics-only batch
+    (`railride.run.reduced`, which a sweep without comfort takes) alike."""
+    from railride.engine import lanes
+
+    intervals: list = []
+    make = lanes.lanes_stepper
+
+    def timed_maker(*args, **kwargs):
+        step = make(*args, **kwargs)
+
+        def timed(*a, **k):
+            start = time.perf_counter()
+            try:
+                return step(*a, **k)
+            finally:
+                intervals.append((start, time.perf_counter()))
+
+        return timed
+
+    lanes.lanes_stepper = timed_maker
+    return intervals
 
 
 if __name__ == "__main__":

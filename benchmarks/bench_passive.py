@@ -105,7 +105,6 @@ def bench_exact_tracks(repeat):
 
 def bench_cli(repeat):
     """Cold start of `railride simulate`: first call with an empty numba cache, then warm."""
-    import railride
 
     exe = shutil.which("railride")
     cmd = (
@@ -113,8 +112,10 @@ def bench_cli(repeat):
         if exe
         else [sys.executable, "-m", "railride.cli", "simulate", "--format", "json"]
     )
-    pkg = Path(railride.__file__).parent / "engine"
-    for f in list((pkg / "__pycache__").glob("*.nbi")) + list((pkg / "__pycache__").glob("*.nbc")):
+    from railride.engine.cache_guard import cache_dir
+
+    cache = Path(cache_dir())  # the engine's __pycache__, or its folder under NUMBA_CACHE_DIR
+    for f in list(cache.glob("*.nbi")) + list(cache.glob("*.nbc")):
         f.unlink()
     t0 = time.perf_counter()
     subprocess.run(cmd, check=True, capture_output=True)

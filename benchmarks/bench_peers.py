@@ -57,7 +57,8 @@ def main():
     vehicle = rr.Vehicle()
     A = vehicle.state_matrix
     arrays = _system_arrays(vehicle)
-    Bw, Bwd = arrays["Bw"], arrays["Bwd"]
+    n = vehicle.n_dof  # the engine pads its arrays to the flexible car's 10 DOF: this rigid car's rows
+    Bw, Bwd = arrays["Bw"][:n], arrays["Bwd"][:n]
     utab, interval = wheelset_input_table(sc, vehicle.wheelset_lag_distance, 1e-4)
     t_out = np.arange(10001) * 1e-3
 
