@@ -7,9 +7,10 @@ speeds, comfort indices on), --runs / 8, --runs / 4 and --runs runs, each in a f
 process after a warm-up sweep that compiles; the peak resident memory of the sweep itself
 (Linux: the peak is reset after the warm-up through /proc/self/clear_refs) and above the
 warm process. If memory is bounded by the chunk (32 runs), the peaks are about the same.
-Time: cProfile of one sweep of --profile-runs runs in this process, warm; the stepper's time is
-the main thread's wait for the compiled kernels (they run in threads that cProfile does not
-see). No test asserts either.
+Time: cProfile of one sweep of about --profile-runs runs in this process, warm, its chunks one
+after another in the main thread (`LocalExecutor(ahead=0)`: cProfile sees the main thread only;
+the compiled kernels' own threads show as the stepper's call). The run counts printed are the
+grids' own (a grid holds whole seeds: at least 32 runs). No test asserts either.
 """
 
 from __future__ import annotations
@@ -88,12 +89,15 @@ def child(runs: int) -> None:
 def profile(runs: int) -> None:
     from railride.studies.sweep import run_sweep
 
+    from railride.studies.executors import LocalExecutor
+
     run_sweep(_grid(32))
     g = _grid(runs)
+    runs = len(g.cases)
     prof = cProfile.Profile()
     t0 = time.perf_counter()
     prof.enable()
-    run_sweep(g)
+    run_sweep(g, executor=LocalExecutor(ahead=0))  # every chunk in this thread, where cProfile looks
     prof.disable()
     wall = time.perf_counter() - t0
     stats = pstats.Stats(prof).stats  # (file, line, name) -> (cc, nc, tottime, cumtime, callers)
