@@ -20,6 +20,7 @@ import json
 import os
 import resource
 import shutil
+from pathlib import Path
 import subprocess
 import sys
 import tempfile
@@ -99,7 +100,11 @@ def main() -> None:
         _fresh_install(precompile=True)
         _fresh_install(precompile=False)
         print()
-    railride = shutil.which("railride") or sys.exit("railride is not installed (python -m pip install .)")
+    # the railride of this interpreter's environment (beside it), else the one on PATH
+    beside = Path(sys.executable).parent / "railride"
+    railride = (str(beside) if beside.exists() else shutil.which("railride")) or sys.exit(
+        "railride is not installed (python -m pip install .)"
+    )
     cold: list[tuple[float, float]] = []
     warm: list[tuple[float, float]] = []
     notes = set()

@@ -32,6 +32,9 @@ from _timing import clipped, covered  # benchmarks/_timing.py: run as a script, 
 
 def main():
     args = sys.argv[1:]
+    if args and args[0] in ("-h", "--help"):  # the rest go to `railride design` as given
+        print(__doc__)
+        return None
     if "--profile" in args:
         return profile([a for a in args if a != "--profile"])
     if "--out" in args:

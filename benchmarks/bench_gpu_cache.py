@@ -60,6 +60,9 @@ print("the CPU's kernels compiled into the cache")
 
 
 def main():
+    if any(a in ("-h", "--help") for a in sys.argv[1:]):  # it takes no options
+        print(__doc__)
+        return
     if os.environ.get("NUMBA_ENABLE_CUDASIM") == "1":
         print("bench_gpu_cache: the simulator compiles nothing; run it on a GPU")
         return

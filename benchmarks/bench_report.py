@@ -115,7 +115,7 @@ def main():
     print(f"| `railride compare` alone, cache warm, best of {args.repeat} | {min(compare):.2f} s | |")
     print(f"| `report_html(comparison)` in-process, warm | {whole:.2f} s | |")
     print(f"| of which the figures and tables (`contents`) | {contents:.2f} s | |")
-    print(f"| the HTML file | {size / 1e6:.1f} MB (plotly's JavaScript 4.8 MB of it) | |")
+    print(f"| the HTML file | {size / 1e6:.1f} MB (plotly's JavaScript and the figures' data inlined, gzip-packed) | |")
     if load is not None:
         print(f"| headless Chromium: load and draw every figure, best of {args.repeat} | {load:.2f} s | |")
 

@@ -122,7 +122,7 @@ CORES=$(nproc)
 step machine 30 bash -c "date -u; nproc; (lscpu | grep -E 'Model name|Thread|Core|Socket|NUMA node\(s\)' || true); (nvidia-smi --query-gpu=name,memory.total,driver_version --format=csv || echo 'no nvidia-smi'); (command -v nsys ncu || echo 'no nsys or ncu on the PATH'); \
 $PY -c 'import sys, numpy, scipy, numba; print(sys.version.split()[0], \"numpy\", numpy.__version__, \"scipy\", scipy.__version__, \"numba\", numba.__version__)'; \
 $PY -c 'import importlib.metadata as m; print(\"numba-cuda\", m.version(\"numba-cuda\"))' || echo 'no numba-cuda'; \
-$PY -c 'from railride.run.solver import gpu_missing; print(\"railride sees a usable GPU\" if gpu_missing() is None else \"railride: \" + gpu_missing())'"
+$PY -c 'import os; from railride.run.solver import gpu_missing; sim = os.environ.get(\"NUMBA_ENABLE_CUDASIM\") == \"1\"; print((\"railride sees a usable GPU\" + (\" (the CUDA simulator: --smoke)\" if sim else \"\")) if gpu_missing() is None else \"railride: \" + gpu_missing())'"
 
 # each step and how it ended, at the end of the log (the device tool returns the last 12,000 characters)
 finish() {
