@@ -17,10 +17,11 @@ import contextlib
 from typing import Callable, Iterator
 
 
-#: seconds each kernel takes to compile (docs/performance.md, "Cold start", 2 cores shared
-#: with other jobs); the kernels not named compile in about a second and go unannounced
-#: (run_lanes: batches of lanes.LANES samples or more, e.g. `compare --controllers all`)
-COMPILE_SECONDS = {"run_batch": 10.0, "run_lanes": 12.0}
+#: seconds each kernel takes to compile (docs/performance.md, "Cold start", re-measured
+#: 2026-11-28 on a 2-core VM: run_batch 34.6-44.4 s, run_lanes 26.6 s); the kernels not named
+#: compile in about a second and go unannounced (run_lanes: batches of lanes.LANES samples or
+#: more, e.g. `compare --controllers all`)
+COMPILE_SECONDS = {"run_batch": 40.0, "run_lanes": 27.0}
 
 #: the closed-loop RK4 stepper: MR dampers, ideal devices, controllers
 STEPPER = "run_batch"

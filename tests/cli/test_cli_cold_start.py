@@ -1,6 +1,6 @@
 """The first run after install says on stderr, in one line, that it compiles the stepper; later
-runs say nothing extra. numba's compile event is raised by hand (a real cold compile takes ten
-seconds)."""
+runs say nothing extra. numba's compile event is raised by hand (a real cold compile takes tens
+of seconds)."""
 
 from __future__ import annotations
 
@@ -12,7 +12,7 @@ from railride.engine import kernels
 from clihelp import ok
 
 RUN = ("compare", "--duration", 1, "--controllers", "pid", "--no-bounds")
-NOTE = "compiling the stepper once, about 10 s; later runs start at once"
+NOTE = "compiling the stepper once, about 40 s; later runs start at once"
 
 
 @pytest.fixture
