@@ -8,7 +8,8 @@ against what they replaced, one thread and two, the second showing whether the G
 With ``--round``, instead: the inputs stage (`railride.run.simulation.inputs`) of one round of
 the default design's tuning, all its laws in one batch as on the GPU: the 36 training conditions
 (fra4 and fra5, seeds 1-3, 30, 50 and 70 m/s, loads 1 and 1.3, 20 s), eight closed loops each,
-the stores emptied before each try, so that its input tables are built too.
+the input and forcing tables' stores emptied before each try, so that those tables are built
+too (the random tracks' realisations are kept: a design's rounds share them).
 
 Run:  python benchmarks/bench_tables.py [--points 400000] [--repeat 5] [--round]
 
