@@ -563,7 +563,7 @@ def measured(path) -> MeasuredTrack:
     return _measured(str(path), stat.st_mtime_ns, stat.st_size)
 
 
-@functools.lru_cache(maxsize=16)
+@functools.lru_cache(maxsize=4)  # a long profile holds its rows and their splines: keep a few, not many
 def _measured(path: str, mtime_ns: int, size: int) -> MeasuredTrack:
     return MeasuredTrack.from_csv(path)
 
