@@ -576,7 +576,7 @@ def _warn_of_a_start_step(track: MeasuredTrack, name: str) -> None:
 
     from railride.validation import PlausibilityWarning, caller_level
 
-    z = [float(f(np.array([0.0]))[0]) for f in track._interp[:2]]
+    z = [float(rail[0]) for rail in track._evaluate(np.zeros(1))[:2]]  # z_L, z_R at s = 0
     if max(abs(z[0]), abs(z[1])) > START_STEP_WARNING:
         warnings.warn(
             f"{name} starts at z_L = {1e3 * z[0]:.3g} mm, z_R = {1e3 * z[1]:.3g} mm at s = 0, not level: the vehicle "

@@ -141,8 +141,7 @@ def _damper_option(damper) -> list[str]:
     of the user's own parameters as its file, ``FILE.toml``)."""
     from railride.defaults import DEFAULT_DAMPER
 
-    if hasattr(damper, "to_dict"):
-        damper = damper.to_dict()
+    damper = _damper_record(damper)
     if isinstance(damper, dict):  # a record: the preset it equals by name, else the user's own file
         damper = damper.get("preset") or damper.get("name") or "FILE.toml"
     if damper is None or damper == DEFAULT_DAMPER:

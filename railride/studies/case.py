@@ -13,6 +13,7 @@ from dataclasses import dataclass, fields
 from railride._cache import hashable
 from railride.errors import InputError
 from railride.defaults import DEFAULT_DAMPER, DEFAULT_DURATION
+from railride.model.track import source_sha256
 from railride.secondary.control import CONSTANT_VOLTAGE
 from railride.secondary.suspension import NAMES, Suspension
 
@@ -149,8 +150,6 @@ class Case:
             # as text, as when the track seed travelled as a NumPy integer: the keys of runs on
             # random tracks stay what they were
             d["scenario_options"]["seed"] = str(d["scenario_options"]["seed"])
-        from railride.model.track import source_sha256
-
         sha = source_sha256(self.scenario)
         if sha is not None:  # a file's values, not its path: an edited file's runs are run again
             d["scenario_sha256"] = sha
